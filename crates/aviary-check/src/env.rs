@@ -1,0 +1,166 @@
+//! What names mean where: scopes of bindings over the world's names, and walking a body.
+
+use aviary_api::Kind;
+use aviary_syntax::ast::*;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Binding {
+    /// A capability's BY actor, a FOR alias.
+    Actor,
+    /// A parameter or bound value, with its kind when known.
+    Value(Option<Kind>),
+}
+
+/// What a name resolves to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Meaning {
+    Local(Binding),
+    Drone,
+    Group,
+    Place,
+    Area,
+    /// Not a name of anything: a symbol (when the world is known).
+    Unbound,
+}
+
+/// Calls `f` on every statement in `body`, nested bodies included, outer first.
+pub(crate) fn visit_stmts<'a>(body: &'a Body, f: &mut dyn FnMut(&'a Stmt)) {
+    for stmt in &body.items {
+        f(stmt);
+        for inner in nested_bodies(stmt) {
+            visit_stmts(inner, f);
+        }
+    }
+}
+
+pub(crate) fn nested_bodies(stmt: &Stmt) -> Vec<&Body> {
+    match stmt {
+        Stmt::Block(b) => vec![&b.body],
+        Stmt::Requirement(r) => r.body.iter().collect(),
+        Stmt::For(f) => vec![&f.body],
+        Stmt::Handler(h) => vec![&h.body],
+        Stmt::ExceptionHandler(h) => vec![&h.body],
+        Stmt::If(i) => i.branches.iter().map(|(_, b)| b).chain(i.otherwise.iter()).collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// Every body of a capability: PERFORM sections and exception handlers.
+pub(crate) fn capability_bodies(c: &Capability) -> Vec<&Body> {
+    let mut out = Vec::new();
+    for section in &c.sections {
+        match section {
+            Section::Perform { body, .. } => out.push(body),
+            Section::Exceptions { handlers, .. } => out.extend(handlers.iter().map(|h| &h.body)),
+            _ => {}
+        }
+    }
+    out
+}
+
+/// Calls `f` on `expr` and every expression inside it.
+pub(crate) fn visit_exprs<'a>(expr: &'a Expr, f: &mut dyn FnMut(&'a Expr)) {
+    f(expr);
+    match &expr.kind {
+        ExprKind::Coordinates(parts) | ExprKind::Geo(parts) => parts.iter().for_each(|p| visit_exprs(p, f)),
+        ExprKind::Distance(a, b) | ExprKind::Binary(a, _, b) => {
+            visit_exprs(a, f);
+            visit_exprs(b, f);
+        }
+        ExprKind::Not(e) | ExprKind::Paren(e) => visit_exprs(e, f),
+        _ => {}
+    }
+}
+
+/// The expressions a statement holds directly (not those of nested bodies).
+pub(crate) fn stmt_exprs(stmt: &Stmt) -> Vec<&Expr> {
+    fn args(args: &[Arg]) -> Vec<&Expr> {
+        args.iter().map(|a| &a.value).collect()
+    }
+    match stmt {
+        Stmt::Statement(s) => args(&s.args),
+        Stmt::Leash(l) => args(&l.args),
+        Stmt::Api(a) => a.args.iter().collect(),
+        Stmt::Requirement(r) => vec![&r.condition],
+        Stmt::For(f) => f.instances.iter().flat_map(|i| i.values.iter()).collect(),
+        Stmt::Signal(r) | Stmt::Throw(r) => args(&r.args),
+        Stmt::If(i) => i.branches.iter().map(|(c, _)| c).collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// The kind a literal has by itself; names and paths need the environment.
+pub(crate) fn literal_kind(expr: &Expr) -> Option<Kind> {
+    match &expr.kind {
+        ExprKind::Number { unit, .. } => Some(unit_kind(*unit)),
+        ExprKind::String(_) => Some(Kind::Text),
+        ExprKind::Bool(_) => Some(Kind::Bool),
+        ExprKind::Coordinates(_) | ExprKind::Geo(_) => Some(Kind::Position),
+        ExprKind::Distance(..) => Some(Kind::Length),
+        ExprKind::Elapsed => Some(Kind::Duration),
+        ExprKind::Paren(e) => literal_kind(e),
+        _ => None,
+    }
+}
+
+pub(crate) fn unit_kind(unit: Option<Unit>) -> Kind {
+    match unit {
+        None => Kind::Number,
+        Some(Unit::Metre | Unit::Kilometre) => Kind::Length,
+        Some(Unit::Second | Unit::Minute | Unit::Hour) => Kind::Duration,
+        Some(Unit::MetrePerSecond | Unit::KilometrePerHour) => Kind::Speed,
+        Some(Unit::Degree) => Kind::Angle,
+        Some(Unit::Percent) => Kind::Ratio,
+    }
+}
+
+/// The unit to suggest for a bare number where `kind` is expected.
+pub(crate) fn unit_for(kind: Kind) -> Option<&'static str> {
+    match kind {
+        Kind::Length => Some("m"),
+        Kind::Duration => Some("s"),
+        Kind::Speed => Some("m/s"),
+        Kind::Angle => Some("deg"),
+        Kind::Ratio => Some("%"),
+        _ => None,
+    }
+}
+
+/// Binds a statement's arguments to a capability's parameters by name and position.
+pub(crate) struct ArgBinding<'a> {
+    pub bound: Vec<Option<&'a Expr>>,
+    pub problems: Vec<BindProblem<'a>>,
+}
+
+pub(crate) enum BindProblem<'a> {
+    UnknownName(&'a Ident),
+    Twice(&'a Ident),
+    TooMany(&'a Expr),
+}
+
+pub(crate) fn bind_args<'a>(params: &[Ident], args: &'a [Arg]) -> ArgBinding<'a> {
+    let mut bound: Vec<Option<&Expr>> = vec![None; params.len()];
+    let mut problems = Vec::new();
+    let mut next = 0;
+    for arg in args {
+        match &arg.name {
+            Some(name) => match params.iter().position(|p| p.name == name.name) {
+                Some(i) if bound[i].is_some() => problems.push(BindProblem::Twice(name)),
+                Some(i) => bound[i] = Some(&arg.value),
+                None => problems.push(BindProblem::UnknownName(name)),
+            },
+            None => {
+                while next < params.len() && bound[next].is_some() {
+                    next += 1;
+                }
+                if next < params.len() {
+                    bound[next] = Some(&arg.value);
+                    next += 1;
+                } else {
+                    problems.push(BindProblem::TooMany(&arg.value));
+                }
+            }
+        }
+    }
+    ArgBinding { bound, problems }
+}

@@ -1,0 +1,106 @@
+//! Reading a mission's files: the root, what it `USE`s (transitively, each once), and
+//! the standard library, then the table of capabilities by name.
+
+use std::collections::BTreeMap;
+
+use aviary_diagnostics::{Code, Diagnostic, FileId, SourceMap};
+use aviary_syntax::ast::Item;
+
+use crate::{DefRef, Program};
+
+/// The standard capability library, compiled into the binary.
+pub const STD_SOURCE: &str = include_str!("../../../std/standard.mission");
+pub const STD_NAME: &str = "<std>/standard.mission";
+
+/// Supplies the files a mission `USE`s.
+pub trait SourceProvider {
+    /// The file that `path`, written in a USE inside the file named `from`, refers to:
+    /// its name (used to read it only once) and its bytes, or why it cannot be read.
+    fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), String>;
+}
+
+pub(crate) fn load(sources: &mut SourceMap, root: FileId, provider: &dyn SourceProvider, diagnostics: &mut Vec<Diagnostic>) -> Program {
+    let std_id = sources.add(STD_NAME, STD_SOURCE);
+    let std_parse = aviary_syntax::parse(std_id, STD_SOURCE);
+    diagnostics.extend(std_parse.diagnostics);
+    let mut files = vec![(std_id, std_parse.tree)];
+
+    let root_parse = aviary_syntax::parse(root, sources.text(root));
+    diagnostics.extend(root_parse.diagnostics);
+    let mut queue = vec![(root, root_parse.tree)];
+    let mut seen = vec![sources.name(root).to_string()];
+    while let Some((id, tree)) = queue.pop() {
+        for item in &tree.items {
+            let Item::Use(u) = item else { continue };
+            let from = sources.name(id).to_string();
+            match provider.load(&from, &u.path) {
+                Ok((name, _)) if seen.contains(&name) => {}
+                Ok((name, bytes)) => {
+                    seen.push(name.clone());
+                    let (text, invalid_at) = aviary_syntax::decode(&bytes);
+                    let file = sources.add(name, text);
+                    let tree = match invalid_at {
+                        Some(at) => {
+                            diagnostics.push(aviary_syntax::invalid_utf8(file, at));
+                            aviary_syntax::ast::SourceFile::default()
+                        }
+                        None => {
+                            let parse = aviary_syntax::parse(file, sources.text(file));
+                            diagnostics.extend(parse.diagnostics);
+                            parse.tree
+                        }
+                    };
+                    queue.push((file, tree));
+                }
+                Err(why) => diagnostics.push(
+                    Diagnostic::new(Code::UseNotFound, id, u.path_span, format!("cannot read `{}`: {why}", u.path))
+                        .with_help("the path is relative to the file that holds the USE"),
+                ),
+            }
+        }
+        files.push((id, tree));
+    }
+    let mut program = Program { files, mission: None, capabilities: BTreeMap::new(), param_kinds: BTreeMap::new() };
+    index_definitions(&mut program, std_id, diagnostics);
+    program
+}
+
+fn index_definitions(program: &mut Program, std_id: FileId, diagnostics: &mut Vec<Diagnostic>) {
+    let mut user: BTreeMap<String, (DefRef, aviary_diagnostics::Span)> = BTreeMap::new();
+    let mut mission: Option<(DefRef, aviary_diagnostics::Span)> = None;
+    for (file, tree) in &program.files {
+        for (index, item) in tree.items.iter().enumerate() {
+            let r = DefRef { file: *file, index };
+            match item {
+                Item::Capability(c) if *file == std_id => {
+                    program.capabilities.insert(c.name.name.clone(), r);
+                }
+                Item::Capability(c) => {
+                    if let Some((first, span)) = user.get(&c.name.name) {
+                        diagnostics.push(
+                            Diagnostic::new(Code::DuplicateCapability, *file, c.name.span, format!("capability `{}` is defined twice", c.name.name))
+                                .also(first.file, *span, "first defined here")
+                                .with_help("rename one of them, or remove one"),
+                        );
+                        continue;
+                    }
+                    user.insert(c.name.name.clone(), (r, c.name.span));
+                    program.capabilities.insert(c.name.name.clone(), r);
+                }
+                Item::Mission(m) => {
+                    if let Some((first, span)) = mission {
+                        diagnostics.push(
+                            Diagnostic::new(Code::DuplicateMission, *file, m.name.span, format!("a second MISSION, `{}`", m.name.name))
+                                .also(first.file, span, "the first MISSION")
+                                .with_help("a mission and the files it USEs hold one MISSION in all; turn the other into a capability"),
+                        );
+                        continue;
+                    }
+                    mission = Some((r, m.name.span));
+                }
+                Item::Use(_) => {}
+            }
+        }
+    }
+    program.mission = mission.map(|(r, _)| r);
+}

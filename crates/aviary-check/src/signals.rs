@@ -1,0 +1,105 @@
+//! Signals and exceptions across the whole program: handlers that can never fire,
+//! waits that can never end, and signals nobody listens to.
+
+use aviary_api::Descriptor;
+use aviary_diagnostics::{Code, Diagnostic, FileId};
+use aviary_syntax::ast::*;
+
+use crate::env::{capability_bodies, stmt_exprs, visit_exprs, visit_stmts};
+use crate::suggest::did_you_mean;
+use crate::Program;
+
+#[derive(Default)]
+struct Uses<'a> {
+    raised: Vec<(FileId, &'a Ident)>,
+    thrown: Vec<&'a str>,
+    handlers: Vec<(FileId, &'a Ident)>,
+    exception_handlers: Vec<(FileId, &'a Ident)>,
+    received: Vec<(FileId, &'a Ident)>,
+}
+
+pub(crate) fn check_signals(program: &Program, api: &Descriptor, diagnostics: &mut Vec<Diagnostic>) {
+    let mut uses = Uses::default();
+    let active = |file: FileId, c: &Capability| program.capabilities.get(&c.name.name).map(|r| r.file) == Some(file);
+    for (file, tree) in &program.files {
+        for item in &tree.items {
+            let mut bodies = match item {
+                Item::Mission(m) => vec![&m.body],
+                Item::Capability(c) if active(*file, c) => capability_bodies(c),
+                _ => continue,
+            };
+            if let Item::Capability(c) = item {
+                for s in &c.sections {
+                    if let Section::Exceptions { handlers, .. } = s {
+                        uses.exception_handlers.extend(handlers.iter().map(|h| (*file, &h.exception)));
+                    }
+                    if let Section::Requirements { conditions, .. } = s {
+                        for c in conditions {
+                            collect_received(*file, c, &mut uses);
+                        }
+                    }
+                }
+            }
+            for body in bodies.drain(..) {
+                visit_stmts(body, &mut |stmt| {
+                    match stmt {
+                        Stmt::Signal(r) => uses.raised.push((*file, &r.name)),
+                        Stmt::Throw(r) => uses.thrown.push(&r.name.name),
+                        Stmt::Handler(h) => uses.handlers.push((*file, &h.signal)),
+                        Stmt::ExceptionHandler(h) => uses.exception_handlers.push((*file, &h.exception)),
+                        _ => {}
+                    }
+                    for e in stmt_exprs(stmt) {
+                        collect_received(*file, e, &mut uses);
+                    }
+                });
+            }
+        }
+    }
+    let raised: Vec<&str> = uses.raised.iter().map(|(_, i)| i.name.as_str()).chain(api.signals.iter().map(|s| s.name)).collect();
+    for (file, h) in &uses.handlers {
+        if !raised.contains(&h.name.as_str()) {
+            let help = did_you_mean(&h.name, raised.iter().copied()).unwrap_or_else(|| format!("raise it somewhere with `SIGNAL {}`", h.name));
+            diagnostics.push(
+                Diagnostic::new(Code::HandlerNeverFires, *file, h.span, format!("nothing raises `{}`, so this handler never runs", h.name)).with_help(help),
+            );
+        }
+    }
+    for (file, r) in &uses.received {
+        if !raised.contains(&r.name.as_str()) {
+            let help = did_you_mean(&r.name, raised.iter().copied()).unwrap_or_else(|| format!("raise it somewhere with `SIGNAL {}`", r.name));
+            diagnostics.push(
+                Diagnostic::new(Code::SignalNeverRaised, *file, r.span, format!("nothing raises `{}`, so RECEIVED({}) is never true", r.name, r.name))
+                    .with_help(help),
+            );
+        }
+    }
+    let exceptions: Vec<&str> = api.exceptions.iter().copied().chain(uses.thrown.iter().copied()).collect();
+    for (file, e) in &uses.exception_handlers {
+        if !exceptions.contains(&e.name.as_str()) {
+            let help = did_you_mean(&e.name, exceptions.iter().copied())
+                .unwrap_or_else(|| format!("the built-in exceptions are {}; or throw it with `THROW EXCEPTION {}`", api.exceptions.join(", "), e.name));
+            diagnostics.push(
+                Diagnostic::new(Code::UnknownException, *file, e.span, format!("`{}` is neither a built-in exception nor thrown anywhere", e.name))
+                    .with_help(help),
+            );
+        }
+    }
+    for (file, s) in &uses.raised {
+        let heard = uses.handlers.iter().chain(&uses.received).any(|(_, h)| h.name == s.name);
+        if !heard {
+            diagnostics.push(
+                Diagnostic::new(Code::SignalNeverHandled, *file, s.span, format!("nothing handles `{}`; it is only recorded in the trace", s.name))
+                    .with_help(format!("handle it with `ON {}:` where it should be heard", s.name)),
+            );
+        }
+    }
+}
+
+fn collect_received<'a>(file: FileId, e: &'a Expr, uses: &mut Uses<'a>) {
+    visit_exprs(e, &mut |x| {
+        if let ExprKind::Received(id) = &x.kind {
+            uses.received.push((file, id));
+        }
+    });
+}

@@ -1,0 +1,74 @@
+//! `aviary`: check, format (and later run) multi-drone missions.
+//!
+//! Exit codes (RUNTIME.md): 0 success, 1 the files have errors (or `fmt --check` would
+//! change them), 2 usage or IO problems.
+
+mod check;
+mod files;
+mod fmt;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+
+#[derive(Parser)]
+#[command(name = "aviary", version, about = "Check, format and run multi-drone missions")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
+pub enum Format {
+    Text,
+    Json,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Parse, resolve and check missions; print every problem found
+    Check {
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// The world file (default: NAME.world.toml beside NAME.mission, if it exists)
+        #[arg(long)]
+        world: Option<PathBuf>,
+        #[arg(long, value_enum, default_value = "text")]
+        format: Format,
+    },
+    /// Rewrite missions in the one canonical layout
+    Fmt {
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Change nothing; exit 1 if a file is not formatted
+        #[arg(long)]
+        check: bool,
+    },
+    /// Explain a diagnostic code, such as E107
+    Explain { code: String },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let code = match cli.command {
+        Command::Check { files, world, format } => check::run(&files, world.as_deref(), format),
+        Command::Fmt { files, check } => fmt::run(&files, check),
+        Command::Explain { code } => explain(&code),
+    };
+    ExitCode::from(code)
+}
+
+fn explain(code: &str) -> u8 {
+    match aviary_diagnostics::Code::from_str(&code.to_ascii_uppercase()) {
+        Some(c) => {
+            println!("{} ({}): {}", c.as_str(), c.severity().as_str(), c.summary());
+            println!("See docs/DIAGNOSTICS.md for an example and the fix.");
+            0
+        }
+        None => {
+            eprintln!("aviary: no diagnostic has the code `{code}`; codes look like E107, W201 or N301");
+            2
+        }
+    }
+}

@@ -1,0 +1,90 @@
+//! The registry of diagnostic codes. A code never changes meaning once published;
+//! `docs/DIAGNOSTICS.md` explains each one, and a test keeps the two in step.
+
+use crate::Severity;
+
+macro_rules! codes {
+    ($($name:ident = $id:literal, $sev:ident, $summary:literal;)*) => {
+        /// A stable diagnostic code.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        pub enum Code { $($name,)* }
+
+        impl Code {
+            pub const ALL: &'static [Code] = &[$(Code::$name,)*];
+            pub fn as_str(self) -> &'static str {
+                match self { $(Code::$name => $id,)* }
+            }
+            pub fn severity(self) -> Severity {
+                match self { $(Code::$name => Severity::$sev,)* }
+            }
+            /// One line on what the code means, for docs and `--explain`.
+            pub fn summary(self) -> &'static str {
+                match self { $(Code::$name => $summary,)* }
+            }
+            pub fn from_str(id: &str) -> Option<Code> {
+                match id { $($id => Some(Code::$name),)* _ => None }
+            }
+        }
+    };
+}
+
+codes! {
+    // Reading the file.
+    InvalidUtf8 = "E001", Error, "the file is not valid UTF-8 text";
+    BinaryFile = "E002", Error, "the file holds binary data (NUL bytes), not mission text";
+    EmptyFile = "E003", Error, "the file is empty";
+    TabIndent = "E004", Error, "a tab in indentation; indent with spaces";
+    InconsistentDedent = "E005", Error, "a dedent that matches no enclosing indentation level";
+    UnexpectedIndent = "E006", Error, "a line indented deeper than its block allows";
+    ExpectedBlock = "E007", Error, "a header ending in `:` with no indented body";
+    Syntax = "E008", Error, "the text does not fit the grammar here";
+    UnterminatedString = "E009", Error, "a string with no closing quote";
+    UnterminatedComment = "E010", Error, "a `/*` comment with no closing `*/`";
+    UnknownCharacter = "E011", Error, "a character that has no meaning in the language";
+    UnknownUnit = "E012", Error, "a number with a unit the language does not know";
+    NestingTooDeep = "E013", Error, "blocks or expressions nested deeper than the limit";
+    SpacedTag = "E014", Error, "an activity tag written with spaces around `-`";
+    KeywordCase = "E015", Error, "a keyword not written in upper case";
+    PaperForm = "E016", Error, "a form from the paper that this language writes differently";
+    MissingColon = "E017", Error, "a header that does not end in `:`";
+    TooManyErrors = "E018", Error, "so many syntax errors that reading stopped";
+    MisplacedItem = "E019", Error, "an item where it is not allowed (ELSE without IF, a section outside a capability, ...)";
+    MissingPerform = "E020", Error, "a capability without its nameless PERFORM section";
+    InvalidNumber = "E021", Error, "a number that cannot be read";
+    // Names, arguments and kinds.
+    UnknownCapability = "E101", Error, "a statement names a capability that is not defined";
+    UnknownActor = "E102", Error, "an actor that is no drone, group, alias or parameter";
+    UnknownPlace = "E103", Error, "a name where a place or area is expected that names none";
+    UnknownArgument = "E104", Error, "a named argument the capability does not have";
+    MissingArgument = "E105", Error, "a parameter with no argument and no default";
+    TooManyArguments = "E106", Error, "more positional arguments than parameters";
+    WrongKind = "E107", Error, "a value of the wrong kind (a duration where a length is expected, ...)";
+    ApiCallOutsideCapability = "E108", Error, "a middle-layer API call outside a capability";
+    UnknownApiFunction = "E109", Error, "an API call to a function the middle layer does not have";
+    UnknownTag = "E110", Error, "a leash on an activity tag that no statement defines";
+    DuplicateCapability = "E111", Error, "two capabilities of one name";
+    DuplicateMission = "E112", Error, "more than one MISSION";
+    UseNotFound = "E113", Error, "a USE of a file that cannot be read";
+    ArgumentsWithoutWith = "E114", Error, "a statement whose arguments do not follow WITH";
+    DuplicateArgument = "E115", Error, "one parameter given two arguments";
+    UnknownLeashSection = "E116", Error, "a leash call to a section the capability does not define";
+    ActorCount = "E117", Error, "a statement with a number of actors the capability cannot take";
+    UnknownTelemetry = "E118", Error, "`a.b` where b is no telemetry field or attribute of a";
+    WorldFile = "E119", Error, "the world file is not valid";
+    UnknownParameter = "E120", Error, "a DEFAULTS entry for a name that is not a parameter";
+    DuplicateParameter = "E121", Error, "a capability that declares one parameter twice";
+    SignalNeverRaised = "E122", Error, "a WAITFOR RECEIVED(X) where nothing raises X";
+    ApiCallOnNonActor = "E123", Error, "an API call on something that is not the capability's actor";
+    // Warnings.
+    HandlerNeverFires = "W201", Warning, "a handler for a signal that nothing raises";
+    UnknownException = "W202", Warning, "an ON EXCEPTION for a name neither built in nor thrown";
+    // Notes.
+    SignalNeverHandled = "N301", Note, "a signal raised but never handled";
+    NoWorld = "N302", Note, "no world file, so actors, places and areas were not checked";
+}
+
+impl std::fmt::Display for Code {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}

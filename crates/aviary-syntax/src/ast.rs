@@ -1,0 +1,351 @@
+//! The syntax tree. Every node keeps its span so that any later stage can point back
+//! into the source. Derived `Debug` output with spans removed is the tree's identity
+//! (see `tests/properties.rs`): formatting must not change it.
+
+use aviary_diagnostics::Span;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ident {
+    pub name: String,
+    pub span: Span,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CommentKind {
+    Line,
+    Block,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Comment {
+    pub span: Span,
+    pub kind: CommentKind,
+}
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SourceFile {
+    pub items: Vec<Item>,
+    pub comments: Vec<Comment>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Item {
+    Use(Use),
+    Capability(Capability),
+    Mission(Mission),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Use {
+    pub path: String,
+    pub path_span: Span,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mission {
+    pub name: Ident,
+    pub body: Body,
+    pub span: Span,
+}
+
+/// The items of an indented body, with where its header ended (after the `:`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Body {
+    pub items: Vec<Stmt>,
+    pub header_end: u32,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Capability {
+    pub name: Ident,
+    /// The `BY` parameters: the actors the capability runs on.
+    pub actors: Vec<Ident>,
+    /// The `WITH` parameters.
+    pub params: Vec<Ident>,
+    pub sections: Vec<Section>,
+    pub header_end: u32,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Section {
+    Requirements { conditions: Vec<Expr>, body_header_end: u32, span: Span },
+    Defaults { entries: Vec<DefaultEntry>, body_header_end: u32, span: Span },
+    /// `PERFORM:` has no name; `PERFORM X:` is a leash section (`ABORT`, `PAUSE`,
+    /// `RESUME` or a name of the user's).
+    Perform { name: Option<Ident>, body: Body, span: Span },
+    Exceptions { handlers: Vec<ExceptionHandler>, body_header_end: u32, span: Span },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct DefaultEntry {
+    pub name: Ident,
+    pub value: Expr,
+    pub span: Span,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BlockKind {
+    Sequential,
+    Parallel,
+}
+
+impl BlockKind {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            BlockKind::Sequential => "SEQUENTIAL",
+            BlockKind::Parallel => "PARALLEL",
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Stmt {
+    Block(Block),
+    Statement(Statement),
+    Leash(LeashCall),
+    Api(ApiCall),
+    Requirement(Requirement),
+    For(ForBlock),
+    Signal(Raise),
+    Throw(Raise),
+    Handler(Handler),
+    ExceptionHandler(ExceptionHandler),
+    If(IfChain),
+    /// A line that could not be read. It was reported; later stages skip it.
+    Error(Span),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Block {
+    pub kind: BlockKind,
+    pub name: Option<Ident>,
+    pub body: Body,
+    pub span: Span,
+}
+
+/// `actor+ Capability[-Tag] WITH args`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Statement {
+    pub actors: Vec<Ident>,
+    pub capability: Ident,
+    pub tag: Option<Ident>,
+    pub args: Vec<Arg>,
+    pub span: Span,
+}
+
+/// `Capability-Tag ACTION WITH args`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LeashCall {
+    pub capability: Ident,
+    pub tag: Ident,
+    /// `ABORT`, `PAUSE`, `RESUME` or a section name, as written.
+    pub action: Ident,
+    pub args: Vec<Arg>,
+    pub span: Span,
+}
+
+/// `actor.Function(args)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ApiCall {
+    pub actor: Ident,
+    pub function: Ident,
+    pub args: Vec<Expr>,
+    pub span: Span,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RequirementKind {
+    StartIf,
+    WaitFor,
+    DoWhile,
+}
+
+impl RequirementKind {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            RequirementKind::StartIf => "STARTIF",
+            RequirementKind::WaitFor => "WAITFOR",
+            RequirementKind::DoWhile => "DOWHILE",
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Requirement {
+    pub kind: RequirementKind,
+    pub condition: Expr,
+    pub body: Option<Body>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ForBlock {
+    pub kind: BlockKind,
+    pub instances: Vec<Instance>,
+    pub alias: Ident,
+    pub params: Vec<Ident>,
+    pub body: Body,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Instance {
+    pub actor: Ident,
+    pub values: Vec<Expr>,
+    pub span: Span,
+}
+
+/// `SIGNAL Name WITH args` or `THROW EXCEPTION Name WITH args`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Raise {
+    pub name: Ident,
+    pub args: Vec<Arg>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Handler {
+    /// `SEQUENTIAL ON` or `PARALLEL ON`; `None` when written as plain `ON` (parallel).
+    pub mode: Option<BlockKind>,
+    pub every: bool,
+    pub signal: Ident,
+    pub by: Option<Ident>,
+    pub bindings: Vec<Ident>,
+    pub body: Body,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExceptionHandler {
+    pub exception: Ident,
+    pub by: Option<Ident>,
+    pub bindings: Vec<Ident>,
+    pub body: Body,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct IfChain {
+    /// `IF c:` then every `ELSE IF c:`, in order.
+    pub branches: Vec<(Expr, Body)>,
+    pub otherwise: Option<Body>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Arg {
+    pub name: Option<Ident>,
+    pub value: Expr,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Unit {
+    Metre,
+    Kilometre,
+    Second,
+    Minute,
+    Hour,
+    MetrePerSecond,
+    KilometrePerHour,
+    Degree,
+    Percent,
+}
+
+impl Unit {
+    pub const ALL: &'static [Unit] = &[
+        Unit::Metre,
+        Unit::Kilometre,
+        Unit::Second,
+        Unit::Minute,
+        Unit::Hour,
+        Unit::MetrePerSecond,
+        Unit::KilometrePerHour,
+        Unit::Degree,
+        Unit::Percent,
+    ];
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Unit::Metre => "m",
+            Unit::Kilometre => "km",
+            Unit::Second => "s",
+            Unit::Minute => "min",
+            Unit::Hour => "h",
+            Unit::MetrePerSecond => "m/s",
+            Unit::KilometrePerHour => "km/h",
+            Unit::Degree => "deg",
+            Unit::Percent => "%",
+        }
+    }
+    pub fn parse(text: &str) -> Option<Unit> {
+        Unit::ALL.iter().copied().find(|u| u.as_str() == text)
+    }
+    /// The factor to SI (m, s, m/s, degrees; a percentage becomes a fraction).
+    pub fn to_si(self) -> f64 {
+        match self {
+            Unit::Metre | Unit::Second | Unit::MetrePerSecond | Unit::Degree => 1.0,
+            Unit::Kilometre => 1000.0,
+            Unit::Minute => 60.0,
+            Unit::Hour => 3600.0,
+            Unit::KilometrePerHour => 1000.0 / 3600.0,
+            Unit::Percent => 0.01,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BinaryOp {
+    Or,
+    And,
+    Eq,
+    Ne,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+}
+
+impl BinaryOp {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            BinaryOp::Or => "OR",
+            BinaryOp::And => "AND",
+            BinaryOp::Eq => "=",
+            BinaryOp::Ne => "!=",
+            BinaryOp::Lt => "<",
+            BinaryOp::Le => "<=",
+            BinaryOp::Gt => ">",
+            BinaryOp::Ge => ">=",
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expr {
+    pub kind: ExprKind,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExprKind {
+    /// `digits` is the number as written, sign included, without its unit.
+    Number { digits: String, value: f64, unit: Option<Unit> },
+    String(String),
+    Bool(bool),
+    /// `(x, y)` or `(x, y, z)`, local metres.
+    Coordinates(Vec<Expr>),
+    /// `GEO(lat, lon)` or `GEO(lat, lon, alt)`.
+    Geo(Vec<Expr>),
+    Name(Ident),
+    /// `a.b`: telemetry or an attribute.
+    Path(Ident, Ident),
+    Distance(Box<Expr>, Box<Expr>),
+    Received(Ident),
+    Elapsed,
+    Not(Box<Expr>),
+    Binary(Box<Expr>, BinaryOp, Box<Expr>),
+    Paren(Box<Expr>),
+    /// Could not be read; already reported.
+    Error,
+}

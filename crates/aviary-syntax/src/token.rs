@@ -1,0 +1,100 @@
+use aviary_diagnostics::Span;
+
+macro_rules! keywords {
+    ($($name:ident = $text:literal,)*) => {
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum Keyword { $($name,)* }
+        impl Keyword {
+            pub const ALL: &'static [Keyword] = &[$(Keyword::$name,)*];
+            pub fn as_str(self) -> &'static str {
+                match self { $(Keyword::$name => $text,)* }
+            }
+            pub fn from_exact(text: &str) -> Option<Keyword> {
+                match text { $($text => Some(Keyword::$name),)* _ => None }
+            }
+        }
+    };
+}
+
+keywords! {
+    Mission = "MISSION", Sequential = "SEQUENTIAL", Parallel = "PARALLEL", On = "ON",
+    Every = "EVERY", By = "BY", With = "WITH", For = "FOR", And = "AND", As = "AS",
+    Signal = "SIGNAL", Throw = "THROW", Exception = "EXCEPTION", StartIf = "STARTIF",
+    WaitFor = "WAITFOR", DoWhile = "DOWHILE", If = "IF", Else = "ELSE",
+    Capability = "CAPABILITY", Requirements = "REQUIREMENTS", Defaults = "DEFAULTS",
+    Perform = "PERFORM", Exceptions = "EXCEPTIONS", Abort = "ABORT", Pause = "PAUSE",
+    Resume = "RESUME", Use = "USE", Not = "NOT", Or = "OR", True = "TRUE", False = "FALSE",
+}
+
+impl Keyword {
+    /// The keyword this word would be if it were upper case.
+    pub fn from_any_case(text: &str) -> Option<Keyword> {
+        Keyword::from_exact(&text.to_ascii_uppercase())
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TokenKind {
+    Ident,
+    Keyword(Keyword),
+    /// `Name-Tag`, glued: one token.
+    TaggedName,
+    /// Digits, with a unit glued on when there is one (`20m`, `5m/s`, `25%`).
+    Number,
+    String,
+    Colon,
+    Comma,
+    LParen,
+    RParen,
+    Dot,
+    Eq,
+    Ne,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Minus,
+    Slash,
+    /// A character with no meaning; the lexer has already reported it.
+    Unknown,
+    Newline,
+    Indent,
+    Dedent,
+    Eof,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Token {
+    pub kind: TokenKind,
+    pub span: Span,
+}
+
+impl TokenKind {
+    pub fn describe(self) -> String {
+        match self {
+            TokenKind::Ident => "a name".into(),
+            TokenKind::Keyword(k) => format!("`{}`", k.as_str()),
+            TokenKind::TaggedName => "a tagged name".into(),
+            TokenKind::Number => "a number".into(),
+            TokenKind::String => "a string".into(),
+            TokenKind::Colon => "`:`".into(),
+            TokenKind::Comma => "`,`".into(),
+            TokenKind::LParen => "`(`".into(),
+            TokenKind::RParen => "`)`".into(),
+            TokenKind::Dot => "`.`".into(),
+            TokenKind::Eq => "`=`".into(),
+            TokenKind::Ne => "`!=`".into(),
+            TokenKind::Lt => "`<`".into(),
+            TokenKind::Le => "`<=`".into(),
+            TokenKind::Gt => "`>`".into(),
+            TokenKind::Ge => "`>=`".into(),
+            TokenKind::Minus => "`-`".into(),
+            TokenKind::Slash => "`/`".into(),
+            TokenKind::Unknown => "an unknown character".into(),
+            TokenKind::Newline => "the end of the line".into(),
+            TokenKind::Indent => "an indented line".into(),
+            TokenKind::Dedent => "the end of the block".into(),
+            TokenKind::Eof => "the end of the file".into(),
+        }
+    }
+}

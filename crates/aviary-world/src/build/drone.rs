@@ -1,0 +1,252 @@
+//! `[drones.NAME]`: the known keys, the backend, and every other key as an attribute.
+
+use aviary_diagnostics::Span;
+
+use super::get;
+use crate::node::{Entry, Node, Value};
+use crate::read::{quoted, suggest, toml_text, Ctx};
+use crate::{AttributeValue, Backend, Drone, BUILTIN_SENSORS};
+
+const BACKEND_KEYS: &[&str] = &["backend", "mavlink", "system_id", "signing_key"];
+const SCHEMES: &[&str] = &[
+    "tcp", "tcpin", "tcpout", "udp", "udpin", "udpout", "udpbcast", "serial",
+];
+/// Telemetry fields: `d.speed` reads these, so no attribute may take their names.
+const TELEMETRY: &[&str] = &["position", "altitude", "speed", "heading", "state", "link"];
+const ADDRESS_HELP: &str =
+    "write `mavlink = \"udp:127.0.0.1:14550\"` or `\"tcp:HOST:PORT\"` (schemes: tcp, tcpin, tcpout, udp, udpin, udpout, udpbcast, serial)";
+
+pub(super) fn drones(
+    cx: &mut Ctx,
+    node: &Node,
+    sensor_kinds: &[String],
+    group_spans: &mut Vec<(String, Span)>,
+) -> Vec<Drone> {
+    let help = "write one table per drone: `[drones.NAME]` followed by `home = [x, y]`";
+    let Some(entries) = cx.table("`drones`", node, help) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for e in entries {
+        cx.identifier("drone", &e.key, e.key_span);
+        let what = format!("drone `{}`", e.key);
+        let Some(keys) = cx.table(&what, &e.node, help) else {
+            continue;
+        };
+        out.push(drone(cx, e, keys, sensor_kinds, group_spans));
+    }
+    out
+}
+
+fn drone(
+    cx: &mut Ctx,
+    e: &Entry,
+    keys: &[Entry],
+    sensor_kinds: &[String],
+    group_spans: &mut Vec<(String, Span)>,
+) -> Drone {
+    let name = &e.key;
+    let mut d = Drone {
+        name: name.clone(),
+        home: [0.0; 3],
+        group: None,
+        sensors: Vec::new(),
+        payload: Vec::new(),
+        max_speed: 10.0,
+        climb_rate: 3.0,
+        acceleration: 3.0,
+        battery: 100.0,
+        endurance: 1800.0,
+        backend: Backend::Sim,
+        attributes: Vec::new(),
+        span: e.key_span,
+    };
+    if get(keys, "home").is_none() {
+        let msg = format!("drone `{name}` has no `home`");
+        cx.error(
+            e.key_span,
+            msg,
+            "add `home = [x, y]`: where the drone starts and lands, in metres",
+        );
+    }
+    for k in keys {
+        let what = format!("`{}` of drone `{name}`", k.key);
+        let n = &k.node;
+        match k.key.as_str() {
+            "home" => d.home = cx.point(&what, n).map_or(d.home, |(p, _)| p),
+            "group" => {
+                let Some(group) = cx.string(&what, n) else {
+                    continue;
+                };
+                if cx.identifier("group", &group, n.span) {
+                    group_spans.push((group.clone(), n.span));
+                    d.group = Some(group);
+                }
+            }
+            "sensors" => {
+                for (kind, span) in cx.strings(&what, n).unwrap_or_default() {
+                    check_sensor(cx, name, &kind, span, sensor_kinds);
+                    d.sensors.push(kind);
+                }
+            }
+            "payload" => {
+                for (kind, span) in cx.strings(&what, n).unwrap_or_default() {
+                    cx.identifier("payload kind", &kind, span);
+                    d.payload.push(kind);
+                }
+            }
+            "max_speed" => d.max_speed = cx.positive(&what, n).unwrap_or(d.max_speed),
+            "climb_rate" => d.climb_rate = cx.positive(&what, n).unwrap_or(d.climb_rate),
+            "acceleration" => d.acceleration = cx.positive(&what, n).unwrap_or(d.acceleration),
+            "endurance" => d.endurance = cx.positive(&what, n).unwrap_or(d.endurance),
+            "battery" => d.battery = cx.within(&what, n, 0.0, 100.0).unwrap_or(d.battery),
+            key if BACKEND_KEYS.contains(&key) => {}
+            _ => {
+                if let Some(attribute) = attribute(cx, name, k) {
+                    d.attributes.push(attribute);
+                }
+            }
+        }
+    }
+    d.backend = backend(cx, name, keys);
+    d
+}
+
+fn check_sensor(cx: &mut Ctx, drone: &str, kind: &str, span: Span, defined: &[String]) {
+    if defined.iter().any(|k| k == kind) || BUILTIN_SENSORS.contains(&kind) {
+        return;
+    }
+    let known: Vec<&str> = defined
+        .iter()
+        .map(String::as_str)
+        .chain(BUILTIN_SENSORS.iter().copied())
+        .collect();
+    let msg = format!("drone `{drone}` has sensor `{kind}`, but no `[sensors.{kind}]` defines it");
+    let help = match suggest(kind, known.iter().copied()) {
+        Some(s) => format!("did you mean `{s}`?"),
+        None => format!(
+            "add a `[sensors.{kind}]` table with `detects` and `range`, or use one of {}",
+            quoted(&known)
+        ),
+    };
+    cx.error(span, msg, help);
+}
+
+fn attribute(cx: &mut Ctx, drone: &str, e: &Entry) -> Option<(String, AttributeValue)> {
+    let key = &e.key;
+    if TELEMETRY.contains(&key.as_str()) {
+        let msg = format!(
+            "attribute `{key}` of drone `{drone}` has the name of a telemetry field, so `{drone}.{key}` could not read it"
+        );
+        let help = format!(
+            "rename the attribute; the telemetry fields are {}",
+            quoted(TELEMETRY)
+        );
+        cx.error(e.key_span, msg, help);
+        return None;
+    }
+    if !cx.identifier("attribute", key, e.key_span) {
+        return None;
+    }
+    let value = match &e.node.value {
+        Value::Int(_) | Value::Float(_) => {
+            AttributeValue::Number(cx.number(&format!("attribute `{key}`"), &e.node)?)
+        }
+        Value::Str(s) => AttributeValue::Text(s.clone()),
+        Value::Bool(b) => AttributeValue::Bool(*b),
+        _ => AttributeValue::Other(toml_text(&e.node)),
+    };
+    Some((key.clone(), value))
+}
+
+fn backend(cx: &mut Ctx, drone: &str, keys: &[Entry]) -> Backend {
+    let what = |key: &str| format!("`{key}` of drone `{drone}`");
+    let chosen =
+        get(keys, "backend").and_then(|b| Some((cx.string(&what("backend"), &b.node)?, b)));
+    let address =
+        get(keys, "mavlink").and_then(|m| Some((cx.string(&what("mavlink"), &m.node)?, m)));
+    if let Some((address, m)) = &address {
+        check_address(cx, drone, address, m.node.span);
+    }
+    let system_id = get(keys, "system_id").and_then(|s| system_id(cx, drone, s));
+    let signing_key =
+        get(keys, "signing_key").and_then(|s| cx.string(&what("signing_key"), &s.node));
+    let mavlink = match (&chosen, &address) {
+        (Some((b, e)), _) if !["sim", "mavlink"].contains(&b.as_str()) => {
+            let msg = format!("unknown backend `{b}` for drone `{drone}`");
+            let help = "write `backend = \"sim\"` (the default), or give a `mavlink = \"udp:HOST:PORT\"` address";
+            cx.error(e.node.span, msg, help);
+            false
+        }
+        (Some((b, e)), Some(_)) if b == "sim" => {
+            let msg = format!("drone `{drone}` has `backend = \"sim\"` and a `mavlink` address");
+            let help = "remove `backend = \"sim\"` to fly it over MAVLink, or remove `mavlink` to simulate it";
+            cx.error(e.node.span, msg, help);
+            false
+        }
+        (Some((b, e)), None) if b == "mavlink" => {
+            let msg =
+                format!("drone `{drone}` has `backend = \"mavlink\"` but no `mavlink` address");
+            cx.error(e.node.span, msg, ADDRESS_HELP);
+            false
+        }
+        (_, address) => address.is_some() || get(keys, "mavlink").is_some(),
+    };
+    if !mavlink {
+        for key in ["system_id", "signing_key"] {
+            let Some(e) = get(keys, key) else { continue };
+            let msg = format!("`{key}` of drone `{drone}` applies only to a MAVLink drone");
+            let help = "add a `mavlink = \"udp:HOST:PORT\"` address, or remove this key";
+            cx.error(e.key_span, msg, help);
+        }
+        return Backend::Sim;
+    }
+    let address = address.map(|(a, _)| a).unwrap_or_default();
+    Backend::Mavlink {
+        address,
+        system_id,
+        signing_key,
+    }
+}
+
+fn system_id(cx: &mut Ctx, drone: &str, e: &Entry) -> Option<u8> {
+    match e.node.value {
+        Value::Int(i) if (1..=255).contains(&i) => u8::try_from(i).ok(),
+        _ => {
+            let msg = format!(
+                "`system_id` of drone `{drone}` must be a whole number from 1 to 255, found {}",
+                toml_text(&e.node)
+            );
+            cx.error(
+                e.node.span,
+                msg,
+                "write the MAVLink system id, e.g. `system_id = 1`",
+            );
+            None
+        }
+    }
+}
+
+/// `SCHEME:HOST:PORT` (for `serial`, `serial:DEVICE:BAUD`).
+fn check_address(cx: &mut Ctx, drone: &str, address: &str, span: Span) {
+    let parts = address.split_once(':').and_then(|(scheme, rest)| {
+        let (host, port) = rest.rsplit_once(':')?;
+        Some((scheme, host, port))
+    });
+    let problem = match parts {
+        None => "is not `SCHEME:HOST:PORT`".to_owned(),
+        Some((scheme, _, _)) if !SCHEMES.contains(&scheme) => {
+            format!("has unknown scheme `{scheme}`")
+        }
+        Some((_, "", _)) => "has no host".to_owned(),
+        Some(("serial", _, baud)) if baud.parse::<u32>().is_err() => {
+            format!("has `{baud}` where the baud rate belongs")
+        }
+        Some((scheme, _, port)) if scheme != "serial" && port.parse::<u16>().is_err() => {
+            format!("has `{port}` where the port number (0 to 65535) belongs")
+        }
+        Some(_) => return,
+    };
+    let msg = format!("the `mavlink` address `{address}` of drone `{drone}` {problem}");
+    cx.error(span, msg, ADDRESS_HELP);
+}

@@ -1,0 +1,246 @@
+//! `[sensors.KIND]`, and the simulator's `[[targets]]` and `[[faults]]`.
+
+use super::get;
+use crate::node::{Entry, Node, Value};
+use crate::read::{quoted, suggest, Ctx};
+use crate::{Fault, FaultKind, Sensor, Target};
+
+const SENSOR_KEYS: &[&str] = &["detects", "range"];
+const TARGET_KEYS: &[&str] = &["kind", "at"];
+const FAULT_KEYS: &[&str] = &["drone", "at", "kind", "duration"];
+
+pub(super) fn sensors(cx: &mut Ctx, node: &Node) -> Vec<Sensor> {
+    let help = "write one table per sensor kind: `[sensors.thermal]` followed by `detects = [\"Body\"]` and `range = 20`";
+    let Some(entries) = cx.table("`sensors`", node, help) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for e in entries {
+        let kind = &e.key;
+        let Some(keys) = cx.table(&format!("sensor `{kind}`"), &e.node, help) else {
+            continue;
+        };
+        cx.known_keys(keys, SENSOR_KEYS, &format!("[sensors.{kind}]"));
+        let detects = match get(keys, "detects") {
+            Some(d) => cx
+                .strings(&format!("`detects` of sensor `{kind}`"), &d.node)
+                .map(|kinds| {
+                    for (name, span) in &kinds {
+                        cx.identifier("target kind", name, *span);
+                    }
+                    kinds.into_iter().map(|(name, _)| name).collect()
+                }),
+            None => {
+                let msg = format!("sensor `{kind}` has no `detects`");
+                cx.error(
+                    e.key_span,
+                    msg,
+                    "add `detects = [\"Body\"]`: the kinds of target it finds",
+                );
+                None
+            }
+        };
+        let range = match get(keys, "range") {
+            Some(r) => cx.positive(&format!("`range` of sensor `{kind}`"), &r.node),
+            None => {
+                let msg = format!("sensor `{kind}` has no `range`");
+                cx.error(
+                    e.key_span,
+                    msg,
+                    "add `range = 20`: metres from the drone's ground point",
+                );
+                None
+            }
+        };
+        if let (Some(detects), Some(range)) = (detects, range) {
+            out.push(Sensor {
+                kind: kind.clone(),
+                detects,
+                range,
+                span: e.key_span,
+            });
+        }
+    }
+    out
+}
+
+/// The tables of a `[[name]]` list, each with the span of its header.
+fn entries<'n>(
+    cx: &mut Ctx,
+    name: &str,
+    node: &'n Node,
+    help: &str,
+) -> Vec<(&'n [Entry], aviary_diagnostics::Span)> {
+    let Value::Array(items) = &node.value else {
+        let msg = format!(
+            "`{name}` must be a list of tables, found {}",
+            node.describe()
+        );
+        cx.error(node.span, msg, help);
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for item in items {
+        let what = format!("an entry of `{name}`");
+        if let Some(keys) = cx.table(&what, item, help) {
+            out.push((keys, cx.header(item.span)));
+        }
+    }
+    out
+}
+
+pub(super) fn targets(cx: &mut Ctx, node: &Node) -> Vec<Target> {
+    let help = "write each target as `[[targets]]` followed by `kind = \"Body\"` and `at = [x, y]`";
+    let mut out = Vec::new();
+    for (keys, head) in entries(cx, "targets", node, help) {
+        cx.known_keys(keys, TARGET_KEYS, "[[targets]]");
+        let kind = match get(keys, "kind") {
+            Some(k) => cx
+                .string("`kind` of a target", &k.node)
+                .filter(|kind| cx.identifier("target kind", kind, k.node.span)),
+            None => {
+                cx.error(
+                    head,
+                    "a target has no `kind`",
+                    "add `kind = \"Body\"`: what a sensor can find",
+                );
+                None
+            }
+        };
+        let at = match get(keys, "at") {
+            Some(a) => cx.point("`at` of a target", &a.node),
+            None => {
+                cx.error(
+                    head,
+                    "a target has no `at`",
+                    "add `at = [x, y]`: where it is, in metres",
+                );
+                None
+            }
+        };
+        if let (Some(kind), Some((at, _))) = (kind, at) {
+            out.push(Target { kind, at });
+        }
+    }
+    out
+}
+
+pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[String]) -> Vec<Fault> {
+    let help = "write each fault as `[[faults]]` followed by `drone = \"NAME\"`, `at = 60` (seconds) and `kind = \"crash\"`";
+    let kinds: Vec<&str> = FaultKind::ALL.iter().map(|k| k.as_str()).collect();
+    let mut out = Vec::new();
+    for (keys, head) in entries(cx, "faults", node, help) {
+        cx.known_keys(keys, FAULT_KEYS, "[[faults]]");
+        let missing = |cx: &mut Ctx, key: &str, help: String| {
+            cx.error(head, format!("a fault has no `{key}`"), help);
+        };
+        let drone = match get(keys, "drone") {
+            Some(d) => cx.string("`drone` of a fault", &d.node).filter(|name| {
+                let known = drones.iter().any(|k| k == name);
+                if !known {
+                    fault_drone(cx, name, d, drones);
+                }
+                known
+            }),
+            None => {
+                missing(
+                    cx,
+                    "drone",
+                    "add `drone = \"NAME\"`: the drone it happens to".into(),
+                );
+                None
+            }
+        };
+        let at = match get(keys, "at") {
+            Some(a) => cx.number("`at` of a fault", &a.node).filter(|&t| {
+                if t < 0.0 {
+                    let msg = format!("`at` of a fault must be zero or more seconds, found {t}");
+                    cx.error(
+                        a.node.span,
+                        msg,
+                        "write the mission time in seconds, e.g. `at = 60`",
+                    );
+                }
+                t >= 0.0
+            }),
+            None => {
+                missing(
+                    cx,
+                    "at",
+                    "add `at = 60`: when it happens, in mission seconds".into(),
+                );
+                None
+            }
+        };
+        let kind = match get(keys, "kind") {
+            Some(k) => cx.string("`kind` of a fault", &k.node).and_then(|name| {
+                let kind = FaultKind::from_name(&name);
+                if kind.is_none() {
+                    let msg = format!("unknown fault kind `{name}`");
+                    let help = match suggest(&name, kinds.iter().copied()) {
+                        Some(s) => {
+                            format!("did you mean `{s}`? The fault kinds are {}", quoted(&kinds))
+                        }
+                        None => format!("write one of {}", quoted(&kinds)),
+                    };
+                    cx.error(k.node.span, msg, help);
+                }
+                kind.map(|kind| (kind, k))
+            }),
+            None => {
+                missing(
+                    cx,
+                    "kind",
+                    format!(
+                        "add `kind = \"crash\"`; the fault kinds are {}",
+                        quoted(&kinds)
+                    ),
+                );
+                None
+            }
+        };
+        let duration = get(keys, "duration");
+        let seconds = duration.and_then(|d| cx.positive("`duration` of a fault", &d.node));
+        match (kind, duration) {
+            (Some((kind, k)), None) if kind.has_duration() => {
+                let msg = format!("a `{}` fault needs a `duration`", kind.as_str());
+                cx.error(
+                    k.node.span,
+                    msg,
+                    "add `duration = 10`: how many seconds it lasts",
+                );
+            }
+            (Some((kind, _)), Some(d)) if !kind.has_duration() => {
+                let msg = format!(
+                    "`duration` applies only to `link_loss` and `gps_loss` faults, not to `{}`",
+                    kind.as_str()
+                );
+                cx.error(d.key_span, msg, "remove `duration`");
+            }
+            _ => {}
+        }
+        if let (Some(drone), Some(at), Some((kind, _))) = (drone, at, kind) {
+            out.push(Fault {
+                drone,
+                at,
+                kind,
+                duration: seconds,
+                span: head,
+            });
+        }
+    }
+    out
+}
+
+fn fault_drone(cx: &mut Ctx, name: &str, e: &Entry, drones: &[String]) {
+    let msg = format!("the fault names drone `{name}`, which is not in `[drones]`");
+    let help = match suggest(name, drones.iter().map(String::as_str)) {
+        Some(s) => format!("did you mean `{s}`?"),
+        None if drones.is_empty() => format!("define it as `[drones.{name}]`"),
+        None => {
+            let names: Vec<&str> = drones.iter().map(String::as_str).collect();
+            format!("name one of the drones: {}", quoted(&names))
+        }
+    };
+    cx.error(e.node.span, msg, help);
+}

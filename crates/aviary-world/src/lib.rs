@@ -1,0 +1,338 @@
+//! The world file: the site, places, areas, drones, sensors and (for the simulator)
+//! targets and faults that a mission runs in. See `RUNTIME.md`, "World file (TOML)".
+//!
+//! Invariants:
+//! - Pure: this crate does no IO. [`parse_world`] takes the text; the CLI reads the file.
+//! - Every problem is located: each diagnostic (code E119) carries the byte span of the
+//!   key or value at fault in that text, and says what to write instead.
+//! - One pass reports every problem; a [`World`] is returned only when there is none.
+//! - No input makes it panic.
+
+mod build;
+mod node;
+mod read;
+#[cfg(test)]
+mod tests;
+
+use aviary_diagnostics::{Diagnostic, FileId, Span};
+use serde::Serialize;
+
+/// Sensor kinds a drone may list without a `[sensors.KIND]` table: the video camera,
+/// which streams and detects nothing.
+pub const BUILTIN_SENSORS: &[&str] = &["camera"];
+
+/// Reads a world file. Returns the world only when there are no errors; the diagnostics
+/// are sorted by position.
+pub fn parse_world(file: FileId, text: &str) -> (Option<World>, Vec<Diagnostic>) {
+    build::parse(file, text)
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct World {
+    pub site: Site,
+    /// In file order.
+    pub places: Vec<Place>,
+    /// In file order.
+    pub areas: Vec<Area>,
+    /// In file order: a group expands to its members in this order.
+    pub drones: Vec<Drone>,
+    /// From the drones' `group` keys, in order of first appearance.
+    pub groups: Vec<Group>,
+    /// `[sensors.KIND]`, in file order.
+    pub sensors: Vec<Sensor>,
+    pub targets: Vec<Target>,
+    pub faults: Vec<Fault>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Site {
+    pub name: Option<String>,
+    /// The geodetic anchor of the local frame (x east, y north, z up, metres).
+    pub origin: Option<Geo>,
+    /// A polygon in local metres.
+    pub geofence: Option<Vec<[f64; 2]>>,
+    pub max_altitude: Option<f64>,
+    /// Metres; default 5.
+    pub min_separation: f64,
+}
+
+impl Default for Site {
+    fn default() -> Site {
+        Site {
+            name: None,
+            origin: None,
+            geofence: None,
+            max_altitude: None,
+            min_separation: 5.0,
+        }
+    }
+}
+
+impl Site {
+    /// Whether a ground point lies inside the geofence (always, when there is none).
+    pub fn in_geofence(&self, p: [f64; 2]) -> bool {
+        match &self.geofence {
+            Some(fence) => contains(fence, p),
+            None => true,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Geo {
+    pub lat: f64,
+    pub lon: f64,
+    /// Metres; default 0.
+    pub alt: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Place {
+    pub name: String,
+    /// z = 0 when only `[x, y]` was written.
+    pub at: [f64; 3],
+    pub has_z: bool,
+    /// The name's key.
+    #[serde(skip)]
+    pub span: Span,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Area {
+    pub name: String,
+    pub polygon: Vec<[f64; 2]>,
+    /// The name's key.
+    #[serde(skip)]
+    pub span: Span,
+}
+
+impl Area {
+    /// The polygon's area centroid; the mean of its corners when it encloses no area.
+    pub fn centroid(&self) -> [f64; 2] {
+        centroid(&self.polygon)
+    }
+
+    /// Whether a ground point lies inside the polygon.
+    pub fn contains(&self, p: [f64; 2]) -> bool {
+        contains(&self.polygon, p)
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Drone {
+    pub name: String,
+    pub home: [f64; 3],
+    pub group: Option<String>,
+    pub sensors: Vec<String>,
+    pub payload: Vec<String>,
+    /// m/s, default 10.
+    pub max_speed: f64,
+    /// m/s, default 3.
+    pub climb_rate: f64,
+    /// m/s², default 3.
+    pub acceleration: f64,
+    /// Start charge in %, default 100.
+    pub battery: f64,
+    /// Seconds of flight on a full battery, default 1800.
+    pub endurance: f64,
+    pub backend: Backend,
+    /// Every other key, in file order: readable as `d.key`.
+    pub attributes: Vec<(String, AttributeValue)>,
+    /// The `NAME` of `[drones.NAME]`.
+    #[serde(skip)]
+    pub span: Span,
+}
+
+impl Drone {
+    pub fn attribute(&self, key: &str) -> Option<&AttributeValue> {
+        self.attributes
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v)
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub enum Backend {
+    Sim,
+    Mavlink {
+        address: String,
+        system_id: Option<u8>,
+        signing_key: Option<String>,
+    },
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub enum AttributeValue {
+    Number(f64),
+    Text(String),
+    Bool(bool),
+    /// The TOML text of a list, table or date.
+    Other(String),
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Group {
+    pub name: String,
+    /// In the drones' file order.
+    pub members: Vec<String>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Sensor {
+    pub kind: String,
+    pub detects: Vec<String>,
+    /// Metres from the drone's ground point.
+    pub range: f64,
+    /// The `KIND` of `[sensors.KIND]`.
+    #[serde(skip)]
+    pub span: Span,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Target {
+    pub kind: String,
+    pub at: [f64; 3],
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Fault {
+    pub drone: String,
+    /// Mission seconds.
+    pub at: f64,
+    pub kind: FaultKind,
+    /// Seconds; given exactly for `link_loss` and `gps_loss`.
+    pub duration: Option<f64>,
+    /// The `[[faults]]` header (or the inline table).
+    #[serde(skip)]
+    pub span: Span,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FaultKind {
+    BatteryCritical,
+    LinkLoss,
+    Crash,
+    GpsLoss,
+    MotorFailure,
+}
+
+impl FaultKind {
+    pub const ALL: &'static [FaultKind] = &[
+        FaultKind::BatteryCritical,
+        FaultKind::LinkLoss,
+        FaultKind::Crash,
+        FaultKind::GpsLoss,
+        FaultKind::MotorFailure,
+    ];
+
+    /// As written in the world file.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FaultKind::BatteryCritical => "battery_critical",
+            FaultKind::LinkLoss => "link_loss",
+            FaultKind::Crash => "crash",
+            FaultKind::GpsLoss => "gps_loss",
+            FaultKind::MotorFailure => "motor_failure",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<FaultKind> {
+        FaultKind::ALL.iter().copied().find(|k| k.as_str() == name)
+    }
+
+    /// Whether the fault lasts a while (and so needs a `duration`).
+    pub fn has_duration(self) -> bool {
+        matches!(self, FaultKind::LinkLoss | FaultKind::GpsLoss)
+    }
+}
+
+impl World {
+    pub fn drone(&self, name: &str) -> Option<&Drone> {
+        self.drones.iter().find(|d| d.name == name)
+    }
+    pub fn group(&self, name: &str) -> Option<&Group> {
+        self.groups.iter().find(|g| g.name == name)
+    }
+    pub fn place(&self, name: &str) -> Option<&Place> {
+        self.places.iter().find(|p| p.name == name)
+    }
+    pub fn area(&self, name: &str) -> Option<&Area> {
+        self.areas.iter().find(|a| a.name == name)
+    }
+    pub fn sensor(&self, kind: &str) -> Option<&Sensor> {
+        self.sensors.iter().find(|s| s.kind == kind)
+    }
+    /// Every name a mission may use (drones, groups, places, areas), for "did you mean".
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        let drones = self.drones.iter().map(|d| d.name.as_str());
+        let groups = self.groups.iter().map(|g| g.name.as_str());
+        let places = self.places.iter().map(|p| p.name.as_str());
+        let areas = self.areas.iter().map(|a| a.name.as_str());
+        drones.chain(groups).chain(places).chain(areas)
+    }
+}
+
+impl Default for World {
+    /// The empty world: what an empty file gives.
+    fn default() -> World {
+        World {
+            site: Site::default(),
+            places: Vec::new(),
+            areas: Vec::new(),
+            drones: Vec::new(),
+            groups: Vec::new(),
+            sensors: Vec::new(),
+            targets: Vec::new(),
+            faults: Vec::new(),
+        }
+    }
+}
+
+/// Shoelace centroid; the corners' mean when the polygon encloses (almost) no area.
+fn centroid(polygon: &[[f64; 2]]) -> [f64; 2] {
+    if polygon.is_empty() {
+        return [0.0, 0.0];
+    }
+    let n = polygon.len() as f64;
+    let mean = [
+        polygon.iter().map(|p| p[0]).sum::<f64>() / n,
+        polygon.iter().map(|p| p[1]).sum::<f64>() / n,
+    ];
+    // Relative to the mean, for precision far from the origin.
+    let (mut twice_area, mut cx, mut cy) = (0.0, 0.0, 0.0);
+    let mut extent: f64 = 0.0;
+    for (i, a) in polygon.iter().enumerate() {
+        let b = polygon[(i + 1) % polygon.len()];
+        let (ax, ay) = (a[0] - mean[0], a[1] - mean[1]);
+        let (bx, by) = (b[0] - mean[0], b[1] - mean[1]);
+        let cross = ax * by - bx * ay;
+        twice_area += cross;
+        cx += (ax + bx) * cross;
+        cy += (ay + by) * cross;
+        extent = extent.max(ax.abs()).max(ay.abs());
+    }
+    if !twice_area.is_finite() || twice_area.abs() <= 1e-12 * extent * extent {
+        return mean;
+    }
+    [
+        mean[0] + cx / (3.0 * twice_area),
+        mean[1] + cy / (3.0 * twice_area),
+    ]
+}
+
+/// Even-odd point-in-polygon test.
+fn contains(polygon: &[[f64; 2]], p: [f64; 2]) -> bool {
+    let mut inside = false;
+    for (i, a) in polygon.iter().enumerate() {
+        let b = polygon[(i + 1) % polygon.len()];
+        if (a[1] > p[1]) != (b[1] > p[1]) {
+            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+            if p[0] < x {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}

@@ -27,21 +27,7 @@ pub(crate) enum Meaning {
 pub(crate) fn visit_stmts<'a>(body: &'a Body, f: &mut dyn FnMut(&'a Stmt)) {
     for stmt in &body.items {
         f(stmt);
-        for inner in nested_bodies(stmt) {
-            visit_stmts(inner, f);
-        }
-    }
-}
-
-pub(crate) fn nested_bodies(stmt: &Stmt) -> Vec<&Body> {
-    match stmt {
-        Stmt::Block(b) => vec![&b.body],
-        Stmt::Requirement(r) => r.body.iter().collect(),
-        Stmt::For(f) => vec![&f.body],
-        Stmt::Handler(h) => vec![&h.body],
-        Stmt::ExceptionHandler(h) => vec![&h.body],
-        Stmt::If(i) => i.branches.iter().map(|(_, b)| b).chain(i.otherwise.iter()).collect(),
-        _ => Vec::new(),
+        stmt.for_each_body(|inner| visit_stmts(inner, f));
     }
 }
 

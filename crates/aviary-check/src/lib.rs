@@ -5,7 +5,10 @@
 //! Invariant: no IO. Files come through a [`SourceProvider`] that the caller supplies
 //! (the CLI reads the disk; tests use a map), as in typst's `World`.
 
+mod chains;
 mod env;
+mod inputs;
+pub mod generate;
 mod infer;
 mod load;
 mod signals;
@@ -19,6 +22,7 @@ use aviary_diagnostics::{Diagnostic, FileId, SourceMap};
 use aviary_syntax::ast::{Capability, Mission, SourceFile};
 use aviary_world::World;
 
+pub use inputs::{check_sources, normalize_path, Checked};
 pub use load::{SourceProvider, STD_NAME, STD_SOURCE};
 
 /// Where a definition lives.
@@ -37,6 +41,8 @@ pub struct Program {
     pub capabilities: BTreeMap<String, DefRef>,
     /// The kind of each `WITH` parameter of each capability, where it could be inferred.
     pub param_kinds: BTreeMap<String, Vec<Option<Kind>>>,
+    /// The paths of `USE`s that could not be read (reported as E113).
+    pub unreadable: Vec<String>,
 }
 
 impl Program {
@@ -57,24 +63,26 @@ impl Program {
             _ => None,
         }
     }
+    /// The capabilities that run: user definitions, and library ones no user one replaces.
+    pub fn active_capabilities(&self) -> impl Iterator<Item = (FileId, &Capability)> {
+        self.files.iter().flat_map(move |(file, tree)| {
+            tree.items.iter().filter_map(move |item| match item {
+                aviary_syntax::ast::Item::Capability(c) if self.is_active(*file, c) => Some((*file, c)),
+                _ => None,
+            })
+        })
+    }
+    /// Whether this definition is the one its name means (not overridden, not a duplicate).
+    pub fn is_active(&self, file: FileId, c: &Capability) -> bool {
+        self.capabilities.get(&c.name.name).map(|r| r.file) == Some(file)
+    }
     pub fn capability_file(&self, name: &str) -> Option<FileId> {
         self.capabilities.get(name).map(|r| r.file)
     }
 }
 
-pub struct Checked {
-    pub program: Program,
-    pub diagnostics: Vec<Diagnostic>,
-}
-
-impl Checked {
-    pub fn has_errors(&self) -> bool {
-        self.diagnostics.iter().any(|d| d.is_error())
-    }
-}
-
-/// Checks the mission file `root` (already in `sources`).
-pub fn check(sources: &mut SourceMap, root: FileId, world: Option<&World>, provider: &dyn SourceProvider, api: &Descriptor) -> Checked {
+/// Checks the mission file `root` (already in `sources`): its program, and every problem.
+pub fn check(sources: &mut SourceMap, root: FileId, world: Option<&World>, provider: &dyn SourceProvider, api: &Descriptor) -> (Program, Vec<Diagnostic>) {
     let mut diagnostics = Vec::new();
     let mut program = load::load(sources, root, provider, &mut diagnostics);
     // Checks on a file that did not parse would only repeat its syntax errors.
@@ -83,8 +91,9 @@ pub fn check(sources: &mut SourceMap, root: FileId, world: Option<&World>, provi
     if syntax_ok {
         walk::check_program(&program, world, api, root, &mut diagnostics);
         signals::check_signals(&program, api, &mut diagnostics);
+        chains::check_chains(&program, api, &mut diagnostics);
     }
     aviary_diagnostics::sort(&mut diagnostics);
     diagnostics.dedup();
-    Checked { program, diagnostics }
+    (program, diagnostics)
 }

@@ -29,6 +29,7 @@ pub(crate) fn load(sources: &mut SourceMap, root: FileId, provider: &dyn SourceP
     diagnostics.extend(root_parse.diagnostics);
     let mut queue = vec![(root, root_parse.tree)];
     let mut seen = vec![sources.name(root).to_string()];
+    let mut unreadable = Vec::new();
     while let Some((id, tree)) = queue.pop() {
         for item in &tree.items {
             let Item::Use(u) = item else { continue };
@@ -52,15 +53,18 @@ pub(crate) fn load(sources: &mut SourceMap, root: FileId, provider: &dyn SourceP
                     };
                     queue.push((file, tree));
                 }
-                Err(why) => diagnostics.push(
+                Err(why) => {
+                    unreadable.push(u.path.clone());
+                    diagnostics.push(
                     Diagnostic::new(Code::UseNotFound, id, u.path_span, format!("cannot read `{}`: {why}", u.path))
                         .with_help("the path is relative to the file that holds the USE"),
-                ),
+                    );
+                }
             }
         }
         files.push((id, tree));
     }
-    let mut program = Program { files, mission: None, capabilities: BTreeMap::new(), param_kinds: BTreeMap::new() };
+    let mut program = Program { files, mission: None, capabilities: BTreeMap::new(), param_kinds: BTreeMap::new(), unreadable };
     index_definitions(&mut program, std_id, diagnostics);
     program
 }

@@ -1,6 +1,8 @@
 //! Signals and exceptions across the whole program: handlers that can never fire,
 //! waits that can never end, and signals nobody listens to.
 
+use std::collections::HashSet;
+
 use aviary_api::Descriptor;
 use aviary_diagnostics::{Code, Diagnostic, FileId};
 use aviary_syntax::ast::*;
@@ -20,12 +22,11 @@ struct Uses<'a> {
 
 pub(crate) fn check_signals(program: &Program, api: &Descriptor, diagnostics: &mut Vec<Diagnostic>) {
     let mut uses = Uses::default();
-    let active = |file: FileId, c: &Capability| program.capabilities.get(&c.name.name).map(|r| r.file) == Some(file);
     for (file, tree) in &program.files {
         for item in &tree.items {
             let mut bodies = match item {
                 Item::Mission(m) => vec![&m.body],
-                Item::Capability(c) if active(*file, c) => capability_bodies(c),
+                Item::Capability(c) if program.is_active(*file, c) => capability_bodies(c),
                 _ => continue,
             };
             if let Item::Capability(c) = item {
@@ -56,9 +57,12 @@ pub(crate) fn check_signals(program: &Program, api: &Descriptor, diagnostics: &m
             }
         }
     }
+    // The lists keep their order for the "did you mean" help; the sets answer membership
+    // in constant time, so a large mission is not checked in quadratic time.
     let raised: Vec<&str> = uses.raised.iter().map(|(_, i)| i.name.as_str()).chain(api.signals.iter().map(|s| s.name)).collect();
+    let raised_set: HashSet<&str> = raised.iter().copied().collect();
     for (file, h) in &uses.handlers {
-        if !raised.contains(&h.name.as_str()) {
+        if !raised_set.contains(h.name.as_str()) {
             let help = did_you_mean(&h.name, raised.iter().copied()).unwrap_or_else(|| format!("raise it somewhere with `SIGNAL {}`", h.name));
             diagnostics.push(
                 Diagnostic::new(Code::HandlerNeverFires, *file, h.span, format!("nothing raises `{}`, so this handler never runs", h.name)).with_help(help),
@@ -66,7 +70,7 @@ pub(crate) fn check_signals(program: &Program, api: &Descriptor, diagnostics: &m
         }
     }
     for (file, r) in &uses.received {
-        if !raised.contains(&r.name.as_str()) {
+        if !raised_set.contains(r.name.as_str()) {
             let help = did_you_mean(&r.name, raised.iter().copied()).unwrap_or_else(|| format!("raise it somewhere with `SIGNAL {}`", r.name));
             diagnostics.push(
                 Diagnostic::new(Code::SignalNeverRaised, *file, r.span, format!("nothing raises `{}`, so RECEIVED({}) is never true", r.name, r.name))
@@ -75,8 +79,15 @@ pub(crate) fn check_signals(program: &Program, api: &Descriptor, diagnostics: &m
         }
     }
     let exceptions: Vec<&str> = api.exceptions.iter().copied().chain(uses.thrown.iter().copied()).collect();
+    let exception_set: HashSet<&str> = exceptions.iter().copied().collect();
     for (file, e) in &uses.exception_handlers {
-        if !exceptions.contains(&e.name.as_str()) {
+        if !exception_set.contains(e.name.as_str()) && raised_set.contains(e.name.as_str()) {
+            // `ON EXCEPTION BatteryLow`: a signal, not an exception.
+            diagnostics.push(
+                Diagnostic::new(Code::UnknownException, *file, e.span, format!("`{}` is a signal, not an exception, so this handler never runs", e.name))
+                    .with_help(format!("handle a signal with `ON {}:`", e.name)),
+            );
+        } else if !exception_set.contains(e.name.as_str()) {
             let help = did_you_mean(&e.name, exceptions.iter().copied())
                 .unwrap_or_else(|| format!("the built-in exceptions are {}; or throw it with `THROW EXCEPTION {}`", api.exceptions.join(", "), e.name));
             diagnostics.push(
@@ -85,9 +96,9 @@ pub(crate) fn check_signals(program: &Program, api: &Descriptor, diagnostics: &m
             );
         }
     }
+    let heard: HashSet<&str> = uses.handlers.iter().chain(&uses.received).map(|(_, h)| h.name.as_str()).collect();
     for (file, s) in &uses.raised {
-        let heard = uses.handlers.iter().chain(&uses.received).any(|(_, h)| h.name == s.name);
-        if !heard {
+        if !heard.contains(s.name.as_str()) {
             diagnostics.push(
                 Diagnostic::new(Code::SignalNeverHandled, *file, s.span, format!("nothing handles `{}`; it is only recorded in the trace", s.name))
                     .with_help(format!("handle it with `ON {}:` where it should be heard", s.name)),

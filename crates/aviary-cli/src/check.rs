@@ -22,40 +22,23 @@ fn check_one(path: &Path, world_path: Option<&Path>, format: Format) -> u8 {
             return 2;
         }
     };
-    let mut sources = SourceMap::new();
-    let mut diagnostics: Vec<Diagnostic> = Vec::new();
     let world_path = world_path.map(Path::to_path_buf).or_else(|| world_beside(path));
-    let mut world = None;
-    if let Some(wp) = &world_path {
-        match std::fs::read(wp) {
-            Ok(wbytes) => {
-                let (text, invalid) = aviary_syntax::decode(&wbytes);
-                let id = sources.add(wp.display().to_string(), text);
-                match invalid {
-                    Some(at) => diagnostics.push(aviary_syntax::invalid_utf8(id, at)),
-                    None => {
-                        let (w, d) = aviary_world::parse_world(id, sources.text(id));
-                        world = w;
-                        diagnostics.extend(d);
-                    }
-                }
-            }
+    let world_bytes = match &world_path {
+        Some(wp) => match std::fs::read(wp) {
+            Ok(b) => Some(b),
             Err(e) => {
                 eprintln!("aviary: cannot read the world file {}: {e}", wp.display());
                 return 2;
             }
-        }
-    }
-    let world_failed = world_path.is_some() && world.is_none();
-    let (text, invalid) = aviary_syntax::decode(&bytes);
-    let root = sources.add(path.display().to_string(), text);
-    if let Some(at) = invalid {
-        diagnostics.push(aviary_syntax::invalid_utf8(root, at));
-    } else {
-        let checked = aviary_check::check(&mut sources, root, world.as_ref(), &DiskProvider, &Descriptor::standard());
-        // Without a usable world the checks would complain of every name; the world's own errors say why.
-        diagnostics.extend(checked.diagnostics.into_iter().filter(|d| !(world_failed && d.code == aviary_diagnostics::Code::NoWorld)));
-    }
+        },
+        None => None,
+    };
+    let world_name = world_path.as_ref().map(|p| p.display().to_string());
+    let mut sources = SourceMap::new();
+    let world = world_name.as_deref().zip(world_bytes.as_deref());
+    let name = path.display().to_string();
+    let checked = aviary_check::check_sources(&mut sources, (&name, &bytes), world, &DiskProvider, &Descriptor::standard());
+    let diagnostics = checked.diagnostics;
     print(&sources, &diagnostics, format, path);
     u8::from(diagnostics.iter().any(Diagnostic::is_error))
 }

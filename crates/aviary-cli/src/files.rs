@@ -1,6 +1,6 @@
 //! Reading from disk: missions, the files they USE, and world files.
 
-use std::path::{Component, Path, PathBuf};
+use std::path::{Path, PathBuf};
 
 use aviary_check::SourceProvider;
 
@@ -10,28 +10,14 @@ pub struct DiskProvider;
 impl SourceProvider for DiskProvider {
     fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
         let base = Path::new(from).parent().unwrap_or(Path::new(""));
-        let full = normalize(&base.join(path));
+        let full = aviary_check::normalize_path(&base.join(path));
         let name = full.to_string_lossy().into_owned();
         match std::fs::read(&full) {
             Ok(bytes) => Ok((name, bytes)),
-            Err(e) => Err(format!("{} ({})", e.kind().to_string().to_lowercase(), name)),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(format!("there is no file {name}")),
+            Err(e) => Err(format!("{} ({name})", e.kind().to_string().to_lowercase())),
         }
     }
-}
-
-/// `a/./b/../c` becomes `a/c`, so one file read through two paths is read once.
-fn normalize(path: &Path) -> PathBuf {
-    let mut out = PathBuf::new();
-    for part in path.components() {
-        match part {
-            Component::CurDir => {}
-            Component::ParentDir if matches!(out.components().next_back(), Some(Component::Normal(_))) => {
-                out.pop();
-            }
-            other => out.push(other.as_os_str()),
-        }
-    }
-    out
 }
 
 /// `NAME.world.toml` beside `NAME.mission`, if it exists.

@@ -3,6 +3,7 @@
 //! Exit codes (RUNTIME.md): 0 success, 1 the files have errors (or `fmt --check` would
 //! change them), 2 usage or IO problems.
 
+mod bench;
 mod check;
 mod files;
 mod fmt;
@@ -47,6 +48,11 @@ enum Command {
     },
     /// Explain a diagnostic code, such as E107
     Explain { code: String },
+    /// Measure the speed of the front end on a generated mission
+    Bench {
+        #[command(subcommand)]
+        which: bench::BenchCommand,
+    },
 }
 
 fn main() -> ExitCode {
@@ -55,6 +61,7 @@ fn main() -> ExitCode {
         Command::Check { files, world, format } => check::run(&files, world.as_deref(), format),
         Command::Fmt { files, check } => fmt::run(&files, check),
         Command::Explain { code } => explain(&code),
+        Command::Bench { which } => bench::run(which),
     };
     ExitCode::from(code)
 }

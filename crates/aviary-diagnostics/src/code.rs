@@ -21,6 +21,8 @@ macro_rules! codes {
             pub fn summary(self) -> &'static str {
                 match self { $(Code::$name => $summary,)* }
             }
+            /// The code written `id` (`"E107"`), if there is one.
+            #[allow(clippy::should_implement_trait)]
             pub fn from_str(id: &str) -> Option<Code> {
                 match id { $($id => Some(Code::$name),)* _ => None }
             }

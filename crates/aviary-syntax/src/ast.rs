@@ -64,6 +64,7 @@ pub struct Capability {
     /// The `WITH` parameters.
     pub params: Vec<Ident>,
     pub sections: Vec<Section>,
+    /// Where the header ended (after the `:`).
     pub header_end: u32,
     pub span: Span,
 }
@@ -115,6 +116,24 @@ pub enum Stmt {
     If(IfChain),
     /// A line that could not be read. It was reported; later stages skip it.
     Error(Span),
+}
+
+impl Stmt {
+    /// Calls `f` on each body directly inside this item, in source order.
+    pub fn for_each_body<'a>(&'a self, mut f: impl FnMut(&'a Body)) {
+        match self {
+            Stmt::Block(b) => f(&b.body),
+            Stmt::Requirement(r) => r.body.iter().for_each(f),
+            Stmt::For(x) => f(&x.body),
+            Stmt::Handler(h) => f(&h.body),
+            Stmt::ExceptionHandler(h) => f(&h.body),
+            Stmt::If(i) => {
+                i.branches.iter().for_each(|(_, b)| f(b));
+                i.otherwise.iter().for_each(f);
+            }
+            Stmt::Statement(_) | Stmt::Leash(_) | Stmt::Api(_) | Stmt::Signal(_) | Stmt::Throw(_) | Stmt::Error(_) => {}
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]

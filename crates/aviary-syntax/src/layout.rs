@@ -99,7 +99,7 @@ fn logical_end<'t>(
         return i;
     }
     let mut k = i + 1;
-    while k < count && indent_of(k) > indent && !starts_construct(tokens_of(k)[0].kind) {
+    while k < count && indent_of(k) > indent && continues(tokens_of(k - 1), tokens_of(k)) {
         depth += paren_delta(tokens_of(k));
         if depth <= 0 && (!wants_header || ends_in_colon(k)) {
             return k;
@@ -115,6 +115,13 @@ fn paren_delta(tokens: &[RawToken]) -> i32 {
         TokenKind::RParen => d - 1,
         _ => d,
     })
+}
+
+/// Whether `line` may continue the header whose previous line is `before`: a line that
+/// starts a construct never does, except `ON ...` after a lone `SEQUENTIAL`/`PARALLEL`.
+fn continues(before: &[RawToken], line: &[RawToken]) -> bool {
+    let after_mode = matches!(before.last().map(|t| t.kind), Some(TokenKind::Keyword(Keyword::Sequential | Keyword::Parallel)));
+    !starts_construct(line[0].kind) || (after_mode && line[0].kind == TokenKind::Keyword(Keyword::On))
 }
 
 /// A line that starts with one of these is a construct of its own, never a continuation.

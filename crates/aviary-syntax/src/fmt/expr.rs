@@ -116,5 +116,10 @@ pub(super) fn names(list: &[Ident]) -> String {
 
 /// Source text on one line, white space collapsed (for nodes that could not be read).
 pub(super) fn verbatim(source: &str, start: usize, end: usize) -> String {
-    source.get(start..end).unwrap_or("").split_whitespace().collect::<Vec<_>>().join(" ")
+    source
+        .get(start..end)
+        .unwrap_or("")
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
 }

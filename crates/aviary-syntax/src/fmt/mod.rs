@@ -40,12 +40,20 @@
 //!   takes no second one: the comment goes on its own line below, as an own-line comment.
 //! - An own-line comment is printed on its own line before the next item, at that item's
 //!   indentation. After the last item of a body, an own-line comment indented deeper than
-//!   the line of that body's header stays at the end of that body, at its indentation;
-//!   one indented less moves out to the enclosing body it is inside of in this sense (a
-//!   comment that comes after one that moved out moves out too: comments keep their
-//!   order). Own-line comments
-//!   inside a header printed on one line follow that line, at the body's indentation.
-//!   Inside a multi-line `FOR` header they stay between the instance lines.
+//!   the line of that body's header stays at the end of that body, at the body's
+//!   indentation; one indented less moves out to the enclosing body that it is indented
+//!   deeper than (or to the top level). Comments keep their order, so a comment after one
+//!   that moved out moves out too.
+//! - Own-line comments inside a header printed on one line (a header over several source
+//!   lines, a value broken inside parentheses) follow that line, at the indentation of the
+//!   next item. Inside a multi-line `FOR` header they stay between the instance lines.
+//!
+//! # How comments are placed
+//! Each printed line knows where its source starts; before printing it, every comment
+//! that starts earlier in the source is printed (trailing ones onto the line printed
+//! last, if it can take one). At the end of each body, the comments up to the next
+//! logical line of code (from `line_starts`) that belong to the body are printed. Since
+//! the output puts each comment where this rule puts it back, formatting is idempotent.
 
 mod expr;
 mod tree;
@@ -127,7 +135,13 @@ impl<'a> Printer<'a> {
                 }
                 pos += 1;
             }
-            comments.push(CommentInfo { start, end, kind: c.kind, trailing, column: indentation(bytes, line_start) });
+            comments.push(CommentInfo {
+                start,
+                end,
+                kind: c.kind,
+                trailing,
+                column: indentation(bytes, line_start),
+            });
         }
         Printer {
             source,
@@ -206,7 +220,11 @@ impl<'a> Printer<'a> {
     fn flush_body_end(&mut self, header: usize, last_end: usize, depth: usize) {
         let column = indentation(self.source.as_bytes(), physical_line_start(self.source.as_bytes(), header));
         let next_code = self.next_line_start(last_end);
-        while self.comments.get(self.next).is_some_and(|c| c.start < next_code && (c.trailing || c.column > column)) {
+        while self
+            .comments
+            .get(self.next)
+            .is_some_and(|c| c.start < next_code && (c.trailing || c.column > column))
+        {
             self.comment(depth);
         }
     }

@@ -55,7 +55,11 @@ impl Printer<'_> {
 
     fn section(&mut self, section: &Section, depth: usize) {
         match section {
-            Section::Requirements { conditions, body_header_end, span } => {
+            Section::Requirements {
+                conditions,
+                body_header_end,
+                span,
+            } => {
                 self.line(depth, "REQUIREMENTS:", Last::Header, span.start as usize, *body_header_end as usize);
                 for c in conditions {
                     let text = expr_text(c, self.source);
@@ -65,7 +69,11 @@ impl Printer<'_> {
                     self.flush_body_end(span.start as usize, last.span.end as usize, depth + 1);
                 }
             }
-            Section::Defaults { entries, body_header_end, span } => {
+            Section::Defaults {
+                entries,
+                body_header_end,
+                span,
+            } => {
                 self.line(depth, "DEFAULTS:", Last::Header, span.start as usize, *body_header_end as usize);
                 for e in entries {
                     let text = format!("{}: {}", e.name.name, expr_text(&e.value, self.source));
@@ -83,7 +91,11 @@ impl Printer<'_> {
                 self.line(depth, &text, Last::Header, span.start as usize, body.header_end as usize);
                 self.body(body, depth + 1, span.start);
             }
-            Section::Exceptions { handlers, body_header_end, span } => {
+            Section::Exceptions {
+                handlers,
+                body_header_end,
+                span,
+            } => {
                 self.line(depth, "EXCEPTIONS:", Last::Header, span.start as usize, *body_header_end as usize);
                 for h in handlers {
                     self.exception_handler(h, depth + 1);
@@ -216,7 +228,9 @@ impl Printer<'_> {
             previous_end = Some(body_end(body));
         }
         if let Some(body) = &chain.otherwise {
-            let start = previous_end.map_or(chain.span.start as usize, |end| self.next_line_start(end).min(body.header_end as usize));
+            let start = previous_end.map_or(chain.span.start as usize, |end| {
+                self.next_line_start(end).min(body.header_end as usize)
+            });
             self.line(depth, "ELSE:", Last::Header, start, body.header_end as usize);
             self.body(body, depth + 1, start as u32);
         }
@@ -248,7 +262,13 @@ impl Printer<'_> {
                 if i + 1 < f.instances.len() {
                     text.push_str(" AND");
                 }
-                self.line(depth + 1, &text, Last::Header, instance.span.start as usize, instance.span.end as usize);
+                self.line(
+                    depth + 1,
+                    &text,
+                    Last::Header,
+                    instance.span.start as usize,
+                    instance.span.end as usize,
+                );
             }
             self.line(depth + 1, &tail, Last::Header, f.alias.span.start as usize, header_end);
             self.in_header = false;
@@ -284,7 +304,10 @@ fn body_end(body: &Body) -> usize {
 
 fn section_span(section: &Section) -> aviary_diagnostics::Span {
     match section {
-        Section::Requirements { span, .. } | Section::Defaults { span, .. } | Section::Perform { span, .. } | Section::Exceptions { span, .. } => *span,
+        Section::Requirements { span, .. }
+        | Section::Defaults { span, .. }
+        | Section::Perform { span, .. }
+        | Section::Exceptions { span, .. } => *span,
     }
 }
 

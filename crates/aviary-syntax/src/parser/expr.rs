@@ -7,6 +7,11 @@ use crate::ast::*;
 use crate::token::{Keyword, TokenKind};
 
 const UNIT_WORDS: &[&str] = &["m", "km", "s", "min", "h", "deg"];
+/// Spelled-out units after a number: reported with the unit to write instead.
+const SPELLED_UNITS: &[&str] = &[
+    "sec", "secs", "second", "seconds", "mins", "minute", "minutes", "hr", "hrs", "hour", "hours", "meter", "meters", "metre",
+    "metres", "kmh", "kph", "mps", "degree", "degrees",
+];
 
 impl Parser<'_> {
     fn expr(&mut self, kind: ExprKind, start: Span) -> Expr {
@@ -27,7 +32,8 @@ impl Parser<'_> {
                 .error(Code::NestingTooDeep, span, format!("an expression nested more than {MAX_DEPTH} levels deep"))
                 .with_help("write the condition more simply");
             self.report(d);
-            while !self.at_line_end() {
+            // Skip the rest, but keep a header's final `:` so the body still reads.
+            while !self.at_line_end() && !self.at_header_colon() {
                 self.bump();
             }
             return fallback(span);
@@ -36,6 +42,11 @@ impl Parser<'_> {
         let out = f(self);
         self.depth -= 1;
         out
+    }
+
+    /// At the `:` that ends a header line.
+    fn at_header_colon(&self) -> bool {
+        self.at(TokenKind::Colon) && matches!(self.peek_at(1), TokenKind::Newline | TokenKind::Eof)
     }
 
     /// A value: a literal, coordinates, a name, `a.b`, `distance(a, b)`, `GEO(...)`.
@@ -171,7 +182,7 @@ impl Parser<'_> {
         let value = match digits.parse::<f64>() {
             Ok(v) if v.is_finite() => v,
             _ => {
-                let d = self.error(Code::InvalidNumber, t.span, format!("`{text}` is not a number that can be used")).with_help("write a number such as 20 or 2.5");
+                let d = self.error(Code::InvalidNumber, t.span, format!("`{}` is not a number that can be used", shorten(text))).with_help("write a number such as 20 or 2.5");
                 self.report(d);
                 return Expr { kind: ExprKind::Error, span: t.span };
             }
@@ -181,7 +192,9 @@ impl Parser<'_> {
         if !unit_text.is_empty() {
             let unit_span = Span::new(t.span.start as usize + split, t.span.end as usize);
             unit = self.unit(unit_text, unit_span);
-        } else if self.peek() == TokenKind::Ident && UNIT_WORDS.contains(&self.text_of(self.span())) {
+        } else if self.peek() == TokenKind::Ident
+            && (UNIT_WORDS.contains(&self.text_of(self.span())) || SPELLED_UNITS.contains(&self.text_of(self.span()).to_ascii_lowercase().as_str()))
+        {
             // `20 m` reads as `20m`; fmt writes it glued.
             let first = self.bump().span;
             let mut unit_span = first;
@@ -227,23 +240,49 @@ impl Parser<'_> {
     }
 
     fn or_expr(&mut self) -> Expr {
+        let base = self.depth;
         let mut left = self.and_expr();
-        while self.eat_keyword(Keyword::Or).is_some() {
+        while self.at_keyword(Keyword::Or) && self.chain_deeper() {
+            self.bump();
             let right = self.and_expr();
             let span = left.span.to(right.span);
             left = Expr { kind: ExprKind::Binary(Box::new(left), BinaryOp::Or, Box::new(right)), span };
         }
+        self.depth = base;
         left
     }
 
     fn and_expr(&mut self) -> Expr {
+        let base = self.depth;
         let mut left = self.not_expr();
-        while self.eat_keyword(Keyword::And).is_some() {
+        while self.at_keyword(Keyword::And) && self.chain_deeper() {
+            self.bump();
             let right = self.not_expr();
             let span = left.span.to(right.span);
             left = Expr { kind: ExprKind::Binary(Box::new(left), BinaryOp::And, Box::new(right)), span };
         }
+        self.depth = base;
         left
+    }
+
+    /// One more operator in an AND/OR chain. The tree of `a AND b AND c ...` is as deep
+    /// as the chain is long, so each operator counts against `MAX_DEPTH` like a
+    /// parenthesis (the caller restores the depth). Past the bound the rest of the line
+    /// is reported and skipped.
+    fn chain_deeper(&mut self) -> bool {
+        if self.depth >= MAX_DEPTH {
+            let span = self.span();
+            let d = self
+                .error(Code::NestingTooDeep, span, format!("a condition that joins more than {MAX_DEPTH} parts with AND or OR"))
+                .with_help("split the condition: give parts of it their own WAITFOR, STARTIF or IF");
+            self.report(d);
+            while !self.at_line_end() {
+                self.bump();
+            }
+            return false;
+        }
+        self.depth += 1;
+        true
     }
 
     fn not_expr(&mut self) -> Expr {
@@ -286,6 +325,10 @@ impl Parser<'_> {
                     return p.coordinates(inner, start);
                 }
                 if p.eat(TokenKind::RParen).is_none() {
+                    // Inside went wrong and was reported: one error is enough.
+                    if inner.kind == ExprKind::Error {
+                        return inner;
+                    }
                     return p.error_expr("`)`", None);
                 }
                 p.expr(ExprKind::Paren(Box::new(inner)), start)
@@ -293,4 +336,12 @@ impl Parser<'_> {
             |span| Expr { kind: ExprKind::Error, span },
         )
     }
+}
+
+/// A long literal, cut to a readable length for messages.
+fn shorten(text: &str) -> String {
+    if text.chars().count() <= 24 {
+        return text.to_string();
+    }
+    format!("{}...", text.chars().take(20).collect::<String>())
 }

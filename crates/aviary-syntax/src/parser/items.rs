@@ -35,6 +35,8 @@ impl Parser<'_> {
                     self.report(d);
                     self.skip_nested();
                 }
+                // The lexer reported the character; the rest of its line is skipped.
+                TokenKind::Unknown => self.recover_line(),
                 _ => {
                     let span = self.span();
                     let d = self
@@ -123,8 +125,9 @@ impl Parser<'_> {
         }
         let params = if self.eat_keyword(Keyword::With).is_some() { self.name_list("a parameter name after WITH") } else { Vec::new() };
         let mut sections = Vec::new();
+        let mut header_end = self.last_end;
         if self.header_colon(start, "the CAPABILITY header") {
-            let header_end = self.last_end;
+            header_end = self.last_end;
             if self.at_line_end() {
                 self.eat(TokenKind::Newline);
             } else {
@@ -144,7 +147,7 @@ impl Parser<'_> {
         }
         let span = Span::new(start.start as usize, self.last_end as usize);
         self.check_sections(&name, &sections);
-        Some(Capability { name, actors, params, sections, header_end: start.end, span })
+        Some(Capability { name, actors, params, sections, header_end, span })
     }
 
     fn check_sections(&mut self, name: &Ident, sections: &[Section]) {

@@ -260,7 +260,7 @@ impl<'a> Parser<'a> {
                 | Keyword::Defaults | Keyword::Perform | Keyword::Exceptions
         );
         let use_line = first == Keyword::Use && self.peek_at(1) == TokenKind::String;
-        if !(header_start && ends_in_colon) && !use_line {
+        if !(use_line || (header_start && ends_in_colon)) {
             return;
         }
         for i in self.pos..line_end {

@@ -85,6 +85,10 @@ impl Parser<'_> {
             TokenKind::TaggedName => self.leash(),
             TokenKind::Ident if self.peek_at(1) == TokenKind::Dot => self.api_call(),
             TokenKind::Ident => self.statement(),
+            TokenKind::Unknown => {
+                self.recover_line();
+                return None;
+            }
             _ => {
                 let d = self
                     .error(Code::Syntax, start, format!("expected a statement, found {}", self.peek().describe()))
@@ -99,9 +103,12 @@ impl Parser<'_> {
 
     /// The end of a one-line item: anything left on the line is an error.
     fn end_line(&mut self, what: &str) {
-        if !self.at_line_end() {
+        // An unknown character was reported by the lexer already.
+        if !self.at_line_end() && !self.at(TokenKind::Unknown) {
             let span = self.span();
-            let d = self.error(Code::Syntax, span, format!("unexpected {} after {what}", self.peek().describe()));
+            let d = self
+                .error(Code::Syntax, span, format!("expected the end of the line after {what}, found {}", self.peek().describe()))
+                .with_help("one statement per line; separate arguments with `,`");
             self.report(d);
         }
         self.skip_line();
@@ -276,7 +283,7 @@ impl Parser<'_> {
         let mut args = Vec::new();
         loop {
             if self.at_line_end() {
-                self.expected("an argument after WITH or `,`", None);
+                self.expected("an argument after WITH or `,`", Some("write the arguments on the same line: `WITH center=Home, radius=50m`"));
                 break;
             }
             let name = if self.peek() == TokenKind::Ident && self.peek_at(1) == TokenKind::Eq {

@@ -1,17 +1,21 @@
 //! The name, argument and kind checks: one walk over the mission and every capability.
 
+use std::collections::{HashMap, HashSet};
+
 use aviary_api::{Descriptor, Kind};
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 use aviary_syntax::ast::*;
-use aviary_world::{AttributeValue, World};
+use aviary_world::World;
 
 use crate::env::*;
 use crate::suggest::did_you_mean;
 use crate::Program;
 
+mod kinds;
+
 pub(crate) fn check_program(program: &Program, world: Option<&World>, api: &Descriptor, root: FileId, diagnostics: &mut Vec<Diagnostic>) {
     let mut tags = Vec::new();
-    let mut aliases = Vec::new();
+    let mut aliases = HashSet::new();
     for (_, tree) in &program.files {
         for item in &tree.items {
             let bodies = match item {
@@ -21,14 +25,19 @@ pub(crate) fn check_program(program: &Program, world: Option<&World>, api: &Desc
             };
             for body in bodies {
                 visit_stmts(body, &mut |stmt| match stmt {
-                    Stmt::Statement(Statement { capability, tag: Some(tag), .. }) => tags.push((capability.name.clone(), tag.name.clone())),
-                    Stmt::For(f) => aliases.push(f.alias.name.clone()),
+                    Stmt::Statement(Statement { capability, tag: Some(tag), .. }) => tags.push((capability.name.as_str(), tag.name.as_str())),
+                    Stmt::For(f) => {
+                        aliases.insert(f.alias.name.as_str());
+                    }
                     _ => {}
                 });
             }
         }
     }
-    let mut checker = Checker { program, world, api, diagnostics, file: root, capability: None, scopes: Vec::new(), tags, aliases };
+    let tag_set = tags.iter().copied().collect();
+    let world_names = world.map(world_names).unwrap_or_default();
+    let mut checker =
+        Checker { program, world, api, diagnostics, file: root, capability: None, scopes: Vec::new(), tags, tag_set, aliases, world_names };
     for (file, tree) in &program.files {
         checker.file = *file;
         for item in &tree.items {
@@ -43,7 +52,7 @@ pub(crate) fn check_program(program: &Program, world: Option<&World>, api: &Desc
                     checker.body(&m.body);
                 }
                 // Overridden library capabilities are never run, so never checked here.
-                Item::Capability(c) if program.capabilities.get(&c.name.name).map(|r| r.file) == Some(*file) || checker.is_user_file(*file) => {
+                Item::Capability(c) if program.is_active(*file, c) || checker.is_user_file(*file) => {
                     checker.capability_def(c);
                 }
                 _ => {}
@@ -59,11 +68,30 @@ struct Checker<'a> {
     diagnostics: &'a mut Vec<Diagnostic>,
     file: FileId,
     capability: Option<&'a Capability>,
-    scopes: Vec<Vec<(String, Binding)>>,
-    /// Every `Capability-Tag` that some statement starts.
-    tags: Vec<(String, String)>,
+    scopes: Vec<Vec<(&'a str, Binding)>>,
+    /// Every `Capability-Tag` that some statement starts, in order (for help lines).
+    tags: Vec<(&'a str, &'a str)>,
+    /// The same, for lookups.
+    tag_set: HashSet<(&'a str, &'a str)>,
     /// Every FOR alias of the mission: a `BY` filter may name one from anywhere.
-    aliases: Vec<String>,
+    aliases: HashSet<&'a str>,
+    /// What each name of the world means (see [`world_names`]).
+    world_names: HashMap<&'a str, Meaning>,
+}
+
+/// The world's names: a drone before a group of the same name, then places, then
+/// areas, as [`Checker::lookup`] has always read them; a table, so that a lookup does
+/// not scan every drone of a large world.
+fn world_names(w: &World) -> HashMap<&str, Meaning> {
+    let mut names = HashMap::new();
+    let drones = w.drones.iter().map(|d| (d.name.as_str(), Meaning::Drone));
+    let groups = w.groups.iter().map(|g| (g.name.as_str(), Meaning::Group));
+    let places = w.places.iter().map(|p| (p.name.as_str(), Meaning::Place));
+    let areas = w.areas.iter().map(|a| (a.name.as_str(), Meaning::Area));
+    for (name, meaning) in drones.chain(groups).chain(places).chain(areas) {
+        names.entry(name).or_insert(meaning);
+    }
+    names
 }
 
 impl<'a> Checker<'a> {
@@ -86,22 +114,11 @@ impl<'a> Checker<'a> {
 
     fn lookup(&self, name: &str) -> Meaning {
         for scope in self.scopes.iter().rev() {
-            if let Some((_, b)) = scope.iter().rev().find(|(n, _)| n == name) {
+            if let Some((_, b)) = scope.iter().rev().find(|(n, _)| *n == name) {
                 return Meaning::Local(*b);
             }
         }
-        let Some(w) = self.world else { return Meaning::Unbound };
-        if w.drone(name).is_some() {
-            Meaning::Drone
-        } else if w.group(name).is_some() {
-            Meaning::Group
-        } else if w.place(name).is_some() {
-            Meaning::Place
-        } else if w.area(name).is_some() {
-            Meaning::Area
-        } else {
-            Meaning::Unbound
-        }
+        self.world_names.get(name).copied().unwrap_or(Meaning::Unbound)
     }
 
     /// Whether an unbound name is known to be a mistake (not merely unknowable).
@@ -110,7 +127,7 @@ impl<'a> Checker<'a> {
     }
 
     fn local_names(&self, want: impl Fn(&Binding) -> bool) -> Vec<&str> {
-        self.scopes.iter().flatten().filter(|(_, b)| want(b)).map(|(n, _)| n.as_str()).collect()
+        self.scopes.iter().flatten().filter(|(_, b)| want(b)).map(|(n, _)| *n).collect()
     }
 
     fn actor_candidates(&self) -> Vec<&'a str> {
@@ -129,15 +146,15 @@ impl<'a> Checker<'a> {
             if let Some(first) = declared.iter().find(|d| d.name == p.name) {
                 let first = first.span;
                 let file = self.file;
-                self.report(Code::DuplicateParameter, p.span, format!("`{}` is declared twice in `{}`", p.name, c.name.name))
-                    .secondary
-                    .push(aviary_diagnostics::Label { file, span: first, message: "first declared here".into() });
+                let d = self.report(Code::DuplicateParameter, p.span, format!("`{}` is declared twice in `{}`", p.name, c.name.name));
+                d.secondary.push(aviary_diagnostics::Label { file, span: first, message: "first declared here".into() });
+                d.help = Some("give each actor and parameter of a capability its own name".into());
             }
             declared.push(p);
         }
         let kinds = self.program.param_kinds.get(&c.name.name).cloned().unwrap_or_default();
-        let mut scope: Vec<(String, Binding)> = c.actors.iter().map(|a| (a.name.clone(), Binding::Actor)).collect();
-        scope.extend(c.params.iter().enumerate().map(|(i, p)| (p.name.clone(), Binding::Value(kinds.get(i).copied().flatten()))));
+        let mut scope: Vec<(&str, Binding)> = c.actors.iter().map(|a| (a.name.as_str(), Binding::Actor)).collect();
+        scope.extend(c.params.iter().enumerate().map(|(i, p)| (p.name.as_str(), Binding::Value(kinds.get(i).copied().flatten()))));
         self.scopes.push(scope);
         for section in &c.sections {
             match section {
@@ -193,7 +210,7 @@ impl<'a> Checker<'a> {
                     self.by_filter(by);
                 }
                 let values = self.api.signal(&h.signal.name).map(|s| s.values.clone()).unwrap_or_default();
-                let scope = h.bindings.iter().enumerate().map(|(i, b)| (b.name.clone(), Binding::Value(values.get(i).map(|v| v.1)))).collect();
+                let scope = h.bindings.iter().enumerate().map(|(i, b)| (b.name.as_str(), Binding::Value(values.get(i).map(|v| v.1)))).collect();
                 self.scopes.push(scope);
                 self.body(&h.body);
                 self.scopes.pop();
@@ -216,7 +233,7 @@ impl<'a> Checker<'a> {
         if let Some(by) = &h.by {
             self.by_filter(by);
         }
-        self.scopes.push(h.bindings.iter().map(|b| (b.name.clone(), Binding::Value(None))).collect());
+        self.scopes.push(h.bindings.iter().map(|b| (b.name.as_str(), Binding::Value(None))).collect());
         self.body(&h.body);
         self.scopes.pop();
     }
@@ -228,11 +245,25 @@ impl<'a> Checker<'a> {
             if inst.values.len() != f.params.len() {
                 let names: Vec<&str> = f.params.iter().map(|p| p.name.as_str()).collect();
                 let code = if inst.values.len() > f.params.len() { Code::TooManyArguments } else { Code::MissingArgument };
-                let d = self.report(code, inst.span, format!("this instance gives {} value(s) for {} parameter(s)", inst.values.len(), f.params.len()));
+                let message = if names.is_empty() {
+                    format!("`{}` is given {}, but the FOR names no parameters after its alias", inst.actor.name, count(inst.values.len(), "value"))
+                } else {
+                    format!(
+                        "`{}` is given {}, but the FOR names {} ({})",
+                        inst.actor.name,
+                        count(inst.values.len(), "value"),
+                        count(f.params.len(), "parameter"),
+                        names.join(", ")
+                    )
+                };
+                let d = self.report(code, inst.span, message);
                 d.help = Some(if names.is_empty() {
                     "name the parameters after the alias: `AS d WITH p:`".into()
                 } else {
-                    format!("give one value for each of {}", names.join(", "))
+                    match names.as_slice() {
+                        [one] => format!("give each instance a value for `{one}`: `{} WITH ...`", inst.actor.name),
+                        _ => format!("give each instance one value for each of {}, in that order", quoted(&names)),
+                    }
                 });
             }
             for (i, v) in inst.values.iter().enumerate() {
@@ -244,8 +275,8 @@ impl<'a> Checker<'a> {
                 }
             }
         }
-        let mut scope = vec![(f.alias.name.clone(), Binding::Actor)];
-        scope.extend(f.params.iter().zip(kinds).map(|(p, k)| (p.name.clone(), Binding::Value(k))));
+        let mut scope = vec![(f.alias.name.as_str(), Binding::Actor)];
+        scope.extend(f.params.iter().zip(kinds).map(|(p, k)| (p.name.as_str(), Binding::Value(k))));
         self.scopes.push(scope);
         self.body(&f.body);
         self.scopes.pop();
@@ -258,7 +289,8 @@ impl<'a> Checker<'a> {
             Meaning::Local(Binding::Value(_)) => "a value, not a drone",
             Meaning::Place => "a place, not a drone",
             Meaning::Area => "an area, not a drone",
-            Meaning::Unbound if !self.names_are_known() && self.capability.is_none() => return,
+            // Without a world, a name that no scope binds may still be a drone of the world.
+            Meaning::Unbound if !self.names_are_known() => return,
             Meaning::Unbound => "no drone, group or alias",
         };
         let mut candidates = self.actor_candidates();
@@ -272,7 +304,7 @@ impl<'a> Checker<'a> {
 
     /// `BY x`: an actor, a group, or any FOR alias of the mission.
     fn by_filter(&mut self, id: &Ident) {
-        if self.aliases.contains(&id.name) {
+        if self.aliases.contains(id.name.as_str()) {
             return;
         }
         self.actor(id);
@@ -292,11 +324,35 @@ impl<'a> Checker<'a> {
                     span,
                     format!("this reads as actors `{}` and capability `{}`", all.join(" "), s.capability.name),
                 );
-                d.help = Some(format!("arguments follow WITH: write `{} {} WITH {}`", actors.join(" "), real.name, rest.join(", ")));
+                let more = if s.args.is_empty() { "" } else { ", ..." };
+                d.help = Some(format!("arguments follow WITH: write `{} {} WITH {}{more}`", actors.join(" "), real.name, rest.join(", ")));
                 return;
             }
-            let help = did_you_mean(&s.capability.name, self.program.capabilities.keys().map(String::as_str))
-                .unwrap_or_else(|| "define it with `CAPABILITY Name BY drone:`, or USE the file that does".into());
+            let help = did_you_mean(&s.capability.name, self.program.capabilities.keys().map(String::as_str)).unwrap_or_else(|| {
+                match self.program.unreadable.as_slice() {
+                    [] => "define it with `CAPABILITY Name BY drone:`, or USE the file that does".into(),
+                    [one] => format!("it may be defined in `{one}`, which could not be read"),
+                    many => format!("it may be defined in one of {}, which could not be read", many.iter().map(|m| format!("`{m}`")).collect::<Vec<_>>().join(", ")),
+                }
+            });
+            // The last name is something else of the world: say what, and what is missing.
+            let actors: Vec<&str> = s.actors.iter().map(|a| a.name.as_str()).collect();
+            let all = format!("{} {}", actors.join(" "), s.capability.name);
+            let fly_there = format!("to fly there, write `{} FlyTo WITH {}`", actors.join(" "), s.capability.name);
+            let names_no_capability = format!("a statement ends with the capability: `{all} FlyTo WITH ...`");
+            let what = match self.lookup(&s.capability.name) {
+                Meaning::Drone => Some(("a drone, not a capability", names_no_capability)),
+                Meaning::Group => Some(("a group of drones, not a capability", names_no_capability)),
+                Meaning::Local(Binding::Actor) => Some(("an actor, not a capability", names_no_capability)),
+                Meaning::Place => Some(("a place, not a capability", fly_there)),
+                Meaning::Area => Some(("an area, not a capability", fly_there)),
+                _ => None,
+            };
+            if let Some((what, help)) = what {
+                let d = self.report(Code::UnknownCapability, s.capability.span, format!("`{}` is {what}", s.capability.name));
+                d.help = Some(help);
+                return;
+            }
             let d = self.report(Code::UnknownCapability, s.capability.span, format!("no capability is called `{}`", s.capability.name));
             d.help = Some(help);
             return;
@@ -335,12 +391,23 @@ impl<'a> Checker<'a> {
                     d.help = Some(help);
                 }
                 BindProblem::Twice(n) => {
+                    // The first argument stays bound; the second is the one reported.
+                    let first = params.iter().position(|p| *p == n.name).and_then(|i| binding.bound[i]).map(|e| e.span);
+                    let file = self.file;
                     let d = self.report(Code::DuplicateArgument, n.span, format!("`{}` is given twice", n.name));
-                    d.help = Some("give each parameter one argument".into());
+                    if let Some(span) = first {
+                        d.secondary.push(aviary_diagnostics::Label { file, span, message: format!("`{}` is already given here", n.name) });
+                    }
+                    d.help = Some("give each parameter one argument; positional arguments fill the parameters in order".into());
                 }
                 BindProblem::TooMany(e) => {
-                    let d = self.report(Code::TooManyArguments, e.span, format!("`{}` takes {} argument(s), this is one more", cap.name.name, params.len()));
-                    d.help = Some(if params.is_empty() { "remove the arguments".into() } else { format!("its parameters are {}", params.join(", ")) });
+                    let message = if params.is_empty() {
+                        format!("`{}` takes no arguments", cap.name.name)
+                    } else {
+                        format!("`{}` takes {}, and this is one too many", cap.name.name, count(params.len(), "argument"))
+                    };
+                    let d = self.report(Code::TooManyArguments, e.span, message);
+                    d.help = Some(if params.is_empty() { "remove the arguments".into() } else { format!("its parameters are {}", quoted(&params)) });
                 }
             }
         }
@@ -373,7 +440,7 @@ impl<'a> Checker<'a> {
 
     fn leash(&mut self, l: &'a LeashCall) {
         let tagged = format!("{}-{}", l.capability.name, l.tag.name);
-        if !self.tags.iter().any(|(c, t)| *c == l.capability.name && *t == l.tag.name) {
+        if !self.tag_set.contains(&(l.capability.name.as_str(), l.tag.name.as_str())) {
             let known: Vec<String> = self.tags.iter().map(|(c, t)| format!("{c}-{t}")).collect();
             let help = did_you_mean(&tagged, known.iter().map(String::as_str))
                 .unwrap_or_else(|| format!("tag the statement that starts the activity: `drone {tagged} WITH ...`"));
@@ -419,19 +486,26 @@ impl<'a> Checker<'a> {
             d.help = Some(format!("call the API on the capability's actor: `{}.{}(...)`", actors.first().unwrap_or(&"drone"), call.function.name));
         }
         let Some(f) = self.api.function(&call.function.name) else {
-            let help = did_you_mean(&call.function.name, self.api.functions.iter().map(|f| f.name))
-                .unwrap_or_else(|| "the middle-layer functions are listed in docs/LANGUAGE.md".into());
+            let names: Vec<&str> = self.api.functions.iter().map(|f| f.name).collect();
+            let help = did_you_mean(&call.function.name, names.iter().copied())
+                .or_else(|| same_start(&call.function.name, names.iter().copied()).map(|c| format!("did you mean `{c}`?")))
+                .unwrap_or_else(|| format!("the middle layer's functions are {}", names.join(", ")));
             let d = self.report(Code::UnknownApiFunction, call.function.span, format!("the middle layer has no function `{}`", call.function.name));
             d.help = Some(help);
             return;
         };
         let n = call.args.len();
         if n < f.required() {
-            let d = self.report(Code::MissingArgument, call.span, format!("`{}` needs {} argument(s), this call gives {n}", f.name, f.required()));
+            let d = self.report(Code::MissingArgument, call.span, format!("`{}` needs {}, and this call gives {}", f.name, count(f.required(), "argument"), count_bare(n)));
             d.help = Some(format!("call it as `{}.{}`", call.actor.name, f.signature()));
         } else if n > f.params.len() && !f.variadic {
             let extra = call.args[f.params.len()].span;
-            let d = self.report(Code::TooManyArguments, extra, format!("`{}` takes at most {} argument(s), this call gives {n}", f.name, f.params.len()));
+            let message = if f.params.is_empty() {
+                format!("`{}` takes no arguments", f.name)
+            } else {
+                format!("`{}` takes at most {}, and this call gives {n}", f.name, count(f.params.len(), "argument"))
+            };
+            let d = self.report(Code::TooManyArguments, extra, message);
             d.help = Some(format!("call it as `{}.{}`", call.actor.name, f.signature()));
         }
         for (j, arg) in call.args.iter().enumerate() {
@@ -441,142 +515,57 @@ impl<'a> Checker<'a> {
         }
     }
 
-    fn condition(&mut self, e: &'a Expr) {
-        let k = self.value(e, None, "a condition");
-        if let Some(k) = k {
-            if k != Kind::Bool {
-                let d = self.report(Code::WrongKind, e.span, format!("a condition must be true or false, and this is {}", k.describe()));
-                d.help = Some("compare it with something: `drone.battery > 25%`, `type = Body`".into());
-            }
-        }
-    }
+}
 
-    /// The kind of a value, checked against `expected` when given. Reports what is wrong.
-    fn value(&mut self, e: &'a Expr, expected: Option<Kind>, what: &str) -> Option<Kind> {
-        let actual = self.kind_of(e);
-        let (Some(expected), Some(actual)) = (expected, actual) else { return actual };
-        if expected.accepts(actual) {
-            return Some(actual);
-        }
-        if let ExprKind::Name(id) = &e.kind {
-            if actual == Kind::Symbol && matches!(expected, Kind::Position | Kind::Area) {
-                let noun = if expected == Kind::Area { "area" } else { "place" };
-                let candidates: Vec<&str> = self.world.map_or(Vec::new(), |w| {
-                    let areas = w.areas.iter().map(|a| a.name.as_str());
-                    if expected == Kind::Area {
-                        areas.collect()
-                    } else {
-                        w.places.iter().map(|p| p.name.as_str()).chain(areas).collect()
-                    }
-                });
-                let help = did_you_mean(&id.name, candidates.iter().copied())
-                    .unwrap_or_else(|| format!("define it in the world file's [{noun}s], or use coordinates such as (100, 50)"));
-                let d = self.report(Code::UnknownPlace, id.span, format!("unknown {noun} `{}`", id.name));
-                d.help = Some(help);
-                return Some(actual);
-            }
-        }
-        if actual == Kind::Number {
-            if let (Some(unit), ExprKind::Number { digits, .. }) = (unit_for(expected), &e.kind) {
-                let d = self.report(Code::WrongKind, e.span, format!("`{digits}` has no unit, and {what} is {}", expected.describe()));
-                d.help = Some(format!("write `{digits}{unit}`"));
-                return Some(actual);
-            }
-        }
-        let d = self.report(Code::WrongKind, e.span, format!("{what} is {}, but this is {}", expected.describe(), actual.describe()));
-        d.primary.message = format!("expected {}", expected.describe());
-        d.help = Some(format!("write {}, such as `{}`", expected.describe(), expected.example()));
-        Some(actual)
+/// `1 argument`, `2 arguments`, `no arguments`.
+fn count(n: usize, word: &str) -> String {
+    match n {
+        0 => format!("no {word}s"),
+        1 => format!("1 {word}"),
+        n => format!("{n} {word}s"),
     }
+}
 
-    fn kind_of(&mut self, e: &'a Expr) -> Option<Kind> {
-        match &e.kind {
-            ExprKind::Name(id) => match self.lookup(&id.name) {
-                Meaning::Local(Binding::Actor) | Meaning::Drone | Meaning::Group => Some(Kind::Actor),
-                Meaning::Local(Binding::Value(k)) => k,
-                Meaning::Place => Some(Kind::Position),
-                Meaning::Area => Some(Kind::Area),
-                Meaning::Unbound if self.names_are_known() => Some(Kind::Symbol),
-                Meaning::Unbound => None,
-            },
-            ExprKind::Path(a, field) => self.path(a, field),
-            ExprKind::Coordinates(parts) => {
-                for p in parts {
-                    if let Some(k) = self.kind_of(p) {
-                        if !matches!(k, Kind::Number | Kind::Length) {
-                            let d = self.report(Code::WrongKind, p.span, format!("a coordinate is a number of metres, and this is {}", k.describe()));
-                            d.help = Some("write coordinates as `(x, y)` or `(x, y, z)` in metres".into());
-                        }
-                    }
-                }
-                Some(Kind::Position)
-            }
-            ExprKind::Geo(parts) => {
-                for p in parts {
-                    self.kind_of(p);
-                }
-                Some(Kind::Position)
-            }
-            ExprKind::Distance(a, b) => {
-                self.value(a, Some(Kind::Position), "`distance`'s first place");
-                self.value(b, Some(Kind::Position), "`distance`'s second place");
-                Some(Kind::Length)
-            }
-            ExprKind::Received(_) => Some(Kind::Bool),
-            ExprKind::Not(inner) => {
-                self.condition(inner);
-                Some(Kind::Bool)
-            }
-            ExprKind::Binary(l, BinaryOp::And | BinaryOp::Or, r) => {
-                self.condition(l);
-                self.condition(r);
-                Some(Kind::Bool)
-            }
-            ExprKind::Binary(l, op, r) => {
-                let lk = self.kind_of(l);
-                match lk {
-                    // A symbol on the left (`x = Hoem` reads fine either way): check the right against it.
-                    Some(k) => {
-                        let what = format!("the other side of `{}`", op.as_str());
-                        self.value(r, Some(k), &what);
-                    }
-                    None => {
-                        self.kind_of(r);
-                    }
-                }
-                Some(Kind::Bool)
-            }
-            ExprKind::Paren(inner) => self.kind_of(inner),
-            ExprKind::Error => None,
-            _ => literal_kind(e),
-        }
+/// `none`, or the number.
+fn count_bare(n: usize) -> String {
+    if n == 0 {
+        "none".into()
+    } else {
+        n.to_string()
     }
+}
 
-    /// `a.field`: telemetry, or an attribute from the world file.
-    fn path(&mut self, a: &'a Ident, field: &'a Ident) -> Option<Kind> {
-        self.actor(a);
-        if let Some(k) = self.api.telemetry(&field.name) {
-            return Some(k);
-        }
-        let world = self.world?;
-        let found = world.drones.iter().find_map(|d| d.attributes.iter().find(|(k, _)| *k == field.name).map(|(_, v)| v));
-        match found {
-            Some(AttributeValue::Number(_)) => Some(Kind::Number),
-            Some(AttributeValue::Text(_)) => Some(Kind::Text),
-            Some(AttributeValue::Bool(_)) => Some(Kind::Bool),
-            Some(AttributeValue::Other(_)) => None,
-            None => {
-                let mut names: Vec<&str> = self.api.telemetry.iter().map(|(n, _)| *n).collect();
-                for d in &world.drones {
-                    names.extend(d.attributes.iter().map(|(k, _)| k.as_str()));
-                }
-                names.sort_unstable();
-                names.dedup();
-                let help = did_you_mean(&field.name, names.iter().copied()).unwrap_or_else(|| format!("telemetry and attributes: {}", names.join(", ")));
-                let d = self.report(Code::UnknownTelemetry, field.span, format!("`{}` is no telemetry field and no attribute of `{}`", field.name, a.name));
-                d.help = Some(help);
-                None
-            }
-        }
+/// A candidate that starts with `name`, or with which `name` starts (`FlyToPos` for
+/// `FlyToPosition`), ignoring case; only for names long enough to mean something.
+fn same_start<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    let lower = name.to_ascii_lowercase();
+    if lower.len() < 4 {
+        return None;
     }
+    candidates
+        .into_iter()
+        .filter(|c| {
+            let c = c.to_ascii_lowercase();
+            c.len() >= 4 && (c.starts_with(&lower) || lower.starts_with(&c))
+        })
+        .min_by_key(|c| (c.len().abs_diff(name.len()), c.to_string()))
+}
+
+/// A short expression as written, for messages: `drone.battery`, `ELAPSED`, `25%`.
+fn shown(e: &Expr) -> Option<String> {
+    match &e.kind {
+        ExprKind::Name(id) => Some(id.name.clone()),
+        ExprKind::Path(a, f) => Some(format!("{}.{}", a.name, f.name)),
+        ExprKind::Elapsed => Some("ELAPSED".into()),
+        ExprKind::Number { digits, unit, .. } => Some(format!("{digits}{}", unit.map_or("", |u| u.as_str()))),
+        ExprKind::Received(id) => Some(format!("RECEIVED({})", id.name)),
+        ExprKind::Distance(a, b) => Some(format!("distance({}, {})", shown(a)?, shown(b)?)),
+        ExprKind::Paren(inner) => shown(inner).map(|s| format!("({s})")),
+        _ => None,
+    }
+}
+
+/// `` `a`, `b` `` for a list of names in a message.
+fn quoted(names: &[&str]) -> String {
+    names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
 }

@@ -1,0 +1,203 @@
+//! The kinds of values: what an expression is, and whether it fits where it stands
+//! (units, places, conditions, telemetry and attributes).
+
+use aviary_api::Kind;
+use aviary_diagnostics::Code;
+use aviary_syntax::ast::*;
+use aviary_world::AttributeValue;
+
+use super::{shown, Checker};
+use crate::env::*;
+use crate::suggest::did_you_mean;
+
+impl<'a> Checker<'a> {
+    pub(super) fn condition(&mut self, e: &'a Expr) {
+        let k = self.value(e, None, "a condition");
+        if let Some(k) = k {
+            if k != Kind::Bool {
+                let d = self.report(Code::WrongKind, e.span, format!("a condition must be true or false, and this is {}", k.describe()));
+                d.help = Some("compare it with something: `drone.battery > 25%`, `type = Body`".into());
+            }
+        }
+    }
+
+    /// The kind of a value, checked against `expected` when given. Reports what is wrong.
+    pub(super) fn value(&mut self, e: &'a Expr, expected: Option<Kind>, what: &str) -> Option<Kind> {
+        let actual = self.kind_of(e);
+        let (Some(expected), Some(actual)) = (expected, actual) else { return actual };
+        if expected.accepts(actual) {
+            return Some(actual);
+        }
+        if let ExprKind::Name(id) = &e.kind {
+            if actual == Kind::Symbol && matches!(expected, Kind::Position | Kind::Area) {
+                let noun = if expected == Kind::Area { "area" } else { "place" };
+                let candidates: Vec<&str> = self.world.map_or(Vec::new(), |w| {
+                    let areas = w.areas.iter().map(|a| a.name.as_str());
+                    if expected == Kind::Area {
+                        areas.collect()
+                    } else {
+                        w.places.iter().map(|p| p.name.as_str()).chain(areas).collect()
+                    }
+                });
+                let help = did_you_mean(&id.name, candidates.iter().copied())
+                    .unwrap_or_else(|| format!("define it in the world file's [{noun}s], or use coordinates such as (100, 50)"));
+                let d = self.report(Code::UnknownPlace, id.span, format!("unknown {noun} `{}`", id.name));
+                d.help = Some(help);
+                return Some(actual);
+            }
+        }
+        if actual == Kind::Number {
+            if let (Some(unit), ExprKind::Number { digits, .. }) = (unit_for(expected), &e.kind) {
+                let d = self.report(Code::WrongKind, e.span, format!("`{digits}` has no unit, and {what} is {}", expected.describe()));
+                d.help = Some(format!("write `{digits}{unit}`"));
+                return Some(actual);
+            }
+        }
+        let origin = self.parameter_origin(e);
+        let file = self.file;
+        let d = self.report(Code::WrongKind, e.span, format!("{what} is {}, but this is {}", expected.describe(), actual.describe()));
+        d.primary.message = format!("expected {}", expected.describe());
+        d.help = Some(format!("write {}, such as `{}`", expected.describe(), expected.example()));
+        if let Some((name, cap, default)) = origin {
+            // A parameter has one kind: say where this one comes from.
+            match default {
+                Some(default) => {
+                    let span = default.span;
+                    d.secondary.push(aviary_diagnostics::Label { file, span, message: format!("`{name}` is {} because of its default", actual.describe()) });
+                    d.help = Some(match (&default.kind, unit_for(expected)) {
+                        (ExprKind::Number { digits, unit: None, .. }, Some(unit)) => format!("give the default its unit: `{name}: {digits}{unit}`"),
+                        _ => format!("change the default of `{name}`, or pass `{name}` only where {} is expected", actual.describe()),
+                    });
+                }
+                None => {
+                    d.help = Some(format!(
+                        "`{name}` is a parameter of `{cap}`, and it is {} where it is first used; a parameter has one kind",
+                        actual.describe()
+                    ))
+                }
+            }
+        }
+        Some(actual)
+    }
+
+    /// For a name that is a parameter of the capability being checked: its name, the
+    /// capability's name, and its default, if it has one.
+    pub(super) fn parameter_origin(&self, e: &Expr) -> Option<(String, String, Option<&'a Expr>)> {
+        let ExprKind::Name(id) = &e.kind else { return None };
+        let cap = self.capability?;
+        if !cap.params.iter().any(|p| p.name == id.name) || !matches!(self.lookup(&id.name), Meaning::Local(Binding::Value(_))) {
+            return None;
+        }
+        let default = cap.sections.iter().find_map(|s| match s {
+            Section::Defaults { entries, .. } => entries.iter().find(|d| d.name.name == id.name).map(|d| &d.value),
+            _ => None,
+        });
+        Some((id.name.clone(), cap.name.name.clone(), default))
+    }
+
+    /// `Some(Actor)` when `e` names a drone, group or alias; reports nothing.
+    pub(super) fn kind_of_quietly(&self, e: &Expr) -> Option<Kind> {
+        match &e.kind {
+            ExprKind::Name(id) => match self.lookup(&id.name) {
+                Meaning::Local(Binding::Actor) | Meaning::Drone | Meaning::Group => Some(Kind::Actor),
+                _ => None,
+            },
+            _ => None,
+        }
+    }
+
+    pub(super) fn kind_of(&mut self, e: &'a Expr) -> Option<Kind> {
+        match &e.kind {
+            ExprKind::Name(id) => match self.lookup(&id.name) {
+                Meaning::Local(Binding::Actor) | Meaning::Drone | Meaning::Group => Some(Kind::Actor),
+                Meaning::Local(Binding::Value(k)) => k,
+                Meaning::Place => Some(Kind::Position),
+                Meaning::Area => Some(Kind::Area),
+                Meaning::Unbound if self.names_are_known() => Some(Kind::Symbol),
+                Meaning::Unbound => None,
+            },
+            ExprKind::Path(a, field) => self.path(a, field),
+            ExprKind::Coordinates(parts) => {
+                for p in parts {
+                    if let Some(k) = self.kind_of(p) {
+                        if !matches!(k, Kind::Number | Kind::Length) {
+                            let d = self.report(Code::WrongKind, p.span, format!("a coordinate is a number of metres, and this is {}", k.describe()));
+                            d.help = Some("write coordinates as `(x, y)` or `(x, y, z)` in metres".into());
+                        }
+                    }
+                }
+                Some(Kind::Position)
+            }
+            ExprKind::Geo(parts) => {
+                for p in parts {
+                    self.kind_of(p);
+                }
+                Some(Kind::Position)
+            }
+            ExprKind::Distance(a, b) => {
+                // A drone stands for where it is now: `distance(drone, Home) < 10m`.
+                for (e, what) in [(a, "`distance`'s first place"), (b, "`distance`'s second place")] {
+                    if self.kind_of_quietly(e) != Some(Kind::Actor) {
+                        self.value(e, Some(Kind::Position), what);
+                    }
+                }
+                Some(Kind::Length)
+            }
+            ExprKind::Received(_) => Some(Kind::Bool),
+            ExprKind::Not(inner) => {
+                self.condition(inner);
+                Some(Kind::Bool)
+            }
+            ExprKind::Binary(l, BinaryOp::And | BinaryOp::Or, r) => {
+                self.condition(l);
+                self.condition(r);
+                Some(Kind::Bool)
+            }
+            ExprKind::Binary(l, op, r) => {
+                let lk = self.kind_of(l);
+                match lk {
+                    // A symbol on the left (`x = Hoem` reads fine either way): check the right against it.
+                    Some(k) => {
+                        let what = shown(l).map_or_else(|| format!("the other side of `{}`", op.as_str()), |l| format!("`{l}`"));
+                        self.value(r, Some(k), &what);
+                    }
+                    None => {
+                        self.kind_of(r);
+                    }
+                }
+                Some(Kind::Bool)
+            }
+            ExprKind::Paren(inner) => self.kind_of(inner),
+            ExprKind::Error => None,
+            _ => literal_kind(e),
+        }
+    }
+
+    /// `a.field`: telemetry, or an attribute from the world file.
+    pub(super) fn path(&mut self, a: &'a Ident, field: &'a Ident) -> Option<Kind> {
+        self.actor(a);
+        if let Some(k) = self.api.telemetry(&field.name) {
+            return Some(k);
+        }
+        let world = self.world?;
+        let found = world.drones.iter().find_map(|d| d.attributes.iter().find(|(k, _)| *k == field.name).map(|(_, v)| v));
+        match found {
+            Some(AttributeValue::Number(_)) => Some(Kind::Number),
+            Some(AttributeValue::Text(_)) => Some(Kind::Text),
+            Some(AttributeValue::Bool(_)) => Some(Kind::Bool),
+            Some(AttributeValue::Other(_)) => None,
+            None => {
+                let mut names: Vec<&str> = self.api.telemetry.iter().map(|(n, _)| *n).collect();
+                for d in &world.drones {
+                    names.extend(d.attributes.iter().map(|(k, _)| k.as_str()));
+                }
+                names.sort_unstable();
+                names.dedup();
+                let help = did_you_mean(&field.name, names.iter().copied()).unwrap_or_else(|| format!("telemetry and attributes: {}", names.join(", ")));
+                let d = self.report(Code::UnknownTelemetry, field.span, format!("`{}` is no telemetry field and no attribute of `{}`", field.name, a.name));
+                d.help = Some(help);
+                None
+            }
+        }
+    }
+}

@@ -1,0 +1,131 @@
+//! `aviary bench parse`: generates a large mission and its world
+//! (`aviary_check::generate`), then times parsing alone and parse + check through the
+//! same pipeline as `aviary check` (source map, world, `aviary_check::check`), and
+//! prints each run and the median throughput. MB here is 10^6 bytes.
+
+use std::time::{Duration, Instant};
+
+use aviary_api::Descriptor;
+use aviary_check::SourceProvider;
+use aviary_diagnostics::{FileId, SourceMap};
+use clap::Subcommand;
+
+/// The generated mission USEs nothing, so nothing is served.
+struct NoFiles;
+
+impl SourceProvider for NoFiles {
+    fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+        Err(format!("the benchmark reads no files ({path})"))
+    }
+}
+
+const MB: f64 = 1_000_000.0;
+
+#[derive(Subcommand)]
+pub enum BenchCommand {
+    /// Parse and check a generated mission of about M megabytes (10^6 bytes)
+    Parse {
+        /// The size of the generated mission, in MB
+        #[arg(long, default_value_t = 5.0)]
+        mb: f64,
+        /// How many timed runs; the median is reported
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+    },
+}
+
+pub fn run(which: BenchCommand) -> u8 {
+    match which {
+        BenchCommand::Parse { mb, runs } => parse(mb, runs),
+    }
+}
+
+fn parse(mb: f64, runs: usize) -> u8 {
+    if !(mb.is_finite() && mb > 0.0) || mb > 4000.0 {
+        eprintln!("aviary: --mb must be a size in megabytes, above 0 and at most 4000");
+        return 2;
+    }
+    let runs = runs.max(1);
+    let started = Instant::now();
+    let (mission, world) = aviary_check::generate::large_mission((mb * MB) as usize);
+    let size = mission.len();
+    println!(
+        "generated a mission of {:.2} MB ({size} bytes, {} lines, {} capabilities) and a world of {} drones in {:.2} s",
+        size as f64 / MB,
+        mission.lines().count(),
+        mission.matches("\nCAPABILITY ").count(),
+        aviary_check::generate::DRONES,
+        started.elapsed().as_secs_f64()
+    );
+
+    // One run outside the timings, to say what the checker thinks of the mission.
+    let (errors, others) = parse_and_check(&mission, &world);
+    if errors > 0 || others > 0 {
+        println!("note: the check reports {errors} error(s) and {others} other diagnostic(s); the generator should give none");
+    }
+
+    let mut parse_times = Vec::with_capacity(runs);
+    let mut check_times = Vec::with_capacity(runs);
+    for run in 1..=runs {
+        // Parse alone: lexing, layout and parsing into the tree (dropping the tree is
+        // not timed here; it is in parse + check, as it is in `aviary check`).
+        let start = Instant::now();
+        let parsed = std::hint::black_box(aviary_syntax::parse(FileId(0), &mission));
+        let parse_time = start.elapsed();
+        drop(parsed);
+
+        let start = Instant::now();
+        std::hint::black_box(parse_and_check(&mission, &world));
+        let check_time = start.elapsed();
+
+        println!(
+            "run {run}: parse {:.3} s ({:.1} MB/s); parse + check {:.3} s ({:.1} MB/s)",
+            parse_time.as_secs_f64(),
+            rate(size, parse_time),
+            check_time.as_secs_f64(),
+            rate(size, check_time)
+        );
+        parse_times.push(parse_time);
+        check_times.push(check_time);
+    }
+    let parse_median = median(&mut parse_times);
+    let check_median = median(&mut check_times);
+    println!(
+        "median of {runs} run(s) over {:.2} MB: parse {:.1} MB/s ({:.3} s); parse + check {:.1} MB/s ({:.3} s)",
+        size as f64 / MB,
+        rate(size, parse_median),
+        parse_median.as_secs_f64(),
+        rate(size, check_median),
+        check_median.as_secs_f64()
+    );
+    0
+}
+
+/// What `aviary check` does with a mission and its world, minus reading and printing:
+/// the number of errors and of other diagnostics.
+fn parse_and_check(mission: &str, world_text: &str) -> (usize, usize) {
+    let mut sources = SourceMap::new();
+    let checked = aviary_check::check_sources(
+        &mut sources,
+        ("generated.mission", mission.as_bytes()),
+        Some(("generated.world.toml", world_text.as_bytes())),
+        &NoFiles,
+        &Descriptor::standard(),
+    );
+    let errors = checked.diagnostics.iter().filter(|d| d.is_error()).count();
+    (errors, checked.diagnostics.len() - errors)
+}
+
+fn rate(bytes: usize, time: Duration) -> f64 {
+    bytes as f64 / MB / time.as_secs_f64().max(1e-9)
+}
+
+fn median(times: &mut [Duration]) -> Duration {
+    times.sort_unstable();
+    let n = times.len();
+    if n % 2 == 1 {
+        times[n / 2]
+    } else {
+        (times[n / 2 - 1] + times[n / 2]) / 2
+    }
+}

@@ -5,11 +5,17 @@
 //! built-in signals and exceptions it raises. The checker reads only the descriptor, so
 //! a backend that adds a function teaches the checker about it.
 //!
+//! At run time a backend implements [`Backend`]: the engine starts calls, interrupts
+//! them, reads telemetry and receives drone events through it, and never learns which
+//! backend it drives.
+//!
 //! Invariant: this crate knows no engine, no backend and no syntax.
 
 mod kind;
+mod runtime;
 
 pub use kind::Kind;
+pub use runtime::*;
 
 /// A part of a drone that one activity at a time may command (LANGUAGE.md §3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]

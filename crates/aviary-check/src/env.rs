@@ -113,18 +113,18 @@ pub(crate) fn unit_for(kind: Kind) -> Option<&'static str> {
 }
 
 /// Binds a statement's arguments to a capability's parameters by name and position.
-pub(crate) struct ArgBinding<'a> {
+pub struct ArgBinding<'a> {
     pub bound: Vec<Option<&'a Expr>>,
     pub problems: Vec<BindProblem<'a>>,
 }
 
-pub(crate) enum BindProblem<'a> {
+pub enum BindProblem<'a> {
     UnknownName(&'a Ident),
     Twice(&'a Ident),
     TooMany(&'a Expr),
 }
 
-pub(crate) fn bind_args<'a>(params: &[Ident], args: &'a [Arg]) -> ArgBinding<'a> {
+pub fn bind_args<'a>(params: &[Ident], args: &'a [Arg]) -> ArgBinding<'a> {
     let mut bound: Vec<Option<&Expr>> = vec![None; params.len()];
     let mut problems = Vec::new();
     let mut next = 0;

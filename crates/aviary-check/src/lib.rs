@@ -22,6 +22,7 @@ use aviary_diagnostics::{Diagnostic, FileId, SourceMap};
 use aviary_syntax::ast::{Capability, Mission, SourceFile};
 use aviary_world::World;
 
+pub use env::{bind_args, ArgBinding, BindProblem};
 pub use inputs::{check_sources, normalize_path, Checked};
 pub use load::{SourceProvider, STD_NAME, STD_SOURCE};
 

@@ -286,6 +286,8 @@ impl<'a> Checker<'a> {
     fn actor(&mut self, id: &Ident) {
         let what = match self.lookup(&id.name) {
             Meaning::Local(Binding::Actor) | Meaning::Drone | Meaning::Group => return,
+            // A bound value of unknown kind may well hold a drone (`SIGNAL Here WITH d`).
+            Meaning::Local(Binding::Value(None)) => return,
             Meaning::Local(Binding::Value(_)) => "a value, not a drone",
             Meaning::Place => "a place, not a drone",
             Meaning::Area => "an area, not a drone",

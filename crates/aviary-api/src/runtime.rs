@@ -1,0 +1,137 @@
+//! The run-time half of the middle layer: values, telemetry, calls and drone events.
+
+use tokio::sync::{mpsc, oneshot};
+
+/// A drone, by its index in the world file's order.
+pub type DroneId = usize;
+
+/// A point in the world's local frame (metres: x east, y north, z up). Without `z`, a
+/// flight keeps the altitude it has.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point {
+    pub x: f64,
+    pub y: f64,
+    pub z: Option<f64>,
+}
+
+impl Point {
+    pub fn flat(x: f64, y: f64) -> Point {
+        Point { x, y, z: None }
+    }
+}
+
+/// A value at run time. Quantities are SI: metres, seconds, m/s, degrees, fractions.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Value {
+    Number(f64),
+    Text(String),
+    Symbol(String),
+    Bool(bool),
+    Position(Point),
+    Area(Vec<[f64; 2]>),
+    Actor(DroneId),
+}
+
+/// What a drone is doing, as telemetry's `state` reports it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FlightState {
+    Landed,
+    TakingOff,
+    Flying,
+    Landing,
+    /// Crashed or otherwise gone for good.
+    Lost,
+}
+
+impl FlightState {
+    /// The symbol a mission compares with: `drone.state = Landed`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FlightState::Landed => "Landed",
+            FlightState::TakingOff => "TakingOff",
+            FlightState::Flying => "Flying",
+            FlightState::Landing => "Landing",
+            FlightState::Lost => "Lost",
+        }
+    }
+    pub fn airborne(self) -> bool {
+        matches!(self, FlightState::TakingOff | FlightState::Flying | FlightState::Landing)
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Telemetry {
+    /// `[x, y, z]`, local metres.
+    pub position: [f64; 3],
+    /// Ground speed, m/s.
+    pub speed: f64,
+    /// Degrees clockwise from north.
+    pub heading: f64,
+    /// What is left, as a fraction of a full battery.
+    pub battery: f64,
+    pub state: FlightState,
+    pub link: bool,
+}
+
+/// A built-in exception (LANGUAGE.md §3), by the name a mission handles it with.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Failure {
+    pub exception: &'static str,
+    /// Why, for people: the trace's `reason` and the summary.
+    pub reason: String,
+}
+
+/// How a call ended.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CallEnd {
+    Done,
+    /// The call cannot be done: the activity that made it gets this exception.
+    Failed(Failure),
+    /// Stopped by [`Backend::interrupt`], or by a fault reported as a [`DroneEvent`].
+    Interrupted,
+}
+
+/// A call in progress. The backend keeps the sending side and answers exactly once.
+pub struct PendingCall {
+    pub id: CallId,
+    pub end: oneshot::Receiver<CallEnd>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct CallId(pub u64);
+
+/// What the engine may do to a call in progress (the leashes of LANGUAGE.md §3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Interrupt {
+    /// Stop it for good; the drone holds where it is. The call ends `Interrupted`.
+    Abort,
+    /// Hold the drone where it is; the call stays in progress.
+    Pause,
+    /// Go on from where the call was paused.
+    Resume,
+}
+
+/// Something a drone reports without being asked.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DroneEvent {
+    /// A target found while detection of its kind is on, once per target per activation.
+    Detected { drone: DroneId, kind: String, location: [f64; 3] },
+    /// A built-in signal of the drone (`BatteryLow`, `ConnectionRestored`).
+    Signal { drone: DroneId, name: &'static str },
+    /// A fault (`BatteryCritical`, `ConnectionLost`, ...). Raised once; the drone's calls
+    /// in progress end `Interrupted`, so the exception is never raised twice.
+    Fault { drone: DroneId, failure: Failure },
+}
+
+/// A fleet of drones as the engine sees it. Implemented by the built-in simulator and by
+/// real-drone backends; the engine never knows which one it drives.
+pub trait Backend {
+    /// The functions, telemetry and built-ins this backend offers.
+    fn descriptor(&self) -> crate::Descriptor;
+    /// Starts `function` on `drone`. Arguments were checked against the descriptor.
+    fn call(&self, drone: DroneId, function: &str, args: &[Value]) -> PendingCall;
+    fn interrupt(&self, call: CallId, how: Interrupt);
+    fn telemetry(&self, drone: DroneId) -> Telemetry;
+    /// The stream of drone events; taken once, by the engine.
+    fn events(&self) -> Option<mpsc::UnboundedReceiver<DroneEvent>>;
+}

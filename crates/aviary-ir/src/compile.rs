@@ -1,0 +1,601 @@
+//! From a checked program to the IR.
+
+use std::collections::BTreeMap;
+
+use aviary_api::{Descriptor, Point, Value};
+use aviary_check::{bind_args, Program};
+use aviary_diagnostics::FileId;
+use aviary_syntax::ast;
+use aviary_world::{AttributeValue, World};
+
+use crate::*;
+
+/// Compiles the checked `program` for the fleet of `world`. `None` when the program
+/// holds no MISSION (a library of capabilities has nothing to run).
+pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mission> {
+    let mission = program.mission()?;
+    let mission_file = program.mission.map(|r| r.file).unwrap_or_default();
+    let mut c = Compiler::new(program, world, api);
+    c.collect_aliases(&mission.body);
+    let actives: Vec<(FileId, &ast::Capability)> = program.active_capabilities().collect();
+    for (i, (_, cap)) in actives.iter().enumerate() {
+        c.caps.insert(cap.name.name.clone(), i);
+    }
+    c.defaults = actives.iter().map(|(_, cap)| c.defaults_of(cap)).collect();
+    let capabilities: Vec<Capability> = actives.iter().map(|(file, cap)| c.capability(*file, cap)).collect();
+    c.file = mission_file;
+    c.scopes.clear();
+    c.frame_size = 0;
+    let body = c.body(&mission.body, &mission.name.name, BlockKind::Sequential, true);
+    let mut out = Mission {
+        name: mission.name.name.clone(),
+        body,
+        frame_size: c.frame_size,
+        capabilities,
+        drones: world.drones.iter().map(|d| d.name.clone()).collect(),
+        signals: c.signals.names,
+        exceptions: c.exceptions.names,
+        tags: c.tags.names,
+        functions: api.functions.iter().map(|f| (f.name.to_string(), f.resource)).collect(),
+        attribute_names: c.attribute_names.clone(),
+        attributes: attribute_table(world, &c.attribute_names),
+        origin: world.site.origin.as_ref().map(|o| (o.lat, o.lon, o.alt)),
+    };
+    compute_claims(&mut out.capabilities, &out.functions);
+    Some(out)
+}
+
+#[derive(Default)]
+struct Interner {
+    names: Vec<String>,
+}
+
+impl Interner {
+    fn id(&mut self, name: &str) -> usize {
+        match self.names.iter().position(|n| n == name) {
+            Some(i) => i,
+            None => {
+                self.names.push(name.to_string());
+                self.names.len() - 1
+            }
+        }
+    }
+}
+
+struct Compiler<'a> {
+    program: &'a Program,
+    world: &'a World,
+    api: &'a Descriptor,
+    caps: BTreeMap<String, CapId>,
+    defaults: Vec<Vec<Option<Expr>>>,
+    signals: Interner,
+    exceptions: Interner,
+    tags: Interner,
+    attribute_names: Vec<String>,
+    /// Every FOR alias of the mission and the drones its instances stand for.
+    aliases: BTreeMap<String, Vec<DroneId>>,
+    /// Names bound in the current frame: (name, slot, is an actor).
+    scopes: Vec<Vec<(String, Slot, bool)>>,
+    frame_size: usize,
+    file: FileId,
+}
+
+impl<'a> Compiler<'a> {
+    fn new(program: &'a Program, world: &'a World, api: &'a Descriptor) -> Self {
+        let mut signals = Interner::default();
+        for s in &api.signals {
+            signals.id(s.name);
+        }
+        let mut exceptions = Interner::default();
+        for e in &api.exceptions {
+            exceptions.id(e);
+        }
+        let mut attribute_names: Vec<String> = Vec::new();
+        for d in &world.drones {
+            for (k, _) in &d.attributes {
+                if !attribute_names.contains(k) {
+                    attribute_names.push(k.clone());
+                }
+            }
+        }
+        Compiler {
+            program,
+            world,
+            api,
+            caps: BTreeMap::new(),
+            defaults: Vec::new(),
+            signals,
+            exceptions,
+            tags: Interner::default(),
+            attribute_names,
+            aliases: BTreeMap::new(),
+            scopes: Vec::new(),
+            frame_size: 0,
+            file: FileId::default(),
+        }
+    }
+
+    fn origin(&self, span: aviary_diagnostics::Span) -> Origin {
+        Origin { file: self.file, span }
+    }
+
+    fn slot(&mut self) -> Slot {
+        self.frame_size += 1;
+        self.frame_size - 1
+    }
+
+    fn local(&self, name: &str) -> Option<(Slot, bool)> {
+        self.scopes.iter().rev().flat_map(|s| s.iter().rev()).find(|(n, _, _)| n == name).map(|&(_, s, a)| (s, a))
+    }
+
+    fn collect_aliases(&mut self, body: &ast::Body) {
+        for stmt in &body.items {
+            if let ast::Stmt::For(f) = stmt {
+                let mut drones = Vec::new();
+                for inst in &f.instances {
+                    match self.actor(&inst.actor.name) {
+                        ActorRef::Drone(d) => drones.push(d),
+                        ActorRef::Group(g) => drones.extend(g),
+                        ActorRef::Slot(_) => {}
+                    }
+                }
+                self.aliases.entry(f.alias.name.clone()).or_default().extend(drones);
+            }
+            stmt.for_each_body(|b| self.collect_aliases(b));
+        }
+    }
+
+    fn actor(&self, name: &str) -> ActorRef {
+        if let Some((slot, _)) = self.local(name) {
+            return ActorRef::Slot(slot);
+        }
+        if let Some(i) = self.world.drones.iter().position(|d| d.name == name) {
+            return ActorRef::Drone(i);
+        }
+        let members = self.world.group(name).map(|g| g.members.iter().filter_map(|m| self.world.drones.iter().position(|d| &d.name == m)).collect());
+        ActorRef::Group(members.unwrap_or_default())
+    }
+
+    fn filter(&self, by: &Option<ast::Ident>) -> Option<ActorFilter> {
+        let by = by.as_ref()?;
+        if let Some((slot, true)) = self.local(&by.name) {
+            return Some(ActorFilter::Slot(slot));
+        }
+        if let Some(drones) = self.aliases.get(&by.name) {
+            return Some(ActorFilter::Drones(drones.clone()));
+        }
+        Some(match self.actor(&by.name) {
+            ActorRef::Drone(d) => ActorFilter::Drones(vec![d]),
+            ActorRef::Group(g) => ActorFilter::Drones(g),
+            ActorRef::Slot(s) => ActorFilter::Slot(s),
+        })
+    }
+
+    fn defaults_of(&mut self, cap: &ast::Capability) -> Vec<Option<Expr>> {
+        let saved = std::mem::take(&mut self.scopes);
+        let mut out = vec![None; cap.params.len()];
+        for section in &cap.sections {
+            if let ast::Section::Defaults { entries, .. } = section {
+                for e in entries {
+                    if let Some(i) = cap.params.iter().position(|p| p.name == e.name.name) {
+                        out[i] = Some(self.expr(&e.value));
+                    }
+                }
+            }
+        }
+        self.scopes = saved;
+        out
+    }
+
+    fn capability(&mut self, file: FileId, cap: &ast::Capability) -> Capability {
+        self.file = file;
+        let mut scope: Vec<(String, Slot, bool)> = cap.actors.iter().enumerate().map(|(i, a)| (a.name.clone(), i, true)).collect();
+        scope.extend(cap.params.iter().enumerate().map(|(i, p)| (p.name.clone(), cap.actors.len() + i, false)));
+        self.frame_size = scope.len();
+        self.scopes = vec![scope];
+        let name = &cap.name.name;
+        let mut out = Capability {
+            name: name.clone(),
+            actors: cap.actors.len(),
+            params: cap.params.iter().map(|p| p.name.clone()).collect(),
+            frame_size: 0,
+            requirements: Vec::new(),
+            perform: empty_block(name),
+            sections: Vec::new(),
+            exception_handlers: Vec::new(),
+            claims: Vec::new(),
+        };
+        for section in &cap.sections {
+            match section {
+                ast::Section::Requirements { conditions, .. } => out.requirements = conditions.iter().map(|c| self.expr(c)).collect(),
+                ast::Section::Defaults { .. } => {}
+                ast::Section::Perform { name: None, body, .. } => out.perform = self.body(body, name, BlockKind::Sequential, false),
+                ast::Section::Perform { name: Some(section), body, .. } => {
+                    let path = format!("{name}/PERFORM {}", section.name);
+                    let block = self.body(body, &path, BlockKind::Sequential, false);
+                    out.sections.push((section.name.clone(), block));
+                }
+                ast::Section::Exceptions { handlers, .. } => {
+                    out.exception_handlers = handlers.iter().map(|h| self.exception_handler(h, name)).collect();
+                }
+            }
+        }
+        out.frame_size = self.frame_size;
+        out
+    }
+
+    fn body(&mut self, body: &ast::Body, path: &str, kind: BlockKind, traced: bool) -> Block {
+        let mut block = Block { kind, path: path.to_string(), traced, items: Vec::new(), handlers: Vec::new(), exception_handlers: Vec::new() };
+        for stmt in &body.items {
+            match stmt {
+                ast::Stmt::Handler(h) => {
+                    let handler = self.handler(h, path);
+                    block.handlers.push(handler);
+                }
+                ast::Stmt::ExceptionHandler(h) => {
+                    let handler = self.exception_handler(h, path);
+                    block.exception_handlers.push(handler);
+                }
+                other => {
+                    if let Some(node) = self.node(other, path) {
+                        block.items.push(node);
+                    }
+                }
+            }
+        }
+        block
+    }
+
+    fn bound_scope<T>(&mut self, names: impl IntoIterator<Item = (String, bool)>, f: impl FnOnce(&mut Self, Vec<Slot>) -> T) -> T {
+        let mut scope = Vec::new();
+        let mut slots = Vec::new();
+        for (name, actor) in names {
+            let s = self.slot();
+            slots.push(s);
+            scope.push((name, s, actor));
+        }
+        self.scopes.push(scope);
+        let out = f(self, slots);
+        self.scopes.pop();
+        out
+    }
+
+    fn handler(&mut self, h: &ast::Handler, parent: &str) -> Handler {
+        let signal = self.signals.id(&h.signal.name);
+        let by = self.filter(&h.by);
+        let path = format!("{parent}/ON {}", h.signal.name);
+        let names = h.bindings.iter().map(|b| (b.name.clone(), false));
+        self.bound_scope(names, |c, bindings| Handler {
+            signal,
+            every: h.every,
+            sequential: h.mode == Some(ast::BlockKind::Sequential),
+            by,
+            bindings,
+            body: c.body(&h.body, &path, BlockKind::Sequential, false),
+        })
+    }
+
+    fn exception_handler(&mut self, h: &ast::ExceptionHandler, parent: &str) -> ExceptionHandler {
+        let exception = self.exceptions.id(&h.exception.name);
+        let by = self.filter(&h.by);
+        let path = format!("{parent}/ON EXCEPTION {}", h.exception.name);
+        let names = h.bindings.iter().map(|b| (b.name.clone(), false));
+        self.bound_scope(names, |c, bindings| ExceptionHandler { exception, by, bindings, body: c.body(&h.body, &path, BlockKind::Sequential, false) })
+    }
+
+    fn node(&mut self, stmt: &ast::Stmt, parent: &str) -> Option<Node> {
+        Some(match stmt {
+            ast::Stmt::Block(b) => {
+                let kind = if b.kind == ast::BlockKind::Parallel { BlockKind::Parallel } else { BlockKind::Sequential };
+                let path = match &b.name {
+                    Some(n) => n.name.clone(),
+                    None => format!("{parent}/{}", b.kind.as_str()),
+                };
+                Node::Block(self.body(&b.body, &path, kind, true))
+            }
+            ast::Stmt::Statement(s) => Node::Call(self.call(s)?),
+            ast::Stmt::Leash(l) => Node::Leash(self.leash(l)?),
+            ast::Stmt::Api(a) => Node::Api(ApiCall {
+                actor: self.actor(&a.actor.name),
+                function: self.api.functions.iter().position(|f| f.name == a.function.name)?,
+                args: a.args.iter().map(|e| self.expr(e)).collect(),
+                origin: self.origin(a.span),
+            }),
+            ast::Stmt::Signal(r) => Node::Signal { signal: self.signals.id(&r.name.name), args: self.args(&r.args), origin: self.origin(r.span) },
+            ast::Stmt::Throw(r) => Node::Throw { exception: self.exceptions.id(&r.name.name), args: self.args(&r.args), origin: self.origin(r.span) },
+            ast::Stmt::Requirement(r) => {
+                let condition = self.expr(&r.condition);
+                let path = format!("{parent}/{}", r.kind.as_str());
+                let body = r.body.as_ref().map(|b| self.body(b, &path, BlockKind::Sequential, false));
+                match r.kind {
+                    ast::RequirementKind::StartIf => Node::StartIf { condition, body: body.unwrap_or_else(|| empty_block(&path)) },
+                    ast::RequirementKind::WaitFor => Node::WaitFor { condition, body },
+                    ast::RequirementKind::DoWhile => Node::DoWhile { condition, body: body.unwrap_or_else(|| empty_block(&path)) },
+                }
+            }
+            ast::Stmt::For(f) => {
+                let instances = f.instances.iter().map(|i| (self.actor(&i.actor.name), i.values.iter().map(|v| self.expr(v)).collect())).collect();
+                let path = format!("{parent}/FOR {}", f.alias.name);
+                let names = std::iter::once((f.alias.name.clone(), true)).chain(f.params.iter().map(|p| (p.name.clone(), false)));
+                self.bound_scope(names, |c, slots| {
+                    Node::For(For {
+                        parallel: f.kind == ast::BlockKind::Parallel,
+                        instances,
+                        alias: slots[0],
+                        params: slots[1..].to_vec(),
+                        body: c.body(&f.body, &path, BlockKind::Sequential, false),
+                    })
+                })
+            }
+            ast::Stmt::If(i) => {
+                let path = format!("{parent}/IF");
+                let branches = i.branches.iter().map(|(c, b)| (self.expr(c), self.body(b, &path, BlockKind::Sequential, false))).collect();
+                let otherwise = i.otherwise.as_ref().map(|b| self.body(b, &format!("{parent}/ELSE"), BlockKind::Sequential, false));
+                Node::If { branches, otherwise }
+            }
+            ast::Stmt::Handler(_) | ast::Stmt::ExceptionHandler(_) | ast::Stmt::Error(_) => return None,
+        })
+    }
+
+    fn args(&mut self, args: &[ast::Arg]) -> Vec<Expr> {
+        args.iter().map(|a| self.expr(&a.value)).collect()
+    }
+
+    fn call(&mut self, s: &ast::Statement) -> Option<Call> {
+        let capability = *self.caps.get(&s.capability.name)?;
+        let callee = self.program.capability(&s.capability.name)?;
+        let binding = bind_args(&callee.params, &s.args);
+        let defaults = self.defaults.get(capability).cloned().unwrap_or_default();
+        let args = binding
+            .bound
+            .iter()
+            .enumerate()
+            .map(|(i, e)| match e {
+                Some(e) => self.expr(e),
+                None => defaults.get(i).cloned().flatten().unwrap_or(Expr::Const(Value::Bool(false))),
+            })
+            .collect();
+        Some(Call {
+            actors: s.actors.iter().map(|a| self.actor(&a.name)).collect(),
+            capability,
+            args,
+            tag: s.tag.as_ref().map(|t| self.tags.id(&t.name)),
+            origin: self.origin(s.span),
+        })
+    }
+
+    fn leash(&mut self, l: &ast::LeashCall) -> Option<Leash> {
+        let capability = *self.caps.get(&l.capability.name)?;
+        let callee = self.program.capability(&l.capability.name)?;
+        let action = match l.action.name.as_str() {
+            "ABORT" => LeashAction::Abort,
+            "PAUSE" => LeashAction::Pause,
+            "RESUME" => LeashAction::Resume,
+            name => {
+                let sections = callee.sections.iter().filter_map(|s| match s {
+                    ast::Section::Perform { name: Some(n), .. } => Some(n.name.as_str()),
+                    _ => None,
+                });
+                LeashAction::Section(sections.enumerate().find(|(_, n)| *n == name)?.0)
+            }
+        };
+        let binding = bind_args(&callee.params, &l.args);
+        let args = binding.bound.iter().enumerate().filter_map(|(i, e)| e.map(|e| (i, self.expr(e)))).collect();
+        Some(Leash { capability, tag: self.tags.id(&l.tag.name), action, action_name: l.action.name.clone(), args, origin: self.origin(l.span) })
+    }
+
+    fn expr(&mut self, e: &ast::Expr) -> Expr {
+        use ast::ExprKind as K;
+        match &e.kind {
+            K::Number { value, unit, .. } => Expr::Const(Value::Number(value * unit.map_or(1.0, |u| u.to_si()))),
+            K::String(s) => Expr::Const(Value::Text(s.clone())),
+            K::Bool(b) => Expr::Const(Value::Bool(*b)),
+            K::Coordinates(parts) => {
+                let parts: Vec<Expr> = parts.iter().map(|p| self.expr(p)).collect();
+                match literal_numbers(&parts) {
+                    Some(n) => Expr::Const(Value::Position(Point { x: n[0], y: n.get(1).copied().unwrap_or(0.0), z: n.get(2).copied() })),
+                    None => Expr::Point(parts),
+                }
+            }
+            K::Geo(parts) => {
+                let parts: Vec<Expr> = parts.iter().map(|p| self.expr(p)).collect();
+                match (literal_numbers(&parts), self.world.site.origin.as_ref()) {
+                    (Some(n), Some(o)) => {
+                        let [x, y, z] = to_local((o.lat, o.lon, o.alt), n[0], n.get(1).copied().unwrap_or(0.0), n.get(2).copied());
+                        Expr::Const(Value::Position(Point { x, y, z: (!z.is_nan()).then_some(z) }))
+                    }
+                    _ => Expr::Geo(parts),
+                }
+            }
+            K::Name(id) => self.name(&id.name),
+            K::Path(a, field) => {
+                let actor = self.actor(&a.name);
+                match telemetry_field(&field.name) {
+                    Some(f) => Expr::Telemetry(actor, f),
+                    None => {
+                        let index = self.attribute_names.iter().position(|n| n == &field.name).unwrap_or(usize::MAX);
+                        Expr::Attribute(actor, index)
+                    }
+                }
+            }
+            K::Distance(a, b) => Expr::Distance(Box::new(self.expr(a)), Box::new(self.expr(b))),
+            K::Received(s) => Expr::Received(self.signals.id(&s.name)),
+            K::Elapsed => Expr::Elapsed,
+            K::Not(inner) => Expr::Not(Box::new(self.expr(inner))),
+            K::Paren(inner) => self.expr(inner),
+            K::Binary(l, op, r) => {
+                let (l, r) = (Box::new(self.expr(l)), Box::new(self.expr(r)));
+                match op {
+                    ast::BinaryOp::And => Expr::And(l, r),
+                    ast::BinaryOp::Or => Expr::Or(l, r),
+                    ast::BinaryOp::Eq => Expr::Compare(l, Compare::Eq, r),
+                    ast::BinaryOp::Ne => Expr::Compare(l, Compare::Ne, r),
+                    ast::BinaryOp::Lt => Expr::Compare(l, Compare::Lt, r),
+                    ast::BinaryOp::Le => Expr::Compare(l, Compare::Le, r),
+                    ast::BinaryOp::Gt => Expr::Compare(l, Compare::Gt, r),
+                    ast::BinaryOp::Ge => Expr::Compare(l, Compare::Ge, r),
+                }
+            }
+            // A checked program has none; a constant keeps the engine total.
+            K::Error => Expr::Const(Value::Bool(false)),
+        }
+    }
+
+    fn name(&self, name: &str) -> Expr {
+        if let Some((slot, _)) = self.local(name) {
+            return Expr::Slot(slot);
+        }
+        let w = self.world;
+        if let Some(i) = w.drones.iter().position(|d| d.name == name) {
+            return Expr::Const(Value::Actor(i));
+        }
+        if w.group(name).is_some() {
+            return Expr::Actor(self.actor(name));
+        }
+        if let Some(p) = w.place(name) {
+            return Expr::Const(Value::Position(Point { x: p.at[0], y: p.at[1], z: p.has_z.then_some(p.at[2]) }));
+        }
+        if let Some(a) = w.area(name) {
+            return Expr::Const(Value::Area(a.polygon.clone()));
+        }
+        Expr::Const(Value::Symbol(name.to_string()))
+    }
+}
+
+fn empty_block(path: &str) -> Block {
+    Block { kind: BlockKind::Sequential, path: path.to_string(), traced: false, items: Vec::new(), handlers: Vec::new(), exception_handlers: Vec::new() }
+}
+
+fn literal_numbers(parts: &[Expr]) -> Option<Vec<f64>> {
+    parts
+        .iter()
+        .map(|p| match p {
+            Expr::Const(Value::Number(n)) => Some(*n),
+            _ => None,
+        })
+        .collect()
+}
+
+fn telemetry_field(name: &str) -> Option<Field> {
+    Some(match name {
+        "position" => Field::Position,
+        "altitude" => Field::Altitude,
+        "speed" => Field::Speed,
+        "heading" => Field::Heading,
+        "battery" => Field::Battery,
+        "state" => Field::State,
+        "link" => Field::Link,
+        _ => return None,
+    })
+}
+
+fn attribute_table(world: &World, names: &[String]) -> Vec<Vec<Option<Value>>> {
+    names
+        .iter()
+        .map(|name| {
+            world
+                .drones
+                .iter()
+                .map(|d| {
+                    d.attributes.iter().find(|(k, _)| k == name).map(|(_, v)| match v {
+                        AttributeValue::Number(n) => Value::Number(*n),
+                        AttributeValue::Text(t) => Value::Text(t.clone()),
+                        AttributeValue::Bool(b) => Value::Bool(*b),
+                        AttributeValue::Other(o) => Value::Text(o.clone()),
+                    })
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// What each capability claims: the resources its own API calls use on its actors, and,
+/// through every statement it makes on its actors, what the called capabilities claim.
+fn compute_claims(caps: &mut [Capability], functions: &[(String, Option<aviary_api::Resource>)]) {
+    let mut claims: Vec<Vec<(usize, aviary_api::Resource)>> = caps.iter().map(|c| direct_claims(c, functions)).collect();
+    // Through calls, to a fixpoint: each round adds at least one claim or stops.
+    loop {
+        let mut changed = false;
+        for i in 0..caps.len() {
+            let mut calls = Vec::new();
+            for block in cap_blocks(&caps[i]) {
+                visit_calls(block, &mut calls);
+            }
+            for call in calls {
+                let callee = claims.get(call.capability).cloned().unwrap_or_default();
+                for (j, resource) in callee {
+                    let targets: Vec<&ActorRef> = if caps[call.capability].actors == 1 { call.actors.iter().collect() } else { call.actors.get(j).into_iter().collect() };
+                    for target in targets {
+                        if let ActorRef::Slot(slot) = target {
+                            if *slot < caps[i].actors && !claims[i].contains(&(*slot, resource)) {
+                                claims[i].push((*slot, resource));
+                                changed = true;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    for (c, mut cl) in caps.iter_mut().zip(claims) {
+        cl.sort();
+        cl.dedup();
+        c.claims = cl;
+    }
+}
+
+fn direct_claims(cap: &Capability, functions: &[(String, Option<aviary_api::Resource>)]) -> Vec<(usize, aviary_api::Resource)> {
+    let mut out = Vec::new();
+    for block in cap_blocks(cap) {
+        visit_nodes(block, &mut |n| {
+            if let Node::Api(a) = n {
+                if let (ActorRef::Slot(s), Some((_, Some(r)))) = (&a.actor, functions.get(a.function)) {
+                    if *s < cap.actors {
+                        out.push((*s, *r));
+                    }
+                }
+            }
+        });
+    }
+    out
+}
+
+/// Every body of a capability: PERFORM, its named sections, its exception handlers.
+fn cap_blocks(cap: &Capability) -> impl Iterator<Item = &Block> {
+    std::iter::once(&cap.perform).chain(cap.sections.iter().map(|(_, b)| b)).chain(cap.exception_handlers.iter().map(|h| &h.body))
+}
+
+fn visit_calls<'b>(block: &'b Block, out: &mut Vec<&'b Call>) {
+    visit_nodes(block, &mut |n| {
+        if let Node::Call(c) = n {
+            out.push(c);
+        }
+    });
+}
+
+fn visit_nodes<'b>(block: &'b Block, f: &mut dyn FnMut(&'b Node)) {
+    let handler_bodies = block.handlers.iter().map(|h| &h.body).chain(block.exception_handlers.iter().map(|h| &h.body));
+    for body in handler_bodies {
+        visit_nodes(body, f);
+    }
+    for node in &block.items {
+        f(node);
+        match node {
+            Node::Block(b) | Node::StartIf { body: b, .. } | Node::DoWhile { body: b, .. } => visit_nodes(b, f),
+            Node::WaitFor { body: Some(b), .. } => visit_nodes(b, f),
+            Node::For(x) => visit_nodes(&x.body, f),
+            Node::If { branches, otherwise } => {
+                for (_, b) in branches {
+                    visit_nodes(b, f);
+                }
+                if let Some(b) = otherwise {
+                    visit_nodes(b, f);
+                }
+            }
+            _ => {}
+        }
+    }
+}

@@ -1,0 +1,237 @@
+//! The compiled mission: what the engine runs.
+//!
+//! Everything a run needs is resolved here, once: capabilities, signals, exceptions,
+//! tags and middle-layer functions are indices; drones are `DroneId`s; numbers are SI;
+//! defaults are filled in; each handler sits on the block whose subtree it hears; each
+//! capability knows every resource its body can use. The engine looks nothing up by
+//! name. Spans survive, so a run-time problem can still point into the source.
+//!
+//! Invariant: no IO; `compile` takes a checked program and never panics.
+
+mod compile;
+mod geo;
+
+pub use compile::compile;
+pub use geo::to_local;
+
+use aviary_api::{DroneId, Resource, Value};
+use aviary_diagnostics::{FileId, Span};
+
+/// Indices into the tables of [`Mission`].
+pub type CapId = usize;
+pub type SignalId = usize;
+pub type ExceptionId = usize;
+pub type TagId = usize;
+pub type FunctionId = usize;
+/// A variable of the frame a node runs in.
+pub type Slot = usize;
+
+/// A place in the source.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Origin {
+    pub file: FileId,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mission {
+    pub name: String,
+    pub body: Block,
+    /// Variables of the mission frame (FOR aliases and parameters, handler bindings).
+    pub frame_size: usize,
+    pub capabilities: Vec<Capability>,
+    pub drones: Vec<String>,
+    pub signals: Vec<String>,
+    pub exceptions: Vec<String>,
+    /// `Capability-Tag` names, as written after the dash.
+    pub tags: Vec<String>,
+    /// Middle-layer functions by index, with the resource each uses.
+    pub functions: Vec<(String, Option<Resource>)>,
+    /// `attributes[a][d]`: attribute `a` of drone `d`, from the world file.
+    pub attribute_names: Vec<String>,
+    pub attributes: Vec<Vec<Option<Value>>>,
+    /// The world's geodetic origin `(lat, lon, alt)`, for `GEO(...)` evaluated at run time.
+    pub origin: Option<(f64, f64, f64)>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Capability {
+    pub name: String,
+    /// Slots 0..actors hold the `BY` actors; the next `params.len()` slots the parameters.
+    pub actors: usize,
+    pub params: Vec<String>,
+    pub frame_size: usize,
+    pub requirements: Vec<Expr>,
+    pub perform: Block,
+    /// Named `PERFORM X:` sections (leashes), by name as written.
+    pub sections: Vec<(String, Block)>,
+    pub exception_handlers: Vec<ExceptionHandler>,
+    /// Every resource of every `BY` actor that the body can use, through the capabilities
+    /// it calls: what a statement claims when it starts (LANGUAGE.md §3).
+    pub claims: Vec<(usize, Resource)>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BlockKind {
+    Sequential,
+    Parallel,
+}
+
+/// A body: its items run in sequence or in parallel; its handlers listen while it runs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Block {
+    pub kind: BlockKind,
+    /// The block's name in the trace: its own name, or a path such as
+    /// `Start_Mission/ON Video1_Ready`.
+    pub path: String,
+    /// Whether the block is a named or written `SEQUENTIAL`/`PARALLEL` block (traced), or
+    /// the body of some other construct.
+    pub traced: bool,
+    pub items: Vec<Node>,
+    pub handlers: Vec<Handler>,
+    pub exception_handlers: Vec<ExceptionHandler>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Node {
+    Block(Block),
+    Call(Call),
+    Leash(Leash),
+    Api(ApiCall),
+    Signal { signal: SignalId, args: Vec<Expr>, origin: Origin },
+    Throw { exception: ExceptionId, args: Vec<Expr>, origin: Origin },
+    StartIf { condition: Expr, body: Block },
+    WaitFor { condition: Expr, body: Option<Block> },
+    DoWhile { condition: Expr, body: Block },
+    For(For),
+    If { branches: Vec<(Expr, Block)>, otherwise: Option<Block> },
+}
+
+/// Who a statement or a call is about.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ActorRef {
+    Drone(DroneId),
+    /// A group: each member, in parallel, in world order.
+    Group(Vec<DroneId>),
+    /// An alias or `BY` parameter of the frame.
+    Slot(Slot),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Call {
+    pub actors: Vec<ActorRef>,
+    pub capability: CapId,
+    /// One per parameter, defaults filled in.
+    pub args: Vec<Expr>,
+    pub tag: Option<TagId>,
+    pub origin: Origin,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LeashAction {
+    Abort,
+    Pause,
+    Resume,
+    /// A named `PERFORM` section, by its index in [`Capability::sections`].
+    Section(usize),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Leash {
+    pub capability: CapId,
+    pub tag: TagId,
+    pub action: LeashAction,
+    /// The action as written, for the trace (`PAUSE`, `Widen`).
+    pub action_name: String,
+    /// Parameter index and value, for a section's arguments.
+    pub args: Vec<(usize, Expr)>,
+    pub origin: Origin,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ApiCall {
+    pub actor: ActorRef,
+    pub function: FunctionId,
+    pub args: Vec<Expr>,
+    pub origin: Origin,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct For {
+    pub parallel: bool,
+    /// Each instance's actor and values. A group instance stands for each member.
+    pub instances: Vec<(ActorRef, Vec<Expr>)>,
+    pub alias: Slot,
+    pub params: Vec<Slot>,
+    pub body: Block,
+}
+
+/// Which signalling actors a `BY` accepts.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ActorFilter {
+    Drones(Vec<DroneId>),
+    Slot(Slot),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Handler {
+    pub signal: SignalId,
+    pub every: bool,
+    /// `SEQUENTIAL ON`: starts when the signalling block has finished.
+    pub sequential: bool,
+    pub by: Option<ActorFilter>,
+    pub bindings: Vec<Slot>,
+    pub body: Block,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExceptionHandler {
+    pub exception: ExceptionId,
+    pub by: Option<ActorFilter>,
+    pub bindings: Vec<Slot>,
+    pub body: Block,
+}
+
+/// Telemetry a condition may read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Field {
+    Position,
+    Altitude,
+    Speed,
+    Heading,
+    Battery,
+    State,
+    Link,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Compare {
+    Eq,
+    Ne,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+}
+
+/// A value or condition, evaluated in a frame at run time.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Expr {
+    Const(Value),
+    Slot(Slot),
+    Actor(ActorRef),
+    Telemetry(ActorRef, Field),
+    /// `attributes[index]` of the actor.
+    Attribute(ActorRef, usize),
+    /// Coordinates with a part that is not a literal: `(x, 20)`.
+    Point(Vec<Expr>),
+    /// `GEO(lat, lon[, alt])` with a part that is not a literal.
+    Geo(Vec<Expr>),
+    Distance(Box<Expr>, Box<Expr>),
+    Elapsed,
+    Received(SignalId),
+    Not(Box<Expr>),
+    And(Box<Expr>, Box<Expr>),
+    Or(Box<Expr>, Box<Expr>),
+    Compare(Box<Expr>, Compare, Box<Expr>),
+}

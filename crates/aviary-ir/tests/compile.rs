@@ -1,0 +1,156 @@
+//! The compiler on the paper's mission and on small missions: names become indices,
+//! handlers sit on the block they hear, defaults and units are resolved once.
+
+use aviary_api::{Descriptor, Point, Resource, Value};
+use aviary_check::SourceProvider;
+use aviary_diagnostics::SourceMap;
+use aviary_ir::*;
+
+struct NoFiles;
+impl SourceProvider for NoFiles {
+    fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+        Err(format!("no file {path}"))
+    }
+}
+
+fn compiled(mission: &str, world: &str) -> Mission {
+    let mut sources = SourceMap::new();
+    let checked = aviary_check::check_sources(&mut sources, ("m.mission", mission.as_bytes()), Some(("w.toml", world.as_bytes())), &NoFiles, &Descriptor::standard());
+    let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).map(|d| d.message.clone()).collect();
+    assert!(errors.is_empty(), "{errors:#?}");
+    compile(&checked.program.expect("program"), &checked.world.expect("world"), &Descriptor::standard()).expect("a mission")
+}
+
+fn paper() -> Mission {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/");
+    compiled(
+        &std::fs::read_to_string(format!("{root}search_and_rescue.mission")).unwrap(),
+        &std::fs::read_to_string(format!("{root}search_and_rescue.world.toml")).unwrap(),
+    )
+}
+
+fn block(node: &Node) -> &Block {
+    match node {
+        Node::Block(b) => b,
+        other => panic!("not a block: {other:?}"),
+    }
+}
+
+fn cap<'m>(m: &'m Mission, name: &str) -> &'m Capability {
+    m.capabilities.iter().find(|c| c.name == name).unwrap_or_else(|| panic!("no {name}"))
+}
+
+#[test]
+fn the_paper_mission_compiles_with_handlers_on_their_block() {
+    let m = paper();
+    assert_eq!(m.name, "Search_and_Rescue");
+    assert_eq!(m.drones.len(), 7);
+    let start = block(&m.body.items[0]);
+    assert_eq!(start.path, "Start_Mission");
+    assert_eq!(start.kind, BlockKind::Parallel);
+    let children: Vec<&str> = start.items.iter().map(|n| block(n).path.as_str()).collect();
+    assert_eq!(children, ["Launch_Video1", "Launch_Video2", "Radiation_Detection"]);
+    let handlers: Vec<(&str, bool, &str)> =
+        start.handlers.iter().map(|h| (m.signals[h.signal].as_str(), h.every, h.body.path.as_str())).collect();
+    assert_eq!(
+        handlers,
+        [
+            ("Video2_Ready", false, "Start_Mission/ON Video2_Ready"),
+            ("Video1_Ready", false, "Start_Mission/ON Video1_Ready"),
+            ("Radiation_Detected", true, "Start_Mission/ON Radiation_Detected"),
+            ("Body_Detected", true, "Start_Mission/ON Body_Detected"),
+        ]
+    );
+    let sensor = m.drones.iter().position(|d| d == "sensor_drone").unwrap();
+    assert_eq!(start.handlers[2].by, Some(ActorFilter::Drones(vec![sensor])));
+    // `BY flir_drone` names the FOR alias of a sibling handler: any of its instances.
+    let flirs: Vec<usize> = ["flir_drone1", "flir_drone2"].iter().map(|n| m.drones.iter().position(|d| d == n).unwrap()).collect();
+    assert_eq!(start.handlers[3].by, Some(ActorFilter::Drones(flirs)));
+}
+
+#[test]
+fn defaults_fill_missing_arguments_in_si_units() {
+    let m = paper();
+    let takeoff = m.capabilities.iter().position(|c| c.name == "TakeOff").unwrap();
+    let launch = block(&block(&m.body.items[0]).items[0]);
+    let Node::Call(first) = &launch.items[0] else { panic!() };
+    assert_eq!(first.capability, takeoff);
+    assert_eq!(first.args, [Expr::Const(Value::Number(20.0))]);
+    let radiation = block(&block(&m.body.items[0]).items[2]);
+    let Node::Call(sensor_takeoff) = &radiation.items[0] else { panic!() };
+    assert_eq!(sensor_takeoff.args, [Expr::Const(Value::Number(10.0))], "TakeOff's default alt is 10m");
+    let Node::Call(patrol) = &radiation.items[1] else { panic!() };
+    assert_eq!(
+        patrol.args,
+        [Expr::Const(Value::Position(Point { x: 0.0, y: -300.0, z: None })), Expr::Const(Value::Number(30.0)), Expr::Const(Value::Number(1.0))],
+        "the place StartPos, then FlyToAndPatrol's defaults"
+    );
+}
+
+#[test]
+fn claims_reach_through_called_capabilities() {
+    let m = paper();
+    assert_eq!(cap(&m, "DeployBeacon").claims, [(0, Resource::Motion), (0, Resource::Payload)]);
+    assert_eq!(cap(&m, "Search").claims, [(0, Resource::Motion), (0, Resource::Detection)]);
+    assert_eq!(cap(&m, "StartStreaming").claims, [(0, Resource::Camera)]);
+    assert_eq!(cap(&m, "FlyTo").claims, [(0, Resource::Motion)], "FlyTo's own call, and TakeOff's through it");
+}
+
+#[test]
+fn units_become_si_and_geo_becomes_local() {
+    let m = compiled(
+        "MISSION M:\n    d1 Hover WITH 2min\n    d1 Hover WITH 1.5h\n    STARTIF d1.battery > 25% AND d1.speed < 36km/h:\n        d1 FlyTo WITH GEO(46.6177, 14.2650, 460)\n",
+        "[site]\norigin = { lat = 46.6167, lon = 14.2650, alt = 440.0 }\n[drones.d1]\nhome = [0, 0]\n",
+    );
+    let Node::Call(h) = &m.body.items[0] else { panic!() };
+    assert_eq!(h.args, [Expr::Const(Value::Number(120.0))]);
+    let Node::Call(h) = &m.body.items[1] else { panic!() };
+    assert_eq!(h.args, [Expr::Const(Value::Number(5400.0))]);
+    let Node::StartIf { condition, body } = &m.body.items[2] else { panic!() };
+    let Expr::And(battery, speed) = condition else { panic!("{condition:?}") };
+    assert_eq!(**battery, Expr::Compare(Box::new(Expr::Telemetry(ActorRef::Drone(0), Field::Battery)), Compare::Gt, Box::new(Expr::Const(Value::Number(0.25)))));
+    let Expr::Compare(_, Compare::Lt, limit) = &**speed else { panic!() };
+    assert_eq!(**limit, Expr::Const(Value::Number(10.0)));
+    let Node::Call(fly) = &body.items[0] else { panic!() };
+    let [Expr::Const(Value::Position(p))] = fly.args.as_slice() else { panic!("{:?}", fly.args) };
+    assert!(p.x.abs() < 1e-9 && (p.y - 111.19).abs() < 0.01 && (p.z.unwrap() - 20.0).abs() < 1e-9, "{p:?}");
+}
+
+#[test]
+fn for_instances_groups_and_slots() {
+    let m = compiled(
+        "MISSION M:\n    PARALLEL FOR\n        team WITH (1, 2) AND\n        d3 WITH (3, 4)\n        AS d WITH spot:\n        d FlyTo WITH spot\n        SIGNAL Here WITH d\n    ON EVERY Here BY d WITH who:\n        who Land\n",
+        "[drones.d1]\nhome = [0, 0]\ngroup = \"team\"\n[drones.d2]\nhome = [5, 0]\ngroup = \"team\"\n[drones.d3]\nhome = [9, 0]\n",
+    );
+    let Node::For(f) = &m.body.items[0] else { panic!() };
+    assert!(f.parallel);
+    assert_eq!(f.instances[0].0, ActorRef::Group(vec![0, 1]));
+    assert_eq!(f.instances[1].0, ActorRef::Drone(2));
+    let Node::Call(fly) = &f.body.items[0] else { panic!() };
+    assert_eq!(fly.actors, [ActorRef::Slot(f.alias)]);
+    assert_eq!(fly.args, [Expr::Slot(f.params[0])]);
+    let handler = &m.body.handlers[0];
+    assert_eq!(handler.by, Some(ActorFilter::Drones(vec![0, 1, 2])), "the alias stands for every instance");
+    let Node::Call(land) = &handler.body.items[0] else { panic!() };
+    assert_eq!(land.actors, [ActorRef::Slot(handler.bindings[0])]);
+    assert!(m.frame_size >= 3);
+}
+
+#[test]
+fn leashes_resolve_their_section_and_tag() {
+    let m = compiled(
+        "CAPABILITY Watch BY d WITH radius:\n    PERFORM:\n        d.Orbit((0, 0), radius)\n    PERFORM Wider:\n        d.Orbit((0, 0), radius)\n\nMISSION M:\n    PARALLEL:\n        d1 Watch-W1 WITH 20m\n        SEQUENTIAL:\n            d1 Hover WITH 5s\n            Watch-W1 Wider WITH radius=40m\n            Watch-W1 ABORT\n",
+        "[drones.d1]\nhome = [0, 0]\n",
+    );
+    let par = block(&m.body.items[0]);
+    let Node::Call(watch) = &par.items[0] else { panic!() };
+    assert_eq!(watch.tag, Some(0));
+    assert_eq!(m.tags, ["W1"]);
+    let seq = block(&par.items[1]);
+    assert_eq!(seq.path, "M/PARALLEL/SEQUENTIAL");
+    let Node::Leash(wider) = &seq.items[1] else { panic!() };
+    assert_eq!((wider.action, wider.action_name.as_str()), (LeashAction::Section(0), "Wider"));
+    assert_eq!(wider.args, [(0, Expr::Const(Value::Number(40.0)))]);
+    let Node::Leash(abort) = &seq.items[2] else { panic!() };
+    assert_eq!(abort.action, LeashAction::Abort);
+}

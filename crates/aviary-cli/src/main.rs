@@ -7,6 +7,7 @@ mod bench;
 mod check;
 mod files;
 mod fmt;
+mod run;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -46,6 +47,28 @@ enum Command {
         #[arg(long)]
         check: bool,
     },
+    /// Compile a mission and fly it on the drones its world binds (the simulator by default)
+    Run {
+        file: PathBuf,
+        /// The world file (default: NAME.world.toml beside NAME.mission)
+        #[arg(long)]
+        world: Option<PathBuf>,
+        /// `max` (as fast as possible) or times real time, such as 1 or 10
+        #[arg(long, default_value = "max")]
+        speed: String,
+        /// The seed of the simulation: the same files and seed give the same trace
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Write every event to this JSON Lines file
+        #[arg(long)]
+        trace: Option<PathBuf>,
+        /// Telemetry events per second of mission time (default: none)
+        #[arg(long)]
+        telemetry_hz: Option<f64>,
+        /// Print nothing but errors
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Explain a diagnostic code, such as E107
     Explain { code: String },
     /// Measure the speed of the front end on a generated mission
@@ -60,6 +83,13 @@ fn main() -> ExitCode {
     let code = match cli.command {
         Command::Check { files, world, format } => check::run(&files, world.as_deref(), format),
         Command::Fmt { files, check } => fmt::run(&files, check),
+        Command::Run { file, world, speed, seed, trace, telemetry_hz, quiet } => match run::parse_speed(&speed) {
+            Ok(speed) => run::run(&run::RunArgs { file, world, speed, seed, trace, telemetry_hz, quiet }),
+            Err(why) => {
+                eprintln!("aviary: {why}");
+                2
+            }
+        },
         Command::Explain { code } => explain(&code),
         Command::Bench { which } => bench::run(which),
     };

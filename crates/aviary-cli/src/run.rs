@@ -1,0 +1,183 @@
+//! `aviary run`: check, compile and fly a mission on the drones its world binds (the
+//! built-in simulator), with a live progress line, a JSON Lines trace and a summary.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use aviary_api::{Backend, Descriptor};
+use aviary_diagnostics::{render_text, SourceMap};
+use aviary_engine::{RunOptions, Status};
+use aviary_sim::{SimBackend, SimOptions};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::files::{color_wanted, world_beside, DiskProvider};
+
+pub struct RunArgs {
+    pub file: PathBuf,
+    pub world: Option<PathBuf>,
+    /// `None`: as fast as possible.
+    pub speed: Option<f64>,
+    pub seed: u64,
+    pub trace: Option<PathBuf>,
+    pub telemetry_hz: Option<f64>,
+    pub quiet: bool,
+}
+
+/// `max` or a positive number of times real time.
+pub fn parse_speed(text: &str) -> Result<Option<f64>, String> {
+    if text == "max" {
+        return Ok(None);
+    }
+    match text.parse::<f64>() {
+        Ok(x) if x > 0.0 && x.is_finite() => Ok(Some(x)),
+        _ => Err(format!("`{text}` is not a speed: write `max` or a positive number such as 1 or 10")),
+    }
+}
+
+pub fn run(args: &RunArgs) -> u8 {
+    let bytes = match std::fs::read(&args.file) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("aviary: cannot read {}: {e}", args.file.display());
+            return 2;
+        }
+    };
+    let Some(world_path) = args.world.clone().or_else(|| world_beside(&args.file)) else {
+        let stem = args.file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        eprintln!("aviary: {} has no world file: put {stem}.world.toml beside it, or pass --world FILE", args.file.display());
+        return 2;
+    };
+    let world_bytes = match std::fs::read(&world_path) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("aviary: cannot read the world file {}: {e}", world_path.display());
+            return 2;
+        }
+    };
+    let mut sources = SourceMap::new();
+    let name = args.file.display().to_string();
+    let world_name = world_path.display().to_string();
+    let checked = aviary_check::check_sources(&mut sources, (&name, &bytes), Some((&world_name, &world_bytes)), &DiskProvider, &Descriptor::standard());
+    if checked.has_errors() {
+        for d in checked.diagnostics.iter().filter(|d| d.is_error()) {
+            eprint!("{}", render_text(&sources, d, color_wanted()));
+        }
+        eprintln!("aviary: {} has errors, so it was not run", args.file.display());
+        return 2;
+    }
+    let (Some(program), Some(world)) = (checked.program, checked.world) else { return 2 };
+    let Some(mission) = aviary_ir::compile(&program, &world, &Descriptor::standard()) else {
+        eprintln!("aviary: {} has no MISSION to run (it holds only capabilities)", args.file.display());
+        return 2;
+    };
+    let mut out: Box<dyn Write> = match &args.trace {
+        Some(path) => match std::fs::File::create(path) {
+            Ok(f) => Box::new(std::io::BufWriter::new(f)),
+            Err(e) => {
+                eprintln!("aviary: cannot write the trace {}: {e}", path.display());
+                return 2;
+            }
+        },
+        None => Box::new(std::io::sink()),
+    };
+    let _ = args.seed; // The simulator has no randomness yet; the seed is kept for it.
+    let runtime = match tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build() {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("aviary: cannot start the runtime: {e}");
+            return 2;
+        }
+    };
+    let progress = progress_bar(args.quiet);
+    let (outcome, summary) = runtime.block_on(async {
+        let sim = SimBackend::start(&world, SimOptions { speed: args.speed, ..SimOptions::default() });
+        let mut stats = Stats::default();
+        let mut sink = |event: serde_json::Value| {
+            stats.observe(&event, &progress, &sim);
+            let _ = writeln!(out, "{event}");
+            // Written event by event: a run cut short keeps every line before the cut.
+            let _ = out.flush();
+        };
+        let options = RunOptions { telemetry_hz: args.telemetry_hz };
+        let outcome = aviary_engine::run(&mission, &*sim, &mut sink, &options).await;
+        sim.stop();
+        let summary = summary(&mission, &sim, &stats);
+        (outcome, summary)
+    });
+    progress.finish_and_clear();
+    if !args.quiet {
+        print!("{summary}");
+        match &outcome.reason {
+            Some(reason) => println!("mission {}: {reason}", outcome.status.as_str()),
+            None => println!("mission {}", outcome.status.as_str()),
+        }
+    }
+    if outcome.status == Status::Ok {
+        0
+    } else {
+        1
+    }
+}
+
+fn progress_bar(quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(ProgressStyle::with_template("{spinner} {msg}").unwrap_or_else(|_| ProgressStyle::default_spinner()));
+    bar
+}
+
+/// What the summary counts, from the trace as it is written.
+#[derive(Default)]
+struct Stats {
+    running: i64,
+    signals: Vec<(String, usize)>,
+    exceptions: Vec<(String, bool)>,
+    detections: usize,
+    last_shown: f64,
+}
+
+impl Stats {
+    fn observe(&mut self, event: &serde_json::Value, progress: &ProgressBar, sim: &SimBackend) {
+        let kind = event["event"].as_str().unwrap_or("");
+        match kind {
+            "capability_start" => self.running += 1,
+            "capability_end" => self.running -= 1,
+            "detection" => self.detections += 1,
+            "signal" => {
+                let name = event["name"].as_str().unwrap_or("").to_string();
+                match self.signals.iter_mut().find(|(n, _)| *n == name) {
+                    Some((_, count)) => *count += 1,
+                    None => self.signals.push((name, 1)),
+                }
+            }
+            "exception" => self.exceptions.push((event["name"].as_str().unwrap_or("").to_string(), event["handled"].as_bool().unwrap_or(false))),
+            _ => {}
+        }
+        let t = event["t"].as_f64().unwrap_or(0.0);
+        if t - self.last_shown >= 1.0 || kind == "mission_end" {
+            self.last_shown = t;
+            let flying = (0..sim.with_fleet(|f| f.len())).filter(|d| sim.telemetry(*d).state.airborne()).count();
+            progress.set_message(format!("t = {t:7.1} s   activities running: {:3}   drones in the air: {flying}", self.running));
+            progress.tick();
+        }
+    }
+}
+
+fn summary(mission: &aviary_ir::Mission, sim: &SimBackend, stats: &Stats) -> String {
+    let mut out = String::new();
+    out.push_str(&format!("{:<16} {:>12} {:>12} {:>9}  {}\n", "drone", "distance m", "flight s", "battery", "state"));
+    for (d, name) in mission.drones.iter().enumerate() {
+        let t = sim.telemetry(d);
+        let (distance, airborne) = sim.with_fleet(|f| f.odometry(d));
+        out.push_str(&format!("{name:<16} {distance:>12.0} {airborne:>12.0} {:>8.0}%  {}\n", t.battery * 100.0, t.state.as_str()));
+    }
+    let signals: Vec<String> = stats.signals.iter().map(|(n, c)| if *c == 1 { n.clone() } else { format!("{n} ×{c}") }).collect();
+    out.push_str(&format!("signals: {}\n", if signals.is_empty() { "none".to_string() } else { signals.join(", ") }));
+    out.push_str(&format!("detections: {}\n", stats.detections));
+    let exceptions: Vec<String> = stats.exceptions.iter().map(|(n, h)| format!("{n} ({})", if *h { "handled" } else { "unhandled" })).collect();
+    out.push_str(&format!("exceptions: {}\n", if exceptions.is_empty() { "none".to_string() } else { exceptions.join(", ") }));
+    out
+}
+

@@ -1,0 +1,108 @@
+//! `aviary run` as a user runs it: the paper's mission flies to its end, the trace is
+//! valid against RUNTIME.md's schema line by line, and the same files give the same bytes.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn aviary(args: &[&str], dir: &Path) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_aviary")).args(args).current_dir(dir).env("NO_COLOR", "1").output().expect("run aviary");
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
+/// The schema of one trace line: the shared contract's copy when it is there, else ours.
+fn schema() -> serde_json::Value {
+    let shared = repo().join("../shared/trace.schema.json");
+    let ours = repo().join("docs/trace.schema.json");
+    let text = std::fs::read_to_string(&shared).or_else(|_| std::fs::read_to_string(&ours)).expect("trace.schema.json");
+    serde_json::from_str(&text).expect("the schema is JSON")
+}
+
+#[test]
+fn the_paper_mission_runs_and_its_trace_fits_the_schema() {
+    let dir = scratch("paper_run");
+    let trace = dir.join("trace.jsonl");
+    let trace_arg = trace.to_string_lossy().into_owned();
+    let (code, out, err) = aviary(&["run", "examples/search_and_rescue.mission", "--trace", &trace_arg, "--telemetry-hz", "1"], &repo());
+    assert_eq!(code, 0, "{out}\n{err}");
+    assert!(out.contains("mission ok"), "{out}");
+    assert!(out.contains("detections: 3"), "{out}");
+    for drone in ["video_drone1", "flir_drone2", "beacon_drone2"] {
+        let line = out.lines().find(|l| l.starts_with(drone)).unwrap_or_else(|| panic!("{drone} in the summary: {out}"));
+        assert!(line.ends_with("Landed"), "{line}");
+    }
+    let validator = jsonschema::validator_for(&schema()).expect("a valid schema");
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let mut last_t = 0.0;
+    let mut kinds = std::collections::BTreeSet::new();
+    for (n, line) in text.lines().enumerate() {
+        let event: serde_json::Value = serde_json::from_str(line).unwrap_or_else(|e| panic!("line {}: {e}", n + 1));
+        let errors: Vec<String> = validator.iter_errors(&event).map(|e| e.to_string()).collect();
+        assert!(errors.is_empty(), "line {}: {line}\n{errors:#?}", n + 1);
+        let t = event["t"].as_f64().unwrap();
+        assert!(t >= last_t, "line {}: time goes forward", n + 1);
+        last_t = t;
+        kinds.insert(event["event"].as_str().unwrap().to_string());
+    }
+    for kind in ["mission_start", "block_start", "block_end", "capability_start", "capability_end", "api_call", "api_done", "signal", "handler_start", "handler_end", "detection", "telemetry", "mission_end"] {
+        assert!(kinds.contains(kind), "the paper's trace has {kind} events");
+    }
+}
+
+#[test]
+fn the_same_files_and_seed_give_the_same_trace_byte_for_byte() {
+    let dir = scratch("determinism");
+    let (a, b) = (dir.join("a.jsonl"), dir.join("b.jsonl"));
+    for t in [&a, &b] {
+        let (code, _, err) = aviary(&["run", "examples/search_and_rescue.mission", "--seed", "7", "--quiet", "--trace", &t.to_string_lossy()], &repo());
+        assert_eq!(code, 0, "{err}");
+    }
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+}
+
+#[test]
+fn exit_codes_follow_runtime_md() {
+    let dir = scratch("run_exits");
+    std::fs::write(dir.join("m.world.toml"), "[drones.d1]\nhome = [0, 0]\n").unwrap();
+    std::fs::write(dir.join("m.mission"), "MISSION M:\n    d1 TakeOff WITH 20m\n    THROW EXCEPTION Broken\n").unwrap();
+    let (code, out, _) = aviary(&["run", "m.mission"], &dir);
+    assert_eq!(code, 1, "an unhandled exception fails the mission: {out}");
+    assert!(out.contains("mission failed: unhandled exception Broken on the mission"), "{out}");
+    std::fs::write(dir.join("m.mission"), "MISSION M:\n    d1 TakeOff WITH 20s\n").unwrap();
+    let (code, _, err) = aviary(&["run", "m.mission"], &dir);
+    assert_eq!(code, 2, "a mission with errors is not run");
+    assert!(err.contains("error[E107]") && err.contains("was not run"), "{err}");
+    std::fs::write(dir.join("lib.mission"), "CAPABILITY Up BY d:\n    PERFORM:\n        d.TakeOff(5m)\n").unwrap();
+    let (code, _, err) = aviary(&["run", "lib.mission", "--world", "m.world.toml"], &dir);
+    assert_eq!(code, 2);
+    assert!(err.contains("no MISSION to run"), "{err}");
+    std::fs::write(dir.join("alone.mission"), "MISSION M:\n    SIGNAL Hi\n").unwrap();
+    let (code, _, err) = aviary(&["run", "alone.mission"], &dir);
+    assert_eq!(code, 2);
+    assert!(err.contains("has no world file"), "{err}");
+    let (code, _, err) = aviary(&["run", "m.mission", "--speed", "fast"], &dir);
+    assert_eq!(code, 2);
+    assert!(err.contains("not a speed"), "{err}");
+}
+
+#[test]
+fn a_speed_paces_the_run_against_the_wall_clock() {
+    let dir = scratch("speed");
+    std::fs::write(dir.join("m.world.toml"), "[drones.d1]\nhome = [0, 0]\n").unwrap();
+    std::fs::write(dir.join("m.mission"), "MISSION M:\n    d1 Hover WITH 1s\n").unwrap();
+    let started = std::time::Instant::now();
+    let (code, _, err) = aviary(&["run", "m.mission", "--speed", "2", "--quiet"], &dir);
+    assert_eq!(code, 0, "{err}");
+    // 1 s of mission time at twice real time: at least half a second of wall time.
+    assert!(started.elapsed() >= std::time::Duration::from_millis(450), "{:?}", started.elapsed());
+}

@@ -1,0 +1,126 @@
+//! Per-drone resources, first come first served, claimed all at once (LANGUAGE.md §3):
+//! a request is granted when none of what it needs is held and no earlier waiting
+//! request needs any of it, so instances never deadlock and never overtake.
+
+use std::cell::RefCell;
+use std::collections::{BTreeMap, BTreeSet};
+use std::rc::Rc;
+
+use aviary_api::{DroneId, Resource};
+use tokio::sync::oneshot;
+
+pub(crate) type Claim = (DroneId, Resource);
+
+#[derive(Default)]
+pub(crate) struct Arbiter {
+    held: BTreeSet<Claim>,
+    /// Granted requests by id, with what they hold.
+    granted: BTreeMap<u64, Vec<Claim>>,
+    waiting: Vec<(u64, Vec<Claim>, oneshot::Sender<()>)>,
+    next: u64,
+}
+
+/// Claims held until dropped. Dropping a request that still waits withdraws it, and one
+/// granted but not yet seen by its waiter is given back: cancellation never leaks.
+pub(crate) struct Held {
+    arbiter: Rc<RefCell<Arbiter>>,
+    id: u64,
+}
+
+impl Drop for Held {
+    fn drop(&mut self) {
+        let mut a = self.arbiter.borrow_mut();
+        if let Some(claims) = a.granted.remove(&self.id) {
+            for c in &claims {
+                a.held.remove(c);
+            }
+        }
+        a.waiting.retain(|(id, _, _)| *id != self.id);
+        a.grant();
+    }
+}
+
+impl Arbiter {
+    fn grant(&mut self) {
+        let mut blocked: BTreeSet<Claim> = BTreeSet::new();
+        let mut i = 0;
+        while i < self.waiting.len() {
+            let needs = &self.waiting[i].1;
+            if needs.iter().all(|c| !self.held.contains(c) && !blocked.contains(c)) {
+                let (id, needs, tx) = self.waiting.remove(i);
+                self.held.extend(needs.iter().copied());
+                self.granted.insert(id, needs);
+                let _ = tx.send(());
+            } else {
+                blocked.extend(needs.iter().copied());
+                i += 1;
+            }
+        }
+    }
+}
+
+/// Waits for `claims` (all at once, in arrival order) and holds them.
+pub(crate) async fn acquire(arbiter: &Rc<RefCell<Arbiter>>, claims: Vec<Claim>) -> Held {
+    let (tx, rx) = oneshot::channel();
+    let id = {
+        let mut a = arbiter.borrow_mut();
+        a.next += 1;
+        let id = a.next;
+        a.waiting.push((id, claims, tx));
+        a.grant();
+        id
+    };
+    // Made before waiting, so that a drop while waiting withdraws the request.
+    let held = Held { arbiter: arbiter.clone(), id };
+    // The sender stays in the arbiter until granted, so this ends only by a grant.
+    let _ = rx.await;
+    held
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::future::Future;
+    use std::pin::pin;
+    use std::task::{Context, Poll};
+
+    fn poll_once<F: Future>(f: std::pin::Pin<&mut F>) -> Poll<F::Output> {
+        let waker = futures_util::task::noop_waker();
+        f.poll(&mut Context::from_waker(&waker))
+    }
+
+    #[test]
+    fn first_come_first_served_all_at_once() {
+        let arbiter = Rc::new(RefCell::new(Arbiter::default()));
+        let m = |d| (d, Resource::Motion);
+        let mut first = pin!(acquire(&arbiter, vec![m(0)]));
+        let Poll::Ready(a) = poll_once(first.as_mut()) else { panic!("free: granted at once") };
+        // Needs 0 and 1: waits for 0.
+        let mut second = pin!(acquire(&arbiter, vec![m(0), m(1)]));
+        assert!(poll_once(second.as_mut()).is_pending());
+        // Needs only 1, which is free, but the earlier waiter wants it: no overtaking.
+        let mut third = pin!(acquire(&arbiter, vec![m(1)]));
+        assert!(poll_once(third.as_mut()).is_pending());
+        drop(a);
+        let Poll::Ready(b) = poll_once(second.as_mut()) else { panic!("granted on release") };
+        assert!(poll_once(third.as_mut()).is_pending());
+        drop(b);
+        assert!(poll_once(third.as_mut()).is_ready());
+    }
+
+    #[test]
+    fn a_cancelled_waiter_leaks_nothing() {
+        let arbiter = Rc::new(RefCell::new(Arbiter::default()));
+        let m = (0, Resource::Motion);
+        let mut first = pin!(acquire(&arbiter, vec![m]));
+        let Poll::Ready(a) = poll_once(first.as_mut()) else { panic!() };
+        {
+            let mut waiter = Box::pin(acquire(&arbiter, vec![m]));
+            assert!(poll_once(waiter.as_mut()).is_pending());
+            drop(a); // grants the waiter, which is dropped before it sees the grant
+        }
+        assert!(arbiter.borrow().held.is_empty(), "the unseen grant was given back");
+        let mut again = pin!(acquire(&arbiter, vec![m]));
+        assert!(poll_once(again.as_mut()).is_ready());
+    }
+}

@@ -1,0 +1,403 @@
+//! The engine's state and its cross-cutting rules: scopes, signals, exceptions, drone
+//! events, the trace, and the run from start to `mission_end`.
+
+use std::cell::{Cell, RefCell};
+use std::collections::{BTreeMap, BTreeSet};
+use std::rc::Rc;
+
+use aviary_api::{Backend, DroneEvent, DroneId, Value};
+use aviary_ir::{ActorFilter, ExceptionHandler, Handler, Mission};
+use serde_json::{json, Value as Json};
+use tokio::sync::{mpsc, Notify};
+use tokio::time::Instant;
+use tokio_util::sync::CancellationToken;
+
+use crate::arbiter::{Arbiter, Claim};
+use crate::value::{airborne, to_json, Env};
+use crate::{Outcome, RunOptions, Status, TraceSink};
+
+pub(crate) type Frame = Rc<Vec<Value>>;
+
+/// Work a scope starts on request, while it runs.
+pub(crate) enum Job<'m> {
+    Signal { handler: &'m Handler, args: Vec<Value>, actor: Option<DroneId>, signal: usize },
+    Exception { handler: &'m ExceptionHandler, args: Vec<Value> },
+    Section { block: &'m aviary_ir::Block, frame: Frame },
+}
+
+/// A running body: what it hears, where its handlers start, whether it is unwinding.
+pub(crate) struct Scope<'m> {
+    pub parent: Option<Rc<Scope<'m>>>,
+    pub path: String,
+    /// A block of the mission itself (not inside a capability): a signalling block.
+    pub mission_block: bool,
+    pub handlers: &'m [Handler],
+    pub fired: RefCell<Vec<bool>>,
+    pub exception_handlers: &'m [ExceptionHandler],
+    pub frame: Frame,
+    pub jobs: mpsc::UnboundedSender<Job<'m>>,
+    /// Set when an exception aborts the sequential chain through this scope.
+    pub unwinding: Cell<bool>,
+    /// `SEQUENTIAL ON` handlers to start, in their own scope, when this block has finished.
+    pub deferred: RefCell<Vec<(Rc<Scope<'m>>, Job<'m>)>>,
+    /// Exception handlers running here; a sequence waits for them before going on.
+    pub catching: Cell<usize>,
+    pub caught: Notify,
+    /// The capability instance this scope is the top of, if any.
+    pub instance: Option<Rc<Instance>>,
+}
+
+impl<'m> Scope<'m> {
+    pub fn chain(self: &Rc<Self>) -> impl Iterator<Item = Rc<Scope<'m>>> {
+        std::iter::successors(Some(self.clone()), |s| s.parent.clone())
+    }
+}
+
+/// A running capability instance (an activity).
+pub(crate) struct Instance {
+    pub id: u64,
+    pub capability: usize,
+    pub tag: Option<usize>,
+    pub actors: Vec<DroneId>,
+    /// The instance a statement of the mission started: pausing it pauses all inside it.
+    pub root: Option<Rc<Instance>>,
+    pub token: CancellationToken,
+    /// Cancels the PERFORM body only: the capability's own exception handler takes its place.
+    pub perform: CancellationToken,
+    pub by_leash: Cell<bool>,
+    pub failed: Cell<bool>,
+    pub paused: Cell<bool>,
+    pub resumed: Notify,
+    pub calls: RefCell<Vec<aviary_api::CallId>>,
+    pub depth: usize,
+    /// What this activity and its ancestors hold: handlers inside it share the claim.
+    pub claims: RefCell<Rc<BTreeSet<Claim>>>,
+}
+
+impl Instance {
+    pub fn root(self: &Rc<Self>) -> Rc<Instance> {
+        self.root.clone().unwrap_or_else(|| self.clone())
+    }
+}
+
+/// What an execution knows about where it is.
+#[derive(Clone)]
+pub(crate) struct Ctx<'m> {
+    pub scope: Rc<Scope<'m>>,
+    pub frame: Frame,
+    pub actor: Option<DroneId>,
+    pub instance: Option<Rc<Instance>>,
+    pub claims: Rc<BTreeSet<Claim>>,
+}
+
+pub(crate) struct Engine<'m> {
+    pub m: &'m Mission,
+    pub backend: &'m dyn Backend,
+    sink: RefCell<&'m mut dyn TraceSink>,
+    start: Instant,
+    pub received: RefCell<Vec<bool>>,
+    pub changed: Notify,
+    pub arbiter: Rc<RefCell<Arbiter>>,
+    pub instances: RefCell<Vec<(Rc<Instance>, Rc<Scope<'m>>)>>,
+    pub detections: RefCell<BTreeMap<(DroneId, String), Rc<Scope<'m>>>>,
+    failure: RefCell<Option<String>>,
+    pub stop: CancellationToken,
+    events: RefCell<Option<mpsc::UnboundedReceiver<DroneEvent>>>,
+    root: RefCell<Option<Rc<Scope<'m>>>>,
+    pub next_id: Cell<u64>,
+}
+
+impl<'m> Engine<'m> {
+    pub fn new(m: &'m Mission, backend: &'m dyn Backend, sink: &'m mut dyn TraceSink) -> Self {
+        Engine {
+            m,
+            backend,
+            sink: RefCell::new(sink),
+            start: Instant::now(),
+            received: RefCell::new(vec![false; m.signals.len()]),
+            changed: Notify::new(),
+            arbiter: Rc::new(RefCell::new(Arbiter::default())),
+            instances: RefCell::new(Vec::new()),
+            detections: RefCell::new(BTreeMap::new()),
+            failure: RefCell::new(None),
+            stop: CancellationToken::new(),
+            events: RefCell::new(backend.events()),
+            root: RefCell::new(None),
+            next_id: Cell::new(0),
+        }
+    }
+
+    /// After a failure nothing new starts: the failsafe takes over.
+    pub fn stopped(&self) -> bool {
+        self.stop.is_cancelled()
+    }
+
+    pub fn now(&self) -> f64 {
+        (Instant::now() - self.start).as_secs_f64()
+    }
+
+    pub fn trace(&self, event: &str, fields: Json) {
+        let mut object = serde_json::Map::new();
+        object.insert("t".into(), json!(self.now()));
+        object.insert("event".into(), json!(event));
+        if let Json::Object(rest) = fields {
+            object.extend(rest);
+        }
+        self.sink.borrow_mut().event(Json::Object(object));
+    }
+
+    pub fn name(&self, d: DroneId) -> &'m str {
+        self.m.drones.get(d).map_or("?", String::as_str)
+    }
+
+    pub fn values(&self, values: &[Value]) -> Json {
+        Json::Array(values.iter().map(|v| to_json(self.m, v)).collect())
+    }
+
+    pub fn env<'a>(&'a self, frame: &'a [Value], received: &'a [bool]) -> Env<'a> {
+        Env { mission: self.m, backend: self.backend, frame, received, elapsed: self.now() }
+    }
+
+    pub async fn run(&self, options: &RunOptions) -> Outcome {
+        self.trace("mission_start", json!({ "mission": self.m.name }));
+        let (tx, rx) = mpsc::unbounded_channel();
+        let root = Rc::new(Scope {
+            parent: None,
+            path: self.m.name.clone(),
+            mission_block: true,
+            handlers: &[],
+            fired: RefCell::new(Vec::new()),
+            exception_handlers: &[],
+            frame: Rc::new(vec![Value::Bool(false); self.m.frame_size]),
+            jobs: tx,
+            unwinding: Cell::new(false),
+            deferred: RefCell::new(Vec::new()),
+            catching: Cell::new(0),
+            caught: Notify::new(),
+            instance: None,
+        });
+        *self.root.borrow_mut() = Some(root.clone());
+        let ctx = Ctx { scope: root.clone(), frame: root.frame.clone(), actor: None, instance: None, claims: Rc::new(BTreeSet::new()) };
+        let body = self.drive(&root, rx, self.block(&self.m.body, &ctx));
+        tokio::select! {
+            biased;
+            _ = self.stop.cancelled() => {}
+            _ = body => {}
+            _ = self.pump() => {}
+            _ = self.telemetry(options.telemetry_hz) => {}
+        }
+        let failure = self.failure.borrow().clone();
+        // Drones still flying go home: at the end of the mission, or as the failsafe.
+        self.all_home().await;
+        let status = if failure.is_some() { Status::Failed } else { Status::Ok };
+        self.trace("mission_end", json!({ "status": status.as_str(), "reason": failure }));
+        Outcome { status, reason: failure }
+    }
+
+    async fn all_home(&self) {
+        let mut homes = Vec::new();
+        for d in 0..self.m.drones.len() {
+            if airborne(self.backend, d) {
+                homes.push(d);
+            }
+        }
+        let calls = homes.into_iter().map(|d| async move {
+            self.trace("api_call", json!({ "actor": self.name(d), "function": "ReturnToLaunch", "args": [] }));
+            let pending = self.backend.call(d, "ReturnToLaunch", &[]);
+            let end = pending.end.await.unwrap_or(aviary_api::CallEnd::Interrupted);
+            self.trace_done(d, "ReturnToLaunch", &[], &end);
+        });
+        futures_util::future::join_all(calls).await;
+    }
+
+    pub fn trace_done(&self, d: DroneId, function: &str, args: &[Value], end: &aviary_api::CallEnd) {
+        let status = match end {
+            aviary_api::CallEnd::Done => "ok",
+            aviary_api::CallEnd::Failed(_) => "failed",
+            aviary_api::CallEnd::Interrupted => "interrupted",
+        };
+        let p = self.backend.telemetry(d).position;
+        self.trace("api_done", json!({ "actor": self.name(d), "function": function, "args": self.values(args), "status": status, "position": p }));
+    }
+
+    async fn telemetry(&self, hz: Option<f64>) {
+        let Some(hz) = hz.filter(|h| *h > 0.0) else { return std::future::pending().await };
+        let period = std::time::Duration::from_secs_f64(1.0 / hz);
+        let mut next = Instant::now();
+        loop {
+            for d in 0..self.m.drones.len() {
+                let t = self.backend.telemetry(d);
+                self.trace("telemetry", json!({ "actor": self.name(d), "position": t.position, "battery": t.battery, "state": t.state.as_str() }));
+            }
+            next += period;
+            tokio::time::sleep_until(next).await;
+        }
+    }
+
+    /// Drone events, as they come.
+    async fn pump(&self) {
+        loop {
+            let event = std::future::poll_fn(|cx| match self.events.borrow_mut().as_mut() {
+                Some(rx) => rx.poll_recv(cx),
+                None => std::task::Poll::Pending,
+            })
+            .await;
+            match event {
+                Some(e) => self.on_event(e),
+                None => std::future::pending().await,
+            }
+        }
+    }
+
+    /// Handles every drone event already queued. A call that ended `Interrupted` does
+    /// this first, so the fault behind it is raised while its activity still runs.
+    pub fn drain_events(&self) {
+        loop {
+            let event = match self.events.borrow_mut().as_mut() {
+                Some(rx) => rx.try_recv().ok(),
+                None => None,
+            };
+            match event {
+                Some(e) => self.on_event(e),
+                None => break,
+            }
+        }
+    }
+
+    fn on_event(&self, event: DroneEvent) {
+        match event {
+            DroneEvent::Detected { drone, kind, location } => {
+                self.trace("detection", json!({ "actor": self.name(drone), "kind": kind, "location": location }));
+                let scope = self.detections.borrow().get(&(drone, kind.clone())).cloned();
+                if let (Some(scope), Some(id)) = (scope, self.signal_id("Detected")) {
+                    // A find is a point on the ground: flying to it keeps the altitude.
+                    let args = vec![Value::Symbol(kind), Value::Position(aviary_api::Point::flat(location[0], location[1]))];
+                    self.raise(id, args, Some(drone), &scope);
+                }
+            }
+            DroneEvent::Signal { drone, name } => {
+                if let Some(id) = self.signal_id(name) {
+                    let scope = self.actor_scope(drone);
+                    self.raise(id, Vec::new(), Some(drone), &scope);
+                }
+            }
+            DroneEvent::Fault { drone, failure } => {
+                let scope = self.actor_scope(drone);
+                let id = self.m.exceptions.iter().position(|e| e == failure.exception).unwrap_or(0);
+                self.throw(id, vec![Value::Text(failure.reason)], Some(drone), &scope);
+            }
+        }
+    }
+
+    fn signal_id(&self, name: &str) -> Option<usize> {
+        self.m.signals.iter().position(|s| s == name)
+    }
+
+    /// Where an actor's built-in events are raised: in its innermost running capability
+    /// instance, or at mission level when it is idle.
+    fn actor_scope(&self, drone: DroneId) -> Rc<Scope<'m>> {
+        let instances = self.instances.borrow();
+        let innermost = instances.iter().filter(|(i, _)| i.actors.contains(&drone)).max_by_key(|(i, _)| (i.depth, i.id));
+        match innermost {
+            Some((_, scope)) => scope.clone(),
+            None => self.root.borrow().clone().expect("the run has a root scope"),
+        }
+    }
+
+    fn matches(&self, by: &Option<ActorFilter>, frame: &[Value], actor: Option<DroneId>) -> bool {
+        match by {
+            None => true,
+            Some(ActorFilter::Drones(ds)) => actor.is_some_and(|a| ds.contains(&a)),
+            Some(ActorFilter::Slot(s)) => matches!((frame.get(*s), actor), (Some(Value::Actor(d)), Some(a)) if *d == a),
+        }
+    }
+
+    /// `SIGNAL`: recorded, then heard by every matching handler of every scope up the chain.
+    pub fn raise(&self, signal: usize, args: Vec<Value>, actor: Option<DroneId>, from: &Rc<Scope<'m>>) {
+        if self.stopped() {
+            return;
+        }
+        self.trace("signal", json!({ "name": self.m.signals[signal], "actor": actor.map(|a| self.name(a)), "args": self.values(&args) }));
+        if let Some(r) = self.received.borrow_mut().get_mut(signal) {
+            *r = true;
+        }
+        self.changed.notify_waiters();
+        let signalling_block = from.chain().find(|s| s.mission_block);
+        for scope in from.chain() {
+            let handlers: &'m [Handler] = scope.handlers;
+            for (i, h) in handlers.iter().enumerate() {
+                if h.signal != signal || !self.matches(&h.by, &scope.frame, actor) {
+                    continue;
+                }
+                if !h.every {
+                    let mut fired = scope.fired.borrow_mut();
+                    if fired[i] {
+                        continue;
+                    }
+                    fired[i] = true;
+                }
+                let job = Job::Signal { handler: h, args: args.clone(), actor, signal };
+                match (&signalling_block, h.sequential) {
+                    (Some(block), true) => block.deferred.borrow_mut().push((scope.clone(), job)),
+                    _ => {
+                        let _ = scope.jobs.send(job);
+                    }
+                }
+            }
+        }
+    }
+
+    /// `THROW EXCEPTION` (or a drone fault): abort the thrower's chain up to the nearest
+    /// handler, abort its other activities, and start the handler in that place.
+    pub fn throw(&self, exception: usize, args: Vec<Value>, actor: Option<DroneId>, from: &Rc<Scope<'m>>) {
+        if self.stopped() {
+            return;
+        }
+        let name = self.m.exceptions.get(exception).cloned().unwrap_or_default();
+        let found = from.chain().find_map(|scope| {
+            let i = scope.exception_handlers.iter().position(|h| h.exception == exception && self.matches(&h.by, &scope.frame, actor))?;
+            Some((scope.clone(), i))
+        });
+        self.trace(
+            "exception",
+            json!({ "name": name, "actor": actor.map(|a| self.name(a)), "args": self.values(&args),
+                    "handled": found.is_some(), "handler": found.as_ref().map(|(s, _)| format!("{}/ON EXCEPTION {name}", s.path)) }),
+        );
+        let Some((handler_scope, index)) = found else {
+            for scope in from.chain() {
+                scope.unwinding.set(true);
+                if let Some(i) = &scope.instance {
+                    i.failed.set(true);
+                }
+            }
+            let who = actor.map_or(String::from("the mission"), |a| self.name(a).to_string());
+            let reason = match args.first() {
+                Some(Value::Text(why)) => format!("unhandled exception {name} on {who}: {why}"),
+                _ => format!("unhandled exception {name} on {who}"),
+            };
+            self.failure.borrow_mut().get_or_insert(reason);
+            self.stop.cancel();
+            return;
+        };
+        let keep: Vec<*const Scope> = handler_scope.chain().map(|s| Rc::as_ptr(&s)).collect();
+        for scope in from.chain().take_while(|s| !Rc::ptr_eq(s, &handler_scope)) {
+            scope.unwinding.set(true);
+            if let Some(i) = &scope.instance {
+                i.failed.set(true);
+            }
+        }
+        if let Some(actor) = actor {
+            for (instance, scope) in self.instances.borrow().iter() {
+                if instance.actors.contains(&actor) && !keep.contains(&Rc::as_ptr(scope)) {
+                    instance.token.cancel();
+                }
+            }
+        }
+        if let Some(instance) = &handler_scope.instance {
+            instance.perform.cancel();
+        }
+        handler_scope.catching.set(handler_scope.catching.get() + 1);
+        let handlers: &'m [ExceptionHandler] = handler_scope.exception_handlers;
+        let _ = handler_scope.jobs.send(Job::Exception { handler: &handlers[index], args });
+    }
+}

@@ -1,0 +1,544 @@
+//! Running the nodes of the IR: blocks, statements and capability instances, API calls,
+//! leashes, requirements, FOR and IF.
+
+use std::cell::{Cell, RefCell};
+use std::collections::BTreeSet;
+use std::future::Future;
+use std::pin::pin;
+use std::rc::Rc;
+use std::time::Duration;
+
+use aviary_api::{CallEnd, DroneId, Interrupt, Value};
+use aviary_ir::{ActorRef, Block, BlockKind, Call, Expr, For, Leash, LeashAction, Node};
+use futures_util::future::{join_all, LocalBoxFuture};
+use futures_util::stream::{FuturesUnordered, StreamExt};
+use serde_json::{json, Map, Value as Json};
+use tokio::sync::{mpsc, Notify};
+use tokio_util::sync::CancellationToken;
+
+use crate::arbiter::acquire;
+use crate::engine::{Ctx, Engine, Instance, Job, Scope};
+use crate::value::to_json;
+
+/// Conditions are looked at again at least this often (LANGUAGE.md §3).
+const RECHECK: Duration = Duration::from_millis(100);
+
+impl<'m> Engine<'m> {
+    /// Runs `items` in `scope`, with the handlers that scope starts, until all are done.
+    pub(crate) async fn drive(&self, scope: &Rc<Scope<'m>>, mut jobs: mpsc::UnboundedReceiver<Job<'m>>, items: impl Future<Output = ()>) {
+        let mut items = pin!(items);
+        let mut running: FuturesUnordered<LocalBoxFuture<'_, ()>> = FuturesUnordered::new();
+        let mut items_done = false;
+        loop {
+            tokio::select! {
+                biased;
+                Some(job) = jobs.recv() => running.push(Box::pin(self.job(job, scope.clone()))),
+                _ = &mut items, if !items_done => {
+                    items_done = true;
+                    // `SEQUENTIAL ON` handlers that waited for this block start now.
+                    for (target, job) in scope.deferred.take() {
+                        let _ = target.jobs.send(job);
+                    }
+                }
+                Some(()) = running.next(), if !running.is_empty() => {}
+            }
+            if items_done && running.is_empty() {
+                match jobs.try_recv() {
+                    Ok(job) => running.push(Box::pin(self.job(job, scope.clone()))),
+                    Err(_) => break,
+                }
+            }
+        }
+    }
+
+    fn new_scope(&self, ctx: &Ctx<'m>, block: &'m Block, instance: Option<Rc<Instance>>) -> (Rc<Scope<'m>>, mpsc::UnboundedReceiver<Job<'m>>) {
+        let (tx, rx) = mpsc::unbounded_channel();
+        let scope = Rc::new(Scope {
+            parent: Some(ctx.scope.clone()),
+            path: block.path.clone(),
+            mission_block: ctx.instance.is_none() && instance.is_none(),
+            handlers: &block.handlers,
+            fired: RefCell::new(vec![false; block.handlers.len()]),
+            exception_handlers: &block.exception_handlers,
+            frame: ctx.frame.clone(),
+            jobs: tx,
+            unwinding: Cell::new(false),
+            deferred: RefCell::new(Vec::new()),
+            catching: Cell::new(0),
+            caught: Notify::new(),
+            instance,
+        });
+        (scope, rx)
+    }
+
+    pub(crate) fn block<'a>(&'a self, block: &'m Block, ctx: &'a Ctx<'m>) -> LocalBoxFuture<'a, ()> {
+        Box::pin(async move {
+            let (scope, rx) = self.new_scope(ctx, block, None);
+            if block.traced {
+                self.trace("block_start", json!({ "block": block.path }));
+            }
+            let inner = Ctx { scope: scope.clone(), ..ctx.clone() };
+            self.drive(&scope, rx, self.items(block, &inner)).await;
+            if block.traced {
+                let status = if scope.unwinding.get() { "aborted" } else { "ok" };
+                self.trace("block_end", json!({ "block": block.path, "status": status }));
+            }
+        })
+    }
+
+    async fn items(&self, block: &'m Block, ctx: &Ctx<'m>) {
+        match block.kind {
+            BlockKind::Sequential => {
+                for node in &block.items {
+                    if ctx.scope.unwinding.get() {
+                        break;
+                    }
+                    self.node(node, ctx).await;
+                    // A handler caught here takes the place of what it aborted.
+                    loop {
+                        let done = ctx.scope.caught.notified();
+                        if ctx.scope.catching.get() == 0 {
+                            break;
+                        }
+                        done.await;
+                    }
+                }
+            }
+            BlockKind::Parallel => {
+                join_all(block.items.iter().map(|n| self.node(n, ctx))).await;
+            }
+        }
+    }
+
+    fn node<'a>(&'a self, node: &'m Node, ctx: &'a Ctx<'m>) -> LocalBoxFuture<'a, ()> {
+        Box::pin(async move {
+            if self.stopped() {
+                return;
+            }
+            match node {
+                Node::Block(b) => self.block(b, ctx).await,
+                Node::Call(c) => self.call(c, ctx).await,
+                Node::Leash(l) => self.leash(l, ctx),
+                Node::Api(a) => self.api(a, ctx).await,
+                Node::Signal { signal, args, .. } => {
+                    let args = self.eval_all(args, ctx);
+                    self.raise(*signal, args, ctx.actor, &ctx.scope);
+                }
+                Node::Throw { exception, args, .. } => {
+                    let args = self.eval_all(args, ctx);
+                    self.throw(*exception, args, ctx.actor, &ctx.scope);
+                }
+                Node::StartIf { condition, body } => {
+                    if self.truth(condition, ctx) {
+                        self.block(body, ctx).await;
+                    }
+                }
+                Node::WaitFor { condition, body } => {
+                    self.wait_until(condition, ctx).await;
+                    if let Some(b) = body {
+                        self.block(b, ctx).await;
+                    }
+                }
+                Node::DoWhile { condition, body } => {
+                    while self.truth(condition, ctx) && !ctx.scope.unwinding.get() {
+                        let before = self.now();
+                        self.block(body, ctx).await;
+                        // A round that takes no time must not starve the clock.
+                        if self.now() == before {
+                            tokio::time::sleep(RECHECK).await;
+                        }
+                    }
+                }
+                Node::For(f) => self.for_each(f, ctx).await,
+                Node::If { branches, otherwise } => {
+                    let chosen = branches.iter().find(|(c, _)| self.truth(c, ctx)).map(|(_, b)| b).or(otherwise.as_ref());
+                    if let Some(b) = chosen {
+                        self.block(b, ctx).await;
+                    }
+                }
+            }
+        })
+    }
+
+    fn eval_all(&self, exprs: &[Expr], ctx: &Ctx<'m>) -> Vec<Value> {
+        let received = self.received.borrow();
+        let env = self.env(&ctx.frame, &received);
+        exprs.iter().map(|e| env.eval(e)).collect()
+    }
+
+    fn truth(&self, e: &Expr, ctx: &Ctx<'m>) -> bool {
+        let received = self.received.borrow();
+        self.env(&ctx.frame, &received).truth(e)
+    }
+
+    async fn wait_until(&self, condition: &Expr, ctx: &Ctx<'m>) {
+        loop {
+            let changed = self.changed.notified();
+            if self.truth(condition, ctx) {
+                return;
+            }
+            tokio::select! {
+                biased;
+                _ = changed => {}
+                _ = tokio::time::sleep(RECHECK) => {}
+            }
+        }
+    }
+
+    /// The drones an actor reference stands for here: a group is each of its members.
+    fn drones(&self, r: &ActorRef, ctx: &Ctx<'m>) -> Vec<DroneId> {
+        match r {
+            ActorRef::Drone(d) => vec![*d],
+            ActorRef::Group(g) => g.clone(),
+            ActorRef::Slot(s) => match ctx.frame.get(*s) {
+                Some(Value::Actor(d)) => vec![*d],
+                _ => Vec::new(),
+            },
+        }
+    }
+
+    async fn for_each(&self, f: &'m For, ctx: &Ctx<'m>) {
+        let mut runs = Vec::new();
+        for (actor, values) in &f.instances {
+            let values = self.eval_all(values, ctx);
+            for d in self.drones(actor, ctx) {
+                let mut frame = (*ctx.frame).clone();
+                set(&mut frame, f.alias, Value::Actor(d));
+                for (slot, v) in f.params.iter().zip(&values) {
+                    set(&mut frame, *slot, v.clone());
+                }
+                runs.push(Ctx { frame: Rc::new(frame), actor: Some(d), ..ctx.clone() });
+            }
+        }
+        if f.parallel {
+            join_all(runs.iter().map(|c| self.block(&f.body, c))).await;
+        } else {
+            for c in &runs {
+                if ctx.scope.unwinding.get() {
+                    break;
+                }
+                self.block(&f.body, c).await;
+            }
+        }
+    }
+
+    /// A statement: one instance, or one per actor when a one-actor capability is given
+    /// several (or a group), in parallel.
+    async fn call(&self, call: &'m Call, ctx: &Ctx<'m>) {
+        let capability = &self.m.capabilities[call.capability];
+        let args = self.eval_all(&call.args, ctx);
+        let per_actor: Vec<Vec<DroneId>> = call.actors.iter().map(|a| self.drones(a, ctx)).collect();
+        let sets: Vec<Vec<DroneId>> = if capability.actors == 1 {
+            per_actor.into_iter().flatten().map(|d| vec![d]).collect()
+        } else {
+            vec![per_actor.iter().filter_map(|ds| ds.first().copied()).collect()]
+        };
+        join_all(sets.into_iter().map(|actors| self.instance(call, actors, args.clone(), ctx))).await;
+    }
+
+    async fn instance(&self, call: &'m Call, actors: Vec<DroneId>, args: Vec<Value>, ctx: &Ctx<'m>) {
+        let cap = &self.m.capabilities[call.capability];
+        let mut frame = vec![Value::Bool(false); cap.frame_size.max(cap.actors + cap.params.len())];
+        for (i, d) in actors.iter().enumerate().take(cap.actors) {
+            frame[i] = Value::Actor(*d);
+        }
+        for (j, v) in args.iter().enumerate() {
+            frame[cap.actors + j] = v.clone();
+        }
+        let id = self.next_id.get() + 1;
+        self.next_id.set(id);
+        let instance = Rc::new(Instance {
+            id,
+            capability: call.capability,
+            tag: call.tag,
+            actors: actors.clone(),
+            root: ctx.instance.as_ref().map(|p| p.root()),
+            token: ctx.instance.as_ref().map_or_else(|| self.stop.child_token(), |p| p.token.child_token()),
+            perform: CancellationToken::new(),
+            by_leash: Cell::new(false),
+            failed: Cell::new(false),
+            paused: Cell::new(false),
+            resumed: Notify::new(),
+            calls: RefCell::new(Vec::new()),
+            depth: ctx.instance.as_ref().map_or(0, |p| p.depth + 1),
+            claims: RefCell::new(ctx.claims.clone()),
+        });
+        let actor = actors.first().copied();
+        let tag = call.tag.map(|t| self.m.tags[t].clone());
+        let shown_args: Map<String, Json> = cap.params.iter().zip(&args).map(|(p, v)| (p.clone(), to_json(self.m, v))).collect();
+        let who = actors.iter().map(|d| self.name(*d)).collect::<Vec<_>>().join(" ");
+        let start = json!({ "actor": who, "capability": cap.name, "tag": tag, "args": shown_args });
+        let end = |status: &str| {
+            let mut e = start.clone();
+            e["status"] = json!(status);
+            self.trace("capability_end", e);
+        };
+        let frame = Rc::new(frame);
+
+        // Known from now on (a leash can abort it while it waits), by where it was called.
+        self.instances.borrow_mut().push((instance.clone(), ctx.scope.clone()));
+        // Claims first (a second instance on a busy resource waits), then the start.
+        let needs: Vec<_> = cap.claims.iter().filter_map(|(i, r)| actors.get(*i).map(|d| (*d, *r))).filter(|c| !ctx.claims.contains(c)).collect();
+        let mut claims: BTreeSet<_> = (*ctx.claims).clone();
+        claims.extend(needs.iter().copied());
+        let held = tokio::select! {
+            biased;
+            _ = instance.token.cancelled() => None,
+            h = acquire(&self.arbiter, needs) => Some(h),
+        };
+        if self.stopped() {
+            return;
+        }
+        self.trace("capability_start", start.clone());
+        if held.is_none() {
+            self.instances.borrow_mut().retain(|(i, _)| i.id != instance.id);
+            end("aborted");
+            return;
+        }
+        let claims = Rc::new(claims);
+        *instance.claims.borrow_mut() = claims.clone();
+
+        let requirements_met = {
+            let received = self.received.borrow();
+            let env = self.env(&frame, &received);
+            cap.requirements.iter().all(|r| env.truth(r))
+        };
+        if !requirements_met {
+            self.instances.borrow_mut().retain(|(i, _)| i.id != instance.id);
+            end("failed");
+            drop(held);
+            let id = self.m.exceptions.iter().position(|e| e == "RequirementNotMet").unwrap_or(0);
+            let why = format!("a requirement of {} does not hold", cap.name);
+            self.throw(id, vec![Value::Text(why)], actor, &ctx.scope);
+            return;
+        }
+
+        let (scope, rx) = {
+            let (tx, rx) = mpsc::unbounded_channel();
+            let scope = Rc::new(Scope {
+                parent: Some(ctx.scope.clone()),
+                path: cap.name.clone(),
+                mission_block: false,
+                handlers: &[],
+                fired: RefCell::new(Vec::new()),
+                exception_handlers: &cap.exception_handlers,
+                frame: frame.clone(),
+                jobs: tx,
+                unwinding: Cell::new(false),
+                deferred: RefCell::new(Vec::new()),
+                catching: Cell::new(0),
+                caught: Notify::new(),
+                instance: Some(instance.clone()),
+            });
+            (scope, rx)
+        };
+        for entry in self.instances.borrow_mut().iter_mut().filter(|(i, _)| i.id == instance.id) {
+            entry.1 = scope.clone();
+        }
+        let inner = Ctx { scope: scope.clone(), frame, actor, instance: Some(instance.clone()), claims };
+        let perform = async {
+            tokio::select! {
+                biased;
+                _ = instance.perform.cancelled() => {}
+                _ = self.block(&cap.perform, &inner) => {}
+            }
+        };
+        let finished = tokio::select! {
+            biased;
+            _ = instance.token.cancelled() => false,
+            _ = self.drive(&scope, rx, perform) => true,
+        };
+        self.instances.borrow_mut().retain(|(i, _)| i.id != instance.id);
+        if !finished && instance.by_leash.get() {
+            // `PERFORM ABORT:` says what aborting this activity also does.
+            if let Some((_, section)) = cap.sections.iter().find(|(n, _)| n == "ABORT") {
+                let after = Ctx { instance: None, ..inner.clone() };
+                self.block(section, &after).await;
+            }
+        }
+        drop(held);
+        let status = if finished && !instance.failed.get() {
+            "ok"
+        } else if instance.failed.get() {
+            "failed"
+        } else {
+            "aborted"
+        };
+        end(status);
+    }
+
+    async fn job(&self, job: Job<'m>, scope: Rc<Scope<'m>>) {
+        match job {
+            Job::Signal { handler, args, actor, signal } => {
+                let mut frame = (*scope.frame).clone();
+                for (slot, v) in handler.bindings.iter().zip(args) {
+                    set(&mut frame, *slot, v);
+                }
+                let who = actor.map(|a| self.name(a));
+                let signal_name = &self.m.signals[signal];
+                self.trace("handler_start", json!({ "signal": signal_name, "handler": handler.body.path, "actor": who }));
+                let ctx = self.scope_ctx(&scope, Rc::new(frame));
+                self.block(&handler.body, &ctx).await;
+                self.trace("handler_end", json!({ "signal": signal_name, "handler": handler.body.path, "actor": who }));
+            }
+            Job::Exception { handler, args } => {
+                let mut frame = (*scope.frame).clone();
+                for (slot, v) in handler.bindings.iter().zip(args) {
+                    set(&mut frame, *slot, v);
+                }
+                let ctx = self.scope_ctx(&scope, Rc::new(frame));
+                self.block(&handler.body, &ctx).await;
+                scope.catching.set(scope.catching.get().saturating_sub(1));
+                scope.caught.notify_waiters();
+            }
+            Job::Section { block, frame } => {
+                let ctx = self.scope_ctx(&scope, frame);
+                self.block(block, &ctx).await;
+            }
+        }
+    }
+
+    /// The context a handler body runs in: inside the scope that declared it.
+    fn scope_ctx(&self, scope: &Rc<Scope<'m>>, frame: Rc<Vec<Value>>) -> Ctx<'m> {
+        let instance = scope.chain().find_map(|s| s.instance.clone());
+        let claims = instance.as_ref().map_or_else(|| Rc::new(BTreeSet::new()), |i| i.claims.borrow().clone());
+        let actor = instance.as_ref().and_then(|i| i.actors.first().copied());
+        Ctx { scope: scope.clone(), frame, actor, instance, claims }
+    }
+
+    fn leash(&self, l: &'m Leash, ctx: &Ctx<'m>) {
+        let cap = &self.m.capabilities[l.capability];
+        self.trace("leash", json!({ "capability": cap.name, "tag": self.m.tags[l.tag], "action": l.action_name }));
+        let targets: Vec<(Rc<Instance>, Rc<Scope<'m>>)> =
+            self.instances.borrow().iter().filter(|(i, _)| i.capability == l.capability && i.tag == Some(l.tag)).cloned().collect();
+        for (instance, scope) in targets {
+            match l.action {
+                LeashAction::Abort => {
+                    instance.by_leash.set(true);
+                    instance.token.cancel();
+                }
+                LeashAction::Pause => {
+                    instance.paused.set(true);
+                    for call in instance.calls.borrow().iter() {
+                        self.backend.interrupt(*call, Interrupt::Pause);
+                    }
+                }
+                LeashAction::Resume => {
+                    instance.paused.set(false);
+                    for call in instance.calls.borrow().iter() {
+                        self.backend.interrupt(*call, Interrupt::Resume);
+                    }
+                    instance.resumed.notify_waiters();
+                }
+                LeashAction::Section(i) => {
+                    let mut frame = (*scope.frame).clone();
+                    let values: Vec<(usize, Value)> = {
+                        let received = self.received.borrow();
+                        let env = self.env(&ctx.frame, &received);
+                        l.args.iter().map(|(p, e)| (*p, env.eval(e))).collect()
+                    };
+                    for (p, v) in values {
+                        set(&mut frame, cap.actors + p, v);
+                    }
+                    let _ = scope.jobs.send(Job::Section { block: &cap.sections[i].1, frame: Rc::new(frame) });
+                }
+            }
+        }
+    }
+
+    async fn api(&self, a: &'m aviary_ir::ApiCall, ctx: &Ctx<'m>) {
+        let drone = {
+            let received = self.received.borrow();
+            self.env(&ctx.frame, &received).actor(&a.actor)
+        };
+        let Some(drone) = drone else { return };
+        let root = ctx.instance.as_ref().map(|i| i.root());
+        if let Some(root) = &root {
+            loop {
+                let resumed = root.resumed.notified();
+                if !root.paused.get() {
+                    break;
+                }
+                resumed.await;
+            }
+        }
+        let args = self.eval_all(&a.args, ctx);
+        let function = self.m.functions[a.function].0.as_str();
+        self.trace("api_call", json!({ "actor": self.name(drone), "function": function, "args": self.values(&args) }));
+        let pending = self.backend.call(drone, function, &args);
+        let guard = CallGuard { engine: self, id: pending.id, root: root.clone(), done: Cell::new(false), drone, function, args: &args };
+        if let Some(root) = &root {
+            root.calls.borrow_mut().push(pending.id);
+            if root.paused.get() {
+                self.backend.interrupt(pending.id, Interrupt::Pause);
+            }
+        }
+        let end = pending.end.await.unwrap_or(CallEnd::Interrupted);
+        guard.done.set(true);
+        drop(guard);
+        self.trace_done(drone, function, &args, &end);
+        match end {
+            CallEnd::Done => self.after_call(function, drone, &args, ctx),
+            CallEnd::Failed(f) => {
+                let id = self.m.exceptions.iter().position(|e| e == f.exception).unwrap_or(0);
+                self.throw(id, vec![Value::Text(f.reason)], Some(drone), &ctx.scope);
+            }
+            CallEnd::Interrupted => {
+                // A fault interrupted it: raise that first, while this activity still runs.
+                self.drain_events();
+                ctx.scope.unwinding.set(true);
+            }
+        }
+    }
+
+    fn after_call(&self, function: &str, drone: DroneId, args: &[Value], ctx: &Ctx<'m>) {
+        let kind = match args.first() {
+            Some(Value::Symbol(k) | Value::Text(k)) => k.clone(),
+            _ => return,
+        };
+        match function {
+            // Finds are raised in the activity that started detection (LANGUAGE.md §5).
+            "StartDetection" => {
+                self.detections.borrow_mut().insert((drone, kind), ctx.scope.clone());
+            }
+            "StopDetection" => {
+                self.detections.borrow_mut().remove(&(drone, kind));
+            }
+            _ => {}
+        }
+    }
+}
+
+/// Interrupts a call whose activity is dropped before the call ended, and says so in
+/// the trace: every `api_call` has its `api_done`.
+struct CallGuard<'e, 'm> {
+    engine: &'e Engine<'m>,
+    id: aviary_api::CallId,
+    root: Option<Rc<Instance>>,
+    done: Cell<bool>,
+    drone: DroneId,
+    function: &'e str,
+    args: &'e [Value],
+}
+
+impl Drop for CallGuard<'_, '_> {
+    fn drop(&mut self) {
+        if !self.done.get() {
+            self.engine.backend.interrupt(self.id, Interrupt::Abort);
+            let p = self.engine.backend.telemetry(self.drone).position;
+            let args = self.engine.values(self.args);
+            let name = self.engine.name(self.drone);
+            self.engine.trace("api_done", json!({ "actor": name, "function": self.function, "args": args, "status": "aborted", "position": p }));
+        }
+        if let Some(root) = &self.root {
+            root.calls.borrow_mut().retain(|c| *c != self.id);
+        }
+    }
+}
+
+fn set(frame: &mut Vec<Value>, slot: usize, value: Value) {
+    if frame.len() <= slot {
+        frame.resize(slot + 1, Value::Bool(false));
+    }
+    frame[slot] = value;
+}

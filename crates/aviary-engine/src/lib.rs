@@ -1,0 +1,63 @@
+//! The executor: runs a compiled mission on a fleet through the middle layer.
+//!
+//! Every block, capability instance and handler instance is its own future, polled
+//! concurrently (`FuturesUnordered`) on one thread: lightweight tasks that borrow the IR.
+//! Cancellation is dropping: resource claims and calls in flight are released by drop
+//! guards, so an abort can never leave a claim held or a drone commanded. Time is tokio's:
+//! with a paused clock a simulated run takes no real time, and on one thread the same
+//! inputs give the same trace.
+//!
+//! Invariant: the engine knows no backend; it talks to `aviary_api::Backend` only.
+
+mod arbiter;
+mod engine;
+mod exec;
+mod value;
+
+use aviary_api::Backend;
+use aviary_ir::Mission;
+
+/// Where trace events go, one JSON object per event, in order.
+pub trait TraceSink {
+    fn event(&mut self, event: serde_json::Value);
+}
+
+impl<F: FnMut(serde_json::Value)> TraceSink for F {
+    fn event(&mut self, event: serde_json::Value) {
+        self(event)
+    }
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Telemetry events per second of mission time; `None` for none.
+    pub telemetry_hz: Option<f64>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Status {
+    Ok,
+    Failed,
+    Aborted,
+}
+
+impl Status {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Failed => "failed",
+            Status::Aborted => "aborted",
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Outcome {
+    pub status: Status,
+    pub reason: Option<String>,
+}
+
+/// Runs `mission` to its end. Must be polled inside a tokio runtime (current-thread).
+pub async fn run(mission: &Mission, backend: &dyn Backend, sink: &mut dyn TraceSink, options: &RunOptions) -> Outcome {
+    engine::Engine::new(mission, backend, sink).run(options).await
+}

@@ -1,0 +1,169 @@
+//! Evaluating expressions at run time, and showing values in the trace.
+
+use aviary_api::{Backend, FlightState, Point, Value};
+use aviary_ir::{ActorRef, Compare, Expr, Field, Mission};
+use serde_json::{json, Value as Json};
+
+/// What an expression needs from the run: the frame, telemetry, signals, the clock.
+pub(crate) struct Env<'a> {
+    pub mission: &'a Mission,
+    pub backend: &'a dyn Backend,
+    pub frame: &'a [Value],
+    pub received: &'a [bool],
+    pub elapsed: f64,
+}
+
+impl Env<'_> {
+    pub fn actor(&self, r: &ActorRef) -> Option<usize> {
+        match r {
+            ActorRef::Drone(d) => Some(*d),
+            ActorRef::Group(g) => g.first().copied(),
+            ActorRef::Slot(s) => match self.frame.get(*s) {
+                Some(Value::Actor(d)) => Some(*d),
+                _ => None,
+            },
+        }
+    }
+
+    pub fn eval(&self, e: &Expr) -> Value {
+        match e {
+            Expr::Const(v) => v.clone(),
+            Expr::Slot(s) => self.frame.get(*s).cloned().unwrap_or(Value::Bool(false)),
+            Expr::Actor(r) => self.actor(r).map_or(Value::Bool(false), Value::Actor),
+            Expr::Telemetry(r, field) => match self.actor(r) {
+                Some(d) => telemetry(self.backend, d, *field),
+                None => Value::Bool(false),
+            },
+            Expr::Attribute(r, i) => {
+                let d = self.actor(r);
+                d.and_then(|d| self.mission.attributes.get(*i)?.get(d)?.clone()).unwrap_or(Value::Bool(false))
+            }
+            Expr::Point(parts) => {
+                let n: Vec<f64> = parts.iter().map(|p| number(&self.eval(p))).collect();
+                Value::Position(Point { x: n[0], y: n.get(1).copied().unwrap_or(0.0), z: n.get(2).copied() })
+            }
+            Expr::Geo(parts) => {
+                let n: Vec<f64> = parts.iter().map(|p| number(&self.eval(p))).collect();
+                let origin = self.mission.origin.unwrap_or((0.0, 0.0, 0.0));
+                let [x, y, z] = aviary_ir::to_local(origin, n[0], n.get(1).copied().unwrap_or(0.0), n.get(2).copied());
+                Value::Position(Point { x, y, z: (!z.is_nan()).then_some(z) })
+            }
+            Expr::Distance(a, b) => {
+                let (a, b) = (self.position(&self.eval(a)), self.position(&self.eval(b)));
+                Value::Number(((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt())
+            }
+            Expr::Elapsed => Value::Number(self.elapsed),
+            Expr::Received(s) => Value::Bool(self.received.get(*s).copied().unwrap_or(false)),
+            Expr::Not(x) => Value::Bool(!truth(&self.eval(x))),
+            Expr::And(a, b) => Value::Bool(truth(&self.eval(a)) && truth(&self.eval(b))),
+            Expr::Or(a, b) => Value::Bool(truth(&self.eval(a)) || truth(&self.eval(b))),
+            Expr::Compare(a, op, b) => Value::Bool(compare(&self.eval(a), *op, &self.eval(b))),
+        }
+    }
+
+    pub fn truth(&self, e: &Expr) -> bool {
+        truth(&self.eval(e))
+    }
+
+    /// Where a value is, on the ground: a drone now, an area's centroid, a point.
+    pub fn position(&self, v: &Value) -> [f64; 2] {
+        match v {
+            Value::Position(p) => [p.x, p.y],
+            Value::Actor(d) => {
+                let p = self.backend.telemetry(*d).position;
+                [p[0], p[1]]
+            }
+            Value::Area(poly) => centroid(poly),
+            _ => [f64::NAN, f64::NAN],
+        }
+    }
+}
+
+fn telemetry(backend: &dyn Backend, d: usize, field: Field) -> Value {
+    let t = backend.telemetry(d);
+    match field {
+        Field::Position => Value::Position(Point { x: t.position[0], y: t.position[1], z: Some(t.position[2]) }),
+        Field::Altitude => Value::Number(t.position[2]),
+        Field::Speed => Value::Number(t.speed),
+        Field::Heading => Value::Number(t.heading),
+        Field::Battery => Value::Number(t.battery),
+        Field::State => Value::Symbol(t.state.as_str().to_string()),
+        Field::Link => Value::Symbol(if t.link { "Connected" } else { "Lost" }.to_string()),
+    }
+}
+
+pub(crate) fn truth(v: &Value) -> bool {
+    matches!(v, Value::Bool(true))
+}
+
+fn number(v: &Value) -> f64 {
+    match v {
+        Value::Number(n) => *n,
+        _ => f64::NAN,
+    }
+}
+
+fn text(v: &Value) -> Option<&str> {
+    match v {
+        Value::Text(s) | Value::Symbol(s) => Some(s),
+        _ => None,
+    }
+}
+
+fn compare(a: &Value, op: Compare, b: &Value) -> bool {
+    if let (Value::Number(x), Value::Number(y)) = (a, b) {
+        return match op {
+            Compare::Eq => x == y,
+            Compare::Ne => x != y,
+            Compare::Lt => x < y,
+            Compare::Le => x <= y,
+            Compare::Gt => x > y,
+            Compare::Ge => x >= y,
+        };
+    }
+    // A symbol and a string are equal when they spell the same (LANGUAGE.md: symbols only equal themselves).
+    let equal = match (text(a), text(b)) {
+        (Some(x), Some(y)) => x == y,
+        _ => a == b,
+    };
+    match op {
+        Compare::Eq => equal,
+        Compare::Ne => !equal,
+        _ => false,
+    }
+}
+
+pub(crate) fn centroid(poly: &[[f64; 2]]) -> [f64; 2] {
+    let (mut a, mut cx, mut cy) = (0.0, 0.0, 0.0);
+    for i in 0..poly.len() {
+        let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
+        let cross = p[0] * q[1] - q[0] * p[1];
+        a += cross;
+        cx += (p[0] + q[0]) * cross;
+        cy += (p[1] + q[1]) * cross;
+    }
+    if a.abs() < 1e-12 {
+        let n = poly.len().max(1) as f64;
+        return [poly.iter().map(|p| p[0]).sum::<f64>() / n, poly.iter().map(|p| p[1]).sum::<f64>() / n];
+    }
+    [cx / (3.0 * a), cy / (3.0 * a)]
+}
+
+/// A value as the trace shows it: SI numbers, `[x, y, z]` positions, names for drones.
+pub(crate) fn to_json(m: &Mission, v: &Value) -> Json {
+    match v {
+        Value::Number(n) => json!(n),
+        Value::Text(s) | Value::Symbol(s) => json!(s),
+        Value::Bool(b) => json!(b),
+        Value::Position(p) => match p.z {
+            Some(z) => json!([p.x, p.y, z]),
+            None => json!([p.x, p.y]),
+        },
+        Value::Area(poly) => json!(poly),
+        Value::Actor(d) => json!(m.drones.get(*d)),
+    }
+}
+
+pub(crate) fn airborne(backend: &dyn Backend, d: usize) -> bool {
+    backend.telemetry(d).state.airborne() && backend.telemetry(d).state != FlightState::Lost
+}

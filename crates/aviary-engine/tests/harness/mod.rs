@@ -1,0 +1,118 @@
+// Shared by several test binaries; each uses part of it.
+#![allow(dead_code)]
+
+//! Runs a mission text on the built-in simulator and returns its outcome and trace.
+
+use aviary_api::Descriptor;
+use aviary_check::SourceProvider;
+use aviary_diagnostics::SourceMap;
+use aviary_engine::{Outcome, RunOptions};
+use aviary_sim::{SimBackend, SimOptions};
+use serde_json::Value;
+
+struct NoFiles;
+impl SourceProvider for NoFiles {
+    fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+        Err(format!("no file {path}"))
+    }
+}
+
+/// A small world: drones a, b, c at the origin's corners, a place and an area.
+pub const WORLD: &str = r#"
+[site]
+geofence = [[-1000, -1000], [1000, -1000], [1000, 1000], [-1000, 1000]]
+max_altitude = 120.0
+[places]
+Home = [0, 0]
+North = [0, 100]
+Far = [0, 400]
+[areas]
+Field = [[100, 100], [200, 100], [200, 200], [100, 200]]
+[drones.a]
+home = [0, 0]
+group = "team"
+sensors = ["camera", "thermal"]
+payload = ["Box"]
+[drones.b]
+home = [10, 0]
+group = "team"
+sensors = ["camera"]
+[drones.c]
+home = [20, 0]
+[sensors.thermal]
+detects = ["Body"]
+range = 20.0
+[[targets]]
+kind = "Body"
+at = [150, 150]
+"#;
+
+pub struct Run {
+    pub outcome: Outcome,
+    pub trace: Vec<Value>,
+    /// Every payload release: (drone, kind, position).
+    pub releases: Vec<(usize, String, [f64; 3])>,
+}
+
+pub fn run(mission: &str) -> Run {
+    run_in(mission, WORLD)
+}
+
+pub fn run_in(mission: &str, world: &str) -> Run {
+    run_with(mission, world, &RunOptions::default())
+}
+
+pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
+    let mut sources = SourceMap::new();
+    let checked = aviary_check::check_sources(&mut sources, ("m.mission", mission.as_bytes()), Some(("w.toml", world.as_bytes())), &NoFiles, &Descriptor::standard());
+    let errors: Vec<String> = checked.diagnostics.iter().filter(|d| d.is_error()).map(|d| format!("{}: {}", d.code, d.message)).collect();
+    assert!(errors.is_empty(), "{errors:#?}");
+    let world = checked.world.expect("world");
+    let mission = aviary_ir::compile(&checked.program.expect("program"), &world, &Descriptor::standard()).expect("mission");
+    let runtime = tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build().expect("runtime");
+    runtime.block_on(async {
+        let sim = SimBackend::start(&world, SimOptions::default());
+        let mut trace = Vec::new();
+        let mut sink = |e: Value| trace.push(e);
+        let outcome = aviary_engine::run(&mission, &*sim, &mut sink, options).await;
+        sim.shutdown().await;
+        let releases = sim.releases().into_iter().map(|r| (r.drone, r.kind, r.position)).collect();
+        Run { outcome, trace, releases }
+    })
+}
+
+impl Run {
+    /// Events of one kind with a field equal to a value.
+    pub fn find(&self, event: &str, field: &str, value: &str) -> Vec<&Value> {
+        self.trace.iter().filter(|e| e["event"] == event && e[field] == value).collect()
+    }
+    /// The time of the first such event.
+    pub fn t(&self, event: &str, field: &str, value: &str) -> f64 {
+        self.first(event, field, value)["t"].as_f64().expect("t")
+    }
+    pub fn first(&self, event: &str, field: &str, value: &str) -> &Value {
+        self.find(event, field, value).into_iter().next().unwrap_or_else(|| panic!("no {event} with {field} = {value}:\n{}", self.dump()))
+    }
+    /// The index of the first such event in the trace.
+    pub fn index(&self, event: &str, field: &str, value: &str) -> usize {
+        self.trace.iter().position(|e| e["event"] == event && e[field] == value).unwrap_or_else(|| panic!("no {event} with {field} = {value}:\n{}", self.dump()))
+    }
+    /// Capability ends of `capability` on `actor`.
+    pub fn ends(&self, capability: &str, actor: &str) -> Vec<&Value> {
+        self.trace.iter().filter(|e| e["event"] == "capability_end" && e["capability"] == capability && e["actor"] == actor).collect()
+    }
+    /// Telemetry positions of a drone, by time.
+    pub fn positions(&self, actor: &str) -> Vec<(f64, [f64; 3])> {
+        self.trace
+            .iter()
+            .filter(|e| e["event"] == "telemetry" && e["actor"] == actor)
+            .map(|e| {
+                let p = &e["position"];
+                (e["t"].as_f64().unwrap(), [p[0].as_f64().unwrap(), p[1].as_f64().unwrap(), p[2].as_f64().unwrap()])
+            })
+            .collect()
+    }
+    pub fn dump(&self) -> String {
+        self.trace.iter().map(|e| e.to_string()).collect::<Vec<_>>().join("\n")
+    }
+}

@@ -1,0 +1,188 @@
+//! One trace-based test per rule of LANGUAGE.md §3, asserting order and timing, on the
+//! built-in simulator with a paused clock (so every time below is simulated seconds).
+
+mod harness;
+
+use aviary_engine::Status;
+use harness::run;
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() < 0.11
+}
+
+#[test]
+fn sequential_runs_children_one_after_another() {
+    let r = run("MISSION M:\n    SEQUENTIAL S:\n        a Hover WITH 5s\n        b Hover WITH 3s\n");
+    assert_eq!(r.outcome.status, Status::Ok);
+    let a_end = r.ends("Hover", "a")[0]["t"].as_f64().unwrap();
+    let b_start = r.t("capability_start", "actor", "b");
+    assert!(close(a_end, 5.0), "{a_end}");
+    assert!(b_start >= a_end && close(b_start, 5.0), "b starts when a has finished: {b_start}");
+    assert!(close(r.t("block_end", "block", "S"), 8.0));
+}
+
+#[test]
+fn parallel_starts_all_at_once_and_ends_with_the_last() {
+    let r = run("MISSION M:\n    PARALLEL P:\n        a Hover WITH 5s\n        b Hover WITH 3s\n");
+    assert_eq!(r.t("capability_start", "actor", "a"), 0.0);
+    assert_eq!(r.t("capability_start", "actor", "b"), 0.0);
+    assert!(close(r.t("block_end", "block", "P"), 5.0));
+}
+
+#[test]
+fn on_fires_once_and_on_every_each_time() {
+    let r = run(
+        "MISSION M:\n    PARALLEL P:\n        SEQUENTIAL S:\n            SIGNAL Ping\n            a Hover WITH 1s\n            SIGNAL Ping\n            a Hover WITH 1s\n            SIGNAL Ping\n        ON Ping:\n            b Hover WITH 1s\n        ON EVERY Ping:\n            c Hover WITH 1s\n",
+    );
+    assert_eq!(r.find("signal", "name", "Ping").len(), 3);
+    assert_eq!(r.find("capability_start", "actor", "b").len(), 1, "ON takes the first signal only");
+    let c: Vec<f64> = r.find("capability_start", "actor", "c").iter().map(|e| e["t"].as_f64().unwrap()).collect();
+    assert_eq!(c.len(), 3, "ON EVERY takes each");
+    assert!(close(c[0], 0.0) && close(c[1], 1.0) && close(c[2], 2.0), "{c:?}");
+    assert!(close(r.t("block_end", "block", "P"), 3.0), "the block waits for its started handlers");
+}
+
+#[test]
+fn sequential_on_waits_for_the_signalling_block_and_parallel_on_does_not() {
+    let r = run(
+        "MISSION M:\n    PARALLEL P:\n        SEQUENTIAL Signaller:\n            SIGNAL Go\n            a Hover WITH 4s\n        SEQUENTIAL ON Go:\n            b Hover WITH 1s\n        PARALLEL ON Go:\n            c Hover WITH 1s\n",
+    );
+    let signaller_end = r.t("block_end", "block", "Signaller");
+    assert!(close(signaller_end, 4.0));
+    assert_eq!(r.t("capability_start", "actor", "c"), 0.0, "PARALLEL ON starts at once");
+    let b = r.t("capability_start", "actor", "b");
+    assert!(b >= signaller_end, "SEQUENTIAL ON starts when the signalling block has ended: {b}");
+    assert!(r.index("block_end", "block", "Signaller") < r.index("capability_start", "actor", "b"), "in causal order");
+}
+
+#[test]
+fn a_handler_outside_the_signals_subtree_never_fires() {
+    let r = run(
+        "MISSION M:\n    PARALLEL:\n        SEQUENTIAL A:\n            SIGNAL Ping\n            a Hover WITH 1s\n        SEQUENTIAL B:\n            ON Ping:\n                b Hover WITH 1s\n            c Hover WITH 2s\n",
+    );
+    assert_eq!(r.find("signal", "name", "Ping").len(), 1, "the signal is recorded");
+    assert!(r.find("capability_start", "actor", "b").is_empty(), "but B does not hear it");
+    assert!(r.find("handler_start", "signal", "Ping").is_empty());
+}
+
+#[test]
+fn by_filters_on_the_signalling_actor() {
+    let r = run("MISSION M:\n    PARALLEL P:\n        PARALLEL FOR a AND b AS d:\n            SIGNAL Ping\n        ON EVERY Ping BY b:\n            c Hover WITH 1s\n");
+    let pings = r.find("signal", "name", "Ping");
+    assert_eq!(pings.len(), 2);
+    assert_eq!(r.find("handler_start", "signal", "Ping").len(), 1);
+    assert_eq!(r.first("handler_start", "signal", "Ping")["actor"], "b");
+    assert_eq!(r.find("capability_start", "actor", "c").len(), 1);
+}
+
+#[test]
+fn an_exception_aborts_the_throwing_actor_and_no_other() {
+    let r = run(
+        "CAPABILITY Boom BY d:\n    PERFORM:\n        d.Hover(1s)\n        THROW EXCEPTION Broken\n        d.Hover(10s)\n\nMISSION M:\n    PARALLEL P:\n        SEQUENTIAL A:\n            a Boom\n            a Hover WITH 5s\n        SEQUENTIAL B:\n            b Hover WITH 3s\n            b Hover WITH 3s\n        ON EXCEPTION Broken:\n            c Hover WITH 1s\n",
+    );
+    assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
+    let e = r.first("exception", "name", "Broken");
+    assert_eq!(e["handled"], true);
+    assert_eq!(e["actor"], "a");
+    assert_eq!(e["handler"], "P/ON EXCEPTION Broken");
+    assert_eq!(r.ends("Boom", "a")[0]["status"], "failed");
+    assert!(close(r.ends("Boom", "a")[0]["t"].as_f64().unwrap(), 1.0), "aborted when it threw");
+    assert!(r.ends("Hover", "a").is_empty(), "the rest of a's sequential chain is aborted");
+    let b: Vec<&str> = r.ends("Hover", "b").iter().map(|e| e["status"].as_str().unwrap()).collect();
+    assert_eq!(b, ["ok", "ok"], "b goes on");
+    assert!(close(r.t("capability_start", "actor", "c"), 1.0), "the handler starts at once");
+}
+
+#[test]
+fn a_capability_handles_its_own_exceptions_first() {
+    let r = run(
+        "CAPABILITY Careful BY d:\n    PERFORM:\n        d.Hover(1s)\n        THROW EXCEPTION Broken\n        d.Hover(10s)\n    EXCEPTIONS:\n        ON EXCEPTION Broken:\n            d.Hover(2s)\n\nMISSION M:\n    SEQUENTIAL S:\n        a Careful\n        b Hover WITH 1s\n    ON EXCEPTION Broken:\n        c Hover WITH 1s\n",
+    );
+    assert_eq!(r.first("exception", "name", "Broken")["handler"], "Careful/ON EXCEPTION Broken");
+    assert!(r.find("capability_start", "actor", "c").is_empty(), "the outer handler is not needed");
+    let careful = r.ends("Careful", "a")[0];
+    assert_eq!(careful["status"], "ok");
+    assert!(close(careful["t"].as_f64().unwrap(), 3.0), "its handler took the place of the rest: 1 s + 2 s");
+    assert!(close(r.t("capability_start", "actor", "b"), 3.0));
+}
+
+#[test]
+fn two_motion_capabilities_on_one_drone_queue() {
+    let r = run("MISSION M:\n    PARALLEL:\n        a Hover WITH 3s\n        a Hover WITH 2s\n        b Hover WITH 1s\n");
+    let starts: Vec<f64> = r.find("capability_start", "actor", "a").iter().map(|e| e["t"].as_f64().unwrap()).collect();
+    let ends: Vec<f64> = r.ends("Hover", "a").iter().map(|e| e["t"].as_f64().unwrap()).collect();
+    assert_eq!(starts[0], 0.0);
+    assert!(close(starts[1], 3.0), "the second waits for the motion resource: {starts:?}");
+    assert!(close(ends[1], 5.0));
+    assert_eq!(r.t("capability_start", "actor", "b"), 0.0, "another drone does not wait");
+}
+
+#[test]
+fn waitfor_startif_and_dowhile() {
+    let r = run(
+        "MISSION M:\n    PARALLEL:\n        SEQUENTIAL:\n            WAITFOR RECEIVED(Go)\n            a Hover WITH 1s\n        SEQUENTIAL:\n            b Hover WITH 2s\n            SIGNAL Go\n            STARTIF b.battery < 10%:\n                b Hover WITH 100s\n            DOWHILE ELAPSED < 5s:\n                c Hover WITH 1s\n",
+    );
+    assert!(close(r.t("capability_start", "actor", "a"), 2.0), "WAITFOR ends when Go is raised");
+    assert_eq!(r.find("capability_start", "actor", "b").len(), 1, "STARTIF with a false condition skips its body");
+    let rounds = r.find("capability_start", "actor", "c").len();
+    assert_eq!(rounds, 3, "DOWHILE checks before each round: 2 s, 3 s, 4 s, then stops at 5 s");
+}
+
+#[test]
+fn groups_and_for_instances() {
+    let r = run("MISSION M:\n    SEQUENTIAL FOR team AS d:\n        d Hover WITH 1s\n    team Hover WITH 2s\n");
+    assert_eq!(r.t("capability_start", "actor", "a"), 0.0);
+    assert!(close(r.t("capability_start", "actor", "b"), 1.0), "SEQUENTIAL FOR runs instances one after another");
+    let second: Vec<f64> = r.trace.iter().filter(|e| e["event"] == "capability_start" && e["args"]["duration"] == 2.0).map(|e| e["t"].as_f64().unwrap()).collect();
+    assert_eq!(second.len(), 2, "a group as actor means each member");
+    assert!(close(second[0], 2.0) && close(second[1], 2.0), "in parallel: {second:?}");
+}
+
+#[test]
+fn an_unhandled_exception_fails_the_mission_and_sends_the_fleet_home() {
+    let r = run("MISSION M:\n    SEQUENTIAL:\n        a TakeOff WITH 20m\n        THROW EXCEPTION Broken\n        b TakeOff WITH 20m\n");
+    assert_eq!(r.outcome.status, Status::Failed);
+    assert!(r.outcome.reason.as_deref().unwrap_or("").contains("Broken"), "{:?}", r.outcome.reason);
+    assert_eq!(r.first("exception", "name", "Broken")["handled"], false);
+    assert!(r.find("capability_start", "actor", "b").is_empty());
+    let rtl = r.trace.iter().position(|e| e["event"] == "api_call" && e["function"] == "ReturnToLaunch" && e["actor"] == "a");
+    assert!(rtl.is_some(), "the drone in the air is sent home");
+    let end = r.trace.last().unwrap();
+    assert_eq!(end["event"], "mission_end");
+    assert_eq!(end["status"], "failed");
+}
+
+#[test]
+fn leashes_pause_resume_and_abort_an_activity() {
+    let r = run(
+        "MISSION M:\n    PARALLEL:\n        a FlyTo-F1 WITH Far\n        SEQUENTIAL:\n            b Hover WITH 10s\n            FlyTo-F1 PAUSE\n            b Hover WITH 10s\n            FlyTo-F1 RESUME\n            b Hover WITH 5s\n            FlyTo-F1 ABORT\n            FlyTo-F1 ABORT\n",
+    );
+    let actions: Vec<&str> = r.trace.iter().filter(|e| e["event"] == "leash").map(|e| e["action"].as_str().unwrap()).collect();
+    assert_eq!(actions, ["PAUSE", "RESUME", "ABORT", "ABORT"], "every leash is recorded, even one on an ended activity");
+    let fly = r.ends("FlyTo", "a")[0];
+    assert_eq!(fly["status"], "aborted");
+    assert!(close(fly["t"].as_f64().unwrap(), 25.0));
+    assert_eq!(r.outcome.status, Status::Ok, "an aborted activity does not change the outcome");
+}
+
+#[test]
+fn the_same_mission_gives_the_same_trace() {
+    let mission = "MISSION M:\n    PARALLEL P:\n        a FlyTo WITH Field\n        SEQUENTIAL:\n            b TakeOff\n            b FlyCircle WITH center=North, radius=30m\n        SEQUENTIAL:\n            c TakeOff\n            SIGNAL Up\n        ON Up:\n            c FlyTo WITH Far\n";
+    let (first, second) = (run(mission), run(mission));
+    assert_eq!(first.outcome.status, Status::Ok, "{}", first.dump());
+    assert_eq!(first.trace, second.trace);
+    assert!(first.trace.len() > 20);
+}
+
+
+#[test]
+fn a_failed_command_is_an_exception_of_its_actor() {
+    let r = run("MISSION M:\n    SEQUENTIAL:\n        b FlyCircle WITH center=North, radius=30m\n        c TakeOff\n");
+    let e = r.first("exception", "name", "CommandFailed");
+    assert_eq!(e["actor"], "b");
+    assert_eq!(e["args"][0], "b is on the ground: take off first");
+    assert_eq!(r.ends("FlyCircle", "b")[0]["status"], "failed");
+    assert!(r.find("capability_start", "actor", "c").is_empty(), "nothing starts after the failure");
+    assert!(r.find("signal", "name", "Up").is_empty());
+    assert_eq!(r.outcome.status, Status::Failed);
+}

@@ -1,0 +1,148 @@
+//! Reading a call's arguments, and the refusals a call can meet before it starts.
+
+use aviary_api::{Failure, Point, Value};
+
+use crate::geom::{self, circle_inside, contains, segment_inside};
+
+pub(crate) fn failed(reason: impl Into<String>) -> Failure {
+    Failure {
+        exception: "CommandFailed",
+        reason: reason.into(),
+    }
+}
+
+pub(crate) fn fence_violation(reason: impl Into<String>) -> Failure {
+    Failure {
+        exception: "GeofenceViolation",
+        reason: reason.into(),
+    }
+}
+
+fn arg<'a>(args: &'a [Value], i: usize, name: &str) -> Result<&'a Value, Failure> {
+    args.get(i)
+        .ok_or_else(|| failed(format!("missing argument `{name}`")))
+}
+
+fn number_value(v: &Value, name: &str) -> Result<f64, Failure> {
+    match v {
+        Value::Number(n) if n.is_finite() => Ok(*n),
+        other => Err(failed(format!(
+            "`{name}` must be a finite number, not {other:?}"
+        ))),
+    }
+}
+
+pub(crate) fn number(args: &[Value], i: usize, name: &str) -> Result<f64, Failure> {
+    number_value(arg(args, i, name)?, name)
+}
+
+pub(crate) fn opt_number(args: &[Value], i: usize, name: &str) -> Result<Option<f64>, Failure> {
+    args.get(i).map(|v| number_value(v, name)).transpose()
+}
+
+/// A position; an area stands for its centroid (at the altitude the drone keeps).
+pub(crate) fn point_value(v: &Value, name: &str) -> Result<Point, Failure> {
+    match v {
+        Value::Position(p)
+            if p.x.is_finite() && p.y.is_finite() && !matches!(p.z, Some(z) if !z.is_finite()) =>
+        {
+            Ok(*p)
+        }
+        Value::Area(polygon) if !polygon.is_empty() => {
+            let c = geom::centroid(polygon);
+            Ok(Point::flat(c[0], c[1]))
+        }
+        other => Err(failed(format!(
+            "`{name}` must be a position, not {other:?}"
+        ))),
+    }
+}
+
+pub(crate) fn point(args: &[Value], i: usize, name: &str) -> Result<Point, Failure> {
+    point_value(arg(args, i, name)?, name)
+}
+
+pub(crate) fn polygon(args: &[Value], i: usize, name: &str) -> Result<Vec<[f64; 2]>, Failure> {
+    match arg(args, i, name)? {
+        Value::Area(p)
+            if p.len() >= 3 && p.iter().all(|c| c[0].is_finite() && c[1].is_finite()) =>
+        {
+            if geom::area(p) <= 1e-9 {
+                return Err(failed(format!("`{name}` encloses no area")));
+            }
+            Ok(p.clone())
+        }
+        other => Err(failed(format!(
+            "`{name}` must be an area of at least 3 corners, not {other:?}"
+        ))),
+    }
+}
+
+/// A kind of target or payload: a symbol (or a text).
+pub(crate) fn kind(args: &[Value], i: usize, name: &str) -> Result<String, Failure> {
+    match arg(args, i, name)? {
+        Value::Symbol(s) | Value::Text(s) => Ok(s.clone()),
+        other => Err(failed(format!(
+            "`{name}` must be a kind such as Body, not {other:?}"
+        ))),
+    }
+}
+
+/// The site's limits on where a drone may fly.
+pub(crate) struct Limits<'a> {
+    pub fence: Option<&'a [[f64; 2]]>,
+    pub max_altitude: Option<f64>,
+}
+
+impl Limits<'_> {
+    pub fn altitude(&self, z: f64) -> Result<(), Failure> {
+        match self.max_altitude {
+            Some(max) if z > max + 1e-9 => Err(fence_violation(format!(
+                "altitude {z:.1} m is above the site's max_altitude of {max:.1} m"
+            ))),
+            _ => Ok(()),
+        }
+    }
+
+    /// A path of straight segments from `from` through `points`: every point within the
+    /// altitude limit and the geofence, and no segment leaving the geofence. (The first
+    /// segment is not checked when the drone is outside the geofence already.)
+    pub fn path(&self, from: [f64; 3], points: &[[f64; 3]]) -> Result<(), Failure> {
+        for p in points {
+            self.altitude(p[2])?;
+        }
+        let Some(fence) = self.fence else {
+            return Ok(());
+        };
+        let mut prev = [from[0], from[1]];
+        let mut check = contains(fence, prev);
+        for p in points {
+            let q = [p[0], p[1]];
+            if !contains(fence, q) {
+                return Err(fence_violation(format!(
+                    "({:.1}, {:.1}) is outside the geofence",
+                    q[0], q[1]
+                )));
+            }
+            if check && !segment_inside(fence, prev, q) {
+                return Err(fence_violation(format!(
+                    "the way from ({:.1}, {:.1}) to ({:.1}, {:.1}) leaves the geofence",
+                    prev[0], prev[1], q[0], q[1]
+                )));
+            }
+            prev = q;
+            check = true;
+        }
+        Ok(())
+    }
+
+    pub fn circle(&self, center: [f64; 2], radius: f64) -> Result<(), Failure> {
+        match self.fence {
+            Some(fence) if !circle_inside(fence, center, radius) => Err(fence_violation(format!(
+                "a circle of {radius:.1} m around ({:.1}, {:.1}) leaves the geofence",
+                center[0], center[1]
+            ))),
+            _ => Ok(()),
+        }
+    }
+}

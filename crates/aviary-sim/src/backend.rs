@@ -1,0 +1,218 @@
+//! [`SimBackend`]: the physics core behind the engine's [`Backend`] trait, driven by one
+//! tokio task that steps it every `tick` seconds of tokio time.
+
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard, Weak};
+use std::time::Duration;
+
+use aviary_api::{
+    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, FlightState, Interrupt, PendingCall,
+    Telemetry, Value,
+};
+use aviary_world::World;
+use tokio::sync::{mpsc, oneshot};
+use tokio::task::JoinHandle;
+use tokio::time::MissedTickBehavior;
+
+use crate::fleet::{Fleet, Release, Report};
+
+/// How the simulator runs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SimOptions {
+    /// Simulated seconds per physics step (default 0.05). Tokio's timer counts whole
+    /// milliseconds, so keep it a multiple of 0.001.
+    pub tick: f64,
+    /// `None`: as fast as the tokio clock goes (with a paused clock, no real time at all).
+    /// `Some(x)`: `x` times real time; the driver sleeps (blocking its thread) so that
+    /// simulated time never runs ahead of `x` × wall time. Run the runtime with a paused
+    /// clock in both cases, so that tokio time is simulated time.
+    pub speed: Option<f64>,
+}
+
+impl Default for SimOptions {
+    fn default() -> SimOptions {
+        SimOptions {
+            tick: 0.05,
+            speed: None,
+        }
+    }
+}
+
+struct State {
+    fleet: Fleet,
+    /// The answer channels of the calls in progress.
+    waiting: BTreeMap<CallId, oneshot::Sender<CallEnd>>,
+    events: mpsc::UnboundedSender<DroneEvent>,
+}
+
+impl State {
+    fn answer(&mut self, call: CallId, end: CallEnd) {
+        if let Some(tx) = self.waiting.remove(&call) {
+            // The engine may have stopped waiting; nothing to do then.
+            let _ = tx.send(end);
+        }
+    }
+}
+
+/// The built-in simulator as a [`Backend`].
+///
+/// The driver task stops at its next tick after [`SimBackend::stop`], or once every
+/// `Arc<SimBackend>` is gone (it holds only a weak reference). After it stops, calls in
+/// progress never end.
+pub struct SimBackend {
+    state: Mutex<State>,
+    events: Mutex<Option<mpsc::UnboundedReceiver<DroneEvent>>>,
+    stopped: AtomicBool,
+    driver: Mutex<Option<JoinHandle<()>>>,
+}
+
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+impl SimBackend {
+    /// Builds the fleet of `world` and spawns the driver task. Call it inside a tokio
+    /// runtime (for determinism and speed, a current-thread one with a paused clock).
+    ///
+    /// # Panics
+    /// Outside a tokio runtime, or when `options.tick` is not a positive number.
+    pub fn start(world: &World, options: SimOptions) -> Arc<SimBackend> {
+        assert!(
+            options.tick.is_finite() && options.tick > 0.0,
+            "SimOptions::tick must be positive"
+        );
+        let (tx, rx) = mpsc::unbounded_channel();
+        let backend = Arc::new(SimBackend {
+            state: Mutex::new(State {
+                fleet: Fleet::new(world),
+                waiting: BTreeMap::new(),
+                events: tx,
+            }),
+            events: Mutex::new(Some(rx)),
+            stopped: AtomicBool::new(false),
+            driver: Mutex::new(None),
+        });
+        let handle = tokio::spawn(drive(Arc::downgrade(&backend), options));
+        *lock(&backend.driver) = Some(handle);
+        backend
+    }
+
+    /// Asks the driver to stop at its next tick.
+    pub fn stop(&self) {
+        self.stopped.store(true, Ordering::SeqCst);
+    }
+
+    /// Stops the driver and waits until it has ended.
+    pub async fn shutdown(&self) {
+        self.stop();
+        let handle = lock(&self.driver).take();
+        if let Some(handle) = handle {
+            let _ = handle.await;
+        }
+    }
+
+    /// The driver task's handle (once), to await its end elsewhere.
+    pub fn take_driver(&self) -> Option<JoinHandle<()>> {
+        lock(&self.driver).take()
+    }
+
+    /// Simulated seconds so far.
+    pub fn time(&self) -> f64 {
+        lock(&self.state).fleet.time()
+    }
+
+    /// Every `ReleasePayload` so far (drone, kind, position, time).
+    pub fn releases(&self) -> Vec<Release> {
+        lock(&self.state).fleet.releases().to_vec()
+    }
+
+    /// Reads the physics core (under the lock: keep it short).
+    pub fn with_fleet<R>(&self, f: impl FnOnce(&Fleet) -> R) -> R {
+        f(&lock(&self.state).fleet)
+    }
+
+    /// One physics step: answers the calls that ended and sends the events.
+    fn tick(&self, dt: f64) {
+        let mut state = lock(&self.state);
+        for report in state.fleet.step(dt) {
+            match report {
+                Report::Ended { call, end } => state.answer(call, end),
+                Report::Event(event) => {
+                    let _ = state.events.send(event);
+                }
+            }
+        }
+    }
+}
+
+async fn drive(backend: Weak<SimBackend>, options: SimOptions) {
+    let period = Duration::from_secs_f64(options.tick);
+    let mut interval = tokio::time::interval_at(tokio::time::Instant::now() + period, period);
+    interval.set_missed_tick_behavior(MissedTickBehavior::Burst);
+    let wall = std::time::Instant::now();
+    let mut ticks: u64 = 0;
+    loop {
+        interval.tick().await;
+        let Some(sim) = backend.upgrade() else { return };
+        if sim.stopped.load(Ordering::SeqCst) {
+            return;
+        }
+        sim.tick(options.tick);
+        drop(sim);
+        ticks += 1;
+        if let Some(speed) = options.speed.filter(|s| s.is_finite() && *s > 0.0) {
+            let due = Duration::from_secs_f64(ticks as f64 * options.tick / speed);
+            let elapsed = wall.elapsed();
+            if due > elapsed {
+                std::thread::sleep(due - elapsed);
+            }
+        }
+    }
+}
+
+impl Backend for SimBackend {
+    fn descriptor(&self) -> Descriptor {
+        Descriptor::standard()
+    }
+
+    fn call(&self, drone: DroneId, function: &str, args: &[Value]) -> PendingCall {
+        let (tx, rx) = oneshot::channel();
+        let mut state = lock(&self.state);
+        let (id, end) = state.fleet.call(drone, function, args);
+        match end {
+            Some(end) => {
+                let _ = tx.send(end);
+            }
+            None => {
+                state.waiting.insert(id, tx);
+            }
+        }
+        PendingCall { id, end: rx }
+    }
+
+    fn interrupt(&self, call: CallId, how: Interrupt) {
+        let mut state = lock(&self.state);
+        if let Some(end) = state.fleet.interrupt(call, how) {
+            state.answer(call, end);
+        }
+    }
+
+    fn telemetry(&self, drone: DroneId) -> Telemetry {
+        lock(&self.state)
+            .fleet
+            .telemetry(drone)
+            .unwrap_or(Telemetry {
+                position: [0.0; 3],
+                speed: 0.0,
+                heading: 0.0,
+                battery: 0.0,
+                state: FlightState::Lost,
+                link: false,
+            })
+    }
+
+    fn events(&self) -> Option<mpsc::UnboundedReceiver<DroneEvent>> {
+        lock(&self.events).take()
+    }
+}

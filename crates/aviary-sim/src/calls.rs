@@ -1,0 +1,375 @@
+//! What each middle-layer function does when called (LANGUAGE.md §4).
+
+use aviary_api::{CallId, DroneId, Failure, FlightState, Value};
+
+use crate::args::{failed, kind, number, opt_number, point, point_value, polygon, Limits};
+use crate::drone::{Loading, SimDrone};
+use crate::fleet::{Fleet, Release};
+use crate::geom::dist;
+use crate::motion::{orbit_legs, Leg, MotionTask};
+use crate::sensors::{detection_range, Activation};
+use crate::sweep::lawnmower;
+
+/// Seconds `LoadPayload` takes.
+pub const LOAD_TIME: f64 = 2.0;
+/// `LoadPayload` needs the drone below this altitude (metres), or landed.
+pub const LOAD_MAX_ALTITUDE: f64 = 5.0;
+/// `ReturnToLaunch` flies home at least this high (metres), or at the site's limit.
+pub const RETURN_ALTITUDE: f64 = 10.0;
+/// A landed drone this close to home (metres) is home.
+const AT_HOME: f64 = 0.5;
+
+const MOTION: &[&str] = &[
+    "Arm",
+    "Disarm",
+    "TakeOff",
+    "Land",
+    "ReturnToLaunch",
+    "FlyToPosition",
+    "DescendTo",
+    "AscendTo",
+    "Hover",
+    "Orbit",
+    "Sweep",
+    "FollowPath",
+];
+
+/// How a call that was not refused goes on.
+enum Start {
+    Done,
+    Moves(Vec<Leg>),
+    Pending,
+}
+
+impl Fleet {
+    fn limits(&self) -> Limits<'_> {
+        Limits {
+            fence: self.fence.as_deref(),
+            max_altitude: self.max_altitude,
+        }
+    }
+
+    /// Starts a call; `Ok(true)` when it is in progress, `Ok(false)` when already done.
+    pub(crate) fn start(
+        &mut self,
+        id: DroneId,
+        call: CallId,
+        function: &str,
+        args: &[Value],
+    ) -> Result<bool, Failure> {
+        let d = self
+            .drones
+            .get(id)
+            .ok_or_else(|| failed(format!("there is no drone number {id}")))?;
+        if d.state == FlightState::Lost {
+            return Err(failed(format!("{} is lost", d.name)));
+        }
+        if d.link_loss.is_some() {
+            return Err(failed(format!("no link to {}", d.name)));
+        }
+        if let Some(why) = &d.disabled {
+            return Err(failed(why.clone()));
+        }
+        let motion = MOTION.contains(&function);
+        if motion && d.motion.is_some() {
+            return Err(failed(format!(
+                "{} is busy with another motion call",
+                d.name
+            )));
+        }
+        if motion && d.gps_loss.is_some() {
+            return Err(failed(format!("{} has no position fix", d.name)));
+        }
+        let start = if motion {
+            self.motion(id, function, args)?
+        } else {
+            self.other(id, call, function, args)?
+        };
+        match start {
+            Start::Done => Ok(false),
+            Start::Pending => Ok(true),
+            Start::Moves(legs) => {
+                let d = &mut self.drones[id];
+                d.motion = Some(MotionTask::new(Some(call), legs));
+                d.begin_leg();
+                Ok(true)
+            }
+        }
+    }
+
+    fn motion(&mut self, id: DroneId, function: &str, args: &[Value]) -> Result<Start, Failure> {
+        let limits = self.limits();
+        let d = &self.drones[id];
+        let here = d.pos;
+        let landed = d.state == FlightState::Landed;
+        let in_air = || {
+            if landed {
+                Err(failed(format!(
+                    "{} is on the ground: take off first",
+                    d.name
+                )))
+            } else {
+                Ok(())
+            }
+        };
+        let fly = |to: [f64; 3], speed: f64| Leg::Move {
+            to,
+            speed,
+            state: FlightState::Flying,
+        };
+        let legs = match function {
+            "Arm" | "Disarm" => {
+                if !landed {
+                    return Err(failed(format!(
+                        "{} can only {} on the ground",
+                        d.name,
+                        function.to_lowercase()
+                    )));
+                }
+                self.drones[id].armed = function == "Arm";
+                return Ok(Start::Done);
+            }
+            "TakeOff" => {
+                let alt = number(args, 0, "alt")?;
+                if alt <= 0.0 {
+                    return Err(failed(format!(
+                        "take-off altitude must be above 0 m, not {alt} m"
+                    )));
+                }
+                limits.altitude(alt)?;
+                let to = [here[0], here[1], alt];
+                if !landed {
+                    vec![fly(to, d.max_speed)]
+                } else if !d.armed {
+                    return Err(failed(format!(
+                        "{} is not armed: call Arm() before TakeOff",
+                        d.name
+                    )));
+                } else {
+                    vec![Leg::Move {
+                        to,
+                        speed: d.max_speed,
+                        state: FlightState::TakingOff,
+                    }]
+                }
+            }
+            "Land" => {
+                if landed {
+                    return Ok(Start::Done);
+                }
+                vec![Leg::Move {
+                    to: [here[0], here[1], 0.0],
+                    speed: d.max_speed,
+                    state: FlightState::Landing,
+                }]
+            }
+            "ReturnToLaunch" => return_legs(d, landed, limits.max_altitude)?,
+            "FlyToPosition" => {
+                in_air()?;
+                let p = point(args, 0, "pos")?;
+                let speed = match opt_number(args, 1, "speed")? {
+                    Some(s) if s <= 0.0 => {
+                        return Err(failed(format!("speed must be above 0 m/s, not {s} m/s")))
+                    }
+                    Some(s) => s.min(d.max_speed),
+                    None => d.max_speed,
+                };
+                let to = [p.x, p.y, p.z.unwrap_or(here[2])];
+                if to[2] < 0.0 {
+                    return Err(failed(format!("altitude {} m is below the ground", to[2])));
+                }
+                limits.path(here, &[to])?;
+                vec![fly(to, speed)]
+            }
+            "DescendTo" | "AscendTo" => {
+                in_air()?;
+                let alt = number(args, 0, "alt")?;
+                if alt < 0.0 {
+                    return Err(failed(format!("altitude {alt} m is below the ground")));
+                }
+                limits.altitude(alt)?;
+                vec![fly([here[0], here[1], alt], d.max_speed)]
+            }
+            "Hover" => {
+                let duration = number(args, 0, "duration")?;
+                if duration < 0.0 {
+                    return Err(failed(format!("a hover cannot last {duration} s")));
+                }
+                vec![Leg::Hold { left: duration }]
+            }
+            "Orbit" => {
+                in_air()?;
+                let c = point(args, 0, "center")?;
+                let radius = number(args, 1, "radius")?;
+                let laps = opt_number(args, 2, "laps")?.unwrap_or(1.0);
+                if radius <= 0.0 || laps <= 0.0 {
+                    return Err(failed(format!(
+                        "an orbit needs a radius and laps above 0 (got {radius} m, {laps})"
+                    )));
+                }
+                let legs = orbit_legs(d, [c.x, c.y], radius, laps);
+                if let Some(Leg::Move { to, .. }) = legs.first() {
+                    limits.path(here, &[*to])?;
+                }
+                limits.circle([c.x, c.y], radius)?;
+                legs
+            }
+            "Sweep" => {
+                in_air()?;
+                let area = polygon(args, 0, "area")?;
+                let spacing = number(args, 1, "spacing")?;
+                if spacing <= 0.0 {
+                    return Err(failed(format!(
+                        "sweep spacing must be above 0 m, not {spacing} m"
+                    )));
+                }
+                let path: Vec<[f64; 3]> = lawnmower(&area, spacing)
+                    .into_iter()
+                    .map(|p| [p[0], p[1], here[2]])
+                    .collect();
+                limits.path(here, &path)?;
+                path.into_iter().map(|to| fly(to, d.max_speed)).collect()
+            }
+            "FollowPath" => {
+                in_air()?;
+                let mut z = here[2];
+                let mut path = Vec::new();
+                for (i, v) in args.iter().enumerate() {
+                    let p = point_value(v, &format!("points[{i}]"))?;
+                    z = p.z.unwrap_or(z);
+                    if z < 0.0 {
+                        return Err(failed(format!("altitude {z} m is below the ground")));
+                    }
+                    path.push([p.x, p.y, z]);
+                }
+                limits.path(here, &path)?;
+                path.into_iter().map(|to| fly(to, d.max_speed)).collect()
+            }
+            other => return Err(failed(format!("unknown function {other}"))),
+        };
+        Ok(if legs.is_empty() {
+            Start::Done
+        } else {
+            Start::Moves(legs)
+        })
+    }
+
+    fn other(
+        &mut self,
+        id: DroneId,
+        call: CallId,
+        function: &str,
+        args: &[Value],
+    ) -> Result<Start, Failure> {
+        let time = self.time;
+        let d = &mut self.drones[id];
+        match function {
+            "StartStreaming" | "StopStreaming" => {
+                if !d.sensors.iter().any(|s| s == "camera") {
+                    return Err(failed(format!("{} has no camera", d.name)));
+                }
+                d.streaming = function == "StartStreaming";
+            }
+            "StartDetection" | "StopDetection" => {
+                let kind = kind(args, 0, "kind")?;
+                let Some(range) = detection_range(&self.sensors, &d.sensors, &kind) else {
+                    return Err(failed(format!(
+                        "{} has no sensor that detects {kind}",
+                        d.name
+                    )));
+                };
+                d.detections.retain(|a| a.kind != kind);
+                if function == "StartDetection" {
+                    d.detections.push(Activation {
+                        kind,
+                        range,
+                        found: vec![false; self.targets.len()],
+                    });
+                }
+            }
+            "LoadPayload" => {
+                let kind = kind(args, 0, "kind")?;
+                if !d.payload_kinds.contains(&kind) {
+                    let can = if d.payload_kinds.is_empty() {
+                        "nothing".to_owned()
+                    } else {
+                        d.payload_kinds.join(", ")
+                    };
+                    return Err(failed(format!(
+                        "{} cannot carry {kind} (it can carry: {can})",
+                        d.name
+                    )));
+                }
+                if let Some(held) = d.carrying.as_ref().or(d.loading.as_ref().map(|l| &l.kind)) {
+                    return Err(failed(format!(
+                        "{} already carries {held}: release it first",
+                        d.name
+                    )));
+                }
+                if d.state != FlightState::Landed && d.pos[2] >= LOAD_MAX_ALTITUDE {
+                    return Err(failed(format!(
+                        "{} is at {:.1} m: load while landed or below {LOAD_MAX_ALTITUDE} m",
+                        d.name, d.pos[2]
+                    )));
+                }
+                d.loading = Some(Loading {
+                    call,
+                    kind,
+                    left: LOAD_TIME,
+                    paused: false,
+                });
+                return Ok(Start::Pending);
+            }
+            "ReleasePayload" => {
+                let Some(kind) = d.carrying.take() else {
+                    return Err(failed(format!("{} carries nothing to release", d.name)));
+                };
+                self.releases.push(Release {
+                    drone: id,
+                    kind,
+                    position: d.pos,
+                    time,
+                });
+            }
+            other => return Err(failed(format!("unknown function {other}"))),
+        }
+        Ok(Start::Done)
+    }
+}
+
+/// `ReturnToLaunch`: up to the return altitude, home, and down.
+fn return_legs(d: &SimDrone, landed: bool, max_altitude: Option<f64>) -> Result<Vec<Leg>, Failure> {
+    let home_dist = dist(d.xy(), d.home);
+    if landed {
+        if home_dist <= AT_HOME {
+            return Ok(Vec::new());
+        }
+        return Err(failed(format!(
+            "{} is on the ground away from home: take off first",
+            d.name
+        )));
+    }
+    let z = d.pos[2];
+    let safe = z.max(RETURN_ALTITUDE.min(max_altitude.unwrap_or(f64::INFINITY)));
+    let mut legs = Vec::new();
+    if safe > z {
+        legs.push(Leg::Move {
+            to: [d.pos[0], d.pos[1], safe],
+            speed: d.max_speed,
+            state: FlightState::Flying,
+        });
+    }
+    if home_dist > 0.0 {
+        legs.push(Leg::Move {
+            to: [d.home[0], d.home[1], safe],
+            speed: d.max_speed,
+            state: FlightState::Flying,
+        });
+    }
+    legs.push(Leg::Move {
+        to: [d.home[0], d.home[1], 0.0],
+        speed: d.max_speed,
+        state: FlightState::Landing,
+    });
+    Ok(legs)
+}

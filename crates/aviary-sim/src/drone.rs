@@ -1,0 +1,142 @@
+//! One simulated drone: what the world file says of it, and its state.
+
+use aviary_api::{CallId, FlightState, Telemetry};
+use aviary_world::Drone;
+
+use crate::motion::MotionTask;
+use crate::sensors::Activation;
+
+/// `LoadPayload` in progress.
+#[derive(Clone, Debug)]
+pub(crate) struct Loading {
+    pub call: CallId,
+    pub kind: String,
+    /// Seconds to go.
+    pub left: f64,
+    pub paused: bool,
+}
+
+/// A fault with a duration (link or GPS loss) in progress.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Outage {
+    /// Simulated time at which it ends.
+    pub until: f64,
+}
+
+#[derive(Clone, Debug)]
+pub(crate) struct SimDrone {
+    pub name: String,
+    pub home: [f64; 2],
+    pub max_speed: f64,
+    pub climb_rate: f64,
+    pub accel: f64,
+    pub endurance: f64,
+    pub sensors: Vec<String>,
+    pub payload_kinds: Vec<String>,
+
+    pub pos: [f64; 3],
+    /// Instantaneous velocity, m/s.
+    pub vel: [f64; 3],
+    pub heading: f64,
+    /// Fraction of a full battery.
+    pub battery: f64,
+    pub state: FlightState,
+    pub armed: bool,
+    pub motion: Option<MotionTask>,
+    pub loading: Option<Loading>,
+    pub carrying: Option<String>,
+    pub streaming: bool,
+    pub detections: Vec<Activation>,
+    pub low_sent: bool,
+    pub critical_sent: bool,
+    pub link_loss: Option<Outage>,
+    pub gps_loss: Option<Outage>,
+    /// Why the drone takes no more commands (a motor failure).
+    pub disabled: Option<String>,
+    /// Metres flown (along the way, climbs included).
+    pub odometer: f64,
+    /// Seconds in the air.
+    pub flight_time: f64,
+}
+
+impl SimDrone {
+    pub fn new(d: &Drone) -> SimDrone {
+        SimDrone {
+            name: d.name.clone(),
+            home: [d.home[0], d.home[1]],
+            max_speed: d.max_speed,
+            climb_rate: d.climb_rate,
+            accel: d.acceleration,
+            endurance: d.endurance,
+            sensors: d.sensors.clone(),
+            payload_kinds: d.payload.clone(),
+            pos: [d.home[0], d.home[1], 0.0],
+            vel: [0.0; 3],
+            heading: 0.0,
+            battery: d.battery / 100.0,
+            state: FlightState::Landed,
+            armed: false,
+            motion: None,
+            loading: None,
+            carrying: None,
+            streaming: false,
+            detections: Vec::new(),
+            low_sent: false,
+            critical_sent: false,
+            link_loss: None,
+            gps_loss: None,
+            disabled: None,
+            odometer: 0.0,
+            flight_time: 0.0,
+        }
+    }
+
+    pub fn xy(&self) -> [f64; 2] {
+        [self.pos[0], self.pos[1]]
+    }
+
+    pub fn telemetry(&self) -> Telemetry {
+        Telemetry {
+            position: self.pos,
+            speed: self.vel[0].hypot(self.vel[1]),
+            heading: self.heading,
+            battery: self.battery,
+            state: self.state,
+            link: self.link_loss.is_none(),
+        }
+    }
+
+    /// Stops every move at once: the drone holds where it is.
+    pub fn hold(&mut self) {
+        self.vel = [0.0; 3];
+        if let Some(task) = &mut self.motion {
+            task.rest();
+        }
+    }
+
+    /// After a move was cut short: hover if in the air, stay landed on the ground.
+    pub fn settle(&mut self) {
+        self.vel = [0.0; 3];
+        if matches!(self.state, FlightState::TakingOff | FlightState::Landing) {
+            self.state = if self.pos[2] > 0.01 {
+                FlightState::Flying
+            } else {
+                FlightState::Landed
+            };
+        }
+    }
+
+    /// Ends every call in progress (motion and loading), for a fault; returns their ids in
+    /// a fixed order (motion first).
+    pub fn cut_calls(&mut self) -> Vec<CallId> {
+        let mut ended = Vec::new();
+        if let Some(task) = self.motion.take() {
+            ended.extend(task.call);
+        }
+        if let Some(load) = self.loading.take() {
+            ended.push(load.call);
+        }
+        self.settle();
+        ended
+    }
+}

@@ -1,0 +1,108 @@
+//! The world file's `[[faults]]`: injected at their mission time (simulated seconds since
+//! the fleet was made), each once.
+//!
+//! - `battery_critical`: `BatteryCritical` (counts as the drone's one battery alarm).
+//! - `crash`: the drone falls (`DroneLost`), as when its battery runs out.
+//! - `motor_failure`: `MotorFailure`; the drone makes an emergency landing where it is and
+//!   refuses every later command.
+//! - `link_loss` (`duration`): `ConnectionLost`; the drone holds where it is and refuses
+//!   commands until the link is back, then raises `ConnectionRestored`.
+//! - `gps_loss` (`duration`): `PositionLost`; the drone holds and refuses motion commands
+//!   until the fix is back.
+//!
+//! Each of them ends the drone's calls in progress `Interrupted`. A fault on a lost drone
+//! does nothing.
+
+use aviary_api::{DroneEvent, FlightState};
+use aviary_world::FaultKind;
+
+use crate::drone::Outage;
+use crate::fleet::{Fleet, Report};
+use crate::motion::{Leg, MotionTask};
+
+impl Fleet {
+    /// Fires the faults due by `end` (in file order), and ends the outages that are over.
+    pub(crate) fn fire_faults(&mut self, end: f64, out: &mut Vec<Report>) {
+        for i in 0..self.faults.len() {
+            let f = &mut self.faults[i];
+            if f.fired || f.at > end + 1e-9 {
+                continue;
+            }
+            f.fired = true;
+            let (id, kind, until) = (f.drone, f.kind, f.at + f.duration);
+            if self.drones[id].state == FlightState::Lost {
+                continue;
+            }
+            let name = self.drones[id].name.clone();
+            match kind {
+                FaultKind::BatteryCritical => {
+                    let d = &mut self.drones[id];
+                    if d.critical_sent {
+                        continue;
+                    }
+                    d.critical_sent = true;
+                    d.low_sent = true;
+                    self.fault(
+                        id,
+                        "BatteryCritical",
+                        format!("{name}: battery critical (simulated fault)"),
+                        out,
+                    );
+                }
+                FaultKind::Crash => self.lose(id, format!("{name} crashed (simulated fault)"), out),
+                FaultKind::MotorFailure => {
+                    self.fault(
+                        id,
+                        "MotorFailure",
+                        format!("{name}: motor failure (simulated fault)"),
+                        out,
+                    );
+                    let d = &mut self.drones[id];
+                    d.disabled = Some(format!("{name} had a motor failure"));
+                    if d.state.airborne() {
+                        let to = [d.pos[0], d.pos[1], 0.0];
+                        let leg = Leg::Move {
+                            to,
+                            speed: d.max_speed,
+                            state: FlightState::Landing,
+                        };
+                        d.motion = Some(MotionTask::new(None, vec![leg]));
+                        d.begin_leg();
+                    }
+                }
+                FaultKind::LinkLoss => {
+                    self.fault(
+                        id,
+                        "ConnectionLost",
+                        format!("{name}: link lost (simulated fault)"),
+                        out,
+                    );
+                    self.drones[id].link_loss = Some(Outage { until });
+                }
+                FaultKind::GpsLoss => {
+                    self.fault(
+                        id,
+                        "PositionLost",
+                        format!("{name}: GPS lost (simulated fault)"),
+                        out,
+                    );
+                    self.drones[id].gps_loss = Some(Outage { until });
+                }
+            }
+        }
+        for (id, d) in self.drones.iter_mut().enumerate() {
+            if d.link_loss.is_some_and(|o| o.until <= end + 1e-9) {
+                d.link_loss = None;
+                if d.state != FlightState::Lost {
+                    out.push(Report::Event(DroneEvent::Signal {
+                        drone: id,
+                        name: "ConnectionRestored",
+                    }));
+                }
+            }
+            if d.gps_loss.is_some_and(|o| o.until <= end + 1e-9) {
+                d.gps_loss = None;
+            }
+        }
+    }
+}

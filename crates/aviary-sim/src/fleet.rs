@@ -1,0 +1,304 @@
+//! The physics core: every drone of the world, advanced tick by tick. Pure: no clock, no
+//! channels, no randomness; the same calls and steps give the same results bit for bit.
+
+use aviary_api::{
+    CallEnd, CallId, DroneEvent, DroneId, Failure, FlightState, Interrupt, Telemetry, Value,
+};
+use aviary_world::{FaultKind, Sensor, Target, World};
+
+use crate::battery;
+use crate::drone::SimDrone;
+use crate::geom::heading;
+use crate::sensors::scan;
+
+/// Something that happened during a [`Fleet::step`], in the order it happened.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Report {
+    /// A call in progress ended.
+    Ended { call: CallId, end: CallEnd },
+    /// A drone event for the engine.
+    Event(DroneEvent),
+}
+
+/// One `ReleasePayload`: which drone let go of what, where and when (simulated seconds).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Release {
+    pub drone: DroneId,
+    pub kind: String,
+    pub position: [f64; 3],
+    pub time: f64,
+}
+
+/// A `[[faults]]` entry of the world file, by drone index.
+#[derive(Clone, Debug)]
+pub(crate) struct ScheduledFault {
+    pub drone: DroneId,
+    pub kind: FaultKind,
+    pub at: f64,
+    pub duration: f64,
+    pub fired: bool,
+}
+
+/// The simulated fleet. Drones are indexed as in the world file.
+#[derive(Clone, Debug)]
+pub struct Fleet {
+    pub(crate) drones: Vec<SimDrone>,
+    pub(crate) fence: Option<Vec<[f64; 2]>>,
+    pub(crate) max_altitude: Option<f64>,
+    pub(crate) sensors: Vec<Sensor>,
+    pub(crate) targets: Vec<Target>,
+    pub(crate) faults: Vec<ScheduledFault>,
+    pub(crate) time: f64,
+    pub(crate) next_call: u64,
+    pub(crate) releases: Vec<Release>,
+}
+
+impl Fleet {
+    /// Every drone of the world, landed and disarmed at its home (at ground level), with
+    /// the world's start charge.
+    pub fn new(world: &World) -> Fleet {
+        let faults = world
+            .faults
+            .iter()
+            .filter_map(|f| {
+                let drone = world.drones.iter().position(|d| d.name == f.drone)?;
+                Some(ScheduledFault {
+                    drone,
+                    kind: f.kind,
+                    at: f.at,
+                    duration: f.duration.unwrap_or(0.0),
+                    fired: false,
+                })
+            })
+            .collect();
+        Fleet {
+            drones: world.drones.iter().map(SimDrone::new).collect(),
+            fence: world.site.geofence.clone(),
+            max_altitude: world.site.max_altitude,
+            sensors: world.sensors.clone(),
+            targets: world.targets.clone(),
+            faults,
+            time: 0.0,
+            next_call: 1,
+            releases: Vec::new(),
+        }
+    }
+
+    /// Simulated seconds since the fleet was made (the sum of the steps).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    pub fn len(&self) -> usize {
+        self.drones.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.drones.is_empty()
+    }
+
+    /// The drone's state now; `None` for an index the world does not have.
+    pub fn telemetry(&self, drone: DroneId) -> Option<Telemetry> {
+        self.drones.get(drone).map(SimDrone::telemetry)
+    }
+
+    /// (metres flown, seconds in the air) of the drone so far; zeros for an index the
+    /// world does not have.
+    pub fn odometry(&self, drone: DroneId) -> (f64, f64) {
+        self.drones
+            .get(drone)
+            .map_or((0.0, 0.0), |d| (d.odometer, d.flight_time))
+    }
+
+    /// Every `ReleasePayload` so far, in order.
+    pub fn releases(&self) -> &[Release] {
+        &self.releases
+    }
+
+    /// What the drone carries.
+    pub fn carrying(&self, drone: DroneId) -> Option<&str> {
+        self.drones.get(drone)?.carrying.as_deref()
+    }
+
+    /// Whether the drone's video stream is on.
+    pub fn streaming(&self, drone: DroneId) -> bool {
+        self.drones.get(drone).is_some_and(|d| d.streaming)
+    }
+
+    /// The kinds the drone is detecting, in the order detection started.
+    pub fn detecting(&self, drone: DroneId) -> Vec<String> {
+        self.drones
+            .get(drone)
+            .map(|d| d.detections.iter().map(|a| a.kind.clone()).collect())
+            .unwrap_or_default()
+    }
+
+    /// Starts `function` on `drone`. Returns the call's id and, when the call is already
+    /// over (an instant function, or a refusal), how it ended; otherwise the end comes in a
+    /// later [`Fleet::step`] (or [`Fleet::interrupt`]).
+    pub fn call(
+        &mut self,
+        drone: DroneId,
+        function: &str,
+        args: &[Value],
+    ) -> (CallId, Option<CallEnd>) {
+        let id = CallId(self.next_call);
+        self.next_call += 1;
+        let end = match self.start(drone, id, function, args) {
+            Ok(true) => None,
+            Ok(false) => Some(CallEnd::Done),
+            Err(failure) => Some(CallEnd::Failed(failure)),
+        };
+        (id, end)
+    }
+
+    /// Aborts, pauses or resumes a call in progress. Returns the call's end when that
+    /// ends it (an abort). A call that is not in progress is left alone.
+    pub fn interrupt(&mut self, call: CallId, how: Interrupt) -> Option<CallEnd> {
+        for d in &mut self.drones {
+            if d.motion.as_ref().is_some_and(|t| t.call == Some(call)) {
+                match how {
+                    Interrupt::Abort => {
+                        d.motion = None;
+                        d.settle();
+                        return Some(CallEnd::Interrupted);
+                    }
+                    Interrupt::Pause => {
+                        if let Some(task) = d.motion.as_mut() {
+                            task.paused = true;
+                        }
+                        d.hold();
+                    }
+                    Interrupt::Resume => {
+                        if let Some(task) = d.motion.as_mut() {
+                            task.paused = false;
+                        }
+                    }
+                }
+                return None;
+            }
+            if let Some(load) = d.loading.as_mut().filter(|l| l.call == call) {
+                match how {
+                    Interrupt::Abort => {
+                        d.loading = None;
+                        return Some(CallEnd::Interrupted);
+                    }
+                    Interrupt::Pause => load.paused = true,
+                    Interrupt::Resume => load.paused = false,
+                }
+                return None;
+            }
+        }
+        None
+    }
+
+    /// Advances every drone by `dt` simulated seconds.
+    pub fn step(&mut self, dt: f64) -> Vec<Report> {
+        let end = self.time + dt;
+        let mut out = Vec::new();
+        self.fire_faults(end, &mut out);
+        for id in 0..self.drones.len() {
+            self.step_drone(id, dt, &mut out);
+        }
+        self.time = end;
+        out
+    }
+
+    fn step_drone(&mut self, id: DroneId, dt: f64, out: &mut Vec<Report>) {
+        let d = &mut self.drones[id];
+        if d.state == FlightState::Lost {
+            return;
+        }
+        let airborne = d.state.airborne();
+        let from = d.xy();
+        let before = d.pos;
+        if let Some(task) = d.tick_motion(dt) {
+            if let Some(call) = task.call {
+                out.push(Report::Ended {
+                    call,
+                    end: CallEnd::Done,
+                });
+            }
+        }
+        if d.vel[0].hypot(d.vel[1]) > 1e-9 {
+            d.heading = heading(d.vel[0], d.vel[1]);
+        }
+        if let Some(load) = d.loading.as_mut().filter(|l| !l.paused) {
+            load.left -= dt;
+            if load.left <= 1e-9 {
+                let call = load.call;
+                d.carrying = d.loading.take().map(|l| l.kind);
+                out.push(Report::Ended {
+                    call,
+                    end: CallEnd::Done,
+                });
+            }
+        }
+        let to = d.xy();
+        let moved = [
+            d.pos[0] - before[0],
+            d.pos[1] - before[1],
+            d.pos[2] - before[2],
+        ];
+        d.odometer += (moved[0] * moved[0] + moved[1] * moved[1] + moved[2] * moved[2]).sqrt();
+        if airborne {
+            d.flight_time += dt;
+        }
+        out.extend(
+            scan(id, &mut d.detections, &self.targets, from, to)
+                .into_iter()
+                .map(Report::Event),
+        );
+        let alarms = battery::drain(d, dt, airborne);
+        if alarms.low {
+            out.push(Report::Event(DroneEvent::Signal {
+                drone: id,
+                name: "BatteryLow",
+            }));
+        }
+        if alarms.critical {
+            let reason = format!(
+                "{}: {:.0}% left, about what it needs to get home",
+                d.name,
+                d.battery * 100.0
+            );
+            self.fault(id, "BatteryCritical", reason, out);
+        }
+        if alarms.empty {
+            let reason = format!("{}: battery empty", self.drones[id].name);
+            self.lose(id, reason, out);
+        }
+    }
+
+    /// Raises a fault on a drone and ends its calls in progress (`Interrupted`).
+    pub(crate) fn fault(
+        &mut self,
+        id: DroneId,
+        exception: &'static str,
+        reason: String,
+        out: &mut Vec<Report>,
+    ) {
+        out.push(Report::Event(DroneEvent::Fault {
+            drone: id,
+            failure: Failure { exception, reason },
+        }));
+        for call in self.drones[id].cut_calls() {
+            out.push(Report::Ended {
+                call,
+                end: CallEnd::Interrupted,
+            });
+        }
+    }
+
+    /// The drone falls to the ground and is gone for good (`DroneLost`).
+    pub(crate) fn lose(&mut self, id: DroneId, reason: String, out: &mut Vec<Report>) {
+        self.fault(id, "DroneLost", reason, out);
+        let d = &mut self.drones[id];
+        d.state = FlightState::Lost;
+        d.armed = false;
+        d.pos[2] = 0.0;
+        d.vel = [0.0; 3];
+        d.streaming = false;
+        d.detections.clear();
+    }
+}

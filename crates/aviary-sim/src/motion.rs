@@ -1,0 +1,217 @@
+//! Moves: a motion call becomes a queue of legs, flown one after the other, each from
+//! rest to rest with the trapezoidal profile of [`crate::profile`].
+
+use std::collections::VecDeque;
+use std::f64::consts::TAU;
+
+use aviary_api::{CallId, FlightState};
+
+use crate::drone::SimDrone;
+use crate::geom;
+use crate::profile::advance;
+
+/// One piece of a move.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum Leg {
+    /// A straight line over the ground to `to[0..2]` at up to `speed`, and at the same time
+    /// a vertical move to `to[2]` at up to the climb rate. `state` is the flight state
+    /// while it lasts: `TakingOff` becomes `Flying` at the end, `Landing` becomes `Landed`
+    /// (and disarmed).
+    Move {
+        to: [f64; 3],
+        speed: f64,
+        state: FlightState,
+    },
+    /// Hold position for `left` seconds.
+    Hold { left: f64 },
+    /// `total` radians of a circle, clockwise seen from above, from angle `start`
+    /// (counter-clockwise from east), at up to `speed`.
+    Arc {
+        center: [f64; 2],
+        radius: f64,
+        start: f64,
+        total: f64,
+        speed: f64,
+    },
+}
+
+/// A motion call in progress (or, with no call, something the drone does on its own, such
+/// as the emergency landing after a motor failure).
+#[derive(Clone, Debug)]
+pub(crate) struct MotionTask {
+    pub call: Option<CallId>,
+    pub legs: VecDeque<Leg>,
+    pub paused: bool,
+    /// Speed along the current leg over the ground, vertically, and along an arc.
+    ground_speed: f64,
+    climb_speed: f64,
+    arc_speed: f64,
+    /// Radians of the current arc flown.
+    arc_done: f64,
+}
+
+impl MotionTask {
+    pub fn new(call: Option<CallId>, legs: Vec<Leg>) -> MotionTask {
+        MotionTask {
+            call,
+            legs: legs.into(),
+            paused: false,
+            ground_speed: 0.0,
+            climb_speed: 0.0,
+            arc_speed: 0.0,
+            arc_done: 0.0,
+        }
+    }
+
+    /// Brings every speed to zero (a pause, or the start of a leg).
+    pub fn rest(&mut self) {
+        self.ground_speed = 0.0;
+        self.climb_speed = 0.0;
+        self.arc_speed = 0.0;
+    }
+}
+
+/// The tangential acceleration on an arc: with the centripetal part at most `a / 2`, the
+/// total stays within `a`.
+fn arc_accel(a: f64) -> f64 {
+    a * 0.75f64.sqrt()
+}
+
+/// The speed of an orbit: at most `max_speed`, and a centripetal acceleration of at most
+/// half the drone's acceleration.
+pub(crate) fn orbit_speed(max_speed: f64, accel: f64, radius: f64) -> f64 {
+    max_speed.min((accel * radius / 2.0).sqrt())
+}
+
+impl SimDrone {
+    /// Sets the flight state the first leg of the task flies in.
+    pub fn begin_leg(&mut self) {
+        if let Some(Leg::Move { state, .. }) = self.motion.as_ref().and_then(|t| t.legs.front()) {
+            self.state = *state;
+        }
+    }
+
+    /// Advances the motion task by `dt`. Returns the finished task, if it finished.
+    pub fn tick_motion(&mut self, dt: f64) -> Option<MotionTask> {
+        let Some(task) = self.motion.as_mut() else {
+            self.vel = [0.0; 3];
+            return None;
+        };
+        if task.paused {
+            self.vel = [0.0; 3];
+            return None;
+        }
+        let done = match task.legs.front_mut() {
+            None => true,
+            Some(Leg::Hold { left }) => {
+                self.vel = [0.0; 3];
+                *left -= dt;
+                *left <= 1e-9
+            }
+            Some(Leg::Move { to, speed, .. }) => {
+                let (to, speed) = (*to, *speed);
+                let here = [self.pos[0], self.pos[1]];
+                let d = geom::dist(here, [to[0], to[1]]);
+                let h = advance(d, task.ground_speed, speed, self.accel, dt);
+                task.ground_speed = h.speed;
+                if h.arrived {
+                    self.pos[0] = to[0];
+                    self.pos[1] = to[1];
+                    self.vel[0] = 0.0;
+                    self.vel[1] = 0.0;
+                } else {
+                    let (ux, uy) = ((to[0] - here[0]) / d, (to[1] - here[1]) / d);
+                    self.pos[0] += ux * h.moved;
+                    self.pos[1] += uy * h.moved;
+                    self.vel[0] = ux * h.speed;
+                    self.vel[1] = uy * h.speed;
+                }
+                let dz = to[2] - self.pos[2];
+                let v = advance(dz.abs(), task.climb_speed, self.climb_rate, self.accel, dt);
+                task.climb_speed = v.speed;
+                if v.arrived {
+                    self.pos[2] = to[2];
+                    self.vel[2] = 0.0;
+                } else {
+                    self.pos[2] += dz.signum() * v.moved;
+                    self.vel[2] = dz.signum() * v.speed;
+                }
+                h.arrived && v.arrived
+            }
+            Some(Leg::Arc {
+                center,
+                radius,
+                start,
+                total,
+                speed,
+            }) => {
+                let (center, radius, start, total, speed) =
+                    (*center, *radius, *start, *total, *speed);
+                let left = (total - task.arc_done) * radius;
+                let step = advance(left, task.arc_speed, speed, arc_accel(self.accel), dt);
+                task.arc_speed = step.speed;
+                task.arc_done = if step.arrived {
+                    total
+                } else {
+                    task.arc_done + step.moved / radius
+                };
+                let theta = start - task.arc_done;
+                self.pos[0] = center[0] + radius * theta.cos();
+                self.pos[1] = center[1] + radius * theta.sin();
+                self.vel = [theta.sin() * step.speed, -theta.cos() * step.speed, 0.0];
+                step.arrived
+            }
+        };
+        if !done {
+            return None;
+        }
+        let leg = task.legs.pop_front();
+        task.rest();
+        task.arc_done = 0.0;
+        self.vel = [0.0; 3];
+        if let Some(Leg::Move { state, .. }) = leg {
+            match state {
+                FlightState::TakingOff => self.state = FlightState::Flying,
+                FlightState::Landing => {
+                    self.state = FlightState::Landed;
+                    self.armed = false;
+                }
+                _ => {}
+            }
+        }
+        if task.legs.is_empty() {
+            return self.motion.take();
+        }
+        self.begin_leg();
+        None
+    }
+}
+
+/// The legs of `Orbit`: to the nearest point of the circle, then `laps` turns.
+pub(crate) fn orbit_legs(d: &SimDrone, center: [f64; 2], radius: f64, laps: f64) -> Vec<Leg> {
+    let (dx, dy) = (d.pos[0] - center[0], d.pos[1] - center[1]);
+    let start = if dx == 0.0 && dy == 0.0 {
+        0.0
+    } else {
+        dy.atan2(dx)
+    };
+    let entry = [
+        center[0] + radius * start.cos(),
+        center[1] + radius * start.sin(),
+        d.pos[2],
+    ];
+    vec![
+        Leg::Move {
+            to: entry,
+            speed: d.max_speed,
+            state: FlightState::Flying,
+        },
+        Leg::Arc {
+            center,
+            radius,
+            start,
+            total: laps * TAU,
+            speed: orbit_speed(d.max_speed, d.accel, radius),
+        },
+    ]
+}

@@ -1,0 +1,61 @@
+//! Detection: while `StartDetection(kind)` is on, every target of that kind that comes
+//! within the sensor's range of the drone's ground point is reported once.
+
+use aviary_api::{DroneEvent, DroneId};
+use aviary_world::{Sensor, Target};
+
+use crate::geom::dist_to_segment;
+
+/// One activation of detection of a kind: from a `StartDetection` to the next
+/// `StartDetection` or `StopDetection` of that kind.
+#[derive(Clone, Debug)]
+pub(crate) struct Activation {
+    pub kind: String,
+    /// Metres from the drone's ground point.
+    pub range: f64,
+    /// Per world target (in file order): found in this activation.
+    pub found: Vec<bool>,
+}
+
+/// The range at which a drone with `sensors` detects `kind`: the largest range of its
+/// sensors whose `detects` lists the kind; `None` when none does.
+pub(crate) fn detection_range(
+    world_sensors: &[Sensor],
+    sensors: &[String],
+    kind: &str,
+) -> Option<f64> {
+    world_sensors
+        .iter()
+        .filter(|s| sensors.contains(&s.kind) && s.detects.iter().any(|k| k == kind))
+        .map(|s| s.range)
+        .reduce(f64::max)
+}
+
+/// The targets found while the drone flew from `from` to `to` (ground points) this tick,
+/// marking them found; events in activation order, then target order.
+pub(crate) fn scan(
+    drone: DroneId,
+    activations: &mut [Activation],
+    targets: &[Target],
+    from: [f64; 2],
+    to: [f64; 2],
+) -> Vec<DroneEvent> {
+    let mut events = Vec::new();
+    for act in activations.iter_mut() {
+        for (i, target) in targets.iter().enumerate() {
+            if act.found[i] || target.kind != act.kind {
+                continue;
+            }
+            let at = [target.at[0], target.at[1]];
+            if dist_to_segment(at, from, to) <= act.range {
+                act.found[i] = true;
+                events.push(DroneEvent::Detected {
+                    drone,
+                    kind: act.kind.clone(),
+                    location: [at[0], at[1], 0.0],
+                });
+            }
+        }
+    }
+    events
+}

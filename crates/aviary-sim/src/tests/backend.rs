@@ -1,0 +1,210 @@
+//! The backend on tokio's paused clock.
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use aviary_api::{Backend, CallEnd, DroneEvent, FlightState, Interrupt, PendingCall};
+use tokio::time::Instant;
+
+use super::*;
+use crate::{SimBackend, SimOptions};
+
+async fn done(call: PendingCall) -> CallEnd {
+    call.end.await.expect("the backend answers every call")
+}
+
+async fn take_off(sim: &Arc<SimBackend>, alt: f64) {
+    assert_eq!(done(sim.call(0, "Arm", &[])).await, CallEnd::Done);
+    assert_eq!(
+        done(sim.call(0, "TakeOff", &[num(alt)])).await,
+        CallEnd::Done
+    );
+}
+
+#[tokio::test(flavor = "current_thread", start_paused = true)]
+async fn calls_end_at_the_simulated_time_they_take() {
+    let sim = SimBackend::start(&one_drone(), SimOptions::default());
+    assert_eq!(sim.descriptor(), aviary_api::Descriptor::standard());
+    let t0 = Instant::now();
+    take_off(&sim, 20.0).await;
+    let took = t0.elapsed().as_secs_f64();
+    assert!((took - (2.0 + 17.0 / 3.0)).abs() < 0.4, "{took}");
+    assert!(
+        (sim.time() - took).abs() < 1e-6,
+        "simulated time is tokio time"
+    );
+    let t1 = Instant::now();
+    assert_eq!(
+        done(sim.call(0, "FlyToPosition", &[pos(300.0, 400.0)])).await,
+        CallEnd::Done
+    );
+    let took = t1.elapsed().as_secs_f64();
+    assert!((took - (50.0 + 10.0 / 3.0)).abs() < 0.6, "{took}");
+    let t = sim.telemetry(0);
+    assert_eq!(
+        (t.position, t.state, t.link),
+        ([300.0, 400.0, 20.0], FlightState::Flying, true)
+    );
+    assert_eq!(sim.telemetry(42).state, FlightState::Lost);
+    match done(sim.call(0, "FlyToPosition", &[pos(5000.0, 0.0)])).await {
+        CallEnd::Failed(f) => assert_eq!(f.exception, "GeofenceViolation"),
+        other => panic!("{other:?}"),
+    }
+    sim.shutdown().await;
+}
+
+#[tokio::test(flavor = "current_thread", start_paused = true)]
+async fn events_are_taken_once_and_detections_arrive() {
+    let sim = SimBackend::start(&one_drone(), SimOptions::default());
+    let mut events = sim.events().expect("the first taker gets the events");
+    assert!(sim.events().is_none());
+    take_off(&sim, 20.0).await;
+    assert_eq!(
+        done(sim.call(0, "StartDetection", &[sym("Body")])).await,
+        CallEnd::Done
+    );
+    assert_eq!(
+        done(sim.call(0, "FlyToPosition", &[pos(320.0, 0.0)])).await,
+        CallEnd::Done
+    );
+    let mut found = Vec::new();
+    while let Ok(e) = events.try_recv() {
+        if let DroneEvent::Detected { location, .. } = e {
+            found.push(location);
+        }
+    }
+    assert_eq!(found, [[100.0, 10.0, 0.0], [300.0, 0.0, 0.0]]);
+    sim.shutdown().await;
+}
+
+#[tokio::test(flavor = "current_thread", start_paused = true)]
+async fn pause_resume_and_abort_through_the_backend() {
+    let sim = SimBackend::start(&one_drone(), SimOptions::default());
+    take_off(&sim, 20.0).await;
+    let mut call = sim.call(0, "FlyToPosition", &[pos(200.0, 0.0)]);
+    tokio::time::sleep(Duration::from_secs(5)).await;
+    sim.interrupt(call.id, Interrupt::Pause);
+    let held = sim.telemetry(0);
+    tokio::time::sleep(Duration::from_secs(10)).await;
+    assert_eq!(sim.telemetry(0).position, held.position);
+    assert!(call.end.try_recv().is_err(), "still in progress");
+    sim.interrupt(call.id, Interrupt::Resume);
+    assert_eq!(done(call).await, CallEnd::Done);
+    assert_eq!(sim.telemetry(0).position, [200.0, 0.0, 20.0]);
+
+    let call = sim.call(0, "FlyToPosition", &[pos(0.0, 0.0)]);
+    tokio::time::sleep(Duration::from_secs(3)).await;
+    sim.interrupt(call.id, Interrupt::Abort);
+    assert_eq!(done(call).await, CallEnd::Interrupted);
+    let here = sim.telemetry(0);
+    tokio::time::sleep(Duration::from_secs(3)).await;
+    assert_eq!(
+        (sim.telemetry(0).position, sim.telemetry(0).speed),
+        (here.position, 0.0)
+    );
+    sim.shutdown().await;
+}
+
+#[tokio::test(flavor = "current_thread", start_paused = true)]
+async fn the_driver_ends_when_stopped_or_dropped() {
+    let sim = SimBackend::start(&one_drone(), SimOptions::default());
+    let driver = sim.take_driver().expect("a driver");
+    tokio::time::sleep(Duration::from_secs(1)).await;
+    sim.stop();
+    tokio::time::timeout(Duration::from_secs(1), driver)
+        .await
+        .expect("ends within a tick")
+        .expect("no panic");
+    let frozen = sim.time();
+    tokio::time::sleep(Duration::from_secs(1)).await;
+    assert_eq!(sim.time(), frozen);
+
+    let sim = SimBackend::start(&one_drone(), SimOptions::default());
+    let driver = sim.take_driver().expect("a driver");
+    drop(sim);
+    tokio::time::timeout(Duration::from_secs(1), driver)
+        .await
+        .expect("ends without an owner")
+        .expect("no panic");
+
+    let sim = SimBackend::start(&one_drone(), SimOptions::default());
+    tokio::time::timeout(Duration::from_secs(1), sim.shutdown())
+        .await
+        .expect("shutdown returns");
+}
+
+#[test]
+fn a_runtime_with_the_simulator_finishes() {
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_time()
+        .start_paused(true)
+        .build()
+        .unwrap();
+    let end = rt.block_on(async {
+        let sim = SimBackend::start(&one_drone(), SimOptions::default());
+        take_off(&sim, 10.0).await;
+        let end = done(sim.call(0, "Land", &[])).await;
+        sim.shutdown().await;
+        end
+    });
+    drop(rt);
+    assert_eq!(end, CallEnd::Done);
+}
+
+/// Runs a scripted mission through the backend; the telemetry every 0.25 s.
+async fn scripted() -> Vec<Telemetry> {
+    let sim = SimBackend::start(&one_drone(), SimOptions::default());
+    let log = Arc::new(std::sync::Mutex::new(Vec::new()));
+    let sampler = {
+        let (sim, log) = (sim.clone(), log.clone());
+        tokio::spawn(async move {
+            let mut every = tokio::time::interval(Duration::from_millis(250));
+            for _ in 0..600 {
+                every.tick().await;
+                log.lock().unwrap().push(sim.telemetry(0));
+            }
+        })
+    };
+    take_off(&sim, 15.0).await;
+    done(sim.call(0, "StartDetection", &[sym("Body")])).await;
+    let area = aviary_api::Value::Area(vec![
+        [50.0, -20.0],
+        [150.0, -20.0],
+        [150.0, 60.0],
+        [50.0, 60.0],
+    ]);
+    done(sim.call(0, "Sweep", &[area, num(20.0)])).await;
+    done(sim.call(0, "ReturnToLaunch", &[])).await;
+    sampler.await.unwrap();
+    sim.shutdown().await;
+    let log = log.lock().unwrap().clone();
+    log
+}
+
+#[tokio::test(flavor = "current_thread", start_paused = true)]
+async fn the_backend_is_deterministic() {
+    let a = scripted().await;
+    let b = scripted().await;
+    assert_eq!(a.len(), 600);
+    assert_eq!(a, b);
+}
+
+#[tokio::test(flavor = "current_thread", start_paused = true)]
+async fn speed_paces_against_the_wall_clock() {
+    let sim = SimBackend::start(
+        &one_drone(),
+        SimOptions {
+            tick: 0.05,
+            speed: Some(50.0),
+        },
+    );
+    let wall = std::time::Instant::now();
+    done(sim.call(0, "Hover", &[num(2.0)])).await;
+    // 2 s of simulated time at 50x: at least 40 ms of wall time.
+    assert!(
+        wall.elapsed() >= Duration::from_millis(39),
+        "{:?}",
+        wall.elapsed()
+    );
+    sim.shutdown().await;
+}

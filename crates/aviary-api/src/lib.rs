@@ -11,9 +11,11 @@
 //!
 //! Invariant: this crate knows no engine, no backend and no syntax.
 
+mod geometry;
 mod kind;
 mod runtime;
 
+pub use geometry::centroid;
 pub use kind::Kind;
 pub use runtime::*;
 

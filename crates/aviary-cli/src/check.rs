@@ -1,6 +1,5 @@
 use std::path::Path;
 
-use aviary_api::Descriptor;
 use aviary_diagnostics::{render_json, render_text, summary_line, Diagnostic, SourceMap};
 
 use crate::files::{color_wanted, world_beside, DiskProvider};
@@ -37,7 +36,7 @@ fn check_one(path: &Path, world_path: Option<&Path>, format: Format) -> u8 {
     let mut sources = SourceMap::new();
     let world = world_name.as_deref().zip(world_bytes.as_deref());
     let name = path.display().to_string();
-    let checked = aviary_check::check_sources(&mut sources, (&name, &bytes), world, &DiskProvider, &Descriptor::standard());
+    let checked = aviary_check::check_sources(&mut sources, (&name, &bytes), world, &DiskProvider, &aviary_sim::descriptor());
     let diagnostics = checked.diagnostics;
     print(&sources, &diagnostics, format, path);
     u8::from(diagnostics.iter().any(Diagnostic::is_error))

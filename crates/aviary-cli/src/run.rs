@@ -4,7 +4,7 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use aviary_api::{Backend, Descriptor};
+use aviary_api::Backend;
 use aviary_diagnostics::{render_text, SourceMap};
 use aviary_engine::{RunOptions, Status};
 use aviary_sim::{SimBackend, SimOptions};
@@ -57,7 +57,7 @@ pub fn run(args: &RunArgs) -> u8 {
     let mut sources = SourceMap::new();
     let name = args.file.display().to_string();
     let world_name = world_path.display().to_string();
-    let checked = aviary_check::check_sources(&mut sources, (&name, &bytes), Some((&world_name, &world_bytes)), &DiskProvider, &Descriptor::standard());
+    let checked = aviary_check::check_sources(&mut sources, (&name, &bytes), Some((&world_name, &world_bytes)), &DiskProvider, &aviary_sim::descriptor());
     if checked.has_errors() {
         for d in checked.diagnostics.iter().filter(|d| d.is_error()) {
             eprint!("{}", render_text(&sources, d, color_wanted()));
@@ -66,7 +66,7 @@ pub fn run(args: &RunArgs) -> u8 {
         return 2;
     }
     let (Some(program), Some(world)) = (checked.program, checked.world) else { return 2 };
-    let Some(mission) = aviary_ir::compile(&program, &world, &Descriptor::standard()) else {
+    let Some(mission) = aviary_ir::compile(&program, &world, &aviary_sim::descriptor()) else {
         eprintln!("aviary: {} has no MISSION to run (it holds only capabilities)", args.file.display());
         return 2;
     };

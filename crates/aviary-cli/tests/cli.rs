@@ -1,25 +1,9 @@
 //! The `aviary` binary as a user runs it: exit codes, output forms, world discovery,
 //! USE, and fmt's promise never to lose data.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn aviary(args: &[&str], dir: &Path) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_aviary")).args(args).current_dir(dir).env("NO_COLOR", "1").output().expect("run aviary");
-    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
-}
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-/// A fresh directory under the target dir, so tests never touch the source tree.
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    dir
-}
+use common::{aviary, repo, scratch};
 
 const WORLD: &str = "[places]\nHome = [0, 0]\n[drones.d1]\nhome = [0, 0]\ngroup = \"g\"\n";
 

@@ -1,24 +1,9 @@
 //! `aviary run` as a user runs it: the paper's mission flies to its end, the trace is
 //! valid against RUNTIME.md's schema line by line, and the same files give the same bytes.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn aviary(args: &[&str], dir: &Path) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_aviary")).args(args).current_dir(dir).env("NO_COLOR", "1").output().expect("run aviary");
-    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
-}
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    dir
-}
+use common::{aviary, repo, scratch};
 
 /// The schema of one trace line: the shared contract's copy when it is there, else ours.
 fn schema() -> serde_json::Value {

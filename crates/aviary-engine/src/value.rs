@@ -73,7 +73,7 @@ impl Env<'_> {
                 let p = self.backend.telemetry(*d).position;
                 [p[0], p[1]]
             }
-            Value::Area(poly) => centroid(poly),
+            Value::Area(poly) => aviary_api::centroid(poly),
             _ => [f64::NAN, f64::NAN],
         }
     }
@@ -133,21 +133,6 @@ fn compare(a: &Value, op: Compare, b: &Value) -> bool {
     }
 }
 
-pub(crate) fn centroid(poly: &[[f64; 2]]) -> [f64; 2] {
-    let (mut a, mut cx, mut cy) = (0.0, 0.0, 0.0);
-    for i in 0..poly.len() {
-        let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
-        let cross = p[0] * q[1] - q[0] * p[1];
-        a += cross;
-        cx += (p[0] + q[0]) * cross;
-        cy += (p[1] + q[1]) * cross;
-    }
-    if a.abs() < 1e-12 {
-        let n = poly.len().max(1) as f64;
-        return [poly.iter().map(|p| p[0]).sum::<f64>() / n, poly.iter().map(|p| p[1]).sum::<f64>() / n];
-    }
-    [cx / (3.0 * a), cy / (3.0 * a)]
-}
 
 /// A value as the trace shows it: SI numbers, `[x, y, z]` positions, names for drones.
 pub(crate) fn to_json(m: &Mission, v: &Value) -> Json {

@@ -186,3 +186,55 @@ fn a_failed_command_is_an_exception_of_its_actor() {
     assert!(r.find("signal", "name", "Up").is_empty());
     assert_eq!(r.outcome.status, Status::Failed);
 }
+
+#[test]
+fn several_actors_bind_in_order_and_one_actor_capabilities_run_once_each() {
+    let r = run(
+        "CAPABILITY Pair BY lead, wing:\n    PERFORM:\n        lead.Hover(2s)\n        wing.Hover(1s)\n\nMISSION M:\n    SEQUENTIAL:\n        a b Pair\n        a c Hover WITH 1s\n",
+    );
+    let pair = r.first("capability_start", "capability", "Pair");
+    assert_eq!(pair["actor"], "a b");
+    let hovers: Vec<(String, f64)> =
+        r.trace.iter().filter(|e| e["event"] == "api_call" && e["function"] == "Hover").map(|e| (e["actor"].as_str().unwrap().to_string(), e["t"].as_f64().unwrap())).collect();
+    assert_eq!(hovers[0].0, "a", "lead is a");
+    assert_eq!(hovers[1].0, "b", "wing is b");
+    assert!(close(hovers[1].1, 2.0));
+    // Hover has one actor: `a c Hover` runs it once for each, in parallel.
+    let last: Vec<f64> = r.trace.iter().filter(|e| e["event"] == "capability_start" && e["capability"] == "Hover").map(|e| e["t"].as_f64().unwrap()).collect();
+    assert_eq!(last.len(), 2);
+    assert!(close(last[0], 3.0) && last[0] == last[1], "{last:?}");
+}
+
+#[test]
+fn a_drone_fault_reaches_the_capability_that_was_flying_it() {
+    let world = format!("{}\n[[faults]]\ndrone = \"a\"\nat = 5.0\nkind = \"battery_critical\"\n", harness::WORLD);
+    let r = harness::run_in(
+        "CAPABILITY Deliver BY d:\n    PERFORM:\n        d TakeOff WITH 20m\n        d.FlyToPosition(Far)\n    EXCEPTIONS:\n        ON EXCEPTION BatteryCritical:\n            d.ReturnToLaunch()\n\nMISSION M:\n    PARALLEL:\n        a Deliver\n        b Hover WITH 10s\n",
+        &world,
+    );
+    assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
+    let e = r.first("exception", "name", "BatteryCritical");
+    assert_eq!((e["actor"].as_str(), e["handled"].as_bool()), (Some("a"), Some(true)));
+    assert_eq!(e["handler"], "Deliver/ON EXCEPTION BatteryCritical");
+    assert!(close(e["t"].as_f64().unwrap(), 5.0));
+    let rtl = r.trace.iter().find(|e| e["event"] == "api_call" && e["function"] == "ReturnToLaunch" && e["actor"] == "a").unwrap();
+    assert!(close(rtl["t"].as_f64().unwrap(), 5.0), "the handler starts at once");
+    assert_eq!(r.find("exception", "name", "BatteryCritical").len(), 1, "one fault, one exception");
+    assert_eq!(r.ends("Hover", "b")[0]["status"], "ok", "the other drone carries on");
+}
+
+#[test]
+fn for_aliases_read_attributes_and_telemetry() {
+    let world = harness::WORLD.replace("[drones.b]\n", "[drones.b]\nrole = \"scout\"\n").replace("[drones.a]\n", "[drones.a]\nrole = \"carrier\"\n");
+    let r = harness::run_in(
+        "MISSION M:\n    PARALLEL FOR team AS d:\n        IF d.role = \"scout\" AND d.state = Landed:\n            d Hover WITH 1s\n        ELSE:\n            d Hover WITH 2s\n",
+        &world,
+    );
+    let durations: Vec<(String, f64)> = r
+        .trace
+        .iter()
+        .filter(|e| e["event"] == "capability_start")
+        .map(|e| (e["actor"].as_str().unwrap().to_string(), e["args"]["duration"].as_f64().unwrap()))
+        .collect();
+    assert_eq!(durations, [("a".to_string(), 2.0), ("b".to_string(), 1.0)]);
+}

@@ -173,7 +173,7 @@ async fn drive(backend: Weak<SimBackend>, options: SimOptions) {
 
 impl Backend for SimBackend {
     fn descriptor(&self) -> Descriptor {
-        Descriptor::standard()
+        crate::descriptor()
     }
 
     fn call(&self, drone: DroneId, function: &str, args: &[Value]) -> PendingCall {

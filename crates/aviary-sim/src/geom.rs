@@ -100,31 +100,7 @@ pub(crate) fn area(polygon: &[[f64; 2]]) -> f64 {
 }
 
 /// The area centroid; the corners' mean when the polygon encloses no area.
-pub(crate) fn centroid(polygon: &[[f64; 2]]) -> [f64; 2] {
-    if polygon.is_empty() {
-        return [0.0, 0.0];
-    }
-    let n = polygon.len() as f64;
-    let mean = [
-        polygon.iter().map(|p| p[0]).sum::<f64>() / n,
-        polygon.iter().map(|p| p[1]).sum::<f64>() / n,
-    ];
-    let (mut twice, mut cx, mut cy) = (0.0, 0.0, 0.0);
-    for (a, b) in edges(polygon) {
-        let (a, b) = (
-            [a[0] - mean[0], a[1] - mean[1]],
-            [b[0] - mean[0], b[1] - mean[1]],
-        );
-        let c = a[0] * b[1] - b[0] * a[1];
-        twice += c;
-        cx += (a[0] + b[0]) * c;
-        cy += (a[1] + b[1]) * c;
-    }
-    if twice.abs() < 1e-12 {
-        return mean;
-    }
-    [mean[0] + cx / (3.0 * twice), mean[1] + cy / (3.0 * twice)]
-}
+pub(crate) use aviary_api::centroid;
 
 /// Degrees clockwise from north of a ground velocity.
 pub(crate) fn heading(vx: f64, vy: f64) -> f64 {

@@ -84,5 +84,11 @@ pub mod sweep;
 mod tests;
 
 pub use backend::{SimBackend, SimOptions};
+
+/// What the simulator offers: the standard middle layer (LANGUAGE.md §4). The checker
+/// reads this before a run, so a function the simulator added would be known to it.
+pub fn descriptor() -> aviary_api::Descriptor {
+    aviary_api::Descriptor::standard()
+}
 pub use calls::{LOAD_MAX_ALTITUDE, LOAD_TIME, RETURN_ALTITUDE};
 pub use fleet::{Fleet, Release, Report};

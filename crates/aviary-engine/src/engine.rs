@@ -100,7 +100,16 @@ pub(crate) struct Engine<'m> {
     pub arbiter: Rc<RefCell<Arbiter>>,
     pub instances: RefCell<Vec<(Rc<Instance>, Rc<Scope<'m>>)>>,
     pub detections: RefCell<BTreeMap<(DroneId, String), Rc<Scope<'m>>>>,
-    failure: RefCell<Option<String>>,
+    /// How the mission ends early, if it does: failed (an unhandled exception, a lost
+    /// backend) or aborted (the operator), and why.
+    ending: RefCell<Option<(Status, String)>>,
+    /// False once the backend cannot answer: then nobody can be sent home.
+    backend_alive: Cell<bool>,
+    /// The operator paused the whole mission.
+    pub mission_paused: Cell<bool>,
+    /// Running scopes that declare handlers, in the order they started (for signals from
+    /// outside the mission, which every running block hears).
+    pub listeners: RefCell<Vec<std::rc::Weak<Scope<'m>>>>,
     pub stop: CancellationToken,
     events: RefCell<Option<mpsc::UnboundedReceiver<DroneEvent>>>,
     root: RefCell<Option<Rc<Scope<'m>>>>,
@@ -119,7 +128,10 @@ impl<'m> Engine<'m> {
             arbiter: Rc::new(RefCell::new(Arbiter::default())),
             instances: RefCell::new(Vec::new()),
             detections: RefCell::new(BTreeMap::new()),
-            failure: RefCell::new(None),
+            ending: RefCell::new(None),
+            backend_alive: Cell::new(true),
+            mission_paused: Cell::new(false),
+            listeners: RefCell::new(Vec::new()),
             stop: CancellationToken::new(),
             events: RefCell::new(backend.events()),
             root: RefCell::new(None),
@@ -158,7 +170,7 @@ impl<'m> Engine<'m> {
         Env { mission: self.m, backend: self.backend, frame, received, elapsed: self.now() }
     }
 
-    pub async fn run(&self, options: &RunOptions) -> Outcome {
+    pub async fn run(&self, options: &RunOptions, controls: Option<mpsc::UnboundedReceiver<crate::ControlRequest>>) -> Outcome {
         self.trace("mission_start", json!({ "mission": self.m.name }));
         let (tx, rx) = mpsc::unbounded_channel();
         let root = Rc::new(Scope {
@@ -179,19 +191,44 @@ impl<'m> Engine<'m> {
         *self.root.borrow_mut() = Some(root.clone());
         let ctx = Ctx { scope: root.clone(), frame: root.frame.clone(), actor: None, instance: None, claims: Rc::new(BTreeSet::new()) };
         let body = self.drive(&root, rx, self.block(&self.m.body, &ctx));
+        let controls = async {
+            match controls {
+                Some(rx) => self.controls(rx).await,
+                None => std::future::pending().await,
+            }
+        };
         tokio::select! {
             biased;
             _ = self.stop.cancelled() => {}
             _ = body => {}
             _ = self.pump() => {}
+            _ = controls => {}
             _ = self.telemetry(options.telemetry_hz) => {}
         }
-        let failure = self.failure.borrow().clone();
+        let ending = self.ending.borrow().clone();
         // Drones still flying go home: at the end of the mission, or as the failsafe.
-        self.all_home().await;
-        let status = if failure.is_some() { Status::Failed } else { Status::Ok };
-        self.trace("mission_end", json!({ "status": status.as_str(), "reason": failure }));
-        Outcome { status, reason: failure }
+        if self.backend_alive.get() {
+            self.all_home().await;
+        }
+        let (status, reason) = match ending {
+            Some((status, reason)) => (status, Some(reason)),
+            None => (Status::Ok, None),
+        };
+        self.trace("mission_end", json!({ "status": status.as_str(), "reason": reason }));
+        Outcome { status, reason }
+    }
+
+    /// Ends the mission early; the first reason given is the one reported.
+    pub fn end_with(&self, status: Status, reason: String, backend_alive: bool) {
+        self.ending.borrow_mut().get_or_insert((status, reason));
+        if !backend_alive {
+            self.backend_alive.set(false);
+        }
+        self.stop.cancel();
+    }
+
+    pub fn root_scope(&self) -> Rc<Scope<'m>> {
+        self.root.borrow().clone().expect("the run has a root scope")
     }
 
     async fn all_home(&self) {
@@ -300,7 +337,7 @@ impl<'m> Engine<'m> {
         let innermost = instances.iter().filter(|(i, _)| i.actors.contains(&drone)).max_by_key(|(i, _)| (i.depth, i.id));
         match innermost {
             Some((_, scope)) => scope.clone(),
-            None => self.root.borrow().clone().expect("the run has a root scope"),
+            None => self.root_scope(),
         }
     }
 
@@ -309,6 +346,21 @@ impl<'m> Engine<'m> {
             None => true,
             Some(ActorFilter::Drones(ds)) => actor.is_some_and(|a| ds.contains(&a)),
             Some(ActorFilter::Slot(s)) => matches!((frame.get(*s), actor), (Some(Value::Actor(d)), Some(a)) if *d == a),
+        }
+    }
+
+    /// A signal from outside the mission (the operator): heard by every running handler
+    /// that matches, at once (there is no signalling block to wait for).
+    pub fn raise_from_outside(&self, signal: usize, args: Vec<Value>) {
+        self.trace("signal", json!({ "name": self.m.signals[signal], "actor": null, "args": self.values(&args) }));
+        if let Some(r) = self.received.borrow_mut().get_mut(signal) {
+            *r = true;
+        }
+        self.changed.notify_waiters();
+        self.listeners.borrow_mut().retain(|w| w.strong_count() > 0);
+        let scopes: Vec<Rc<Scope<'m>>> = self.listeners.borrow().iter().filter_map(|w| w.upgrade()).collect();
+        for scope in scopes {
+            self.deliver(&scope, signal, &args, None, None);
         }
     }
 
@@ -324,24 +376,30 @@ impl<'m> Engine<'m> {
         self.changed.notify_waiters();
         let signalling_block = from.chain().find(|s| s.mission_block);
         for scope in from.chain() {
-            let handlers: &'m [Handler] = scope.handlers;
-            for (i, h) in handlers.iter().enumerate() {
-                if h.signal != signal || !self.matches(&h.by, &scope.frame, actor) {
+            self.deliver(&scope, signal, &args, actor, signalling_block.as_ref());
+        }
+    }
+
+    /// Starts (or, for `SEQUENTIAL ON`, defers to the signalling block's end) each handler
+    /// of `scope` that hears this signal.
+    fn deliver(&self, scope: &Rc<Scope<'m>>, signal: usize, args: &[Value], actor: Option<DroneId>, signalling_block: Option<&Rc<Scope<'m>>>) {
+        let handlers: &'m [Handler] = scope.handlers;
+        for (i, h) in handlers.iter().enumerate() {
+            if h.signal != signal || !self.matches(&h.by, &scope.frame, actor) {
+                continue;
+            }
+            if !h.every {
+                let mut fired = scope.fired.borrow_mut();
+                if fired[i] {
                     continue;
                 }
-                if !h.every {
-                    let mut fired = scope.fired.borrow_mut();
-                    if fired[i] {
-                        continue;
-                    }
-                    fired[i] = true;
-                }
-                let job = Job::Signal { handler: h, args: args.clone(), actor, signal };
-                match (&signalling_block, h.sequential) {
-                    (Some(block), true) => block.deferred.borrow_mut().push((scope.clone(), job)),
-                    _ => {
-                        let _ = scope.jobs.send(job);
-                    }
+                fired[i] = true;
+            }
+            let job = Job::Signal { handler: h, args: args.to_vec(), actor, signal };
+            match (signalling_block, h.sequential) {
+                (Some(block), true) => block.deferred.borrow_mut().push((scope.clone(), job)),
+                _ => {
+                    let _ = scope.jobs.send(job);
                 }
             }
         }
@@ -375,8 +433,7 @@ impl<'m> Engine<'m> {
                 Some(Value::Text(why)) => format!("unhandled exception {name} on {who}: {why}"),
                 _ => format!("unhandled exception {name} on {who}"),
             };
-            self.failure.borrow_mut().get_or_insert(reason);
-            self.stop.cancel();
+            self.end_with(Status::Failed, reason, true);
             return;
         };
         let keep: Vec<*const Scope> = handler_scope.chain().map(|s| Rc::as_ptr(&s)).collect();

@@ -68,6 +68,9 @@ impl<'m> Engine<'m> {
             caught: Notify::new(),
             instance,
         });
+        if !block.handlers.is_empty() {
+            self.listeners.borrow_mut().push(Rc::downgrade(&scope));
+        }
         (scope, rx)
     }
 
@@ -257,7 +260,8 @@ impl<'m> Engine<'m> {
             perform: CancellationToken::new(),
             by_leash: Cell::new(false),
             failed: Cell::new(false),
-            paused: Cell::new(false),
+            // An activity started while the operator holds the mission starts held.
+            paused: Cell::new(ctx.instance.is_none() && self.mission_paused.get()),
             resumed: Notify::new(),
             calls: RefCell::new(Vec::new()),
             depth: ctx.instance.as_ref().map_or(0, |p| p.depth + 1),
@@ -407,12 +411,23 @@ impl<'m> Engine<'m> {
     }
 
     fn leash(&self, l: &'m Leash, ctx: &Ctx<'m>) {
-        let cap = &self.m.capabilities[l.capability];
-        self.trace("leash", json!({ "capability": cap.name, "tag": self.m.tags[l.tag], "action": l.action_name }));
+        let values: Vec<(usize, Value)> = {
+            let received = self.received.borrow();
+            let env = self.env(&ctx.frame, &received);
+            l.args.iter().map(|(p, e)| (*p, env.eval(e))).collect()
+        };
+        self.leash_by_id(l.capability, l.tag, l.action, &l.action_name, values);
+    }
+
+    /// A leash on every running activity of `capability` tagged `tag`; recorded even when
+    /// none runs (LANGUAGE.md §3).
+    pub(crate) fn leash_by_id(&self, capability: usize, tag: usize, action: LeashAction, action_name: &str, values: Vec<(usize, Value)>) {
+        let cap = &self.m.capabilities[capability];
+        self.trace("leash", json!({ "capability": cap.name, "tag": self.m.tags[tag], "action": action_name }));
         let targets: Vec<(Rc<Instance>, Rc<Scope<'m>>)> =
-            self.instances.borrow().iter().filter(|(i, _)| i.capability == l.capability && i.tag == Some(l.tag)).cloned().collect();
+            self.instances.borrow().iter().filter(|(i, _)| i.capability == capability && i.tag == Some(tag)).cloned().collect();
         for (instance, scope) in targets {
-            match l.action {
+            match action {
                 LeashAction::Abort => {
                     instance.by_leash.set(true);
                     instance.token.cancel();
@@ -432,13 +447,8 @@ impl<'m> Engine<'m> {
                 }
                 LeashAction::Section(i) => {
                     let mut frame = (*scope.frame).clone();
-                    let values: Vec<(usize, Value)> = {
-                        let received = self.received.borrow();
-                        let env = self.env(&ctx.frame, &received);
-                        l.args.iter().map(|(p, e)| (*p, env.eval(e))).collect()
-                    };
-                    for (p, v) in values {
-                        set(&mut frame, cap.actors + p, v);
+                    for (p, v) in &values {
+                        set(&mut frame, cap.actors + p, v.clone());
                     }
                     let _ = scope.jobs.send(Job::Section { block: &cap.sections[i].1, frame: Rc::new(frame) });
                 }

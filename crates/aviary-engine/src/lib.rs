@@ -10,11 +10,14 @@
 //! Invariant: the engine knows no backend; it talks to `aviary_api::Backend` only.
 
 mod arbiter;
+mod control;
 mod engine;
 mod exec;
 mod value;
 
 use aviary_api::Backend;
+
+pub use control::{Control, ControlRequest, Controller};
 use aviary_ir::Mission;
 
 /// Where trace events go, one JSON object per event, in order.
@@ -59,5 +62,16 @@ pub struct Outcome {
 
 /// Runs `mission` to its end. Must be polled inside a tokio runtime (current-thread).
 pub async fn run(mission: &Mission, backend: &dyn Backend, sink: &mut dyn TraceSink, options: &RunOptions) -> Outcome {
-    engine::Engine::new(mission, backend, sink).run(options).await
+    engine::Engine::new(mission, backend, sink).run(options, None).await
+}
+
+/// As [`run`], and takes live controls (an operator, Ctrl-C) from `controls`.
+pub async fn run_controlled(
+    mission: &Mission,
+    backend: &dyn Backend,
+    sink: &mut dyn TraceSink,
+    options: &RunOptions,
+    controls: tokio::sync::mpsc::UnboundedReceiver<ControlRequest>,
+) -> Outcome {
+    engine::Engine::new(mission, backend, sink).run(options, Some(controls)).await
 }

@@ -1,0 +1,121 @@
+//! Live control from outside the mission: an operator's leashes and signals, pausing
+//! and aborting the whole mission (issue: operator API), and a backend that died.
+
+use aviary_api::{Interrupt, Value};
+use aviary_ir::LeashAction;
+use tokio::sync::{mpsc, oneshot};
+
+use crate::engine::Engine;
+
+/// What an operator (or the process) asks of a running mission.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Control {
+    /// A leash by tag, as a mission would write it: `FlyCircle-C1 PAUSE`.
+    Leash { capability: String, tag: String, action: String, args: Vec<(String, Value)> },
+    /// Raises a signal at mission level (no actor), as the mission's own `SIGNAL` would.
+    Signal { name: String, args: Vec<Value> },
+    /// Holds every drone's activity where it is, until `Resume`.
+    Pause,
+    Resume,
+    /// Ends the mission: the fleet returns home, and the mission ends `aborted`.
+    Abort { reason: String },
+    /// The backend can no longer answer (its task panicked): end at once, `failed`.
+    BackendLost { reason: String },
+}
+
+/// A control and where to send its answer (`Err` says why it was refused).
+pub type ControlRequest = (Control, oneshot::Sender<Result<(), String>>);
+
+/// The sending side, for a server or a signal handler; cheap to clone, usable from any thread.
+#[derive(Clone)]
+pub struct Controller {
+    tx: mpsc::UnboundedSender<ControlRequest>,
+}
+
+impl Controller {
+    /// A controller and the receiver to pass to [`crate::run_controlled`].
+    pub fn new() -> (Controller, mpsc::UnboundedReceiver<ControlRequest>) {
+        let (tx, rx) = mpsc::unbounded_channel();
+        (Controller { tx }, rx)
+    }
+    /// Sends without waiting for the answer (for signal handlers).
+    pub fn send(&self, control: Control) {
+        let (answer, _) = oneshot::channel();
+        let _ = self.tx.send((control, answer));
+    }
+    /// Sends and waits for the engine's answer.
+    pub async fn ask(&self, control: Control) -> Result<(), String> {
+        let (answer, rx) = oneshot::channel();
+        self.tx.send((control, answer)).map_err(|_| "the mission has ended".to_string())?;
+        rx.await.unwrap_or_else(|_| Err("the mission has ended".to_string()))
+    }
+}
+
+impl Default for Controller {
+    fn default() -> Self {
+        Controller::new().0
+    }
+}
+
+impl<'m> Engine<'m> {
+    pub(crate) async fn controls(&self, mut rx: mpsc::UnboundedReceiver<ControlRequest>) {
+        while let Some((control, answer)) = rx.recv().await {
+            let _ = answer.send(self.apply(control));
+        }
+        std::future::pending::<()>().await;
+    }
+
+    fn apply(&self, control: Control) -> Result<(), String> {
+        if self.stopped() {
+            return Err("the mission is ending".into());
+        }
+        match control {
+            Control::Leash { capability, tag, action, args } => {
+                let cap = self.m.capabilities.iter().position(|c| c.name == capability).ok_or_else(|| format!("no capability is called {capability}"))?;
+                let action_kind = match action.as_str() {
+                    "ABORT" => LeashAction::Abort,
+                    "PAUSE" => LeashAction::Pause,
+                    "RESUME" => LeashAction::Resume,
+                    name => LeashAction::Section(
+                        self.m.capabilities[cap].sections.iter().position(|(n, _)| n == name).ok_or_else(|| format!("{capability} has no section PERFORM {name}"))?,
+                    ),
+                };
+                let params = &self.m.capabilities[cap].params;
+                let mut values = Vec::new();
+                for (name, value) in args {
+                    let p = params.iter().position(|p| *p == name).ok_or_else(|| format!("{capability} has no parameter {name}"))?;
+                    values.push((p, value));
+                }
+                // A tag no statement defines can never match: refuse it, as the checker would.
+                let tag_id = self.m.tags.iter().position(|t| *t == tag).ok_or_else(|| format!("no statement starts an activity tagged {capability}-{tag}"))?;
+                self.leash_by_id(cap, tag_id, action_kind, &action, values);
+                Ok(())
+            }
+            Control::Signal { name, args } => {
+                let id = self.m.signals.iter().position(|s| *s == name).ok_or_else(|| format!("the mission neither raises nor hears {name}"))?;
+                self.raise_from_outside(id, args);
+                Ok(())
+            }
+            Control::Pause | Control::Resume => {
+                let pause = control == Control::Pause;
+                self.mission_paused.set(pause);
+                for (instance, _) in self.instances.borrow().iter().filter(|(i, _)| i.root.is_none()) {
+                    instance.paused.set(pause);
+                    for call in instance.calls.borrow().iter() {
+                        self.backend.interrupt(*call, if pause { Interrupt::Pause } else { Interrupt::Resume });
+                    }
+                    instance.resumed.notify_waiters();
+                }
+                Ok(())
+            }
+            Control::Abort { reason } => {
+                self.end_with(crate::Status::Aborted, reason, true);
+                Ok(())
+            }
+            Control::BackendLost { reason } => {
+                self.end_with(crate::Status::Failed, reason, false);
+                Ok(())
+            }
+        }
+    }
+}

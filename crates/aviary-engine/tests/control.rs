@@ -1,0 +1,128 @@
+//! Live control of a running mission, as the operator API and Ctrl-C use it.
+
+mod harness;
+
+use aviary_api::{Descriptor, Value};
+use aviary_check::SourceProvider;
+use aviary_diagnostics::SourceMap;
+use aviary_engine::{Control, Controller, Outcome, RunOptions, Status};
+use aviary_sim::{SimBackend, SimOptions};
+use serde_json::Value as Json;
+
+struct NoFiles;
+impl SourceProvider for NoFiles {
+    fn load(&self, _: &str, p: &str) -> Result<(String, Vec<u8>), String> {
+        Err(p.to_string())
+    }
+}
+
+/// Runs `mission`, sending each control at its mission time; returns the outcome, the
+/// trace and the engine's answers.
+fn run_with_controls(mission: &str, controls: Vec<(f64, Control)>) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
+    let mut sources = SourceMap::new();
+    let checked = aviary_check::check_sources(&mut sources, ("m.mission", mission.as_bytes()), Some(("w.toml", harness::WORLD.as_bytes())), &NoFiles, &Descriptor::standard());
+    assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
+    let world = checked.world.unwrap();
+    let compiled = aviary_ir::compile(&checked.program.unwrap(), &world, &Descriptor::standard()).unwrap();
+    let rt = tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build().unwrap();
+    rt.block_on(async {
+        let sim = SimBackend::start(&world, SimOptions::default());
+        let (controller, rx) = Controller::new();
+        let mut trace = Vec::new();
+        let mut sink = |e: Json| trace.push(e);
+        let operator = async {
+            let start = tokio::time::Instant::now();
+            let mut answers = Vec::new();
+            for (at, control) in controls {
+                tokio::time::sleep_until(start + std::time::Duration::from_secs_f64(at)).await;
+                answers.push(controller.ask(control).await);
+            }
+            answers
+        };
+        let mission_run = aviary_engine::run_controlled(&compiled, &*sim, &mut sink, &RunOptions { telemetry_hz: Some(10.0) }, rx);
+        let (outcome, answers) = tokio::join!(mission_run, operator);
+        sim.shutdown().await;
+        (outcome, trace, answers)
+    })
+}
+
+fn positions(trace: &[Json], actor: &str, from: f64, to: f64) -> Vec<Json> {
+    trace.iter().filter(|e| e["event"] == "telemetry" && e["actor"] == actor && e["t"].as_f64().unwrap() > from && e["t"].as_f64().unwrap() < to).map(|e| e["position"].clone()).collect()
+}
+
+#[test]
+fn an_operator_leash_pauses_and_resumes_by_tag() {
+    let (outcome, trace, answers) = run_with_controls(
+        "MISSION M:\n    a FlyTo-F1 WITH Far\n",
+        vec![
+            (10.0, Control::Leash { capability: "FlyTo".into(), tag: "F1".into(), action: "PAUSE".into(), args: vec![] }),
+            (20.0, Control::Leash { capability: "FlyTo".into(), tag: "F1".into(), action: "RESUME".into(), args: vec![] }),
+        ],
+    );
+    assert_eq!(outcome.status, Status::Ok);
+    assert_eq!(answers, [Ok(()), Ok(())]);
+    let held = positions(&trace, "a", 10.2, 19.9);
+    assert!(held.len() > 50 && held.iter().all(|p| *p == held[0]), "paused by the operator, a holds");
+    let leashes: Vec<&str> = trace.iter().filter(|e| e["event"] == "leash").map(|e| e["action"].as_str().unwrap()).collect();
+    assert_eq!(leashes, ["PAUSE", "RESUME"]);
+}
+
+#[test]
+fn operator_controls_that_cannot_apply_are_refused_with_a_reason() {
+    let (_, _, answers) = run_with_controls(
+        "MISSION M:\n    a FlyTo-F1 WITH North\n    ON Go:\n        b Hover WITH 1s\n",
+        vec![
+            (1.0, Control::Leash { capability: "FlyTo".into(), tag: "F9".into(), action: "PAUSE".into(), args: vec![] }),
+            (1.0, Control::Leash { capability: "Fly".into(), tag: "F1".into(), action: "PAUSE".into(), args: vec![] }),
+            (1.0, Control::Leash { capability: "FlyTo".into(), tag: "F1".into(), action: "Widen".into(), args: vec![] }),
+            (1.0, Control::Signal { name: "Nobody".into(), args: vec![] }),
+        ],
+    );
+    assert_eq!(answers[0], Err("no statement starts an activity tagged FlyTo-F9".to_string()));
+    assert_eq!(answers[1], Err("no capability is called Fly".to_string()));
+    assert_eq!(answers[2], Err("FlyTo has no section PERFORM Widen".to_string()));
+    assert_eq!(answers[3], Err("the mission neither raises nor hears Nobody".to_string()));
+}
+
+#[test]
+fn an_operator_signal_is_heard_by_the_mission() {
+    let (outcome, trace, answers) = run_with_controls(
+        "MISSION M:\n    PARALLEL:\n        a Hover WITH 10s\n        ON Go WITH what:\n            b Hover WITH 1s\n",
+        vec![(7.0, Control::Signal { name: "Go".into(), args: vec![Value::Text("now".into())] })],
+    );
+    assert_eq!(answers, [Ok(())]);
+    assert_eq!(outcome.status, Status::Ok);
+    let signal = trace.iter().find(|e| e["event"] == "signal").unwrap();
+    assert_eq!((signal["actor"].clone(), signal["args"][0].clone()), (Json::Null, Json::from("now")));
+    let hover = trace.iter().find(|e| e["event"] == "capability_start" && e["actor"] == "b").unwrap();
+    assert_eq!(hover["t"].as_f64().unwrap(), 7.0);
+}
+
+#[test]
+fn pausing_the_mission_holds_every_drone_and_resuming_goes_on() {
+    let (outcome, trace, _) = run_with_controls(
+        "MISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        b FlyTo WITH Field\n",
+        vec![(15.0, Control::Pause), (25.0, Control::Resume)],
+    );
+    assert_eq!(outcome.status, Status::Ok);
+    for drone in ["a", "b"] {
+        let held = positions(&trace, drone, 15.2, 24.9);
+        assert!(held.len() > 50 && held.iter().all(|p| *p == held[0]), "{drone} holds while the mission is paused");
+    }
+}
+
+#[test]
+fn aborting_the_mission_sends_the_fleet_home() {
+    let (outcome, trace, _) = run_with_controls(
+        "MISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        b FlyTo WITH Field\n",
+        vec![(12.0, Control::Abort { reason: "aborted by the operator".into() })],
+    );
+    assert_eq!(outcome.status, Status::Aborted);
+    assert_eq!(outcome.reason.as_deref(), Some("aborted by the operator"));
+    let home: Vec<&str> = trace.iter().filter(|e| e["event"] == "api_done" && e["function"] == "ReturnToLaunch").map(|e| e["actor"].as_str().unwrap()).collect();
+    assert!(home.contains(&"a") && home.contains(&"b"), "both drones were sent home: {home:?}");
+    let last = trace.last().unwrap();
+    assert_eq!((last["event"].as_str(), last["status"].as_str()), (Some("mission_end"), Some("aborted")));
+    let aborted = trace.iter().filter(|e| e["event"] == "capability_end" && e["capability"] == "FlyTo").count();
+    assert_eq!(aborted, 0, "the activities were cut off with the mission: no end is invented for them");
+}

@@ -8,6 +8,7 @@ mod check;
 mod files;
 mod fmt;
 mod run;
+mod trace_file;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

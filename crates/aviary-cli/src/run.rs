@@ -3,14 +3,16 @@
 
 use std::io::Write;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use aviary_api::Backend;
 use aviary_diagnostics::{render_text, SourceMap};
-use aviary_engine::{RunOptions, Status};
+use aviary_engine::{Control, Controller, RunOptions, Status};
 use aviary_sim::{SimBackend, SimOptions};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::files::{color_wanted, world_beside, DiskProvider};
+use crate::trace_file::{lock, SharedTrace, TraceFile};
 
 pub struct RunArgs {
     pub file: PathBuf,
@@ -70,9 +72,9 @@ pub fn run(args: &RunArgs) -> u8 {
         eprintln!("aviary: {} has no MISSION to run (it holds only capabilities)", args.file.display());
         return 2;
     };
-    let mut out: Box<dyn Write> = match &args.trace {
+    let out: Box<dyn Write + Send> = match &args.trace {
         Some(path) => match std::fs::File::create(path) {
-            Ok(f) => Box::new(std::io::BufWriter::new(f)),
+            Ok(f) => Box::new(f),
             Err(e) => {
                 eprintln!("aviary: cannot write the trace {}: {e}", path.display());
                 return 2;
@@ -80,6 +82,7 @@ pub fn run(args: &RunArgs) -> u8 {
         },
         None => Box::new(std::io::sink()),
     };
+    let trace = TraceFile::new(out);
     let _ = args.seed; // The simulator has no randomness yet; the seed is kept for it.
     let runtime = match tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build() {
         Ok(r) => r,
@@ -88,18 +91,23 @@ pub fn run(args: &RunArgs) -> u8 {
             return 2;
         }
     };
+    let (controller, controls) = Controller::new();
+    on_ctrl_c(controller.clone(), trace.clone());
     let progress = progress_bar(args.quiet);
     let (outcome, summary) = runtime.block_on(async {
         let sim = SimBackend::start(&world, SimOptions { speed: args.speed, ..SimOptions::default() });
+        let watch = watch_backend(sim.take_driver(), controller.clone());
         let mut stats = Stats::default();
         let mut sink = |event: serde_json::Value| {
             stats.observe(&event, &progress, &sim);
-            let _ = writeln!(out, "{event}");
-            // Written event by event: a run cut short keeps every line before the cut.
-            let _ = out.flush();
+            lock(&trace).write(&event);
         };
         let options = RunOptions { telemetry_hz: args.telemetry_hz };
-        let outcome = aviary_engine::run(&mission, &*sim, &mut sink, &options).await;
+        let outcome = tokio::select! {
+            biased;
+            outcome = aviary_engine::run_controlled(&mission, &*sim, &mut sink, &options, controls) => outcome,
+            _ = watch => unreachable!("the watch never ends"),
+        };
         sim.stop();
         let summary = summary(&mission, &sim, &stats);
         (outcome, summary)
@@ -112,11 +120,37 @@ pub fn run(args: &RunArgs) -> u8 {
             None => println!("mission {}", outcome.status.as_str()),
         }
     }
-    if outcome.status == Status::Ok {
-        0
-    } else {
-        1
+    u8::from(outcome.status != Status::Ok)
+}
+
+/// The first Ctrl-C ends the mission gracefully (the fleet returns home); a second one
+/// stops at once, closing the trace with `mission_end`.
+fn on_ctrl_c(controller: Controller, trace: SharedTrace) {
+    let presses = AtomicUsize::new(0);
+    let installed = ctrlc::set_handler(move || {
+        if presses.fetch_add(1, Ordering::SeqCst) == 0 {
+            eprintln!("\naviary: stopping; the fleet returns home (press Ctrl-C again to stop at once)");
+            controller.send(Control::Abort { reason: "interrupted by Ctrl-C".into() });
+        } else {
+            lock(&trace).close_now("stopped at once by a second Ctrl-C");
+            std::process::exit(130);
+        }
+    });
+    if let Err(e) = installed {
+        eprintln!("aviary: Ctrl-C will stop at once: {e}");
     }
+}
+
+/// A panic in the simulator's task ends the mission at once, `failed`, with the reason.
+async fn watch_backend(driver: Option<tokio::task::JoinHandle<()>>, controller: Controller) {
+    if let Some(handle) = driver {
+        if let Err(e) = handle.await {
+            if e.is_panic() {
+                controller.send(Control::BackendLost { reason: "the simulator stopped: its task panicked".into() });
+            }
+        }
+    }
+    std::future::pending::<()>().await
 }
 
 fn progress_bar(quiet: bool) -> ProgressBar {

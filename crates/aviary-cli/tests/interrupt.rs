@@ -1,0 +1,101 @@
+//! Nothing is lost when a run is cut short: killed at random points, every line written
+//! is a whole JSON event and the lines are exactly the start of the full trace (a
+//! simulated run is deterministic, so the full trace is known); Ctrl-C ends gracefully,
+//! and a second Ctrl-C stops at once, with `mission_end` written either way.
+
+mod common;
+
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+use common::{aviary, repo, scratch};
+
+fn spawn(trace: &std::path::Path, speed: &str) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(["run", "examples/search_and_rescue.mission", "--quiet", "--speed", speed, "--trace", &trace.to_string_lossy()])
+        .current_dir(repo())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("spawn aviary")
+}
+
+fn lines(path: &std::path::Path) -> Vec<String> {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    assert!(text.is_empty() || text.ends_with('\n'), "the last line is whole");
+    text.lines().map(str::to_string).collect()
+}
+
+fn interrupt(child: &Child) {
+    let status = Command::new("kill").args(["-INT", &child.id().to_string()]).status().expect("kill -INT");
+    assert!(status.success());
+}
+
+/// A small deterministic generator, so the "random" cut points are the same every run.
+fn cut_points(seed: u64, n: usize) -> Vec<u64> {
+    let mut x = seed;
+    (0..n)
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            100 + x % 3_800
+        })
+        .collect()
+}
+
+#[test]
+fn a_killed_run_keeps_every_event_before_the_cut() {
+    let dir = scratch("killed");
+    let full = dir.join("full.jsonl");
+    let (code, _, err) = aviary(&["run", "examples/search_and_rescue.mission", "--quiet", "--trace", &full.to_string_lossy()], &repo());
+    assert_eq!(code, 0, "{err}");
+    let reference = lines(&full);
+    for (i, ms) in cut_points(0x5eed, 4).into_iter().enumerate() {
+        let cut = dir.join(format!("cut{i}.jsonl"));
+        // 100 times real time: the 490 s mission takes about 4.9 s, and the cut lands inside it.
+        let mut child = spawn(&cut, "100");
+        std::thread::sleep(Duration::from_millis(ms));
+        child.kill().expect("kill");
+        child.wait().expect("wait");
+        let written = lines(&cut);
+        for (n, line) in written.iter().enumerate() {
+            serde_json::from_str::<serde_json::Value>(line).unwrap_or_else(|e| panic!("cut at {ms} ms, line {}: {e}", n + 1));
+        }
+        assert!(written.len() < reference.len(), "cut at {ms} ms: the run was cut before its end");
+        assert_eq!(written[..], reference[..written.len()], "cut at {ms} ms: no event before the cut is lost or changed");
+    }
+}
+
+#[test]
+fn ctrl_c_ends_the_mission_with_the_fleet_home() {
+    let dir = scratch("ctrl_c");
+    let trace = dir.join("t.jsonl");
+    let mut child = spawn(&trace, "20");
+    std::thread::sleep(Duration::from_millis(1500));
+    interrupt(&child);
+    let status = child.wait().expect("wait");
+    assert_eq!(status.code(), Some(1), "an aborted mission exits 1");
+    let events: Vec<serde_json::Value> = lines(&trace).iter().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let end = events.last().unwrap();
+    assert_eq!((end["event"].as_str(), end["status"].as_str(), end["reason"].as_str()), (Some("mission_end"), Some("aborted"), Some("interrupted by Ctrl-C")));
+    let home: Vec<&str> = events.iter().filter(|e| e["event"] == "api_done" && e["function"] == "ReturnToLaunch" && e["status"] == "ok").map(|e| e["actor"].as_str().unwrap()).collect();
+    assert!(home.contains(&"video_drone1"), "the drones in the air were brought home: {home:?}");
+}
+
+#[test]
+fn a_second_ctrl_c_stops_at_once_and_still_closes_the_trace() {
+    let dir = scratch("ctrl_c_twice");
+    let trace = dir.join("t.jsonl");
+    let mut child = spawn(&trace, "2");
+    std::thread::sleep(Duration::from_millis(1500));
+    interrupt(&child);
+    std::thread::sleep(Duration::from_millis(300));
+    interrupt(&child);
+    let status = child.wait().expect("wait");
+    assert_eq!(status.code(), Some(130));
+    let written = lines(&trace);
+    let end: serde_json::Value = serde_json::from_str(written.last().unwrap()).unwrap();
+    assert_eq!((end["event"].as_str(), end["reason"].as_str()), (Some("mission_end"), Some("stopped at once by a second Ctrl-C")));
+    assert_eq!(written.iter().filter(|l| l.contains("\"mission_end\"")).count(), 1);
+}

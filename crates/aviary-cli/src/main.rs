@@ -5,6 +5,7 @@
 
 mod bench;
 mod check;
+mod ctl;
 mod files;
 mod fmt;
 mod run;
@@ -54,9 +55,9 @@ enum Command {
         /// The world file (default: NAME.world.toml beside NAME.mission)
         #[arg(long)]
         world: Option<PathBuf>,
-        /// `max` (as fast as possible) or times real time, such as 1 or 10
-        #[arg(long, default_value = "max")]
-        speed: String,
+        /// `max` (as fast as possible; the default) or times real time, such as 1 or 10
+        #[arg(long)]
+        speed: Option<String>,
         /// The seed of the simulation: the same files and seed give the same trace
         #[arg(long, default_value_t = 0)]
         seed: u64,
@@ -69,6 +70,21 @@ enum Command {
         /// Print nothing but errors
         #[arg(long)]
         quiet: bool,
+        /// Serve the operator API on PORT (loopback) or HOST:PORT; runs in real time
+        /// unless --speed says otherwise
+        #[arg(long, value_name = "[HOST:]PORT")]
+        serve: Option<String>,
+    },
+    /// Talk to a running mission's operator API (see `aviary run --serve`)
+    Ctl {
+        /// The API's address, as the run printed it
+        #[arg(long, env = "AVIARY_URL")]
+        url: String,
+        /// The run's token (needed for control calls)
+        #[arg(long, env = "AVIARY_TOKEN")]
+        token: Option<String>,
+        #[command(subcommand)]
+        command: CtlArgs,
     },
     /// Explain a diagnostic code, such as E107
     Explain { code: String },
@@ -79,18 +95,55 @@ enum Command {
     },
 }
 
+#[derive(Subcommand)]
+enum CtlArgs {
+    /// Print the mission's state: blocks, activities with tags, drones
+    State,
+    /// Print every event as it happens, one JSON object per line
+    Events,
+    /// A leash on a running activity: `leash FlyCircle-C1 PAUSE`, `leash FlyCircle-C1 Widen radius=200m`
+    Leash { activity: String, action: String, args: Vec<String> },
+    /// Raise a signal the mission hears: `signal Go`
+    Signal { name: String, values: Vec<String> },
+    /// Hold every drone where it is
+    Pause,
+    /// Go on after `pause`
+    Resume,
+    /// End the mission; the fleet returns home
+    Abort,
+}
+
+impl From<CtlArgs> for ctl::CtlCommand {
+    fn from(a: CtlArgs) -> Self {
+        match a {
+            CtlArgs::State => ctl::CtlCommand::State,
+            CtlArgs::Events => ctl::CtlCommand::Events,
+            CtlArgs::Leash { activity, action, args } => ctl::CtlCommand::Leash { activity, action, args },
+            CtlArgs::Signal { name, values } => ctl::CtlCommand::Signal { name, values },
+            CtlArgs::Pause => ctl::CtlCommand::Pause,
+            CtlArgs::Resume => ctl::CtlCommand::Resume,
+            CtlArgs::Abort => ctl::CtlCommand::Abort,
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let code = match cli.command {
         Command::Check { files, world, format } => check::run(&files, world.as_deref(), format),
         Command::Fmt { files, check } => fmt::run(&files, check),
-        Command::Run { file, world, speed, seed, trace, telemetry_hz, quiet } => match run::parse_speed(&speed) {
-            Ok(speed) => run::run(&run::RunArgs { file, world, speed, seed, trace, telemetry_hz, quiet }),
-            Err(why) => {
-                eprintln!("aviary: {why}");
-                2
+        Command::Run { file, world, speed, seed, trace, telemetry_hz, quiet, serve } => {
+            // Served to an operator, a mission runs in real time unless told otherwise.
+            let speed = speed.unwrap_or_else(|| if serve.is_some() { "1".into() } else { "max".into() });
+            match (run::parse_speed(&speed), serve.as_deref().map(run::parse_serve).transpose()) {
+                (Ok(speed), Ok(serve)) => run::run(&run::RunArgs { file, world, speed, seed, trace, telemetry_hz, quiet, serve }),
+                (Err(why), _) | (_, Err(why)) => {
+                    eprintln!("aviary: {why}");
+                    2
+                }
             }
-        },
+        }
+        Command::Ctl { url, token, command } => ctl::run(&url, token.as_deref(), command.into()),
         Command::Explain { code } => explain(&code),
         Command::Bench { which } => bench::run(which),
     };

@@ -23,6 +23,16 @@ pub struct RunArgs {
     pub trace: Option<PathBuf>,
     pub telemetry_hz: Option<f64>,
     pub quiet: bool,
+    /// Where to serve the operator API.
+    pub serve: Option<std::net::SocketAddr>,
+}
+
+/// `7878` is loopback port 7878; `HOST:PORT` binds exactly that.
+pub fn parse_serve(text: &str) -> Result<std::net::SocketAddr, String> {
+    if let Ok(port) = text.parse::<u16>() {
+        return Ok(std::net::SocketAddr::from(([127, 0, 0, 1], port)));
+    }
+    text.parse().map_err(|_| format!("`{text}` is not a port or HOST:PORT for --serve: write 7878 or 127.0.0.1:7878"))
 }
 
 /// `max` or a positive number of times real time.
@@ -93,6 +103,19 @@ pub fn run(args: &RunArgs) -> u8 {
     };
     let (controller, controls) = Controller::new();
     on_ctrl_c(controller.clone(), trace.clone());
+    let server = match args.serve.map(|addr| aviary_server::start(addr, controller.clone())).transpose() {
+        Ok(s) => s,
+        Err(why) => {
+            eprintln!("aviary: {why}");
+            return 2;
+        }
+    };
+    if let Some(s) = &server {
+        eprintln!("aviary: operator API on http://{}  token {}", s.address, s.token);
+    }
+    let feed = server.as_ref().map(|s| s.feed.clone());
+    // The operator's view of the drones comes from telemetry events.
+    let telemetry_hz = args.telemetry_hz.or(server.as_ref().map(|_| 2.0));
     let progress = progress_bar(args.quiet);
     let (outcome, summary) = runtime.block_on(async {
         let sim = SimBackend::start(&world, SimOptions { speed: args.speed, ..SimOptions::default() });
@@ -101,8 +124,11 @@ pub fn run(args: &RunArgs) -> u8 {
         let mut sink = |event: serde_json::Value| {
             stats.observe(&event, &progress, &sim);
             lock(&trace).write(&event);
+            if let Some(feed) = &feed {
+                feed.publish(&event);
+            }
         };
-        let options = RunOptions { telemetry_hz: args.telemetry_hz };
+        let options = RunOptions { telemetry_hz };
         let outcome = tokio::select! {
             biased;
             outcome = aviary_engine::run_controlled(&mission, &*sim, &mut sink, &options, controls) => outcome,
@@ -113,6 +139,9 @@ pub fn run(args: &RunArgs) -> u8 {
         (outcome, summary)
     });
     progress.finish_and_clear();
+    if let Some(s) = &server {
+        s.finish(std::time::Duration::from_secs(2));
+    }
     if !args.quiet {
         print!("{summary}");
         match &outcome.reason {

@@ -1,0 +1,105 @@
+//! The operator API: the mission's state, its live event stream, and control calls, over
+//! HTTP and WebSocket (axum). A web ground station builds on it; `aviary ctl` is its
+//! command-line client; `docs/OPERATOR_API.md` documents it.
+//!
+//! It runs on a thread and runtime of its own, in real time, beside the engine's
+//! simulated clock. It knows the mission only through the trace events it is fed
+//! ([`Feed::publish`]) and the [`Controller`] it sends controls with.
+//!
+//! Invariants: every control call needs the run's token; reading needs none. The server
+//! binds the address it is given; the CLI gives loopback unless told otherwise.
+
+mod routes;
+mod state;
+
+use std::net::SocketAddr;
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use aviary_engine::Controller;
+use serde_json::Value;
+use tokio::sync::broadcast;
+
+use crate::state::MissionState;
+
+/// How many events a slow WebSocket client may fall behind before it misses some.
+const BACKLOG: usize = 4096;
+
+pub(crate) struct Shared {
+    /// Event streams still open.
+    pub streams: std::sync::atomic::AtomicUsize,
+    pub token: String,
+    pub controller: Controller,
+    pub state: Mutex<MissionState>,
+    pub events: broadcast::Sender<Arc<str>>,
+}
+
+impl Shared {
+    pub fn state(&self) -> MutexGuard<'_, MissionState> {
+        self.state.lock().unwrap_or_else(|p| p.into_inner())
+    }
+}
+
+/// The engine's side: every trace event goes through here.
+#[derive(Clone)]
+pub struct Feed {
+    shared: Arc<Shared>,
+}
+
+impl Feed {
+    pub fn publish(&self, event: &Value) {
+        self.shared.state().observe(event);
+        let _ = self.shared.events.send(Arc::from(event.to_string()));
+    }
+}
+
+/// A running server.
+pub struct Server {
+    pub address: SocketAddr,
+    pub token: String,
+    pub feed: Feed,
+}
+
+impl Server {
+    /// After `mission_end`: waits (at most `limit`) until every open event stream has
+    /// delivered it, so that no client misses how the mission ended.
+    pub fn finish(&self, limit: std::time::Duration) {
+        let start = std::time::Instant::now();
+        while self.feed.shared.streams.load(std::sync::atomic::Ordering::SeqCst) > 0 && start.elapsed() < limit {
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+    }
+}
+
+/// Binds `address` and serves in the background. The token is new for each run.
+pub fn start(address: SocketAddr, controller: Controller) -> Result<Server, String> {
+    let listener = std::net::TcpListener::bind(address).map_err(|e| format!("cannot listen on {address}: {e}"))?;
+    listener.set_nonblocking(true).map_err(|e| e.to_string())?;
+    let bound = listener.local_addr().map_err(|e| e.to_string())?;
+    let token = new_token()?;
+    let (events, _) = broadcast::channel(BACKLOG);
+    let shared = Arc::new(Shared { streams: Default::default(), token: token.clone(), controller, state: Mutex::new(MissionState::default()), events });
+    let app = routes::router(shared.clone());
+    let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(1).enable_all().build().map_err(|e| e.to_string())?;
+    std::thread::Builder::new()
+        .name("aviary-server".into())
+        .spawn(move || {
+            runtime.block_on(async move {
+                match tokio::net::TcpListener::from_std(listener) {
+                    Ok(listener) => {
+                        if let Err(e) = axum::serve(listener, app).await {
+                            eprintln!("aviary: the operator API stopped: {e}");
+                        }
+                    }
+                    Err(e) => eprintln!("aviary: the operator API cannot start: {e}"),
+                }
+            })
+        })
+        .map_err(|e| e.to_string())?;
+    Ok(Server { address: bound, token, feed: Feed { shared } })
+}
+
+fn new_token() -> Result<String, String> {
+    let mut bytes = [0u8; 16];
+    getrandom::fill(&mut bytes).map_err(|e| format!("no randomness for the token: {e}"))?;
+    Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())
+}

@@ -113,6 +113,8 @@ pub(crate) struct Engine<'m> {
     pub stop: CancellationToken,
     events: RefCell<Option<mpsc::UnboundedReceiver<DroneEvent>>>,
     root: RefCell<Option<Rc<Scope<'m>>>>,
+    /// The MISSION body's own block: "mission level", where an idle drone's events are raised.
+    pub mission_scope: RefCell<Option<Rc<Scope<'m>>>>,
     pub next_id: Cell<u64>,
 }
 
@@ -135,6 +137,7 @@ impl<'m> Engine<'m> {
             stop: CancellationToken::new(),
             events: RefCell::new(backend.events()),
             root: RefCell::new(None),
+            mission_scope: RefCell::new(None),
             next_id: Cell::new(0),
         }
     }
@@ -337,7 +340,7 @@ impl<'m> Engine<'m> {
         let innermost = instances.iter().filter(|(i, _)| i.actors.contains(&drone)).max_by_key(|(i, _)| (i.depth, i.id));
         match innermost {
             Some((_, scope)) => scope.clone(),
-            None => self.root_scope(),
+            None => self.mission_scope.borrow().clone().unwrap_or_else(|| self.root_scope()),
         }
     }
 

@@ -71,6 +71,9 @@ impl<'m> Engine<'m> {
         if !block.handlers.is_empty() {
             self.listeners.borrow_mut().push(Rc::downgrade(&scope));
         }
+        if ctx.scope.parent.is_none() {
+            *self.mission_scope.borrow_mut() = Some(scope.clone());
+        }
         (scope, rx)
     }
 

@@ -33,18 +33,14 @@ fn error(status: StatusCode, message: impl Into<String>) -> Response {
 }
 
 /// Control calls carry `Authorization: Bearer TOKEN`, the token the run printed.
-fn authorized(shared: &Shared, headers: &HeaderMap) -> Result<(), Response> {
+fn authorized(shared: &Shared, headers: &HeaderMap) -> bool {
     let given = headers.get("authorization").and_then(|v| v.to_str().ok()).and_then(|v| v.strip_prefix("Bearer "));
-    if given == Some(shared.token.as_str()) {
-        Ok(())
-    } else {
-        Err(error(StatusCode::UNAUTHORIZED, "control calls need the token the run printed: send `Authorization: Bearer TOKEN`"))
-    }
+    given == Some(shared.token.as_str())
 }
 
 async fn control(shared: &Shared, headers: &HeaderMap, control: Control) -> Response {
-    if let Err(refused) = authorized(shared, headers) {
-        return refused;
+    if !authorized(shared, headers) {
+        return error(StatusCode::UNAUTHORIZED, "control calls need the token the run printed: send `Authorization: Bearer TOKEN`");
     }
     match shared.controller.ask(control).await {
         Ok(()) => Json(json!({ "ok": true })).into_response(),

@@ -21,6 +21,7 @@ const SITE_KEYS: &[&str] = &[
     "geofence",
     "max_altitude",
     "min_separation",
+    "link_loss_rtl_after",
 ];
 const ORIGIN_KEYS: &[&str] = &["lat", "lon", "alt"];
 
@@ -153,6 +154,11 @@ fn site(cx: &mut Ctx, node: &Node) -> Site {
                 Some(v) => site.min_separation = v,
                 None => {}
             },
+            "link_loss_rtl_after" => {
+                if let Some(v) = cx.positive("`link_loss_rtl_after`", n) {
+                    site.link_loss_rtl_after = v;
+                }
+            }
             _ => {}
         }
     }

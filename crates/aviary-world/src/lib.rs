@@ -54,6 +54,9 @@ pub struct Site {
     pub max_altitude: Option<f64>,
     /// Metres; default 5.
     pub min_separation: f64,
+    /// Seconds a simulated drone holds after losing its link before it returns to launch
+    /// on its own; default 10.
+    pub link_loss_rtl_after: f64,
 }
 
 impl Default for Site {
@@ -64,6 +67,7 @@ impl Default for Site {
             geofence: None,
             max_altitude: None,
             min_separation: 5.0,
+            link_loss_rtl_after: 10.0,
         }
     }
 }

@@ -91,3 +91,19 @@ fn a_speed_paces_the_run_against_the_wall_clock() {
     // 1 s of mission time at twice real time: at least half a second of wall time.
     assert!(started.elapsed() >= std::time::Duration::from_millis(450), "{:?}", started.elapsed());
 }
+
+#[test]
+fn an_unhandled_crash_exits_1_with_the_others_home() {
+    let dir = scratch("unhandled_crash");
+    std::fs::write(dir.join("m.world.toml"), "[places]\nFar = [0, 300]\n[drones.a]\nhome = [0, 0]\n[drones.b]\nhome = [10, 0]\n[[faults]]\ndrone = \"a\"\nat = 10.0\nkind = \"crash\"\n").unwrap();
+    std::fs::write(dir.join("m.mission"), "MISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        b FlyTo WITH Far\n").unwrap();
+    let (code, out, _) = aviary(&["run", "m.mission", "--trace", "t.jsonl"], &dir);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains("mission failed: unhandled exception DroneLost on a"), "{out}");
+    let trace = std::fs::read_to_string(dir.join("t.jsonl")).unwrap();
+    assert!(trace.lines().any(|l| l.contains("\"function\":\"ReturnToLaunch\"") && l.contains("\"actor\":\"b\"") && l.contains("\"status\":\"ok\"")), "b is brought home");
+    let b = out.lines().find(|l| l.starts_with("b ")).unwrap();
+    assert!(b.ends_with("Landed"), "{b}");
+    let a = out.lines().find(|l| l.starts_with("a ")).unwrap();
+    assert!(a.ends_with("Lost"), "{a}");
+}

@@ -126,3 +126,16 @@ fn aborting_the_mission_sends_the_fleet_home() {
     let aborted = trace.iter().filter(|e| e["event"] == "capability_end" && e["capability"] == "FlyTo").count();
     assert_eq!(aborted, 0, "the activities were cut off with the mission: no end is invented for them");
 }
+
+#[test]
+fn a_lost_backend_ends_the_mission_at_once_without_commanding_anyone() {
+    let (outcome, trace, _) = run_with_controls(
+        "MISSION M:\n    a FlyTo WITH Far\n",
+        vec![(10.0, Control::BackendLost { reason: "the simulator stopped: its task panicked".into() })],
+    );
+    assert_eq!(outcome.status, Status::Failed);
+    let last = trace.last().unwrap();
+    assert_eq!((last["event"].as_str(), last["reason"].as_str()), (Some("mission_end"), Some("the simulator stopped: its task panicked")));
+    assert_eq!(last["t"].as_f64().unwrap(), 10.0, "at once");
+    assert!(!trace.iter().any(|e| e["event"] == "api_call" && e["function"] == "ReturnToLaunch"), "nobody can be commanded");
+}

@@ -11,7 +11,7 @@
 //!
 //! Invariant: this crate knows no engine, no backend and no syntax.
 
-mod geometry;
+pub mod geometry;
 mod kind;
 mod runtime;
 

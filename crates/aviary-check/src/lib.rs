@@ -7,6 +7,7 @@
 
 mod chains;
 mod env;
+mod geofence;
 mod inputs;
 pub mod generate;
 mod infer;
@@ -92,6 +93,9 @@ pub fn check(sources: &mut SourceMap, root: FileId, world: Option<&World>, provi
     if syntax_ok {
         walk::check_program(&program, world, api, root, &mut diagnostics);
         signals::check_signals(&program, api, &mut diagnostics);
+        if let Some(world) = world {
+            geofence::check_geofence(&program, world, &mut diagnostics);
+        }
         chains::check_chains(&program, api, &mut diagnostics);
     }
     aviary_diagnostics::sort(&mut diagnostics);

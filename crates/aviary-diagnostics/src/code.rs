@@ -77,6 +77,8 @@ codes! {
     DuplicateParameter = "E121", Error, "a capability that declares one parameter twice";
     SignalNeverRaised = "E122", Error, "a WAITFOR RECEIVED(X) where nothing raises X";
     ApiCallOnNonActor = "E123", Error, "an API call on something that is not the capability's actor";
+    LeavesGeofence = "E124", Error, "a flight to a place, area, orbit or sweep that leaves the geofence";
+    AboveCeiling = "E125", Error, "an altitude above the site's max_altitude";
     // Warnings.
     HandlerNeverFires = "W201", Warning, "a handler for a signal that nothing raises";
     UnknownException = "W202", Warning, "an ON EXCEPTION for a name neither built in nor thrown";

@@ -1,0 +1,225 @@
+//! Geofence and ceiling before flight (LANGUAGE.md §7): every place, area, orbit and
+//! sweep the mission flies to, where it is known before the run, lies inside the world's
+//! geofence, and every altitude stays under `max_altitude`.
+//!
+//! Values are followed from each mission statement into the capabilities it calls (by
+//! their parameters and defaults), down to the middle-layer calls that fly. A problem is
+//! reported at the mission statement, with the call that flies as a second place.
+
+use std::collections::BTreeMap;
+
+use aviary_api::geometry::{circle_inside, contains, segment_inside};
+use aviary_diagnostics::{Code, Diagnostic, FileId, Label, Span};
+use aviary_syntax::ast::*;
+use aviary_world::World;
+
+use crate::env::{bind_args, capability_bodies};
+use crate::Program;
+
+/// How deep capabilities may call each other before the analysis stops following.
+const MAX_CALLS: usize = 16;
+
+#[derive(Clone, Debug)]
+enum Known {
+    Point([f64; 2], Option<f64>),
+    Area(Vec<[f64; 2]>),
+    Number(f64),
+}
+
+type Values = BTreeMap<String, Known>;
+
+pub(crate) fn check_geofence(program: &Program, world: &World, diagnostics: &mut Vec<Diagnostic>) {
+    let (fence, ceiling) = (world.site.geofence.as_deref(), world.site.max_altitude);
+    if fence.is_none() && ceiling.is_none() {
+        return;
+    }
+    let (Some(mission), Some(file)) = (program.mission(), program.mission.map(|r| r.file)) else { return };
+    let mut walker = Walker { program, world, fence, ceiling, diagnostics };
+    walker.body(&mission.body, &Values::new(), None, file, 0);
+}
+
+struct Walker<'a> {
+    program: &'a Program,
+    world: &'a World,
+    fence: Option<&'a [[f64; 2]]>,
+    ceiling: Option<f64>,
+    diagnostics: &'a mut Vec<Diagnostic>,
+}
+
+impl Walker<'_> {
+    fn value(&self, e: &Expr, values: &Values) -> Option<Known> {
+        match &e.kind {
+            ExprKind::Number { value, unit, .. } => Some(Known::Number(value * unit.map_or(1.0, |u| u.to_si()))),
+            ExprKind::Coordinates(parts) => {
+                let n: Option<Vec<f64>> = parts.iter().map(|p| match self.value(p, values) {
+                    Some(Known::Number(n)) => Some(n),
+                    _ => None,
+                }).collect();
+                let n = n?;
+                Some(Known::Point([n[0], *n.get(1)?], n.get(2).copied()))
+            }
+            ExprKind::Name(id) => {
+                if let Some(v) = values.get(&id.name) {
+                    return Some(v.clone());
+                }
+                if let Some(p) = self.world.place(&id.name) {
+                    return Some(Known::Point([p.at[0], p.at[1]], p.has_z.then_some(p.at[2])));
+                }
+                self.world.area(&id.name).map(|a| Known::Area(a.polygon.clone()))
+            }
+            ExprKind::Paren(inner) => self.value(inner, values),
+            _ => None,
+        }
+    }
+
+    /// `site`: the mission statement this body runs for, if inside a capability.
+    fn body(&mut self, body: &Body, values: &Values, site: Option<(FileId, Span)>, file: FileId, depth: usize) {
+        for stmt in &body.items {
+            match stmt {
+                Stmt::Statement(s) => self.statement(s, values, site.or(Some((file, s.span))), depth),
+                Stmt::Api(a) => self.api(a, values, site, file),
+                Stmt::For(f) => {
+                    for inst in &f.instances {
+                        let mut inner = values.clone();
+                        inner.remove(&f.alias.name);
+                        for (p, v) in f.params.iter().zip(&inst.values) {
+                            match self.value(v, values) {
+                                Some(k) => inner.insert(p.name.clone(), k),
+                                None => inner.remove(&p.name),
+                            };
+                        }
+                        self.body(&f.body, &inner, site, file, depth);
+                    }
+                }
+                Stmt::Handler(h) => self.body(&h.body, &without(values, &h.bindings), site, file, depth),
+                Stmt::ExceptionHandler(h) => self.body(&h.body, &without(values, &h.bindings), site, file, depth),
+                other => other.for_each_body(|b| self.body(b, values, site, file, depth)),
+            }
+        }
+    }
+
+    fn statement(&mut self, s: &Statement, values: &Values, site: Option<(FileId, Span)>, depth: usize) {
+        let (Some(callee), Some(file)) = (self.program.capability(&s.capability.name), self.program.capability_file(&s.capability.name)) else { return };
+        if depth >= MAX_CALLS {
+            return;
+        }
+        let binding = bind_args(&callee.params, &s.args);
+        let defaults: BTreeMap<&str, &Expr> = callee
+            .sections
+            .iter()
+            .filter_map(|sec| match sec {
+                Section::Defaults { entries, .. } => Some(entries.iter().map(|e| (e.name.name.as_str(), &e.value))),
+                _ => None,
+            })
+            .flatten()
+            .collect();
+        let mut inner = Values::new();
+        for (i, p) in callee.params.iter().enumerate() {
+            let known = match binding.bound[i] {
+                Some(e) => self.value(e, values),
+                None => defaults.get(p.name.as_str()).and_then(|e| self.value(e, &Values::new())),
+            };
+            if let Some(k) = known {
+                inner.insert(p.name.clone(), k);
+            }
+        }
+        for body in capability_bodies(callee) {
+            self.body(body, &inner, site, file, depth + 1);
+        }
+    }
+
+    fn api(&mut self, call: &ApiCall, values: &Values, site: Option<(FileId, Span)>, file: FileId) {
+        let arg = |i: usize| call.args.get(i).and_then(|e| self.value(e, values));
+        match call.function.name.as_str() {
+            "FlyToPosition" => {
+                if let Some(k) = arg(0) {
+                    self.point(&k, call, site, file);
+                }
+            }
+            "TakeOff" | "AscendTo" | "DescendTo" => {
+                if let Some(Known::Number(alt)) = arg(0) {
+                    self.altitude(alt, call, site, file);
+                }
+            }
+            "Orbit" => {
+                if let (Some(center), Some(Known::Number(radius)), Some(fence)) = (arg(0).and_then(|k| ground(&k)), arg(1), self.fence) {
+                    if !circle_inside(fence, center, radius) {
+                        let what = format!("the circle of {radius} m around {} leaves the geofence", shown(center));
+                        self.report(Code::LeavesGeofence, what, call, site, file);
+                    }
+                }
+            }
+            "Sweep" => {
+                if let (Some(Known::Area(area)), Some(fence)) = (arg(0), self.fence) {
+                    // A corner outside, or else an edge that crosses the fence.
+                    let corner = area.iter().find(|p| !contains(fence, **p));
+                    let crossing = || area.iter().zip(area.iter().cycle().skip(1)).find(|(p, q)| !segment_inside(fence, **p, **q)).map(|(p, _)| p);
+                    if let Some(p) = corner.or_else(crossing) {
+                        let what = format!("the area swept reaches outside the geofence, at {}", shown(*p));
+                        self.report(Code::LeavesGeofence, what, call, site, file);
+                    }
+                }
+            }
+            "FollowPath" => {
+                for e in &call.args {
+                    if let Some(k) = self.value(e, values) {
+                        self.point(&k, call, site, file);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn point(&mut self, k: &Known, call: &ApiCall, site: Option<(FileId, Span)>, file: FileId) {
+        if let (Some(p), Some(fence)) = (ground(k), self.fence) {
+            if !contains(fence, p) {
+                self.report(Code::LeavesGeofence, format!("this flies to {}, outside the geofence", shown(p)), call, site, file);
+            }
+        }
+        if let Known::Point(_, Some(z)) = k {
+            self.altitude(*z, call, site, file);
+        }
+    }
+
+    fn altitude(&mut self, alt: f64, call: &ApiCall, site: Option<(FileId, Span)>, file: FileId) {
+        if let Some(ceiling) = self.ceiling {
+            if alt > ceiling {
+                self.report(Code::AboveCeiling, format!("this flies at {alt} m, above the site's max_altitude of {ceiling} m"), call, site, file);
+            }
+        }
+    }
+
+    fn report(&mut self, code: Code, message: String, call: &ApiCall, site: Option<(FileId, Span)>, file: FileId) {
+        let (at_file, at) = site.unwrap_or((file, call.span));
+        let help = match code {
+            Code::AboveCeiling => "fly lower, or raise `max_altitude` in the world file's [site]",
+            _ => "choose a place inside the geofence, or widen `geofence` in the world file's [site]",
+        };
+        let mut d = Diagnostic::new(code, at_file, at, message).with_help(help);
+        if site.is_some() {
+            d.secondary.push(Label { file, span: call.span, message: format!("{} is called here", call.function.name) });
+        }
+        self.diagnostics.push(d);
+    }
+}
+
+fn ground(k: &Known) -> Option<[f64; 2]> {
+    match k {
+        Known::Point(p, _) => Some(*p),
+        Known::Area(a) => Some(aviary_api::centroid(a)),
+        Known::Number(_) => None,
+    }
+}
+
+fn shown(p: [f64; 2]) -> String {
+    format!("({}, {})", p[0], p[1])
+}
+
+fn without(values: &Values, bound: &[Ident]) -> Values {
+    let mut v = values.clone();
+    for b in bound {
+        v.remove(&b.name);
+    }
+    v
+}

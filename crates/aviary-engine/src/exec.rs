@@ -294,6 +294,7 @@ impl<'m> Engine<'m> {
             h = acquire(&self.arbiter, needs) => Some(h),
         };
         if self.stopped() {
+            self.instances.borrow_mut().retain(|(i, _)| i.id != instance.id);
             return;
         }
         self.trace("capability_start", start.clone());

@@ -1,6 +1,6 @@
 //! Evaluating expressions at run time, and showing values in the trace.
 
-use aviary_api::{Backend, FlightState, Point, Value};
+use aviary_api::{Backend, Point, Value};
 use aviary_ir::{ActorRef, Compare, Expr, Field, Mission};
 use serde_json::{json, Value as Json};
 
@@ -150,5 +150,5 @@ pub(crate) fn to_json(m: &Mission, v: &Value) -> Json {
 }
 
 pub(crate) fn airborne(backend: &dyn Backend, d: usize) -> bool {
-    backend.telemetry(d).state.airborne() && backend.telemetry(d).state != FlightState::Lost
+    backend.telemetry(d).state.airborne()
 }

@@ -91,8 +91,10 @@ fn a_link_loss_is_connection_lost_and_its_return_is_connection_restored() {
 
 #[test]
 fn a_geofence_refusal_is_geofence_violation() {
+    // The target comes with a signal, so only the run knows it (`aviary check` reports
+    // the flights it can see before take-off: E124).
     let r = harness::run(
-        "MISSION M:\n    SEQUENTIAL:\n        a TakeOff\n        a FlyTo WITH (5000, 0)\n    ON EXCEPTION GeofenceViolation BY a:\n        a ReturnHome\n",
+        "MISSION M:\n    SEQUENTIAL:\n        a TakeOff\n        SIGNAL Go WITH (5000, 0)\n    ON Go WITH spot:\n        a FlyTo WITH spot\n    ON EXCEPTION GeofenceViolation BY a:\n        a ReturnHome\n",
     );
     let e = r.first("exception", "name", "GeofenceViolation");
     assert_eq!(e["handled"], true);

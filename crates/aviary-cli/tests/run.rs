@@ -107,3 +107,30 @@ fn an_unhandled_crash_exits_1_with_the_others_home() {
     let a = out.lines().find(|l| l.starts_with("a ")).unwrap();
     assert!(a.ends_with("Lost"), "{a}");
 }
+
+#[test]
+fn in_the_trace_no_two_airborne_drones_come_closer_than_min_separation() {
+    let dir = scratch("separation");
+    let trace = dir.join("t.jsonl");
+    let (code, _, err) = aviary(&["run", "examples/search_and_rescue.mission", "--quiet", "--telemetry-hz", "20", "--trace", &trace.to_string_lossy()], &repo());
+    assert_eq!(code, 0, "{err}");
+    let mut by_time: std::collections::BTreeMap<String, Vec<[f64; 3]>> = Default::default();
+    for line in std::fs::read_to_string(&trace).unwrap().lines() {
+        let e: serde_json::Value = serde_json::from_str(line).unwrap();
+        let airborne = matches!(e["state"].as_str(), Some("TakingOff" | "Flying" | "Landing"));
+        if e["event"] == "telemetry" && airborne && e["position"][2].as_f64().unwrap() > 0.0 {
+            let p: Vec<f64> = e["position"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+            by_time.entry(e["t"].to_string()).or_default().push([p[0], p[1], p[2]]);
+        }
+    }
+    assert!(by_time.len() > 5000, "telemetry at 20 Hz over the whole mission");
+    let mut closest = f64::INFINITY;
+    for drones in by_time.values() {
+        for (i, a) in drones.iter().enumerate() {
+            for b in &drones[i + 1..] {
+                closest = closest.min(((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt());
+            }
+        }
+    }
+    assert!(closest >= 5.0 - 1e-6, "two drones in the air came within {closest} m");
+}

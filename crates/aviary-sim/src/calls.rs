@@ -71,7 +71,9 @@ impl Fleet {
             return Err(failed(why.clone()));
         }
         let motion = MOTION.contains(&function);
-        if motion && d.motion.is_some() {
+        // A return the drone started on its own (after a link loss) gives way to a command.
+        let own_return = d.motion.as_ref().is_some_and(|t| t.call.is_none());
+        if motion && d.motion.is_some() && !own_return {
             return Err(failed(format!(
                 "{} is busy with another motion call",
                 d.name
@@ -90,6 +92,9 @@ impl Fleet {
             Start::Pending => Ok(true),
             Start::Moves(legs) => {
                 let d = &mut self.drones[id];
+                if d.motion.take().is_some() {
+                    d.settle();
+                }
                 d.motion = Some(MotionTask::new(Some(call), legs));
                 d.begin_leg();
                 Ok(true)
@@ -101,6 +106,8 @@ impl Fleet {
         let limits = self.limits();
         let d = &self.drones[id];
         let here = d.pos;
+        // The altitude a move without one keeps (not a detour around another drone).
+        let level = d.level();
         let landed = d.state == FlightState::Landed;
         let in_air = || {
             if landed {
@@ -174,7 +181,7 @@ impl Fleet {
                     Some(s) => s.min(d.max_speed),
                     None => d.max_speed,
                 };
-                let to = [p.x, p.y, p.z.unwrap_or(here[2])];
+                let to = [p.x, p.y, p.z.unwrap_or(level)];
                 if to[2] < 0.0 {
                     return Err(failed(format!("altitude {} m is below the ground", to[2])));
                 }
@@ -225,14 +232,14 @@ impl Fleet {
                 }
                 let path: Vec<[f64; 3]> = lawnmower(&area, spacing)
                     .into_iter()
-                    .map(|p| [p[0], p[1], here[2]])
+                    .map(|p| [p[0], p[1], level])
                     .collect();
                 limits.path(here, &path)?;
                 path.into_iter().map(|to| fly(to, d.max_speed)).collect()
             }
             "FollowPath" => {
                 in_air()?;
-                let mut z = here[2];
+                let mut z = level;
                 let mut path = Vec::new();
                 for (i, v) in args.iter().enumerate() {
                     let p = point_value(v, &format!("points[{i}]"))?;
@@ -338,7 +345,11 @@ impl Fleet {
 }
 
 /// `ReturnToLaunch`: up to the return altitude, home, and down.
-fn return_legs(d: &SimDrone, landed: bool, max_altitude: Option<f64>) -> Result<Vec<Leg>, Failure> {
+pub(crate) fn return_legs(
+    d: &SimDrone,
+    landed: bool,
+    max_altitude: Option<f64>,
+) -> Result<Vec<Leg>, Failure> {
     let home_dist = dist(d.xy(), d.home);
     if landed {
         if home_dist <= AT_HOME {

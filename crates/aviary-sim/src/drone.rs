@@ -3,6 +3,7 @@
 use aviary_api::{CallId, FlightState, Telemetry};
 use aviary_world::Drone;
 
+use crate::avoid::Yield;
 use crate::motion::MotionTask;
 use crate::sensors::Activation;
 
@@ -19,8 +20,12 @@ pub(crate) struct Loading {
 /// A fault with a duration (link or GPS loss) in progress.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Outage {
+    /// Simulated time at which it began.
+    pub since: f64,
     /// Simulated time at which it ends.
     pub until: f64,
+    /// Whether the drone has already decided on its own return to launch (link loss).
+    pub returned: bool,
 }
 
 #[derive(Clone, Debug)]
@@ -43,6 +48,13 @@ pub(crate) struct SimDrone {
     pub state: FlightState,
     pub armed: bool,
     pub motion: Option<MotionTask>,
+    /// How the drone yields to another one, if it does (see [`crate::avoid`]).
+    pub avoid: Option<Yield>,
+    /// Seconds the safety filter has held the drone back without a break.
+    pub stalled: f64,
+    /// Whether the drone, after such a standstill, gives way to every drone until its
+    /// yield is over.
+    pub humble: bool,
     pub loading: Option<Loading>,
     pub carrying: Option<String>,
     pub streaming: bool,
@@ -77,6 +89,9 @@ impl SimDrone {
             state: FlightState::Landed,
             armed: false,
             motion: None,
+            avoid: None,
+            stalled: 0.0,
+            humble: false,
             loading: None,
             carrying: None,
             streaming: false,
@@ -93,6 +108,19 @@ impl SimDrone {
 
     pub fn xy(&self) -> [f64; 2] {
         [self.pos[0], self.pos[1]]
+    }
+
+    /// The altitude the drone flies at: where it is, or, while it is displaced up or down
+    /// to let another drone pass, where it came from.
+    pub fn level(&self) -> f64 {
+        match self.avoid {
+            Some(Yield {
+                alt: Some(_),
+                back_to,
+                ..
+            }) => back_to,
+            _ => self.pos[2],
+        }
     }
 
     pub fn telemetry(&self) -> Telemetry {

@@ -6,7 +6,12 @@
 //! - `motor_failure`: `MotorFailure`; the drone makes an emergency landing where it is and
 //!   refuses every later command.
 //! - `link_loss` (`duration`): `ConnectionLost`; the drone holds where it is and refuses
-//!   commands until the link is back, then raises `ConnectionRestored`.
+//!   commands until the link is back, then raises `ConnectionRestored` (a signal) and takes
+//!   commands again. If the link is still lost `[site] link_loss_rtl_after` seconds (default
+//!   10) after it went, a drone in the air flies `ReturnToLaunch` on its own (no call: up to
+//!   the return altitude, home, and down). That return goes on after the link is back,
+//!   until the drone has landed or a new motion command replaces it (stopping it where it
+//!   is first, as an abort does). A crash during the outage ends the drone as always.
 //! - `gps_loss` (`duration`): `PositionLost`; the drone holds and refuses motion commands
 //!   until the fix is back.
 //!
@@ -16,6 +21,7 @@
 use aviary_api::{DroneEvent, FlightState};
 use aviary_world::FaultKind;
 
+use crate::calls::return_legs;
 use crate::drone::Outage;
 use crate::fleet::{Fleet, Report};
 use crate::motion::{Leg, MotionTask};
@@ -29,7 +35,7 @@ impl Fleet {
                 continue;
             }
             f.fired = true;
-            let (id, kind, until) = (f.drone, f.kind, f.at + f.duration);
+            let (id, kind, at, until) = (f.drone, f.kind, f.at, f.at + f.duration);
             if self.drones[id].state == FlightState::Lost {
                 continue;
             }
@@ -77,7 +83,11 @@ impl Fleet {
                         format!("{name}: link lost (simulated fault)"),
                         out,
                     );
-                    self.drones[id].link_loss = Some(Outage { until });
+                    self.drones[id].link_loss = Some(Outage {
+                        since: at,
+                        until,
+                        returned: false,
+                    });
                 }
                 FaultKind::GpsLoss => {
                     self.fault(
@@ -86,7 +96,11 @@ impl Fleet {
                         format!("{name}: GPS lost (simulated fault)"),
                         out,
                     );
-                    self.drones[id].gps_loss = Some(Outage { until });
+                    self.drones[id].gps_loss = Some(Outage {
+                        since: at,
+                        until,
+                        returned: false,
+                    });
                 }
             }
         }
@@ -102,6 +116,23 @@ impl Fleet {
             }
             if d.gps_loss.is_some_and(|o| o.until <= end + 1e-9) {
                 d.gps_loss = None;
+            }
+        }
+        let max_altitude = self.max_altitude;
+        for d in &mut self.drones {
+            let Some(outage) = d.link_loss.as_mut() else {
+                continue;
+            };
+            if outage.returned || end + 1e-9 < outage.since + self.link_loss_rtl_after {
+                continue;
+            }
+            outage.returned = true;
+            let on_its_own = d.state.airborne() && d.motion.is_none() && d.disabled.is_none();
+            if on_its_own {
+                if let Ok(legs) = return_legs(d, false, max_altitude) {
+                    d.motion = Some(MotionTask::new(None, legs));
+                    d.begin_leg();
+                }
             }
         }
     }

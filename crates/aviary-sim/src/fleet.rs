@@ -1,11 +1,14 @@
 //! The physics core: every drone of the world, advanced tick by tick. Pure: no clock, no
 //! channels, no randomness; the same calls and steps give the same results bit for bit.
 
+use std::collections::BTreeMap;
+
 use aviary_api::{
     CallEnd, CallId, DroneEvent, DroneId, Failure, FlightState, Interrupt, Telemetry, Value,
 };
 use aviary_world::{FaultKind, Sensor, Target, World};
 
+use crate::avoid::Track;
 use crate::battery;
 use crate::drone::SimDrone;
 use crate::geom::heading;
@@ -45,12 +48,21 @@ pub struct Fleet {
     pub(crate) drones: Vec<SimDrone>,
     pub(crate) fence: Option<Vec<[f64; 2]>>,
     pub(crate) max_altitude: Option<f64>,
+    /// `[site] min_separation`: metres kept between drones in the air (0: none).
+    pub(crate) min_separation: f64,
+    /// `[site] link_loss_rtl_after`: seconds without link before a drone returns on its own.
+    pub(crate) link_loss_rtl_after: f64,
     pub(crate) sensors: Vec<Sensor>,
     pub(crate) targets: Vec<Target>,
     pub(crate) faults: Vec<ScheduledFault>,
     pub(crate) time: f64,
     pub(crate) next_call: u64,
     pub(crate) releases: Vec<Release>,
+    /// The drones in an airborne state at the start of this step (the only ones that
+    /// can take part in separation during it), in order.
+    pub(crate) aloft: Vec<DroneId>,
+    /// The planner's predicted tracks of drones that moved already in this step.
+    pub(crate) tracks: BTreeMap<DroneId, Track>,
 }
 
 impl Fleet {
@@ -75,12 +87,16 @@ impl Fleet {
             drones: world.drones.iter().map(SimDrone::new).collect(),
             fence: world.site.geofence.clone(),
             max_altitude: world.site.max_altitude,
+            min_separation: world.site.min_separation,
+            link_loss_rtl_after: world.site.link_loss_rtl_after,
             sensors: world.sensors.clone(),
             targets: world.targets.clone(),
             faults,
             time: 0.0,
             next_call: 1,
             releases: Vec::new(),
+            aloft: Vec::new(),
+            tracks: BTreeMap::new(),
         }
     }
 
@@ -197,6 +213,13 @@ impl Fleet {
         let end = self.time + dt;
         let mut out = Vec::new();
         self.fire_faults(end, &mut out);
+        self.tracks.clear();
+        self.aloft.clear();
+        for (id, d) in self.drones.iter().enumerate() {
+            if d.state.airborne() {
+                self.aloft.push(id);
+            }
+        }
         for id in 0..self.drones.len() {
             self.step_drone(id, dt, &mut out);
         }
@@ -205,14 +228,15 @@ impl Fleet {
     }
 
     fn step_drone(&mut self, id: DroneId, dt: f64, out: &mut Vec<Report>) {
-        let d = &mut self.drones[id];
-        if d.state == FlightState::Lost {
+        if self.drones[id].state == FlightState::Lost {
             return;
         }
-        let airborne = d.state.airborne();
-        let from = d.xy();
-        let before = d.pos;
-        if let Some(task) = d.tick_motion(dt) {
+        let airborne = self.drones[id].state.airborne();
+        let from = self.drones[id].xy();
+        let before = self.drones[id].pos;
+        let finished = self.move_drone(id, dt);
+        let d = &mut self.drones[id];
+        if let Some(task) = finished {
             if let Some(call) = task.call {
                 out.push(Report::Ended {
                     call,
@@ -295,6 +319,7 @@ impl Fleet {
         self.fault(id, "DroneLost", reason, out);
         let d = &mut self.drones[id];
         d.state = FlightState::Lost;
+        d.avoid = None;
         d.armed = false;
         d.pos[2] = 0.0;
         d.vel = [0.0; 3];

@@ -1,23 +1,9 @@
 //! Plane geometry on `[x, y]` points in local metres: polygon containment, distances, and
 //! the geofence checks of a planned path. Pure and deterministic.
 
-/// Points this close to a polygon's edge count as inside it (metres).
-const ON_EDGE: f64 = 1e-6;
-
-pub(crate) fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
-    (b[0] - a[0]).hypot(b[1] - a[1])
-}
-
-/// Distance from `p` to the segment `a`-`b`.
-pub(crate) fn dist_to_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let len2 = dx * dx + dy * dy;
-    if len2 == 0.0 {
-        return dist(p, a);
-    }
-    let t = (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0);
-    dist(p, [a[0] + t * dx, a[1] + t * dy])
-}
+// Containment, distances and the geofence checks of a path live in `aviary_api::geometry`,
+// shared with the checker's pre-flight geofence analysis.
+pub(crate) use aviary_api::geometry::{circle_inside, contains, dist, dist_to_segment, edges, segment_inside};
 
 /// Distance from `p` to a polyline (to the point itself when the polyline has one point).
 #[cfg(test)]
@@ -30,64 +16,6 @@ pub(crate) fn dist_to_polyline(p: [f64; 2], line: &[[f64; 2]]) -> f64 {
             .map(|w| dist_to_segment(p, w[0], w[1]))
             .fold(f64::INFINITY, f64::min),
     }
-}
-
-fn edges(polygon: &[[f64; 2]]) -> impl Iterator<Item = ([f64; 2], [f64; 2])> + '_ {
-    polygon
-        .iter()
-        .enumerate()
-        .map(|(i, &a)| (a, polygon[(i + 1) % polygon.len()]))
-}
-
-/// Distance from `p` to the polygon's boundary.
-pub(crate) fn dist_to_boundary(polygon: &[[f64; 2]], p: [f64; 2]) -> f64 {
-    edges(polygon)
-        .map(|(a, b)| dist_to_segment(p, a, b))
-        .fold(f64::INFINITY, f64::min)
-}
-
-/// Even-odd containment; a point on the boundary (within a micrometre) is inside.
-pub(crate) fn contains(polygon: &[[f64; 2]], p: [f64; 2]) -> bool {
-    let mut inside = false;
-    for (a, b) in edges(polygon) {
-        if (a[1] > p[1]) != (b[1] > p[1]) {
-            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
-            if p[0] < x {
-                inside = !inside;
-            }
-        }
-    }
-    inside || dist_to_boundary(polygon, p) <= ON_EDGE
-}
-
-fn cross(o: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-}
-
-/// Whether segments `p`-`q` and `a`-`b` cross each other properly (each one's ends strictly
-/// on both sides of the other). Touching and overlapping do not count.
-fn crosses(p: [f64; 2], q: [f64; 2], a: [f64; 2], b: [f64; 2]) -> bool {
-    let scale = dist(p, q).max(dist(a, b)).max(1.0);
-    let tol = ON_EDGE * scale;
-    let d1 = cross(a, b, p);
-    let d2 = cross(a, b, q);
-    let d3 = cross(p, q, a);
-    let d4 = cross(p, q, b);
-    ((d1 > tol && d2 < -tol) || (d1 < -tol && d2 > tol))
-        && ((d3 > tol && d4 < -tol) || (d3 < -tol && d4 > tol))
-}
-
-/// Whether the straight segment `p`-`q` stays inside the polygon: both ends inside and no
-/// edge crossed.
-pub(crate) fn segment_inside(polygon: &[[f64; 2]], p: [f64; 2], q: [f64; 2]) -> bool {
-    contains(polygon, p)
-        && contains(polygon, q)
-        && !edges(polygon).any(|(a, b)| crosses(p, q, a, b))
-}
-
-/// Whether the whole circle (its inside and its line) lies in the polygon.
-pub(crate) fn circle_inside(polygon: &[[f64; 2]], center: [f64; 2], radius: f64) -> bool {
-    contains(polygon, center) && dist_to_boundary(polygon, center) >= radius - ON_EDGE
 }
 
 /// The polygon's area (positive either way round).

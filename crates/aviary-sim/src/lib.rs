@@ -28,8 +28,8 @@
 //!   at each corner. Orbits fly clockwise at up to `max_speed`, slow enough that the
 //!   centripetal acceleration stays within half of `acceleration`.
 //! - A pause or an abort stops the drone at once, where it is; it then hovers.
-//! - No wind, no sensor noise, no collision avoidance or separation between drones (the
-//!   safety work adds separation later), no terrain: the ground is z = 0 everywhere.
+//! - No wind, no sensor noise, no obstacles, no terrain: the ground is z = 0 everywhere.
+//!   Drones keep their separation from each other (below), nothing else.
 //! - The battery drains only in the air, linearly in time (`1 / endurance` of a full
 //!   battery per second, whatever the drone does).
 //! - Sensors see every target of their kinds within their range of the drone's ground
@@ -55,12 +55,55 @@
 //! progress is refused (`CommandFailed`); the engine serialises calls per resource, so
 //! that does not happen.
 //!
+//! # Separation
+//! No two drones *in the air* (taking off, flying or landing, and above the ground; a
+//! landed or lost drone does not count) are ever closer than `[site] min_separation`
+//! (default 5 m; 0 turns this off), in 3-D Euclidean distance, after any step. Exactly
+//! `min_separation` apart is allowed, so drones take off side by side from homes that far
+//! apart. Two layers run for each drone, in world-file order, every tick before it moves:
+//! - the priority planner (the `avoid` module). The drone predicts its own path and the
+//!   paths of the drones before it in the world file (higher priority), 6 s ahead. When
+//!   they would come too close, it gives way: it slows or stops on its path (when the
+//!   others are moving on), or climbs or descends to pass above or below them (within its
+//!   climb rate and acceleration, 2 m above the ground and `max_altitude`), and comes back
+//!   to its own altitude once clear. Its ground track never changes, and a leg does not
+//!   end while the drone is off its altitude, so every call still ends exactly at its
+//!   target, only later. Priority is fixed and the choice deterministic, so there is no
+//!   "after you" dance: in a head-on or crossing encounter both drones arrive.
+//! - the safety filter (the `separation` module). A move is kept only if the drone's
+//!   stopping envelope (where it could still get to when braking hard) stays
+//!   `min_separation` clear of every other drone's; otherwise it brakes instead, which
+//!   only shrinks its envelope. By induction, this gives the guarantee above whatever the
+//!   planner chose. It is what holds back a higher-priority drone in the rare case that a
+//!   lower-priority one cannot get out of its way in time (two drones side by side at
+//!   exactly `min_separation` that set off towards each other). A drone held back for 3 s
+//!   then gives way to every drone near it, whatever the priority, until it is clear.
+//!
+//! Drones whose predicted paths and envelopes never come within `min_separation` of each
+//! other fly exactly, bit for bit, as with no separation. The cost grows with the number
+//! of pairs of drones in the air, plus a few short predictions for each pair that is near.
+//!
+//! Limits: the planner resolves head-on, crossing, converging and overtaking encounters
+//! (and random crowds of up to a dozen drones in a 60 m square, in the tests), but it
+//! does not search for a way around, and a drone never leaves its ground track or backs
+//! up. A drone with no free altitude to pass at (boxed in by others, or between the
+//! ceiling and the floor) waits where it is; so do two drones that must pass each other
+//! in height on vertical paths closer than `min_separation` (one landing at its home
+//! while the other climbs beside it). A target within `min_separation` of a drone that
+//! stays there cannot be reached: the call waits nearby until that drone leaves. A drone
+//! about to take off under another one waits on the ground. The filter may make a drone
+//! brake harder than its plan would (never beyond `acceleration` per axis).
+//!
 //! # Battery and faults
 //! With `need` = (distance home / `max_speed` + altitude / `climb_rate`) / `endurance`,
 //! `BatteryLow` is signalled once when the charge falls under `2 × need + 10 %`, and
 //! `BatteryCritical` raised once under `need + 10 %` (ending the drone's calls in
 //! progress `Interrupted`); at zero the drone falls (`Lost`, `DroneLost`). The world's
-//! `[[faults]]` fire at their time in simulated seconds (see the `faults` module).
+//! `[[faults]]` fire at their time in simulated seconds (see the `faults` module). Under
+//! link loss a drone holds (and refuses commands); if the link is still lost after
+//! `[site] link_loss_rtl_after` seconds (default 10) it returns to launch on its own and
+//! lands, and keeps at that after the link is back (`ConnectionRestored`) until it has
+//! landed or a new motion command replaces it.
 //!
 //! # Driver
 //! [`SimBackend::start`] spawns the driver; it ends at its next tick after
@@ -69,6 +112,7 @@
 //! (as long as the runtime keeps up, as it does with a paused clock).
 
 mod args;
+mod avoid;
 mod backend;
 mod battery;
 mod calls;
@@ -79,6 +123,7 @@ mod geom;
 mod motion;
 mod profile;
 mod sensors;
+mod separation;
 pub mod sweep;
 #[cfg(test)]
 mod tests;

@@ -43,11 +43,11 @@ pub(crate) struct MotionTask {
     pub legs: VecDeque<Leg>,
     pub paused: bool,
     /// Speed along the current leg over the ground, vertically, and along an arc.
-    ground_speed: f64,
-    climb_speed: f64,
-    arc_speed: f64,
+    pub ground_speed: f64,
+    pub climb_speed: f64,
+    pub arc_speed: f64,
     /// Radians of the current arc flown.
-    arc_done: f64,
+    pub arc_done: f64,
 }
 
 impl MotionTask {
@@ -73,7 +73,7 @@ impl MotionTask {
 
 /// The tangential acceleration on an arc: with the centripetal part at most `a / 2`, the
 /// total stays within `a`.
-fn arc_accel(a: f64) -> f64 {
+pub(crate) fn arc_accel(a: f64) -> f64 {
     a * 0.75f64.sqrt()
 }
 
@@ -91,8 +91,24 @@ impl SimDrone {
         }
     }
 
-    /// Advances the motion task by `dt`. Returns the finished task, if it finished.
+    /// Advances the motion task by `dt`, yielding as [`SimDrone::avoid`] says. Returns the
+    /// finished task, if it finished. Without a yield this is the plain move.
     pub fn tick_motion(&mut self, dt: f64) -> Option<MotionTask> {
+        let Some(y) = self.avoid else {
+            return self.tick_task(dt, None, false);
+        };
+        let vz = self.vel[2];
+        let finished = self.tick_task(dt, Some(y.scale), y.alt.is_some());
+        if let Some(alt) = y.alt {
+            self.steer_altitude(alt, vz, dt);
+        }
+        finished
+    }
+
+    /// The legs of the task: speeds along the path scaled by `scale` (when yielding), and,
+    /// when `owns_z`, the altitude left to [`SimDrone::steer_altitude`] and no leg ending.
+    fn tick_task(&mut self, dt: f64, scale: Option<f64>, owns_z: bool) -> Option<MotionTask> {
+        let limit = |v: f64| scale.map_or(v, |s| v * s);
         let Some(task) = self.motion.as_mut() else {
             self.vel = [0.0; 3];
             return None;
@@ -106,13 +122,13 @@ impl SimDrone {
             Some(Leg::Hold { left }) => {
                 self.vel = [0.0; 3];
                 *left -= dt;
-                *left <= 1e-9
+                *left <= 1e-9 && !owns_z
             }
             Some(Leg::Move { to, speed, .. }) => {
                 let (to, speed) = (*to, *speed);
                 let here = [self.pos[0], self.pos[1]];
                 let d = geom::dist(here, [to[0], to[1]]);
-                let h = advance(d, task.ground_speed, speed, self.accel, dt);
+                let h = advance(d, task.ground_speed, limit(speed), self.accel, dt);
                 task.ground_speed = h.speed;
                 if h.arrived {
                     self.pos[0] = to[0];
@@ -126,17 +142,23 @@ impl SimDrone {
                     self.vel[0] = ux * h.speed;
                     self.vel[1] = uy * h.speed;
                 }
-                let dz = to[2] - self.pos[2];
-                let v = advance(dz.abs(), task.climb_speed, self.climb_rate, self.accel, dt);
-                task.climb_speed = v.speed;
-                if v.arrived {
-                    self.pos[2] = to[2];
-                    self.vel[2] = 0.0;
+                if owns_z {
+                    task.climb_speed = 0.0;
+                    false
                 } else {
-                    self.pos[2] += dz.signum() * v.moved;
-                    self.vel[2] = dz.signum() * v.speed;
+                    let dz = to[2] - self.pos[2];
+                    let climb = limit(self.climb_rate);
+                    let v = advance(dz.abs(), task.climb_speed, climb, self.accel, dt);
+                    task.climb_speed = v.speed;
+                    if v.arrived {
+                        self.pos[2] = to[2];
+                        self.vel[2] = 0.0;
+                    } else {
+                        self.pos[2] += dz.signum() * v.moved;
+                        self.vel[2] = dz.signum() * v.speed;
+                    }
+                    h.arrived && v.arrived
                 }
-                h.arrived && v.arrived
             }
             Some(Leg::Arc {
                 center,
@@ -148,7 +170,13 @@ impl SimDrone {
                 let (center, radius, start, total, speed) =
                     (*center, *radius, *start, *total, *speed);
                 let left = (total - task.arc_done) * radius;
-                let step = advance(left, task.arc_speed, speed, arc_accel(self.accel), dt);
+                let step = advance(
+                    left,
+                    task.arc_speed,
+                    limit(speed),
+                    arc_accel(self.accel),
+                    dt,
+                );
                 task.arc_speed = step.speed;
                 task.arc_done = if step.arrived {
                     total
@@ -159,7 +187,7 @@ impl SimDrone {
                 self.pos[0] = center[0] + radius * theta.cos();
                 self.pos[1] = center[1] + radius * theta.sin();
                 self.vel = [theta.sin() * step.speed, -theta.cos() * step.speed, 0.0];
-                step.arrived
+                step.arrived && !owns_z
             }
         };
         if !done {
@@ -198,7 +226,7 @@ pub(crate) fn orbit_legs(d: &SimDrone, center: [f64; 2], radius: f64, laps: f64)
     let entry = [
         center[0] + radius * start.cos(),
         center[1] + radius * start.sin(),
-        d.pos[2],
+        d.level(),
     ];
     vec![
         Leg::Move {

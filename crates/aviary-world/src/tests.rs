@@ -159,7 +159,12 @@ fn empty_text_is_the_empty_world() {
 fn link_loss_rtl_after_is_positive_seconds() {
     let w = ok("[site]\nlink_loss_rtl_after = 4.5\n");
     assert_eq!(w.site.link_loss_rtl_after, 4.5);
-    assert_eq!(ok("[site]\nlink_loss_rtl_after = 30\n").site.link_loss_rtl_after, 30.0);
+    assert_eq!(
+        ok("[site]\nlink_loss_rtl_after = 30\n")
+            .site
+            .link_loss_rtl_after,
+        30.0
+    );
     for bad in ["0", "-2"] {
         let (msg, at, help) = error(&format!("[site]\nlink_loss_rtl_after = {bad}\n"));
         assert_eq!(
@@ -170,7 +175,10 @@ fn link_loss_rtl_after_is_positive_seconds() {
         assert_eq!(help, "write a positive number");
     }
     let (msg, _, _) = error("[site]\nlink_loss_rtl_after = \"soon\"\n");
-    assert!(msg.starts_with("`link_loss_rtl_after` must be a number"), "{msg}");
+    assert!(
+        msg.starts_with("`link_loss_rtl_after` must be a number"),
+        "{msg}"
+    );
     let (_, _, help) = error("[site]\nlink_loss_rtl = 3\n");
     assert!(help.contains("link_loss_rtl_after"), "{help}");
 }

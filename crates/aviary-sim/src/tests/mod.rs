@@ -1,8 +1,12 @@
 //! Tests of the physics core (plain) and of the backend (tokio, paused clock).
 
 mod backend;
+mod envelope;
 mod flight;
+mod link;
 mod rules;
+mod separation;
+mod sky;
 
 use aviary_api::{CallEnd, CallId, DroneEvent, Point, Telemetry, Value};
 use aviary_diagnostics::FileId;

@@ -1,0 +1,320 @@
+//! The priority planner: who gives way, and how.
+//!
+//! Priority is the drone's index in the world file: the first drone has the highest. Every
+//! tick, before a drone moves, the planner predicts (with the drone's own motion code, in
+//! steps of [`STEP`] over [`HORIZON`] seconds, straight between the points) its path and
+//! the paths of the higher-priority drones near it, as they are flying now (their own
+//! yields included). When the drone's path would come closer than `min_separation` to one
+//! of theirs, it tries these ways to give way, in this order:
+//!
+//! 1. go on as planned (when yielding already: come back to its own altitude);
+//! 2. when off its altitude already, go on at full speed at the altitude it is holding;
+//! 3. go on at full speed at the altitude it is at now;
+//! 4. slow to half speed along its path;
+//! 5. stop on its path (only when every drone in the way is moving, so that waiting helps);
+//! 6. pass above them, 7. below them, at full speed;
+//! 8. the same two, stopped on the path until the altitude is reached.
+//!
+//! It takes the first one that it can fly now (the safety filter of [`crate::separation`]
+//! lets the first step through) and that is clear: its predicted path keeps
+//! `min_separation +` [`MARGIN`] from theirs, or, when it is that close already, never gets
+//! any closer. When none is, it takes the flyable one that comes least short. A yield
+//! starts when going on as planned would come closer than `min_separation`, and ends
+//! when coming back keeps the margin. Passing altitudes are `min_separation +`
+//! [`MARGIN`] above the highest (below the lowest) point of the drones in the way over the
+//! horizon, within the site's `max_altitude` and [`FLOOR`].
+//!
+//! A yield never changes the ground track, only the speed along it and the altitude
+//! (within the climb rate and the acceleration). A leg does not end while the drone is off
+//! its altitude, so a call still ends at its own target. Lower-priority drones are not
+//! planned around: they give way themselves; the filter holds this drone back if one of
+//! them does not get out of the way in time. A drone held back for [`STALL`] seconds
+//! gives way to every drone near it, whatever their priority (their paths taken as they
+//! would fly without yielding), until its yield is over: this breaks the standstills in
+//! which the drone with priority is the one that has to move.
+
+use aviary_api::DroneId;
+
+use crate::drone::SimDrone;
+use crate::fleet::Fleet;
+use crate::motion::Leg;
+use crate::separation::{clear_of, counts, Envelope};
+
+/// Seconds of look-ahead.
+pub(crate) const HORIZON: f64 = 6.0;
+/// Seconds between predicted points (straight between them).
+pub(crate) const STEP: f64 = 0.25;
+/// Metres kept beyond `min_separation` by a yield.
+pub(crate) const MARGIN: f64 = 1.0;
+/// A drone does not pass below another one lower than this (metres).
+pub(crate) const FLOOR: f64 = 2.0;
+/// Seconds held back by the safety filter after which a drone gives way to every drone,
+/// whatever their priority (this breaks the rare standstill in which the drone with
+/// priority is the one that has to move).
+pub(crate) const STALL: f64 = 3.0;
+
+/// How a drone gives way.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Yield {
+    /// Fraction of the path speeds flown (horizontal; vertical too when `alt` is `None`).
+    pub scale: f64,
+    /// Altitude flown instead of the leg's, to pass above or below.
+    pub alt: Option<f64>,
+    /// Altitude to come back to when the leg does not set one (a hover, an orbit, none).
+    pub back_to: f64,
+}
+
+/// Predicted positions every [`STEP`]; `None` while the drone is not in the air.
+pub(crate) type Track = Vec<Option<[f64; 3]>>;
+
+/// The drone's path if it keeps flying as it does now, from now.
+fn predict(d: &SimDrone) -> Track {
+    let steps = (HORIZON / STEP) as usize;
+    let mut ghost = d.clone();
+    let mut track = vec![counts(&ghost).then_some(ghost.pos)];
+    for _ in 0..steps {
+        ghost.tick_motion(STEP);
+        track.push(counts(&ghost).then_some(ghost.pos));
+    }
+    track
+}
+
+/// The drone's path one tick from now (after `dt`) on, flying `way`, and whether the
+/// safety filter would let it take the first step.
+fn predict_with(
+    d: &SimDrone,
+    way: Option<Yield>,
+    dt: f64,
+    near: &[Envelope],
+    sep: f64,
+) -> (Track, bool) {
+    let mut ghost = d.clone();
+    ghost.avoid = way;
+    ghost.tick_motion(dt);
+    let free = clear_of(&ghost, near, sep);
+    (predict(&ghost), free)
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn norm(v: [f64; 3]) -> f64 {
+    v[0].hypot(v[1]).hypot(v[2])
+}
+
+/// The smallest distance between two tracks sampled at the same times, moving straight
+/// between samples.
+pub(crate) fn closest(a: &Track, b: &Track) -> f64 {
+    let mut best = f64::INFINITY;
+    for k in 0..a.len().min(b.len()) {
+        let (Some(p), Some(q)) = (a[k], b[k]) else {
+            continue;
+        };
+        let r0 = sub(p, q);
+        best = best.min(norm(r0));
+        if let (Some(Some(p1)), Some(Some(q1))) = (a.get(k + 1), b.get(k + 1)) {
+            let r1 = sub(*p1, *q1);
+            let dr = sub(r1, r0);
+            let len2 = dr[0] * dr[0] + dr[1] * dr[1] + dr[2] * dr[2];
+            if len2 > 0.0 {
+                let t = (-(r0[0] * dr[0] + r0[1] * dr[1] + r0[2] * dr[2]) / len2).clamp(0.0, 1.0);
+                best = best.min(norm([
+                    r0[0] + t * dr[0],
+                    r0[1] + t * dr[1],
+                    r0[2] + t * dr[2],
+                ]));
+            }
+        }
+    }
+    best
+}
+
+/// The distance between two tracks at their first common point.
+fn first_gap(a: &Track, b: &Track) -> f64 {
+    a.iter()
+        .zip(b)
+        .find_map(|(p, q)| Some(norm(sub((*p)?, (*q)?))))
+        .unwrap_or(f64::INFINITY)
+}
+
+/// The altitude the drone's own plan holds it at: the leg's, or where it came from.
+fn own_altitude(d: &SimDrone, back_to: f64) -> f64 {
+    match d.motion.as_ref().and_then(|t| t.legs.front()) {
+        Some(Leg::Move { to, .. }) => to[2],
+        _ => back_to,
+    }
+}
+
+/// Whether the drone has somewhere to go along its path (so that slowing means something).
+fn on_the_move(d: &SimDrone) -> bool {
+    d.motion.as_ref().is_some_and(|t| {
+        !t.paused && matches!(t.legs.front(), Some(Leg::Move { .. } | Leg::Arc { .. }))
+    })
+}
+
+impl Fleet {
+    /// The predicted track of drone `j` for the planning of drone `id`: for a drone before
+    /// `id`, which has moved in this step already, computed once per step. Drones after `id` (only a humble drone looks at them) have not moved yet: they are
+    /// predicted afresh, going their own way as if they did not yield.
+    fn track(&mut self, j: DroneId, id: DroneId) -> Track {
+        let d = &self.drones[j];
+        if j > id {
+            let mut plain = d.clone();
+            plain.avoid = None;
+            return predict(&plain);
+        }
+        self.tracks.entry(j).or_insert_with(|| predict(d)).clone()
+    }
+
+    /// Chooses how drone `id` gives way this tick (see the module doc); sets its `avoid`.
+    pub(crate) fn plan(&mut self, id: DroneId, dt: f64, near: &[Envelope]) {
+        let sep = self.min_separation;
+        let d = &self.drones[id];
+        if !d.state.airborne() {
+            self.drones[id].avoid = None;
+            return;
+        }
+        let speed = |d: &SimDrone| d.max_speed + d.climb_rate;
+        let range = |o: &SimDrone| sep + MARGIN + HORIZON * (speed(d) + speed(o)) + 1.0;
+        // A drone held back for long gives way to everyone, not only to those before it,
+        // until it no longer needs to give way.
+        let humble = d.humble || d.stalled >= STALL;
+        let higher: Vec<DroneId> = (self.aloft.iter().copied())
+            .filter(|&j| j < id || (humble && j != id))
+            .filter(|&j| {
+                let o = &self.drones[j];
+                o.state.airborne() && norm(sub(o.pos, d.pos)) < range(o)
+            })
+            .collect();
+        if higher.is_empty() && d.avoid.is_none() {
+            self.drones[id].humble = false;
+            return;
+        }
+        let theirs: Vec<Track> = higher.iter().map(|&j| self.track(j, id)).collect();
+        let d = &self.drones[id];
+        // How far the drone's path would keep from theirs beyond what is needed (clear when
+        // not negative), and who comes within the margin. Going on as planned needs
+        // `min_separation`; a way to give way needs the margin too, or, when the drone is
+        // that close already, never to get any closer.
+        let score = |way: Option<Yield>, strict: bool| -> (f64, bool, Vec<usize>) {
+            let (mine, free) = predict_with(d, way, dt, near, sep);
+            let mut worst = f64::INFINITY;
+            let mut close = Vec::new();
+            for (k, t) in theirs.iter().enumerate() {
+                let c = closest(&mine, t);
+                let need = if strict {
+                    sep
+                } else {
+                    (sep + MARGIN).min(first_gap(&mine, t)).max(sep)
+                };
+                worst = worst.min(c - need);
+                if c < sep + MARGIN {
+                    close.push(k);
+                }
+            }
+            (worst, free, close)
+        };
+        let current = d.avoid;
+        let back_to = current
+            .filter(|y| y.alt.is_some())
+            .map_or(d.pos[2], |y| y.back_to);
+        let nominal = match current.filter(|y| y.alt.is_some()) {
+            None => None,
+            Some(_) => {
+                let home = own_altitude(d, back_to);
+                (d.pos[2] != home || d.vel[2] != 0.0).then_some(Yield {
+                    scale: 1.0,
+                    alt: Some(home),
+                    back_to,
+                })
+            }
+        };
+        let (first, free, close) = score(nominal, current.is_none());
+        if first >= 0.0 {
+            self.drones[id].avoid = nominal;
+            self.drones[id].humble = humble && nominal.is_some();
+            return;
+        }
+        // Who is in the way, how high they fly, and whether they are going anywhere.
+        let (mut top, mut bottom, mut moving) = (f64::NEG_INFINITY, f64::INFINITY, true);
+        for &k in &close {
+            let t = &theirs[k];
+            for p in t.iter().flatten() {
+                top = top.max(p[2]);
+                bottom = bottom.min(p[2]);
+            }
+            let ends: Vec<[f64; 3]> = t.iter().flatten().copied().collect();
+            let still = match (ends.first(), ends.last()) {
+                (Some(a), Some(b)) => norm(sub(*a, *b)) < 1.0,
+                _ => false,
+            };
+            moving &= !still;
+        }
+        let held = current.and_then(|y| y.alt);
+        let mut ways: Vec<Option<Yield>> = Vec::new();
+        if on_the_move(d) {
+            if held.is_some() {
+                ways.push(Some(Yield {
+                    scale: 1.0,
+                    alt: held,
+                    back_to,
+                }));
+            }
+            ways.push(Some(Yield {
+                scale: 1.0,
+                alt: Some(d.pos[2]),
+                back_to,
+            }));
+            ways.push(Some(Yield {
+                scale: 0.5,
+                alt: held,
+                back_to,
+            }));
+            if moving {
+                ways.push(Some(Yield {
+                    scale: 0.0,
+                    alt: held,
+                    back_to,
+                }));
+            }
+        }
+        let ceiling = self.max_altitude.unwrap_or(f64::INFINITY);
+        let up = (top + sep + MARGIN).min(ceiling);
+        let down = (bottom - sep - MARGIN).max(FLOOR);
+        let mut levels = Vec::new();
+        if !close.is_empty() && up >= top + sep {
+            levels.push(up);
+        }
+        if !close.is_empty() && down <= bottom - sep {
+            levels.push(down);
+        }
+        if held.is_some_and(|h| h < own_altitude(d, back_to)) {
+            levels.reverse();
+        }
+        for &scale in &[1.0, 0.0] {
+            for &alt in &levels {
+                ways.push(Some(Yield {
+                    scale,
+                    alt: Some(alt),
+                    back_to,
+                }));
+            }
+        }
+        // The first way that is clear and can be flown now; else the one that keeps the most
+        // distance, among those that can be flown if any can.
+        let mut best = (free, first, nominal);
+        for way in ways {
+            let (s, free, _) = score(way, false);
+            if s >= 0.0 && free {
+                best = (free, s, way);
+                break;
+            }
+            if (free, s) > (best.0, best.1) {
+                best = (free, s, way);
+            }
+        }
+        self.drones[id].avoid = best.2;
+        self.drones[id].humble = humble && best.2.is_some();
+    }
+}

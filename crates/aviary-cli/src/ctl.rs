@@ -2,15 +2,24 @@
 //! starts (docs/OPERATOR_API.md).
 
 use aviary_syntax::ast::Unit;
+use clap::Subcommand;
 use serde_json::{json, Value};
 
+#[derive(Subcommand)]
 pub enum CtlCommand {
+    /// Print the mission's state: blocks, activities with tags, drones
     State,
+    /// Print every event as it happens, one JSON object per line
     Events,
+    /// A leash on a running activity: `leash FlyCircle-C1 PAUSE`, `leash FlyCircle-C1 Widen radius=200m`
     Leash { activity: String, action: String, args: Vec<String> },
+    /// Raise a signal the mission hears: `signal Go`
     Signal { name: String, values: Vec<String> },
+    /// Hold every drone where it is
     Pause,
+    /// Go on after `pause`
     Resume,
+    /// End the mission; the fleet returns home
     Abort,
 }
 

@@ -84,7 +84,7 @@ enum Command {
         #[arg(long, env = "AVIARY_TOKEN")]
         token: Option<String>,
         #[command(subcommand)]
-        command: CtlArgs,
+        command: ctl::CtlCommand,
     },
     /// Explain a diagnostic code, such as E107
     Explain { code: String },
@@ -93,38 +93,6 @@ enum Command {
         #[command(subcommand)]
         which: bench::BenchCommand,
     },
-}
-
-#[derive(Subcommand)]
-enum CtlArgs {
-    /// Print the mission's state: blocks, activities with tags, drones
-    State,
-    /// Print every event as it happens, one JSON object per line
-    Events,
-    /// A leash on a running activity: `leash FlyCircle-C1 PAUSE`, `leash FlyCircle-C1 Widen radius=200m`
-    Leash { activity: String, action: String, args: Vec<String> },
-    /// Raise a signal the mission hears: `signal Go`
-    Signal { name: String, values: Vec<String> },
-    /// Hold every drone where it is
-    Pause,
-    /// Go on after `pause`
-    Resume,
-    /// End the mission; the fleet returns home
-    Abort,
-}
-
-impl From<CtlArgs> for ctl::CtlCommand {
-    fn from(a: CtlArgs) -> Self {
-        match a {
-            CtlArgs::State => ctl::CtlCommand::State,
-            CtlArgs::Events => ctl::CtlCommand::Events,
-            CtlArgs::Leash { activity, action, args } => ctl::CtlCommand::Leash { activity, action, args },
-            CtlArgs::Signal { name, values } => ctl::CtlCommand::Signal { name, values },
-            CtlArgs::Pause => ctl::CtlCommand::Pause,
-            CtlArgs::Resume => ctl::CtlCommand::Resume,
-            CtlArgs::Abort => ctl::CtlCommand::Abort,
-        }
-    }
 }
 
 fn main() -> ExitCode {
@@ -143,7 +111,7 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Ctl { url, token, command } => ctl::run(&url, token.as_deref(), command.into()),
+        Command::Ctl { url, token, command } => ctl::run(&url, token.as_deref(), command),
         Command::Explain { code } => explain(&code),
         Command::Bench { which } => bench::run(which),
     };

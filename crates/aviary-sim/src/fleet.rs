@@ -52,6 +52,8 @@ pub struct Fleet {
     pub(crate) min_separation: f64,
     /// `[site] link_loss_rtl_after`: seconds without link before a drone returns on its own.
     pub(crate) link_loss_rtl_after: f64,
+    /// `[site] separation_timeout`: seconds a call may be held back by separation.
+    pub(crate) separation_timeout: f64,
     pub(crate) sensors: Vec<Sensor>,
     pub(crate) targets: Vec<Target>,
     pub(crate) faults: Vec<ScheduledFault>,
@@ -89,6 +91,7 @@ impl Fleet {
             max_altitude: world.site.max_altitude,
             min_separation: world.site.min_separation,
             link_loss_rtl_after: world.site.link_loss_rtl_after,
+            separation_timeout: world.site.separation_timeout,
             sensors: world.sensors.clone(),
             targets: world.targets.clone(),
             faults,
@@ -235,6 +238,9 @@ impl Fleet {
         let from = self.drones[id].xy();
         let before = self.drones[id].pos;
         let finished = self.move_drone(id, dt);
+        if finished.is_none() {
+            out.extend(self.held_back(id, dt));
+        }
         let d = &mut self.drones[id];
         if let Some(task) = finished {
             if let Some(call) = task.call {

@@ -90,9 +90,23 @@
 //! ceiling and the floor) waits where it is; so do two drones that must pass each other
 //! in height on vertical paths closer than `min_separation` (one landing at its home
 //! while the other climbs beside it). A target within `min_separation` of a drone that
-//! stays there cannot be reached: the call waits nearby until that drone leaves. A drone
-//! about to take off under another one waits on the ground. The filter may make a drone
-//! brake harder than its plan would (never beyond `acceleration` per axis).
+//! stays there cannot be reached (two drones sent to the same point): the call waits
+//! nearby (or above it) until that drone leaves. A drone about to take off under another
+//! one waits on the ground. The filter may make a drone brake harder than its plan would
+//! (never beyond `acceleration` per axis).
+//!
+//! No such wait is endless: a motion call held back by separation for `[site]
+//! separation_timeout` seconds (default 30) of simulated time ends `Failed` with the
+//! exception `Timeout` ("b waited 30 s for a to make room", naming the nearest drone in
+//! the air, when there is one within `2 × min_separation + 1` m), and the drone stops where
+//! it is and hovers (or stays on the ground, for a take-off). *Held back*: in a tick in
+//! which the planner has the drone give way or the filter makes it brake, its call gets no
+//! nearer its end than the nearest it has been (legs left, then the 3-D distance to the
+//! end of the current leg, the arc left on an orbit, the time left of a hover); a tick that
+//! gets nearer than ever resets the clock, and so does a pause. The short yields of
+//! ordinary encounters (passing above, slowing, a few seconds stopped) never come near
+//! it. A task the drone flies on its own, with no call (a return after a link loss, an
+//! emergency landing), is not timed.
 //!
 //! # Battery and faults
 //! With `need` = (distance home / `max_speed` + altitude / `climb_rate`) / `endurance`,

@@ -48,7 +48,17 @@ pub(crate) struct MotionTask {
     pub arc_speed: f64,
     /// Radians of the current arc flown.
     pub arc_done: f64,
+    /// Seconds separation has held the call back without it getting nearer its goal, and
+    /// the nearest it has got (see [`crate::fleet::Fleet::held_back`]).
+    pub held: f64,
+    pub best: Progress,
 }
+
+/// How far a task is from its end: (legs left, phase, amount left on the current leg),
+/// compared in that order. On a straight leg the amount is the 3-D distance to its end, on
+/// an arc the length left; on a hover it is the time left (phase 1) and, once that is up,
+/// the height to come back to its own altitude (phase 0).
+pub(crate) type Progress = (usize, u8, f64);
 
 impl MotionTask {
     pub fn new(call: Option<CallId>, legs: Vec<Leg>) -> MotionTask {
@@ -60,6 +70,8 @@ impl MotionTask {
             climb_speed: 0.0,
             arc_speed: 0.0,
             arc_done: 0.0,
+            held: 0.0,
+            best: (usize::MAX, u8::MAX, f64::INFINITY),
         }
     }
 

@@ -14,17 +14,21 @@
 //! tick or not), otherwise the drone brakes, and braking only shrinks its envelope. So the
 //! invariant holds from tick to tick, and since every drone is inside its own envelope, no
 //! two drones in the air are ever closer than `min_separation`. Stopping at once (a pause,
-//! an abort, a fault) also shrinks the envelope, and every new move starts at rest.
+//! an abort, a fault, a separation timeout) also shrinks the envelope, and every new move starts at rest.
 //!
 //! The filter alone is safe but can stall two drones in front of each other; the planner
 //! of [`crate::avoid`] makes the lower-priority one give way early.
+//!
+//! Neither can make room where there is none (two drones sent to the same point), so a
+//! call that separation holds back for too long ends: see [`Fleet::held_back`].
 
-use aviary_api::{DroneId, FlightState};
+use aviary_api::{CallEnd, DroneId, Failure, FlightState};
 
+use crate::avoid::MARGIN;
 use crate::drone::SimDrone;
-use crate::fleet::Fleet;
+use crate::fleet::{Fleet, Report};
 use crate::geom::{dist, dist_to_segment};
-use crate::motion::{arc_accel, Leg, MotionTask};
+use crate::motion::{arc_accel, Leg, MotionTask, Progress};
 use crate::profile::advance;
 
 /// Whether the drone takes part in separation: in an airborne state and off the ground. A
@@ -314,5 +318,98 @@ impl Fleet {
         d.brake_all(dt);
         d.stalled += dt;
         None
+    }
+}
+
+/// A task gets nearer its end only by more than this (metres, or seconds of a hover).
+const GAIN: f64 = 1e-6;
+
+/// How far the drone's task is from its end (see [`Progress`]).
+fn progress(d: &SimDrone, task: &MotionTask) -> Progress {
+    let n = task.legs.len();
+    match task.legs.front() {
+        Some(Leg::Move { to, .. }) => {
+            let gap = |k: usize| d.pos[k] - to[k];
+            (n, 0, gap(0).hypot(gap(1)).hypot(gap(2)))
+        }
+        Some(Leg::Arc { radius, total, .. }) => (n, 0, (total - task.arc_done) * radius),
+        Some(Leg::Hold { left }) if *left > 1e-9 => (n, 1, *left),
+        Some(Leg::Hold { .. }) => (n, 0, (d.pos[2] - d.level()).abs()),
+        None => (0, 0, 0.0),
+    }
+}
+
+fn nearer(now: Progress, best: Progress) -> bool {
+    (now.0, now.1) < (best.0, best.1)
+        || ((now.0, now.1) == (best.0, best.1) && now.2 < best.2 - GAIN)
+}
+
+impl Fleet {
+    /// After drone `id` moved by one tick (and its call did not end): counts how long
+    /// separation has held its motion call back, and ends the call once that reaches
+    /// `[site] separation_timeout`.
+    ///
+    /// *Held back* means: in this tick, separation acted on the drone (the planner had it
+    /// give way, or the filter made it brake) and its task got no nearer its end than the
+    /// nearest it had been (see [`Progress`]: a leg finished, or the distance, arc or hover
+    /// time left on the current leg fell below its lowest value so far). Each tick that
+    /// gets the task nearer than ever resets the count; so does a pause, or the drone not
+    /// being airborne, and a tick in which separation did not act leaves it as it is. A
+    /// yield that goes on moving along the path (slower, or above or below another drone)
+    /// keeps getting nearer and is never held back; a climb or descent while stopped
+    /// counts until the drone is past its nearest point again. Only calls count: a task
+    /// the drone flies on its own (a return after a link loss, an emergency landing) waits
+    /// as long as it takes.
+    ///
+    /// The call ends `Failed` with `Timeout`, naming the nearest drone in the air within
+    /// `2 × min_separation + MARGIN` (the one in the way), and the drone stops at once where
+    /// it is, as after an abort, and hovers (or stays on the ground, for a take-off that
+    /// never left it).
+    pub(crate) fn held_back(&mut self, id: DroneId, dt: f64) -> Option<Report> {
+        let (sep, limit) = (self.min_separation, self.separation_timeout);
+        let d = &self.drones[id];
+        let task = d.motion.as_ref()?;
+        let now = progress(d, task);
+        let acted = d.stalled > 0.0 || d.avoid.is_some();
+        let counting = sep > 0.0 && d.state.airborne() && task.call.is_some() && !task.paused;
+        let d = &mut self.drones[id];
+        let task = d.motion.as_mut()?;
+        if !counting || nearer(now, task.best) {
+            task.best = now;
+            task.held = 0.0;
+            return None;
+        }
+        if !acted {
+            return None;
+        }
+        task.held += dt;
+        if task.held < limit - 1e-9 {
+            return None;
+        }
+        let call = task.call?;
+        let d = &self.drones[id];
+        let blocker = (self.drones.iter().enumerate())
+            .filter(|&(j, o)| j != id && counts(o))
+            .map(|(_, o)| {
+                let gap = |k: usize| o.pos[k] - d.pos[k];
+                (gap(0).hypot(gap(1)).hypot(gap(2)), o)
+            })
+            .filter(|(apart, _)| *apart <= 2.0 * sep + MARGIN)
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map_or_else(|| "the drones near it".to_owned(), |(_, o)| o.name.clone());
+        let reason = format!("{} waited {limit} s for {blocker} to make room", d.name);
+        let d = &mut self.drones[id];
+        d.motion = None;
+        d.avoid = None;
+        d.humble = false;
+        d.stalled = 0.0;
+        d.settle();
+        Some(Report::Ended {
+            call,
+            end: CallEnd::Failed(Failure {
+                exception: "Timeout",
+                reason,
+            }),
+        })
     }
 }

@@ -22,6 +22,7 @@ const SITE_KEYS: &[&str] = &[
     "max_altitude",
     "min_separation",
     "link_loss_rtl_after",
+    "separation_timeout",
 ];
 const ORIGIN_KEYS: &[&str] = &["lat", "lon", "alt"];
 
@@ -157,6 +158,11 @@ fn site(cx: &mut Ctx, node: &Node) -> Site {
             "link_loss_rtl_after" => {
                 if let Some(v) = cx.positive("`link_loss_rtl_after`", n) {
                     site.link_loss_rtl_after = v;
+                }
+            }
+            "separation_timeout" => {
+                if let Some(v) = cx.positive("`separation_timeout`", n) {
+                    site.separation_timeout = v;
                 }
             }
             _ => {}

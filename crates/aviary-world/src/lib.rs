@@ -57,6 +57,9 @@ pub struct Site {
     /// Seconds a simulated drone holds after losing its link before it returns to launch
     /// on its own; default 10.
     pub link_loss_rtl_after: f64,
+    /// Seconds a simulated drone's motion call may be held back by separation (no
+    /// progress towards its target) before it ends with `Timeout`; default 30.
+    pub separation_timeout: f64,
 }
 
 impl Default for Site {
@@ -68,6 +71,7 @@ impl Default for Site {
             max_altitude: None,
             min_separation: 5.0,
             link_loss_rtl_after: 10.0,
+            separation_timeout: 30.0,
         }
     }
 }
@@ -293,7 +297,6 @@ impl Default for World {
         }
     }
 }
-
 
 /// Even-odd point-in-polygon test.
 fn contains(polygon: &[[f64; 2]], p: [f64; 2]) -> bool {

@@ -153,6 +153,39 @@ fn empty_text_is_the_empty_world() {
     assert_eq!(ok("# nothing here\n\n"), World::default());
     assert_eq!(ok("").site.min_separation, 5.0);
     assert_eq!(ok("").site.link_loss_rtl_after, 10.0);
+    assert_eq!(ok("").site.separation_timeout, 30.0);
+}
+
+#[test]
+fn separation_timeout_is_positive_seconds() {
+    assert_eq!(
+        ok("[site]\nseparation_timeout = 12.5\n")
+            .site
+            .separation_timeout,
+        12.5
+    );
+    assert_eq!(
+        ok("[site]\nseparation_timeout = 60\n")
+            .site
+            .separation_timeout,
+        60.0
+    );
+    for bad in ["0", "-1"] {
+        let (msg, at, help) = error(&format!("[site]\nseparation_timeout = {bad}\n"));
+        assert_eq!(
+            msg,
+            format!("`separation_timeout` must be greater than zero, found {bad}")
+        );
+        assert_eq!(at, bad);
+        assert_eq!(help, "write a positive number");
+    }
+    let (msg, _, _) = error("[site]\nseparation_timeout = \"long\"\n");
+    assert!(
+        msg.starts_with("`separation_timeout` must be a number"),
+        "{msg}"
+    );
+    let (_, _, help) = error("[site]\nseparation_time = 3\n");
+    assert!(help.contains("separation_timeout"), "{help}");
 }
 
 #[test]

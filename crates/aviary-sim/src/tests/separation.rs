@@ -1,7 +1,7 @@
 //! Separation: drones on colliding courses keep `min_separation`, every step, and still
 //! get where they were going.
 
-use aviary_api::FlightState;
+use aviary_api::{CallEnd, CallId, FlightState, Telemetry};
 use aviary_world::World;
 
 use super::sky::{call, fly, Act, Flight};
@@ -327,4 +327,105 @@ fn random_crowds_keep_separation_and_all_finish() {
         let f = fly(&world(&text), scripts, 600.0);
         assert!(f.closest >= 5.0);
     }
+}
+
+/// Two drones (`site`: extra `[site]` keys) take off to 20 m and, at 10 s, are both sent to the same point. Returns the
+/// fleet, each call's end and when it came (simulated seconds), and the second drone's
+/// telemetry after every step from then on.
+fn same_point(site: &str) -> (Fleet, Vec<(CallEnd, f64)>, Vec<Telemetry>) {
+    let w = world(&format!(
+        "{site}\n[drones.a]\nhome = [0, 0]\n\n[drones.b]\nhome = [10, 0]\n"
+    ));
+    let mut fleet = Fleet::new(&w);
+    for d in 0..2 {
+        assert_eq!(instant(&mut fleet, d, "Arm", &[]), CallEnd::Done);
+        start(&mut fleet, d, "TakeOff", &[num(20.0)]);
+    }
+    run_for(&mut fleet, 10.0);
+    let calls: Vec<CallId> = (0..2)
+        .map(|d| start(&mut fleet, d, "FlyToPosition", &[pos(0.0, 100.0)]))
+        .collect();
+    let mut ends: Vec<Option<(CallEnd, f64)>> = vec![None, None];
+    let mut log = Vec::new();
+    while ends.iter().any(Option::is_none) && fleet.time() < 200.0 {
+        for r in fleet.step(DT) {
+            if let Report::Ended { call, end } = r {
+                if let Some(d) = calls.iter().position(|c| *c == call) {
+                    ends[d] = Some((end, fleet.time()));
+                }
+            }
+        }
+        log.push(fleet.telemetry(1).unwrap());
+    }
+    let ends = ends
+        .into_iter()
+        .map(|e| e.expect("the call ended"))
+        .collect();
+    (fleet, ends, log)
+}
+
+/// When drone 1 last got nearer the point (0, 100, 20), after `log`.
+fn last_gain(log: &[Telemetry], until: f64) -> f64 {
+    let far = |t: &Telemetry| {
+        let p = t.position;
+        p[0].hypot(p[1] - 100.0).hypot(p[2] - 20.0)
+    };
+    let mut best = f64::INFINITY;
+    let mut when = 0.0;
+    for (k, t) in log.iter().enumerate() {
+        if far(t) < best - 1e-6 {
+            best = far(t);
+            when = 10.0 + (k + 1) as f64 * DT;
+        }
+    }
+    assert!(when < until);
+    when
+}
+
+#[test]
+fn two_drones_sent_to_the_same_point_the_second_times_out_and_hovers() {
+    let (mut fleet, ends, log) = same_point("");
+    // The first drone arrives, on time.
+    assert_eq!(ends[0].0, CallEnd::Done);
+    let nominal = 10.0 + 100.0 / 10.0 + 10.0 / 3.0;
+    assert!((ends[0].1 - nominal).abs() < 0.2, "{}", ends[0].1);
+    assert_eq!(fleet.telemetry(0).unwrap().position, [0.0, 100.0, 20.0]);
+    // The second one passes above it and waits there, over the point; 30 s after it last
+    // got nearer, its call ends with `Timeout`.
+    let (end, at) = &ends[1];
+    let CallEnd::Failed(failure) = end else {
+        panic!("{end:?}")
+    };
+    assert_eq!(failure.exception, "Timeout");
+    assert_eq!(failure.reason, "b waited 30 s for a to make room");
+    let waited = at - last_gain(&log, *at);
+    assert!((29.99..31.0).contains(&waited), "{waited}");
+    // Then it hovers where it is, clear of the first drone, and takes new calls.
+    let held = fleet.telemetry(1).unwrap();
+    assert_eq!((held.speed, held.state), (0.0, FlightState::Flying));
+    let apart = |t: &Telemetry| {
+        let p = t.position;
+        p[0].hypot(p[1] - 100.0).hypot(p[2] - 20.0)
+    };
+    assert!(apart(&held) >= 5.0, "{held:?}");
+    run_for(&mut fleet, 10.0);
+    assert_eq!(fleet.telemetry(1).unwrap().position, held.position);
+    let id = start(&mut fleet, 1, "FlyToPosition", &[pos(10.0, 0.0)]);
+    assert_eq!(run_until(&mut fleet, 1, id, 60.0).end, CallEnd::Done);
+}
+
+#[test]
+fn the_separation_timeout_is_the_sites() {
+    let (_, ends, log) = same_point("separation_timeout = 5");
+    assert_eq!(ends[0].0, CallEnd::Done);
+    let (end, at) = &ends[1];
+    match end {
+        CallEnd::Failed(f) => {
+            assert_eq!(f.exception, "Timeout");
+            assert_eq!(f.reason, "b waited 5 s for a to make room");
+        }
+        other => panic!("{other:?}"),
+    }
+    let waited = at - last_gain(&log, *at);
+    assert!((4.99..6.0).contains(&waited), "{waited}");
 }

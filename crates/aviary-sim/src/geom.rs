@@ -40,18 +40,15 @@ pub(crate) fn heading(vx: f64, vy: f64) -> f64 {
     }
 }
 
+/// A non-convex polygon for tests: an L, 100 m on its long sides.
+#[cfg(test)]
+pub(crate) const L_SHAPE: [[f64; 2]; 6] = [[0.0, 0.0], [100.0, 0.0], [100.0, 40.0], [40.0, 40.0], [40.0, 100.0], [0.0, 100.0]];
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    const L: [[f64; 2]; 6] = [
-        [0.0, 0.0],
-        [100.0, 0.0],
-        [100.0, 40.0],
-        [40.0, 40.0],
-        [40.0, 100.0],
-        [0.0, 100.0],
-    ];
+    const L: [[f64; 2]; 6] = L_SHAPE;
 
     #[test]
     fn containment_and_segments() {

@@ -159,14 +159,7 @@ mod tests {
 
     #[test]
     fn covers_an_l_shape() {
-        let l = [
-            [0.0, 0.0],
-            [100.0, 0.0],
-            [100.0, 40.0],
-            [40.0, 40.0],
-            [40.0, 100.0],
-            [0.0, 100.0],
-        ];
+        let l = crate::geom::L_SHAPE;
         let path = lawnmower(&l, 15.0);
         assert!(
             worst_gap(&l, &path, 0.5) <= 7.5 + 1e-6,

@@ -220,14 +220,7 @@ fn orbit_keeps_its_radius_and_speed() {
 fn sweep_flies_the_lawnmower_path_and_covers_the_area() {
     let w = one_drone();
     let mut fleet = airborne(&w, 15.0);
-    let l = vec![
-        [0.0, 0.0],
-        [100.0, 0.0],
-        [100.0, 40.0],
-        [40.0, 40.0],
-        [40.0, 100.0],
-        [0.0, 100.0],
-    ];
+    let l = crate::geom::L_SHAPE.to_vec();
     let id = start(&mut fleet, 0, "Sweep", &[Value::Area(l.clone()), num(20.0)]);
     let run = run_until(&mut fleet, 0, id, 1000.0);
     let flown: Vec<[f64; 2]> = run

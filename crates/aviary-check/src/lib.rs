@@ -25,6 +25,7 @@ use aviary_world::World;
 
 pub use env::{bind_args, ArgBinding, BindProblem};
 pub use inputs::{check_sources, normalize_path, Checked};
+pub use infer::KindOrigin;
 pub use load::{SourceProvider, STD_NAME, STD_SOURCE};
 
 /// Where a definition lives.
@@ -43,6 +44,8 @@ pub struct Program {
     pub capabilities: BTreeMap<String, DefRef>,
     /// The kind of each `WITH` parameter of each capability, where it could be inferred.
     pub param_kinds: BTreeMap<String, Vec<Option<Kind>>>,
+    /// Where each of those kinds was fixed: the chain an E107 report shows.
+    pub param_origins: BTreeMap<String, Vec<Option<KindOrigin>>>,
     /// The paths of `USE`s that could not be read (reported as E113).
     pub unreadable: Vec<String>,
 }
@@ -89,7 +92,7 @@ pub fn check(sources: &mut SourceMap, root: FileId, world: Option<&World>, provi
     let mut program = load::load(sources, root, provider, &mut diagnostics);
     // Checks on a file that did not parse would only repeat its syntax errors.
     let syntax_ok = !diagnostics.iter().any(|d: &Diagnostic| d.is_error() && d.code.as_str().starts_with("E0"));
-    program.param_kinds = infer::parameter_kinds(&program, api);
+    (program.param_kinds, program.param_origins) = infer::parameter_kinds(&program, api);
     if syntax_ok {
         walk::check_program(&program, world, api, root, &mut diagnostics);
         signals::check_signals(&program, api, &mut diagnostics);

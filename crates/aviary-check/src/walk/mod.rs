@@ -416,7 +416,12 @@ impl<'a> Checker<'a> {
         for (i, value) in binding.bound.iter().enumerate() {
             if let Some(v) = value {
                 let what = format!("`{}`'s `{}`", cap.name.name, params[i]);
+                let before = self.diagnostics.len();
                 self.value(v, kinds.get(i).copied().flatten(), &what);
+                if self.diagnostics.len() > before && self.diagnostics[before].code == Code::WrongKind {
+                    let chain = self.kind_chain(&cap.name.name, i);
+                    self.diagnostics[before].secondary.extend(chain);
+                }
             }
         }
         if !need_all {
@@ -438,6 +443,24 @@ impl<'a> Checker<'a> {
                 d.help = Some(format!("add `{p}={example}` after WITH, or give `{p}` a default in the capability's DEFAULTS"));
             }
         }
+    }
+
+    /// The uses that fixed the kind of `capability`'s parameter `index`, outermost first,
+    /// through the capabilities it is passed on to.
+    fn kind_chain(&self, capability: &str, index: usize) -> Vec<aviary_diagnostics::Label> {
+        let mut labels = Vec::new();
+        let mut at = Some((capability.to_string(), index));
+        while let Some((cap, i)) = at.take() {
+            let origin = self.program.param_origins.get(&cap).and_then(|o| o.get(i)).cloned().flatten();
+            let (Some(origin), Some(file)) = (origin, self.program.capability_file(&cap)) else { break };
+            labels.push(aviary_diagnostics::Label { file, span: origin.span, message: origin.why });
+            // Bounded: a chain never passes through more capabilities than there are.
+            if labels.len() > self.program.capabilities.len() {
+                break;
+            }
+            at = origin.from;
+        }
+        labels
     }
 
     fn leash(&mut self, l: &'a LeashCall) {

@@ -145,7 +145,8 @@ fn every_code_is_produced_by_some_invalid_fixture() {
     for rel in fixtures("invalid") {
         seen.extend(check_fixture(&rel).codes());
     }
-    let missing: Vec<&str> = Code::ALL.iter().filter(|c| !seen.contains(c)).map(|c| c.as_str()).collect();
+    // The pre-flight codes come after compilation; aviary-verify's fixtures cover them.
+    let missing: Vec<&str> = Code::ALL.iter().filter(|c| !seen.contains(c) && !Code::PREFLIGHT.contains(c)).map(|c| c.as_str()).collect();
     assert!(missing.is_empty(), "no invalid fixture produces {}", missing.join(", "));
 }
 

@@ -5,15 +5,15 @@ use aviary_diagnostics::{render_json, render_text, summary_line, Diagnostic, Sou
 use crate::files::{color_wanted, world_beside, DiskProvider};
 use crate::Format;
 
-pub fn run(files: &[std::path::PathBuf], world: Option<&Path>, format: Format) -> u8 {
+pub fn run(files: &[std::path::PathBuf], world: Option<&Path>, format: Format, plan: bool) -> u8 {
     let mut worst = 0;
     for file in files {
-        worst = worst.max(check_one(file, world, format));
+        worst = worst.max(check_one(file, world, format, plan));
     }
     worst
 }
 
-fn check_one(path: &Path, world_path: Option<&Path>, format: Format) -> u8 {
+fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want_plan: bool) -> u8 {
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
         Err(e) => {
@@ -36,10 +36,52 @@ fn check_one(path: &Path, world_path: Option<&Path>, format: Format) -> u8 {
     let mut sources = SourceMap::new();
     let world = world_name.as_deref().zip(world_bytes.as_deref());
     let name = path.display().to_string();
-    let checked = aviary_check::check_sources(&mut sources, (&name, &bytes), world, &DiskProvider, &aviary_sim::descriptor());
-    let diagnostics = checked.diagnostics;
-    print(&sources, &diagnostics, format, path);
-    u8::from(diagnostics.iter().any(Diagnostic::is_error))
+    let api = aviary_sim::descriptor();
+    let checked = aviary_check::check_sources(&mut sources, (&name, &bytes), world, &DiskProvider, &api);
+    let verified = aviary_verify::preflight(&checked, &api);
+    let mut diagnostics = checked.diagnostics;
+    let mut plan = None;
+    if let Some((_, v)) = verified {
+        diagnostics.extend(v.diagnostics);
+        aviary_diagnostics::sort(&mut diagnostics);
+        plan = Some(v.plan);
+    }
+    let failed = u8::from(diagnostics.iter().any(Diagnostic::is_error));
+    if !want_plan {
+        print(&sources, &diagnostics, format, path);
+        return failed;
+    }
+    let Some(mut plan) = plan else {
+        print(&sources, &diagnostics, format, path);
+        eprintln!("aviary: no plan for {}: {}", path.display(), why_no_plan(failed == 1, world_name.is_some()));
+        return failed.max(1);
+    };
+    plan.locate(|o| {
+        let at = sources.line_col(o.file, o.span.start);
+        format!("{}:{}:{}", sources.name(o.file), at.line, at.column)
+    });
+    match format {
+        Format::Text => {
+            print(&sources, &diagnostics, format, path);
+            print!("\n{}", plan.render_text());
+        }
+        Format::Json => {
+            let diagnostics: Vec<serde_json::Value> = diagnostics.iter().map(|d| render_json(&sources, d)).collect();
+            let doc = serde_json::json!({ "file": path.display().to_string(), "plan": plan, "diagnostics": diagnostics });
+            println!("{doc}");
+        }
+    }
+    failed
+}
+
+fn why_no_plan(errors: bool, world: bool) -> &'static str {
+    if errors {
+        "fix its errors first"
+    } else if !world {
+        "a plan needs the world file (put NAME.world.toml beside it, or pass --world)"
+    } else {
+        "it holds no MISSION"
+    }
 }
 
 fn print(sources: &SourceMap, diagnostics: &[Diagnostic], format: Format, path: &Path) {

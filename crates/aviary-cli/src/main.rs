@@ -40,6 +40,9 @@ enum Command {
         world: Option<PathBuf>,
         #[arg(long, value_enum, default_value = "text")]
         format: Format,
+        /// Also print the energy and time plan: per drone, a timeline, distance, flight time and battery left
+        #[arg(long)]
+        plan: bool,
     },
     /// Rewrite missions in the one canonical layout
     Fmt {
@@ -98,7 +101,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let code = match cli.command {
-        Command::Check { files, world, format } => check::run(&files, world.as_deref(), format),
+        Command::Check { files, world, format, plan } => check::run(&files, world.as_deref(), format, plan),
         Command::Fmt { files, check } => fmt::run(&files, check),
         Command::Run { file, world, speed, seed, trace, telemetry_hz, quiet, serve } => {
             // Served to an operator, a mission runs in real time unless told otherwise.

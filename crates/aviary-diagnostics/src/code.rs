@@ -82,9 +82,18 @@ codes! {
     // Warnings.
     HandlerNeverFires = "W201", Warning, "a handler for a signal that nothing raises";
     UnknownException = "W202", Warning, "an ON EXCEPTION for a name neither built in nor thrown";
+    CommandsMayCollide = "W203", Warning, "one drone commanded from two places that may run at once";
+    LowReserve = "W204", Warning, "a drone's estimated battery reserve falls under 20%";
     // Notes.
     SignalNeverHandled = "N301", Note, "a signal raised but never handled";
     NoWorld = "N302", Note, "no world file, so actors, places and areas were not checked";
+    CommandsQueue = "N303", Note, "a handler that may wait for its drone, held by the flow that raised its signal or by an earlier firing";
+}
+
+impl Code {
+    /// The codes of the pre-flight analyses that run on the compiled mission
+    /// (`aviary-verify`), not in the checker.
+    pub const PREFLIGHT: &'static [Code] = &[Code::CommandsMayCollide, Code::LowReserve, Code::CommandsQueue];
 }
 
 impl std::fmt::Display for Code {

@@ -1,0 +1,109 @@
+//! `aviary check --plan`: the estimate agrees with a simulated run of the same mission
+//! within 15% for each drone's flight time and distance, and its forms (text, JSON,
+//! refusals) are as docs/GUIDE.md describes.
+
+mod common;
+
+use common::{aviary, repo, scratch};
+
+/// Per drone: (distance m, flight s), from the summary `aviary run` prints.
+fn simulated(mission: &str) -> Vec<(String, f64, f64)> {
+    let (code, out, err) = aviary(&["run", mission], &repo());
+    assert_eq!(code, 0, "the run failed: {err}");
+    out.lines()
+        .skip_while(|l| !l.starts_with("drone "))
+        .skip(1)
+        .take_while(|l| !l.starts_with("signals:"))
+        .map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            (f[0].to_string(), f[1].parse().expect("distance"), f[2].parse().expect("flight time"))
+        })
+        .collect()
+}
+
+fn planned(mission: &str) -> serde_json::Value {
+    let (code, out, err) = aviary(&["check", "--plan", "--format", "json", mission], &repo());
+    assert_eq!(code, 0, "check --plan failed: {err}");
+    serde_json::from_str(&out).expect("one JSON document")
+}
+
+fn agrees_within_15_percent(mission: &str) {
+    let sim = simulated(mission);
+    let plan = planned(mission);
+    let drones = plan["plan"]["drones"].as_array().expect("drones");
+    assert_eq!(drones.len(), sim.len());
+    let mut off = Vec::new();
+    for (d, (name, distance, flight)) in drones.iter().zip(&sim) {
+        assert_eq!(d["drone"].as_str(), Some(name.as_str()));
+        for (what, est, real) in [("distance", d["distance"].as_f64().expect("distance"), *distance), ("flight time", d["flight_time"].as_f64().expect("flight time"), *flight)] {
+            // The summary rounds to whole metres and seconds.
+            if (est - real).abs() > 0.15 * real + 1.0 {
+                off.push(format!("{name}: {what} planned {est:.0}, simulated {real:.0}"));
+            }
+        }
+    }
+    assert!(off.is_empty(), "the plan is off by more than 15%:\n{}", off.join("\n"));
+}
+
+#[test]
+fn the_papers_plan_agrees_with_its_simulated_run() {
+    agrees_within_15_percent("examples/search_and_rescue.mission");
+}
+
+#[test]
+fn the_shared_papers_plan_agrees_with_its_simulated_run() {
+    let shared = repo().join("../shared/examples/search_and_rescue.mission");
+    if !shared.is_file() {
+        eprintln!("skipped: ../shared/examples is not beside the repository");
+        return;
+    }
+    agrees_within_15_percent("../shared/examples/search_and_rescue.mission");
+}
+
+#[test]
+fn the_papers_mission_checks_clean_apart_from_notes() {
+    let (code, out, _) = aviary(&["check", "examples/search_and_rescue.mission"], &repo());
+    assert_eq!(code, 0);
+    assert!(!out.contains("warning["), "{out}");
+    assert!(out.contains("note[N303]"), "the queueing of video_drone2 and the beacons is noted:\n{out}");
+}
+
+#[test]
+fn the_text_plan_lists_every_drone_with_its_timeline() {
+    let (code, out, _) = aviary(&["check", "--plan", "examples/search_and_rescue.mission"], &repo());
+    assert_eq!(code, 0);
+    assert!(out.contains("plan: the mission takes about"), "{out}");
+    for drone in ["video_drone1", "video_drone2", "flir_drone1", "flir_drone2", "sensor_drone", "beacon_drone1", "beacon_drone2"] {
+        assert!(out.lines().any(|l| l.starts_with(&format!("{drone}: ")) && l.contains("battery left")), "no line for {drone}:\n{out}");
+    }
+    // beacon_drone2 flies one beacon per body the world holds.
+    assert_eq!(out.matches("DeployBeacon  (examples/search_and_rescue.mission:43:13)").count(), 2, "{out}");
+}
+
+#[test]
+fn a_plan_needs_a_world_and_a_mission_without_errors() {
+    let dir = scratch("plan_refusals");
+    std::fs::write(dir.join("alone.mission"), "MISSION M:\n    scout TakeOff\n").expect("write");
+    let (code, _, err) = aviary(&["check", "--plan", "alone.mission"], &dir);
+    assert_eq!(code, 1);
+    assert!(err.contains("no plan for alone.mission: a plan needs the world file"), "{err}");
+    std::fs::write(dir.join("broken.mission"), "MISSION M:\n    scout TakeOf\n").expect("write");
+    std::fs::write(dir.join("broken.world.toml"), "[drones.scout]\nhome = [0, 0]\n").expect("write");
+    let (code, out, err) = aviary(&["check", "--plan", "broken.mission"], &dir);
+    assert_eq!(code, 1);
+    assert!(out.contains("error[E101]") || out.contains("error["), "{out}");
+    assert!(err.contains("fix its errors first"), "{err}");
+}
+
+#[test]
+fn a_low_reserve_is_a_warning_in_check_and_flagged_in_the_plan() {
+    let dir = scratch("plan_reserve");
+    std::fs::write(dir.join("long.mission"), "MISSION Long:\n    spare TakeOff\n    spare Hover WITH 25min\n    spare ReturnHome\n").expect("write");
+    std::fs::write(dir.join("long.world.toml"), "[drones.spare]\nhome = [0, 0]\nendurance = 1800\n").expect("write");
+    let (code, out, _) = aviary(&["check", "--plan", "--format", "json", "long.mission"], &dir);
+    assert_eq!(code, 0, "a warning does not fail the check");
+    let doc: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    assert_eq!(doc["diagnostics"][0]["code"], "W204");
+    let left = doc["plan"]["drones"][0]["battery_left"].as_f64().expect("battery");
+    assert!(left < 0.2 && left > 0.1, "{left}");
+}

@@ -1,0 +1,43 @@
+//! Pre-flight analyses of a compiled mission (LANGUAGE.md §7): conflicting commands
+//! (W203, N303) and the energy and time plan (W204, `aviary check --plan`).
+//!
+//! Invariant: no IO. They run on the IR, after the checker found no error, so names are
+//! resolved, units are SI and every statement keeps its origin for the report.
+
+mod conflicts;
+pub mod plan;
+mod sites;
+
+use aviary_api::Descriptor;
+use aviary_check::Checked;
+use aviary_diagnostics::Diagnostic;
+use aviary_ir::Mission;
+use aviary_world::World;
+
+pub use plan::Plan;
+
+pub struct Verification {
+    pub diagnostics: Vec<Diagnostic>,
+    pub plan: Plan,
+}
+
+/// Every pre-flight analysis of `mission` on `world`.
+pub fn verify(mission: &Mission, world: &World) -> Verification {
+    let mut diagnostics = Vec::new();
+    conflicts::check_conflicts(mission, &mut diagnostics);
+    let plan = plan::estimate(mission, world, &mut diagnostics);
+    aviary_diagnostics::sort(&mut diagnostics);
+    Verification { diagnostics, plan }
+}
+
+/// Compiles and verifies what the checker accepted: `None` when it has errors, no world
+/// or no MISSION.
+pub fn preflight(checked: &Checked, api: &Descriptor) -> Option<(Mission, Verification)> {
+    if checked.has_errors() {
+        return None;
+    }
+    let (program, world) = (checked.program.as_ref()?, checked.world.as_ref()?);
+    let mission = aviary_ir::compile(program, world, api)?;
+    let verification = verify(&mission, world);
+    Some((mission, verification))
+}

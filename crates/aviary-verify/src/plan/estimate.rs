@@ -1,0 +1,380 @@
+//! The estimate: the compiled mission walked once in estimated time, the way the engine
+//! would run it, with each drone's flight costed by [`super::model`].
+//!
+//! Parallel branches are walked one after the other from the same start time; a
+//! statement that claims a drone's motion starts no earlier than the drone is free, so
+//! queueing follows program order. Handlers run after their block's items, in the order
+//! of their signals' times. Detections come from the world's targets (simulation data).
+
+use std::collections::BTreeSet;
+
+use aviary_api::{DroneId, Resource, Value};
+use aviary_ir::{ActorFilter, ActorRef, ApiCall, Block, BlockKind, Call, Expr, Handler, Mission, Node, Origin, SignalId};
+use aviary_world::World;
+
+use super::eval::{number, Frame, Scope};
+use super::model::{first_within, Flyer};
+use super::Activity;
+
+#[derive(Clone, Debug)]
+pub struct Raise {
+    pub t: f64,
+    pub signal: SignalId,
+    pub actor: Option<DroneId>,
+    pub args: Vec<Option<Value>>,
+}
+
+/// Everything a walk changes; cloned to try both sides of an `IF` it cannot decide.
+#[derive(Clone)]
+pub struct State {
+    pub drones: Vec<Flyer>,
+    pub activities: Vec<Vec<Activity>>,
+    pub raised: Vec<Option<f64>>,
+    /// Per drone: the mission-level statement during which the reserve fell under 20%.
+    pub reserve: Vec<Option<Origin>>,
+    /// What the estimate had to assume, with where.
+    pub assumptions: BTreeSet<(Option<(u32, u32)>, String)>,
+    /// Handlers that fired, by address.
+    pub fired: BTreeSet<usize>,
+}
+
+#[derive(Clone)]
+struct Ctx {
+    frame: Frame,
+    /// The signalling actor: of the capability or FOR instance.
+    actor: Option<DroneId>,
+    /// The mission-level statement running, while inside a capability.
+    statement: Option<Origin>,
+}
+
+pub struct Estimator<'m> {
+    pub mission: &'m Mission,
+    pub world: &'m World,
+    /// First raise times from the previous pass, for `WAITFOR RECEIVED` ahead of its signal.
+    pub known: Vec<Option<f64>>,
+    pub s: State,
+}
+
+const RESERVE: f64 = 0.20;
+
+impl<'m> Estimator<'m> {
+    pub fn new(mission: &'m Mission, world: &'m World, known: Vec<Option<f64>>) -> Estimator<'m> {
+        let drones: Vec<Flyer> = world.drones.iter().map(Flyer::new).collect();
+        let n = drones.len();
+        Estimator {
+            mission,
+            world,
+            known,
+            s: State { drones, activities: vec![Vec::new(); n], raised: vec![None; mission.signals.len()], reserve: vec![None; n], assumptions: BTreeSet::new(), fired: BTreeSet::new() },
+        }
+    }
+
+    /// Walks the mission body, then sends home what is still in the air; the end time.
+    pub fn run(&mut self) -> f64 {
+        let mut ctx = Ctx { frame: vec![None; self.mission.frame_size], actor: None, statement: None };
+        let (end, _) = self.block(&self.mission.body, &mut ctx, 0.0);
+        let mut last = end;
+        for d in 0..self.s.drones.len() {
+            if self.s.drones[d].airborne {
+                let f = &mut self.s.drones[d];
+                let start = end.max(f.free_at);
+                let done = start + f.return_home(self.world.site.max_altitude);
+                f.land(done);
+                self.s.activities[d].push(Activity { start, end: done, what: "ReturnToLaunch (mission end)".into(), at: None, origin: None });
+                last = last.max(done);
+            }
+        }
+        last
+    }
+
+    /// What one firing of `h` at `t` would add, per drone it flies: (metres, seconds in
+    /// the air, battery left at the end). The state is left as it was.
+    pub fn bound(&mut self, h: &Handler, t: f64) -> Vec<(DroneId, (f64, f64, f64))> {
+        let before = self.s.clone();
+        let mut ctx = Ctx { frame: vec![None; self.mission.frame_size], actor: None, statement: None };
+        let (end, _) = self.block(&h.body, &mut ctx, t);
+        let mut out = Vec::new();
+        for d in 0..self.s.drones.len() {
+            let f = &mut self.s.drones[d];
+            if f.airborne {
+                let took = f.return_home(self.world.site.max_altitude);
+                f.land(end.max(f.free_at) + took);
+            }
+            let (now, then) = (&self.s.drones[d], &before.drones[d]);
+            if now.distance > then.distance {
+                out.push((d, (now.distance - then.distance, now.flight_time - then.flight_time, now.battery_start - now.flight_time / now.endurance)));
+            }
+        }
+        let notes = std::mem::take(&mut self.s.assumptions);
+        self.s = before;
+        self.s.assumptions.extend(notes);
+        out
+    }
+
+    pub fn note(&mut self, at: Option<Origin>, text: String) {
+        self.s.assumptions.insert((at.map(|o| (o.file.0, o.span.start)), text));
+    }
+
+    fn scope<'a>(&'a self, ctx: &'a Ctx, t: f64) -> Scope<'a> {
+        Scope { mission: self.mission, frame: &ctx.frame, drones: &self.s.drones, raised: &self.s.raised, t }
+    }
+
+    fn block(&mut self, b: &Block, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
+        let mut raises = Vec::new();
+        let mut end = t;
+        for node in &b.items {
+            let start = if b.kind == BlockKind::Sequential { end } else { t };
+            let (e, r) = self.node(node, ctx, start);
+            end = if b.kind == BlockKind::Sequential { e } else { end.max(e) };
+            raises.extend(r);
+        }
+        if b.handlers.is_empty() {
+            return (end, raises);
+        }
+        let items_end = end;
+        let mut once = vec![false; b.handlers.len()];
+        let (mut pending, mut heard) = (raises, Vec::new());
+        while let Some(i) = (0..pending.len()).min_by(|&x, &y| pending[x].t.total_cmp(&pending[y].t)) {
+            let r = pending.remove(i);
+            for (hi, h) in b.handlers.iter().enumerate() {
+                if h.signal != r.signal || (!h.every && once[hi]) || !matches(h, &ctx.frame, r.actor) {
+                    continue;
+                }
+                once[hi] = true;
+                self.s.fired.insert(h as *const Handler as usize);
+                let mut hctx = ctx.clone();
+                for (slot, v) in h.bindings.iter().zip(&r.args) {
+                    hctx.frame[*slot] = v.clone();
+                }
+                let start = if h.sequential { items_end.max(r.t) } else { r.t };
+                let (e, more) = self.block(&h.body, &mut hctx, start);
+                end = end.max(e);
+                pending.extend(more);
+            }
+            heard.push(r);
+        }
+        (end, heard)
+    }
+
+    fn node(&mut self, node: &Node, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
+        match node {
+            Node::Block(b) => self.block(b, ctx, t),
+            Node::Call(c) => self.call(c, ctx, t),
+            Node::Api(a) => self.api(a, ctx, t),
+            Node::Signal { signal, args, .. } => {
+                let args = args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
+                let first = &mut self.s.raised[*signal];
+                *first = Some(first.map_or(t, |f| f.min(t)));
+                (t, vec![Raise { t, signal: *signal, actor: ctx.actor, args }])
+            }
+            Node::Leash(_) | Node::Throw { .. } => (t, Vec::new()),
+            Node::StartIf { condition, body } => match self.scope(ctx, t).condition(condition) {
+                Some(false) => (t, Vec::new()),
+                known => {
+                    if known.is_none() {
+                        self.note(ctx.statement, "a STARTIF whose condition is unknown before flight is counted as run".into());
+                    }
+                    self.block(body, ctx, t)
+                }
+            },
+            Node::WaitFor { condition, body } => {
+                let t = self.wait(condition, ctx, t);
+                match body {
+                    Some(b) => self.block(b, ctx, t),
+                    None => (t, Vec::new()),
+                }
+            }
+            Node::DoWhile { condition, body } => match self.scope(ctx, t).condition(condition) {
+                Some(false) => (t, Vec::new()),
+                _ => {
+                    self.note(ctx.statement, "a DOWHILE whose rounds cannot be counted before flight is counted once; its worst case has no bound".into());
+                    self.block(body, ctx, t)
+                }
+            },
+            Node::For(f) => {
+                let mut end = t;
+                let mut raises = Vec::new();
+                for (actor, values) in &f.instances {
+                    let members = match actor {
+                        ActorRef::Group(g) => g.clone(),
+                        a => self.scope(ctx, t).actor(a).into_iter().collect(),
+                    };
+                    for d in members {
+                        let mut ictx = ctx.clone();
+                        ictx.frame[f.alias] = Some(Value::Actor(d));
+                        for (slot, v) in f.params.iter().zip(values) {
+                            ictx.frame[*slot] = self.scope(ctx, t).eval(v);
+                        }
+                        ictx.actor = Some(d);
+                        let start = if f.parallel { t } else { end };
+                        let (e, r) = self.block(&f.body, &mut ictx, start);
+                        end = end.max(e);
+                        raises.extend(r);
+                    }
+                }
+                (end, raises)
+            }
+            Node::If { branches, otherwise } => self.choose(branches, otherwise.as_ref(), ctx, t),
+        }
+    }
+
+    /// The first branch whose condition holds; when one cannot be decided, the longer of
+    /// taking it and not (the worst case).
+    fn choose(&mut self, branches: &[(Expr, Block)], otherwise: Option<&Block>, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
+        let Some(((cond, body), rest)) = branches.split_first() else {
+            return otherwise.map_or((t, Vec::new()), |b| self.block(b, ctx, t));
+        };
+        match self.scope(ctx, t).condition(cond) {
+            Some(true) => self.block(body, ctx, t),
+            Some(false) => self.choose(rest, otherwise, ctx, t),
+            None => {
+                let before = self.s.clone();
+                let taken = self.block(body, &mut ctx.clone(), t);
+                let after_taken = std::mem::replace(&mut self.s, before);
+                let skipped = self.choose(rest, otherwise, ctx, t);
+                if taken.0 > skipped.0 {
+                    self.s = after_taken;
+                    return taken;
+                }
+                skipped
+            }
+        }
+    }
+
+    fn wait(&mut self, condition: &Expr, ctx: &Ctx, t: f64) -> f64 {
+        if let Expr::Received(s) = condition {
+            if let Some(at) = self.s.raised[*s].or(self.known[*s]) {
+                return t.max(at);
+            }
+        }
+        if self.scope(ctx, t).condition(condition) != Some(true) {
+            let what = match condition {
+                Expr::Received(s) => format!("a WAITFOR RECEIVED({}) whose signal the estimate never raises is counted as no wait", self.mission.signals[*s]),
+                _ => "a WAITFOR whose condition is unknown before flight is counted as no wait".into(),
+            };
+            self.note(ctx.statement, what);
+        }
+        t
+    }
+
+    fn call(&mut self, c: &Call, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
+        let cap = &self.mission.capabilities[c.capability];
+        let args: Vec<Option<Value>> = c.args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
+        let sets: Vec<Vec<DroneId>> = c
+            .actors
+            .iter()
+            .map(|a| match a {
+                ActorRef::Group(g) => g.clone(),
+                a => self.scope(ctx, t).actor(a).into_iter().collect(),
+            })
+            .collect();
+        let runs: Vec<Vec<DroneId>> = if cap.actors == 1 { sets.concat().into_iter().map(|d| vec![d]).collect() } else { vec![sets.iter().filter_map(|s| s.first().copied()).collect()] };
+        let top = ctx.statement.is_none();
+        let motion: Vec<usize> = cap.claims.iter().filter(|(_, r)| *r == Resource::Motion).map(|(slot, _)| *slot).collect();
+        let (mut end, mut raises) = (t, Vec::new());
+        for actors in runs {
+            let mut start = t;
+            if top {
+                for &slot in &motion {
+                    if let Some(&d) = actors.get(slot) {
+                        start = start.max(self.s.drones[d].free_at);
+                    }
+                }
+            }
+            let mut frame = vec![None; cap.frame_size];
+            for (i, d) in actors.iter().enumerate() {
+                frame[i] = Some(Value::Actor(*d));
+            }
+            for (j, v) in args.iter().enumerate() {
+                frame[cap.actors + j] = v.clone();
+            }
+            let mut cctx = Ctx { frame, actor: actors.first().copied(), statement: Some(ctx.statement.unwrap_or(c.origin)) };
+            let (e, r) = self.block(&cap.perform, &mut cctx, start);
+            if top {
+                for &slot in &motion {
+                    if let Some(&d) = actors.get(slot) {
+                        self.s.drones[d].free_at = self.s.drones[d].free_at.max(e);
+                    }
+                }
+                for &d in &actors {
+                    self.s.activities[d].push(Activity { start, end: e, what: cap.name.clone(), at: None, origin: Some(c.origin) });
+                }
+            }
+            end = end.max(e);
+            raises.extend(r);
+        }
+        (end, raises)
+    }
+
+    fn api(&mut self, a: &ApiCall, ctx: &Ctx, t: f64) -> (f64, Vec<Raise>) {
+        let Some(d) = self.scope(ctx, t).actor(&a.actor) else { return (t, Vec::new()) };
+        let args: Vec<Option<Value>> = a.args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
+        let name = self.mission.functions[a.function].0.as_str();
+        let (duration, raises) = super::flight::fly(self, d, name, &args, ctx.statement, t);
+        let end = t + duration;
+        let f = &self.s.drones[d];
+        if f.battery_at(end) < RESERVE && self.s.reserve[d].is_none() {
+            self.s.reserve[d] = ctx.statement;
+        }
+        (end, raises)
+    }
+
+    /// Targets of the kinds `d` detects that its ground track `from`→`to`, flown during
+    /// `[t, t + duration]`, comes within range of: each is a `Detected` at that moment.
+    pub fn scan(&mut self, d: DroneId, from: [f64; 2], to: [f64; 2], t: f64, duration: f64) -> Vec<Raise> {
+        let Some(detected) = self.mission.signals.iter().position(|s| s == "Detected") else { return Vec::new() };
+        let mut out = Vec::new();
+        for (kind, range, found) in self.s.drones[d].detecting.iter_mut() {
+            for (i, target) in self.world.targets.iter().enumerate() {
+                if target.kind != *kind || found.contains(&i) {
+                    continue;
+                }
+                if let Some(s) = first_within(from, to, [target.at[0], target.at[1]], *range) {
+                    found.push(i);
+                    let location = aviary_api::Point { x: target.at[0], y: target.at[1], z: Some(0.0) };
+                    out.push(Raise { t: t + s * duration, signal: detected, actor: Some(d), args: vec![Some(Value::Symbol(kind.clone())), Some(Value::Position(location))] });
+                }
+            }
+        }
+        out
+    }
+
+    pub fn position_arg(&mut self, v: &Option<Value>, d: DroneId, at: Option<Origin>) -> Option<[f64; 3]> {
+        match v {
+            Some(Value::Position(p)) => Some([p.x, p.y, p.z.unwrap_or(self.s.drones[d].pos[2])]),
+            Some(Value::Actor(o)) => self.s.drones.get(*o).map(|f| f.pos),
+            Some(Value::Area(polygon)) => {
+                let c = aviary_api::centroid(polygon);
+                Some([c[0], c[1], self.s.drones[d].pos[2]])
+            }
+            _ => {
+                // Unknown before flight: the farthest corner of the geofence is the worst case.
+                let here = self.s.drones[d].pos;
+                let far = self.world.site.geofence.as_ref().and_then(|fence| {
+                    fence.iter().copied().max_by(|p, q| dist2(*p, here).total_cmp(&dist2(*q, here)))
+                });
+                self.note(at, match far {
+                    Some(_) => "a position known only in flight is taken as the geofence corner farthest from the drone".into(),
+                    None => "a position known only in flight is not counted: the site has no geofence to bound it".into(),
+                });
+                far.map(|p| [p[0], p[1], here[2]])
+            }
+        }
+    }
+}
+
+fn dist2(p: [f64; 2], q: [f64; 3]) -> f64 {
+    (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)
+}
+
+fn matches(h: &Handler, frame: &Frame, actor: Option<DroneId>) -> bool {
+    match &h.by {
+        None => true,
+        Some(ActorFilter::Drones(ds)) => actor.is_some_and(|a| ds.contains(&a)),
+        Some(ActorFilter::Slot(s)) => matches!((frame.get(*s), actor), (Some(Some(Value::Actor(d))), Some(a)) if *d == a),
+    }
+}
+
+pub fn number_arg(args: &[Option<Value>], i: usize) -> Option<f64> {
+    args.get(i)?.as_ref().and_then(number)
+}

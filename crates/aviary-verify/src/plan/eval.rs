@@ -1,0 +1,126 @@
+//! Values and conditions as the estimate can know them before flight: `None` is unknown
+//! (a binding of a signal nobody can predict, telemetry the model does not follow).
+
+use aviary_api::{DroneId, FlightState, Point, Value};
+use aviary_ir::{ActorRef, Compare, Expr, Field, Mission};
+
+use super::model::Flyer;
+
+pub type Frame = Vec<Option<Value>>;
+
+/// What an expression reads: the frame, the drones as estimated at `t`, the signals'
+/// first raise times.
+pub struct Scope<'a> {
+    pub mission: &'a Mission,
+    pub frame: &'a Frame,
+    pub drones: &'a [Flyer],
+    pub raised: &'a [Option<f64>],
+    pub t: f64,
+}
+
+impl Scope<'_> {
+    pub fn actor(&self, actor: &ActorRef) -> Option<DroneId> {
+        match actor {
+            ActorRef::Drone(d) => Some(*d),
+            ActorRef::Group(g) => g.first().copied(),
+            ActorRef::Slot(s) => match self.frame.get(*s)? {
+                Some(Value::Actor(d)) => Some(*d),
+                _ => None,
+            },
+        }
+    }
+
+    pub fn eval(&self, e: &Expr) -> Option<Value> {
+        Some(match e {
+            Expr::Const(v) => v.clone(),
+            Expr::Slot(s) => self.frame.get(*s)?.clone()?,
+            Expr::Actor(a) => Value::Actor(self.actor(a)?),
+            Expr::Telemetry(a, field) => self.telemetry(self.actor(a)?, *field)?,
+            Expr::Attribute(a, i) => self.mission.attributes.get(*i)?.get(self.actor(a)?)?.clone()?,
+            Expr::Point(parts) => {
+                let n: Vec<f64> = parts.iter().map(|p| number(&self.eval(p)?)).collect::<Option<_>>()?;
+                Value::Position(Point { x: *n.first()?, y: *n.get(1)?, z: n.get(2).copied() })
+            }
+            Expr::Geo(parts) => {
+                let n: Vec<f64> = parts.iter().map(|p| number(&self.eval(p)?)).collect::<Option<_>>()?;
+                let p = aviary_ir::to_local(self.mission.origin?, *n.first()?, *n.get(1)?, n.get(2).copied());
+                Value::Position(Point { x: p[0], y: p[1], z: n.get(2).map(|_| p[2]) })
+            }
+            Expr::Distance(a, b) => {
+                let (p, q) = (self.position(a)?, self.position(b)?);
+                Value::Number(((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt())
+            }
+            Expr::Elapsed => Value::Number(self.t),
+            Expr::Received(s) => Value::Bool(self.raised.get(*s).copied().flatten().is_some_and(|at| at <= self.t)),
+            Expr::Not(x) => Value::Bool(!truth(&self.eval(x)?)?),
+            Expr::And(x, y) => match (self.eval(x).as_ref().and_then(truth), self.eval(y).as_ref().and_then(truth)) {
+                (Some(false), _) | (_, Some(false)) => Value::Bool(false),
+                (Some(true), Some(true)) => Value::Bool(true),
+                _ => return None,
+            },
+            Expr::Or(x, y) => match (self.eval(x).as_ref().and_then(truth), self.eval(y).as_ref().and_then(truth)) {
+                (Some(true), _) | (_, Some(true)) => Value::Bool(true),
+                (Some(false), Some(false)) => Value::Bool(false),
+                _ => return None,
+            },
+            Expr::Compare(x, op, y) => Value::Bool(compare(&self.eval(x)?, *op, &self.eval(y)?)?),
+        })
+    }
+
+    pub fn condition(&self, e: &Expr) -> Option<bool> {
+        truth(&self.eval(e)?)
+    }
+
+    fn position(&self, e: &Expr) -> Option<[f64; 2]> {
+        match self.eval(e)? {
+            Value::Position(p) => Some([p.x, p.y]),
+            Value::Actor(d) => self.drones.get(d).map(|f| [f.pos[0], f.pos[1]]),
+            _ => None,
+        }
+    }
+
+    fn telemetry(&self, d: DroneId, field: Field) -> Option<Value> {
+        let f = self.drones.get(d)?;
+        Some(match field {
+            Field::Position => Value::Position(Point { x: f.pos[0], y: f.pos[1], z: Some(f.pos[2]) }),
+            Field::Altitude => Value::Number(f.pos[2]),
+            Field::Battery => Value::Number(f.battery_at(self.t)),
+            Field::State => Value::Symbol(if f.airborne { FlightState::Flying } else { FlightState::Landed }.as_str().to_string()),
+            // Between activities the estimate has the drone at rest.
+            Field::Speed => Value::Number(0.0),
+            Field::Heading | Field::Link => return None,
+        })
+    }
+}
+
+pub fn number(v: &Value) -> Option<f64> {
+    match v {
+        Value::Number(n) => Some(*n),
+        _ => None,
+    }
+}
+
+fn truth(v: &Value) -> Option<bool> {
+    match v {
+        Value::Bool(b) => Some(*b),
+        _ => None,
+    }
+}
+
+fn compare(x: &Value, op: Compare, y: &Value) -> Option<bool> {
+    if let (Value::Number(a), Value::Number(b)) = (x, y) {
+        return Some(match op {
+            Compare::Eq => a == b,
+            Compare::Ne => a != b,
+            Compare::Lt => a < b,
+            Compare::Le => a <= b,
+            Compare::Gt => a > b,
+            Compare::Ge => a >= b,
+        });
+    }
+    match op {
+        Compare::Eq => Some(x == y),
+        Compare::Ne => Some(x != y),
+        _ => None,
+    }
+}

@@ -1,0 +1,108 @@
+//! Each middle-layer function's cost in the estimate (LANGUAGE.md §4), as the simulator
+//! flies it.
+
+use aviary_api::{DroneId, Value};
+use aviary_ir::Origin;
+
+use super::estimate::{number_arg, Estimator, Raise};
+use super::model::LOAD_TIME;
+
+/// How long `function` takes on drone `d` from time `t`, and the detections on the way.
+pub fn fly(e: &mut Estimator, d: DroneId, function: &str, args: &[Option<Value>], at: Option<Origin>, t: f64) -> (f64, Vec<Raise>) {
+    let max_altitude = e.world.site.max_altitude;
+    let mut raises = Vec::new();
+    let duration = match function {
+        "TakeOff" => {
+            let alt = number_arg(args, 0).unwrap_or(10.0);
+            let f = &mut e.s.drones[d];
+            f.take_off(t);
+            f.leg([f.pos[0], f.pos[1], alt])
+        }
+        "Land" => {
+            let f = &mut e.s.drones[d];
+            let took = f.leg([f.pos[0], f.pos[1], 0.0]);
+            f.land(t + took);
+            took
+        }
+        "ReturnToLaunch" => {
+            let f = &mut e.s.drones[d];
+            let took = f.return_home(max_altitude);
+            f.land(t + took);
+            took
+        }
+        "DescendTo" | "AscendTo" => match number_arg(args, 0) {
+            Some(alt) => {
+                let f = &mut e.s.drones[d];
+                f.leg([f.pos[0], f.pos[1], alt])
+            }
+            None => 0.0,
+        },
+        "Hover" => number_arg(args, 0).unwrap_or(0.0),
+        "FlyToPosition" => {
+            let Some(to) = e.position_arg(&args[0], d, at) else { return (0.0, raises) };
+            let f = &e.s.drones[d];
+            let speed = number_arg(args, 1).map_or(f.max_speed, |s| s.min(f.max_speed));
+            leg(e, d, to, speed, t, &mut raises)
+        }
+        "Orbit" => {
+            let center = e.position_arg(&args[0], d, at);
+            let radius = number_arg(args, 1);
+            match (center, radius) {
+                (Some(c), Some(r)) => e.s.drones[d].orbit([c[0], c[1]], r, number_arg(args, 2).unwrap_or(1.0)),
+                _ => 0.0,
+            }
+        }
+        "Sweep" => match (&args[0], number_arg(args, 1)) {
+            (Some(Value::Area(area)), Some(spacing)) => {
+                let z = e.s.drones[d].pos[2];
+                let mut took = 0.0;
+                for p in aviary_api::sweep::lawnmower(area, spacing) {
+                    let speed = e.s.drones[d].max_speed;
+                    took += leg(e, d, [p[0], p[1], z], speed, t + took, &mut raises);
+                }
+                took
+            }
+            _ => 0.0,
+        },
+        "FollowPath" => {
+            let mut took = 0.0;
+            for v in args {
+                if let Some(to) = e.position_arg(v, d, at) {
+                    let speed = e.s.drones[d].max_speed;
+                    took += leg(e, d, to, speed, t + took, &mut raises);
+                }
+            }
+            took
+        }
+        "StartDetection" => {
+            if let Some(Value::Symbol(kind)) = &args[0] {
+                let f = &e.s.drones[d];
+                let range = e.world.sensors.iter().filter(|s| f.sensors.contains(&s.kind) && s.detects.contains(kind)).map(|s| s.range).reduce(f64::max);
+                let f = &mut e.s.drones[d];
+                f.detecting.retain(|(k, _, _)| k != kind);
+                if let Some(range) = range {
+                    f.detecting.push((kind.clone(), range, Vec::new()));
+                }
+            }
+            0.0
+        }
+        "StopDetection" => {
+            if let Some(Value::Symbol(kind)) = &args[0] {
+                e.s.drones[d].detecting.retain(|(k, _, _)| k != kind);
+            }
+            0.0
+        }
+        "LoadPayload" => LOAD_TIME,
+        // Arm, Disarm, streaming, ReleasePayload and a backend's own functions: at once.
+        _ => 0.0,
+    };
+    (duration, raises)
+}
+
+/// A straight leg, scanning for targets on the way.
+fn leg(e: &mut Estimator, d: DroneId, to: [f64; 3], speed: f64, t: f64, raises: &mut Vec<Raise>) -> f64 {
+    let from = e.s.drones[d].pos;
+    let took = e.s.drones[d].leg_at(to, speed);
+    raises.extend(e.scan(d, [from[0], from[1]], [to[0], to[1]], t, took));
+    took
+}

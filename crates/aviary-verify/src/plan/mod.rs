@@ -1,0 +1,189 @@
+//! The energy and time plan of `aviary check --plan`: per drone, an estimated timeline of
+//! its activities, distance, flight time and battery left at the end, from the world's
+//! speeds and endurance. Handlers whose trigger the estimate never sees get a worst-case
+//! bound per firing. A reserve under 20% is a W204 at the statement during which it is
+//! crossed.
+
+mod estimate;
+mod eval;
+mod flight;
+mod model;
+
+use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
+use aviary_ir::{Block, Handler, Mission, Node, Origin};
+use aviary_world::World;
+use serde::Serialize;
+
+use estimate::Estimator;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Activity {
+    /// Seconds from the mission's start.
+    pub start: f64,
+    pub end: f64,
+    /// The capability (or the mission's closing return).
+    pub what: String,
+    /// `path:line:col` of the statement, once [`Plan::locate`] has run.
+    pub at: Option<String>,
+    #[serde(skip)]
+    pub origin: Option<Origin>,
+}
+
+/// What one firing of a handler whose trigger is unknown adds to a drone, at worst.
+#[derive(Clone, Debug, Serialize)]
+pub struct Bound {
+    pub handler: String,
+    pub distance: f64,
+    pub flight_time: f64,
+    /// Battery left at the end if it fires once, as a fraction.
+    pub battery_left: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct DronePlan {
+    pub drone: String,
+    /// Metres flown, climbs and descents included.
+    pub distance: f64,
+    /// Seconds in the air.
+    pub flight_time: f64,
+    /// Battery left at the end, as a fraction.
+    pub battery_left: f64,
+    pub activities: Vec<Activity>,
+    pub worst_case: Vec<Bound>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Assumption {
+    pub at: Option<String>,
+    pub text: String,
+    #[serde(skip)]
+    pub origin: Option<(u32, u32)>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Plan {
+    /// Seconds until the last drone is down.
+    pub mission_time: f64,
+    pub drones: Vec<DronePlan>,
+    pub assumptions: Vec<Assumption>,
+}
+
+/// How many walks may pass for `WAITFOR RECEIVED` to learn times raised later in the walk.
+const PASSES: usize = 4;
+
+/// Estimates `mission` on `world`; appends a W204 per drone whose reserve falls under 20%.
+pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnostic>) -> Plan {
+    let mut known = vec![None; mission.signals.len()];
+    let mut est = Estimator::new(mission, world, known.clone());
+    let mut end = est.run();
+    for _ in 1..PASSES {
+        if est.s.raised == known {
+            break;
+        }
+        known = est.s.raised.clone();
+        est = Estimator::new(mission, world, known.clone());
+        end = est.run();
+    }
+    let mut drones: Vec<DronePlan> = world
+        .drones
+        .iter()
+        .zip(&est.s.drones)
+        .zip(&est.s.activities)
+        .map(|((w, f), acts)| DronePlan { drone: w.name.clone(), distance: f.distance, flight_time: f.flight_time, battery_left: f.battery_at(end), activities: acts.clone(), worst_case: Vec::new() })
+        .collect();
+    for (d, at) in est.s.reserve.iter().enumerate() {
+        if let Some(o) = at {
+            let p = &drones[d];
+            diagnostics.push(
+                Diagnostic::new(Code::LowReserve, o.file, o.span, format!("{}'s battery is estimated to fall under 20% during this statement ({:.0}% left at the end)", p.drone, p.battery_left * 100.0))
+                    .label("the reserve is crossed here")
+                    .with_help("shorten the drone's work, split it with another drone, or raise its `battery` or `endurance` in the world file if they are wrong; `aviary check --plan` shows the estimate"),
+            );
+        }
+    }
+    for h in unfired(&mission.body, &est.s.fired) {
+        let label = format!("ON {}{}", if h.every { "EVERY " } else { "" }, mission.signals[h.signal]);
+        for (d, b) in est.bound(h, end) {
+            drones[d].worst_case.push(Bound { handler: label.clone(), distance: b.0, flight_time: b.1, battery_left: b.2 });
+        }
+    }
+    let assumptions = est.s.assumptions.iter().map(|(o, text)| Assumption { at: None, text: text.clone(), origin: *o }).collect();
+    Plan { mission_time: end, drones, assumptions }
+}
+
+/// The mission-level handlers (not those inside capabilities) that never fired.
+fn unfired<'m>(block: &'m Block, fired: &std::collections::BTreeSet<usize>) -> Vec<&'m Handler> {
+    let mut out = Vec::new();
+    let mut visit = |b: &'m Block| {
+        for h in &b.handlers {
+            if !fired.contains(&(h as *const Handler as usize)) {
+                out.push(h);
+            }
+        }
+    };
+    visit(block);
+    crate::sites::visit(block, &mut |node| match node {
+        Node::Block(b) => visit(b),
+        Node::StartIf { body, .. } | Node::DoWhile { body, .. } | Node::WaitFor { body: Some(body), .. } => visit(body),
+        Node::For(f) => visit(&f.body),
+        Node::If { branches, otherwise } => {
+            branches.iter().for_each(|(_, b)| visit(b));
+            otherwise.iter().for_each(&mut visit);
+        }
+        _ => {}
+    });
+    out
+}
+
+impl Plan {
+    /// Fills each `at` with the place of its origin, as the caller names places.
+    pub fn locate(&mut self, place: impl Fn(Origin) -> String) {
+        for d in &mut self.drones {
+            for a in &mut d.activities {
+                a.at = a.origin.map(&place);
+            }
+        }
+        for a in &mut self.assumptions {
+            a.at = a.origin.map(|(file, start)| place(Origin { file: FileId(file), span: Span::point(start as usize) }));
+        }
+    }
+
+    /// The plan as a table per drone, for people.
+    pub fn render_text(&self) -> String {
+        let mut out = format!("plan: the mission takes about {} (estimate)\n", clock(self.mission_time));
+        for d in &self.drones {
+            out.push_str(&format!(
+                "\n{}: {:.0} m, {} in the air, {:.0}% battery left{}\n",
+                d.drone,
+                d.distance,
+                clock(d.flight_time),
+                d.battery_left * 100.0,
+                if d.battery_left < 0.2 { "  (under the 20% reserve)" } else { "" }
+            ));
+            for a in &d.activities {
+                out.push_str(&format!("  {:>7.1} – {:>7.1} s  {}{}\n", a.start, a.end, a.what, a.at.as_ref().map(|p| format!("  ({p})")).unwrap_or_default()));
+            }
+            for b in &d.worst_case {
+                out.push_str(&format!(
+                    "  worst case per firing of {} (its trigger is unknown before flight): +{:.0} m, +{}, {:.0}% battery left\n",
+                    b.handler,
+                    b.distance,
+                    clock(b.flight_time),
+                    b.battery_left * 100.0
+                ));
+            }
+        }
+        if !self.assumptions.is_empty() {
+            out.push_str("\nassumed:\n");
+            for a in &self.assumptions {
+                out.push_str(&format!("  {}{}\n", a.at.as_ref().map(|p| format!("{p}: ")).unwrap_or_default(), a.text));
+            }
+        }
+        out
+    }
+}
+
+fn clock(seconds: f64) -> String {
+    let s = seconds.max(0.0).round() as u64;
+    format!("{}:{:02} min", s / 60, s % 60)
+}

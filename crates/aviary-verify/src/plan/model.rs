@@ -1,0 +1,165 @@
+//! What a drone's flight costs: the same kinematic model the built-in simulator flies
+//! (each leg a trapezoidal speed profile, horizontal and vertical at once; orbits at the
+//! speed a centripetal limit allows; sweeps along the middle layer's lawnmower path),
+//! in closed form instead of ticks.
+
+use aviary_api::geometry::dist_to_segment;
+use aviary_world::Drone;
+
+/// `LoadPayload` takes this long (the simulator's figure).
+pub const LOAD_TIME: f64 = 2.0;
+/// `ReturnToLaunch` climbs to at least this altitude first.
+pub const RETURN_ALTITUDE: f64 = 10.0;
+
+/// A drone as the estimate follows it.
+#[derive(Clone, Debug)]
+pub struct Flyer {
+    pub pos: [f64; 3],
+    pub home: [f64; 3],
+    pub max_speed: f64,
+    pub climb_rate: f64,
+    pub accel: f64,
+    pub endurance: f64,
+    pub battery_start: f64,
+    pub sensors: Vec<String>,
+    pub airborne: bool,
+    /// When the drone last took off, while it is in the air.
+    pub since: f64,
+    pub flight_time: f64,
+    pub distance: f64,
+    /// When its motion is next free: a statement that claims it starts no earlier.
+    pub free_at: f64,
+    /// Kinds being detected, with the sensor range, and the targets already found.
+    pub detecting: Vec<(String, f64, Vec<usize>)>,
+}
+
+impl Flyer {
+    pub fn new(d: &Drone) -> Flyer {
+        Flyer {
+            pos: d.home,
+            home: d.home,
+            max_speed: d.max_speed,
+            climb_rate: d.climb_rate,
+            accel: d.acceleration,
+            endurance: d.endurance,
+            battery_start: d.battery / 100.0,
+            sensors: d.sensors.clone(),
+            airborne: false,
+            since: 0.0,
+            flight_time: 0.0,
+            distance: 0.0,
+            free_at: 0.0,
+            detecting: Vec::new(),
+        }
+    }
+
+    /// Battery left at time `t`, as a fraction.
+    pub fn battery_at(&self, t: f64) -> f64 {
+        let air = self.flight_time + if self.airborne { (t - self.since).max(0.0) } else { 0.0 };
+        self.battery_start - air / self.endurance
+    }
+
+    pub fn take_off(&mut self, t: f64) {
+        if !self.airborne {
+            self.airborne = true;
+            self.since = t;
+        }
+    }
+
+    pub fn land(&mut self, t: f64) {
+        if self.airborne {
+            self.airborne = false;
+            self.flight_time += (t - self.since).max(0.0);
+        }
+    }
+
+    /// Flies a straight leg to `to`; returns its duration.
+    pub fn leg(&mut self, to: [f64; 3]) -> f64 {
+        self.leg_at(to, self.max_speed)
+    }
+
+    pub fn leg_at(&mut self, to: [f64; 3], speed: f64) -> f64 {
+        let h = ((to[0] - self.pos[0]).powi(2) + (to[1] - self.pos[1]).powi(2)).sqrt();
+        let v = (to[2] - self.pos[2]).abs();
+        self.distance += (h * h + v * v).sqrt();
+        self.pos = to;
+        trapezoid(h, speed, self.accel).max(trapezoid(v, self.climb_rate, self.accel))
+    }
+
+    /// `Orbit`: to the nearest point of the circle, then `laps` turns.
+    pub fn orbit(&mut self, center: [f64; 2], radius: f64, laps: f64) -> f64 {
+        let (dx, dy) = (self.pos[0] - center[0], self.pos[1] - center[1]);
+        let angle = if dx == 0.0 && dy == 0.0 { 0.0 } else { dy.atan2(dx) };
+        let entry = [center[0] + radius * angle.cos(), center[1] + radius * angle.sin(), self.pos[2]];
+        let to_circle = self.leg(entry);
+        let arc = laps * std::f64::consts::TAU * radius;
+        let speed = self.max_speed.min((self.accel * radius / 2.0).sqrt());
+        self.distance += arc;
+        to_circle + trapezoid(arc, speed, self.accel * 0.75f64.sqrt())
+    }
+
+    /// `ReturnToLaunch`: up to a safe altitude, home, down.
+    pub fn return_home(&mut self, max_altitude: Option<f64>) -> f64 {
+        if !self.airborne {
+            return 0.0;
+        }
+        let safe = self.pos[2].max(RETURN_ALTITUDE.min(max_altitude.unwrap_or(f64::INFINITY)));
+        let up = self.leg([self.pos[0], self.pos[1], safe]);
+        let across = self.leg([self.home[0], self.home[1], safe]);
+        up + across + self.leg([self.home[0], self.home[1], 0.0])
+    }
+}
+
+/// The time of a move of `d` metres from rest to rest: accelerate at `a`, cruise at `v`,
+/// brake at `a` (a triangle when `d` is too short to reach `v`).
+pub fn trapezoid(d: f64, v: f64, a: f64) -> f64 {
+    if d <= 0.0 || v <= 0.0 || a <= 0.0 {
+        return 0.0;
+    }
+    if d >= v * v / a {
+        d / v + v / a
+    } else {
+        2.0 * (d / a).sqrt()
+    }
+}
+
+/// Where along the ground segment `from`→`to` a target at `p` first comes within `range`,
+/// as a fraction of the segment; `None` if it never does.
+pub fn first_within(from: [f64; 2], to: [f64; 2], p: [f64; 2], range: f64) -> Option<f64> {
+    if dist_to_segment(p, from, to) > range {
+        return None;
+    }
+    let (dx, dy) = (to[0] - from[0], to[1] - from[1]);
+    let len2 = dx * dx + dy * dy;
+    if len2 == 0.0 {
+        return Some(0.0);
+    }
+    // |from + s·d − p| = range, the smaller root, clamped to the segment.
+    let (fx, fy) = (from[0] - p[0], from[1] - p[1]);
+    let b = 2.0 * (fx * dx + fy * dy);
+    let c = fx * fx + fy * fy - range * range;
+    let disc = (b * b - 4.0 * len2 * c).max(0.0);
+    Some(((-b - disc.sqrt()) / (2.0 * len2)).clamp(0.0, 1.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_long_move_cruises_and_a_short_one_never_reaches_full_speed() {
+        // 100 m at 10 m/s with 2 m/s²: 10 s cruising plus 5 s lost to speeding up and braking.
+        assert!((trapezoid(100.0, 10.0, 2.0) - 15.0).abs() < 1e-9);
+        // 25 m: a triangle, 2·sqrt(25/2).
+        assert!((trapezoid(25.0, 10.0, 2.0) - 2.0 * 12.5f64.sqrt()).abs() < 1e-9);
+        assert_eq!(trapezoid(0.0, 10.0, 2.0), 0.0);
+    }
+
+    #[test]
+    fn a_target_is_met_where_the_path_enters_its_range() {
+        let s = first_within([0.0, 0.0], [100.0, 0.0], [50.0, 0.0], 10.0);
+        assert_eq!(s, Some(0.4));
+        assert_eq!(first_within([0.0, 0.0], [100.0, 0.0], [50.0, 30.0], 10.0), None);
+        assert_eq!(first_within([0.0, 0.0], [100.0, 0.0], [0.0, 5.0], 10.0), Some(0.0));
+    }
+}

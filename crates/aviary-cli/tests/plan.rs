@@ -7,8 +7,8 @@ mod common;
 use common::{aviary, repo, scratch};
 
 /// Per drone: (distance m, flight s), from the summary `aviary run` prints.
-fn simulated(mission: &str) -> Vec<(String, f64, f64)> {
-    let (code, out, err) = aviary(&["run", mission], &repo());
+fn simulated(mission: &str, world: &[&str]) -> Vec<(String, f64, f64)> {
+    let (code, out, err) = aviary(&[&["run", mission], world].concat(), &repo());
     assert_eq!(code, 0, "the run failed: {err}");
     out.lines()
         .skip_while(|l| !l.starts_with("drone "))
@@ -21,15 +21,15 @@ fn simulated(mission: &str) -> Vec<(String, f64, f64)> {
         .collect()
 }
 
-fn planned(mission: &str) -> serde_json::Value {
-    let (code, out, err) = aviary(&["check", "--plan", "--format", "json", mission], &repo());
+fn planned(mission: &str, world: &[&str]) -> serde_json::Value {
+    let (code, out, err) = aviary(&[&["check", "--plan", "--format", "json", mission], world].concat(), &repo());
     assert_eq!(code, 0, "check --plan failed: {err}");
     serde_json::from_str(&out).expect("one JSON document")
 }
 
-fn agrees_within_15_percent(mission: &str) {
-    let sim = simulated(mission);
-    let plan = planned(mission);
+fn agrees_within_15_percent(mission: &str, world: &[&str]) {
+    let sim = simulated(mission, world);
+    let plan = planned(mission, world);
     let drones = plan["plan"]["drones"].as_array().expect("drones");
     assert_eq!(drones.len(), sim.len());
     let mut off = Vec::new();
@@ -47,7 +47,7 @@ fn agrees_within_15_percent(mission: &str) {
 
 #[test]
 fn the_papers_plan_agrees_with_its_simulated_run() {
-    agrees_within_15_percent("examples/search_and_rescue.mission");
+    agrees_within_15_percent("examples/search_and_rescue.mission", &[]);
 }
 
 #[test]
@@ -57,7 +57,60 @@ fn the_shared_papers_plan_agrees_with_its_simulated_run() {
         eprintln!("skipped: ../shared/examples is not beside the repository");
         return;
     }
-    agrees_within_15_percent("../shared/examples/search_and_rescue.mission");
+    agrees_within_15_percent("../shared/examples/search_and_rescue.mission", &[]);
+}
+
+const FIXTURES: &str = "crates/aviary-verify/tests/fixtures";
+
+#[test]
+fn the_plan_agrees_with_simulated_runs_of_the_preflight_fixtures() {
+    let world = format!("{FIXTURES}/world.toml");
+    for fixture in ["n303_every_firing", "n303_after_signal", "ok_no_conflicts", "w203_two_handlers", "w203_parallel_branches"] {
+        agrees_within_15_percent(&format!("{FIXTURES}/{fixture}.mission"), &["--world", &world]);
+    }
+}
+
+/// `(start, end)` of each activity of `actor` running `capability` with `args`, in order.
+fn activities(trace: &str, actor: &str, capability: &str, args: &serde_json::Value) -> Vec<(f64, f64)> {
+    let events: Vec<serde_json::Value> = trace.lines().map(|l| serde_json::from_str(l).expect("JSON line")).collect();
+    let mine = |e: &&serde_json::Value| e["actor"] == actor && e["capability"] == capability && e["args"] == *args;
+    let starts = events.iter().filter(|e| e["event"] == "capability_start").filter(mine).map(|e| e["t"].as_f64().expect("t"));
+    let ends = events.iter().filter(|e| e["event"] == "capability_end").filter(mine).map(|e| e["t"].as_f64().expect("t"));
+    starts.zip(ends).collect()
+}
+
+#[test]
+fn what_n303_says_waits_does_wait_in_the_engine() {
+    let dir = scratch("n303_engine");
+    let trace = dir.join("trace.jsonl");
+    let world = format!("{FIXTURES}/world.toml");
+    let (code, _, err) = aviary(&["run", &format!("{FIXTURES}/n303_after_signal.mission"), "--world", &world, "--trace", trace.to_str().expect("path")], &repo());
+    assert_eq!(code, 0, "{err}");
+    let trace = std::fs::read_to_string(&trace).expect("trace");
+    let flow = activities(&trace, "scout1", "FlyTo", &serde_json::json!({ "target": [300.0, 0.0] }));
+    let handler = activities(&trace, "scout1", "FlyTo", &serde_json::json!({ "target": [0.0, 300.0] }));
+    assert_eq!((flow.len(), handler.len()), (1, 1), "{trace}");
+    assert!(handler[0].0 >= flow[0].1, "the handler's flight starts at {} before the flow's ends at {}", handler[0].0, flow[0].1);
+    // And the plan puts them in the same order.
+    let plan = planned(&format!("{FIXTURES}/n303_after_signal.mission"), &["--world", &world]);
+    let acts = plan["plan"]["drones"][0]["activities"].as_array().expect("activities").clone();
+    let lines: Vec<&str> = acts.iter().map(|a| a["at"].as_str().expect("at")).collect();
+    assert_eq!(lines.iter().map(|l| l.rsplit(':').nth(1).expect("line")).collect::<Vec<_>>(), ["5", "7", "9", "10"]);
+}
+
+#[test]
+fn each_on_every_firing_waits_for_the_last_one_in_the_engine() {
+    let dir = scratch("n303_every_engine");
+    let trace = dir.join("trace.jsonl");
+    let world = format!("{FIXTURES}/world.toml");
+    let (code, _, err) = aviary(&["run", &format!("{FIXTURES}/n303_every_firing.mission"), "--world", &world, "--trace", trace.to_str().expect("path")], &repo());
+    assert_eq!(code, 0, "{err}");
+    let trace = std::fs::read_to_string(&trace).expect("trace");
+    let events: Vec<serde_json::Value> = trace.lines().map(|l| serde_json::from_str(l).expect("JSON line")).collect();
+    let of = |kind: &str| -> Vec<f64> { events.iter().filter(|e| e["event"] == kind && e["capability"] == "Deliver").map(|e| e["t"].as_f64().expect("t")).collect() };
+    let (starts, ends) = (of("capability_start"), of("capability_end"));
+    assert_eq!(starts.len(), 2, "one delivery per target: {starts:?}");
+    assert!(starts[1] >= ends[0], "the second delivery starts at {} before the first ends at {}", starts[1], ends[0]);
 }
 
 #[test]

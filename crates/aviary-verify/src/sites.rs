@@ -7,7 +7,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use aviary_api::{DroneId, Resource};
-use aviary_ir::{ActorRef, Block, BlockKind, Call, CapId, Mission, Node, Origin, SignalId};
+use aviary_ir::{ActorFilter, ActorRef, Block, BlockKind, Call, CapId, Mission, Node, Origin, SignalId};
 
 /// Which child of a construct a step goes to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -31,10 +31,12 @@ pub enum Construct {
 /// One step down: a construct (by id) and which of its children.
 pub type Step = (usize, Key);
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct HandlerInfo {
     pub signal: SignalId,
     pub every: bool,
+    /// The drones its `BY` accepts; `None` without a filter.
+    pub by: Option<Vec<DroneId>>,
 }
 
 /// A statement that claims resources when it starts.
@@ -99,7 +101,11 @@ impl Walk<'_> {
             self.under(id, Key::Item(i), |w| w.node(node));
         }
         for (i, h) in block.handlers.iter().enumerate() {
-            self.out.handlers.insert((id, i), HandlerInfo { signal: h.signal, every: h.every });
+            let by = h.by.as_ref().map(|f| match f {
+                ActorFilter::Drones(ds) => ds.clone(),
+                ActorFilter::Slot(s) => self.env.get(*s).cloned().unwrap_or_default(),
+            });
+            self.out.handlers.insert((id, i), HandlerInfo { signal: h.signal, every: h.every, by });
             self.under(id, Key::Handler(i), |w| w.block(&h.body));
         }
         // Exception handlers take the place of what they abort; they are not analysed.

@@ -94,8 +94,13 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
     for (d, at) in est.s.reserve.iter().enumerate() {
         if let Some(o) = at {
             let p = &drones[d];
+            let end = if p.battery_left > 0.0 {
+                format!("{:.0}% left at the end", p.battery_left * 100.0)
+            } else {
+                format!("it runs out before the end: the mission needs {:.0}% of a full battery", (1.0 - p.battery_left) * 100.0)
+            };
             diagnostics.push(
-                Diagnostic::new(Code::LowReserve, o.file, o.span, format!("{}'s battery is estimated to fall under 20% during this statement ({:.0}% left at the end)", p.drone, p.battery_left * 100.0))
+                Diagnostic::new(Code::LowReserve, o.file, o.span, format!("{}'s battery is estimated to fall under 20% during this statement ({end})", p.drone))
                     .label("the reserve is crossed here")
                     .with_help("shorten the drone's work, split it with another drone, or raise its `battery` or `endurance` in the world file if they are wrong; `aviary check --plan` shows the estimate"),
             );

@@ -155,6 +155,25 @@ mod tests {
         assert_eq!(trapezoid(0.0, 10.0, 2.0), 0.0);
     }
 
+    proptest::proptest! {
+        /// A move never beats cruising the whole way, and a longer one never takes less time.
+        #[test]
+        fn a_move_takes_at_least_cruising_time_and_grows_with_distance(d in 0.0f64..5000.0, extra in 0.0f64..500.0, v in 0.5f64..30.0, a in 0.5f64..10.0) {
+            let t = trapezoid(d, v, a);
+            proptest::prop_assert!(t + 1e-9 >= d / v);
+            proptest::prop_assert!(trapezoid(d + extra, v, a) + 1e-9 >= t);
+        }
+
+        /// Where a target first comes within range is a point of the segment within range.
+        #[test]
+        fn the_first_point_within_range_is_within_range(fx in -100.0f64..100.0, tx in -100.0f64..100.0, px in -100.0f64..100.0, py in -50.0f64..50.0, r in 1.0f64..60.0) {
+            if let Some(s) = first_within([fx, 0.0], [tx, 0.0], [px, py], r) {
+                let x = fx + s * (tx - fx);
+                proptest::prop_assert!(((x - px).powi(2) + py * py).sqrt() <= r + 1e-6);
+            }
+        }
+    }
+
     #[test]
     fn a_target_is_met_where_the_path_enters_its_range() {
         let s = first_within([0.0, 0.0], [100.0, 0.0], [50.0, 0.0], 10.0);

@@ -56,6 +56,8 @@ pub struct Estimator<'m> {
 }
 
 const RESERVE: f64 = 0.20;
+/// More rounds than any mission flies: a loop past it is taken as endless.
+const MAX_ROUNDS: usize = 10_000;
 
 impl<'m> Estimator<'m> {
     pub fn new(mission: &'m Mission, world: &'m World, known: Vec<Option<f64>>) -> Estimator<'m> {
@@ -184,13 +186,7 @@ impl<'m> Estimator<'m> {
                     None => (t, Vec::new()),
                 }
             }
-            Node::DoWhile { condition, body } => match self.scope(ctx, t).condition(condition) {
-                Some(false) => (t, Vec::new()),
-                _ => {
-                    self.note(ctx.statement, "a DOWHILE whose rounds cannot be counted before flight is counted once; its worst case has no bound".into());
-                    self.block(body, ctx, t)
-                }
-            },
+            Node::DoWhile { condition, body } => self.repeat(condition, body, ctx, t),
             Node::For(f) => {
                 let mut end = t;
                 let mut raises = Vec::new();
@@ -239,6 +235,33 @@ impl<'m> Estimator<'m> {
                 skipped
             }
         }
+    }
+
+    /// A `DOWHILE`: rounds while its condition holds as far as the estimate knows it. A
+    /// condition it cannot decide counts one round; a loop it never sees end is cut where
+    /// the fleet's longest flight on a full battery would end, the physical worst case.
+    fn repeat(&mut self, condition: &Expr, body: &Block, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
+        let limit = t + self.s.drones.iter().map(|f| f.endurance).fold(0.0, f64::max);
+        let (mut now, mut raises) = (t, Vec::new());
+        for round in 0..MAX_ROUNDS {
+            match self.scope(ctx, now).condition(condition) {
+                Some(false) => return (now, raises),
+                None => {
+                    self.note(ctx.statement, "a DOWHILE whose condition is unknown before flight is counted as one round".into());
+                    let (e, r) = self.block(body, ctx, now);
+                    raises.extend(r);
+                    return (e, raises);
+                }
+                Some(true) if now > limit || (round > 0 && raises.is_empty() && now == t) => break,
+                Some(true) => {
+                    let (e, r) = self.block(body, ctx, now);
+                    raises.extend(r);
+                    now = e;
+                }
+            }
+        }
+        self.note(ctx.statement, "a DOWHILE that the estimate never sees end is cut where the longest endurance in the fleet runs out (its worst case)".into());
+        (now.max(limit), raises)
     }
 
     fn wait(&mut self, condition: &Expr, ctx: &Ctx, t: f64) -> f64 {

@@ -518,7 +518,7 @@ fn compute_claims(caps: &mut [Capability], functions: &[(String, Option<aviary_a
         let mut changed = false;
         for i in 0..caps.len() {
             let mut calls = Vec::new();
-            for block in cap_blocks(&caps[i]) {
+            for block in caps[i].bodies() {
                 visit_calls(block, &mut calls);
             }
             for call in calls {
@@ -549,8 +549,8 @@ fn compute_claims(caps: &mut [Capability], functions: &[(String, Option<aviary_a
 
 fn direct_claims(cap: &Capability, functions: &[(String, Option<aviary_api::Resource>)]) -> Vec<(usize, aviary_api::Resource)> {
     let mut out = Vec::new();
-    for block in cap_blocks(cap) {
-        visit_nodes(block, &mut |n| {
+    for block in cap.bodies() {
+        block.visit(&mut |n| {
             if let Node::Api(a) = n {
                 if let (ActorRef::Slot(s), Some((_, Some(r)))) = (&a.actor, functions.get(a.function)) {
                     if *s < cap.actors {
@@ -563,39 +563,12 @@ fn direct_claims(cap: &Capability, functions: &[(String, Option<aviary_api::Reso
     out
 }
 
-/// Every body of a capability: PERFORM, its named sections, its exception handlers.
-fn cap_blocks(cap: &Capability) -> impl Iterator<Item = &Block> {
-    std::iter::once(&cap.perform).chain(cap.sections.iter().map(|(_, b)| b)).chain(cap.exception_handlers.iter().map(|h| &h.body))
-}
 
 fn visit_calls<'b>(block: &'b Block, out: &mut Vec<&'b Call>) {
-    visit_nodes(block, &mut |n| {
+    block.visit(&mut |n| {
         if let Node::Call(c) = n {
             out.push(c);
         }
     });
 }
 
-fn visit_nodes<'b>(block: &'b Block, f: &mut dyn FnMut(&'b Node)) {
-    let handler_bodies = block.handlers.iter().map(|h| &h.body).chain(block.exception_handlers.iter().map(|h| &h.body));
-    for body in handler_bodies {
-        visit_nodes(body, f);
-    }
-    for node in &block.items {
-        f(node);
-        match node {
-            Node::Block(b) | Node::StartIf { body: b, .. } | Node::DoWhile { body: b, .. } => visit_nodes(b, f),
-            Node::WaitFor { body: Some(b), .. } => visit_nodes(b, f),
-            Node::For(x) => visit_nodes(&x.body, f),
-            Node::If { branches, otherwise } => {
-                for (_, b) in branches {
-                    visit_nodes(b, f);
-                }
-                if let Some(b) = otherwise {
-                    visit_nodes(b, f);
-                }
-            }
-            _ => {}
-        }
-    }
-}

@@ -71,6 +71,13 @@ pub struct Capability {
     pub claims: Vec<(usize, Resource)>,
 }
 
+impl Capability {
+    /// Every body: PERFORM, its named sections, its exception handlers.
+    pub fn bodies(&self) -> impl Iterator<Item = &Block> {
+        std::iter::once(&self.perform).chain(self.sections.iter().map(|(_, b)| b)).chain(self.exception_handlers.iter().map(|h| &h.body))
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BlockKind {
     Sequential,
@@ -90,6 +97,32 @@ pub struct Block {
     pub items: Vec<Node>,
     pub handlers: Vec<Handler>,
     pub exception_handlers: Vec<ExceptionHandler>,
+}
+
+impl Block {
+    /// Calls `f` on every node below this block: items, nested bodies, and the bodies of
+    /// its handlers and exception handlers.
+    pub fn visit<'b>(&'b self, f: &mut dyn FnMut(&'b Node)) {
+        for body in self.handlers.iter().map(|h| &h.body).chain(self.exception_handlers.iter().map(|h| &h.body)) {
+            body.visit(f);
+        }
+        for node in &self.items {
+            f(node);
+            match node {
+                Node::Block(b) | Node::StartIf { body: b, .. } | Node::DoWhile { body: b, .. } | Node::WaitFor { body: Some(b), .. } => b.visit(f),
+                Node::For(x) => x.body.visit(f),
+                Node::If { branches, otherwise } => {
+                    for (_, b) in branches {
+                        b.visit(f);
+                    }
+                    if let Some(b) = otherwise {
+                        b.visit(f);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]

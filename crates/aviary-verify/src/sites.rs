@@ -183,11 +183,8 @@ fn capability_raises(mission: &Mission) -> Vec<BTreeSet<SignalId>> {
     let mut calls: Vec<BTreeSet<CapId>> = Vec::new();
     for cap in &mission.capabilities {
         let (mut raised, mut called) = (BTreeSet::new(), BTreeSet::new());
-        let blocks = std::iter::once(&cap.perform)
-            .chain(cap.sections.iter().map(|(_, b)| b))
-            .chain(cap.exception_handlers.iter().map(|h| &h.body));
-        for block in blocks {
-            visit(block, &mut |node| match node {
+        for block in cap.bodies() {
+            block.visit(&mut |node| match node {
                 Node::Signal { signal, .. } => {
                     raised.insert(*signal);
                 }
@@ -213,32 +210,5 @@ fn capability_raises(mission: &Mission) -> Vec<BTreeSet<SignalId>> {
         if !grew {
             return direct;
         }
-    }
-}
-
-/// Every node of a block, handlers and nested bodies included.
-pub fn visit<'a>(block: &'a Block, f: &mut impl FnMut(&'a Node)) {
-    for node in &block.items {
-        f(node);
-        match node {
-            Node::Block(b) => visit(b, f),
-            Node::StartIf { body, .. } | Node::DoWhile { body, .. } | Node::WaitFor { body: Some(body), .. } => visit(body, f),
-            Node::For(x) => visit(&x.body, f),
-            Node::If { branches, otherwise } => {
-                for (_, b) in branches {
-                    visit(b, f);
-                }
-                if let Some(b) = otherwise {
-                    visit(b, f);
-                }
-            }
-            _ => {}
-        }
-    }
-    for h in &block.handlers {
-        visit(&h.body, f);
-    }
-    for h in &block.exception_handlers {
-        visit(&h.body, f);
     }
 }

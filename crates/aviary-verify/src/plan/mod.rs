@@ -127,7 +127,7 @@ fn unfired<'m>(block: &'m Block, fired: &std::collections::BTreeSet<usize>) -> V
         }
     };
     visit(block);
-    crate::sites::visit(block, &mut |node| match node {
+    block.visit(&mut |node| match node {
         Node::Block(b) => visit(b),
         Node::StartIf { body, .. } | Node::DoWhile { body, .. } | Node::WaitFor { body: Some(body), .. } => visit(body),
         Node::For(f) => visit(&f.body),

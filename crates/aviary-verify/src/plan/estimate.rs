@@ -55,7 +55,6 @@ pub struct Estimator<'m> {
     pub s: State,
 }
 
-const RESERVE: f64 = 0.20;
 /// More rounds than any mission flies: a loop past it is taken as endless.
 const MAX_ROUNDS: usize = 10_000;
 
@@ -336,7 +335,7 @@ impl<'m> Estimator<'m> {
         let (duration, raises) = super::flight::fly(self, d, name, &args, ctx.statement, t);
         let end = t + duration;
         let f = &self.s.drones[d];
-        if f.battery_at(end) < RESERVE && self.s.reserve[d].is_none() {
+        if f.battery_at(end) < super::RESERVE && self.s.reserve[d].is_none() {
             self.s.reserve[d] = ctx.statement;
         }
         (end, raises)

@@ -68,6 +68,9 @@ pub struct Plan {
     pub assumptions: Vec<Assumption>,
 }
 
+/// Under this fraction of a full battery, a drone has no reserve left (W204).
+const RESERVE: f64 = 0.20;
+
 /// How many walks may pass for `WAITFOR RECEIVED` to learn times raised later in the walk.
 const PASSES: usize = 4;
 
@@ -92,6 +95,8 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
         .map(|((w, f), acts)| DronePlan { drone: w.name.clone(), distance: f.distance, flight_time: f.flight_time, battery_left: f.battery_at(end), activities: acts.clone(), worst_case: Vec::new() })
         .collect();
     for (d, at) in est.s.reserve.iter().enumerate() {
+        // Crossed on the way home after the mission's end: at the drone's last statement.
+        let at = at.or_else(|| (drones[d].battery_left < RESERVE).then(|| drones[d].activities.iter().rev().find_map(|a| a.origin)).flatten());
         if let Some(o) = at {
             let p = &drones[d];
             let end = if p.battery_left > 0.0 {

@@ -96,6 +96,7 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
         .collect();
     for (d, at) in est.s.reserve.iter().enumerate() {
         // Crossed on the way home after the mission's end: at the drone's last statement.
+        let after_end = at.is_none();
         let at = at.or_else(|| (drones[d].battery_left < RESERVE).then(|| drones[d].activities.iter().rev().find_map(|a| a.origin)).flatten());
         if let Some(o) = at {
             let p = &drones[d];
@@ -105,7 +106,7 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
                 format!("it runs out before the end: the mission needs {:.0}% of a full battery", (1.0 - p.battery_left) * 100.0)
             };
             diagnostics.push(
-                Diagnostic::new(Code::LowReserve, o.file, o.span, format!("{}'s battery is estimated to fall under 20% during this statement ({end})", p.drone))
+                Diagnostic::new(Code::LowReserve, o.file, o.span, format!("{}'s battery is estimated to fall under 20% {} ({end})", p.drone, if after_end { "on its way home after the mission ends; this is its last statement" } else { "during this statement" }))
                     .label("the reserve is crossed here")
                     .with_help("shorten the drone's work, split it with another drone, or raise its `battery` or `endurance` in the world file if they are wrong; `aviary check --plan` shows the estimate"),
             );

@@ -8,6 +8,7 @@ mod check;
 mod ctl;
 mod files;
 mod fmt;
+mod mixed;
 mod run;
 mod trace_file;
 mod vehicles;

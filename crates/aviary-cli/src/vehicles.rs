@@ -68,12 +68,14 @@ pub fn run(args: &VehiclesArgs) -> u8 {
         };
         let scheme = if matches!(listen, aviary_vehicles::Listen::Tcp(_)) { "tcp" } else { "udp" };
         // The first line says where: tests and scripts read the port from it.
-        println!("aviary vehicles: listening on {scheme}:{}", server.address);
-        for (i, d) in world.drones.iter().enumerate() {
-            println!("  {} = system {}", d.name, server.systems[i]);
-        }
+        // Written without println!, which would panic once a reader closes the pipe.
         use std::io::Write;
-        let _ = std::io::stdout().flush();
+        let mut out = std::io::stdout();
+        let _ = writeln!(out, "aviary vehicles: listening on {scheme}:{}", server.address);
+        for (i, d) in world.drones.iter().enumerate() {
+            let _ = writeln!(out, "  {} = system {}", d.name, server.systems[i]);
+        }
+        let _ = out.flush();
         let _ = tokio::signal::ctrl_c().await;
         server.stop();
         0

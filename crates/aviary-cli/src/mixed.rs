@@ -5,7 +5,9 @@ use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
-use aviary_api::{Backend, CallId, Descriptor, DroneEvent, DroneId, Interrupt, PendingCall, Telemetry, Value};
+use aviary_api::{
+    Backend, CallId, Descriptor, DroneEvent, DroneId, Interrupt, PendingCall, Telemetry, Value,
+};
 use aviary_mavlink::MavlinkBackend;
 use aviary_sim::SimBackend;
 use tokio::sync::mpsc;
@@ -22,7 +24,9 @@ pub struct Mixed {
 
 fn drone_of(event: &DroneEvent) -> DroneId {
     match event {
-        DroneEvent::Detected { drone, .. } | DroneEvent::Signal { drone, .. } | DroneEvent::Fault { drone, .. } => *drone,
+        DroneEvent::Detected { drone, .. }
+        | DroneEvent::Signal { drone, .. }
+        | DroneEvent::Fault { drone, .. } => *drone,
     }
 }
 
@@ -30,7 +34,9 @@ impl Mixed {
     /// Call inside the tokio runtime (it starts the task that merges the event streams).
     pub fn new(sim: Arc<SimBackend>, mavlink: MavlinkBackend) -> Mixed {
         let (tx, rx) = mpsc::unbounded_channel();
-        let served: Vec<bool> = (0..sim.with_fleet(|f| f.len())).map(|d| mavlink.serves(d)).collect();
+        let served: Vec<bool> = (0..sim.with_fleet(|f| f.len()))
+            .map(|d| mavlink.serves(d))
+            .collect();
         if let Some(mut from_sim) = sim.events() {
             let tx = tx.clone();
             let served = served.clone();
@@ -53,7 +59,13 @@ impl Mixed {
                 }
             });
         }
-        Mixed { sim, mavlink, calls: Mutex::new(BTreeMap::new()), next: AtomicU64::new(1), events: Mutex::new(Some(rx)) }
+        Mixed {
+            sim,
+            mavlink,
+            calls: Mutex::new(BTreeMap::new()),
+            next: AtomicU64::new(1),
+            events: Mutex::new(Some(rx)),
+        }
     }
 }
 
@@ -64,14 +76,29 @@ impl Backend for Mixed {
 
     fn call(&self, drone: DroneId, function: &str, args: &[Value]) -> PendingCall {
         let by_mavlink = self.mavlink.serves(drone);
-        let inner = if by_mavlink { self.mavlink.call(drone, function, args) } else { self.sim.call(drone, function, args) };
+        let inner = if by_mavlink {
+            self.mavlink.call(drone, function, args)
+        } else {
+            self.sim.call(drone, function, args)
+        };
         let id = CallId(self.next.fetch_add(1, Ordering::SeqCst));
-        self.calls.lock().unwrap_or_else(|p| p.into_inner()).insert(id, (by_mavlink, inner.id));
+        self.calls
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .insert(id, (by_mavlink, inner.id));
         PendingCall { id, end: inner.end }
     }
 
     fn interrupt(&self, call: CallId, how: Interrupt) {
-        let Some((by_mavlink, inner)) = self.calls.lock().unwrap_or_else(|p| p.into_inner()).get(&call).copied() else { return };
+        let Some((by_mavlink, inner)) = self
+            .calls
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .get(&call)
+            .copied()
+        else {
+            return;
+        };
         if by_mavlink {
             self.mavlink.interrupt(inner, how);
         } else {
@@ -95,5 +122,7 @@ impl Backend for Mixed {
 /// The runtime of a run with MAVLink drones: one thread as in a simulated run (the engine
 /// relies on it), but the wall clock and sockets.
 pub fn live_runtime() -> std::io::Result<tokio::runtime::Runtime> {
-    tokio::runtime::Builder::new_current_thread().enable_all().build()
+    tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
 }

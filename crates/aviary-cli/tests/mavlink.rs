@@ -27,7 +27,15 @@ struct Vehicles {
 impl Vehicles {
     fn start(world: &Path, speed: &str) -> Vehicles {
         let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
-            .args(["vehicles", "--world", &world.to_string_lossy(), "--listen", "tcp:127.0.0.1:0", "--speed", speed])
+            .args([
+                "vehicles",
+                "--world",
+                &world.to_string_lossy(),
+                "--listen",
+                "tcp:127.0.0.1:0",
+                "--speed",
+                speed,
+            ])
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
             .spawn()
@@ -35,8 +43,17 @@ impl Vehicles {
         let mut first = String::new();
         let mut stdout = BufReader::new(child.stdout.take().expect("stdout"));
         stdout.read_line(&mut first).expect("read the first line");
-        let port = first.trim().rsplit(':').next().and_then(|p| p.parse().ok()).unwrap_or_else(|| panic!("no port in {first:?}"));
-        Vehicles { child, port, _stdout: stdout }
+        let port = first
+            .trim()
+            .rsplit(':')
+            .next()
+            .and_then(|p| p.parse().ok())
+            .unwrap_or_else(|| panic!("no port in {first:?}"));
+        Vehicles {
+            child,
+            port,
+            _stdout: stdout,
+        }
     }
 }
 
@@ -53,7 +70,9 @@ fn bind(world: &str, port: u16, drones: &[&str]) -> String {
     for line in world.lines() {
         out.push_str(line);
         out.push('\n');
-        let name = line.strip_prefix("[drones.").and_then(|l| l.strip_suffix(']'));
+        let name = line
+            .strip_prefix("[drones.")
+            .and_then(|l| l.strip_suffix(']'));
         if name.is_some_and(|n| drones.is_empty() || drones.contains(&n)) {
             out.push_str(&format!("mavlink = \"tcp:127.0.0.1:{port}\"\n"));
         }
@@ -63,7 +82,13 @@ fn bind(world: &str, port: u16, drones: &[&str]) -> String {
 
 /// Runs `aviary run` in `dir`, killed if it takes longer than `limit`.
 fn run_within(dir: &Path, args: &[&str], limit: Duration) -> i32 {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_aviary")).args(args).current_dir(dir).stdout(Stdio::null()).stderr(Stdio::null()).spawn().expect("spawn aviary run");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(args)
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("spawn aviary run");
     let start = Instant::now();
     loop {
         if let Some(status) = child.try_wait().expect("wait") {
@@ -79,7 +104,11 @@ fn run_within(dir: &Path, args: &[&str], limit: Duration) -> i32 {
 }
 
 fn events(path: &Path) -> Vec<Value> {
-    std::fs::read_to_string(path).unwrap_or_default().lines().map(|l| serde_json::from_str(l).expect("a JSON line")).collect()
+    std::fs::read_to_string(path)
+        .unwrap_or_default()
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("a JSON line"))
+        .collect()
 }
 
 /// Per event kind and actor, what a trace says, in a form two runs can be compared in:
@@ -93,10 +122,18 @@ fn facts(trace: &[Value], event: &str, key: &str) -> Vec<(String, String, Vec<f6
                 Some(v) => flatten(v),
                 None => Vec::new(),
             };
-            (e["actor"].as_str().unwrap_or("").to_owned(), e[key].to_string(), numbers)
+            (
+                e["actor"].as_str().unwrap_or("").to_owned(),
+                e[key].to_string(),
+                numbers,
+            )
         })
         .collect();
-    out.sort_by(|a, b| (&a.0, &a.1).cmp(&(&b.0, &b.1)).then(a.2.partial_cmp(&b.2).unwrap_or(std::cmp::Ordering::Equal)));
+    out.sort_by(|a, b| {
+        (&a.0, &a.1)
+            .cmp(&(&b.0, &b.1))
+            .then(a.2.partial_cmp(&b.2).unwrap_or(std::cmp::Ordering::Equal))
+    });
     out
 }
 
@@ -109,8 +146,17 @@ fn flatten(v: &Value) -> Vec<f64> {
     }
 }
 
-fn agree(what: &str, direct: &[(String, String, Vec<f64>)], mavlink: &[(String, String, Vec<f64>)], tolerance: f64) {
-    assert_eq!(direct.len(), mavlink.len(), "{what}: {direct:?}\nvs\n{mavlink:?}");
+fn agree(
+    what: &str,
+    direct: &[(String, String, Vec<f64>)],
+    mavlink: &[(String, String, Vec<f64>)],
+    tolerance: f64,
+) {
+    assert_eq!(
+        direct.len(),
+        mavlink.len(),
+        "{what}: {direct:?}\nvs\n{mavlink:?}"
+    );
     for (a, b) in direct.iter().zip(mavlink) {
         assert_eq!((&a.0, &a.1), (&b.0, &b.1), "{what}");
         assert_eq!(a.2.len(), b.2.len(), "{what}: {a:?} vs {b:?}");
@@ -124,28 +170,70 @@ fn agree(what: &str, direct: &[(String, String, Vec<f64>)], mavlink: &[(String, 
 fn the_paper_mission_over_mavlink_agrees_with_a_simulated_run() {
     let dir = scratch("mavlink_paper");
     let examples = repo().join("examples");
-    let world = std::fs::read_to_string(examples.join("search_and_rescue.world.toml")).expect("world");
-    std::fs::copy(examples.join("search_and_rescue.mission"), dir.join("m.mission")).expect("copy");
+    let world =
+        std::fs::read_to_string(examples.join("search_and_rescue.world.toml")).expect("world");
+    std::fs::copy(
+        examples.join("search_and_rescue.mission"),
+        dir.join("m.mission"),
+    )
+    .expect("copy");
     std::fs::write(dir.join("m.world.toml"), &world).expect("world");
-    let (code, _, err) = aviary(&["run", "m.mission", "--quiet", "--trace", "direct.jsonl"], &dir);
+    let (code, _, err) = aviary(
+        &["run", "m.mission", "--quiet", "--trace", "direct.jsonl"],
+        &dir,
+    );
     assert_eq!(code, 0, "{err}");
 
     let vehicles = Vehicles::start(&examples.join("search_and_rescue.world.toml"), "20");
     let live = dir.join("live");
     std::fs::create_dir_all(&live).expect("dir");
-    std::fs::copy(examples.join("search_and_rescue.mission"), live.join("m.mission")).expect("copy");
+    std::fs::copy(
+        examples.join("search_and_rescue.mission"),
+        live.join("m.mission"),
+    )
+    .expect("copy");
     std::fs::write(live.join("m.world.toml"), bind(&world, vehicles.port, &[])).expect("world");
-    let code = run_within(&live, &["run", "m.mission", "--quiet", "--trace", "t.jsonl"], Duration::from_secs(240));
+    let code = run_within(
+        &live,
+        &["run", "m.mission", "--quiet", "--trace", "t.jsonl"],
+        Duration::from_secs(240),
+    );
     let direct = events(&dir.join("direct.jsonl"));
     let mavlink = events(&live.join("t.jsonl"));
-    assert_eq!(code, 0, "the mission ends ok over MAVLink: {:?}", mavlink.last());
-    assert_eq!(mavlink.last().map(|e| e["status"].clone()), Some(Value::from("ok")));
+    assert_eq!(
+        code,
+        0,
+        "the mission ends ok over MAVLink: {:?}",
+        mavlink.last()
+    );
+    assert_eq!(
+        mavlink.last().map(|e| e["status"].clone()),
+        Some(Value::from("ok"))
+    );
     // The same signals, the same finds at the same places, the same calls with the
     // same positions (the beacons fly to where the bodies were found).
-    agree("signals", &facts(&direct, "signal", "name"), &facts(&mavlink, "signal", "name"), 0.0);
-    agree("detections", &facts(&direct, "detection", "kind"), &facts(&mavlink, "detection", "kind"), 1.0);
-    agree("calls", &facts(&direct, "api_call", "function"), &facts(&mavlink, "api_call", "function"), 1.0);
-    assert!(mavlink.iter().all(|e| e["event"] != "exception"), "no exception over MAVLink");
+    agree(
+        "signals",
+        &facts(&direct, "signal", "name"),
+        &facts(&mavlink, "signal", "name"),
+        0.0,
+    );
+    agree(
+        "detections",
+        &facts(&direct, "detection", "kind"),
+        &facts(&mavlink, "detection", "kind"),
+        1.0,
+    );
+    agree(
+        "calls",
+        &facts(&direct, "api_call", "function"),
+        &facts(&mavlink, "api_call", "function"),
+        1.0,
+    );
+    assert!(
+        mavlink.iter().all(|e| e["event"] != "exception"),
+        "no exception over MAVLink"
+    );
 }
 
 const SMALL_MISSION: &str = "\
@@ -184,7 +272,11 @@ fn a_killed_vehicle_raises_connection_lost_within_the_heartbeat_timeout() {
     std::fs::write(dir.join("vehicles.world.toml"), SMALL_WORLD).expect("world");
     let mut vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
     std::fs::write(dir.join("m.mission"), SMALL_MISSION).expect("mission");
-    std::fs::write(dir.join("m.world.toml"), bind(SMALL_WORLD, vehicles.port, &["scout", "buddy"])).expect("world");
+    std::fs::write(
+        dir.join("m.world.toml"),
+        bind(SMALL_WORLD, vehicles.port, &["scout", "buddy"]),
+    )
+    .expect("world");
     let mut run = Command::new(env!("CARGO_BIN_EXE_aviary"))
         .args(["run", "m.mission", "--quiet", "--trace", "t.jsonl"])
         .current_dir(&dir)
@@ -196,7 +288,11 @@ fn a_killed_vehicle_raises_connection_lost_within_the_heartbeat_timeout() {
     let hovering = |e: &Value| e["event"] == "api_call" && e["function"] == "Hover";
     let start = Instant::now();
     while !events(&trace).iter().any(hovering) {
-        assert!(start.elapsed() < Duration::from_secs(60), "the scout never got to hover: {:?}", events(&trace));
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "the scout never got to hover: {:?}",
+            events(&trace)
+        );
         std::thread::sleep(Duration::from_millis(50));
     }
     vehicles.child.kill().expect("kill the vehicles");
@@ -204,14 +300,25 @@ fn a_killed_vehicle_raises_connection_lost_within_the_heartbeat_timeout() {
     let lost = |e: &Value| e["event"] == "exception" && e["name"] == "ConnectionLost";
     while !events(&trace).iter().any(lost) {
         // The backend's heartbeat timeout is 3 s; allow 2 s for the rest.
-        assert!(killed.elapsed() < Duration::from_secs(5), "no ConnectionLost 5 s after the kill: {:?}", events(&trace));
+        assert!(
+            killed.elapsed() < Duration::from_secs(5),
+            "no ConnectionLost 5 s after the kill: {:?}",
+            events(&trace)
+        );
         std::thread::sleep(Duration::from_millis(20));
     }
     let waited = killed.elapsed();
     // The timeout runs from the last HEARTBEAT, which came at most 1 s before the kill.
-    assert!(waited >= Duration::from_millis(1800), "raised after {waited:?}: before the heartbeat timeout?");
+    assert!(
+        waited >= Duration::from_millis(1800),
+        "raised after {waited:?}: before the heartbeat timeout?"
+    );
     let status = run.wait().expect("wait");
-    assert_eq!(status.code(), Some(1), "unhandled, ConnectionLost fails the mission");
+    assert_eq!(
+        status.code(),
+        Some(1),
+        "unhandled, ConnectionLost fails the mission"
+    );
 }
 
 #[test]
@@ -221,13 +328,29 @@ fn a_mixed_fleet_flies_one_drone_over_mavlink_and_one_simulated() {
     let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
     let mission = SMALL_MISSION.replace("scout Hover WITH 60s", "scout ReturnHome");
     std::fs::write(dir.join("m.mission"), mission).expect("mission");
-    std::fs::write(dir.join("m.world.toml"), bind(SMALL_WORLD, vehicles.port, &["scout"])).expect("world");
-    let code = run_within(&dir, &["run", "m.mission", "--quiet", "--trace", "t.jsonl"], Duration::from_secs(120));
+    std::fs::write(
+        dir.join("m.world.toml"),
+        bind(SMALL_WORLD, vehicles.port, &["scout"]),
+    )
+    .expect("world");
+    let code = run_within(
+        &dir,
+        &["run", "m.mission", "--quiet", "--trace", "t.jsonl"],
+        Duration::from_secs(120),
+    );
     let trace = events(&dir.join("t.jsonl"));
     assert_eq!(code, 0, "{:?}", trace.last());
     for actor in ["scout", "buddy"] {
-        let done: Vec<&str> = trace.iter().filter(|e| e["event"] == "api_done" && e["actor"] == actor).filter_map(|e| e["function"].as_str()).collect();
-        assert_eq!(done, ["Arm", "TakeOff", "FlyToPosition", "ReturnToLaunch"], "{actor}: {trace:?}");
+        let done: Vec<&str> = trace
+            .iter()
+            .filter(|e| e["event"] == "api_done" && e["actor"] == actor)
+            .filter_map(|e| e["function"].as_str())
+            .collect();
+        assert_eq!(
+            done,
+            ["Arm", "TakeOff", "FlyToPosition", "ReturnToLaunch"],
+            "{actor}: {trace:?}"
+        );
     }
 }
 
@@ -239,5 +362,8 @@ fn an_unreachable_vehicle_is_a_clear_error() {
     std::fs::write(dir.join("m.mission"), SMALL_MISSION).expect("mission");
     let (code, _, err) = aviary(&["run", "m.mission", "--quiet"], &dir);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("cannot reach the MAVLink address `tcp:127.0.0.1:1`"), "{err}");
+    assert!(
+        err.contains("cannot reach the MAVLink address `tcp:127.0.0.1:1`"),
+        "{err}"
+    );
 }

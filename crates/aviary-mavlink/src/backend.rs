@@ -9,8 +9,8 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
 use aviary_api::{
-    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Failure, FlightState, Interrupt, PendingCall,
-    Telemetry, Value,
+    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Failure, FlightState, Interrupt,
+    PendingCall, Telemetry, Value,
 };
 use aviary_world::Sensor;
 use tokio::sync::{mpsc, oneshot, watch};
@@ -50,7 +50,10 @@ impl MavlinkBackend {
     pub(crate) fn new(
         crafts: Vec<Option<Arc<Craft>>>,
         sensors: Vec<Sensor>,
-        events: (mpsc::UnboundedSender<DroneEvent>, mpsc::UnboundedReceiver<DroneEvent>),
+        events: (
+            mpsc::UnboundedSender<DroneEvent>,
+            mpsc::UnboundedReceiver<DroneEvent>,
+        ),
         alarms: mpsc::UnboundedReceiver<(DroneId, Failure)>,
         heartbeat_timeout: Duration,
     ) -> MavlinkBackend {
@@ -94,7 +97,11 @@ impl Inner {
         let _ = self.events.send(DroneEvent::Fault { drone, failure });
         let cut: Vec<Slot> = {
             let mut calls = lock(&self.calls);
-            let ids: Vec<CallId> = calls.iter().filter(|(_, s)| s.drone == drone).map(|(id, _)| *id).collect();
+            let ids: Vec<CallId> = calls
+                .iter()
+                .filter(|(_, s)| s.drone == drone)
+                .map(|(id, _)| *id)
+                .collect();
             ids.into_iter().filter_map(|id| calls.remove(&id)).collect()
         };
         for slot in cut {
@@ -107,7 +114,10 @@ impl Inner {
     }
 }
 
-async fn alarms_task(inner: std::sync::Weak<Inner>, mut alarms: mpsc::UnboundedReceiver<(DroneId, Failure)>) {
+async fn alarms_task(
+    inner: std::sync::Weak<Inner>,
+    mut alarms: mpsc::UnboundedReceiver<(DroneId, Failure)>,
+) {
     while let Some((drone, failure)) = alarms.recv().await {
         let Some(inner) = inner.upgrade() else { return };
         inner.fault(drone, failure);
@@ -124,12 +134,18 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
         let now = tokio::time::Instant::now();
         for (drone, craft) in inner.crafts.iter().enumerate() {
             let Some(c) = craft else { continue };
-            let fresh = c.v.seen().heartbeat.is_some_and(|t| now.duration_since(t) < limit);
+            let fresh =
+                c.v.seen()
+                    .heartbeat
+                    .is_some_and(|t| now.duration_since(t) < limit);
             let was_lost = lock(&inner.lost)[drone];
             if was_lost == fresh {
                 lock(&inner.lost)[drone] = !fresh;
                 if fresh {
-                    let _ = inner.events.send(DroneEvent::Signal { drone, name: "ConnectionRestored" });
+                    let _ = inner.events.send(DroneEvent::Signal {
+                        drone,
+                        name: "ConnectionRestored",
+                    });
                 } else {
                     let reason = format!(
                         "{}: no HEARTBEAT from system {} for {:.1} s on {}",
@@ -138,7 +154,13 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
                         limit.as_secs_f64(),
                         c.link.address
                     );
-                    inner.fault(drone, Failure { exception: "ConnectionLost", reason });
+                    inner.fault(
+                        drone,
+                        Failure {
+                            exception: "ConnectionLost",
+                            reason,
+                        },
+                    );
                 }
             }
         }
@@ -154,11 +176,16 @@ impl Backend for MavlinkBackend {
         let id = CallId(self.inner.next.fetch_add(1, Ordering::SeqCst));
         let (tx, rx) = oneshot::channel();
         let Some(Some(craft)) = self.inner.crafts.get(drone).cloned() else {
-            let _ = tx.send(CallEnd::Failed(failed(format!("drone number {drone} is not a MAVLink drone"))));
+            let _ = tx.send(CallEnd::Failed(failed(format!(
+                "drone number {drone} is not a MAVLink drone"
+            ))));
             return PendingCall { id, end: rx };
         };
         if lock(&self.inner.lost)[drone] {
-            let _ = tx.send(CallEnd::Failed(failed(format!("no link to {}", craft.name))));
+            let _ = tx.send(CallEnd::Failed(failed(format!(
+                "no link to {}",
+                craft.name
+            ))));
             return PendingCall { id, end: rx };
         }
         let (paused_tx, paused_rx) = watch::channel(false);
@@ -174,14 +201,24 @@ impl Backend for MavlinkBackend {
             };
             inner.finish(id, end);
         });
-        calls.insert(id, Slot { drone, task: task.abort_handle(), paused: paused_tx, end: tx });
+        calls.insert(
+            id,
+            Slot {
+                drone,
+                task: task.abort_handle(),
+                paused: paused_tx,
+                end: tx,
+            },
+        );
         PendingCall { id, end: rx }
     }
 
     fn interrupt(&self, call: CallId, how: Interrupt) {
         match how {
             Interrupt::Abort => {
-                let Some(slot) = lock(&self.inner.calls).remove(&call) else { return };
+                let Some(slot) = lock(&self.inner.calls).remove(&call) else {
+                    return;
+                };
                 slot.task.abort();
                 if let Some(Some(c)) = self.inner.crafts.get(slot.drone).cloned() {
                     c.set_doing(Doing::Other);
@@ -202,7 +239,14 @@ impl Backend for MavlinkBackend {
 
     fn telemetry(&self, drone: DroneId) -> Telemetry {
         let Some(Some(c)) = self.inner.crafts.get(drone) else {
-            return Telemetry { position: [0.0; 3], speed: 0.0, heading: 0.0, battery: 0.0, state: FlightState::Lost, link: false };
+            return Telemetry {
+                position: [0.0; 3],
+                speed: 0.0,
+                heading: 0.0,
+                battery: 0.0,
+                state: FlightState::Lost,
+                link: false,
+            };
         };
         let state = c.state();
         let seen = c.v.seen();

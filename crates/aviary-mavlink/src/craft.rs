@@ -47,11 +47,17 @@ pub struct Craft {
 }
 
 pub fn failed(reason: impl Into<String>) -> Failure {
-    Failure { exception: "CommandFailed", reason: reason.into() }
+    Failure {
+        exception: "CommandFailed",
+        reason: reason.into(),
+    }
 }
 
 pub fn timeout(reason: impl Into<String>) -> Failure {
-    Failure { exception: "Timeout", reason: reason.into() }
+    Failure {
+        exception: "Timeout",
+        reason: reason.into(),
+    }
 }
 
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
@@ -88,7 +94,13 @@ impl Craft {
     pub async fn command(&self, command: MavCmd, p: [f32; 7]) -> Result<(), Failure> {
         self.command_with(command, |confirmation| {
             MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
-                param1: p[0], param2: p[1], param3: p[2], param4: p[3], param5: p[4], param6: p[5], param7: p[6],
+                param1: p[0],
+                param2: p[1],
+                param3: p[2],
+                param4: p[3],
+                param5: p[4],
+                param6: p[5],
+                param7: p[6],
                 command,
                 target_system: self.v.system,
                 target_component: 1,
@@ -99,11 +111,23 @@ impl Craft {
     }
 
     /// COMMAND_INT (positions as degrees × 10⁷ in a relative-altitude frame), with ACK.
-    pub async fn command_int(&self, command: MavCmd, p: [f32; 4], lat: i32, lon: i32, z: f32) -> Result<(), Failure> {
+    pub async fn command_int(
+        &self,
+        command: MavCmd,
+        p: [f32; 4],
+        lat: i32,
+        lon: i32,
+        z: f32,
+    ) -> Result<(), Failure> {
         self.command_with(command, |_| {
             MavMessage::COMMAND_INT(COMMAND_INT_DATA {
-                param1: p[0], param2: p[1], param3: p[2], param4: p[3],
-                x: lat, y: lon, z,
+                param1: p[0],
+                param2: p[1],
+                param3: p[2],
+                param4: p[3],
+                x: lat,
+                y: lon,
+                z,
                 command,
                 target_system: self.v.system,
                 target_component: 1,
@@ -115,7 +139,11 @@ impl Craft {
         .await
     }
 
-    async fn command_with(&self, command: MavCmd, msg: impl Fn(u8) -> MavMessage) -> Result<(), Failure> {
+    async fn command_with(
+        &self,
+        command: MavCmd,
+        msg: impl Fn(u8) -> MavMessage,
+    ) -> Result<(), Failure> {
         let started = Instant::now();
         for attempt in 0..self.tuning.command_tries {
             let ack = self.v.expect_ack(command);
@@ -125,8 +153,14 @@ impl Craft {
                 Ok(Ok(result)) => {
                     // The reason usually comes just before the ACK; give a late one a moment.
                     tokio::time::sleep(Duration::from_millis(50)).await;
-                    let why = self.v.texts_since(started).unwrap_or_else(|| "no reason given".into());
-                    return Err(failed(format!("{} refused {command:?} ({result:?}): {why}", self.name)));
+                    let why = self
+                        .v
+                        .texts_since(started)
+                        .unwrap_or_else(|| "no reason given".into());
+                    return Err(failed(format!(
+                        "{} refused {command:?} ({result:?}): {why}",
+                        self.name
+                    )));
                 }
                 _ => continue,
             }
@@ -141,14 +175,23 @@ impl Craft {
     }
 
     /// Waits (polling the last messages) until `done` holds, or fails after `limit`.
-    pub async fn wait_for(&self, limit: Duration, what: &str, mut done: impl FnMut(&Craft) -> bool) -> Result<(), Failure> {
+    pub async fn wait_for(
+        &self,
+        limit: Duration,
+        what: &str,
+        mut done: impl FnMut(&Craft) -> bool,
+    ) -> Result<(), Failure> {
         let deadline = Instant::now() + limit;
         loop {
             if done(self) {
                 return Ok(());
             }
             if Instant::now() >= deadline {
-                return Err(timeout(format!("{}: {what} took longer than {:.0} s", self.name, limit.as_secs_f64())));
+                return Err(timeout(format!(
+                    "{}: {what} took longer than {:.0} s",
+                    self.name,
+                    limit.as_secs_f64()
+                )));
             }
             tokio::time::sleep(self.tuning.poll).await;
         }
@@ -158,9 +201,16 @@ impl Craft {
     /// while it boots is ignored by ArduPilot.
     pub async fn ready(&self) -> Result<(), Failure> {
         use mavlink::dialects::ardupilotmega::MavState::{MAV_STATE_ACTIVE, MAV_STATE_STANDBY};
-        self.wait_for(self.tuning.ready_timeout, "waiting for the autopilot to be ready (MAV_STATE_STANDBY)", |c| {
-            matches!(c.v.seen().status, Some(MAV_STATE_STANDBY | MAV_STATE_ACTIVE))
-        })
+        self.wait_for(
+            self.tuning.ready_timeout,
+            "waiting for the autopilot to be ready (MAV_STATE_STANDBY)",
+            |c| {
+                matches!(
+                    c.v.seen().status,
+                    Some(MAV_STATE_STANDBY | MAV_STATE_ACTIVE)
+                )
+            },
+        )
         .await
     }
 
@@ -177,12 +227,19 @@ impl Craft {
                 return Ok(());
             }
             let custom = MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED.bits() as f32;
-            self.command(MavCmd::MAV_CMD_DO_SET_MODE, [custom, p2, p3, 0.0, 0.0, 0.0, 0.0]).await?;
+            self.command(
+                MavCmd::MAV_CMD_DO_SET_MODE,
+                [custom, p2, p3, 0.0, 0.0, 0.0, 0.0],
+            )
+            .await?;
             if self.wait_for(Duration::from_secs(3), "", is).await.is_ok() {
                 return Ok(());
             }
         }
-        Err(failed(format!("{}: the autopilot accepted {want:?} mode but did not switch to it", self.name)))
+        Err(failed(format!(
+            "{}: the autopilot accepted {want:?} mode but did not switch to it",
+            self.name
+        )))
     }
 
     /// Sets the ground speed (only when it changes: each is a command with an ACK).
@@ -190,7 +247,11 @@ impl Craft {
         if lock(&self.speed).is_some_and(|s| (s - speed).abs() < 1e-6) {
             return Ok(());
         }
-        self.command(MavCmd::MAV_CMD_DO_CHANGE_SPEED, [1.0, speed as f32, -1.0, 0.0, 0.0, 0.0, 0.0]).await?;
+        self.command(
+            MavCmd::MAV_CMD_DO_CHANGE_SPEED,
+            [1.0, speed as f32, -1.0, 0.0, 0.0, 0.0, 0.0],
+        )
+        .await?;
         *lock(&self.speed) = Some(speed);
         Ok(())
     }
@@ -202,7 +263,14 @@ impl Craft {
         match self.v.flavour() {
             Flavour::Px4 => {
                 // -1: keep the default speed; bit 0 of param2: switch to the reposition mode.
-                self.command_int(MavCmd::MAV_CMD_DO_REPOSITION, [-1.0, 1.0, 0.0, f32::NAN], lat, lon, to[2] as f32).await
+                self.command_int(
+                    MavCmd::MAV_CMD_DO_REPOSITION,
+                    [-1.0, 1.0, 0.0, f32::NAN],
+                    lat,
+                    lon,
+                    to[2] as f32,
+                )
+                .await
             }
             Flavour::ArduPilot => {
                 let ignore = PositionTargetTypemask::POSITION_TARGET_TYPEMASK_VX_IGNORE
@@ -213,17 +281,26 @@ impl Craft {
                     | PositionTargetTypemask::POSITION_TARGET_TYPEMASK_AZ_IGNORE
                     | PositionTargetTypemask::POSITION_TARGET_TYPEMASK_YAW_IGNORE
                     | PositionTargetTypemask::POSITION_TARGET_TYPEMASK_YAW_RATE_IGNORE;
-                let msg = MavMessage::SET_POSITION_TARGET_GLOBAL_INT(SET_POSITION_TARGET_GLOBAL_INT_DATA {
-                    time_boot_ms: 0,
-                    lat_int: lat,
-                    lon_int: lon,
-                    alt: to[2] as f32,
-                    vx: 0.0, vy: 0.0, vz: 0.0, afx: 0.0, afy: 0.0, afz: 0.0, yaw: 0.0, yaw_rate: 0.0,
-                    type_mask: ignore,
-                    target_system: self.v.system,
-                    target_component: 1,
-                    coordinate_frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
-                });
+                let msg = MavMessage::SET_POSITION_TARGET_GLOBAL_INT(
+                    SET_POSITION_TARGET_GLOBAL_INT_DATA {
+                        time_boot_ms: 0,
+                        lat_int: lat,
+                        lon_int: lon,
+                        alt: to[2] as f32,
+                        vx: 0.0,
+                        vy: 0.0,
+                        vz: 0.0,
+                        afx: 0.0,
+                        afy: 0.0,
+                        afz: 0.0,
+                        yaw: 0.0,
+                        yaw_rate: 0.0,
+                        type_mask: ignore,
+                        target_system: self.v.system,
+                        target_component: 1,
+                        coordinate_frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+                    },
+                );
                 self.link.send(&msg).await;
                 Ok(())
             }

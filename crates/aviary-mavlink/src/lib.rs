@@ -22,6 +22,7 @@ mod flight;
 pub mod geo;
 pub mod link;
 pub mod mode;
+mod motion;
 mod vehicle;
 
 use std::collections::BTreeMap;
@@ -109,10 +110,20 @@ pub fn bindings(world: &World) -> Vec<(usize, String, u8, Option<String>)> {
     let mut count: BTreeMap<String, u8> = BTreeMap::new();
     let mut out = Vec::new();
     for (i, d) in world.drones.iter().enumerate() {
-        if let Binding::Mavlink { address, system_id, signing_key } = &d.backend {
+        if let Binding::Mavlink {
+            address,
+            system_id,
+            signing_key,
+        } = &d.backend
+        {
             let n = count.entry(address.clone()).or_insert(0);
             *n = n.saturating_add(1);
-            out.push((i, address.clone(), system_id.unwrap_or(*n), signing_key.clone()));
+            out.push((
+                i,
+                address.clone(),
+                system_id.unwrap_or(*n),
+                signing_key.clone(),
+            ));
         }
     }
     out
@@ -123,7 +134,15 @@ pub fn bindings(world: &World) -> Vec<(usize, String, u8, Option<String>)> {
 /// system id.
 pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, String> {
     let bound = bindings(world);
-    let origin = world.site.origin.as_ref().map_or(Origin::default(), |g| Origin { lat: g.lat, lon: g.lon, alt: g.alt });
+    let origin = world
+        .site
+        .origin
+        .as_ref()
+        .map_or(Origin::default(), |g| Origin {
+            lat: g.lat,
+            lon: g.lon,
+            alt: g.alt,
+        });
     let mut links: BTreeMap<String, (Arc<link::Link>, Option<String>)> = BTreeMap::new();
     let mut used: BTreeMap<(String, u8), usize> = BTreeMap::new();
     for (i, address, system, key) in &bound {
@@ -150,7 +169,15 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
     for (i, address, system, _) in &bound {
         let d = &world.drones[*i];
         let link = Arc::clone(&links[address].0);
-        let v = Arc::new(Vehicle::new(*i, d.name.clone(), *system, origin, world.targets.clone(), events_tx.clone(), alarms_tx.clone()));
+        let v = Arc::new(Vehicle::new(
+            *i,
+            d.name.clone(),
+            *system,
+            origin,
+            world.targets.clone(),
+            events_tx.clone(),
+            alarms_tx.clone(),
+        ));
         link.add(Arc::clone(&v));
         crafts[*i] = Some(Arc::new(Craft {
             name: d.name.clone(),
@@ -170,10 +197,20 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
         }));
     }
     for c in crafts.iter().flatten() {
-        let what = format!("a HEARTBEAT from system {} (drone `{}`) on {}", c.v.system, c.name, c.link.address);
-        c.wait_for(tuning.connect_timeout, &what, |c| c.v.seen().heartbeat.is_some())
-            .await
-            .map_err(|_| format!("no answer: waited {} s for {what}; is the vehicle on, and is its system id right?", tuning.connect_timeout.as_secs()))?;
+        let what = format!(
+            "a HEARTBEAT from system {} (drone `{}`) on {}",
+            c.v.system, c.name, c.link.address
+        );
+        c.wait_for(tuning.connect_timeout, &what, |c| {
+            c.v.seen().heartbeat.is_some()
+        })
+        .await
+        .map_err(|_| {
+            format!(
+                "no answer: waited {} s for {what}; is the vehicle on, and is its system id right?",
+                tuning.connect_timeout.as_secs()
+            )
+        })?;
         request_streams(c, tuning.position_hz);
     }
     for c in crafts.iter().flatten() {
@@ -181,7 +218,13 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
             format!("drone `{}` sends HEARTBEAT but no GLOBAL_POSITION_INT (it was asked for {} a second): has it a position fix?", c.name, tuning.position_hz)
         })?;
     }
-    Ok(MavlinkBackend::new(crafts, world.sensors.clone(), (events_tx, events_rx), alarms_rx, tuning.heartbeat_timeout))
+    Ok(MavlinkBackend::new(
+        crafts,
+        world.sensors.clone(),
+        (events_tx, events_rx),
+        alarms_rx,
+        tuning.heartbeat_timeout,
+    ))
 }
 
 /// Asks for the telemetry streams with SET_MESSAGE_INTERVAL (in the background: a
@@ -191,9 +234,20 @@ fn request_streams(c: &Arc<Craft>, position_hz: f64) {
     tokio::spawn(async move {
         // Message ids: HEARTBEAT 0, SYS_STATUS 1, GLOBAL_POSITION_INT 33,
         // BATTERY_STATUS 147, EXTENDED_SYS_STATE 245.
-        for (id, hz) in [(33.0, position_hz), (1.0, 1.0), (147.0, 1.0), (245.0, 1.0), (0.0, 1.0)] {
+        for (id, hz) in [
+            (33.0, position_hz),
+            (1.0, 1.0),
+            (147.0, 1.0),
+            (245.0, 1.0),
+            (0.0, 1.0),
+        ] {
             let interval_us = (1e6 / hz) as f32;
-            let _ = c.command(MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL, [id, interval_us, 0.0, 0.0, 0.0, 0.0, 0.0]).await;
+            let _ = c
+                .command(
+                    MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL,
+                    [id, interval_us, 0.0, 0.0, 0.0, 0.0, 0.0],
+                )
+                .await;
         }
     });
 }

@@ -7,7 +7,9 @@ use std::sync::{Mutex, MutexGuard};
 use aviary_api::geometry::dist_to_segment;
 use aviary_api::{DroneEvent, DroneId, Failure};
 use aviary_world::Target;
-use mavlink::dialects::ardupilotmega::{MavCmd, MavLandedState, MavMessage, MavModeFlag, MavResult, MavState};
+use mavlink::dialects::ardupilotmega::{
+    MavCmd, MavLandedState, MavMessage, MavModeFlag, MavResult, MavState,
+};
 use tokio::sync::{mpsc, oneshot};
 use tokio::time::Instant;
 
@@ -74,7 +76,16 @@ impl Vehicle {
         events: mpsc::UnboundedSender<DroneEvent>,
         alarms: mpsc::UnboundedSender<(DroneId, Failure)>,
     ) -> Vehicle {
-        Vehicle { drone, name, system, origin, targets, seen: Mutex::new(Seen::default()), events, alarms }
+        Vehicle {
+            drone,
+            name,
+            system,
+            origin,
+            targets,
+            seen: Mutex::new(Seen::default()),
+            events,
+            alarms,
+        }
     }
 
     pub fn seen(&self) -> MutexGuard<'_, Seen> {
@@ -99,8 +110,12 @@ impl Vehicle {
     /// STATUSTEXTs received since `since`, joined: the autopilot's reason for a refusal.
     pub fn texts_since(&self, since: Instant) -> Option<String> {
         let seen = self.seen();
-        let texts: Vec<&str> =
-            seen.texts.iter().filter(|(t, _)| *t >= since).map(|(_, s)| s.as_str()).collect();
+        let texts: Vec<&str> = seen
+            .texts
+            .iter()
+            .filter(|(t, _)| *t >= since)
+            .map(|(_, s)| s.as_str())
+            .collect();
         (!texts.is_empty()).then(|| texts.join("; "))
     }
 
@@ -111,19 +126,35 @@ impl Vehicle {
         match msg {
             MavMessage::HEARTBEAT(hb) => {
                 let flavour = Flavour::of(hb.autopilot);
-                let before = seen.heartbeat.map(|_| mode::classify(flavour, seen.custom_mode));
+                let before = seen
+                    .heartbeat
+                    .map(|_| mode::classify(flavour, seen.custom_mode));
                 seen.heartbeat = Some(now);
                 seen.flavour = Some(flavour);
                 seen.custom_mode = hb.custom_mode;
-                seen.armed = hb.base_mode.contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);
+                seen.armed = hb
+                    .base_mode
+                    .contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);
                 seen.status = Some(hb.system_status);
                 let after = mode::classify(flavour, hb.custom_mode);
                 let changed = before.is_some_and(|b| b != after);
-                if changed && matches!(after, Mode::Rtl | Mode::Land) && seen.expected != Some(after) {
+                if changed
+                    && matches!(after, Mode::Rtl | Mode::Land)
+                    && seen.expected != Some(after)
+                {
                     // The autopilot changed mode by itself: a failsafe.
                     let since = now - std::time::Duration::from_secs(3);
-                    let why: Vec<&str> = seen.texts.iter().filter(|(t, _)| *t >= since).map(|(_, s)| s.as_str()).collect();
-                    let failure = failsafe(&self.name, &mode::name(flavour, hb.custom_mode), &why.join("; "));
+                    let why: Vec<&str> = seen
+                        .texts
+                        .iter()
+                        .filter(|(t, _)| *t >= since)
+                        .map(|(_, s)| s.as_str())
+                        .collect();
+                    let failure = failsafe(
+                        &self.name,
+                        &mode::name(flavour, hb.custom_mode),
+                        &why.join("; "),
+                    );
                     seen.expected = Some(after);
                     let _ = self.alarms.send((self.drone, failure));
                 }
@@ -133,7 +164,11 @@ impl Vehicle {
                 let fix = Fix {
                     pos: [xy[0], xy[1], f64::from(p.relative_alt) / 1000.0],
                     speed: f64::from(p.vx).hypot(f64::from(p.vy)) / 100.0,
-                    heading: if p.hdg == u16::MAX { 0.0 } else { f64::from(p.hdg) / 100.0 },
+                    heading: if p.hdg == u16::MAX {
+                        0.0
+                    } else {
+                        f64::from(p.hdg) / 100.0
+                    },
                 };
                 let from = seen.fix.map_or(xy, |f| [f.pos[0], f.pos[1]]);
                 seen.fix = Some(fix);
@@ -147,14 +182,23 @@ impl Vehicle {
             }
             MavMessage::EXTENDED_SYS_STATE(e) => seen.landed = Some(e.landed_state),
             MavMessage::STATUSTEXT(t) => {
-                let text = t.text.to_str().unwrap_or("").trim_end_matches('\0').to_owned();
+                let text = t
+                    .text
+                    .to_str()
+                    .unwrap_or("")
+                    .trim_end_matches('\0')
+                    .to_owned();
                 seen.texts.push_back((now, text));
                 while seen.texts.len() > TEXTS_KEPT {
                     seen.texts.pop_front();
                 }
             }
             MavMessage::COMMAND_ACK(ack) if ack.result != MavResult::MAV_RESULT_IN_PROGRESS => {
-                if let Some(i) = seen.acks.iter().position(|(c, tx)| *c == ack.command && !tx.is_closed()) {
+                if let Some(i) = seen
+                    .acks
+                    .iter()
+                    .position(|(c, tx)| *c == ack.command && !tx.is_closed())
+                {
                     let (_, tx) = seen.acks.remove(i);
                     let _ = tx.send(ack.result);
                 }
@@ -199,13 +243,23 @@ fn failsafe(name: &str, mode: &str, why: &str) -> Failure {
         "PositionLost"
     } else if lower.contains("fence") {
         "GeofenceViolation"
-    } else if ["radio", "gcs", "link", "telemetry", "rc "].iter().any(|w| lower.contains(w)) {
+    } else if ["radio", "gcs", "link", "telemetry", "rc "]
+        .iter()
+        .any(|w| lower.contains(w))
+    {
         "ConnectionLost"
     } else {
         "CommandFailed"
     };
-    let said = if why.is_empty() { "no reason given".to_owned() } else { format!("it said: {why}") };
-    Failure { exception, reason: format!("{name}: the autopilot switched to {mode} by itself ({said})") }
+    let said = if why.is_empty() {
+        "no reason given".to_owned()
+    } else {
+        format!("it said: {why}")
+    };
+    Failure {
+        exception,
+        reason: format!("{name}: the autopilot switched to {mode} by itself ({said})"),
+    }
 }
 
 #[cfg(test)]
@@ -214,9 +268,18 @@ mod tests {
 
     #[test]
     fn failsafe_reasons_pick_the_exception() {
-        assert_eq!(failsafe("a", "RTL", "Battery 1 is critical").exception, "BatteryCritical");
-        assert_eq!(failsafe("a", "LAND", "EKF variance").exception, "PositionLost");
-        assert_eq!(failsafe("a", "RTL", "Radio Failsafe").exception, "ConnectionLost");
+        assert_eq!(
+            failsafe("a", "RTL", "Battery 1 is critical").exception,
+            "BatteryCritical"
+        );
+        assert_eq!(
+            failsafe("a", "LAND", "EKF variance").exception,
+            "PositionLost"
+        );
+        assert_eq!(
+            failsafe("a", "RTL", "Radio Failsafe").exception,
+            "ConnectionLost"
+        );
         assert_eq!(failsafe("a", "RTL", "").exception, "CommandFailed");
     }
 }

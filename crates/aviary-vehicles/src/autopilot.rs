@@ -23,7 +23,10 @@ pub struct Behaviour {
 
 impl Default for Behaviour {
     fn default() -> Behaviour {
-        Behaviour { boot_time: 1.0, prearm_time: 3.0 }
+        Behaviour {
+            boot_time: 1.0,
+            prearm_time: 3.0,
+        }
     }
 }
 
@@ -33,10 +36,10 @@ pub struct Copter {
     pub armed: bool,
     /// The motion call in progress (a new command replaces it).
     call: Option<CallId>,
-    speed: f64,
-    max_speed: f64,
+    pub(crate) speed: f64,
+    pub(crate) max_speed: f64,
     target: Option<[f64; 3]>,
-    payload: Option<String>,
+    pub(crate) payload: Option<String>,
     was_airborne: bool,
 }
 
@@ -51,7 +54,7 @@ pub struct Autopilot {
     pub fleet: Fleet,
     pub origin: Origin,
     pub copters: Vec<Copter>,
-    behaviour: Behaviour,
+    pub(crate) behaviour: Behaviour,
     /// GLOBAL_POSITION_INT per second, as the ground station last asked.
     pub position_hz: f64,
 }
@@ -68,7 +71,9 @@ impl Autopilot {
             .enumerate()
             .map(|(i, d)| {
                 let system = match &d.backend {
-                    aviary_world::Backend::Mavlink { system_id: Some(s), .. } => *s,
+                    aviary_world::Backend::Mavlink {
+                        system_id: Some(s), ..
+                    } => *s,
                     _ => u8::try_from(i + 1).unwrap_or(u8::MAX),
                 };
                 Copter {
@@ -84,8 +89,22 @@ impl Autopilot {
                 }
             })
             .collect();
-        let origin = world.site.origin.as_ref().map_or(Origin::default(), |g| Origin { lat: g.lat, lon: g.lon, alt: g.alt });
-        Autopilot { fleet: Fleet::new(world), origin, copters, behaviour, position_hz: 4.0 }
+        let origin = world
+            .site
+            .origin
+            .as_ref()
+            .map_or(Origin::default(), |g| Origin {
+                lat: g.lat,
+                lon: g.lon,
+                alt: g.alt,
+            });
+        Autopilot {
+            fleet: Fleet::new(world),
+            origin,
+            copters,
+            behaviour,
+            position_hz: 4.0,
+        }
     }
 
     pub fn booting(&self) -> bool {
@@ -107,16 +126,28 @@ impl Autopilot {
         for report in self.fleet.step(dt) {
             match report {
                 Report::Ended { call, end } => {
-                    let Some(i) = self.copters.iter().position(|c| c.call == Some(call)) else { continue };
+                    let Some(i) = self.copters.iter().position(|c| c.call == Some(call)) else {
+                        continue;
+                    };
                     self.copters[i].call = None;
                     if let CallEnd::Failed(f) = end {
-                        out.push(text(self.copters[i].system, MavSeverity::MAV_SEVERITY_WARNING, &f.reason));
+                        out.push(text(
+                            self.copters[i].system,
+                            MavSeverity::MAV_SEVERITY_WARNING,
+                            &f.reason,
+                        ));
                     }
                 }
-                Report::Event(DroneEvent::Fault { drone, failure }) if failure.exception == "BatteryCritical" => {
+                Report::Event(DroneEvent::Fault { drone, failure })
+                    if failure.exception == "BatteryCritical" =>
+                {
                     // ArduCopter's battery failsafe: say so, then return to launch.
                     let system = self.copters[drone].system;
-                    out.push(text(system, MavSeverity::MAV_SEVERITY_CRITICAL, "Battery 1 is critical: failsafe RTL"));
+                    out.push(text(
+                        system,
+                        MavSeverity::MAV_SEVERITY_CRITICAL,
+                        "Battery 1 is critical: failsafe RTL",
+                    ));
                     self.copters[drone].mode = COPTER_RTL;
                     if let Err(why) = self.motion(drone, "ReturnToLaunch", &[]) {
                         out.push(text(system, MavSeverity::MAV_SEVERITY_CRITICAL, &why));
@@ -126,7 +157,10 @@ impl Autopilot {
             }
         }
         for (i, c) in self.copters.iter_mut().enumerate() {
-            let state = self.fleet.telemetry(i).map_or(FlightState::Lost, |t| t.state);
+            let state = self
+                .fleet
+                .telemetry(i)
+                .map_or(FlightState::Lost, |t| t.state);
             if c.was_airborne && !state.airborne() {
                 // Down (landed, or fallen): the motors stop, as ArduCopter's auto-disarm.
                 c.armed = false;
@@ -137,7 +171,12 @@ impl Autopilot {
     }
 
     /// Starts a motion call, replacing the one in progress. `Err` has the reason.
-    fn motion(&mut self, i: usize, function: &str, args: &[Value]) -> Result<(), String> {
+    pub(crate) fn motion(
+        &mut self,
+        i: usize,
+        function: &str,
+        args: &[Value],
+    ) -> Result<(), String> {
         if let Some(call) = self.copters[i].call.take() {
             self.fleet.interrupt(call, aviary_api::Interrupt::Abort);
         }
@@ -161,17 +200,33 @@ impl Autopilot {
         if c.mode != COPTER_GUIDED {
             return Err("position target ignored: not in GUIDED".into());
         }
-        let state = self.fleet.telemetry(i).map_or(FlightState::Lost, |t| t.state);
+        let state = self
+            .fleet
+            .telemetry(i)
+            .map_or(FlightState::Lost, |t| t.state);
         if !matches!(state, FlightState::Flying) {
             return Err("position target ignored: not flying".into());
         }
-        let same = c.target.is_some_and(|t| (0..3).all(|k| (t[k] - to[k]).abs() < 0.01));
+        let same = c
+            .target
+            .is_some_and(|t| (0..3).all(|k| (t[k] - to[k]).abs() < 0.01));
         if same && c.call.is_some() {
             return Ok(());
         }
         self.copters[i].target = Some(to);
         let speed = self.copters[i].speed;
-        self.motion(i, "FlyToPosition", &[Value::Position(Point { x: to[0], y: to[1], z: Some(to[2]) }), Value::Number(speed)])
+        self.motion(
+            i,
+            "FlyToPosition",
+            &[
+                Value::Position(Point {
+                    x: to[0],
+                    y: to[1],
+                    z: Some(to[2]),
+                }),
+                Value::Number(speed),
+            ],
+        )
     }
 
     /// Stops where it is (GUIDED, LOITER or BRAKE entered in the air).
@@ -185,7 +240,10 @@ impl Autopilot {
     /// A mode change (DO_SET_MODE or SET_MODE).
     pub fn set_mode(&mut self, i: usize, mode: u32) -> (MavResult, Option<String>) {
         if self.booting() {
-            return (MavResult::MAV_RESULT_TEMPORARILY_REJECTED, Some("Mode change refused: still booting".into()));
+            return (
+                MavResult::MAV_RESULT_TEMPORARILY_REJECTED,
+                Some("Mode change refused: still booting".into()),
+            );
         }
         let airborne = self.fleet.telemetry(i).is_some_and(|t| t.state.airborne());
         let outcome = match mode {
@@ -198,7 +256,12 @@ impl Autopilot {
             COPTER_RTL if airborne => self.motion(i, "ReturnToLaunch", &[]),
             COPTER_LAND if airborne => self.motion(i, "Land", &[]),
             COPTER_RTL | COPTER_LAND => Ok(()),
-            other => return (MavResult::MAV_RESULT_DENIED, Some(format!("Mode {other} is not simulated"))),
+            other => {
+                return (
+                    MavResult::MAV_RESULT_DENIED,
+                    Some(format!("Mode {other} is not simulated")),
+                )
+            }
         };
         match outcome {
             Ok(()) => {
@@ -208,99 +271,21 @@ impl Autopilot {
             Err(why) => (MavResult::MAV_RESULT_FAILED, Some(why)),
         }
     }
-
-    /// One COMMAND_LONG or COMMAND_INT (positions already in `at`): the ACK and any
-    /// reason (sent first, as ArduPilot does).
-    pub fn command(&mut self, i: usize, cmd: MavCmd, p: [f32; 7], at: Option<(i32, i32, f32)>) -> (MavResult, Option<String>) {
-        use MavResult::*;
-        let state = self.fleet.telemetry(i).map_or(FlightState::Lost, |t| t.state);
-        let refused = |why: &str| (MAV_RESULT_FAILED, Some(why.to_owned()));
-        let done = |r: Result<(), String>| match r {
-            Ok(()) => (MAV_RESULT_ACCEPTED, None),
-            Err(why) => (MAV_RESULT_FAILED, Some(why)),
-        };
-        match cmd {
-            MavCmd::MAV_CMD_DO_SET_MODE => self.set_mode(i, p[1] as u32),
-            MavCmd::MAV_CMD_COMPONENT_ARM_DISARM if p[0] >= 0.5 => {
-                if self.booting() {
-                    return (MAV_RESULT_TEMPORARILY_REJECTED, Some("Arm: still booting".into()));
-                }
-                if self.fleet.time() < self.behaviour.prearm_time {
-                    return refused("PreArm: GPS: waiting for 3D fix");
-                }
-                if matches!(self.copters[i].mode, COPTER_RTL | COPTER_LAND) {
-                    return refused("Arm: Mode not armable");
-                }
-                if self.copters[i].armed {
-                    return (MAV_RESULT_ACCEPTED, None);
-                }
-                let r = done(self.instant(i, "Arm", &[]));
-                self.copters[i].armed = r.0 == MAV_RESULT_ACCEPTED;
-                r
-            }
-            MavCmd::MAV_CMD_COMPONENT_ARM_DISARM => {
-                if state.airborne() {
-                    return refused("Disarm: vehicle is flying");
-                }
-                let r = done(self.instant(i, "Disarm", &[]));
-                self.copters[i].armed &= r.0 != MAV_RESULT_ACCEPTED;
-                r
-            }
-            MavCmd::MAV_CMD_NAV_TAKEOFF => {
-                if self.copters[i].mode != COPTER_GUIDED {
-                    return refused("Takeoff: not in GUIDED mode");
-                }
-                if !self.copters[i].armed {
-                    return refused("Takeoff: arm motors first");
-                }
-                if state != FlightState::Landed {
-                    return refused("Takeoff: already flying");
-                }
-                done(self.motion(i, "TakeOff", &[Value::Number(f64::from(p[6]))]))
-            }
-            MavCmd::MAV_CMD_NAV_LAND => self.set_mode(i, COPTER_LAND),
-            MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH => self.set_mode(i, COPTER_RTL),
-            MavCmd::MAV_CMD_DO_CHANGE_SPEED if p[1] > 0.0 => {
-                let c = &mut self.copters[i];
-                c.speed = f64::from(p[1]).min(c.max_speed);
-                (MAV_RESULT_ACCEPTED, None)
-            }
-            MavCmd::MAV_CMD_DO_REPOSITION => match at {
-                Some((lat, lon, z)) => done(self.goto(i, lat, lon, f64::from(z))),
-                None => (MAV_RESULT_COMMAND_INT_ONLY, None),
-            },
-            MavCmd::MAV_CMD_DO_GRIPPER => {
-                if p[1] >= 0.5 {
-                    let kind = self.copters[i].payload.clone().unwrap_or_default();
-                    done(self.instant(i, "LoadPayload", &[Value::Symbol(kind)]))
-                } else {
-                    done(self.instant(i, "ReleasePayload", &[]))
-                }
-            }
-            MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL => {
-                // Only GLOBAL_POSITION_INT's rate changes; the rest go at 1 Hz.
-                if p[0] as u32 == 33 && p[1] > 0.0 {
-                    self.position_hz = (1e6 / f64::from(p[1])).clamp(0.2, 50.0);
-                }
-                (MAV_RESULT_ACCEPTED, None)
-            }
-            _ => (MAV_RESULT_UNSUPPORTED, None),
-        }
-    }
-
-    /// A call that does not move the drone (arming, the gripper): left to finish alone.
-    fn instant(&mut self, i: usize, function: &str, args: &[Value]) -> Result<(), String> {
-        match self.fleet.call(i, function, args).1 {
-            Some(CallEnd::Failed(f)) => Err(f.reason),
-            _ => Ok(()),
-        }
-    }
 }
 
 pub fn text(system: u8, severity: MavSeverity, s: &str) -> Out {
-    Out { system, msg: MavMessage::STATUSTEXT(STATUSTEXT_DATA { severity, text: s.into() }) }
+    Out {
+        system,
+        msg: MavMessage::STATUSTEXT(STATUSTEXT_DATA {
+            severity,
+            text: s.into(),
+        }),
+    }
 }
 
 pub fn ack(system: u8, command: MavCmd, result: MavResult) -> Out {
-    Out { system, msg: MavMessage::COMMAND_ACK(COMMAND_ACK_DATA { command, result }) }
+    Out {
+        system,
+        msg: MavMessage::COMMAND_ACK(COMMAND_ACK_DATA { command, result }),
+    }
 }

@@ -16,6 +16,7 @@
 //! `battery_critical` fault is ArduCopter's battery failsafe (STATUSTEXT, then RTL).
 
 mod autopilot;
+mod commands;
 mod server;
 mod telemetry;
 
@@ -41,7 +42,11 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Options {
-        Options { speed: 1.0, behaviour: Behaviour::default(), signing_key: None }
+        Options {
+            speed: 1.0,
+            behaviour: Behaviour::default(),
+            signing_key: None,
+        }
     }
 }
 
@@ -61,21 +66,35 @@ pub async fn serve(world: &World, listen: Listen, options: Options) -> std::io::
     let systems = ap.copters.iter().map(|c| c.system).collect();
     let ap = Arc::new(Mutex::new(ap));
     let (out, _) = broadcast::channel(4096);
-    let speed = if options.speed.is_finite() && options.speed > 0.0 { options.speed } else { 1.0 };
+    let speed = if options.speed.is_finite() && options.speed > 0.0 {
+        options.speed
+    } else {
+        1.0
+    };
     let pace = tokio::spawn(server::pace(Arc::clone(&ap), out.clone(), 0.05, speed));
     let (address, serve) = match listen {
         Listen::Tcp(addr) => {
             let listener = TcpListener::bind(addr).await?;
             let address = listener.local_addr()?;
-            (address, tokio::spawn(server::tcp(listener, ap, out, options.signing_key)))
+            (
+                address,
+                tokio::spawn(server::tcp(listener, ap, out, options.signing_key)),
+            )
         }
         Listen::Udp(addr) => {
             let socket = UdpSocket::bind(addr).await?;
             let address = socket.local_addr()?;
-            (address, tokio::spawn(server::udp(socket, ap, out, options.signing_key)))
+            (
+                address,
+                tokio::spawn(server::udp(socket, ap, out, options.signing_key)),
+            )
         }
     };
-    Ok(Vehicles { address, systems, tasks: vec![pace, serve] })
+    Ok(Vehicles {
+        address,
+        systems,
+        tasks: vec![pace, serve],
+    })
 }
 
 impl Vehicles {

@@ -21,7 +21,9 @@ pub enum Listen {
 }
 
 pub fn parse_listen(text: &str) -> Result<Listen, String> {
-    let bad = || format!("`{text}` is not an address to listen on: write tcp:127.0.0.1:5760 or udp:127.0.0.1:14550");
+    let bad = || {
+        format!("`{text}` is not an address to listen on: write tcp:127.0.0.1:5760 or udp:127.0.0.1:14550")
+    };
     let (scheme, rest) = text.split_once(':').ok_or_else(bad)?;
     let addr: SocketAddr = rest.parse().map_err(|_| bad())?;
     match scheme {
@@ -52,7 +54,9 @@ fn dispatch(ap: &Shared, msg: &MavMessage) -> Vec<Out> {
         _ => return Vec::new(),
     };
     // A vehicle whose radio is down (a world `link_loss` fault) hears nothing.
-    let Some(i) = ap.index(target).filter(|i| ap.link(*i)) else { return Vec::new() };
+    let Some(i) = ap.index(target).filter(|i| ap.link(*i)) else {
+        return Vec::new();
+    };
     let system = ap.copters[i].system;
     let answer = |command, (result, why): (_, Option<String>)| {
         let mut out = Vec::new();
@@ -64,19 +68,30 @@ fn dispatch(ap: &Shared, msg: &MavMessage) -> Vec<Out> {
     };
     match msg {
         MavMessage::COMMAND_LONG(c) => {
-            let p = [c.param1, c.param2, c.param3, c.param4, c.param5, c.param6, c.param7];
+            let p = [
+                c.param1, c.param2, c.param3, c.param4, c.param5, c.param6, c.param7,
+            ];
             let r = ap.command(i, c.command, p, None);
             answer(c.command, r)
         }
         MavMessage::COMMAND_INT(c) => {
-            let relative = matches!(c.frame, MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT) || c.frame as u32 == 6;
+            let relative =
+                matches!(c.frame, MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT) || c.frame as u32 == 6;
             let at = relative.then_some((c.x, c.y, c.z));
-            let r = ap.command(i, c.command, [c.param1, c.param2, c.param3, c.param4, 0.0, 0.0, 0.0], at);
+            let r = ap.command(
+                i,
+                c.command,
+                [c.param1, c.param2, c.param3, c.param4, 0.0, 0.0, 0.0],
+                at,
+            );
             answer(c.command, r)
         }
         MavMessage::SET_MODE(m) => {
             let r = ap.set_mode(i, m.custom_mode);
-            answer(aviary_mavlink::mavlink::dialects::ardupilotmega::MavCmd::MAV_CMD_DO_SET_MODE, r)
+            answer(
+                aviary_mavlink::mavlink::dialects::ardupilotmega::MavCmd::MAV_CMD_DO_SET_MODE,
+                r,
+            )
         }
         MavMessage::SET_POSITION_TARGET_GLOBAL_INT(t) => {
             // Ignored outside GUIDED or on the ground, silently, as ArduCopter does.
@@ -84,7 +99,10 @@ fn dispatch(ap: &Shared, msg: &MavMessage) -> Vec<Out> {
             Vec::new()
         }
         MavMessage::REQUEST_DATA_STREAM(r) => {
-            if r.start_stop == 1 && r.req_message_rate > 0 && matches!(r.req_stream_id as u32, 0 | 6) {
+            if r.start_stop == 1
+                && r.req_message_rate > 0
+                && matches!(r.req_stream_id as u32, 0 | 6)
+            {
                 ap.position_hz = f64::from(r.req_message_rate).clamp(0.2, 50.0);
             }
             Vec::new()
@@ -118,7 +136,10 @@ pub(crate) async fn pace(ap: Shared, out: broadcast::Sender<Out>, tick: f64, spe
             next_beat = wall + 1.0;
             for i in (0..n).filter(|i| up[*i]) {
                 let system = ap.copters[i].system;
-                let _ = out.send(Out { system, msg: ap.heartbeat(i) });
+                let _ = out.send(Out {
+                    system,
+                    msg: ap.heartbeat(i),
+                });
                 for msg in ap.status(i) {
                     let _ = out.send(Out { system, msg });
                 }
@@ -128,7 +149,10 @@ pub(crate) async fn pace(ap: Shared, out: broadcast::Sender<Out>, tick: f64, spe
             next_pos = wall + 1.0 / ap.position_hz;
             for i in (0..n).filter(|i| up[*i]) {
                 if let Some(msg) = ap.position(i) {
-                    let _ = out.send(Out { system: ap.copters[i].system, msg });
+                    let _ = out.send(Out {
+                        system: ap.copters[i].system,
+                        msg,
+                    });
                 }
             }
         }
@@ -141,10 +165,19 @@ fn signing(key: Option<[u8; 32]>) -> Option<SigningData> {
 
 fn header(system: u8, sequence: &mut u8) -> MavHeader {
     *sequence = sequence.wrapping_add(1);
-    MavHeader { system_id: u32::from(system), component_id: 1, sequence: *sequence }
+    MavHeader {
+        system_id: u32::from(system),
+        component_id: 1,
+        sequence: *sequence,
+    }
 }
 
-pub(crate) async fn tcp(listener: TcpListener, ap: Shared, out: broadcast::Sender<Out>, key: Option<[u8; 32]>) {
+pub(crate) async fn tcp(
+    listener: TcpListener,
+    ap: Shared,
+    out: broadcast::Sender<Out>,
+    key: Option<[u8; 32]>,
+) {
     while let Ok((stream, _)) = listener.accept().await {
         let _ = stream.set_nodelay(true);
         let (read, mut write) = stream.into_split();
@@ -161,7 +194,15 @@ pub(crate) async fn tcp(listener: TcpListener, ap: Shared, out: broadcast::Sende
                     Err(_) => return,
                 };
                 let h = header(o.system, &mut seq);
-                if mavlink::write_v2_msg_async_signed(&mut write, h, &o.msg, sign_w.as_ref().as_ref()).await.is_err() {
+                if mavlink::write_v2_msg_async_signed(
+                    &mut write,
+                    h,
+                    &o.msg,
+                    sign_w.as_ref().as_ref(),
+                )
+                .await
+                .is_err()
+                {
                     return;
                 }
             }
@@ -169,7 +210,10 @@ pub(crate) async fn tcp(listener: TcpListener, ap: Shared, out: broadcast::Sende
         tokio::spawn(async move {
             let mut reader = AsyncMavlinkReader::new(read);
             loop {
-                match reader.read_any_message_signed::<MavMessage>(sign.as_ref().as_ref()).await {
+                match reader
+                    .read_any_message_signed::<MavMessage>(sign.as_ref().as_ref())
+                    .await
+                {
                     Ok((_, msg)) => {
                         for o in dispatch(&ap, &msg) {
                             let _ = out.send(o);
@@ -184,11 +228,21 @@ pub(crate) async fn tcp(listener: TcpListener, ap: Shared, out: broadcast::Sende
     }
 }
 
-pub(crate) async fn udp(socket: UdpSocket, ap: Shared, out: broadcast::Sender<Out>, key: Option<[u8; 32]>) {
+pub(crate) async fn udp(
+    socket: UdpSocket,
+    ap: Shared,
+    out: broadcast::Sender<Out>,
+    key: Option<[u8; 32]>,
+) {
     let socket = Arc::new(socket);
     let peers: Arc<Mutex<Vec<SocketAddr>>> = Arc::default();
     let sign = Arc::new(signing(key));
-    let (mut rx, sender, to, sign_w) = (out.subscribe(), Arc::clone(&socket), Arc::clone(&peers), Arc::clone(&sign));
+    let (mut rx, sender, to, sign_w) = (
+        out.subscribe(),
+        Arc::clone(&socket),
+        Arc::clone(&peers),
+        Arc::clone(&sign),
+    );
     tokio::spawn(async move {
         let mut seq = 0u8;
         loop {
@@ -199,7 +253,10 @@ pub(crate) async fn udp(socket: UdpSocket, ap: Shared, out: broadcast::Sender<Ou
             };
             let mut buf = Vec::new();
             let h = header(o.system, &mut seq);
-            if mavlink::write_v2_msg_async_signed(&mut buf, h, &o.msg, sign_w.as_ref().as_ref()).await.is_err() {
+            if mavlink::write_v2_msg_async_signed(&mut buf, h, &o.msg, sign_w.as_ref().as_ref())
+                .await
+                .is_err()
+            {
                 continue;
             }
             let peers = to.lock().unwrap_or_else(|p| p.into_inner()).clone();
@@ -210,7 +267,9 @@ pub(crate) async fn udp(socket: UdpSocket, ap: Shared, out: broadcast::Sender<Ou
     });
     let mut buf = vec![0u8; 65_536];
     loop {
-        let Ok((n, from)) = socket.recv_from(&mut buf).await else { continue };
+        let Ok((n, from)) = socket.recv_from(&mut buf).await else {
+            continue;
+        };
         {
             let mut peers = peers.lock().unwrap_or_else(|p| p.into_inner());
             if !peers.contains(&from) {
@@ -218,7 +277,10 @@ pub(crate) async fn udp(socket: UdpSocket, ap: Shared, out: broadcast::Sender<Ou
             }
         }
         let mut reader = AsyncMavlinkReader::new(&buf[..n]);
-        while let Ok((_, msg)) = reader.read_any_message_signed::<MavMessage>(sign.as_ref().as_ref()).await {
+        while let Ok((_, msg)) = reader
+            .read_any_message_signed::<MavMessage>(sign.as_ref().as_ref())
+            .await
+        {
             for o in dispatch(&ap, &msg) {
                 let _ = out.send(o);
             }

@@ -3,9 +3,9 @@
 
 use aviary_api::FlightState;
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
-    MavAutopilot, MavBatteryFunction, MavBatteryType, MavLandedState, MavMessage, MavModeFlag, MavState,
-    MavSysStatusSensor, MavType, MavVtolState, BATTERY_STATUS_DATA, EXTENDED_SYS_STATE_DATA,
-    GLOBAL_POSITION_INT_DATA, HEARTBEAT_DATA, SYS_STATUS_DATA,
+    MavAutopilot, MavBatteryFunction, MavBatteryType, MavLandedState, MavMessage, MavModeFlag,
+    MavState, MavSysStatusSensor, MavType, MavVtolState, BATTERY_STATUS_DATA,
+    EXTENDED_SYS_STATE_DATA, GLOBAL_POSITION_INT_DATA, HEARTBEAT_DATA, SYS_STATUS_DATA,
 };
 use aviary_mavlink::mode::COPTER_GUIDED;
 
@@ -14,8 +14,12 @@ use crate::autopilot::Autopilot;
 impl Autopilot {
     pub fn heartbeat(&self, i: usize) -> MavMessage {
         let c = &self.copters[i];
-        let state = self.fleet.telemetry(i).map_or(FlightState::Lost, |t| t.state);
-        let mut base = MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | MavModeFlag::MAV_MODE_FLAG_STABILIZE_ENABLED;
+        let state = self
+            .fleet
+            .telemetry(i)
+            .map_or(FlightState::Lost, |t| t.state);
+        let mut base = MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
+            | MavModeFlag::MAV_MODE_FLAG_STABILIZE_ENABLED;
         if c.mode == COPTER_GUIDED {
             base |= MavModeFlag::MAV_MODE_FLAG_GUIDED_ENABLED;
         }
@@ -62,9 +66,12 @@ impl Autopilot {
 
     /// SYS_STATUS, BATTERY_STATUS and EXTENDED_SYS_STATE.
     pub fn status(&self, i: usize) -> Vec<MavMessage> {
-        let Some(t) = self.fleet.telemetry(i) else { return Vec::new() };
+        let Some(t) = self.fleet.telemetry(i) else {
+            return Vec::new();
+        };
         let remaining = (t.battery * 100.0).round().clamp(0.0, 100.0) as i8;
-        let sensors = MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_GPS | MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_3D_GYRO;
+        let sensors = MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_GPS
+            | MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_3D_GYRO;
         let landed = match t.state {
             FlightState::Landed | FlightState::Lost => MavLandedState::MAV_LANDED_STATE_ON_GROUND,
             FlightState::TakingOff => MavLandedState::MAV_LANDED_STATE_TAKEOFF,

@@ -24,23 +24,53 @@ fn scout(address: &str, extra: &str) -> String {
 }
 
 fn quick() -> Tuning {
-    Tuning { connect_timeout: Duration::from_secs(3), arm_timeout: Duration::from_secs(1), arm_retry: Duration::from_millis(200), ..Tuning::default() }
+    Tuning {
+        connect_timeout: Duration::from_secs(3),
+        arm_timeout: Duration::from_secs(1),
+        arm_retry: Duration::from_millis(200),
+        ..Tuning::default()
+    }
 }
 
 async fn call(backend: &dyn Backend, function: &str, args: &[Value]) -> CallEnd {
     let pending = backend.call(0, function, args);
-    tokio::time::timeout(Duration::from_secs(30), pending.end).await.expect("the call ends").expect("answered")
+    tokio::time::timeout(Duration::from_secs(30), pending.end)
+        .await
+        .expect("the call ends")
+        .expect("answered")
 }
 
 #[tokio::test]
 async fn arming_refused_by_pre_arm_checks_says_why() {
-    let behaviour = Behaviour { prearm_time: 1e9, ..Behaviour::default() };
-    let vehicles = aviary_vehicles::serve(&world(&scout("tcp:x:1", "")), Listen::Tcp("127.0.0.1:0".parse().unwrap()), Options { speed: 10.0, behaviour, ..Options::default() }).await.unwrap();
-    let backend = aviary_mavlink::connect(&world(&scout(&format!("tcp:{}", vehicles.address), "")), quick()).await.unwrap();
+    let behaviour = Behaviour {
+        prearm_time: 1e9,
+        ..Behaviour::default()
+    };
+    let vehicles = aviary_vehicles::serve(
+        &world(&scout("tcp:x:1", "")),
+        Listen::Tcp("127.0.0.1:0".parse().unwrap()),
+        Options {
+            speed: 10.0,
+            behaviour,
+            ..Options::default()
+        },
+    )
+    .await
+    .unwrap();
+    let backend = aviary_mavlink::connect(
+        &world(&scout(&format!("tcp:{}", vehicles.address), "")),
+        quick(),
+    )
+    .await
+    .unwrap();
     match call(&backend, "Arm", &[]).await {
         CallEnd::Failed(f) => {
             assert_eq!(f.exception, "CommandFailed");
-            assert!(f.reason.contains("PreArm: GPS: waiting for 3D fix"), "{}", f.reason);
+            assert!(
+                f.reason.contains("PreArm: GPS: waiting for 3D fix"),
+                "{}",
+                f.reason
+            );
         }
         other => panic!("{other:?}"),
     }
@@ -50,32 +80,78 @@ async fn arming_refused_by_pre_arm_checks_says_why() {
 #[tokio::test]
 async fn a_battery_failsafe_rtl_raises_battery_critical() {
     let faults = "\n[[faults]]\ndrone = \"scout\"\nat = 80\nkind = \"battery_critical\"\n";
-    let vehicles = aviary_vehicles::serve(&world(&scout("tcp:x:1", faults)), Listen::Tcp("127.0.0.1:0".parse().unwrap()), Options { speed: 10.0, ..Options::default() }).await.unwrap();
-    let backend = aviary_mavlink::connect(&world(&scout(&format!("tcp:{}", vehicles.address), "")), quick()).await.unwrap();
+    let vehicles = aviary_vehicles::serve(
+        &world(&scout("tcp:x:1", faults)),
+        Listen::Tcp("127.0.0.1:0".parse().unwrap()),
+        Options {
+            speed: 10.0,
+            ..Options::default()
+        },
+    )
+    .await
+    .unwrap();
+    let backend = aviary_mavlink::connect(
+        &world(&scout(&format!("tcp:{}", vehicles.address), "")),
+        quick(),
+    )
+    .await
+    .unwrap();
     let mut events = backend.events().unwrap();
     let armed = call(&backend, "Arm", &[]).await;
     assert_eq!(armed, CallEnd::Done, "{:?}", events.try_recv());
     let hover = backend.call(0, "Hover", &[Value::Number(60.0)]);
-    let event = tokio::time::timeout(Duration::from_secs(20), events.recv()).await.expect("an event").expect("open");
+    let event = tokio::time::timeout(Duration::from_secs(20), events.recv())
+        .await
+        .expect("an event")
+        .expect("open");
     match event {
         DroneEvent::Fault { drone: 0, failure } => {
             assert_eq!(failure.exception, "BatteryCritical");
-            assert!(failure.reason.contains("switched to RTL by itself") && failure.reason.contains("Battery 1 is critical"), "{}", failure.reason);
+            assert!(
+                failure.reason.contains("switched to RTL by itself")
+                    && failure.reason.contains("Battery 1 is critical"),
+                "{}",
+                failure.reason
+            );
         }
         other => panic!("{other:?}"),
     }
-    assert_eq!(hover.end.await.unwrap(), CallEnd::Interrupted, "a fault ends the drone's calls");
+    assert_eq!(
+        hover.end.await.unwrap(),
+        CallEnd::Interrupted,
+        "a fault ends the drone's calls"
+    );
     vehicles.stop();
 }
 
 #[tokio::test]
 async fn take_off_and_land_over_udp() {
-    let vehicles = aviary_vehicles::serve(&world(&scout("tcp:x:1", "")), Listen::Udp("127.0.0.1:0".parse().unwrap()), Options { speed: 10.0, ..Options::default() }).await.unwrap();
-    let backend = aviary_mavlink::connect(&world(&scout(&format!("udpout:{}", vehicles.address), "")), quick()).await.unwrap();
+    let vehicles = aviary_vehicles::serve(
+        &world(&scout("tcp:x:1", "")),
+        Listen::Udp("127.0.0.1:0".parse().unwrap()),
+        Options {
+            speed: 10.0,
+            ..Options::default()
+        },
+    )
+    .await
+    .unwrap();
+    let backend = aviary_mavlink::connect(
+        &world(&scout(&format!("udpout:{}", vehicles.address), "")),
+        quick(),
+    )
+    .await
+    .unwrap();
     assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
-    assert_eq!(call(&backend, "TakeOff", &[Value::Number(5.0)]).await, CallEnd::Done);
+    assert_eq!(
+        call(&backend, "TakeOff", &[Value::Number(5.0)]).await,
+        CallEnd::Done
+    );
     let t = backend.telemetry(0);
-    assert!((t.position[2] - 5.0).abs() <= 0.5 && t.state == aviary_api::FlightState::Flying, "{t:?}");
+    assert!(
+        (t.position[2] - 5.0).abs() <= 0.5 && t.state == aviary_api::FlightState::Flying,
+        "{t:?}"
+    );
     assert_eq!(call(&backend, "Land", &[]).await, CallEnd::Done);
     assert_eq!(backend.telemetry(0).state, aviary_api::FlightState::Landed);
     vehicles.stop();
@@ -84,14 +160,32 @@ async fn take_off_and_land_over_udp() {
 #[tokio::test]
 async fn signed_links_take_only_the_right_key() {
     let key = aviary_mavlink::signing_key("correct horse battery staple");
-    let options = Options { speed: 10.0, signing_key: Some(key), ..Options::default() };
-    let vehicles = aviary_vehicles::serve(&world(&scout("tcp:x:1", "")), Listen::Tcp("127.0.0.1:0".parse().unwrap()), options).await.unwrap();
+    let options = Options {
+        speed: 10.0,
+        signing_key: Some(key),
+        ..Options::default()
+    };
+    let vehicles = aviary_vehicles::serve(
+        &world(&scout("tcp:x:1", "")),
+        Listen::Tcp("127.0.0.1:0".parse().unwrap()),
+        options,
+    )
+    .await
+    .unwrap();
     let address = format!("tcp:{}", vehicles.address);
-    let right = world(&scout(&address, "signing_key = \"correct horse battery staple\"\n"));
-    let backend = aviary_mavlink::connect(&right, quick()).await.expect("the right key connects");
+    let right = world(&scout(
+        &address,
+        "signing_key = \"correct horse battery staple\"\n",
+    ));
+    let backend = aviary_mavlink::connect(&right, quick())
+        .await
+        .expect("the right key connects");
     assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
     let wrong = world(&scout(&address, "signing_key = \"wrong\"\n"));
-    let err = aviary_mavlink::connect(&wrong, quick()).await.err().expect("a wrong key hears nothing");
+    let err = aviary_mavlink::connect(&wrong, quick())
+        .await
+        .err()
+        .expect("a wrong key hears nothing");
     assert!(err.contains("no answer"), "{err}");
     vehicles.stop();
 }

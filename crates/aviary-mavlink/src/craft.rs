@@ -43,6 +43,9 @@ pub struct Craft {
     pub doing: Mutex<Doing>,
     /// The ground speed last set with DO_CHANGE_SPEED.
     pub speed: Mutex<Option<f64>>,
+    /// The altitude last commanded: a flight without one keeps it (as the simulator's
+    /// drones do), not the height reported on the way up to it.
+    pub level: Mutex<Option<f64>>,
     pub tuning: Tuning,
 }
 
@@ -67,6 +70,17 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
 impl Craft {
     pub fn fix(&self) -> Option<Fix> {
         self.v.seen().fix
+    }
+
+    /// The altitude a flight without one keeps.
+    pub fn level(&self) -> f64 {
+        lock(&self.level)
+            .or_else(|| self.fix().map(|f| f.pos[2]))
+            .unwrap_or(f64::NAN)
+    }
+
+    pub fn set_level(&self, z: Option<f64>) {
+        *lock(&self.level) = z;
     }
 
     pub fn set_doing(&self, doing: Doing) {

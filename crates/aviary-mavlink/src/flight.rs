@@ -90,7 +90,8 @@ pub async fn run(
                     "sweep spacing must be above 0 m, not {spacing} m"
                 )));
             }
-            let z = here(c)?[2];
+            here(c)?;
+            let z = c.level();
             let path: Vec<[f64; 3]> = aviary_sim::sweep::lawnmower(area, spacing)
                 .into_iter()
                 .map(|p| [p[0], p[1], z])
@@ -98,7 +99,8 @@ pub async fn run(
             fly(c, &path, c.max_speed, paused).await
         }
         "FollowPath" => {
-            let mut z = here(c)?[2];
+            here(c)?;
+            let mut z = c.level();
             let mut path = Vec::new();
             for v in args {
                 let p = point(c, Some(v), "points")?;
@@ -155,7 +157,7 @@ fn number(args: &[Value], i: usize, name: &str) -> Result<f64, Failure> {
 
 /// A position argument in local metres; z is NaN when it has none (keep the altitude).
 fn point(c: &Craft, v: Option<&Value>, name: &str) -> Result<[f64; 3], Failure> {
-    let here_z = c.fix().map_or(f64::NAN, |f| f.pos[2]);
+    let here_z = c.level();
     match v {
         Some(Value::Position(p)) if p.x.is_finite() && p.y.is_finite() => Ok([
             p.x,

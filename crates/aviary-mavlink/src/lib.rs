@@ -134,15 +134,15 @@ pub fn bindings(world: &World) -> Vec<(usize, String, u8, Option<String>)> {
 /// system id.
 pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, String> {
     let bound = bindings(world);
-    let origin = world
-        .site
-        .origin
-        .as_ref()
-        .map_or(Origin::default(), |g| Origin {
-            lat: g.lat,
-            lon: g.lon,
-            alt: g.alt,
-        });
+    // The world's frame must be pinned to the Earth: without an origin, local metres
+    // would be sent as if the site were at 0°N 0°E.
+    let Some(origin) = world.site.origin.as_ref().map(|g| Origin {
+        lat: g.lat,
+        lon: g.lon,
+        alt: g.alt,
+    }) else {
+        return Err("a world with MAVLink drones needs `origin = { lat, lon, alt }` in [site]: where the local frame sits on the Earth".into());
+    };
     let mut links: BTreeMap<String, (Arc<link::Link>, Option<String>)> = BTreeMap::new();
     let mut used: BTreeMap<(String, u8), usize> = BTreeMap::new();
     for (i, address, system, key) in &bound {
@@ -193,6 +193,7 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
             carrying: Mutex::new(None),
             doing: Mutex::new(Doing::Other),
             speed: Mutex::new(None),
+            level: Mutex::new(None),
             tuning,
         }));
     }

@@ -78,6 +78,7 @@ pub(crate) async fn take_off(c: &Craft, alt: f64, paused: Paused) -> Result<(), 
     // NAV_TAKEOFF is refused outside GUIDED, so make sure of it first.
     c.set_mode(Mode::Guided).await?;
     c.set_doing(Doing::TakingOff);
+    c.set_level(Some(alt));
     let result = async {
         c.command(
             MavCmd::MAV_CMD_NAV_TAKEOFF,
@@ -101,6 +102,7 @@ pub(crate) async fn land(c: &Craft) -> Result<(), Failure> {
         return Ok(());
     }
     c.v.seen().expected = Some(Mode::Land);
+    c.set_level(None);
     c.set_doing(Doing::Landing);
     let z = here(c).map_or(0.0, |p| p[2]);
     let result = async {
@@ -135,6 +137,7 @@ pub(crate) async fn rtl(c: &Craft) -> Result<(), Failure> {
         )));
     }
     c.v.seen().expected = Some(Mode::Rtl);
+    c.set_level(None);
     c.command(MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH, [0.0; 7])
         .await?;
     let limit =
@@ -157,12 +160,13 @@ pub(crate) async fn fly(
     c.speed(speed).await?;
     for &to in path {
         let from = here(c)?;
-        let to = [to[0], to[1], if to[2].is_nan() { from[2] } else { to[2] }];
+        let to = [to[0], to[1], if to[2].is_nan() { c.level() } else { to[2] }];
         if to[2] < 0.0 {
             return Err(failed(format!("altitude {} m is below the ground", to[2])));
         }
         let far = dist([from[0], from[1]], [to[0], to[1]]).hypot(to[2] - from[2]);
         let mut left = Duration::from_secs_f64(far / speed.max(0.5) * 3.0 + 30.0);
+        c.set_level(Some(to[2]));
         c.target(to).await?;
         let mut resend = Instant::now() + c.tuning.resend;
         loop {

@@ -204,7 +204,8 @@ impl Autopilot {
             .fleet
             .telemetry(i)
             .map_or(FlightState::Lost, |t| t.state);
-        if !matches!(state, FlightState::Flying) {
+        // As ArduCopter: a target during the take-off replaces the climb.
+        if !matches!(state, FlightState::Flying | FlightState::TakingOff) {
             return Err("position target ignored: not flying".into());
         }
         let same = c

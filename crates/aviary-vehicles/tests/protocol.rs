@@ -189,3 +189,62 @@ async fn signed_links_take_only_the_right_key() {
     assert!(err.contains("no answer"), "{err}");
     vehicles.stop();
 }
+
+#[tokio::test]
+async fn pause_holds_resume_goes_on_and_abort_stops() {
+    let vehicles = aviary_vehicles::serve(
+        &world(&scout("tcp:x:1", "")),
+        Listen::Tcp("127.0.0.1:0".parse().unwrap()),
+        Options {
+            speed: 5.0,
+            ..Options::default()
+        },
+    )
+    .await
+    .unwrap();
+    let backend = aviary_mavlink::connect(
+        &world(&scout(&format!("tcp:{}", vehicles.address), "")),
+        quick(),
+    )
+    .await
+    .unwrap();
+    assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
+    assert_eq!(
+        call(&backend, "TakeOff", &[Value::Number(5.0)]).await,
+        CallEnd::Done
+    );
+    let far = Value::Position(aviary_api::Point {
+        x: 300.0,
+        y: 0.0,
+        z: None,
+    });
+    let flight = backend.call(0, "FlyToPosition", &[far.clone()]);
+    tokio::time::sleep(Duration::from_secs(2)).await;
+    backend.interrupt(flight.id, aviary_api::Interrupt::Pause);
+    tokio::time::sleep(Duration::from_secs(2)).await;
+    let held = backend.telemetry(0).position;
+    tokio::time::sleep(Duration::from_secs(1)).await;
+    let still = backend.telemetry(0).position;
+    assert!(
+        held[0] > 1.0 && (still[0] - held[0]).abs() < 0.5,
+        "paused: {held:?} then {still:?}"
+    );
+    backend.interrupt(flight.id, aviary_api::Interrupt::Resume);
+    tokio::time::sleep(Duration::from_secs(2)).await;
+    let moved = backend.telemetry(0).position;
+    assert!(
+        moved[0] > still[0] + 1.0,
+        "resumed: {still:?} then {moved:?}"
+    );
+    backend.interrupt(flight.id, aviary_api::Interrupt::Abort);
+    assert_eq!(flight.end.await.unwrap(), CallEnd::Interrupted);
+    tokio::time::sleep(Duration::from_secs(2)).await;
+    let stopped = backend.telemetry(0).position;
+    tokio::time::sleep(Duration::from_secs(1)).await;
+    let after = backend.telemetry(0).position;
+    assert!(
+        stopped[0] < 290.0 && (after[0] - stopped[0]).abs() < 0.5,
+        "aborted: {stopped:?} then {after:?}"
+    );
+    vehicles.stop();
+}

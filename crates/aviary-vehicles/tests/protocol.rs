@@ -218,7 +218,7 @@ async fn pause_holds_resume_goes_on_and_abort_stops() {
         y: 0.0,
         z: None,
     });
-    let flight = backend.call(0, "FlyToPosition", &[far.clone()]);
+    let flight = backend.call(0, "FlyToPosition", &[far]);
     tokio::time::sleep(Duration::from_secs(2)).await;
     backend.interrupt(flight.id, aviary_api::Interrupt::Pause);
     tokio::time::sleep(Duration::from_secs(2)).await;

@@ -57,6 +57,7 @@ pub struct Vehicles {
     /// Each drone's MAVLink system id, in world order.
     pub systems: Vec<u8>,
     tasks: Vec<JoinHandle<()>>,
+    clients: server::Clients,
 }
 
 /// Binds `listen` and starts serving `world`'s drones. Call inside a tokio runtime with
@@ -72,13 +73,20 @@ pub async fn serve(world: &World, listen: Listen, options: Options) -> std::io::
         1.0
     };
     let pace = tokio::spawn(server::pace(Arc::clone(&ap), out.clone(), 0.05, speed));
+    let clients = server::Clients::default();
     let (address, serve) = match listen {
         Listen::Tcp(addr) => {
             let listener = TcpListener::bind(addr).await?;
             let address = listener.local_addr()?;
             (
                 address,
-                tokio::spawn(server::tcp(listener, ap, out, options.signing_key)),
+                tokio::spawn(server::tcp(
+                    listener,
+                    ap,
+                    out,
+                    options.signing_key,
+                    Arc::clone(&clients),
+                )),
             )
         }
         Listen::Udp(addr) => {
@@ -86,7 +94,13 @@ pub async fn serve(world: &World, listen: Listen, options: Options) -> std::io::
             let address = socket.local_addr()?;
             (
                 address,
-                tokio::spawn(server::udp(socket, ap, out, options.signing_key)),
+                tokio::spawn(server::udp(
+                    socket,
+                    ap,
+                    out,
+                    options.signing_key,
+                    Arc::clone(&clients),
+                )),
             )
         }
     };
@@ -94,6 +108,7 @@ pub async fn serve(world: &World, listen: Listen, options: Options) -> std::io::
         address,
         systems,
         tasks: vec![pace, serve],
+        clients,
     })
 }
 
@@ -101,6 +116,14 @@ impl Vehicles {
     pub fn stop(&self) {
         for t in &self.tasks {
             t.abort();
+        }
+        for c in self
+            .clients
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .iter()
+        {
+            c.abort();
         }
     }
 }

@@ -172,11 +172,16 @@ fn header(system: u8, sequence: &mut u8) -> MavHeader {
     }
 }
 
+/// Tasks a stopped server must end too (each client's reader and writer), so that its
+/// connections close as a killed process's would.
+pub(crate) type Clients = Arc<Mutex<Vec<tokio::task::AbortHandle>>>;
+
 pub(crate) async fn tcp(
     listener: TcpListener,
     ap: Shared,
     out: broadcast::Sender<Out>,
     key: Option<[u8; 32]>,
+    clients: Clients,
 ) {
     while let Ok((stream, _)) = listener.accept().await {
         let _ = stream.set_nodelay(true);
@@ -207,7 +212,8 @@ pub(crate) async fn tcp(
                 }
             }
         });
-        tokio::spawn(async move {
+        let writer_handle = writer.abort_handle();
+        let reader = tokio::spawn(async move {
             let mut reader = AsyncMavlinkReader::new(read);
             loop {
                 match reader
@@ -225,6 +231,9 @@ pub(crate) async fn tcp(
             }
             writer.abort();
         });
+        let mut all = clients.lock().unwrap_or_else(|p| p.into_inner());
+        all.retain(|h| !h.is_finished());
+        all.extend([writer_handle, reader.abort_handle()]);
     }
 }
 
@@ -233,6 +242,7 @@ pub(crate) async fn udp(
     ap: Shared,
     out: broadcast::Sender<Out>,
     key: Option<[u8; 32]>,
+    clients: Clients,
 ) {
     let socket = Arc::new(socket);
     let peers: Arc<Mutex<Vec<SocketAddr>>> = Arc::default();
@@ -243,7 +253,7 @@ pub(crate) async fn udp(
         Arc::clone(&peers),
         Arc::clone(&sign),
     );
-    tokio::spawn(async move {
+    let writer = tokio::spawn(async move {
         let mut seq = 0u8;
         loop {
             let o = match rx.recv().await {
@@ -265,6 +275,10 @@ pub(crate) async fn udp(
             }
         }
     });
+    clients
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .push(writer.abort_handle());
     let mut buf = vec![0u8; 65_536];
     loop {
         let Ok((n, from)) = socket.recv_from(&mut buf).await else {

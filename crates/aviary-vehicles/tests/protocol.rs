@@ -248,3 +248,53 @@ async fn pause_holds_resume_goes_on_and_abort_stops() {
     );
     vehicles.stop();
 }
+
+#[tokio::test]
+async fn a_vehicle_that_goes_and_comes_back_raises_lost_then_restored() {
+    let scout_world = world(&scout("tcp:x:1", ""));
+    let tcp = Listen::Tcp("127.0.0.1:0".parse().unwrap());
+    let options = Options {
+        speed: 5.0,
+        ..Options::default()
+    };
+    let first = aviary_vehicles::serve(&scout_world, tcp, options)
+        .await
+        .unwrap();
+    let address = first.address;
+    let backend = aviary_mavlink::connect(&world(&scout(&format!("tcp:{address}"), "")), quick())
+        .await
+        .unwrap();
+    let mut events = backend.events().unwrap();
+    first.stop();
+    let lost = tokio::time::timeout(Duration::from_secs(6), events.recv())
+        .await
+        .expect("an event")
+        .unwrap();
+    assert!(
+        matches!(&lost, DroneEvent::Fault { failure, .. } if failure.exception == "ConnectionLost"),
+        "{lost:?}"
+    );
+    assert!(!backend.telemetry(0).link);
+    match call(&backend, "Arm", &[]).await {
+        CallEnd::Failed(f) => assert!(f.reason.contains("no link"), "{}", f.reason),
+        other => panic!("{other:?}"),
+    }
+    // The same port again: the backend opens the connection anew and hears HEARTBEAT.
+    let second = aviary_vehicles::serve(&scout_world, Listen::Tcp(address), options)
+        .await
+        .unwrap();
+    let back = tokio::time::timeout(Duration::from_secs(6), events.recv())
+        .await
+        .expect("an event")
+        .unwrap();
+    assert_eq!(
+        back,
+        DroneEvent::Signal {
+            drone: 0,
+            name: "ConnectionRestored"
+        }
+    );
+    assert!(backend.telemetry(0).link);
+    assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
+    second.stop();
+}

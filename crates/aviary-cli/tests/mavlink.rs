@@ -298,20 +298,23 @@ fn a_killed_vehicle_raises_connection_lost_within_the_heartbeat_timeout() {
     vehicles.child.kill().expect("kill the vehicles");
     let killed = Instant::now();
     let lost = |e: &Value| e["event"] == "exception" && e["name"] == "ConnectionLost";
-    while !events(&trace).iter().any(lost) {
-        // The backend's heartbeat timeout is 3 s; allow 2 s for the rest.
+    let exception = loop {
+        if let Some(e) = events(&trace).into_iter().find(lost) {
+            break e;
+        }
+        // The heartbeat timeout is 3 s from the last HEARTBEAT (sent each second); allow
+        // 3 s more for a loaded machine.
         assert!(
-            killed.elapsed() < Duration::from_secs(5),
-            "no ConnectionLost 5 s after the kill: {:?}",
+            killed.elapsed() < Duration::from_secs(6),
+            "no ConnectionLost 6 s after the kill: {:?}",
             events(&trace)
         );
         std::thread::sleep(Duration::from_millis(20));
-    }
-    let waited = killed.elapsed();
-    // The timeout runs from the last HEARTBEAT, which came at most 1 s before the kill.
+    };
+    let reason = exception["args"][0].as_str().unwrap_or("");
     assert!(
-        waited >= Duration::from_millis(1800),
-        "raised after {waited:?}: before the heartbeat timeout?"
+        reason.contains("no HEARTBEAT from system 1 for 3.0 s"),
+        "{exception}"
     );
     let status = run.wait().expect("wait");
     assert_eq!(

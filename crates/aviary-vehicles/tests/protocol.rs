@@ -221,7 +221,8 @@ async fn pause_holds_resume_goes_on_and_abort_stops() {
     let flight = backend.call(0, "FlyToPosition", &[far]);
     tokio::time::sleep(Duration::from_secs(2)).await;
     backend.interrupt(flight.id, aviary_api::Interrupt::Pause);
-    tokio::time::sleep(Duration::from_secs(2)).await;
+    // Braking from 10 m/s and coming back to where it was paused takes a few seconds.
+    tokio::time::sleep(Duration::from_secs(3)).await;
     let held = backend.telemetry(0).position;
     tokio::time::sleep(Duration::from_secs(1)).await;
     let still = backend.telemetry(0).position;

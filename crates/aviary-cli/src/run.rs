@@ -149,8 +149,11 @@ pub fn run(args: &RunArgs) -> u8 {
             _ = watch => unreachable!("the watch never ends"),
         };
         sim.stop();
-        // A MAVLink drone's distance and flight time are not tracked: shown as `-`.
-        let odometry = |d: usize| (!mixed.as_ref().is_some_and(|m| m.mavlink.serves(d))).then(|| sim.with_fleet(|f| f.odometry(d)));
+        // A MAVLink drone's distance and flight time come from the track it reported.
+        let odometry = |d: usize| match mixed.as_ref().filter(|m| m.mavlink.serves(d)) {
+            Some(m) => m.mavlink.odometry(d),
+            None => Some(sim.with_fleet(|f| f.odometry(d))),
+        };
         let summary = summary(&mission, backend, &odometry, &stats);
         Ok::<_, String>((outcome, summary))
     });

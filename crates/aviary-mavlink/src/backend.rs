@@ -34,6 +34,8 @@ pub(crate) struct Inner {
     pub events: mpsc::UnboundedSender<DroneEvent>,
     taken: Mutex<Option<mpsc::UnboundedReceiver<DroneEvent>>>,
     lost: Mutex<Vec<bool>>,
+    /// Per drone: `BatteryLow` signalled, `BatteryCritical` raised (each once).
+    battery: Mutex<Vec<(bool, bool)>>,
 }
 
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
@@ -66,6 +68,7 @@ impl MavlinkBackend {
             events: events.0,
             taken: Mutex::new(Some(events.1)),
             lost: Mutex::new(vec![false; n]),
+            battery: Mutex::new(vec![(false, false); n]),
         });
         tokio::spawn(alarms_task(Arc::downgrade(&inner), alarms));
         tokio::spawn(watchdog(Arc::downgrade(&inner), heartbeat_timeout));
@@ -75,6 +78,13 @@ impl MavlinkBackend {
     /// Whether `drone` is one of this backend's.
     pub fn serves(&self, drone: DroneId) -> bool {
         self.inner.crafts.get(drone).is_some_and(Option::is_some)
+    }
+
+    /// Metres flown and seconds in the air, from the track the drone reported.
+    pub fn odometry(&self, drone: DroneId) -> Option<(f64, f64)> {
+        let c = self.inner.crafts.get(drone)?.as_ref()?;
+        let seen = c.v.seen();
+        Some((seen.odometer, seen.flight_time))
     }
 
     /// Whether the video stream is on, and what the drone carries.
@@ -94,6 +104,15 @@ impl Inner {
     /// A fault: the event first, then every call of the drone ends `Interrupted` (so the
     /// engine raises one exception, once).
     fn fault(&self, drone: DroneId, failure: Failure) {
+        if failure.exception == "BatteryCritical" {
+            // The rule below and the autopilot's battery failsafe may both see it: one
+            // fault, one exception.
+            let mut flags = lock(&self.battery);
+            if flags[drone].1 {
+                return;
+            }
+            flags[drone].1 = true;
+        }
         let _ = self.events.send(DroneEvent::Fault { drone, failure });
         let cut: Vec<Slot> = {
             let mut calls = lock(&self.calls);
@@ -110,6 +129,48 @@ impl Inner {
         }
         if let Some(Some(c)) = self.crafts.get(drone) {
             c.set_doing(Doing::Other);
+        }
+    }
+}
+
+impl Inner {
+    /// RUNTIME.md's battery rule, on the charge the vehicle reports: with `need` the share
+    /// of a full battery it takes to fly home at `max_speed` and descend at `climb_rate`,
+    /// `BatteryLow` under `2 × need + 10 %`, `BatteryCritical` under `need + 10 %`.
+    fn battery_rule(&self, drone: DroneId, c: &Craft) {
+        let (fix, battery) = {
+            let seen = c.v.seen();
+            (seen.fix, seen.battery)
+        };
+        let (Some(fix), Some(battery)) = (fix, battery) else {
+            return;
+        };
+        if !c.state().airborne() {
+            return;
+        }
+        let home = aviary_api::geometry::dist([fix.pos[0], fix.pos[1]], c.home);
+        let need = (home / c.max_speed + fix.pos[2].max(0.0) / c.climb_rate) / c.endurance;
+        let (low, critical) = lock(&self.battery)[drone];
+        if !low && battery < 2.0 * need + 0.10 {
+            lock(&self.battery)[drone].0 = true;
+            let _ = self.events.send(DroneEvent::Signal {
+                drone,
+                name: "BatteryLow",
+            });
+        }
+        if !critical && battery < need + 0.10 {
+            let reason = format!(
+                "{}: {:.0}% left, about what it needs to get home",
+                c.name,
+                battery * 100.0
+            );
+            self.fault(
+                drone,
+                Failure {
+                    exception: "BatteryCritical",
+                    reason,
+                },
+            );
         }
     }
 }
@@ -134,6 +195,7 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
         let now = tokio::time::Instant::now();
         for (drone, craft) in inner.crafts.iter().enumerate() {
             let Some(c) = craft else { continue };
+            inner.battery_rule(drone, c);
             let fresh =
                 c.v.seen()
                     .heartbeat

@@ -33,6 +33,9 @@ pub struct Craft {
     pub link: Arc<Link>,
     pub v: Arc<Vehicle>,
     pub max_speed: f64,
+    pub climb_rate: f64,
+    /// Seconds of flight on a full battery (the world's), for the battery alarms.
+    pub endurance: f64,
     pub home: [f64; 2],
     pub sensors: Vec<String>,
     pub payload: Vec<String>,

@@ -184,6 +184,8 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
             link,
             v,
             max_speed: d.max_speed,
+            climb_rate: d.climb_rate,
+            endurance: d.endurance,
             home: [d.home[0], d.home[1]],
             sensors: d.sensors.clone(),
             payload: d.payload.clone(),

@@ -49,6 +49,10 @@ pub struct Seen {
     /// The mode this backend last asked for; another RTL or LAND is the autopilot's own.
     pub expected: Option<Mode>,
     pub detecting: Vec<Activation>,
+    /// Metres flown and seconds in the air while armed, from the reported track.
+    pub odometer: f64,
+    pub flight_time: f64,
+    fix_at: Option<Instant>,
     acks: Vec<(MavCmd, oneshot::Sender<MavResult>)>,
 }
 
@@ -171,6 +175,14 @@ impl Vehicle {
                     },
                 };
                 let from = seen.fix.map_or(xy, |f| [f.pos[0], f.pos[1]]);
+                if let (Some(before), Some(at), true) = (seen.fix, seen.fix_at, seen.armed) {
+                    let d: f64 = (0..3).map(|k| (fix.pos[k] - before.pos[k]).powi(2)).sum();
+                    seen.odometer += d.sqrt();
+                    if before.pos[2] > 0.3 {
+                        seen.flight_time += now.duration_since(at).as_secs_f64();
+                    }
+                }
+                seen.fix_at = Some(now);
                 seen.fix = Some(fix);
                 self.scan(&mut seen, from, xy);
             }

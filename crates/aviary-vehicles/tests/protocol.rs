@@ -299,3 +299,47 @@ async fn a_vehicle_that_goes_and_comes_back_raises_lost_then_restored() {
     assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
     second.stop();
 }
+
+#[tokio::test]
+async fn the_battery_rule_signals_low_then_raises_critical_once() {
+    // 10.3 % at the start: just above what a drone 10 m up at home needs plus 10 %.
+    let text = scout("tcp:x:1", "battery = 10.3\n");
+    let vehicles = aviary_vehicles::serve(
+        &world(&text),
+        Listen::Tcp("127.0.0.1:0".parse().unwrap()),
+        Options {
+            speed: 5.0,
+            ..Options::default()
+        },
+    )
+    .await
+    .unwrap();
+    let backend = aviary_mavlink::connect(
+        &world(&scout(
+            &format!("tcp:{}", vehicles.address),
+            "battery = 10.3\n",
+        )),
+        quick(),
+    )
+    .await
+    .unwrap();
+    let mut events = backend.events().unwrap();
+    assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
+    let _climb = backend.call(0, "TakeOff", &[Value::Number(10.0)]);
+    let mut seen = Vec::new();
+    let until = tokio::time::Instant::now() + Duration::from_secs(10);
+    while let Ok(Some(e)) = tokio::time::timeout_at(until, events.recv()).await {
+        seen.push(e);
+    }
+    let names: Vec<&str> = seen
+        .iter()
+        .map(|e| match e {
+            DroneEvent::Signal { name, .. } => *name,
+            DroneEvent::Fault { failure, .. } => failure.exception,
+            DroneEvent::Detected { .. } => "Detected",
+        })
+        .collect();
+    // The vehicle's own battery failsafe (RTL) comes too: still one exception.
+    assert_eq!(names, ["BatteryLow", "BatteryCritical"], "{seen:?}");
+    vehicles.stop();
+}

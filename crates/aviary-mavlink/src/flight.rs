@@ -24,7 +24,7 @@ pub async fn run(
     match function {
         "Arm" => arm(c).await,
         "Disarm" => {
-            if c.v.seen().armed && c.state().airborne() {
+            if c.state().airborne() {
                 return Err(failed(format!("{} can only disarm on the ground", c.name)));
             }
             c.command(MavCmd::MAV_CMD_COMPONENT_ARM_DISARM, [0.0; 7])

@@ -154,6 +154,7 @@ async fn take_off_and_land_over_udp() {
     );
     assert_eq!(call(&backend, "Land", &[]).await, CallEnd::Done);
     assert_eq!(backend.telemetry(0).state, aviary_api::FlightState::Landed);
+    assert_eq!(call(&backend, "Disarm", &[]).await, CallEnd::Done);
     vehicles.stop();
 }
 

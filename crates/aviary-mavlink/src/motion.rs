@@ -80,9 +80,14 @@ pub(crate) async fn take_off(c: &Craft, alt: f64, paused: Paused) -> Result<(), 
     c.set_doing(Doing::TakingOff);
     c.set_level(Some(alt));
     let result = async {
+        // ArduPilot reads the take-off altitude above home, PX4 above sea level.
+        let param7 = match c.v.flavour() {
+            crate::mode::Flavour::ArduPilot => alt,
+            crate::mode::Flavour::Px4 => c.fix().map_or(alt, |f| f.home_amsl + alt),
+        };
         c.command(
             MavCmd::MAV_CMD_NAV_TAKEOFF,
-            [0.0, 0.0, 0.0, f32::NAN, f32::NAN, f32::NAN, alt as f32],
+            [0.0, 0.0, 0.0, f32::NAN, f32::NAN, f32::NAN, param7 as f32],
         )
         .await?;
         let limit = Duration::from_secs_f64(alt / 0.5 + 30.0);

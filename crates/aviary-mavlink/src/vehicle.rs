@@ -24,6 +24,8 @@ pub struct Fix {
     pub speed: f64,
     /// Degrees clockwise from north.
     pub heading: f64,
+    /// Metres above sea level of the vehicle's home (its `alt` less its `relative_alt`).
+    pub home_amsl: f64,
 }
 
 /// One activation of `StartDetection(kind)`: which world targets it has found.
@@ -173,6 +175,7 @@ impl Vehicle {
                     } else {
                         f64::from(p.hdg) / 100.0
                     },
+                    home_amsl: (f64::from(p.alt) - f64::from(p.relative_alt)) / 1000.0,
                 };
                 let from = seen.fix.map_or(xy, |f| [f.pos[0], f.pos[1]]);
                 if let (Some(before), Some(at), true) = (seen.fix, seen.fix_at, seen.armed) {

@@ -118,7 +118,8 @@ fn facts(trace: &[Value], event: &str, key: &str) -> Vec<(String, String, Vec<f6
         .iter()
         .filter(|e| e["event"] == event)
         .map(|e| {
-            let numbers = match e.get("location").or_else(|| e.get("args")) {
+            // A detection's location; a call's arguments; where a call ended.
+            let numbers = match e.get("location").or_else(|| e.get("position")).or_else(|| e.get("args")) {
                 Some(v) => flatten(v),
                 None => Vec::new(),
             };
@@ -229,6 +230,14 @@ fn the_paper_mission_over_mavlink_agrees_with_a_simulated_run() {
         &facts(&direct, "api_call", "function"),
         &facts(&mavlink, "api_call", "function"),
         1.0,
+    );
+    // Where each call left its drone: within the arrival tolerances (1 m over the
+    // ground, 0.5 m in height) and the rounding of the reported position.
+    agree(
+        "positions",
+        &facts(&direct, "api_done", "function"),
+        &facts(&mavlink, "api_done", "function"),
+        1.5,
     );
     assert!(
         mavlink.iter().all(|e| e["event"] != "exception"),

@@ -74,7 +74,13 @@ pub async fn run(
             let here = here(c)?;
             fly(
                 c,
-                &orbit(here, [center[0], center[1]], radius, laps),
+                &orbit(
+                    here,
+                    [center[0], center[1]],
+                    radius,
+                    laps,
+                    c.tuning.arrive_xy,
+                ),
                 c.max_speed,
                 paused,
             )

@@ -248,9 +248,22 @@ pub(crate) async fn hover(duration: f64, paused: Paused) -> Result<(), Failure> 
     Ok(())
 }
 
-/// Points on the circle, clockwise from the one nearest the drone, at its altitude.
-pub(crate) fn orbit(here: [f64; 3], center: [f64; 2], radius: f64, laps: f64) -> Vec<[f64; 3]> {
-    let start = (here[1] - center[1]).atan2(here[0] - center[0]);
+/// Points on the circle, clockwise from the one nearest the drone, at its altitude. A
+/// drone at the center (within `at_center`, the arrival tolerance: which way it is off
+/// is noise) starts east of it, as the simulator's does.
+pub(crate) fn orbit(
+    here: [f64; 3],
+    center: [f64; 2],
+    radius: f64,
+    laps: f64,
+    at_center: f64,
+) -> Vec<[f64; 3]> {
+    let (dx, dy) = (here[0] - center[0], here[1] - center[1]);
+    let start = if dx.hypot(dy) <= at_center {
+        0.0
+    } else {
+        dy.atan2(dx)
+    };
     let n = (laps * ORBIT_POINTS as f64).ceil() as usize;
     let step = laps * std::f64::consts::TAU / n as f64;
     (0..=n)

@@ -119,7 +119,11 @@ fn facts(trace: &[Value], event: &str, key: &str) -> Vec<(String, String, Vec<f6
         .filter(|e| e["event"] == event)
         .map(|e| {
             // A detection's location; a call's arguments; where a call ended.
-            let numbers = match e.get("location").or_else(|| e.get("position")).or_else(|| e.get("args")) {
+            let numbers = match e
+                .get("location")
+                .or_else(|| e.get("position"))
+                .or_else(|| e.get("args"))
+            {
                 Some(v) => flatten(v),
                 None => Vec::new(),
             };
@@ -376,6 +380,70 @@ fn an_unreachable_vehicle_is_a_clear_error() {
     assert_eq!(code, 2, "{err}");
     assert!(
         err.contains("cannot reach the MAVLink address `tcp:127.0.0.1:1`"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_vehicles_and_speed_arguments_are_usage_errors() {
+    let dir = scratch("mavlink_usage");
+    std::fs::write(dir.join("w.world.toml"), SMALL_WORLD).expect("world");
+    let (code, _, err) = aviary(
+        &[
+            "vehicles",
+            "--world",
+            "w.world.toml",
+            "--listen",
+            "carrier-pigeon",
+        ],
+        &dir,
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("`carrier-pigeon` is not an address to listen on"),
+        "{err}"
+    );
+    let (code, _, err) = aviary(
+        &[
+            "vehicles",
+            "--world",
+            "w.world.toml",
+            "--listen",
+            "tcp:127.0.0.1:0",
+            "--speed",
+            "0",
+        ],
+        &dir,
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--speed must be a positive number"), "{err}");
+    std::fs::write(
+        dir.join("bad.world.toml"),
+        "[drones.a]\nhome = [0, 0]\nmavlink = \"udp:127.0.0.1:99999\"\n",
+    )
+    .expect("world");
+    let (code, _, err) = aviary(
+        &[
+            "vehicles",
+            "--world",
+            "bad.world.toml",
+            "--listen",
+            "tcp:127.0.0.1:0",
+        ],
+        &dir,
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("bad.world.toml:3:11: error[E119]") && err.contains("99999"),
+        "{err}"
+    );
+    // MAVLink drones fly in real time: --speed is refused, before any connection.
+    std::fs::write(dir.join("m.world.toml"), bind(SMALL_WORLD, 1, &["scout"])).expect("world");
+    std::fs::write(dir.join("m.mission"), SMALL_MISSION).expect("mission");
+    let (code, _, err) = aviary(&["run", "m.mission", "--speed", "10"], &dir);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("MAVLink drones, which fly in real time: leave out --speed"),
         "{err}"
     );
 }

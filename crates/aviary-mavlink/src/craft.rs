@@ -214,17 +214,21 @@ impl Craft {
         }
     }
 
-    /// Waits until the autopilot is ready (MAV_STATE_STANDBY or later): a mode change sent
-    /// while it boots is ignored by ArduPilot.
+    /// Waits until the autopilot is ready (MAV_STATE_STANDBY, ACTIVE, or CRITICAL: up but
+    /// in a failsafe, which arming will then report): a mode change sent while it boots is
+    /// ignored by ArduPilot. (ArduCopter on the ground already says STANDBY while it
+    /// initialises, so `set_mode` also checks HEARTBEAT and asks again.)
     pub async fn ready(&self) -> Result<(), Failure> {
-        use mavlink::dialects::ardupilotmega::MavState::{MAV_STATE_ACTIVE, MAV_STATE_STANDBY};
+        use mavlink::dialects::ardupilotmega::MavState::{
+            MAV_STATE_ACTIVE, MAV_STATE_CRITICAL, MAV_STATE_STANDBY,
+        };
         self.wait_for(
             self.tuning.ready_timeout,
             "waiting for the autopilot to be ready (MAV_STATE_STANDBY)",
             |c| {
                 matches!(
                     c.v.seen().status,
-                    Some(MAV_STATE_STANDBY | MAV_STATE_ACTIVE)
+                    Some(MAV_STATE_STANDBY | MAV_STATE_ACTIVE | MAV_STATE_CRITICAL)
                 )
             },
         )

@@ -34,6 +34,8 @@ pub struct Copter {
     pub system: u8,
     pub mode: u32,
     pub armed: bool,
+    /// A failsafe has triggered (HEARTBEAT says CRITICAL from then on).
+    pub failsafe: bool,
     /// The motion call in progress (a new command replaces it).
     call: Option<CallId>,
     pub(crate) speed: f64,
@@ -80,6 +82,7 @@ impl Autopilot {
                     system,
                     mode: STABILIZE,
                     armed: false,
+                    failsafe: false,
                     call: None,
                     speed: d.max_speed,
                     max_speed: d.max_speed,
@@ -149,6 +152,7 @@ impl Autopilot {
                         "Battery 1 is critical: failsafe RTL",
                     ));
                     self.copters[drone].mode = COPTER_RTL;
+                    self.copters[drone].failsafe = true;
                     if let Err(why) = self.motion(drone, "ReturnToLaunch", &[]) {
                         out.push(text(system, MavSeverity::MAV_SEVERITY_CRITICAL, &why));
                     }

@@ -3,7 +3,8 @@
 //! Every drone of a world becomes its own MAVLink system (its `system_id`, or its place
 //! in the world: 1, 2, ...), component 1, with the behaviour of an ArduCopter-like
 //! autopilot (`autopilot`): HEARTBEAT with the ArduCopter mode number and the system
-//! state (BOOT, then STANDBY, ACTIVE when armed), the command protocol with COMMAND_ACK
+//! state (BOOT, then as ArduCopter: STANDBY on the ground, ACTIVE in the air, CRITICAL
+//! after a failsafe), the command protocol with COMMAND_ACK
 //! and STATUSTEXT reasons (arm with pre-arm checks, NAV_TAKEOFF only in GUIDED, LAND,
 //! RTL, DO_SET_MODE and SET_MODE, DO_CHANGE_SPEED, DO_REPOSITION, DO_GRIPPER,
 //! SET_MESSAGE_INTERVAL), SET_POSITION_TARGET_GLOBAL_INT in GUIDED, and the telemetry

@@ -26,11 +26,16 @@ impl Autopilot {
         if c.armed {
             base |= MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED;
         }
+        // As ArduCopter: CRITICAL in a failsafe, STANDBY on the ground (armed or not),
+        // ACTIVE in the air; BOOT (which ArduCopter does not show on the ground) marks the
+        // simulated boot, when mode changes are refused.
         let status = if self.booting() {
             MavState::MAV_STATE_BOOT
         } else if state == FlightState::Lost {
             MavState::MAV_STATE_EMERGENCY
-        } else if c.armed {
+        } else if c.failsafe {
+            MavState::MAV_STATE_CRITICAL
+        } else if state.airborne() {
             MavState::MAV_STATE_ACTIVE
         } else {
             MavState::MAV_STATE_STANDBY

@@ -10,14 +10,14 @@ use aviary_api::{
 };
 use aviary_mavlink::MavlinkBackend;
 use aviary_sim::SimBackend;
-use tokio::sync::mpsc;
+use tokio::sync::{mpsc, oneshot};
 
 pub struct Mixed {
     pub sim: Arc<SimBackend>,
     pub mavlink: MavlinkBackend,
     /// The engine's call ids → (by MAVLink, the backend's own id): the two backends
     /// number their calls independently.
-    calls: Mutex<BTreeMap<CallId, (bool, CallId)>>,
+    calls: Arc<Mutex<BTreeMap<CallId, (bool, CallId)>>>,
     next: AtomicU64,
     events: Mutex<Option<mpsc::UnboundedReceiver<DroneEvent>>>,
 }
@@ -62,7 +62,7 @@ impl Mixed {
         Mixed {
             sim,
             mavlink,
-            calls: Mutex::new(BTreeMap::new()),
+            calls: Arc::default(),
             next: AtomicU64::new(1),
             events: Mutex::new(Some(rx)),
         }
@@ -86,7 +86,17 @@ impl Backend for Mixed {
             .lock()
             .unwrap_or_else(|p| p.into_inner())
             .insert(id, (by_mavlink, inner.id));
-        PendingCall { id, end: inner.end }
+        // Pass the end on, and forget the call once it has ended.
+        let (tx, rx) = oneshot::channel();
+        let calls = Arc::clone(&self.calls);
+        tokio::spawn(async move {
+            let end = inner.end.await;
+            calls.lock().unwrap_or_else(|p| p.into_inner()).remove(&id);
+            if let Ok(end) = end {
+                let _ = tx.send(end);
+            }
+        });
+        PendingCall { id, end: rx }
     }
 
     fn interrupt(&self, call: CallId, how: Interrupt) {

@@ -141,7 +141,35 @@ impl Vehicle {
                 seen.armed = hb
                     .base_mode
                     .contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);
-                seen.status = Some(hb.system_status);
+                let was = seen.status.replace(hb.system_status);
+                let gone = |s: Option<MavState>| {
+                    matches!(
+                        s,
+                        Some(
+                            MavState::MAV_STATE_EMERGENCY
+                                | MavState::MAV_STATE_FLIGHT_TERMINATION
+                                | MavState::MAV_STATE_POWEROFF
+                        )
+                    )
+                };
+                if gone(Some(hb.system_status)) && !gone(was) {
+                    // The vehicle says it is going down (or gone): it is lost to the mission.
+                    let why = seen
+                        .texts
+                        .back()
+                        .map_or("no reason given", |(_, s)| s.as_str());
+                    let reason = format!(
+                        "{}: the autopilot reports {:?} ({why})",
+                        self.name, hb.system_status
+                    );
+                    let _ = self.alarms.send((
+                        self.drone,
+                        Failure {
+                            exception: "DroneLost",
+                            reason,
+                        },
+                    ));
+                }
                 let after = mode::classify(flavour, hb.custom_mode);
                 let changed = before.is_some_and(|b| b != after);
                 if changed

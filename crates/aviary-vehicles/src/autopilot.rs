@@ -157,6 +157,17 @@ impl Autopilot {
                         out.push(text(system, MavSeverity::MAV_SEVERITY_CRITICAL, &why));
                     }
                 }
+                Report::Event(DroneEvent::Fault { drone, failure })
+                    if failure.exception == "DroneLost" =>
+                {
+                    // Down for good: HEARTBEAT says EMERGENCY from now on; say why first.
+                    let system = self.copters[drone].system;
+                    out.push(text(
+                        system,
+                        MavSeverity::MAV_SEVERITY_EMERGENCY,
+                        &format!("Crash: {}", failure.reason),
+                    ));
+                }
                 Report::Event(_) => {}
             }
         }

@@ -344,3 +344,48 @@ async fn the_battery_rule_signals_low_then_raises_critical_once() {
     assert_eq!(names, ["BatteryLow", "BatteryCritical"], "{seen:?}");
     vehicles.stop();
 }
+
+#[tokio::test]
+async fn a_crash_raises_drone_lost() {
+    let faults = "\n[[faults]]\ndrone = \"scout\"\nat = 60\nkind = \"crash\"\n";
+    let vehicles = aviary_vehicles::serve(
+        &world(&scout("tcp:x:1", faults)),
+        Listen::Tcp("127.0.0.1:0".parse().unwrap()),
+        Options {
+            speed: 10.0,
+            ..Options::default()
+        },
+    )
+    .await
+    .unwrap();
+    let backend = aviary_mavlink::connect(
+        &world(&scout(&format!("tcp:{}", vehicles.address), "")),
+        quick(),
+    )
+    .await
+    .unwrap();
+    let mut events = backend.events().unwrap();
+    assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
+    assert_eq!(
+        call(&backend, "TakeOff", &[Value::Number(10.0)]).await,
+        CallEnd::Done
+    );
+    let hover = backend.call(0, "Hover", &[Value::Number(60.0)]);
+    match tokio::time::timeout(Duration::from_secs(15), events.recv())
+        .await
+        .expect("an event")
+        .unwrap()
+    {
+        DroneEvent::Fault { drone: 0, failure } => {
+            assert_eq!(failure.exception, "DroneLost");
+            assert!(
+                failure.reason.contains("MAV_STATE_EMERGENCY") && failure.reason.contains("Crash"),
+                "{}",
+                failure.reason
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(hover.end.await.unwrap(), CallEnd::Interrupted);
+    vehicles.stop();
+}

@@ -14,7 +14,8 @@
 //! Not simulated: parameters, missions (MISSION_ITEM), RC input, manual modes (STABILIZE
 //! is accepted and does nothing), more than one component per vehicle. A world
 //! `link_loss` fault silences the drone (no messages either way) for its duration; a
-//! `battery_critical` fault is ArduCopter's battery failsafe (STATUSTEXT, then RTL).
+//! `battery_critical` fault is ArduCopter's battery failsafe (STATUSTEXT, then RTL); a
+//! `crash` says "Crash: ..." and turns the state to EMERGENCY.
 
 mod autopilot;
 mod commands;

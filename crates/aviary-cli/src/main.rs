@@ -8,8 +8,10 @@ mod check;
 mod ctl;
 mod files;
 mod fmt;
+mod mixed;
 mod run;
 mod trace_file;
+mod vehicles;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -89,6 +91,21 @@ enum Command {
         #[command(subcommand)]
         command: ctl::CtlCommand,
     },
+    /// Serve the world's drones as simulated MAVLink vehicles (ArduCopter-like) until Ctrl-C
+    Vehicles {
+        /// The world file whose drones to serve
+        #[arg(long)]
+        world: PathBuf,
+        /// tcp:HOST:PORT or udp:HOST:PORT (port 0: any free port; the first line printed says which)
+        #[arg(long)]
+        listen: String,
+        /// Times real time, such as 1 (the default) or 20
+        #[arg(long, default_value_t = 1.0)]
+        speed: f64,
+        /// MAVLink 2 signing: a passphrase (hashed with SHA-256) or 64 hex digits
+        #[arg(long)]
+        signing_key: Option<String>,
+    },
     /// Explain a diagnostic code, such as E107
     Explain { code: String },
     /// Measure the speed of the front end on a generated mission
@@ -115,6 +132,9 @@ fn main() -> ExitCode {
             }
         }
         Command::Ctl { url, token, command } => ctl::run(&url, token.as_deref(), command),
+        Command::Vehicles { world, listen, speed, signing_key } => {
+            vehicles::run(&vehicles::VehiclesArgs { world: &world, listen: &listen, speed, signing_key: signing_key.as_deref() })
+        }
         Command::Explain { code } => explain(&code),
         Command::Bench { which } => bench::run(which),
     };

@@ -94,7 +94,13 @@ pub fn run(args: &RunArgs) -> u8 {
     };
     let trace = TraceFile::new(out);
     let _ = args.seed; // The simulator has no randomness yet; the seed is kept for it.
-    let runtime = match tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build() {
+    // Any MAVLink drone: the wall clock, and the simulated drones in real time with it.
+    let live = !aviary_mavlink::bindings(&world).is_empty();
+    if live && args.speed.is_some() {
+        eprintln!("aviary: {} has MAVLink drones, which fly in real time: leave out --speed", world_path.display());
+        return 2;
+    }
+    let runtime = match if live { crate::mixed::live_runtime() } else { tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build() } {
         Ok(r) => r,
         Err(e) => {
             eprintln!("aviary: cannot start the runtime: {e}");
@@ -117,12 +123,20 @@ pub fn run(args: &RunArgs) -> u8 {
     // The operator's view of the drones comes from telemetry events.
     let telemetry_hz = args.telemetry_hz.or(server.as_ref().map(|_| 2.0));
     let progress = progress_bar(args.quiet);
-    let (outcome, summary) = runtime.block_on(async {
+    let ran = runtime.block_on(async {
         let sim = SimBackend::start(&world, SimOptions { speed: args.speed, ..SimOptions::default() });
+        let mixed = match live {
+            true => Some(crate::mixed::Mixed::new(sim.clone(), aviary_mavlink::connect(&world, aviary_mavlink::Tuning::default()).await?)),
+            false => None,
+        };
+        let backend: &dyn Backend = match &mixed {
+            Some(m) => m,
+            None => &*sim,
+        };
         let watch = watch_backend(sim.take_driver(), controller.clone());
         let mut stats = Stats::default();
         let mut sink = |event: serde_json::Value| {
-            stats.observe(&event, &progress, &sim);
+            stats.observe(&event, &progress, backend, mission.drones.len());
             lock(&trace).write(&event);
             if let Some(feed) = &feed {
                 feed.publish(&event);
@@ -131,13 +145,26 @@ pub fn run(args: &RunArgs) -> u8 {
         let options = RunOptions { telemetry_hz };
         let outcome = tokio::select! {
             biased;
-            outcome = aviary_engine::run_controlled(&mission, &*sim, &mut sink, &options, controls) => outcome,
+            outcome = aviary_engine::run_controlled(&mission, backend, &mut sink, &options, controls) => outcome,
             _ = watch => unreachable!("the watch never ends"),
         };
         sim.stop();
-        let summary = summary(&mission, &sim, &stats);
-        (outcome, summary)
+        // A MAVLink drone's distance and flight time come from the track it reported.
+        let odometry = |d: usize| match mixed.as_ref().filter(|m| m.mavlink.serves(d)) {
+            Some(m) => m.mavlink.odometry(d),
+            None => Some(sim.with_fleet(|f| f.odometry(d))),
+        };
+        let summary = summary(&mission, backend, &odometry, &stats);
+        Ok::<_, String>((outcome, summary))
     });
+    let (outcome, summary) = match ran {
+        Ok(r) => r,
+        Err(why) => {
+            progress.finish_and_clear();
+            eprintln!("aviary: {why}");
+            return 2;
+        }
+    };
     progress.finish_and_clear();
     if let Some(s) = &server {
         s.finish(std::time::Duration::from_secs(2));
@@ -202,7 +229,7 @@ struct Stats {
 }
 
 impl Stats {
-    fn observe(&mut self, event: &serde_json::Value, progress: &ProgressBar, sim: &SimBackend) {
+    fn observe(&mut self, event: &serde_json::Value, progress: &ProgressBar, backend: &dyn Backend, drones: usize) {
         let kind = event["event"].as_str().unwrap_or("");
         match kind {
             "capability_start" => self.running += 1,
@@ -221,20 +248,23 @@ impl Stats {
         let t = event["t"].as_f64().unwrap_or(0.0);
         if t - self.last_shown >= 1.0 || kind == "mission_end" {
             self.last_shown = t;
-            let flying = (0..sim.with_fleet(|f| f.len())).filter(|d| sim.telemetry(*d).state.airborne()).count();
+            let flying = (0..drones).filter(|d| backend.telemetry(*d).state.airborne()).count();
             progress.set_message(format!("t = {t:7.1} s   activities running: {:3}   drones in the air: {flying}", self.running));
             progress.tick();
         }
     }
 }
 
-fn summary(mission: &aviary_ir::Mission, sim: &SimBackend, stats: &Stats) -> String {
+fn summary(mission: &aviary_ir::Mission, backend: &dyn Backend, odometry: &dyn Fn(usize) -> Option<(f64, f64)>, stats: &Stats) -> String {
     let mut out = String::new();
     out.push_str(&format!("{:<16} {:>12} {:>12} {:>9}  {}\n", "drone", "distance m", "flight s", "battery", "state"));
     for (d, name) in mission.drones.iter().enumerate() {
-        let t = sim.telemetry(d);
-        let (distance, airborne) = sim.with_fleet(|f| f.odometry(d));
-        out.push_str(&format!("{name:<16} {distance:>12.0} {airborne:>12.0} {:>8.0}%  {}\n", t.battery * 100.0, t.state.as_str()));
+        let t = backend.telemetry(d);
+        let (distance, airborne) = match odometry(d) {
+            Some((m, s)) => (format!("{m:.0}"), format!("{s:.0}")),
+            None => ("-".to_owned(), "-".to_owned()),
+        };
+        out.push_str(&format!("{name:<16} {distance:>12} {airborne:>12} {:>8.0}%  {}\n", t.battery * 100.0, t.state.as_str()));
     }
     let signals: Vec<String> = stats.signals.iter().map(|(n, c)| if *c == 1 { n.clone() } else { format!("{n} ×{c}") }).collect();
     out.push_str(&format!("signals: {}\n", if signals.is_empty() { "none".to_string() } else { signals.join(", ") }));

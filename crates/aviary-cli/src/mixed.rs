@@ -1,0 +1,138 @@
+//! A world with MAVLink drones: each drone goes to the backend that flies it, the
+//! simulator (then in real time) or MAVLink, behind one [`Backend`] for the engine.
+
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+
+use aviary_api::{
+    Backend, CallId, Descriptor, DroneEvent, DroneId, Interrupt, PendingCall, Telemetry, Value,
+};
+use aviary_mavlink::MavlinkBackend;
+use aviary_sim::SimBackend;
+use tokio::sync::{mpsc, oneshot};
+
+pub struct Mixed {
+    pub sim: Arc<SimBackend>,
+    pub mavlink: MavlinkBackend,
+    /// The engine's call ids → (by MAVLink, the backend's own id): the two backends
+    /// number their calls independently.
+    calls: Arc<Mutex<BTreeMap<CallId, (bool, CallId)>>>,
+    next: AtomicU64,
+    events: Mutex<Option<mpsc::UnboundedReceiver<DroneEvent>>>,
+}
+
+fn drone_of(event: &DroneEvent) -> DroneId {
+    match event {
+        DroneEvent::Detected { drone, .. }
+        | DroneEvent::Signal { drone, .. }
+        | DroneEvent::Fault { drone, .. } => *drone,
+    }
+}
+
+impl Mixed {
+    /// Call inside the tokio runtime (it starts the task that merges the event streams).
+    pub fn new(sim: Arc<SimBackend>, mavlink: MavlinkBackend) -> Mixed {
+        let (tx, rx) = mpsc::unbounded_channel();
+        let served: Vec<bool> = (0..sim.with_fleet(|f| f.len()))
+            .map(|d| mavlink.serves(d))
+            .collect();
+        if let Some(mut from_sim) = sim.events() {
+            let tx = tx.clone();
+            let served = served.clone();
+            tokio::spawn(async move {
+                while let Some(e) = from_sim.recv().await {
+                    // The simulator also models the MAVLink drones (idle at home): drop
+                    // what it says of them.
+                    if !served.get(drone_of(&e)).copied().unwrap_or(false) && tx.send(e).is_err() {
+                        return;
+                    }
+                }
+            });
+        }
+        if let Some(mut from_mav) = mavlink.events() {
+            tokio::spawn(async move {
+                while let Some(e) = from_mav.recv().await {
+                    if tx.send(e).is_err() {
+                        return;
+                    }
+                }
+            });
+        }
+        Mixed {
+            sim,
+            mavlink,
+            calls: Arc::default(),
+            next: AtomicU64::new(1),
+            events: Mutex::new(Some(rx)),
+        }
+    }
+}
+
+impl Backend for Mixed {
+    fn descriptor(&self) -> Descriptor {
+        aviary_sim::descriptor()
+    }
+
+    fn call(&self, drone: DroneId, function: &str, args: &[Value]) -> PendingCall {
+        let by_mavlink = self.mavlink.serves(drone);
+        let inner = if by_mavlink {
+            self.mavlink.call(drone, function, args)
+        } else {
+            self.sim.call(drone, function, args)
+        };
+        let id = CallId(self.next.fetch_add(1, Ordering::SeqCst));
+        self.calls
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .insert(id, (by_mavlink, inner.id));
+        // Pass the end on, and forget the call once it has ended.
+        let (tx, rx) = oneshot::channel();
+        let calls = Arc::clone(&self.calls);
+        tokio::spawn(async move {
+            let end = inner.end.await;
+            calls.lock().unwrap_or_else(|p| p.into_inner()).remove(&id);
+            if let Ok(end) = end {
+                let _ = tx.send(end);
+            }
+        });
+        PendingCall { id, end: rx }
+    }
+
+    fn interrupt(&self, call: CallId, how: Interrupt) {
+        let Some((by_mavlink, inner)) = self
+            .calls
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .get(&call)
+            .copied()
+        else {
+            return;
+        };
+        if by_mavlink {
+            self.mavlink.interrupt(inner, how);
+        } else {
+            self.sim.interrupt(inner, how);
+        }
+    }
+
+    fn telemetry(&self, drone: DroneId) -> Telemetry {
+        if self.mavlink.serves(drone) {
+            self.mavlink.telemetry(drone)
+        } else {
+            self.sim.telemetry(drone)
+        }
+    }
+
+    fn events(&self) -> Option<mpsc::UnboundedReceiver<DroneEvent>> {
+        self.events.lock().unwrap_or_else(|p| p.into_inner()).take()
+    }
+}
+
+/// The runtime of a run with MAVLink drones: one thread as in a simulated run (the engine
+/// relies on it), but the wall clock and sockets.
+pub fn live_runtime() -> std::io::Result<tokio::runtime::Runtime> {
+    tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+}

@@ -1,0 +1,449 @@
+//! `aviary run` over MAVLink against a real peer: the `aviary vehicles` binary on
+//! loopback (an ephemeral port, read from its first line). Nothing is mocked: both ends
+//! are the programs a user runs, talking MAVLink 2 over TCP.
+//!
+//! The vehicles run at 20 times real time so that the paper's 490 s mission takes about
+//! half a minute; the mission's own waits (none in the paper's mission) run on the wall
+//! clock.
+
+mod common;
+
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use common::{aviary, repo, scratch};
+use serde_json::Value;
+
+/// A running `aviary vehicles`, killed when dropped.
+struct Vehicles {
+    child: Child,
+    port: u16,
+    /// Kept open: the server's later lines must have somewhere to go.
+    _stdout: BufReader<std::process::ChildStdout>,
+}
+
+impl Vehicles {
+    fn start(world: &Path, speed: &str) -> Vehicles {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
+            .args([
+                "vehicles",
+                "--world",
+                &world.to_string_lossy(),
+                "--listen",
+                "tcp:127.0.0.1:0",
+                "--speed",
+                speed,
+            ])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("spawn aviary vehicles");
+        let mut first = String::new();
+        let mut stdout = BufReader::new(child.stdout.take().expect("stdout"));
+        stdout.read_line(&mut first).expect("read the first line");
+        let port = first
+            .trim()
+            .rsplit(':')
+            .next()
+            .and_then(|p| p.parse().ok())
+            .unwrap_or_else(|| panic!("no port in {first:?}"));
+        Vehicles {
+            child,
+            port,
+            _stdout: stdout,
+        }
+    }
+}
+
+impl Drop for Vehicles {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// The world with `mavlink = "tcp:127.0.0.1:PORT"` given to the drones named.
+fn bind(world: &str, port: u16, drones: &[&str]) -> String {
+    let mut out = String::new();
+    for line in world.lines() {
+        out.push_str(line);
+        out.push('\n');
+        let name = line
+            .strip_prefix("[drones.")
+            .and_then(|l| l.strip_suffix(']'));
+        if name.is_some_and(|n| drones.is_empty() || drones.contains(&n)) {
+            out.push_str(&format!("mavlink = \"tcp:127.0.0.1:{port}\"\n"));
+        }
+    }
+    out
+}
+
+/// Runs `aviary run` in `dir`, killed if it takes longer than `limit`.
+fn run_within(dir: &Path, args: &[&str], limit: Duration) -> i32 {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(args)
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("spawn aviary run");
+    let start = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().expect("wait") {
+            return status.code().unwrap_or(-1);
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("aviary run took longer than {limit:?}");
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
+fn events(path: &Path) -> Vec<Value> {
+    std::fs::read_to_string(path)
+        .unwrap_or_default()
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("a JSON line"))
+        .collect()
+}
+
+/// Per event kind and actor, what a trace says, in a form two runs can be compared in:
+/// sorted, because the two runs' timing differs (which body is found first).
+fn facts(trace: &[Value], event: &str, key: &str) -> Vec<(String, String, Vec<f64>)> {
+    let mut out: Vec<(String, String, Vec<f64>)> = trace
+        .iter()
+        .filter(|e| e["event"] == event)
+        .map(|e| {
+            // A detection's location; a call's arguments; where a call ended.
+            let numbers = match e
+                .get("location")
+                .or_else(|| e.get("position"))
+                .or_else(|| e.get("args"))
+            {
+                Some(v) => flatten(v),
+                None => Vec::new(),
+            };
+            (
+                e["actor"].as_str().unwrap_or("").to_owned(),
+                e[key].to_string(),
+                numbers,
+            )
+        })
+        .collect();
+    out.sort_by(|a, b| {
+        (&a.0, &a.1)
+            .cmp(&(&b.0, &b.1))
+            .then(a.2.partial_cmp(&b.2).unwrap_or(std::cmp::Ordering::Equal))
+    });
+    out
+}
+
+fn flatten(v: &Value) -> Vec<f64> {
+    match v {
+        Value::Number(n) => vec![n.as_f64().unwrap_or(0.0)],
+        Value::Array(a) => a.iter().flat_map(flatten).collect(),
+        Value::Object(o) => o.values().flat_map(flatten).collect(),
+        _ => Vec::new(),
+    }
+}
+
+fn agree(
+    what: &str,
+    direct: &[(String, String, Vec<f64>)],
+    mavlink: &[(String, String, Vec<f64>)],
+    tolerance: f64,
+) {
+    assert_eq!(
+        direct.len(),
+        mavlink.len(),
+        "{what}: {direct:?}\nvs\n{mavlink:?}"
+    );
+    for (a, b) in direct.iter().zip(mavlink) {
+        assert_eq!((&a.0, &a.1), (&b.0, &b.1), "{what}");
+        assert_eq!(a.2.len(), b.2.len(), "{what}: {a:?} vs {b:?}");
+        for (x, y) in a.2.iter().zip(&b.2) {
+            assert!((x - y).abs() <= tolerance, "{what}: {a:?} vs {b:?}");
+        }
+    }
+}
+
+#[test]
+fn the_paper_mission_over_mavlink_agrees_with_a_simulated_run() {
+    let dir = scratch("mavlink_paper");
+    let examples = repo().join("examples");
+    let world =
+        std::fs::read_to_string(examples.join("search_and_rescue.world.toml")).expect("world");
+    std::fs::copy(
+        examples.join("search_and_rescue.mission"),
+        dir.join("m.mission"),
+    )
+    .expect("copy");
+    std::fs::write(dir.join("m.world.toml"), &world).expect("world");
+    let (code, _, err) = aviary(
+        &["run", "m.mission", "--quiet", "--trace", "direct.jsonl"],
+        &dir,
+    );
+    assert_eq!(code, 0, "{err}");
+
+    let vehicles = Vehicles::start(&examples.join("search_and_rescue.world.toml"), "20");
+    let live = dir.join("live");
+    std::fs::create_dir_all(&live).expect("dir");
+    std::fs::copy(
+        examples.join("search_and_rescue.mission"),
+        live.join("m.mission"),
+    )
+    .expect("copy");
+    std::fs::write(live.join("m.world.toml"), bind(&world, vehicles.port, &[])).expect("world");
+    let code = run_within(
+        &live,
+        &["run", "m.mission", "--quiet", "--trace", "t.jsonl"],
+        Duration::from_secs(240),
+    );
+    let direct = events(&dir.join("direct.jsonl"));
+    let mavlink = events(&live.join("t.jsonl"));
+    assert_eq!(
+        code,
+        0,
+        "the mission ends ok over MAVLink: {:?}",
+        mavlink.last()
+    );
+    assert_eq!(
+        mavlink.last().map(|e| e["status"].clone()),
+        Some(Value::from("ok"))
+    );
+    // The same signals, the same finds at the same places, the same calls with the
+    // same positions (the beacons fly to where the bodies were found).
+    agree(
+        "signals",
+        &facts(&direct, "signal", "name"),
+        &facts(&mavlink, "signal", "name"),
+        0.0,
+    );
+    agree(
+        "detections",
+        &facts(&direct, "detection", "kind"),
+        &facts(&mavlink, "detection", "kind"),
+        1.0,
+    );
+    agree(
+        "calls",
+        &facts(&direct, "api_call", "function"),
+        &facts(&mavlink, "api_call", "function"),
+        1.0,
+    );
+    // Where each call left its drone: within the arrival tolerances (1 m over the
+    // ground, 0.5 m in height) and the rounding of the reported position.
+    agree(
+        "positions",
+        &facts(&direct, "api_done", "function"),
+        &facts(&mavlink, "api_done", "function"),
+        1.5,
+    );
+    assert!(
+        mavlink.iter().all(|e| e["event"] != "exception"),
+        "no exception over MAVLink"
+    );
+}
+
+const SMALL_MISSION: &str = "\
+MISSION Hold:
+    PARALLEL Both:
+        SEQUENTIAL Real:
+            scout TakeOff WITH 10m
+            scout FlyTo WITH Near
+            scout Hover WITH 60s
+        SEQUENTIAL Simulated:
+            buddy TakeOff WITH 10m
+            buddy FlyTo WITH Far
+            buddy ReturnHome
+";
+
+const SMALL_WORLD: &str = "\
+[site]
+name = \"Loopback field\"
+origin = { lat = 46.6167, lon = 14.2650, alt = 440.0 }
+geofence = [[-100, -100], [100, -100], [100, 100], [-100, 100]]
+
+[places]
+Near = [10, 10]
+Far = [-20, 10]
+
+[drones.scout]
+home = [0, 0]
+
+[drones.buddy]
+home = [10, 0]
+";
+
+#[test]
+fn a_killed_vehicle_raises_connection_lost_within_the_heartbeat_timeout() {
+    let dir = scratch("mavlink_link_loss");
+    std::fs::write(dir.join("vehicles.world.toml"), SMALL_WORLD).expect("world");
+    let mut vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
+    std::fs::write(dir.join("m.mission"), SMALL_MISSION).expect("mission");
+    std::fs::write(
+        dir.join("m.world.toml"),
+        bind(SMALL_WORLD, vehicles.port, &["scout", "buddy"]),
+    )
+    .expect("world");
+    let mut run = Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(["run", "m.mission", "--quiet", "--trace", "t.jsonl"])
+        .current_dir(&dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("spawn aviary run");
+    let trace = dir.join("t.jsonl");
+    let hovering = |e: &Value| e["event"] == "api_call" && e["function"] == "Hover";
+    let start = Instant::now();
+    while !events(&trace).iter().any(hovering) {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "the scout never got to hover: {:?}",
+            events(&trace)
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    vehicles.child.kill().expect("kill the vehicles");
+    let killed = Instant::now();
+    let lost = |e: &Value| e["event"] == "exception" && e["name"] == "ConnectionLost";
+    let exception = loop {
+        if let Some(e) = events(&trace).into_iter().find(lost) {
+            break e;
+        }
+        // The heartbeat timeout is 3 s from the last HEARTBEAT (sent each second); allow
+        // 3 s more for a loaded machine.
+        assert!(
+            killed.elapsed() < Duration::from_secs(6),
+            "no ConnectionLost 6 s after the kill: {:?}",
+            events(&trace)
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let reason = exception["args"][0].as_str().unwrap_or("");
+    assert!(
+        reason.contains("no HEARTBEAT from system 1 for 3.0 s"),
+        "{exception}"
+    );
+    let status = run.wait().expect("wait");
+    assert_eq!(
+        status.code(),
+        Some(1),
+        "unhandled, ConnectionLost fails the mission"
+    );
+}
+
+#[test]
+fn a_mixed_fleet_flies_one_drone_over_mavlink_and_one_simulated() {
+    let dir = scratch("mavlink_mixed");
+    std::fs::write(dir.join("vehicles.world.toml"), SMALL_WORLD).expect("world");
+    let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
+    let mission = SMALL_MISSION.replace("scout Hover WITH 60s", "scout ReturnHome");
+    std::fs::write(dir.join("m.mission"), mission).expect("mission");
+    std::fs::write(
+        dir.join("m.world.toml"),
+        bind(SMALL_WORLD, vehicles.port, &["scout"]),
+    )
+    .expect("world");
+    let code = run_within(
+        &dir,
+        &["run", "m.mission", "--quiet", "--trace", "t.jsonl"],
+        Duration::from_secs(120),
+    );
+    let trace = events(&dir.join("t.jsonl"));
+    assert_eq!(code, 0, "{:?}", trace.last());
+    for actor in ["scout", "buddy"] {
+        let done: Vec<&str> = trace
+            .iter()
+            .filter(|e| e["event"] == "api_done" && e["actor"] == actor)
+            .filter_map(|e| e["function"].as_str())
+            .collect();
+        assert_eq!(
+            done,
+            ["Arm", "TakeOff", "FlyToPosition", "ReturnToLaunch"],
+            "{actor}: {trace:?}"
+        );
+    }
+}
+
+#[test]
+fn an_unreachable_vehicle_is_a_clear_error() {
+    let dir = scratch("mavlink_unreachable");
+    // Port 1 on loopback: nothing listens there.
+    std::fs::write(dir.join("m.world.toml"), bind(SMALL_WORLD, 1, &["scout"])).expect("world");
+    std::fs::write(dir.join("m.mission"), SMALL_MISSION).expect("mission");
+    let (code, _, err) = aviary(&["run", "m.mission", "--quiet"], &dir);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("cannot reach the MAVLink address `tcp:127.0.0.1:1`"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_vehicles_and_speed_arguments_are_usage_errors() {
+    let dir = scratch("mavlink_usage");
+    std::fs::write(dir.join("w.world.toml"), SMALL_WORLD).expect("world");
+    let (code, _, err) = aviary(
+        &[
+            "vehicles",
+            "--world",
+            "w.world.toml",
+            "--listen",
+            "carrier-pigeon",
+        ],
+        &dir,
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("`carrier-pigeon` is not an address to listen on"),
+        "{err}"
+    );
+    let (code, _, err) = aviary(
+        &[
+            "vehicles",
+            "--world",
+            "w.world.toml",
+            "--listen",
+            "tcp:127.0.0.1:0",
+            "--speed",
+            "0",
+        ],
+        &dir,
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--speed must be a positive number"), "{err}");
+    std::fs::write(
+        dir.join("bad.world.toml"),
+        "[drones.a]\nhome = [0, 0]\nmavlink = \"udp:127.0.0.1:99999\"\n",
+    )
+    .expect("world");
+    let (code, _, err) = aviary(
+        &[
+            "vehicles",
+            "--world",
+            "bad.world.toml",
+            "--listen",
+            "tcp:127.0.0.1:0",
+        ],
+        &dir,
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("bad.world.toml:3:11: error[E119]") && err.contains("99999"),
+        "{err}"
+    );
+    // MAVLink drones fly in real time: --speed is refused, before any connection.
+    std::fs::write(dir.join("m.world.toml"), bind(SMALL_WORLD, 1, &["scout"])).expect("world");
+    std::fs::write(dir.join("m.mission"), SMALL_MISSION).expect("mission");
+    let (code, _, err) = aviary(&["run", "m.mission", "--speed", "10"], &dir);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("MAVLink drones, which fly in real time: leave out --speed"),
+        "{err}"
+    );
+}

@@ -1,0 +1,329 @@
+//! [`MavlinkBackend`]: the engine's [`Backend`] over MAVLink. Each call runs as a tokio
+//! task of MAVLink exchanges; a watchdog turns a silent vehicle into `ConnectionLost`
+//! (and its return into `ConnectionRestored`), and an RTL or LAND the autopilot chose by
+//! itself into the matching exception. A fault ends the drone's calls `Interrupted`.
+
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::Duration;
+
+use aviary_api::{
+    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Failure, FlightState, Interrupt,
+    PendingCall, Telemetry, Value,
+};
+use aviary_world::Sensor;
+use tokio::sync::{mpsc, oneshot, watch};
+use tokio::task::AbortHandle;
+
+use crate::craft::{failed, Craft, Doing};
+use crate::flight;
+
+struct Slot {
+    drone: DroneId,
+    task: AbortHandle,
+    paused: watch::Sender<bool>,
+    end: oneshot::Sender<CallEnd>,
+}
+
+pub(crate) struct Inner {
+    pub crafts: Vec<Option<Arc<Craft>>>,
+    pub sensors: Vec<Sensor>,
+    calls: Mutex<BTreeMap<CallId, Slot>>,
+    next: AtomicU64,
+    pub events: mpsc::UnboundedSender<DroneEvent>,
+    taken: Mutex<Option<mpsc::UnboundedReceiver<DroneEvent>>>,
+    lost: Mutex<Vec<bool>>,
+    /// Per drone: `BatteryLow` signalled, `BatteryCritical` raised (each once).
+    battery: Mutex<Vec<(bool, bool)>>,
+}
+
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// MAVLink drones as a [`Backend`]. Drones of the world that are not MAVLink drones are
+/// not served here (calls on them fail); `aviary run` sends those to the simulator.
+pub struct MavlinkBackend {
+    inner: Arc<Inner>,
+}
+
+impl MavlinkBackend {
+    pub(crate) fn new(
+        crafts: Vec<Option<Arc<Craft>>>,
+        sensors: Vec<Sensor>,
+        events: (
+            mpsc::UnboundedSender<DroneEvent>,
+            mpsc::UnboundedReceiver<DroneEvent>,
+        ),
+        alarms: mpsc::UnboundedReceiver<(DroneId, Failure)>,
+        heartbeat_timeout: Duration,
+    ) -> MavlinkBackend {
+        let n = crafts.len();
+        let inner = Arc::new(Inner {
+            crafts,
+            sensors,
+            calls: Mutex::new(BTreeMap::new()),
+            next: AtomicU64::new(1),
+            events: events.0,
+            taken: Mutex::new(Some(events.1)),
+            lost: Mutex::new(vec![false; n]),
+            battery: Mutex::new(vec![(false, false); n]),
+        });
+        tokio::spawn(alarms_task(Arc::downgrade(&inner), alarms));
+        tokio::spawn(watchdog(Arc::downgrade(&inner), heartbeat_timeout));
+        MavlinkBackend { inner }
+    }
+
+    /// Whether `drone` is one of this backend's.
+    pub fn serves(&self, drone: DroneId) -> bool {
+        self.inner.crafts.get(drone).is_some_and(Option::is_some)
+    }
+
+    /// Metres flown and seconds in the air, from the track the drone reported.
+    pub fn odometry(&self, drone: DroneId) -> Option<(f64, f64)> {
+        let c = self.inner.crafts.get(drone)?.as_ref()?;
+        let seen = c.v.seen();
+        Some((seen.odometer, seen.flight_time))
+    }
+
+    /// Whether the video stream is on, and what the drone carries.
+    pub fn payload_state(&self, drone: DroneId) -> Option<(bool, Option<String>)> {
+        let c = self.inner.crafts.get(drone)?.as_ref()?;
+        Some((c.streaming(), lock(&c.carrying).clone()))
+    }
+}
+
+impl Inner {
+    fn finish(&self, call: CallId, end: CallEnd) {
+        if let Some(slot) = lock(&self.calls).remove(&call) {
+            let _ = slot.end.send(end);
+        }
+    }
+
+    /// A fault: the event first, then every call of the drone ends `Interrupted` (so the
+    /// engine raises one exception, once).
+    fn fault(&self, drone: DroneId, failure: Failure) {
+        if failure.exception == "BatteryCritical" {
+            // The rule below and the autopilot's battery failsafe may both see it: one
+            // fault, one exception.
+            let mut flags = lock(&self.battery);
+            if flags[drone].1 {
+                return;
+            }
+            flags[drone].1 = true;
+        }
+        let _ = self.events.send(DroneEvent::Fault { drone, failure });
+        let cut: Vec<Slot> = {
+            let mut calls = lock(&self.calls);
+            let ids: Vec<CallId> = calls
+                .iter()
+                .filter(|(_, s)| s.drone == drone)
+                .map(|(id, _)| *id)
+                .collect();
+            ids.into_iter().filter_map(|id| calls.remove(&id)).collect()
+        };
+        for slot in cut {
+            slot.task.abort();
+            let _ = slot.end.send(CallEnd::Interrupted);
+        }
+        if let Some(Some(c)) = self.crafts.get(drone) {
+            c.set_doing(Doing::Other);
+        }
+    }
+}
+
+impl Inner {
+    /// RUNTIME.md's battery rule, on the charge the vehicle reports: with `need` the share
+    /// of a full battery it takes to fly home at `max_speed` and descend at `climb_rate`,
+    /// `BatteryLow` under `2 × need + 10 %`, `BatteryCritical` under `need + 10 %`.
+    fn battery_rule(&self, drone: DroneId, c: &Craft) {
+        let (fix, battery) = {
+            let seen = c.v.seen();
+            (seen.fix, seen.battery)
+        };
+        let (Some(fix), Some(battery)) = (fix, battery) else {
+            return;
+        };
+        if !c.state().airborne() {
+            return;
+        }
+        let home = aviary_api::geometry::dist([fix.pos[0], fix.pos[1]], c.home);
+        let need = (home / c.max_speed + fix.pos[2].max(0.0) / c.climb_rate) / c.endurance;
+        let (low, critical) = lock(&self.battery)[drone];
+        if !low && battery < 2.0 * need + 0.10 {
+            lock(&self.battery)[drone].0 = true;
+            let _ = self.events.send(DroneEvent::Signal {
+                drone,
+                name: "BatteryLow",
+            });
+        }
+        if !critical && battery < need + 0.10 {
+            let reason = format!(
+                "{}: {:.0}% left, about what it needs to get home",
+                c.name,
+                battery * 100.0
+            );
+            self.fault(
+                drone,
+                Failure {
+                    exception: "BatteryCritical",
+                    reason,
+                },
+            );
+        }
+    }
+}
+
+async fn alarms_task(
+    inner: std::sync::Weak<Inner>,
+    mut alarms: mpsc::UnboundedReceiver<(DroneId, Failure)>,
+) {
+    while let Some((drone, failure)) = alarms.recv().await {
+        let Some(inner) = inner.upgrade() else { return };
+        inner.fault(drone, failure);
+    }
+}
+
+/// HEARTBEAT watchdog: none for `limit` → `ConnectionLost`; the first one after →
+/// `ConnectionRestored`.
+async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
+    let mut every = tokio::time::interval(Duration::from_millis(100));
+    loop {
+        every.tick().await;
+        let Some(inner) = inner.upgrade() else { return };
+        let now = tokio::time::Instant::now();
+        for (drone, craft) in inner.crafts.iter().enumerate() {
+            let Some(c) = craft else { continue };
+            inner.battery_rule(drone, c);
+            let fresh =
+                c.v.seen()
+                    .heartbeat
+                    .is_some_and(|t| now.duration_since(t) < limit);
+            let was_lost = lock(&inner.lost)[drone];
+            if was_lost == fresh {
+                lock(&inner.lost)[drone] = !fresh;
+                if fresh {
+                    let _ = inner.events.send(DroneEvent::Signal {
+                        drone,
+                        name: "ConnectionRestored",
+                    });
+                } else {
+                    let reason = format!(
+                        "{}: no HEARTBEAT from system {} for {:.1} s on {}",
+                        c.name,
+                        c.v.system,
+                        limit.as_secs_f64(),
+                        c.link.address
+                    );
+                    inner.fault(
+                        drone,
+                        Failure {
+                            exception: "ConnectionLost",
+                            reason,
+                        },
+                    );
+                }
+            }
+        }
+    }
+}
+
+impl Backend for MavlinkBackend {
+    fn descriptor(&self) -> Descriptor {
+        Descriptor::standard()
+    }
+
+    fn call(&self, drone: DroneId, function: &str, args: &[Value]) -> PendingCall {
+        let id = CallId(self.inner.next.fetch_add(1, Ordering::SeqCst));
+        let (tx, rx) = oneshot::channel();
+        let Some(Some(craft)) = self.inner.crafts.get(drone).cloned() else {
+            let _ = tx.send(CallEnd::Failed(failed(format!(
+                "drone number {drone} is not a MAVLink drone"
+            ))));
+            return PendingCall { id, end: rx };
+        };
+        if lock(&self.inner.lost)[drone] {
+            let _ = tx.send(CallEnd::Failed(failed(format!(
+                "no link to {}",
+                craft.name
+            ))));
+            return PendingCall { id, end: rx };
+        }
+        let (paused_tx, paused_rx) = watch::channel(false);
+        let inner = Arc::clone(&self.inner);
+        let function = function.to_owned();
+        let args = args.to_vec();
+        // Hold the table while spawning, so that a call that ends at once finds its slot.
+        let mut calls = lock(&self.inner.calls);
+        let task = tokio::spawn(async move {
+            let end = match flight::run(&craft, &function, &args, paused_rx, &inner.sensors).await {
+                Ok(()) => CallEnd::Done,
+                Err(failure) => CallEnd::Failed(failure),
+            };
+            inner.finish(id, end);
+        });
+        calls.insert(
+            id,
+            Slot {
+                drone,
+                task: task.abort_handle(),
+                paused: paused_tx,
+                end: tx,
+            },
+        );
+        PendingCall { id, end: rx }
+    }
+
+    fn interrupt(&self, call: CallId, how: Interrupt) {
+        match how {
+            Interrupt::Abort => {
+                let Some(slot) = lock(&self.inner.calls).remove(&call) else {
+                    return;
+                };
+                slot.task.abort();
+                if let Some(Some(c)) = self.inner.crafts.get(slot.drone).cloned() {
+                    c.set_doing(Doing::Other);
+                    // The drone stops where it is and hovers (the task that flew it is gone).
+                    if c.state().airborne() {
+                        tokio::spawn(async move { c.hold().await });
+                    }
+                }
+                let _ = slot.end.send(CallEnd::Interrupted);
+            }
+            Interrupt::Pause | Interrupt::Resume => {
+                if let Some(slot) = lock(&self.inner.calls).get(&call) {
+                    let _ = slot.paused.send(how == Interrupt::Pause);
+                }
+            }
+        }
+    }
+
+    fn telemetry(&self, drone: DroneId) -> Telemetry {
+        let Some(Some(c)) = self.inner.crafts.get(drone) else {
+            return Telemetry {
+                position: [0.0; 3],
+                speed: 0.0,
+                heading: 0.0,
+                battery: 0.0,
+                state: FlightState::Lost,
+                link: false,
+            };
+        };
+        let state = c.state();
+        let seen = c.v.seen();
+        let fix = seen.fix;
+        Telemetry {
+            position: fix.map_or([c.home[0], c.home[1], 0.0], |f| f.pos),
+            speed: fix.map_or(0.0, |f| f.speed),
+            heading: fix.map_or(0.0, |f| f.heading),
+            battery: seen.battery.unwrap_or(1.0),
+            state,
+            link: !lock(&self.inner.lost)[drone],
+        }
+    }
+
+    fn events(&self) -> Option<mpsc::UnboundedReceiver<DroneEvent>> {
+        lock(&self.inner.taken).take()
+    }
+}

@@ -1,0 +1,340 @@
+//! One MAVLink drone of the world and the protocol steps every function is made of:
+//! commands with ACK, retries and the autopilot's reason; mode changes confirmed by
+//! HEARTBEAT; position targets; waits that always end.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use aviary_api::{Failure, FlightState};
+use mavlink::dialects::ardupilotmega::{
+    MavCmd, MavFrame, MavMessage, MavModeFlag, MavResult, PositionTargetTypemask, COMMAND_INT_DATA,
+    COMMAND_LONG_DATA, SET_POSITION_TARGET_GLOBAL_INT_DATA,
+};
+use tokio::sync::watch;
+use tokio::time::Instant;
+
+use crate::link::Link;
+use crate::mode::{self, Flavour, Mode};
+use crate::vehicle::{Fix, Vehicle};
+use crate::Tuning;
+
+/// What a drone does now, for telemetry's `state` (the autopilot reports only armed,
+/// mode and height, so the call in progress says whether it is taking off or landing).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Doing {
+    Other,
+    TakingOff,
+    Landing,
+}
+
+pub struct Craft {
+    pub name: String,
+    pub link: Arc<Link>,
+    pub v: Arc<Vehicle>,
+    pub max_speed: f64,
+    pub climb_rate: f64,
+    /// Seconds of flight on a full battery (the world's), for the battery alarms.
+    pub endurance: f64,
+    pub home: [f64; 2],
+    pub sensors: Vec<String>,
+    pub payload: Vec<String>,
+    pub fence: Option<Vec<[f64; 2]>>,
+    pub max_altitude: Option<f64>,
+    pub streaming: AtomicBool,
+    pub carrying: Mutex<Option<String>>,
+    pub doing: Mutex<Doing>,
+    /// The ground speed last set with DO_CHANGE_SPEED.
+    pub speed: Mutex<Option<f64>>,
+    /// The altitude last commanded: a flight without one keeps it (as the simulator's
+    /// drones do), not the height reported on the way up to it.
+    pub level: Mutex<Option<f64>>,
+    pub tuning: Tuning,
+}
+
+pub fn failed(reason: impl Into<String>) -> Failure {
+    Failure {
+        exception: "CommandFailed",
+        reason: reason.into(),
+    }
+}
+
+pub fn timeout(reason: impl Into<String>) -> Failure {
+    Failure {
+        exception: "Timeout",
+        reason: reason.into(),
+    }
+}
+
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+impl Craft {
+    pub fn fix(&self) -> Option<Fix> {
+        self.v.seen().fix
+    }
+
+    /// The altitude a flight without one keeps.
+    pub fn level(&self) -> f64 {
+        lock(&self.level)
+            .or_else(|| self.fix().map(|f| f.pos[2]))
+            .unwrap_or(f64::NAN)
+    }
+
+    pub fn set_level(&self, z: Option<f64>) {
+        *lock(&self.level) = z;
+    }
+
+    pub fn set_doing(&self, doing: Doing) {
+        *lock(&self.doing) = doing;
+    }
+
+    pub fn state(&self) -> FlightState {
+        let seen = self.v.seen();
+        let z = seen.fix.map_or(0.0, |f| f.pos[2]);
+        match *lock(&self.doing) {
+            _ if !seen.armed => FlightState::Landed,
+            Doing::TakingOff => FlightState::TakingOff,
+            Doing::Landing => FlightState::Landing,
+            Doing::Other if z < 0.3 => FlightState::Landed,
+            Doing::Other => FlightState::Flying,
+        }
+    }
+
+    pub fn streaming(&self) -> bool {
+        self.streaming.load(Ordering::SeqCst)
+    }
+
+    /// COMMAND_LONG with ACK: resent (with `confirmation` counting up) when no ACK comes,
+    /// refused with the autopilot's STATUSTEXT as the reason.
+    pub async fn command(&self, command: MavCmd, p: [f32; 7]) -> Result<(), Failure> {
+        self.command_with(command, |confirmation| {
+            MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
+                param1: p[0],
+                param2: p[1],
+                param3: p[2],
+                param4: p[3],
+                param5: p[4],
+                param6: p[5],
+                param7: p[6],
+                command,
+                target_system: self.v.system,
+                target_component: 1,
+                confirmation,
+            })
+        })
+        .await
+    }
+
+    /// COMMAND_INT (positions as degrees × 10⁷ in a relative-altitude frame), with ACK.
+    pub async fn command_int(
+        &self,
+        command: MavCmd,
+        p: [f32; 4],
+        lat: i32,
+        lon: i32,
+        z: f32,
+    ) -> Result<(), Failure> {
+        self.command_with(command, |_| {
+            MavMessage::COMMAND_INT(COMMAND_INT_DATA {
+                param1: p[0],
+                param2: p[1],
+                param3: p[2],
+                param4: p[3],
+                x: lat,
+                y: lon,
+                z,
+                command,
+                target_system: self.v.system,
+                target_component: 1,
+                frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+                current: 0,
+                autocontinue: 0,
+            })
+        })
+        .await
+    }
+
+    async fn command_with(
+        &self,
+        command: MavCmd,
+        msg: impl Fn(u8) -> MavMessage,
+    ) -> Result<(), Failure> {
+        let started = Instant::now();
+        for attempt in 0..self.tuning.command_tries {
+            let ack = self.v.expect_ack(command);
+            self.link.send(&msg(attempt)).await;
+            match tokio::time::timeout(self.tuning.ack_timeout, ack).await {
+                Ok(Ok(MavResult::MAV_RESULT_ACCEPTED)) => return Ok(()),
+                Ok(Ok(result)) => {
+                    // The reason usually comes just before the ACK; give a late one a moment.
+                    tokio::time::sleep(Duration::from_millis(50)).await;
+                    let why = self
+                        .v
+                        .texts_since(started)
+                        .unwrap_or_else(|| "no reason given".into());
+                    return Err(failed(format!(
+                        "{} refused {command:?} ({result:?}): {why}",
+                        self.name
+                    )));
+                }
+                _ => continue,
+            }
+        }
+        Err(timeout(format!(
+            "{} did not acknowledge {command:?} after {} tries ({} s each) on {}",
+            self.name,
+            self.tuning.command_tries,
+            self.tuning.ack_timeout.as_secs_f64(),
+            self.link.address
+        )))
+    }
+
+    /// Waits (polling the last messages) until `done` holds, or fails after `limit`.
+    pub async fn wait_for(
+        &self,
+        limit: Duration,
+        what: &str,
+        mut done: impl FnMut(&Craft) -> bool,
+    ) -> Result<(), Failure> {
+        let deadline = Instant::now() + limit;
+        loop {
+            if done(self) {
+                return Ok(());
+            }
+            if Instant::now() >= deadline {
+                return Err(timeout(format!(
+                    "{}: {what} took longer than {:.0} s",
+                    self.name,
+                    limit.as_secs_f64()
+                )));
+            }
+            tokio::time::sleep(self.tuning.poll).await;
+        }
+    }
+
+    /// Waits until the autopilot is ready (MAV_STATE_STANDBY, ACTIVE, or CRITICAL: up but
+    /// in a failsafe, which arming will then report): a mode change sent while it boots is
+    /// ignored by ArduPilot. (ArduCopter on the ground already says STANDBY while it
+    /// initialises, so `set_mode` also checks HEARTBEAT and asks again.)
+    pub async fn ready(&self) -> Result<(), Failure> {
+        use mavlink::dialects::ardupilotmega::MavState::{
+            MAV_STATE_ACTIVE, MAV_STATE_CRITICAL, MAV_STATE_STANDBY,
+        };
+        self.wait_for(
+            self.tuning.ready_timeout,
+            "waiting for the autopilot to be ready (MAV_STATE_STANDBY)",
+            |c| {
+                matches!(
+                    c.v.seen().status,
+                    Some(MAV_STATE_STANDBY | MAV_STATE_ACTIVE | MAV_STATE_CRITICAL)
+                )
+            },
+        )
+        .await
+    }
+
+    /// Switches to `mode` and waits until HEARTBEAT shows it, asking again if it does not.
+    pub async fn set_mode(&self, want: Mode) -> Result<(), Failure> {
+        let flavour = self.v.flavour();
+        let Some((p2, p3)) = mode::set_mode_params(flavour, want) else {
+            return Err(failed(format!("{}: no such mode", self.name)));
+        };
+        self.v.seen().expected = Some(want);
+        let is = |c: &Craft| mode::classify(flavour, c.v.seen().custom_mode) == want;
+        for _ in 0..self.tuning.command_tries {
+            if is(self) {
+                return Ok(());
+            }
+            let custom = MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED.bits() as f32;
+            self.command(
+                MavCmd::MAV_CMD_DO_SET_MODE,
+                [custom, p2, p3, 0.0, 0.0, 0.0, 0.0],
+            )
+            .await?;
+            if self.wait_for(Duration::from_secs(3), "", is).await.is_ok() {
+                return Ok(());
+            }
+        }
+        Err(failed(format!(
+            "{}: the autopilot accepted {want:?} mode but did not switch to it",
+            self.name
+        )))
+    }
+
+    /// Sets the ground speed (only when it changes: each is a command with an ACK).
+    pub async fn speed(&self, speed: f64) -> Result<(), Failure> {
+        if lock(&self.speed).is_some_and(|s| (s - speed).abs() < 1e-6) {
+            return Ok(());
+        }
+        self.command(
+            MavCmd::MAV_CMD_DO_CHANGE_SPEED,
+            [1.0, speed as f32, -1.0, 0.0, 0.0, 0.0, 0.0],
+        )
+        .await?;
+        *lock(&self.speed) = Some(speed);
+        Ok(())
+    }
+
+    /// Sends a position target (local metres, z above home). ArduPilot takes
+    /// SET_POSITION_TARGET_GLOBAL_INT in GUIDED; PX4 takes DO_REPOSITION in HOLD.
+    pub async fn target(&self, to: [f64; 3]) -> Result<(), Failure> {
+        let (lat, lon) = self.v.origin().to_e7(to[0], to[1]);
+        match self.v.flavour() {
+            Flavour::Px4 => {
+                // -1: keep the default speed; bit 0 of param2: switch to the reposition mode.
+                self.command_int(
+                    MavCmd::MAV_CMD_DO_REPOSITION,
+                    [-1.0, 1.0, 0.0, f32::NAN],
+                    lat,
+                    lon,
+                    to[2] as f32,
+                )
+                .await
+            }
+            Flavour::ArduPilot => {
+                let ignore = PositionTargetTypemask::POSITION_TARGET_TYPEMASK_VX_IGNORE
+                    | PositionTargetTypemask::POSITION_TARGET_TYPEMASK_VY_IGNORE
+                    | PositionTargetTypemask::POSITION_TARGET_TYPEMASK_VZ_IGNORE
+                    | PositionTargetTypemask::POSITION_TARGET_TYPEMASK_AX_IGNORE
+                    | PositionTargetTypemask::POSITION_TARGET_TYPEMASK_AY_IGNORE
+                    | PositionTargetTypemask::POSITION_TARGET_TYPEMASK_AZ_IGNORE
+                    | PositionTargetTypemask::POSITION_TARGET_TYPEMASK_YAW_IGNORE
+                    | PositionTargetTypemask::POSITION_TARGET_TYPEMASK_YAW_RATE_IGNORE;
+                let msg = MavMessage::SET_POSITION_TARGET_GLOBAL_INT(
+                    SET_POSITION_TARGET_GLOBAL_INT_DATA {
+                        time_boot_ms: 0,
+                        lat_int: lat,
+                        lon_int: lon,
+                        alt: to[2] as f32,
+                        vx: 0.0,
+                        vy: 0.0,
+                        vz: 0.0,
+                        afx: 0.0,
+                        afy: 0.0,
+                        afz: 0.0,
+                        yaw: 0.0,
+                        yaw_rate: 0.0,
+                        type_mask: ignore,
+                        target_system: self.v.system,
+                        target_component: 1,
+                        coordinate_frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+                    },
+                );
+                self.link.send(&msg).await;
+                Ok(())
+            }
+        }
+    }
+
+    /// Holds where the drone is (for PAUSE and ABORT).
+    pub async fn hold(&self) {
+        if let Some(fix) = self.fix() {
+            let _ = self.target(fix.pos).await;
+        }
+    }
+}
+
+/// The engine's PAUSE/RESUME for one call: `true` while paused.
+pub type Paused = watch::Receiver<bool>;

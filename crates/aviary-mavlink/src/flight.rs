@@ -1,0 +1,255 @@
+//! The middle-layer functions (LANGUAGE.md §4) as MAVLink exchanges. Every wait has a
+//! limit, from the tuning or from the distance to fly, so a silent vehicle ends a call
+//! with `Timeout` and never hangs the mission.
+
+use aviary_api::geometry::centroid;
+use aviary_api::{Failure, Value};
+use mavlink::dialects::ardupilotmega::MavCmd;
+
+use crate::craft::{failed, Craft, Paused};
+use crate::motion::{arm, fly, here, hover, land, orbit, rtl, take_off};
+use crate::vehicle::Activation;
+
+/// Seconds `LoadPayload` waits after closing the gripper, as the simulator does.
+pub const LOAD_TIME: f64 = 2.0;
+
+/// Runs one call to its end.
+pub async fn run(
+    c: &Craft,
+    function: &str,
+    args: &[Value],
+    paused: Paused,
+    sensors: &[aviary_world::Sensor],
+) -> Result<(), Failure> {
+    match function {
+        "Arm" => arm(c).await,
+        "Disarm" => {
+            if c.state().airborne() {
+                return Err(failed(format!("{} can only disarm on the ground", c.name)));
+            }
+            c.command(MavCmd::MAV_CMD_COMPONENT_ARM_DISARM, [0.0; 7])
+                .await?;
+            c.wait_for(c.tuning.ready_timeout, "disarming", |c| !c.v.seen().armed)
+                .await
+        }
+        "TakeOff" => take_off(c, number(args, 0, "alt")?, paused).await,
+        "Land" => land(c).await,
+        "ReturnToLaunch" => rtl(c).await,
+        "FlyToPosition" => {
+            let to = point(c, args.first(), "pos")?;
+            let speed = match args.get(1) {
+                Some(Value::Number(s)) if *s > 0.0 => s.min(c.max_speed),
+                Some(other) => {
+                    return Err(failed(format!(
+                        "`speed` must be above 0 m/s, not {other:?}"
+                    )))
+                }
+                None => c.max_speed,
+            };
+            fly(c, &[to], speed, paused).await
+        }
+        "DescendTo" | "AscendTo" => {
+            let here = here(c)?;
+            fly(
+                c,
+                &[[here[0], here[1], number(args, 0, "alt")?]],
+                c.max_speed,
+                paused,
+            )
+            .await
+        }
+        "Hover" => hover(number(args, 0, "duration")?, paused).await,
+        "Orbit" => {
+            let center = point(c, args.first(), "center")?;
+            let radius = number(args, 1, "radius")?;
+            let laps = match args.get(2) {
+                Some(_) => number(args, 2, "laps")?,
+                None => 1.0,
+            };
+            if radius <= 0.0 || laps <= 0.0 {
+                return Err(failed(format!(
+                    "an orbit needs a radius and laps above 0 (got {radius} m, {laps})"
+                )));
+            }
+            let here = here(c)?;
+            fly(
+                c,
+                &orbit(
+                    here,
+                    [center[0], center[1]],
+                    radius,
+                    laps,
+                    c.tuning.arrive_xy,
+                ),
+                c.max_speed,
+                paused,
+            )
+            .await
+        }
+        "Sweep" => {
+            let Some(Value::Area(area)) = args.first() else {
+                return Err(failed("`area` must be an area"));
+            };
+            let spacing = number(args, 1, "spacing")?;
+            if spacing <= 0.0 {
+                return Err(failed(format!(
+                    "sweep spacing must be above 0 m, not {spacing} m"
+                )));
+            }
+            here(c)?;
+            let z = c.level();
+            let path: Vec<[f64; 3]> = aviary_sim::sweep::lawnmower(area, spacing)
+                .into_iter()
+                .map(|p| [p[0], p[1], z])
+                .collect();
+            fly(c, &path, c.max_speed, paused).await
+        }
+        "FollowPath" => {
+            here(c)?;
+            let mut z = c.level();
+            let mut path = Vec::new();
+            for v in args {
+                let p = point(c, Some(v), "points")?;
+                if !p[2].is_nan() {
+                    z = p[2];
+                }
+                path.push([p[0], p[1], z]);
+            }
+            fly(c, &path, c.max_speed, paused).await
+        }
+        "StartStreaming" | "StopStreaming" => {
+            // Video is not carried over MAVLink: this records the state a mission reads.
+            if !c.sensors.iter().any(|s| s == "camera") {
+                return Err(failed(format!("{} has no camera", c.name)));
+            }
+            c.streaming.store(
+                function == "StartStreaming",
+                std::sync::atomic::Ordering::SeqCst,
+            );
+            Ok(())
+        }
+        "StartDetection" | "StopDetection" => {
+            detection(c, function == "StartDetection", args, sensors)
+        }
+        "LoadPayload" => load(c, args, paused).await,
+        "ReleasePayload" => {
+            if c.carrying
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .is_none()
+            {
+                return Err(failed(format!("{} carries nothing to release", c.name)));
+            }
+            c.command(
+                MavCmd::MAV_CMD_DO_GRIPPER,
+                [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+            )
+            .await?;
+            *c.carrying.lock().unwrap_or_else(|p| p.into_inner()) = None;
+            Ok(())
+        }
+        other => Err(failed(format!("{} cannot do {other} over MAVLink", c.name))),
+    }
+}
+
+fn number(args: &[Value], i: usize, name: &str) -> Result<f64, Failure> {
+    match args.get(i) {
+        Some(Value::Number(n)) if n.is_finite() => Ok(*n),
+        other => Err(failed(format!(
+            "`{name}` must be a finite number, not {other:?}"
+        ))),
+    }
+}
+
+/// A position argument in local metres; z is NaN when it has none (keep the altitude).
+fn point(c: &Craft, v: Option<&Value>, name: &str) -> Result<[f64; 3], Failure> {
+    let here_z = c.level();
+    match v {
+        Some(Value::Position(p)) if p.x.is_finite() && p.y.is_finite() => Ok([
+            p.x,
+            p.y,
+            p.z.unwrap_or(if name == "points" { f64::NAN } else { here_z }),
+        ]),
+        Some(Value::Area(a)) if !a.is_empty() => {
+            let m = centroid(a);
+            Ok([m[0], m[1], if name == "points" { f64::NAN } else { here_z }])
+        }
+        other => Err(failed(format!(
+            "`{name}` must be a position, not {other:?}"
+        ))),
+    }
+}
+
+fn detection(
+    c: &Craft,
+    start: bool,
+    args: &[Value],
+    sensors: &[aviary_world::Sensor],
+) -> Result<(), Failure> {
+    let kind = match args.first() {
+        Some(Value::Symbol(s) | Value::Text(s)) => s.clone(),
+        other => {
+            return Err(failed(format!(
+                "`kind` must be a kind such as Body, not {other:?}"
+            )))
+        }
+    };
+    let range = sensors
+        .iter()
+        .filter(|s| c.sensors.contains(&s.kind) && s.detects.contains(&kind))
+        .map(|s| s.range)
+        .reduce(f64::max)
+        .ok_or_else(|| failed(format!("{} has no sensor that detects {kind}", c.name)))?;
+    let n = c.v.target_count();
+    let mut seen = c.v.seen();
+    seen.detecting.retain(|a| a.kind != kind);
+    if start {
+        seen.detecting.push(Activation {
+            kind,
+            range,
+            found: vec![false; n],
+        });
+    }
+    Ok(())
+}
+
+/// Closes the gripper (MAV_CMD_DO_GRIPPER grab) and gives the crew `LOAD_TIME` to hook on.
+async fn load(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
+    let kind = match args.first() {
+        Some(Value::Symbol(s) | Value::Text(s)) => s.clone(),
+        other => {
+            return Err(failed(format!(
+                "`kind` must be a kind such as Body, not {other:?}"
+            )))
+        }
+    };
+    if !c.payload.contains(&kind) {
+        return Err(failed(format!("{} cannot carry {kind}", c.name)));
+    }
+    if let Some(held) = c
+        .carrying
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .as_ref()
+    {
+        return Err(failed(format!(
+            "{} already carries {held}: release it first",
+            c.name
+        )));
+    }
+    let z = c.fix().map_or(0.0, |f| f.pos[2]);
+    if c.state().airborne() && z >= 5.0 {
+        return Err(failed(format!(
+            "{} is at {z:.1} m: load while landed or below 5 m",
+            c.name
+        )));
+    }
+    c.command(
+        MavCmd::MAV_CMD_DO_GRIPPER,
+        [1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    )
+    .await?;
+    hover(LOAD_TIME, paused).await?;
+    *c.carrying.lock().unwrap_or_else(|p| p.into_inner()) = Some(kind);
+    Ok(())
+}

@@ -1,0 +1,279 @@
+//! The flight itself: arming, take-off, landing, return and flying through points,
+//! each confirmed by what the vehicle reports and bounded in time.
+
+use std::time::Duration;
+
+use aviary_api::geometry::{contains, dist};
+use aviary_api::Failure;
+use mavlink::dialects::ardupilotmega::MavCmd;
+use tokio::time::Instant;
+
+use crate::craft::{failed, timeout, Craft, Doing, Paused};
+use crate::mode::Mode;
+
+/// Legs an orbit is flown in, per lap.
+const ORBIT_POINTS: usize = 24;
+
+pub(crate) fn here(c: &Craft) -> Result<[f64; 3], Failure> {
+    c.fix()
+        .map(|f| f.pos)
+        .ok_or_else(|| failed(format!("{} has reported no position yet", c.name)))
+}
+
+pub(crate) fn in_air(c: &Craft) -> Result<(), Failure> {
+    if c.state().airborne() {
+        Ok(())
+    } else {
+        Err(failed(format!(
+            "{} is on the ground: take off first",
+            c.name
+        )))
+    }
+}
+
+/// Ready, GUIDED, then ARM, asked again while the pre-arm checks still fail (GPS and EKF
+/// take about 40 s on a fresh ArduCopter), and confirmed by HEARTBEAT.
+pub(crate) async fn arm(c: &Craft) -> Result<(), Failure> {
+    if c.v.seen().armed {
+        return Ok(());
+    }
+    c.ready().await?;
+    c.set_mode(Mode::Guided).await?;
+    let deadline = Instant::now() + c.tuning.arm_timeout;
+    loop {
+        match c
+            .command(
+                MavCmd::MAV_CMD_COMPONENT_ARM_DISARM,
+                [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+            )
+            .await
+        {
+            Ok(()) => break,
+            Err(f) if f.exception == "CommandFailed" && Instant::now() < deadline => {
+                tokio::time::sleep(c.tuning.arm_retry).await;
+            }
+            Err(f) => return Err(f),
+        }
+    }
+    c.wait_for(Duration::from_secs(5), "arming", |c| c.v.seen().armed)
+        .await
+}
+
+pub(crate) async fn take_off(c: &Craft, alt: f64, paused: Paused) -> Result<(), Failure> {
+    if alt <= 0.0 {
+        return Err(failed(format!(
+            "take-off altitude must be above 0 m, not {alt} m"
+        )));
+    }
+    if c.state().airborne() {
+        let here = here(c)?;
+        return fly(c, &[[here[0], here[1], alt]], c.max_speed, paused).await;
+    }
+    if !c.v.seen().armed {
+        return Err(failed(format!(
+            "{} is not armed: call Arm() before TakeOff",
+            c.name
+        )));
+    }
+    // NAV_TAKEOFF is refused outside GUIDED, so make sure of it first.
+    c.set_mode(Mode::Guided).await?;
+    c.set_doing(Doing::TakingOff);
+    c.set_level(Some(alt));
+    let result = async {
+        // ArduPilot reads the take-off altitude above home, PX4 above sea level.
+        let param7 = match c.v.flavour() {
+            crate::mode::Flavour::ArduPilot => alt,
+            crate::mode::Flavour::Px4 => c.fix().map_or(alt, |f| f.home_amsl + alt),
+        };
+        c.command(
+            MavCmd::MAV_CMD_NAV_TAKEOFF,
+            [0.0, 0.0, 0.0, f32::NAN, f32::NAN, f32::NAN, param7 as f32],
+        )
+        .await?;
+        let limit = Duration::from_secs_f64(alt / 0.5 + 30.0);
+        let tol = c.tuning.arrive_z;
+        c.wait_for(limit, &format!("climbing to {alt} m"), |c| {
+            c.fix().is_some_and(|f| f.pos[2] >= alt - tol)
+        })
+        .await
+    }
+    .await;
+    c.set_doing(Doing::Other);
+    result
+}
+
+pub(crate) async fn land(c: &Craft) -> Result<(), Failure> {
+    if !c.state().airborne() {
+        return Ok(());
+    }
+    c.v.seen().expected = Some(Mode::Land);
+    c.set_level(None);
+    c.set_doing(Doing::Landing);
+    let z = here(c).map_or(0.0, |p| p[2]);
+    let result = async {
+        c.command(
+            MavCmd::MAV_CMD_NAV_LAND,
+            [0.0, 0.0, 0.0, f32::NAN, f32::NAN, f32::NAN, 0.0],
+        )
+        .await?;
+        // ArduCopter disarms by itself once down.
+        c.wait_for(Duration::from_secs_f64(z / 0.5 + 60.0), "landing", |c| {
+            !c.v.seen().armed
+        })
+        .await
+    }
+    .await;
+    c.set_doing(Doing::Other);
+    result
+}
+
+pub(crate) async fn rtl(c: &Craft) -> Result<(), Failure> {
+    let Some(here) = c.fix().map(|f| f.pos) else {
+        return Err(failed(format!("{} has reported no position yet", c.name)));
+    };
+    let away = dist([here[0], here[1]], c.home);
+    if !c.state().airborne() {
+        if away <= 2.0 {
+            return Ok(());
+        }
+        return Err(failed(format!(
+            "{} is on the ground away from home: take off first",
+            c.name
+        )));
+    }
+    c.v.seen().expected = Some(Mode::Rtl);
+    c.set_level(None);
+    c.command(MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH, [0.0; 7])
+        .await?;
+    let limit =
+        Duration::from_secs_f64(away / c.max_speed.max(1.0) * 2.0 + (here[2] + 20.0) / 0.5 + 60.0);
+    c.wait_for(limit, "returning to launch", |c| !c.v.seen().armed)
+        .await
+}
+
+/// Flies through `path` (local metres), each point reached by position within the
+/// tolerances; PAUSE holds where the drone is, RESUME sends the target again.
+pub(crate) async fn fly(
+    c: &Craft,
+    path: &[[f64; 3]],
+    speed: f64,
+    mut paused: Paused,
+) -> Result<(), Failure> {
+    in_air(c)?;
+    fenced(c, path)?;
+    c.set_mode(Mode::Guided).await?;
+    c.speed(speed).await?;
+    for &to in path {
+        let from = here(c)?;
+        let to = [to[0], to[1], if to[2].is_nan() { c.level() } else { to[2] }];
+        if to[2] < 0.0 {
+            return Err(failed(format!("altitude {} m is below the ground", to[2])));
+        }
+        let far = dist([from[0], from[1]], [to[0], to[1]]).hypot(to[2] - from[2]);
+        let mut left = Duration::from_secs_f64(far / speed.max(0.5) * 3.0 + 30.0);
+        c.set_level(Some(to[2]));
+        c.target(to).await?;
+        let mut resend = Instant::now() + c.tuning.resend;
+        loop {
+            let fix = here(c)?;
+            if dist([fix[0], fix[1]], [to[0], to[1]]) <= c.tuning.arrive_xy
+                && (fix[2] - to[2]).abs() <= c.tuning.arrive_z
+            {
+                break;
+            }
+            if *paused.borrow() {
+                c.hold().await;
+                while *paused.borrow() {
+                    if paused.changed().await.is_err() {
+                        return Err(failed("the call was dropped"));
+                    }
+                }
+                c.target(to).await?;
+            }
+            if Instant::now() >= resend {
+                // A lost UDP datagram must not leave the drone without its target.
+                c.target(to).await?;
+                resend = Instant::now() + c.tuning.resend;
+            }
+            if left.is_zero() {
+                return Err(timeout(format!(
+                    "{} did not reach ({:.1}, {:.1}, {:.1}) in time",
+                    c.name, to[0], to[1], to[2]
+                )));
+            }
+            tokio::time::sleep(c.tuning.poll).await;
+            left = left.saturating_sub(c.tuning.poll);
+        }
+    }
+    Ok(())
+}
+
+/// The world's geofence and ceiling hold for MAVLink drones too: a path that leaves them
+/// is refused before anything is sent (`GeofenceViolation`).
+pub(crate) fn fenced(c: &Craft, path: &[[f64; 3]]) -> Result<(), Failure> {
+    let violation = |reason: String| Failure {
+        exception: "GeofenceViolation",
+        reason,
+    };
+    for p in path {
+        if let Some(max) = c.max_altitude.filter(|m| p[2] > m + 1e-9) {
+            return Err(violation(format!(
+                "altitude {:.1} m is above the site's max_altitude of {max:.1} m",
+                p[2]
+            )));
+        }
+        if let Some(fence) = c.fence.as_deref().filter(|f| !contains(f, [p[0], p[1]])) {
+            let _ = fence;
+            return Err(violation(format!(
+                "({:.1}, {:.1}) is outside the geofence",
+                p[0], p[1]
+            )));
+        }
+    }
+    Ok(())
+}
+
+pub(crate) async fn hover(duration: f64, paused: Paused) -> Result<(), Failure> {
+    if duration < 0.0 || !duration.is_finite() {
+        return Err(failed(format!("a hover cannot last {duration} s")));
+    }
+    let step = Duration::from_millis(50);
+    let mut left = Duration::from_secs_f64(duration);
+    while !left.is_zero() {
+        tokio::time::sleep(step.min(left)).await;
+        if !*paused.borrow() {
+            left = left.saturating_sub(step);
+        }
+    }
+    Ok(())
+}
+
+/// Points on the circle, clockwise from the one nearest the drone, at its altitude. A
+/// drone at the center (within `at_center`, the arrival tolerance: which way it is off
+/// is noise) starts east of it, as the simulator's does.
+pub(crate) fn orbit(
+    here: [f64; 3],
+    center: [f64; 2],
+    radius: f64,
+    laps: f64,
+    at_center: f64,
+) -> Vec<[f64; 3]> {
+    let (dx, dy) = (here[0] - center[0], here[1] - center[1]);
+    let start = if dx.hypot(dy) <= at_center {
+        0.0
+    } else {
+        dy.atan2(dx)
+    };
+    let n = (laps * ORBIT_POINTS as f64).ceil() as usize;
+    let step = laps * std::f64::consts::TAU / n as f64;
+    (0..=n)
+        .map(|i| {
+            let a = start - step * i as f64;
+            [
+                center[0] + radius * a.cos(),
+                center[1] + radius * a.sin(),
+                here[2],
+            ]
+        })
+        .collect()
+}

@@ -1,0 +1,328 @@
+//! What the backend knows of one vehicle: the last of each message it sent, the answers
+//! commands wait for, and detection (a geometric sensor over the reported track).
+
+use std::collections::VecDeque;
+use std::sync::{Mutex, MutexGuard};
+
+use aviary_api::geometry::dist_to_segment;
+use aviary_api::{DroneEvent, DroneId, Failure};
+use aviary_world::Target;
+use mavlink::dialects::ardupilotmega::{
+    MavCmd, MavLandedState, MavMessage, MavModeFlag, MavResult, MavState,
+};
+use tokio::sync::{mpsc, oneshot};
+use tokio::time::Instant;
+
+use crate::geo::Origin;
+use crate::mode::{self, Flavour, Mode};
+
+/// The last fix a vehicle reported, in the local frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fix {
+    pub pos: [f64; 3],
+    /// Ground speed, m/s.
+    pub speed: f64,
+    /// Degrees clockwise from north.
+    pub heading: f64,
+    /// Metres above sea level of the vehicle's home (its `alt` less its `relative_alt`).
+    pub home_amsl: f64,
+}
+
+/// One activation of `StartDetection(kind)`: which world targets it has found.
+pub struct Activation {
+    pub kind: String,
+    pub range: f64,
+    pub found: Vec<bool>,
+}
+
+#[derive(Default)]
+pub struct Seen {
+    pub heartbeat: Option<Instant>,
+    pub flavour: Option<Flavour>,
+    pub custom_mode: u32,
+    pub armed: bool,
+    pub status: Option<MavState>,
+    pub fix: Option<Fix>,
+    /// Fraction of a full battery, when the vehicle reports one.
+    pub battery: Option<f64>,
+    pub landed: Option<MavLandedState>,
+    /// Recent STATUSTEXTs (the autopilot's reasons), newest last.
+    pub texts: VecDeque<(Instant, String)>,
+    /// The mode this backend last asked for; another RTL or LAND is the autopilot's own.
+    pub expected: Option<Mode>,
+    pub detecting: Vec<Activation>,
+    /// Metres flown and seconds in the air while armed, from the reported track.
+    pub odometer: f64,
+    pub flight_time: f64,
+    fix_at: Option<Instant>,
+    acks: Vec<(MavCmd, oneshot::Sender<MavResult>)>,
+}
+
+/// A vehicle of a link, by its MAVLink system id.
+pub struct Vehicle {
+    pub drone: DroneId,
+    pub name: String,
+    pub system: u8,
+    origin: Origin,
+    targets: Vec<Target>,
+    seen: Mutex<Seen>,
+    events: mpsc::UnboundedSender<DroneEvent>,
+    alarms: mpsc::UnboundedSender<(DroneId, Failure)>,
+}
+
+const TEXTS_KEPT: usize = 16;
+
+impl Vehicle {
+    pub fn new(
+        drone: DroneId,
+        name: String,
+        system: u8,
+        origin: Origin,
+        targets: Vec<Target>,
+        events: mpsc::UnboundedSender<DroneEvent>,
+        alarms: mpsc::UnboundedSender<(DroneId, Failure)>,
+    ) -> Vehicle {
+        Vehicle {
+            drone,
+            name,
+            system,
+            origin,
+            targets,
+            seen: Mutex::new(Seen::default()),
+            events,
+            alarms,
+        }
+    }
+
+    pub fn seen(&self) -> MutexGuard<'_, Seen> {
+        self.seen.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    pub fn origin(&self) -> Origin {
+        self.origin
+    }
+
+    pub fn flavour(&self) -> Flavour {
+        self.seen().flavour.unwrap_or(Flavour::ArduPilot)
+    }
+
+    /// Waits for the COMMAND_ACK of `command`; register before sending.
+    pub fn expect_ack(&self, command: MavCmd) -> oneshot::Receiver<MavResult> {
+        let (tx, rx) = oneshot::channel();
+        self.seen().acks.push((command, tx));
+        rx
+    }
+
+    /// STATUSTEXTs received since `since`, joined: the autopilot's reason for a refusal.
+    pub fn texts_since(&self, since: Instant) -> Option<String> {
+        let seen = self.seen();
+        let texts: Vec<&str> = seen
+            .texts
+            .iter()
+            .filter(|(t, _)| *t >= since)
+            .map(|(_, s)| s.as_str())
+            .collect();
+        (!texts.is_empty()).then(|| texts.join("; "))
+    }
+
+    /// Takes in one message from this vehicle's autopilot.
+    pub fn observe(&self, msg: &MavMessage) {
+        let now = Instant::now();
+        let mut seen = self.seen();
+        match msg {
+            MavMessage::HEARTBEAT(hb) => {
+                let flavour = Flavour::of(hb.autopilot);
+                let before = seen
+                    .heartbeat
+                    .map(|_| mode::classify(flavour, seen.custom_mode));
+                seen.heartbeat = Some(now);
+                seen.flavour = Some(flavour);
+                seen.custom_mode = hb.custom_mode;
+                seen.armed = hb
+                    .base_mode
+                    .contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);
+                let was = seen.status.replace(hb.system_status);
+                let gone = |s: Option<MavState>| {
+                    matches!(
+                        s,
+                        Some(
+                            MavState::MAV_STATE_EMERGENCY
+                                | MavState::MAV_STATE_FLIGHT_TERMINATION
+                                | MavState::MAV_STATE_POWEROFF
+                        )
+                    )
+                };
+                if gone(Some(hb.system_status)) && !gone(was) {
+                    // The vehicle says it is going down (or gone): it is lost to the mission.
+                    let why = seen
+                        .texts
+                        .back()
+                        .map_or("no reason given", |(_, s)| s.as_str());
+                    let reason = format!(
+                        "{}: the autopilot reports {:?} ({why})",
+                        self.name, hb.system_status
+                    );
+                    let _ = self.alarms.send((
+                        self.drone,
+                        Failure {
+                            exception: "DroneLost",
+                            reason,
+                        },
+                    ));
+                }
+                let after = mode::classify(flavour, hb.custom_mode);
+                let changed = before.is_some_and(|b| b != after);
+                if changed
+                    && matches!(after, Mode::Rtl | Mode::Land)
+                    && seen.expected != Some(after)
+                {
+                    // The autopilot changed mode by itself: a failsafe.
+                    let since = now - std::time::Duration::from_secs(3);
+                    let why: Vec<&str> = seen
+                        .texts
+                        .iter()
+                        .filter(|(t, _)| *t >= since)
+                        .map(|(_, s)| s.as_str())
+                        .collect();
+                    let failure = failsafe(
+                        &self.name,
+                        &mode::name(flavour, hb.custom_mode),
+                        &why.join("; "),
+                    );
+                    seen.expected = Some(after);
+                    let _ = self.alarms.send((self.drone, failure));
+                }
+            }
+            MavMessage::GLOBAL_POSITION_INT(p) => {
+                let xy = self.origin.from_e7(p.lat, p.lon);
+                let fix = Fix {
+                    pos: [xy[0], xy[1], f64::from(p.relative_alt) / 1000.0],
+                    speed: f64::from(p.vx).hypot(f64::from(p.vy)) / 100.0,
+                    heading: if p.hdg == u16::MAX {
+                        0.0
+                    } else {
+                        f64::from(p.hdg) / 100.0
+                    },
+                    home_amsl: (f64::from(p.alt) - f64::from(p.relative_alt)) / 1000.0,
+                };
+                let from = seen.fix.map_or(xy, |f| [f.pos[0], f.pos[1]]);
+                if let (Some(before), Some(at), true) = (seen.fix, seen.fix_at, seen.armed) {
+                    let d: f64 = (0..3).map(|k| (fix.pos[k] - before.pos[k]).powi(2)).sum();
+                    seen.odometer += d.sqrt();
+                    if before.pos[2] > 0.3 {
+                        seen.flight_time += now.duration_since(at).as_secs_f64();
+                    }
+                }
+                seen.fix_at = Some(now);
+                seen.fix = Some(fix);
+                self.scan(&mut seen, from, xy);
+            }
+            MavMessage::SYS_STATUS(s) if s.battery_remaining >= 0 => {
+                seen.battery = Some(f64::from(s.battery_remaining) / 100.0);
+            }
+            MavMessage::BATTERY_STATUS(b) if b.battery_remaining >= 0 && b.id == 0 => {
+                seen.battery = Some(f64::from(b.battery_remaining) / 100.0);
+            }
+            MavMessage::EXTENDED_SYS_STATE(e) => seen.landed = Some(e.landed_state),
+            MavMessage::STATUSTEXT(t) => {
+                let text = t
+                    .text
+                    .to_str()
+                    .unwrap_or("")
+                    .trim_end_matches('\0')
+                    .to_owned();
+                seen.texts.push_back((now, text));
+                while seen.texts.len() > TEXTS_KEPT {
+                    seen.texts.pop_front();
+                }
+            }
+            MavMessage::COMMAND_ACK(ack) if ack.result != MavResult::MAV_RESULT_IN_PROGRESS => {
+                if let Some(i) = seen
+                    .acks
+                    .iter()
+                    .position(|(c, tx)| *c == ack.command && !tx.is_closed())
+                {
+                    let (_, tx) = seen.acks.remove(i);
+                    let _ = tx.send(ack.result);
+                }
+                seen.acks.retain(|(_, tx)| !tx.is_closed());
+            }
+            _ => {}
+        }
+    }
+
+    /// Detection: each world target of an active kind within range of the ground track
+    /// flown between two fixes is found once per activation (as the simulator does).
+    fn scan(&self, seen: &mut Seen, from: [f64; 2], to: [f64; 2]) {
+        for act in &mut seen.detecting {
+            for (i, target) in self.targets.iter().enumerate() {
+                if act.found[i] || target.kind != act.kind {
+                    continue;
+                }
+                let at = [target.at[0], target.at[1]];
+                if dist_to_segment(at, from, to) <= act.range {
+                    act.found[i] = true;
+                    let _ = self.events.send(DroneEvent::Detected {
+                        drone: self.drone,
+                        kind: act.kind.clone(),
+                        location: [at[0], at[1], 0.0],
+                    });
+                }
+            }
+        }
+    }
+
+    pub fn target_count(&self) -> usize {
+        self.targets.len()
+    }
+}
+
+/// The exception a failsafe RTL or LAND stands for, from the autopilot's own words.
+fn failsafe(name: &str, mode: &str, why: &str) -> Failure {
+    let lower = why.to_ascii_lowercase();
+    let exception = if lower.contains("battery") {
+        "BatteryCritical"
+    } else if ["gps", "ekf", "position"].iter().any(|w| lower.contains(w)) {
+        "PositionLost"
+    } else if lower.contains("fence") {
+        "GeofenceViolation"
+    } else if ["radio", "gcs", "link", "telemetry", "rc "]
+        .iter()
+        .any(|w| lower.contains(w))
+    {
+        "ConnectionLost"
+    } else {
+        "CommandFailed"
+    };
+    let said = if why.is_empty() {
+        "no reason given".to_owned()
+    } else {
+        format!("it said: {why}")
+    };
+    Failure {
+        exception,
+        reason: format!("{name}: the autopilot switched to {mode} by itself ({said})"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::failsafe;
+
+    #[test]
+    fn failsafe_reasons_pick_the_exception() {
+        assert_eq!(
+            failsafe("a", "RTL", "Battery 1 is critical").exception,
+            "BatteryCritical"
+        );
+        assert_eq!(
+            failsafe("a", "LAND", "EKF variance").exception,
+            "PositionLost"
+        );
+        assert_eq!(
+            failsafe("a", "RTL", "Radio Failsafe").exception,
+            "ConnectionLost"
+        );
+        assert_eq!(failsafe("a", "RTL", "").exception, "CommandFailed");
+    }
+}

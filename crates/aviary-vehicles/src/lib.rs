@@ -1,0 +1,131 @@
+//! The simulator's drones served as MAVLink 2 vehicles: `aviary vehicles`.
+//!
+//! Every drone of a world becomes its own MAVLink system (its `system_id`, or its place
+//! in the world: 1, 2, ...), component 1, with the behaviour of an ArduCopter-like
+//! autopilot (`autopilot`): HEARTBEAT with the ArduCopter mode number and the system
+//! state (BOOT, then as ArduCopter: STANDBY on the ground, ACTIVE in the air, CRITICAL
+//! after a failsafe), the command protocol with COMMAND_ACK
+//! and STATUSTEXT reasons (arm with pre-arm checks, NAV_TAKEOFF only in GUIDED, LAND,
+//! RTL, DO_SET_MODE and SET_MODE, DO_CHANGE_SPEED, DO_REPOSITION, DO_GRIPPER,
+//! SET_MESSAGE_INTERVAL), SET_POSITION_TARGET_GLOBAL_INT in GUIDED, and the telemetry
+//! streams (`telemetry`). Underneath is the same [`aviary_sim::Fleet`] as `aviary run`,
+//! stepped in whole 0.05 s ticks at `speed` times real time.
+//!
+//! Not simulated: parameters, missions (MISSION_ITEM), RC input, manual modes (STABILIZE
+//! is accepted and does nothing), more than one component per vehicle. A world
+//! `link_loss` fault silences the drone (no messages either way) for its duration; a
+//! `battery_critical` fault is ArduCopter's battery failsafe (STATUSTEXT, then RTL); a
+//! `crash` says "Crash: ..." and turns the state to EMERGENCY.
+
+mod autopilot;
+mod commands;
+mod server;
+mod telemetry;
+
+use std::net::SocketAddr;
+use std::sync::{Arc, Mutex};
+
+use aviary_world::World;
+use tokio::net::{TcpListener, UdpSocket};
+use tokio::sync::broadcast;
+use tokio::task::JoinHandle;
+
+pub use autopilot::Behaviour;
+pub use server::{parse_listen, Listen};
+
+#[derive(Clone, Copy, Debug)]
+pub struct Options {
+    /// Times real time (1: real time). Tests run the paper's mission at 20.
+    pub speed: f64,
+    pub behaviour: Behaviour,
+    /// MAVLink 2 signing: sign what is sent, take only signed messages.
+    pub signing_key: Option<[u8; 32]>,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            speed: 1.0,
+            behaviour: Behaviour::default(),
+            signing_key: None,
+        }
+    }
+}
+
+/// A running server. Dropping it does not stop it: call [`Vehicles::stop`].
+pub struct Vehicles {
+    /// The address bound (with the port chosen when 0 was asked for).
+    pub address: SocketAddr,
+    /// Each drone's MAVLink system id, in world order.
+    pub systems: Vec<u8>,
+    tasks: Vec<JoinHandle<()>>,
+    clients: server::Clients,
+}
+
+/// Binds `listen` and starts serving `world`'s drones. Call inside a tokio runtime with
+/// a real clock (not paused).
+pub async fn serve(world: &World, listen: Listen, options: Options) -> std::io::Result<Vehicles> {
+    let ap = autopilot::Autopilot::new(world, options.behaviour);
+    let systems = ap.copters.iter().map(|c| c.system).collect();
+    let ap = Arc::new(Mutex::new(ap));
+    let (out, _) = broadcast::channel(4096);
+    let speed = if options.speed.is_finite() && options.speed > 0.0 {
+        options.speed
+    } else {
+        1.0
+    };
+    let pace = tokio::spawn(server::pace(Arc::clone(&ap), out.clone(), 0.05, speed));
+    let clients = server::Clients::default();
+    let (address, serve) = match listen {
+        Listen::Tcp(addr) => {
+            let listener = TcpListener::bind(addr).await?;
+            let address = listener.local_addr()?;
+            (
+                address,
+                tokio::spawn(server::tcp(
+                    listener,
+                    ap,
+                    out,
+                    options.signing_key,
+                    Arc::clone(&clients),
+                )),
+            )
+        }
+        Listen::Udp(addr) => {
+            let socket = UdpSocket::bind(addr).await?;
+            let address = socket.local_addr()?;
+            (
+                address,
+                tokio::spawn(server::udp(
+                    socket,
+                    ap,
+                    out,
+                    options.signing_key,
+                    Arc::clone(&clients),
+                )),
+            )
+        }
+    };
+    Ok(Vehicles {
+        address,
+        systems,
+        tasks: vec![pace, serve],
+        clients,
+    })
+}
+
+impl Vehicles {
+    pub fn stop(&self) {
+        for t in &self.tasks {
+            t.abort();
+        }
+        for c in self
+            .clients
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .iter()
+        {
+            c.abort();
+        }
+    }
+}

@@ -50,6 +50,9 @@ pub enum BenchCommand {
         /// Print the generated mission instead of running it
         #[arg(long)]
         emit: bool,
+        /// Build every trace event (as `aviary run --trace` does), not only those checked
+        #[arg(long)]
+        full_trace: bool,
     },
     /// N simulated drones, each sweeping its own area with detection on; prints
     /// simulated seconds per wall second
@@ -65,7 +68,7 @@ pub enum BenchCommand {
 pub fn run(which: BenchCommand) -> u8 {
     match which {
         BenchCommand::Parse { mb, runs } => parse(mb, runs),
-        BenchCommand::W { n, k, emit } => w::run(n, k, emit),
+        BenchCommand::W { n, k, emit, full_trace } => w::run(n, k, emit, full_trace),
         BenchCommand::Swarm { drones, emit } => swarm::run(drones, emit),
     }
 }

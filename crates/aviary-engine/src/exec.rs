@@ -13,11 +13,12 @@ use aviary_ir::{ActorRef, Block, BlockKind, Call, Expr, For, Leash, LeashAction,
 use futures_util::future::{join_all, LocalBoxFuture};
 use futures_util::stream::{FuturesUnordered, StreamExt};
 use serde_json::{json, Map, Value as Json};
-use tokio::sync::{mpsc, Notify};
+use tokio::sync::Notify;
 use tokio_util::sync::CancellationToken;
 
 use crate::arbiter::acquire;
 use crate::engine::{Ctx, Engine, Instance, Job, Scope};
+use crate::jobs::Jobs;
 use crate::value::to_json;
 
 /// Conditions are looked at again at least this often (LANGUAGE.md §3).
@@ -25,14 +26,15 @@ const RECHECK: Duration = Duration::from_millis(100);
 
 impl<'m> Engine<'m> {
     /// Runs `items` in `scope`, with the handlers that scope starts, until all are done.
-    pub(crate) async fn drive(&self, scope: &Rc<Scope<'m>>, mut jobs: mpsc::UnboundedReceiver<Job<'m>>, items: impl Future<Output = ()>) {
+    pub(crate) async fn drive(&self, scope: &Rc<Scope<'m>>, items: impl Future<Output = ()>) {
         let mut items = pin!(items);
+        let jobs = &scope.jobs;
         let mut running: FuturesUnordered<LocalBoxFuture<'_, ()>> = FuturesUnordered::new();
         let mut items_done = false;
         loop {
             tokio::select! {
                 biased;
-                Some(job) = jobs.recv() => running.push(Box::pin(self.job(job, scope.clone()))),
+                job = std::future::poll_fn(|cx| jobs.poll_recv(cx)) => running.push(Box::pin(self.job(job, scope.clone()))),
                 _ = &mut items, if !items_done => {
                     items_done = true;
                     // `SEQUENTIAL ON` handlers that waited for this block start now.
@@ -44,15 +46,14 @@ impl<'m> Engine<'m> {
             }
             if items_done && running.is_empty() {
                 match jobs.try_recv() {
-                    Ok(job) => running.push(Box::pin(self.job(job, scope.clone()))),
-                    Err(_) => break,
+                    Some(job) => running.push(Box::pin(self.job(job, scope.clone()))),
+                    None => break,
                 }
             }
         }
     }
 
-    fn new_scope(&self, ctx: &Ctx<'m>, block: &'m Block, instance: Option<Rc<Instance>>) -> (Rc<Scope<'m>>, mpsc::UnboundedReceiver<Job<'m>>) {
-        let (tx, rx) = mpsc::unbounded_channel();
+    fn new_scope(&self, ctx: &Ctx<'m>, block: &'m Block, instance: Option<Rc<Instance>>) -> Rc<Scope<'m>> {
         let scope = Rc::new(Scope {
             parent: Some(ctx.scope.clone()),
             path: block.path.clone(),
@@ -61,7 +62,7 @@ impl<'m> Engine<'m> {
             fired: RefCell::new(vec![false; block.handlers.len()]),
             exception_handlers: &block.exception_handlers,
             frame: ctx.frame.clone(),
-            jobs: tx,
+            jobs: Jobs::default(),
             unwinding: Cell::new(false),
             deferred: RefCell::new(Vec::new()),
             catching: Cell::new(0),
@@ -74,20 +75,20 @@ impl<'m> Engine<'m> {
         if ctx.scope.parent.is_none() {
             *self.mission_scope.borrow_mut() = Some(scope.clone());
         }
-        (scope, rx)
+        scope
     }
 
     pub(crate) fn block<'a>(&'a self, block: &'m Block, ctx: &'a Ctx<'m>) -> LocalBoxFuture<'a, ()> {
         Box::pin(async move {
-            let (scope, rx) = self.new_scope(ctx, block, None);
+            let scope = self.new_scope(ctx, block, None);
             if block.traced {
-                self.trace("block_start", json!({ "block": block.path }));
+                self.trace("block_start", || json!({ "block": block.path }));
             }
             let inner = Ctx { scope: scope.clone(), ..ctx.clone() };
-            self.drive(&scope, rx, self.items(block, &inner)).await;
+            self.drive(&scope, self.items(block, &inner)).await;
             if block.traced {
                 let status = if scope.unwinding.get() { "aborted" } else { "ok" };
-                self.trace("block_end", json!({ "block": block.path, "status": status }));
+                self.trace("block_end", || json!({ "block": block.path, "status": status }));
             }
         })
     }
@@ -271,19 +272,24 @@ impl<'m> Engine<'m> {
             claims: RefCell::new(ctx.claims.clone()),
         });
         let actor = actors.first().copied();
-        let tag = call.tag.map(|t| self.m.tags[t].clone());
-        let shown_args: Map<String, Json> = cap.params.iter().zip(&args).map(|(p, v)| (p.clone(), to_json(self.m, v))).collect();
-        let who = actors.iter().map(|d| self.name(*d)).collect::<Vec<_>>().join(" ");
-        let start = json!({ "actor": who, "capability": cap.name, "tag": tag, "args": shown_args });
+        // Built only when the trace wants it.
+        let start = || {
+            let tag = call.tag.map(|t| self.m.tags[t].clone());
+            let shown_args: Map<String, Json> = cap.params.iter().zip(&args).map(|(p, v)| (p.clone(), to_json(self.m, v))).collect();
+            let who = actors.iter().map(|d| self.name(*d)).collect::<Vec<_>>().join(" ");
+            json!({ "actor": who, "capability": cap.name, "tag": tag, "args": shown_args })
+        };
         let end = |status: &str| {
-            let mut e = start.clone();
-            e["status"] = json!(status);
-            self.trace("capability_end", e);
+            self.trace("capability_end", || {
+                let mut e = start();
+                e["status"] = json!(status);
+                e
+            });
         };
         let frame = Rc::new(frame);
 
         // Known from now on (a leash can abort it while it waits), by where it was called.
-        self.instances.borrow_mut().push((instance.clone(), ctx.scope.clone()));
+        self.instances.borrow_mut().insert(instance.clone(), ctx.scope.clone());
         // Claims first (a second instance on a busy resource waits), then the start.
         let needs: Vec<_> = cap.claims.iter().filter_map(|(i, r)| actors.get(*i).map(|d| (*d, *r))).filter(|c| !ctx.claims.contains(c)).collect();
         let mut claims: BTreeSet<_> = (*ctx.claims).clone();
@@ -294,12 +300,12 @@ impl<'m> Engine<'m> {
             h = acquire(&self.arbiter, needs) => Some(h),
         };
         if self.stopped() {
-            self.instances.borrow_mut().retain(|(i, _)| i.id != instance.id);
+            self.instances.borrow_mut().remove(instance.id);
             return;
         }
-        self.trace("capability_start", start.clone());
+        self.trace("capability_start", start);
         if held.is_none() {
-            self.instances.borrow_mut().retain(|(i, _)| i.id != instance.id);
+            self.instances.borrow_mut().remove(instance.id);
             end("aborted");
             return;
         }
@@ -312,7 +318,7 @@ impl<'m> Engine<'m> {
             cap.requirements.iter().all(|r| env.truth(r))
         };
         if !requirements_met {
-            self.instances.borrow_mut().retain(|(i, _)| i.id != instance.id);
+            self.instances.borrow_mut().remove(instance.id);
             end("failed");
             drop(held);
             let id = self.m.exceptions.iter().position(|e| e == "RequirementNotMet").unwrap_or(0);
@@ -321,9 +327,8 @@ impl<'m> Engine<'m> {
             return;
         }
 
-        let (scope, rx) = {
-            let (tx, rx) = mpsc::unbounded_channel();
-            let scope = Rc::new(Scope {
+        let scope = {
+            Rc::new(Scope {
                 parent: Some(ctx.scope.clone()),
                 path: cap.name.clone(),
                 mission_block: false,
@@ -331,18 +336,15 @@ impl<'m> Engine<'m> {
                 fired: RefCell::new(Vec::new()),
                 exception_handlers: &cap.exception_handlers,
                 frame: frame.clone(),
-                jobs: tx,
+                jobs: Jobs::default(),
                 unwinding: Cell::new(false),
                 deferred: RefCell::new(Vec::new()),
                 catching: Cell::new(0),
                 caught: Notify::new(),
                 instance: Some(instance.clone()),
-            });
-            (scope, rx)
+            })
         };
-        for entry in self.instances.borrow_mut().iter_mut().filter(|(i, _)| i.id == instance.id) {
-            entry.1 = scope.clone();
-        }
+        self.instances.borrow_mut().set_scope(instance.id, scope.clone());
         let inner = Ctx { scope: scope.clone(), frame, actor, instance: Some(instance.clone()), claims };
         let perform = async {
             tokio::select! {
@@ -354,9 +356,9 @@ impl<'m> Engine<'m> {
         let finished = tokio::select! {
             biased;
             _ = instance.token.cancelled() => false,
-            _ = self.drive(&scope, rx, perform) => true,
+            _ = self.drive(&scope, perform) => true,
         };
-        self.instances.borrow_mut().retain(|(i, _)| i.id != instance.id);
+        self.instances.borrow_mut().remove(instance.id);
         if !finished && instance.by_leash.get() {
             // `PERFORM ABORT:` says what aborting this activity also does.
             if let Some((_, section)) = cap.sections.iter().find(|(n, _)| n == "ABORT") {
@@ -384,10 +386,10 @@ impl<'m> Engine<'m> {
                 }
                 let who = actor.map(|a| self.name(a));
                 let signal_name = &self.m.signals[signal];
-                self.trace("handler_start", json!({ "signal": signal_name, "handler": handler.body.path, "actor": who }));
+                self.trace("handler_start", || json!({ "signal": signal_name, "handler": handler.body.path, "actor": who }));
                 let ctx = self.scope_ctx(&scope, Rc::new(frame));
                 self.block(&handler.body, &ctx).await;
-                self.trace("handler_end", json!({ "signal": signal_name, "handler": handler.body.path, "actor": who }));
+                self.trace("handler_end", || json!({ "signal": signal_name, "handler": handler.body.path, "actor": who }));
             }
             Job::Exception { handler, args } => {
                 let mut frame = (*scope.frame).clone();
@@ -427,9 +429,8 @@ impl<'m> Engine<'m> {
     /// none runs (LANGUAGE.md §3).
     pub(crate) fn leash_by_id(&self, capability: usize, tag: usize, action: LeashAction, action_name: &str, values: Vec<(usize, Value)>) {
         let cap = &self.m.capabilities[capability];
-        self.trace("leash", json!({ "capability": cap.name, "tag": self.m.tags[tag], "action": action_name }));
-        let targets: Vec<(Rc<Instance>, Rc<Scope<'m>>)> =
-            self.instances.borrow().iter().filter(|(i, _)| i.capability == capability && i.tag == Some(tag)).cloned().collect();
+        self.trace("leash", || json!({ "capability": cap.name, "tag": self.m.tags[tag], "action": action_name }));
+        let targets: Vec<(Rc<Instance>, Rc<Scope<'m>>)> = self.instances.borrow().tagged(capability, tag).cloned().collect();
         for (instance, scope) in targets {
             match action {
                 LeashAction::Abort => {
@@ -478,7 +479,7 @@ impl<'m> Engine<'m> {
         }
         let args = self.eval_all(&a.args, ctx);
         let function = self.m.functions[a.function].0.as_str();
-        self.trace("api_call", json!({ "actor": self.name(drone), "function": function, "args": self.values(&args) }));
+        self.trace("api_call", || json!({ "actor": self.name(drone), "function": function, "args": self.values(&args) }));
         let pending = self.backend.call(drone, function, &args);
         let guard = CallGuard { engine: self, id: pending.id, root: root.clone(), done: Cell::new(false), drone, function, args: &args };
         if let Some(root) = &root {
@@ -539,10 +540,11 @@ impl Drop for CallGuard<'_, '_> {
     fn drop(&mut self) {
         if !self.done.get() {
             self.engine.backend.interrupt(self.id, Interrupt::Abort);
-            let p = self.engine.backend.telemetry(self.drone).position;
-            let args = self.engine.values(self.args);
-            let name = self.engine.name(self.drone);
-            self.engine.trace("api_done", json!({ "actor": name, "function": self.function, "args": args, "status": "aborted", "position": p }));
+            let engine = self.engine;
+            engine.trace("api_done", || {
+                let p = engine.backend.telemetry(self.drone).position;
+                json!({ "actor": engine.name(self.drone), "function": self.function, "args": engine.values(self.args), "status": "aborted", "position": p })
+            });
         }
         if let Some(root) = &self.root {
             root.calls.borrow_mut().retain(|c| *c != self.id);

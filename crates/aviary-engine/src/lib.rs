@@ -13,6 +13,8 @@ mod arbiter;
 mod control;
 mod engine;
 mod exec;
+mod jobs;
+mod registry;
 mod value;
 
 use aviary_api::Backend;
@@ -23,6 +25,12 @@ use aviary_ir::Mission;
 /// Where trace events go, one JSON object per event, in order.
 pub trait TraceSink {
     fn event(&mut self, event: serde_json::Value);
+    /// Whether this sink takes events of this kind (`"signal"`, `"api_call"`, ...). The
+    /// engine builds an event only when its sink wants it, so a sink that keeps a few
+    /// kinds spares the cost of the rest; what the mission does is the same either way.
+    fn wants(&self, _event: &str) -> bool {
+        true
+    }
 }
 
 impl<F: FnMut(serde_json::Value)> TraceSink for F {

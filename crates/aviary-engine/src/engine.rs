@@ -31,7 +31,7 @@ pub(crate) enum Job<'m> {
 /// A running body: what it hears, where its handlers start, whether it is unwinding.
 pub(crate) struct Scope<'m> {
     pub parent: Option<Rc<Scope<'m>>>,
-    pub path: String,
+    pub path: &'m str,
     /// A block of the mission itself (not inside a capability): a signalling block.
     pub mission_block: bool,
     pub handlers: &'m [Handler],
@@ -185,7 +185,7 @@ impl<'m> Engine<'m> {
         self.trace("mission_start", || json!({ "mission": self.m.name }));
         let root = Rc::new(Scope {
             parent: None,
-            path: self.m.name.clone(),
+            path: &self.m.name,
             mission_block: true,
             handlers: &[],
             fired: RefCell::new(Vec::new()),

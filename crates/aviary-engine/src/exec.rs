@@ -19,6 +19,7 @@ use tokio_util::sync::CancellationToken;
 use crate::arbiter::acquire;
 use crate::engine::{Ctx, Engine, Instance, Job, Scope};
 use crate::jobs::Jobs;
+use crate::join::{join_eager, SMALL};
 use crate::value::to_json;
 
 /// Conditions are looked at again at least this often (LANGUAGE.md §3).
@@ -29,12 +30,15 @@ impl<'m> Engine<'m> {
     pub(crate) async fn drive(&self, scope: &Rc<Scope<'m>>, items: impl Future<Output = ()>) {
         let mut items = pin!(items);
         let jobs = &scope.jobs;
-        let mut running: FuturesUnordered<LocalBoxFuture<'_, ()>> = FuturesUnordered::new();
+        // Made at the first job: most scopes never start a handler, and an empty
+        // `FuturesUnordered` still allocates.
+        let mut running: Option<FuturesUnordered<LocalBoxFuture<'_, ()>>> = None;
         let mut items_done = false;
         loop {
+            let any_running = running.as_ref().is_some_and(|r| !r.is_empty());
             tokio::select! {
                 biased;
-                job = std::future::poll_fn(|cx| jobs.poll_recv(cx)) => running.push(Box::pin(self.job(job, scope.clone()))),
+                job = std::future::poll_fn(|cx| jobs.poll_recv(cx)) => running.get_or_insert_with(FuturesUnordered::new).push(Box::pin(self.job(job, scope.clone()))),
                 _ = &mut items, if !items_done => {
                     items_done = true;
                     // `SEQUENTIAL ON` handlers that waited for this block start now.
@@ -42,11 +46,11 @@ impl<'m> Engine<'m> {
                         let _ = target.jobs.send(job);
                     }
                 }
-                Some(()) = running.next(), if !running.is_empty() => {}
+                Some(()) = async { running.as_mut()?.next().await }, if any_running => {}
             }
-            if items_done && running.is_empty() {
+            if items_done && !running.as_ref().is_some_and(|r| !r.is_empty()) {
                 match jobs.try_recv() {
-                    Some(job) => running.push(Box::pin(self.job(job, scope.clone()))),
+                    Some(job) => running.get_or_insert_with(FuturesUnordered::new).push(Box::pin(self.job(job, scope.clone()))),
                     None => break,
                 }
             }
@@ -56,7 +60,7 @@ impl<'m> Engine<'m> {
     fn new_scope(&self, ctx: &Ctx<'m>, block: &'m Block, instance: Option<Rc<Instance>>) -> Rc<Scope<'m>> {
         let scope = Rc::new(Scope {
             parent: Some(ctx.scope.clone()),
-            path: block.path.clone(),
+            path: &block.path,
             mission_block: ctx.instance.is_none() && instance.is_none(),
             handlers: &block.handlers,
             fired: RefCell::new(vec![false; block.handlers.len()]),
@@ -205,26 +209,34 @@ impl<'m> Engine<'m> {
     }
 
     async fn for_each(&self, f: &'m For, ctx: &Ctx<'m>) {
-        let mut runs = Vec::new();
+        // Every instance's values are taken when the FOR starts; the frames are made as
+        // the instances start (making them has no effect but memory).
+        let mut instances = Vec::new();
         for (actor, values) in &f.instances {
-            let values = self.eval_all(values, ctx);
-            for d in self.drones(actor, ctx) {
-                let mut frame = (*ctx.frame).clone();
-                set(&mut frame, f.alias, Value::Actor(d));
-                for (slot, v) in f.params.iter().zip(&values) {
-                    set(&mut frame, *slot, v.clone());
-                }
-                runs.push(Ctx { frame: Rc::new(frame), actor: Some(d), ..ctx.clone() });
-            }
+            let values = Rc::new(self.eval_all(values, ctx));
+            instances.extend(self.drones(actor, ctx).into_iter().map(|d| (d, values.clone())));
         }
-        if f.parallel {
-            join_all(runs.iter().map(|c| self.block(&f.body, c))).await;
+        let count = instances.len();
+        let runs = instances.into_iter().map(|(d, values)| {
+            let mut frame = (*ctx.frame).clone();
+            set(&mut frame, f.alias, Value::Actor(d));
+            for (slot, v) in f.params.iter().zip(values.iter()) {
+                set(&mut frame, *slot, v.clone());
+            }
+            Ctx { frame: Rc::new(frame), actor: Some(d), ..ctx.clone() }
+        });
+        let body = &f.body;
+        if f.parallel && count <= SMALL {
+            let runs: Vec<Ctx<'m>> = runs.collect();
+            join_all(runs.iter().map(|c| self.block(body, c))).await;
+        } else if f.parallel {
+            join_eager(runs.map(|c| async move { self.block(body, &c).await })).await;
         } else {
-            for c in &runs {
+            for c in runs {
                 if ctx.scope.unwinding.get() {
                     break;
                 }
-                self.block(&f.body, c).await;
+                self.block(body, &c).await;
             }
         }
     }
@@ -234,13 +246,27 @@ impl<'m> Engine<'m> {
     async fn call(&self, call: &'m Call, ctx: &Ctx<'m>) {
         let capability = &self.m.capabilities[call.capability];
         let args = self.eval_all(&call.args, ctx);
+        // The common case, one actor for a one-actor capability: no join.
+        if let ([actor], 1) = (call.actors.as_slice(), capability.actors) {
+            if !matches!(actor, ActorRef::Group(_)) {
+                if let [d] = self.drones(actor, ctx)[..] {
+                    self.instance(call, vec![d], args, ctx).await;
+                }
+                return;
+            }
+        }
         let per_actor: Vec<Vec<DroneId>> = call.actors.iter().map(|a| self.drones(a, ctx)).collect();
         let sets: Vec<Vec<DroneId>> = if capability.actors == 1 {
             per_actor.into_iter().flatten().map(|d| vec![d]).collect()
         } else {
             vec![per_actor.iter().filter_map(|ds| ds.first().copied()).collect()]
         };
-        join_all(sets.into_iter().map(|actors| self.instance(call, actors, args.clone(), ctx))).await;
+        let runs = sets.into_iter().map(|actors| self.instance(call, actors, args.clone(), ctx));
+        if runs.len() <= SMALL {
+            join_all(runs).await;
+        } else {
+            join_eager(runs).await;
+        }
     }
 
     async fn instance(&self, call: &'m Call, actors: Vec<DroneId>, args: Vec<Value>, ctx: &Ctx<'m>) {
@@ -330,7 +356,7 @@ impl<'m> Engine<'m> {
         let scope = {
             Rc::new(Scope {
                 parent: Some(ctx.scope.clone()),
-                path: cap.name.clone(),
+                path: &cap.name,
                 mission_block: false,
                 handlers: &[],
                 fired: RefCell::new(Vec::new()),

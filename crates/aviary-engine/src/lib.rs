@@ -14,6 +14,7 @@ mod control;
 mod engine;
 mod exec;
 mod jobs;
+mod join;
 mod registry;
 mod value;
 

@@ -45,7 +45,7 @@ pub fn run(drones: usize, emit: bool) -> u8 {
             return 1;
         }
     };
-    let flying = stages.0.iter().find(|(n, _)| *n == "engine + sim").map_or(0.0, |(_, d)| d.as_secs_f64());
+    let flying = stages.get("engine + sim").map_or(0.0, |d| d.as_secs_f64());
     let ok = ran.outcome.status == aviary_engine::Status::Ok && tally.found_handled == tally.detections;
     println!(
         "aviary swarm drones={drones} status={} simulated={:.1}s engine+sim wall={flying:.3}s speed={:.1}x real time; detections={} handled={} ok={ok}; whole process {:.3}s peak={}",

@@ -13,7 +13,7 @@ use tokio::sync::{mpsc, Notify};
 use crate::jobs::Jobs;
 use crate::registry::Registry;
 use tokio::time::Instant;
-use tokio_util::sync::CancellationToken;
+use crate::cancel::Token as CancellationToken;
 
 use crate::arbiter::{Arbiter, Claim};
 use crate::value::{airborne, to_json, Env};
@@ -178,7 +178,7 @@ impl<'m> Engine<'m> {
     }
 
     pub fn env<'a>(&'a self, frame: &'a [Value], received: &'a [bool]) -> Env<'a> {
-        Env { mission: self.m, backend: self.backend, frame, received, elapsed: self.now() }
+        Env { mission: self.m, backend: self.backend, frame, received, start: self.start }
     }
 
     pub async fn run(&self, options: &RunOptions, controls: Option<mpsc::UnboundedReceiver<crate::ControlRequest>>) -> Outcome {
@@ -415,7 +415,7 @@ impl<'m> Engine<'m> {
             match (signalling_block, h.sequential) {
                 (Some(block), true) => block.deferred.borrow_mut().push((scope.clone(), job)),
                 _ => {
-                    let _ = scope.jobs.send(job);
+                    scope.jobs.send(job);
                 }
             }
         }
@@ -470,6 +470,6 @@ impl<'m> Engine<'m> {
         }
         handler_scope.catching.set(handler_scope.catching.get() + 1);
         let handlers: &'m [ExceptionHandler] = handler_scope.exception_handlers;
-        let _ = handler_scope.jobs.send(Job::Exception { handler: &handlers[index], args });
+        handler_scope.jobs.send(Job::Exception { handler: &handlers[index], args });
     }
 }

@@ -14,7 +14,7 @@ use futures_util::future::{join_all, LocalBoxFuture};
 use futures_util::stream::{FuturesUnordered, StreamExt};
 use serde_json::{json, Map, Value as Json};
 use tokio::sync::Notify;
-use tokio_util::sync::CancellationToken;
+use crate::cancel::Token as CancellationToken;
 
 use crate::arbiter::acquire;
 use crate::engine::{Ctx, Engine, Instance, Job, Scope};
@@ -43,12 +43,12 @@ impl<'m> Engine<'m> {
                     items_done = true;
                     // `SEQUENTIAL ON` handlers that waited for this block start now.
                     for (target, job) in scope.deferred.take() {
-                        let _ = target.jobs.send(job);
+                        target.jobs.send(job);
                     }
                 }
                 Some(()) = async { running.as_mut()?.next().await }, if any_running => {}
             }
-            if items_done && !running.as_ref().is_some_and(|r| !r.is_empty()) {
+            if items_done && running.as_ref().is_none_or(|r| r.is_empty()) {
                 match jobs.try_recv() {
                     Some(job) => running.get_or_insert_with(FuturesUnordered::new).push(Box::pin(self.job(job, scope.clone()))),
                     None => break,
@@ -106,7 +106,7 @@ impl<'m> Engine<'m> {
                     }
                     self.node(node, ctx).await;
                     // A handler caught here takes the place of what it aborted.
-                    loop {
+                    while ctx.scope.catching.get() > 0 {
                         let done = ctx.scope.caught.notified();
                         if ctx.scope.catching.get() == 0 {
                             break;
@@ -122,15 +122,39 @@ impl<'m> Engine<'m> {
     }
 
     fn node<'a>(&'a self, node: &'m Node, ctx: &'a Ctx<'m>) -> LocalBoxFuture<'a, ()> {
-        Box::pin(async move {
-            if self.stopped() {
-                return;
-            }
+        // Each kind of node is boxed at its own size: with one future type for all, every
+        // SIGNAL or API call took the room of a capability instance's future.
+        match node {
+            Node::Call(c) => Box::pin(async move {
+                if !self.stopped() {
+                    self.call(c, ctx).await;
+                }
+            }),
+            Node::Api(a) => Box::pin(async move {
+                if !self.stopped() {
+                    self.api(a, ctx).await;
+                }
+            }),
+            Node::For(f) => Box::pin(async move {
+                if !self.stopped() {
+                    self.for_each(f, ctx).await;
+                }
+            }),
+            _ => Box::pin(async move {
+                if !self.stopped() {
+                    self.other_node(node, ctx).await;
+                }
+            }),
+        }
+    }
+
+    /// Blocks, leashes, signals, exceptions, requirements and IF.
+    async fn other_node(&self, node: &'m Node, ctx: &Ctx<'m>) {
+        {
             match node {
                 Node::Block(b) => self.block(b, ctx).await,
-                Node::Call(c) => self.call(c, ctx).await,
+                Node::Call(_) | Node::Api(_) | Node::For(_) => unreachable!("boxed apart in `node`"),
                 Node::Leash(l) => self.leash(l, ctx),
-                Node::Api(a) => self.api(a, ctx).await,
                 Node::Signal { signal, args, .. } => {
                     let args = self.eval_all(args, ctx);
                     self.raise(*signal, args, ctx.actor, &ctx.scope);
@@ -160,7 +184,6 @@ impl<'m> Engine<'m> {
                         }
                     }
                 }
-                Node::For(f) => self.for_each(f, ctx).await,
                 Node::If { branches, otherwise } => {
                     let chosen = branches.iter().find(|(c, _)| self.truth(c, ctx)).map(|(_, b)| b).or(otherwise.as_ref());
                     if let Some(b) = chosen {
@@ -168,7 +191,7 @@ impl<'m> Engine<'m> {
                     }
                 }
             }
-        })
+        }
     }
 
     fn eval_all(&self, exprs: &[Expr], ctx: &Ctx<'m>) -> Vec<Value> {
@@ -481,7 +504,7 @@ impl<'m> Engine<'m> {
                     for (p, v) in &values {
                         set(&mut frame, cap.actors + p, v.clone());
                     }
-                    let _ = scope.jobs.send(Job::Section { block: &cap.sections[i].1, frame: Rc::new(frame) });
+                    scope.jobs.send(Job::Section { block: &cap.sections[i].1, frame: Rc::new(frame) });
                 }
             }
         }

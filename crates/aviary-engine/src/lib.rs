@@ -10,6 +10,7 @@
 //! Invariant: the engine knows no backend; it talks to `aviary_api::Backend` only.
 
 mod arbiter;
+mod cancel;
 mod control;
 mod engine;
 mod exec;

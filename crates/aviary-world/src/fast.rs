@@ -135,6 +135,9 @@ impl Table {
     }
 }
 
+/// `[[` or `[`, where the header starts, and its keys so far.
+type Header = (bool, usize, Vec<(String, Span)>);
+
 /// An array or inline table whose closing bracket is still to come.
 enum Open {
     Array { start: usize, items: Vec<Node> },
@@ -148,7 +151,7 @@ struct Builder<'i> {
     /// an array of tables). `None` before the first header.
     current: Option<Vec<usize>>,
     /// A table header being read: `[[` or `[`, where it starts, its keys.
-    header: Option<(bool, usize, Vec<(String, Span)>)>,
+    header: Option<Header>,
     /// The key of a key/value pair whose value is being read.
     key: Option<(String, Span)>,
     /// A key was followed by `.`: a dotted key.

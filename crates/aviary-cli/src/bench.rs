@@ -50,6 +50,9 @@ pub enum BenchCommand {
         /// Print the generated mission instead of running it
         #[arg(long)]
         emit: bool,
+        /// Print the generated world instead of running it
+        #[arg(long)]
+        emit_world: bool,
         /// Build every trace event (as `aviary run --trace` does), not only those checked
         #[arg(long)]
         full_trace: bool,
@@ -62,14 +65,17 @@ pub enum BenchCommand {
         /// Print the generated mission instead of running it
         #[arg(long)]
         emit: bool,
+        /// Print the generated world instead of running it
+        #[arg(long)]
+        emit_world: bool,
     },
 }
 
 pub fn run(which: BenchCommand) -> u8 {
     match which {
         BenchCommand::Parse { mb, runs } => parse(mb, runs),
-        BenchCommand::W { n, k, emit, full_trace } => w::run(n, k, emit, full_trace),
-        BenchCommand::Swarm { drones, emit } => swarm::run(drones, emit),
+        BenchCommand::W { n, k, emit, emit_world, full_trace } => w::run(n, k, emit, emit_world, full_trace),
+        BenchCommand::Swarm { drones, emit, emit_world } => swarm::run(drones, emit, emit_world),
     }
 }
 

@@ -180,7 +180,11 @@ impl Fleet {
         // A drone held back for long gives way to everyone, not only to those before it,
         // until it no longer needs to give way.
         let humble = d.humble || d.stalled >= STALL;
-        let higher: Vec<DroneId> = (self.aloft.iter().copied())
+        // Every drone that could be in range, in index order, from the sky's grid.
+        let mut candidates = Vec::new();
+        let reach = sep + MARGIN + HORIZON * (speed(d) + self.fastest) + 1.0;
+        self.sky.around(d.xy(), d.xy(), reach, &mut candidates);
+        let higher: Vec<DroneId> = (candidates.iter().copied())
             .filter(|&j| j < id || (humble && j != id))
             .filter(|&j| {
                 let o = &self.drones[j];

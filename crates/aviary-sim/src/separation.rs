@@ -137,7 +137,7 @@ fn reach(d: &SimDrone, dt: f64) -> f64 {
 }
 
 /// How far a drone's envelope reaches from it.
-fn extent(e: &Envelope) -> f64 {
+pub(crate) fn extent(e: &Envelope) -> f64 {
     dist(e.from, e.to) + e.pad + (e.high - e.low)
 }
 
@@ -281,7 +281,11 @@ impl Fleet {
     fn near(&self, id: DroneId, dt: f64) -> Vec<Envelope> {
         let me = &self.drones[id];
         let (here, reach) = (me.pos, reach(me, dt));
-        self.aloft
+        // The sky's grid gives every drone that could be that near, in index order.
+        let mut candidates = Vec::new();
+        let xy = [here[0], here[1]];
+        self.sky.around(xy, xy, self.min_separation + reach + self.max_extent, &mut candidates);
+        candidates
             .iter()
             .filter(|&&j| j != id && counts(&self.drones[j]))
             .map(|&j| (self.drones[j].pos, envelope(&self.drones[j])))

@@ -16,7 +16,7 @@ struct Tally {
     events: u64,
 }
 
-pub fn run(drones: usize, emit: bool) -> u8 {
+pub fn run(drones: usize, emit: bool, emit_world: bool) -> u8 {
     if drones == 0 {
         eprintln!("aviary: --drones must be at least 1");
         return 2;
@@ -29,6 +29,10 @@ pub fn run(drones: usize, emit: bool) -> u8 {
         return 0;
     }
     let world = stages.time("generate", || aviary_check::generate::swarm_world(drones));
+    if emit_world {
+        print!("{world}");
+        return 0;
+    }
     let mut tally = Tally::default();
     let mut sink = |e: Json| {
         tally.events += 1;

@@ -50,7 +50,7 @@ impl Tally {
     }
 }
 
-pub fn run(n: usize, k: usize, emit: bool, full_trace: bool) -> u8 {
+pub fn run(n: usize, k: usize, emit: bool, emit_world: bool, full_trace: bool) -> u8 {
     if n == 0 || k == 0 {
         eprintln!("aviary: --n and --k must be at least 1");
         return 2;
@@ -63,6 +63,10 @@ pub fn run(n: usize, k: usize, emit: bool, full_trace: bool) -> u8 {
         return 0;
     }
     let world = stages.time("generate", || aviary_check::generate::w_world(n));
+    if emit_world {
+        print!("{world}");
+        return 0;
+    }
     let mut tally = Tally { full: full_trace, ..Tally::default() };
     let ran = pipeline::run(&mission, &world, &mut tally, &mut stages);
     let ran = match ran {

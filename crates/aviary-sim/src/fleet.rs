@@ -81,7 +81,7 @@ pub struct Fleet {
 }
 
 /// Metres on a side of a cell of [`Fleet::sky`]: about the planner's reach.
-const SKY_CELL: f64 = 100.0;
+const SKY_CELL: f64 = 400.0;
 /// Metres on a side of a cell of [`Fleet::target_grid`]: about a sensor's range.
 const TARGET_CELL: f64 = 50.0;
 

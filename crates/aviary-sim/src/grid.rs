@@ -6,13 +6,49 @@
 //! cost, which no longer grows with the size of the fleet.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 type Cell = (i64, i64);
+
+/// A cell's hash: SipHash (the default, made to resist chosen keys) was most of the cost
+/// of a query, and cells are no one's choice. The multiply-and-rotate of Firefox's and
+/// rustc's "FxHash".
+#[derive(Default)]
+struct CellHasher(u64);
+
+impl Hasher for CellHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for b in bytes {
+            self.write_u64(u64::from(*b));
+        }
+    }
+    fn write_i64(&mut self, i: i64) {
+        self.write_u64(i as u64);
+    }
+    fn write_u64(&mut self, i: u64) {
+        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+type Cells = HashMap<Cell, Vec<usize>, BuildHasherDefault<CellHasher>>;
+
+/// `x.floor() as i64` without a call to `floor` (this build has no SSE4.1 to inline it).
+fn floor(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x {
+        t - 1
+    } else {
+        t
+    }
+}
 
 #[derive(Clone, Debug)]
 pub(crate) struct Grid {
     size: f64,
-    cells: HashMap<Cell, Vec<usize>>,
+    cells: Cells,
     /// Where each item is, by index (`None`: not in the grid).
     at: Vec<Option<Cell>>,
 }
@@ -20,11 +56,11 @@ pub(crate) struct Grid {
 impl Grid {
     /// An empty grid of cells `size` metres on a side.
     pub fn new(size: f64) -> Grid {
-        Grid { size, cells: HashMap::new(), at: Vec::new() }
+        Grid { size, cells: Cells::default(), at: Vec::new() }
     }
 
     fn cell(&self, p: [f64; 2]) -> Cell {
-        ((p[0] / self.size).floor() as i64, (p[1] / self.size).floor() as i64)
+        (floor(p[0] / self.size), floor(p[1] / self.size))
     }
 
     pub fn contains(&self, i: usize) -> bool {

@@ -6,6 +6,9 @@ use std::fmt::Write;
 
 /// Metres on a side of each drone's cell.
 pub const CELL: usize = 100;
+/// Metres from one cell's corner to the next: the cells are apart by more than the
+/// separation planner's reach (about 160 m at 10 m/s), so each drone flies its own sky.
+pub const PITCH: usize = 300;
 /// Lane spacing of each sweep, metres.
 const SPACING: usize = 25;
 
@@ -45,7 +48,7 @@ pub fn swarm_world(n: usize) -> String {
     let side = (n as f64).sqrt().ceil().max(1.0) as usize;
     let mut w = String::with_capacity(256 + 160 * n);
     w.push_str("[site]\nname = \"Swarm\"\norigin = { lat = 46.6, lon = 14.2, alt = 440.0 }\nmax_altitude = 120.0\n\n[areas]\n");
-    let corner = |i: usize| ((i % side) * CELL, (i / side) * CELL);
+    let corner = |i: usize| ((i % side) * PITCH, (i / side) * PITCH);
     for i in 0..n {
         let (x, y) = corner(i);
         let (x1, y1) = (x + CELL - 10, y + CELL - 10);

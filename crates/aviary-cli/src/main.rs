@@ -11,6 +11,10 @@ mod fmt;
 mod run;
 mod trace_file;
 
+/// mimalloc rather than glibc's malloc: docs/BENCHMARKS.md says why.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 use std::path::PathBuf;
 use std::process::ExitCode;
 

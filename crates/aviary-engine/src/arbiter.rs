@@ -35,8 +35,10 @@ impl Drop for Held {
                 a.held.remove(c);
             }
         }
-        a.waiting.retain(|(id, _, _)| *id != self.id);
-        a.grant();
+        if !a.waiting.is_empty() {
+            a.waiting.retain(|(id, _, _)| *id != self.id);
+            a.grant();
+        }
     }
 }
 
@@ -61,6 +63,18 @@ impl Arbiter {
 
 /// Waits for `claims` (all at once, in arrival order) and holds them.
 pub(crate) async fn acquire(arbiter: &Rc<RefCell<Arbiter>>, claims: Vec<Claim>) -> Held {
+    {
+        // Nobody waits and all of it is free: granted now, as `grant` would, without a
+        // channel to wait on.
+        let mut a = arbiter.borrow_mut();
+        if a.waiting.is_empty() && claims.iter().all(|c| !a.held.contains(c)) {
+            a.next += 1;
+            let id = a.next;
+            a.held.extend(claims.iter().copied());
+            a.granted.insert(id, claims);
+            return Held { arbiter: arbiter.clone(), id };
+        }
+    }
     let (tx, rx) = oneshot::channel();
     let id = {
         let mut a = arbiter.borrow_mut();

@@ -12,6 +12,9 @@ use std::task::{Poll, Waker};
 #[derive(Default)]
 struct Node {
     cancelled: Cell<bool>,
+    /// Who waits: almost always one task (the activity's own), so one slot and a list
+    /// for the rare others.
+    waiter: RefCell<Option<Waker>>,
     waiters: RefCell<Vec<Waker>>,
     children: RefCell<Vec<Weak<Node>>>,
 }
@@ -52,9 +55,16 @@ impl Token {
             if self.0.cancelled.get() {
                 return Poll::Ready(());
             }
-            let mut waiters = self.0.waiters.borrow_mut();
-            if !waiters.iter().any(|w| w.will_wake(cx.waker())) {
-                waiters.push(cx.waker().clone());
+            let mut first = self.0.waiter.borrow_mut();
+            match &*first {
+                None => *first = Some(cx.waker().clone()),
+                Some(w) if w.will_wake(cx.waker()) => {}
+                Some(_) => {
+                    let mut waiters = self.0.waiters.borrow_mut();
+                    if !waiters.iter().any(|w| w.will_wake(cx.waker())) {
+                        waiters.push(cx.waker().clone());
+                    }
+                }
             }
             Poll::Pending
         })
@@ -65,6 +75,9 @@ impl Token {
 fn cancel(node: &Rc<Node>) {
     if node.cancelled.replace(true) {
         return;
+    }
+    if let Some(waker) = node.waiter.take() {
+        waker.wake();
     }
     for waker in node.waiters.take() {
         waker.wake();

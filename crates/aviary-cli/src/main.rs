@@ -3,6 +3,7 @@
 //! Exit codes (RUNTIME.md): 0 success, 1 the files have errors (or `fmt --check` would
 //! change them), 2 usage or IO problems.
 
+mod alloc;
 mod bench;
 mod check;
 mod ctl;
@@ -11,9 +12,8 @@ mod fmt;
 mod run;
 mod trace_file;
 
-/// mimalloc rather than glibc's malloc: docs/BENCHMARKS.md says why.
 #[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+static ALLOCATOR: alloc::MiMalloc = alloc::MiMalloc;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -28,6 +28,16 @@ const RECHECK: Duration = Duration::from_millis(100);
 impl<'m> Engine<'m> {
     /// Runs `items` in `scope`, with the handlers that scope starts, until all are done.
     pub(crate) async fn drive(&self, scope: &Rc<Scope<'m>>, items: impl Future<Output = ()>) {
+        // Jobs come only to a scope that declares handlers or exception handlers (signals,
+        // exceptions, `SEQUENTIAL ON` starting) or that tops a capability instance (leash
+        // sections). Any other scope, most of them, just runs its items.
+        if scope.handlers.is_empty() && scope.exception_handlers.is_empty() && scope.instance.is_none() {
+            items.await;
+            for (target, job) in scope.deferred.take() {
+                target.jobs.send(job);
+            }
+            return;
+        }
         let mut items = pin!(items);
         let jobs = &scope.jobs;
         // Made at the first job: most scopes never start a handler, and an empty

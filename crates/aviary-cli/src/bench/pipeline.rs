@@ -41,13 +41,15 @@ pub struct Ran {
 /// Checks, compiles and runs `mission` in `world` on the simulator (at `--speed max`),
 /// feeding every trace event to `sink`. Every stage really runs; a mission with errors
 /// is refused, as `aviary run` refuses it.
-pub fn run(mission: &str, world: &str, sink: &mut dyn TraceSink, stages: &mut Stages) -> Result<Ran, String> {
+/// The texts are handed over (to the source map), not copied: a large world's text is
+/// megabytes.
+pub fn run(mission: String, world: String, sink: &mut dyn TraceSink, stages: &mut Stages) -> Result<Ran, String> {
     let api = aviary_sim::descriptor();
     let mut sources = SourceMap::new();
-    let wid = sources.add("bench.world.toml", world.to_string());
+    let wid = sources.add("bench.world.toml", world);
     let (world, diags) = stages.time("world", || aviary_world::parse_world(wid, sources.text(wid)));
     let Some(world) = world else { return Err(render(&sources, &diags)) };
-    let root = sources.add("bench.mission", mission.to_string());
+    let root = sources.add("bench.mission", mission);
     let (program, diags) = stages.time("check", || aviary_check::check(&mut sources, root, Some(&world), &NoFiles, &api));
     if diags.iter().any(|d| d.is_error()) {
         return Err(render(&sources, &diags));

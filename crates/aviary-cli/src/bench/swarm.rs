@@ -42,7 +42,7 @@ pub fn run(drones: usize, emit: bool, emit_world: bool) -> u8 {
             _ => {}
         }
     };
-    let ran = match pipeline::run(&mission, &world, &mut sink, &mut stages) {
+    let ran = match pipeline::run(mission, world, &mut sink, &mut stages) {
         Ok(r) => r,
         Err(why) => {
             eprintln!("aviary: the swarm mission did not run:\n{why}");

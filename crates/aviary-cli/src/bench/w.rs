@@ -68,7 +68,7 @@ pub fn run(n: usize, k: usize, emit: bool, emit_world: bool, full_trace: bool) -
         return 0;
     }
     let mut tally = Tally { full: full_trace, ..Tally::default() };
-    let ran = pipeline::run(&mission, &world, &mut tally, &mut stages);
+    let ran = pipeline::run(mission, world, &mut tally, &mut stages);
     let ran = match ran {
         Ok(r) => r,
         Err(why) => {

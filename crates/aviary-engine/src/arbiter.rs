@@ -25,11 +25,16 @@ pub(crate) struct Arbiter {
 pub(crate) struct Held {
     arbiter: Rc<RefCell<Arbiter>>,
     id: u64,
+    /// The claims of a request granted at once (not recorded in `granted`).
+    own: Vec<Claim>,
 }
 
 impl Drop for Held {
     fn drop(&mut self) {
         let mut a = self.arbiter.borrow_mut();
+        for c in &self.own {
+            a.held.remove(c);
+        }
         if let Some(claims) = a.granted.remove(&self.id) {
             for c in &claims {
                 a.held.remove(c);
@@ -71,8 +76,7 @@ pub(crate) async fn acquire(arbiter: &Rc<RefCell<Arbiter>>, claims: Vec<Claim>) 
             a.next += 1;
             let id = a.next;
             a.held.extend(claims.iter().copied());
-            a.granted.insert(id, claims);
-            return Held { arbiter: arbiter.clone(), id };
+            return Held { arbiter: arbiter.clone(), id, own: claims };
         }
     }
     let (tx, rx) = oneshot::channel();
@@ -85,7 +89,7 @@ pub(crate) async fn acquire(arbiter: &Rc<RefCell<Arbiter>>, claims: Vec<Claim>) 
         id
     };
     // Made before waiting, so that a drop while waiting withdraws the request.
-    let held = Held { arbiter: arbiter.clone(), id };
+    let held = Held { arbiter: arbiter.clone(), id, own: Vec::new() };
     // The sender stays in the arbiter until granted, so this ends only by a grant.
     let _ = rx.await;
     held

@@ -359,12 +359,12 @@ impl<'m> Engine<'m> {
             h = acquire(&self.arbiter, needs) => Some(h),
         };
         if self.stopped() {
-            self.instances.borrow_mut().remove(instance.id);
+            self.instances.borrow_mut().remove(&instance);
             return;
         }
         self.trace("capability_start", start);
         if held.is_none() {
-            self.instances.borrow_mut().remove(instance.id);
+            self.instances.borrow_mut().remove(&instance);
             end("aborted");
             return;
         }
@@ -377,7 +377,7 @@ impl<'m> Engine<'m> {
             cap.requirements.iter().all(|r| env.truth(r))
         };
         if !requirements_met {
-            self.instances.borrow_mut().remove(instance.id);
+            self.instances.borrow_mut().remove(&instance);
             end("failed");
             drop(held);
             let id = self.m.exceptions.iter().position(|e| e == "RequirementNotMet").unwrap_or(0);
@@ -403,7 +403,7 @@ impl<'m> Engine<'m> {
                 instance: Some(instance.clone()),
             })
         };
-        self.instances.borrow_mut().set_scope(instance.id, scope.clone());
+        self.instances.borrow_mut().set_scope(&instance, scope.clone());
         let inner = Ctx { scope: scope.clone(), frame, actor, instance: Some(instance.clone()), claims };
         let perform = async {
             tokio::select! {
@@ -417,7 +417,7 @@ impl<'m> Engine<'m> {
             _ = instance.token.cancelled() => false,
             _ = self.drive(&scope, perform) => true,
         };
-        self.instances.borrow_mut().remove(instance.id);
+        self.instances.borrow_mut().remove(&instance);
         if !finished && instance.by_leash.get() {
             // `PERFORM ABORT:` says what aborting this activity also does.
             if let Some((_, section)) = cap.sections.iter().find(|(n, _)| n == "ABORT") {

@@ -92,7 +92,7 @@ enum Command {
     },
     /// Explain a diagnostic code, such as E107
     Explain { code: String },
-    /// Measure the speed of the front end on a generated mission
+    /// Benchmarks on generated missions: the front end (parse), the engine (w), the simulator (swarm)
     Bench {
         #[command(subcommand)]
         which: bench::BenchCommand,

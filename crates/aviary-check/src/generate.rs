@@ -11,7 +11,13 @@
 //! every signal raised is heard and every handler can fire, so `aviary check` reports
 //! nothing on it. The output is a function of `target_bytes` only.
 
+mod swarm;
+mod w;
+
 use std::fmt::Write;
+
+pub use swarm::{swarm_mission, swarm_world};
+pub use w::{w_mission, w_world};
 
 /// Drones in the generated world.
 pub const DRONES: usize = 200;

@@ -2,6 +2,12 @@
 //! (`aviary_check::generate`), then times parsing alone and parse + check through the
 //! same pipeline as `aviary check` (source map, world, `aviary_check::check`), and
 //! prints each run and the median throughput. MB here is 10^6 bytes.
+//! `aviary bench w` and `aviary bench swarm` (in `bench/`) run generated missions
+//! through the whole pipeline.
+
+mod pipeline;
+mod swarm;
+mod w;
 
 use std::time::{Duration, Instant};
 
@@ -11,7 +17,7 @@ use aviary_diagnostics::{FileId, SourceMap};
 use clap::Subcommand;
 
 /// The generated mission USEs nothing, so nothing is served.
-struct NoFiles;
+pub(crate) struct NoFiles;
 
 impl SourceProvider for NoFiles {
     fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
@@ -32,11 +38,44 @@ pub enum BenchCommand {
         #[arg(long, default_value_t = 5)]
         runs: usize,
     },
+    /// The engine benchmark W(N, K) in the language: N actors in parallel, K steps each,
+    /// then `Done` to one handler; prints wall time, peak memory and where the time went
+    W {
+        /// Actors (drones in the world's one group)
+        #[arg(long, default_value_t = 100_000)]
+        n: usize,
+        /// Steps per actor
+        #[arg(long, default_value_t = 10)]
+        k: usize,
+        /// Print the generated mission instead of running it
+        #[arg(long)]
+        emit: bool,
+        /// Print the generated world instead of running it
+        #[arg(long)]
+        emit_world: bool,
+        /// Build every trace event (as `aviary run --trace` does), not only those checked
+        #[arg(long)]
+        full_trace: bool,
+    },
+    /// N simulated drones, each sweeping its own area with detection on; prints
+    /// simulated seconds per wall second
+    Swarm {
+        #[arg(long, default_value_t = 10_000)]
+        drones: usize,
+        /// Print the generated mission instead of running it
+        #[arg(long)]
+        emit: bool,
+        /// Print the generated world instead of running it
+        #[arg(long)]
+        emit_world: bool,
+    },
 }
 
 pub fn run(which: BenchCommand) -> u8 {
     match which {
         BenchCommand::Parse { mb, runs } => parse(mb, runs),
+        BenchCommand::W { n, k, emit, emit_world, full_trace } => w::run(n, k, emit, emit_world, full_trace),
+        BenchCommand::Swarm { drones, emit, emit_world } => swarm::run(drones, emit, emit_world),
     }
 }
 

@@ -3,6 +3,7 @@
 //! Exit codes (RUNTIME.md): 0 success, 1 the files have errors (or `fmt --check` would
 //! change them), 2 usage or IO problems.
 
+mod alloc;
 mod bench;
 mod check;
 mod ctl;
@@ -12,6 +13,9 @@ mod mixed;
 mod run;
 mod trace_file;
 mod vehicles;
+
+#[global_allocator]
+static ALLOCATOR: alloc::MiMalloc = alloc::MiMalloc;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -108,7 +112,7 @@ enum Command {
     },
     /// Explain a diagnostic code, such as E107
     Explain { code: String },
-    /// Measure the speed of the front end on a generated mission
+    /// Benchmarks on generated missions: the front end (parse), the engine (w), the simulator (swarm)
     Bench {
         #[command(subcommand)]
         which: bench::BenchCommand,

@@ -25,18 +25,25 @@ pub(crate) struct Arbiter {
 pub(crate) struct Held {
     arbiter: Rc<RefCell<Arbiter>>,
     id: u64,
+    /// The claims of a request granted at once (not recorded in `granted`).
+    own: Vec<Claim>,
 }
 
 impl Drop for Held {
     fn drop(&mut self) {
         let mut a = self.arbiter.borrow_mut();
+        for c in &self.own {
+            a.held.remove(c);
+        }
         if let Some(claims) = a.granted.remove(&self.id) {
             for c in &claims {
                 a.held.remove(c);
             }
         }
-        a.waiting.retain(|(id, _, _)| *id != self.id);
-        a.grant();
+        if !a.waiting.is_empty() {
+            a.waiting.retain(|(id, _, _)| *id != self.id);
+            a.grant();
+        }
     }
 }
 
@@ -61,6 +68,17 @@ impl Arbiter {
 
 /// Waits for `claims` (all at once, in arrival order) and holds them.
 pub(crate) async fn acquire(arbiter: &Rc<RefCell<Arbiter>>, claims: Vec<Claim>) -> Held {
+    {
+        // Nobody waits and all of it is free: granted now, as `grant` would, without a
+        // channel to wait on.
+        let mut a = arbiter.borrow_mut();
+        if a.waiting.is_empty() && claims.iter().all(|c| !a.held.contains(c)) {
+            a.next += 1;
+            let id = a.next;
+            a.held.extend(claims.iter().copied());
+            return Held { arbiter: arbiter.clone(), id, own: claims };
+        }
+    }
     let (tx, rx) = oneshot::channel();
     let id = {
         let mut a = arbiter.borrow_mut();
@@ -71,7 +89,7 @@ pub(crate) async fn acquire(arbiter: &Rc<RefCell<Arbiter>>, claims: Vec<Claim>) 
         id
     };
     // Made before waiting, so that a drop while waiting withdraws the request.
-    let held = Held { arbiter: arbiter.clone(), id };
+    let held = Held { arbiter: arbiter.clone(), id, own: Vec::new() };
     // The sender stays in the arbiter until granted, so this ends only by a grant.
     let _ = rx.await;
     held

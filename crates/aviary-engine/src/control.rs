@@ -99,7 +99,7 @@ impl<'m> Engine<'m> {
             Control::Pause | Control::Resume => {
                 let pause = control == Control::Pause;
                 self.mission_paused.set(pause);
-                for (instance, _) in self.instances.borrow().iter().filter(|(i, _)| i.root.is_none()) {
+                for (instance, _) in self.instances.borrow().all().iter().filter(|(i, _)| i.root.is_none()) {
                     instance.paused.set(pause);
                     for call in instance.calls.borrow().iter() {
                         self.backend.interrupt(*call, if pause { Interrupt::Pause } else { Interrupt::Resume });

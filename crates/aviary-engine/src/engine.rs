@@ -9,8 +9,11 @@ use aviary_api::{Backend, DroneEvent, DroneId, Value};
 use aviary_ir::{ActorFilter, ExceptionHandler, Handler, Mission};
 use serde_json::{json, Value as Json};
 use tokio::sync::{mpsc, Notify};
+
+use crate::jobs::Jobs;
+use crate::registry::Registry;
 use tokio::time::Instant;
-use tokio_util::sync::CancellationToken;
+use crate::cancel::Token as CancellationToken;
 
 use crate::arbiter::{Arbiter, Claim};
 use crate::value::{airborne, to_json, Env};
@@ -28,14 +31,14 @@ pub(crate) enum Job<'m> {
 /// A running body: what it hears, where its handlers start, whether it is unwinding.
 pub(crate) struct Scope<'m> {
     pub parent: Option<Rc<Scope<'m>>>,
-    pub path: String,
+    pub path: &'m str,
     /// A block of the mission itself (not inside a capability): a signalling block.
     pub mission_block: bool,
     pub handlers: &'m [Handler],
     pub fired: RefCell<Vec<bool>>,
     pub exception_handlers: &'m [ExceptionHandler],
     pub frame: Frame,
-    pub jobs: mpsc::UnboundedSender<Job<'m>>,
+    pub jobs: Jobs<'m>,
     /// Set when an exception aborts the sequential chain through this scope.
     pub unwinding: Cell<bool>,
     /// `SEQUENTIAL ON` handlers to start, in their own scope, when this block has finished.
@@ -98,7 +101,7 @@ pub(crate) struct Engine<'m> {
     pub received: RefCell<Vec<bool>>,
     pub changed: Notify,
     pub arbiter: Rc<RefCell<Arbiter>>,
-    pub instances: RefCell<Vec<(Rc<Instance>, Rc<Scope<'m>>)>>,
+    pub instances: RefCell<Registry<'m>>,
     pub detections: RefCell<BTreeMap<(DroneId, String), Rc<Scope<'m>>>>,
     /// How the mission ends early, if it does: failed (an unhandled exception, a lost
     /// backend) or aborted (the operator), and why.
@@ -128,7 +131,7 @@ impl<'m> Engine<'m> {
             received: RefCell::new(vec![false; m.signals.len()]),
             changed: Notify::new(),
             arbiter: Rc::new(RefCell::new(Arbiter::default())),
-            instances: RefCell::new(Vec::new()),
+            instances: RefCell::new(Registry::default()),
             detections: RefCell::new(BTreeMap::new()),
             ending: RefCell::new(None),
             backend_alive: Cell::new(true),
@@ -151,7 +154,12 @@ impl<'m> Engine<'m> {
         (Instant::now() - self.start).as_secs_f64()
     }
 
-    pub fn trace(&self, event: &str, fields: Json) {
+    /// Records an event, if the sink wants its kind: `fields` is built only then.
+    pub fn trace(&self, event: &str, fields: impl FnOnce() -> Json) {
+        if !self.sink.borrow().wants(event) {
+            return;
+        }
+        let fields = fields();
         let mut object = serde_json::Map::new();
         object.insert("t".into(), json!(self.now()));
         object.insert("event".into(), json!(event));
@@ -170,21 +178,20 @@ impl<'m> Engine<'m> {
     }
 
     pub fn env<'a>(&'a self, frame: &'a [Value], received: &'a [bool]) -> Env<'a> {
-        Env { mission: self.m, backend: self.backend, frame, received, elapsed: self.now() }
+        Env { mission: self.m, backend: self.backend, frame, received, start: self.start }
     }
 
     pub async fn run(&self, options: &RunOptions, controls: Option<mpsc::UnboundedReceiver<crate::ControlRequest>>) -> Outcome {
-        self.trace("mission_start", json!({ "mission": self.m.name }));
-        let (tx, rx) = mpsc::unbounded_channel();
+        self.trace("mission_start", || json!({ "mission": self.m.name }));
         let root = Rc::new(Scope {
             parent: None,
-            path: self.m.name.clone(),
+            path: &self.m.name,
             mission_block: true,
             handlers: &[],
             fired: RefCell::new(Vec::new()),
             exception_handlers: &[],
             frame: Rc::new(vec![Value::Bool(false); self.m.frame_size]),
-            jobs: tx,
+            jobs: Jobs::default(),
             unwinding: Cell::new(false),
             deferred: RefCell::new(Vec::new()),
             catching: Cell::new(0),
@@ -193,13 +200,20 @@ impl<'m> Engine<'m> {
         });
         *self.root.borrow_mut() = Some(root.clone());
         let ctx = Ctx { scope: root.clone(), frame: root.frame.clone(), actor: None, instance: None, claims: Rc::new(BTreeSet::new()) };
-        let body = self.drive(&root, rx, self.block(&self.m.body, &ctx));
+        let body = self.drive(&root, self.block(&self.m.body, &ctx));
         let controls = async {
             match controls {
                 Some(rx) => self.controls(rx).await,
                 None => std::future::pending().await,
             }
         };
+        // Unconstrained by tokio's cooperative budget: the budget makes a task yield
+        // after 128 channel operations, and each yield re-polls the mission's tree of
+        // futures from its root. With N actors in parallel that turned every step into
+        // a walk over many of them (W(100k, 10) was quadratic). Nothing here needs it:
+        // the mission is one task, every wait is on time or a notification, and the
+        // simulator's driver runs whenever the mission waits.
+        let body = tokio::task::unconstrained(body);
         tokio::select! {
             biased;
             _ = self.stop.cancelled() => {}
@@ -217,7 +231,7 @@ impl<'m> Engine<'m> {
             Some((status, reason)) => (status, Some(reason)),
             None => (Status::Ok, None),
         };
-        self.trace("mission_end", json!({ "status": status.as_str(), "reason": reason }));
+        self.trace("mission_end", || json!({ "status": status.as_str(), "reason": reason }));
         Outcome { status, reason }
     }
 
@@ -242,7 +256,7 @@ impl<'m> Engine<'m> {
             }
         }
         let calls = homes.into_iter().map(|d| async move {
-            self.trace("api_call", json!({ "actor": self.name(d), "function": "ReturnToLaunch", "args": [] }));
+            self.trace("api_call", || json!({ "actor": self.name(d), "function": "ReturnToLaunch", "args": [] }));
             let pending = self.backend.call(d, "ReturnToLaunch", &[]);
             let end = pending.end.await.unwrap_or(aviary_api::CallEnd::Interrupted);
             self.trace_done(d, "ReturnToLaunch", &[], &end);
@@ -256,8 +270,7 @@ impl<'m> Engine<'m> {
             aviary_api::CallEnd::Failed(_) => "failed",
             aviary_api::CallEnd::Interrupted => "interrupted",
         };
-        let p = self.backend.telemetry(d).position;
-        self.trace("api_done", json!({ "actor": self.name(d), "function": function, "args": self.values(args), "status": status, "position": p }));
+        self.trace("api_done", || json!({ "actor": self.name(d), "function": function, "args": self.values(args), "status": status, "position": self.backend.telemetry(d).position }));
     }
 
     async fn telemetry(&self, hz: Option<f64>) {
@@ -267,7 +280,7 @@ impl<'m> Engine<'m> {
         loop {
             for d in 0..self.m.drones.len() {
                 let t = self.backend.telemetry(d);
-                self.trace("telemetry", json!({ "actor": self.name(d), "position": t.position, "battery": t.battery, "state": t.state.as_str() }));
+                self.trace("telemetry", || json!({ "actor": self.name(d), "position": t.position, "battery": t.battery, "state": t.state.as_str() }));
             }
             next += period;
             tokio::time::sleep_until(next).await;
@@ -307,7 +320,7 @@ impl<'m> Engine<'m> {
     fn on_event(&self, event: DroneEvent) {
         match event {
             DroneEvent::Detected { drone, kind, location } => {
-                self.trace("detection", json!({ "actor": self.name(drone), "kind": kind, "location": location }));
+                self.trace("detection", || json!({ "actor": self.name(drone), "kind": kind, "location": location }));
                 let scope = self.detections.borrow().get(&(drone, kind.clone())).cloned();
                 if let (Some(scope), Some(id)) = (scope, self.signal_id("Detected")) {
                     // A find is a point on the ground: flying to it keeps the altitude.
@@ -337,7 +350,7 @@ impl<'m> Engine<'m> {
     /// instance, or at mission level when it is idle.
     fn actor_scope(&self, drone: DroneId) -> Rc<Scope<'m>> {
         let instances = self.instances.borrow();
-        let innermost = instances.iter().filter(|(i, _)| i.actors.contains(&drone)).max_by_key(|(i, _)| (i.depth, i.id));
+        let innermost = instances.of_actor(drone).max_by_key(|(i, _)| (i.depth, i.id));
         match innermost {
             Some((_, scope)) => scope.clone(),
             None => self.mission_scope.borrow().clone().unwrap_or_else(|| self.root_scope()),
@@ -355,7 +368,7 @@ impl<'m> Engine<'m> {
     /// A signal from outside the mission (the operator): heard by every running handler
     /// that matches, at once (there is no signalling block to wait for).
     pub fn raise_from_outside(&self, signal: usize, args: Vec<Value>) {
-        self.trace("signal", json!({ "name": self.m.signals[signal], "actor": null, "args": self.values(&args) }));
+        self.trace("signal", || json!({ "name": self.m.signals[signal], "actor": null, "args": self.values(&args) }));
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {
             *r = true;
         }
@@ -372,7 +385,7 @@ impl<'m> Engine<'m> {
         if self.stopped() {
             return;
         }
-        self.trace("signal", json!({ "name": self.m.signals[signal], "actor": actor.map(|a| self.name(a)), "args": self.values(&args) }));
+        self.trace("signal", || json!({ "name": self.m.signals[signal], "actor": actor.map(|a| self.name(a)), "args": self.values(&args) }));
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {
             *r = true;
         }
@@ -402,7 +415,7 @@ impl<'m> Engine<'m> {
             match (signalling_block, h.sequential) {
                 (Some(block), true) => block.deferred.borrow_mut().push((scope.clone(), job)),
                 _ => {
-                    let _ = scope.jobs.send(job);
+                    scope.jobs.send(job);
                 }
             }
         }
@@ -419,11 +432,10 @@ impl<'m> Engine<'m> {
             let i = scope.exception_handlers.iter().position(|h| h.exception == exception && self.matches(&h.by, &scope.frame, actor))?;
             Some((scope.clone(), i))
         });
-        self.trace(
-            "exception",
+        self.trace("exception", || {
             json!({ "name": name, "actor": actor.map(|a| self.name(a)), "args": self.values(&args),
-                    "handled": found.is_some(), "handler": found.as_ref().map(|(s, _)| format!("{}/ON EXCEPTION {name}", s.path)) }),
-        );
+                    "handled": found.is_some(), "handler": found.as_ref().map(|(s, _)| format!("{}/ON EXCEPTION {name}", s.path)) })
+        });
         let Some((handler_scope, index)) = found else {
             for scope in from.chain() {
                 scope.unwinding.set(true);
@@ -447,8 +459,8 @@ impl<'m> Engine<'m> {
             }
         }
         if let Some(actor) = actor {
-            for (instance, scope) in self.instances.borrow().iter() {
-                if instance.actors.contains(&actor) && !keep.contains(&Rc::as_ptr(scope)) {
+            for (instance, scope) in self.instances.borrow().of_actor(actor) {
+                if !keep.contains(&Rc::as_ptr(scope)) {
                     instance.token.cancel();
                 }
             }
@@ -458,6 +470,6 @@ impl<'m> Engine<'m> {
         }
         handler_scope.catching.set(handler_scope.catching.get() + 1);
         let handlers: &'m [ExceptionHandler] = handler_scope.exception_handlers;
-        let _ = handler_scope.jobs.send(Job::Exception { handler: &handlers[index], args });
+        handler_scope.jobs.send(Job::Exception { handler: &handlers[index], args });
     }
 }

@@ -13,11 +13,13 @@ use aviary_ir::{ActorRef, Block, BlockKind, Call, Expr, For, Leash, LeashAction,
 use futures_util::future::{join_all, LocalBoxFuture};
 use futures_util::stream::{FuturesUnordered, StreamExt};
 use serde_json::{json, Map, Value as Json};
-use tokio::sync::{mpsc, Notify};
-use tokio_util::sync::CancellationToken;
+use tokio::sync::Notify;
+use crate::cancel::Token as CancellationToken;
 
 use crate::arbiter::acquire;
 use crate::engine::{Ctx, Engine, Instance, Job, Scope};
+use crate::jobs::Jobs;
+use crate::join::{join_eager, SMALL};
 use crate::value::to_json;
 
 /// Conditions are looked at again at least this often (LANGUAGE.md §3).
@@ -25,43 +27,56 @@ const RECHECK: Duration = Duration::from_millis(100);
 
 impl<'m> Engine<'m> {
     /// Runs `items` in `scope`, with the handlers that scope starts, until all are done.
-    pub(crate) async fn drive(&self, scope: &Rc<Scope<'m>>, mut jobs: mpsc::UnboundedReceiver<Job<'m>>, items: impl Future<Output = ()>) {
+    pub(crate) async fn drive(&self, scope: &Rc<Scope<'m>>, items: impl Future<Output = ()>) {
+        // Jobs come only to a scope that declares handlers or exception handlers (signals,
+        // exceptions, `SEQUENTIAL ON` starting) or that tops a capability instance (leash
+        // sections). Any other scope, most of them, just runs its items.
+        if scope.handlers.is_empty() && scope.exception_handlers.is_empty() && scope.instance.is_none() {
+            items.await;
+            for (target, job) in scope.deferred.take() {
+                target.jobs.send(job);
+            }
+            return;
+        }
         let mut items = pin!(items);
-        let mut running: FuturesUnordered<LocalBoxFuture<'_, ()>> = FuturesUnordered::new();
+        let jobs = &scope.jobs;
+        // Made at the first job: most scopes never start a handler, and an empty
+        // `FuturesUnordered` still allocates.
+        let mut running: Option<FuturesUnordered<LocalBoxFuture<'_, ()>>> = None;
         let mut items_done = false;
         loop {
+            let any_running = running.as_ref().is_some_and(|r| !r.is_empty());
             tokio::select! {
                 biased;
-                Some(job) = jobs.recv() => running.push(Box::pin(self.job(job, scope.clone()))),
+                job = std::future::poll_fn(|cx| jobs.poll_recv(cx)) => running.get_or_insert_with(FuturesUnordered::new).push(Box::pin(self.job(job, scope.clone()))),
                 _ = &mut items, if !items_done => {
                     items_done = true;
                     // `SEQUENTIAL ON` handlers that waited for this block start now.
                     for (target, job) in scope.deferred.take() {
-                        let _ = target.jobs.send(job);
+                        target.jobs.send(job);
                     }
                 }
-                Some(()) = running.next(), if !running.is_empty() => {}
+                Some(()) = async { running.as_mut()?.next().await }, if any_running => {}
             }
-            if items_done && running.is_empty() {
+            if items_done && running.as_ref().is_none_or(|r| r.is_empty()) {
                 match jobs.try_recv() {
-                    Ok(job) => running.push(Box::pin(self.job(job, scope.clone()))),
-                    Err(_) => break,
+                    Some(job) => running.get_or_insert_with(FuturesUnordered::new).push(Box::pin(self.job(job, scope.clone()))),
+                    None => break,
                 }
             }
         }
     }
 
-    fn new_scope(&self, ctx: &Ctx<'m>, block: &'m Block, instance: Option<Rc<Instance>>) -> (Rc<Scope<'m>>, mpsc::UnboundedReceiver<Job<'m>>) {
-        let (tx, rx) = mpsc::unbounded_channel();
+    fn new_scope(&self, ctx: &Ctx<'m>, block: &'m Block, instance: Option<Rc<Instance>>) -> Rc<Scope<'m>> {
         let scope = Rc::new(Scope {
             parent: Some(ctx.scope.clone()),
-            path: block.path.clone(),
+            path: &block.path,
             mission_block: ctx.instance.is_none() && instance.is_none(),
             handlers: &block.handlers,
             fired: RefCell::new(vec![false; block.handlers.len()]),
             exception_handlers: &block.exception_handlers,
             frame: ctx.frame.clone(),
-            jobs: tx,
+            jobs: Jobs::default(),
             unwinding: Cell::new(false),
             deferred: RefCell::new(Vec::new()),
             catching: Cell::new(0),
@@ -74,20 +89,20 @@ impl<'m> Engine<'m> {
         if ctx.scope.parent.is_none() {
             *self.mission_scope.borrow_mut() = Some(scope.clone());
         }
-        (scope, rx)
+        scope
     }
 
     pub(crate) fn block<'a>(&'a self, block: &'m Block, ctx: &'a Ctx<'m>) -> LocalBoxFuture<'a, ()> {
         Box::pin(async move {
-            let (scope, rx) = self.new_scope(ctx, block, None);
+            let scope = self.new_scope(ctx, block, None);
             if block.traced {
-                self.trace("block_start", json!({ "block": block.path }));
+                self.trace("block_start", || json!({ "block": block.path }));
             }
             let inner = Ctx { scope: scope.clone(), ..ctx.clone() };
-            self.drive(&scope, rx, self.items(block, &inner)).await;
+            self.drive(&scope, self.items(block, &inner)).await;
             if block.traced {
                 let status = if scope.unwinding.get() { "aborted" } else { "ok" };
-                self.trace("block_end", json!({ "block": block.path, "status": status }));
+                self.trace("block_end", || json!({ "block": block.path, "status": status }));
             }
         })
     }
@@ -101,7 +116,7 @@ impl<'m> Engine<'m> {
                     }
                     self.node(node, ctx).await;
                     // A handler caught here takes the place of what it aborted.
-                    loop {
+                    while ctx.scope.catching.get() > 0 {
                         let done = ctx.scope.caught.notified();
                         if ctx.scope.catching.get() == 0 {
                             break;
@@ -117,15 +132,39 @@ impl<'m> Engine<'m> {
     }
 
     fn node<'a>(&'a self, node: &'m Node, ctx: &'a Ctx<'m>) -> LocalBoxFuture<'a, ()> {
-        Box::pin(async move {
-            if self.stopped() {
-                return;
-            }
+        // Each kind of node is boxed at its own size: with one future type for all, every
+        // SIGNAL or API call took the room of a capability instance's future.
+        match node {
+            Node::Call(c) => Box::pin(async move {
+                if !self.stopped() {
+                    self.call(c, ctx).await;
+                }
+            }),
+            Node::Api(a) => Box::pin(async move {
+                if !self.stopped() {
+                    self.api(a, ctx).await;
+                }
+            }),
+            Node::For(f) => Box::pin(async move {
+                if !self.stopped() {
+                    self.for_each(f, ctx).await;
+                }
+            }),
+            _ => Box::pin(async move {
+                if !self.stopped() {
+                    self.other_node(node, ctx).await;
+                }
+            }),
+        }
+    }
+
+    /// Blocks, leashes, signals, exceptions, requirements and IF.
+    async fn other_node(&self, node: &'m Node, ctx: &Ctx<'m>) {
+        {
             match node {
                 Node::Block(b) => self.block(b, ctx).await,
-                Node::Call(c) => self.call(c, ctx).await,
+                Node::Call(_) | Node::Api(_) | Node::For(_) => unreachable!("boxed apart in `node`"),
                 Node::Leash(l) => self.leash(l, ctx),
-                Node::Api(a) => self.api(a, ctx).await,
                 Node::Signal { signal, args, .. } => {
                     let args = self.eval_all(args, ctx);
                     self.raise(*signal, args, ctx.actor, &ctx.scope);
@@ -155,7 +194,6 @@ impl<'m> Engine<'m> {
                         }
                     }
                 }
-                Node::For(f) => self.for_each(f, ctx).await,
                 Node::If { branches, otherwise } => {
                     let chosen = branches.iter().find(|(c, _)| self.truth(c, ctx)).map(|(_, b)| b).or(otherwise.as_ref());
                     if let Some(b) = chosen {
@@ -163,7 +201,7 @@ impl<'m> Engine<'m> {
                     }
                 }
             }
-        })
+        }
     }
 
     fn eval_all(&self, exprs: &[Expr], ctx: &Ctx<'m>) -> Vec<Value> {
@@ -204,26 +242,34 @@ impl<'m> Engine<'m> {
     }
 
     async fn for_each(&self, f: &'m For, ctx: &Ctx<'m>) {
-        let mut runs = Vec::new();
+        // Every instance's values are taken when the FOR starts; the frames are made as
+        // the instances start (making them has no effect but memory).
+        let mut instances = Vec::new();
         for (actor, values) in &f.instances {
-            let values = self.eval_all(values, ctx);
-            for d in self.drones(actor, ctx) {
-                let mut frame = (*ctx.frame).clone();
-                set(&mut frame, f.alias, Value::Actor(d));
-                for (slot, v) in f.params.iter().zip(&values) {
-                    set(&mut frame, *slot, v.clone());
-                }
-                runs.push(Ctx { frame: Rc::new(frame), actor: Some(d), ..ctx.clone() });
-            }
+            let values = Rc::new(self.eval_all(values, ctx));
+            instances.extend(self.drones(actor, ctx).into_iter().map(|d| (d, values.clone())));
         }
-        if f.parallel {
-            join_all(runs.iter().map(|c| self.block(&f.body, c))).await;
+        let count = instances.len();
+        let runs = instances.into_iter().map(|(d, values)| {
+            let mut frame = (*ctx.frame).clone();
+            set(&mut frame, f.alias, Value::Actor(d));
+            for (slot, v) in f.params.iter().zip(values.iter()) {
+                set(&mut frame, *slot, v.clone());
+            }
+            Ctx { frame: Rc::new(frame), actor: Some(d), ..ctx.clone() }
+        });
+        let body = &f.body;
+        if f.parallel && count <= SMALL {
+            let runs: Vec<Ctx<'m>> = runs.collect();
+            join_all(runs.iter().map(|c| self.block(body, c))).await;
+        } else if f.parallel {
+            join_eager(runs.map(|c| async move { self.block(body, &c).await })).await;
         } else {
-            for c in &runs {
+            for c in runs {
                 if ctx.scope.unwinding.get() {
                     break;
                 }
-                self.block(&f.body, c).await;
+                self.block(body, &c).await;
             }
         }
     }
@@ -233,13 +279,27 @@ impl<'m> Engine<'m> {
     async fn call(&self, call: &'m Call, ctx: &Ctx<'m>) {
         let capability = &self.m.capabilities[call.capability];
         let args = self.eval_all(&call.args, ctx);
+        // The common case, one actor for a one-actor capability: no join.
+        if let ([actor], 1) = (call.actors.as_slice(), capability.actors) {
+            if !matches!(actor, ActorRef::Group(_)) {
+                if let [d] = self.drones(actor, ctx)[..] {
+                    self.instance(call, vec![d], args, ctx).await;
+                }
+                return;
+            }
+        }
         let per_actor: Vec<Vec<DroneId>> = call.actors.iter().map(|a| self.drones(a, ctx)).collect();
         let sets: Vec<Vec<DroneId>> = if capability.actors == 1 {
             per_actor.into_iter().flatten().map(|d| vec![d]).collect()
         } else {
             vec![per_actor.iter().filter_map(|ds| ds.first().copied()).collect()]
         };
-        join_all(sets.into_iter().map(|actors| self.instance(call, actors, args.clone(), ctx))).await;
+        let runs = sets.into_iter().map(|actors| self.instance(call, actors, args.clone(), ctx));
+        if runs.len() <= SMALL {
+            join_all(runs).await;
+        } else {
+            join_eager(runs).await;
+        }
     }
 
     async fn instance(&self, call: &'m Call, actors: Vec<DroneId>, args: Vec<Value>, ctx: &Ctx<'m>) {
@@ -271,19 +331,24 @@ impl<'m> Engine<'m> {
             claims: RefCell::new(ctx.claims.clone()),
         });
         let actor = actors.first().copied();
-        let tag = call.tag.map(|t| self.m.tags[t].clone());
-        let shown_args: Map<String, Json> = cap.params.iter().zip(&args).map(|(p, v)| (p.clone(), to_json(self.m, v))).collect();
-        let who = actors.iter().map(|d| self.name(*d)).collect::<Vec<_>>().join(" ");
-        let start = json!({ "actor": who, "capability": cap.name, "tag": tag, "args": shown_args });
+        // Built only when the trace wants it.
+        let start = || {
+            let tag = call.tag.map(|t| self.m.tags[t].clone());
+            let shown_args: Map<String, Json> = cap.params.iter().zip(&args).map(|(p, v)| (p.clone(), to_json(self.m, v))).collect();
+            let who = actors.iter().map(|d| self.name(*d)).collect::<Vec<_>>().join(" ");
+            json!({ "actor": who, "capability": cap.name, "tag": tag, "args": shown_args })
+        };
         let end = |status: &str| {
-            let mut e = start.clone();
-            e["status"] = json!(status);
-            self.trace("capability_end", e);
+            self.trace("capability_end", || {
+                let mut e = start();
+                e["status"] = json!(status);
+                e
+            });
         };
         let frame = Rc::new(frame);
 
         // Known from now on (a leash can abort it while it waits), by where it was called.
-        self.instances.borrow_mut().push((instance.clone(), ctx.scope.clone()));
+        self.instances.borrow_mut().insert(instance.clone(), ctx.scope.clone());
         // Claims first (a second instance on a busy resource waits), then the start.
         let needs: Vec<_> = cap.claims.iter().filter_map(|(i, r)| actors.get(*i).map(|d| (*d, *r))).filter(|c| !ctx.claims.contains(c)).collect();
         let mut claims: BTreeSet<_> = (*ctx.claims).clone();
@@ -294,12 +359,12 @@ impl<'m> Engine<'m> {
             h = acquire(&self.arbiter, needs) => Some(h),
         };
         if self.stopped() {
-            self.instances.borrow_mut().retain(|(i, _)| i.id != instance.id);
+            self.instances.borrow_mut().remove(&instance);
             return;
         }
-        self.trace("capability_start", start.clone());
+        self.trace("capability_start", start);
         if held.is_none() {
-            self.instances.borrow_mut().retain(|(i, _)| i.id != instance.id);
+            self.instances.borrow_mut().remove(&instance);
             end("aborted");
             return;
         }
@@ -312,7 +377,7 @@ impl<'m> Engine<'m> {
             cap.requirements.iter().all(|r| env.truth(r))
         };
         if !requirements_met {
-            self.instances.borrow_mut().retain(|(i, _)| i.id != instance.id);
+            self.instances.borrow_mut().remove(&instance);
             end("failed");
             drop(held);
             let id = self.m.exceptions.iter().position(|e| e == "RequirementNotMet").unwrap_or(0);
@@ -321,28 +386,24 @@ impl<'m> Engine<'m> {
             return;
         }
 
-        let (scope, rx) = {
-            let (tx, rx) = mpsc::unbounded_channel();
-            let scope = Rc::new(Scope {
+        let scope = {
+            Rc::new(Scope {
                 parent: Some(ctx.scope.clone()),
-                path: cap.name.clone(),
+                path: &cap.name,
                 mission_block: false,
                 handlers: &[],
                 fired: RefCell::new(Vec::new()),
                 exception_handlers: &cap.exception_handlers,
                 frame: frame.clone(),
-                jobs: tx,
+                jobs: Jobs::default(),
                 unwinding: Cell::new(false),
                 deferred: RefCell::new(Vec::new()),
                 catching: Cell::new(0),
                 caught: Notify::new(),
                 instance: Some(instance.clone()),
-            });
-            (scope, rx)
+            })
         };
-        for entry in self.instances.borrow_mut().iter_mut().filter(|(i, _)| i.id == instance.id) {
-            entry.1 = scope.clone();
-        }
+        self.instances.borrow_mut().set_scope(&instance, scope.clone());
         let inner = Ctx { scope: scope.clone(), frame, actor, instance: Some(instance.clone()), claims };
         let perform = async {
             tokio::select! {
@@ -354,9 +415,9 @@ impl<'m> Engine<'m> {
         let finished = tokio::select! {
             biased;
             _ = instance.token.cancelled() => false,
-            _ = self.drive(&scope, rx, perform) => true,
+            _ = self.drive(&scope, perform) => true,
         };
-        self.instances.borrow_mut().retain(|(i, _)| i.id != instance.id);
+        self.instances.borrow_mut().remove(&instance);
         if !finished && instance.by_leash.get() {
             // `PERFORM ABORT:` says what aborting this activity also does.
             if let Some((_, section)) = cap.sections.iter().find(|(n, _)| n == "ABORT") {
@@ -384,10 +445,10 @@ impl<'m> Engine<'m> {
                 }
                 let who = actor.map(|a| self.name(a));
                 let signal_name = &self.m.signals[signal];
-                self.trace("handler_start", json!({ "signal": signal_name, "handler": handler.body.path, "actor": who }));
+                self.trace("handler_start", || json!({ "signal": signal_name, "handler": handler.body.path, "actor": who }));
                 let ctx = self.scope_ctx(&scope, Rc::new(frame));
                 self.block(&handler.body, &ctx).await;
-                self.trace("handler_end", json!({ "signal": signal_name, "handler": handler.body.path, "actor": who }));
+                self.trace("handler_end", || json!({ "signal": signal_name, "handler": handler.body.path, "actor": who }));
             }
             Job::Exception { handler, args } => {
                 let mut frame = (*scope.frame).clone();
@@ -427,9 +488,8 @@ impl<'m> Engine<'m> {
     /// none runs (LANGUAGE.md §3).
     pub(crate) fn leash_by_id(&self, capability: usize, tag: usize, action: LeashAction, action_name: &str, values: Vec<(usize, Value)>) {
         let cap = &self.m.capabilities[capability];
-        self.trace("leash", json!({ "capability": cap.name, "tag": self.m.tags[tag], "action": action_name }));
-        let targets: Vec<(Rc<Instance>, Rc<Scope<'m>>)> =
-            self.instances.borrow().iter().filter(|(i, _)| i.capability == capability && i.tag == Some(tag)).cloned().collect();
+        self.trace("leash", || json!({ "capability": cap.name, "tag": self.m.tags[tag], "action": action_name }));
+        let targets: Vec<(Rc<Instance>, Rc<Scope<'m>>)> = self.instances.borrow().tagged(capability, tag).cloned().collect();
         for (instance, scope) in targets {
             match action {
                 LeashAction::Abort => {
@@ -454,7 +514,7 @@ impl<'m> Engine<'m> {
                     for (p, v) in &values {
                         set(&mut frame, cap.actors + p, v.clone());
                     }
-                    let _ = scope.jobs.send(Job::Section { block: &cap.sections[i].1, frame: Rc::new(frame) });
+                    scope.jobs.send(Job::Section { block: &cap.sections[i].1, frame: Rc::new(frame) });
                 }
             }
         }
@@ -478,7 +538,7 @@ impl<'m> Engine<'m> {
         }
         let args = self.eval_all(&a.args, ctx);
         let function = self.m.functions[a.function].0.as_str();
-        self.trace("api_call", json!({ "actor": self.name(drone), "function": function, "args": self.values(&args) }));
+        self.trace("api_call", || json!({ "actor": self.name(drone), "function": function, "args": self.values(&args) }));
         let pending = self.backend.call(drone, function, &args);
         let guard = CallGuard { engine: self, id: pending.id, root: root.clone(), done: Cell::new(false), drone, function, args: &args };
         if let Some(root) = &root {
@@ -539,10 +599,11 @@ impl Drop for CallGuard<'_, '_> {
     fn drop(&mut self) {
         if !self.done.get() {
             self.engine.backend.interrupt(self.id, Interrupt::Abort);
-            let p = self.engine.backend.telemetry(self.drone).position;
-            let args = self.engine.values(self.args);
-            let name = self.engine.name(self.drone);
-            self.engine.trace("api_done", json!({ "actor": name, "function": self.function, "args": args, "status": "aborted", "position": p }));
+            let engine = self.engine;
+            engine.trace("api_done", || {
+                let p = engine.backend.telemetry(self.drone).position;
+                json!({ "actor": engine.name(self.drone), "function": self.function, "args": engine.values(self.args), "status": "aborted", "position": p })
+            });
         }
         if let Some(root) = &self.root {
             root.calls.borrow_mut().retain(|c| *c != self.id);

@@ -10,9 +10,13 @@
 //! Invariant: the engine knows no backend; it talks to `aviary_api::Backend` only.
 
 mod arbiter;
+mod cancel;
 mod control;
 mod engine;
 mod exec;
+mod jobs;
+mod join;
+mod registry;
 mod value;
 
 use aviary_api::Backend;
@@ -23,6 +27,12 @@ use aviary_ir::Mission;
 /// Where trace events go, one JSON object per event, in order.
 pub trait TraceSink {
     fn event(&mut self, event: serde_json::Value);
+    /// Whether this sink takes events of this kind (`"signal"`, `"api_call"`, ...). The
+    /// engine builds an event only when its sink wants it, so a sink that keeps a few
+    /// kinds spares the cost of the rest; what the mission does is the same either way.
+    fn wants(&self, _event: &str) -> bool {
+        true
+    }
 }
 
 impl<F: FnMut(serde_json::Value)> TraceSink for F {

@@ -10,7 +10,9 @@ pub(crate) struct Env<'a> {
     pub backend: &'a dyn Backend,
     pub frame: &'a [Value],
     pub received: &'a [bool],
-    pub elapsed: f64,
+    /// When the mission started: `ELAPSED` is read from the clock only when evaluated
+    /// (most expressions never ask, and reading tokio's clock is not free).
+    pub start: tokio::time::Instant,
 }
 
 impl Env<'_> {
@@ -52,7 +54,7 @@ impl Env<'_> {
                 let (a, b) = (self.position(&self.eval(a)), self.position(&self.eval(b)));
                 Value::Number(((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt())
             }
-            Expr::Elapsed => Value::Number(self.elapsed),
+            Expr::Elapsed => Value::Number((tokio::time::Instant::now() - self.start).as_secs_f64()),
             Expr::Received(s) => Value::Bool(self.received.get(*s).copied().unwrap_or(false)),
             Expr::Not(x) => Value::Bool(!truth(&self.eval(x))),
             Expr::And(a, b) => Value::Bool(truth(&self.eval(a)) && truth(&self.eval(b))),

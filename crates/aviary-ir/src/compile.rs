@@ -1,6 +1,6 @@
 //! From a checked program to the IR.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 
 use aviary_api::{Descriptor, Point, Value};
 use aviary_check::{bind_args, Program};
@@ -72,6 +72,9 @@ struct Compiler<'a> {
     exceptions: Interner,
     tags: Interner,
     attribute_names: Vec<String>,
+    /// The world's names, looked up once each: a scan per name would make a group of N
+    /// drones cost N² to compile.
+    index: WorldIndex<'a>,
     /// Every FOR alias of the mission and the drones its instances stand for.
     aliases: BTreeMap<String, Vec<DroneId>>,
     /// Names bound in the current frame: (name, slot, is an actor).
@@ -108,6 +111,7 @@ impl<'a> Compiler<'a> {
             exceptions,
             tags: Interner::default(),
             attribute_names,
+            index: WorldIndex::new(world),
             aliases: BTreeMap::new(),
             scopes: Vec::new(),
             frame_size: 0,
@@ -149,10 +153,10 @@ impl<'a> Compiler<'a> {
         if let Some((slot, _)) = self.local(name) {
             return ActorRef::Slot(slot);
         }
-        if let Some(i) = self.world.drones.iter().position(|d| d.name == name) {
+        if let Some(&i) = self.index.drones.get(name) {
             return ActorRef::Drone(i);
         }
-        let members = self.world.group(name).map(|g| g.members.iter().filter_map(|m| self.world.drones.iter().position(|d| &d.name == m)).collect());
+        let members = self.index.groups.get(name).map(|g| g.members.iter().filter_map(|m| self.index.drones.get(m.as_str()).copied()).collect());
         ActorRef::Group(members.unwrap_or_default())
     }
 
@@ -445,17 +449,17 @@ impl<'a> Compiler<'a> {
         if let Some((slot, _)) = self.local(name) {
             return Expr::Slot(slot);
         }
-        let w = self.world;
-        if let Some(i) = w.drones.iter().position(|d| d.name == name) {
+        let w = &self.index;
+        if let Some(&i) = w.drones.get(name) {
             return Expr::Const(Value::Actor(i));
         }
-        if w.group(name).is_some() {
+        if w.groups.contains_key(name) {
             return Expr::Actor(self.actor(name));
         }
-        if let Some(p) = w.place(name) {
+        if let Some(p) = w.places.get(name) {
             return Expr::Const(Value::Position(Point { x: p.at[0], y: p.at[1], z: p.has_z.then_some(p.at[2]) }));
         }
-        if let Some(a) = w.area(name) {
+        if let Some(a) = w.areas.get(name) {
             return Expr::Const(Value::Area(a.polygon.clone()));
         }
         Expr::Const(Value::Symbol(name.to_string()))
@@ -572,3 +576,29 @@ fn visit_calls<'b>(block: &'b Block, out: &mut Vec<&'b Call>) {
     });
 }
 
+/// The world's drones, groups, places and areas by name (the first of a name wins, as a
+/// scan in file order would find it).
+struct WorldIndex<'w> {
+    drones: HashMap<&'w str, DroneId>,
+    groups: HashMap<&'w str, &'w aviary_world::Group>,
+    places: HashMap<&'w str, &'w aviary_world::Place>,
+    areas: HashMap<&'w str, &'w aviary_world::Area>,
+}
+
+impl<'w> WorldIndex<'w> {
+    fn new(w: &'w World) -> Self {
+        fn first<'w, T>(items: impl Iterator<Item = (&'w str, T)>) -> HashMap<&'w str, T> {
+            let mut map = HashMap::new();
+            for (name, item) in items {
+                map.entry(name).or_insert(item);
+            }
+            map
+        }
+        WorldIndex {
+            drones: first(w.drones.iter().enumerate().map(|(i, d)| (d.name.as_str(), i))),
+            groups: first(w.groups.iter().map(|g| (g.name.as_str(), g))),
+            places: first(w.places.iter().map(|p| (p.name.as_str(), p))),
+            areas: first(w.areas.iter().map(|a| (a.name.as_str(), a))),
+        }
+    }
+}

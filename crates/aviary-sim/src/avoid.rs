@@ -153,6 +153,12 @@ fn on_the_move(d: &SimDrone) -> bool {
     })
 }
 
+/// How far from drone `d` another drone can be and still matter to its planning: at
+/// least `range` below for every drone of the fleet.
+pub(crate) fn reach(fleet: &Fleet, d: &SimDrone) -> f64 {
+    fleet.min_separation + MARGIN + HORIZON * (d.max_speed + d.climb_rate + fleet.fastest) + 1.0
+}
+
 impl Fleet {
     /// The predicted track of drone `j` for the planning of drone `id`: for a drone before
     /// `id`, which has moved in this step already, computed once per step. Drones after `id` (only a humble drone looks at them) have not moved yet: they are
@@ -180,7 +186,10 @@ impl Fleet {
         // A drone held back for long gives way to everyone, not only to those before it,
         // until it no longer needs to give way.
         let humble = d.humble || d.stalled >= STALL;
-        let higher: Vec<DroneId> = (self.aloft.iter().copied())
+        // Every drone that could be in range, in index order, from the sky's grid.
+        let mut candidates = Vec::new();
+        self.sky.around(d.xy(), d.xy(), reach(self, d), &mut candidates);
+        let higher: Vec<DroneId> = (candidates.iter().copied())
             .filter(|&j| j < id || (humble && j != id))
             .filter(|&j| {
                 let o = &self.drones[j];

@@ -12,7 +12,9 @@ use crate::avoid::Track;
 use crate::battery;
 use crate::drone::SimDrone;
 use crate::geom::heading;
+use crate::grid::Grid;
 use crate::sensors::scan;
+use crate::separation::{envelope, extent};
 
 /// Something that happened during a [`Fleet::step`], in the order it happened.
 #[derive(Clone, Debug, PartialEq)]
@@ -65,7 +67,23 @@ pub struct Fleet {
     pub(crate) aloft: Vec<DroneId>,
     /// The planner's predicted tracks of drones that moved already in this step.
     pub(crate) tracks: BTreeMap<DroneId, Track>,
+    /// The drones of `aloft`, by where they are now (updated as each one moves).
+    pub(crate) sky: Grid,
+    /// At least the largest `extent` of the envelope of a drone of `aloft` during this
+    /// step: how far, beyond the usual, separation must look for one.
+    pub(crate) max_extent: f64,
+    /// The largest `max_speed + climb_rate` of the fleet (the planner's reach).
+    pub(crate) fastest: f64,
+    /// The world's targets by where they are.
+    pub(crate) target_grid: Grid,
+    /// A scratch list for grid queries.
+    pub(crate) nearby: Vec<usize>,
 }
+
+/// Metres on a side of a cell of [`Fleet::sky`]: about the planner's reach.
+const SKY_CELL: f64 = 400.0;
+/// Metres on a side of a cell of [`Fleet::target_grid`]: about a sensor's range.
+const TARGET_CELL: f64 = 50.0;
 
 impl Fleet {
     /// Every drone of the world, landed and disarmed at its home (at ground level), with
@@ -100,6 +118,17 @@ impl Fleet {
             releases: Vec::new(),
             aloft: Vec::new(),
             tracks: BTreeMap::new(),
+            sky: Grid::new(SKY_CELL),
+            max_extent: 0.0,
+            fastest: world.drones.iter().map(|d| d.max_speed + d.climb_rate).fold(0.0, f64::max),
+            target_grid: {
+                let mut g = Grid::new(TARGET_CELL);
+                for (i, t) in world.targets.iter().enumerate() {
+                    g.put(i, [t.at[0], t.at[1]]);
+                }
+                g
+            },
+            nearby: Vec::new(),
         }
     }
 
@@ -218,13 +247,23 @@ impl Fleet {
         self.fire_faults(end, &mut out);
         self.tracks.clear();
         self.aloft.clear();
+        self.sky.clear();
+        self.max_extent = 0.0;
         for (id, d) in self.drones.iter().enumerate() {
             if d.state.airborne() {
                 self.aloft.push(id);
+                self.sky.put(id, d.xy());
+                self.max_extent = self.max_extent.max(extent(&envelope(d)));
             }
         }
         for id in 0..self.drones.len() {
             self.step_drone(id, dt, &mut out);
+            // Keep the sky current for the drones after this one.
+            if self.sky.contains(id) {
+                let d = &self.drones[id];
+                self.sky.put(id, d.xy());
+                self.max_extent = self.max_extent.max(extent(&envelope(d)));
+            }
         }
         self.time = end;
         out
@@ -274,8 +313,13 @@ impl Fleet {
         if airborne {
             d.flight_time += dt;
         }
+        // Only the targets near the way flown, in their order.
+        match d.detections.iter().map(|a| a.range).reduce(f64::max) {
+            Some(range) => self.target_grid.around(from, to, range, &mut self.nearby),
+            None => self.nearby.clear(),
+        }
         out.extend(
-            scan(id, &mut d.detections, &self.targets, from, to)
+            scan(id, &mut d.detections, &self.targets, &self.nearby, from, to)
                 .into_iter()
                 .map(Report::Event),
         );

@@ -134,6 +134,7 @@ mod drone;
 mod faults;
 mod fleet;
 mod geom;
+mod grid;
 mod motion;
 mod profile;
 mod sensors;

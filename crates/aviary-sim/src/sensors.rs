@@ -32,17 +32,19 @@ pub(crate) fn detection_range(
 }
 
 /// The targets found while the drone flew from `from` to `to` (ground points) this tick,
-/// marking them found; events in activation order, then target order.
+/// marking them found; events in activation order, then target order. Only `candidates`
+/// (ascending target indices: at least every target within range of the way) are looked at.
 pub(crate) fn scan(
     drone: DroneId,
     activations: &mut [Activation],
     targets: &[Target],
+    candidates: &[usize],
     from: [f64; 2],
     to: [f64; 2],
 ) -> Vec<DroneEvent> {
     let mut events = Vec::new();
     for act in activations.iter_mut() {
-        for (i, target) in targets.iter().enumerate() {
+        for (i, target) in candidates.iter().map(|&i| (i, &targets[i])) {
             if act.found[i] || target.kind != act.kind {
                 continue;
             }

@@ -137,7 +137,7 @@ fn reach(d: &SimDrone, dt: f64) -> f64 {
 }
 
 /// How far a drone's envelope reaches from it.
-fn extent(e: &Envelope) -> f64 {
+pub(crate) fn extent(e: &Envelope) -> f64 {
     dist(e.from, e.to) + e.pad + (e.high - e.low)
 }
 
@@ -281,7 +281,11 @@ impl Fleet {
     fn near(&self, id: DroneId, dt: f64) -> Vec<Envelope> {
         let me = &self.drones[id];
         let (here, reach) = (me.pos, reach(me, dt));
-        self.aloft
+        // The sky's grid gives every drone that could be that near, in index order.
+        let mut candidates = Vec::new();
+        let xy = [here[0], here[1]];
+        self.sky.around(xy, xy, self.min_separation + reach + self.max_extent, &mut candidates);
+        candidates
             .iter()
             .filter(|&&j| j != id && counts(&self.drones[j]))
             .map(|&j| (self.drones[j].pos, envelope(&self.drones[j])))
@@ -293,6 +297,26 @@ impl Fleet {
             .collect()
     }
 
+    /// Whether no other drone of the sky is within reach of drone `id`, neither of
+    /// separation (`near`) nor of the planner (`plan`), and it is giving way to nobody.
+    fn alone(&mut self, id: DroneId, dt: f64) -> bool {
+        let d = &self.drones[id];
+        if d.avoid.is_some() {
+            return false;
+        }
+        let separation = self.min_separation + reach(d, dt) + self.max_extent;
+        let r = separation.max(crate::avoid::reach(self, d));
+        let mut candidates = std::mem::take(&mut self.nearby);
+        self.sky.around(d.xy(), d.xy(), r, &mut candidates);
+        let here = self.drones[id].xy();
+        let alone = candidates.iter().all(|&j| {
+            let p = self.drones[j].xy();
+            j == id || (p[0] - here[0]).abs() > r || (p[1] - here[1]).abs() > r
+        });
+        self.nearby = candidates;
+        alone
+    }
+
     /// Moves drone `id` by one tick: the planner's choice if its envelope stays clear of
     /// every other drone in the air, else hard braking. Returns the task that finished.
     pub(crate) fn move_drone(&mut self, id: DroneId, dt: f64) -> Option<MotionTask> {
@@ -300,6 +324,14 @@ impl Fleet {
             self.drones[id].avoid = None;
             self.drones[id].stalled = 0.0;
             return self.drones[id].tick_motion(dt);
+        }
+        if self.alone(id, dt) {
+            // What `near` and `plan` would conclude with nobody in reach: nothing to keep
+            // clear of, no way to give (most drones of a large fleet, most of the time).
+            let d = &mut self.drones[id];
+            d.humble = false;
+            d.stalled = 0.0;
+            return d.tick_motion(dt);
         }
         let near = self.near(id, dt);
         self.plan(id, dt, &near);

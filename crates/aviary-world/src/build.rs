@@ -36,7 +36,7 @@ pub(crate) fn parse(file: FileId, text: &str) -> (Option<World>, Vec<Diagnostic>
         text,
         diags: Vec::new(),
     };
-    let world = build(&mut cx, &root);
+    let world = build(&mut cx, root);
     let mut diags = cx.diags;
     aviary_diagnostics::sort(&mut diags);
     if diags.iter().any(Diagnostic::is_error) {
@@ -70,8 +70,21 @@ pub(crate) fn get<'n>(entries: &'n [Entry], key: &str) -> Option<&'n Entry> {
     entries.iter().find(|e| e.key == key)
 }
 
-fn build(cx: &mut Ctx, root: &Node) -> World {
+fn build(cx: &mut Ctx, mut root: Node) -> World {
     let mut world = World::default();
+    // The drones' tables are read (and freed) one by one below: for a large fleet the
+    // tree and the drones built from it need not be in memory whole at once.
+    let drone_names = keys_of(match &root.value {
+        Value::Table(top) => get(top, "drones"),
+        _ => None,
+    });
+    let drones_table = match &mut root.value {
+        Value::Table(top) => top.iter_mut().find(|e| e.key == "drones").map(|e| {
+            let empty = Node { span: e.node.span, value: Value::Table(Vec::new()) };
+            std::mem::replace(&mut e.node, empty)
+        }),
+        _ => None,
+    };
     let Value::Table(top) = &root.value else {
         return world;
     };
@@ -106,14 +119,13 @@ fn build(cx: &mut Ctx, root: &Node) -> World {
         world.sensors = sim::sensors(cx, &e.node);
     }
     let mut group_spans = Vec::new();
-    if let Some(e) = table("drones") {
-        world.drones = drone::drones(cx, &e.node, &sensor_kinds, &mut group_spans);
+    if let Some(node) = drones_table {
+        world.drones = drone::drones(cx, node, &sensor_kinds, &mut group_spans);
     }
     world.groups = groups(&world, &group_spans);
     if let Some(e) = table("targets") {
         world.targets = sim::targets(cx, &e.node);
     }
-    let drone_names = keys_of(table("drones"));
     if let Some(e) = table("faults") {
         world.faults = sim::faults(cx, &e.node, &drone_names);
     }
@@ -132,18 +144,18 @@ fn keys_of(entry: Option<&Entry>) -> Vec<String> {
 fn site(cx: &mut Ctx, node: &Node) -> Site {
     let mut site = Site::default();
     let help = "write `[site]` followed by lines such as `name = \"...\"` and `max_altitude = 120`";
-    let Some(entries) = cx.table("`site`", node, help) else {
+    let Some(entries) = cx.table(&"`site`", node, help) else {
         return site;
     };
     cx.known_keys(entries, SITE_KEYS, "[site]");
     for e in entries {
         let n = &e.node;
         match e.key.as_str() {
-            "name" => site.name = cx.string("`name` in [site]", n),
+            "name" => site.name = cx.string(&"`name` in [site]", n),
             "origin" => site.origin = origin(cx, e),
-            "geofence" => site.geofence = cx.polygon("the geofence", n),
-            "max_altitude" => site.max_altitude = cx.positive("`max_altitude`", n),
-            "min_separation" => match cx.number("`min_separation`", n) {
+            "geofence" => site.geofence = cx.polygon(&"the geofence", n),
+            "max_altitude" => site.max_altitude = cx.positive(&"`max_altitude`", n),
+            "min_separation" => match cx.number(&"`min_separation`", n) {
                 Some(v) if v < 0.0 => {
                     let msg = format!("`min_separation` must be zero or more metres, found {v}");
                     cx.error(
@@ -156,12 +168,12 @@ fn site(cx: &mut Ctx, node: &Node) -> Site {
                 None => {}
             },
             "link_loss_rtl_after" => {
-                if let Some(v) = cx.positive("`link_loss_rtl_after`", n) {
+                if let Some(v) = cx.positive(&"`link_loss_rtl_after`", n) {
                     site.link_loss_rtl_after = v;
                 }
             }
             "separation_timeout" => {
-                if let Some(v) = cx.positive("`separation_timeout`", n) {
+                if let Some(v) = cx.positive(&"`separation_timeout`", n) {
                     site.separation_timeout = v;
                 }
             }
@@ -173,7 +185,7 @@ fn site(cx: &mut Ctx, node: &Node) -> Site {
 
 fn origin(cx: &mut Ctx, e: &Entry) -> Option<Geo> {
     let help = "write `origin = { lat = 46.6167, lon = 14.2650, alt = 440.0 }` (degrees, metres)";
-    let entries = cx.table("`origin`", &e.node, help)?;
+    let entries = cx.table(&"`origin`", &e.node, help)?;
     cx.known_keys(entries, ORIGIN_KEYS, "`origin`");
     let mut read = |key: &str, min: f64, max: f64| match get(entries, key) {
         Some(v) => cx.within(&format!("`{key}` of `origin`"), &v.node, min, max),
@@ -195,7 +207,7 @@ fn origin(cx: &mut Ctx, e: &Entry) -> Option<Geo> {
 
 fn places(cx: &mut Ctx, node: &Node) -> Vec<Place> {
     let help = "write `[places]` followed by lines `NAME = [x, y]` or `NAME = [x, y, z]`";
-    let Some(entries) = cx.table("`places`", node, help) else {
+    let Some(entries) = cx.table(&"`places`", node, help) else {
         return Vec::new();
     };
     let mut out = Vec::new();
@@ -215,7 +227,7 @@ fn places(cx: &mut Ctx, node: &Node) -> Vec<Place> {
 
 fn areas(cx: &mut Ctx, node: &Node) -> Vec<Area> {
     let help = "write `[areas]` followed by lines `NAME = [[x, y], [x, y], [x, y], ...]`";
-    let Some(entries) = cx.table("`areas`", node, help) else {
+    let Some(entries) = cx.table(&"`areas`", node, help) else {
         return Vec::new();
     };
     let mut out = Vec::new();

@@ -9,6 +9,7 @@
 //! - No input makes it panic.
 
 mod build;
+mod fast;
 mod node;
 mod read;
 #[cfg(test)]

@@ -1,6 +1,8 @@
 //! Typed readers over the spanned tree: each one either returns the value or records a
 //! located diagnostic and returns `None`, so that one pass reports every problem.
 
+use std::fmt::Display;
+
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 
 use crate::node::{Entry, Node, Value};
@@ -34,7 +36,7 @@ impl Ctx<'_> {
         Span::new(span.start as usize, span.start as usize + len)
     }
 
-    pub fn table<'n>(&mut self, what: &str, node: &'n Node, help: &str) -> Option<&'n [Entry]> {
+    pub fn table<'n>(&mut self, what: &dyn Display, node: &'n Node, help: &str) -> Option<&'n [Entry]> {
         match &node.value {
             Value::Table(entries) => Some(entries),
             _ => {
@@ -61,7 +63,7 @@ impl Ctx<'_> {
         }
     }
 
-    pub fn number(&mut self, what: &str, node: &Node) -> Option<f64> {
+    pub fn number(&mut self, what: &dyn Display, node: &Node) -> Option<f64> {
         let value = match node.value {
             Value::Int(i) => i as f64,
             Value::Float(f) => f,
@@ -84,7 +86,7 @@ impl Ctx<'_> {
     }
 
     /// A number that must be greater than zero.
-    pub fn positive(&mut self, what: &str, node: &Node) -> Option<f64> {
+    pub fn positive(&mut self, what: &dyn Display, node: &Node) -> Option<f64> {
         let value = self.number(what, node)?;
         if value <= 0.0 {
             let msg = format!("{what} must be greater than zero, found {value}");
@@ -95,7 +97,7 @@ impl Ctx<'_> {
     }
 
     /// A number in `min..=max`.
-    pub fn within(&mut self, what: &str, node: &Node, min: f64, max: f64) -> Option<f64> {
+    pub fn within(&mut self, what: &dyn Display, node: &Node, min: f64, max: f64) -> Option<f64> {
         let value = self.number(what, node)?;
         if !(min..=max).contains(&value) {
             let msg = format!("{what} must be between {min} and {max}, found {value}");
@@ -109,7 +111,7 @@ impl Ctx<'_> {
         Some(value)
     }
 
-    pub fn string(&mut self, what: &str, node: &Node) -> Option<String> {
+    pub fn string(&mut self, what: &dyn Display, node: &Node) -> Option<String> {
         match &node.value {
             Value::Str(s) => Some(s.clone()),
             _ => {
@@ -121,7 +123,7 @@ impl Ctx<'_> {
     }
 
     /// A list of strings, each with its span.
-    pub fn strings(&mut self, what: &str, node: &Node) -> Option<Vec<(String, Span)>> {
+    pub fn strings(&mut self, what: &dyn Display, node: &Node) -> Option<Vec<(String, Span)>> {
         let help = "write a list of strings, e.g. `[\"Body\", \"Radiation\"]`";
         let Value::Array(items) = &node.value else {
             let msg = format!(
@@ -147,7 +149,7 @@ impl Ctx<'_> {
     }
 
     /// A position: `[x, y]` (z = 0) or `[x, y, z]`. Returns the point and whether z was given.
-    pub fn point(&mut self, what: &str, node: &Node) -> Option<([f64; 3], bool)> {
+    pub fn point(&mut self, what: &dyn Display, node: &Node) -> Option<([f64; 3], bool)> {
         let help = "write `[x, y]` or `[x, y, z]` in metres, e.g. `[150, 100]`";
         let Value::Array(items) = &node.value else {
             let msg = format!(
@@ -177,7 +179,7 @@ impl Ctx<'_> {
     }
 
     /// A polygon `[[x, y], ...]` of at least three points.
-    pub fn polygon(&mut self, what: &str, node: &Node) -> Option<Vec<[f64; 2]>> {
+    pub fn polygon(&mut self, what: &dyn Display, node: &Node) -> Option<Vec<[f64; 2]>> {
         let help = "write at least three corners, e.g. `[[0, 0], [100, 0], [100, 100]]`";
         let Value::Array(items) = &node.value else {
             let msg = format!(

@@ -778,3 +778,49 @@ fn random_inputs_never_panic() {
         }
     }
 }
+
+/// The fast reader (`fast.rs`) gives the serde path's tree, spans and all, for every
+/// world of the examples and for the forms around them; it leaves the rest to serde.
+#[test]
+fn the_fast_reader_gives_the_same_tree_as_serde() {
+    let examples = [
+        include_str!("../../../examples/search_and_rescue.world.toml"),
+        EXAMPLE,
+        "[site]\nname = \"X\"   # trailing\n# comment\n\n[empty]\n\n[drones.a]\nhome = [0, 0]\n[drones.b]\n",
+        "[a]\nx = 1\n[a.b]\ny = 2.5\n[a.c.d]\nz = -3\nw = true\n",
+        "[[t]]\n[[t]]\nk = 1\n[[t]]\nk = { a = [1, 2], b = 'lit' }\n",
+        "[areas]\nA = [\n  [0, 0],\n  [10, 0], # c\n  [10, 10],\n]\n[places]\nP = [1e3, 2_000]\n",
+        "[site]\norigin = { lat = 46.6, lon = 14.2, alt = 440.0 }\ngeofence = [[-600, -600], [600, -600], [600, 600]]\n",
+        "\n\n# only comments\n",
+        "",
+    ];
+    for text in examples {
+        let fast = crate::fast::parse(text).unwrap_or_else(|| panic!("the fast reader reads {text:?}"));
+        assert_eq!(fast, Node::parse_serde(text).unwrap(), "{text:?}");
+    }
+    let mut faults = String::new();
+    for entry in std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/faults")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.to_string_lossy().ends_with(".world.toml") {
+            faults = std::fs::read_to_string(&path).unwrap();
+            let fast = crate::fast::parse(&faults).unwrap_or_else(|| panic!("the fast reader reads {path:?}"));
+            assert_eq!(fast, Node::parse_serde(&faults).unwrap(), "{path:?}");
+        }
+    }
+    assert!(!faults.is_empty());
+    // Forms left to serde, which reports or reads them.
+    for text in [
+        "top = 1\n",
+        "[a]\nb.c = 1\n",
+        "[a]\n\"q\" = 1\n",
+        "[a]\nx = 1\nx = 2\n",
+        "[a]\n[a]\n",
+        "[a.b]\n[a]\n",
+        "[a]\nd = 1979-05-27\n",
+        "[a]\nx = \n",
+        "[a]\nx = 0x10\n",
+        "[a\n",
+    ] {
+        assert!(crate::fast::parse(text).is_none(), "{text:?}");
+    }
+}

@@ -18,22 +18,24 @@ const ADDRESS_HELP: &str =
 
 pub(super) fn drones(
     cx: &mut Ctx,
-    node: &Node,
+    node: Node,
     sensor_kinds: &[String],
     group_spans: &mut Vec<(String, Span)>,
 ) -> Vec<Drone> {
     let help = "write one table per drone: `[drones.NAME]` followed by `home = [x, y]`";
-    let Some(entries) = cx.table("`drones`", node, help) else {
+    if cx.table(&"`drones`", &node, help).is_none() {
         return Vec::new();
-    };
-    let mut out = Vec::new();
+    }
+    let Value::Table(entries) = node.value else { return Vec::new() };
+    let mut out = Vec::with_capacity(entries.len());
+    // Each drone's table is dropped once read.
     for e in entries {
         cx.identifier("drone", &e.key, e.key_span);
-        let what = format!("drone `{}`", e.key);
+        let what = Named("drone", &e.key);
         let Some(keys) = cx.table(&what, &e.node, help) else {
             continue;
         };
-        out.push(drone(cx, e, keys, sensor_kinds, group_spans));
+        out.push(drone(cx, &e, keys, sensor_kinds, group_spans));
     }
     out
 }
@@ -70,7 +72,8 @@ fn drone(
         );
     }
     for k in keys {
-        let what = format!("`{}` of drone `{name}`", k.key);
+        // Said only in a message: not formatted unless one is written.
+        let what = KeyOf(&k.key, name);
         let n = &k.node;
         match k.key.as_str() {
             "home" => d.home = cx.point(&what, n).map_or(d.home, |(p, _)| p),
@@ -249,4 +252,22 @@ fn check_address(cx: &mut Ctx, drone: &str, address: &str, span: Span) {
     };
     let msg = format!("the `mavlink` address `{address}` of drone `{drone}` {problem}");
     cx.error(span, msg, ADDRESS_HELP);
+}
+
+/// "drone `NAME`", for messages.
+struct Named<'a>(&'static str, &'a str);
+
+impl std::fmt::Display for Named<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} `{}`", self.0, self.1)
+    }
+}
+
+/// "`KEY` of drone `NAME`", for messages.
+struct KeyOf<'a>(&'a str, &'a str);
+
+impl std::fmt::Display for KeyOf<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "`{}` of drone `{}`", self.0, self.1)
+    }
 }

@@ -11,7 +11,7 @@ const FAULT_KEYS: &[&str] = &["drone", "at", "kind", "duration"];
 
 pub(super) fn sensors(cx: &mut Ctx, node: &Node) -> Vec<Sensor> {
     let help = "write one table per sensor kind: `[sensors.thermal]` followed by `detects = [\"Body\"]` and `range = 20`";
-    let Some(entries) = cx.table("`sensors`", node, help) else {
+    let Some(entries) = cx.table(&"`sensors`", node, help) else {
         return Vec::new();
     };
     let mut out = Vec::new();
@@ -96,7 +96,7 @@ pub(super) fn targets(cx: &mut Ctx, node: &Node) -> Vec<Target> {
         cx.known_keys(keys, TARGET_KEYS, "[[targets]]");
         let kind = match get(keys, "kind") {
             Some(k) => cx
-                .string("`kind` of a target", &k.node)
+                .string(&"`kind` of a target", &k.node)
                 .filter(|kind| cx.identifier("target kind", kind, k.node.span)),
             None => {
                 cx.error(
@@ -108,7 +108,7 @@ pub(super) fn targets(cx: &mut Ctx, node: &Node) -> Vec<Target> {
             }
         };
         let at = match get(keys, "at") {
-            Some(a) => cx.point("`at` of a target", &a.node),
+            Some(a) => cx.point(&"`at` of a target", &a.node),
             None => {
                 cx.error(
                     head,
@@ -135,7 +135,7 @@ pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[String]) -> Vec<Fault>
             cx.error(head, format!("a fault has no `{key}`"), help);
         };
         let drone = match get(keys, "drone") {
-            Some(d) => cx.string("`drone` of a fault", &d.node).filter(|name| {
+            Some(d) => cx.string(&"`drone` of a fault", &d.node).filter(|name| {
                 let known = drones.iter().any(|k| k == name);
                 if !known {
                     fault_drone(cx, name, d, drones);
@@ -152,7 +152,7 @@ pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[String]) -> Vec<Fault>
             }
         };
         let at = match get(keys, "at") {
-            Some(a) => cx.number("`at` of a fault", &a.node).filter(|&t| {
+            Some(a) => cx.number(&"`at` of a fault", &a.node).filter(|&t| {
                 if t < 0.0 {
                     let msg = format!("`at` of a fault must be zero or more seconds, found {t}");
                     cx.error(
@@ -173,7 +173,7 @@ pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[String]) -> Vec<Fault>
             }
         };
         let kind = match get(keys, "kind") {
-            Some(k) => cx.string("`kind` of a fault", &k.node).and_then(|name| {
+            Some(k) => cx.string(&"`kind` of a fault", &k.node).and_then(|name| {
                 let kind = FaultKind::from_name(&name);
                 if kind.is_none() {
                     let msg = format!("unknown fault kind `{name}`");
@@ -200,7 +200,7 @@ pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[String]) -> Vec<Fault>
             }
         };
         let duration = get(keys, "duration");
-        let seconds = duration.and_then(|d| cx.positive("`duration` of a fault", &d.node));
+        let seconds = duration.and_then(|d| cx.positive(&"`duration` of a fault", &d.node));
         match (kind, duration) {
             (Some((kind, k)), None) if kind.has_duration() => {
                 let msg = format!("a `{}` fault needs a `duration`", kind.as_str());

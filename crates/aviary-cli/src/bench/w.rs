@@ -1,0 +1,96 @@
+//! `aviary bench w --n N --k K`: the engine benchmark W(N, K) of
+//! `../shared/anchors/README.md`, written in the language
+//! (`aviary_check::generate::w_mission`) and run through the whole pipeline.
+//! The sink checks from the trace that the work was done: N `Done` signals, each taken
+//! by the handler, whose indices sum to N(N-1)/2 (and, with `--full-trace`, N·K steps
+//! that ended ok). By default it asks the engine only for the events it checks
+//! (`TraceSink::wants`): building the other 40-odd JSON objects per actor that
+//! `aviary run --trace` writes would measure serde_json, not the language.
+
+use std::time::Instant;
+
+use aviary_engine::TraceSink;
+use serde_json::Value as Json;
+
+use super::pipeline::{self, mib, peak_rss, Stages};
+
+/// Counts what W must have done, from the trace.
+#[derive(Default)]
+struct Tally {
+    full: bool,
+    done_signals: u64,
+    index_sum: u64,
+    handled: u64,
+    steps: u64,
+    events: u64,
+}
+
+impl TraceSink for Tally {
+    fn wants(&self, event: &str) -> bool {
+        self.full || matches!(event, "signal" | "handler_start")
+    }
+
+    fn event(&mut self, event: Json) {
+        self.observe(&event);
+    }
+}
+
+impl Tally {
+    fn observe(&mut self, event: &Json) {
+        self.events += 1;
+        match event["event"].as_str() {
+            Some("signal") if event["name"] == "Done" => {
+                self.done_signals += 1;
+                self.index_sum += event["args"][0].as_f64().unwrap_or(f64::NAN) as u64;
+            }
+            Some("handler_start") if event["signal"] == "Done" => self.handled += 1,
+            Some("capability_end") if event["capability"] == "Step" && event["status"] == "ok" => self.steps += 1,
+            _ => {}
+        }
+    }
+}
+
+pub fn run(n: usize, k: usize, emit: bool, emit_world: bool, full_trace: bool) -> u8 {
+    if n == 0 || k == 0 {
+        eprintln!("aviary: --n and --k must be at least 1");
+        return 2;
+    }
+    let started = Instant::now();
+    let mut stages = Stages::default();
+    let mission = stages.time("generate", || aviary_check::generate::w_mission(k));
+    if emit {
+        print!("{mission}");
+        return 0;
+    }
+    let world = stages.time("generate", || aviary_check::generate::w_world(n));
+    if emit_world {
+        print!("{world}");
+        return 0;
+    }
+    let mut tally = Tally { full: full_trace, ..Tally::default() };
+    let ran = pipeline::run(mission, world, &mut tally, &mut stages);
+    let ran = match ran {
+        Ok(r) => r,
+        Err(why) => {
+            eprintln!("aviary: the W mission did not run:\n{why}");
+            return 1;
+        }
+    };
+    let wall = started.elapsed().as_secs_f64();
+    let (n64, k64) = (n as u64, k as u64);
+    let ok = ran.outcome.status == aviary_engine::Status::Ok
+        && tally.done_signals == n64
+        && tally.handled == n64
+        && tally.index_sum == n64 * (n64 - 1) / 2
+        && (!full_trace || tally.steps == n64 * k64);
+    let steps = if full_trace { format!(" steps={}", tally.steps) } else { String::new() };
+    println!(
+        "aviary W N={n} K={k} done={} handled={} sum={}{steps} ok={ok} elapsed={wall:.3}s peak={}",
+        tally.done_signals,
+        tally.handled,
+        tally.index_sum,
+        mib(peak_rss())
+    );
+    println!("stages: {}; {} trace events", stages.show(), tally.events);
+    u8::from(!ok)
+}

@@ -1,0 +1,108 @@
+//! Cancellation on one thread: a token is cancelled by itself or by any ancestor, and
+//! `cancelled()` wakes whoever waits. `tokio_util`'s `CancellationToken` is made for
+//! threads: each child, check and drop takes its parent's mutex, and every top-level
+//! activity is a child of the mission's one `stop` token, so each step of every actor
+//! took the same lock several times. Here it is cells and `Rc`s.
+
+use std::cell::{Cell, RefCell};
+use std::future::poll_fn;
+use std::rc::{Rc, Weak};
+use std::task::{Poll, Waker};
+
+#[derive(Default)]
+struct Node {
+    cancelled: Cell<bool>,
+    /// Who waits: almost always one task (the activity's own), so one slot and a list
+    /// for the rare others.
+    waiter: RefCell<Option<Waker>>,
+    waiters: RefCell<Vec<Waker>>,
+    children: RefCell<Vec<Weak<Node>>>,
+}
+
+#[derive(Clone, Default)]
+pub(crate) struct Token(Rc<Node>);
+
+impl Token {
+    pub fn new() -> Token {
+        Token::default()
+    }
+
+    /// A token cancelled with this one (or on its own).
+    pub fn child_token(&self) -> Token {
+        let child = Token::new();
+        child.0.cancelled.set(self.0.cancelled.get());
+        let mut children = self.0.children.borrow_mut();
+        // Forget children that are gone, now and then, so the list stays within twice
+        // the live ones.
+        if children.len() >= 8 && children.len().is_power_of_two() {
+            children.retain(|c| c.strong_count() > 0);
+        }
+        children.push(Rc::downgrade(&child.0));
+        child
+    }
+
+    pub fn is_cancelled(&self) -> bool {
+        self.0.cancelled.get()
+    }
+
+    pub fn cancel(&self) {
+        cancel(&self.0);
+    }
+
+    /// Ends once the token is cancelled.
+    pub async fn cancelled(&self) {
+        poll_fn(|cx| {
+            if self.0.cancelled.get() {
+                return Poll::Ready(());
+            }
+            let mut first = self.0.waiter.borrow_mut();
+            match &*first {
+                None => *first = Some(cx.waker().clone()),
+                Some(w) if w.will_wake(cx.waker()) => {}
+                Some(_) => {
+                    let mut waiters = self.0.waiters.borrow_mut();
+                    if !waiters.iter().any(|w| w.will_wake(cx.waker())) {
+                        waiters.push(cx.waker().clone());
+                    }
+                }
+            }
+            Poll::Pending
+        })
+        .await
+    }
+}
+
+fn cancel(node: &Rc<Node>) {
+    if node.cancelled.replace(true) {
+        return;
+    }
+    if let Some(waker) = node.waiter.take() {
+        waker.wake();
+    }
+    for waker in node.waiters.take() {
+        waker.wake();
+    }
+    let children = node.children.take();
+    for child in children.iter().filter_map(Weak::upgrade) {
+        cancel(&child);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cancelling_reaches_every_descendant_and_not_the_parent() {
+        let root = Token::new();
+        let child = root.child_token();
+        let grandchild = child.child_token();
+        let other = root.child_token();
+        child.cancel();
+        assert!(child.is_cancelled() && grandchild.is_cancelled());
+        assert!(!root.is_cancelled() && !other.is_cancelled());
+        root.cancel();
+        assert!(other.is_cancelled());
+        assert!(root.child_token().is_cancelled(), "a child of a cancelled token starts cancelled");
+    }
+}

@@ -1,0 +1,87 @@
+//! The running capability instances, indexed so that no event scans them all: by actor
+//! (drone events and exceptions go to one drone's activities) and by (capability, tag)
+//! (leashes). With ten thousand drones in the air, a per-event scan over every running
+//! activity would make each event cost the fleet's size. Keys end with the instance's id
+//! (ids grow), so every walk is in the order the instances started, as the single list
+//! it replaces was. An instance of several actors is listed under each.
+
+use std::collections::BTreeMap;
+use std::rc::Rc;
+
+use aviary_api::DroneId;
+
+use crate::engine::{Instance, Scope};
+
+pub(crate) type Entry<'m> = (Rc<Instance>, Rc<Scope<'m>>);
+
+#[derive(Default)]
+pub(crate) struct Registry<'m> {
+    by_actor: BTreeMap<(DroneId, u64), Entry<'m>>,
+    by_tag: BTreeMap<(usize, usize, u64), Entry<'m>>,
+    /// Instances without an actor (all of whose actor references were empty), so that
+    /// `all` still sees them.
+    loose: BTreeMap<u64, Entry<'m>>,
+}
+
+impl<'m> Registry<'m> {
+    pub fn insert(&mut self, instance: Rc<Instance>, scope: Rc<Scope<'m>>) {
+        let id = instance.id;
+        if let Some(tag) = instance.tag {
+            self.by_tag.insert((instance.capability, tag, id), (instance.clone(), scope.clone()));
+        }
+        if instance.actors.is_empty() {
+            self.loose.insert(id, (instance.clone(), scope.clone()));
+        }
+        for d in &instance.actors {
+            self.by_actor.insert((*d, id), (instance.clone(), scope.clone()));
+        }
+    }
+
+    pub fn remove(&mut self, instance: &Instance) {
+        let id = instance.id;
+        self.loose.remove(&id);
+        for d in &instance.actors {
+            self.by_actor.remove(&(*d, id));
+        }
+        if let Some(tag) = instance.tag {
+            self.by_tag.remove(&(instance.capability, tag, id));
+        }
+    }
+
+    /// The scope an instance's events are raised in (once its own scope exists).
+    pub fn set_scope(&mut self, instance: &Instance, scope: Rc<Scope<'m>>) {
+        let id = instance.id;
+        if let Some(entry) = self.loose.get_mut(&id) {
+            entry.1 = scope.clone();
+        }
+        for d in &instance.actors {
+            if let Some(entry) = self.by_actor.get_mut(&(*d, id)) {
+                entry.1 = scope.clone();
+            }
+        }
+        if let Some(tag) = instance.tag {
+            if let Some(entry) = self.by_tag.get_mut(&(instance.capability, tag, id)) {
+                entry.1 = scope;
+            }
+        }
+    }
+
+    /// Every running instance once, in the order they started (for the operator's pause
+    /// and resume of the whole mission, not for events).
+    pub fn all(&self) -> Vec<Entry<'m>> {
+        let mut all: Vec<&Entry<'m>> = self.by_actor.values().chain(self.loose.values()).collect();
+        all.sort_by_key(|(i, _)| i.id);
+        all.dedup_by_key(|(i, _)| i.id);
+        all.into_iter().cloned().collect()
+    }
+
+    /// The instances `drone` takes part in, in the order they started.
+    pub fn of_actor(&self, drone: DroneId) -> impl Iterator<Item = &Entry<'m>> {
+        self.by_actor.range((drone, 0)..=(drone, u64::MAX)).map(|(_, e)| e)
+    }
+
+    /// The instances of `capability` tagged `tag`, in the order they started.
+    pub fn tagged(&self, capability: usize, tag: usize) -> impl Iterator<Item = &Entry<'m>> {
+        self.by_tag.range((capability, tag, 0)..=(capability, tag, u64::MAX)).map(|(_, e)| e)
+    }
+}

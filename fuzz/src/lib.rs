@@ -52,6 +52,13 @@ pub fn mission(data: &[u8]) {
         let _ = render_text(&sources, d, false);
         let _ = render_json(&sources, d);
     }
+    // A mission without errors is compiled and goes through the pre-flight analyses.
+    if let Some((_, verified)) = aviary_verify::preflight(&checked, &Descriptor::standard()) {
+        for d in &verified.diagnostics {
+            let _ = render_text(&sources, d, false);
+        }
+        let _ = verified.plan.render_text();
+    }
 }
 
 /// Reads the bytes (lossily decoded) as a world file and renders every diagnostic.
@@ -59,6 +66,7 @@ pub fn world(data: &[u8]) {
     let text = String::from_utf8_lossy(data);
     let mut sources = SourceMap::new();
     let id = sources.add("world.toml", text.as_ref());
+    aviary_world::assert_fast_reader_agrees(sources.text(id));
     let (world, diagnostics) = aviary_world::parse_world(id, sources.text(id));
     assert!(
         world.is_some() == diagnostics.is_empty(),

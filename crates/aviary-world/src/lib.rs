@@ -24,6 +24,18 @@ pub const BUILTIN_SENSORS: &[&str] = &["camera"];
 
 /// Reads a world file. Returns the world only when there are no errors; the diagnostics
 /// are sorted by position.
+/// For the fuzz target and tests: panics when the fast reader accepts `text` but builds
+/// another tree than the serde path (the fast path must only ever be a shortcut).
+#[doc(hidden)]
+pub fn assert_fast_reader_agrees(text: &str) {
+    if let Some(fast) = fast::parse(text) {
+        match node::Node::parse_serde(text) {
+            Ok(slow) => assert!(fast == slow, "the fast reader and serde read {text:?} differently:\n{fast:#?}\n{slow:#?}"),
+            Err(e) => panic!("the fast reader accepts {text:?}, which serde refuses: {e}"),
+        }
+    }
+}
+
 pub fn parse_world(file: FileId, text: &str) -> (Option<World>, Vec<Diagnostic>) {
     build::parse(file, text)
 }

@@ -25,6 +25,9 @@ use crate::node::{Entry, Node, Value};
 
 /// The tree of `text`, or `None` when the serde path should read it.
 pub(crate) fn parse(text: &str) -> Option<Node> {
+    if !within_toml_1_0(text.as_bytes()) {
+        return None;
+    }
     let source = Source::new(text);
     let mut builder = Builder {
         source,
@@ -41,7 +44,26 @@ pub(crate) fn parse(text: &str) -> Option<Node> {
     // memory than its tree. A `[` that opens a line outside any bracket starts a table.
     let mut tokens = Vec::with_capacity(64);
     let (mut depth, mut line_start) = (0i64, true);
+    let (mut inline, mut last) = (0i64, TokenKind::Newline);
     for token in source.lex() {
+        // TOML 1.1 forms (`toml_parser` reads 1.1, the serde path `toml` 0.8 reads 1.0):
+        // line breaks and a trailing comma in an inline table, `\e` and `\x` escapes.
+        match token.kind() {
+            TokenKind::Newline if inline > 0 => return None,
+            TokenKind::RightCurlyBracket if last == TokenKind::Comma => return None,
+            TokenKind::BasicString | TokenKind::MlBasicString => {
+                let raw = text.get(token.span().start()..token.span().end())?;
+                if raw.contains("\\e") || raw.contains("\\x") {
+                    return None;
+                }
+            }
+            TokenKind::LeftCurlyBracket => inline += 1,
+            TokenKind::RightCurlyBracket => inline -= 1,
+            _ => {}
+        }
+        if !matches!(token.kind(), TokenKind::Whitespace | TokenKind::Comment) {
+            last = token.kind();
+        }
         match token.kind() {
             TokenKind::LeftSquareBracket => {
                 if depth == 0 && line_start && !tokens.is_empty() {
@@ -62,6 +84,18 @@ pub(crate) fn parse(text: &str) -> Option<Node> {
         return None;
     }
     Some(builder.root.into_node())
+}
+
+/// No control character but tab and line breaks, and no carriage return outside a CRLF:
+/// TOML forbids them, and `toml_parser`'s lexer lets some through (a lone `\r` breaks a
+/// line there).
+fn within_toml_1_0(bytes: &[u8]) -> bool {
+    bytes.iter().enumerate().all(|(i, &b)| match b {
+        b'\r' => bytes.get(i + 1) == Some(&b'\n'),
+        b'\t' | b'\n' => true,
+        0..=0x1f | 0x7f => false,
+        _ => true,
+    })
 }
 
 struct Errors(bool);
@@ -261,7 +295,15 @@ impl Builder<'_> {
         if encoding.is_some() || self.dotted {
             return None;
         }
-        let name = self.source.input().get(at.start()..at.end())?.to_string();
+        // The parser leaves a bare key's characters to the decoder (`Lookout@` lexes as
+        // one key), so decode it and take serde's path on any complaint.
+        let text = self.source.input().get(at.start()..at.end())?;
+        let mut name = String::new();
+        let mut errors = Errors(false);
+        toml_parser::Raw::new_unchecked(text, None, at).decode_key(&mut name, &mut errors);
+        if errors.0 {
+            return None;
+        }
         let key = (name, span(at));
         if let Some((_, _, keys)) = &mut self.header {
             keys.push(key);

@@ -820,6 +820,17 @@ fn the_fast_reader_gives_the_same_tree_as_serde() {
         "[a]\nx = \n",
         "[a]\nx = 0x10\n",
         "[a\n",
+        "[places]\nLookout@= [100, 40]\n",
+        "[drones.a]\nhom\u{e9} = [0, 0]\n",
+        "[a@b]\n",
+        "[a]\rx = 1\n",
+        "[a]\nx = 1\r",
+        "# a\u{7f}comment\n[a]\n",
+        "[a]\nx = \"tab\u{1}\"\n",
+        "[a]\nx = \"\\e\"\n",
+        "[a]\nx = \"\\x41\"\n",
+        "[a]\nx = { b = 1, }\n",
+        "[a]\nx = { b = 1,\n c = 2 }\n",
     ] {
         assert!(crate::fast::parse(text).is_none(), "{text:?}");
     }

@@ -47,16 +47,19 @@ pub(crate) fn parse(text: &str) -> Option<Node> {
     let (mut inline, mut last) = (0i64, TokenKind::Newline);
     for token in source.lex() {
         // TOML 1.1 forms (`toml_parser` reads 1.1, the serde path `toml` 0.8 reads 1.0):
-        // line breaks and a trailing comma in an inline table, `\e` and `\x` escapes.
+        // line breaks and a trailing comma in an inline table, `\e` and `\x` escapes;
+        // and CRLF in multi-line strings, which the two decode differently.
         match token.kind() {
             TokenKind::Newline if inline > 0 => return None,
             TokenKind::RightCurlyBracket if last == TokenKind::Comma => return None,
             TokenKind::BasicString | TokenKind::MlBasicString => {
                 let raw = text.get(token.span().start()..token.span().end())?;
-                if raw.contains("\\e") || raw.contains("\\x") {
+                if raw.contains("\\e") || raw.contains("\\x") || raw.contains('\r') {
                     return None;
                 }
             }
+            // `toml` reads a CRLF inside a multi-line string as LF; `toml_parser` keeps it.
+            TokenKind::MlLiteralString if text.get(token.span().start()..token.span().end())?.contains('\r') => return None,
             TokenKind::LeftCurlyBracket => inline += 1,
             TokenKind::RightCurlyBracket => inline -= 1,
             _ => {}

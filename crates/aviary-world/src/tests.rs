@@ -831,6 +831,8 @@ fn the_fast_reader_gives_the_same_tree_as_serde() {
         "[a]\nx = \"\\x41\"\n",
         "[a]\nx = { b = 1, }\n",
         "[a]\nx = { b = 1,\n c = 2 }\n",
+        "[a]\nx = \'\'\'\r\nline\r\n\'\'\'\r\n",
+        "[a]\nx = \"\"\"\r\nline\r\n\"\"\"\r\n",
     ] {
         assert!(crate::fast::parse(text).is_none(), "{text:?}");
     }

@@ -1,5 +1,6 @@
 //! One simulated drone: what the world file says of it, and its state.
 
+use aviary_api::geometry::hypot;
 use aviary_api::{CallId, FlightState, Telemetry};
 use aviary_world::Drone;
 
@@ -126,7 +127,7 @@ impl SimDrone {
     pub fn telemetry(&self) -> Telemetry {
         Telemetry {
             position: self.pos,
-            speed: self.vel[0].hypot(self.vel[1]),
+            speed: hypot(self.vel[0], self.vel[1]),
             heading: self.heading,
             battery: self.battery,
             state: self.state,

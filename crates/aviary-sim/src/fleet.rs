@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use aviary_api::{
     CallEnd, CallId, DroneEvent, DroneId, Failure, FlightState, Interrupt, Telemetry, Value,
 };
+use aviary_api::geometry::hypot;
 use aviary_world::{FaultKind, Sensor, Target, World};
 
 use crate::avoid::Track;
@@ -123,6 +124,12 @@ impl Fleet {
             fastest: world.drones.iter().map(|d| d.max_speed + d.climb_rate).fold(0.0, f64::max),
             target_grid: {
                 let mut g = Grid::new(TARGET_CELL);
+                let at = || world.targets.iter().map(|t| t.at);
+                g.reframe(
+                    [at().map(|p| p[0]).fold(f64::INFINITY, f64::min), at().map(|p| p[1]).fold(f64::INFINITY, f64::min)],
+                    [at().map(|p| p[0]).fold(f64::NEG_INFINITY, f64::max), at().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max)],
+                    world.targets.len(),
+                );
                 for (i, t) in world.targets.iter().enumerate() {
                     g.put(i, [t.at[0], t.at[1]]);
                 }
@@ -247,14 +254,21 @@ impl Fleet {
         self.fire_faults(end, &mut out);
         self.tracks.clear();
         self.aloft.clear();
-        self.sky.clear();
         self.max_extent = 0.0;
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for (id, d) in self.drones.iter().enumerate() {
             if d.state.airborne() {
                 self.aloft.push(id);
-                self.sky.put(id, d.xy());
-                self.max_extent = self.max_extent.max(extent(&envelope(d)));
+                let p = d.xy();
+                (lo, hi) = ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])]);
             }
+        }
+        // The sky's window: where the drones in the air are now.
+        self.sky.reframe(lo, hi, self.aloft.len());
+        for &id in &self.aloft {
+            let d = &self.drones[id];
+            self.sky.put(id, d.xy());
+            self.max_extent = self.max_extent.max(extent(&envelope(d)));
         }
         for id in 0..self.drones.len() {
             self.step_drone(id, dt, &mut out);
@@ -289,7 +303,7 @@ impl Fleet {
                 });
             }
         }
-        if d.vel[0].hypot(d.vel[1]) > 1e-9 {
+        if hypot(d.vel[0], d.vel[1]) > 1e-9 {
             d.heading = heading(d.vel[0], d.vel[1]);
         }
         if let Some(load) = d.loading.as_mut().filter(|l| !l.paused) {

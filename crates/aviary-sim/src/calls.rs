@@ -290,7 +290,7 @@ impl Fleet {
                     d.detections.push(Activation {
                         kind,
                         range,
-                        found: vec![false; self.targets.len()],
+                        found: Vec::new(),
                     });
                 }
             }

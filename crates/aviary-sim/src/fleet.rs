@@ -83,8 +83,30 @@ pub struct Fleet {
 
 /// Metres on a side of a cell of [`Fleet::sky`]: about the planner's reach.
 const SKY_CELL: f64 = 400.0;
-/// Metres on a side of a cell of [`Fleet::target_grid`]: about a sensor's range.
+/// Metres on a side of a cell of [`Fleet::target_grid`], at least: about a sensor's range.
 const TARGET_CELL: f64 = 50.0;
+
+/// The world's targets in cells of [`TARGET_CELL`], or larger where targets are sparse:
+/// about one cell per target over the box they cover, so that the cells fit the grid's
+/// array (a query looks at a few cells, whose lists it filters exactly: the cell size
+/// changes the cost, not the answer).
+fn target_grid(targets: &[Target]) -> Grid {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for t in targets {
+        (lo, hi) = ([lo[0].min(t.at[0]), lo[1].min(t.at[1])], [hi[0].max(t.at[0]), hi[1].max(t.at[1])]);
+    }
+    let area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
+    let size = match (area / targets.len() as f64).sqrt() {
+        s if s.is_finite() && s > TARGET_CELL => s,
+        _ => TARGET_CELL,
+    };
+    let mut g = Grid::new(size);
+    g.reframe(lo, hi, targets.len());
+    for (i, t) in targets.iter().enumerate() {
+        g.put(i, [t.at[0], t.at[1]]);
+    }
+    g
+}
 
 impl Fleet {
     /// Every drone of the world, landed and disarmed at its home (at ground level), with
@@ -122,19 +144,7 @@ impl Fleet {
             sky: Grid::new(SKY_CELL),
             max_extent: 0.0,
             fastest: world.drones.iter().map(|d| d.max_speed + d.climb_rate).fold(0.0, f64::max),
-            target_grid: {
-                let mut g = Grid::new(TARGET_CELL);
-                let at = || world.targets.iter().map(|t| t.at);
-                g.reframe(
-                    [at().map(|p| p[0]).fold(f64::INFINITY, f64::min), at().map(|p| p[1]).fold(f64::INFINITY, f64::min)],
-                    [at().map(|p| p[0]).fold(f64::NEG_INFINITY, f64::max), at().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max)],
-                    world.targets.len(),
-                );
-                for (i, t) in world.targets.iter().enumerate() {
-                    g.put(i, [t.at[0], t.at[1]]);
-                }
-                g
-            },
+            target_grid: target_grid(&world.targets),
             nearby: Vec::new(),
         }
     }

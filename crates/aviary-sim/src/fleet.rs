@@ -1,7 +1,7 @@
 //! The physics core: every drone of the world, advanced tick by tick. Pure: no clock, no
 //! channels, no randomness; the same calls and steps give the same results bit for bit.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 
 use aviary_api::{
     CallEnd, CallId, DroneEvent, DroneId, Failure, FlightState, Interrupt, Telemetry, Value,
@@ -79,6 +79,10 @@ pub struct Fleet {
     pub(crate) target_grid: Grid,
     /// A scratch list for grid queries.
     pub(crate) nearby: Vec<usize>,
+    /// The drone of each call in progress (a call id is only ever that drone's), so that
+    /// [`Fleet::interrupt`] looks at one drone, not the fleet. Entries go when the call's
+    /// end is reported; one left over (a task replaced without an end) only costs a lookup.
+    pub(crate) calls: HashMap<CallId, DroneId>,
 }
 
 /// Metres on a side of a cell of [`Fleet::sky`]: about the planner's reach.
@@ -146,6 +150,7 @@ impl Fleet {
             fastest: world.drones.iter().map(|d| d.max_speed + d.climb_rate).fold(0.0, f64::max),
             target_grid: target_grid(&world.targets),
             nearby: Vec::new(),
+            calls: HashMap::new(),
         }
     }
 
@@ -210,7 +215,10 @@ impl Fleet {
         let id = CallId(self.next_call);
         self.next_call += 1;
         let end = match self.start(drone, id, function, args) {
-            Ok(true) => None,
+            Ok(true) => {
+                self.calls.insert(id, drone);
+                None
+            }
             Ok(false) => Some(CallEnd::Done),
             Err(failure) => Some(CallEnd::Failed(failure)),
         };
@@ -220,7 +228,17 @@ impl Fleet {
     /// Aborts, pauses or resumes a call in progress. Returns the call's end when that
     /// ends it (an abort). A call that is not in progress is left alone.
     pub fn interrupt(&mut self, call: CallId, how: Interrupt) -> Option<CallEnd> {
-        for d in &mut self.drones {
+        let end = self.interrupt_on(call, how);
+        if end.is_some() {
+            self.calls.remove(&call);
+        }
+        end
+    }
+
+    fn interrupt_on(&mut self, call: CallId, how: Interrupt) -> Option<CallEnd> {
+        // Only the call's own drone can have it in progress.
+        let &drone = self.calls.get(&call)?;
+        if let Some(d) = self.drones.get_mut(drone) {
             if d.motion.as_ref().is_some_and(|t| t.call == Some(call)) {
                 match how {
                     Interrupt::Abort => {
@@ -290,6 +308,11 @@ impl Fleet {
             }
         }
         self.time = end;
+        for report in &out {
+            if let Report::Ended { call, .. } = report {
+                self.calls.remove(call);
+            }
+        }
         out
     }
 

@@ -148,7 +148,7 @@ struct Snapshot {
     vel: [f64; 3],
     state: FlightState,
     armed: bool,
-    motion: Option<MotionTask>,
+    motion: Option<Box<MotionTask>>,
 }
 
 impl SimDrone {

@@ -37,7 +37,22 @@ pub fn centroid(polygon: &[[f64; 2]]) -> [f64; 2] {
 pub const ON_EDGE: f64 = 1e-6;
 
 pub fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
-    (b[0] - a[0]).hypot(b[1] - a[1])
+    hypot(b[0] - a[0], b[1] - a[1])
+}
+
+/// `x.hypot(y)`, bit for bit, without the call to libm when one side is zero (a drone
+/// at rest, or moving along an axis, as a sweep's legs do): libm's `hypot` returns
+/// `|x| + |y|` whenever the smaller side is that small, and then `|x| + 0` is `|x|`.
+/// The simulator calls it several times per drone per tick.
+#[inline]
+pub fn hypot(x: f64, y: f64) -> f64 {
+    if y == 0.0 {
+        x.abs()
+    } else if x == 0.0 {
+        y.abs()
+    } else {
+        x.hypot(y)
+    }
 }
 
 /// Distance from `p` to the segment `a`-`b`.
@@ -109,3 +124,19 @@ pub fn circle_inside(polygon: &[[f64; 2]], center: [f64; 2], radius: f64) -> boo
     contains(polygon, center) && dist_to_boundary(polygon, center) >= radius - ON_EDGE
 }
 
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hypot_is_libms_bit_for_bit() {
+        let xs = [0.0, -0.0, 1e-300, 3.0, -4.5, 1e300, f64::INFINITY, f64::NEG_INFINITY, f64::NAN, 0.1, -7e-320];
+        for x in xs {
+            for y in xs {
+                let (a, b) = (hypot(x, y), x.hypot(y));
+                assert!(a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()), "{x} {y}: {a} {b}");
+            }
+        }
+    }
+}

@@ -159,13 +159,25 @@ impl<'m> Engine<'m> {
         if !self.sink.borrow().wants(event) {
             return;
         }
-        let fields = fields();
-        let mut object = serde_json::Map::new();
-        object.insert("t".into(), json!(self.now()));
-        object.insert("event".into(), json!(event));
-        if let Json::Object(rest) = fields {
-            object.extend(rest);
-        }
+        let object = match fields() {
+            // `t` and `event` put in front of the fields' own map: the same object as
+            // building a new map and moving every field into it, without hashing and
+            // moving each field again (no event has fields of those names).
+            Json::Object(mut rest) if !rest.contains_key("t") && !rest.contains_key("event") => {
+                rest.shift_insert(0, "t".into(), json!(self.now()));
+                rest.shift_insert(1, "event".into(), json!(event));
+                rest
+            }
+            fields => {
+                let mut object = serde_json::Map::new();
+                object.insert("t".into(), json!(self.now()));
+                object.insert("event".into(), json!(event));
+                if let Json::Object(rest) = fields {
+                    object.extend(rest);
+                }
+                object
+            }
+        };
         self.sink.borrow_mut().event(Json::Object(object));
     }
 

@@ -95,7 +95,7 @@ impl Fleet {
                 if d.motion.take().is_some() {
                     d.settle();
                 }
-                d.motion = Some(MotionTask::new(Some(call), legs));
+                d.motion = Some(Box::new(MotionTask::new(Some(call), legs)));
                 d.begin_leg();
                 Ok(true)
             }
@@ -290,7 +290,7 @@ impl Fleet {
                     d.detections.push(Activation {
                         kind,
                         range,
-                        found: vec![false; self.targets.len()],
+                        found: Vec::new(),
                     });
                 }
             }
@@ -319,12 +319,12 @@ impl Fleet {
                         d.name, d.pos[2]
                     )));
                 }
-                d.loading = Some(Loading {
+                d.loading = Some(Box::new(Loading {
                     call,
                     kind,
                     left: LOAD_TIME,
                     paused: false,
-                });
+                }));
                 return Ok(Start::Pending);
             }
             "ReleasePayload" => {

@@ -72,7 +72,7 @@ impl Fleet {
                             speed: d.max_speed,
                             state: FlightState::Landing,
                         };
-                        d.motion = Some(MotionTask::new(None, vec![leg]));
+                        d.motion = Some(Box::new(MotionTask::new(None, vec![leg])));
                         d.begin_leg();
                     }
                 }
@@ -83,11 +83,11 @@ impl Fleet {
                         format!("{name}: link lost (simulated fault)"),
                         out,
                     );
-                    self.drones[id].link_loss = Some(Outage {
+                    self.drones[id].link_loss = Some(Box::new(Outage {
                         since: at,
                         until,
                         returned: false,
-                    });
+                    }));
                 }
                 FaultKind::GpsLoss => {
                     self.fault(
@@ -96,16 +96,16 @@ impl Fleet {
                         format!("{name}: GPS lost (simulated fault)"),
                         out,
                     );
-                    self.drones[id].gps_loss = Some(Outage {
+                    self.drones[id].gps_loss = Some(Box::new(Outage {
                         since: at,
                         until,
                         returned: false,
-                    });
+                    }));
                 }
             }
         }
         for (id, d) in self.drones.iter_mut().enumerate() {
-            if d.link_loss.is_some_and(|o| o.until <= end + 1e-9) {
+            if d.link_loss.as_ref().is_some_and(|o| o.until <= end + 1e-9) {
                 d.link_loss = None;
                 if d.state != FlightState::Lost {
                     out.push(Report::Event(DroneEvent::Signal {
@@ -114,7 +114,7 @@ impl Fleet {
                     }));
                 }
             }
-            if d.gps_loss.is_some_and(|o| o.until <= end + 1e-9) {
+            if d.gps_loss.as_ref().is_some_and(|o| o.until <= end + 1e-9) {
                 d.gps_loss = None;
             }
         }
@@ -130,7 +130,7 @@ impl Fleet {
             let on_its_own = d.state.airborne() && d.motion.is_none() && d.disabled.is_none();
             if on_its_own {
                 if let Ok(legs) = return_legs(d, false, max_altitude) {
-                    d.motion = Some(MotionTask::new(None, legs));
+                    d.motion = Some(Box::new(MotionTask::new(None, legs)));
                     d.begin_leg();
                 }
             }

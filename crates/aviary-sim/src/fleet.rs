@@ -1,11 +1,12 @@
 //! The physics core: every drone of the world, advanced tick by tick. Pure: no clock, no
 //! channels, no randomness; the same calls and steps give the same results bit for bit.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 
 use aviary_api::{
     CallEnd, CallId, DroneEvent, DroneId, Failure, FlightState, Interrupt, Telemetry, Value,
 };
+use aviary_api::geometry::hypot;
 use aviary_world::{FaultKind, Sensor, Target, World};
 
 use crate::avoid::Track;
@@ -78,12 +79,38 @@ pub struct Fleet {
     pub(crate) target_grid: Grid,
     /// A scratch list for grid queries.
     pub(crate) nearby: Vec<usize>,
+    /// The drone of each call in progress (a call id is only ever that drone's), so that
+    /// [`Fleet::interrupt`] looks at one drone, not the fleet. Entries go when the call's
+    /// end is reported; one left over (a task replaced without an end) only costs a lookup.
+    pub(crate) calls: HashMap<CallId, DroneId>,
 }
 
 /// Metres on a side of a cell of [`Fleet::sky`]: about the planner's reach.
 const SKY_CELL: f64 = 400.0;
-/// Metres on a side of a cell of [`Fleet::target_grid`]: about a sensor's range.
+/// Metres on a side of a cell of [`Fleet::target_grid`], at least: about a sensor's range.
 const TARGET_CELL: f64 = 50.0;
+
+/// The world's targets in cells of [`TARGET_CELL`], or larger where targets are sparse:
+/// about one cell per target over the box they cover, so that the cells fit the grid's
+/// array (a query looks at a few cells, whose lists it filters exactly: the cell size
+/// changes the cost, not the answer).
+fn target_grid(targets: &[Target]) -> Grid {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for t in targets {
+        (lo, hi) = ([lo[0].min(t.at[0]), lo[1].min(t.at[1])], [hi[0].max(t.at[0]), hi[1].max(t.at[1])]);
+    }
+    let area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
+    let size = match (area / targets.len() as f64).sqrt() {
+        s if s.is_finite() && s > TARGET_CELL => s,
+        _ => TARGET_CELL,
+    };
+    let mut g = Grid::new(size);
+    g.reframe(lo, hi, targets.len());
+    for (i, t) in targets.iter().enumerate() {
+        g.put(i, [t.at[0], t.at[1]]);
+    }
+    g
+}
 
 impl Fleet {
     /// Every drone of the world, landed and disarmed at its home (at ground level), with
@@ -121,14 +148,9 @@ impl Fleet {
             sky: Grid::new(SKY_CELL),
             max_extent: 0.0,
             fastest: world.drones.iter().map(|d| d.max_speed + d.climb_rate).fold(0.0, f64::max),
-            target_grid: {
-                let mut g = Grid::new(TARGET_CELL);
-                for (i, t) in world.targets.iter().enumerate() {
-                    g.put(i, [t.at[0], t.at[1]]);
-                }
-                g
-            },
+            target_grid: target_grid(&world.targets),
             nearby: Vec::new(),
+            calls: HashMap::new(),
         }
     }
 
@@ -193,7 +215,10 @@ impl Fleet {
         let id = CallId(self.next_call);
         self.next_call += 1;
         let end = match self.start(drone, id, function, args) {
-            Ok(true) => None,
+            Ok(true) => {
+                self.calls.insert(id, drone);
+                None
+            }
             Ok(false) => Some(CallEnd::Done),
             Err(failure) => Some(CallEnd::Failed(failure)),
         };
@@ -203,7 +228,17 @@ impl Fleet {
     /// Aborts, pauses or resumes a call in progress. Returns the call's end when that
     /// ends it (an abort). A call that is not in progress is left alone.
     pub fn interrupt(&mut self, call: CallId, how: Interrupt) -> Option<CallEnd> {
-        for d in &mut self.drones {
+        let end = self.interrupt_on(call, how);
+        if end.is_some() {
+            self.calls.remove(&call);
+        }
+        end
+    }
+
+    fn interrupt_on(&mut self, call: CallId, how: Interrupt) -> Option<CallEnd> {
+        // Only the call's own drone can have it in progress.
+        let &drone = self.calls.get(&call)?;
+        if let Some(d) = self.drones.get_mut(drone) {
             if d.motion.as_ref().is_some_and(|t| t.call == Some(call)) {
                 match how {
                     Interrupt::Abort => {
@@ -247,14 +282,21 @@ impl Fleet {
         self.fire_faults(end, &mut out);
         self.tracks.clear();
         self.aloft.clear();
-        self.sky.clear();
         self.max_extent = 0.0;
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for (id, d) in self.drones.iter().enumerate() {
             if d.state.airborne() {
                 self.aloft.push(id);
-                self.sky.put(id, d.xy());
-                self.max_extent = self.max_extent.max(extent(&envelope(d)));
+                let p = d.xy();
+                (lo, hi) = ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])]);
             }
+        }
+        // The sky's window: where the drones in the air are now.
+        self.sky.reframe(lo, hi, self.aloft.len());
+        for &id in &self.aloft {
+            let d = &self.drones[id];
+            self.sky.put(id, d.xy());
+            self.max_extent = self.max_extent.max(extent(&envelope(d)));
         }
         for id in 0..self.drones.len() {
             self.step_drone(id, dt, &mut out);
@@ -266,6 +308,11 @@ impl Fleet {
             }
         }
         self.time = end;
+        for report in &out {
+            if let Report::Ended { call, .. } = report {
+                self.calls.remove(call);
+            }
+        }
         out
     }
 
@@ -289,7 +336,7 @@ impl Fleet {
                 });
             }
         }
-        if d.vel[0].hypot(d.vel[1]) > 1e-9 {
+        if hypot(d.vel[0], d.vel[1]) > 1e-9 {
             d.heading = heading(d.vel[0], d.vel[1]);
         }
         if let Some(load) = d.loading.as_mut().filter(|l| !l.paused) {

@@ -220,7 +220,7 @@ impl SimDrone {
             }
         }
         if task.legs.is_empty() {
-            return self.motion.take();
+            return self.motion.take().map(|task| *task);
         }
         self.begin_leg();
         None

@@ -13,8 +13,9 @@ pub(crate) struct Activation {
     pub kind: String,
     /// Metres from the drone's ground point.
     pub range: f64,
-    /// Per world target (in file order): found in this activation.
-    pub found: Vec<bool>,
+    /// The world targets (their indices, ascending) found in this activation: few, where
+    /// a flag per target cost every drone as much memory as the world has targets.
+    pub found: Vec<usize>,
 }
 
 /// The range at which a drone with `sensors` detects `kind`: the largest range of its
@@ -44,13 +45,21 @@ pub(crate) fn scan(
 ) -> Vec<DroneEvent> {
     let mut events = Vec::new();
     for act in activations.iter_mut() {
+        // Far outside the box of the way widened by the range: out of range, without the
+        // kind's string or the found list (the margin is far above rounding).
+        let slack = act.range * (1.0 + 1e-9) + 1e-9;
+        let (lo, hi) = ([from[0].min(to[0]) - slack, from[1].min(to[1]) - slack], [from[0].max(to[0]) + slack, from[1].max(to[1]) + slack]);
         for (i, target) in candidates.iter().map(|&i| (i, &targets[i])) {
-            if act.found[i] || target.kind != act.kind {
+            let at = [target.at[0], target.at[1]];
+            if at[0] < lo[0] || at[0] > hi[0] || at[1] < lo[1] || at[1] > hi[1] {
                 continue;
             }
-            let at = [target.at[0], target.at[1]];
+            let Err(place) = act.found.binary_search(&i) else { continue };
+            if target.kind != act.kind {
+                continue;
+            }
             if dist_to_segment(at, from, to) <= act.range {
-                act.found[i] = true;
+                act.found.insert(place, i);
                 events.push(DroneEvent::Detected {
                     drone,
                     kind: act.kind.clone(),

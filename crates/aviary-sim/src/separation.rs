@@ -22,6 +22,7 @@
 //! Neither can make room where there is none (two drones sent to the same point), so a
 //! call that separation holds back for too long ends: see [`Fleet::held_back`].
 
+use aviary_api::geometry::hypot;
 use aviary_api::{CallEnd, DroneId, Failure, FlightState};
 
 use crate::avoid::MARGIN;
@@ -71,7 +72,7 @@ fn current_leg(d: &SimDrone) -> Option<&Leg> {
 
 pub(crate) fn envelope(d: &SimDrone) -> Envelope {
     let here = d.xy();
-    let vh = d.vel[0].hypot(d.vel[1]);
+    let vh = hypot(d.vel[0], d.vel[1]);
     // Straight on: the stopping distance ahead. On an arc of radius r, the arc of length L
     // it needs to stop stays within L²/2r of the tangent segment of length L; and braking
     // along the arc keeps that region nested (for arcs under a right angle, which orbit
@@ -133,7 +134,7 @@ pub(crate) fn gap(e: &Envelope, f: &Envelope) -> f64 {
 fn reach(d: &SimDrone, dt: f64) -> f64 {
     let a = d.accel;
     let grow = |v: f64| (v + a * dt) * dt + (v + a * dt).powi(2) / a;
-    grow(d.vel[0].hypot(d.vel[1])) + grow(d.vel[2].abs()) + 1.0
+    grow(hypot(d.vel[0], d.vel[1])) + grow(d.vel[2].abs()) + 1.0
 }
 
 /// How far a drone's envelope reaches from it.
@@ -147,7 +148,7 @@ struct Snapshot {
     vel: [f64; 3],
     state: FlightState,
     armed: bool,
-    motion: Option<MotionTask>,
+    motion: Option<Box<MotionTask>>,
 }
 
 impl SimDrone {
@@ -306,15 +307,8 @@ impl Fleet {
         }
         let separation = self.min_separation + reach(d, dt) + self.max_extent;
         let r = separation.max(crate::avoid::reach(self, d));
-        let mut candidates = std::mem::take(&mut self.nearby);
-        self.sky.around(d.xy(), d.xy(), r, &mut candidates);
-        let here = self.drones[id].xy();
-        let alone = candidates.iter().all(|&j| {
-            let p = self.drones[j].xy();
-            j == id || (p[0] - here[0]).abs() > r || (p[1] - here[1]).abs() > r
-        });
-        self.nearby = candidates;
-        alone
+        // The sky holds every drone of `aloft` where it is now (moved ones included).
+        !self.sky.any_within(d.xy(), r, id)
     }
 
     /// Moves drone `id` by one tick: the planner's choice if its envelope stays clear of

@@ -119,8 +119,25 @@ enum Command {
     },
 }
 
+/// The stack the command runs on. The checker, the plan and the engine follow capability
+/// calls by recursion, and a mission may chain thousands of capabilities; the main
+/// thread's 8 MiB would overflow. The size is reserved, not used, until needed.
+const STACK: usize = 1 << 30;
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    let worker = std::thread::Builder::new().name("aviary".into()).stack_size(STACK).spawn(move || command(cli));
+    match worker.map(|w| w.join()) {
+        Ok(Ok(code)) => ExitCode::from(code),
+        Ok(Err(_)) => ExitCode::from(101),
+        Err(e) => {
+            eprintln!("aviary: cannot start: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn command(cli: Cli) -> u8 {
     let code = match cli.command {
         Command::Check { files, world, format, plan } => check::run(&files, world.as_deref(), format, plan),
         Command::Fmt { files, check } => fmt::run(&files, check),
@@ -142,7 +159,7 @@ fn main() -> ExitCode {
         Command::Explain { code } => explain(&code),
         Command::Bench { which } => bench::run(which),
     };
-    ExitCode::from(code)
+    code
 }
 
 fn explain(code: &str) -> u8 {

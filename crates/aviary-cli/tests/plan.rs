@@ -160,3 +160,32 @@ fn a_low_reserve_is_a_warning_in_check_and_flagged_in_the_plan() {
     let left = doc["plan"]["drones"][0]["battery_left"].as_f64().expect("battery");
     assert!(left < 0.2 && left > 0.1, "{left}");
 }
+
+#[test]
+fn a_long_chain_of_capabilities_checks_plans_and_runs_without_overflowing() {
+    let dir = scratch("deep_chain");
+    let n = 5000;
+    let mut text = String::from("MISSION M:\n    scout TakeOff\n    scout C0\n    scout ReturnHome\n");
+    for i in 0..n {
+        let body = if i + 1 < n { format!("drone C{}", i + 1) } else { "drone.Hover(1s)".to_string() };
+        text.push_str(&format!("\nCAPABILITY C{i} BY drone:\n    PERFORM:\n        {body}\n"));
+    }
+    std::fs::write(dir.join("deep.mission"), text).expect("write");
+    std::fs::write(dir.join("deep.world.toml"), "[drones.scout]\nhome = [0, 0]\n").expect("write");
+    let (code, out, err) = aviary(&["check", "--plan", "deep.mission"], &dir);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("C0  (deep.mission:3:5)"), "{out}");
+    let (code, out, err) = aviary(&["run", "deep.mission"], &dir);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("mission ok"), "{out}");
+}
+
+#[test]
+fn a_capability_that_calls_itself_is_planned_once_with_a_note() {
+    let dir = scratch("recursive_plan");
+    std::fs::write(dir.join("rec.mission"), "MISSION M:\n    scout Loop\n\nCAPABILITY Loop BY drone:\n    PERFORM:\n        drone.Hover(1s)\n        drone Loop\n").expect("write");
+    std::fs::write(dir.join("rec.world.toml"), "[drones.scout]\nhome = [0, 0]\n").expect("write");
+    let (code, out, err) = aviary(&["check", "--plan", "rec.mission"], &dir);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("rec.mission:7:9: `Loop` calls itself; the estimate counts one round of it"), "{out}");
+}

@@ -53,6 +53,8 @@ pub struct Estimator<'m> {
     /// First raise times from the previous pass, for `WAITFOR RECEIVED` ahead of its signal.
     pub known: Vec<Option<f64>>,
     pub s: State,
+    /// The capabilities being walked, innermost last.
+    calling: Vec<usize>,
 }
 
 /// More rounds than any mission flies: a loop past it is taken as endless.
@@ -66,6 +68,7 @@ impl<'m> Estimator<'m> {
             mission,
             world,
             known,
+            calling: Vec::new(),
             s: State { drones, activities: vec![Vec::new(); n], raised: vec![None; mission.signals.len()], reserve: vec![None; n], assumptions: BTreeSet::new(), fired: BTreeSet::new() },
         }
     }
@@ -145,7 +148,7 @@ impl<'m> Estimator<'m> {
                 self.s.fired.insert(h as *const Handler as usize);
                 let mut hctx = ctx.clone();
                 for (slot, v) in h.bindings.iter().zip(&r.args) {
-                    hctx.frame[*slot] = v.clone();
+                    set(&mut hctx.frame, *slot, v.clone());
                 }
                 let start = if h.sequential { items_end.max(r.t) } else { r.t };
                 let (e, more) = self.block(&h.body, &mut hctx, start);
@@ -196,9 +199,9 @@ impl<'m> Estimator<'m> {
                     };
                     for d in members {
                         let mut ictx = ctx.clone();
-                        ictx.frame[f.alias] = Some(Value::Actor(d));
+                        set(&mut ictx.frame, f.alias, Some(Value::Actor(d)));
                         for (slot, v) in f.params.iter().zip(values) {
-                            ictx.frame[*slot] = self.scope(ctx, t).eval(v);
+                            set(&mut ictx.frame, *slot, self.scope(ctx, t).eval(v));
                         }
                         ictx.actor = Some(d);
                         let start = if f.parallel { t } else { end };
@@ -281,6 +284,11 @@ impl<'m> Estimator<'m> {
 
     fn call(&mut self, c: &Call, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
         let cap = &self.mission.capabilities[c.capability];
+        // A capability that calls itself, directly or not, would never end here.
+        if self.calling.contains(&c.capability) {
+            self.note(Some(c.origin), format!("`{}` calls itself; the estimate counts one round of it", cap.name));
+            return (t, Vec::new());
+        }
         let args: Vec<Option<Value>> = c.args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
         let sets: Vec<Vec<DroneId>> = c
             .actors
@@ -304,14 +312,13 @@ impl<'m> Estimator<'m> {
                 }
             }
             let mut frame = vec![None; cap.frame_size];
-            for (i, d) in actors.iter().enumerate() {
-                frame[i] = Some(Value::Actor(*d));
-            }
-            for (j, v) in args.iter().enumerate() {
-                frame[cap.actors + j] = v.clone();
+            for (slot, v) in frame.iter_mut().zip(actors.iter().map(|d| Some(Value::Actor(*d))).chain(args.iter().cloned())) {
+                *slot = v;
             }
             let mut cctx = Ctx { frame, actor: actors.first().copied(), statement: Some(ctx.statement.unwrap_or(c.origin)) };
+            self.calling.push(c.capability);
             let (e, r) = self.block(&cap.perform, &mut cctx, start);
+            self.calling.pop();
             if top {
                 for &slot in &motion {
                     if let Some(&d) = actors.get(slot) {
@@ -382,6 +389,12 @@ impl<'m> Estimator<'m> {
                 far.map(|p| [p[0], p[1], here[2]])
             }
         }
+    }
+}
+
+fn set(frame: &mut Frame, slot: usize, value: Option<Value>) {
+    if let Some(s) = frame.get_mut(slot) {
+        *s = value;
     }
 }
 

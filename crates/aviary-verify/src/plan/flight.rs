@@ -39,21 +39,21 @@ pub fn fly(e: &mut Estimator, d: DroneId, function: &str, args: &[Option<Value>]
         },
         "Hover" => number_arg(args, 0).unwrap_or(0.0),
         "FlyToPosition" => {
-            let Some(to) = e.position_arg(&args[0], d, at) else { return (0.0, raises) };
+            let Some(to) = e.position_arg(args.first().unwrap_or(&None), d, at) else { return (0.0, raises) };
             let f = &e.s.drones[d];
             let speed = number_arg(args, 1).map_or(f.max_speed, |s| s.min(f.max_speed));
             leg(e, d, to, speed, t, &mut raises)
         }
         "Orbit" => {
-            let center = e.position_arg(&args[0], d, at);
+            let center = e.position_arg(args.first().unwrap_or(&None), d, at);
             let radius = number_arg(args, 1);
             match (center, radius) {
                 (Some(c), Some(r)) => e.s.drones[d].orbit([c[0], c[1]], r, number_arg(args, 2).unwrap_or(1.0)),
                 _ => 0.0,
             }
         }
-        "Sweep" => match (&args[0], number_arg(args, 1)) {
-            (Some(Value::Area(area)), Some(spacing)) => {
+        "Sweep" => match (args.first(), number_arg(args, 1)) {
+            (Some(Some(Value::Area(area))), Some(spacing)) => {
                 let z = e.s.drones[d].pos[2];
                 let mut took = 0.0;
                 for p in aviary_api::sweep::lawnmower(area, spacing) {
@@ -75,7 +75,7 @@ pub fn fly(e: &mut Estimator, d: DroneId, function: &str, args: &[Option<Value>]
             took
         }
         "StartDetection" => {
-            if let Some(Value::Symbol(kind)) = &args[0] {
+            if let Some(Some(Value::Symbol(kind))) = args.first() {
                 let f = &e.s.drones[d];
                 let range = e.world.sensors.iter().filter(|s| f.sensors.contains(&s.kind) && s.detects.contains(kind)).map(|s| s.range).reduce(f64::max);
                 let f = &mut e.s.drones[d];
@@ -87,7 +87,7 @@ pub fn fly(e: &mut Estimator, d: DroneId, function: &str, args: &[Option<Value>]
             0.0
         }
         "StopDetection" => {
-            if let Some(Value::Symbol(kind)) = &args[0] {
+            if let Some(Some(Value::Symbol(kind))) = args.first() {
                 e.s.drones[d].detecting.retain(|(k, _, _)| k != kind);
             }
             0.0

@@ -1,7 +1,7 @@
 //! Evaluating expressions at run time, and showing values in the trace.
 
 use aviary_api::{Backend, Point, Value};
-use aviary_ir::{ActorRef, Compare, Expr, Field, Mission};
+use aviary_ir::{ActorRef, Expr, Field, Mission};
 use serde_json::{json, Value as Json};
 
 /// What an expression needs from the run: the frame, telemetry, signals, the clock.
@@ -59,7 +59,7 @@ impl Env<'_> {
             Expr::Not(x) => Value::Bool(!truth(&self.eval(x))),
             Expr::And(a, b) => Value::Bool(truth(&self.eval(a)) && truth(&self.eval(b))),
             Expr::Or(a, b) => Value::Bool(truth(&self.eval(a)) || truth(&self.eval(b))),
-            Expr::Compare(a, op, b) => Value::Bool(compare(&self.eval(a), *op, &self.eval(b))),
+            Expr::Compare(a, op, b) => Value::Bool(op.holds(&self.eval(a), &self.eval(b))),
         }
     }
 
@@ -104,37 +104,6 @@ fn number(v: &Value) -> f64 {
         _ => f64::NAN,
     }
 }
-
-fn text(v: &Value) -> Option<&str> {
-    match v {
-        Value::Text(s) | Value::Symbol(s) => Some(s),
-        _ => None,
-    }
-}
-
-fn compare(a: &Value, op: Compare, b: &Value) -> bool {
-    if let (Value::Number(x), Value::Number(y)) = (a, b) {
-        return match op {
-            Compare::Eq => x == y,
-            Compare::Ne => x != y,
-            Compare::Lt => x < y,
-            Compare::Le => x <= y,
-            Compare::Gt => x > y,
-            Compare::Ge => x >= y,
-        };
-    }
-    // A symbol and a string are equal when they spell the same (LANGUAGE.md: symbols only equal themselves).
-    let equal = match (text(a), text(b)) {
-        (Some(x), Some(y)) => x == y,
-        _ => a == b,
-    };
-    match op {
-        Compare::Eq => equal,
-        Compare::Ne => !equal,
-        _ => false,
-    }
-}
-
 
 /// A value as the trace shows it: SI numbers, `[x, y, z]` positions, names for drones.
 pub(crate) fn to_json(m: &Mission, v: &Value) -> Json {

@@ -247,6 +247,40 @@ pub enum Compare {
     Ge,
 }
 
+impl Compare {
+    /// Whether `a op b` holds. Numbers compare as numbers; anything else only by equality,
+    /// where a symbol and a string are equal when they spell the same (LANGUAGE.md:
+    /// symbols only equal themselves). The engine and the pre-flight plan both decide
+    /// conditions with it.
+    pub fn holds(self, a: &Value, b: &Value) -> bool {
+        if let (Value::Number(x), Value::Number(y)) = (a, b) {
+            return match self {
+                Compare::Eq => x == y,
+                Compare::Ne => x != y,
+                Compare::Lt => x < y,
+                Compare::Le => x <= y,
+                Compare::Gt => x > y,
+                Compare::Ge => x >= y,
+            };
+        }
+        fn text(v: &Value) -> Option<&str> {
+            match v {
+                Value::Text(s) | Value::Symbol(s) => Some(s),
+                _ => None,
+            }
+        }
+        let equal = match (text(a), text(b)) {
+            (Some(x), Some(y)) => x == y,
+            _ => a == b,
+        };
+        match self {
+            Compare::Eq => equal,
+            Compare::Ne => !equal,
+            _ => false,
+        }
+    }
+}
+
 /// A value or condition, evaluated in a frame at run time.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Expr {
@@ -267,4 +301,20 @@ pub enum Expr {
     And(Box<Expr>, Box<Expr>),
     Or(Box<Expr>, Box<Expr>),
     Compare(Box<Expr>, Compare, Box<Expr>),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_symbol_equals_a_string_of_the_same_spelling_and_only_numbers_order() {
+        let (sym, text) = (Value::Symbol("Body".into()), Value::Text("Body".into()));
+        assert!(Compare::Eq.holds(&sym, &text));
+        assert!(!Compare::Ne.holds(&sym, &text));
+        assert!(!Compare::Lt.holds(&sym, &text));
+        assert!(Compare::Le.holds(&Value::Number(1.0), &Value::Number(1.0)));
+        assert!(!Compare::Eq.holds(&Value::Number(f64::NAN), &Value::Number(f64::NAN)));
+        assert!(Compare::Ne.holds(&Value::Actor(0), &Value::Actor(1)));
+    }
 }

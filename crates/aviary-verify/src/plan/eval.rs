@@ -2,7 +2,7 @@
 //! (a binding of a signal nobody can predict, telemetry the model does not follow).
 
 use aviary_api::{DroneId, FlightState, Point, Value};
-use aviary_ir::{ActorRef, Compare, Expr, Field, Mission};
+use aviary_ir::{ActorRef, Expr, Field, Mission};
 
 use super::model::Flyer;
 
@@ -63,7 +63,7 @@ impl Scope<'_> {
                 (Some(false), Some(false)) => Value::Bool(false),
                 _ => return None,
             },
-            Expr::Compare(x, op, y) => Value::Bool(compare(&self.eval(x)?, *op, &self.eval(y)?)?),
+            Expr::Compare(x, op, y) => Value::Bool(op.holds(&self.eval(x)?, &self.eval(y)?)),
         })
     }
 
@@ -103,24 +103,6 @@ pub fn number(v: &Value) -> Option<f64> {
 fn truth(v: &Value) -> Option<bool> {
     match v {
         Value::Bool(b) => Some(*b),
-        _ => None,
-    }
-}
-
-fn compare(x: &Value, op: Compare, y: &Value) -> Option<bool> {
-    if let (Value::Number(a), Value::Number(b)) = (x, y) {
-        return Some(match op {
-            Compare::Eq => a == b,
-            Compare::Ne => a != b,
-            Compare::Lt => a < b,
-            Compare::Le => a <= b,
-            Compare::Gt => a > b,
-            Compare::Ge => a >= b,
-        });
-    }
-    match op {
-        Compare::Eq => Some(x == y),
-        Compare::Ne => Some(x != y),
         _ => None,
     }
 }

@@ -9,7 +9,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
 use aviary_api::{
-    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Failure, FlightState, Interrupt,
+    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Failure, Interrupt,
     PendingCall, Telemetry, Value,
 };
 use aviary_world::Sensor;
@@ -301,14 +301,7 @@ impl Backend for MavlinkBackend {
 
     fn telemetry(&self, drone: DroneId) -> Telemetry {
         let Some(Some(c)) = self.inner.crafts.get(drone) else {
-            return Telemetry {
-                position: [0.0; 3],
-                speed: 0.0,
-                heading: 0.0,
-                battery: 0.0,
-                state: FlightState::Lost,
-                link: false,
-            };
+            return Telemetry::LOST;
         };
         let state = c.state();
         let seen = c.v.seen();

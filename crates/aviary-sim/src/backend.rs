@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex, MutexGuard, Weak};
 use std::time::Duration;
 
 use aviary_api::{
-    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, FlightState, Interrupt, PendingCall,
+    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Interrupt, PendingCall,
     Telemetry, Value,
 };
 use aviary_world::World;
@@ -202,14 +202,7 @@ impl Backend for SimBackend {
         lock(&self.state)
             .fleet
             .telemetry(drone)
-            .unwrap_or(Telemetry {
-                position: [0.0; 3],
-                speed: 0.0,
-                heading: 0.0,
-                battery: 0.0,
-                state: FlightState::Lost,
-                link: false,
-            })
+            .unwrap_or(Telemetry::LOST)
     }
 
     fn events(&self) -> Option<mpsc::UnboundedReceiver<DroneEvent>> {

@@ -169,7 +169,7 @@ impl Plan {
                 d.distance,
                 clock(d.flight_time),
                 d.battery_left * 100.0,
-                if d.battery_left < 0.2 { "  (under the 20% reserve)" } else { "" }
+                if d.battery_left < RESERVE { "  (under the 20% reserve)" } else { "" }
             ));
             for a in &d.activities {
                 out.push_str(&format!("  {:>7.1} – {:>7.1} s  {}{}\n", a.start, a.end, a.what, a.at.as_ref().map(|p| format!("  ({p})")).unwrap_or_default()));

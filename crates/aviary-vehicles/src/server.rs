@@ -174,6 +174,18 @@ fn header(system: u8, sequence: &mut u8) -> MavHeader {
 
 /// Tasks a stopped server must end too (each client's reader and writer), so that its
 /// connections close as a killed process's would.
+/// The next message to send; `None` once the server is gone. A client too slow to keep
+/// up skips what it missed rather than falling further behind.
+async fn next(rx: &mut broadcast::Receiver<Out>) -> Option<Out> {
+    loop {
+        match rx.recv().await {
+            Ok(o) => return Some(o),
+            Err(broadcast::error::RecvError::Lagged(_)) => continue,
+            Err(_) => return None,
+        }
+    }
+}
+
 pub(crate) type Clients = Arc<Mutex<Vec<tokio::task::AbortHandle>>>;
 
 pub(crate) async fn tcp(
@@ -193,11 +205,7 @@ pub(crate) async fn tcp(
         let writer = tokio::spawn(async move {
             let mut seq = 0u8;
             loop {
-                let o = match rx.recv().await {
-                    Ok(o) => o,
-                    Err(broadcast::error::RecvError::Lagged(_)) => continue,
-                    Err(_) => return,
-                };
+                let Some(o) = next(&mut rx).await else { return };
                 let h = header(o.system, &mut seq);
                 if mavlink::write_v2_msg_async_signed(
                     &mut write,
@@ -256,11 +264,7 @@ pub(crate) async fn udp(
     let writer = tokio::spawn(async move {
         let mut seq = 0u8;
         loop {
-            let o = match rx.recv().await {
-                Ok(o) => o,
-                Err(broadcast::error::RecvError::Lagged(_)) => continue,
-                Err(_) => return,
-            };
+            let Some(o) = next(&mut rx).await else { return };
             let mut buf = Vec::new();
             let h = header(o.system, &mut seq);
             if mavlink::write_v2_msg_async_signed(&mut buf, h, &o.msg, sign_w.as_ref().as_ref())

@@ -55,6 +55,8 @@ pub struct Estimator<'m> {
     pub s: State,
     /// The capabilities being walked, innermost last.
     calling: Vec<usize>,
+    /// The built-in `Detected` signal, when the mission can hear it.
+    detected: Option<SignalId>,
 }
 
 /// More rounds than any mission flies: a loop past it is taken as endless.
@@ -69,6 +71,7 @@ impl<'m> Estimator<'m> {
             world,
             known,
             calling: Vec::new(),
+            detected: mission.signals.iter().position(|s| s == "Detected"),
             s: State { drones, activities: vec![Vec::new(); n], raised: vec![None; mission.signals.len()], reserve: vec![None; n], assumptions: BTreeSet::new(), fired: BTreeSet::new() },
         }
     }
@@ -351,7 +354,7 @@ impl<'m> Estimator<'m> {
     /// Targets of the kinds `d` detects that its ground track `from`→`to`, flown during
     /// `[t, t + duration]`, comes within range of: each is a `Detected` at that moment.
     pub fn scan(&mut self, d: DroneId, from: [f64; 2], to: [f64; 2], t: f64, duration: f64) -> Vec<Raise> {
-        let Some(detected) = self.mission.signals.iter().position(|s| s == "Detected") else { return Vec::new() };
+        let Some(detected) = self.detected else { return Vec::new() };
         let mut out = Vec::new();
         for (kind, range, found) in self.s.drones[d].detecting.iter_mut() {
             for (i, target) in self.world.targets.iter().enumerate() {

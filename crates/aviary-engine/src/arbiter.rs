@@ -3,21 +3,85 @@
 //! request needs any of it, so instances never deadlock and never overtake.
 
 use std::cell::RefCell;
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 use std::rc::Rc;
 
 use aviary_api::{DroneId, Resource};
+use smallvec::SmallVec;
 use tokio::sync::oneshot;
 
 pub(crate) type Claim = (DroneId, Resource);
+/// What one request needs: a drone's resource or two, kept inline.
+pub(crate) type Needs = SmallVec<[Claim; 2]>;
+
+/// What an activity and its ancestors hold (handlers inside it share the claim). Shared,
+/// not copied, by an activity that needs nothing more than its parent holds.
+#[derive(Clone, Default)]
+pub(crate) struct Claims(Option<Rc<[Claim]>>);
+
+impl Claims {
+    pub fn contains(&self, claim: &Claim) -> bool {
+        self.0.as_deref().is_some_and(|held| held.contains(claim))
+    }
+
+    /// These and `more`.
+    pub fn with(&self, more: &[Claim]) -> Claims {
+        if more.is_empty() {
+            return self.clone();
+        }
+        let held = self.0.as_deref().unwrap_or_default();
+        Claims(Some(held.iter().chain(more).copied().collect()))
+    }
+}
 
 #[derive(Default)]
 pub(crate) struct Arbiter {
-    held: BTreeSet<Claim>,
+    held: ClaimSet,
     /// Granted requests by id, with what they hold.
-    granted: BTreeMap<u64, Vec<Claim>>,
-    waiting: Vec<(u64, Vec<Claim>, oneshot::Sender<()>)>,
+    granted: BTreeMap<u64, Needs>,
+    waiting: Vec<(u64, Needs, oneshot::Sender<()>)>,
     next: u64,
+}
+
+/// A set of claims as one bit per resource per drone: a claim's test, grant and release
+/// are an index and a mask, whatever the fleet's size.
+#[derive(Default)]
+struct ClaimSet {
+    bits: Vec<u8>,
+}
+
+impl ClaimSet {
+    fn mask(r: Resource) -> u8 {
+        1 << (r as u8)
+    }
+
+    fn contains(&self, (d, r): &Claim) -> bool {
+        self.bits.get(*d).is_some_and(|b| b & Self::mask(*r) != 0)
+    }
+
+    fn insert(&mut self, (d, r): Claim) {
+        if self.bits.len() <= d {
+            self.bits.resize(d + 1, 0);
+        }
+        self.bits[d] |= Self::mask(r);
+    }
+
+    fn remove(&mut self, (d, r): &Claim) {
+        if let Some(b) = self.bits.get_mut(*d) {
+            *b &= !Self::mask(*r);
+        }
+    }
+
+    fn extend(&mut self, claims: impl IntoIterator<Item = Claim>) {
+        for c in claims {
+            self.insert(c);
+        }
+    }
+
+    #[cfg(test)]
+    fn is_empty(&self) -> bool {
+        self.bits.iter().all(|b| *b == 0)
+    }
 }
 
 /// Claims held until dropped. Dropping a request that still waits withdraws it, and one
@@ -26,7 +90,7 @@ pub(crate) struct Held {
     arbiter: Rc<RefCell<Arbiter>>,
     id: u64,
     /// The claims of a request granted at once (not recorded in `granted`).
-    own: Vec<Claim>,
+    own: Needs,
 }
 
 impl Drop for Held {
@@ -49,7 +113,7 @@ impl Drop for Held {
 
 impl Arbiter {
     fn grant(&mut self) {
-        let mut blocked: BTreeSet<Claim> = BTreeSet::new();
+        let mut blocked = ClaimSet::default();
         let mut i = 0;
         while i < self.waiting.len() {
             let needs = &self.waiting[i].1;
@@ -67,7 +131,7 @@ impl Arbiter {
 }
 
 /// Waits for `claims` (all at once, in arrival order) and holds them.
-pub(crate) async fn acquire(arbiter: &Rc<RefCell<Arbiter>>, claims: Vec<Claim>) -> Held {
+pub(crate) async fn acquire(arbiter: &Rc<RefCell<Arbiter>>, claims: Needs) -> Held {
     {
         // Nobody waits and all of it is free: granted now, as `grant` would, without a
         // channel to wait on.
@@ -89,7 +153,7 @@ pub(crate) async fn acquire(arbiter: &Rc<RefCell<Arbiter>>, claims: Vec<Claim>) 
         id
     };
     // Made before waiting, so that a drop while waiting withdraws the request.
-    let held = Held { arbiter: arbiter.clone(), id, own: Vec::new() };
+    let held = Held { arbiter: arbiter.clone(), id, own: Needs::new() };
     // The sender stays in the arbiter until granted, so this ends only by a grant.
     let _ = rx.await;
     held
@@ -111,13 +175,13 @@ mod tests {
     fn first_come_first_served_all_at_once() {
         let arbiter = Rc::new(RefCell::new(Arbiter::default()));
         let m = |d| (d, Resource::Motion);
-        let mut first = pin!(acquire(&arbiter, vec![m(0)]));
+        let mut first = pin!(acquire(&arbiter, smallvec::smallvec![m(0)]));
         let Poll::Ready(a) = poll_once(first.as_mut()) else { panic!("free: granted at once") };
         // Needs 0 and 1: waits for 0.
-        let mut second = pin!(acquire(&arbiter, vec![m(0), m(1)]));
+        let mut second = pin!(acquire(&arbiter, smallvec::smallvec![m(0), m(1)]));
         assert!(poll_once(second.as_mut()).is_pending());
         // Needs only 1, which is free, but the earlier waiter wants it: no overtaking.
-        let mut third = pin!(acquire(&arbiter, vec![m(1)]));
+        let mut third = pin!(acquire(&arbiter, smallvec::smallvec![m(1)]));
         assert!(poll_once(third.as_mut()).is_pending());
         drop(a);
         let Poll::Ready(b) = poll_once(second.as_mut()) else { panic!("granted on release") };
@@ -130,15 +194,15 @@ mod tests {
     fn a_cancelled_waiter_leaks_nothing() {
         let arbiter = Rc::new(RefCell::new(Arbiter::default()));
         let m = (0, Resource::Motion);
-        let mut first = pin!(acquire(&arbiter, vec![m]));
+        let mut first = pin!(acquire(&arbiter, smallvec::smallvec![m]));
         let Poll::Ready(a) = poll_once(first.as_mut()) else { panic!() };
         {
-            let mut waiter = Box::pin(acquire(&arbiter, vec![m]));
+            let mut waiter = Box::pin(acquire(&arbiter, smallvec::smallvec![m]));
             assert!(poll_once(waiter.as_mut()).is_pending());
             drop(a); // grants the waiter, which is dropped before it sees the grant
         }
         assert!(arbiter.borrow().held.is_empty(), "the unseen grant was given back");
-        let mut again = pin!(acquire(&arbiter, vec![m]));
+        let mut again = pin!(acquire(&arbiter, smallvec::smallvec![m]));
         assert!(poll_once(again.as_mut()).is_ready());
     }
 }

@@ -5,9 +5,10 @@
 //! took the same lock several times. Here it is cells and `Rc`s.
 
 use std::cell::{Cell, RefCell};
-use std::future::poll_fn;
+use std::future::{poll_fn, Future};
+use std::pin::pin;
 use std::rc::{Rc, Weak};
-use std::task::{Poll, Waker};
+use std::task::{Context, Poll, Waker};
 
 #[derive(Default)]
 struct Node {
@@ -55,20 +56,48 @@ impl Token {
             if self.0.cancelled.get() {
                 return Poll::Ready(());
             }
-            let mut first = self.0.waiter.borrow_mut();
-            match &*first {
-                None => *first = Some(cx.waker().clone()),
-                Some(w) if w.will_wake(cx.waker()) => {}
-                Some(_) => {
-                    let mut waiters = self.0.waiters.borrow_mut();
-                    if !waiters.iter().any(|w| w.will_wake(cx.waker())) {
-                        waiters.push(cx.waker().clone());
-                    }
-                }
+            self.wake_on_cancel(cx);
+            Poll::Pending
+        })
+        .await
+    }
+
+    /// Runs `work` until it ends (`Some`) or the token is cancelled (`None`), the token
+    /// looked at first, as a biased `select!` of `cancelled()` and `work` would. Work
+    /// that ends in its first poll (an instant step) never registers a waker.
+    pub async fn run<T>(&self, work: impl Future<Output = T>) -> Option<T> {
+        let mut work = pin!(work);
+        poll_fn(|cx| {
+            if self.0.cancelled.get() {
+                return Poll::Ready(None);
+            }
+            if let Poll::Ready(out) = work.as_mut().poll(cx) {
+                return Poll::Ready(Some(out));
+            }
+            if self.0.cancelled.get() {
+                // Cancelled by the work itself: the `select!` would have been woken by
+                // the token and seen it at its next poll; so will this.
+                cx.waker().wake_by_ref();
+            } else {
+                self.wake_on_cancel(cx);
             }
             Poll::Pending
         })
         .await
+    }
+
+    fn wake_on_cancel(&self, cx: &Context<'_>) {
+        let mut first = self.0.waiter.borrow_mut();
+        match &*first {
+            None => *first = Some(cx.waker().clone()),
+            Some(w) if w.will_wake(cx.waker()) => {}
+            Some(_) => {
+                let mut waiters = self.0.waiters.borrow_mut();
+                if !waiters.iter().any(|w| w.will_wake(cx.waker())) {
+                    waiters.push(cx.waker().clone());
+                }
+            }
+        }
     }
 }
 

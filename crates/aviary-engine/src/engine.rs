@@ -2,7 +2,7 @@
 //! events, the trace, and the run from start to `mission_end`.
 
 use std::cell::{Cell, RefCell};
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 use std::rc::Rc;
 
 use aviary_api::{Backend, DroneEvent, DroneId, Value};
@@ -15,11 +15,14 @@ use crate::registry::Registry;
 use tokio::time::Instant;
 use crate::cancel::Token as CancellationToken;
 
-use crate::arbiter::{Arbiter, Claim};
+use crate::arbiter::{Arbiter, Claims};
+use crate::trace::{Event, Field};
 use crate::value::{airborne, to_json, Env};
 use crate::{Outcome, RunOptions, Status, TraceSink};
 
-pub(crate) type Frame = Rc<Vec<Value>>;
+pub(crate) type Frame = Rc<[Value]>;
+/// The drones of an activity: nearly always one, kept inline.
+pub(crate) type Actors = smallvec::SmallVec<[DroneId; 2]>;
 
 /// Work a scope starts on request, while it runs.
 pub(crate) enum Job<'m> {
@@ -61,20 +64,20 @@ pub(crate) struct Instance {
     pub id: u64,
     pub capability: usize,
     pub tag: Option<usize>,
-    pub actors: Vec<DroneId>,
+    pub actors: Actors,
     /// The instance a statement of the mission started: pausing it pauses all inside it.
     pub root: Option<Rc<Instance>>,
     pub token: CancellationToken,
     /// Cancels the PERFORM body only: the capability's own exception handler takes its place.
-    pub perform: CancellationToken,
+    pub perform: Option<CancellationToken>,
     pub by_leash: Cell<bool>,
     pub failed: Cell<bool>,
     pub paused: Cell<bool>,
     pub resumed: Notify,
-    pub calls: RefCell<Vec<aviary_api::CallId>>,
+    pub calls: RefCell<smallvec::SmallVec<[aviary_api::CallId; 2]>>,
     pub depth: usize,
     /// What this activity and its ancestors hold: handlers inside it share the claim.
-    pub claims: RefCell<Rc<BTreeSet<Claim>>>,
+    pub claims: RefCell<Claims>,
 }
 
 impl Instance {
@@ -90,7 +93,7 @@ pub(crate) struct Ctx<'m> {
     pub frame: Frame,
     pub actor: Option<DroneId>,
     pub instance: Option<Rc<Instance>>,
-    pub claims: Rc<BTreeSet<Claim>>,
+    pub claims: Claims,
 }
 
 pub(crate) struct Engine<'m> {
@@ -155,30 +158,13 @@ impl<'m> Engine<'m> {
     }
 
     /// Records an event, if the sink wants its kind: `fields` is built only then.
-    pub fn trace(&self, event: &str, fields: impl FnOnce() -> Json) {
-        if !self.sink.borrow().wants(event) {
+    pub fn trace<'a, const N: usize>(&self, kind: &'static str, fields: impl FnOnce() -> [(&'static str, Field<'a>); N]) {
+        if !self.sink.borrow().wants(kind) {
             return;
         }
-        let object = match fields() {
-            // `t` and `event` put in front of the fields' own map: the same object as
-            // building a new map and moving every field into it, without hashing and
-            // moving each field again (no event has fields of those names).
-            Json::Object(mut rest) if !rest.contains_key("t") && !rest.contains_key("event") => {
-                rest.shift_insert(0, "t".into(), json!(self.now()));
-                rest.shift_insert(1, "event".into(), json!(event));
-                rest
-            }
-            fields => {
-                let mut object = serde_json::Map::new();
-                object.insert("t".into(), json!(self.now()));
-                object.insert("event".into(), json!(event));
-                if let Json::Object(rest) = fields {
-                    object.extend(rest);
-                }
-                object
-            }
-        };
-        self.sink.borrow_mut().event(Json::Object(object));
+        let fields = fields();
+        let event = Event { t: self.now(), kind, fields: &fields };
+        self.sink.borrow_mut().record(&event);
     }
 
     pub fn name(&self, d: DroneId) -> &'m str {
@@ -194,7 +180,7 @@ impl<'m> Engine<'m> {
     }
 
     pub async fn run(&self, options: &RunOptions, controls: Option<mpsc::UnboundedReceiver<crate::ControlRequest>>) -> Outcome {
-        self.trace("mission_start", || json!({ "mission": self.m.name }));
+        self.trace("mission_start", || [("mission", Field::Str(&self.m.name))]);
         let root = Rc::new(Scope {
             parent: None,
             path: &self.m.name,
@@ -202,7 +188,7 @@ impl<'m> Engine<'m> {
             handlers: &[],
             fired: RefCell::new(Vec::new()),
             exception_handlers: &[],
-            frame: Rc::new(vec![Value::Bool(false); self.m.frame_size]),
+            frame: Rc::from(vec![Value::Bool(false); self.m.frame_size]),
             jobs: Jobs::default(),
             unwinding: Cell::new(false),
             deferred: RefCell::new(Vec::new()),
@@ -211,7 +197,7 @@ impl<'m> Engine<'m> {
             instance: None,
         });
         *self.root.borrow_mut() = Some(root.clone());
-        let ctx = Ctx { scope: root.clone(), frame: root.frame.clone(), actor: None, instance: None, claims: Rc::new(BTreeSet::new()) };
+        let ctx = Ctx { scope: root.clone(), frame: root.frame.clone(), actor: None, instance: None, claims: Claims::default() };
         let body = self.drive(&root, self.block(&self.m.body, &ctx));
         let controls = async {
             match controls {
@@ -243,7 +229,7 @@ impl<'m> Engine<'m> {
             Some((status, reason)) => (status, Some(reason)),
             None => (Status::Ok, None),
         };
-        self.trace("mission_end", || json!({ "status": status.as_str(), "reason": reason }));
+        self.trace("mission_end", || [("status", Field::Str(status.as_str())), ("reason", Field::name(reason.as_deref()))]);
         Outcome { status, reason }
     }
 
@@ -268,7 +254,7 @@ impl<'m> Engine<'m> {
             }
         }
         let calls = homes.into_iter().map(|d| async move {
-            self.trace("api_call", || json!({ "actor": self.name(d), "function": "ReturnToLaunch", "args": [] }));
+            self.trace("api_call", || [("actor", Field::Str(self.name(d))), ("function", Field::Str("ReturnToLaunch")), ("args", Field::Json(json!([])))]);
             let pending = self.backend.call(d, "ReturnToLaunch", &[]);
             let end = pending.end.await.unwrap_or(aviary_api::CallEnd::Interrupted);
             self.trace_done(d, "ReturnToLaunch", &[], &end);
@@ -282,7 +268,15 @@ impl<'m> Engine<'m> {
             aviary_api::CallEnd::Failed(_) => "failed",
             aviary_api::CallEnd::Interrupted => "interrupted",
         };
-        self.trace("api_done", || json!({ "actor": self.name(d), "function": function, "args": self.values(args), "status": status, "position": self.backend.telemetry(d).position }));
+        self.trace("api_done", || {
+            [
+                ("actor", Field::Str(self.name(d))),
+                ("function", Field::Str(function)),
+                ("args", Field::Json(self.values(args))),
+                ("status", Field::Str(status)),
+                ("position", Field::Json(json!(self.backend.telemetry(d).position))),
+            ]
+        });
     }
 
     async fn telemetry(&self, hz: Option<f64>) {
@@ -292,7 +286,7 @@ impl<'m> Engine<'m> {
         loop {
             for d in 0..self.m.drones.len() {
                 let t = self.backend.telemetry(d);
-                self.trace("telemetry", || json!({ "actor": self.name(d), "position": t.position, "battery": t.battery, "state": t.state.as_str() }));
+                self.trace("telemetry", || [("actor", Field::Str(self.name(d))), ("position", Field::Json(json!(t.position))), ("battery", Field::Json(json!(t.battery))), ("state", Field::Str(t.state.as_str()))]);
             }
             next += period;
             tokio::time::sleep_until(next).await;
@@ -332,7 +326,7 @@ impl<'m> Engine<'m> {
     fn on_event(&self, event: DroneEvent) {
         match event {
             DroneEvent::Detected { drone, kind, location } => {
-                self.trace("detection", || json!({ "actor": self.name(drone), "kind": kind, "location": location }));
+                self.trace("detection", || [("actor", Field::Str(self.name(drone))), ("kind", Field::Str(&kind)), ("location", Field::Json(json!(location)))]);
                 let scope = self.detections.borrow().get(&(drone, kind.clone())).cloned();
                 if let (Some(scope), Some(id)) = (scope, self.signal_id("Detected")) {
                     // A find is a point on the ground: flying to it keeps the altitude.
@@ -380,7 +374,7 @@ impl<'m> Engine<'m> {
     /// A signal from outside the mission (the operator): heard by every running handler
     /// that matches, at once (there is no signalling block to wait for).
     pub fn raise_from_outside(&self, signal: usize, args: Vec<Value>) {
-        self.trace("signal", || json!({ "name": self.m.signals[signal], "actor": null, "args": self.values(&args) }));
+        self.trace("signal", || [("name", Field::Str(&self.m.signals[signal])), ("actor", Field::Null), ("args", Field::Json(self.values(&args)))]);
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {
             *r = true;
         }
@@ -397,7 +391,7 @@ impl<'m> Engine<'m> {
         if self.stopped() {
             return;
         }
-        self.trace("signal", || json!({ "name": self.m.signals[signal], "actor": actor.map(|a| self.name(a)), "args": self.values(&args) }));
+        self.trace("signal", || [("name", Field::Str(&self.m.signals[signal])), ("actor", Field::name(actor.map(|a| self.name(a)))), ("args", Field::Json(self.values(&args)))]);
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {
             *r = true;
         }
@@ -445,8 +439,14 @@ impl<'m> Engine<'m> {
             Some((scope.clone(), i))
         });
         self.trace("exception", || {
-            json!({ "name": name, "actor": actor.map(|a| self.name(a)), "args": self.values(&args),
-                    "handled": found.is_some(), "handler": found.as_ref().map(|(s, _)| format!("{}/ON EXCEPTION {name}", s.path)) })
+            let handler = found.as_ref().map(|(s, _)| format!("{}/ON EXCEPTION {name}", s.path));
+            [
+                ("name", Field::Str(&name)),
+                ("actor", Field::name(actor.map(|a| self.name(a)))),
+                ("args", Field::Json(self.values(&args))),
+                ("handled", Field::Bool(found.is_some())),
+                ("handler", handler.map_or(Field::Null, Field::Text)),
+            ]
         });
         let Some((handler_scope, index)) = found else {
             for scope in from.chain() {
@@ -477,8 +477,8 @@ impl<'m> Engine<'m> {
                 }
             }
         }
-        if let Some(instance) = &handler_scope.instance {
-            instance.perform.cancel();
+        if let Some(perform) = handler_scope.instance.as_ref().and_then(|i| i.perform.as_ref()) {
+            perform.cancel();
         }
         handler_scope.catching.set(handler_scope.catching.get() + 1);
         let handlers: &'m [ExceptionHandler] = handler_scope.exception_handlers;

@@ -2,7 +2,6 @@
 //! leashes, requirements, FOR and IF.
 
 use std::cell::{Cell, RefCell};
-use std::collections::BTreeSet;
 use std::future::Future;
 use std::pin::pin;
 use std::rc::Rc;
@@ -12,14 +11,16 @@ use aviary_api::{CallEnd, DroneId, Interrupt, Value};
 use aviary_ir::{ActorRef, Block, BlockKind, Call, Expr, For, Leash, LeashAction, Node};
 use futures_util::future::{join_all, LocalBoxFuture};
 use futures_util::stream::{FuturesUnordered, StreamExt};
+use smallvec::SmallVec;
 use serde_json::{json, Map, Value as Json};
 use tokio::sync::Notify;
 use crate::cancel::Token as CancellationToken;
 
-use crate::arbiter::acquire;
-use crate::engine::{Ctx, Engine, Instance, Job, Scope};
+use crate::arbiter::{acquire, Claims, Needs};
+use crate::engine::{Actors, Ctx, Engine, Frame, Instance, Job, Scope};
 use crate::jobs::Jobs;
 use crate::join::{join_eager, SMALL};
+use crate::trace::Field;
 use crate::value::to_json;
 
 /// Conditions are looked at again at least this often (LANGUAGE.md §3).
@@ -29,9 +30,10 @@ impl<'m> Engine<'m> {
     /// Runs `items` in `scope`, with the handlers that scope starts, until all are done.
     pub(crate) async fn drive(&self, scope: &Rc<Scope<'m>>, items: impl Future<Output = ()>) {
         // Jobs come only to a scope that declares handlers or exception handlers (signals,
-        // exceptions, `SEQUENTIAL ON` starting) or that tops a capability instance (leash
-        // sections). Any other scope, most of them, just runs its items.
-        if scope.handlers.is_empty() && scope.exception_handlers.is_empty() && scope.instance.is_none() {
+        // exceptions, `SEQUENTIAL ON` starting) or that tops an instance of a capability
+        // with leash sections. Any other scope, most of them, just runs its items.
+        let takes_sections = scope.instance.as_ref().is_some_and(|i| !self.m.capabilities[i.capability].sections.is_empty());
+        if scope.handlers.is_empty() && scope.exception_handlers.is_empty() && !takes_sections {
             items.await;
             for (target, job) in scope.deferred.take() {
                 target.jobs.send(job);
@@ -96,13 +98,13 @@ impl<'m> Engine<'m> {
         Box::pin(async move {
             let scope = self.new_scope(ctx, block, None);
             if block.traced {
-                self.trace("block_start", || json!({ "block": block.path }));
+                self.trace("block_start", || [("block", Field::Str(&block.path))]);
             }
             let inner = Ctx { scope: scope.clone(), ..ctx.clone() };
             self.drive(&scope, self.items(block, &inner)).await;
             if block.traced {
                 let status = if scope.unwinding.get() { "aborted" } else { "ok" };
-                self.trace("block_end", || json!({ "block": block.path, "status": status }));
+                self.trace("block_end", || [("block", Field::Str(&block.path)), ("status", Field::Str(status))]);
             }
         })
     }
@@ -114,7 +116,7 @@ impl<'m> Engine<'m> {
                     if ctx.scope.unwinding.get() {
                         break;
                     }
-                    self.node(node, ctx).await;
+                    self.statement(node, ctx).await;
                     // A handler caught here takes the place of what it aborted.
                     while ctx.scope.catching.get() > 0 {
                         let done = ctx.scope.caught.notified();
@@ -128,6 +130,26 @@ impl<'m> Engine<'m> {
             BlockKind::Parallel => {
                 join_all(block.items.iter().map(|n| self.node(n, ctx))).await;
             }
+        }
+    }
+
+    /// A statement of a sequence. API calls and signals run inside the sequence's own
+    /// future rather than in a box of their own; a capability call's future is far
+    /// larger, and every block holding it would be as large.
+    async fn statement(&self, node: &'m Node, ctx: &Ctx<'m>) {
+        match node {
+            Node::Api(a) => {
+                if !self.stopped() {
+                    self.api(a, ctx).await;
+                }
+            }
+            Node::Signal { signal, args, .. } => {
+                if !self.stopped() {
+                    let args = self.eval_all(args, ctx);
+                    self.raise(*signal, args, ctx.actor, &ctx.scope);
+                }
+            }
+            _ => self.node(node, ctx).await,
         }
     }
 
@@ -251,12 +273,12 @@ impl<'m> Engine<'m> {
         }
         let count = instances.len();
         let runs = instances.into_iter().map(|(d, values)| {
-            let mut frame = (*ctx.frame).clone();
+            let mut frame = ctx.frame.to_vec();
             set(&mut frame, f.alias, Value::Actor(d));
             for (slot, v) in f.params.iter().zip(values.iter()) {
                 set(&mut frame, *slot, v.clone());
             }
-            Ctx { frame: Rc::new(frame), actor: Some(d), ..ctx.clone() }
+            Ctx { frame: Rc::from(frame), actor: Some(d), ..ctx.clone() }
         });
         let body = &f.body;
         if f.parallel && count <= SMALL {
@@ -281,16 +303,20 @@ impl<'m> Engine<'m> {
         let args = self.eval_all(&call.args, ctx);
         // The common case, one actor for a one-actor capability: no join.
         if let ([actor], 1) = (call.actors.as_slice(), capability.actors) {
-            if !matches!(actor, ActorRef::Group(_)) {
-                if let [d] = self.drones(actor, ctx)[..] {
-                    self.instance(call, vec![d], args, ctx).await;
+            match actor {
+                ActorRef::Drone(d) => return self.instance(call, Actors::from_elem(*d, 1), args, ctx).await,
+                ActorRef::Slot(s) => {
+                    if let Some(Value::Actor(d)) = ctx.frame.get(*s) {
+                        self.instance(call, Actors::from_elem(*d, 1), args, ctx).await;
+                    }
+                    return;
                 }
-                return;
+                ActorRef::Group(_) => {}
             }
         }
         let per_actor: Vec<Vec<DroneId>> = call.actors.iter().map(|a| self.drones(a, ctx)).collect();
-        let sets: Vec<Vec<DroneId>> = if capability.actors == 1 {
-            per_actor.into_iter().flatten().map(|d| vec![d]).collect()
+        let sets: Vec<Actors> = if capability.actors == 1 {
+            per_actor.into_iter().flatten().map(|d| Actors::from_elem(d, 1)).collect()
         } else {
             vec![per_actor.iter().filter_map(|ds| ds.first().copied()).collect()]
         };
@@ -302,15 +328,16 @@ impl<'m> Engine<'m> {
         }
     }
 
-    async fn instance(&self, call: &'m Call, actors: Vec<DroneId>, args: Vec<Value>, ctx: &Ctx<'m>) {
+    async fn instance(&self, call: &'m Call, actors: Actors, args: Vec<Value>, ctx: &Ctx<'m>) {
         let cap = &self.m.capabilities[call.capability];
-        let mut frame = vec![Value::Bool(false); cap.frame_size.max(cap.actors + cap.params.len())];
-        for (i, d) in actors.iter().enumerate().take(cap.actors) {
-            frame[i] = Value::Actor(*d);
-        }
-        for (j, v) in args.iter().enumerate() {
-            frame[cap.actors + j] = v.clone();
-        }
+        // Actors, then arguments, then the body's own slots: one allocation.
+        let size = cap.frame_size.max(cap.actors + cap.params.len());
+        let frame: Frame = (0..size)
+            .map(|i| match i.checked_sub(cap.actors) {
+                None => actors.get(i).map_or(Value::Bool(false), |d| Value::Actor(*d)),
+                Some(j) => args.get(j).cloned().unwrap_or(Value::Bool(false)),
+            })
+            .collect();
         let id = self.next_id.get() + 1;
         self.next_id.set(id);
         let instance = Rc::new(Instance {
@@ -320,44 +347,40 @@ impl<'m> Engine<'m> {
             actors: actors.clone(),
             root: ctx.instance.as_ref().map(|p| p.root()),
             token: ctx.instance.as_ref().map_or_else(|| self.stop.child_token(), |p| p.token.child_token()),
-            perform: CancellationToken::new(),
+            // Only the capability's own exception handler cancels its PERFORM body.
+            perform: (!cap.exception_handlers.is_empty()).then(CancellationToken::new),
             by_leash: Cell::new(false),
             failed: Cell::new(false),
             // An activity started while the operator holds the mission starts held.
             paused: Cell::new(ctx.instance.is_none() && self.mission_paused.get()),
             resumed: Notify::new(),
-            calls: RefCell::new(Vec::new()),
+            calls: RefCell::new(SmallVec::new()),
             depth: ctx.instance.as_ref().map_or(0, |p| p.depth + 1),
             claims: RefCell::new(ctx.claims.clone()),
         });
         let actor = actors.first().copied();
         // Built only when the trace wants it.
         let start = || {
-            let tag = call.tag.map(|t| self.m.tags[t].clone());
+            let tag = Field::name(call.tag.map(|t| self.m.tags[t].as_str()));
             let shown_args: Map<String, Json> = cap.params.iter().zip(&args).map(|(p, v)| (p.clone(), to_json(self.m, v))).collect();
-            let who = actors.iter().map(|d| self.name(*d)).collect::<Vec<_>>().join(" ");
-            json!({ "actor": who, "capability": cap.name, "tag": tag, "args": shown_args })
+            let who = match actors.as_slice() {
+                [one] => Field::Str(self.name(*one)),
+                all => Field::Text(all.iter().map(|d| self.name(*d)).collect::<Vec<_>>().join(" ")),
+            };
+            [("actor", who), ("capability", Field::Str(&cap.name)), ("tag", tag), ("args", Field::Json(Json::Object(shown_args)))]
         };
-        let end = |status: &str| {
+        let end = |status: &'static str| {
             self.trace("capability_end", || {
-                let mut e = start();
-                e["status"] = json!(status);
-                e
+                let [actor, capability, tag, args] = start();
+                [actor, capability, tag, args, ("status", Field::Str(status))]
             });
         };
-        let frame = Rc::new(frame);
-
         // Known from now on (a leash can abort it while it waits), by where it was called.
         self.instances.borrow_mut().insert(instance.clone(), ctx.scope.clone());
         // Claims first (a second instance on a busy resource waits), then the start.
-        let needs: Vec<_> = cap.claims.iter().filter_map(|(i, r)| actors.get(*i).map(|d| (*d, *r))).filter(|c| !ctx.claims.contains(c)).collect();
-        let mut claims: BTreeSet<_> = (*ctx.claims).clone();
-        claims.extend(needs.iter().copied());
-        let held = tokio::select! {
-            biased;
-            _ = instance.token.cancelled() => None,
-            h = acquire(&self.arbiter, needs) => Some(h),
-        };
+        let needs: Needs = cap.claims.iter().filter_map(|(i, r)| actors.get(*i).map(|d| (*d, *r))).filter(|c| !ctx.claims.contains(c)).collect();
+        let claims = ctx.claims.with(&needs);
+        let held = instance.token.run(acquire(&self.arbiter, needs)).await;
         if self.stopped() {
             self.instances.borrow_mut().remove(&instance);
             return;
@@ -368,7 +391,6 @@ impl<'m> Engine<'m> {
             end("aborted");
             return;
         }
-        let claims = Rc::new(claims);
         *instance.claims.borrow_mut() = claims.clone();
 
         let requirements_met = {
@@ -406,17 +428,12 @@ impl<'m> Engine<'m> {
         self.instances.borrow_mut().set_scope(&instance, scope.clone());
         let inner = Ctx { scope: scope.clone(), frame, actor, instance: Some(instance.clone()), claims };
         let perform = async {
-            tokio::select! {
-                biased;
-                _ = instance.perform.cancelled() => {}
-                _ = self.block(&cap.perform, &inner) => {}
+            match &instance.perform {
+                Some(perform) => _ = perform.run(self.block(&cap.perform, &inner)).await,
+                None => self.block(&cap.perform, &inner).await,
             }
         };
-        let finished = tokio::select! {
-            biased;
-            _ = instance.token.cancelled() => false,
-            _ = self.drive(&scope, perform) => true,
-        };
+        let finished = instance.token.run(self.drive(&scope, perform)).await.is_some();
         self.instances.borrow_mut().remove(&instance);
         if !finished && instance.by_leash.get() {
             // `PERFORM ABORT:` says what aborting this activity also does.
@@ -439,23 +456,23 @@ impl<'m> Engine<'m> {
     async fn job(&self, job: Job<'m>, scope: Rc<Scope<'m>>) {
         match job {
             Job::Signal { handler, args, actor, signal } => {
-                let mut frame = (*scope.frame).clone();
+                let mut frame = scope.frame.to_vec();
                 for (slot, v) in handler.bindings.iter().zip(args) {
                     set(&mut frame, *slot, v);
                 }
                 let who = actor.map(|a| self.name(a));
                 let signal_name = &self.m.signals[signal];
-                self.trace("handler_start", || json!({ "signal": signal_name, "handler": handler.body.path, "actor": who }));
-                let ctx = self.scope_ctx(&scope, Rc::new(frame));
+                self.trace("handler_start", || [("signal", Field::Str(signal_name)), ("handler", Field::Str(&handler.body.path)), ("actor", Field::name(who))]);
+                let ctx = self.scope_ctx(&scope, Rc::from(frame));
                 self.block(&handler.body, &ctx).await;
-                self.trace("handler_end", || json!({ "signal": signal_name, "handler": handler.body.path, "actor": who }));
+                self.trace("handler_end", || [("signal", Field::Str(signal_name)), ("handler", Field::Str(&handler.body.path)), ("actor", Field::name(who))]);
             }
             Job::Exception { handler, args } => {
-                let mut frame = (*scope.frame).clone();
+                let mut frame = scope.frame.to_vec();
                 for (slot, v) in handler.bindings.iter().zip(args) {
                     set(&mut frame, *slot, v);
                 }
-                let ctx = self.scope_ctx(&scope, Rc::new(frame));
+                let ctx = self.scope_ctx(&scope, Rc::from(frame));
                 self.block(&handler.body, &ctx).await;
                 scope.catching.set(scope.catching.get().saturating_sub(1));
                 scope.caught.notify_waiters();
@@ -468,9 +485,9 @@ impl<'m> Engine<'m> {
     }
 
     /// The context a handler body runs in: inside the scope that declared it.
-    fn scope_ctx(&self, scope: &Rc<Scope<'m>>, frame: Rc<Vec<Value>>) -> Ctx<'m> {
+    fn scope_ctx(&self, scope: &Rc<Scope<'m>>, frame: Frame) -> Ctx<'m> {
         let instance = scope.chain().find_map(|s| s.instance.clone());
-        let claims = instance.as_ref().map_or_else(|| Rc::new(BTreeSet::new()), |i| i.claims.borrow().clone());
+        let claims = instance.as_ref().map_or_else(Claims::default, |i| i.claims.borrow().clone());
         let actor = instance.as_ref().and_then(|i| i.actors.first().copied());
         Ctx { scope: scope.clone(), frame, actor, instance, claims }
     }
@@ -488,7 +505,7 @@ impl<'m> Engine<'m> {
     /// none runs (LANGUAGE.md §3).
     pub(crate) fn leash_by_id(&self, capability: usize, tag: usize, action: LeashAction, action_name: &str, values: Vec<(usize, Value)>) {
         let cap = &self.m.capabilities[capability];
-        self.trace("leash", || json!({ "capability": cap.name, "tag": self.m.tags[tag], "action": action_name }));
+        self.trace("leash", || [("capability", Field::Str(&cap.name)), ("tag", Field::Str(&self.m.tags[tag])), ("action", Field::Str(action_name))]);
         let targets: Vec<(Rc<Instance>, Rc<Scope<'m>>)> = self.instances.borrow().tagged(capability, tag).cloned().collect();
         for (instance, scope) in targets {
             match action {
@@ -510,11 +527,11 @@ impl<'m> Engine<'m> {
                     instance.resumed.notify_waiters();
                 }
                 LeashAction::Section(i) => {
-                    let mut frame = (*scope.frame).clone();
+                    let mut frame = scope.frame.to_vec();
                     for (p, v) in &values {
                         set(&mut frame, cap.actors + p, v.clone());
                     }
-                    scope.jobs.send(Job::Section { block: &cap.sections[i].1, frame: Rc::new(frame) });
+                    scope.jobs.send(Job::Section { block: &cap.sections[i].1, frame: Rc::from(frame) });
                 }
             }
         }
@@ -538,7 +555,7 @@ impl<'m> Engine<'m> {
         }
         let args = self.eval_all(&a.args, ctx);
         let function = self.m.functions[a.function].0.as_str();
-        self.trace("api_call", || json!({ "actor": self.name(drone), "function": function, "args": self.values(&args) }));
+        self.trace("api_call", || [("actor", Field::Str(self.name(drone))), ("function", Field::Str(function)), ("args", Field::Json(self.values(&args)))]);
         let pending = self.backend.call(drone, function, &args);
         let guard = CallGuard { engine: self, id: pending.id, root: root.clone(), done: Cell::new(false), drone, function, args: &args };
         if let Some(root) = &root {
@@ -602,7 +619,13 @@ impl Drop for CallGuard<'_, '_> {
             let engine = self.engine;
             engine.trace("api_done", || {
                 let p = engine.backend.telemetry(self.drone).position;
-                json!({ "actor": engine.name(self.drone), "function": self.function, "args": engine.values(self.args), "status": "aborted", "position": p })
+                [
+                    ("actor", Field::Str(engine.name(self.drone))),
+                    ("function", Field::Str(self.function)),
+                    ("args", Field::Json(engine.values(self.args))),
+                    ("status", Field::Str("aborted")),
+                    ("position", Field::Json(json!(p))),
+                ]
             });
         }
         if let Some(root) = &self.root {

@@ -17,11 +17,13 @@ mod exec;
 mod jobs;
 mod join;
 mod registry;
+mod trace;
 mod value;
 
 use aviary_api::Backend;
 
 pub use control::{Control, ControlRequest, Controller};
+pub use trace::{Event, Field};
 use aviary_ir::Mission;
 
 /// Where trace events go, one JSON object per event, in order.
@@ -32,6 +34,11 @@ pub trait TraceSink {
     /// kinds spares the cost of the rest; what the mission does is the same either way.
     fn wants(&self, _event: &str) -> bool {
         true
+    }
+    /// An event as the engine makes it, fields borrowed. By default its JSON object goes
+    /// to `event`; a sink that reads only a field or two can look at them here instead.
+    fn record(&mut self, event: &Event<'_>) {
+        self.event(event.to_json());
     }
 }
 

@@ -1,14 +1,18 @@
 //! The running capability instances, indexed so that no event scans them all: by actor
 //! (drone events and exceptions go to one drone's activities) and by (capability, tag)
 //! (leashes). With ten thousand drones in the air, a per-event scan over every running
-//! activity would make each event cost the fleet's size. Keys end with the instance's id
-//! (ids grow), so every walk is in the order the instances started, as the single list
-//! it replaces was. An instance of several actors is listed under each.
+//! activity would make each event cost the fleet's size. Each list is in the order the
+//! instances started (ids grow), as the single list it replaces was. An instance of
+//! several actors is listed under each.
+//!
+//! By actor it is a slot per drone, with room for one activity inline: starting and
+//! ending the activity of a drone allocates nothing and hashes nothing.
 
 use std::collections::BTreeMap;
 use std::rc::Rc;
 
 use aviary_api::DroneId;
+use smallvec::SmallVec;
 
 use crate::engine::{Instance, Scope};
 
@@ -16,7 +20,7 @@ pub(crate) type Entry<'m> = (Rc<Instance>, Rc<Scope<'m>>);
 
 #[derive(Default)]
 pub(crate) struct Registry<'m> {
-    by_actor: BTreeMap<(DroneId, u64), Entry<'m>>,
+    by_actor: Vec<SmallVec<[Entry<'m>; 1]>>,
     by_tag: BTreeMap<(usize, usize, u64), Entry<'m>>,
     /// Instances without an actor (all of whose actor references were empty), so that
     /// `all` still sees them.
@@ -33,15 +37,30 @@ impl<'m> Registry<'m> {
             self.loose.insert(id, (instance.clone(), scope.clone()));
         }
         for d in &instance.actors {
-            self.by_actor.insert((*d, id), (instance.clone(), scope.clone()));
+            if self.by_actor.len() <= *d {
+                self.by_actor.resize_with(*d + 1, SmallVec::new);
+            }
+            // Ids grow, so a push keeps the list in starting order. A drone named twice
+            // in one instance is listed once.
+            let list = &mut self.by_actor[*d];
+            if list.last().is_none_or(|(i, _)| i.id != id) {
+                list.push((instance.clone(), scope.clone()));
+            }
         }
     }
 
     pub fn remove(&mut self, instance: &Instance) {
         let id = instance.id;
-        self.loose.remove(&id);
+        if instance.actors.is_empty() {
+            self.loose.remove(&id);
+        }
         for d in &instance.actors {
-            self.by_actor.remove(&(*d, id));
+            if let Some(list) = self.by_actor.get_mut(*d) {
+                // Nearly always the last one: the innermost activity ends first.
+                if let Some(at) = list.iter().rposition(|(i, _)| i.id == id) {
+                    list.remove(at);
+                }
+            }
         }
         if let Some(tag) = instance.tag {
             self.by_tag.remove(&(instance.capability, tag, id));
@@ -55,7 +74,7 @@ impl<'m> Registry<'m> {
             entry.1 = scope.clone();
         }
         for d in &instance.actors {
-            if let Some(entry) = self.by_actor.get_mut(&(*d, id)) {
+            if let Some(entry) = self.by_actor.get_mut(*d).and_then(|l| l.iter_mut().rfind(|(i, _)| i.id == id)) {
                 entry.1 = scope.clone();
             }
         }
@@ -69,7 +88,7 @@ impl<'m> Registry<'m> {
     /// Every running instance once, in the order they started (for the operator's pause
     /// and resume of the whole mission, not for events).
     pub fn all(&self) -> Vec<Entry<'m>> {
-        let mut all: Vec<&Entry<'m>> = self.by_actor.values().chain(self.loose.values()).collect();
+        let mut all: Vec<&Entry<'m>> = self.by_actor.iter().flatten().chain(self.loose.values()).collect();
         all.sort_by_key(|(i, _)| i.id);
         all.dedup_by_key(|(i, _)| i.id);
         all.into_iter().cloned().collect()
@@ -77,7 +96,7 @@ impl<'m> Registry<'m> {
 
     /// The instances `drone` takes part in, in the order they started.
     pub fn of_actor(&self, drone: DroneId) -> impl Iterator<Item = &Entry<'m>> {
-        self.by_actor.range((drone, 0)..=(drone, u64::MAX)).map(|(_, e)| e)
+        self.by_actor.get(drone).into_iter().flatten()
     }
 
     /// The instances of `capability` tagged `tag`, in the order they started.

@@ -9,7 +9,7 @@
 
 use std::time::Instant;
 
-use aviary_engine::TraceSink;
+use aviary_engine::{Event, Field, TraceSink};
 use serde_json::Value as Json;
 
 use super::pipeline::{self, mib, peak_rss, Stages};
@@ -32,6 +32,25 @@ impl TraceSink for Tally {
 
     fn event(&mut self, event: Json) {
         self.observe(&event);
+    }
+
+    /// Reads the fields it checks where the engine made them (no JSON object), except
+    /// with `--full-trace`, which builds every event's object as `aviary run --trace` does.
+    fn record(&mut self, event: &Event<'_>) {
+        if self.full {
+            return self.event(event.to_json());
+        }
+        self.events += 1;
+        let field = |key| event.get(key).and_then(Field::as_str);
+        match event.kind {
+            "signal" if field("name") == Some("Done") => {
+                self.done_signals += 1;
+                let index = event.get("args").and_then(Field::as_json).and_then(|a| a[0].as_f64());
+                self.index_sum += index.unwrap_or(f64::NAN) as u64;
+            }
+            "handler_start" if field("signal") == Some("Done") => self.handled += 1,
+            _ => {}
+        }
     }
 }
 

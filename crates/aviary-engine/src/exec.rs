@@ -427,10 +427,15 @@ impl<'m> Engine<'m> {
         };
         self.instances.borrow_mut().set_scope(&instance, scope.clone());
         let inner = Ctx { scope: scope.clone(), frame, actor, instance: Some(instance.clone()), claims };
+        // A PERFORM body that declares no handlers, in a capability without exception
+        // handlers, runs its statements in the instance's own scope: a scope of its own
+        // would hear nothing and catch nothing, and an exception unwinds both alike.
+        let own_scope = !cap.perform.handlers.is_empty() || !cap.perform.exception_handlers.is_empty() || cap.perform.traced;
         let perform = async {
             match &instance.perform {
                 Some(perform) => _ = perform.run(self.block(&cap.perform, &inner)).await,
-                None => self.block(&cap.perform, &inner).await,
+                None if own_scope => self.block(&cap.perform, &inner).await,
+                None => self.items(&cap.perform, &inner).await,
             }
         };
         let finished = instance.token.run(self.drive(&scope, perform)).await.is_some();

@@ -96,10 +96,28 @@ pub enum CallEnd {
     Interrupted,
 }
 
-/// A call in progress. The backend keeps the sending side and answers exactly once.
+/// A call just made: its id, and how its end comes.
 pub struct PendingCall {
     pub id: CallId,
-    pub end: oneshot::Receiver<CallEnd>,
+    pub end: Ending,
+}
+
+/// A call's end: known as the call is made (refused, or done at once: no channel to
+/// make and poll, the common case of an instant step), or answered later by the
+/// backend, which keeps the sending side and answers exactly once.
+pub enum Ending {
+    Now(CallEnd),
+    Later(oneshot::Receiver<CallEnd>),
+}
+
+impl Ending {
+    /// The call's end; `None` when the backend dropped the call without answering.
+    pub async fn wait(self) -> Option<CallEnd> {
+        match self {
+            Ending::Now(end) => Some(end),
+            Ending::Later(rx) => rx.await.ok(),
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]

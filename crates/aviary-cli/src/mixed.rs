@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 use aviary_api::{
-    Backend, CallId, Descriptor, DroneEvent, DroneId, Interrupt, PendingCall, Telemetry, Value,
+    Backend, CallId, Descriptor, DroneEvent, DroneId, Ending, Interrupt, PendingCall, Telemetry, Value,
 };
 use aviary_mavlink::MavlinkBackend;
 use aviary_sim::SimBackend;
@@ -82,6 +82,10 @@ impl Backend for Mixed {
             self.sim.call(drone, function, args)
         };
         let id = CallId(self.next.fetch_add(1, Ordering::SeqCst));
+        let inner_end = match inner.end {
+            Ending::Now(end) => return PendingCall { id, end: Ending::Now(end) },
+            Ending::Later(rx) => rx,
+        };
         self.calls
             .lock()
             .unwrap_or_else(|p| p.into_inner())
@@ -90,13 +94,13 @@ impl Backend for Mixed {
         let (tx, rx) = oneshot::channel();
         let calls = Arc::clone(&self.calls);
         tokio::spawn(async move {
-            let end = inner.end.await;
+            let end = inner_end.await;
             calls.lock().unwrap_or_else(|p| p.into_inner()).remove(&id);
             if let Ok(end) = end {
                 let _ = tx.send(end);
             }
         });
-        PendingCall { id, end: rx }
+        PendingCall { id, end: Ending::Later(rx) }
     }
 
     fn interrupt(&self, call: CallId, how: Interrupt) {

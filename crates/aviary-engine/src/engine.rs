@@ -256,7 +256,7 @@ impl<'m> Engine<'m> {
         let calls = homes.into_iter().map(|d| async move {
             self.trace("api_call", || [("actor", Field::Str(self.name(d))), ("function", Field::Str("ReturnToLaunch")), ("args", Field::Json(json!([])))]);
             let pending = self.backend.call(d, "ReturnToLaunch", &[]);
-            let end = pending.end.await.unwrap_or(aviary_api::CallEnd::Interrupted);
+            let end = pending.end.wait().await.unwrap_or(aviary_api::CallEnd::Interrupted);
             self.trace_done(d, "ReturnToLaunch", &[], &end);
         });
         futures_util::future::join_all(calls).await;

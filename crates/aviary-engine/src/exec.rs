@@ -569,7 +569,7 @@ impl<'m> Engine<'m> {
                 self.backend.interrupt(pending.id, Interrupt::Pause);
             }
         }
-        let end = pending.end.await.unwrap_or(CallEnd::Interrupted);
+        let end = pending.end.wait().await.unwrap_or(CallEnd::Interrupted);
         guard.done.set(true);
         drop(guard);
         self.trace_done(drone, function, &args, &end);

@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use aviary_api::{
     Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Failure, Interrupt,
-    PendingCall, Telemetry, Value,
+    Ending, PendingCall, Telemetry, Value,
 };
 use aviary_world::Sensor;
 use tokio::sync::{mpsc, oneshot, watch};
@@ -241,14 +241,14 @@ impl Backend for MavlinkBackend {
             let _ = tx.send(CallEnd::Failed(failed(format!(
                 "drone number {drone} is not a MAVLink drone"
             ))));
-            return PendingCall { id, end: rx };
+            return PendingCall { id, end: Ending::Later(rx) };
         };
         if lock(&self.inner.lost)[drone] {
             let _ = tx.send(CallEnd::Failed(failed(format!(
                 "no link to {}",
                 craft.name
             ))));
-            return PendingCall { id, end: rx };
+            return PendingCall { id, end: Ending::Later(rx) };
         }
         let (paused_tx, paused_rx) = watch::channel(false);
         let inner = Arc::clone(&self.inner);
@@ -272,7 +272,7 @@ impl Backend for MavlinkBackend {
                 end: tx,
             },
         );
-        PendingCall { id, end: rx }
+        PendingCall { id, end: Ending::Later(rx) }
     }
 
     fn interrupt(&self, call: CallId, how: Interrupt) {

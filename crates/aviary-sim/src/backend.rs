@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex, MutexGuard, Weak};
 use std::time::Duration;
 
 use aviary_api::{
-    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Interrupt, PendingCall,
+    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Ending, Interrupt, PendingCall,
     Telemetry, Value,
 };
 use aviary_world::World;
@@ -177,18 +177,17 @@ impl Backend for SimBackend {
     }
 
     fn call(&self, drone: DroneId, function: &str, args: &[Value]) -> PendingCall {
-        let (tx, rx) = oneshot::channel();
         let mut state = lock(&self.state);
         let (id, end) = state.fleet.call(drone, function, args);
-        match end {
-            Some(end) => {
-                let _ = tx.send(end);
-            }
+        let end = match end {
+            Some(end) => Ending::Now(end),
             None => {
+                let (tx, rx) = oneshot::channel();
                 state.waiting.insert(id, tx);
+                Ending::Later(rx)
             }
-        }
-        PendingCall { id, end: rx }
+        };
+        PendingCall { id, end }
     }
 
     fn interrupt(&self, call: CallId, how: Interrupt) {

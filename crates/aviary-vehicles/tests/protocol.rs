@@ -34,7 +34,7 @@ fn quick() -> Tuning {
 
 async fn call(backend: &dyn Backend, function: &str, args: &[Value]) -> CallEnd {
     let pending = backend.call(0, function, args);
-    tokio::time::timeout(Duration::from_secs(30), pending.end)
+    tokio::time::timeout(Duration::from_secs(30), pending.end.wait())
         .await
         .expect("the call ends")
         .expect("answered")
@@ -117,7 +117,7 @@ async fn a_battery_failsafe_rtl_raises_battery_critical() {
         other => panic!("{other:?}"),
     }
     assert_eq!(
-        hover.end.await.unwrap(),
+        hover.end.wait().await.unwrap(),
         CallEnd::Interrupted,
         "a fault ends the drone's calls"
     );
@@ -239,7 +239,7 @@ async fn pause_holds_resume_goes_on_and_abort_stops() {
         "resumed: {still:?} then {moved:?}"
     );
     backend.interrupt(flight.id, aviary_api::Interrupt::Abort);
-    assert_eq!(flight.end.await.unwrap(), CallEnd::Interrupted);
+    assert_eq!(flight.end.wait().await.unwrap(), CallEnd::Interrupted);
     tokio::time::sleep(Duration::from_secs(2)).await;
     let stopped = backend.telemetry(0).position;
     tokio::time::sleep(Duration::from_secs(1)).await;
@@ -386,6 +386,6 @@ async fn a_crash_raises_drone_lost() {
         }
         other => panic!("{other:?}"),
     }
-    assert_eq!(hover.end.await.unwrap(), CallEnd::Interrupted);
+    assert_eq!(hover.end.wait().await.unwrap(), CallEnd::Interrupted);
     vehicles.stop();
 }

@@ -3,14 +3,14 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use aviary_api::{Backend, CallEnd, DroneEvent, FlightState, Interrupt, PendingCall};
+use aviary_api::{Backend, CallEnd, DroneEvent, Ending, FlightState, Interrupt, PendingCall};
 use tokio::time::Instant;
 
 use super::*;
 use crate::{SimBackend, SimOptions};
 
 async fn done(call: PendingCall) -> CallEnd {
-    call.end.await.expect("the backend answers every call")
+    call.end.wait().await.expect("the backend answers every call")
 }
 
 async fn take_off(sim: &Arc<SimBackend>, alt: f64) {
@@ -81,15 +81,16 @@ async fn events_are_taken_once_and_detections_arrive() {
 async fn pause_resume_and_abort_through_the_backend() {
     let sim = SimBackend::start(&one_drone(), SimOptions::default());
     take_off(&sim, 20.0).await;
-    let mut call = sim.call(0, "FlyToPosition", &[pos(200.0, 0.0)]);
+    let call = sim.call(0, "FlyToPosition", &[pos(200.0, 0.0)]);
     tokio::time::sleep(Duration::from_secs(5)).await;
     sim.interrupt(call.id, Interrupt::Pause);
     let held = sim.telemetry(0);
     tokio::time::sleep(Duration::from_secs(10)).await;
     assert_eq!(sim.telemetry(0).position, held.position);
-    assert!(call.end.try_recv().is_err(), "still in progress");
+    let Ending::Later(mut end) = call.end else { panic!("a flight does not end at once") };
+    assert!(end.try_recv().is_err(), "still in progress");
     sim.interrupt(call.id, Interrupt::Resume);
-    assert_eq!(done(call).await, CallEnd::Done);
+    assert_eq!(end.await, Ok(CallEnd::Done));
     assert_eq!(sim.telemetry(0).position, [200.0, 0.0, 20.0]);
 
     let call = sim.call(0, "FlyToPosition", &[pos(0.0, 0.0)]);
@@ -207,4 +208,14 @@ async fn speed_paces_against_the_wall_clock() {
         wall.elapsed()
     );
     sim.shutdown().await;
+}
+
+#[tokio::test(flavor = "current_thread", start_paused = true)]
+async fn a_call_done_as_it_is_made_ends_now_and_a_flight_later() {
+    let sim = SimBackend::start(&one_drone(), SimOptions::default());
+    assert!(matches!(sim.call(0, "Arm", &[]).end, Ending::Now(CallEnd::Done)));
+    take_off(&sim, 20.0).await;
+    let flight = sim.call(0, "FlyToPosition", &[pos(50.0, 0.0)]);
+    assert!(matches!(flight.end, Ending::Later(_)));
+    assert_eq!(done(flight).await, CallEnd::Done);
 }

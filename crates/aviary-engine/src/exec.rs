@@ -101,7 +101,10 @@ impl<'m> Engine<'m> {
                 self.trace("block_start", || [("block", Field::Str(&block.path))]);
             }
             let inner = Ctx { scope: scope.clone(), ..ctx.clone() };
-            self.drive(&scope, self.items(block, &inner)).await;
+            // Futures made in place and passed pinned: moving a large future into the
+            // next one's state is a copy of all of it, at every step.
+            let items = pin!(self.items(block, &inner));
+            self.drive(&scope, items).await;
             if block.traced {
                 let status = if scope.unwinding.get() { "aborted" } else { "ok" };
                 self.trace("block_end", || [("block", Field::Str(&block.path)), ("status", Field::Str(status))]);
@@ -431,14 +434,15 @@ impl<'m> Engine<'m> {
         // handlers, runs its statements in the instance's own scope: a scope of its own
         // would hear nothing and catch nothing, and an exception unwinds both alike.
         let own_scope = !cap.perform.handlers.is_empty() || !cap.perform.exception_handlers.is_empty() || cap.perform.traced;
-        let perform = async {
+        let perform = pin!(async {
             match &instance.perform {
                 Some(perform) => _ = perform.run(self.block(&cap.perform, &inner)).await,
                 None if own_scope => self.block(&cap.perform, &inner).await,
                 None => self.items(&cap.perform, &inner).await,
             }
-        };
-        let finished = instance.token.run(self.drive(&scope, perform)).await.is_some();
+        });
+        let drive = pin!(self.drive(&scope, perform));
+        let finished = instance.token.run(drive).await.is_some();
         self.instances.borrow_mut().remove(&instance);
         if !finished && instance.by_leash.get() {
             // `PERFORM ABORT:` says what aborting this activity also does.

@@ -44,13 +44,13 @@ impl<'m> Engine<'m> {
         let jobs = &scope.jobs;
         // Made at the first job: most scopes never start a handler, and an empty
         // `FuturesUnordered` still allocates.
-        let mut running: Option<FuturesUnordered<LocalBoxFuture<'_, ()>>> = None;
+        let mut running: Option<FuturesUnordered<_>> = None;
         let mut items_done = false;
         loop {
             let any_running = running.as_ref().is_some_and(|r| !r.is_empty());
             tokio::select! {
                 biased;
-                job = std::future::poll_fn(|cx| jobs.poll_recv(cx)) => running.get_or_insert_with(FuturesUnordered::new).push(Box::pin(self.job(job, scope.clone()))),
+                job = std::future::poll_fn(|cx| jobs.poll_recv(cx)) => running.get_or_insert_with(FuturesUnordered::new).push(self.start_job(job, scope.clone())),
                 _ = &mut items, if !items_done => {
                     items_done = true;
                     // `SEQUENTIAL ON` handlers that waited for this block start now.
@@ -62,11 +62,18 @@ impl<'m> Engine<'m> {
             }
             if items_done && running.as_ref().is_none_or(|r| r.is_empty()) {
                 match jobs.try_recv() {
-                    Some(job) => running.get_or_insert_with(FuturesUnordered::new).push(Box::pin(self.job(job, scope.clone()))),
+                    Some(job) => running.get_or_insert_with(FuturesUnordered::new).push(self.start_job(job, scope.clone())),
                     None => break,
                 }
             }
         }
+    }
+
+    /// A job as it waits for its first poll: the job itself, not its future. Every job
+    /// taken is pushed before any is polled (they start in order), so a burst of signals
+    /// (W's N `Done`s) would otherwise hold a handler's whole future for each.
+    async fn start_job(&self, job: Job<'m>, scope: Rc<Scope<'m>>) {
+        Box::pin(self.job(job, scope)).await;
     }
 
     fn new_scope(&self, ctx: &Ctx<'m>, block: &'m Block, instance: Option<Rc<Instance>>) -> Rc<Scope<'m>> {

@@ -134,4 +134,39 @@ mod tests {
         assert!(other.is_cancelled());
         assert!(root.child_token().is_cancelled(), "a child of a cancelled token starts cancelled");
     }
+
+    fn poll_once<F: Future>(f: std::pin::Pin<&mut F>) -> Poll<F::Output> {
+        let waker = futures_util::task::noop_waker();
+        f.poll(&mut Context::from_waker(&waker))
+    }
+
+    #[test]
+    fn run_is_a_biased_select_of_cancellation_and_the_work() {
+        // Work that ends in its first poll: its output.
+        let token = Token::new();
+        assert_eq!(poll_once(pin!(token.run(async { 7 }))), Poll::Ready(Some(7)));
+        // Cancelled before: the work is not polled at all.
+        token.cancel();
+        let mut polled = false;
+        let work = async {
+            polled = true;
+        };
+        assert_eq!(poll_once(pin!(token.run(work))), Poll::Ready(None));
+        assert!(!polled);
+        // Cancelled while the work waits: ends at the next poll, without the work.
+        let token = Token::new();
+        let mut waiting = Box::pin(token.run(std::future::pending::<()>()));
+        assert!(poll_once(waiting.as_mut()).is_pending());
+        token.cancel();
+        assert_eq!(poll_once(waiting.as_mut()), Poll::Ready(None));
+        // Work that cancels its own token and then waits: ends at the next poll, as the
+        // select! woken by the token would.
+        let token = Token::new();
+        let mut cancels_itself = Box::pin(token.run(async {
+            token.cancel();
+            std::future::pending::<()>().await
+        }));
+        assert!(poll_once(cancels_itself.as_mut()).is_pending());
+        assert_eq!(poll_once(cancels_itself.as_mut()), Poll::Ready(None));
+    }
 }

@@ -16,7 +16,7 @@ use tokio::time::Instant;
 use crate::cancel::Token as CancellationToken;
 
 use crate::arbiter::{Arbiter, Claims};
-use crate::trace::{Event, Field};
+use crate::trace::{Event, Field, Kind};
 use crate::value::{airborne, to_json, Env};
 use crate::{Outcome, RunOptions, Status, TraceSink};
 
@@ -100,6 +100,8 @@ pub(crate) struct Engine<'m> {
     pub m: &'m Mission,
     pub backend: &'m dyn Backend,
     sink: RefCell<&'m mut dyn TraceSink>,
+    /// What the sink wants, by kind (asked once).
+    wanted: [bool; Kind::ALL.len()],
     start: Instant,
     pub received: RefCell<Vec<bool>>,
     pub changed: Notify,
@@ -129,6 +131,7 @@ impl<'m> Engine<'m> {
         Engine {
             m,
             backend,
+            wanted: Kind::ALL.map(|k| sink.wants(k.as_str())),
             sink: RefCell::new(sink),
             start: Instant::now(),
             received: RefCell::new(vec![false; m.signals.len()]),
@@ -158,12 +161,12 @@ impl<'m> Engine<'m> {
     }
 
     /// Records an event, if the sink wants its kind: `fields` is built only then.
-    pub fn trace<'a, const N: usize>(&self, kind: &'static str, fields: impl FnOnce() -> [(&'static str, Field<'a>); N]) {
-        if !self.sink.borrow().wants(kind) {
+    pub fn trace<'a, const N: usize>(&self, kind: Kind, fields: impl FnOnce() -> [(&'static str, Field<'a>); N]) {
+        if !self.wanted[kind as usize] {
             return;
         }
         let fields = fields();
-        let event = Event { t: self.now(), kind, fields: &fields };
+        let event = Event { t: self.now(), kind: kind.as_str(), fields: &fields };
         self.sink.borrow_mut().record(&event);
     }
 
@@ -180,7 +183,7 @@ impl<'m> Engine<'m> {
     }
 
     pub async fn run(&self, options: &RunOptions, controls: Option<mpsc::UnboundedReceiver<crate::ControlRequest>>) -> Outcome {
-        self.trace("mission_start", || [("mission", Field::Str(&self.m.name))]);
+        self.trace(Kind::MissionStart, || [("mission", Field::Str(&self.m.name))]);
         let root = Rc::new(Scope {
             parent: None,
             path: &self.m.name,
@@ -229,7 +232,7 @@ impl<'m> Engine<'m> {
             Some((status, reason)) => (status, Some(reason)),
             None => (Status::Ok, None),
         };
-        self.trace("mission_end", || [("status", Field::Str(status.as_str())), ("reason", Field::name(reason.as_deref()))]);
+        self.trace(Kind::MissionEnd, || [("status", Field::Str(status.as_str())), ("reason", Field::name(reason.as_deref()))]);
         Outcome { status, reason }
     }
 
@@ -254,7 +257,7 @@ impl<'m> Engine<'m> {
             }
         }
         let calls = homes.into_iter().map(|d| async move {
-            self.trace("api_call", || [("actor", Field::Str(self.name(d))), ("function", Field::Str("ReturnToLaunch")), ("args", Field::Json(json!([])))]);
+            self.trace(Kind::ApiCall, || [("actor", Field::Str(self.name(d))), ("function", Field::Str("ReturnToLaunch")), ("args", Field::Json(json!([])))]);
             let pending = self.backend.call(d, "ReturnToLaunch", &[]);
             let end = pending.end.wait().await.unwrap_or(aviary_api::CallEnd::Interrupted);
             self.trace_done(d, "ReturnToLaunch", &[], &end);
@@ -268,7 +271,7 @@ impl<'m> Engine<'m> {
             aviary_api::CallEnd::Failed(_) => "failed",
             aviary_api::CallEnd::Interrupted => "interrupted",
         };
-        self.trace("api_done", || {
+        self.trace(Kind::ApiDone, || {
             [
                 ("actor", Field::Str(self.name(d))),
                 ("function", Field::Str(function)),
@@ -286,7 +289,7 @@ impl<'m> Engine<'m> {
         loop {
             for d in 0..self.m.drones.len() {
                 let t = self.backend.telemetry(d);
-                self.trace("telemetry", || [("actor", Field::Str(self.name(d))), ("position", Field::Json(json!(t.position))), ("battery", Field::Json(json!(t.battery))), ("state", Field::Str(t.state.as_str()))]);
+                self.trace(Kind::Telemetry, || [("actor", Field::Str(self.name(d))), ("position", Field::Json(json!(t.position))), ("battery", Field::Json(json!(t.battery))), ("state", Field::Str(t.state.as_str()))]);
             }
             next += period;
             tokio::time::sleep_until(next).await;
@@ -326,7 +329,7 @@ impl<'m> Engine<'m> {
     fn on_event(&self, event: DroneEvent) {
         match event {
             DroneEvent::Detected { drone, kind, location } => {
-                self.trace("detection", || [("actor", Field::Str(self.name(drone))), ("kind", Field::Str(&kind)), ("location", Field::Json(json!(location)))]);
+                self.trace(Kind::Detection, || [("actor", Field::Str(self.name(drone))), ("kind", Field::Str(&kind)), ("location", Field::Json(json!(location)))]);
                 let scope = self.detections.borrow().get(&(drone, kind.clone())).cloned();
                 if let (Some(scope), Some(id)) = (scope, self.signal_id("Detected")) {
                     // A find is a point on the ground: flying to it keeps the altitude.
@@ -374,7 +377,7 @@ impl<'m> Engine<'m> {
     /// A signal from outside the mission (the operator): heard by every running handler
     /// that matches, at once (there is no signalling block to wait for).
     pub fn raise_from_outside(&self, signal: usize, args: Vec<Value>) {
-        self.trace("signal", || [("name", Field::Str(&self.m.signals[signal])), ("actor", Field::Null), ("args", Field::Json(self.values(&args)))]);
+        self.trace(Kind::Signal, || [("name", Field::Str(&self.m.signals[signal])), ("actor", Field::Null), ("args", Field::Json(self.values(&args)))]);
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {
             *r = true;
         }
@@ -391,7 +394,7 @@ impl<'m> Engine<'m> {
         if self.stopped() {
             return;
         }
-        self.trace("signal", || [("name", Field::Str(&self.m.signals[signal])), ("actor", Field::name(actor.map(|a| self.name(a)))), ("args", Field::Json(self.values(&args)))]);
+        self.trace(Kind::Signal, || [("name", Field::Str(&self.m.signals[signal])), ("actor", Field::name(actor.map(|a| self.name(a)))), ("args", Field::Json(self.values(&args)))]);
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {
             *r = true;
         }
@@ -438,7 +441,7 @@ impl<'m> Engine<'m> {
             let i = scope.exception_handlers.iter().position(|h| h.exception == exception && self.matches(&h.by, &scope.frame, actor))?;
             Some((scope.clone(), i))
         });
-        self.trace("exception", || {
+        self.trace(Kind::Exception, || {
             let handler = found.as_ref().map(|(s, _)| format!("{}/ON EXCEPTION {name}", s.path));
             [
                 ("name", Field::Str(&name)),

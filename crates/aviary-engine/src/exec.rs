@@ -20,7 +20,7 @@ use crate::arbiter::{acquire, Claims, Needs};
 use crate::engine::{Actors, Ctx, Engine, Frame, Instance, Job, Scope};
 use crate::jobs::Jobs;
 use crate::join::{join_eager, SMALL};
-use crate::trace::Field;
+use crate::trace::{Field, Kind};
 use crate::value::to_json;
 
 /// Conditions are looked at again at least this often (LANGUAGE.md §3).
@@ -105,7 +105,7 @@ impl<'m> Engine<'m> {
         Box::pin(async move {
             let scope = self.new_scope(ctx, block, None);
             if block.traced {
-                self.trace("block_start", || [("block", Field::Str(&block.path))]);
+                self.trace(Kind::BlockStart, || [("block", Field::Str(&block.path))]);
             }
             let inner = Ctx { scope: scope.clone(), ..ctx.clone() };
             // Futures made in place and passed pinned: moving a large future into the
@@ -114,7 +114,7 @@ impl<'m> Engine<'m> {
             self.drive(&scope, items).await;
             if block.traced {
                 let status = if scope.unwinding.get() { "aborted" } else { "ok" };
-                self.trace("block_end", || [("block", Field::Str(&block.path)), ("status", Field::Str(status))]);
+                self.trace(Kind::BlockEnd, || [("block", Field::Str(&block.path)), ("status", Field::Str(status))]);
             }
         })
     }
@@ -380,7 +380,7 @@ impl<'m> Engine<'m> {
             [("actor", who), ("capability", Field::Str(&cap.name)), ("tag", tag), ("args", Field::Json(Json::Object(shown_args)))]
         };
         let end = |status: &'static str| {
-            self.trace("capability_end", || {
+            self.trace(Kind::CapabilityEnd, || {
                 let [actor, capability, tag, args] = start();
                 [actor, capability, tag, args, ("status", Field::Str(status))]
             });
@@ -395,7 +395,7 @@ impl<'m> Engine<'m> {
             self.instances.borrow_mut().remove(&instance);
             return;
         }
-        self.trace("capability_start", start);
+        self.trace(Kind::CapabilityStart, start);
         if held.is_none() {
             self.instances.borrow_mut().remove(&instance);
             end("aborted");
@@ -478,10 +478,10 @@ impl<'m> Engine<'m> {
                 }
                 let who = actor.map(|a| self.name(a));
                 let signal_name = &self.m.signals[signal];
-                self.trace("handler_start", || [("signal", Field::Str(signal_name)), ("handler", Field::Str(&handler.body.path)), ("actor", Field::name(who))]);
+                self.trace(Kind::HandlerStart, || [("signal", Field::Str(signal_name)), ("handler", Field::Str(&handler.body.path)), ("actor", Field::name(who))]);
                 let ctx = self.scope_ctx(&scope, Rc::from(frame));
                 self.block(&handler.body, &ctx).await;
-                self.trace("handler_end", || [("signal", Field::Str(signal_name)), ("handler", Field::Str(&handler.body.path)), ("actor", Field::name(who))]);
+                self.trace(Kind::HandlerEnd, || [("signal", Field::Str(signal_name)), ("handler", Field::Str(&handler.body.path)), ("actor", Field::name(who))]);
             }
             Job::Exception { handler, args } => {
                 let mut frame = scope.frame.to_vec();
@@ -521,7 +521,7 @@ impl<'m> Engine<'m> {
     /// none runs (LANGUAGE.md §3).
     pub(crate) fn leash_by_id(&self, capability: usize, tag: usize, action: LeashAction, action_name: &str, values: Vec<(usize, Value)>) {
         let cap = &self.m.capabilities[capability];
-        self.trace("leash", || [("capability", Field::Str(&cap.name)), ("tag", Field::Str(&self.m.tags[tag])), ("action", Field::Str(action_name))]);
+        self.trace(Kind::Leash, || [("capability", Field::Str(&cap.name)), ("tag", Field::Str(&self.m.tags[tag])), ("action", Field::Str(action_name))]);
         let targets: Vec<(Rc<Instance>, Rc<Scope<'m>>)> = self.instances.borrow().tagged(capability, tag).cloned().collect();
         for (instance, scope) in targets {
             match action {
@@ -571,7 +571,7 @@ impl<'m> Engine<'m> {
         }
         let args = self.eval_all(&a.args, ctx);
         let function = self.m.functions[a.function].0.as_str();
-        self.trace("api_call", || [("actor", Field::Str(self.name(drone))), ("function", Field::Str(function)), ("args", Field::Json(self.values(&args)))]);
+        self.trace(Kind::ApiCall, || [("actor", Field::Str(self.name(drone))), ("function", Field::Str(function)), ("args", Field::Json(self.values(&args)))]);
         let pending = self.backend.call(drone, function, &args);
         let guard = CallGuard { engine: self, id: pending.id, root: root.clone(), done: Cell::new(false), drone, function, args: &args };
         if let Some(root) = &root {
@@ -633,7 +633,7 @@ impl Drop for CallGuard<'_, '_> {
         if !self.done.get() {
             self.engine.backend.interrupt(self.id, Interrupt::Abort);
             let engine = self.engine;
-            engine.trace("api_done", || {
+            engine.trace(Kind::ApiDone, || {
                 let p = engine.backend.telemetry(self.drone).position;
                 [
                     ("actor", Field::Str(engine.name(self.drone))),

@@ -23,15 +23,16 @@ mod value;
 use aviary_api::Backend;
 
 pub use control::{Control, ControlRequest, Controller};
-pub use trace::{Event, Field};
+pub use trace::{Event, Field, Kind};
 use aviary_ir::Mission;
 
 /// Where trace events go, one JSON object per event, in order.
 pub trait TraceSink {
     fn event(&mut self, event: serde_json::Value);
     /// Whether this sink takes events of this kind (`"signal"`, `"api_call"`, ...). The
-    /// engine builds an event only when its sink wants it, so a sink that keeps a few
-    /// kinds spares the cost of the rest; what the mission does is the same either way.
+    /// engine asks once per kind as the run starts and builds an event only when its
+    /// sink wants it, so a sink that keeps a few kinds spares the cost of the rest; what
+    /// the mission does is the same either way.
     fn wants(&self, _event: &str) -> bool {
         true
     }

@@ -7,6 +7,51 @@
 use serde::ser::{Serialize, SerializeMap, Serializer};
 use serde_json::{Map, Value as Json};
 
+/// The kinds of trace event (RUNTIME.md), so that what a sink wants is asked once per
+/// kind when the run starts, not at every event.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    MissionStart,
+    MissionEnd,
+    BlockStart,
+    BlockEnd,
+    CapabilityStart,
+    CapabilityEnd,
+    HandlerStart,
+    HandlerEnd,
+    ApiCall,
+    ApiDone,
+    Signal,
+    Exception,
+    Leash,
+    Detection,
+    Telemetry,
+}
+
+impl Kind {
+    pub const ALL: [Kind; 15] = [Kind::MissionStart, Kind::MissionEnd, Kind::BlockStart, Kind::BlockEnd, Kind::CapabilityStart, Kind::CapabilityEnd, Kind::HandlerStart, Kind::HandlerEnd, Kind::ApiCall, Kind::ApiDone, Kind::Signal, Kind::Exception, Kind::Leash, Kind::Detection, Kind::Telemetry];
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Kind::MissionStart => "mission_start",
+            Kind::MissionEnd => "mission_end",
+            Kind::BlockStart => "block_start",
+            Kind::BlockEnd => "block_end",
+            Kind::CapabilityStart => "capability_start",
+            Kind::CapabilityEnd => "capability_end",
+            Kind::HandlerStart => "handler_start",
+            Kind::HandlerEnd => "handler_end",
+            Kind::ApiCall => "api_call",
+            Kind::ApiDone => "api_done",
+            Kind::Signal => "signal",
+            Kind::Exception => "exception",
+            Kind::Leash => "leash",
+            Kind::Detection => "detection",
+            Kind::Telemetry => "telemetry",
+        }
+    }
+}
+
 /// One event: `{"t": …, "event": kind, fields…}`.
 pub struct Event<'a> {
     pub t: f64,
@@ -138,5 +183,16 @@ mod tests {
         assert_eq!(event.get("name").and_then(Field::as_str), Some("Done"));
         assert_eq!(event.get("args").and_then(Field::as_json), Some(&json!([3])));
         assert!(event.get("missing").is_none());
+    }
+
+    #[test]
+    fn every_kind_is_listed_once_at_its_own_index() {
+        for (i, kind) in Kind::ALL.iter().enumerate() {
+            assert_eq!(*kind as usize, i, "{kind:?}");
+        }
+        let mut names: Vec<&str> = Kind::ALL.iter().map(|k| k.as_str()).collect();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), Kind::ALL.len());
     }
 }

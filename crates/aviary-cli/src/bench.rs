@@ -88,7 +88,7 @@ fn parse(mb: f64, runs: usize) -> u8 {
     let started = Instant::now();
     let (mission, world) = aviary_check::generate::large_mission((mb * MB) as usize);
     let size = mission.len();
-    println!(
+    outln!(
         "generated a mission of {:.2} MB ({size} bytes, {} lines, {} capabilities) and a world of {} drones in {:.2} s",
         size as f64 / MB,
         mission.lines().count(),
@@ -100,7 +100,7 @@ fn parse(mb: f64, runs: usize) -> u8 {
     // One run outside the timings, to say what the checker thinks of the mission.
     let (errors, others) = parse_and_check(&mission, &world);
     if errors > 0 || others > 0 {
-        println!("note: the check reports {errors} error(s) and {others} other diagnostic(s); the generator should give none");
+        outln!("note: the check reports {errors} error(s) and {others} other diagnostic(s); the generator should give none");
     }
 
     let mut parse_times = Vec::with_capacity(runs);
@@ -117,7 +117,7 @@ fn parse(mb: f64, runs: usize) -> u8 {
         std::hint::black_box(parse_and_check(&mission, &world));
         let check_time = start.elapsed();
 
-        println!(
+        outln!(
             "run {run}: parse {:.3} s ({:.1} MB/s); parse + check {:.3} s ({:.1} MB/s)",
             parse_time.as_secs_f64(),
             rate(size, parse_time),
@@ -129,7 +129,7 @@ fn parse(mb: f64, runs: usize) -> u8 {
     }
     let parse_median = median(&mut parse_times);
     let check_median = median(&mut check_times);
-    println!(
+    outln!(
         "median of {runs} run(s) over {:.2} MB: parse {:.1} MB/s ({:.3} s); parse + check {:.1} MB/s ({:.3} s)",
         size as f64 / MB,
         rate(size, parse_median),

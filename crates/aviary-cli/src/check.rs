@@ -63,12 +63,12 @@ fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want_plan: 
     match format {
         Format::Text => {
             print(&sources, &diagnostics, format, path);
-            print!("\n{}", plan.render_text());
+            out!("\n{}", plan.render_text());
         }
         Format::Json => {
             let diagnostics: Vec<serde_json::Value> = diagnostics.iter().map(|d| render_json(&sources, d)).collect();
             let doc = serde_json::json!({ "file": path.display().to_string(), "plan": plan, "diagnostics": diagnostics });
-            println!("{doc}");
+            outln!("{doc}");
         }
     }
     failed
@@ -88,21 +88,21 @@ fn print(sources: &SourceMap, diagnostics: &[Diagnostic], format: Format, path: 
     match format {
         Format::Json => {
             for d in diagnostics {
-                println!("{}", render_json(sources, d));
+                outln!("{}", render_json(sources, d));
             }
         }
         Format::Text => {
             let color = color_wanted();
             for d in diagnostics {
-                print!("{}", render_text(sources, d, color));
+                out!("{}", render_text(sources, d, color));
             }
             let summary = summary_line(diagnostics);
             if diagnostics.iter().any(Diagnostic::is_error) {
-                println!("{}: {summary}", path.display());
+                outln!("{}: {summary}", path.display());
             } else if summary.is_empty() {
-                println!("{}: ok", path.display());
+                outln!("{}: ok", path.display());
             } else {
-                println!("{}: ok ({summary})", path.display());
+                outln!("{}: ok ({summary})", path.display());
             }
         }
     }

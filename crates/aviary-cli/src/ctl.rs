@@ -46,7 +46,7 @@ pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
     };
     match result {
         Ok((200, body)) => {
-            println!("{body}");
+            outln!("{body}");
             0
         }
         Ok((status, body)) => {
@@ -95,7 +95,12 @@ fn events(base: &str) -> u8 {
     };
     loop {
         match socket.read() {
-            Ok(tungstenite::Message::Text(text)) => println!("{text}"),
+            Ok(tungstenite::Message::Text(text)) => {
+                outln!("{text}");
+                if crate::out::closed() {
+                    return 0;
+                }
+            }
             Ok(tungstenite::Message::Close(_)) | Err(_) => return 0,
             Ok(_) => {}
         }

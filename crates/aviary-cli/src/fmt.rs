@@ -28,9 +28,9 @@ fn format_one(path: &Path, check: bool) -> u8 {
         let mut sources = SourceMap::new();
         sources.add(path.display().to_string(), text);
         for d in parse.diagnostics.iter().filter(|d| d.is_error()) {
-            print!("{}", render_text(&sources, d, color_wanted()));
+            out!("{}", render_text(&sources, d, color_wanted()));
         }
-        println!("{}: not formatted, because it has syntax errors", path.display());
+        outln!("{}: not formatted, because it has syntax errors", path.display());
         return 1;
     }
     let formatted = aviary_syntax::format(&parse.tree, &text, &parse.line_starts);
@@ -38,12 +38,12 @@ fn format_one(path: &Path, check: bool) -> u8 {
         return 0;
     }
     if check {
-        println!("{}: would be reformatted", path.display());
+        outln!("{}: would be reformatted", path.display());
         return 1;
     }
     match write_atomically(path, &formatted) {
         Ok(()) => {
-            println!("{}: formatted", path.display());
+            outln!("{}: formatted", path.display());
             0
         }
         Err(e) => {

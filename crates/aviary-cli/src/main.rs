@@ -3,6 +3,8 @@
 //! Exit codes (RUNTIME.md): 0 success, 1 the files have errors (or `fmt --check` would
 //! change them), 2 usage or IO problems.
 
+#[macro_use]
+mod out;
 mod alloc;
 mod bench;
 mod check;
@@ -165,8 +167,8 @@ fn command(cli: Cli) -> u8 {
 fn explain(code: &str) -> u8 {
     match aviary_diagnostics::Code::from_str(&code.to_ascii_uppercase()) {
         Some(c) => {
-            println!("{} ({}): {}", c.as_str(), c.severity().as_str(), c.summary());
-            println!("See docs/DIAGNOSTICS.md for an example and the fix.");
+            outln!("{} ({}): {}", c.as_str(), c.severity().as_str(), c.summary());
+            outln!("See docs/DIAGNOSTICS.md for an example and the fix.");
             0
         }
         None => {

@@ -170,10 +170,10 @@ pub fn run(args: &RunArgs) -> u8 {
         s.finish(std::time::Duration::from_secs(2));
     }
     if !args.quiet {
-        print!("{summary}");
+        out!("{summary}");
         match &outcome.reason {
-            Some(reason) => println!("mission {}: {reason}", outcome.status.as_str()),
-            None => println!("mission {}", outcome.status.as_str()),
+            Some(reason) => outln!("mission {}: {reason}", outcome.status.as_str()),
+            None => outln!("mission {}", outcome.status.as_str()),
         }
     }
     u8::from(outcome.status != Status::Ok)

@@ -154,3 +154,21 @@ fn explain_prints_what_a_code_means() {
     let (code, _, _) = aviary(&["explain", "X999"], &repo());
     assert_eq!(code, 2);
 }
+
+#[test]
+fn a_reader_that_stops_reading_ends_the_output_not_in_a_panic() {
+    use std::process::{Command, Stdio};
+    // Hundreds of kilobytes to a pipe whose reader is gone before the first write ends.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(["bench", "w", "--n", "20000", "--k", "1", "--emit-world"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{:?}: {stderr}", out.status);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(stderr.is_empty(), "a closed pipe is not an error to report: {stderr}");
+}

@@ -25,12 +25,12 @@ pub fn run(drones: usize, emit: bool, emit_world: bool) -> u8 {
     let mut stages = Stages::default();
     let mission = stages.time("generate", || aviary_check::generate::swarm_mission(drones));
     if emit {
-        print!("{mission}");
+        out!("{mission}");
         return 0;
     }
     let world = stages.time("generate", || aviary_check::generate::swarm_world(drones));
     if emit_world {
-        print!("{world}");
+        out!("{world}");
         return 0;
     }
     let mut tally = Tally::default();
@@ -51,7 +51,7 @@ pub fn run(drones: usize, emit: bool, emit_world: bool) -> u8 {
     };
     let flying = stages.get("engine + sim").map_or(0.0, |d| d.as_secs_f64());
     let ok = ran.outcome.status == aviary_engine::Status::Ok && tally.found_handled == tally.detections;
-    println!(
+    outln!(
         "aviary swarm drones={drones} status={} simulated={:.1}s engine+sim wall={flying:.3}s speed={:.1}x real time; detections={} handled={} ok={ok}; whole process {:.3}s peak={}",
         ran.outcome.status.as_str(),
         ran.simulated,
@@ -61,6 +61,6 @@ pub fn run(drones: usize, emit: bool, emit_world: bool) -> u8 {
         started.elapsed().as_secs_f64(),
         mib(peak_rss())
     );
-    println!("stages: {}; {} trace events", stages.show(), tally.events);
+    outln!("stages: {}; {} trace events", stages.show(), tally.events);
     u8::from(!ok)
 }

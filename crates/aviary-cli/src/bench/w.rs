@@ -78,12 +78,12 @@ pub fn run(n: usize, k: usize, emit: bool, emit_world: bool, full_trace: bool) -
     let mut stages = Stages::default();
     let mission = stages.time("generate", || aviary_check::generate::w_mission(k));
     if emit {
-        print!("{mission}");
+        out!("{mission}");
         return 0;
     }
     let world = stages.time("generate", || aviary_check::generate::w_world(n));
     if emit_world {
-        print!("{world}");
+        out!("{world}");
         return 0;
     }
     let mut tally = Tally { full: full_trace, ..Tally::default() };
@@ -103,13 +103,13 @@ pub fn run(n: usize, k: usize, emit: bool, emit_world: bool, full_trace: bool) -
         && tally.index_sum == n64 * (n64 - 1) / 2
         && (!full_trace || tally.steps == n64 * k64);
     let steps = if full_trace { format!(" steps={}", tally.steps) } else { String::new() };
-    println!(
+    outln!(
         "aviary W N={n} K={k} done={} handled={} sum={}{steps} ok={ok} elapsed={wall:.3}s peak={}",
         tally.done_signals,
         tally.handled,
         tally.index_sum,
         mib(peak_rss())
     );
-    println!("stages: {}; {} trace events", stages.show(), tally.events);
+    outln!("stages: {}; {} trace events", stages.show(), tally.events);
     u8::from(!ok)
 }

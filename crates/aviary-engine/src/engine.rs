@@ -54,8 +54,9 @@ pub(crate) struct Scope<'m> {
 }
 
 impl<'m> Scope<'m> {
-    pub fn chain(self: &Rc<Self>) -> impl Iterator<Item = Rc<Scope<'m>>> {
-        std::iter::successors(Some(self.clone()), |s| s.parent.clone())
+    /// This scope and those around it, innermost first.
+    pub fn chain(self: &Rc<Self>) -> impl Iterator<Item = &Rc<Scope<'m>>> {
+        std::iter::successors(Some(self), |s| s.parent.as_ref())
     }
 }
 
@@ -401,7 +402,7 @@ impl<'m> Engine<'m> {
         self.changed.notify_waiters();
         let signalling_block = from.chain().find(|s| s.mission_block);
         for scope in from.chain() {
-            self.deliver(&scope, signal, &args, actor, signalling_block.as_ref());
+            self.deliver(scope, signal, &args, actor, signalling_block);
         }
     }
 
@@ -466,7 +467,7 @@ impl<'m> Engine<'m> {
             self.end_with(Status::Failed, reason, true);
             return;
         };
-        let keep: Vec<*const Scope> = handler_scope.chain().map(|s| Rc::as_ptr(&s)).collect();
+        let keep: Vec<*const Scope> = handler_scope.chain().map(Rc::as_ptr).collect();
         for scope in from.chain().take_while(|s| !Rc::ptr_eq(s, &handler_scope)) {
             scope.unwinding.set(true);
             if let Some(i) = &scope.instance {

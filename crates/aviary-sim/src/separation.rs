@@ -125,7 +125,7 @@ pub(crate) fn segment_gap(p: [f64; 2], q: [f64; 2], a: [f64; 2], b: [f64; 2]) ->
 pub(crate) fn gap(e: &Envelope, f: &Envelope) -> f64 {
     let h = (segment_gap(e.from, e.to, f.from, f.to) - e.pad - f.pad).max(0.0);
     let v = (f.low - e.high).max(e.low - f.high).max(0.0);
-    h.hypot(v)
+    hypot(h, v)
 }
 
 /// How far from where it is a drone's envelope could reach after one tick (generous: on
@@ -291,7 +291,7 @@ impl Fleet {
             .filter(|&&j| j != id && counts(&self.drones[j]))
             .map(|&j| (self.drones[j].pos, envelope(&self.drones[j])))
             .filter(|(p, e)| {
-                let apart = (p[0] - here[0]).hypot(p[1] - here[1]).hypot(p[2] - here[2]);
+                let apart = hypot(hypot(p[0] - here[0], p[1] - here[1]), p[2] - here[2]);
                 apart < self.min_separation + reach + extent(e)
             })
             .map(|(_, e)| e)
@@ -356,7 +356,7 @@ fn progress(d: &SimDrone, task: &MotionTask) -> Progress {
     match task.legs.front() {
         Some(Leg::Move { to, .. }) => {
             let gap = |k: usize| d.pos[k] - to[k];
-            (n, 0, gap(0).hypot(gap(1)).hypot(gap(2)))
+            (n, 0, hypot(hypot(gap(0), gap(1)), gap(2)))
         }
         Some(Leg::Arc { radius, total, .. }) => (n, 0, (total - task.arc_done) * radius),
         Some(Leg::Hold { left }) if *left > 1e-9 => (n, 1, *left),
@@ -418,7 +418,7 @@ impl Fleet {
             .filter(|&(j, o)| j != id && counts(o))
             .map(|(_, o)| {
                 let gap = |k: usize| o.pos[k] - d.pos[k];
-                (gap(0).hypot(gap(1)).hypot(gap(2)), o)
+                (hypot(hypot(gap(0), gap(1)), gap(2)), o)
             })
             .filter(|(apart, _)| *apart <= 2.0 * sep + MARGIN)
             .min_by(|a, b| a.0.total_cmp(&b.0))

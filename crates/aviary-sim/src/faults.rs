@@ -36,6 +36,7 @@ impl Fleet {
             }
             f.fired = true;
             let (id, kind, at, until) = (f.drone, f.kind, f.at, f.at + f.duration);
+            self.touch(id);
             if self.drones[id].state == FlightState::Lost {
                 continue;
             }
@@ -119,7 +120,7 @@ impl Fleet {
             }
         }
         let max_altitude = self.max_altitude;
-        for d in &mut self.drones {
+        for (id, d) in self.drones.iter_mut().enumerate() {
             let Some(outage) = d.link_loss.as_mut() else {
                 continue;
             };
@@ -127,6 +128,9 @@ impl Fleet {
                 continue;
             }
             outage.returned = true;
+            if let Some(e) = self.extents.get_mut(id) {
+                *e = f64::NAN;
+            }
             let on_its_own = d.state.airborne() && d.motion.is_none() && d.disabled.is_none();
             if on_its_own {
                 if let Ok(legs) = return_legs(d, false, max_altitude) {

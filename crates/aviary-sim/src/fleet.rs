@@ -11,11 +11,25 @@ use aviary_world::{FaultKind, Sensor, Target, World};
 
 use crate::avoid::Track;
 use crate::battery;
+use crate::clearance::Clearance;
 use crate::drone::SimDrone;
 use crate::geom::heading;
 use crate::grid::Grid;
+use crate::nearby::Nearby;
 use crate::sensors::scan;
 use crate::separation::{envelope, extent};
+
+/// Whether a step would change nothing of the drone: on the ground, with nothing to do
+/// (no move, load, detection or yield in progress, at rest).
+fn idle(d: &SimDrone) -> bool {
+    !d.state.airborne()
+        && d.motion.is_none()
+        && d.loading.is_none()
+        && d.detections.is_empty()
+        && d.avoid.is_none()
+        && d.stalled == 0.0
+        && d.vel.iter().all(|v| v.to_bits() == 0)
+}
 
 /// Something that happened during a [`Fleet::step`], in the order it happened.
 #[derive(Clone, Debug, PartialEq)]
@@ -68,17 +82,27 @@ pub struct Fleet {
     pub(crate) aloft: Vec<DroneId>,
     /// The planner's predicted tracks of drones that moved already in this step.
     pub(crate) tracks: BTreeMap<DroneId, Track>,
-    /// The drones of `aloft`, by where they are now (updated as each one moves).
+    /// Whether each drone is in `aloft`.
+    pub(crate) in_sky: Vec<bool>,
+    /// The drones of `aloft`, by where they are now (updated as each one moves), when
+    /// `sky_fresh`: built in a step only once a drone needs it (see [`Fleet::fresh_sky`]).
     pub(crate) sky: Grid,
+    pub(crate) sky_fresh: bool,
+    /// How far apart the drones of `aloft` are, at least: answers most "anybody near?"
+    /// without the sky.
+    pub(crate) clearance: Clearance,
     /// At least the largest `extent` of the envelope of a drone of `aloft` during this
     /// step: how far, beyond the usual, separation must look for one.
     pub(crate) max_extent: f64,
+    /// Each drone's envelope extent after its last move; NaN when not known (not in the
+    /// air then, or changed since by a call, an interrupt or a fault).
+    pub(crate) extents: Vec<f64>,
     /// The largest `max_speed + climb_rate` of the fleet (the planner's reach).
     pub(crate) fastest: f64,
     /// The world's targets by where they are.
     pub(crate) target_grid: Grid,
-    /// A scratch list for grid queries.
-    pub(crate) nearby: Vec<usize>,
+    /// The targets near each drone's way, kept between ticks.
+    pub(crate) near_targets: Vec<Nearby>,
     /// The drone of each call in progress (a call id is only ever that drone's), so that
     /// [`Fleet::interrupt`] looks at one drone, not the fleet. Entries go when the call's
     /// end is reported; one left over (a task replaced without an end) only costs a lookup.
@@ -87,6 +111,9 @@ pub struct Fleet {
 
 /// Metres on a side of a cell of [`Fleet::sky`]: about the planner's reach.
 const SKY_CELL: f64 = 400.0;
+/// Metres the drones of the sky may drift from where [`Fleet::clearance`] measured them
+/// before it measures again.
+const REMEASURE: f64 = 25.0;
 /// Metres on a side of a cell of [`Fleet::target_grid`], at least: about a sensor's range.
 const TARGET_CELL: f64 = 50.0;
 
@@ -145,11 +172,15 @@ impl Fleet {
             releases: Vec::new(),
             aloft: Vec::new(),
             tracks: BTreeMap::new(),
+            in_sky: vec![false; world.drones.len()],
             sky: Grid::new(SKY_CELL),
+            sky_fresh: false,
+            clearance: Clearance::new(world.drones.len()),
             max_extent: 0.0,
+            extents: vec![f64::NAN; world.drones.len()],
             fastest: world.drones.iter().map(|d| d.max_speed + d.climb_rate).fold(0.0, f64::max),
             target_grid: target_grid(&world.targets),
-            nearby: Vec::new(),
+            near_targets: vec![Nearby::default(); world.drones.len()],
             calls: HashMap::new(),
         }
     }
@@ -214,6 +245,7 @@ impl Fleet {
     ) -> (CallId, Option<CallEnd>) {
         let id = CallId(self.next_call);
         self.next_call += 1;
+        self.touch(drone);
         let end = match self.start(drone, id, function, args) {
             Ok(true) => {
                 self.calls.insert(id, drone);
@@ -238,6 +270,7 @@ impl Fleet {
     fn interrupt_on(&mut self, call: CallId, how: Interrupt) -> Option<CallEnd> {
         // Only the call's own drone can have it in progress.
         let &drone = self.calls.get(&call)?;
+        self.touch(drone);
         if let Some(d) = self.drones.get_mut(drone) {
             if d.motion.as_ref().is_some_and(|t| t.call == Some(call)) {
                 match how {
@@ -275,6 +308,13 @@ impl Fleet {
         None
     }
 
+    /// Forgets what the fleet keeps about drone `id` between steps (it may have changed).
+    pub(crate) fn touch(&mut self, id: DroneId) {
+        if let Some(e) = self.extents.get_mut(id) {
+            *e = f64::NAN;
+        }
+    }
+
     /// Advances every drone by `dt` simulated seconds.
     pub fn step(&mut self, dt: f64) -> Vec<Report> {
         let end = self.time + dt;
@@ -282,29 +322,43 @@ impl Fleet {
         self.fire_faults(end, &mut out);
         self.tracks.clear();
         self.aloft.clear();
+        self.sky_fresh = false;
         self.max_extent = 0.0;
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        let mut joined = false;
         for (id, d) in self.drones.iter().enumerate() {
-            if d.state.airborne() {
-                self.aloft.push(id);
-                let p = d.xy();
-                (lo, hi) = ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])]);
+            let up = d.state.airborne();
+            self.in_sky[id] = up;
+            if !up {
+                self.clearance.leave(id);
+                self.extents[id] = f64::NAN;
+                continue;
             }
+            self.aloft.push(id);
+            joined |= !self.clearance.moved(id, d.xy());
+            // Unchanged since its last move, unless touched.
+            let e = match self.extents[id] {
+                e if e >= 0.0 => e,
+                _ => extent(&envelope(d)),
+            };
+            self.max_extent = self.max_extent.max(e);
         }
-        // The sky's window: where the drones in the air are now.
-        self.sky.reframe(lo, hi, self.aloft.len());
-        for &id in &self.aloft {
-            let d = &self.drones[id];
-            self.sky.put(id, d.xy());
-            self.max_extent = self.max_extent.max(extent(&envelope(d)));
+        if joined || !(self.clearance.drift() <= REMEASURE) {
+            self.fresh_sky();
+            let cap = self.clearance_cap();
+            self.clearance.rebuild(&self.aloft, &self.sky, cap);
         }
         for id in 0..self.drones.len() {
             self.step_drone(id, dt, &mut out);
             // Keep the sky current for the drones after this one.
-            if self.sky.contains(id) {
+            if self.in_sky[id] {
                 let d = &self.drones[id];
-                self.sky.put(id, d.xy());
-                self.max_extent = self.max_extent.max(extent(&envelope(d)));
+                if self.sky_fresh {
+                    self.sky.put(id, d.xy());
+                }
+                self.clearance.moved(id, d.xy());
+                let e = extent(&envelope(d));
+                self.extents[id] = e;
+                self.max_extent = self.max_extent.max(e);
             }
         }
         self.time = end;
@@ -316,8 +370,33 @@ impl Fleet {
         out
     }
 
+    /// Makes the sky hold every drone of `aloft` where it is now (once per step at most).
+    pub(crate) fn fresh_sky(&mut self) {
+        if self.sky_fresh {
+            return;
+        }
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for &id in &self.aloft {
+            let p = self.drones[id].xy();
+            (lo, hi) = ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])]);
+        }
+        self.sky.reframe(lo, hi, self.aloft.len());
+        for &id in &self.aloft {
+            self.sky.put(id, self.drones[id].xy());
+        }
+        self.sky_fresh = true;
+    }
+
+    /// How far [`Fleet::clearance`] measures: twice the planner's longest reach, plus the
+    /// drift allowed (farther gaps would tell nothing more).
+    fn clearance_cap(&self) -> f64 {
+        let reach = self.min_separation + crate::avoid::MARGIN + crate::avoid::HORIZON * 2.0 * self.fastest + 1.0;
+        2.0 * reach + 2.0 * REMEASURE
+    }
+
     fn step_drone(&mut self, id: DroneId, dt: f64, out: &mut Vec<Report>) {
-        if self.drones[id].state == FlightState::Lost {
+        let d = &self.drones[id];
+        if d.state == FlightState::Lost || idle(d) {
             return;
         }
         let airborne = self.drones[id].state.airborne();
@@ -361,12 +440,12 @@ impl Fleet {
             d.flight_time += dt;
         }
         // Only the targets near the way flown, in their order.
-        match d.detections.iter().map(|a| a.range).reduce(f64::max) {
-            Some(range) => self.target_grid.around(from, to, range, &mut self.nearby),
-            None => self.nearby.clear(),
-        }
+        let nearby = match d.detections.iter().map(|a| a.range).reduce(f64::max) {
+            Some(range) => self.near_targets[id].around(&self.target_grid, from, to, range),
+            None => &[],
+        };
         out.extend(
-            scan(id, &mut d.detections, &self.targets, &self.nearby, from, to)
+            scan(id, &mut d.detections, &self.targets, nearby, from, to)
                 .into_iter()
                 .map(Report::Event),
         );

@@ -307,8 +307,13 @@ impl Fleet {
         }
         let separation = self.min_separation + reach(d, dt) + self.max_extent;
         let r = separation.max(crate::avoid::reach(self, d));
+        let p = d.xy();
+        if self.clearance.clear(id, p, r) {
+            return true;
+        }
         // The sky holds every drone of `aloft` where it is now (moved ones included).
-        !self.sky.any_within(d.xy(), r, id)
+        self.fresh_sky();
+        !self.sky.any_within(p, r, id)
     }
 
     /// Moves drone `id` by one tick: the planner's choice if its envelope stays clear of
@@ -327,6 +332,7 @@ impl Fleet {
             d.stalled = 0.0;
             return d.tick_motion(dt);
         }
+        self.fresh_sky();
         let near = self.near(id, dt);
         self.plan(id, dt, &near);
         if near.is_empty() {

@@ -49,7 +49,8 @@ pub(crate) fn drain(d: &mut SimDrone, dt: f64, airborne: bool) -> Alarms {
         alarms.empty = true;
     }
     // Most ticks the bound shows that neither alarm can be due: no square root.
-    let may = |k: f64| !(d.battery >= k * energy_home_bound(d) + 0.10);
+    let bound = energy_home_bound(d);
+    let may = |k: f64| !(d.battery >= k * bound + 0.10);
     if !((!d.low_sent && may(2.0)) || (!d.critical_sent && may(1.0))) {
         return alarms;
     }

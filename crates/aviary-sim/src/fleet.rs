@@ -17,7 +17,7 @@ use crate::geom::heading;
 use crate::grid::Grid;
 use crate::nearby::Nearby;
 use crate::sensors::scan;
-use crate::separation::{envelope, extent};
+use crate::separation::extent_bound;
 
 /// Whether a step would change nothing of the drone: on the ground, with nothing to do
 /// (no move, load, detection or yield in progress, at rest).
@@ -92,9 +92,9 @@ pub struct Fleet {
     /// without the sky.
     pub(crate) clearance: Clearance,
     /// At least the largest `extent` of the envelope of a drone of `aloft` during this
-    /// step: how far, beyond the usual, separation must look for one.
+    /// step (from [`extent_bound`]): how far, beyond the usual, separation must look for one.
     pub(crate) max_extent: f64,
-    /// Each drone's envelope extent after its last move; NaN when not known (not in the
+    /// Each drone's [`extent_bound`] after its last move; NaN when not known (not in the
     /// air then, or changed since by a call, an interrupt or a fault).
     pub(crate) extents: Vec<f64>,
     /// The largest `max_speed + climb_rate` of the fleet (the planner's reach).
@@ -338,7 +338,7 @@ impl Fleet {
             // Unchanged since its last move, unless touched.
             let e = match self.extents[id] {
                 e if e >= 0.0 => e,
-                _ => extent(&envelope(d)),
+                _ => extent_bound(d),
             };
             self.max_extent = self.max_extent.max(e);
         }
@@ -356,7 +356,7 @@ impl Fleet {
                     self.sky.put(id, d.xy());
                 }
                 self.clearance.moved(id, d.xy());
-                let e = extent(&envelope(d));
+                let e = extent_bound(d);
                 self.extents[id] = e;
                 self.max_extent = self.max_extent.max(e);
             }
@@ -404,7 +404,9 @@ impl Fleet {
         let before = self.drones[id].pos;
         let finished = self.move_drone(id, dt);
         if finished.is_none() {
-            out.extend(self.held_back(id, dt));
+            if let Some(report) = self.held_back(id, dt) {
+                out.push(report);
+            }
         }
         let d = &mut self.drones[id];
         if let Some(task) = finished {
@@ -444,11 +446,10 @@ impl Fleet {
             Some(range) => self.near_targets[id].around(&self.target_grid, from, to, range),
             None => &[],
         };
-        out.extend(
-            scan(id, &mut d.detections, &self.targets, nearby, from, to)
-                .into_iter()
-                .map(Report::Event),
-        );
+        let found = scan(id, &mut d.detections, &self.targets, nearby, from, to);
+        if !found.is_empty() {
+            out.extend(found.into_iter().map(Report::Event));
+        }
         let alarms = battery::drain(d, dt, airborne);
         if alarms.low {
             out.push(Report::Event(DroneEvent::Signal {

@@ -142,6 +142,24 @@ pub(crate) fn extent(e: &Envelope) -> f64 {
     dist(e.from, e.to) + e.pad + (e.high - e.low)
 }
 
+/// At least `extent(&envelope(d))` (or NaN), without building the envelope: the stopping
+/// distance stands for the track's length, widened beyond the rounding of both. Enough
+/// for [`Fleet::max_extent`], which only needs to be large enough.
+pub(crate) fn extent_bound(d: &SimDrone) -> f64 {
+    let vh = hypot(d.vel[0], d.vel[1]);
+    let (stop, pad) = match current_leg(d) {
+        _ if vh == 0.0 => (0.0, 0.0),
+        Some(Leg::Arc { radius, .. }) => {
+            let l = vh * vh / (2.0 * arc_accel(d.accel));
+            (l, l * l / (2.0 * radius))
+        }
+        _ => (vh * vh / (2.0 * d.accel), 0.0),
+    };
+    let climb = (d.vel[2] * d.vel[2].abs() / (2.0 * d.accel)).abs();
+    let scale = 1.0 + d.pos[0].abs() + d.pos[1].abs() + d.pos[2].abs();
+    (stop + pad + climb) * (1.0 + 1e-9) + 1e-9 * scale
+}
+
 /// What a move may change, to put back when the filter refuses it.
 struct Snapshot {
     pos: [f64; 3],

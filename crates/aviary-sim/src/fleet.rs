@@ -15,21 +15,9 @@ use crate::clearance::Clearance;
 use crate::drone::SimDrone;
 use crate::geom::heading;
 use crate::grid::Grid;
+use crate::hot::Hot;
 use crate::nearby::Nearby;
 use crate::sensors::scan;
-use crate::separation::extent_bound;
-
-/// Whether a step would change nothing of the drone: on the ground, with nothing to do
-/// (no move, load, detection or yield in progress, at rest).
-fn idle(d: &SimDrone) -> bool {
-    !d.state.airborne()
-        && d.motion.is_none()
-        && d.loading.is_none()
-        && d.detections.is_empty()
-        && d.avoid.is_none()
-        && d.stalled == 0.0
-        && d.vel.iter().all(|v| v.to_bits() == 0)
-}
 
 /// Something that happened during a [`Fleet::step`], in the order it happened.
 #[derive(Clone, Debug, PartialEq)]
@@ -92,11 +80,12 @@ pub struct Fleet {
     /// without the sky.
     pub(crate) clearance: Clearance,
     /// At least the largest `extent` of the envelope of a drone of `aloft` during this
-    /// step (from [`extent_bound`]): how far, beyond the usual, separation must look for one.
+    /// step (from `extent_bound`): how far, beyond the usual, separation must look for one.
     pub(crate) max_extent: f64,
-    /// Each drone's [`extent_bound`] after its last move; NaN when not known (not in the
-    /// air then, or changed since by a call, an interrupt or a fault).
-    pub(crate) extents: Vec<f64>,
+    /// Each drone as its last turn in a step left it (see [`crate::hot`]).
+    pub(crate) hot: Vec<Hot>,
+    /// The drones with a link or GPS outage, ascending.
+    pub(crate) outages: Vec<DroneId>,
     /// The largest `max_speed + climb_rate` of the fleet (the planner's reach).
     pub(crate) fastest: f64,
     /// The world's targets by where they are.
@@ -114,6 +103,9 @@ const SKY_CELL: f64 = 400.0;
 /// Metres the drones of the sky may drift from where [`Fleet::clearance`] measured them
 /// before it measures again.
 const REMEASURE: f64 = 25.0;
+/// How many drones ahead [`Fleet::step`] warms the caches for the leg (twice as many for
+/// the task before it).
+const AHEAD: usize = 6;
 /// Metres on a side of a cell of [`Fleet::target_grid`], at least: about a sensor's range.
 const TARGET_CELL: f64 = 50.0;
 
@@ -177,7 +169,8 @@ impl Fleet {
             sky_fresh: false,
             clearance: Clearance::new(world.drones.len()),
             max_extent: 0.0,
-            extents: vec![f64::NAN; world.drones.len()],
+            hot: vec![Hot::UNKNOWN; world.drones.len()],
+            outages: Vec::new(),
             fastest: world.drones.iter().map(|d| d.max_speed + d.climb_rate).fold(0.0, f64::max),
             target_grid: target_grid(&world.targets),
             near_targets: vec![Nearby::default(); world.drones.len()],
@@ -310,8 +303,8 @@ impl Fleet {
 
     /// Forgets what the fleet keeps about drone `id` between steps (it may have changed).
     pub(crate) fn touch(&mut self, id: DroneId) {
-        if let Some(e) = self.extents.get_mut(id) {
-            *e = f64::NAN;
+        if let Some(h) = self.hot.get_mut(id) {
+            h.known = false;
         }
     }
 
@@ -320,27 +313,25 @@ impl Fleet {
         let end = self.time + dt;
         let mut out = Vec::new();
         self.fire_faults(end, &mut out);
+        #[cfg(test)]
+        self.check_hot();
         self.tracks.clear();
         self.aloft.clear();
         self.sky_fresh = false;
         self.max_extent = 0.0;
         let mut joined = false;
-        for (id, d) in self.drones.iter().enumerate() {
-            let up = d.state.airborne();
-            self.in_sky[id] = up;
-            if !up {
+        for (id, h) in self.hot.iter_mut().enumerate() {
+            if !h.known {
+                *h = Hot::of(&self.drones[id]);
+            }
+            self.in_sky[id] = h.up;
+            if !h.up {
                 self.clearance.leave(id);
-                self.extents[id] = f64::NAN;
                 continue;
             }
             self.aloft.push(id);
-            joined |= !self.clearance.moved(id, d.xy());
-            // Unchanged since its last move, unless touched.
-            let e = match self.extents[id] {
-                e if e >= 0.0 => e,
-                _ => extent_bound(d),
-            };
-            self.max_extent = self.max_extent.max(e);
+            joined |= !self.clearance.moved(id, h.xy);
+            self.max_extent = self.max_extent.max(h.extent);
         }
         if joined || !(self.clearance.drift() <= REMEASURE) {
             self.fresh_sky();
@@ -348,17 +339,26 @@ impl Fleet {
             self.clearance.rebuild(&self.aloft, &self.sky, cap);
         }
         for id in 0..self.drones.len() {
+            // Overlap the cache misses of the drones to come (tasks, then their legs).
+            if let Some(d) = self.drones.get(id + 2 * AHEAD) {
+                d.warm();
+            }
+            if let Some(d) = self.drones.get(id + AHEAD) {
+                d.warm_leg();
+            }
+            if self.hot[id].idle {
+                continue;
+            }
             self.step_drone(id, dt, &mut out);
+            let h = Hot::of(&self.drones[id]);
+            self.hot[id] = h;
             // Keep the sky current for the drones after this one.
             if self.in_sky[id] {
-                let d = &self.drones[id];
                 if self.sky_fresh {
-                    self.sky.put(id, d.xy());
+                    self.sky.put(id, h.xy);
                 }
-                self.clearance.moved(id, d.xy());
-                let e = extent_bound(d);
-                self.extents[id] = e;
-                self.max_extent = self.max_extent.max(e);
+                self.clearance.moved(id, h.xy);
+                self.max_extent = self.max_extent.max(h.extent);
             }
         }
         self.time = end;
@@ -395,8 +395,7 @@ impl Fleet {
     }
 
     fn step_drone(&mut self, id: DroneId, dt: f64, out: &mut Vec<Report>) {
-        let d = &self.drones[id];
-        if d.state == FlightState::Lost || idle(d) {
+        if self.drones[id].state == FlightState::Lost {
             return;
         }
         let airborne = self.drones[id].state.airborne();

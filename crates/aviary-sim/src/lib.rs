@@ -136,6 +136,7 @@ mod faults;
 mod fleet;
 mod geom;
 mod grid;
+mod hot;
 mod motion;
 mod nearby;
 mod profile;

@@ -327,6 +327,8 @@ impl Fleet {
         let r = separation.max(crate::avoid::reach(self, d));
         let p = d.xy();
         if self.clearance.clear(id, p, r) {
+            #[cfg(test)]
+            self.check_clear(id, r);
             return true;
         }
         // The sky holds every drone of `aloft` where it is now (moved ones included).

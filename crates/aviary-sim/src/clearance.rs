@@ -69,6 +69,10 @@ impl Clearance {
         true
     }
 
+    pub fn is_member(&self, i: usize) -> bool {
+        matches!(self.base.get(i), Some(Some(_)))
+    }
+
     /// `i` is no longer in the set (its bound is dropped; the others' stay valid).
     pub fn leave(&mut self, i: usize) {
         if let Some(b) = self.base.get_mut(i) {

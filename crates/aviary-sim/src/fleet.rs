@@ -321,7 +321,9 @@ impl Fleet {
         self.max_extent = 0.0;
         let mut joined = false;
         for (id, h) in self.hot.iter_mut().enumerate() {
-            if !h.known {
+            // A known copy is where the drone was at its last `moved`, if a member.
+            let fresh = !h.known;
+            if fresh {
                 *h = Hot::of(&self.drones[id]);
             }
             self.in_sky[id] = h.up;
@@ -330,7 +332,7 @@ impl Fleet {
                 continue;
             }
             self.aloft.push(id);
-            joined |= !self.clearance.moved(id, h.xy);
+            joined |= !if fresh { self.clearance.moved(id, h.xy) } else { self.clearance.is_member(id) };
             self.max_extent = self.max_extent.max(h.extent);
         }
         if joined || !(self.clearance.drift() <= REMEASURE) {

@@ -146,14 +146,15 @@ pub(crate) fn extent(e: &Envelope) -> f64 {
 /// distance stands for the track's length, widened beyond the rounding of both. Enough
 /// for [`Fleet::max_extent`], which only needs to be large enough.
 pub(crate) fn extent_bound(d: &SimDrone) -> f64 {
-    let vh = hypot(d.vel[0], d.vel[1]);
+    // The square of the speed, without its root.
+    let vh2 = d.vel[0] * d.vel[0] + d.vel[1] * d.vel[1];
     let (stop, pad) = match current_leg(d) {
-        _ if vh == 0.0 => (0.0, 0.0),
+        _ if d.vel[0] == 0.0 && d.vel[1] == 0.0 => (0.0, 0.0),
         Some(Leg::Arc { radius, .. }) => {
-            let l = vh * vh / (2.0 * arc_accel(d.accel));
+            let l = vh2 / (2.0 * arc_accel(d.accel));
             (l, l * l / (2.0 * radius))
         }
-        _ => (vh * vh / (2.0 * d.accel), 0.0),
+        _ => (vh2 / (2.0 * d.accel), 0.0),
     };
     let climb = (d.vel[2] * d.vel[2].abs() / (2.0 * d.accel)).abs();
     let scale = 1.0 + d.pos[0].abs() + d.pos[1].abs() + d.pos[2].abs();

@@ -33,6 +33,7 @@
 //! would fly without yielding), until its yield is over: this breaks the standstills in
 //! which the drone with priority is the one that has to move.
 
+use aviary_api::geometry::hypot;
 use aviary_api::DroneId;
 
 use crate::drone::SimDrone;
@@ -100,7 +101,7 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 
 fn norm(v: [f64; 3]) -> f64 {
-    v[0].hypot(v[1]).hypot(v[2])
+    hypot(hypot(v[0], v[1]), v[2])
 }
 
 /// The smallest distance between two tracks sampled at the same times, moving straight

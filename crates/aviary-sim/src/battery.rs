@@ -22,6 +22,17 @@ pub(crate) fn energy_home(d: &SimDrone) -> f64 {
     time / d.endurance
 }
 
+/// At least [`energy_home`] (or NaN), bit for bit: `|dx| + |dy|`, widened far beyond the
+/// rounding of both, bounds the distance, and rounding keeps the order of the rest.
+pub(crate) fn energy_home_bound(d: &SimDrone) -> f64 {
+    if !(d.max_speed > 0.0 && d.climb_rate > 0.0 && d.endurance > 0.0) {
+        return f64::NAN;
+    }
+    let far = ((d.home[0] - d.pos[0]).abs() + (d.home[1] - d.pos[1]).abs()) * (1.0 + 1e-12);
+    let time = far / d.max_speed + d.pos[2].max(0.0) / d.climb_rate;
+    time / d.endurance
+}
+
 /// Drains `dt` seconds of flight (when `airborne`) and raises each alarm at most once.
 pub(crate) fn drain(d: &mut SimDrone, dt: f64, airborne: bool) -> Alarms {
     let mut alarms = Alarms {
@@ -37,6 +48,12 @@ pub(crate) fn drain(d: &mut SimDrone, dt: f64, airborne: bool) -> Alarms {
         d.battery = 0.0;
         alarms.empty = true;
     }
+    // Most ticks the bound shows that neither alarm can be due: no square root.
+    let bound = energy_home_bound(d);
+    let may = |k: f64| !(d.battery >= k * bound + 0.10);
+    if !((!d.low_sent && may(2.0)) || (!d.critical_sent && may(1.0))) {
+        return alarms;
+    }
     let need = energy_home(d);
     if !d.low_sent && d.battery < 2.0 * need + 0.10 {
         d.low_sent = true;
@@ -47,4 +64,29 @@ pub(crate) fn drain(d: &mut SimDrone, dt: f64, airborne: bool) -> Alarms {
         alarms.critical = true;
     }
     alarms
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn the_bound_is_never_below_the_energy(
+            x in -1e5f64..1e5, y in -1e5f64..1e5, z in -10f64..200.0,
+            hx in -1e5f64..1e5, hy in -1e5f64..1e5, axis in 0u8..3,
+            speed in 0.5f64..30.0, climb in 0.5f64..10.0, endurance in 10f64..5000.0,
+        ) {
+            let mut d = SimDrone::new(&crate::tests::one_drone().drones[0]);
+            (d.max_speed, d.climb_rate, d.endurance, d.home) = (speed, climb, endurance, [hx, hy]);
+            // On an axis of home, too, where the distance is one side alone.
+            d.pos = match axis { 0 => [hx, y, z], 1 => [x, hy, z], _ => [x, y, z] };
+            let (exact, bound) = (energy_home(&d), energy_home_bound(&d));
+            prop_assert!(bound >= exact, "{bound} < {exact}");
+            for k in [1.0, 2.0] {
+                prop_assert!(k * bound + 0.10 >= k * exact + 0.10);
+            }
+        }
+    }
 }

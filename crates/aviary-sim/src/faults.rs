@@ -36,6 +36,7 @@ impl Fleet {
             }
             f.fired = true;
             let (id, kind, at, until) = (f.drone, f.kind, f.at, f.at + f.duration);
+            self.touch(id);
             if self.drones[id].state == FlightState::Lost {
                 continue;
             }
@@ -88,6 +89,7 @@ impl Fleet {
                         until,
                         returned: false,
                     }));
+                    self.outage(id);
                 }
                 FaultKind::GpsLoss => {
                     self.fault(
@@ -101,10 +103,13 @@ impl Fleet {
                         until,
                         returned: false,
                     }));
+                    self.outage(id);
                 }
             }
         }
-        for (id, d) in self.drones.iter_mut().enumerate() {
+        // Only drones with an outage have anything to end or to return for.
+        for &id in &self.outages {
+            let d = &mut self.drones[id];
             if d.link_loss.as_ref().is_some_and(|o| o.until <= end + 1e-9) {
                 d.link_loss = None;
                 if d.state != FlightState::Lost {
@@ -119,7 +124,8 @@ impl Fleet {
             }
         }
         let max_altitude = self.max_altitude;
-        for d in &mut self.drones {
+        for &id in &self.outages {
+            let d = &mut self.drones[id];
             let Some(outage) = d.link_loss.as_mut() else {
                 continue;
             };
@@ -127,6 +133,7 @@ impl Fleet {
                 continue;
             }
             outage.returned = true;
+            self.hot[id].known = false;
             let on_its_own = d.state.airborne() && d.motion.is_none() && d.disabled.is_none();
             if on_its_own {
                 if let Ok(legs) = return_legs(d, false, max_altitude) {
@@ -134,6 +141,15 @@ impl Fleet {
                     d.begin_leg();
                 }
             }
+        }
+        let drones = &self.drones;
+        self.outages.retain(|&id| drones[id].link_loss.is_some() || drones[id].gps_loss.is_some());
+    }
+
+    /// Notes that drone `id` has an outage (the list stays ascending, without repeats).
+    fn outage(&mut self, id: usize) {
+        if let Err(at) = self.outages.binary_search(&id) {
+            self.outages.insert(at, id);
         }
     }
 }

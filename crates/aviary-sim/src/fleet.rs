@@ -11,11 +11,13 @@ use aviary_world::{FaultKind, Sensor, Target, World};
 
 use crate::avoid::Track;
 use crate::battery;
+use crate::clearance::Clearance;
 use crate::drone::SimDrone;
 use crate::geom::heading;
 use crate::grid::Grid;
+use crate::hot::Hot;
+use crate::nearby::Nearby;
 use crate::sensors::scan;
-use crate::separation::{envelope, extent};
 
 /// Something that happened during a [`Fleet::step`], in the order it happened.
 #[derive(Clone, Debug, PartialEq)]
@@ -68,17 +70,28 @@ pub struct Fleet {
     pub(crate) aloft: Vec<DroneId>,
     /// The planner's predicted tracks of drones that moved already in this step.
     pub(crate) tracks: BTreeMap<DroneId, Track>,
-    /// The drones of `aloft`, by where they are now (updated as each one moves).
+    /// Whether each drone is in `aloft`.
+    pub(crate) in_sky: Vec<bool>,
+    /// The drones of `aloft`, by where they are now (updated as each one moves), when
+    /// `sky_fresh`: built in a step only once a drone needs it (see [`Fleet::fresh_sky`]).
     pub(crate) sky: Grid,
+    pub(crate) sky_fresh: bool,
+    /// How far apart the drones of `aloft` are, at least: answers most "anybody near?"
+    /// without the sky.
+    pub(crate) clearance: Clearance,
     /// At least the largest `extent` of the envelope of a drone of `aloft` during this
-    /// step: how far, beyond the usual, separation must look for one.
+    /// step (from `extent_bound`): how far, beyond the usual, separation must look for one.
     pub(crate) max_extent: f64,
+    /// Each drone as its last turn in a step left it (see [`crate::hot`]).
+    pub(crate) hot: Vec<Hot>,
+    /// The drones with a link or GPS outage, ascending.
+    pub(crate) outages: Vec<DroneId>,
     /// The largest `max_speed + climb_rate` of the fleet (the planner's reach).
     pub(crate) fastest: f64,
     /// The world's targets by where they are.
     pub(crate) target_grid: Grid,
-    /// A scratch list for grid queries.
-    pub(crate) nearby: Vec<usize>,
+    /// The targets near each drone's way, kept between ticks.
+    pub(crate) near_targets: Vec<Nearby>,
     /// The drone of each call in progress (a call id is only ever that drone's), so that
     /// [`Fleet::interrupt`] looks at one drone, not the fleet. Entries go when the call's
     /// end is reported; one left over (a task replaced without an end) only costs a lookup.
@@ -87,6 +100,12 @@ pub struct Fleet {
 
 /// Metres on a side of a cell of [`Fleet::sky`]: about the planner's reach.
 const SKY_CELL: f64 = 400.0;
+/// Metres the drones of the sky may drift from where [`Fleet::clearance`] measured them
+/// before it measures again.
+const REMEASURE: f64 = 25.0;
+/// How many drones ahead [`Fleet::step`] warms the caches for the leg (twice as many for
+/// the task before it).
+const AHEAD: usize = 6;
 /// Metres on a side of a cell of [`Fleet::target_grid`], at least: about a sensor's range.
 const TARGET_CELL: f64 = 50.0;
 
@@ -145,11 +164,16 @@ impl Fleet {
             releases: Vec::new(),
             aloft: Vec::new(),
             tracks: BTreeMap::new(),
+            in_sky: vec![false; world.drones.len()],
             sky: Grid::new(SKY_CELL),
+            sky_fresh: false,
+            clearance: Clearance::new(world.drones.len()),
             max_extent: 0.0,
+            hot: vec![Hot::UNKNOWN; world.drones.len()],
+            outages: Vec::new(),
             fastest: world.drones.iter().map(|d| d.max_speed + d.climb_rate).fold(0.0, f64::max),
             target_grid: target_grid(&world.targets),
-            nearby: Vec::new(),
+            near_targets: vec![Nearby::default(); world.drones.len()],
             calls: HashMap::new(),
         }
     }
@@ -214,6 +238,7 @@ impl Fleet {
     ) -> (CallId, Option<CallEnd>) {
         let id = CallId(self.next_call);
         self.next_call += 1;
+        self.touch(drone);
         let end = match self.start(drone, id, function, args) {
             Ok(true) => {
                 self.calls.insert(id, drone);
@@ -238,6 +263,7 @@ impl Fleet {
     fn interrupt_on(&mut self, call: CallId, how: Interrupt) -> Option<CallEnd> {
         // Only the call's own drone can have it in progress.
         let &drone = self.calls.get(&call)?;
+        self.touch(drone);
         if let Some(d) = self.drones.get_mut(drone) {
             if d.motion.as_ref().is_some_and(|t| t.call == Some(call)) {
                 match how {
@@ -275,36 +301,66 @@ impl Fleet {
         None
     }
 
+    /// Forgets what the fleet keeps about drone `id` between steps (it may have changed).
+    pub(crate) fn touch(&mut self, id: DroneId) {
+        if let Some(h) = self.hot.get_mut(id) {
+            h.known = false;
+        }
+    }
+
     /// Advances every drone by `dt` simulated seconds.
     pub fn step(&mut self, dt: f64) -> Vec<Report> {
         let end = self.time + dt;
         let mut out = Vec::new();
         self.fire_faults(end, &mut out);
+        #[cfg(test)]
+        self.check_hot();
         self.tracks.clear();
         self.aloft.clear();
+        self.sky_fresh = false;
         self.max_extent = 0.0;
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for (id, d) in self.drones.iter().enumerate() {
-            if d.state.airborne() {
-                self.aloft.push(id);
-                let p = d.xy();
-                (lo, hi) = ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])]);
+        let mut joined = false;
+        for (id, h) in self.hot.iter_mut().enumerate() {
+            // A known copy is where the drone was at its last `moved`, if a member.
+            let fresh = !h.known;
+            if fresh {
+                *h = Hot::of(&self.drones[id]);
             }
+            self.in_sky[id] = h.up;
+            if !h.up {
+                self.clearance.leave(id);
+                continue;
+            }
+            self.aloft.push(id);
+            joined |= !if fresh { self.clearance.moved(id, h.xy) } else { self.clearance.is_member(id) };
+            self.max_extent = self.max_extent.max(h.extent);
         }
-        // The sky's window: where the drones in the air are now.
-        self.sky.reframe(lo, hi, self.aloft.len());
-        for &id in &self.aloft {
-            let d = &self.drones[id];
-            self.sky.put(id, d.xy());
-            self.max_extent = self.max_extent.max(extent(&envelope(d)));
+        if joined || !(self.clearance.drift() <= REMEASURE) {
+            self.fresh_sky();
+            let cap = self.clearance_cap();
+            self.clearance.rebuild(&self.aloft, &self.sky, cap);
         }
         for id in 0..self.drones.len() {
+            // Overlap the cache misses of the drones to come (tasks, then their legs).
+            if let Some(d) = self.drones.get(id + 2 * AHEAD) {
+                d.warm();
+            }
+            if let Some(d) = self.drones.get(id + AHEAD) {
+                d.warm_leg();
+            }
+            if self.hot[id].idle {
+                continue;
+            }
             self.step_drone(id, dt, &mut out);
+            let h = Hot::of(&self.drones[id]);
+            self.hot[id] = h;
             // Keep the sky current for the drones after this one.
-            if self.sky.contains(id) {
-                let d = &self.drones[id];
-                self.sky.put(id, d.xy());
-                self.max_extent = self.max_extent.max(extent(&envelope(d)));
+            if self.in_sky[id] {
+                if self.sky_fresh {
+                    self.sky.put(id, h.xy);
+                }
+                self.clearance.moved(id, h.xy);
+                self.max_extent = self.max_extent.max(h.extent);
             }
         }
         self.time = end;
@@ -316,6 +372,30 @@ impl Fleet {
         out
     }
 
+    /// Makes the sky hold every drone of `aloft` where it is now (once per step at most).
+    pub(crate) fn fresh_sky(&mut self) {
+        if self.sky_fresh {
+            return;
+        }
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for &id in &self.aloft {
+            let p = self.drones[id].xy();
+            (lo, hi) = ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])]);
+        }
+        self.sky.reframe(lo, hi, self.aloft.len());
+        for &id in &self.aloft {
+            self.sky.put(id, self.drones[id].xy());
+        }
+        self.sky_fresh = true;
+    }
+
+    /// How far [`Fleet::clearance`] measures: twice the planner's longest reach, plus the
+    /// drift allowed (farther gaps would tell nothing more).
+    fn clearance_cap(&self) -> f64 {
+        let reach = self.min_separation + crate::avoid::MARGIN + crate::avoid::HORIZON * 2.0 * self.fastest + 1.0;
+        2.0 * reach + 2.0 * REMEASURE
+    }
+
     fn step_drone(&mut self, id: DroneId, dt: f64, out: &mut Vec<Report>) {
         if self.drones[id].state == FlightState::Lost {
             return;
@@ -325,7 +405,9 @@ impl Fleet {
         let before = self.drones[id].pos;
         let finished = self.move_drone(id, dt);
         if finished.is_none() {
-            out.extend(self.held_back(id, dt));
+            if let Some(report) = self.held_back(id, dt) {
+                out.push(report);
+            }
         }
         let d = &mut self.drones[id];
         if let Some(task) = finished {
@@ -361,15 +443,14 @@ impl Fleet {
             d.flight_time += dt;
         }
         // Only the targets near the way flown, in their order.
-        match d.detections.iter().map(|a| a.range).reduce(f64::max) {
-            Some(range) => self.target_grid.around(from, to, range, &mut self.nearby),
-            None => self.nearby.clear(),
+        let nearby = match d.detections.iter().map(|a| a.range).reduce(f64::max) {
+            Some(range) => self.near_targets[id].around(&self.target_grid, from, to, range),
+            None => &[],
+        };
+        let found = scan(id, &mut d.detections, &self.targets, nearby, from, to);
+        if !found.is_empty() {
+            out.extend(found.into_iter().map(Report::Event));
         }
-        out.extend(
-            scan(id, &mut d.detections, &self.targets, &self.nearby, from, to)
-                .into_iter()
-                .map(Report::Event),
-        );
         let alarms = battery::drain(d, dt, airborne);
         if alarms.low {
             out.push(Report::Event(DroneEvent::Signal {

@@ -30,9 +30,25 @@ pub(crate) fn area(polygon: &[[f64; 2]]) -> f64 {
 /// The area centroid; the corners' mean when the polygon encloses no area.
 pub(crate) use aviary_api::centroid;
 
+/// `y.atan2(x)`, bit for bit, without libm when a side is zero (a drone moving along an
+/// axis, as a sweep's legs do): then the result is one of ±0, ±π/2, ±π (C99 Annex F).
+fn atan2(y: f64, x: f64) -> f64 {
+    if y == 0.0 && !x.is_nan() {
+        if x > 0.0 || (x == 0.0 && x.is_sign_positive()) {
+            y
+        } else {
+            std::f64::consts::PI.copysign(y)
+        }
+    } else if x == 0.0 && !y.is_nan() {
+        std::f64::consts::FRAC_PI_2.copysign(y)
+    } else {
+        y.atan2(x)
+    }
+}
+
 /// Degrees clockwise from north of a ground velocity.
 pub(crate) fn heading(vx: f64, vy: f64) -> f64 {
-    let h = vx.atan2(vy).to_degrees();
+    let h = atan2(vx, vy).to_degrees();
     if h < 0.0 {
         h + 360.0
     } else {
@@ -71,6 +87,17 @@ mod tests {
             centroid(&[[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]),
             [1.0, 1.0]
         );
+    }
+
+    #[test]
+    fn atan2_is_libms_bit_for_bit() {
+        let xs = [0.0, -0.0, 1e-300, 3.0, -4.5, 1e300, f64::INFINITY, f64::NEG_INFINITY, f64::NAN, -7e-320];
+        for y in xs {
+            for x in xs {
+                let (a, b) = (atan2(y, x), y.atan2(x));
+                assert!(a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()), "{y} {x}: {a} {b}");
+            }
+        }
     }
 
     #[test]

@@ -101,10 +101,6 @@ impl Grid {
         }
     }
 
-    pub fn contains(&self, i: usize) -> bool {
-        self.at.get(i).is_some_and(Option::is_some)
-    }
-
     /// Empties the grid and sets its window to the box from `lo` to `hi` (where about
     /// `n` items will be put), unless that box has too many cells for `n`; items may
     /// still be put anywhere.
@@ -166,6 +162,30 @@ impl Grid {
                 j != except && !((q[0] - p[0]).abs() > r || (q[1] - p[1]).abs() > r)
             })
         })
+    }
+
+    /// Where item `i` was last put.
+    pub fn at(&self, i: usize) -> [f64; 2] {
+        self.pos[i]
+    }
+
+    /// The Chebyshev distance from `p` to the nearest item other than `except`, or `cap`
+    /// when none is within `cap`; NaN when one that may be is at NaN.
+    pub fn nearest(&self, p: [f64; 2], cap: f64, except: usize) -> f64 {
+        let mut best = cap;
+        self.visit(p, p, cap, |list| {
+            for &j in list.iter().filter(|&&j| j != except) {
+                let q = self.pos[j];
+                let (dx, dy) = ((q[0] - p[0]).abs(), (q[1] - p[1]).abs());
+                if dx.is_nan() || dy.is_nan() {
+                    best = f64::NAN;
+                    return true;
+                }
+                best = best.min(dx.max(dy));
+            }
+            false
+        });
+        best
     }
 
     /// Calls `f` on the list of every cell that meets the square of half-side `r` around

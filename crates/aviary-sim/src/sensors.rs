@@ -34,7 +34,8 @@ pub(crate) fn detection_range(
 
 /// The targets found while the drone flew from `from` to `to` (ground points) this tick,
 /// marking them found; events in activation order, then target order. Only `candidates`
-/// (ascending target indices: at least every target within range of the way) are looked at.
+/// are looked at: ascending target indices, at least every target inside the way's box
+/// widened by the range and a metre (see [`crate::nearby`]).
 pub(crate) fn scan(
     drone: DroneId,
     activations: &mut [Activation],
@@ -44,6 +45,9 @@ pub(crate) fn scan(
     to: [f64; 2],
 ) -> Vec<DroneEvent> {
     let mut events = Vec::new();
+    if candidates.is_empty() {
+        return events;
+    }
     for act in activations.iter_mut() {
         // Far outside the box of the way widened by the range: out of range, without the
         // kind's string or the found list (the margin is far above rounding).

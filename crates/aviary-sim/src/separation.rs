@@ -125,7 +125,7 @@ pub(crate) fn segment_gap(p: [f64; 2], q: [f64; 2], a: [f64; 2], b: [f64; 2]) ->
 pub(crate) fn gap(e: &Envelope, f: &Envelope) -> f64 {
     let h = (segment_gap(e.from, e.to, f.from, f.to) - e.pad - f.pad).max(0.0);
     let v = (f.low - e.high).max(e.low - f.high).max(0.0);
-    h.hypot(v)
+    hypot(h, v)
 }
 
 /// How far from where it is a drone's envelope could reach after one tick (generous: on
@@ -140,6 +140,25 @@ fn reach(d: &SimDrone, dt: f64) -> f64 {
 /// How far a drone's envelope reaches from it.
 pub(crate) fn extent(e: &Envelope) -> f64 {
     dist(e.from, e.to) + e.pad + (e.high - e.low)
+}
+
+/// At least `extent(&envelope(d))` (or NaN), without building the envelope: the stopping
+/// distance stands for the track's length, widened beyond the rounding of both. Enough
+/// for [`Fleet::max_extent`], which only needs to be large enough.
+pub(crate) fn extent_bound(d: &SimDrone) -> f64 {
+    // The square of the speed, without its root.
+    let vh2 = d.vel[0] * d.vel[0] + d.vel[1] * d.vel[1];
+    let (stop, pad) = match current_leg(d) {
+        _ if d.vel[0] == 0.0 && d.vel[1] == 0.0 => (0.0, 0.0),
+        Some(Leg::Arc { radius, .. }) => {
+            let l = vh2 / (2.0 * arc_accel(d.accel));
+            (l, l * l / (2.0 * radius))
+        }
+        _ => (vh2 / (2.0 * d.accel), 0.0),
+    };
+    let climb = (d.vel[2] * d.vel[2].abs() / (2.0 * d.accel)).abs();
+    let scale = 1.0 + d.pos[0].abs() + d.pos[1].abs() + d.pos[2].abs();
+    (stop + pad + climb) * (1.0 + 1e-9) + 1e-9 * scale
 }
 
 /// What a move may change, to put back when the filter refuses it.
@@ -291,7 +310,7 @@ impl Fleet {
             .filter(|&&j| j != id && counts(&self.drones[j]))
             .map(|&j| (self.drones[j].pos, envelope(&self.drones[j])))
             .filter(|(p, e)| {
-                let apart = (p[0] - here[0]).hypot(p[1] - here[1]).hypot(p[2] - here[2]);
+                let apart = hypot(hypot(p[0] - here[0], p[1] - here[1]), p[2] - here[2]);
                 apart < self.min_separation + reach + extent(e)
             })
             .map(|(_, e)| e)
@@ -307,8 +326,15 @@ impl Fleet {
         }
         let separation = self.min_separation + reach(d, dt) + self.max_extent;
         let r = separation.max(crate::avoid::reach(self, d));
+        let p = d.xy();
+        if self.clearance.clear(id, p, r) {
+            #[cfg(test)]
+            self.check_clear(id, r);
+            return true;
+        }
         // The sky holds every drone of `aloft` where it is now (moved ones included).
-        !self.sky.any_within(d.xy(), r, id)
+        self.fresh_sky();
+        !self.sky.any_within(p, r, id)
     }
 
     /// Moves drone `id` by one tick: the planner's choice if its envelope stays clear of
@@ -327,6 +353,7 @@ impl Fleet {
             d.stalled = 0.0;
             return d.tick_motion(dt);
         }
+        self.fresh_sky();
         let near = self.near(id, dt);
         self.plan(id, dt, &near);
         if near.is_empty() {
@@ -356,7 +383,7 @@ fn progress(d: &SimDrone, task: &MotionTask) -> Progress {
     match task.legs.front() {
         Some(Leg::Move { to, .. }) => {
             let gap = |k: usize| d.pos[k] - to[k];
-            (n, 0, gap(0).hypot(gap(1)).hypot(gap(2)))
+            (n, 0, hypot(hypot(gap(0), gap(1)), gap(2)))
         }
         Some(Leg::Arc { radius, total, .. }) => (n, 0, (total - task.arc_done) * radius),
         Some(Leg::Hold { left }) if *left > 1e-9 => (n, 1, *left),
@@ -418,7 +445,7 @@ impl Fleet {
             .filter(|&(j, o)| j != id && counts(o))
             .map(|(_, o)| {
                 let gap = |k: usize| o.pos[k] - d.pos[k];
-                (gap(0).hypot(gap(1)).hypot(gap(2)), o)
+                (hypot(hypot(gap(0), gap(1)), gap(2)), o)
             })
             .filter(|(apart, _)| *apart <= 2.0 * sep + MARGIN)
             .min_by(|a, b| a.0.total_cmp(&b.0))

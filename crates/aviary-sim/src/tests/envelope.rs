@@ -130,3 +130,36 @@ fn the_distance_between_envelopes_combines_ground_and_height() {
     // 3 m over the ground and 4 m of height: 5 m.
     assert_eq!(gap(&point([13.0, 0.0, 16.0]), &a), 5.0);
 }
+
+mod bound {
+    use super::*;
+    use crate::motion::{Leg, MotionTask};
+    use crate::separation::{extent, extent_bound};
+    use aviary_api::FlightState;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// `extent_bound` never falls below the extent of the envelope it stands for, on
+        /// straight legs, arcs and hovers, far from the origin too.
+        #[test]
+        fn extent_bound_is_at_least_the_extent(
+            pos in (-1e5f64..1e5, -1e5f64..1e5, 0f64..150.0),
+            vel in (-20f64..20.0, -20f64..20.0, -6f64..6.0),
+            axis in 0u8..3, accel in 0.5f64..10.0, radius in 1f64..500.0, leg in 0u8..3,
+        ) {
+            let mut d = Fleet::new(&one_drone()).drones[0].clone();
+            d.pos = [pos.0, pos.1, pos.2];
+            d.vel = match axis { 0 => [vel.0, 0.0, vel.2], 1 => [0.0, vel.1, 0.0], _ => [vel.0, vel.1, vel.2] };
+            d.accel = accel;
+            d.state = FlightState::Flying;
+            let legs = match leg {
+                0 => vec![Leg::Move { to: [0.0, 0.0, 20.0], speed: 10.0, state: FlightState::Flying }],
+                1 => vec![Leg::Arc { center: [0.0, 0.0], radius, start: 0.0, total: 6.0, speed: 10.0 }],
+                _ => vec![Leg::Hold { left: 3.0 }],
+            };
+            d.motion = Some(Box::new(MotionTask::new(None, legs)));
+            let (exact, bound) = (extent(&envelope(&d)), extent_bound(&d));
+            prop_assert!(bound >= exact, "{bound} < {exact}");
+        }
+    }
+}

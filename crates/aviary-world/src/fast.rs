@@ -12,8 +12,13 @@
 //! a dotted or quoted key, a date, a key/value pair outside any table, a table defined
 //! twice or implicitly first) returns `None`, and the caller takes the serde path,
 //! which reports the problem with the same words as before.
+//!
+//! Each `[drones.NAME]` table is handed to the caller as soon as it is complete (when
+//! the next header starts), and leaves the tree: a world of many drones never has all
+//! their tables in memory. So that this stays exact, every entry of `[drones]` must come
+//! from such a header, once: anything else there takes the serde path.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use aviary_diagnostics::Span;
 use toml_parser::decoder::{Encoding, IntegerRadix, ScalarKind};
@@ -25,6 +30,20 @@ use crate::node::{Entry, Node, Value};
 
 /// The tree of `text`, or `None` when the serde path should read it.
 pub(crate) fn parse(text: &str) -> Option<Node> {
+    let mut drones = Vec::new();
+    let mut root = parse_with(text, &mut |e| drones.push(e))?;
+    if let Value::Table(top) = &mut root.value {
+        if let Some(Entry { node: Node { value: Value::Table(entries), .. }, .. }) = top.iter_mut().find(|e| e.key == "drones") {
+            *entries = drones;
+        }
+    }
+    Some(root)
+}
+
+/// As [`parse`], but each `[drones.NAME]` table goes to `on_drone` (in file order) as
+/// soon as it has been read, and the tree's `drones` table is left empty. When this
+/// returns `None`, some tables may have gone to `on_drone` already.
+pub(crate) fn parse_with(text: &str, on_drone: &mut dyn FnMut(Entry)) -> Option<Node> {
     if !within_toml_1_0(text.as_bytes()) {
         return None;
     }
@@ -38,6 +57,10 @@ pub(crate) fn parse(text: &str) -> Option<Node> {
         dotted: false,
         stack: Vec::new(),
         bail: false,
+        on_drone,
+        drone_names: HashSet::new(),
+        drones_at: None,
+        open_drone: false,
     };
     let mut errors = Errors(false);
     // Parsed a table at a time: all the tokens of a large world at once would take more
@@ -86,6 +109,7 @@ pub(crate) fn parse(text: &str) -> Option<Node> {
     if errors.0 || builder.bail || !builder.stack.is_empty() {
         return None;
     }
+    builder.hand_over_drone()?;
     Some(builder.root.into_node())
 }
 
@@ -181,7 +205,7 @@ enum Open {
     Inline { start: usize, entries: Vec<Entry>, key: Option<(String, Span)> },
 }
 
-struct Builder<'i> {
+struct Builder<'i, 's> {
     source: Source<'i>,
     root: Table,
     /// Where key/value pairs go: entry indices from the root (into the last table of
@@ -195,13 +219,52 @@ struct Builder<'i> {
     dotted: bool,
     stack: Vec<Open>,
     bail: bool,
+    /// Takes each `[drones.NAME]` table once it is complete.
+    on_drone: &'s mut dyn FnMut(Entry),
+    /// The drones read so far (their tables are gone): a second `[drones.NAME]` of one
+    /// of them takes the serde path.
+    drone_names: HashSet<&'i str>,
+    /// The root's entry of `drones`.
+    drones_at: Option<usize>,
+    /// The current table is a `[drones.NAME]`, to be handed over at the next header.
+    open_drone: bool,
 }
 
 fn span(s: toml_parser::Span) -> Span {
     Span::new(s.start(), s.end())
 }
 
-impl Builder<'_> {
+impl<'i> Builder<'i, '_> {
+    /// Hands the `[drones.NAME]` table just read to `on_drone`: it is the only entry
+    /// of `drones`, since every earlier one went the same way.
+    fn hand_over_drone(&mut self) -> Option<()> {
+        if !std::mem::take(&mut self.open_drone) {
+            return Some(());
+        }
+        let Item::Table(drones) = &mut self.root.entries.get_mut(self.drones_at?)?.2 else { return None };
+        let (key, key_span, Item::Table(table)) = drones.entries.pop()? else { return None };
+        self.current = None;
+        (self.on_drone)(Entry { key, key_span, node: table.into_node() });
+        Some(())
+    }
+
+    /// Whether a header may open a table under `drones` (`[drones]` or `[drones.NAME]`,
+    /// each once) and whether it is a drone's; `None` for the serde path.
+    fn drone_header(&mut self, array: bool, keys: &[(String, Span)]) -> Option<bool> {
+        if keys.first().is_none_or(|(k, _)| k != "drones") {
+            return Some(false);
+        }
+        match keys {
+            [_] if !array => Some(false),
+            [_, (name, at)] if !array => {
+                // A bare key: its text is its name.
+                let text: &'i str = self.source.input().get(at.range())?;
+                (text == name && self.drone_names.insert(text)).then_some(true)
+            }
+            _ => None,
+        }
+    }
+
     fn table_at<'t>(root: &'t mut Table, path: &[usize]) -> Option<&'t mut Table> {
         let mut table = root;
         for &i in path {
@@ -216,6 +279,8 @@ impl Builder<'_> {
 
     /// `[a.b.c]` or `[[a.b.c]]`, from `start` to `end`.
     fn header(&mut self, array: bool, start: usize, end: usize, keys: Vec<(String, Span)>) -> Option<()> {
+        self.hand_over_drone()?;
+        let drone = self.drone_header(array, &keys)?;
         let (last, parents) = keys.split_last()?;
         let mut path = Vec::with_capacity(keys.len());
         let mut table = &mut self.root;
@@ -246,6 +311,10 @@ impl Builder<'_> {
             (Some(_), false) => return None,
         };
         path.push(i);
+        if keys[0].0 == "drones" {
+            self.drones_at = path.first().copied();
+        }
+        self.open_drone = drone;
         self.current = Some(path);
         Some(())
     }
@@ -264,6 +333,10 @@ impl Builder<'_> {
             None => {
                 let (k, key_span) = self.key.take()?;
                 let path = self.current.as_ref()?;
+                // `[drones]` holds only `[drones.NAME]` tables here.
+                if path.len() == 1 && Some(path[0]) == self.drones_at {
+                    return None;
+                }
                 let table = Self::table_at(&mut self.root, path)?;
                 if table.find(&k).is_some() {
                     return None;
@@ -327,7 +400,7 @@ impl Builder<'_> {
     }
 }
 
-impl EventReceiver for Builder<'_> {
+impl EventReceiver for Builder<'_, '_> {
     fn std_table_open(&mut self, at: toml_parser::Span, _: &mut dyn ErrorSink) {
         self.header = Some((false, at.start(), Vec::new()));
     }
@@ -382,7 +455,7 @@ impl EventReceiver for Builder<'_> {
     }
 }
 
-impl Builder<'_> {
+impl Builder<'_, '_> {
     fn close_header(&mut self, at: toml_parser::Span) {
         let ok = match self.header.take() {
             Some((array, start, keys)) => self.header(array, start, at.end(), keys),

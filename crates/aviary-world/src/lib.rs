@@ -25,7 +25,8 @@ pub const BUILTIN_SENSORS: &[&str] = &["camera"];
 /// Reads a world file. Returns the world only when there are no errors; the diagnostics
 /// are sorted by position.
 /// For the fuzz target and tests: panics when the fast reader accepts `text` but builds
-/// another tree than the serde path (the fast path must only ever be a shortcut).
+/// another tree than the serde path, or (reading drones as it goes) another world or
+/// other diagnostics (the fast path must only ever be a shortcut).
 #[doc(hidden)]
 pub fn assert_fast_reader_agrees(text: &str) {
     if let Some(fast) = fast::parse(text) {
@@ -33,6 +34,14 @@ pub fn assert_fast_reader_agrees(text: &str) {
             Ok(slow) => assert!(fast == slow, "the fast reader and serde read {text:?} differently:\n{fast:#?}\n{slow:#?}"),
             Err(e) => panic!("the fast reader accepts {text:?}, which serde refuses: {e}"),
         }
+    }
+    if let Some((world, mut diags)) = build::read_fast(FileId::default(), text) {
+        let slow = node::Node::parse_serde(text).unwrap_or_else(|e| panic!("the fast reader accepts {text:?}, which serde refuses: {e}"));
+        let (slow_world, mut slow_diags) = build::read_tree(FileId::default(), text, slow);
+        aviary_diagnostics::sort(&mut diags);
+        aviary_diagnostics::sort(&mut slow_diags);
+        assert!(world == slow_world, "the fast reader builds another world from {text:?}:\n{world:#?}\n{slow_world:#?}");
+        assert!(diags == slow_diags, "the fast reader finds other problems in {text:?}:\n{diags:#?}\n{slow_diags:#?}");
     }
 }
 

@@ -1,10 +1,9 @@
 //! From the spanned tree to a [`World`]: the top level, `[site]`, `[places]`, `[areas]`,
 //! and the checks across tables (one name, one meaning).
 
-use std::collections::HashMap;
-
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 
+use crate::hash::QuickMap;
 use crate::node::{Entry, Node, Value};
 use crate::read::{suggest, Ctx};
 use crate::{fast, Area, Geo, Place, Site, World};
@@ -55,8 +54,9 @@ pub(crate) fn read_fast(file: FileId, text: &str) -> Option<(World, Vec<Diagnost
     let mut cx = Ctx { file, text, diags: Vec::new() };
     // Room for the drones up front: doubling a vector of many drones costs more than
     // counting their headers.
-    let mut drones = Drones::with_capacity(text.matches("\n[drones.").count());
-    let root = fast::parse_with(text, &mut |e| drones.entry(&mut cx, e))?;
+    let count = text.matches("\n[drones.").count() + usize::from(text.starts_with("[drones."));
+    let mut drones = Drones::with_capacity(count);
+    let root = fast::parse_with(text, count, &mut |e| drones.entry(&mut cx, e))?;
     Some(build(cx, root, drones))
 }
 
@@ -268,7 +268,7 @@ fn areas(cx: &mut Ctx, node: &Node) -> Vec<Area> {
 /// Within each kind names are unique already (TOML keys, one group per name), so only
 /// names of two kinds can clash: the drones, the many, are looked up among the others.
 fn unique_names(cx: &mut Ctx, world: &World, group_spans: &[Span]) {
-    let mut named: HashMap<&str, Vec<(&str, Span)>> = HashMap::new();
+    let mut named: QuickMap<&str, Vec<(&str, Span)>> = QuickMap::default();
     let places = world.places.iter().map(|p| (p.name.as_str(), "a place", p.span));
     let areas = world.areas.iter().map(|a| (a.name.as_str(), "an area", a.span));
     let groups = world.groups.iter().zip(group_spans).map(|(g, span)| (g.name.as_str(), "a group", *span));

@@ -18,7 +18,7 @@
 //! their tables in memory. So that this stays exact, every entry of `[drones]` must come
 //! from such a header, once: anything else there takes the serde path.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
 use aviary_diagnostics::Span;
 use toml_parser::decoder::{Encoding, IntegerRadix, ScalarKind};
@@ -26,12 +26,13 @@ use toml_parser::lexer::TokenKind;
 use toml_parser::parser::EventReceiver;
 use toml_parser::{ErrorSink, ParseError, Source};
 
+use crate::hash::QuickSet;
 use crate::node::{Entry, Node, Value};
 
 /// The tree of `text`, or `None` when the serde path should read it.
 pub(crate) fn parse(text: &str) -> Option<Node> {
     let mut drones = Vec::new();
-    let mut root = parse_with(text, &mut |e| drones.push(e))?;
+    let mut root = parse_with(text, 0, &mut |e| drones.push(e))?;
     if let Value::Table(top) = &mut root.value {
         if let Some(Entry { node: Node { value: Value::Table(entries), .. }, .. }) = top.iter_mut().find(|e| e.key == "drones") {
             *entries = drones;
@@ -42,8 +43,9 @@ pub(crate) fn parse(text: &str) -> Option<Node> {
 
 /// As [`parse`], but each `[drones.NAME]` table goes to `on_drone` (in file order) as
 /// soon as it has been read, and the tree's `drones` table is left empty. When this
-/// returns `None`, some tables may have gone to `on_drone` already.
-pub(crate) fn parse_with(text: &str, on_drone: &mut dyn FnMut(Entry)) -> Option<Node> {
+/// returns `None`, some tables may have gone to `on_drone` already. `drones`: about how
+/// many there are.
+pub(crate) fn parse_with(text: &str, drones: usize, on_drone: &mut dyn FnMut(Entry)) -> Option<Node> {
     if !within_toml_1_0(text.as_bytes()) {
         return None;
     }
@@ -58,7 +60,7 @@ pub(crate) fn parse_with(text: &str, on_drone: &mut dyn FnMut(Entry)) -> Option<
         stack: Vec::new(),
         bail: false,
         on_drone,
-        drone_names: HashSet::new(),
+        drone_names: QuickSet::with_capacity_and_hasher(drones, Default::default()),
         drones_at: None,
         open_drone: false,
     };
@@ -76,8 +78,9 @@ pub(crate) fn parse_with(text: &str, on_drone: &mut dyn FnMut(Entry)) -> Option<
             TokenKind::Newline if inline > 0 => return None,
             TokenKind::RightCurlyBracket if last == TokenKind::Comma => return None,
             TokenKind::BasicString | TokenKind::MlBasicString => {
-                let raw = text.get(token.span().start()..token.span().end())?;
-                if raw.contains("\\e") || raw.contains("\\x") || raw.contains('\r') {
+                let raw = text.get(token.span().start()..token.span().end())?.as_bytes();
+                let escapes = raw.windows(2).any(|w| w[0] == b'\\' && matches!(w[1], b'e' | b'x'));
+                if escapes || raw.contains(&b'\r') {
                     return None;
                 }
             }
@@ -123,6 +126,34 @@ fn within_toml_1_0(bytes: &[u8]) -> bool {
         0..=0x1f | 0x7f => false,
         _ => true,
     })
+}
+
+/// A TOML 1.0 bare key: the decoder would return it unchanged.
+fn is_bare_key(text: &str) -> bool {
+    !text.is_empty() && text.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
+}
+
+/// The scalars most files are made of, read without the decoder: a decimal integer
+/// without sign, underscores or leading zeros (that fits), a boolean, and a one-line
+/// string without escapes. `None`: ask the decoder.
+fn plain_scalar(text: &str, encoding: Option<Encoding>) -> Option<Value> {
+    let quoted = |q: u8| {
+        let inner = text.strip_prefix(q as char)?.strip_suffix(q as char)?;
+        (!inner.contains([q as char, '\\'])).then(|| Value::Str(inner.to_owned()))
+    };
+    match encoding {
+        None => match text {
+            "true" => Some(Value::Bool(true)),
+            "false" => Some(Value::Bool(false)),
+            _ if (1..=18).contains(&text.len()) && text.bytes().all(|b| b.is_ascii_digit()) && (text.len() == 1 || !text.starts_with('0')) => {
+                text.parse().ok().map(Value::Int)
+            }
+            _ => None,
+        },
+        Some(Encoding::BasicString) => quoted(b'"'),
+        Some(Encoding::LiteralString) => quoted(b'\''),
+        Some(_) => None,
+    }
 }
 
 struct Errors(bool);
@@ -223,7 +254,7 @@ struct Builder<'i, 's> {
     on_drone: &'s mut dyn FnMut(Entry),
     /// The drones read so far (their tables are gone): a second `[drones.NAME]` of one
     /// of them takes the serde path.
-    drone_names: HashSet<&'i str>,
+    drone_names: QuickSet<&'i str>,
     /// The root's entry of `drones`.
     drones_at: Option<usize>,
     /// The current table is a `[drones.NAME]`, to be handed over at the next header.
@@ -350,6 +381,9 @@ impl<'i> Builder<'i, '_> {
 
     fn scalar(&mut self, at: toml_parser::Span, encoding: Option<Encoding>) -> Option<()> {
         let text = self.source.input().get(at.start()..at.end())?;
+        if let Some(value) = plain_scalar(text, encoding) {
+            return self.value(Node { span: span(at), value });
+        }
         let raw = toml_parser::Raw::new_unchecked(text, encoding, at);
         let mut out = String::new();
         let mut errors = Errors(false);
@@ -374,12 +408,17 @@ impl<'i> Builder<'i, '_> {
         // The parser leaves a bare key's characters to the decoder (`Lookout@` lexes as
         // one key), so decode it and take serde's path on any complaint.
         let text = self.source.input().get(at.start()..at.end())?;
-        let mut name = String::new();
-        let mut errors = Errors(false);
-        toml_parser::Raw::new_unchecked(text, None, at).decode_key(&mut name, &mut errors);
-        if errors.0 {
-            return None;
-        }
+        let name = if is_bare_key(text) {
+            text.to_owned()
+        } else {
+            let mut name = String::new();
+            let mut errors = Errors(false);
+            toml_parser::Raw::new_unchecked(text, None, at).decode_key(&mut name, &mut errors);
+            if errors.0 {
+                return None;
+            }
+            name
+        };
         let key = (name, span(at));
         if let Some((_, _, keys)) = &mut self.header {
             keys.push(key);

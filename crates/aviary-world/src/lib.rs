@@ -10,6 +10,7 @@
 
 mod build;
 mod fast;
+mod hash;
 mod node;
 mod read;
 #[cfg(test)]

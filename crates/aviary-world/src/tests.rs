@@ -795,6 +795,9 @@ fn the_fast_reader_gives_the_same_tree_as_serde() {
         "[site]\norigin = { lat = 46.6, lon = 14.2, alt = 440.0 }\ngeofence = [[-600, -600], [600, -600], [600, 600]]\n",
         "\n\n# only comments\n",
         "",
+        // Scalars read without the decoder, and their neighbours read with it.
+        "[a]\ni = 0\nj = -0\nk = 123456789012345678\nl = 1234567890123456789\nm = +7\nn = 'lit \"q\"'\no = \"tab\there\"\np = \"\"\nq = ''\nb = false\nc = true\nu = 1_000\ne = \"\\u00e9\\\\\"\nf = -12\ng = 2.5\nh = \"\u{e9}t\u{e9}\"\n",
+        "[a]\nk-1 = 1\n_k = 2\n3 = 3\n",
     ];
     for text in examples {
         let fast = crate::fast::parse(text).unwrap_or_else(|| panic!("the fast reader reads {text:?}"));
@@ -821,6 +824,9 @@ fn the_fast_reader_gives_the_same_tree_as_serde() {
         "[a]\nd = 1979-05-27\n",
         "[a]\nx = \n",
         "[a]\nx = 0x10\n",
+        "[a]\nx = 01\n",
+        "[a]\nx = \"open\n",
+        "[a]\nx = 'open\n",
         "[a\n",
         "[places]\nLookout@= [100, 40]\n",
         "[drones.a]\nhom\u{e9} = [0, 0]\n",

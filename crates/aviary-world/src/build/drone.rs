@@ -1,10 +1,9 @@
 //! `[drones.NAME]`: the known keys, the backend, and every other key as an attribute.
 
-use std::collections::HashMap;
-
 use aviary_diagnostics::Span;
 
 use super::get;
+use crate::hash::QuickMap;
 use crate::node::{Entry, Node, Value};
 use crate::read::{quoted, suggest, toml_text, Ctx};
 use crate::{AttributeValue, Backend, Drone, Group, BUILTIN_SENSORS};
@@ -28,7 +27,7 @@ pub(super) struct Drones {
     pub groups: Vec<Group>,
     /// Where each group of `groups` is first named.
     pub group_spans: Vec<Span>,
-    group_index: HashMap<String, usize>,
+    group_index: QuickMap<String, usize>,
     /// (drone, its sensor's index, span) of every sensor named.
     sensors: Vec<(usize, usize, Span)>,
     /// Entries that are not tables, each with the number of drones before it.
@@ -198,7 +197,7 @@ fn attribute(cx: &mut Ctx, drone: &str, e: &Entry) -> Option<(String, AttributeV
     }
     let value = match &e.node.value {
         Value::Int(_) | Value::Float(_) => {
-            AttributeValue::Number(cx.number(&format!("attribute `{key}`"), &e.node)?)
+            AttributeValue::Number(cx.number(&Named("attribute", key), &e.node)?)
         }
         Value::Str(s) => AttributeValue::Text(s.clone()),
         Value::Bool(b) => AttributeValue::Bool(*b),

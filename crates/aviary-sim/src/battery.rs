@@ -18,8 +18,8 @@ pub(crate) struct Alarms {
 
 /// The fraction of a full battery the drone needs to fly home and land from where it is.
 pub(crate) fn energy_home(d: &SimDrone) -> f64 {
-    let time = dist(d.xy(), d.home) / d.max_speed + d.pos[2].max(0.0) / d.climb_rate;
-    time / d.endurance
+    let time = dist(d.xy(), d.home) / d.spec.max_speed + d.pos[2].max(0.0) / d.spec.climb_rate;
+    time / d.spec.endurance
 }
 
 /// Drains `dt` seconds of flight (when `airborne`) and raises each alarm at most once.
@@ -32,7 +32,7 @@ pub(crate) fn drain(d: &mut SimDrone, dt: f64, airborne: bool) -> Alarms {
     if !airborne {
         return alarms;
     }
-    d.battery -= dt / d.endurance;
+    d.battery -= dt / d.spec.endurance;
     if d.battery <= 0.0 {
         d.battery = 0.0;
         alarms.empty = true;

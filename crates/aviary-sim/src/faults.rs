@@ -39,7 +39,7 @@ impl Fleet {
             if self.drones[id].state == FlightState::Lost {
                 continue;
             }
-            let name = self.drones[id].name.clone();
+            let name = self.names[id].to_owned();
             match kind {
                 FaultKind::BatteryCritical => {
                     let d = &mut self.drones[id];
@@ -64,12 +64,12 @@ impl Fleet {
                         out,
                     );
                     let d = &mut self.drones[id];
-                    d.disabled = Some(format!("{name} had a motor failure"));
+                    d.rare_mut().disabled = Some(format!("{name} had a motor failure"));
                     if d.state.airborne() {
                         let to = [d.pos[0], d.pos[1], 0.0];
                         let leg = Leg::Move {
                             to,
-                            speed: d.max_speed,
+                            speed: d.spec.max_speed,
                             state: FlightState::Landing,
                         };
                         d.motion = Some(Box::new(MotionTask::new(None, vec![leg])));
@@ -83,11 +83,11 @@ impl Fleet {
                         format!("{name}: link lost (simulated fault)"),
                         out,
                     );
-                    self.drones[id].link_loss = Some(Box::new(Outage {
+                    self.drones[id].rare_mut().link_loss = Some(Outage {
                         since: at,
                         until,
                         returned: false,
-                    }));
+                    });
                 }
                 FaultKind::GpsLoss => {
                     self.fault(
@@ -96,17 +96,18 @@ impl Fleet {
                         format!("{name}: GPS lost (simulated fault)"),
                         out,
                     );
-                    self.drones[id].gps_loss = Some(Box::new(Outage {
+                    self.drones[id].rare_mut().gps_loss = Some(Outage {
                         since: at,
                         until,
                         returned: false,
-                    }));
+                    });
                 }
             }
         }
         for (id, d) in self.drones.iter_mut().enumerate() {
-            if d.link_loss.as_ref().is_some_and(|o| o.until <= end + 1e-9) {
-                d.link_loss = None;
+            let Some(rare) = d.rare.as_deref_mut() else { continue };
+            if rare.link_loss.as_ref().is_some_and(|o| o.until <= end + 1e-9) {
+                rare.link_loss = None;
                 if d.state != FlightState::Lost {
                     out.push(Report::Event(DroneEvent::Signal {
                         drone: id,
@@ -114,22 +115,22 @@ impl Fleet {
                     }));
                 }
             }
-            if d.gps_loss.as_ref().is_some_and(|o| o.until <= end + 1e-9) {
-                d.gps_loss = None;
+            if rare.gps_loss.as_ref().is_some_and(|o| o.until <= end + 1e-9) {
+                rare.gps_loss = None;
             }
         }
         let max_altitude = self.max_altitude;
-        for d in &mut self.drones {
-            let Some(outage) = d.link_loss.as_mut() else {
+        for (id, d) in self.drones.iter_mut().enumerate() {
+            let Some(outage) = d.rare.as_mut().and_then(|r| r.link_loss.as_mut()) else {
                 continue;
             };
             if outage.returned || end + 1e-9 < outage.since + self.link_loss_rtl_after {
                 continue;
             }
             outage.returned = true;
-            let on_its_own = d.state.airborne() && d.motion.is_none() && d.disabled.is_none();
+            let on_its_own = d.state.airborne() && d.motion.is_none() && d.disabled().is_none();
             if on_its_own {
-                if let Ok(legs) = return_legs(d, false, max_altitude) {
+                if let Ok(legs) = return_legs(d, &self.names[id], false, max_altitude) {
                     d.motion = Some(Box::new(MotionTask::new(None, legs)));
                     d.begin_leg();
                 }

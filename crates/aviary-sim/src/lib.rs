@@ -136,6 +136,7 @@ mod fleet;
 mod geom;
 mod grid;
 mod motion;
+mod names;
 mod profile;
 mod sensors;
 mod separation;

@@ -16,6 +16,8 @@ mod read;
 #[cfg(test)]
 mod tests;
 
+use std::sync::Arc;
+
 use aviary_diagnostics::{Diagnostic, FileId, Span};
 use serde::Serialize;
 
@@ -149,13 +151,17 @@ impl Area {
     }
 }
 
+/// One `[drones.NAME]`. A world may have a great many, all alive while a mission runs: what
+/// most drones leave empty or share (a group's name, attribute keys, a MAVLink link) costs
+/// them a pointer at most.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Drone {
     pub name: String,
     pub home: [f64; 3],
-    pub group: Option<String>,
-    pub sensors: Vec<String>,
-    pub payload: Vec<String>,
+    /// Shared with the other members of the group.
+    pub group: Option<Arc<str>>,
+    pub sensors: Box<[String]>,
+    pub payload: Box<[String]>,
     /// m/s, default 10.
     pub max_speed: f64,
     /// m/s, default 3.
@@ -167,8 +173,9 @@ pub struct Drone {
     /// Seconds of flight on a full battery, default 1800.
     pub endurance: f64,
     pub backend: Backend,
-    /// Every other key, in file order: readable as `d.key`.
-    pub attributes: Vec<(String, AttributeValue)>,
+    /// Every other key, in file order: readable as `d.key`. Keys are shared by the
+    /// drones that have them.
+    pub attributes: Box<[(Arc<str>, AttributeValue)]>,
     /// The `NAME` of `[drones.NAME]`.
     #[serde(skip)]
     pub span: Span,
@@ -178,7 +185,7 @@ impl Drone {
     pub fn attribute(&self, key: &str) -> Option<&AttributeValue> {
         self.attributes
             .iter()
-            .find(|(k, _)| k == key)
+            .find(|(k, _)| &**k == key)
             .map(|(_, v)| v)
     }
 }
@@ -186,11 +193,16 @@ impl Drone {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub enum Backend {
     Sim,
-    Mavlink {
-        address: String,
-        system_id: Option<u8>,
-        signing_key: Option<String>,
-    },
+    /// Boxed: a simulated drone then spends 8 bytes on its backend.
+    Mavlink(Box<Mavlink>),
+}
+
+/// How to reach a drone over MAVLink.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Mavlink {
+    pub address: String,
+    pub system_id: Option<u8>,
+    pub signing_key: Option<String>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -205,8 +217,8 @@ pub enum AttributeValue {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Group {
     pub name: String,
-    /// In the drones' file order.
-    pub members: Vec<String>,
+    /// Indices into [`World::drones`], in the drones' file order.
+    pub members: Vec<usize>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -69,7 +69,7 @@ fn example_world() {
         .map(|g| {
             (
                 g.name.as_str(),
-                g.members.iter().map(String::as_str).collect(),
+                g.members.iter().map(|&m| w.drones[m].name.as_str()).collect(),
             )
         })
         .collect();
@@ -100,7 +100,7 @@ fn example_world() {
     assert_eq!(w.site.geofence.as_ref().map(Vec::len), Some(4));
     let d = w.drone("flir_drone2").unwrap();
     assert_eq!(d.home, [5.0, 5.0, 0.0]);
-    assert_eq!(d.sensors, ["thermal"]);
+    assert_eq!(*d.sensors, ["thermal"]);
     assert_eq!(
         (d.max_speed, d.climb_rate, d.acceleration),
         (10.0, 3.0, 3.0)
@@ -110,7 +110,7 @@ fn example_world() {
         (100.0, 1800.0, &Backend::Sim)
     );
     assert_eq!(&EXAMPLE[d.span.range()], "flir_drone2");
-    assert_eq!(w.drone("beacon_drone2").unwrap().payload, ["Body"]);
+    assert_eq!(*w.drone("beacon_drone2").unwrap().payload, ["Body"]);
     assert_eq!(w.sensor("thermal").unwrap().detects, ["Body"]);
     assert_eq!(w.sensor("radiation").unwrap().range, 25.0);
     assert_eq!(
@@ -273,11 +273,11 @@ fn attributes_and_mavlink() {
     assert_eq!(a.attributes.len(), 4);
     assert_eq!(
         a.backend,
-        Backend::Mavlink {
+        Backend::Mavlink(Box::new(Mavlink {
             address: "udp:127.0.0.1:14550".into(),
             system_id: Some(3),
             signing_key: None
-        }
+        }))
     );
     let w = ok("[drones.c]\nhome = [0, 0]\nsince = 1979-05-27T07:32:00Z\n");
     let since = w.drones[0].attribute("since");
@@ -287,7 +287,7 @@ fn attributes_and_mavlink() {
     );
     let w =
         ok("[drones.b]\nhome = [0, 0]\nbackend = \"mavlink\"\nmavlink = \"tcp:10.0.0.2:5760\"\n");
-    assert!(matches!(w.drones[0].backend, Backend::Mavlink { .. }));
+    assert!(matches!(w.drones[0].backend, Backend::Mavlink(_)));
 }
 
 #[test]
@@ -896,8 +896,13 @@ fn drones_read_table_by_table_give_the_serde_paths_world() {
     let (world, _) = parse(&texts[3]);
     let world = world.unwrap();
     assert_eq!(world.groups.len(), 2);
-    assert_eq!(world.groups[0].members, ["a", "c"]);
-    assert_eq!(world.drones[0].sensors, ["thermal", "camera"]);
+    assert_eq!(world.groups[0].members, [0, 2]);
+    assert_eq!(*world.drones[0].sensors, ["thermal", "camera"]);
+    // One string for a group's name and for each attribute key, whatever the drones.
+    let (a, c) = (&world.drones[0], &world.drones[2]);
+    assert!(std::sync::Arc::ptr_eq(a.group.as_ref().unwrap(), c.group.as_ref().unwrap()));
+    let w = ok("[drones.d]\nhome = [0, 0]\nnote = 1\n[drones.e]\nhome = [0, 0]\nnote = \"x\"\n");
+    assert!(std::sync::Arc::ptr_eq(&w.drones[0].attributes[0].0, &w.drones[1].attributes[0].0));
 }
 
 /// A large generated fleet: every drone table read by the fast reader as it goes.

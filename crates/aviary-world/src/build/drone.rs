@@ -3,10 +3,12 @@
 use aviary_diagnostics::Span;
 
 use super::get;
-use crate::hash::QuickMap;
+use std::sync::Arc;
+
+use crate::hash::{QuickMap, QuickSet};
 use crate::node::{Entry, Node, Value};
 use crate::read::{quoted, suggest, toml_text, Ctx};
-use crate::{AttributeValue, Backend, Drone, Group, BUILTIN_SENSORS};
+use crate::{AttributeValue, Backend, Drone, Group, Mavlink, BUILTIN_SENSORS};
 
 const BACKEND_KEYS: &[&str] = &["backend", "mavlink", "system_id", "signing_key"];
 const SCHEMES: &[&str] = &[
@@ -27,7 +29,10 @@ pub(super) struct Drones {
     pub groups: Vec<Group>,
     /// Where each group of `groups` is first named.
     pub group_spans: Vec<Span>,
-    group_index: QuickMap<String, usize>,
+    /// Each group's index and shared name.
+    group_index: QuickMap<String, (usize, Arc<str>)>,
+    /// Attribute keys, each kept once.
+    keys: QuickSet<Arc<str>>,
     /// (drone, its sensor's index, span) of every sensor named.
     sensors: Vec<(usize, usize, Span)>,
     /// Entries that are not tables, each with the number of drones before it.
@@ -83,15 +88,15 @@ impl Drones {
             name: String::new(),
             home: [0.0; 3],
             group: None,
-            sensors: Vec::new(),
-            payload: Vec::new(),
+            sensors: Box::default(),
+            payload: Box::default(),
             max_speed: 10.0,
             climb_rate: 3.0,
             acceleration: 3.0,
             battery: 100.0,
             endurance: 1800.0,
             backend: Backend::Sim,
-            attributes: Vec::new(),
+            attributes: Box::default(),
             span: key_span,
         };
         if get(keys, "home").is_none() {
@@ -103,6 +108,7 @@ impl Drones {
             );
         }
         let index = self.out.len();
+        let mut attributes = Vec::new();
         for k in keys {
             // Said only in a message: not formatted unless one is written.
             let what = KeyOf(&k.key, name);
@@ -114,30 +120,35 @@ impl Drones {
                         continue;
                     };
                     if cx.identifier("group", &group, n.span) {
-                        let g = match self.group_index.get(&group) {
-                            Some(&g) => g,
+                        let (g, shared) = match self.group_index.get(&group) {
+                            Some((g, shared)) => (*g, shared.clone()),
                             None => {
-                                self.group_index.insert(group.clone(), self.groups.len());
-                                self.groups.push(Group { name: group.clone(), members: Vec::new() });
+                                let shared: Arc<str> = group.as_str().into();
+                                self.group_index.insert(group.clone(), (self.groups.len(), shared.clone()));
+                                self.groups.push(Group { name: group, members: Vec::new() });
                                 self.group_spans.push(n.span);
-                                self.groups.len() - 1
+                                (self.groups.len() - 1, shared)
                             }
                         };
-                        self.groups[g].members.push(name.to_owned());
-                        d.group = Some(group);
+                        self.groups[g].members.push(index);
+                        d.group = Some(shared);
                     }
                 }
                 "sensors" => {
+                    let mut sensors = Vec::new();
                     for (kind, span) in cx.strings(&what, n).unwrap_or_default() {
-                        self.sensors.push((index, d.sensors.len(), span));
-                        d.sensors.push(kind);
+                        self.sensors.push((index, sensors.len(), span));
+                        sensors.push(kind);
                     }
+                    d.sensors = sensors.into();
                 }
                 "payload" => {
+                    let mut payload = Vec::new();
                     for (kind, span) in cx.strings(&what, n).unwrap_or_default() {
                         cx.identifier("payload kind", &kind, span);
-                        d.payload.push(kind);
+                        payload.push(kind);
                     }
+                    d.payload = payload.into();
                 }
                 "max_speed" => d.max_speed = cx.positive(&what, n).unwrap_or(d.max_speed),
                 "climb_rate" => d.climb_rate = cx.positive(&what, n).unwrap_or(d.climb_rate),
@@ -146,14 +157,22 @@ impl Drones {
                 "battery" => d.battery = cx.within(&what, n, 0.0, 100.0).unwrap_or(d.battery),
                 key if BACKEND_KEYS.contains(&key) => {}
                 _ => {
-                    if let Some(attribute) = attribute(cx, name, k) {
-                        d.attributes.push(attribute);
+                    if let Some((key, value)) = attribute(cx, name, k) {
+                        let key = match self.keys.get(key) {
+                            Some(shared) => shared.clone(),
+                            None => {
+                                let shared: Arc<str> = key.into();
+                                self.keys.insert(shared.clone());
+                                shared
+                            }
+                        };
+                        attributes.push((key, value));
                     }
                 }
             }
         }
         d.backend = backend(cx, name, keys);
-        d.attributes.shrink_to_fit();
+        d.attributes = attributes.into();
         d.name = owned;
         d
     }
@@ -179,7 +198,7 @@ fn check_sensor(cx: &mut Ctx, drone: &str, kind: &str, span: Span, defined: &[St
     cx.error(span, msg, help);
 }
 
-fn attribute(cx: &mut Ctx, drone: &str, e: &Entry) -> Option<(String, AttributeValue)> {
+fn attribute<'e>(cx: &mut Ctx, drone: &str, e: &'e Entry) -> Option<(&'e str, AttributeValue)> {
     let key = &e.key;
     if TELEMETRY.contains(&key.as_str()) {
         let msg = format!(
@@ -203,7 +222,7 @@ fn attribute(cx: &mut Ctx, drone: &str, e: &Entry) -> Option<(String, AttributeV
         Value::Bool(b) => AttributeValue::Bool(*b),
         _ => AttributeValue::Other(toml_text(&e.node)),
     };
-    Some((key.clone(), value))
+    Some((key, value))
 }
 
 fn backend(cx: &mut Ctx, drone: &str, keys: &[Entry]) -> Backend {
@@ -249,11 +268,11 @@ fn backend(cx: &mut Ctx, drone: &str, keys: &[Entry]) -> Backend {
         return Backend::Sim;
     }
     let address = address.map(|(a, _)| a).unwrap_or_default();
-    Backend::Mavlink {
+    Backend::Mavlink(Box::new(Mavlink {
         address,
         system_id,
         signing_key,
-    }
+    }))
 }
 
 fn system_id(cx: &mut Ctx, drone: &str, e: &Entry) -> Option<u8> {

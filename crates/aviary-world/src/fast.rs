@@ -19,6 +19,7 @@
 //! from such a header, once: anything else there takes the serde path.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasher, BuildHasherDefault};
 
 use aviary_diagnostics::Span;
 use toml_parser::decoder::{Encoding, IntegerRadix, ScalarKind};
@@ -26,7 +27,7 @@ use toml_parser::lexer::TokenKind;
 use toml_parser::parser::EventReceiver;
 use toml_parser::{ErrorSink, ParseError, Source};
 
-use crate::hash::QuickSet;
+use crate::hash::{Quick, QuickSet};
 use crate::node::{Entry, Node, Value};
 
 /// The tree of `text`, or `None` when the serde path should read it.
@@ -252,9 +253,10 @@ struct Builder<'i, 's> {
     bail: bool,
     /// Takes each `[drones.NAME]` table once it is complete.
     on_drone: &'s mut dyn FnMut(Entry),
-    /// The drones read so far (their tables are gone): a second `[drones.NAME]` of one
-    /// of them takes the serde path.
-    drone_names: QuickSet<&'i str>,
+    /// The hashes of the names of the drones read so far (their tables are gone): a
+    /// second `[drones.NAME]` of one of them (or, once in a blue moon, of a name with
+    /// the same 64-bit hash) takes the serde path. Half the memory of the names.
+    drone_names: QuickSet<u64>,
     /// The root's entry of `drones`.
     drones_at: Option<usize>,
     /// The current table is a `[drones.NAME]`, to be handed over at the next header.
@@ -290,7 +292,8 @@ impl<'i> Builder<'i, '_> {
             [_, (name, at)] if !array => {
                 // A bare key: its text is its name.
                 let text: &'i str = self.source.input().get(at.range())?;
-                (text == name && self.drone_names.insert(text)).then_some(true)
+                let hash = BuildHasherDefault::<Quick>::default().hash_one(text);
+                (text == name && self.drone_names.insert(hash)).then_some(true)
             }
             _ => None,
         }

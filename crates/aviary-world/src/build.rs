@@ -54,7 +54,7 @@ pub(crate) fn read_fast(file: FileId, text: &str) -> Option<(World, Vec<Diagnost
     let mut cx = Ctx { file, text, diags: Vec::new() };
     // Room for the drones up front: doubling a vector of many drones costs more than
     // counting their headers.
-    let count = text.matches("\n[drones.").count() + usize::from(text.starts_with("[drones."));
+    let count = memchr::memmem::find_iter(text.as_bytes(), b"\n[drones.").count() + usize::from(text.starts_with("[drones."));
     let mut drones = Drones::with_capacity(count);
     let root = fast::parse_with(text, count, &mut |e| drones.entry(&mut cx, e))?;
     Some(build(cx, root, drones))

@@ -133,18 +133,24 @@ impl Fleet {
                 })
             })
             .collect();
-        // One `Spec` per make of drone.
+        // One `Spec` per make of drone; neighbours in the file are mostly of one make.
         let mut specs: HashSet<Arc<Spec>> = HashSet::new();
+        let mut last: Option<Arc<Spec>> = None;
         let mut spec = |d: &aviary_world::Drone| {
             let spec = Spec::of(d);
-            match specs.get(&spec) {
-                Some(shared) => shared.clone(),
-                None => {
-                    let shared = Arc::new(spec);
-                    specs.insert(shared.clone());
-                    shared
-                }
-            }
+            let shared = match &last {
+                Some(last) if **last == spec => last.clone(),
+                _ => match specs.get(&spec) {
+                    Some(shared) => shared.clone(),
+                    None => {
+                        let shared = Arc::new(spec);
+                        specs.insert(shared.clone());
+                        shared
+                    }
+                },
+            };
+            last = Some(shared.clone());
+            shared
         };
         Fleet {
             drones: world.drones.iter().map(|d| SimDrone::new(d, spec(d))).collect(),

@@ -52,8 +52,8 @@ impl Spec {
             climb_rate: d.climb_rate,
             accel: d.acceleration,
             endurance: d.endurance,
-            sensors: d.sensors.clone().into(),
-            payload_kinds: d.payload.clone().into(),
+            sensors: d.sensors.clone(),
+            payload_kinds: d.payload.clone(),
         }
     }
 }

@@ -116,16 +116,18 @@ impl Drones {
             match k.key.as_str() {
                 "home" => d.home = cx.point(&what, n).map_or(d.home, |(p, _)| p),
                 "group" => {
-                    let Some(group) = cx.string(&what, n) else {
+                    // Read in place: most drones name a group that exists already.
+                    let Value::Str(group) = &n.value else {
+                        cx.string(&what, n);
                         continue;
                     };
-                    if cx.identifier("group", &group, n.span) {
-                        let (g, shared) = match self.group_index.get(&group) {
+                    if cx.identifier("group", group, n.span) {
+                        let (g, shared) = match self.group_index.get(group.as_str()) {
                             Some((g, shared)) => (*g, shared.clone()),
                             None => {
                                 let shared: Arc<str> = group.as_str().into();
                                 self.group_index.insert(group.clone(), (self.groups.len(), shared.clone()));
-                                self.groups.push(Group { name: group, members: Vec::new() });
+                                self.groups.push(Group { name: group.clone(), members: Vec::new() });
                                 self.group_spans.push(n.span);
                                 (self.groups.len() - 1, shared)
                             }

@@ -96,8 +96,8 @@ impl<'a> Compiler<'a> {
         let mut attribute_names: Vec<String> = Vec::new();
         for d in &world.drones {
             for (k, _) in &d.attributes {
-                if !attribute_names.contains(k) {
-                    attribute_names.push(k.clone());
+                if !attribute_names.iter().any(|n| **n == **k) {
+                    attribute_names.push(k.to_string());
                 }
             }
         }
@@ -156,7 +156,7 @@ impl<'a> Compiler<'a> {
         if let Some(&i) = self.index.drones.get(name) {
             return ActorRef::Drone(i);
         }
-        let members = self.index.groups.get(name).map(|g| g.members.iter().filter_map(|m| self.index.drones.get(m.as_str()).copied()).collect());
+        let members = self.index.groups.get(name).map(|g| g.members.clone());
         ActorRef::Group(members.unwrap_or_default())
     }
 
@@ -501,7 +501,7 @@ fn attribute_table(world: &World, names: &[String]) -> Vec<Vec<Option<Value>>> {
                 .drones
                 .iter()
                 .map(|d| {
-                    d.attributes.iter().find(|(k, _)| k == name).map(|(_, v)| match v {
+                    d.attributes.iter().find(|(k, _)| **k == **name).map(|(_, v)| match v {
                         AttributeValue::Number(n) => Value::Number(*n),
                         AttributeValue::Text(t) => Value::Text(t.clone()),
                         AttributeValue::Bool(b) => Value::Bool(*b),

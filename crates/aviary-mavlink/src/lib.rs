@@ -110,12 +110,12 @@ pub fn bindings(world: &World) -> Vec<(usize, String, u8, Option<String>)> {
     let mut count: BTreeMap<String, u8> = BTreeMap::new();
     let mut out = Vec::new();
     for (i, d) in world.drones.iter().enumerate() {
-        if let Binding::Mavlink {
-            address,
-            system_id,
-            signing_key,
-        } = &d.backend
-        {
+        if let Binding::Mavlink(link) = &d.backend {
+            let aviary_world::Mavlink {
+                address,
+                system_id,
+                signing_key,
+            } = &**link;
             let n = count.entry(address.clone()).or_insert(0);
             *n = n.saturating_add(1);
             out.push((
@@ -187,8 +187,8 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
             climb_rate: d.climb_rate,
             endurance: d.endurance,
             home: [d.home[0], d.home[1]],
-            sensors: d.sensors.clone(),
-            payload: d.payload.clone(),
+            sensors: d.sensors.to_vec(),
+            payload: d.payload.to_vec(),
             fence: world.site.geofence.clone(),
             max_altitude: world.site.max_altitude,
             streaming: false.into(),

@@ -157,7 +157,7 @@ fn on_the_move(d: &SimDrone) -> bool {
 /// How far from drone `d` another drone can be and still matter to its planning: at
 /// least `range` below for every drone of the fleet.
 pub(crate) fn reach(fleet: &Fleet, d: &SimDrone) -> f64 {
-    fleet.min_separation + MARGIN + HORIZON * (d.max_speed + d.climb_rate + fleet.fastest) + 1.0
+    fleet.min_separation + MARGIN + HORIZON * (d.spec.max_speed + d.spec.climb_rate + fleet.fastest) + 1.0
 }
 
 impl Fleet {
@@ -182,7 +182,7 @@ impl Fleet {
             self.drones[id].avoid = None;
             return;
         }
-        let speed = |d: &SimDrone| d.max_speed + d.climb_rate;
+        let speed = |d: &SimDrone| d.spec.max_speed + d.spec.climb_rate;
         let range = |o: &SimDrone| sep + MARGIN + HORIZON * (speed(d) + speed(o)) + 1.0;
         // A drone held back for long gives way to everyone, not only to those before it,
         // until it no longer needs to give way.

@@ -18,19 +18,19 @@ pub(crate) struct Alarms {
 
 /// The fraction of a full battery the drone needs to fly home and land from where it is.
 pub(crate) fn energy_home(d: &SimDrone) -> f64 {
-    let time = dist(d.xy(), d.home) / d.max_speed + d.pos[2].max(0.0) / d.climb_rate;
-    time / d.endurance
+    let time = dist(d.xy(), d.home) / d.spec.max_speed + d.pos[2].max(0.0) / d.spec.climb_rate;
+    time / d.spec.endurance
 }
 
 /// At least [`energy_home`] (or NaN), bit for bit: `|dx| + |dy|`, widened far beyond the
 /// rounding of both, bounds the distance, and rounding keeps the order of the rest.
 pub(crate) fn energy_home_bound(d: &SimDrone) -> f64 {
-    if !(d.max_speed > 0.0 && d.climb_rate > 0.0 && d.endurance > 0.0) {
+    if !(d.spec.max_speed > 0.0 && d.spec.climb_rate > 0.0 && d.spec.endurance > 0.0) {
         return f64::NAN;
     }
     let far = ((d.home[0] - d.pos[0]).abs() + (d.home[1] - d.pos[1]).abs()) * (1.0 + 1e-12);
-    let time = far / d.max_speed + d.pos[2].max(0.0) / d.climb_rate;
-    time / d.endurance
+    let time = far / d.spec.max_speed + d.pos[2].max(0.0) / d.spec.climb_rate;
+    time / d.spec.endurance
 }
 
 /// Drains `dt` seconds of flight (when `airborne`) and raises each alarm at most once.
@@ -43,7 +43,7 @@ pub(crate) fn drain(d: &mut SimDrone, dt: f64, airborne: bool) -> Alarms {
     if !airborne {
         return alarms;
     }
-    d.battery -= dt / d.endurance;
+    d.battery -= dt / d.spec.endurance;
     if d.battery <= 0.0 {
         d.battery = 0.0;
         alarms.empty = true;
@@ -78,8 +78,11 @@ mod tests {
             hx in -1e5f64..1e5, hy in -1e5f64..1e5, axis in 0u8..3,
             speed in 0.5f64..30.0, climb in 0.5f64..10.0, endurance in 10f64..5000.0,
         ) {
-            let mut d = SimDrone::new(&crate::tests::one_drone().drones[0]);
-            (d.max_speed, d.climb_rate, d.endurance, d.home) = (speed, climb, endurance, [hx, hy]);
+            let world = crate::tests::one_drone();
+            let mut spec = crate::drone::Spec::of(&world.drones[0]);
+            (spec.max_speed, spec.climb_rate, spec.endurance) = (speed, climb, endurance);
+            let mut d = SimDrone::new(&world.drones[0], std::sync::Arc::new(spec));
+            d.home = [hx, hy];
             // On an axis of home, too, where the distance is one side alone.
             d.pos = match axis { 0 => [hx, y, z], 1 => [x, hy, z], _ => [x, y, z] };
             let (exact, bound) = (energy_home(&d), energy_home_bound(&d));

@@ -62,12 +62,12 @@ impl Fleet {
             .get(id)
             .ok_or_else(|| failed(format!("there is no drone number {id}")))?;
         if d.state == FlightState::Lost {
-            return Err(failed(format!("{} is lost", d.name)));
+            return Err(failed(format!("{} is lost", &self.names[id])));
         }
-        if d.link_loss.is_some() {
-            return Err(failed(format!("no link to {}", d.name)));
+        if d.link_loss().is_some() {
+            return Err(failed(format!("no link to {}", &self.names[id])));
         }
-        if let Some(why) = &d.disabled {
+        if let Some(why) = d.disabled() {
             return Err(failed(why.clone()));
         }
         let motion = MOTION.contains(&function);
@@ -76,11 +76,11 @@ impl Fleet {
         if motion && d.motion.is_some() && !own_return {
             return Err(failed(format!(
                 "{} is busy with another motion call",
-                d.name
+                &self.names[id]
             )));
         }
-        if motion && d.gps_loss.is_some() {
-            return Err(failed(format!("{} has no position fix", d.name)));
+        if motion && d.gps_loss().is_some() {
+            return Err(failed(format!("{} has no position fix", &self.names[id])));
         }
         let start = if motion {
             self.motion(id, function, args)?
@@ -113,7 +113,7 @@ impl Fleet {
             if landed {
                 Err(failed(format!(
                     "{} is on the ground: take off first",
-                    d.name
+                    &self.names[id]
                 )))
             } else {
                 Ok(())
@@ -129,7 +129,7 @@ impl Fleet {
                 if !landed {
                     return Err(failed(format!(
                         "{} can only {} on the ground",
-                        d.name,
+                        &self.names[id],
                         function.to_lowercase()
                     )));
                 }
@@ -146,16 +146,16 @@ impl Fleet {
                 limits.altitude(alt)?;
                 let to = [here[0], here[1], alt];
                 if !landed {
-                    vec![fly(to, d.max_speed)]
+                    vec![fly(to, d.spec.max_speed)]
                 } else if !d.armed {
                     return Err(failed(format!(
                         "{} is not armed: call Arm() before TakeOff",
-                        d.name
+                        &self.names[id]
                     )));
                 } else {
                     vec![Leg::Move {
                         to,
-                        speed: d.max_speed,
+                        speed: d.spec.max_speed,
                         state: FlightState::TakingOff,
                     }]
                 }
@@ -166,11 +166,11 @@ impl Fleet {
                 }
                 vec![Leg::Move {
                     to: [here[0], here[1], 0.0],
-                    speed: d.max_speed,
+                    speed: d.spec.max_speed,
                     state: FlightState::Landing,
                 }]
             }
-            "ReturnToLaunch" => return_legs(d, landed, limits.max_altitude)?,
+            "ReturnToLaunch" => return_legs(d, &self.names[id], landed, limits.max_altitude)?,
             "FlyToPosition" => {
                 in_air()?;
                 let p = point(args, 0, "pos")?;
@@ -178,8 +178,8 @@ impl Fleet {
                     Some(s) if s <= 0.0 => {
                         return Err(failed(format!("speed must be above 0 m/s, not {s} m/s")))
                     }
-                    Some(s) => s.min(d.max_speed),
-                    None => d.max_speed,
+                    Some(s) => s.min(d.spec.max_speed),
+                    None => d.spec.max_speed,
                 };
                 let to = [p.x, p.y, p.z.unwrap_or(level)];
                 if to[2] < 0.0 {
@@ -195,7 +195,7 @@ impl Fleet {
                     return Err(failed(format!("altitude {alt} m is below the ground")));
                 }
                 limits.altitude(alt)?;
-                vec![fly([here[0], here[1], alt], d.max_speed)]
+                vec![fly([here[0], here[1], alt], d.spec.max_speed)]
             }
             "Hover" => {
                 let duration = number(args, 0, "duration")?;
@@ -235,7 +235,7 @@ impl Fleet {
                     .map(|p| [p[0], p[1], level])
                     .collect();
                 limits.path(here, &path)?;
-                path.into_iter().map(|to| fly(to, d.max_speed)).collect()
+                path.into_iter().map(|to| fly(to, d.spec.max_speed)).collect()
             }
             "FollowPath" => {
                 in_air()?;
@@ -250,7 +250,7 @@ impl Fleet {
                     path.push([p.x, p.y, z]);
                 }
                 limits.path(here, &path)?;
-                path.into_iter().map(|to| fly(to, d.max_speed)).collect()
+                path.into_iter().map(|to| fly(to, d.spec.max_speed)).collect()
             }
             other => return Err(failed(format!("unknown function {other}"))),
         };
@@ -272,22 +272,23 @@ impl Fleet {
         let d = &mut self.drones[id];
         match function {
             "StartStreaming" | "StopStreaming" => {
-                if !d.sensors.iter().any(|s| s == "camera") {
-                    return Err(failed(format!("{} has no camera", d.name)));
+                if !d.spec.sensors.iter().any(|s| s == "camera") {
+                    return Err(failed(format!("{} has no camera", &self.names[id])));
                 }
                 d.streaming = function == "StartStreaming";
             }
             "StartDetection" | "StopDetection" => {
                 let kind = kind(args, 0, "kind")?;
-                let Some(range) = detection_range(&self.sensors, &d.sensors, &kind) else {
+                let Some(range) = detection_range(&self.sensors, &d.spec.sensors, &kind) else {
                     return Err(failed(format!(
                         "{} has no sensor that detects {kind}",
-                        d.name
+                        &self.names[id]
                     )));
                 };
-                d.detections.retain(|a| a.kind != kind);
+                let detections = &mut d.rare_mut().detections;
+                detections.retain(|a| a.kind != kind);
                 if function == "StartDetection" {
-                    d.detections.push(Activation {
+                    detections.push(Activation {
                         kind,
                         range,
                         found: Vec::new(),
@@ -296,40 +297,40 @@ impl Fleet {
             }
             "LoadPayload" => {
                 let kind = kind(args, 0, "kind")?;
-                if !d.payload_kinds.contains(&kind) {
-                    let can = if d.payload_kinds.is_empty() {
+                if !d.spec.payload_kinds.contains(&kind) {
+                    let can = if d.spec.payload_kinds.is_empty() {
                         "nothing".to_owned()
                     } else {
-                        d.payload_kinds.join(", ")
+                        d.spec.payload_kinds.join(", ")
                     };
                     return Err(failed(format!(
                         "{} cannot carry {kind} (it can carry: {can})",
-                        d.name
+                        &self.names[id]
                     )));
                 }
-                if let Some(held) = d.carrying.as_ref().or(d.loading.as_ref().map(|l| &l.kind)) {
+                if let Some(held) = d.carrying().or(d.loading().map(|l| &l.kind)) {
                     return Err(failed(format!(
                         "{} already carries {held}: release it first",
-                        d.name
+                        &self.names[id]
                     )));
                 }
                 if d.state != FlightState::Landed && d.pos[2] >= LOAD_MAX_ALTITUDE {
                     return Err(failed(format!(
                         "{} is at {:.1} m: load while landed or below {LOAD_MAX_ALTITUDE} m",
-                        d.name, d.pos[2]
+                        &self.names[id], d.pos[2]
                     )));
                 }
-                d.loading = Some(Box::new(Loading {
+                d.rare_mut().loading = Some(Loading {
                     call,
                     kind,
                     left: LOAD_TIME,
                     paused: false,
-                }));
+                });
                 return Ok(Start::Pending);
             }
             "ReleasePayload" => {
-                let Some(kind) = d.carrying.take() else {
-                    return Err(failed(format!("{} carries nothing to release", d.name)));
+                let Some(kind) = d.rare.as_mut().and_then(|r| r.carrying.take()) else {
+                    return Err(failed(format!("{} carries nothing to release", &self.names[id])));
                 };
                 self.releases.push(Release {
                     drone: id,
@@ -347,6 +348,7 @@ impl Fleet {
 /// `ReturnToLaunch`: up to the return altitude, home, and down.
 pub(crate) fn return_legs(
     d: &SimDrone,
+    name: &str,
     landed: bool,
     max_altitude: Option<f64>,
 ) -> Result<Vec<Leg>, Failure> {
@@ -356,8 +358,7 @@ pub(crate) fn return_legs(
             return Ok(Vec::new());
         }
         return Err(failed(format!(
-            "{} is on the ground away from home: take off first",
-            d.name
+            "{name} is on the ground away from home: take off first"
         )));
     }
     let z = d.pos[2];
@@ -366,20 +367,20 @@ pub(crate) fn return_legs(
     if safe > z {
         legs.push(Leg::Move {
             to: [d.pos[0], d.pos[1], safe],
-            speed: d.max_speed,
+            speed: d.spec.max_speed,
             state: FlightState::Flying,
         });
     }
     if home_dist > 0.0 {
         legs.push(Leg::Move {
             to: [d.home[0], d.home[1], safe],
-            speed: d.max_speed,
+            speed: d.spec.max_speed,
             state: FlightState::Flying,
         });
     }
     legs.push(Leg::Move {
         to: [d.home[0], d.home[1], 0.0],
-        speed: d.max_speed,
+        speed: d.spec.max_speed,
         state: FlightState::Landing,
     });
     Ok(legs)

@@ -1,5 +1,8 @@
 //! One simulated drone: what the world file says of it, and its state.
 
+use std::hash::{Hash, Hasher};
+use std::sync::Arc;
+
 use aviary_api::geometry::hypot;
 use aviary_api::{CallId, FlightState, Telemetry};
 use aviary_world::Drone;
@@ -29,16 +32,63 @@ pub(crate) struct Outage {
     pub returned: bool,
 }
 
-#[derive(Clone, Debug)]
-pub(crate) struct SimDrone {
-    pub name: String,
-    pub home: [f64; 2],
+/// What the world file says of a drone's make: shared by the drones that agree on it
+/// (a large fleet is mostly of one make), so that each carries a pointer, not 64 bytes
+/// and two lists.
+#[derive(Debug, PartialEq)]
+pub(crate) struct Spec {
     pub max_speed: f64,
     pub climb_rate: f64,
     pub accel: f64,
     pub endurance: f64,
     pub sensors: Box<[String]>,
     pub payload_kinds: Box<[String]>,
+}
+
+impl Spec {
+    pub fn of(d: &Drone) -> Spec {
+        Spec {
+            max_speed: d.max_speed,
+            climb_rate: d.climb_rate,
+            accel: d.acceleration,
+            endurance: d.endurance,
+            sensors: d.sensors.clone(),
+            payload_kinds: d.payload.clone(),
+        }
+    }
+}
+
+// The world's numbers are finite (it refuses others), so bitwise equality is equality.
+impl Eq for Spec {}
+
+impl Hash for Spec {
+    fn hash<H: Hasher>(&self, h: &mut H) {
+        for x in [self.max_speed, self.climb_rate, self.accel, self.endurance] {
+            x.to_bits().hash(h);
+        }
+        self.sensors.hash(h);
+        self.payload_kinds.hash(h);
+    }
+}
+
+/// The states a drone is seldom in: boxed together, so that a drone in none of them
+/// (most of a large fleet, most of the time) carries 8 bytes for them all.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Rare {
+    pub loading: Option<Loading>,
+    pub carrying: Option<String>,
+    pub detections: Vec<Activation>,
+    pub link_loss: Option<Outage>,
+    pub gps_loss: Option<Outage>,
+    /// Why the drone takes no more commands (a motor failure).
+    pub disabled: Option<String>,
+}
+
+/// Every drone's state; its name is the fleet's ([`crate::fleet::Names`]).
+#[derive(Clone, Debug)]
+pub(crate) struct SimDrone {
+    pub home: [f64; 2],
+    pub spec: Arc<Spec>,
 
     pub pos: [f64; 3],
     /// Instantaneous velocity, m/s.
@@ -57,18 +107,10 @@ pub(crate) struct SimDrone {
     /// Whether the drone, after such a standstill, gives way to every drone until its
     /// yield is over.
     pub humble: bool,
-    /// Rare states are boxed: a drone of a large fleet mostly has none, and every byte
-    /// here is a byte per drone (and per cache line walked each tick).
-    pub loading: Option<Box<Loading>>,
-    pub carrying: Option<String>,
     pub streaming: bool,
-    pub detections: Vec<Activation>,
     pub low_sent: bool,
     pub critical_sent: bool,
-    pub link_loss: Option<Box<Outage>>,
-    pub gps_loss: Option<Box<Outage>>,
-    /// Why the drone takes no more commands (a motor failure).
-    pub disabled: Option<String>,
+    pub rare: Option<Box<Rare>>,
     /// Metres flown (along the way, climbs included).
     pub odometer: f64,
     /// Seconds in the air.
@@ -76,16 +118,10 @@ pub(crate) struct SimDrone {
 }
 
 impl SimDrone {
-    pub fn new(d: &Drone) -> SimDrone {
+    pub fn new(d: &Drone, spec: Arc<Spec>) -> SimDrone {
         SimDrone {
-            name: d.name.clone(),
             home: [d.home[0], d.home[1]],
-            max_speed: d.max_speed,
-            climb_rate: d.climb_rate,
-            accel: d.acceleration,
-            endurance: d.endurance,
-            sensors: d.sensors.clone().into(),
-            payload_kinds: d.payload.clone().into(),
+            spec,
             pos: [d.home[0], d.home[1], 0.0],
             vel: [0.0; 3],
             heading: 0.0,
@@ -96,18 +132,37 @@ impl SimDrone {
             avoid: None,
             stalled: 0.0,
             humble: false,
-            loading: None,
-            carrying: None,
             streaming: false,
-            detections: Vec::new(),
             low_sent: false,
             critical_sent: false,
-            link_loss: None,
-            gps_loss: None,
-            disabled: None,
+            rare: None,
             odometer: 0.0,
             flight_time: 0.0,
         }
+    }
+
+    /// The rare states, made on first use.
+    pub fn rare_mut(&mut self) -> &mut Rare {
+        self.rare.get_or_insert_with(Box::default)
+    }
+
+    pub fn loading(&self) -> Option<&Loading> {
+        self.rare.as_ref()?.loading.as_ref()
+    }
+    pub fn carrying(&self) -> Option<&String> {
+        self.rare.as_ref()?.carrying.as_ref()
+    }
+    pub fn detections(&self) -> &[Activation] {
+        self.rare.as_ref().map_or(&[], |r| &r.detections)
+    }
+    pub fn link_loss(&self) -> Option<&Outage> {
+        self.rare.as_ref()?.link_loss.as_ref()
+    }
+    pub fn gps_loss(&self) -> Option<&Outage> {
+        self.rare.as_ref()?.gps_loss.as_ref()
+    }
+    pub fn disabled(&self) -> Option<&String> {
+        self.rare.as_ref()?.disabled.as_ref()
     }
 
     pub fn xy(&self) -> [f64; 2] {
@@ -134,7 +189,7 @@ impl SimDrone {
             heading: self.heading,
             battery: self.battery,
             state: self.state,
-            link: self.link_loss.is_none(),
+            link: self.link_loss().is_none(),
         }
     }
 
@@ -148,8 +203,8 @@ impl SimDrone {
             prefetch(at);
             prefetch(at.cast::<u8>().wrapping_add(64));
         }
-        if !self.detections.is_empty() {
-            prefetch(self.detections.as_ptr());
+        if !self.detections().is_empty() {
+            prefetch(self.detections().as_ptr());
         }
     }
 
@@ -187,7 +242,7 @@ impl SimDrone {
         if let Some(task) = self.motion.take() {
             ended.extend(task.call);
         }
-        if let Some(load) = self.loading.take() {
+        if let Some(load) = self.rare.as_mut().and_then(|r| r.loading.take()) {
             ended.push(load.call);
         }
         self.settle();

@@ -40,7 +40,7 @@ impl Fleet {
             if self.drones[id].state == FlightState::Lost {
                 continue;
             }
-            let name = self.drones[id].name.clone();
+            let name = self.names[id].to_owned();
             match kind {
                 FaultKind::BatteryCritical => {
                     let d = &mut self.drones[id];
@@ -65,12 +65,12 @@ impl Fleet {
                         out,
                     );
                     let d = &mut self.drones[id];
-                    d.disabled = Some(format!("{name} had a motor failure"));
+                    d.rare_mut().disabled = Some(format!("{name} had a motor failure"));
                     if d.state.airborne() {
                         let to = [d.pos[0], d.pos[1], 0.0];
                         let leg = Leg::Move {
                             to,
-                            speed: d.max_speed,
+                            speed: d.spec.max_speed,
                             state: FlightState::Landing,
                         };
                         d.motion = Some(Box::new(MotionTask::new(None, vec![leg])));
@@ -84,11 +84,11 @@ impl Fleet {
                         format!("{name}: link lost (simulated fault)"),
                         out,
                     );
-                    self.drones[id].link_loss = Some(Box::new(Outage {
+                    self.drones[id].rare_mut().link_loss = Some(Outage {
                         since: at,
                         until,
                         returned: false,
-                    }));
+                    });
                     self.outage(id);
                 }
                 FaultKind::GpsLoss => {
@@ -98,11 +98,11 @@ impl Fleet {
                         format!("{name}: GPS lost (simulated fault)"),
                         out,
                     );
-                    self.drones[id].gps_loss = Some(Box::new(Outage {
+                    self.drones[id].rare_mut().gps_loss = Some(Outage {
                         since: at,
                         until,
                         returned: false,
-                    }));
+                    });
                     self.outage(id);
                 }
             }
@@ -110,8 +110,9 @@ impl Fleet {
         // Only drones with an outage have anything to end or to return for.
         for &id in &self.outages {
             let d = &mut self.drones[id];
-            if d.link_loss.as_ref().is_some_and(|o| o.until <= end + 1e-9) {
-                d.link_loss = None;
+            let Some(rare) = d.rare.as_deref_mut() else { continue };
+            if rare.link_loss.as_ref().is_some_and(|o| o.until <= end + 1e-9) {
+                rare.link_loss = None;
                 if d.state != FlightState::Lost {
                     out.push(Report::Event(DroneEvent::Signal {
                         drone: id,
@@ -119,14 +120,14 @@ impl Fleet {
                     }));
                 }
             }
-            if d.gps_loss.as_ref().is_some_and(|o| o.until <= end + 1e-9) {
-                d.gps_loss = None;
+            if rare.gps_loss.as_ref().is_some_and(|o| o.until <= end + 1e-9) {
+                rare.gps_loss = None;
             }
         }
         let max_altitude = self.max_altitude;
         for &id in &self.outages {
             let d = &mut self.drones[id];
-            let Some(outage) = d.link_loss.as_mut() else {
+            let Some(outage) = d.rare.as_mut().and_then(|r| r.link_loss.as_mut()) else {
                 continue;
             };
             if outage.returned || end + 1e-9 < outage.since + self.link_loss_rtl_after {
@@ -134,16 +135,16 @@ impl Fleet {
             }
             outage.returned = true;
             self.hot[id].known = false;
-            let on_its_own = d.state.airborne() && d.motion.is_none() && d.disabled.is_none();
+            let on_its_own = d.state.airborne() && d.motion.is_none() && d.disabled().is_none();
             if on_its_own {
-                if let Ok(legs) = return_legs(d, false, max_altitude) {
+                if let Ok(legs) = return_legs(d, &self.names[id], false, max_altitude) {
                     d.motion = Some(Box::new(MotionTask::new(None, legs)));
                     d.begin_leg();
                 }
             }
         }
         let drones = &self.drones;
-        self.outages.retain(|&id| drones[id].link_loss.is_some() || drones[id].gps_loss.is_some());
+        self.outages.retain(|&id| drones[id].rare.as_ref().is_some_and(|r| r.link_loss.is_some() || r.gps_loss.is_some()));
     }
 
     /// Notes that drone `id` has an outage (the list stays ascending, without repeats).

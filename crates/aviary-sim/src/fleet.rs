@@ -1,7 +1,8 @@
 //! The physics core: every drone of the world, advanced tick by tick. Pure: no clock, no
 //! channels, no randomness; the same calls and steps give the same results bit for bit.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, HashMap, HashSet};
+use std::sync::Arc;
 
 use aviary_api::{
     CallEnd, CallId, DroneEvent, DroneId, Failure, FlightState, Interrupt, Telemetry, Value,
@@ -12,10 +13,11 @@ use aviary_world::{FaultKind, Sensor, Target, World};
 use crate::avoid::Track;
 use crate::battery;
 use crate::clearance::Clearance;
-use crate::drone::SimDrone;
+use crate::drone::{SimDrone, Spec};
 use crate::geom::heading;
 use crate::grid::Grid;
 use crate::hot::Hot;
+use crate::names::Names;
 use crate::nearby::Nearby;
 use crate::sensors::scan;
 
@@ -51,6 +53,7 @@ pub(crate) struct ScheduledFault {
 #[derive(Clone, Debug)]
 pub struct Fleet {
     pub(crate) drones: Vec<SimDrone>,
+    pub(crate) names: Names,
     pub(crate) fence: Option<Vec<[f64; 2]>>,
     pub(crate) max_altitude: Option<f64>,
     /// `[site] min_separation`: metres kept between drones in the air (0: none).
@@ -149,8 +152,28 @@ impl Fleet {
                 })
             })
             .collect();
+        // One `Spec` per make of drone; neighbours in the file are mostly of one make.
+        let mut specs: HashSet<Arc<Spec>> = HashSet::new();
+        let mut last: Option<Arc<Spec>> = None;
+        let mut spec = |d: &aviary_world::Drone| {
+            let spec = Spec::of(d);
+            let shared = match &last {
+                Some(last) if **last == spec => last.clone(),
+                _ => match specs.get(&spec) {
+                    Some(shared) => shared.clone(),
+                    None => {
+                        let shared = Arc::new(spec);
+                        specs.insert(shared.clone());
+                        shared
+                    }
+                },
+            };
+            last = Some(shared.clone());
+            shared
+        };
         Fleet {
-            drones: world.drones.iter().map(SimDrone::new).collect(),
+            drones: world.drones.iter().map(|d| SimDrone::new(d, spec(d))).collect(),
+            names: Names::new(world.drones.iter().map(|d| d.name.as_str())),
             fence: world.site.geofence.clone(),
             max_altitude: world.site.max_altitude,
             min_separation: world.site.min_separation,
@@ -211,7 +234,7 @@ impl Fleet {
 
     /// What the drone carries.
     pub fn carrying(&self, drone: DroneId) -> Option<&str> {
-        self.drones.get(drone)?.carrying.as_deref()
+        self.drones.get(drone)?.carrying().map(String::as_str)
     }
 
     /// Whether the drone's video stream is on.
@@ -223,7 +246,7 @@ impl Fleet {
     pub fn detecting(&self, drone: DroneId) -> Vec<String> {
         self.drones
             .get(drone)
-            .map(|d| d.detections.iter().map(|a| a.kind.clone()).collect())
+            .map(|d| d.detections().iter().map(|a| a.kind.clone()).collect())
             .unwrap_or_default()
     }
 
@@ -286,14 +309,15 @@ impl Fleet {
                 }
                 return None;
             }
-            if let Some(load) = d.loading.as_mut().filter(|l| l.call == call) {
+            let rare = d.rare.as_deref_mut();
+            if let Some(rare) = rare.filter(|r| r.loading.as_ref().is_some_and(|l| l.call == call)) {
                 match how {
                     Interrupt::Abort => {
-                        d.loading = None;
+                        rare.loading = None;
                         return Some(CallEnd::Interrupted);
                     }
-                    Interrupt::Pause => load.paused = true,
-                    Interrupt::Resume => load.paused = false,
+                    Interrupt::Pause => rare.loading.iter_mut().for_each(|l| l.paused = true),
+                    Interrupt::Resume => rare.loading.iter_mut().for_each(|l| l.paused = false),
                 }
                 return None;
             }
@@ -421,15 +445,17 @@ impl Fleet {
         if hypot(d.vel[0], d.vel[1]) > 1e-9 {
             d.heading = heading(d.vel[0], d.vel[1]);
         }
-        if let Some(load) = d.loading.as_mut().filter(|l| !l.paused) {
-            load.left -= dt;
-            if load.left <= 1e-9 {
-                let call = load.call;
-                d.carrying = d.loading.take().map(|l| l.kind);
-                out.push(Report::Ended {
-                    call,
-                    end: CallEnd::Done,
-                });
+        if let Some(rare) = d.rare.as_deref_mut() {
+            if let Some(load) = rare.loading.as_mut().filter(|l| !l.paused) {
+                load.left -= dt;
+                if load.left <= 1e-9 {
+                    let call = load.call;
+                    rare.carrying = rare.loading.take().map(|l| l.kind);
+                    out.push(Report::Ended {
+                        call,
+                        end: CallEnd::Done,
+                    });
+                }
             }
         }
         let to = d.xy();
@@ -443,13 +469,15 @@ impl Fleet {
             d.flight_time += dt;
         }
         // Only the targets near the way flown, in their order.
-        let nearby = match d.detections.iter().map(|a| a.range).reduce(f64::max) {
+        let nearby = match d.detections().iter().map(|a| a.range).reduce(f64::max) {
             Some(range) => self.near_targets[id].around(&self.target_grid, from, to, range),
             None => &[],
         };
-        let found = scan(id, &mut d.detections, &self.targets, nearby, from, to);
-        if !found.is_empty() {
-            out.extend(found.into_iter().map(Report::Event));
+        if let Some(rare) = d.rare.as_deref_mut() {
+            let found = scan(id, &mut rare.detections, &self.targets, nearby, from, to);
+            if !found.is_empty() {
+                out.extend(found.into_iter().map(Report::Event));
+            }
         }
         let alarms = battery::drain(d, dt, airborne);
         if alarms.low {
@@ -461,13 +489,13 @@ impl Fleet {
         if alarms.critical {
             let reason = format!(
                 "{}: {:.0}% left, about what it needs to get home",
-                d.name,
+                &self.names[id],
                 d.battery * 100.0
             );
             self.fault(id, "BatteryCritical", reason, out);
         }
         if alarms.empty {
-            let reason = format!("{}: battery empty", self.drones[id].name);
+            let reason = format!("{}: battery empty", &self.names[id]);
             self.lose(id, reason, out);
         }
     }
@@ -502,6 +530,8 @@ impl Fleet {
         d.pos[2] = 0.0;
         d.vel = [0.0; 3];
         d.streaming = false;
-        d.detections.clear();
+        if let Some(rare) = d.rare.as_deref_mut() {
+            rare.detections.clear();
+        }
     }
 }

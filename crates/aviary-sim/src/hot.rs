@@ -35,8 +35,8 @@ impl Hot {
 fn idle(d: &SimDrone) -> bool {
     !d.state.airborne()
         && d.motion.is_none()
-        && d.loading.is_none()
-        && d.detections.is_empty()
+        && d.loading().is_none()
+        && d.detections().is_empty()
         && d.avoid.is_none()
         && d.stalled == 0.0
         && d.vel.iter().all(|v| v.to_bits() == 0)

@@ -138,6 +138,7 @@ mod geom;
 mod grid;
 mod hot;
 mod motion;
+mod names;
 mod nearby;
 mod profile;
 mod sensors;

@@ -140,7 +140,7 @@ impl SimDrone {
                 let (to, speed) = (*to, *speed);
                 let here = [self.pos[0], self.pos[1]];
                 let d = geom::dist(here, [to[0], to[1]]);
-                let h = advance(d, task.ground_speed, limit(speed), self.accel, dt);
+                let h = advance(d, task.ground_speed, limit(speed), self.spec.accel, dt);
                 task.ground_speed = h.speed;
                 if h.arrived {
                     self.pos[0] = to[0];
@@ -159,8 +159,8 @@ impl SimDrone {
                     false
                 } else {
                     let dz = to[2] - self.pos[2];
-                    let climb = limit(self.climb_rate);
-                    let v = advance(dz.abs(), task.climb_speed, climb, self.accel, dt);
+                    let climb = limit(self.spec.climb_rate);
+                    let v = advance(dz.abs(), task.climb_speed, climb, self.spec.accel, dt);
                     task.climb_speed = v.speed;
                     if v.arrived {
                         self.pos[2] = to[2];
@@ -186,7 +186,7 @@ impl SimDrone {
                     left,
                     task.arc_speed,
                     limit(speed),
-                    arc_accel(self.accel),
+                    arc_accel(self.spec.accel),
                     dt,
                 );
                 task.arc_speed = step.speed;
@@ -243,7 +243,7 @@ pub(crate) fn orbit_legs(d: &SimDrone, center: [f64; 2], radius: f64, laps: f64)
     vec![
         Leg::Move {
             to: entry,
-            speed: d.max_speed,
+            speed: d.spec.max_speed,
             state: FlightState::Flying,
         },
         Leg::Arc {
@@ -251,7 +251,7 @@ pub(crate) fn orbit_legs(d: &SimDrone, center: [f64; 2], radius: f64, laps: f64)
             radius,
             start,
             total: laps * TAU,
-            speed: orbit_speed(d.max_speed, d.accel, radius),
+            speed: orbit_speed(d.spec.max_speed, d.spec.accel, radius),
         },
     ]
 }

@@ -80,10 +80,10 @@ pub(crate) fn envelope(d: &SimDrone) -> Envelope {
     let (stop, pad) = match current_leg(d) {
         _ if vh == 0.0 => (0.0, 0.0),
         Some(Leg::Arc { radius, .. }) => {
-            let l = vh * vh / (2.0 * arc_accel(d.accel));
+            let l = vh * vh / (2.0 * arc_accel(d.spec.accel));
             (l, l * l / (2.0 * radius))
         }
-        _ => (vh * vh / (2.0 * d.accel), 0.0),
+        _ => (vh * vh / (2.0 * d.spec.accel), 0.0),
     };
     let to = if vh == 0.0 {
         here
@@ -94,7 +94,7 @@ pub(crate) fn envelope(d: &SimDrone) -> Envelope {
         ]
     };
     let z = d.pos[2];
-    let stop = z + d.vel[2] * d.vel[2].abs() / (2.0 * d.accel);
+    let stop = z + d.vel[2] * d.vel[2].abs() / (2.0 * d.spec.accel);
     Envelope {
         from: here,
         to,
@@ -132,7 +132,7 @@ pub(crate) fn gap(e: &Envelope, f: &Envelope) -> f64 {
 /// each axis a tick at a higher speed, then twice the straight stopping distance, which
 /// also covers the longer stop along an arc and its width).
 fn reach(d: &SimDrone, dt: f64) -> f64 {
-    let a = d.accel;
+    let a = d.spec.accel;
     let grow = |v: f64| (v + a * dt) * dt + (v + a * dt).powi(2) / a;
     grow(hypot(d.vel[0], d.vel[1])) + grow(d.vel[2].abs()) + 1.0
 }
@@ -151,12 +151,12 @@ pub(crate) fn extent_bound(d: &SimDrone) -> f64 {
     let (stop, pad) = match current_leg(d) {
         _ if d.vel[0] == 0.0 && d.vel[1] == 0.0 => (0.0, 0.0),
         Some(Leg::Arc { radius, .. }) => {
-            let l = vh2 / (2.0 * arc_accel(d.accel));
+            let l = vh2 / (2.0 * arc_accel(d.spec.accel));
             (l, l * l / (2.0 * radius))
         }
-        _ => (vh2 / (2.0 * d.accel), 0.0),
+        _ => (vh2 / (2.0 * d.spec.accel), 0.0),
     };
-    let climb = (d.vel[2] * d.vel[2].abs() / (2.0 * d.accel)).abs();
+    let climb = (d.vel[2] * d.vel[2].abs() / (2.0 * d.spec.accel)).abs();
     let scale = 1.0 + d.pos[0].abs() + d.pos[1].abs() + d.pos[2].abs();
     (stop + pad + climb) * (1.0 + 1e-9) + 1e-9 * scale
 }
@@ -176,11 +176,11 @@ impl SimDrone {
     pub(crate) fn steer_altitude(&mut self, target: f64, vz: f64, dt: f64) {
         let dz = target - self.pos[2];
         if vz != 0.0 && (dz == 0.0 || dz.signum() != vz.signum()) {
-            let (moved, after) = brake(vz.abs(), self.accel, dt);
+            let (moved, after) = brake(vz.abs(), self.spec.accel, dt);
             self.pos[2] += vz.signum() * moved;
             self.vel[2] = vz.signum() * after;
         } else {
-            let v = advance(dz.abs(), vz.abs(), self.climb_rate, self.accel, dt);
+            let v = advance(dz.abs(), vz.abs(), self.spec.climb_rate, self.spec.accel, dt);
             if v.arrived {
                 self.pos[2] = target;
                 self.vel[2] = 0.0;
@@ -195,7 +195,7 @@ impl SimDrone {
     /// One tick of hard braking on every axis, along the path: the drone ends inside its
     /// envelope, whose stopping points do not move. No leg ends.
     pub(crate) fn brake_all(&mut self, dt: f64) {
-        let (a, here, z) = (self.accel, self.xy(), self.pos[2]);
+        let (a, here, z) = (self.spec.accel, self.xy(), self.pos[2]);
         let owns_z = self.avoid.is_some_and(|y| y.alt.is_some());
         let Some(task) = self.motion.as_mut().filter(|t| !t.paused) else {
             self.vel[0] = 0.0;
@@ -263,7 +263,7 @@ impl SimDrone {
 
     fn brake_vertical(&mut self, dt: f64) {
         let vz = self.vel[2];
-        let (moved, after) = brake(vz.abs(), self.accel, dt);
+        let (moved, after) = brake(vz.abs(), self.spec.accel, dt);
         self.pos[2] = (self.pos[2] + vz.signum() * moved).max(0.0);
         self.vel[2] = vz.signum() * after;
     }
@@ -443,14 +443,14 @@ impl Fleet {
         let d = &self.drones[id];
         let blocker = (self.drones.iter().enumerate())
             .filter(|&(j, o)| j != id && counts(o))
-            .map(|(_, o)| {
+            .map(|(j, o)| {
                 let gap = |k: usize| o.pos[k] - d.pos[k];
-                (hypot(hypot(gap(0), gap(1)), gap(2)), o)
+                (hypot(hypot(gap(0), gap(1)), gap(2)), j)
             })
             .filter(|(apart, _)| *apart <= 2.0 * sep + MARGIN)
             .min_by(|a, b| a.0.total_cmp(&b.0))
-            .map_or_else(|| "the drones near it".to_owned(), |(_, o)| o.name.clone());
-        let reason = format!("{} waited {limit} s for {blocker} to make room", d.name);
+            .map_or_else(|| "the drones near it".to_owned(), |(_, j)| self.names[j].to_owned());
+        let reason = format!("{} waited {limit} s for {blocker} to make room", &self.names[id]);
         let d = &mut self.drones[id];
         d.motion = None;
         d.avoid = None;

@@ -73,11 +73,10 @@ impl Autopilot {
             .enumerate()
             .map(|(i, d)| {
                 let system = match &d.backend {
-                    aviary_world::Backend::Mavlink {
-                        system_id: Some(s), ..
-                    } => *s,
-                    _ => u8::try_from(i + 1).unwrap_or(u8::MAX),
-                };
+                    aviary_world::Backend::Mavlink(link) => link.system_id,
+                    aviary_world::Backend::Sim => None,
+                }
+                .unwrap_or_else(|| u8::try_from(i + 1).unwrap_or(u8::MAX));
                 Copter {
                     system,
                     mode: STABILIZE,

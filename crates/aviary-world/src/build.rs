@@ -1,16 +1,17 @@
 //! From the spanned tree to a [`World`]: the top level, `[site]`, `[places]`, `[areas]`,
 //! and the checks across tables (one name, one meaning).
 
-use std::collections::HashMap;
-
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 
+use crate::hash::QuickMap;
 use crate::node::{Entry, Node, Value};
 use crate::read::{suggest, Ctx};
-use crate::{Area, Geo, Group, Place, Site, World};
+use crate::{fast, Area, Geo, Place, Site, World};
 
 mod drone;
 mod sim;
+
+use drone::Drones;
 
 const TABLES: &[&str] = &[
     "site", "places", "areas", "drones", "sensors", "targets", "faults",
@@ -27,23 +28,50 @@ const SITE_KEYS: &[&str] = &[
 const ORIGIN_KEYS: &[&str] = &["lat", "lon", "alt"];
 
 pub(crate) fn parse(file: FileId, text: &str) -> (Option<World>, Vec<Diagnostic>) {
-    let root = match Node::parse(text) {
-        Ok(root) => root,
+    let (world, mut diags) = match read(file, text) {
+        Ok(read) => read,
         Err(e) => return (None, vec![syntax_error(file, text, &e)]),
     };
-    let mut cx = Ctx {
-        file,
-        text,
-        diags: Vec::new(),
-    };
-    let world = build(&mut cx, root);
-    let mut diags = cx.diags;
     aviary_diagnostics::sort(&mut diags);
     if diags.iter().any(Diagnostic::is_error) {
         (None, diags)
     } else {
         (Some(world), diags)
     }
+}
+
+/// The world and its diagnostics (unsorted), or the TOML parser's error.
+pub(crate) fn read(file: FileId, text: &str) -> Result<(World, Vec<Diagnostic>), toml::de::Error> {
+    match read_fast(file, text) {
+        Some(read) => Ok(read),
+        None => Ok(read_tree(file, text, Node::parse_serde(text)?)),
+    }
+}
+
+/// The fast reader's way: each drone is built as soon as its table has been read, and
+/// the table dropped. `None`: take the serde path.
+pub(crate) fn read_fast(file: FileId, text: &str) -> Option<(World, Vec<Diagnostic>)> {
+    let mut cx = Ctx { file, text, diags: Vec::new() };
+    // Room for the drones up front: doubling a vector of many drones costs more than
+    // counting their headers.
+    let count = memchr::memmem::find_iter(text.as_bytes(), b"\n[drones.").count() + usize::from(text.starts_with("[drones."));
+    let mut drones = Drones::with_capacity(count);
+    let root = fast::parse_with(text, count, &mut |e| drones.entry(&mut cx, e))?;
+    Some(build(cx, root, drones))
+}
+
+/// The serde path's way, from the whole tree.
+pub(crate) fn read_tree(file: FileId, text: &str, mut root: Node) -> (World, Vec<Diagnostic>) {
+    let mut cx = Ctx { file, text, diags: Vec::new() };
+    let mut drones = Drones::default();
+    if let Value::Table(top) = &mut root.value {
+        if let Some(Entry { node: Node { value: Value::Table(entries), .. }, .. }) = top.iter_mut().find(|e| e.key == "drones") {
+            for e in std::mem::take(entries) {
+                drones.entry(&mut cx, e);
+            }
+        }
+    }
+    build(cx, root, drones)
 }
 
 fn syntax_error(file: FileId, text: &str, e: &toml::de::Error) -> Diagnostic {
@@ -70,23 +98,13 @@ pub(crate) fn get<'n>(entries: &'n [Entry], key: &str) -> Option<&'n Entry> {
     entries.iter().find(|e| e.key == key)
 }
 
-fn build(cx: &mut Ctx, mut root: Node) -> World {
+/// Everything but the drones' own tables, which `drones` has read (`[drones]` is left
+/// without its entries).
+fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Diagnostic>) {
+    let cx = &mut cx;
     let mut world = World::default();
-    // The drones' tables are read (and freed) one by one below: for a large fleet the
-    // tree and the drones built from it need not be in memory whole at once.
-    let drone_names = keys_of(match &root.value {
-        Value::Table(top) => get(top, "drones"),
-        _ => None,
-    });
-    let drones_table = match &mut root.value {
-        Value::Table(top) => top.iter_mut().find(|e| e.key == "drones").map(|e| {
-            let empty = Node { span: e.node.span, value: Value::Table(Vec::new()) };
-            std::mem::replace(&mut e.node, empty)
-        }),
-        _ => None,
-    };
     let Value::Table(top) = &root.value else {
-        return world;
+        return (world, std::mem::take(&mut cx.diags));
     };
     for e in top.iter().filter(|e| !TABLES.contains(&e.key.as_str())) {
         let what = match e.node.value {
@@ -118,19 +136,21 @@ fn build(cx: &mut Ctx, mut root: Node) -> World {
     if let Some(e) = table("sensors") {
         world.sensors = sim::sensors(cx, &e.node);
     }
-    let mut group_spans = Vec::new();
-    if let Some(node) = drones_table {
-        world.drones = drone::drones(cx, node, &sensor_kinds, &mut group_spans);
+    if let Some(e) = table("drones") {
+        cx.table(&"`drones`", &e.node, drone::HELP);
     }
-    world.groups = groups(&world, &group_spans);
+    drones.finish(cx, &sensor_kinds);
     if let Some(e) = table("targets") {
         world.targets = sim::targets(cx, &e.node);
     }
     if let Some(e) = table("faults") {
-        world.faults = sim::faults(cx, &e.node, &drone_names);
+        world.faults = sim::faults(cx, &e.node, &drones.names());
     }
+    let group_spans = std::mem::take(&mut drones.group_spans);
+    world.groups = std::mem::take(&mut drones.groups);
+    world.drones = std::mem::take(&mut drones.out);
     unique_names(cx, &world, &group_spans);
-    world
+    (world, std::mem::take(&mut cx.diags))
 }
 
 /// The keys of a table, whatever their values: what the file defines, even with errors.
@@ -244,74 +264,40 @@ fn areas(cx: &mut Ctx, node: &Node) -> Vec<Area> {
     out
 }
 
-/// Groups in order of first appearance, members in the drones' file order.
-fn groups(world: &World, group_spans: &[(String, Span)]) -> Vec<Group> {
-    let mut out: Vec<Group> = Vec::new();
-    for (name, _) in group_spans {
-        if out.iter().all(|g| &g.name != name) {
-            out.push(Group {
-                name: name.clone(),
-                members: Vec::new(),
-            });
-        }
+/// A name stands for one drone, group, place or area: mission code names them alike.
+/// Within each kind names are unique already (TOML keys, one group per name), so only
+/// names of two kinds can clash: the drones, the many, are looked up among the others.
+fn unique_names(cx: &mut Ctx, world: &World, group_spans: &[Span]) {
+    let mut named: QuickMap<&str, Vec<(&str, Span)>> = QuickMap::default();
+    let places = world.places.iter().map(|p| (p.name.as_str(), "a place", p.span));
+    let areas = world.areas.iter().map(|a| (a.name.as_str(), "an area", a.span));
+    let groups = world.groups.iter().zip(group_spans).map(|(g, span)| (g.name.as_str(), "a group", *span));
+    for (name, what, span) in places.chain(areas).chain(groups) {
+        named.entry(name).or_default().push((what, span));
     }
     for d in &world.drones {
-        let Some(name) = &d.group else { continue };
-        if let Some(g) = out.iter_mut().find(|g| &g.name == name) {
-            g.members.push(d.name.clone());
+        if let Some(uses) = named.get_mut(d.name.as_str()) {
+            uses.push(("a drone", d.span));
         }
     }
-    out
-}
-
-/// A name stands for one drone, group, place or area: mission code names them alike.
-fn unique_names(cx: &mut Ctx, world: &World, group_spans: &[(String, Span)]) {
-    let mut all: Vec<(&str, &str, Span)> = Vec::new();
-    all.extend(
-        world
-            .drones
-            .iter()
-            .map(|d| (d.name.as_str(), "a drone", d.span)),
-    );
-    all.extend(
-        world
-            .places
-            .iter()
-            .map(|p| (p.name.as_str(), "a place", p.span)),
-    );
-    all.extend(
-        world
-            .areas
-            .iter()
-            .map(|a| (a.name.as_str(), "an area", a.span)),
-    );
-    let mut first_group: HashMap<&str, Span> = HashMap::new();
-    for (name, span) in group_spans {
-        first_group.entry(name.as_str()).or_insert(*span);
-    }
-    all.extend(
-        first_group
-            .iter()
-            .map(|(name, span)| (*name, "a group", *span)),
-    );
-    all.sort_by_key(|(_, _, span)| (span.start, span.end));
-    let mut seen: HashMap<&str, (&str, Span)> = HashMap::new();
-    for (name, what, span) in all {
-        let Some(&(first, first_span)) = seen.get(name) else {
-            seen.insert(name, (what, span));
-            continue;
-        };
-        let msg = format!(
-            "the name `{name}` is used for {first} and for {what}, so mission code could not tell which is meant"
-        );
-        let help = "rename one of them: drones, groups, places and areas share one set of names";
-        let d = Diagnostic::new(Code::WorldFile, cx.file, span, msg)
-            .with_help(help)
-            .also(
-                cx.file,
-                first_span,
-                format!("{first} `{name}` is defined here"),
+    let mut clashes: Vec<(&str, Vec<(&str, Span)>)> = named.into_iter().filter(|(_, uses)| uses.len() > 1).collect();
+    clashes.sort_by_key(|(_, uses)| uses.iter().map(|(_, s)| (s.start, s.end)).min());
+    for (name, mut uses) in clashes {
+        uses.sort_by_key(|(_, span)| (span.start, span.end));
+        let (first, first_span) = uses[0];
+        for &(what, span) in &uses[1..] {
+            let msg = format!(
+                "the name `{name}` is used for {first} and for {what}, so mission code could not tell which is meant"
             );
-        cx.push(d);
+            let help = "rename one of them: drones, groups, places and areas share one set of names";
+            let d = Diagnostic::new(Code::WorldFile, cx.file, span, msg)
+                .with_help(help)
+                .also(
+                    cx.file,
+                    first_span,
+                    format!("{first} `{name}` is defined here"),
+                );
+            cx.push(d);
+        }
     }
 }

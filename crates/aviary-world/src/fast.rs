@@ -12,8 +12,14 @@
 //! a dotted or quoted key, a date, a key/value pair outside any table, a table defined
 //! twice or implicitly first) returns `None`, and the caller takes the serde path,
 //! which reports the problem with the same words as before.
+//!
+//! Each `[drones.NAME]` table is handed to the caller as soon as it is complete (when
+//! the next header starts), and leaves the tree: a world of many drones never has all
+//! their tables in memory. So that this stays exact, every entry of `[drones]` must come
+//! from such a header, once: anything else there takes the serde path.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasher, BuildHasherDefault};
 
 use aviary_diagnostics::Span;
 use toml_parser::decoder::{Encoding, IntegerRadix, ScalarKind};
@@ -21,10 +27,26 @@ use toml_parser::lexer::TokenKind;
 use toml_parser::parser::EventReceiver;
 use toml_parser::{ErrorSink, ParseError, Source};
 
+use crate::hash::{Quick, QuickSet};
 use crate::node::{Entry, Node, Value};
 
 /// The tree of `text`, or `None` when the serde path should read it.
 pub(crate) fn parse(text: &str) -> Option<Node> {
+    let mut drones = Vec::new();
+    let mut root = parse_with(text, 0, &mut |e| drones.push(e))?;
+    if let Value::Table(top) = &mut root.value {
+        if let Some(Entry { node: Node { value: Value::Table(entries), .. }, .. }) = top.iter_mut().find(|e| e.key == "drones") {
+            *entries = drones;
+        }
+    }
+    Some(root)
+}
+
+/// As [`parse`], but each `[drones.NAME]` table goes to `on_drone` (in file order) as
+/// soon as it has been read, and the tree's `drones` table is left empty. When this
+/// returns `None`, some tables may have gone to `on_drone` already. `drones`: about how
+/// many there are.
+pub(crate) fn parse_with(text: &str, drones: usize, on_drone: &mut dyn FnMut(Entry)) -> Option<Node> {
     if !within_toml_1_0(text.as_bytes()) {
         return None;
     }
@@ -38,6 +60,10 @@ pub(crate) fn parse(text: &str) -> Option<Node> {
         dotted: false,
         stack: Vec::new(),
         bail: false,
+        on_drone,
+        drone_names: QuickSet::with_capacity_and_hasher(drones, Default::default()),
+        drones_at: None,
+        open_drone: false,
     };
     let mut errors = Errors(false);
     // Parsed a table at a time: all the tokens of a large world at once would take more
@@ -53,8 +79,9 @@ pub(crate) fn parse(text: &str) -> Option<Node> {
             TokenKind::Newline if inline > 0 => return None,
             TokenKind::RightCurlyBracket if last == TokenKind::Comma => return None,
             TokenKind::BasicString | TokenKind::MlBasicString => {
-                let raw = text.get(token.span().start()..token.span().end())?;
-                if raw.contains("\\e") || raw.contains("\\x") || raw.contains('\r') {
+                let raw = text.get(token.span().start()..token.span().end())?.as_bytes();
+                let escapes = raw.windows(2).any(|w| w[0] == b'\\' && matches!(w[1], b'e' | b'x'));
+                if escapes || raw.contains(&b'\r') {
                     return None;
                 }
             }
@@ -86,6 +113,7 @@ pub(crate) fn parse(text: &str) -> Option<Node> {
     if errors.0 || builder.bail || !builder.stack.is_empty() {
         return None;
     }
+    builder.hand_over_drone()?;
     Some(builder.root.into_node())
 }
 
@@ -93,12 +121,46 @@ pub(crate) fn parse(text: &str) -> Option<Node> {
 /// TOML forbids them, and `toml_parser`'s lexer lets some through (a lone `\r` breaks a
 /// line there).
 fn within_toml_1_0(bytes: &[u8]) -> bool {
+    // Most files have no control character but tab and LF: counted without a branch (so
+    // the loop is vectorised) before the exact walk.
+    let odd = |b: u8| (b < 0x20 && b != b'\t' && b != b'\n') || b == 0x7f;
+    if bytes.iter().fold(0usize, |n, &b| n + usize::from(odd(b))) == 0 {
+        return true;
+    }
     bytes.iter().enumerate().all(|(i, &b)| match b {
         b'\r' => bytes.get(i + 1) == Some(&b'\n'),
         b'\t' | b'\n' => true,
         0..=0x1f | 0x7f => false,
         _ => true,
     })
+}
+
+/// A TOML 1.0 bare key: the decoder would return it unchanged.
+fn is_bare_key(text: &str) -> bool {
+    !text.is_empty() && text.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
+}
+
+/// The scalars most files are made of, read without the decoder: a decimal integer
+/// without sign, underscores or leading zeros (that fits), a boolean, and a one-line
+/// string without escapes. `None`: ask the decoder.
+fn plain_scalar(text: &str, encoding: Option<Encoding>) -> Option<Value> {
+    let quoted = |q: u8| {
+        let inner = text.strip_prefix(q as char)?.strip_suffix(q as char)?;
+        (!inner.contains([q as char, '\\'])).then(|| Value::Str(inner.to_owned()))
+    };
+    match encoding {
+        None => match text {
+            "true" => Some(Value::Bool(true)),
+            "false" => Some(Value::Bool(false)),
+            _ if (1..=18).contains(&text.len()) && text.bytes().all(|b| b.is_ascii_digit()) && (text.len() == 1 || !text.starts_with('0')) => {
+                text.parse().ok().map(Value::Int)
+            }
+            _ => None,
+        },
+        Some(Encoding::BasicString) => quoted(b'"'),
+        Some(Encoding::LiteralString) => quoted(b'\''),
+        Some(_) => None,
+    }
 }
 
 struct Errors(bool);
@@ -181,7 +243,7 @@ enum Open {
     Inline { start: usize, entries: Vec<Entry>, key: Option<(String, Span)> },
 }
 
-struct Builder<'i> {
+struct Builder<'i, 's> {
     source: Source<'i>,
     root: Table,
     /// Where key/value pairs go: entry indices from the root (into the last table of
@@ -195,13 +257,54 @@ struct Builder<'i> {
     dotted: bool,
     stack: Vec<Open>,
     bail: bool,
+    /// Takes each `[drones.NAME]` table once it is complete.
+    on_drone: &'s mut dyn FnMut(Entry),
+    /// The hashes of the names of the drones read so far (their tables are gone): a
+    /// second `[drones.NAME]` of one of them (or, once in a blue moon, of a name with
+    /// the same 64-bit hash) takes the serde path. Half the memory of the names.
+    drone_names: QuickSet<u64>,
+    /// The root's entry of `drones`.
+    drones_at: Option<usize>,
+    /// The current table is a `[drones.NAME]`, to be handed over at the next header.
+    open_drone: bool,
 }
 
 fn span(s: toml_parser::Span) -> Span {
     Span::new(s.start(), s.end())
 }
 
-impl Builder<'_> {
+impl<'i> Builder<'i, '_> {
+    /// Hands the `[drones.NAME]` table just read to `on_drone`: it is the only entry
+    /// of `drones`, since every earlier one went the same way.
+    fn hand_over_drone(&mut self) -> Option<()> {
+        if !std::mem::take(&mut self.open_drone) {
+            return Some(());
+        }
+        let Item::Table(drones) = &mut self.root.entries.get_mut(self.drones_at?)?.2 else { return None };
+        let (key, key_span, Item::Table(table)) = drones.entries.pop()? else { return None };
+        self.current = None;
+        (self.on_drone)(Entry { key, key_span, node: table.into_node() });
+        Some(())
+    }
+
+    /// Whether a header may open a table under `drones` (`[drones]` or `[drones.NAME]`,
+    /// each once) and whether it is a drone's; `None` for the serde path.
+    fn drone_header(&mut self, array: bool, keys: &[(String, Span)]) -> Option<bool> {
+        if keys.first().is_none_or(|(k, _)| k != "drones") {
+            return Some(false);
+        }
+        match keys {
+            [_] if !array => Some(false),
+            [_, (name, at)] if !array => {
+                // A bare key: its text is its name.
+                let text: &'i str = self.source.input().get(at.range())?;
+                let hash = BuildHasherDefault::<Quick>::default().hash_one(text);
+                (text == name && self.drone_names.insert(hash)).then_some(true)
+            }
+            _ => None,
+        }
+    }
+
     fn table_at<'t>(root: &'t mut Table, path: &[usize]) -> Option<&'t mut Table> {
         let mut table = root;
         for &i in path {
@@ -216,6 +319,8 @@ impl Builder<'_> {
 
     /// `[a.b.c]` or `[[a.b.c]]`, from `start` to `end`.
     fn header(&mut self, array: bool, start: usize, end: usize, keys: Vec<(String, Span)>) -> Option<()> {
+        self.hand_over_drone()?;
+        let drone = self.drone_header(array, &keys)?;
         let (last, parents) = keys.split_last()?;
         let mut path = Vec::with_capacity(keys.len());
         let mut table = &mut self.root;
@@ -246,6 +351,10 @@ impl Builder<'_> {
             (Some(_), false) => return None,
         };
         path.push(i);
+        if keys[0].0 == "drones" {
+            self.drones_at = path.first().copied();
+        }
+        self.open_drone = drone;
         self.current = Some(path);
         Some(())
     }
@@ -264,6 +373,10 @@ impl Builder<'_> {
             None => {
                 let (k, key_span) = self.key.take()?;
                 let path = self.current.as_ref()?;
+                // `[drones]` holds only `[drones.NAME]` tables here.
+                if path.len() == 1 && Some(path[0]) == self.drones_at {
+                    return None;
+                }
                 let table = Self::table_at(&mut self.root, path)?;
                 if table.find(&k).is_some() {
                     return None;
@@ -277,6 +390,9 @@ impl Builder<'_> {
 
     fn scalar(&mut self, at: toml_parser::Span, encoding: Option<Encoding>) -> Option<()> {
         let text = self.source.input().get(at.start()..at.end())?;
+        if let Some(value) = plain_scalar(text, encoding) {
+            return self.value(Node { span: span(at), value });
+        }
         let raw = toml_parser::Raw::new_unchecked(text, encoding, at);
         let mut out = String::new();
         let mut errors = Errors(false);
@@ -301,12 +417,17 @@ impl Builder<'_> {
         // The parser leaves a bare key's characters to the decoder (`Lookout@` lexes as
         // one key), so decode it and take serde's path on any complaint.
         let text = self.source.input().get(at.start()..at.end())?;
-        let mut name = String::new();
-        let mut errors = Errors(false);
-        toml_parser::Raw::new_unchecked(text, None, at).decode_key(&mut name, &mut errors);
-        if errors.0 {
-            return None;
-        }
+        let name = if is_bare_key(text) {
+            text.to_owned()
+        } else {
+            let mut name = String::new();
+            let mut errors = Errors(false);
+            toml_parser::Raw::new_unchecked(text, None, at).decode_key(&mut name, &mut errors);
+            if errors.0 {
+                return None;
+            }
+            name
+        };
         let key = (name, span(at));
         if let Some((_, _, keys)) = &mut self.header {
             keys.push(key);
@@ -327,7 +448,7 @@ impl Builder<'_> {
     }
 }
 
-impl EventReceiver for Builder<'_> {
+impl EventReceiver for Builder<'_, '_> {
     fn std_table_open(&mut self, at: toml_parser::Span, _: &mut dyn ErrorSink) {
         self.header = Some((false, at.start(), Vec::new()));
     }
@@ -382,7 +503,7 @@ impl EventReceiver for Builder<'_> {
     }
 }
 
-impl Builder<'_> {
+impl Builder<'_, '_> {
     fn close_header(&mut self, at: toml_parser::Span) {
         let ok = match self.header.take() {
             Some((array, start, keys)) => self.header(array, start, at.end(), keys),

@@ -50,14 +50,6 @@ pub(crate) struct Entry {
 }
 
 impl Node {
-    /// Parses TOML text into a tree; the error is the parser's own.
-    pub fn parse(text: &str) -> Result<Node, toml::de::Error> {
-        match crate::fast::parse(text) {
-            Some(node) => Ok(node),
-            None => Node::parse_serde(text),
-        }
-    }
-
     /// The serde path: every TOML file, and the error messages of `toml`.
     pub fn parse_serde(text: &str) -> Result<Node, toml::de::Error> {
         let raw = NodeSeed { spanned: true }.deserialize(toml::Deserializer::new(text))?;

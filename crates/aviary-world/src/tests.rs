@@ -69,7 +69,7 @@ fn example_world() {
         .map(|g| {
             (
                 g.name.as_str(),
-                g.members.iter().map(String::as_str).collect(),
+                g.members.iter().map(|&m| w.drones[m].name.as_str()).collect(),
             )
         })
         .collect();
@@ -100,7 +100,7 @@ fn example_world() {
     assert_eq!(w.site.geofence.as_ref().map(Vec::len), Some(4));
     let d = w.drone("flir_drone2").unwrap();
     assert_eq!(d.home, [5.0, 5.0, 0.0]);
-    assert_eq!(d.sensors, ["thermal"]);
+    assert_eq!(*d.sensors, ["thermal"]);
     assert_eq!(
         (d.max_speed, d.climb_rate, d.acceleration),
         (10.0, 3.0, 3.0)
@@ -110,7 +110,7 @@ fn example_world() {
         (100.0, 1800.0, &Backend::Sim)
     );
     assert_eq!(&EXAMPLE[d.span.range()], "flir_drone2");
-    assert_eq!(w.drone("beacon_drone2").unwrap().payload, ["Body"]);
+    assert_eq!(*w.drone("beacon_drone2").unwrap().payload, ["Body"]);
     assert_eq!(w.sensor("thermal").unwrap().detects, ["Body"]);
     assert_eq!(w.sensor("radiation").unwrap().range, 25.0);
     assert_eq!(
@@ -144,7 +144,8 @@ fn every_key_and_value_of_the_example_has_its_own_span() {
             _ => assert!(!node.span.range().is_empty()),
         }
     }
-    walk(&Node::parse(EXAMPLE).unwrap(), EXAMPLE);
+    walk(&Node::parse_serde(EXAMPLE).unwrap(), EXAMPLE);
+    walk(&crate::fast::parse(EXAMPLE).unwrap(), EXAMPLE);
 }
 
 #[test]
@@ -272,11 +273,11 @@ fn attributes_and_mavlink() {
     assert_eq!(a.attributes.len(), 4);
     assert_eq!(
         a.backend,
-        Backend::Mavlink {
+        Backend::Mavlink(Box::new(Mavlink {
             address: "udp:127.0.0.1:14550".into(),
             system_id: Some(3),
             signing_key: None
-        }
+        }))
     );
     let w = ok("[drones.c]\nhome = [0, 0]\nsince = 1979-05-27T07:32:00Z\n");
     let since = w.drones[0].attribute("since");
@@ -286,7 +287,7 @@ fn attributes_and_mavlink() {
     );
     let w =
         ok("[drones.b]\nhome = [0, 0]\nbackend = \"mavlink\"\nmavlink = \"tcp:10.0.0.2:5760\"\n");
-    assert!(matches!(w.drones[0].backend, Backend::Mavlink { .. }));
+    assert!(matches!(w.drones[0].backend, Backend::Mavlink(_)));
 }
 
 #[test]
@@ -768,6 +769,7 @@ fn random_inputs_never_panic() {
             }
             chars.into_iter().collect()
         };
+        assert_fast_reader_agrees(&text);
         let (world, diags) = parse(&text);
         assert_eq!(world.is_some(), diags.is_empty(), "{text:?}");
         for d in &diags {
@@ -793,6 +795,9 @@ fn the_fast_reader_gives_the_same_tree_as_serde() {
         "[site]\norigin = { lat = 46.6, lon = 14.2, alt = 440.0 }\ngeofence = [[-600, -600], [600, -600], [600, 600]]\n",
         "\n\n# only comments\n",
         "",
+        // Scalars read without the decoder, and their neighbours read with it.
+        "[a]\ni = 0\nj = -0\nk = 123456789012345678\nl = 1234567890123456789\nm = +7\nn = 'lit \"q\"'\no = \"tab\there\"\np = \"\"\nq = ''\nb = false\nc = true\nu = 1_000\ne = \"\\u00e9\\\\\"\nf = -12\ng = 2.5\nh = \"\u{e9}t\u{e9}\"\n",
+        "[a]\nk-1 = 1\n_k = 2\n3 = 3\n",
     ];
     for text in examples {
         let fast = crate::fast::parse(text).unwrap_or_else(|| panic!("the fast reader reads {text:?}"));
@@ -819,6 +824,9 @@ fn the_fast_reader_gives_the_same_tree_as_serde() {
         "[a]\nd = 1979-05-27\n",
         "[a]\nx = \n",
         "[a]\nx = 0x10\n",
+        "[a]\nx = 01\n",
+        "[a]\nx = \"open\n",
+        "[a]\nx = 'open\n",
         "[a\n",
         "[places]\nLookout@= [100, 40]\n",
         "[drones.a]\nhom\u{e9} = [0, 0]\n",
@@ -836,4 +844,77 @@ fn the_fast_reader_gives_the_same_tree_as_serde() {
     ] {
         assert!(crate::fast::parse(text).is_none(), "{text:?}");
     }
+}
+
+/// The fast reader builds each drone as its table ends: the same world and the same
+/// diagnostics as the serde path's whole tree, whatever the drones' tables hold and
+/// wherever the tables they refer to (`[sensors]`, `[[faults]]`) stand.
+#[test]
+fn drones_read_table_by_table_give_the_serde_paths_world() {
+    let sensors = "[sensors.thermal]\ndetects = [\"Body\"]\nrange = 20\n";
+    let fleet = "[drones.a]\nhome = [0, 0]\ngroup = \"g\"\nsensors = [\"thermal\", \"camera\"]\nindex = 0\n\
+                 [drones.b]\nhome = [5, 0, 1]\ngroup = \"h\"\npayload = [\"kit\"]\nnote = \"x\"\nlist = [1, 2]\n\
+                 [drones.c]\nhome = [9, 9]\ngroup = \"g\"\nmavlink = \"udp:127.0.0.1:14550\"\nsystem_id = 3\n";
+    let texts = [
+        EXAMPLE.to_owned(),
+        fleet.to_owned(),
+        format!("{sensors}{fleet}"),
+        // `[sensors]` after the drones that name them.
+        format!("{fleet}{sensors}"),
+        format!("[drones]\n{fleet}[[faults]]\ndrone = \"b\"\nat = 5\nkind = \"crash\"\n"),
+        format!("{fleet}[[faults]]\ndrone = \"bb\"\nat = 5\nkind = \"crash\"\n[[faults]]\ndrone = \"zz\"\nat = 1\nkind = \"crash\"\n"),
+        // Problems in the drones' tables, and names shared with other tables.
+        "[drones.a]\nsensors = [\"thermel\", 3]\nmax_speed = -1\nspeed = 2\n[drones.b]\nhome = \"x\"\ngroup = \"a\"\nbackend = \"warp\"\n[places]\nb = [1, 2]\n".to_owned(),
+        "[drones.a]\n[drones.b]\nhome = [0, 0]\n[site]\nname = \"S\"\n[drones.c]\nhome = [1, 1]\ngroup = \"b\"\n".to_owned(),
+        "[drones.x1]\nhome = [0, 0]\ngroup = \"9g\"\nmavlink = \"bad\"\nsigning_key = 1\n[drones.x2]\nhome = [0, 0]\nbattery = 101\n".to_owned(),
+        // Forms the fast reader leaves to serde: the same answer either way.
+        "[drones]\na = 5\n[drones.b]\nhome = [0, 0]\n".to_owned(),
+        "[drones.a]\nhome = [0, 0]\n[drones.a.home]\nx = 1\n".to_owned(),
+        "[drones.a]\nhome = [0, 0]\n[site]\n[drones.a.extra]\nx = 1\n".to_owned(),
+        "[drones.a.b]\nx = 1\n[drones.c]\nhome = [0, 0]\n".to_owned(),
+        "[[drones]]\nhome = [0, 0]\n".to_owned(),
+        "[drones.a]\nhome = [0, 0]\n[drones.a]\nhome = [1, 1]\n".to_owned(),
+    ];
+    for text in &texts {
+        assert_fast_reader_agrees(text);
+        let (world, diags) = parse(text);
+        let Ok(tree) = Node::parse_serde(text) else {
+            assert!(world.is_none() && diags.len() == 1, "{text}");
+            continue;
+        };
+        let (slow_world, mut slow_diags) = crate::build::read_tree(FileId(7), text, tree);
+        aviary_diagnostics::sort(&mut slow_diags);
+        assert_eq!(diags, slow_diags, "{text}");
+        if let Some(world) = world {
+            assert_eq!(world, slow_world, "{text}");
+        }
+    }
+    // Which of them the fast reader takes: the first nine.
+    for (i, text) in texts.iter().enumerate() {
+        assert_eq!(crate::build::read_fast(FileId(7), text).is_some(), i < 9, "{text}");
+    }
+    let (world, _) = parse(&texts[3]);
+    let world = world.unwrap();
+    assert_eq!(world.groups.len(), 2);
+    assert_eq!(world.groups[0].members, [0, 2]);
+    assert_eq!(*world.drones[0].sensors, ["thermal", "camera"]);
+    // One string for a group's name and for each attribute key, whatever the drones.
+    let (a, c) = (&world.drones[0], &world.drones[2]);
+    assert!(std::sync::Arc::ptr_eq(a.group.as_ref().unwrap(), c.group.as_ref().unwrap()));
+    let w = ok("[drones.d]\nhome = [0, 0]\nnote = 1\n[drones.e]\nhome = [0, 0]\nnote = \"x\"\n");
+    assert!(std::sync::Arc::ptr_eq(&w.drones[0].attributes[0].0, &w.drones[1].attributes[0].0));
+}
+
+/// A large generated fleet: every drone table read by the fast reader as it goes.
+#[test]
+fn a_large_fleet_is_read_table_by_table() {
+    let mut text = String::from("[site]\nname = \"W\"\n");
+    for i in 0..500 {
+        text.push_str(&format!("\n[drones.a{i}]\nhome = [{}, 0]\ngroup = \"fleet{}\"\nindex = {i}\n", i * 5, i % 3));
+    }
+    assert_fast_reader_agrees(&text);
+    let world = ok(&text);
+    assert_eq!(world.drones.len(), 500);
+    assert_eq!(world.drones[499].name, "a499");
+    assert_eq!(world.groups.iter().map(|g| g.members.len()).collect::<Vec<_>>(), [167, 167, 166]);
 }

@@ -180,7 +180,7 @@ impl<'a> Checker<'a> {
             return Some(k);
         }
         let world = self.world?;
-        let found = world.drones.iter().find_map(|d| d.attributes.iter().find(|(k, _)| *k == field.name).map(|(_, v)| v));
+        let found = world.drones.iter().find_map(|d| d.attributes.iter().find(|(k, _)| **k == *field.name).map(|(_, v)| v));
         match found {
             Some(AttributeValue::Number(_)) => Some(Kind::Number),
             Some(AttributeValue::Text(_)) => Some(Kind::Text),
@@ -189,7 +189,7 @@ impl<'a> Checker<'a> {
             None => {
                 let mut names: Vec<&str> = self.api.telemetry.iter().map(|(n, _)| *n).collect();
                 for d in &world.drones {
-                    names.extend(d.attributes.iter().map(|(k, _)| k.as_str()));
+                    names.extend(d.attributes.iter().map(|(k, _)| &**k));
                 }
                 names.sort_unstable();
                 names.dedup();

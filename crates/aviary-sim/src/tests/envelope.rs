@@ -147,10 +147,12 @@ mod bound {
             vel in (-20f64..20.0, -20f64..20.0, -6f64..6.0),
             axis in 0u8..3, accel in 0.5f64..10.0, radius in 1f64..500.0, leg in 0u8..3,
         ) {
-            let mut d = Fleet::new(&one_drone()).drones[0].clone();
+            let world = one_drone();
+            let mut spec = crate::drone::Spec::of(&world.drones[0]);
+            spec.accel = accel;
+            let mut d = crate::drone::SimDrone::new(&world.drones[0], std::sync::Arc::new(spec));
             d.pos = [pos.0, pos.1, pos.2];
             d.vel = match axis { 0 => [vel.0, 0.0, vel.2], 1 => [0.0, vel.1, 0.0], _ => [vel.0, vel.1, vel.2] };
-            d.accel = accel;
             d.state = FlightState::Flying;
             let legs = match leg {
                 0 => vec![Leg::Move { to: [0.0, 0.0, 20.0], speed: 10.0, state: FlightState::Flying }],

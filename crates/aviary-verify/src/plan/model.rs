@@ -43,7 +43,7 @@ impl Flyer {
             accel: d.acceleration,
             endurance: d.endurance,
             battery_start: d.battery / 100.0,
-            sensors: d.sensors.clone(),
+            sensors: d.sensors.to_vec(),
             airborne: false,
             since: 0.0,
             flight_time: 0.0,

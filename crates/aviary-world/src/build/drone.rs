@@ -3,9 +3,12 @@
 use aviary_diagnostics::Span;
 
 use super::get;
+use std::sync::Arc;
+
+use crate::hash::{QuickMap, QuickSet};
 use crate::node::{Entry, Node, Value};
 use crate::read::{quoted, suggest, toml_text, Ctx};
-use crate::{AttributeValue, Backend, Drone, BUILTIN_SENSORS};
+use crate::{AttributeValue, Backend, Drone, Group, Mavlink, BUILTIN_SENSORS};
 
 const BACKEND_KEYS: &[&str] = &["backend", "mavlink", "system_id", "signing_key"];
 const SCHEMES: &[&str] = &[
@@ -16,103 +19,165 @@ const TELEMETRY: &[&str] = &["position", "altitude", "speed", "heading", "state"
 const ADDRESS_HELP: &str =
     "write `mavlink = \"udp:127.0.0.1:14550\"` or `\"tcp:HOST:PORT\"` (schemes: tcp, tcpin, tcpout, udp, udpin, udpout, udpbcast, serial)";
 
-pub(super) fn drones(
-    cx: &mut Ctx,
-    node: Node,
-    sensor_kinds: &[String],
-    group_spans: &mut Vec<(String, Span)>,
-) -> Vec<Drone> {
-    let help = "write one table per drone: `[drones.NAME]` followed by `home = [x, y]`";
-    if cx.table(&"`drones`", &node, help).is_none() {
-        return Vec::new();
-    }
-    let Value::Table(entries) = node.value else { return Vec::new() };
-    let mut out = Vec::with_capacity(entries.len());
-    // Each drone's table is dropped once read.
-    for e in entries {
-        cx.identifier("drone", &e.key, e.key_span);
-        let what = Named("drone", &e.key);
-        let Some(keys) = cx.table(&what, &e.node, help) else {
-            continue;
-        };
-        out.push(drone(cx, &e, keys, sensor_kinds, group_spans));
-    }
-    out
+/// The drones as their tables come: from the fast reader one by one while it reads,
+/// or from the serde path's tree. What needs other tables (the sensors' kinds) waits
+/// for [`Drones::finish`].
+#[derive(Default)]
+pub(super) struct Drones {
+    pub out: Vec<Drone>,
+    /// In order of first appearance, members in the drones' file order.
+    pub groups: Vec<Group>,
+    /// Where each group of `groups` is first named.
+    pub group_spans: Vec<Span>,
+    /// Each group's index and shared name.
+    group_index: QuickMap<String, (usize, Arc<str>)>,
+    /// Attribute keys, each kept once.
+    keys: QuickSet<Arc<str>>,
+    /// (drone, its sensor's index, span) of every sensor named.
+    sensors: Vec<(usize, usize, Span)>,
+    /// Entries that are not tables, each with the number of drones before it.
+    others: Vec<(usize, String)>,
 }
 
-fn drone(
-    cx: &mut Ctx,
-    e: &Entry,
-    keys: &[Entry],
-    sensor_kinds: &[String],
-    group_spans: &mut Vec<(String, Span)>,
-) -> Drone {
-    let name = &e.key;
-    let mut d = Drone {
-        name: name.clone(),
-        home: [0.0; 3],
-        group: None,
-        sensors: Vec::new(),
-        payload: Vec::new(),
-        max_speed: 10.0,
-        climb_rate: 3.0,
-        acceleration: 3.0,
-        battery: 100.0,
-        endurance: 1800.0,
-        backend: Backend::Sim,
-        attributes: Vec::new(),
-        span: e.key_span,
-    };
-    if get(keys, "home").is_none() {
-        let msg = format!("drone `{name}` has no `home`");
-        cx.error(
-            e.key_span,
-            msg,
-            "add `home = [x, y]`: where the drone starts and lands, in metres",
-        );
+pub(super) const HELP: &str = "write one table per drone: `[drones.NAME]` followed by `home = [x, y]`";
+
+impl Drones {
+    /// Room for about `n` drones.
+    pub fn with_capacity(n: usize) -> Drones {
+        Drones { out: Vec::with_capacity(n), ..Drones::default() }
     }
-    for k in keys {
-        // Said only in a message: not formatted unless one is written.
-        let what = KeyOf(&k.key, name);
-        let n = &k.node;
-        match k.key.as_str() {
-            "home" => d.home = cx.point(&what, n).map_or(d.home, |(p, _)| p),
-            "group" => {
-                let Some(group) = cx.string(&what, n) else {
-                    continue;
-                };
-                if cx.identifier("group", &group, n.span) {
-                    group_spans.push((group.clone(), n.span));
-                    d.group = Some(group);
-                }
+
+    /// One entry of `[drones]`; its table is dropped once read.
+    pub fn entry(&mut self, cx: &mut Ctx, e: Entry) {
+        cx.identifier("drone", &e.key, e.key_span);
+        if !matches!(e.node.value, Value::Table(_)) {
+            cx.table(&Named("drone", &e.key), &e.node, HELP);
+            self.others.push((self.out.len(), e.key));
+            return;
+        }
+        let Entry { key, key_span, node: Node { value: Value::Table(keys), .. } } = e else { return };
+        let d = self.drone(cx, key, key_span, &keys);
+        self.out.push(d);
+    }
+
+    /// Checks every drone's sensors against `[sensors]`.
+    pub fn finish(&self, cx: &mut Ctx, sensor_kinds: &[String]) {
+        for &(d, i, span) in &self.sensors {
+            let drone = &self.out[d];
+            check_sensor(cx, &drone.name, &drone.sensors[i], span, sensor_kinds);
+        }
+    }
+
+    /// Every key of `[drones]`, in file order, tables or not.
+    pub fn names(&self) -> Vec<&str> {
+        let mut others = self.others.iter().peekable();
+        let mut names = Vec::with_capacity(self.out.len() + self.others.len());
+        for (i, d) in self.out.iter().enumerate() {
+            while let Some((_, name)) = others.next_if(|(before, _)| *before == i) {
+                names.push(name.as_str());
             }
-            "sensors" => {
-                for (kind, span) in cx.strings(&what, n).unwrap_or_default() {
-                    check_sensor(cx, name, &kind, span, sensor_kinds);
-                    d.sensors.push(kind);
+            names.push(d.name.as_str());
+        }
+        names.extend(others.map(|(_, name)| name.as_str()));
+        names
+    }
+
+    fn drone(&mut self, cx: &mut Ctx, owned: String, key_span: Span, keys: &[Entry]) -> Drone {
+        let name = owned.as_str();
+        let mut d = Drone {
+            name: String::new(),
+            home: [0.0; 3],
+            group: None,
+            sensors: Box::default(),
+            payload: Box::default(),
+            max_speed: 10.0,
+            climb_rate: 3.0,
+            acceleration: 3.0,
+            battery: 100.0,
+            endurance: 1800.0,
+            backend: Backend::Sim,
+            attributes: Box::default(),
+            span: key_span,
+        };
+        if get(keys, "home").is_none() {
+            let msg = format!("drone `{name}` has no `home`");
+            cx.error(
+                key_span,
+                msg,
+                "add `home = [x, y]`: where the drone starts and lands, in metres",
+            );
+        }
+        let index = self.out.len();
+        let mut attributes = Vec::new();
+        for k in keys {
+            // Said only in a message: not formatted unless one is written.
+            let what = KeyOf(&k.key, name);
+            let n = &k.node;
+            match k.key.as_str() {
+                "home" => d.home = cx.point(&what, n).map_or(d.home, |(p, _)| p),
+                "group" => {
+                    // Read in place: most drones name a group that exists already.
+                    let Value::Str(group) = &n.value else {
+                        cx.string(&what, n);
+                        continue;
+                    };
+                    if cx.identifier("group", group, n.span) {
+                        let (g, shared) = match self.group_index.get(group.as_str()) {
+                            Some((g, shared)) => (*g, shared.clone()),
+                            None => {
+                                let shared: Arc<str> = group.as_str().into();
+                                self.group_index.insert(group.clone(), (self.groups.len(), shared.clone()));
+                                self.groups.push(Group { name: group.clone(), members: Vec::new() });
+                                self.group_spans.push(n.span);
+                                (self.groups.len() - 1, shared)
+                            }
+                        };
+                        self.groups[g].members.push(index);
+                        d.group = Some(shared);
+                    }
                 }
-            }
-            "payload" => {
-                for (kind, span) in cx.strings(&what, n).unwrap_or_default() {
-                    cx.identifier("payload kind", &kind, span);
-                    d.payload.push(kind);
+                "sensors" => {
+                    let mut sensors = Vec::new();
+                    for (kind, span) in cx.strings(&what, n).unwrap_or_default() {
+                        self.sensors.push((index, sensors.len(), span));
+                        sensors.push(kind);
+                    }
+                    d.sensors = sensors.into();
                 }
-            }
-            "max_speed" => d.max_speed = cx.positive(&what, n).unwrap_or(d.max_speed),
-            "climb_rate" => d.climb_rate = cx.positive(&what, n).unwrap_or(d.climb_rate),
-            "acceleration" => d.acceleration = cx.positive(&what, n).unwrap_or(d.acceleration),
-            "endurance" => d.endurance = cx.positive(&what, n).unwrap_or(d.endurance),
-            "battery" => d.battery = cx.within(&what, n, 0.0, 100.0).unwrap_or(d.battery),
-            key if BACKEND_KEYS.contains(&key) => {}
-            _ => {
-                if let Some(attribute) = attribute(cx, name, k) {
-                    d.attributes.push(attribute);
+                "payload" => {
+                    let mut payload = Vec::new();
+                    for (kind, span) in cx.strings(&what, n).unwrap_or_default() {
+                        cx.identifier("payload kind", &kind, span);
+                        payload.push(kind);
+                    }
+                    d.payload = payload.into();
+                }
+                "max_speed" => d.max_speed = cx.positive(&what, n).unwrap_or(d.max_speed),
+                "climb_rate" => d.climb_rate = cx.positive(&what, n).unwrap_or(d.climb_rate),
+                "acceleration" => d.acceleration = cx.positive(&what, n).unwrap_or(d.acceleration),
+                "endurance" => d.endurance = cx.positive(&what, n).unwrap_or(d.endurance),
+                "battery" => d.battery = cx.within(&what, n, 0.0, 100.0).unwrap_or(d.battery),
+                key if BACKEND_KEYS.contains(&key) => {}
+                _ => {
+                    if let Some((key, value)) = attribute(cx, name, k) {
+                        let key = match self.keys.get(key) {
+                            Some(shared) => shared.clone(),
+                            None => {
+                                let shared: Arc<str> = key.into();
+                                self.keys.insert(shared.clone());
+                                shared
+                            }
+                        };
+                        attributes.push((key, value));
+                    }
                 }
             }
         }
+        d.backend = backend(cx, name, keys);
+        d.attributes = attributes.into();
+        d.name = owned;
+        d
     }
-    d.backend = backend(cx, name, keys);
-    d
 }
 
 fn check_sensor(cx: &mut Ctx, drone: &str, kind: &str, span: Span, defined: &[String]) {
@@ -135,7 +200,7 @@ fn check_sensor(cx: &mut Ctx, drone: &str, kind: &str, span: Span, defined: &[St
     cx.error(span, msg, help);
 }
 
-fn attribute(cx: &mut Ctx, drone: &str, e: &Entry) -> Option<(String, AttributeValue)> {
+fn attribute<'e>(cx: &mut Ctx, drone: &str, e: &'e Entry) -> Option<(&'e str, AttributeValue)> {
     let key = &e.key;
     if TELEMETRY.contains(&key.as_str()) {
         let msg = format!(
@@ -153,13 +218,13 @@ fn attribute(cx: &mut Ctx, drone: &str, e: &Entry) -> Option<(String, AttributeV
     }
     let value = match &e.node.value {
         Value::Int(_) | Value::Float(_) => {
-            AttributeValue::Number(cx.number(&format!("attribute `{key}`"), &e.node)?)
+            AttributeValue::Number(cx.number(&Named("attribute", key), &e.node)?)
         }
         Value::Str(s) => AttributeValue::Text(s.clone()),
         Value::Bool(b) => AttributeValue::Bool(*b),
         _ => AttributeValue::Other(toml_text(&e.node)),
     };
-    Some((key.clone(), value))
+    Some((key, value))
 }
 
 fn backend(cx: &mut Ctx, drone: &str, keys: &[Entry]) -> Backend {
@@ -205,11 +270,11 @@ fn backend(cx: &mut Ctx, drone: &str, keys: &[Entry]) -> Backend {
         return Backend::Sim;
     }
     let address = address.map(|(a, _)| a).unwrap_or_default();
-    Backend::Mavlink {
+    Backend::Mavlink(Box::new(Mavlink {
         address,
         system_id,
         signing_key,
-    }
+    }))
 }
 
 fn system_id(cx: &mut Ctx, drone: &str, e: &Entry) -> Option<u8> {

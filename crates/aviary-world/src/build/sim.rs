@@ -125,7 +125,7 @@ pub(super) fn targets(cx: &mut Ctx, node: &Node) -> Vec<Target> {
     out
 }
 
-pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[String]) -> Vec<Fault> {
+pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[&str]) -> Vec<Fault> {
     let help = "write each fault as `[[faults]]` followed by `drone = \"NAME\"`, `at = 60` (seconds) and `kind = \"crash\"`";
     let kinds: Vec<&str> = FaultKind::ALL.iter().map(|k| k.as_str()).collect();
     let mut out = Vec::new();
@@ -136,7 +136,7 @@ pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[String]) -> Vec<Fault>
         };
         let drone = match get(keys, "drone") {
             Some(d) => cx.string(&"`drone` of a fault", &d.node).filter(|name| {
-                let known = drones.iter().any(|k| k == name);
+                let known = drones.contains(&name.as_str());
                 if !known {
                     fault_drone(cx, name, d, drones);
                 }
@@ -232,14 +232,13 @@ pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[String]) -> Vec<Fault>
     out
 }
 
-fn fault_drone(cx: &mut Ctx, name: &str, e: &Entry, drones: &[String]) {
+fn fault_drone(cx: &mut Ctx, name: &str, e: &Entry, drones: &[&str]) {
     let msg = format!("the fault names drone `{name}`, which is not in `[drones]`");
-    let help = match suggest(name, drones.iter().map(String::as_str)) {
+    let help = match suggest(name, drones.iter().copied()) {
         Some(s) => format!("did you mean `{s}`?"),
         None if drones.is_empty() => format!("define it as `[drones.{name}]`"),
         None => {
-            let names: Vec<&str> = drones.iter().map(String::as_str).collect();
-            format!("name one of the drones: {}", quoted(&names))
+            format!("name one of the drones: {}", quoted(drones))
         }
     };
     cx.error(e.node.span, msg, help);

@@ -94,7 +94,8 @@ pub struct Fleet {
     /// The world's targets by where they are.
     pub(crate) target_grid: Grid,
     /// The targets near each drone's way, kept between ticks.
-    pub(crate) near_targets: Vec<Nearby>,
+    /// Made for a drone when it first detects: most drones of a large fleet never do.
+    pub(crate) near_targets: Vec<Option<Box<Nearby>>>,
     /// The drone of each call in progress (a call id is only ever that drone's), so that
     /// [`Fleet::interrupt`] looks at one drone, not the fleet. Entries go when the call's
     /// end is reported; one left over (a task replaced without an end) only costs a lookup.
@@ -196,7 +197,7 @@ impl Fleet {
             outages: Vec::new(),
             fastest: world.drones.iter().map(|d| d.max_speed + d.climb_rate).fold(0.0, f64::max),
             target_grid: target_grid(&world.targets),
-            near_targets: vec![Nearby::default(); world.drones.len()],
+            near_targets: vec![None; world.drones.len()],
             calls: HashMap::new(),
         }
     }
@@ -470,7 +471,7 @@ impl Fleet {
         }
         // Only the targets near the way flown, in their order.
         let nearby = match d.detections().iter().map(|a| a.range).reduce(f64::max) {
-            Some(range) => self.near_targets[id].around(&self.target_grid, from, to, range),
+            Some(range) => self.near_targets[id].get_or_insert_with(Box::default).around(&self.target_grid, from, to, range),
             None => &[],
         };
         if let Some(rare) = d.rare.as_deref_mut() {

@@ -65,6 +65,8 @@ pub fn run(mission: String, world: String, sink: &mut dyn TraceSink, stages: &mu
         .map_err(|e| format!("cannot start the runtime: {e}"))?;
     runtime.block_on(async {
         let sim = stages.time("sim start", || SimBackend::start(&world, SimOptions::default()));
+        // The simulator keeps what it needs of the world, as in `aviary run`.
+        drop(world);
         let outcome = {
             let start = Instant::now();
             let outcome = aviary_engine::run(&compiled, &*sim, sink, &RunOptions::default()).await;

@@ -65,6 +65,7 @@ pub(crate) fn parse_with(text: &str, drones: usize, on_drone: &mut dyn FnMut(Ent
         drones_at: None,
         open_drone: false,
     };
+    const MAX_DEPTH: i64 = 32;
     let mut errors = Errors(false);
     // Parsed a table at a time: all the tokens of a large world at once would take more
     // memory than its tree. A `[` that opens a line outside any bracket starts a table.
@@ -105,6 +106,12 @@ pub(crate) fn parse_with(text: &str, drones: usize, on_drone: &mut dyn FnMut(Ent
             TokenKind::LeftCurlyBracket => depth += 1,
             TokenKind::RightSquareBracket | TokenKind::RightCurlyBracket => depth -= 1,
             _ => {}
+        }
+        // `toml_parser` recurses once per open bracket, without a limit: deep nesting
+        // goes to the serde path, which stops at its recursion limit with an error
+        // (a world file nests four deep at most).
+        if depth > MAX_DEPTH {
+            return None;
         }
         line_start = token.kind() == TokenKind::Newline;
         tokens.push(token);

@@ -734,6 +734,12 @@ fn garbage_gives_diagnostics_not_panics() {
     assert!(parse(&deep).0.is_none());
     let deep = format!("a = {}", "{ b = ".repeat(5000));
     assert!(parse(&deep).0.is_none());
+    // A million open brackets on a test thread's small stack: neither reader recurses
+    // that deep (the fast one leaves deep nesting to serde, which has a limit).
+    for open in ["[", "{ b = ", "[{ b = "] {
+        let (world, diags) = parse(&format!("a = {}", open.repeat(1_000_000)));
+        assert!(world.is_none() && diags.iter().any(|d| d.is_error()), "{open}");
+    }
 }
 
 /// Random texts and random edits of the example: never a panic, every span in the text.

@@ -82,8 +82,8 @@ pub(crate) struct Instance {
 }
 
 impl Instance {
-    pub fn root(self: &Rc<Self>) -> Rc<Instance> {
-        self.root.clone().unwrap_or_else(|| self.clone())
+    pub fn root(self: &Rc<Self>) -> &Rc<Instance> {
+        self.root.as_ref().unwrap_or(self)
     }
 }
 

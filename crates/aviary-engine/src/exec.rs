@@ -7,7 +7,7 @@ use std::pin::pin;
 use std::rc::Rc;
 use std::time::Duration;
 
-use aviary_api::{CallEnd, DroneId, Interrupt, Value};
+use aviary_api::{CallEnd, DroneId, Ending, Interrupt, Value};
 use aviary_ir::{ActorRef, Block, BlockKind, Call, Expr, For, Leash, LeashAction, Node};
 use futures_util::future::{join_all, LocalBoxFuture};
 use futures_util::stream::{FuturesUnordered, StreamExt};
@@ -355,7 +355,7 @@ impl<'m> Engine<'m> {
             capability: call.capability,
             tag: call.tag,
             actors: actors.clone(),
-            root: ctx.instance.as_ref().map(|p| p.root()),
+            root: ctx.instance.as_ref().map(|p| p.root().clone()),
             token: ctx.instance.as_ref().map_or_else(|| self.stop.child_token(), |p| p.token.child_token()),
             // Only the capability's own exception handler cancels its PERFORM body.
             perform: (!cap.exception_handlers.is_empty()).then(CancellationToken::new),
@@ -573,16 +573,22 @@ impl<'m> Engine<'m> {
         let function = self.m.functions[a.function].0.as_str();
         self.trace(Kind::ApiCall, || [("actor", Field::Str(self.name(drone))), ("function", Field::Str(function)), ("args", Field::Json(self.values(&args)))]);
         let pending = self.backend.call(drone, function, &args);
-        let guard = CallGuard { engine: self, id: pending.id, root: root.clone(), done: Cell::new(false), drone, function, args: &args };
-        if let Some(root) = &root {
-            root.calls.borrow_mut().push(pending.id);
-            if root.paused.get() {
-                self.backend.interrupt(pending.id, Interrupt::Pause);
+        let end = match pending.end {
+            // Over as it was made: nothing in flight to pause, resume or abort.
+            Ending::Now(end) => end,
+            Ending::Later(answer) => {
+                let guard = CallGuard { engine: self, id: pending.id, root, done: Cell::new(false), drone, function, args: &args };
+                if let Some(root) = root {
+                    root.calls.borrow_mut().push(pending.id);
+                    if root.paused.get() {
+                        self.backend.interrupt(pending.id, Interrupt::Pause);
+                    }
+                }
+                let end = answer.await.unwrap_or(CallEnd::Interrupted);
+                guard.done.set(true);
+                end
             }
-        }
-        let end = pending.end.wait().await.unwrap_or(CallEnd::Interrupted);
-        guard.done.set(true);
-        drop(guard);
+        };
         self.trace_done(drone, function, &args, &end);
         match end {
             CallEnd::Done => self.after_call(function, drone, &args, ctx),
@@ -621,7 +627,7 @@ impl<'m> Engine<'m> {
 struct CallGuard<'e, 'm> {
     engine: &'e Engine<'m>,
     id: aviary_api::CallId,
-    root: Option<Rc<Instance>>,
+    root: Option<&'e Rc<Instance>>,
     done: Cell<bool>,
     drone: DroneId,
     function: &'e str,

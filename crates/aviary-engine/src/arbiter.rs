@@ -130,19 +130,26 @@ impl Arbiter {
     }
 }
 
+/// `claims` now, when nobody waits and all of it is free (as `grant` would give them);
+/// else they are given back.
+pub(crate) fn try_acquire(arbiter: &Rc<RefCell<Arbiter>>, claims: Needs) -> Result<Held, Needs> {
+    let mut a = arbiter.borrow_mut();
+    if a.waiting.is_empty() && claims.iter().all(|c| !a.held.contains(c)) {
+        a.next += 1;
+        let id = a.next;
+        a.held.extend(claims.iter().copied());
+        return Ok(Held { arbiter: arbiter.clone(), id, own: claims });
+    }
+    Err(claims)
+}
+
 /// Waits for `claims` (all at once, in arrival order) and holds them.
 pub(crate) async fn acquire(arbiter: &Rc<RefCell<Arbiter>>, claims: Needs) -> Held {
-    {
-        // Nobody waits and all of it is free: granted now, as `grant` would, without a
-        // channel to wait on.
-        let mut a = arbiter.borrow_mut();
-        if a.waiting.is_empty() && claims.iter().all(|c| !a.held.contains(c)) {
-            a.next += 1;
-            let id = a.next;
-            a.held.extend(claims.iter().copied());
-            return Held { arbiter: arbiter.clone(), id, own: claims };
-        }
-    }
+    // Granted now without a channel to wait on, when it can be.
+    let claims = match try_acquire(arbiter, claims) {
+        Ok(held) => return held,
+        Err(claims) => claims,
+    };
     let (tx, rx) = oneshot::channel();
     let id = {
         let mut a = arbiter.borrow_mut();
@@ -188,6 +195,21 @@ mod tests {
         assert!(poll_once(third.as_mut()).is_pending());
         drop(b);
         assert!(poll_once(third.as_mut()).is_ready());
+    }
+
+    #[test]
+    fn granted_at_once_only_when_free_and_nobody_waits() {
+        let arbiter = Rc::new(RefCell::new(Arbiter::default()));
+        let m = |d| (d, Resource::Motion);
+        let a = try_acquire(&arbiter, smallvec::smallvec![m(0)]).ok().expect("free");
+        let refused = try_acquire(&arbiter, smallvec::smallvec![m(0), m(1)]).err().expect("0 is held");
+        assert_eq!(refused.as_slice(), &[m(0), m(1)], "given back whole");
+        // Someone waits for 0 and 1: 1 alone is free but not granted past the waiter.
+        let mut waiter = pin!(acquire(&arbiter, refused));
+        assert!(poll_once(waiter.as_mut()).is_pending());
+        assert!(try_acquire(&arbiter, smallvec::smallvec![m(1)]).is_err());
+        drop(a);
+        assert!(poll_once(waiter.as_mut()).is_ready());
     }
 
     #[test]

@@ -16,7 +16,7 @@ use serde_json::{json, Map, Value as Json};
 use tokio::sync::Notify;
 use crate::cancel::Token as CancellationToken;
 
-use crate::arbiter::{acquire, Claims, Needs};
+use crate::arbiter::{acquire, try_acquire, Claims, Needs};
 use crate::engine::{Actors, Ctx, Engine, Frame, Instance, Job, Scope};
 use crate::jobs::Jobs;
 use crate::join::{join_eager, SMALL};
@@ -385,12 +385,24 @@ impl<'m> Engine<'m> {
                 [actor, capability, tag, args, ("status", Field::Str(status))]
             });
         };
-        // Known from now on (a leash can abort it while it waits), by where it was called.
-        self.instances.borrow_mut().insert(instance.clone(), ctx.scope.clone());
         // Claims first (a second instance on a busy resource waits), then the start.
         let needs: Needs = cap.claims.iter().filter_map(|(i, r)| actors.get(*i).map(|d| (*d, *r))).filter(|c| !ctx.claims.contains(c)).collect();
         let claims = ctx.claims.with(&needs);
-        let held = instance.token.run(acquire(&self.arbiter, needs)).await;
+        // An instance that waits is known while it waits (a leash can abort it), by where
+        // it was called; one granted at once is listed once its own scope exists.
+        let mut listed = false;
+        let held = if instance.token.is_cancelled() {
+            None
+        } else {
+            match try_acquire(&self.arbiter, needs) {
+                Ok(held) => Some(held),
+                Err(needs) => {
+                    self.instances.borrow_mut().insert(instance.clone(), ctx.scope.clone());
+                    listed = true;
+                    instance.token.run(acquire(&self.arbiter, needs)).await
+                }
+            }
+        };
         if self.stopped() {
             self.instances.borrow_mut().remove(&instance);
             return;
@@ -435,7 +447,11 @@ impl<'m> Engine<'m> {
                 instance: Some(instance.clone()),
             })
         };
-        self.instances.borrow_mut().set_scope(&instance, scope.clone());
+        if listed {
+            self.instances.borrow_mut().set_scope(&instance, scope.clone());
+        } else {
+            self.instances.borrow_mut().insert(instance.clone(), scope.clone());
+        }
         let inner = Ctx { scope: scope.clone(), frame, actor, instance: Some(instance.clone()), claims };
         // A PERFORM body that declares no handlers, in a capability without exception
         // handlers, runs its statements in the instance's own scope: a scope of its own

@@ -411,7 +411,9 @@ impl<'i> Builder<'i, '_> {
             ScalarKind::String => Value::Str(out),
             ScalarKind::Boolean(b) => Value::Bool(b),
             ScalarKind::Integer(IntegerRadix::Dec) => Value::Int(out.parse().ok()?),
-            ScalarKind::Float if encoding.is_none() => Value::Float(out.parse().ok()?),
+            // A literal too large for an f64 (`14E2650`) reads as infinity here and is an
+            // error for the serde path: not finite, it takes that path (as do `inf`, `nan`).
+            ScalarKind::Float if encoding.is_none() => Value::Float(out.parse::<f64>().ok().filter(|f| f.is_finite())?),
             _ => return None,
         };
         self.value(Node { span: span(at), value })

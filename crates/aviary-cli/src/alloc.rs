@@ -19,7 +19,7 @@ pub struct MiMalloc;
 /// second, and commits arena memory as it is used, rather than up front. Peak memory
 /// then follows what is alive: a short run such as W(100k, 10) frees the world it read
 /// before its engine peaks, and that memory used to stay resident for the whole run
-/// (98 MiB against 65 MiB now, at the same speed: docs/BENCHMARKS.md).
+/// (98 MiB against 65 MiB now, for about 5% more time: docs/BENCHMARKS.md).
 /// `MIMALLOC_PURGE_DELAY` and `MIMALLOC_ARENA_EAGER_COMMIT` in the environment still win.
 ///
 /// Run before `main` (`ctor`): the first arena is made at the first allocation, before
@@ -42,12 +42,9 @@ fn tune() {
 /// Whether the variable is set, without allocating (this runs before the allocator is
 /// ready for Rust's own use).
 fn in_environment(name: &std::ffi::CStr) -> bool {
-    unsafe extern "C" {
-        fn getenv(name: *const std::ffi::c_char) -> *mut std::ffi::c_char;
-    }
     // SAFETY: a NUL-terminated name; the result is only compared with null, and nothing
     // changes the environment before `main`.
-    !unsafe { getenv(name.as_ptr()) }.is_null()
+    !unsafe { libc::getenv(name.as_ptr()) }.is_null()
 }
 
 // Ids in mimalloc v3's `mi_option_e` (its `mimalloc.h`, the version this crate builds);

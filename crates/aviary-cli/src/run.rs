@@ -123,9 +123,7 @@ pub fn run(args: &RunArgs) -> u8 {
     // The operator's view of the drones comes from telemetry events.
     let telemetry_hz = args.telemetry_hz.or(server.as_ref().map(|_| 2.0));
     let progress = progress_bar(args.quiet);
-    let mut world = Some(world);
     let ran = runtime.block_on(async {
-        let Some(world) = world.take() else { unreachable!("the world is taken once") };
         let sim = SimBackend::start(&world, SimOptions { speed: args.speed, ..SimOptions::default() });
         let mixed = match live {
             true => Some(crate::mixed::Mixed::new(sim.clone(), aviary_mavlink::connect(&world, aviary_mavlink::Tuning::default()).await?)),

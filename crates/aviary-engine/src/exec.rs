@@ -155,8 +155,7 @@ impl<'m> Engine<'m> {
             }
             Node::Signal { signal, args, .. } => {
                 if !self.stopped() {
-                    let args = self.eval_all(args, ctx);
-                    self.raise(*signal, args, ctx.actor, &ctx.scope);
+                    self.signal(*signal, args, ctx);
                 }
             }
             _ => self.node(node, ctx).await,
@@ -197,10 +196,7 @@ impl<'m> Engine<'m> {
                 Node::Block(b) => self.block(b, ctx).await,
                 Node::Call(_) | Node::Api(_) | Node::For(_) => unreachable!("boxed apart in `node`"),
                 Node::Leash(l) => self.leash(l, ctx),
-                Node::Signal { signal, args, .. } => {
-                    let args = self.eval_all(args, ctx);
-                    self.raise(*signal, args, ctx.actor, &ctx.scope);
-                }
+                Node::Signal { signal, args, .. } => self.signal(*signal, args, ctx),
                 Node::Throw { exception, args, .. } => {
                     let args = self.eval_all(args, ctx);
                     self.throw(*exception, args, ctx.actor, &ctx.scope);
@@ -234,6 +230,12 @@ impl<'m> Engine<'m> {
                 }
             }
         }
+    }
+
+    /// `SIGNAL`: raised by the actor of this place, from its scope.
+    fn signal(&self, signal: usize, args: &[Expr], ctx: &Ctx<'m>) {
+        let args = self.eval_all(args, ctx);
+        self.raise(signal, args, ctx.actor, &ctx.scope);
     }
 
     fn eval_all(&self, exprs: &[Expr], ctx: &Ctx<'m>) -> Vec<Value> {

@@ -145,7 +145,7 @@ pub fn run(args: &RunArgs) -> u8 {
                 feed.publish(&event);
             }
         };
-        let options = RunOptions { telemetry_hz };
+        let options = RunOptions { telemetry_hz, ..RunOptions::default() };
         let outcome = tokio::select! {
             biased;
             outcome = aviary_engine::run_controlled(&mission, backend, &mut sink, &options, controls) => outcome,

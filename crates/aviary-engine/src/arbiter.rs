@@ -143,6 +143,22 @@ pub(crate) fn try_acquire(arbiter: &Rc<RefCell<Arbiter>>, claims: Needs) -> Resu
     Err(claims)
 }
 
+/// Takes `claims` that [`free`] found free, with nothing asked of the arbiter since.
+pub(crate) fn take(arbiter: &Rc<RefCell<Arbiter>>, claims: Needs) -> Held {
+    debug_assert!(free(arbiter, &claims), "taken claims were free");
+    let mut a = arbiter.borrow_mut();
+    a.next += 1;
+    let id = a.next;
+    a.held.extend(claims.iter().copied());
+    Held { arbiter: arbiter.clone(), id, own: claims }
+}
+
+/// Whether `claims` would be granted now (`try_acquire` would succeed), without taking them.
+pub(crate) fn free(arbiter: &RefCell<Arbiter>, claims: &[Claim]) -> bool {
+    let a = arbiter.borrow();
+    a.waiting.is_empty() && claims.iter().all(|c| !a.held.contains(c))
+}
+
 /// Waits for `claims` (all at once, in arrival order) and holds them.
 pub(crate) async fn acquire(arbiter: &Rc<RefCell<Arbiter>>, claims: Needs) -> Held {
     // Granted now without a channel to wait on, when it can be.

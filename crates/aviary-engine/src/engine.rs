@@ -125,10 +125,12 @@ pub(crate) struct Engine<'m> {
     /// The MISSION body's own block: "mission level", where an idle drone's events are raised.
     pub mission_scope: RefCell<Option<Rc<Scope<'m>>>>,
     pub next_id: Cell<u64>,
+    /// Which capabilities may run as instant activities (`instant.rs`).
+    pub instant: Vec<bool>,
 }
 
 impl<'m> Engine<'m> {
-    pub fn new(m: &'m Mission, backend: &'m dyn Backend, sink: &'m mut dyn TraceSink) -> Self {
+    pub fn new(m: &'m Mission, backend: &'m dyn Backend, sink: &'m mut dyn TraceSink, options: &RunOptions) -> Self {
         Engine {
             m,
             backend,
@@ -149,6 +151,7 @@ impl<'m> Engine<'m> {
             root: RefCell::new(None),
             mission_scope: RefCell::new(None),
             next_id: Cell::new(0),
+            instant: if options.instant_activities { crate::instant::instant_capabilities(m) } else { vec![false; m.capabilities.len()] },
         }
     }
 

@@ -7,21 +7,17 @@ use std::pin::pin;
 use std::rc::Rc;
 use std::time::Duration;
 
-use aviary_api::{CallEnd, DroneId, Ending, Interrupt, Value};
+use aviary_api::{DroneId, Interrupt, Value};
 use aviary_ir::{ActorRef, Block, BlockKind, Call, Expr, For, Leash, LeashAction, Node};
-use futures_util::future::{join_all, LocalBoxFuture};
+use futures_util::future::{join_all, Either, LocalBoxFuture};
 use futures_util::stream::{FuturesUnordered, StreamExt};
-use smallvec::SmallVec;
-use serde_json::{json, Map, Value as Json};
 use tokio::sync::Notify;
-use crate::cancel::Token as CancellationToken;
 
-use crate::arbiter::{acquire, try_acquire, Claims, Needs};
+use crate::arbiter::Claims;
 use crate::engine::{Actors, Ctx, Engine, Frame, Instance, Job, Scope};
 use crate::jobs::Jobs;
 use crate::join::{join_eager, SMALL};
 use crate::trace::{Field, Kind};
-use crate::value::to_json;
 
 /// Conditions are looked at again at least this often (LANGUAGE.md §3).
 const RECHECK: Duration = Duration::from_millis(100);
@@ -119,27 +115,34 @@ impl<'m> Engine<'m> {
         })
     }
 
-    async fn items(&self, block: &'m Block, ctx: &Ctx<'m>) {
+    pub(crate) async fn items(&self, block: &'m Block, ctx: &Ctx<'m>) {
         match block.kind {
-            BlockKind::Sequential => {
-                for node in &block.items {
-                    if ctx.scope.unwinding.get() {
-                        break;
-                    }
-                    self.statement(node, ctx).await;
-                    // A handler caught here takes the place of what it aborted.
-                    while ctx.scope.catching.get() > 0 {
-                        let done = ctx.scope.caught.notified();
-                        if ctx.scope.catching.get() == 0 {
-                            break;
-                        }
-                        done.await;
-                    }
-                }
-            }
+            BlockKind::Sequential => self.sequence(&block.items, ctx).await,
             BlockKind::Parallel => {
                 join_all(block.items.iter().map(|n| self.node(n, ctx))).await;
             }
+        }
+    }
+
+    /// Statements one after another, until the scope unwinds.
+    pub(crate) async fn sequence(&self, items: &'m [Node], ctx: &Ctx<'m>) {
+        for node in items {
+            if ctx.scope.unwinding.get() {
+                break;
+            }
+            self.statement(node, ctx).await;
+            self.caught(ctx).await;
+        }
+    }
+
+    /// A handler caught here takes the place of what it aborted: waits for it.
+    pub(crate) async fn caught(&self, ctx: &Ctx<'m>) {
+        while ctx.scope.catching.get() > 0 {
+            let done = ctx.scope.caught.notified();
+            if ctx.scope.catching.get() == 0 {
+                break;
+            }
+            done.await;
         }
     }
 
@@ -158,14 +161,24 @@ impl<'m> Engine<'m> {
                     self.signal(*signal, args, ctx);
                 }
             }
+            Node::Call(c) if self.instant[c.capability] => {
+                if !self.stopped() {
+                    self.instant_call(c, ctx).await;
+                }
+            }
             _ => self.node(node, ctx).await,
         }
     }
 
-    fn node<'a>(&'a self, node: &'m Node, ctx: &'a Ctx<'m>) -> LocalBoxFuture<'a, ()> {
+    pub(crate) fn node<'a>(&'a self, node: &'m Node, ctx: &'a Ctx<'m>) -> LocalBoxFuture<'a, ()> {
         // Each kind of node is boxed at its own size: with one future type for all, every
         // SIGNAL or API call took the room of a capability instance's future.
         match node {
+            Node::Call(c) if self.instant[c.capability] => Box::pin(async move {
+                if !self.stopped() {
+                    self.instant_call(c, ctx).await;
+                }
+            }),
             Node::Call(c) => Box::pin(async move {
                 if !self.stopped() {
                     self.call(c, ctx).await;
@@ -310,7 +323,7 @@ impl<'m> Engine<'m> {
 
     /// A statement: one instance, or one per actor when a one-actor capability is given
     /// several (or a group), in parallel.
-    async fn call(&self, call: &'m Call, ctx: &Ctx<'m>) {
+    pub(crate) async fn call(&self, call: &'m Call, ctx: &Ctx<'m>) {
         let capability = &self.m.capabilities[call.capability];
         let args = self.eval_all(&call.args, ctx);
         // The common case, one actor for a one-actor capability: no join.
@@ -332,159 +345,16 @@ impl<'m> Engine<'m> {
         } else {
             vec![per_actor.iter().filter_map(|ds| ds.first().copied()).collect()]
         };
-        let runs = sets.into_iter().map(|actors| self.instance(call, actors, args.clone(), ctx));
+        let instant = self.instant[call.capability];
+        let runs = sets.into_iter().map(|actors| match (instant, actors.as_slice()) {
+            (true, [drone]) => Either::Left(self.instant_instance(call, *drone, args.clone(), ctx)),
+            _ => Either::Right(self.instance(call, actors, args.clone(), ctx)),
+        });
         if runs.len() <= SMALL {
             join_all(runs).await;
         } else {
             join_eager(runs).await;
         }
-    }
-
-    async fn instance(&self, call: &'m Call, actors: Actors, args: Vec<Value>, ctx: &Ctx<'m>) {
-        let cap = &self.m.capabilities[call.capability];
-        // Actors, then arguments, then the body's own slots: one allocation.
-        let size = cap.frame_size.max(cap.actors + cap.params.len());
-        let frame: Frame = (0..size)
-            .map(|i| match i.checked_sub(cap.actors) {
-                None => actors.get(i).map_or(Value::Bool(false), |d| Value::Actor(*d)),
-                Some(j) => args.get(j).cloned().unwrap_or(Value::Bool(false)),
-            })
-            .collect();
-        let id = self.next_id.get() + 1;
-        self.next_id.set(id);
-        let instance = Rc::new(Instance {
-            id,
-            capability: call.capability,
-            tag: call.tag,
-            actors: actors.clone(),
-            root: ctx.instance.as_ref().map(|p| p.root().clone()),
-            token: ctx.instance.as_ref().map_or_else(|| self.stop.child_token(), |p| p.token.child_token()),
-            // Only the capability's own exception handler cancels its PERFORM body.
-            perform: (!cap.exception_handlers.is_empty()).then(CancellationToken::new),
-            by_leash: Cell::new(false),
-            failed: Cell::new(false),
-            // An activity started while the operator holds the mission starts held.
-            paused: Cell::new(ctx.instance.is_none() && self.mission_paused.get()),
-            resumed: Notify::new(),
-            calls: RefCell::new(SmallVec::new()),
-            depth: ctx.instance.as_ref().map_or(0, |p| p.depth + 1),
-            claims: RefCell::new(ctx.claims.clone()),
-        });
-        let actor = actors.first().copied();
-        // Built only when the trace wants it.
-        let start = || {
-            let tag = Field::name(call.tag.map(|t| self.m.tags[t].as_str()));
-            let shown_args: Map<String, Json> = cap.params.iter().zip(&args).map(|(p, v)| (p.clone(), to_json(self.m, v))).collect();
-            let who = match actors.as_slice() {
-                [one] => Field::Str(self.name(*one)),
-                all => Field::Text(all.iter().map(|d| self.name(*d)).collect::<Vec<_>>().join(" ")),
-            };
-            [("actor", who), ("capability", Field::Str(&cap.name)), ("tag", tag), ("args", Field::Json(Json::Object(shown_args)))]
-        };
-        let end = |status: &'static str| {
-            self.trace(Kind::CapabilityEnd, || {
-                let [actor, capability, tag, args] = start();
-                [actor, capability, tag, args, ("status", Field::Str(status))]
-            });
-        };
-        // Claims first (a second instance on a busy resource waits), then the start.
-        let needs: Needs = cap.claims.iter().filter_map(|(i, r)| actors.get(*i).map(|d| (*d, *r))).filter(|c| !ctx.claims.contains(c)).collect();
-        let claims = ctx.claims.with(&needs);
-        // An instance that waits is known while it waits (a leash can abort it), by where
-        // it was called; one granted at once is listed once its own scope exists.
-        let mut listed = false;
-        let held = if instance.token.is_cancelled() {
-            None
-        } else {
-            match try_acquire(&self.arbiter, needs) {
-                Ok(held) => Some(held),
-                Err(needs) => {
-                    self.instances.borrow_mut().insert(instance.clone(), ctx.scope.clone());
-                    listed = true;
-                    instance.token.run(acquire(&self.arbiter, needs)).await
-                }
-            }
-        };
-        if self.stopped() {
-            self.instances.borrow_mut().remove(&instance);
-            return;
-        }
-        self.trace(Kind::CapabilityStart, start);
-        if held.is_none() {
-            self.instances.borrow_mut().remove(&instance);
-            end("aborted");
-            return;
-        }
-        *instance.claims.borrow_mut() = claims.clone();
-
-        let requirements_met = {
-            let received = self.received.borrow();
-            let env = self.env(&frame, &received);
-            cap.requirements.iter().all(|r| env.truth(r))
-        };
-        if !requirements_met {
-            self.instances.borrow_mut().remove(&instance);
-            end("failed");
-            drop(held);
-            let id = self.m.exceptions.iter().position(|e| e == "RequirementNotMet").unwrap_or(0);
-            let why = format!("a requirement of {} does not hold", cap.name);
-            self.throw(id, vec![Value::Text(why)], actor, &ctx.scope);
-            return;
-        }
-
-        let scope = {
-            Rc::new(Scope {
-                parent: Some(ctx.scope.clone()),
-                path: &cap.name,
-                mission_block: false,
-                handlers: &[],
-                fired: RefCell::new(Vec::new()),
-                exception_handlers: &cap.exception_handlers,
-                frame: frame.clone(),
-                jobs: Jobs::default(),
-                unwinding: Cell::new(false),
-                deferred: RefCell::new(Vec::new()),
-                catching: Cell::new(0),
-                caught: Notify::new(),
-                instance: Some(instance.clone()),
-            })
-        };
-        if listed {
-            self.instances.borrow_mut().set_scope(&instance, scope.clone());
-        } else {
-            self.instances.borrow_mut().insert(instance.clone(), scope.clone());
-        }
-        let inner = Ctx { scope: scope.clone(), frame, actor, instance: Some(instance.clone()), claims };
-        // A PERFORM body that declares no handlers, in a capability without exception
-        // handlers, runs its statements in the instance's own scope: a scope of its own
-        // would hear nothing and catch nothing, and an exception unwinds both alike.
-        let own_scope = !cap.perform.handlers.is_empty() || !cap.perform.exception_handlers.is_empty() || cap.perform.traced;
-        let perform = pin!(async {
-            match &instance.perform {
-                Some(perform) => _ = perform.run(self.block(&cap.perform, &inner)).await,
-                None if own_scope => self.block(&cap.perform, &inner).await,
-                None => self.items(&cap.perform, &inner).await,
-            }
-        });
-        let drive = pin!(self.drive(&scope, perform));
-        let finished = instance.token.run(drive).await.is_some();
-        self.instances.borrow_mut().remove(&instance);
-        if !finished && instance.by_leash.get() {
-            // `PERFORM ABORT:` says what aborting this activity also does.
-            if let Some((_, section)) = cap.sections.iter().find(|(n, _)| n == "ABORT") {
-                let after = Ctx { instance: None, ..inner.clone() };
-                self.block(section, &after).await;
-            }
-        }
-        drop(held);
-        let status = if finished && !instance.failed.get() {
-            "ok"
-        } else if instance.failed.get() {
-            "failed"
-        } else {
-            "aborted"
-        };
-        end(status);
     }
 
     async fn job(&self, job: Job<'m>, scope: Rc<Scope<'m>>) {
@@ -570,111 +440,9 @@ impl<'m> Engine<'m> {
             }
         }
     }
-
-    async fn api(&self, a: &'m aviary_ir::ApiCall, ctx: &Ctx<'m>) {
-        let drone = {
-            let received = self.received.borrow();
-            self.env(&ctx.frame, &received).actor(&a.actor)
-        };
-        let Some(drone) = drone else { return };
-        let root = ctx.instance.as_ref().map(|i| i.root());
-        if let Some(root) = &root {
-            loop {
-                let resumed = root.resumed.notified();
-                if !root.paused.get() {
-                    break;
-                }
-                resumed.await;
-            }
-        }
-        let args = self.eval_all(&a.args, ctx);
-        let function = self.m.functions[a.function].0.as_str();
-        self.trace(Kind::ApiCall, || [("actor", Field::Str(self.name(drone))), ("function", Field::Str(function)), ("args", Field::Json(self.values(&args)))]);
-        let pending = self.backend.call(drone, function, &args);
-        let end = match pending.end {
-            // Over as it was made: nothing in flight to pause, resume or abort.
-            Ending::Now(end) => end,
-            Ending::Later(answer) => {
-                let guard = CallGuard { engine: self, id: pending.id, root, done: Cell::new(false), drone, function, args: &args };
-                if let Some(root) = root {
-                    root.calls.borrow_mut().push(pending.id);
-                    if root.paused.get() {
-                        self.backend.interrupt(pending.id, Interrupt::Pause);
-                    }
-                }
-                let end = answer.await.unwrap_or(CallEnd::Interrupted);
-                guard.done.set(true);
-                end
-            }
-        };
-        self.trace_done(drone, function, &args, &end);
-        match end {
-            CallEnd::Done => self.after_call(function, drone, &args, ctx),
-            CallEnd::Failed(f) => {
-                let id = self.m.exceptions.iter().position(|e| e == f.exception).unwrap_or(0);
-                self.throw(id, vec![Value::Text(f.reason)], Some(drone), &ctx.scope);
-            }
-            CallEnd::Interrupted => {
-                // A fault interrupted it: raise that first, while this activity still runs.
-                self.drain_events();
-                ctx.scope.unwinding.set(true);
-            }
-        }
-    }
-
-    fn after_call(&self, function: &str, drone: DroneId, args: &[Value], ctx: &Ctx<'m>) {
-        let kind = match args.first() {
-            Some(Value::Symbol(k) | Value::Text(k)) => k.clone(),
-            _ => return,
-        };
-        match function {
-            // Finds are raised in the activity that started detection (LANGUAGE.md §5).
-            "StartDetection" => {
-                self.detections.borrow_mut().insert((drone, kind), ctx.scope.clone());
-            }
-            "StopDetection" => {
-                self.detections.borrow_mut().remove(&(drone, kind));
-            }
-            _ => {}
-        }
-    }
 }
 
-/// Interrupts a call whose activity is dropped before the call ended, and says so in
-/// the trace: every `api_call` has its `api_done`.
-struct CallGuard<'e, 'm> {
-    engine: &'e Engine<'m>,
-    id: aviary_api::CallId,
-    root: Option<&'e Rc<Instance>>,
-    done: Cell<bool>,
-    drone: DroneId,
-    function: &'e str,
-    args: &'e [Value],
-}
-
-impl Drop for CallGuard<'_, '_> {
-    fn drop(&mut self) {
-        if !self.done.get() {
-            self.engine.backend.interrupt(self.id, Interrupt::Abort);
-            let engine = self.engine;
-            engine.trace(Kind::ApiDone, || {
-                let p = engine.backend.telemetry(self.drone).position;
-                [
-                    ("actor", Field::Str(engine.name(self.drone))),
-                    ("function", Field::Str(self.function)),
-                    ("args", Field::Json(engine.values(self.args))),
-                    ("status", Field::Str("aborted")),
-                    ("position", Field::Json(json!(p))),
-                ]
-            });
-        }
-        if let Some(root) = &self.root {
-            root.calls.borrow_mut().retain(|c| *c != self.id);
-        }
-    }
-}
-
-fn set(frame: &mut Vec<Value>, slot: usize, value: Value) {
+pub(crate) fn set(frame: &mut Vec<Value>, slot: usize, value: Value) {
     if frame.len() <= slot {
         frame.resize(slot + 1, Value::Bool(false));
     }

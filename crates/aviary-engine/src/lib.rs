@@ -9,11 +9,14 @@
 //!
 //! Invariant: the engine knows no backend; it talks to `aviary_api::Backend` only.
 
+mod activity;
+mod api;
 mod arbiter;
 mod cancel;
 mod control;
 mod engine;
 mod exec;
+mod instant;
 mod jobs;
 mod join;
 mod registry;
@@ -49,10 +52,20 @@ impl<F: FnMut(serde_json::Value)> TraceSink for F {
     }
 }
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct RunOptions {
     /// Telemetry events per second of mission time; `None` for none.
     pub telemetry_hz: Option<f64>,
+    /// Whether activities whose calls end at once run without the machinery of one that
+    /// waits (`instant.rs`). On by default; off, every activity takes the general path,
+    /// which gives the same trace: tests compare the two.
+    pub instant_activities: bool,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions { telemetry_hz: None, instant_activities: true }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -80,7 +93,7 @@ pub struct Outcome {
 
 /// Runs `mission` to its end. Must be polled inside a tokio runtime (current-thread).
 pub async fn run(mission: &Mission, backend: &dyn Backend, sink: &mut dyn TraceSink, options: &RunOptions) -> Outcome {
-    engine::Engine::new(mission, backend, sink).run(options, None).await
+    engine::Engine::new(mission, backend, sink, options).run(options, None).await
 }
 
 /// As [`run`], and takes live controls (an operator, Ctrl-C) from `controls`.
@@ -91,5 +104,5 @@ pub async fn run_controlled(
     options: &RunOptions,
     controls: tokio::sync::mpsc::UnboundedReceiver<ControlRequest>,
 ) -> Outcome {
-    engine::Engine::new(mission, backend, sink).run(options, Some(controls)).await
+    engine::Engine::new(mission, backend, sink, options).run(options, Some(controls)).await
 }

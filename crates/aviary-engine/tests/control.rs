@@ -19,6 +19,10 @@ impl SourceProvider for NoFiles {
 /// Runs `mission`, sending each control at its mission time; returns the outcome, the
 /// trace and the engine's answers.
 fn run_with_controls(mission: &str, controls: Vec<(f64, Control)>) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
+    run_with_controls_and(mission, controls, RunOptions { telemetry_hz: Some(10.0), ..RunOptions::default() })
+}
+
+fn run_with_controls_and(mission: &str, controls: Vec<(f64, Control)>, options: RunOptions) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
     let mut sources = SourceMap::new();
     let checked = aviary_check::check_sources(&mut sources, ("m.mission", mission.as_bytes()), Some(("w.toml", harness::WORLD.as_bytes())), &NoFiles, &Descriptor::standard());
     assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
@@ -39,7 +43,7 @@ fn run_with_controls(mission: &str, controls: Vec<(f64, Control)>) -> (Outcome, 
             }
             answers
         };
-        let mission_run = aviary_engine::run_controlled(&compiled, &*sim, &mut sink, &RunOptions { telemetry_hz: Some(10.0) }, rx);
+        let mission_run = aviary_engine::run_controlled(&compiled, &*sim, &mut sink, &options, rx);
         let (outcome, answers) = tokio::join!(mission_run, operator);
         sim.shutdown().await;
         (outcome, trace, answers)
@@ -109,6 +113,22 @@ fn pausing_the_mission_holds_every_drone_and_resuming_goes_on() {
         let held = positions(&trace, drone, 15.2, 24.9);
         assert!(held.len() > 50 && held.iter().all(|p| *p == held[0]), "{drone} holds while the mission is paused");
     }
+}
+
+#[test]
+fn an_activity_started_while_the_mission_is_paused_starts_held_on_either_path() {
+    // Ping's calls end at once (an instant activity, src/instant.rs); it starts at 18 s,
+    // inside the pause, and makes its first call only at the resume.
+    let mission = "CAPABILITY Ping BY d:\n    PERFORM:\n        d.StartStreaming()\n        d.StopStreaming()\n\nMISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        SEQUENTIAL:\n            WAITFOR ELAPSED >= 18s\n            b Ping\n";
+    let controls = || vec![(15.0, Control::Pause), (25.0, Control::Resume)];
+    let (outcome, trace, _) = run_with_controls(mission, controls());
+    let general = run_with_controls_and(mission, controls(), RunOptions { telemetry_hz: Some(10.0), instant_activities: false });
+    assert_eq!((&outcome, &trace), (&general.0, &general.1), "the same trace both ways");
+    let start = trace.iter().find(|e| e["event"] == "capability_start" && e["capability"] == "Ping").unwrap();
+    let call = trace.iter().find(|e| e["event"] == "api_call" && e["function"] == "StartStreaming").unwrap();
+    assert!((start["t"].as_f64().unwrap() - 18.0).abs() < 0.11, "{start}");
+    assert_eq!(call["t"].as_f64().unwrap(), 25.0, "held until the resume");
+    assert_eq!(outcome.status, Status::Ok);
 }
 
 #[test]

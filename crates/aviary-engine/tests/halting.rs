@@ -12,7 +12,7 @@ fn close(a: f64, b: f64) -> bool {
 }
 
 fn with_telemetry(mission: &str) -> harness::Run {
-    run_with(mission, WORLD, &RunOptions { telemetry_hz: Some(10.0) })
+    run_with(mission, WORLD, &RunOptions { telemetry_hz: Some(10.0), ..RunOptions::default() })
 }
 
 #[test]

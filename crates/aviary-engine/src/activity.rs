@@ -1,0 +1,213 @@
+//! Capability instances (activities) on the general path: claims, start, requirements,
+//! the PERFORM body in the instance's scope, leash abort sections, the end.
+
+use std::cell::{Cell, RefCell};
+use std::pin::pin;
+use std::rc::Rc;
+
+use aviary_api::{DroneId, Value};
+use aviary_ir::{BlockKind, Call, Capability};
+use serde_json::{Map, Value as Json};
+use smallvec::SmallVec;
+use tokio::sync::Notify;
+
+use crate::api::Begun;
+use crate::arbiter::{acquire, try_acquire, Claims, Held, Needs};
+use crate::cancel::Token as CancellationToken;
+use crate::engine::{Actors, Ctx, Engine, Frame, Instance, Scope};
+use crate::jobs::Jobs;
+use crate::trace::{Field, Kind};
+use crate::value::to_json;
+
+/// Where an instance's PERFORM body starts: at its beginning, or (an instant activity
+/// that has to wait, `instant.rs`) at a statement of its sequence, that statement's
+/// call perhaps already made.
+pub(crate) enum Resume<'m> {
+    Start,
+    At(usize, Option<Begun<'m>>),
+}
+
+/// An instance's frame: actors, then arguments, then the body's own slots.
+pub(crate) fn frame_values<'a>(cap: &'a Capability, actors: &'a [DroneId], args: &'a [Value]) -> impl ExactSizeIterator<Item = Value> + 'a {
+    let size = cap.frame_size.max(cap.actors + cap.params.len());
+    (0..size).map(move |i| match i.checked_sub(cap.actors) {
+        None => actors.get(i).map_or(Value::Bool(false), |d| Value::Actor(*d)),
+        Some(j) => args.get(j).cloned().unwrap_or(Value::Bool(false)),
+    })
+}
+
+impl<'m> Engine<'m> {
+    pub(crate) async fn instance(&self, call: &'m Call, actors: Actors, args: Vec<Value>, ctx: &Ctx<'m>) {
+        let cap = &self.m.capabilities[call.capability];
+        let frame: Frame = frame_values(cap, &actors, &args).collect();
+        let instance = self.new_instance(self.new_id(), call, actors, ctx);
+        let actor = instance.actors.first().copied();
+        // Claims first (a second instance on a busy resource waits), then the start.
+        let needs = self.needs(cap, &instance.actors, ctx);
+        let claims = ctx.claims.with(&needs);
+        // An instance that waits is known while it waits (a leash can abort it), by where
+        // it was called; one granted at once is listed once its own scope exists.
+        let mut listed = false;
+        let held = if instance.token.is_cancelled() {
+            None
+        } else {
+            match try_acquire(&self.arbiter, needs) {
+                Ok(held) => Some(held),
+                Err(needs) => {
+                    self.instances.borrow_mut().insert(instance.clone(), ctx.scope.clone());
+                    listed = true;
+                    instance.token.run(acquire(&self.arbiter, needs)).await
+                }
+            }
+        };
+        if self.stopped() {
+            self.instances.borrow_mut().remove(&instance);
+            return;
+        }
+        self.trace(Kind::CapabilityStart, || self.capability_fields(call, &instance.actors, &args));
+        let Some(held) = held else {
+            self.instances.borrow_mut().remove(&instance);
+            self.capability_end(call, &instance.actors, &args, "aborted");
+            return;
+        };
+        let requirements_met = {
+            let received = self.received.borrow();
+            let env = self.env(&frame, &received);
+            cap.requirements.iter().all(|r| env.truth(r))
+        };
+        if !requirements_met {
+            self.instances.borrow_mut().remove(&instance);
+            self.capability_end(call, &instance.actors, &args, "failed");
+            drop(held);
+            let id = self.m.exceptions.iter().position(|e| e == "RequirementNotMet").unwrap_or(0);
+            let why = format!("a requirement of {} does not hold", cap.name);
+            self.throw(id, vec![Value::Text(why)], actor, &ctx.scope);
+            return;
+        }
+        self.perform(call, instance, held, frame, claims, listed, args, ctx, Resume::Start).await;
+    }
+
+    /// The rest of an instance, once it holds its claims and has started: its body in its
+    /// own scope until it ends or is aborted, then its end.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) async fn perform(&self, call: &'m Call, instance: Rc<Instance>, held: Held, frame: Frame, claims: Claims, listed: bool, args: Vec<Value>, ctx: &Ctx<'m>, resume: Resume<'m>) {
+        let cap = &self.m.capabilities[call.capability];
+        *instance.claims.borrow_mut() = claims.clone();
+        let scope = Rc::new(Scope {
+            parent: Some(ctx.scope.clone()),
+            path: &cap.name,
+            mission_block: false,
+            handlers: &[],
+            fired: RefCell::new(Vec::new()),
+            exception_handlers: &cap.exception_handlers,
+            frame: frame.clone(),
+            jobs: Jobs::default(),
+            unwinding: Cell::new(false),
+            deferred: RefCell::new(Vec::new()),
+            catching: Cell::new(0),
+            caught: Notify::new(),
+            instance: Some(instance.clone()),
+        });
+        if listed {
+            self.instances.borrow_mut().set_scope(&instance, scope.clone());
+        } else {
+            self.instances.borrow_mut().insert(instance.clone(), scope.clone());
+        }
+        let actor = instance.actors.first().copied();
+        let inner = Ctx { scope: scope.clone(), frame, actor, instance: Some(instance.clone()), claims };
+        // A PERFORM body that declares no handlers, in a capability without exception
+        // handlers, runs its statements in the instance's own scope: a scope of its own
+        // would hear nothing and catch nothing, and an exception unwinds both alike.
+        let own_scope = !cap.perform.handlers.is_empty() || !cap.perform.exception_handlers.is_empty() || cap.perform.traced;
+        let body = pin!(async {
+            match resume {
+                Resume::Start => match &instance.perform {
+                    Some(perform) => _ = perform.run(self.block(&cap.perform, &inner)).await,
+                    None if own_scope => self.block(&cap.perform, &inner).await,
+                    None => self.items(&cap.perform, &inner).await,
+                },
+                // Only for a sequence run in the instance's scope (`instant.rs`).
+                Resume::At(at, begun) => {
+                    debug_assert!(cap.perform.kind == BlockKind::Sequential && !own_scope && instance.perform.is_none());
+                    let next = at + usize::from(begun.is_some());
+                    if let Some(begun) = begun {
+                        self.api_end(begun, &inner).await;
+                        self.caught(&inner).await;
+                    }
+                    self.sequence(&cap.perform.items[next..], &inner).await;
+                }
+            }
+        });
+        let drive = pin!(self.drive(&scope, body));
+        let finished = instance.token.run(drive).await.is_some();
+        self.instances.borrow_mut().remove(&instance);
+        if !finished && instance.by_leash.get() {
+            // `PERFORM ABORT:` says what aborting this activity also does.
+            if let Some((_, section)) = cap.sections.iter().find(|(n, _)| n == "ABORT") {
+                let after = Ctx { instance: None, ..inner.clone() };
+                self.block(section, &after).await;
+            }
+        }
+        drop(held);
+        let status = if finished && !instance.failed.get() {
+            "ok"
+        } else if instance.failed.get() {
+            "failed"
+        } else {
+            "aborted"
+        };
+        self.capability_end(call, &instance.actors, &args, status);
+    }
+
+    pub(crate) fn new_id(&self) -> u64 {
+        let id = self.next_id.get() + 1;
+        self.next_id.set(id);
+        id
+    }
+
+    pub(crate) fn new_instance(&self, id: u64, call: &'m Call, actors: Actors, ctx: &Ctx<'m>) -> Rc<Instance> {
+        let cap = &self.m.capabilities[call.capability];
+        Rc::new(Instance {
+            id,
+            capability: call.capability,
+            tag: call.tag,
+            actors,
+            root: ctx.instance.as_ref().map(|p| p.root().clone()),
+            token: ctx.instance.as_ref().map_or_else(|| self.stop.child_token(), |p| p.token.child_token()),
+            // Only the capability's own exception handler cancels its PERFORM body.
+            perform: (!cap.exception_handlers.is_empty()).then(CancellationToken::new),
+            by_leash: Cell::new(false),
+            failed: Cell::new(false),
+            // An activity started while the operator holds the mission starts held.
+            paused: Cell::new(ctx.instance.is_none() && self.mission_paused.get()),
+            resumed: Notify::new(),
+            calls: RefCell::new(SmallVec::new()),
+            depth: ctx.instance.as_ref().map_or(0, |p| p.depth + 1),
+            claims: RefCell::new(ctx.claims.clone()),
+        })
+    }
+
+    /// What an instance claims beyond what its caller already holds.
+    pub(crate) fn needs(&self, cap: &Capability, actors: &[DroneId], ctx: &Ctx<'m>) -> Needs {
+        cap.claims.iter().filter_map(|(i, r)| actors.get(*i).map(|d| (*d, *r))).filter(|c| !ctx.claims.contains(c)).collect()
+    }
+
+    /// The fields of `capability_start` (built only when the trace wants them).
+    pub(crate) fn capability_fields(&self, call: &Call, actors: &[DroneId], args: &[Value]) -> [(&'static str, Field<'m>); 4] {
+        let cap = &self.m.capabilities[call.capability];
+        let tag = Field::name(call.tag.map(|t| self.m.tags[t].as_str()));
+        let shown_args: Map<String, Json> = cap.params.iter().zip(args).map(|(p, v)| (p.clone(), to_json(self.m, v))).collect();
+        let who = match actors {
+            [one] => Field::Str(self.name(*one)),
+            all => Field::Text(all.iter().map(|d| self.name(*d)).collect::<Vec<_>>().join(" ")),
+        };
+        [("actor", who), ("capability", Field::Str(&cap.name)), ("tag", tag), ("args", Field::Json(Json::Object(shown_args)))]
+    }
+
+    pub(crate) fn capability_end(&self, call: &Call, actors: &[DroneId], args: &[Value], status: &'static str) {
+        self.trace(Kind::CapabilityEnd, || {
+            let [actor, capability, tag, args] = self.capability_fields(call, actors, args);
+            [actor, capability, tag, args, ("status", Field::Str(status))]
+        });
+    }
+}

@@ -1,0 +1,148 @@
+//! Middle-layer calls: made, waited for (held while the activity is paused, interrupted
+//! when it is dropped), traced, and what their ending raises.
+
+use std::cell::Cell;
+use std::rc::Rc;
+
+use aviary_api::{CallEnd, CallId, DroneId, Ending, Interrupt, Value};
+use aviary_ir::ApiCall;
+use serde_json::json;
+
+use crate::engine::{Ctx, Engine, Instance};
+use crate::trace::{Field, Kind};
+
+/// A call made: what the rest of its statement needs.
+pub(crate) struct Begun<'m> {
+    pub drone: DroneId,
+    pub function: &'m str,
+    pub args: Vec<Value>,
+    pub id: CallId,
+    pub end: Ending,
+}
+
+/// Whether a call's ending is remembered with the scope that made it (detection: finds
+/// are raised in the activity that started it, LANGUAGE.md §5).
+pub(crate) fn remembers_scope(function: &str) -> bool {
+    matches!(function, "StartDetection" | "StopDetection")
+}
+
+impl<'m> Engine<'m> {
+    pub(crate) async fn api(&self, a: &'m ApiCall, ctx: &Ctx<'m>) {
+        let Some(drone) = self.api_drone(a, &ctx.frame) else { return };
+        if let Some(root) = ctx.instance.as_ref().map(|i| i.root()) {
+            loop {
+                let resumed = root.resumed.notified();
+                if !root.paused.get() {
+                    break;
+                }
+                resumed.await;
+            }
+        }
+        let begun = self.api_begin(a, drone, &ctx.frame);
+        self.api_end(begun, ctx).await;
+    }
+
+    /// The drone a call is made to, if its actor reference stands for one here.
+    pub(crate) fn api_drone(&self, a: &ApiCall, frame: &[Value]) -> Option<DroneId> {
+        self.env(frame, &[]).actor(&a.actor)
+    }
+
+    /// Evaluates the arguments, records `api_call` and makes the call.
+    pub(crate) fn api_begin(&self, a: &'m ApiCall, drone: DroneId, frame: &[Value]) -> Begun<'m> {
+        let args = {
+            let received = self.received.borrow();
+            let env = self.env(frame, &received);
+            a.args.iter().map(|e| env.eval(e)).collect::<Vec<_>>()
+        };
+        let function = self.m.functions[a.function].0.as_str();
+        self.trace(Kind::ApiCall, || [("actor", Field::Str(self.name(drone))), ("function", Field::Str(function)), ("args", Field::Json(self.values(&args)))]);
+        let pending = self.backend.call(drone, function, &args);
+        Begun { drone, function, args, id: pending.id, end: pending.end }
+    }
+
+    /// The rest of a call's statement: waits for its ending, records `api_done`, and
+    /// raises what a failure or an interruption means.
+    pub(crate) async fn api_end(&self, begun: Begun<'m>, ctx: &Ctx<'m>) {
+        let Begun { drone, function, args, id, end } = begun;
+        let root = ctx.instance.as_ref().map(|i| i.root());
+        let end = match end {
+            // Over as it was made: nothing in flight to pause, resume or abort.
+            Ending::Now(end) => end,
+            Ending::Later(answer) => {
+                let guard = CallGuard { engine: self, id, root, done: Cell::new(false), drone, function, args: &args };
+                if let Some(root) = root {
+                    root.calls.borrow_mut().push(id);
+                    if root.paused.get() {
+                        self.backend.interrupt(id, Interrupt::Pause);
+                    }
+                }
+                let end = answer.await.unwrap_or(CallEnd::Interrupted);
+                guard.done.set(true);
+                end
+            }
+        };
+        self.trace_done(drone, function, &args, &end);
+        match end {
+            CallEnd::Done => self.after_call(function, drone, &args, ctx),
+            CallEnd::Failed(f) => {
+                let id = self.m.exceptions.iter().position(|e| e == f.exception).unwrap_or(0);
+                self.throw(id, vec![Value::Text(f.reason)], Some(drone), &ctx.scope);
+            }
+            CallEnd::Interrupted => {
+                // A fault interrupted it: raise that first, while this activity still runs.
+                self.drain_events();
+                ctx.scope.unwinding.set(true);
+            }
+        }
+    }
+
+    fn after_call(&self, function: &str, drone: DroneId, args: &[Value], ctx: &Ctx<'m>) {
+        if !remembers_scope(function) {
+            return;
+        }
+        let kind = match args.first() {
+            Some(Value::Symbol(k) | Value::Text(k)) => k.clone(),
+            _ => return,
+        };
+        if function == "StartDetection" {
+            self.detections.borrow_mut().insert((drone, kind), ctx.scope.clone());
+        } else {
+            self.detections.borrow_mut().remove(&(drone, kind));
+        }
+    }
+}
+
+/// Interrupts a call whose activity is dropped before the call ended, and says so in
+/// the trace: every `api_call` has its `api_done`.
+struct CallGuard<'e, 'm> {
+    engine: &'e Engine<'m>,
+    id: CallId,
+    root: Option<&'e Rc<Instance>>,
+    done: Cell<bool>,
+    drone: DroneId,
+    function: &'e str,
+    args: &'e [Value],
+}
+
+impl Drop for CallGuard<'_, '_> {
+    fn drop(&mut self) {
+        if !self.done.get() {
+            self.engine.backend.interrupt(self.id, Interrupt::Abort);
+            let engine = self.engine;
+            engine.trace(Kind::ApiDone, || {
+                let p = engine.backend.telemetry(self.drone).position;
+                [
+                    ("actor", Field::Str(engine.name(self.drone))),
+                    ("function", Field::Str(self.function)),
+                    ("args", Field::Json(engine.values(self.args))),
+                    ("status", Field::Str("aborted")),
+                    ("position", Field::Json(json!(p))),
+                ]
+            });
+        }
+        if let Some(root) = &self.root {
+            root.calls.borrow_mut().retain(|c| *c != self.id);
+        }
+    }
+}
+

@@ -166,6 +166,8 @@ impl<'m> Engine<'m> {
                     self.instant_call(c, ctx).await;
                 }
             }
+            // A wait that is over before it starts (`wait_until` looks first): no box.
+            Node::WaitFor { condition, body: None } if self.stopped() || self.truth(condition, ctx) => {}
             _ => self.node(node, ctx).await,
         }
     }

@@ -24,7 +24,18 @@ use crate::value::to_json;
 /// call perhaps already made.
 pub(crate) enum Resume<'m> {
     Start,
-    At(usize, Option<Begun<'m>>),
+    /// The call is boxed: the future of every instance has room for its `Resume`.
+    At(usize, Option<Box<Begun<'m>>>),
+}
+
+/// An instance that has started, for `perform`.
+struct Started {
+    instance: Rc<Instance>,
+    held: Held,
+    frame: Frame,
+    claims: Claims,
+    listed: bool,
+    args: Vec<Value>,
 }
 
 /// An instance's frame: actors, then arguments, then the body's own slots.
@@ -38,6 +49,17 @@ pub(crate) fn frame_values<'a>(cap: &'a Capability, actors: &'a [DroneId], args:
 
 impl<'m> Engine<'m> {
     pub(crate) async fn instance(&self, call: &'m Call, actors: Actors, args: Vec<Value>, ctx: &Ctx<'m>) {
+        // What `start` made is handed to `perform` and not kept beside its future.
+        let rest = match self.start(call, actors, args, ctx).await {
+            Some(Started { instance, held, frame, claims, listed, args }) => self.perform(call, instance, held, frame, claims, listed, args, ctx, Resume::Start),
+            None => return,
+        };
+        rest.await;
+    }
+
+    /// An instance up to its start: its claims held (waited for if need be), `capability_start`
+    /// recorded, its requirements met. `None` if it ends there.
+    async fn start(&self, call: &'m Call, actors: Actors, args: Vec<Value>, ctx: &Ctx<'m>) -> Option<Started> {
         let cap = &self.m.capabilities[call.capability];
         let frame: Frame = frame_values(cap, &actors, &args).collect();
         let instance = self.new_instance(self.new_id(), call, actors, ctx);
@@ -62,13 +84,13 @@ impl<'m> Engine<'m> {
         };
         if self.stopped() {
             self.instances.borrow_mut().remove(&instance);
-            return;
+            return None;
         }
         self.trace(Kind::CapabilityStart, || self.capability_fields(call, &instance.actors, &args));
         let Some(held) = held else {
             self.instances.borrow_mut().remove(&instance);
             self.capability_end(call, &instance.actors, &args, "aborted");
-            return;
+            return None;
         };
         let requirements_met = {
             let received = self.received.borrow();
@@ -82,9 +104,9 @@ impl<'m> Engine<'m> {
             let id = self.m.exceptions.iter().position(|e| e == "RequirementNotMet").unwrap_or(0);
             let why = format!("a requirement of {} does not hold", cap.name);
             self.throw(id, vec![Value::Text(why)], actor, &ctx.scope);
-            return;
+            return None;
         }
-        self.perform(call, instance, held, frame, claims, listed, args, ctx, Resume::Start).await;
+        Some(Started { instance, held, frame, claims, listed, args })
     }
 
     /// The rest of an instance, once it holds its claims and has started: its body in its
@@ -131,7 +153,7 @@ impl<'m> Engine<'m> {
                     debug_assert!(cap.perform.kind == BlockKind::Sequential && !own_scope && instance.perform.is_none());
                     let next = at + usize::from(begun.is_some());
                     if let Some(begun) = begun {
-                        self.api_end(begun, &inner).await;
+                        self.api_end(*begun, &inner).await;
                         self.caught(&inner).await;
                     }
                     self.sequence(&cap.perform.items[next..], &inner).await;

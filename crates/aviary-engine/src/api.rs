@@ -13,11 +13,16 @@ use crate::trace::{Field, Kind};
 
 /// A call made: what the rest of its statement needs.
 pub(crate) struct Begun<'m> {
+    pub call: Made<'m>,
+    pub end: Ending,
+}
+
+/// Which call was made, with what.
+pub(crate) struct Made<'m> {
     pub drone: DroneId,
     pub function: &'m str,
     pub args: Vec<Value>,
     pub id: CallId,
-    pub end: Ending,
 }
 
 /// Whether a call's ending is remembered with the scope that made it (detection: finds
@@ -38,8 +43,12 @@ impl<'m> Engine<'m> {
                 resumed.await;
             }
         }
-        let begun = self.api_begin(a, drone, &ctx.frame);
-        self.api_end(begun, ctx).await;
+        // Made in a block of its own, so the call made is not kept twice while it runs.
+        let rest = {
+            let begun = self.api_begin(a, drone, &ctx.frame);
+            self.api_end(begun, ctx)
+        };
+        rest.await;
     }
 
     /// The drone a call is made to, if its actor reference stands for one here.
@@ -57,23 +66,23 @@ impl<'m> Engine<'m> {
         let function = self.m.functions[a.function].0.as_str();
         self.trace(Kind::ApiCall, || [("actor", Field::Str(self.name(drone))), ("function", Field::Str(function)), ("args", Field::Json(self.values(&args)))]);
         let pending = self.backend.call(drone, function, &args);
-        Begun { drone, function, args, id: pending.id, end: pending.end }
+        Begun { call: Made { drone, function, args, id: pending.id }, end: pending.end }
     }
 
     /// The rest of a call's statement: waits for its ending, records `api_done`, and
     /// raises what a failure or an interruption means.
     pub(crate) async fn api_end(&self, begun: Begun<'m>, ctx: &Ctx<'m>) {
-        let Begun { drone, function, args, id, end } = begun;
-        let root = ctx.instance.as_ref().map(|i| i.root());
+        let Begun { call, end } = begun;
         let end = match end {
             // Over as it was made: nothing in flight to pause, resume or abort.
             Ending::Now(end) => end,
             Ending::Later(answer) => {
-                let guard = CallGuard { engine: self, id, root, done: Cell::new(false), drone, function, args: &args };
+                let root = ctx.instance.as_ref().map(|i| i.root());
+                let guard = CallGuard { engine: self, call: &call, root, done: Cell::new(false) };
                 if let Some(root) = root {
-                    root.calls.borrow_mut().push(id);
+                    root.calls.borrow_mut().push(call.id);
                     if root.paused.get() {
-                        self.backend.interrupt(id, Interrupt::Pause);
+                        self.backend.interrupt(call.id, Interrupt::Pause);
                     }
                 }
                 let end = answer.await.unwrap_or(CallEnd::Interrupted);
@@ -81,9 +90,10 @@ impl<'m> Engine<'m> {
                 end
             }
         };
-        self.trace_done(drone, function, &args, &end);
+        let Made { drone, function, ref args, .. } = call;
+        self.trace_done(drone, function, args, &end);
         match end {
-            CallEnd::Done => self.after_call(function, drone, &args, ctx),
+            CallEnd::Done => self.after_call(function, drone, args, ctx),
             CallEnd::Failed(f) => {
                 let id = self.m.exceptions.iter().position(|e| e == f.exception).unwrap_or(0);
                 self.throw(id, vec![Value::Text(f.reason)], Some(drone), &ctx.scope);
@@ -116,33 +126,30 @@ impl<'m> Engine<'m> {
 /// the trace: every `api_call` has its `api_done`.
 struct CallGuard<'e, 'm> {
     engine: &'e Engine<'m>,
-    id: CallId,
+    call: &'e Made<'m>,
     root: Option<&'e Rc<Instance>>,
     done: Cell<bool>,
-    drone: DroneId,
-    function: &'e str,
-    args: &'e [Value],
 }
 
 impl Drop for CallGuard<'_, '_> {
     fn drop(&mut self) {
+        let call = self.call;
         if !self.done.get() {
-            self.engine.backend.interrupt(self.id, Interrupt::Abort);
+            self.engine.backend.interrupt(call.id, Interrupt::Abort);
             let engine = self.engine;
             engine.trace(Kind::ApiDone, || {
-                let p = engine.backend.telemetry(self.drone).position;
+                let p = engine.backend.telemetry(call.drone).position;
                 [
-                    ("actor", Field::Str(engine.name(self.drone))),
-                    ("function", Field::Str(self.function)),
-                    ("args", Field::Json(engine.values(self.args))),
+                    ("actor", Field::Str(engine.name(call.drone))),
+                    ("function", Field::Str(call.function)),
+                    ("args", Field::Json(engine.values(&call.args))),
                     ("status", Field::Str("aborted")),
                     ("position", Field::Json(json!(p))),
                 ]
             });
         }
         if let Some(root) = &self.root {
-            root.calls.borrow_mut().retain(|c| *c != self.id);
+            root.calls.borrow_mut().retain(|c| *c != call.id);
         }
     }
 }
-

@@ -162,8 +162,9 @@ impl<'m> Engine<'m> {
                 }
             }
             Node::Call(c) if self.instant[c.capability] => {
-                if !self.stopped() {
-                    self.instant_call(c, ctx).await;
+                let rest = if self.stopped() { None } else { self.instant_call(c, ctx) };
+                if let Some(rest) = rest {
+                    rest.await;
                 }
             }
             // A wait that is over before it starts (`wait_until` looks first): no box.
@@ -176,9 +177,11 @@ impl<'m> Engine<'m> {
         // Each kind of node is boxed at its own size: with one future type for all, every
         // SIGNAL or API call took the room of a capability instance's future.
         match node {
+            // Started when first polled, as every node is.
             Node::Call(c) if self.instant[c.capability] => Box::pin(async move {
-                if !self.stopped() {
-                    self.instant_call(c, ctx).await;
+                let rest = if self.stopped() { None } else { self.instant_call(c, ctx) };
+                if let Some(rest) = rest {
+                    rest.await;
                 }
             }),
             Node::Call(c) => Box::pin(async move {
@@ -349,7 +352,14 @@ impl<'m> Engine<'m> {
         };
         let instant = self.instant[call.capability];
         let runs = sets.into_iter().map(|actors| match (instant, actors.as_slice()) {
-            (true, [drone]) => Either::Left(self.instant_instance(call, *drone, args.clone(), ctx)),
+            (true, &[drone]) => {
+                let args = args.clone();
+                Either::Left(async move {
+                    if let Some(rest) = self.instant_instance(call, drone, args, ctx) {
+                        rest.await;
+                    }
+                })
+            }
             _ => Either::Right(self.instance(call, actors, args.clone(), ctx)),
         });
         if runs.len() <= SMALL {

@@ -43,7 +43,9 @@ fn may_be_instant(m: &Mission, cap: &Capability) -> bool {
         && body.items.iter().all(|n| matches!(n, Node::Api(a) if !remembers_scope(&m.functions[a.function].0)))
 }
 
-/// An instant activity that has to wait, and where it stands.
+/// An instant activity that has to wait, and where it stands. Made and taken apart at
+/// once, never kept: its size does not matter.
+#[allow(clippy::large_enum_variant)]
 enum Stopped<'m> {
     /// Before anything of it happened.
     Start(Vec<Value>),
@@ -55,34 +57,33 @@ enum Stopped<'m> {
 type LocalFrame = SmallVec<[Value; 4]>;
 
 impl<'m> Engine<'m> {
-    /// A statement calling a capability that may be instant.
-    pub(crate) async fn instant_call(&self, call: &'m Call, ctx: &Ctx<'m>) {
+    /// A statement calling a capability that may be instant: runs what it can at once,
+    /// and gives the rest, if any, to be awaited. Not `async`: a future holding what this
+    /// makes along the way would hold it as long as the activity waits, in every block
+    /// that waits on it.
+    pub(crate) fn instant_call<'a>(&'a self, call: &'m Call, ctx: &'a Ctx<'m>) -> Option<LocalBoxFuture<'a, ()>> {
         let drone = match call.actors.as_slice() {
             [ActorRef::Drone(d)] => *d,
             // Not an actor here: `call` does nothing either.
             [ActorRef::Slot(s)] => match ctx.frame.get(*s) {
                 Some(Value::Actor(d)) => *d,
-                _ => return,
+                _ => return None,
             },
             // A group or several actors: an instance per actor, each perhaps instant.
-            _ => {
-                let general: LocalBoxFuture<'_, ()> = Box::pin(self.call(call, ctx));
-                return general.await;
-            }
+            _ => return Some(Box::pin(self.call(call, ctx))),
         };
         let args = {
             let received = self.received.borrow();
             let env = self.env(&ctx.frame, &received);
             call.args.iter().map(|e| env.eval(e)).collect()
         };
-        self.instant_instance(call, drone, args, ctx).await;
+        self.instant_instance(call, drone, args, ctx)
     }
 
-    /// One instance of a capability that may be instant, on `drone`.
-    pub(crate) async fn instant_instance(&self, call: &'m Call, drone: DroneId, args: Vec<Value>, ctx: &Ctx<'m>) {
-        if let Some(stopped) = self.run_instant(call, drone, args, ctx) {
-            self.go_on(call, drone, stopped, ctx).await;
-        }
+    /// One instance of a capability that may be instant, on `drone`: as `instant_call`.
+    pub(crate) fn instant_instance<'a>(&'a self, call: &'m Call, drone: DroneId, args: Vec<Value>, ctx: &'a Ctx<'m>) -> Option<LocalBoxFuture<'a, ()>> {
+        let stopped = self.run_instant(call, drone, args, ctx)?;
+        Some(self.go_on(call, drone, stopped, ctx))
     }
 
     /// Runs the activity as far as it goes at once; `None` when it ended.
@@ -122,27 +123,26 @@ impl<'m> Engine<'m> {
             if !matches!(begun.end, Ending::Now(CallEnd::Done)) {
                 return Some(Stopped::At { id, needs, frame, args, at, begun: Some(begun) });
             }
-            self.trace_done(begun.drone, begun.function, &begun.args, &CallEnd::Done);
+            self.trace_done(begun.call.drone, begun.call.function, &begun.call.args, &CallEnd::Done);
         }
         self.capability_end(call, &actors, &args, "ok");
         None
     }
 
-    /// The rest of an activity that had to wait, on the general path. Boxed: its future
-    /// is an instance's, far larger than the statement's that holds it.
+    /// The rest of an activity that had to wait, on the general path. Boxed, each way at
+    /// its own size: the future is an instance's, far larger than the statement's that
+    /// holds it, and it lives as long as the activity.
     fn go_on<'a>(&'a self, call: &'m Call, drone: DroneId, stopped: Stopped<'m>, ctx: &'a Ctx<'m>) -> LocalBoxFuture<'a, ()> {
-        Box::pin(async move {
-            match stopped {
-                Stopped::Start(args) => self.instance(call, Actors::from_elem(drone, 1), args, ctx).await,
-                Stopped::At { id, needs, frame, args, at, begun } => {
-                    // Free when the activity started, and nothing has run since.
-                    let held = take(&self.arbiter, needs.clone());
-                    let instance = self.new_instance(id, call, Actors::from_elem(drone, 1), ctx);
-                    let claims = ctx.claims.with(&needs);
-                    let frame = frame.into_iter().collect();
-                    self.perform(call, instance, held, frame, claims, false, args, ctx, Resume::At(at, begun)).await;
-                }
+        match stopped {
+            Stopped::Start(args) => Box::pin(self.instance(call, Actors::from_elem(drone, 1), args, ctx)),
+            Stopped::At { id, needs, frame, args, at, begun } => {
+                // Free when the activity started, and nothing has run since.
+                let claims = ctx.claims.with(&needs);
+                let held = take(&self.arbiter, needs);
+                let instance = self.new_instance(id, call, Actors::from_elem(drone, 1), ctx);
+                let frame = frame.into_iter().collect();
+                Box::pin(self.perform(call, instance, held, frame, claims, false, args, ctx, Resume::At(at, begun.map(Box::new))))
             }
-        })
+        }
     }
 }

@@ -14,10 +14,12 @@
 pub mod geometry;
 pub mod sweep;
 mod kind;
+mod names;
 mod runtime;
 
 pub use geometry::centroid;
 pub use kind::Kind;
+pub use names::Names;
 pub use runtime::*;
 
 /// A part of a drone that one activity at a time may command (LANGUAGE.md §3).

@@ -175,7 +175,7 @@ impl<'m> Engine<'m> {
     }
 
     pub fn name(&self, d: DroneId) -> &'m str {
-        self.m.drones.get(d).map_or("?", String::as_str)
+        self.m.drones.get(d).unwrap_or("?")
     }
 
     pub fn values(&self, values: &[Value]) -> Json {

@@ -32,7 +32,7 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
         body,
         frame_size: c.frame_size,
         capabilities,
-        drones: world.drones.iter().map(|d| d.name.clone()).collect(),
+        drones: aviary_api::Names::new(world.drones.iter().map(|d| d.name.as_str())),
         signals: c.signals.names,
         exceptions: c.exceptions.names,
         tags: c.tags.names,

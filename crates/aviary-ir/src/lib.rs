@@ -40,7 +40,8 @@ pub struct Mission {
     /// Variables of the mission frame (FOR aliases and parameters, handler bindings).
     pub frame_size: usize,
     pub capabilities: Vec<Capability>,
-    pub drones: Vec<String>,
+    /// Drone names, by `DroneId`.
+    pub drones: aviary_api::Names,
     pub signals: Vec<String>,
     pub exceptions: Vec<String>,
     /// `Capability-Tag` names, as written after the dash.

@@ -61,10 +61,10 @@ fn the_paper_mission_compiles_with_handlers_on_their_block() {
             ("Body_Detected", true, "Start_Mission/ON Body_Detected"),
         ]
     );
-    let sensor = m.drones.iter().position(|d| d == "sensor_drone").unwrap();
+    let sensor = m.drones.position("sensor_drone").unwrap();
     assert_eq!(start.handlers[2].by, Some(ActorFilter::Drones(vec![sensor])));
     // `BY flir_drone` names the FOR alias of a sibling handler: any of its instances.
-    let flirs: Vec<usize> = ["flir_drone1", "flir_drone2"].iter().map(|n| m.drones.iter().position(|d| d == n).unwrap()).collect();
+    let flirs: Vec<usize> = ["flir_drone1", "flir_drone2"].iter().map(|n| m.drones.position(n).unwrap()).collect();
     assert_eq!(start.handlers[3].by, Some(ActorFilter::Drones(flirs)));
 }
 

@@ -1,0 +1,72 @@
+//! The drones' names in one string: a `String` per drone costs 40 bytes a drone (and an
+//! allocation), where a fleet's names are mostly read to say who did what.
+
+use std::ops::Index;
+
+use crate::DroneId;
+
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Names {
+    text: String,
+    /// Where each name ends in `text`.
+    ends: Vec<usize>,
+}
+
+impl Names {
+    pub fn new<'a>(names: impl ExactSizeIterator<Item = &'a str>) -> Names {
+        let mut out = Names { text: String::new(), ends: Vec::with_capacity(names.len()) };
+        for name in names {
+            out.text.push_str(name);
+            out.ends.push(out.text.len());
+        }
+        out.text.shrink_to_fit();
+        out
+    }
+
+    pub fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.ends.is_empty()
+    }
+
+    /// The drone's name, if the fleet has it.
+    pub fn get(&self, id: DroneId) -> Option<&str> {
+        let end = *self.ends.get(id)?;
+        let start = id.checked_sub(1).map_or(0, |before| self.ends[before]);
+        self.text.get(start..end)
+    }
+
+    /// Every name, in drone order.
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = &str> + '_ {
+        (0..self.len()).map(|d| &self[d])
+    }
+
+    /// The drone of this name (the first, if two share it).
+    pub fn position(&self, name: &str) -> Option<DroneId> {
+        self.iter().position(|n| n == name)
+    }
+}
+
+impl Index<DroneId> for Names {
+    type Output = str;
+    /// The drone's name; empty for an index the fleet does not have.
+    fn index(&self, id: DroneId) -> &str {
+        self.get(id).unwrap_or("")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_name_in_order() {
+        let names = Names::new(["alpha", "", "b2"].into_iter());
+        assert_eq!((&names[0], &names[1], &names[2], &names[3]), ("alpha", "", "b2", ""));
+        assert_eq!((names.len(), names.get(2), names.get(3)), (3, Some("b2"), None));
+        assert_eq!(names.iter().collect::<Vec<_>>(), ["alpha", "", "b2"]);
+        assert_eq!((names.position("b2"), names.position("c")), (Some(2), None));
+    }
+}

@@ -38,7 +38,7 @@ impl Env<'_> {
             },
             Expr::Attribute(r, i) => {
                 let d = self.actor(r);
-                d.and_then(|d| self.mission.attributes.get(*i)?.get(d)?.clone()).unwrap_or(Value::Bool(false))
+                d.and_then(|d| self.mission.attribute(*i, d)).unwrap_or(Value::Bool(false))
             }
             Expr::Point(parts) => {
                 let n: Vec<f64> = parts.iter().map(|p| number(&self.eval(p))).collect();

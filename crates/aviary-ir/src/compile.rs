@@ -493,11 +493,11 @@ fn telemetry_field(name: &str) -> Option<Field> {
     })
 }
 
-fn attribute_table(world: &World, names: &[String]) -> Vec<Vec<Option<Value>>> {
+fn attribute_table(world: &World, names: &[String]) -> Vec<Column> {
     names
         .iter()
         .map(|name| {
-            world
+            let values = world
                 .drones
                 .iter()
                 .map(|d| {
@@ -508,7 +508,8 @@ fn attribute_table(world: &World, names: &[String]) -> Vec<Vec<Option<Value>>> {
                         AttributeValue::Other(o) => Value::Text(o.clone()),
                     })
                 })
-                .collect()
+                .collect();
+            Column::new(values)
         })
         .collect()
 }

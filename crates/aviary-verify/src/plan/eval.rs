@@ -36,7 +36,7 @@ impl Scope<'_> {
             Expr::Slot(s) => self.frame.get(*s)?.clone()?,
             Expr::Actor(a) => Value::Actor(self.actor(a)?),
             Expr::Telemetry(a, field) => self.telemetry(self.actor(a)?, *field)?,
-            Expr::Attribute(a, i) => self.mission.attributes.get(*i)?.get(self.actor(a)?)?.clone()?,
+            Expr::Attribute(a, i) => self.mission.attribute(*i, self.actor(a)?)?,
             Expr::Point(parts) => {
                 let n: Vec<f64> = parts.iter().map(|p| number(&self.eval(p)?)).collect::<Option<_>>()?;
                 Value::Position(Point { x: *n.first()?, y: *n.get(1)?, z: n.get(2).copied() })

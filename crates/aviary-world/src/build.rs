@@ -54,7 +54,7 @@ pub(crate) fn read_fast(file: FileId, text: &str) -> Option<(World, Vec<Diagnost
     let mut cx = Ctx { file, text, diags: Vec::new() };
     // Room for the drones up front: doubling a vector of many drones costs more than
     // counting their headers.
-    let count = memchr::memmem::find_iter(text.as_bytes(), b"\n[drones.").count() + usize::from(text.starts_with("[drones."));
+    let count = count_drones(text);
     let mut drones = Drones::with_capacity(count);
     let root = fast::parse_with(text, count, &mut |e| drones.entry(&mut cx, e))?;
     Some(build(cx, root, drones))
@@ -104,9 +104,11 @@ pub(crate) fn read_fast_in_two(file: FileId, text: &str, at: usize, join: Join) 
         return None;
     }
     let (mut head, mut tail) = (None, None);
+    // The head's drones get room for the tail's, which are moved in after them.
+    let everyone = count_drones(text);
     join(
-        &mut || head = read_part(file, text, 0..at, fast::Part::Head),
-        &mut || tail = read_part(file, text, at..text.len(), fast::Part::Tail),
+        &mut || head = read_part(file, text, 0..at, fast::Part::Head, everyone),
+        &mut || tail = read_part(file, text, at..text.len(), fast::Part::Tail, 0),
     );
     let ((head, mut cx, mut drones), (tail, tail_cx, tail_drones)) = (head?, tail?);
     let root = fast::join(head, tail)?;
@@ -116,13 +118,18 @@ pub(crate) fn read_fast_in_two(file: FileId, text: &str, at: usize, join: Join) 
 }
 
 /// One part of a file read in two, its diagnostics and its drones.
-fn read_part(file: FileId, text: &str, range: std::ops::Range<usize>, part: fast::Part) -> Option<(fast::Read, Ctx<'_>, Drones)> {
+/// `room`: for at least that many drones.
+fn read_part(file: FileId, text: &str, range: std::ops::Range<usize>, part: fast::Part, room: usize) -> Option<(fast::Read, Ctx<'_>, Drones)> {
     let mut cx = Ctx { file, text, diags: Vec::new() };
-    let lines = text.get(range.clone())?;
-    let count = memchr::memmem::find_iter(lines.as_bytes(), b"\n[drones.").count() + usize::from(lines.starts_with("[drones."));
-    let mut drones = Drones::with_capacity(count);
+    let count = count_drones(text.get(range.clone())?);
+    let mut drones = Drones::with_capacity(count.max(room));
     let read = fast::parse_part(text, range, part, count, &mut |e| drones.entry(&mut cx, e))?;
     Some((read, cx, drones))
+}
+
+/// About how many drones `lines` hold: the lines that start `[drones.`.
+fn count_drones(lines: &str) -> usize {
+    memchr::memmem::find_iter(lines.as_bytes(), b"\n[drones.").count() + usize::from(lines.starts_with("[drones."))
 }
 
 /// The serde path's way, from the whole tree.

@@ -74,16 +74,22 @@ pub fn run(args: &RunArgs) -> u8 {
     // bench w` does). The same checks and diagnostics as `check_sources`.
     let read = aviary_check::read_world_joined(&mut sources, Some((&world_name, &world_bytes)), &crate::cores::join);
     let api = aviary_sim::descriptor();
-    let mut front = || {
+    // The source texts are kept only to show errors: without any, they go before the
+    // compiled mission joins the fleet being built (a large world's text is megabytes).
+    let front = || {
+        let mut sources = sources;
         let (program, mission_diagnostics) = aviary_check::check_mission(&mut sources, (&name, &bytes), &read, &DiskProvider, &api);
-        let errors = read.diagnostics.iter().chain(&mission_diagnostics).any(|d| d.is_error());
+        if read.diagnostics.iter().chain(&mission_diagnostics).any(|d| d.is_error()) {
+            return (program, mission_diagnostics, None, Some(sources));
+        }
+        drop(sources);
         let mission = match (&read.world, &program) {
-            (Some(world), Some(program)) if !errors => aviary_ir::compile(program, world, &api),
+            (Some(world), Some(program)) => aviary_ir::compile(program, world, &api),
             _ => None,
         };
-        (program, mission_diagnostics, mission)
+        (program, mission_diagnostics, mission, None)
     };
-    let ((program, mission_diagnostics, mission), fleet) = match &read.world {
+    let ((program, mission_diagnostics, mission, sources), fleet) = match &read.world {
         Some(world) => {
             let (done, fleet, _) = crate::cores::beside(world, front);
             (done, Some(fleet))
@@ -92,7 +98,7 @@ pub fn run(args: &RunArgs) -> u8 {
     };
     let aviary_check::WorldRead { world, mut diagnostics, .. } = read;
     diagnostics.extend(mission_diagnostics);
-    if diagnostics.iter().any(|d| d.is_error()) {
+    if let Some(sources) = sources.filter(|_| diagnostics.iter().any(|d| d.is_error())) {
         for d in diagnostics.iter().filter(|d| d.is_error()) {
             eprint!("{}", render_text(&sources, d, color_wanted()));
         }

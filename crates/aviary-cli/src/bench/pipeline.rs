@@ -57,10 +57,17 @@ pub fn run(mission: String, world: String, sink: &mut dyn TraceSink, stages: &mu
         if diags.iter().any(|d| d.is_error()) {
             return Err(render(&sources, &diags));
         }
+        // The source texts are needed only to show errors: they go before the compiled
+        // mission joins the fleet being built (as in `aviary run`).
+        let freeing = Instant::now();
+        drop(sources);
+        let texts_freed = freeing.elapsed();
         let compiled = stages.time("compile", || aviary_ir::compile(&program, &world, &api));
         let Some(compiled) = compiled else { return Err("the mission has no MISSION".into()) };
-        // The tree and the source texts are not needed to fly.
-        stages.time("free front end", || drop((program, sources)));
+        // The tree is not needed to fly either.
+        let freeing = Instant::now();
+        drop(program);
+        stages.0.push(("free front end", texts_freed + freeing.elapsed(), peak_rss()));
         Ok(compiled)
     };
     let (compiled, fleet, waited) = crate::cores::beside(&world, || front(stages));

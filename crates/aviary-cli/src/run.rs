@@ -83,6 +83,7 @@ pub fn run(args: &RunArgs) -> u8 {
             return (program, mission_diagnostics, None, Some(sources));
         }
         drop(sources);
+        crate::alloc::give_back();
         let mission = match (&read.world, &program) {
             (Some(world), Some(program)) => aviary_ir::compile(program, world, &api),
             _ => None,

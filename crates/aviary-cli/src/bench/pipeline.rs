@@ -61,6 +61,7 @@ pub fn run(mission: String, world: String, sink: &mut dyn TraceSink, stages: &mu
         // mission joins the fleet being built (as in `aviary run`).
         let freeing = Instant::now();
         drop(sources);
+        crate::alloc::give_back();
         let texts_freed = freeing.elapsed();
         let compiled = stages.time("compile", || aviary_ir::compile(&program, &world, &api));
         let Some(compiled) = compiled else { return Err("the mission has no MISSION".into()) };

@@ -10,6 +10,7 @@ mod bench;
 mod check;
 mod ctl;
 mod files;
+mod cores;
 mod fmt;
 mod mixed;
 mod run;

@@ -69,16 +69,45 @@ pub fn run(args: &RunArgs) -> u8 {
     let mut sources = SourceMap::new();
     let name = args.file.display().to_string();
     let world_name = world_path.display().to_string();
-    let checked = aviary_check::check_sources(&mut sources, (&name, &bytes), Some((&world_name, &world_bytes)), &DiskProvider, &aviary_sim::descriptor());
-    if checked.has_errors() {
-        for d in checked.diagnostics.iter().filter(|d| d.is_error()) {
+    // The world first (a large one read on two threads): with it, the simulator's fleet
+    // is built on a second thread while the mission is checked and compiled (as `aviary
+    // bench w` does). The same checks and diagnostics as `check_sources`.
+    let read = aviary_check::read_world_joined(&mut sources, Some((&world_name, &world_bytes)), &crate::cores::join);
+    let api = aviary_sim::descriptor();
+    // The source texts are kept only to show errors: without any, they go before the
+    // compiled mission joins the fleet being built (a large world's text is megabytes).
+    let front = || {
+        let mut sources = sources;
+        let (program, mission_diagnostics) = aviary_check::check_mission(&mut sources, (&name, &bytes), &read, &DiskProvider, &api);
+        if read.diagnostics.iter().chain(&mission_diagnostics).any(|d| d.is_error()) {
+            return (program, mission_diagnostics, None, Some(sources));
+        }
+        drop(sources);
+        crate::alloc::give_back();
+        let mission = match (&read.world, &program) {
+            (Some(world), Some(program)) => aviary_ir::compile(program, world, &api),
+            _ => None,
+        };
+        (program, mission_diagnostics, mission, None)
+    };
+    let ((program, mission_diagnostics, mission, sources), fleet) = match &read.world {
+        Some(world) => {
+            let (done, fleet, _) = crate::cores::beside(world, front);
+            (done, Some(fleet))
+        }
+        None => (front(), None),
+    };
+    let aviary_check::WorldRead { world, mut diagnostics, .. } = read;
+    diagnostics.extend(mission_diagnostics);
+    if let Some(sources) = sources.filter(|_| diagnostics.iter().any(|d| d.is_error())) {
+        for d in diagnostics.iter().filter(|d| d.is_error()) {
             eprint!("{}", render_text(&sources, d, color_wanted()));
         }
         eprintln!("aviary: {} has errors, so it was not run", args.file.display());
         return 2;
     }
-    let (Some(program), Some(world)) = (checked.program, checked.world) else { return 2 };
-    let Some(mission) = aviary_ir::compile(&program, &world, &aviary_sim::descriptor()) else {
+    let (Some(_), Some(world), Some(fleet)) = (program, world, fleet) else { return 2 };
+    let Some(mission) = mission else {
         eprintln!("aviary: {} has no MISSION to run (it holds only capabilities)", args.file.display());
         return 2;
     };
@@ -124,7 +153,7 @@ pub fn run(args: &RunArgs) -> u8 {
     let telemetry_hz = args.telemetry_hz.or(server.as_ref().map(|_| 2.0));
     let progress = progress_bar(args.quiet);
     let ran = runtime.block_on(async {
-        let sim = SimBackend::start(&world, SimOptions { speed: args.speed, ..SimOptions::default() });
+        let sim = SimBackend::start_with(fleet, SimOptions { speed: args.speed, ..SimOptions::default() });
         let mixed = match live {
             true => Some(crate::mixed::Mixed::new(sim.clone(), aviary_mavlink::connect(&world, aviary_mavlink::Tuning::default()).await?)),
             false => None,

@@ -1,6 +1,6 @@
 //! From a checked program to the IR.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 
 use aviary_api::{Descriptor, Point, Value};
 use aviary_check::{bind_args, Program};
@@ -579,17 +579,19 @@ fn visit_calls<'b>(block: &'b Block, out: &mut Vec<&'b Call>) {
 
 /// The world's drones, groups, places and areas by name (the first of a name wins, as a
 /// scan in file order would find it).
+/// Hashed with foldhash (seeded per process): SipHash was most of building the drones'
+/// table of a large world.
 struct WorldIndex<'w> {
-    drones: HashMap<&'w str, DroneId>,
-    groups: HashMap<&'w str, &'w aviary_world::Group>,
-    places: HashMap<&'w str, &'w aviary_world::Place>,
-    areas: HashMap<&'w str, &'w aviary_world::Area>,
+    drones: foldhash::HashMap<&'w str, DroneId>,
+    groups: foldhash::HashMap<&'w str, &'w aviary_world::Group>,
+    places: foldhash::HashMap<&'w str, &'w aviary_world::Place>,
+    areas: foldhash::HashMap<&'w str, &'w aviary_world::Area>,
 }
 
 impl<'w> WorldIndex<'w> {
     fn new(w: &'w World) -> Self {
-        fn first<'w, T>(items: impl Iterator<Item = (&'w str, T)>) -> HashMap<&'w str, T> {
-            let mut map = HashMap::new();
+        fn first<'w, T>(items: impl ExactSizeIterator<Item = (&'w str, T)>) -> foldhash::HashMap<&'w str, T> {
+            let mut map = foldhash::HashMap::with_capacity_and_hasher(items.len(), Default::default());
             for (name, item) in items {
                 map.entry(name).or_insert(item);
             }

@@ -78,6 +78,16 @@ impl SimBackend {
     /// # Panics
     /// Outside a tokio runtime, or when `options.tick` is not a positive number.
     pub fn start(world: &World, options: SimOptions) -> Arc<SimBackend> {
+        SimBackend::start_with(Fleet::new(world), options)
+    }
+
+    /// As [`SimBackend::start`], with the fleet already built by [`Fleet::new`] (which is
+    /// pure: the caller may build it on another thread while it does other work). The
+    /// same fleet gives the same run.
+    ///
+    /// # Panics
+    /// Outside a tokio runtime, or when `options.tick` is not a positive number.
+    pub fn start_with(fleet: Fleet, options: SimOptions) -> Arc<SimBackend> {
         assert!(
             options.tick.is_finite() && options.tick > 0.0,
             "SimOptions::tick must be positive"
@@ -85,7 +95,7 @@ impl SimBackend {
         let (tx, rx) = mpsc::unbounded_channel();
         let backend = Arc::new(SimBackend {
             state: Mutex::new(State {
-                fleet: Fleet::new(world),
+                fleet,
                 waiting: BTreeMap::new(),
                 events: tx,
             }),

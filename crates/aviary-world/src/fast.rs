@@ -47,12 +47,49 @@ pub(crate) fn parse(text: &str) -> Option<Node> {
 /// returns `None`, some tables may have gone to `on_drone` already. `drones`: about how
 /// many there are.
 pub(crate) fn parse_with(text: &str, drones: usize, on_drone: &mut dyn FnMut(Entry)) -> Option<Node> {
+    let part = parse_part(text, 0..text.len(), Part::Whole, drones, on_drone)?;
+    Some(part.root.into_node())
+}
+
+/// Which part of a file [`parse_part`] reads.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(crate) enum Part {
+    /// All of it.
+    Whole,
+    /// From the start to a line that starts a `[drones.NAME]` table: it must end on a
+    /// line break, outside any bracket or string, with no key waiting for its value.
+    Head,
+    /// From such a line to the end: nothing but `[drones.NAME]` tables.
+    Tail,
+}
+
+/// What [`parse_part`] read, before the parts are put together ([`join`]).
+pub(crate) struct Read {
+    root: Table,
+    /// The hashes of the drones' names.
+    names: QuickSet<u64>,
+}
+
+/// Reads `text[range]` (spans stay those of `text`) as the part `part` of the file,
+/// exactly as [`parse_with`] reads those lines within the whole: a file is read in
+/// tables (`parse_document` is called once per table), so a head that ends where a
+/// table starts, and a tail that starts there, are handed to the parser in the same
+/// pieces, and the builder is at the same point between them (no header, key, open
+/// bracket or dotted key pending; checked). What differs is what the builder keeps
+/// across tables: the tree and the names of the drones, which [`join`] puts together.
+/// `None`: the serde path reads the file (for a head or a tail: the whole file is read
+/// in one part, which decides).
+pub(crate) fn parse_part(text: &str, range: std::ops::Range<usize>, part: Part, drones: usize, on_drone: &mut dyn FnMut(Entry)) -> Option<Read> {
+    let whole = text;
+    let base = range.start;
+    let text = text.get(range)?;
     if !within_toml_1_0(text.as_bytes()) {
         return None;
     }
     let source = Source::new(text);
     let mut builder = Builder {
-        source,
+        text: whole,
+        base,
         root: Table::new(Span::new(0, 0)),
         current: None,
         header: None,
@@ -64,6 +101,7 @@ pub(crate) fn parse_with(text: &str, drones: usize, on_drone: &mut dyn FnMut(Ent
         drone_names: QuickSet::with_capacity_and_hasher(drones, Default::default()),
         drones_at: None,
         open_drone: false,
+        only_drones: part == Part::Tail,
     };
     const MAX_DEPTH: i64 = 32;
     let mut errors = Errors(false);
@@ -90,6 +128,8 @@ pub(crate) fn parse_with(text: &str, drones: usize, on_drone: &mut dyn FnMut(Ent
             TokenKind::MlLiteralString if text.get(token.span().start()..token.span().end())?.contains('\r') => return None,
             TokenKind::LeftCurlyBracket => inline += 1,
             TokenKind::RightCurlyBracket => inline -= 1,
+            // A head is a piece of the file: its end is not the file's.
+            TokenKind::Eof if part == Part::Head => continue,
             _ => {}
         }
         if !matches!(token.kind(), TokenKind::Whitespace | TokenKind::Comment) {
@@ -116,12 +156,54 @@ pub(crate) fn parse_with(text: &str, drones: usize, on_drone: &mut dyn FnMut(Ent
         line_start = token.kind() == TokenKind::Newline;
         tokens.push(token);
     }
+    if part == Part::Head {
+        // The whole file's lexer, too, ends a token at the end of the head: its last
+        // token is a line break (a string or comment running on would have taken it).
+        let ends_line = tokens.last().is_some_and(|t| t.kind() == TokenKind::Newline && t.span().end() == text.len());
+        if !(ends_line && depth == 0 && inline == 0) {
+            return None;
+        }
+    }
     toml_parser::parser::parse_document(&tokens, &mut builder, &mut errors);
-    if errors.0 || builder.bail || !builder.stack.is_empty() {
+    let pending = builder.header.is_some() || builder.key.is_some() || builder.dotted;
+    if errors.0 || builder.bail || !builder.stack.is_empty() || (part == Part::Head && pending) {
         return None;
     }
     builder.hand_over_drone()?;
-    Some(builder.root.into_node())
+    Some(Read { root: builder.root, names: builder.drone_names })
+}
+
+/// The tree of a head and a tail read by [`parse_part`], as [`parse_with`] builds it
+/// from the whole file; `None` when the whole file must be read in one part (a drone's
+/// name in both, or a `drones` of the head that is not a table of drones).
+pub(crate) fn join(head: Read, tail: Read) -> Option<Node> {
+    let Read { mut root, names } = head;
+    if tail.names.len() > names.len() {
+        if names.iter().any(|n| tail.names.contains(n)) {
+            return None;
+        }
+    } else if tail.names.iter().any(|n| names.contains(n)) {
+        return None;
+    }
+    // The tail holds only `[drones.NAME]` tables, all handed over: its tree is one empty
+    // table `drones`, made by its first header.
+    let mut tail_entries = tail.root.entries.into_iter();
+    let (Some((key, key_span, Item::Table(drones))), None) = (tail_entries.next(), tail_entries.next()) else { return None };
+    if key != "drones" || !drones.entries.is_empty() {
+        return None;
+    }
+    match root.find("drones") {
+        // The whole file's reader found it there, and added nothing to it.
+        Some(i) => match &root.entries[i].2 {
+            Item::Table(t) if t.entries.is_empty() => {}
+            _ => return None,
+        },
+        // ... or made it at the tail's first header, after every table of the head.
+        None => {
+            root.push(key, key_span, Item::Table(drones));
+        }
+    }
+    Some(root.into_node())
 }
 
 /// No control character but tab and line breaks, and no carriage return outside a CRLF:
@@ -251,7 +333,10 @@ enum Open {
 }
 
 struct Builder<'i, 's> {
-    source: Source<'i>,
+    /// The whole file: spans are offsets into it.
+    text: &'i str,
+    /// Where the part being read starts in `text`: the parser's spans count from there.
+    base: usize,
     root: Table,
     /// Where key/value pairs go: entry indices from the root (into the last table of
     /// an array of tables). `None` before the first header.
@@ -274,13 +359,21 @@ struct Builder<'i, 's> {
     drones_at: Option<usize>,
     /// The current table is a `[drones.NAME]`, to be handed over at the next header.
     open_drone: bool,
-}
-
-fn span(s: toml_parser::Span) -> Span {
-    Span::new(s.start(), s.end())
+    /// Every header must be a `[drones.NAME]` (the tail of a file read in two parts).
+    only_drones: bool,
 }
 
 impl<'i> Builder<'i, '_> {
+    /// A span of the parser's, in the whole file.
+    fn span(&self, s: toml_parser::Span) -> Span {
+        Span::new(self.base + s.start(), self.base + s.end())
+    }
+
+    /// The text of a span of the parser's.
+    fn raw(&self, s: toml_parser::Span) -> Option<&'i str> {
+        self.text.get(self.base + s.start()..self.base + s.end())
+    }
+
     /// Hands the `[drones.NAME]` table just read to `on_drone`: it is the only entry
     /// of `drones`, since every earlier one went the same way.
     fn hand_over_drone(&mut self) -> Option<()> {
@@ -304,7 +397,7 @@ impl<'i> Builder<'i, '_> {
             [_] if !array => Some(false),
             [_, (name, at)] if !array => {
                 // A bare key: its text is its name.
-                let text: &'i str = self.source.input().get(at.range())?;
+                let text: &'i str = self.text.get(at.range())?;
                 let hash = BuildHasherDefault::<Quick>::default().hash_one(text);
                 (text == name && self.drone_names.insert(hash)).then_some(true)
             }
@@ -328,6 +421,9 @@ impl<'i> Builder<'i, '_> {
     fn header(&mut self, array: bool, start: usize, end: usize, keys: Vec<(String, Span)>) -> Option<()> {
         self.hand_over_drone()?;
         let drone = self.drone_header(array, &keys)?;
+        if self.only_drones && !drone {
+            return None;
+        }
         let (last, parents) = keys.split_last()?;
         let mut path = Vec::with_capacity(keys.len());
         let mut table = &mut self.root;
@@ -396,9 +492,9 @@ impl<'i> Builder<'i, '_> {
     }
 
     fn scalar(&mut self, at: toml_parser::Span, encoding: Option<Encoding>) -> Option<()> {
-        let text = self.source.input().get(at.start()..at.end())?;
+        let text = self.raw(at)?;
         if let Some(value) = plain_scalar(text, encoding) {
-            return self.value(Node { span: span(at), value });
+            return self.value(Node { span: self.span(at), value });
         }
         let raw = toml_parser::Raw::new_unchecked(text, encoding, at);
         let mut out = String::new();
@@ -416,7 +512,7 @@ impl<'i> Builder<'i, '_> {
             ScalarKind::Float if encoding.is_none() => Value::Float(out.parse::<f64>().ok().filter(|f| f.is_finite())?),
             _ => return None,
         };
-        self.value(Node { span: span(at), value })
+        self.value(Node { span: self.span(at), value })
     }
 
     fn key(&mut self, at: toml_parser::Span, encoding: Option<Encoding>) -> Option<()> {
@@ -425,7 +521,7 @@ impl<'i> Builder<'i, '_> {
         }
         // The parser leaves a bare key's characters to the decoder (`Lookout@` lexes as
         // one key), so decode it and take serde's path on any complaint.
-        let text = self.source.input().get(at.start()..at.end())?;
+        let text = self.raw(at)?;
         let name = if is_bare_key(text) {
             text.to_owned()
         } else {
@@ -437,7 +533,7 @@ impl<'i> Builder<'i, '_> {
             }
             name
         };
-        let key = (name, span(at));
+        let key = (name, self.span(at));
         if let Some((_, _, keys)) = &mut self.header {
             keys.push(key);
             return Some(());
@@ -459,10 +555,10 @@ impl<'i> Builder<'i, '_> {
 
 impl EventReceiver for Builder<'_, '_> {
     fn std_table_open(&mut self, at: toml_parser::Span, _: &mut dyn ErrorSink) {
-        self.header = Some((false, at.start(), Vec::new()));
+        self.header = Some((false, self.base + at.start(), Vec::new()));
     }
     fn array_table_open(&mut self, at: toml_parser::Span, _: &mut dyn ErrorSink) {
-        self.header = Some((true, at.start(), Vec::new()));
+        self.header = Some((true, self.base + at.start(), Vec::new()));
     }
     fn std_table_close(&mut self, at: toml_parser::Span, _: &mut dyn ErrorSink) {
         self.close_header(at);
@@ -471,23 +567,23 @@ impl EventReceiver for Builder<'_, '_> {
         self.close_header(at);
     }
     fn inline_table_open(&mut self, at: toml_parser::Span, _: &mut dyn ErrorSink) -> bool {
-        self.stack.push(Open::Inline { start: at.start(), entries: Vec::new(), key: None });
+        self.stack.push(Open::Inline { start: self.base + at.start(), entries: Vec::new(), key: None });
         true
     }
     fn inline_table_close(&mut self, at: toml_parser::Span, _: &mut dyn ErrorSink) {
         let ok = match self.stack.pop() {
-            Some(Open::Inline { start, entries, key: None }) => self.value(Node { span: Span::new(start, at.end()), value: Value::Table(entries) }),
+            Some(Open::Inline { start, entries, key: None }) => self.value(Node { span: Span::new(start, self.base + at.end()), value: Value::Table(entries) }),
             _ => None,
         };
         self.check(ok);
     }
     fn array_open(&mut self, at: toml_parser::Span, _: &mut dyn ErrorSink) -> bool {
-        self.stack.push(Open::Array { start: at.start(), items: Vec::new() });
+        self.stack.push(Open::Array { start: self.base + at.start(), items: Vec::new() });
         true
     }
     fn array_close(&mut self, at: toml_parser::Span, _: &mut dyn ErrorSink) {
         let ok = match self.stack.pop() {
-            Some(Open::Array { start, items }) => self.value(Node { span: Span::new(start, at.end()), value: Value::Array(items) }),
+            Some(Open::Array { start, items }) => self.value(Node { span: Span::new(start, self.base + at.end()), value: Value::Array(items) }),
             _ => None,
         };
         self.check(ok);
@@ -515,7 +611,7 @@ impl EventReceiver for Builder<'_, '_> {
 impl Builder<'_, '_> {
     fn close_header(&mut self, at: toml_parser::Span) {
         let ok = match self.header.take() {
-            Some((array, start, keys)) => self.header(array, start, at.end(), keys),
+            Some((array, start, keys)) => self.header(array, start, self.base + at.end(), keys),
             None => None,
         };
         self.check(ok);

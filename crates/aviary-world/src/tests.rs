@@ -924,3 +924,131 @@ fn a_large_fleet_is_read_table_by_table() {
     assert_eq!(world.drones[499].name, "a499");
     assert_eq!(world.groups.iter().map(|g| g.members.len()).collect::<Vec<_>>(), [167, 167, 166]);
 }
+
+/// Reads `text` as `aviary` reads a large world: in two parts, on two threads.
+fn parse_on_two_threads(text: &str) -> (Option<World>, Vec<Diagnostic>) {
+    let join = |a: &mut (dyn FnMut() + Send), b: &mut (dyn FnMut() + Send)| {
+        std::thread::scope(|s| {
+            s.spawn(b);
+            a();
+        })
+    };
+    parse_world_joined(FileId(7), text, &join)
+}
+
+/// A file cut at any `[drones.NAME]` line and read in two parts gives the world and the
+/// diagnostics of the whole file, or is read whole: groups and problems on both sides,
+/// tables the drones refer to before and after, and cuts that are not between tables.
+#[test]
+fn a_file_read_in_two_parts_is_read_as_whole() {
+    let fleet = |from: usize, to: usize| -> String {
+        (from..to)
+            .map(|i| format!("[drones.d{i}]\nhome = [{i}, 0]\ngroup = \"g{}\"\nindex = {i}\nsensors = [\"thermal\"]\n", i % 3))
+            .collect()
+    };
+    let texts = [
+        fleet(0, 8),
+        format!("[site]\nname = \"S\"\n[sensors.thermal]\ndetects = [\"B\"]\nrange = 5\n{}", fleet(0, 6)),
+        format!("{}[sensors.thermol]\ndetects = [\"B\"]\nrange = 5\n", fleet(0, 6)),
+        format!("[drones]\n{}", fleet(0, 4)),
+        format!("{}[drones.x]\nhome = [0, 0]\n[[faults]]\ndrone = \"d5\"\nat = 1\nkind = \"crash\"\n{}", fleet(0, 3), fleet(3, 6)),
+        // Problems in both parts, names shared with places.
+        format!("[places]\ng1 = [0, 0]\n{}[drones.bad]\nhome = \"x\"\nspeed = 1\n{}[drones.9]\nbattery = 200\n", fleet(0, 3), fleet(3, 5)),
+        // One drone twice, on either side of a cut: the whole file's serde path.
+        format!("{}[drones.d1]\nhome = [1, 1]\n", fleet(0, 4)),
+        // A string that runs over lines that look like tables.
+        format!("{}[site]\nname = \"\"\"\n[drones.q]\nhome = [0, 0]\n\"\"\"\n{}", fleet(0, 2), fleet(2, 4)),
+        format!("{}[site]\nname = '''\n[drones.q]\n'''\n{}", fleet(0, 2), fleet(2, 4)),
+        format!("[areas]\nA = [\n[drones.x]\n]\n{}", fleet(0, 2)),
+        format!("{}[drones.x]\nhome = [0, 0\n[drones.y]\nhome = [0, 0]\n", fleet(0, 2)),
+        format!("{}[drones.x]\nhome = [0, 0]\nnote = \n[drones.y]\nhome = [0, 0]\n", fleet(0, 2)),
+        format!("{}[drones.x]\r\nhome = [0, 0]\r\n[drones.y]\r\nhome = [0, 0]\r\n", fleet(0, 2)),
+        format!("{}[drones.x.y]\nhome = [0, 0]\n{}", fleet(0, 2), fleet(2, 4)),
+        format!("[[drones]]\nhome = [0, 0]\n{}", fleet(0, 2)),
+        format!("[site]\ndrones = 1\n{}", fleet(0, 2)),
+        format!("{}# [drones.c]\n[drones.z] # [drones.c]\nhome = [0, 0]\n", fleet(0, 2)),
+    ];
+    for text in &texts {
+        assert_fast_reader_agrees(text);
+        assert_eq!(parse_on_two_threads(text), parse(text), "{text}");
+    }
+    // Some cuts are taken: every cut of a plain fleet.
+    let text = &texts[1];
+    let whole = crate::build::read_fast(FileId(7), text).unwrap();
+    let cuts = (1..text.len()).filter_map(|near| crate::build::split_point(text, near)).collect::<std::collections::BTreeSet<_>>();
+    assert_eq!(cuts.len(), 6);
+    for at in cuts {
+        let parts = crate::build::read_fast_in_two(FileId(7), text, at, &join_in_turn).unwrap();
+        assert_eq!(parts, whole, "cut at {at}");
+    }
+    // ... and none where the tail is not all drones, or a drone is in both parts.
+    for (text, line) in [(&texts[4], "[drones.x]"), (&texts[6], "[drones.d1]\nhome = [1, 1]")] {
+        let at = text.find(line).unwrap();
+        assert!(crate::build::read_fast_in_two(FileId(7), text, at, &join_in_turn).is_none(), "{text}");
+    }
+}
+
+/// A large world is read in two parts, on two threads, into the world read whole.
+#[test]
+fn a_large_fleet_read_on_two_threads_is_the_fleet_read_whole() {
+    let mut text = String::from("[site]\nname = \"W\"\n[sensors.ir]\ndetects = [\"P\"]\nrange = 9\n");
+    for i in 0..3000 {
+        text.push_str(&format!("\n[drones.a{i}]\nhome = [{}, 0]\ngroup = \"fleet{}\"\nindex = {i}\nsensors = [\"ir\"]\n", i * 5, i * 7 / 3000));
+    }
+    assert!(text.len() > crate::build::JOIN_FROM);
+    let at = crate::build::split_point(&text, text.len() / 2).unwrap();
+    assert!(crate::build::read_fast_in_two(FileId(7), &text, at, &join_in_turn).is_some());
+    let (world, diags) = parse_on_two_threads(&text);
+    assert_eq!((world.as_ref(), &diags), (parse(&text).0.as_ref(), &parse(&text).1));
+    let world = world.unwrap();
+    assert_eq!(world.drones.len(), 3000);
+    assert_eq!(world.groups.len(), 7);
+    assert_eq!(world.groups[3].members.first(), Some(&1286));
+    // The same problems, with their spans, in both parts.
+    let broken = text.replace("index = 7\n", "index = 7\nspeed = 1\n").replace("index = 2900\n", "index = 2900\nbattery = -1\n");
+    let (none, diags) = parse_on_two_threads(&broken);
+    assert!(none.is_none());
+    assert_eq!(diags.len(), 2);
+    assert_eq!((None, diags), parse(&broken));
+}
+
+mod split_props {
+    use proptest::prelude::*;
+
+    /// Pieces of world files, some of them odd, to be put together in any order.
+    const PIECES: &[&str] = &[
+        "[drones.a]\nhome = [0, 0]\ngroup = \"g\"\n",
+        "[drones.b]\nhome = [1, 0]\ngroup = \"h\"\nsensors = [\"ir\", \"camera\"]\n",
+        "[drones.c]\nhome = [2, 0, 3]\nnote = \"x\"\nlist = [1, {a = 2}]\n",
+        "[drones.a]\nhome = [9, 9]\n",
+        "[drones.d]\nhome = \"nowhere\"\nmax_speed = -2\n",
+        "[drones.e]\nmavlink = \"udp:1.2.3.4:5\"\nsystem_id = 2\nhome = [0, 0]\n",
+        "[drones.f]\nhome = [0, 0]\ngroup = \"a\"\n",
+        "[drones.g.h]\nx = 1\n",
+        "[drones]\n",
+        "[[drones]]\nx = 1\n",
+        "[sensors.ir]\ndetects = [\"P\"]\nrange = 3\n",
+        "[places]\nh = [0, 0]\n",
+        "[site]\nname = \"\"\"\n[drones.z]\n\"\"\"\n",
+        "[site]\nname = \"S\"\n",
+        "[[faults]]\ndrone = \"b\"\nat = 1\nkind = \"crash\"\n",
+        "[targets]\nx = 1\n",
+        "# [drones.y]\n\n",
+        "[drones.y]\r\nhome = [0, 0]\r\n",
+        "[drones.w]\nhome = [0,\n0]\n",
+        "[drones.v]\nhome = [0, 0\n",
+        "[drones.u]\nx = \n",
+        "x = 1\n",
+    ];
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(400))]
+        /// Any file put together from the pieces, cut at any `[drones.NAME]` line.
+        #[test]
+        fn any_cut_reads_as_the_whole(pieces in proptest::collection::vec(0..PIECES.len(), 0..12)) {
+            let text: String = pieces.iter().map(|&i| PIECES[i]).collect();
+            crate::assert_split_reader_agrees(&text);
+            prop_assert_eq!(super::parse_on_two_threads(&text), super::parse(&text));
+        }
+    }
+}

@@ -40,31 +40,48 @@ pub struct Ran {
 
 /// Checks, compiles and runs `mission` in `world` on the simulator (at `--speed max`),
 /// feeding every trace event to `sink`. Every stage really runs; a mission with errors
-/// is refused, as `aviary run` refuses it.
+/// is refused, as `aviary run` refuses it. As in `aviary run`, the simulator's fleet is
+/// built on a second thread while the mission is checked and compiled
+/// ([`crate::cores::beside`]): `sim start` is the wait for it, and the backend's start.
 /// The texts are handed over (to the source map), not copied: a large world's text is
 /// megabytes.
 pub fn run(mission: String, world: String, sink: &mut dyn TraceSink, stages: &mut Stages) -> Result<Ran, String> {
     let api = aviary_sim::descriptor();
     let mut sources = SourceMap::new();
     let wid = sources.add("bench.world.toml", world);
-    let (world, diags) = stages.time("world", || aviary_world::parse_world(wid, sources.text(wid)));
+    let (world, diags) = stages.time("world", || aviary_world::parse_world_joined(wid, sources.text(wid), &crate::cores::join));
     let Some(world) = world else { return Err(render(&sources, &diags)) };
     let root = sources.add("bench.mission", mission);
-    let (program, diags) = stages.time("check", || aviary_check::check(&mut sources, root, Some(&world), &NoFiles, &api));
-    if diags.iter().any(|d| d.is_error()) {
-        return Err(render(&sources, &diags));
-    }
-    let compiled = stages.time("compile", || aviary_ir::compile(&program, &world, &api));
-    let Some(compiled) = compiled else { return Err("the mission has no MISSION".into()) };
-    // The tree and the source texts are not needed to fly.
-    stages.time("free front end", || drop((program, sources)));
+    let front = |stages: &mut Stages| {
+        let (program, diags) = stages.time("check", || aviary_check::check(&mut sources, root, Some(&world), &NoFiles, &api));
+        if diags.iter().any(|d| d.is_error()) {
+            return Err(render(&sources, &diags));
+        }
+        // The source texts are needed only to show errors: they go before the compiled
+        // mission joins the fleet being built (as in `aviary run`).
+        let freeing = Instant::now();
+        drop(sources);
+        crate::alloc::give_back();
+        let texts_freed = freeing.elapsed();
+        let compiled = stages.time("compile", || aviary_ir::compile(&program, &world, &api));
+        let Some(compiled) = compiled else { return Err("the mission has no MISSION".into()) };
+        // The tree is not needed to fly either.
+        let freeing = Instant::now();
+        drop(program);
+        stages.0.push(("free front end", texts_freed + freeing.elapsed(), peak_rss()));
+        Ok(compiled)
+    };
+    let (compiled, fleet, waited) = crate::cores::beside(&world, || front(stages));
+    let compiled = compiled?;
     let runtime = tokio::runtime::Builder::new_current_thread()
         .enable_time()
         .start_paused(true)
         .build()
         .map_err(|e| format!("cannot start the runtime: {e}"))?;
     runtime.block_on(async {
-        let sim = stages.time("sim start", || SimBackend::start(&world, SimOptions::default()));
+        let start = Instant::now();
+        let sim = SimBackend::start_with(fleet, SimOptions::default());
+        stages.0.push(("sim start", waited + start.elapsed(), peak_rss()));
         // The simulator keeps what it needs of the world, as in `aviary run`.
         drop(world);
         let outcome = {

@@ -60,6 +60,33 @@ impl Drones {
         self.out.push(d);
     }
 
+    /// Adds the drones of `tail`, read from the lines after this one's, as if this had
+    /// read them itself: groups, sensors and other entries with the drones' indices.
+    pub fn append(&mut self, tail: Drones) {
+        let offset = self.out.len();
+        let Drones { out, groups, group_spans, group_index, keys, sensors, others } = tail;
+        for (group, span) in groups.into_iter().zip(group_spans) {
+            let members = group.members.into_iter().map(|m| m + offset);
+            match self.group_index.get(group.name.as_str()) {
+                Some((g, _)) => self.groups[*g].members.extend(members),
+                None => {
+                    let Some((_, shared)) = group_index.get(group.name.as_str()) else { continue };
+                    self.group_index.insert(group.name.clone(), (self.groups.len(), shared.clone()));
+                    self.groups.push(Group { name: group.name, members: members.collect() });
+                    self.group_spans.push(span);
+                }
+            }
+        }
+        for key in keys {
+            if !self.keys.contains(&key) {
+                self.keys.insert(key);
+            }
+        }
+        self.sensors.extend(sensors.into_iter().map(|(d, i, span)| (d + offset, i, span)));
+        self.others.extend(others.into_iter().map(|(before, name)| (before + offset, name)));
+        self.out.extend(out);
+    }
+
     /// Checks every drone's sensors against `[sensors]`.
     pub fn finish(&self, cx: &mut Ctx, sensor_kinds: &[String]) {
         for &(d, i, span) in &self.sensors {

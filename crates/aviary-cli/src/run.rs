@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use aviary_api::Backend;
 use aviary_diagnostics::{render_text, SourceMap};
 use aviary_engine::{Control, Controller, RunOptions, Status};
-use aviary_sim::{SimBackend, SimOptions};
+use aviary_sim::{Fleet, SimBackend, SimOptions};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::files::{color_wanted, world_beside, DiskProvider};
@@ -69,33 +69,24 @@ pub fn run(args: &RunArgs) -> u8 {
     let mut sources = SourceMap::new();
     let name = args.file.display().to_string();
     let world_name = world_path.display().to_string();
-    // The world first (a large one read on two threads): with it, the simulator's fleet
-    // is built on a second thread while the mission is checked and compiled (as `aviary
-    // bench w` does). The same checks and diagnostics as `check_sources`.
+    // The world first (a large one read on two threads, as `aviary bench w` does), then
+    // the mission: the same checks and diagnostics as `check_sources`.
     let read = aviary_check::read_world_joined(&mut sources, Some((&world_name, &world_bytes)), &crate::cores::join);
     let api = aviary_sim::descriptor();
     // The source texts are kept only to show errors: without any, they go before the
-    // compiled mission joins the fleet being built (a large world's text is megabytes).
-    let front = || {
-        let mut sources = sources;
-        let (program, mission_diagnostics) = aviary_check::check_mission(&mut sources, (&name, &bytes), &read, &DiskProvider, &api);
-        if read.diagnostics.iter().chain(&mission_diagnostics).any(|d| d.is_error()) {
-            return (program, mission_diagnostics, None, Some(sources));
-        }
+    // mission is compiled (a large world's text is megabytes).
+    let (program, mission_diagnostics) = aviary_check::check_mission(&mut sources, (&name, &bytes), &read, &DiskProvider, &api);
+    let clean = !read.diagnostics.iter().chain(&mission_diagnostics).any(|d| d.is_error());
+    let (mission, sources) = if clean {
         drop(sources);
         crate::alloc::give_back();
         let mission = match (&read.world, &program) {
             (Some(world), Some(program)) => aviary_ir::compile(program, world, &api),
             _ => None,
         };
-        (program, mission_diagnostics, mission, None)
-    };
-    let ((program, mission_diagnostics, mission, sources), fleet) = match &read.world {
-        Some(world) => {
-            let (done, fleet, _) = crate::cores::beside(world, front);
-            (done, Some(fleet))
-        }
-        None => (front(), None),
+        (mission, None)
+    } else {
+        (None, Some(sources))
     };
     let aviary_check::WorldRead { world, mut diagnostics, .. } = read;
     diagnostics.extend(mission_diagnostics);
@@ -106,7 +97,7 @@ pub fn run(args: &RunArgs) -> u8 {
         eprintln!("aviary: {} has errors, so it was not run", args.file.display());
         return 2;
     }
-    let (Some(_), Some(world), Some(fleet)) = (program, world, fleet) else { return 2 };
+    let (Some(_), Some(world)) = (program, world) else { return 2 };
     let Some(mission) = mission else {
         eprintln!("aviary: {} has no MISSION to run (it holds only capabilities)", args.file.display());
         return 2;
@@ -129,6 +120,9 @@ pub fn run(args: &RunArgs) -> u8 {
         eprintln!("aviary: {} has MAVLink drones, which fly in real time: leave out --speed", world_path.display());
         return 2;
     }
+    // Simulated drones only: the fleet takes the world's drones where they lie. With
+    // MAVLink drones the world is kept to connect them.
+    let (fleet, world) = if live { (Fleet::new(&world), Some(world)) } else { (Fleet::from_world(world), None) };
     let runtime = match if live { crate::mixed::live_runtime() } else { tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build() } {
         Ok(r) => r,
         Err(e) => {
@@ -154,9 +148,9 @@ pub fn run(args: &RunArgs) -> u8 {
     let progress = progress_bar(args.quiet);
     let ran = runtime.block_on(async {
         let sim = SimBackend::start_with(fleet, SimOptions { speed: args.speed, ..SimOptions::default() });
-        let mixed = match live {
-            true => Some(crate::mixed::Mixed::new(sim.clone(), aviary_mavlink::connect(&world, aviary_mavlink::Tuning::default()).await?)),
-            false => None,
+        let mixed = match &world {
+            Some(world) => Some(crate::mixed::Mixed::new(sim.clone(), aviary_mavlink::connect(world, aviary_mavlink::Tuning::default()).await?)),
+            None => None,
         };
         // The backends keep what they need of the world: a large fleet's is not held
         // through the flight.

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use aviary_diagnostics::{render_text, SourceMap};
 use aviary_engine::{Outcome, RunOptions, TraceSink};
-use aviary_sim::{SimBackend, SimOptions};
+use aviary_sim::{Fleet, SimBackend, SimOptions};
 
 use super::NoFiles;
 
@@ -40,9 +40,10 @@ pub struct Ran {
 
 /// Checks, compiles and runs `mission` in `world` on the simulator (at `--speed max`),
 /// feeding every trace event to `sink`. Every stage really runs; a mission with errors
-/// is refused, as `aviary run` refuses it. As in `aviary run`, the simulator's fleet is
-/// built on a second thread while the mission is checked and compiled
-/// ([`crate::cores::beside`]): `sim start` is the wait for it, and the backend's start.
+/// is refused, as `aviary run` refuses it. As in `aviary run`, the world is read on two
+/// threads when it is large ([`crate::cores::join`]), the source texts go once the
+/// mission checks clean, and the simulator's fleet takes the world's drones where they
+/// lie ([`aviary_sim::Fleet::from_world`]).
 /// The texts are handed over (to the source map), not copied: a large world's text is
 /// megabytes.
 pub fn run(mission: String, world: String, sink: &mut dyn TraceSink, stages: &mut Stages) -> Result<Ran, String> {
@@ -52,38 +53,28 @@ pub fn run(mission: String, world: String, sink: &mut dyn TraceSink, stages: &mu
     let (world, diags) = stages.time("world", || aviary_world::parse_world_joined(wid, sources.text(wid), &crate::cores::join));
     let Some(world) = world else { return Err(render(&sources, &diags)) };
     let root = sources.add("bench.mission", mission);
-    let front = |stages: &mut Stages| {
-        let (program, diags) = stages.time("check", || aviary_check::check(&mut sources, root, Some(&world), &NoFiles, &api));
-        if diags.iter().any(|d| d.is_error()) {
-            return Err(render(&sources, &diags));
-        }
-        // The source texts are needed only to show errors: they go before the compiled
-        // mission joins the fleet being built (as in `aviary run`).
-        let freeing = Instant::now();
-        drop(sources);
-        crate::alloc::give_back();
-        let texts_freed = freeing.elapsed();
-        let compiled = stages.time("compile", || aviary_ir::compile(&program, &world, &api));
-        let Some(compiled) = compiled else { return Err("the mission has no MISSION".into()) };
-        // The tree is not needed to fly either.
-        let freeing = Instant::now();
-        drop(program);
-        stages.0.push(("free front end", texts_freed + freeing.elapsed(), peak_rss()));
-        Ok(compiled)
-    };
-    let (compiled, fleet, waited) = crate::cores::beside(&world, || front(stages));
-    let compiled = compiled?;
+    let (program, diags) = stages.time("check", || aviary_check::check(&mut sources, root, Some(&world), &NoFiles, &api));
+    if diags.iter().any(|d| d.is_error()) {
+        return Err(render(&sources, &diags));
+    }
+    // The source texts are needed only to show errors.
+    let freeing = Instant::now();
+    drop(sources);
+    crate::alloc::give_back();
+    let texts_freed = freeing.elapsed();
+    let compiled = stages.time("compile", || aviary_ir::compile(&program, &world, &api));
+    let Some(compiled) = compiled else { return Err("the mission has no MISSION".into()) };
+    // The tree is not needed to fly either.
+    let freeing = Instant::now();
+    drop(program);
+    stages.0.push(("free front end", texts_freed + freeing.elapsed(), peak_rss()));
     let runtime = tokio::runtime::Builder::new_current_thread()
         .enable_time()
         .start_paused(true)
         .build()
         .map_err(|e| format!("cannot start the runtime: {e}"))?;
     runtime.block_on(async {
-        let start = Instant::now();
-        let sim = SimBackend::start_with(fleet, SimOptions::default());
-        stages.0.push(("sim start", waited + start.elapsed(), peak_rss()));
-        // The simulator keeps what it needs of the world, as in `aviary run`.
-        drop(world);
+        let sim = stages.time("sim start", || SimBackend::start_with(Fleet::from_world(world), SimOptions::default()));
         let outcome = {
             let start = Instant::now();
             let outcome = aviary_engine::run(&compiled, &*sim, sink, &RunOptions::default()).await;

@@ -7,6 +7,7 @@ mod link;
 mod rules;
 mod separation;
 mod sky;
+mod start;
 
 use aviary_api::{CallEnd, CallId, DroneEvent, Point, Telemetry, Value};
 use aviary_diagnostics::FileId;

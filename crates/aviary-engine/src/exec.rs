@@ -3,6 +3,7 @@
 
 use std::cell::{Cell, RefCell};
 use std::future::Future;
+use std::task::Poll;
 use std::pin::pin;
 use std::rc::Rc;
 use std::time::Duration;
@@ -38,37 +39,54 @@ impl<'m> Engine<'m> {
         }
         let mut items = pin!(items);
         let jobs = &scope.jobs;
+        // A job taken and not yet polled. The next job waits in the queue until then: a
+        // burst of signals (W's N `Done`s, raised in one poll of its FOR) is started one
+        // job at a time, not made N tasks at once.
+        let unstarted = Cell::new(false);
         // Made at the first job: most scopes never start a handler, and an empty
         // `FuturesUnordered` still allocates.
         let mut running: Option<FuturesUnordered<_>> = None;
         let mut items_done = false;
-        loop {
-            let any_running = running.as_ref().is_some_and(|r| !r.is_empty());
-            tokio::select! {
-                biased;
-                job = std::future::poll_fn(|cx| jobs.poll_recv(cx)) => running.get_or_insert_with(FuturesUnordered::new).push(self.start_job(job, scope.clone())),
-                _ = &mut items, if !items_done => {
-                    items_done = true;
-                    // `SEQUENTIAL ON` handlers that waited for this block start now.
-                    for (target, job) in scope.deferred.take() {
-                        target.jobs.send(job);
-                    }
+        std::future::poll_fn(|cx| loop {
+            // Jobs first, then the items, then the handlers running, as a biased select.
+            let took_jobs = !unstarted.get();
+            if took_jobs {
+                if let Poll::Ready(job) = jobs.poll_recv(cx) {
+                    unstarted.set(true);
+                    running.get_or_insert_with(FuturesUnordered::new).push(self.start_job(job, scope.clone(), &unstarted));
+                    continue;
                 }
-                Some(()) = async { running.as_mut()?.next().await }, if any_running => {}
             }
+            if !items_done && items.as_mut().poll(cx).is_ready() {
+                items_done = true;
+                // `SEQUENTIAL ON` handlers that waited for this block start now.
+                for (target, job) in scope.deferred.take() {
+                    target.jobs.send(job);
+                }
+                continue;
+            }
+            if let Some(r) = running.as_mut().filter(|r| !r.is_empty()) {
+                if let Poll::Ready(Some(())) = r.poll_next_unpin(cx) {
+                    continue;
+                }
+            }
+            // The job taken was polled just now: the queue is looked at again.
+            if !took_jobs && !unstarted.get() {
+                continue;
+            }
+            // Nothing queued (looked at above), nothing running, the items done: over.
             if items_done && running.as_ref().is_none_or(|r| r.is_empty()) {
-                match jobs.try_recv() {
-                    Some(job) => running.get_or_insert_with(FuturesUnordered::new).push(self.start_job(job, scope.clone())),
-                    None => break,
-                }
+                return Poll::Ready(());
             }
-        }
+            return Poll::Pending;
+        })
+        .await;
     }
 
-    /// A job as it waits for its first poll: the job itself, not its future. Every job
-    /// taken is pushed before any is polled (they start in order), so a burst of signals
-    /// (W's N `Done`s) would otherwise hold a handler's whole future for each.
-    async fn start_job(&self, job: Job<'m>, scope: Rc<Scope<'m>>) {
+    /// A job as it waits for its first poll: the job itself, not its future (88 bytes,
+    /// not a handler's whole future). Its first poll clears `unstarted`.
+    async fn start_job(&self, job: Job<'m>, scope: Rc<Scope<'m>>, unstarted: &Cell<bool>) {
+        unstarted.set(false);
         Box::pin(self.job(job, scope)).await;
     }
 

@@ -43,6 +43,28 @@ fn on_fires_once_and_on_every_each_time() {
 }
 
 #[test]
+fn a_burst_of_signals_starts_its_handlers_one_after_another_in_signal_order() {
+    // Twelve signals in one instant; each handler takes off its drone after a wait
+    // (most of them wait: tasks pile up) and the first one's signal wakes a waiting handler.
+    let raise: String = (1..=12).map(|i| format!("        SIGNAL Ping WITH {i}s\n")).collect();
+    let mission = format!(
+        "MISSION M:\n    PARALLEL P:\n{raise}        WAITFOR RECEIVED(Pong)\n    ON EVERY Ping WITH i:\n        STARTIF i = 1s:\n            SIGNAL Pong\n        WAITFOR ELAPSED >= i\n    ON Pong:\n        WAITFOR RECEIVED(Pong)\n"
+    );
+    let r = run(&mission);
+    let starts: Vec<(usize, f64)> = r.trace.iter().enumerate().filter(|(_, e)| e["event"] == "handler_start" && e["signal"] == "Ping").map(|(at, e)| (at, e["t"].as_f64().unwrap())).collect();
+    let signals: Vec<usize> = r.trace.iter().enumerate().filter(|(_, e)| e["event"] == "signal" && e["name"] == "Ping").map(|(at, _)| at).collect();
+    assert_eq!(starts.len(), 12);
+    assert!(starts.iter().all(|(_, t)| *t == 0.0), "all in the instant of their signals");
+    assert!(signals.iter().max() < starts.iter().map(|(at, _)| at).min(), "raised in one poll of the block, then started");
+    let ends: Vec<f64> = r.trace.iter().filter(|e| e["event"] == "handler_end" && e["signal"] == "Ping").map(|e| e["t"].as_f64().unwrap()).collect();
+    assert_eq!(ends.len(), 12);
+    assert!(ends.windows(2).all(|w| w[0] <= w[1]), "in signal order: {ends:?}");
+    assert!(close(ends[11], 12.0), "each waits its own time, concurrently: {ends:?}");
+    assert_eq!(r.find("handler_start", "signal", "Pong").len(), 1);
+    assert_eq!(r.dump(), run(&mission).dump(), "the same interleaving every time");
+}
+
+#[test]
 fn sequential_on_waits_for_the_signalling_block_and_parallel_on_does_not() {
     let r = run(
         "MISSION M:\n    PARALLEL P:\n        SEQUENTIAL Signaller:\n            SIGNAL Go\n            a Hover WITH 4s\n        SEQUENTIAL ON Go:\n            b Hover WITH 1s\n        PARALLEL ON Go:\n            c Hover WITH 1s\n",

@@ -84,7 +84,7 @@ pub(crate) struct Rare {
     pub disabled: Option<String>,
 }
 
-/// Every drone's state; its name is the fleet's ([`crate::fleet::Names`]).
+/// Every drone's state; its name is the fleet's ([`aviary_api::Names`]).
 #[derive(Clone, Debug)]
 pub(crate) struct SimDrone {
     pub home: [f64; 2],

@@ -17,7 +17,7 @@ use crate::drone::{SimDrone, Spec};
 use crate::geom::heading;
 use crate::grid::Grid;
 use crate::hot::Hot;
-use crate::names::Names;
+use aviary_api::Names;
 use crate::nearby::Nearby;
 use crate::sensors::scan;
 

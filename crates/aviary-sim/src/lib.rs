@@ -138,7 +138,6 @@ mod geom;
 mod grid;
 mod hot;
 mod motion;
-mod names;
 mod nearby;
 mod profile;
 mod sensors;

@@ -61,25 +61,6 @@ fn in_environment(name: &std::ffi::CStr) -> bool {
 const ARENA_EAGER_COMMIT: mi::mi_option_t = 4;
 const PURGE_DELAY: mi::mi_option_t = 15;
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_options_set_are_the_ones_meant() {
-        tune();
-        // SAFETY: getters of mimalloc's option table.
-        let (purge, eager, errors) = unsafe { (mi::mi_option_get(PURGE_DELAY), mi::mi_option_get(ARENA_EAGER_COMMIT), mi::mi_option_get(mi::mi_option_show_errors)) };
-        if std::env::var_os("MIMALLOC_PURGE_DELAY").is_none() {
-            assert_eq!(purge, 10);
-        }
-        if std::env::var_os("MIMALLOC_ARENA_EAGER_COMMIT").is_none() {
-            assert_eq!(eager, 0);
-        }
-        assert_eq!(errors, 0, "an option near them is untouched");
-    }
-}
-
 // SAFETY: every block comes from mimalloc with at least the layout's alignment (16
 // bytes by default, else asked for) and goes back to it through `mi_free`, which takes
 // blocks of either kind.
@@ -110,5 +91,24 @@ unsafe impl GlobalAlloc for MiMalloc {
         } else {
             mi::mi_realloc_aligned(ptr.cast(), new_size, layout.align()).cast()
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_options_set_are_the_ones_meant() {
+        tune();
+        // SAFETY: getters of mimalloc's option table.
+        let (purge, eager, errors) = unsafe { (mi::mi_option_get(PURGE_DELAY), mi::mi_option_get(ARENA_EAGER_COMMIT), mi::mi_option_get(mi::mi_option_show_errors)) };
+        if std::env::var_os("MIMALLOC_PURGE_DELAY").is_none() {
+            assert_eq!(purge, 10);
+        }
+        if std::env::var_os("MIMALLOC_ARENA_EAGER_COMMIT").is_none() {
+            assert_eq!(eager, 0);
+        }
+        assert_eq!(errors, 0, "an option near them is untouched");
     }
 }

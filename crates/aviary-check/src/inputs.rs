@@ -25,7 +25,6 @@ impl Checked {
 }
 
 /// Checks the mission `(name, bytes)` against the world file `(name, bytes)`, if given.
-/// The same as [`read_world`] then [`check_mission`].
 pub fn check_sources(
     sources: &mut SourceMap,
     mission: (&str, &[u8]),
@@ -33,32 +32,19 @@ pub fn check_sources(
     provider: &dyn SourceProvider,
     api: &Descriptor,
 ) -> Checked {
-    let read = read_world(sources, world);
-    let (program, mission_diagnostics) = check_mission(sources, mission, &read, provider, api);
-    let WorldRead { world, mut diagnostics, .. } = read;
-    diagnostics.extend(mission_diagnostics);
-    Checked { program, world, diagnostics }
+    check_sources_joined(sources, mission, world, provider, api, &aviary_world::join_in_turn)
 }
 
-/// The world file, read: the first half of [`check_sources`]. A caller may start on
-/// the world (say, a simulator's fleet) while [`check_mission`] checks the mission.
-pub struct WorldRead {
-    /// `None` when there is no world file, or it has errors.
-    pub world: Option<World>,
-    /// The world file's own problems.
-    pub diagnostics: Vec<Diagnostic>,
-    /// A world file was given but gave no world.
-    pub failed: bool,
-}
-
-/// Reads the world file `(name, bytes)`, if given, into `sources`.
-pub fn read_world(sources: &mut SourceMap, world: Option<(&str, &[u8])>) -> WorldRead {
-    read_world_joined(sources, world, &aviary_world::join_in_turn)
-}
-
-/// As [`read_world`], a large file perhaps in two parts run through `join`
-/// ([`aviary_world::parse_world_joined`]: the same world and diagnostics).
-pub fn read_world_joined(sources: &mut SourceMap, world: Option<(&str, &[u8])>, join: aviary_world::Join) -> WorldRead {
+/// As [`check_sources`], a large world file perhaps read in two parts run through
+/// `join` ([`aviary_world::parse_world_joined`]: the same world and diagnostics).
+pub fn check_sources_joined(
+    sources: &mut SourceMap,
+    mission: (&str, &[u8]),
+    world: Option<(&str, &[u8])>,
+    provider: &dyn SourceProvider,
+    api: &Descriptor,
+    join: aviary_world::Join,
+) -> Checked {
     let mut diagnostics = Vec::new();
     let mut parsed_world = None;
     if let Some((name, bytes)) = world {
@@ -73,33 +59,19 @@ pub fn read_world_joined(sources: &mut SourceMap, world: Option<(&str, &[u8])>, 
             }
         }
     }
-    let failed = world.is_some() && parsed_world.is_none();
-    WorldRead { world: parsed_world, diagnostics, failed }
-}
-
-/// Checks the mission `(name, bytes)` against the world [`read_world`] read: the second
-/// half of [`check_sources`]. Returns the program (`None` when the mission file is not
-/// UTF-8) and the mission's diagnostics, which follow the world's.
-pub fn check_mission(
-    sources: &mut SourceMap,
-    mission: (&str, &[u8]),
-    world: &WorldRead,
-    provider: &dyn SourceProvider,
-    api: &Descriptor,
-) -> (Option<Program>, Vec<Diagnostic>) {
-    let mut diagnostics = Vec::new();
+    let world_failed = world.is_some() && parsed_world.is_none();
     let (text, invalid) = aviary_syntax::decode(mission.1);
     let root = sources.add(mission.0, text);
     let mut program = None;
     if let Some(at) = invalid {
         diagnostics.push(aviary_syntax::invalid_utf8(root, at));
     } else {
-        let (p, d) = crate::check(sources, root, world.world.as_ref(), provider, api);
+        let (p, d) = crate::check(sources, root, parsed_world.as_ref(), provider, api);
         program = Some(p);
         // With a broken world, its own errors say why names went unchecked.
-        diagnostics.extend(d.into_iter().filter(|d| !(world.failed && d.code == Code::NoWorld)));
+        diagnostics.extend(d.into_iter().filter(|d| !(world_failed && d.code == Code::NoWorld)));
     }
-    (program, diagnostics)
+    Checked { program, world: parsed_world, diagnostics }
 }
 
 /// `a/./b/../c` becomes `a/c`, lexically, so that a file reached through two paths is

@@ -24,7 +24,7 @@ use aviary_syntax::ast::{Capability, Mission, SourceFile};
 use aviary_world::World;
 
 pub use env::{bind_args, ArgBinding, BindProblem};
-pub use inputs::{check_mission, check_sources, normalize_path, read_world, read_world_joined, Checked, WorldRead};
+pub use inputs::{check_sources, check_sources_joined, normalize_path, Checked};
 pub use infer::KindOrigin;
 pub use load::{SourceProvider, STD_NAME, STD_SOURCE};
 

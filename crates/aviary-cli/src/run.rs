@@ -69,39 +69,26 @@ pub fn run(args: &RunArgs) -> u8 {
     let mut sources = SourceMap::new();
     let name = args.file.display().to_string();
     let world_name = world_path.display().to_string();
-    // The world first (a large one read on two threads, as `aviary bench w` does), then
-    // the mission: the same checks and diagnostics as `check_sources`.
-    let read = aviary_check::read_world_joined(&mut sources, Some((&world_name, &world_bytes)), &crate::cores::join);
+    // A large world is read on two threads, as `aviary bench w` does.
     let api = aviary_sim::descriptor();
-    // The source texts are kept only to show errors: without any, they go before the
-    // mission is compiled (a large world's text is megabytes).
-    let (program, mission_diagnostics) = aviary_check::check_mission(&mut sources, (&name, &bytes), &read, &DiskProvider, &api);
-    let clean = !read.diagnostics.iter().chain(&mission_diagnostics).any(|d| d.is_error());
-    let (mission, sources) = if clean {
-        drop(sources);
-        crate::alloc::give_back();
-        let mission = match (&read.world, &program) {
-            (Some(world), Some(program)) => aviary_ir::compile(program, world, &api),
-            _ => None,
-        };
-        (mission, None)
-    } else {
-        (None, Some(sources))
-    };
-    let aviary_check::WorldRead { world, mut diagnostics, .. } = read;
-    diagnostics.extend(mission_diagnostics);
-    if let Some(sources) = sources.filter(|_| diagnostics.iter().any(|d| d.is_error())) {
-        for d in diagnostics.iter().filter(|d| d.is_error()) {
+    let checked = aviary_check::check_sources_joined(&mut sources, (&name, &bytes), Some((&world_name, &world_bytes)), &DiskProvider, &api, &crate::cores::join);
+    if checked.has_errors() {
+        for d in checked.diagnostics.iter().filter(|d| d.is_error()) {
             eprint!("{}", render_text(&sources, d, color_wanted()));
         }
         eprintln!("aviary: {} has errors, so it was not run", args.file.display());
         return 2;
     }
-    let (Some(_), Some(world)) = (program, world) else { return 2 };
-    let Some(mission) = mission else {
+    // The source texts are needed only to show errors: they go before the mission is
+    // compiled (a large world's text is megabytes).
+    drop(sources);
+    crate::alloc::give_back();
+    let (Some(program), Some(world)) = (checked.program, checked.world) else { return 2 };
+    let Some(mission) = aviary_ir::compile(&program, &world, &api) else {
         eprintln!("aviary: {} has no MISSION to run (it holds only capabilities)", args.file.display());
         return 2;
     };
+    drop(program);
     let out: Box<dyn Write + Send> = match &args.trace {
         Some(path) => match std::fs::File::create(path) {
             Ok(f) => Box::new(f),

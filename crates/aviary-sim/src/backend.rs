@@ -81,9 +81,9 @@ impl SimBackend {
         SimBackend::start_with(Fleet::new(world), options)
     }
 
-    /// As [`SimBackend::start`], with the fleet already built by [`Fleet::new`] (which is
-    /// pure: the caller may build it on another thread while it does other work). The
-    /// same fleet gives the same run.
+    /// As [`SimBackend::start`], with the fleet already built: by [`Fleet::new`], or by
+    /// [`Fleet::from_world`] from a world the caller gives up. The same fleet gives the
+    /// same run.
     ///
     /// # Panics
     /// Outside a tokio runtime, or when `options.tick` is not a positive number.

@@ -133,14 +133,11 @@ impl Arbiter {
 /// `claims` now, when nobody waits and all of it is free (as `grant` would give them);
 /// else they are given back.
 pub(crate) fn try_acquire(arbiter: &Rc<RefCell<Arbiter>>, claims: Needs) -> Result<Held, Needs> {
-    let mut a = arbiter.borrow_mut();
-    if a.waiting.is_empty() && claims.iter().all(|c| !a.held.contains(c)) {
-        a.next += 1;
-        let id = a.next;
-        a.held.extend(claims.iter().copied());
-        return Ok(Held { arbiter: arbiter.clone(), id, own: claims });
+    if free(arbiter, &claims) {
+        Ok(take(arbiter, claims))
+    } else {
+        Err(claims)
     }
-    Err(claims)
 }
 
 /// Takes `claims` that [`free`] found free, with nothing asked of the arbiter since.

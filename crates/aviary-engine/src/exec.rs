@@ -179,12 +179,7 @@ impl<'m> Engine<'m> {
                     self.signal(*signal, args, ctx);
                 }
             }
-            Node::Call(c) if self.instant[c.capability] => {
-                let rest = if self.stopped() { None } else { self.instant_call(c, ctx) };
-                if let Some(rest) = rest {
-                    rest.await;
-                }
-            }
+            Node::Call(c) if self.instant[c.capability] => self.instant_statement(c, ctx).await,
             // A wait that is over before it starts (`wait_until` looks first): no box.
             Node::WaitFor { condition, body: None } if self.stopped() || self.truth(condition, ctx) => {}
             _ => self.node(node, ctx).await,
@@ -196,12 +191,7 @@ impl<'m> Engine<'m> {
         // SIGNAL or API call took the room of a capability instance's future.
         match node {
             // Started when first polled, as every node is.
-            Node::Call(c) if self.instant[c.capability] => Box::pin(async move {
-                let rest = if self.stopped() { None } else { self.instant_call(c, ctx) };
-                if let Some(rest) = rest {
-                    rest.await;
-                }
-            }),
+            Node::Call(c) if self.instant[c.capability] => Box::pin(self.instant_statement(c, ctx)),
             Node::Call(c) => Box::pin(async move {
                 if !self.stopped() {
                     self.call(c, ctx).await;

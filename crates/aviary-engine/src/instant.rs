@@ -57,6 +57,15 @@ enum Stopped<'m> {
 type LocalFrame = SmallVec<[Value; 4]>;
 
 impl<'m> Engine<'m> {
+    /// A statement calling a capability that may be instant, unless the mission has
+    /// stopped: what `instant_call` leaves, awaited.
+    pub(crate) async fn instant_statement(&self, call: &'m Call, ctx: &Ctx<'m>) {
+        let rest = if self.stopped() { None } else { self.instant_call(call, ctx) };
+        if let Some(rest) = rest {
+            rest.await;
+        }
+    }
+
     /// A statement calling a capability that may be instant: runs what it can at once,
     /// and gives the rest, if any, to be awaited. Not `async`: a future holding what this
     /// makes along the way would hold it as long as the activity waits, in every block

@@ -118,7 +118,7 @@ pub fn run(args: &RunArgs) -> u8 {
         }
     };
     let (controller, controls) = Controller::new();
-    on_ctrl_c(controller.clone(), trace.clone());
+    on_stop_signals(controller.clone(), trace.clone());
     let server = match args.serve.map(|addr| aviary_server::start(addr, controller.clone())).transpose() {
         Ok(s) => s,
         Err(why) => {
@@ -192,21 +192,41 @@ pub fn run(args: &RunArgs) -> u8 {
     u8::from(outcome.status != Status::Ok)
 }
 
-/// The first Ctrl-C ends the mission gracefully (the fleet returns home); a second one
-/// stops at once, closing the trace with `mission_end`.
-fn on_ctrl_c(controller: Controller, trace: SharedTrace) {
-    let presses = AtomicUsize::new(0);
-    let installed = ctrlc::set_handler(move || {
-        if presses.fetch_add(1, Ordering::SeqCst) == 0 {
-            eprintln!("\naviary: stopping; the fleet returns home (press Ctrl-C again to stop at once)");
-            controller.send(Control::Abort { reason: "interrupted by Ctrl-C".into() });
-        } else {
-            lock(&trace).close_now("stopped at once by a second Ctrl-C");
-            std::process::exit(130);
+/// The first Ctrl-C, SIGTERM or SIGHUP ends the mission gracefully: the fleet returns
+/// home and the trace is closed with `mission_end`. SIGTERM and SIGHUP count as a first
+/// Ctrl-C because they are how a session ends without a keyboard (a closed laptop lid,
+/// a logout, a service manager): with MAVLink drones, stopping at once would leave them
+/// without a ground station. A second signal of any of the three stops at once, still
+/// closing the trace.
+fn on_stop_signals(controller: Controller, trace: SharedTrace) {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let mut signals = match signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("aviary: Ctrl-C, SIGTERM and SIGHUP will stop at once: {e}");
+            return;
+        }
+    };
+    let spawned = std::thread::Builder::new().name("stop-signals".into()).spawn(move || {
+        let mut presses = 0usize;
+        for signal in signals.forever() {
+            let by = match signal {
+                SIGTERM => "SIGTERM",
+                SIGHUP => "SIGHUP",
+                _ => "Ctrl-C",
+            };
+            presses += 1;
+            if presses == 1 {
+                eprintln!("\naviary: stopping ({by}); the fleet returns home (press Ctrl-C again to stop at once)");
+                controller.send(Control::Abort { reason: format!("interrupted by {by}") });
+            } else {
+                lock(&trace).close_now(&format!("stopped at once by a second {by}"));
+                std::process::exit(130);
+            }
         }
     });
-    if let Err(e) = installed {
-        eprintln!("aviary: Ctrl-C will stop at once: {e}");
+    if let Err(e) = spawned {
+        eprintln!("aviary: Ctrl-C, SIGTERM and SIGHUP will stop at once: {e}");
     }
 }
 

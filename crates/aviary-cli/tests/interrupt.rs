@@ -27,7 +27,11 @@ fn lines(path: &std::path::Path) -> Vec<String> {
 }
 
 fn interrupt(child: &Child) {
-    let status = Command::new("kill").args(["-INT", &child.id().to_string()]).status().expect("kill -INT");
+    send(child, "INT");
+}
+
+fn send(child: &Child, signal: &str) {
+    let status = Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().expect("kill");
     assert!(status.success());
 }
 
@@ -67,20 +71,43 @@ fn a_killed_run_keeps_every_event_before_the_cut() {
     }
 }
 
-#[test]
-fn ctrl_c_ends_the_mission_with_the_fleet_home() {
-    let dir = scratch("ctrl_c");
+/// One signal, as a first Ctrl-C: the mission is aborted with `reason`, every drone in
+/// the air is brought home, and the trace ends with `mission_end` after those returns.
+fn ends_gracefully_on(signal: &str, reason: &str) {
+    let dir = scratch(&format!("graceful_{signal}"));
     let trace = dir.join("t.jsonl");
     let mut child = spawn(&trace, "20");
     std::thread::sleep(Duration::from_millis(1500));
-    interrupt(&child);
+    send(&child, signal);
     let status = child.wait().expect("wait");
     assert_eq!(status.code(), Some(1), "an aborted mission exits 1");
     let events: Vec<serde_json::Value> = lines(&trace).iter().map(|l| serde_json::from_str(l).unwrap()).collect();
     let end = events.last().unwrap();
-    assert_eq!((end["event"].as_str(), end["status"].as_str(), end["reason"].as_str()), (Some("mission_end"), Some("aborted"), Some("interrupted by Ctrl-C")));
+    assert_eq!((end["event"].as_str(), end["status"].as_str(), end["reason"].as_str()), (Some("mission_end"), Some("aborted"), Some(reason)));
+    assert_eq!(events.iter().filter(|e| e["event"] == "mission_end").count(), 1);
     let home: Vec<&str> = events.iter().filter(|e| e["event"] == "api_done" && e["function"] == "ReturnToLaunch" && e["status"] == "ok").map(|e| e["actor"].as_str().unwrap()).collect();
     assert!(home.contains(&"video_drone1"), "the drones in the air were brought home: {home:?}");
+    // Ordering: the running activities are aborted first, then the drones are sent home,
+    // and the trace ends only once every return has ended.
+    let aborted = events.iter().position(|e| e["event"] == "api_done" && e["status"] == "aborted").expect("activities were aborted");
+    let first_home = events.iter().position(|e| e["event"] == "api_call" && e["function"] == "ReturnToLaunch").expect("a return");
+    let last_home = events.iter().rposition(|e| e["event"] == "api_done" && e["function"] == "ReturnToLaunch").expect("a return ended");
+    assert!(aborted < first_home && last_home < events.len() - 1, "abort, then returns, then mission_end");
+}
+
+#[test]
+fn ctrl_c_ends_the_mission_with_the_fleet_home() {
+    ends_gracefully_on("INT", "interrupted by Ctrl-C");
+}
+
+#[test]
+fn sigterm_ends_the_mission_like_a_first_ctrl_c() {
+    ends_gracefully_on("TERM", "interrupted by SIGTERM");
+}
+
+#[test]
+fn sighup_ends_the_mission_like_a_first_ctrl_c() {
+    ends_gracefully_on("HUP", "interrupted by SIGHUP");
 }
 
 #[test]

@@ -36,6 +36,13 @@ pub fn centroid(polygon: &[[f64; 2]]) -> [f64; 2] {
 /// Points this close to a polygon's edge count as inside it (metres).
 pub const ON_EDGE: f64 = 1e-6;
 
+/// The speed of an orbit of `radius`: at most `max_speed`, and a centripetal
+/// acceleration of at most half the drone's `accel`. The simulator flies it, the plan
+/// counts with it and the MAVLink backend asks a vehicle for it.
+pub fn orbit_speed(max_speed: f64, accel: f64, radius: f64) -> f64 {
+    max_speed.min((accel * radius / 2.0).sqrt())
+}
+
 pub fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     hypot(b[0] - a[0], b[1] - a[1])
 }

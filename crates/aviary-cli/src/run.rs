@@ -3,7 +3,6 @@
 
 use std::io::Write;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use aviary_api::Backend;
 use aviary_diagnostics::{render_text, SourceMap};
@@ -297,7 +296,15 @@ fn summary(mission: &aviary_ir::Mission, backend: &dyn Backend, odometry: &dyn F
             Some((m, s)) => (format!("{m:.0}"), format!("{s:.0}")),
             None => ("-".to_owned(), "-".to_owned()),
         };
-        out.push_str(&format!("{name:<16} {distance:>12} {airborne:>12} {:>8.0}%  {}\n", t.battery * 100.0, t.state.as_str()));
+        // A drone without a link is not shown as what it last said (often `Flying`):
+        // what it does now is unknown, so the summary says so and where it was last seen.
+        let state = if t.link {
+            t.state.as_str().to_owned()
+        } else {
+            let p = t.position;
+            format!("no link: last seen {} at ({:.0}, {:.0}, {:.0})", t.state.as_str(), p[0], p[1], p[2])
+        };
+        out.push_str(&format!("{name:<16} {distance:>12} {airborne:>12} {:>8.0}%  {state}\n", t.battery * 100.0));
     }
     let signals: Vec<String> = stats.signals.iter().map(|(n, c)| if *c == 1 { n.clone() } else { format!("{n} ×{c}") }).collect();
     out.push_str(&format!("signals: {}\n", if signals.is_empty() { "none".to_string() } else { signals.join(", ") }));

@@ -1,141 +1,354 @@
-//! The paper's kind of flight on ArduCopter SITL: one vehicle, then two (`-I N`,
-//! `--sysid`), each a SITL process of its own, flown by `aviary run` over TCP.
+//! Aviary against a real autopilot: ArduCopter SITL (`../shared/sitl/arducopter`), each
+//! vehicle a process of its own, flown by `aviary run` over MAVLink on TCP.
 //!
-//! Ignored by default, with the reason in the test list; run them with
-//! `AVIARY_SITL=.../arducopter AVIARY_SITL_DEFAULTS=.../copter.parm cargo test -p
-//! aviary-cli --test sitl -- --ignored` (the parameter file is
-//! `Tools/autotest/default_params/copter.parm` of the ArduPilot tree). Run that way
-//! without the variables, they fail and say what is missing. See docs/REAL_DRONES.md. NOTE: written for SITL but not yet run
-//! against it (no SITL could be built where this was written); treat a failure as a bug
-//! report, not a regression.
+//! - `fleet::`: the paper's mission on seven SITL copters, and on two SITL copters with
+//!   five simulated drones. These are the long ones (10 minutes of real flight); their
+//!   module sorts first so that the test harness starts them first and side by side.
+//! - `single::`: one copter: a flight with an orbit whose trace agrees with what SITL
+//!   reports to a second ground station; each autopilot failsafe (battery, geofence, GPS,
+//!   link) reaching the mission as the language's exception; a refused command; a vehicle
+//!   that is not where the world says.
+//!
+//! SITL runs at real time (`--speedup 1`): the mission clock is the wall clock, which a
+//! faster SITL would leave behind (docs/REAL_DRONES.md).
 
 mod common;
 
-use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command};
 use std::time::{Duration, Instant};
 
-use aviary_mavlink::Origin;
-use common::scratch;
+use common::sitl::{wait_until, Sitl};
+use common::{aviary, repo, scratch};
+use serde_json::Value;
 
-const ORIGIN: Origin = Origin {
-    lat: 46.6167,
-    lon: 14.2650,
-    alt: 440.0,
-};
+/// Battery parameters for a copter that can fly the paper's mission: SITL's default
+/// (3300 mAh, some 6.5 minutes) is not enough for the longest drone's ~10 minutes.
+const BIG_BATTERY: &[(&str, f64)] = &[("BATT_CAPACITY", 16500.0), ("SIM_BATT_CAP_AH", 16.5)];
 
-struct Sitl(Child);
+/// `aviary run` started in `dir`, killed if the test ends first.
+struct Run(Child);
 
-impl Drop for Sitl {
+impl Drop for Run {
     fn drop(&mut self) {
         let _ = self.0.kill();
         let _ = self.0.wait();
     }
 }
 
-fn sitl() -> (PathBuf, PathBuf) {
-    match (
-        std::env::var_os("AVIARY_SITL"),
-        std::env::var_os("AVIARY_SITL_DEFAULTS"),
-    ) {
-        (Some(bin), Some(defaults)) => (bin.into(), defaults.into()),
-        _ => panic!(
-            "set AVIARY_SITL to the arducopter SITL binary and AVIARY_SITL_DEFAULTS to copter.parm"
-        ),
-    }
-}
-
-/// Flies `drones` SITL copters (homes 10 m apart, east of the origin): take off to 10 m,
-/// fly 20 m north, return home.
-fn fly(drones: usize) {
-    let (bin, defaults) = sitl();
-    let dir = scratch(&format!("sitl_{drones}"));
-    let mut world = format!(
-        "[site]\nname = \"SITL\"\norigin = {{ lat = {}, lon = {}, alt = {} }}\nmax_altitude = 50\n\n[places]\n",
-        ORIGIN.lat, ORIGIN.lon, ORIGIN.alt
-    );
-    let mut mission = String::from("MISSION Sitl:\n    PARALLEL All:\n");
-    let mut vehicles = Vec::new();
-    for i in 0..drones {
-        let home = [10.0 * i as f64, 0.0];
-        let (lat, lon) = ORIGIN.to_geodetic(home[0], home[1]);
-        // Instances from 40 up: ports 6160, 6170, ... away from a SITL someone else runs.
-        let instance = 40 + i;
-        let run = dir.join(format!("i{instance}"));
-        std::fs::create_dir_all(&run).expect("dir");
-        let child = Command::new(&bin)
-            .args([
-                "--model",
-                "quad",
-                "--home",
-                &format!("{lat},{lon},{},0", ORIGIN.alt),
-                "-I",
-                &instance.to_string(),
-            ])
-            .args([
-                "--sysid",
-                &(i + 1).to_string(),
-                "--defaults",
-                &defaults.to_string_lossy(),
-            ])
-            .current_dir(&run)
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("start SITL");
-        vehicles.push(Sitl(child));
-        world.push_str(&format!("North{i} = [{}, 20]\n", home[0]));
-        mission.push_str(&format!(
-            "        SEQUENTIAL Fly{i}:\n            d{i} TakeOff WITH 10m\n            d{i} FlyTo WITH North{i}\n            d{i} ReturnHome\n"
-        ));
-    }
-    for i in 0..drones {
-        world.push_str(&format!(
-            "\n[drones.d{i}]\nhome = [{}, 0]\nmavlink = \"tcp:127.0.0.1:{}\"\nsystem_id = {}\n",
-            10 * i,
-            5760 + 10 * (40 + i),
-            i + 1
-        ));
-    }
-    std::fs::write(dir.join("m.world.toml"), world).expect("world");
-    std::fs::write(dir.join("m.mission"), mission).expect("mission");
-    std::thread::sleep(Duration::from_secs(3)); // SITL opens its port
-    let mut run = Command::new(env!("CARGO_BIN_EXE_aviary"))
-        .args(["run", "m.mission", "--trace", "t.jsonl"])
-        .current_dir(&dir)
-        .stdout(Stdio::inherit())
-        .stderr(Stdio::inherit())
+fn start_run(dir: &Path, mission: &str) -> Run {
+    let child = Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(["run", mission, "--trace", "t.jsonl", "--telemetry-hz", "2"])
+        .current_dir(dir)
+        .env("NO_COLOR", "1")
+        .stdout(std::fs::File::create(dir.join("stdout.txt")).expect("stdout"))
+        .stderr(std::fs::File::create(dir.join("stderr.txt")).expect("stderr"))
         .spawn()
         .expect("aviary run");
+    Run(child)
+}
+
+/// Waits for the run to end: its exit code and the output it printed.
+fn finish(run: &mut Run, dir: &Path, limit: Duration) -> (i32, String) {
     let start = Instant::now();
     let status = loop {
-        if let Some(s) = run.try_wait().expect("wait") {
+        if let Some(s) = run.0.try_wait().expect("wait") {
             break s;
         }
-        // Pre-arm checks take about 40 s; the flight about a minute.
-        assert!(
-            start.elapsed() < Duration::from_secs(400),
-            "aviary run on SITL took more than 400 s"
-        );
-        std::thread::sleep(Duration::from_millis(200));
+        assert!(start.elapsed() < limit, "aviary run took more than {} s; see {}", limit.as_secs(), dir.display());
+        std::thread::sleep(Duration::from_millis(250));
     };
-    assert_eq!(
-        status.code(),
-        Some(0),
-        "see {}",
-        dir.join("t.jsonl").display()
-    );
-    drop(vehicles);
+    let out = std::fs::read_to_string(dir.join("stdout.txt")).unwrap_or_default() + &std::fs::read_to_string(dir.join("stderr.txt")).unwrap_or_default();
+    (status.code().unwrap_or(-1), out)
 }
 
-#[test]
-#[ignore = "needs ArduCopter SITL: set AVIARY_SITL and AVIARY_SITL_DEFAULTS, run with --ignored"]
-fn one_sitl_copter_flies_a_mission() {
-    fly(1);
+fn events(path: &Path) -> Vec<Value> {
+    std::fs::read_to_string(path).unwrap_or_default().lines().map(|l| serde_json::from_str(l).expect("a whole JSON event")).collect()
 }
 
-#[test]
-#[ignore = "needs ArduCopter SITL: set AVIARY_SITL and AVIARY_SITL_DEFAULTS, run with --ignored"]
-fn two_sitl_copters_fly_a_mission() {
-    fly(2);
+fn named<'a>(events: &'a [Value], event: &str) -> impl Iterator<Item = &'a Value> {
+    let event = event.to_owned();
+    events.iter().filter(move |e| e["event"] == event.as_str())
 }
+
+fn pos(v: &Value) -> [f64; 3] {
+    let a = v.as_array().expect("a position");
+    let n = |i: usize| a.get(i).and_then(Value::as_f64).unwrap_or(0.0);
+    [n(0), n(1), n(2)]
+}
+
+fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// A world of one SITL copter `d` at home (0, 0): `extra` adds places or a fence.
+fn one_copter_world(sitl: &Sitl, extra: &str) -> String {
+    format!(
+        "[site]\nname = \"SITL\"\norigin = {{ lat = {}, lon = {}, alt = {} }}\nmax_altitude = 60\n{extra}\n[drones.d]\nhome = [0, 0]\nmavlink = \"{}\"\nsystem_id = {}\n",
+        common::sitl::ORIGIN.lat,
+        common::sitl::ORIGIN.lon,
+        common::sitl::ORIGIN.alt,
+        sitl.address(),
+        sitl.system
+    )
+}
+
+/// The example world with `mavlink` and `system_id` for the drones `sitls` names.
+fn example_world(sitls: &[(&str, &Sitl)]) -> String {
+    let text = std::fs::read_to_string(repo().join("examples/search_and_rescue.world.toml")).expect("example world");
+    let mut out = String::new();
+    for line in text.lines() {
+        out.push_str(line);
+        out.push('\n');
+        if let Some(name) = line.strip_prefix("[drones.").and_then(|l| l.strip_suffix(']')) {
+            if let Some((_, s)) = sitls.iter().find(|(n, _)| *n == name) {
+                out.push_str(&format!("mavlink = \"{}\"\nsystem_id = {}\n", s.address(), s.system));
+            }
+        }
+    }
+    out
+}
+
+fn home_of(name: &str) -> [f64; 2] {
+    match name {
+        "video_drone1" => [0.0, 0.0],
+        "video_drone2" => [5.0, 0.0],
+        "flir_drone1" => [0.0, 5.0],
+        "flir_drone2" => [5.0, 5.0],
+        "sensor_drone" => [10.0, 0.0],
+        "beacon_drone1" => [-10.0, -10.0],
+        "beacon_drone2" => [10.0, -10.0],
+        other => panic!("no drone {other} in the example"),
+    }
+}
+
+/// The signals (with their counts) and finds of a trace, which must not depend on
+/// whether the drones are real or simulated.
+fn outcome(events: &[Value]) -> (Vec<String>, Vec<(String, i64, i64)>) {
+    let mut signals: Vec<String> = named(events, "signal").map(|e| e["name"].as_str().unwrap_or("").to_owned()).collect();
+    signals.sort();
+    let mut finds: Vec<(String, i64, i64)> = named(events, "detection")
+        .map(|e| {
+            let p = pos(&e["location"]);
+            (e["kind"].as_str().unwrap_or("").to_owned(), p[0].round() as i64, p[1].round() as i64)
+        })
+        .collect();
+    finds.sort();
+    (signals, finds)
+}
+
+/// The paper's mission with the drones in `real` on SITL and the rest simulated: it ends
+/// ok with the signals and finds of the simulated run, and every beacon is dropped within
+/// 5 m of its target.
+fn paper_mission(tag: &str, first_instance: u16, real: &[&str]) {
+    let dir = scratch(tag);
+    let sitls: Vec<(&str, Sitl)> = real
+        .iter()
+        .enumerate()
+        .map(|(i, name)| (*name, Sitl::start(&dir, first_instance, i as u8 + 1, home_of(name), BIG_BATTERY)))
+        .collect();
+    let refs: Vec<(&str, &Sitl)> = sitls.iter().map(|(n, s)| (*n, s)).collect();
+    std::fs::copy(repo().join("examples/search_and_rescue.mission"), dir.join("m.mission")).expect("mission");
+    std::fs::write(dir.join("m.world.toml"), example_world(&refs)).expect("world");
+
+    let (code, _, err) = aviary(&["run", "examples/search_and_rescue.mission", "--quiet", "--trace", &dir.join("sim.jsonl").to_string_lossy()], &repo());
+    assert_eq!(code, 0, "the simulated run: {err}");
+    let simulated = events(&dir.join("sim.jsonl"));
+
+    let mut run = start_run(&dir, "m.mission");
+    let (code, out) = finish(&mut run, &dir, Duration::from_secs(1500));
+    assert_eq!(code, 0, "the mission on SITL ended badly:\n{out}\nsee {}", dir.display());
+    let flown = events(&dir.join("t.jsonl"));
+    assert_eq!(outcome(&flown), outcome(&simulated), "the same signals and finds as the simulated run");
+    let finds: Vec<[f64; 3]> = named(&flown, "detection").map(|e| pos(&e["location"])).collect();
+    let drops: Vec<&Value> = named(&flown, "api_done").filter(|e| e["function"] == "ReleasePayload").collect();
+    assert_eq!(drops.len(), finds.len(), "a beacon for every find");
+    for drop in drops {
+        let at = pos(&drop["position"]);
+        let near = finds.iter().map(|f| dist2(*f, at)).fold(f64::INFINITY, f64::min);
+        assert!(near <= 5.0, "{} dropped its beacon {near:.1} m from the nearest find", drop["actor"]);
+    }
+    let end = flown.last().expect("events");
+    assert_eq!((end["event"].as_str(), end["status"].as_str()), (Some("mission_end"), Some("ok")));
+}
+
+mod fleet {
+    #[test]
+    fn paper_mission_on_seven_sitl_copters() {
+        super::paper_mission(
+            "sitl_paper",
+            0,
+            &["video_drone1", "video_drone2", "flir_drone1", "flir_drone2", "sensor_drone", "beacon_drone1", "beacon_drone2"],
+        );
+    }
+
+    #[test]
+    fn paper_mission_on_two_sitl_copters_and_five_simulated() {
+        super::paper_mission("sitl_mixed", 10, &["flir_drone2", "beacon_drone2"]);
+    }
+}
+
+mod single {
+    use super::*;
+
+    /// One copter, and the test's own ground station on the vehicle's second port.
+    fn one(tag: &str, params: &[(&str, f64)], world_extra: &str, mission: &str) -> (PathBuf, Sitl, Run) {
+        let dir = scratch(tag);
+        let sitl = Sitl::start(&dir, 20, 1, [0.0, 0.0], params);
+        std::fs::write(dir.join("m.world.toml"), one_copter_world(&sitl, world_extra)).expect("world");
+        std::fs::write(dir.join("m.mission"), mission).expect("mission");
+        let run = start_run(&dir, "m.mission");
+        (dir, sitl, run)
+    }
+
+    fn exception<'a>(events: &'a [Value], name: &str) -> Option<&'a Value> {
+        named(events, "exception").find(|e| e["name"] == name)
+    }
+
+    /// Waits until the trace shows the drone in the air (after GPS lock and take-off).
+    fn airborne(dir: &Path) {
+        wait_until(Duration::from_secs(150), "the take-off", || {
+            events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_done" && e["function"] == "TakeOff")
+        });
+    }
+
+    #[test]
+    fn takes_off_flies_orbits_and_lands_where_sitl_says() {
+        let mission = "MISSION Sitl:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d FlyTo WITH North\n        d FlyCircle WITH North, 20m, 1\n        d Land\n";
+        let (dir, sitl, mut run) = one("sitl_one", &[], "[places]\nNorth = [0, 40]\n", mission);
+        let gcs = sitl.gcs(Duration::from_secs(30));
+        let (code, out) = finish(&mut run, &dir, Duration::from_secs(400));
+        assert_eq!(code, 0, "{out}");
+        let flown = events(&dir.join("t.jsonl"));
+        // Every position the trace gives lies on the track SITL reported to the ground
+        // station (10 Hz, so within a metre or two of some point of it).
+        let track = gcs.seen.lock().unwrap().track.clone();
+        assert!(track.len() > 100, "the ground station saw the flight");
+        let points: Vec<[f64; 3]> = named(&flown, "telemetry").map(|e| pos(&e["position"])).collect();
+        assert!(points.len() > 50, "telemetry in the trace");
+        for p in &points {
+            let near = track.iter().map(|(_, q)| dist2(*p, *q).hypot(p[2] - q[2])).fold(f64::INFINITY, f64::min);
+            assert!(near < 2.5, "trace position {p:?} is {near:.1} m from anything SITL reported");
+        }
+        // The orbit went round: points in all four quadrants about North at ~20 m.
+        let circle: Vec<[f64; 3]> = track.iter().map(|t| t.1).filter(|q| (dist2(*q, [0.0, 40.0, 0.0]) - 20.0).abs() < 3.0).collect();
+        for (sx, sy) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+            assert!(circle.iter().any(|q| q[0] * sx > 5.0 && (q[1] - 40.0) * sy > 5.0), "the orbit passed the ({sx}, {sy}) quadrant");
+        }
+        // It landed where the trace says, and SITL agrees.
+        let end = named(&flown, "api_done").filter(|e| e["function"] == "Land").last().expect("Land ended");
+        let landed = gcs.last().expect("a last position");
+        assert!(dist2(pos(&end["position"]), landed) < 1.0 && landed[2].abs() < 0.5, "landed at {landed:?}");
+        // Orbit legs are flown through: the lap (126 m) takes nowhere near the ~5 s a stop
+        // at each of its 24 points would add.
+        let orbit = named(&flown, "api_call").find(|e| e["function"] == "Orbit").expect("orbit");
+        let done = named(&flown, "api_done").find(|e| e["function"] == "Orbit").expect("orbit end");
+        let took = done["t"].as_f64().unwrap() - orbit["t"].as_f64().unwrap();
+        assert!(took < 60.0, "the orbit took {took:.0} s");
+    }
+
+    #[test]
+    fn a_drained_battery_raises_battery_critical() {
+        // ArduCopter's own battery failsafe: under 10.5 V for 2 s, RTL.
+        let params = [("BATT_LOW_VOLT", 10.5), ("BATT_FS_LOW_ACT", 2.0), ("BATT_LOW_TIMER", 2.0)];
+        let mission = "MISSION Drill:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d Hover WITH 120s\n    ON EXCEPTION BatteryCritical BY d:\n        SIGNAL Caught\n";
+        let (dir, sitl, mut run) = one("sitl_battery", &params, "", mission);
+        airborne(&dir);
+        sitl.gcs(Duration::from_secs(10)).set_param("SIM_BATT_VOLTAGE", 10.0);
+        let (_, out) = finish(&mut run, &dir, Duration::from_secs(200));
+        let flown = events(&dir.join("t.jsonl"));
+        let e = exception(&flown, "BatteryCritical").unwrap_or_else(|| panic!("no BatteryCritical:\n{out}"));
+        assert_eq!((e["actor"].as_str(), e["handled"].as_bool()), (Some("d"), Some(true)));
+        assert!(named(&flown, "signal").any(|s| s["name"] == "Caught"));
+    }
+
+    #[test]
+    fn the_vehicles_own_fence_raises_geofence_violation() {
+        // ArduCopter holds a GUIDED target outside its fence instead of flying there, so
+        // the breach is made as on a real site: the drone is 80 m out when the ground
+        // station turns on the vehicle's fence, a 50 m circle with RTL, which the world
+        // knows nothing of. The breach is the autopilot's, not Aviary's own check.
+        let params = [("FENCE_TYPE", 2.0), ("FENCE_RADIUS", 50.0), ("FENCE_ACTION", 1.0)];
+        let mission = "MISSION Drill:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d FlyTo WITH Far\n        d Hover WITH 120s\n    ON EXCEPTION GeofenceViolation BY d:\n        SIGNAL Caught\n";
+        let (dir, sitl, mut run) = one("sitl_fence", &params, "[places]\nFar = [0, 80]\n", mission);
+        wait_until(Duration::from_secs(200), "the flight out", || {
+            events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_done" && e["function"] == "FlyToPosition")
+        });
+        sitl.gcs(Duration::from_secs(10)).set_param("FENCE_ENABLE", 1.0);
+        let (_, out) = finish(&mut run, &dir, Duration::from_secs(200));
+        let flown = events(&dir.join("t.jsonl"));
+        let e = exception(&flown, "GeofenceViolation").unwrap_or_else(|| panic!("no GeofenceViolation:\n{out}"));
+        assert_eq!((e["actor"].as_str(), e["handled"].as_bool()), (Some("d"), Some(true)));
+        assert!(named(&flown, "signal").any(|s| s["name"] == "Caught"));
+    }
+
+    #[test]
+    fn gps_loss_raises_position_lost() {
+        let mission = "MISSION Drill:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d Hover WITH 120s\n    ON EXCEPTION PositionLost BY d:\n        SIGNAL Caught\n";
+        let (dir, sitl, mut run) = one("sitl_gps", &[], "", mission);
+        airborne(&dir);
+        sitl.gcs(Duration::from_secs(10)).set_param("SIM_GPS1_ENABLE", 0.0);
+        let (_, out) = finish(&mut run, &dir, Duration::from_secs(300));
+        let flown = events(&dir.join("t.jsonl"));
+        let e = exception(&flown, "PositionLost").unwrap_or_else(|| panic!("no PositionLost:\n{out}"));
+        assert_eq!(e["actor"].as_str(), Some("d"));
+    }
+
+    #[test]
+    fn a_stopped_vehicle_is_lost_and_a_restarted_one_restored() {
+        // Lost: later statements on the drone raise ConnectionLost, which a handler
+        // catches; restarted: ConnectionRestored is heard.
+        let mission = "MISSION Drill:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d Hover WITH 200s\n    ON EXCEPTION ConnectionLost BY d:\n        SIGNAL Offline\n        SEQUENTIAL Again:\n            d FlyTo WITH North\n        ON EXCEPTION ConnectionLost BY d:\n            SIGNAL Still_Offline\n        WAITFOR RECEIVED(Back)\n    ON ConnectionRestored BY d:\n        SIGNAL Back\n";
+        let (dir, mut sitl, mut run) = one("sitl_link", &[], "[places]\nNorth = [0, 30]\n", mission);
+        airborne(&dir);
+        sitl.kill();
+        let lost_at = Instant::now();
+        wait_until(Duration::from_secs(20), "ConnectionLost", || exception(&events(&dir.join("t.jsonl")), "ConnectionLost").is_some());
+        let noticed = lost_at.elapsed();
+        assert!(noticed < Duration::from_secs(8), "the lost link was noticed after {noticed:?}");
+        wait_until(Duration::from_secs(20), "the second ConnectionLost", || {
+            named(&events(&dir.join("t.jsonl")), "signal").any(|s| s["name"] == "Still_Offline")
+        });
+        sitl.restart();
+        let (code, out) = finish(&mut run, &dir, Duration::from_secs(120));
+        let flown = events(&dir.join("t.jsonl"));
+        let signals: Vec<&str> = named(&flown, "signal").filter_map(|s| s["name"].as_str()).collect();
+        for s in ["Offline", "Still_Offline", "ConnectionRestored", "Back"] {
+            assert!(signals.contains(&s), "{s} in {signals:?}:\n{out}");
+        }
+        let lost: Vec<&Value> = named(&flown, "exception").filter(|e| e["name"] == "ConnectionLost").collect();
+        assert!(lost.len() >= 2 && lost.iter().all(|e| e["handled"] == true), "both ConnectionLost handled: {lost:?}");
+        assert!(!named(&flown, "exception").any(|e| e["name"] == "CommandFailed"), "no CommandFailed on a lost drone");
+        assert_eq!(code, 0, "{out}");
+    }
+
+    #[test]
+    fn a_refused_command_fails_with_the_autopilots_reason() {
+        // A minimum arming voltage above the battery's: ArduCopter refuses to arm, and
+        // says why.
+        let mission = "MISSION Drill:\n    d TakeOff WITH 10m\n";
+        let (dir, _sitl, mut run) = one("sitl_refused", &[("BATT_ARM_VOLT", 14.0)], "", mission);
+        let (code, out) = finish(&mut run, &dir, Duration::from_secs(300));
+        assert_eq!(code, 1, "{out}");
+        let flown = events(&dir.join("t.jsonl"));
+        let e = exception(&flown, "CommandFailed").unwrap_or_else(|| panic!("no CommandFailed:\n{out}"));
+        let reason = e["args"].to_string();
+        assert!(reason.to_ascii_lowercase().contains("arm"), "ArduPilot's reason in {reason}");
+        assert!(reason.contains("PreArm") || reason.contains("Arm:"), "ArduPilot's own text in {reason}");
+    }
+
+    #[test]
+    fn a_vehicle_away_from_its_world_home_is_refused_before_flight() {
+        let dir = scratch("sitl_home");
+        // SITL stands 40 m east of where the world puts it.
+        let sitl = Sitl::start(&dir, 20, 1, [40.0, 0.0], &[]);
+        std::fs::write(dir.join("m.world.toml"), one_copter_world(&sitl, "")).expect("world");
+        std::fs::write(dir.join("m.mission"), "MISSION M:\n    d TakeOff WITH 10m\n").expect("mission");
+        let mut run = start_run(&dir, "m.mission");
+        let (code, out) = finish(&mut run, &dir, Duration::from_secs(120));
+        assert_eq!(code, 2, "{out}");
+        assert!(out.contains("40") && out.contains("home"), "says how far from home: {out}");
+        assert!(!events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_call"), "nothing flew");
+    }
+}
+

@@ -244,10 +244,12 @@ impl Backend for MavlinkBackend {
             return PendingCall { id, end: Ending::Later(rx) };
         };
         if lock(&self.inner.lost)[drone] {
-            let _ = tx.send(CallEnd::Failed(failed(format!(
-                "no link to {}",
-                craft.name
-            ))));
+            // The drone stays lost to the mission until its link is back: what is asked
+            // of it meanwhile raises the exception a handler of the loss already knows.
+            let _ = tx.send(CallEnd::Failed(Failure {
+                exception: "ConnectionLost",
+                reason: format!("{}: no link since its HEARTBEATs stopped; `{function}` was not sent", craft.name),
+            }));
             return PendingCall { id, end: Ending::Later(rx) };
         }
         let (paused_tx, paused_rx) = watch::channel(false);

@@ -34,6 +34,8 @@ pub struct Craft {
     pub v: Arc<Vehicle>,
     pub max_speed: f64,
     pub climb_rate: f64,
+    /// The world's `acceleration` (m/s²): orbit speeds and where a path's points are passed.
+    pub acceleration: f64,
     /// Seconds of flight on a full battery (the world's), for the battery alarms.
     pub endurance: f64,
     pub home: [f64; 2],

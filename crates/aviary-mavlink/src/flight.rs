@@ -81,7 +81,7 @@ pub async fn run(
                     laps,
                     c.tuning.arrive_xy,
                 ),
-                c.max_speed,
+                aviary_api::geometry::orbit_speed(c.max_speed, c.acceleration, radius),
                 paused,
             )
             .await

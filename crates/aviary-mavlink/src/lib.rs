@@ -67,6 +67,10 @@ pub struct Tuning {
     pub arrive_z: f64,
     /// GLOBAL_POSITION_INT messages per second asked of each vehicle.
     pub position_hz: f64,
+    /// At connect: how far (m) a vehicle's home may be from its world home ...
+    pub home_tolerance: f64,
+    /// ... and how long to wait for its HOME_POSITION after its first fix.
+    pub home_wait: Duration,
 }
 
 impl Default for Tuning {
@@ -84,6 +88,8 @@ impl Default for Tuning {
             arrive_xy: 1.0,
             arrive_z: 0.5,
             position_hz: 10.0,
+            home_tolerance: 5.0,
+            home_wait: Duration::from_secs(30),
         }
     }
 }
@@ -185,6 +191,7 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
             v,
             max_speed: d.max_speed,
             climb_rate: d.climb_rate,
+            acceleration: d.acceleration,
             endurance: d.endurance,
             home: [d.home[0], d.home[1]],
             sensors: d.sensors.to_vec(),
@@ -217,9 +224,14 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
         request_streams(c, tuning.position_hz);
     }
     for c in crafts.iter().flatten() {
-        c.wait_for(tuning.connect_timeout, "", |c| c.fix().is_some()).await.map_err(|_| {
-            format!("drone `{}` sends HEARTBEAT but no GLOBAL_POSITION_INT (it was asked for {} a second): has it a position fix?", c.name, tuning.position_hz)
+        c.wait_for(tuning.ready_timeout, "", |c| c.fix().is_some()).await.map_err(|_| {
+            format!("drone `{}` sends HEARTBEAT but no position within {} s (GLOBAL_POSITION_INT was asked for {} a second): has it a GPS fix?", c.name, tuning.ready_timeout.as_secs(), tuning.position_hz)
         })?;
+    }
+    // One deadline for all: the vehicles boot side by side.
+    let homes_by = tokio::time::Instant::now() + tuning.home_wait;
+    for c in crafts.iter().flatten() {
+        check_home(c, tuning, homes_by).await?;
     }
     Ok(MavlinkBackend::new(
         crafts,
@@ -230,19 +242,53 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
     ))
 }
 
+/// Before anything flies, the vehicle must stand where the world puts it: its home
+/// (HOME_POSITION; on the ground without one, where it stands) within
+/// [`Tuning::home_tolerance`] of the drone's `home`. Otherwise the world's places, areas
+/// and fence would be flown at an offset: the run is refused with the distance and the
+/// coordinates to write.
+async fn check_home(c: &Arc<Craft>, tuning: Tuning, by: tokio::time::Instant) -> Result<(), String> {
+    // ArduPilot sets home once its EKF has an origin, some seconds after the first fix.
+    let left = by.saturating_duration_since(tokio::time::Instant::now());
+    let _ = c.wait_for(left, "", |c| c.v.seen().home.is_some()).await;
+    let (home, how) = {
+        let seen = c.v.seen();
+        match (seen.home, seen.fix) {
+            (Some(h), _) => ([h[0], h[1]], "its home (HOME_POSITION)"),
+            (None, Some(f)) if !seen.armed => ([f.pos[0], f.pos[1]], "where it stands (it sent no HOME_POSITION)"),
+            _ => return Ok(()),
+        }
+    };
+    let off = aviary_api::geometry::dist(home, c.home);
+    if off <= tuning.home_tolerance {
+        return Ok(());
+    }
+    // + 0.0: no "-0.0" in the message.
+    let home = [home[0] + 0.0, home[1] + 0.0];
+    let (lat, lon) = c.v.origin().to_geodetic(home[0], home[1]);
+    Err(format!(
+        "drone `{}` is not where the world says: {how} is at ({:.1}, {:.1}), {off:.1} m from its world home ({:.1}, {:.1}) (more than {:.0} m). Move the vehicle (or set its home) to the world's, or write `home = [{:.1}, {:.1}]` for it in the world ({lat:.7}°, {lon:.7}°); nothing was flown",
+        c.name, home[0], home[1], c.home[0], c.home[1], tuning.home_tolerance, home[0], home[1]
+    ))
+}
+
 /// Asks for the telemetry streams with SET_MESSAGE_INTERVAL (in the background: a
 /// vehicle that refuses one still flies, only with less telemetry).
 fn request_streams(c: &Arc<Craft>, position_hz: f64) {
     let c = Arc::clone(c);
     tokio::spawn(async move {
         // Message ids: HEARTBEAT 0, SYS_STATUS 1, GLOBAL_POSITION_INT 33,
-        // BATTERY_STATUS 147, EXTENDED_SYS_STATE 245.
+        // BATTERY_STATUS 147, EXTENDED_SYS_STATE 245, HOME_POSITION 242, FENCE_STATUS 162,
+        // GPS_RAW_INT 24.
         for (id, hz) in [
             (33.0, position_hz),
             (1.0, 1.0),
             (147.0, 1.0),
             (245.0, 1.0),
             (0.0, 1.0),
+            (242.0, 0.5),
+            (162.0, 1.0),
+            (24.0, 1.0),
         ] {
             let interval_us = (1e6 / hz) as f32;
             let _ = c

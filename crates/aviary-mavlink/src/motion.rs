@@ -151,8 +151,18 @@ pub(crate) async fn rtl(c: &Craft) -> Result<(), Failure> {
         .await
 }
 
-/// Flies through `path` (local metres), each point reached by position within the
-/// tolerances; PAUSE holds where the drone is, RESUME sends the target again.
+/// How close to a point of a path, not its last, the drone may come before the next
+/// point is sent: its braking distance at `speed` (ArduPilot's position controller starts
+/// to slow down that far from a target), at least the arrival tolerance, at most 25 m.
+/// Switching there keeps the drone at speed through the path's corners, as ArduPilot's
+/// own waypoint navigation does, instead of stopping at every point.
+pub(crate) fn pass_radius(speed: f64, accel: f64, arrive_xy: f64) -> f64 {
+    (speed * speed / (2.0 * accel.max(0.1))).clamp(arrive_xy, 25.0)
+}
+
+/// Flies through `path` (local metres): the last point is reached by position within the
+/// tolerances, the ones before it are passed within [`pass_radius`]. PAUSE holds where the
+/// drone is, RESUME sends the target again.
 pub(crate) async fn fly(
     c: &Craft,
     path: &[[f64; 3]],
@@ -163,7 +173,9 @@ pub(crate) async fn fly(
     fenced(c, path)?;
     c.set_mode(Mode::Guided).await?;
     c.speed(speed).await?;
-    for &to in path {
+    let pass = pass_radius(speed, c.acceleration, c.tuning.arrive_xy);
+    for (i, &to) in path.iter().enumerate() {
+        let last = i + 1 == path.len();
         let from = here(c)?;
         let to = [to[0], to[1], if to[2].is_nan() { c.level() } else { to[2] }];
         if to[2] < 0.0 {
@@ -176,9 +188,9 @@ pub(crate) async fn fly(
         let mut resend = Instant::now() + c.tuning.resend;
         loop {
             let fix = here(c)?;
-            if dist([fix[0], fix[1]], [to[0], to[1]]) <= c.tuning.arrive_xy
-                && (fix[2] - to[2]).abs() <= c.tuning.arrive_z
-            {
+            let off = dist([fix[0], fix[1]], [to[0], to[1]]);
+            let arrived = off <= c.tuning.arrive_xy && (fix[2] - to[2]).abs() <= c.tuning.arrive_z;
+            if arrived || (!last && off.hypot(fix[2] - to[2]) <= pass) {
                 break;
             }
             if *paused.borrow() {

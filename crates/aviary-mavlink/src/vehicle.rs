@@ -8,7 +8,7 @@ use aviary_api::geometry::dist_to_segment;
 use aviary_api::{DroneEvent, DroneId, Failure};
 use aviary_world::Target;
 use mavlink::dialects::ardupilotmega::{
-    MavCmd, MavLandedState, MavMessage, MavModeFlag, MavResult, MavState,
+    MavCmd, MavLandedState, MavMessage, MavModeFlag, MavResult, MavState, MavSysStatusSensor,
 };
 use tokio::sync::{mpsc, oneshot};
 use tokio::time::Instant;
@@ -43,6 +43,8 @@ pub struct Seen {
     pub armed: bool,
     pub status: Option<MavState>,
     pub fix: Option<Fix>,
+    /// The vehicle's home (HOME_POSITION) in the local frame, height above the origin.
+    pub home: Option<[f64; 3]>,
     /// Fraction of a full battery, when the vehicle reports one.
     pub battery: Option<f64>,
     pub landed: Option<MavLandedState>,
@@ -50,6 +52,14 @@ pub struct Seen {
     pub texts: VecDeque<(Instant, String)>,
     /// The mode this backend last asked for; another RTL or LAND is the autopilot's own.
     pub expected: Option<Mode>,
+    /// A failsafe mode change not yet named: when it was seen, and the mode.
+    failsafe: Option<(Instant, String)>,
+    /// What the vehicle reports of itself, for naming a failsafe: the battery's charge
+    /// state is LOW or worse, its fence is breached, its GPS has no 3D fix.
+    battery_failing: bool,
+    fence_unhealthy: bool,
+    fence_breached: bool,
+    no_gps: bool,
     pub detecting: Vec<Activation>,
     /// Metres flown and seconds in the air while armed, from the reported track.
     pub odometer: f64,
@@ -176,22 +186,18 @@ impl Vehicle {
                     && matches!(after, Mode::Rtl | Mode::Land)
                     && seen.expected != Some(after)
                 {
-                    // The autopilot changed mode by itself: a failsafe.
-                    let since = now - std::time::Duration::from_secs(3);
-                    let why: Vec<&str> = seen
-                        .texts
-                        .iter()
-                        .filter(|(t, _)| *t >= since)
-                        .map(|(_, s)| s.as_str())
-                        .collect();
-                    let failure = failsafe(
-                        &self.name,
-                        &mode::name(flavour, hb.custom_mode),
-                        &why.join("; "),
-                    );
+                    // The autopilot changed mode by itself: a failsafe. Its reason may
+                    // come just after the HEARTBEAT (ArduCopter queues its STATUSTEXT),
+                    // so it is named once the vehicle has said why, or after a moment.
                     seen.expected = Some(after);
-                    let _ = self.alarms.send((self.drone, failure));
+                    seen.failsafe = Some((now, mode::name(flavour, hb.custom_mode)));
                 }
+            }
+            // ArduPilot sends 0°N 0°E until its EKF has an origin: that is no position.
+            MavMessage::GLOBAL_POSITION_INT(p) if p.lat == 0 && p.lon == 0 => {}
+            MavMessage::HOME_POSITION(h) if h.latitude != 0 || h.longitude != 0 => {
+                let xy = self.origin.from_e7(h.latitude, h.longitude);
+                seen.home = Some([xy[0], xy[1], f64::from(h.altitude) / 1000.0 - self.origin.alt]);
             }
             MavMessage::GLOBAL_POSITION_INT(p) => {
                 let xy = self.origin.from_e7(p.lat, p.lon);
@@ -217,13 +223,28 @@ impl Vehicle {
                 seen.fix = Some(fix);
                 self.scan(&mut seen, from, xy);
             }
-            MavMessage::SYS_STATUS(s) if s.battery_remaining >= 0 => {
-                seen.battery = Some(f64::from(s.battery_remaining) / 100.0);
+            MavMessage::SYS_STATUS(s) => {
+                if s.battery_remaining >= 0 {
+                    seen.battery = Some(f64::from(s.battery_remaining) / 100.0);
+                }
+                // A sensor the vehicle has and uses but calls unhealthy (ArduPilot clears
+                // the battery's bit with its battery failsafe, the fence's on a breach).
+                let failing = |bit: MavSysStatusSensor| {
+                    s.onboard_control_sensors_enabled.contains(bit) && !s.onboard_control_sensors_health.contains(bit)
+                };
+                seen.battery_failing = failing(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_BATTERY);
+                seen.fence_unhealthy = failing(MavSysStatusSensor::MAV_SYS_STATUS_GEOFENCE);
             }
-            MavMessage::BATTERY_STATUS(b) if b.battery_remaining >= 0 && b.id == 0 => {
-                seen.battery = Some(f64::from(b.battery_remaining) / 100.0);
+            MavMessage::BATTERY_STATUS(b) if b.id == 0 => {
+                if b.battery_remaining >= 0 {
+                    seen.battery = Some(f64::from(b.battery_remaining) / 100.0);
+                }
             }
             MavMessage::EXTENDED_SYS_STATE(e) => seen.landed = Some(e.landed_state),
+            MavMessage::FENCE_STATUS(f) => seen.fence_breached = f.breach_status != 0,
+            MavMessage::GPS_RAW_INT(g) => {
+                seen.no_gps = (g.fix_type as u8) < 3;
+            }
             MavMessage::STATUSTEXT(t) => {
                 let text = t
                     .text
@@ -249,6 +270,30 @@ impl Vehicle {
             }
             _ => {}
         }
+        self.name_failsafe(&mut seen, now);
+    }
+
+    /// Names a pending failsafe once the vehicle's state or words say what it was, or
+    /// after [`FAILSAFE_WAIT`] with what is known then.
+    fn name_failsafe(&self, seen: &mut Seen, now: Instant) {
+        let Some((at, mode)) = seen.failsafe.clone() else { return };
+        let since = at - std::time::Duration::from_secs(3);
+        let why: Vec<&str> = seen.texts.iter().filter(|(t, _)| *t >= since).map(|(_, s)| s.as_str()).collect();
+        let state = if seen.battery_failing {
+            Some("BatteryCritical")
+        } else if seen.fence_unhealthy || seen.fence_breached {
+            Some("GeofenceViolation")
+        } else if seen.no_gps {
+            Some("PositionLost")
+        } else {
+            None
+        };
+        let failure = failsafe(&self.name, &mode, &why.join("; "), state);
+        if failure.exception == "CommandFailed" && now.duration_since(at) < FAILSAFE_WAIT {
+            return;
+        }
+        seen.failsafe = None;
+        let _ = self.alarms.send((self.drone, failure));
     }
 
     /// Detection: each world target of an active kind within range of the ground track
@@ -277,10 +322,16 @@ impl Vehicle {
     }
 }
 
-/// The exception a failsafe RTL or LAND stands for, from the autopilot's own words.
-fn failsafe(name: &str, mode: &str, why: &str) -> Failure {
+/// How long a failsafe mode change waits for the vehicle to say why.
+const FAILSAFE_WAIT: std::time::Duration = std::time::Duration::from_millis(2500);
+
+/// The exception a failsafe RTL or LAND stands for: from what the vehicle reports of
+/// itself (`state`: its battery, fence or GPS), else from its own words.
+fn failsafe(name: &str, mode: &str, why: &str, state: Option<&'static str>) -> Failure {
     let lower = why.to_ascii_lowercase();
-    let exception = if lower.contains("battery") {
+    let exception = if let Some(e) = state {
+        e
+    } else if lower.contains("battery") {
         "BatteryCritical"
     } else if ["gps", "ekf", "position"].iter().any(|w| lower.contains(w)) {
         "PositionLost"
@@ -312,17 +363,19 @@ mod tests {
     #[test]
     fn failsafe_reasons_pick_the_exception() {
         assert_eq!(
-            failsafe("a", "RTL", "Battery 1 is critical").exception,
+            failsafe("a", "RTL", "Battery 1 is critical", None).exception,
             "BatteryCritical"
         );
         assert_eq!(
-            failsafe("a", "LAND", "EKF variance").exception,
+            failsafe("a", "LAND", "EKF variance", None).exception,
             "PositionLost"
         );
         assert_eq!(
-            failsafe("a", "RTL", "Radio Failsafe").exception,
+            failsafe("a", "RTL", "Radio Failsafe", None).exception,
             "ConnectionLost"
         );
-        assert_eq!(failsafe("a", "RTL", "").exception, "CommandFailed");
+        assert_eq!(failsafe("a", "RTL", "", None).exception, "CommandFailed");
+        // What the vehicle reports of itself comes before its words.
+        assert_eq!(failsafe("a", "RTL", "Fence breached", Some("BatteryCritical")).exception, "BatteryCritical");
     }
 }

@@ -89,12 +89,6 @@ pub(crate) fn arc_accel(a: f64) -> f64 {
     a * 0.75f64.sqrt()
 }
 
-/// The speed of an orbit: at most `max_speed`, and a centripetal acceleration of at most
-/// half the drone's acceleration.
-pub(crate) fn orbit_speed(max_speed: f64, accel: f64, radius: f64) -> f64 {
-    max_speed.min((accel * radius / 2.0).sqrt())
-}
-
 impl SimDrone {
     /// Sets the flight state the first leg of the task flies in.
     pub fn begin_leg(&mut self) {
@@ -251,7 +245,7 @@ pub(crate) fn orbit_legs(d: &SimDrone, center: [f64; 2], radius: f64, laps: f64)
             radius,
             start,
             total: laps * TAU,
-            speed: orbit_speed(d.spec.max_speed, d.spec.accel, radius),
+            speed: aviary_api::geometry::orbit_speed(d.spec.max_speed, d.spec.accel, radius),
         },
     ]
 }

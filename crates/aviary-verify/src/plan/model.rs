@@ -93,7 +93,7 @@ impl Flyer {
         let entry = [center[0] + radius * angle.cos(), center[1] + radius * angle.sin(), self.pos[2]];
         let to_circle = self.leg(entry);
         let arc = laps * std::f64::consts::TAU * radius;
-        let speed = self.max_speed.min((self.accel * radius / 2.0).sqrt());
+        let speed = aviary_api::geometry::orbit_speed(self.max_speed, self.accel, radius);
         self.distance += arc;
         to_circle + trapezoid(arc, speed, self.accel * 0.75f64.sqrt())
     }

@@ -243,19 +243,23 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
 }
 
 /// Before anything flies, the vehicle must stand where the world puts it: its home
-/// (HOME_POSITION; on the ground without one, where it stands) within
-/// [`Tuning::home_tolerance`] of the drone's `home`. Otherwise the world's places, areas
-/// and fence would be flown at an offset: the run is refused with the distance and the
-/// coordinates to write.
+/// (HOME_POSITION), or on the ground where it stands (which is where ArduPilot and PX4
+/// set home), within [`Tuning::home_tolerance`] of the drone's `home`. Otherwise the
+/// world's places, areas and fence would be flown at an offset: the run is refused with
+/// the distance and the coordinates to write.
 async fn check_home(c: &Arc<Craft>, tuning: Tuning, by: tokio::time::Instant) -> Result<(), String> {
-    // ArduPilot sets home once its EKF has an origin, some seconds after the first fix.
-    let left = by.saturating_duration_since(tokio::time::Instant::now());
-    let _ = c.wait_for(left, "", |c| c.v.seen().home.is_some()).await;
+    // HOME_POSITION was asked for with the streams; a moment for its first one.
+    let _ = c.wait_for(tuning.home_wait.min(std::time::Duration::from_secs(2)), "", |c| c.v.seen().home.is_some()).await;
+    if c.v.seen().armed {
+        // Already flying: only its home says where it started.
+        let left = by.saturating_duration_since(tokio::time::Instant::now());
+        let _ = c.wait_for(left, "", |c| c.v.seen().home.is_some()).await;
+    }
     let (home, how) = {
         let seen = c.v.seen();
         match (seen.home, seen.fix) {
             (Some(h), _) => ([h[0], h[1]], "its home (HOME_POSITION)"),
-            (None, Some(f)) if !seen.armed => ([f.pos[0], f.pos[1]], "where it stands (it sent no HOME_POSITION)"),
+            (None, Some(f)) if !seen.armed => ([f.pos[0], f.pos[1]], "where it stands on the ground"),
             _ => return Ok(()),
         }
     };

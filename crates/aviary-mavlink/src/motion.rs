@@ -152,12 +152,14 @@ pub(crate) async fn rtl(c: &Craft) -> Result<(), Failure> {
 }
 
 /// How close to a point of a path, not its last, the drone may come before the next
-/// point is sent: its braking distance at `speed` (ArduPilot's position controller starts
-/// to slow down that far from a target), at least the arrival tolerance, at most 25 m.
-/// Switching there keeps the drone at speed through the path's corners, as ArduPilot's
-/// own waypoint navigation does, instead of stopping at every point.
+/// point is sent: 1.5 times its braking distance at `speed` (ArduPilot's position
+/// controller starts to slow down that far from a target; the margin covers an autopilot
+/// that brakes more gently than the world's `acceleration`), at least the arrival
+/// tolerance, at most 25 m. Switching there keeps the drone at speed through the path's
+/// corners, as ArduPilot's own waypoint navigation does, instead of stopping at every
+/// point; an orbit is cut inside by well under a metre.
 pub(crate) fn pass_radius(speed: f64, accel: f64, arrive_xy: f64) -> f64 {
-    (speed * speed / (2.0 * accel.max(0.1))).clamp(arrive_xy, 25.0)
+    (1.5 * speed * speed / (2.0 * accel.max(0.1))).clamp(arrive_xy, 25.0)
 }
 
 /// Flies through `path` (local metres): the last point is reached by position within the
@@ -288,4 +290,34 @@ pub(crate) fn orbit(
             ]
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{orbit, pass_radius};
+
+    #[test]
+    fn points_are_passed_at_the_braking_distance_within_bounds() {
+        // 10 m/s at 3 m/s²: 16.7 m to brake, 25 m with the margin (the cap).
+        assert_eq!(pass_radius(10.0, 3.0, 1.0), 25.0);
+        assert!((pass_radius(5.0, 3.0, 1.0) - 6.25).abs() < 1e-9);
+        // Slow: never closer than the arrival tolerance; no acceleration: no division by 0.
+        assert_eq!(pass_radius(0.5, 3.0, 1.0), 1.0);
+        assert_eq!(pass_radius(10.0, 0.0, 1.0), 25.0);
+        let mut last = 0.0;
+        for v in 0..40 {
+            let r = pass_radius(f64::from(v) * 0.5, 3.0, 1.0);
+            assert!(r >= last && (1.0..=25.0).contains(&r));
+            last = r;
+        }
+    }
+
+    #[test]
+    fn an_orbit_ends_where_it_began_after_whole_laps() {
+        let path = orbit([120.0, 0.0, 10.0], [100.0, 0.0], 20.0, 2.0, 1.0);
+        assert_eq!(path.len(), 49);
+        let (a, b) = (path[0], path[48]);
+        assert!((a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9);
+        assert!(path.iter().all(|p| ((p[0] - 100.0).hypot(p[1]) - 20.0).abs() < 1e-9 && p[2] == 10.0));
+    }
 }

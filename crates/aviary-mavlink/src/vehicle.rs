@@ -235,10 +235,8 @@ impl Vehicle {
                 seen.battery_failing = failing(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_BATTERY);
                 seen.fence_unhealthy = failing(MavSysStatusSensor::MAV_SYS_STATUS_GEOFENCE);
             }
-            MavMessage::BATTERY_STATUS(b) if b.id == 0 => {
-                if b.battery_remaining >= 0 {
-                    seen.battery = Some(f64::from(b.battery_remaining) / 100.0);
-                }
+            MavMessage::BATTERY_STATUS(b) if b.battery_remaining >= 0 && b.id == 0 => {
+                seen.battery = Some(f64::from(b.battery_remaining) / 100.0);
             }
             MavMessage::EXTENDED_SYS_STATE(e) => seen.landed = Some(e.landed_state),
             MavMessage::FENCE_STATUS(f) => seen.fence_breached = f.breach_status != 0,

@@ -214,7 +214,7 @@ impl Gcs {
                     }
                     Err(_) => continue,
                 };
-                if u32::from(header.system_id) != u32::from(system) {
+                if header.system_id != u32::from(system) {
                     continue;
                 }
                 let mut seen = s.lock().unwrap();

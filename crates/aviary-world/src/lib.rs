@@ -206,8 +206,25 @@ pub struct Drone {
     pub acceleration: f64,
     /// Start charge in %, default 100.
     pub battery: f64,
-    /// Seconds of flight on a full battery, default 1800.
+    /// Seconds of flight on a full battery, default 1800; when both `battery_capacity`
+    /// and `flight_current` are given, their quotient instead.
     pub endurance: f64,
+    /// m/s down, default `climb_rate`.
+    pub descent_rate: f64,
+    /// m/s down in the last `land_speed_below` metres of a landing, default `descent_rate`
+    /// (autopilots land slowly: ArduCopter's LAND_SPEED is 0.5 m/s).
+    pub land_speed: f64,
+    /// m, default 10 (ArduCopter's LAND_ALT_LOW).
+    pub land_speed_below: f64,
+    /// m, default 10: `ReturnToLaunch` flies home at least this high (ArduCopter's RTL_ALT).
+    pub return_altitude: f64,
+    /// s, default 0: `ReturnToLaunch` waits this long above home before it lands
+    /// (ArduCopter's RTL_LOIT_TIME).
+    pub return_loiter: f64,
+    /// mAh, if known (a MAVLink vehicle reports its own: BATT_CAPACITY).
+    pub battery_capacity: Option<f64>,
+    /// A drawn in flight on average, if known.
+    pub flight_current: Option<f64>,
     pub backend: Backend,
     /// Every other key, in file order: readable as `d.key`. Keys are shared by the
     /// drones that have them.
@@ -218,6 +235,14 @@ pub struct Drone {
 }
 
 impl Drone {
+    /// The endurance that capacity and draw give, when both are known.
+    pub fn endurance_from_battery(capacity: Option<f64>, current: Option<f64>) -> Option<f64> {
+        match (capacity, current) {
+            (Some(mah), Some(amps)) if mah > 0.0 && amps > 0.0 => Some(mah / 1000.0 / amps * 3600.0),
+            _ => None,
+        }
+    }
+
     pub fn attribute(&self, key: &str) -> Option<&AttributeValue> {
         self.attributes
             .iter()

@@ -96,6 +96,17 @@ impl Ctx<'_> {
         Some(value)
     }
 
+    /// A number that must not be below zero.
+    pub fn non_negative(&mut self, what: &dyn Display, node: &Node) -> Option<f64> {
+        let value = self.number(what, node)?;
+        if value < 0.0 {
+            let msg = format!("{what} must not be below zero, found {value}");
+            self.error(node.span, msg, "write zero or a positive number");
+            return None;
+        }
+        Some(value)
+    }
+
     /// A number in `min..=max`.
     pub fn within(&mut self, what: &dyn Display, node: &Node, min: f64, max: f64) -> Option<f64> {
         let value = self.number(what, node)?;

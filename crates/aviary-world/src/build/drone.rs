@@ -122,6 +122,13 @@ impl Drones {
             acceleration: 3.0,
             battery: 100.0,
             endurance: 1800.0,
+            descent_rate: f64::NAN,
+            land_speed: f64::NAN,
+            land_speed_below: 10.0,
+            return_altitude: 10.0,
+            return_loiter: 0.0,
+            battery_capacity: None,
+            flight_current: None,
             backend: Backend::Sim,
             attributes: Box::default(),
             span: key_span,
@@ -184,6 +191,13 @@ impl Drones {
                 "acceleration" => d.acceleration = cx.positive(&what, n).unwrap_or(d.acceleration),
                 "endurance" => d.endurance = cx.positive(&what, n).unwrap_or(d.endurance),
                 "battery" => d.battery = cx.within(&what, n, 0.0, 100.0).unwrap_or(d.battery),
+                "descent_rate" => d.descent_rate = cx.positive(&what, n).unwrap_or(d.descent_rate),
+                "land_speed" => d.land_speed = cx.positive(&what, n).unwrap_or(d.land_speed),
+                "land_speed_below" => d.land_speed_below = cx.non_negative(&what, n).unwrap_or(d.land_speed_below),
+                "return_altitude" => d.return_altitude = cx.non_negative(&what, n).unwrap_or(d.return_altitude),
+                "return_loiter" => d.return_loiter = cx.non_negative(&what, n).unwrap_or(d.return_loiter),
+                "battery_capacity" => d.battery_capacity = cx.positive(&what, n).or(d.battery_capacity),
+                "flight_current" => d.flight_current = cx.positive(&what, n).or(d.flight_current),
                 key if BACKEND_KEYS.contains(&key) => {}
                 _ => {
                     if let Some((key, value)) = attribute(cx, name, k) {
@@ -199,6 +213,16 @@ impl Drones {
                     }
                 }
             }
+        }
+        // Defaults that follow other keys of the same drone.
+        if d.descent_rate.is_nan() {
+            d.descent_rate = d.climb_rate;
+        }
+        if d.land_speed.is_nan() {
+            d.land_speed = d.descent_rate;
+        }
+        if let Some(endurance) = Drone::endurance_from_battery(d.battery_capacity, d.flight_current) {
+            d.endurance = endurance;
         }
         d.backend = backend(cx, name, keys);
         d.attributes = attributes.into();

@@ -11,6 +11,7 @@
 //!
 //! Invariant: this crate knows no engine, no backend and no syntax.
 
+pub mod flight;
 pub mod geometry;
 pub mod sweep;
 mod kind;

@@ -243,6 +243,11 @@ impl Drone {
         }
     }
 
+    /// How the drone comes down.
+    pub fn descent(&self) -> aviary_api::flight::Descent {
+        aviary_api::flight::Descent { rate: self.descent_rate, land_speed: self.land_speed, slow_below: self.land_speed_below }
+    }
+
     pub fn attribute(&self, key: &str) -> Option<&AttributeValue> {
         self.attributes
             .iter()

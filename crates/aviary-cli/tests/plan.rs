@@ -10,15 +10,7 @@ use common::{aviary, repo, scratch};
 fn simulated(mission: &str, world: &[&str]) -> Vec<(String, f64, f64)> {
     let (code, out, err) = aviary(&[&["run", mission], world].concat(), &repo());
     assert_eq!(code, 0, "the run failed: {err}");
-    out.lines()
-        .skip_while(|l| !l.starts_with("drone "))
-        .skip(1)
-        .take_while(|l| !l.starts_with("signals:"))
-        .map(|l| {
-            let f: Vec<&str> = l.split_whitespace().collect();
-            (f[0].to_string(), f[1].parse().expect("distance"), f[2].parse().expect("flight time"))
-        })
-        .collect()
+    common::summary_rows(&out)
 }
 
 fn planned(mission: &str, world: &[&str]) -> serde_json::Value {
@@ -58,6 +50,16 @@ fn the_shared_papers_plan_agrees_with_its_simulated_run() {
         return;
     }
     agrees_within_15_percent("../shared/examples/search_and_rescue.mission", &[]);
+}
+
+#[test]
+fn the_plan_agrees_with_a_simulated_run_of_drones_with_arducopters_figures() {
+    // Slower climbs and descents, a slow touch-down, a higher return with a wait above
+    // home: the plan follows each as the simulator flies it.
+    let dir = scratch("plan_arducopter");
+    let world = dir.join("arducopter.world.toml");
+    std::fs::write(&world, common::example_world_with(|_| common::ARDUCOPTER.to_owned())).expect("world");
+    agrees_within_15_percent("examples/search_and_rescue.mission", &["--world", &world.to_string_lossy()]);
 }
 
 const FIXTURES: &str = "crates/aviary-verify/tests/fixtures";

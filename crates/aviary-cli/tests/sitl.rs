@@ -95,18 +95,10 @@ fn one_copter_world(sitl: &Sitl, extra: &str) -> String {
 
 /// The example world with `mavlink` and `system_id` for the drones `sitls` names.
 fn example_world(sitls: &[(&str, &Sitl)]) -> String {
-    let text = std::fs::read_to_string(repo().join("examples/search_and_rescue.world.toml")).expect("example world");
-    let mut out = String::new();
-    for line in text.lines() {
-        out.push_str(line);
-        out.push('\n');
-        if let Some(name) = line.strip_prefix("[drones.").and_then(|l| l.strip_suffix(']')) {
-            if let Some((_, s)) = sitls.iter().find(|(n, _)| *n == name) {
-                out.push_str(&format!("mavlink = \"{}\"\nsystem_id = {}\n", s.address(), s.system));
-            }
-        }
-    }
-    out
+    common::example_world_with(|name| match sitls.iter().find(|(n, _)| *n == name) {
+        Some((_, s)) => format!("mavlink = \"{}\"\nsystem_id = {}\n", s.address(), s.system),
+        None => String::new(),
+    })
 }
 
 fn home_of(name: &str) -> [f64; 2] {
@@ -138,8 +130,9 @@ fn outcome(events: &[Value]) -> (Vec<String>, Vec<(String, i64, i64)>) {
 }
 
 /// The paper's mission with the drones in `real` on SITL and the rest simulated: it ends
-/// ok with the signals and finds of the simulated run, and every beacon is dropped within
-/// 5 m of its target.
+/// ok with the signals and finds of the simulated run, every beacon is dropped within
+/// 5 m of its target, and each SITL drone's flight time is within 15% of what the plan
+/// and the simulator give for a drone with ArduCopter's figures.
 fn paper_mission(tag: &str, first_instance: u16, real: &[&str]) {
     let dir = scratch(tag);
     let sitls: Vec<(&str, Sitl)> = real
@@ -150,10 +143,17 @@ fn paper_mission(tag: &str, first_instance: u16, real: &[&str]) {
     let refs: Vec<(&str, &Sitl)> = sitls.iter().map(|(n, s)| (*n, s)).collect();
     std::fs::copy(repo().join("examples/search_and_rescue.mission"), dir.join("m.mission")).expect("mission");
     std::fs::write(dir.join("m.world.toml"), example_world(&refs)).expect("world");
+    // The same drones in the simulator: those on SITL with ArduCopter's figures.
+    let sim_world = dir.join("sim.world.toml");
+    std::fs::write(&sim_world, common::example_world_with(|name| if real.contains(&name) { common::ARDUCOPTER.to_owned() } else { String::new() })).expect("world");
+    let sim_world = sim_world.to_string_lossy().into_owned();
 
-    let (code, _, err) = aviary(&["run", "examples/search_and_rescue.mission", "--quiet", "--trace", &dir.join("sim.jsonl").to_string_lossy()], &repo());
+    let (code, sim_out, err) = aviary(&["run", "examples/search_and_rescue.mission", "--world", &sim_world, "--trace", &dir.join("sim.jsonl").to_string_lossy()], &repo());
     assert_eq!(code, 0, "the simulated run: {err}");
     let simulated = events(&dir.join("sim.jsonl"));
+    let (code, plan, err) = aviary(&["check", "--plan", "--format", "json", "examples/search_and_rescue.mission", "--world", &sim_world], &repo());
+    assert_eq!(code, 0, "the plan: {err}");
+    let plan: Value = serde_json::from_str(&plan).expect("the plan's JSON");
 
     let mut run = start_run(&dir, "m.mission");
     let (code, out) = finish(&mut run, &dir, Duration::from_secs(1500));
@@ -170,6 +170,25 @@ fn paper_mission(tag: &str, first_instance: u16, real: &[&str]) {
     }
     let end = flown.last().expect("events");
     assert_eq!((end["event"].as_str(), end["status"].as_str()), (Some("mission_end"), Some("ok")));
+
+    // Flight times: SITL's (from the track it reported) against the simulator's and the
+    // plan's for the same drone.
+    let sitl = common::summary_rows(&out);
+    let sim = common::summary_rows(&sim_out);
+    let flight = |rows: &[(String, f64, f64)], name: &str| rows.iter().find(|r| r.0 == name).map(|r| r.2).expect("a summary row");
+    let planned = |name: &str| {
+        plan["plan"]["drones"].as_array().expect("drones").iter().find(|d| d["drone"] == name).and_then(|d| d["flight_time"].as_f64()).expect("a planned flight time")
+    };
+    let mut off = Vec::new();
+    for name in real {
+        let real_time = flight(&sitl, name);
+        for (what, t) in [("the simulator", flight(&sim, name)), ("the plan", planned(name))] {
+            if (t - real_time).abs() > 0.15 * real_time {
+                off.push(format!("{name}: {real_time:.0} s on SITL, {t:.0} s in {what}"));
+            }
+        }
+    }
+    assert!(off.is_empty(), "flight times more than 15% apart:\n{}", off.join("\n"));
 }
 
 mod fleet {

@@ -1,7 +1,7 @@
 //! Battery: drains only in the air, `dt / endurance` of a full battery per `dt` seconds.
 //!
-//! The energy needed to get home is the time to fly there at `max_speed` plus the time to
-//! descend at `climb_rate`, as a fraction of the endurance. `BatteryLow` is raised (once)
+//! The energy needed to get home is the time to fly there at `max_speed`, wait above home
+//! and land (`aviary_api::flight::time_home`), as a fraction of the endurance. `BatteryLow` is raised (once)
 //! when what is left falls under twice that plus 10 %; `BatteryCritical` (once) under
 //! that plus 10 %; at zero the drone falls and is lost.
 
@@ -18,19 +18,21 @@ pub(crate) struct Alarms {
 
 /// The fraction of a full battery the drone needs to fly home and land from where it is.
 pub(crate) fn energy_home(d: &SimDrone) -> f64 {
-    let time = dist(d.xy(), d.home) / d.spec.max_speed + d.pos[2].max(0.0) / d.spec.climb_rate;
-    time / d.spec.endurance
+    time_home(dist(d.xy(), d.home), d) / d.spec.endurance
 }
 
 /// At least [`energy_home`] (or NaN), bit for bit: `|dx| + |dy|`, widened far beyond the
 /// rounding of both, bounds the distance, and rounding keeps the order of the rest.
 pub(crate) fn energy_home_bound(d: &SimDrone) -> f64 {
-    if !(d.spec.max_speed > 0.0 && d.spec.climb_rate > 0.0 && d.spec.endurance > 0.0) {
+    if !(d.spec.max_speed > 0.0 && d.spec.descent.rate > 0.0 && d.spec.descent.land_speed > 0.0 && d.spec.endurance > 0.0) {
         return f64::NAN;
     }
     let far = ((d.home[0] - d.pos[0]).abs() + (d.home[1] - d.pos[1]).abs()) * (1.0 + 1e-12);
-    let time = far / d.spec.max_speed + d.pos[2].max(0.0) / d.spec.climb_rate;
-    time / d.spec.endurance
+    time_home(far, d) / d.spec.endurance
+}
+
+fn time_home(ground: f64, d: &SimDrone) -> f64 {
+    aviary_api::flight::time_home(ground, d.spec.max_speed, d.pos[2], d.spec.return_loiter, &d.spec.descent)
 }
 
 /// Drains `dt` seconds of flight (when `airborne`) and raises each alarm at most once.

@@ -14,8 +14,6 @@ use crate::sweep::lawnmower;
 pub const LOAD_TIME: f64 = 2.0;
 /// `LoadPayload` needs the drone below this altitude (metres), or landed.
 pub const LOAD_MAX_ALTITUDE: f64 = 5.0;
-/// `ReturnToLaunch` flies home at least this high (metres), or at the site's limit.
-pub const RETURN_ALTITUDE: f64 = 10.0;
 /// A landed drone this close to home (metres) is home.
 const AT_HOME: f64 = 0.5;
 
@@ -164,11 +162,7 @@ impl Fleet {
                 if landed {
                     return Ok(Start::Done);
                 }
-                vec![Leg::Move {
-                    to: [here[0], here[1], 0.0],
-                    speed: d.spec.max_speed,
-                    state: FlightState::Landing,
-                }]
+                landing_legs(d, [here[0], here[1]])
             }
             "ReturnToLaunch" => return_legs(d, &self.names[id], landed, limits.max_altitude)?,
             "FlyToPosition" => {
@@ -362,7 +356,7 @@ pub(crate) fn return_legs(
         )));
     }
     let z = d.pos[2];
-    let safe = z.max(RETURN_ALTITUDE.min(max_altitude.unwrap_or(f64::INFINITY)));
+    let safe = z.max(d.spec.return_altitude.min(max_altitude.unwrap_or(f64::INFINITY)));
     let mut legs = Vec::new();
     if safe > z {
         legs.push(Leg::Move {
@@ -378,10 +372,31 @@ pub(crate) fn return_legs(
             state: FlightState::Flying,
         });
     }
-    legs.push(Leg::Move {
-        to: [d.home[0], d.home[1], 0.0],
+    if d.spec.return_loiter > 0.0 {
+        legs.push(Leg::Hold { left: d.spec.return_loiter });
+    }
+    legs.extend(landing_legs_from(d, d.home, safe));
+    Ok(legs)
+}
+
+/// A landing straight down from where the drone is.
+fn landing_legs(d: &SimDrone, here: [f64; 2]) -> Vec<Leg> {
+    landing_legs_from(d, here, d.pos[2])
+}
+
+/// Down to the ground at `at` from `height`: at the descent rate, and, when the drone
+/// lands slower than it descends, first to `slow_below` and from there at the landing
+/// speed (the motion's rule for a landing leg low enough), as an autopilot lands.
+fn landing_legs_from(d: &SimDrone, at: [f64; 2], height: f64) -> Vec<Leg> {
+    let down = |z: f64| Leg::Move {
+        to: [at[0], at[1], z],
         speed: d.spec.max_speed,
         state: FlightState::Landing,
-    });
-    Ok(legs)
+    };
+    let descent = d.spec.descent;
+    if descent.slows(height) && height > descent.slow_below {
+        vec![down(descent.slow_below), down(0.0)]
+    } else {
+        vec![down(0.0)]
+    }
 }

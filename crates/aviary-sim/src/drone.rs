@@ -41,6 +41,9 @@ pub(crate) struct Spec {
     pub climb_rate: f64,
     pub accel: f64,
     pub endurance: f64,
+    pub descent: aviary_api::flight::Descent,
+    pub return_altitude: f64,
+    pub return_loiter: f64,
     pub sensors: Box<[String]>,
     pub payload_kinds: Box<[String]>,
 }
@@ -52,6 +55,9 @@ impl Spec {
             climb_rate: d.climb_rate,
             accel: d.acceleration,
             endurance: d.endurance,
+            descent: d.descent(),
+            return_altitude: d.return_altitude,
+            return_loiter: d.return_loiter,
             sensors: d.sensors.clone(),
             payload_kinds: d.payload.clone(),
         }
@@ -63,7 +69,9 @@ impl Eq for Spec {}
 
 impl Hash for Spec {
     fn hash<H: Hasher>(&self, h: &mut H) {
-        for x in [self.max_speed, self.climb_rate, self.accel, self.endurance] {
+        let figures = [self.max_speed, self.climb_rate, self.accel, self.endurance, self.return_altitude, self.return_loiter];
+        let descent = [self.descent.rate, self.descent.land_speed, self.descent.slow_below];
+        for x in figures.into_iter().chain(descent) {
             x.to_bits().hash(h);
         }
         self.sensors.hash(h);

@@ -6,7 +6,7 @@ use std::f64::consts::TAU;
 
 use aviary_api::{CallId, FlightState};
 
-use crate::drone::SimDrone;
+use crate::drone::{SimDrone, Spec};
 use crate::geom;
 use crate::profile::advance;
 
@@ -130,8 +130,8 @@ impl SimDrone {
                 *left -= dt;
                 *left <= 1e-9 && !owns_z
             }
-            Some(Leg::Move { to, speed, .. }) => {
-                let (to, speed) = (*to, *speed);
+            Some(Leg::Move { to, speed, state }) => {
+                let (to, speed, landing) = (*to, *speed, *state == FlightState::Landing);
                 let here = [self.pos[0], self.pos[1]];
                 let d = geom::dist(here, [to[0], to[1]]);
                 let h = advance(d, task.ground_speed, limit(speed), self.spec.accel, dt);
@@ -153,7 +153,7 @@ impl SimDrone {
                     false
                 } else {
                     let dz = to[2] - self.pos[2];
-                    let climb = limit(self.spec.climb_rate);
+                    let climb = limit(vertical_limit(&self.spec, self.pos[2], dz, to[2], landing));
                     let v = advance(dz.abs(), task.climb_speed, climb, self.spec.accel, dt);
                     task.climb_speed = v.speed;
                     if v.arrived {
@@ -248,4 +248,18 @@ pub(crate) fn orbit_legs(d: &SimDrone, center: [f64; 2], radius: f64, laps: f64)
             speed: aviary_api::geometry::orbit_speed(d.spec.max_speed, d.spec.accel, radius),
         },
     ]
+}
+
+/// The vertical speed limit of a leg `dz` away from its end at `to_z`, for a drone at
+/// height `z`: the climb rate up, the descent rate down, and the landing speed for the
+/// last part of a landing (from `slow_below` to the ground).
+fn vertical_limit(spec: &Spec, z: f64, dz: f64, to_z: f64, landing: bool) -> f64 {
+    let descent = spec.descent;
+    if dz >= 0.0 {
+        spec.climb_rate
+    } else if landing && to_z <= 0.0 && z <= descent.slow_below + 1e-9 && descent.slows(z) {
+        descent.land_speed
+    } else {
+        descent.rate
+    }
 }

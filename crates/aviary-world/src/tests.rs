@@ -479,7 +479,7 @@ fn durations_of_faults() {
 
 #[test]
 fn speeds_and_endurance_must_be_positive() {
-    for key in ["max_speed", "climb_rate", "acceleration", "endurance"] {
+    for key in ["max_speed", "climb_rate", "acceleration", "endurance", "descent_rate", "land_speed", "battery_capacity", "flight_current"] {
         let (msg, at, _) = error(&format!("{HOME}{key} = -2\n"));
         assert_eq!(
             msg,
@@ -493,6 +493,35 @@ fn speeds_and_endurance_must_be_positive() {
         "`endurance` of drone `d` must be greater than zero, found 0"
     );
     assert_eq!(at, "0.0");
+}
+
+#[test]
+fn heights_and_waits_may_be_zero_but_not_below() {
+    for key in ["land_speed_below", "return_altitude", "return_loiter"] {
+        let (msg, at, help) = error(&format!("{HOME}{key} = -1\n"));
+        assert_eq!(msg, format!("`{key}` of drone `d` must not be below zero, found -1"));
+        assert_eq!((at.as_str(), help.as_str()), ("-1", "write zero or a positive number"));
+    }
+}
+
+#[test]
+fn descent_and_landing_follow_the_climb_unless_given() {
+    let w = ok(&format!("{HOME}climb_rate = 2\n"));
+    let d = &w.drones[0];
+    assert_eq!((d.descent_rate, d.land_speed, d.land_speed_below, d.return_altitude, d.return_loiter), (2.0, 2.0, 10.0, 10.0, 0.0));
+    let w = ok(&format!("{HOME}climb_rate = 2.5\ndescent_rate = 1.5\nland_speed = 0.5\nreturn_altitude = 15\nreturn_loiter = 5\n"));
+    let d = &w.drones[0];
+    assert_eq!((d.descent_rate, d.land_speed, d.return_altitude, d.return_loiter), (1.5, 0.5, 15.0, 5.0));
+    assert!(d.attributes.is_empty(), "figures are not attributes");
+}
+
+#[test]
+fn capacity_and_draw_give_the_endurance() {
+    let w = ok(&format!("{HOME}endurance = 1800\nbattery_capacity = 3300\nflight_current = 30\n"));
+    assert!((w.drones[0].endurance - 396.0).abs() < 1e-9);
+    // One of the two alone leaves the endurance as it is.
+    let w = ok(&format!("{HOME}battery_capacity = 3300\n"));
+    assert_eq!((w.drones[0].endurance, w.drones[0].battery_capacity), (1800.0, Some(3300.0)));
 }
 
 #[test]

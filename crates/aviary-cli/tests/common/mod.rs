@@ -24,3 +24,35 @@ pub fn scratch(name: &str) -> PathBuf {
     dir
 }
 pub mod sitl;
+
+/// ArduCopter's own figures (its default parameters) as a drone's world keys:
+/// WPNAV_SPEED_UP 250 cm/s, WPNAV_SPEED_DN 150 cm/s, WPNAV_ACCEL 250 cm/s², LAND_SPEED
+/// 50 cm/s under LAND_ALT_LOW 1000 cm, RTL_ALT 1500 cm, RTL_LOIT_TIME 5000 ms.
+pub const ARDUCOPTER: &str = "climb_rate = 2.5\ndescent_rate = 1.5\nacceleration = 2.5\nland_speed = 0.5\nland_speed_below = 10\nreturn_altitude = 15\nreturn_loiter = 5\n";
+
+/// The paper's example world with `keys(name)` added to each drone's table.
+pub fn example_world_with(keys: impl Fn(&str) -> String) -> String {
+    let text = std::fs::read_to_string(repo().join("examples/search_and_rescue.world.toml")).expect("example world");
+    let mut out = String::new();
+    for line in text.lines() {
+        out.push_str(line);
+        out.push('\n');
+        if let Some(name) = line.strip_prefix("[drones.").and_then(|l| l.strip_suffix(']')) {
+            out.push_str(&keys(name));
+        }
+    }
+    out
+}
+
+/// The summary table `aviary run` prints: per drone, (name, distance m, flight s).
+pub fn summary_rows(out: &str) -> Vec<(String, f64, f64)> {
+    out.lines()
+        .skip_while(|l| !l.starts_with("drone "))
+        .skip(1)
+        .take_while(|l| !l.starts_with("signals:"))
+        .map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            (f[0].to_string(), f[1].parse().expect("distance"), f[2].parse().expect("flight time"))
+        })
+        .collect()
+}

@@ -3,6 +3,7 @@
 mod backend;
 mod envelope;
 mod flight;
+mod landing;
 mod link;
 mod rules;
 mod separation;

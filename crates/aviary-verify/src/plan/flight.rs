@@ -20,7 +20,7 @@ pub fn fly(e: &mut Estimator, d: DroneId, function: &str, args: &[Option<Value>]
         }
         "Land" => {
             let f = &mut e.s.drones[d];
-            let took = f.leg([f.pos[0], f.pos[1], 0.0]);
+            let took = f.land_here();
             f.land(t + took);
             took
         }

@@ -3,13 +3,12 @@
 //! speed a centripetal limit allows; sweeps along the middle layer's lawnmower path),
 //! in closed form instead of ticks.
 
+use aviary_api::flight::Descent;
 use aviary_api::geometry::dist_to_segment;
 use aviary_world::Drone;
 
 /// `LoadPayload` takes this long (the simulator's figure).
 pub const LOAD_TIME: f64 = 2.0;
-/// `ReturnToLaunch` climbs to at least this altitude first.
-pub const RETURN_ALTITUDE: f64 = 10.0;
 
 /// A drone as the estimate follows it.
 #[derive(Clone, Debug)]
@@ -18,6 +17,9 @@ pub struct Flyer {
     pub home: [f64; 3],
     pub max_speed: f64,
     pub climb_rate: f64,
+    pub descent: Descent,
+    pub return_altitude: f64,
+    pub return_loiter: f64,
     pub accel: f64,
     pub endurance: f64,
     pub battery_start: f64,
@@ -40,6 +42,9 @@ impl Flyer {
             home: d.home,
             max_speed: d.max_speed,
             climb_rate: d.climb_rate,
+            descent: d.descent(),
+            return_altitude: d.return_altitude,
+            return_loiter: d.return_loiter,
             accel: d.acceleration,
             endurance: d.endurance,
             battery_start: d.battery / 100.0,
@@ -82,8 +87,25 @@ impl Flyer {
         let h = ((to[0] - self.pos[0]).powi(2) + (to[1] - self.pos[1]).powi(2)).sqrt();
         let v = (to[2] - self.pos[2]).abs();
         self.distance += (h * h + v * v).sqrt();
+        let vertical = if to[2] >= self.pos[2] { self.climb_rate } else { self.descent.rate };
         self.pos = to;
-        trapezoid(h, speed, self.accel).max(trapezoid(v, self.climb_rate, self.accel))
+        trapezoid(h, speed, self.accel).max(trapezoid(v, vertical, self.accel))
+    }
+
+    /// `Land`, and the end of `ReturnToLaunch`: straight down, the last `slow_below`
+    /// metres at the landing speed when the drone lands slower than it descends (as the
+    /// simulator flies it: two legs).
+    pub fn land_here(&mut self) -> f64 {
+        let (x, y, z) = (self.pos[0], self.pos[1], self.pos[2]);
+        let descent = self.descent;
+        if !descent.slows(z) {
+            return self.leg([x, y, 0.0]);
+        }
+        let upper = if z > descent.slow_below { self.leg([x, y, descent.slow_below]) } else { 0.0 };
+        let low = self.pos[2];
+        self.distance += low;
+        self.pos[2] = 0.0;
+        upper + trapezoid(low, descent.land_speed, self.accel)
     }
 
     /// `Orbit`: to the nearest point of the circle, then `laps` turns.
@@ -103,10 +125,10 @@ impl Flyer {
         if !self.airborne {
             return 0.0;
         }
-        let safe = self.pos[2].max(RETURN_ALTITUDE.min(max_altitude.unwrap_or(f64::INFINITY)));
+        let safe = self.pos[2].max(self.return_altitude.min(max_altitude.unwrap_or(f64::INFINITY)));
         let up = self.leg([self.pos[0], self.pos[1], safe]);
         let across = self.leg([self.home[0], self.home[1], safe]);
-        up + across + self.leg([self.home[0], self.home[1], 0.0])
+        up + across + self.return_loiter + self.land_here()
     }
 }
 

@@ -98,7 +98,7 @@ pub fn run(args: &RunArgs) -> u8 {
         },
         None => Box::new(std::io::sink()),
     };
-    let trace = TraceFile::new(out);
+    let trace = TraceFile::new(out, args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default());
     let _ = args.seed; // The simulator has no randomness yet; the seed is kept for it.
     // Any MAVLink drone: the wall clock, and the simulated drones in real time with it.
     let live = !aviary_mavlink::bindings(&world).is_empty();
@@ -187,6 +187,10 @@ pub fn run(args: &RunArgs) -> u8 {
             Some(reason) => outln!("mission {}: {reason}", outcome.status.as_str()),
             None => outln!("mission {}", outcome.status.as_str()),
         }
+    }
+    if let Some(why) = lock(&trace).failed() {
+        eprintln!("aviary: the trace {} is not whole: {why}", args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default());
+        return 3;
     }
     u8::from(outcome.status != Status::Ok)
 }

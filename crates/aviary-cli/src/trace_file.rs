@@ -1,13 +1,22 @@
 //! The trace file: one JSON object per line, each written whole and flushed at once, so a
 //! run cut short (a kill, a crash, a second Ctrl-C) keeps every event before the cut.
+//!
+//! A write that fails (a full disk, `/dev/full`, a closed pipe) is said on stderr at
+//! once, and nothing more is written: a line written after a failed one could follow half
+//! an event. The mission flies on (stopping a fleet in the air because a disk filled up
+//! would be the worse failure), and `aviary run` exits 3 at its end.
 
 use std::io::Write;
 use std::sync::{Arc, Mutex, MutexGuard};
 
 pub struct TraceFile {
     out: Box<dyn Write + Send>,
+    /// Where it goes, for messages.
+    name: String,
     last_t: f64,
     closed: bool,
+    /// The first write error, once one happened.
+    failed: Option<String>,
 }
 
 pub type SharedTrace = Arc<Mutex<TraceFile>>;
@@ -17,18 +26,26 @@ pub fn lock(trace: &SharedTrace) -> MutexGuard<'_, TraceFile> {
 }
 
 impl TraceFile {
-    pub fn new(out: Box<dyn Write + Send>) -> SharedTrace {
-        Arc::new(Mutex::new(TraceFile { out, last_t: 0.0, closed: false }))
+    pub fn new(out: Box<dyn Write + Send>, name: String) -> SharedTrace {
+        Arc::new(Mutex::new(TraceFile { out, name, last_t: 0.0, closed: false, failed: None }))
+    }
+
+    /// Why the trace is not whole, if it is not.
+    pub fn failed(&self) -> Option<&str> {
+        self.failed.as_deref()
     }
 
     pub fn write(&mut self, event: &serde_json::Value) {
-        if self.closed {
+        if self.closed || self.failed.is_some() {
             return;
         }
         // One write of the whole line: a cut never leaves half an event behind.
         let line = format!("{event}\n");
-        let _ = self.out.write_all(line.as_bytes());
-        let _ = self.out.flush();
+        if let Err(e) = self.out.write_all(line.as_bytes()).and_then(|()| self.out.flush()) {
+            eprintln!("\naviary: cannot write the trace {}: {e}; the mission goes on without it, and aviary will exit 3", self.name);
+            self.failed = Some(e.to_string());
+            return;
+        }
         if let Some(t) = event["t"].as_f64() {
             self.last_t = t;
         }

@@ -134,3 +134,16 @@ fn in_the_trace_no_two_airborne_drones_come_closer_than_min_separation() {
     }
     assert!(closest >= 5.0 - 1e-6, "two drones in the air came within {closest} m");
 }
+
+#[test]
+fn a_trace_that_cannot_be_written_is_said_at_once_and_exits_3_after_a_whole_flight() {
+    // /dev/full takes the open and refuses every write, as a full disk does.
+    let (code, out, err) = aviary(&["run", "examples/search_and_rescue.mission", "--trace", "/dev/full"], &repo());
+    assert_eq!(code, 3, "{out}\n{err}");
+    assert!(err.contains("cannot write the trace /dev/full") && err.contains("No space left"), "{err}");
+    // Said once, not once per event.
+    assert_eq!(err.matches("cannot write the trace").count(), 1, "{err}");
+    // The fleet flew the mission to its end all the same.
+    assert!(out.contains("mission ok"), "{out}");
+    assert!(out.lines().filter(|l| l.ends_with("Landed")).count() == 7, "every drone down:\n{out}");
+}

@@ -17,7 +17,7 @@ use crate::cancel::Token as CancellationToken;
 
 use crate::arbiter::{Arbiter, Claims};
 use crate::trace::{Event, Field, Kind};
-use crate::value::{airborne, to_json, Env};
+use crate::value::{to_json, Env};
 use crate::{Outcome, RunOptions, Status, TraceSink};
 
 pub(crate) type Frame = Rc<[Value]>;
@@ -229,13 +229,18 @@ impl<'m> Engine<'m> {
         }
         let ending = self.ending.borrow().clone();
         // Drones still flying go home: at the end of the mission, or as the failsafe.
-        if self.backend_alive.get() {
-            self.all_home().await;
-        }
-        let (status, reason) = match ending {
+        let home = if self.backend_alive.get() { self.all_home().await } else { Default::default() };
+        let (mut status, mut reason) = match ending {
             Some((status, reason)) => (status, Some(reason)),
             None => (Status::Ok, None),
         };
+        // A drone that did not come down safely fails a mission that had ended well; a
+        // fault on the way down that a drone survived is said in the reason all the same.
+        if !home.stranded.is_empty() && status == Status::Ok {
+            status = Status::Failed;
+        }
+        let said: Vec<String> = reason.into_iter().chain(home.stranded).chain(home.notes).collect();
+        reason = (!said.is_empty()).then(|| said.join("; "));
         self.trace(Kind::MissionEnd, || [("status", Field::Str(status.as_str())), ("reason", Field::name(reason.as_deref()))]);
         Outcome { status, reason }
     }
@@ -251,22 +256,6 @@ impl<'m> Engine<'m> {
 
     pub fn root_scope(&self) -> Rc<Scope<'m>> {
         self.root.borrow().clone().expect("the run has a root scope")
-    }
-
-    async fn all_home(&self) {
-        let mut homes = Vec::new();
-        for d in 0..self.m.drones.len() {
-            if airborne(self.backend, d) {
-                homes.push(d);
-            }
-        }
-        let calls = homes.into_iter().map(|d| async move {
-            self.trace(Kind::ApiCall, || [("actor", Field::Str(self.name(d))), ("function", Field::Str("ReturnToLaunch")), ("args", Field::Json(json!([])))]);
-            let pending = self.backend.call(d, "ReturnToLaunch", &[]);
-            let end = pending.end.wait().await.unwrap_or(aviary_api::CallEnd::Interrupted);
-            self.trace_done(d, "ReturnToLaunch", &[], &end);
-        });
-        futures_util::future::join_all(calls).await;
     }
 
     pub fn trace_done(&self, d: DroneId, function: &str, args: &[Value], end: &aviary_api::CallEnd) {
@@ -300,15 +289,19 @@ impl<'m> Engine<'m> {
         }
     }
 
+    /// The next drone event (`None` once the backend has no more).
+    pub(crate) async fn next_event(&self) -> Option<DroneEvent> {
+        std::future::poll_fn(|cx| match self.events.borrow_mut().as_mut() {
+            Some(rx) => rx.poll_recv(cx),
+            None => std::task::Poll::Pending,
+        })
+        .await
+    }
+
     /// Drone events, as they come.
     async fn pump(&self) {
         loop {
-            let event = std::future::poll_fn(|cx| match self.events.borrow_mut().as_mut() {
-                Some(rx) => rx.poll_recv(cx),
-                None => std::task::Poll::Pending,
-            })
-            .await;
-            match event {
+            match self.next_event().await {
                 Some(e) => self.on_event(e),
                 None => std::future::pending().await,
             }

@@ -16,6 +16,7 @@ mod cancel;
 mod control;
 mod engine;
 mod exec;
+mod homing;
 mod instant;
 mod jobs;
 mod join;

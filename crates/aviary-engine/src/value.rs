@@ -119,7 +119,3 @@ pub(crate) fn to_json(m: &Mission, v: &Value) -> Json {
         Value::Actor(d) => json!(m.drones.get(*d)),
     }
 }
-
-pub(crate) fn airborne(backend: &dyn Backend, d: usize) -> bool {
-    backend.telemetry(d).state.airborne()
-}

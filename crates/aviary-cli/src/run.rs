@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use aviary_api::Backend;
 use aviary_diagnostics::{render_text, SourceMap};
-use aviary_engine::{Control, Controller, RunOptions, Status};
+use aviary_engine::{Control, Controller, Outcome, RunOptions, Status};
 use aviary_sim::{Fleet, SimBackend, SimOptions};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -98,7 +98,7 @@ pub fn run(args: &RunArgs) -> u8 {
         },
         None => Box::new(std::io::sink()),
     };
-    let trace = TraceFile::new(out, args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default());
+    let trace = TraceFile::new(out, args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default(), mission.name.clone());
     let _ = args.seed; // The simulator has no randomness yet; the seed is kept for it.
     // Any MAVLink drone: the wall clock, and the simulated drones in real time with it.
     let live = !aviary_mavlink::bindings(&world).is_empty();
@@ -117,7 +117,9 @@ pub fn run(args: &RunArgs) -> u8 {
         }
     };
     let (controller, controls) = Controller::new();
-    on_stop_signals(controller.clone(), trace.clone());
+    // The first stop signal, also seen before the engine runs (while vehicles connect).
+    let (stop_tx, stop_rx) = tokio::sync::watch::channel(None::<&'static str>);
+    on_stop_signals(controller.clone(), stop_tx, trace.clone());
     let server = match args.serve.map(|addr| aviary_server::start(addr, controller.clone())).transpose() {
         Ok(s) => s,
         Err(why) => {
@@ -135,7 +137,21 @@ pub fn run(args: &RunArgs) -> u8 {
     let ran = runtime.block_on(async {
         let sim = SimBackend::start_with(fleet, SimOptions { speed: args.speed, ..SimOptions::default() });
         let mixed = match &world {
-            Some(world) => Some(crate::mixed::Mixed::new(sim.clone(), aviary_mavlink::connect(world, aviary_mavlink::Tuning::default()).await?)),
+            Some(world) => {
+                let mut stop = stop_rx.clone();
+                // A stop while the vehicles connect is answered at once: nothing has
+                // flown, so there is nothing to bring home.
+                let connected = tokio::select! {
+                    connected = aviary_mavlink::connect(world, aviary_mavlink::Tuning::default()) => connected?,
+                    by = stop.wait_for(Option::is_some) => {
+                        let by = by.ok().and_then(|b| *b).unwrap_or("a stop signal");
+                        let reason = format!("stopped by {by} while the vehicles connected; nothing flew");
+                        lock(&trace).close_now(&reason);
+                        return Ok((Outcome { status: Status::Aborted, reason: Some(reason) }, String::new()));
+                    }
+                };
+                Some(crate::mixed::Mixed::new(sim.clone(), connected))
+            }
             None => None,
         };
         // The backends keep what they need of the world: a large fleet's is not held
@@ -201,7 +217,7 @@ pub fn run(args: &RunArgs) -> u8 {
 /// a logout, a service manager): with MAVLink drones, stopping at once would leave them
 /// without a ground station. A second signal of any of the three stops at once, still
 /// closing the trace.
-fn on_stop_signals(controller: Controller, trace: SharedTrace) {
+fn on_stop_signals(controller: Controller, stop: tokio::sync::watch::Sender<Option<&'static str>>, trace: SharedTrace) {
     use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     let mut signals = match signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
         Ok(s) => s,
@@ -222,6 +238,7 @@ fn on_stop_signals(controller: Controller, trace: SharedTrace) {
             if presses == 1 {
                 eprintln!("\naviary: stopping ({by}); the fleet returns home (press Ctrl-C again to stop at once)");
                 controller.send(Control::Abort { reason: format!("interrupted by {by}") });
+                stop.send_replace(Some(by));
             } else {
                 lock(&trace).close_now(&format!("stopped at once by a second {by}"));
                 std::process::exit(130);

@@ -13,6 +13,9 @@ pub struct TraceFile {
     out: Box<dyn Write + Send>,
     /// Where it goes, for messages.
     name: String,
+    /// The mission's name, for a `mission_start` the trace must begin with.
+    mission: String,
+    started: bool,
     last_t: f64,
     closed: bool,
     /// The first write error, once one happened.
@@ -26,8 +29,8 @@ pub fn lock(trace: &SharedTrace) -> MutexGuard<'_, TraceFile> {
 }
 
 impl TraceFile {
-    pub fn new(out: Box<dyn Write + Send>, name: String) -> SharedTrace {
-        Arc::new(Mutex::new(TraceFile { out, name, last_t: 0.0, closed: false, failed: None }))
+    pub fn new(out: Box<dyn Write + Send>, name: String, mission: String) -> SharedTrace {
+        Arc::new(Mutex::new(TraceFile { out, name, mission, started: false, last_t: 0.0, closed: false, failed: None }))
     }
 
     /// Why the trace is not whole, if it is not.
@@ -49,13 +52,22 @@ impl TraceFile {
         if let Some(t) = event["t"].as_f64() {
             self.last_t = t;
         }
+        if event["event"] == "mission_start" {
+            self.started = true;
+        }
         if event["event"] == "mission_end" {
             self.closed = true;
         }
     }
 
-    /// Ends the trace now, from outside the engine (a second Ctrl-C).
+    /// Ends the trace now, from outside the engine (a second Ctrl-C, or a stop before
+    /// the mission started): a trace is whole, from `mission_start` to `mission_end`,
+    /// whenever it is cut.
     pub fn close_now(&mut self, reason: &str) {
+        if !self.started {
+            let start = serde_json::json!({ "t": 0.0, "event": "mission_start", "mission": self.mission });
+            self.write(&start);
+        }
         let end = serde_json::json!({ "t": self.last_t, "event": "mission_end", "status": "aborted", "reason": reason });
         self.write(&end);
     }

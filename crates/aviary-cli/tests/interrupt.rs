@@ -126,3 +126,61 @@ fn a_second_ctrl_c_stops_at_once_and_still_closes_the_trace() {
     assert_eq!((end["event"].as_str(), end["reason"].as_str()), (Some("mission_end"), Some("stopped at once by a second Ctrl-C")));
     assert_eq!(written.iter().filter(|l| l.contains("\"mission_end\"")).count(), 1);
 }
+
+/// A run whose one drone is a MAVLink vehicle that never answers (a UDP address nobody
+/// sends to): it waits up to 15 s for it before the mission starts.
+fn connecting(dir: &std::path::Path) -> Child {
+    let port = std::net::UdpSocket::bind("127.0.0.1:0").expect("a free port").local_addr().expect("addr").port();
+    std::fs::write(dir.join("m.mission"), "MISSION Waiting:\n    d TakeOff WITH 10m\n").expect("mission");
+    std::fs::write(dir.join("m.world.toml"), format!("[site]\norigin = {{ lat = 46.6, lon = 14.2, alt = 440 }}\n[drones.d]\nhome = [0, 0]\nmavlink = \"udp:127.0.0.1:{port}\"\n")).expect("world");
+    Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(["run", "m.mission", "--trace", "t.jsonl"])
+        .current_dir(dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn aviary")
+}
+
+fn wait_at_most(child: &mut Child, limit: Duration) -> std::process::ExitStatus {
+    let start = std::time::Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().expect("wait") {
+            return status;
+        }
+        assert!(start.elapsed() < limit, "still running after {limit:?}");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+#[test]
+fn ctrl_c_while_the_vehicles_connect_stops_at_once_with_a_whole_trace() {
+    let dir = scratch("interrupt_connecting");
+    let mut child = connecting(&dir);
+    std::thread::sleep(Duration::from_millis(800));
+    interrupt(&child);
+    // Not the 15 s the connection would wait.
+    let status = wait_at_most(&mut child, Duration::from_secs(3));
+    assert_eq!(status.code(), Some(1));
+    let out = child.wait_with_output().expect("output");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("mission aborted: stopped by Ctrl-C while the vehicles connected; nothing flew"), "{stdout}");
+    let trace = lines(&dir.join("t.jsonl"));
+    let events: Vec<serde_json::Value> = trace.iter().map(|l| serde_json::from_str(l).expect("JSON")).collect();
+    assert_eq!(events.iter().map(|e| e["event"].as_str().unwrap()).collect::<Vec<_>>(), ["mission_start", "mission_end"]);
+    assert_eq!((events[0]["mission"].as_str(), events[1]["status"].as_str()), (Some("Waiting"), Some("aborted")));
+}
+
+#[test]
+fn two_quick_stops_while_the_vehicles_connect_leave_a_whole_trace() {
+    let dir = scratch("interrupt_connecting_twice");
+    let mut child = connecting(&dir);
+    std::thread::sleep(Duration::from_millis(800));
+    send(&child, "TERM");
+    std::thread::sleep(Duration::from_millis(5));
+    let _ = Command::new("kill").args(["-TERM", &child.id().to_string()]).status();
+    wait_at_most(&mut child, Duration::from_secs(3));
+    let events: Vec<serde_json::Value> = lines(&dir.join("t.jsonl")).iter().map(|l| serde_json::from_str(l).expect("JSON")).collect();
+    let kinds: Vec<&str> = events.iter().map(|e| e["event"].as_str().unwrap()).collect();
+    assert_eq!(kinds, ["mission_start", "mission_end"], "whole, whichever stop came first");
+}

@@ -175,7 +175,12 @@ async fn drive(backend: Weak<SimBackend>, options: SimOptions) {
             let due = Duration::from_secs_f64(ticks as f64 * options.tick / speed);
             let elapsed = wall.elapsed();
             if due > elapsed {
-                std::thread::sleep(due - elapsed);
+                // On the blocking pool, not on this thread: the engine shares it and goes
+                // on with what does not need the clock (an operator's request, a drone
+                // event). A blocking task also holds the paused clock still (tokio does
+                // not advance it while one runs), so simulated time waits for the wall.
+                let wait = due - elapsed;
+                let _ = tokio::task::spawn_blocking(move || std::thread::sleep(wait)).await;
             }
         }
     }

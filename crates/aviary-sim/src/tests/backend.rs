@@ -211,6 +211,37 @@ async fn speed_paces_against_the_wall_clock() {
 }
 
 #[tokio::test(flavor = "current_thread", start_paused = true)]
+async fn pacing_leaves_the_thread_free_and_the_clock_still() {
+    // At a tenth of real time each 0.05 s tick waits 0.5 s of wall time. A message sent
+    // from another thread 20 ms into that wait is taken at once by a task on the same
+    // thread, not when the wait is over; and the simulated clock has not moved meanwhile.
+    let sim = SimBackend::start(
+        &one_drone(),
+        SimOptions {
+            tick: 0.05,
+            speed: Some(0.1),
+        },
+    );
+    let hover = sim.call(0, "Hover", &[num(10.0)]);
+    tokio::time::sleep(Duration::from_millis(60)).await;
+    let (tx, mut rx) = tokio::sync::mpsc::unbounded_channel();
+    let sent = std::time::Instant::now();
+    std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_millis(20));
+        let _ = tx.send(std::time::Instant::now());
+    });
+    let simulated = tokio::time::Instant::now();
+    let at = rx.recv().await.expect("the message");
+    let late = at.elapsed();
+    // Blocked, it would be taken some 450 ms late.
+    assert!(late < Duration::from_millis(200), "taken {late:?} after it was sent");
+    assert!(sent.elapsed() < Duration::from_millis(250), "not after a whole tick's wait: {:?}", sent.elapsed());
+    assert!(tokio::time::Instant::now() - simulated <= Duration::from_millis(50), "the clock moved by at most one tick");
+    sim.interrupt(hover.id, aviary_api::Interrupt::Abort);
+    sim.shutdown().await;
+}
+
+#[tokio::test(flavor = "current_thread", start_paused = true)]
 async fn a_call_done_as_it_is_made_ends_now_and_a_flight_later() {
     let sim = SimBackend::start(&one_drone(), SimOptions::default());
     assert!(matches!(sim.call(0, "Arm", &[]).end, Ending::Now(CallEnd::Done)));

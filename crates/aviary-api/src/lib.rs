@@ -23,7 +23,7 @@ pub use kind::Kind;
 pub use names::Names;
 pub use runtime::*;
 
-/// A part of a drone that one activity at a time may command (LANGUAGE.md §3).
+/// A part of a drone that one activity at a time may command (docs/LANGUAGE.md, section 6).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Resource {
     Motion,
@@ -119,7 +119,7 @@ impl Descriptor {
         }
     }
 
-    /// The minimum set of LANGUAGE.md §4 that every backend offers.
+    /// The functions of docs/LANGUAGE.md, section 19, which every backend offers.
     pub fn standard() -> Descriptor {
         use Kind::*;
         use Resource::*;

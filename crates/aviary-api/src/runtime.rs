@@ -78,7 +78,7 @@ impl Telemetry {
     pub const LOST: Telemetry = Telemetry { position: [0.0; 3], speed: 0.0, heading: 0.0, battery: 0.0, state: FlightState::Lost, link: false };
 }
 
-/// A built-in exception (LANGUAGE.md §3), by the name a mission handles it with.
+/// A built-in exception (docs/LANGUAGE.md, section 17), by the name a mission handles it with.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Failure {
     pub exception: &'static str,
@@ -123,7 +123,7 @@ impl Ending {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct CallId(pub u64);
 
-/// What the engine may do to a call in progress (the leashes of LANGUAGE.md §3).
+/// What the engine may do to a call in progress (the leashes of docs/LANGUAGE.md, section 14).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Interrupt {
     /// Stop it for good; the drone holds where it is. The call ends `Interrupted`.

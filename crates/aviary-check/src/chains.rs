@@ -1,5 +1,5 @@
 //! Signals in time: a `WAITFOR RECEIVED(X)` whose X comes only later in the same
-//! sequence (LANGUAGE.md §7: it can never end), and a handler's `BY` filter on a signal
+//! sequence (docs/LANGUAGE.md, section 9: it can never end), and a handler's `BY` filter on a signal
 //! that no actor ever raises (§7: a handler whose `BY` can never match).
 
 use std::collections::{HashMap, HashSet};

@@ -1,4 +1,4 @@
-//! Geofence and ceiling before flight (LANGUAGE.md §7): every place, area, orbit and
+//! Geofence and ceiling before flight (docs/LANGUAGE.md, section 22): every place, area, orbit and
 //! sweep the mission flies to, where it is known before the run, lies inside the world's
 //! geofence, and every altitude stays under `max_altitude`.
 //!

@@ -1,6 +1,6 @@
 //! `aviary`: check, format (and later run) multi-drone missions.
 //!
-//! Exit codes (RUNTIME.md): 0 success, 1 the files have errors (or `fmt --check` would
+//! Exit codes (README.md): 0 success, 1 the files have errors (or `fmt --check` would
 //! change them), 2 usage or IO problems.
 
 #[macro_use]

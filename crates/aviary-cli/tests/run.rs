@@ -1,5 +1,6 @@
 //! `aviary run` as a user runs it: the paper's mission flies to its end, the trace is
-//! valid against RUNTIME.md's schema line by line, and the same files give the same bytes.
+//! valid against the trace's schema (docs/trace.schema.json) line by line, and the same
+//! files give the same bytes.
 
 mod common;
 

@@ -1,6 +1,6 @@
 //! Text rendering goes through codespan-reporting (the renderer gleam uses); the first
 //! line is ours so that it reads `path:line:col: error[CODE]: message`, the form
-//! RUNTIME.md promises and editors jump to.
+//! docs/DIAGNOSTICS.md describes and editors jump to.
 
 use codespan_reporting::diagnostic as cs;
 use codespan_reporting::term::{self, termcolor};

@@ -26,7 +26,7 @@ pub(crate) struct Made<'m> {
 }
 
 /// Whether a call's ending is remembered with the scope that made it (detection: finds
-/// are raised in the activity that started it, LANGUAGE.md §5).
+/// are raised in the activity that started it, docs/LANGUAGE.md, section 16).
 pub(crate) fn remembers_scope(function: &str) -> bool {
     matches!(function, "StartDetection" | "StopDetection")
 }

@@ -1,4 +1,4 @@
-//! Per-drone resources, first come first served, claimed all at once (LANGUAGE.md §3):
+//! Per-drone resources, first come first served, claimed all at once (docs/LANGUAGE.md, section 6):
 //! a request is granted when none of what it needs is held and no earlier waiting
 //! request needs any of it, so instances never deadlock and never overtake.
 

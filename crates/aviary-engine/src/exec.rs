@@ -20,7 +20,7 @@ use crate::jobs::Jobs;
 use crate::join::{join_eager, SMALL};
 use crate::trace::{Field, Kind};
 
-/// Conditions are looked at again at least this often (LANGUAGE.md §3).
+/// Conditions are looked at again at least this often (docs/LANGUAGE.md, section 7).
 const RECHECK: Duration = Duration::from_millis(100);
 
 impl<'m> Engine<'m> {
@@ -426,7 +426,7 @@ impl<'m> Engine<'m> {
     }
 
     /// A leash on every running activity of `capability` tagged `tag`; recorded even when
-    /// none runs (LANGUAGE.md §3).
+    /// none runs (docs/LANGUAGE.md, section 14).
     pub(crate) fn leash_by_id(&self, capability: usize, tag: usize, action: LeashAction, action_name: &str, values: Vec<(usize, Value)>) {
         let cap = &self.m.capabilities[capability];
         self.trace(Kind::Leash, || [("capability", Field::Str(&cap.name)), ("tag", Field::Str(&self.m.tags[tag])), ("action", Field::Str(action_name))]);

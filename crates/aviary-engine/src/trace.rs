@@ -7,7 +7,7 @@
 use serde::ser::{Serialize, SerializeMap, Serializer};
 use serde_json::{Map, Value as Json};
 
-/// The kinds of trace event (RUNTIME.md), so that what a sink wants is asked once per
+/// The kinds of trace event (docs/TRACE.md), so that what a sink wants is asked once per
 /// kind when the run starts, not at every event.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
@@ -110,7 +110,7 @@ impl Event<'_> {
         self.fields.iter().find(|(k, _)| *k == key).map(|(_, v)| v)
     }
 
-    /// The JSON object of the trace format (RUNTIME.md): `t`, `event`, then the fields.
+    /// The JSON object of the trace format (docs/TRACE.md): `t`, `event`, then the fields.
     pub fn to_json(&self) -> Json {
         let mut object = Map::with_capacity(self.fields.len() + 2);
         object.insert("t".into(), Json::from(self.t));

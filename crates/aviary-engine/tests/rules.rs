@@ -1,4 +1,4 @@
-//! One trace-based test per rule of LANGUAGE.md §3, asserting order and timing, on the
+//! One trace-based test per rule of the language's semantics (docs/LANGUAGE.md), asserting order and timing, on the
 //! built-in simulator with a paused clock (so every time below is simulated seconds).
 
 mod harness;

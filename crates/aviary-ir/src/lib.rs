@@ -98,7 +98,7 @@ pub struct Capability {
     pub sections: Vec<(String, Block)>,
     pub exception_handlers: Vec<ExceptionHandler>,
     /// Every resource of every `BY` actor that the body can use, through the capabilities
-    /// it calls: what a statement claims when it starts (LANGUAGE.md §3).
+    /// it calls: what a statement claims when it starts (docs/LANGUAGE.md, section 6).
     pub claims: Vec<(usize, Resource)>,
 }
 
@@ -280,8 +280,8 @@ pub enum Compare {
 
 impl Compare {
     /// Whether `a op b` holds. Numbers compare as numbers; anything else only by equality,
-    /// where a symbol and a string are equal when they spell the same (LANGUAGE.md:
-    /// symbols only equal themselves). The engine and the pre-flight plan both decide
+    /// where a symbol and a string are equal when they spell the same (docs/LANGUAGE.md,
+    /// section 3: symbols only equal themselves). The engine and the pre-flight plan both decide
     /// conditions with it.
     pub fn holds(self, a: &Value, b: &Value) -> bool {
         if let (Value::Number(x), Value::Number(y)) = (a, b) {

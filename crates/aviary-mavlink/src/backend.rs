@@ -134,7 +134,7 @@ impl Inner {
 }
 
 impl Inner {
-    /// RUNTIME.md's battery rule, on the charge the vehicle reports: with `need` the share
+    /// The battery rule of docs/WORLD.md, on the charge the vehicle reports: with `need` the share
     /// of a full battery it takes to fly home at `max_speed` and descend at `climb_rate`,
     /// `BatteryLow` under `2 × need + 10 %`, `BatteryCritical` under `need + 10 %`.
     fn battery_rule(&self, drone: DroneId, c: &Craft) {

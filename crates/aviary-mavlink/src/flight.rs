@@ -1,4 +1,4 @@
-//! The middle-layer functions (LANGUAGE.md §4) as MAVLink exchanges. Every wait has a
+//! The middle-layer functions (docs/LANGUAGE.md, section 19) as MAVLink exchanges. Every wait has a
 //! limit, from the tuning or from the distance to fly, so a silent vehicle ends a call
 //! with `Timeout` and never hangs the mission.
 

@@ -1,4 +1,4 @@
-//! What each middle-layer function does when called (LANGUAGE.md §4).
+//! What each middle-layer function does when called (docs/LANGUAGE.md, section 19).
 
 use aviary_api::{CallId, DroneId, Failure, FlightState, Value};
 

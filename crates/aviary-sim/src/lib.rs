@@ -148,7 +148,7 @@ mod tests;
 
 pub use backend::{SimBackend, SimOptions};
 
-/// What the simulator offers: the standard middle layer (LANGUAGE.md §4). The checker
+/// What the simulator offers: the standard middle layer (docs/LANGUAGE.md, section 19). The checker
 /// reads this before a run, so a function the simulator added would be known to it.
 pub fn descriptor() -> aviary_api::Descriptor {
     aviary_api::Descriptor::standard()

@@ -1,6 +1,6 @@
 //! Turns physical lines into logical lines with NEWLINE, INDENT and DEDENT tokens.
 //!
-//! Two things join physical lines (LANGUAGE.md §1): a header that starts with MISSION,
+//! Two things join physical lines (docs/LANGUAGE.md, section 2): a header that starts with MISSION,
 //! CAPABILITY, SEQUENTIAL, PARALLEL or ON and does not end in `:` continues over the
 //! deeper lines after it up to one that ends in `:`; and inside `( )` a line break is
 //! free. Both only ever join lines indented deeper than the first, and a header joins

@@ -1,5 +1,5 @@
 //! Conflicting commands: two mission-level statements that may run at once and claim the
-//! same resource of the same drone. The second to start waits (LANGUAGE.md §3).
+//! same resource of the same drone. The second to start waits (docs/LANGUAGE.md, section 6).
 //!
 //! May-run-in-parallel comes from the block structure: two statements are compared at
 //! the construct where their paths part. Parallel branches, parallel `FOR` instances and

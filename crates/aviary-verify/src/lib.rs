@@ -1,4 +1,4 @@
-//! Pre-flight analyses of a compiled mission (LANGUAGE.md §7): conflicting commands
+//! Pre-flight analyses of a compiled mission (docs/LANGUAGE.md, section 22): conflicting commands
 //! (W203, N303) and the energy and time plan (W204, `aviary check --plan`).
 //!
 //! Invariant: no IO. They run on the IR, after the checker found no error, so names are

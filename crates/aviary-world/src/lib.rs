@@ -1,5 +1,5 @@
 //! The world file: the site, places, areas, drones, sensors and (for the simulator)
-//! targets and faults that a mission runs in. See `RUNTIME.md`, "World file (TOML)".
+//! targets and faults that a mission runs in. Every key is in docs/WORLD.md.
 //!
 //! Invariants:
 //! - Pure: this crate does no IO. [`parse_world`] takes the text; the CLI reads the file.

@@ -1,4 +1,4 @@
-//! The engine benchmark W(N, K) of `../shared/anchors/README.md`, written in the
+//! The engine benchmark W(N, K) of docs/BENCHMARKS.md, written in the
 //! language: N actors start in parallel; each runs K instant steps, each step a
 //! capability instance of its own that the actor waits for; each actor then raises
 //! `Done` carrying its index, and one mission-level `ON EVERY Done` handler takes every

@@ -1,5 +1,5 @@
 //! `aviary bench w --n N --k K`: the engine benchmark W(N, K) of
-//! `../shared/anchors/README.md`, written in the language
+//! docs/BENCHMARKS.md, written in the language
 //! (`aviary_check::generate::w_mission`) and run through the whole pipeline.
 //! The sink checks from the trace that the work was done: N `Done` signals, each taken
 //! by the handler, whose indices sum to N(N-1)/2 (and, with `--full-trace`, N·K steps

@@ -1,4 +1,4 @@
-//! Each middle-layer function's cost in the estimate (LANGUAGE.md §4), as the simulator
+//! Each middle-layer function's cost in the estimate (docs/LANGUAGE.md, section 19), as the simulator
 //! flies it.
 
 use aviary_api::{DroneId, Value};

@@ -23,7 +23,8 @@
 //!   a home's z is ignored) at the start.
 //! - A move is a chain of legs flown from rest to rest: straight lines over the ground at
 //!   up to the speed asked (at most `max_speed`) with, at the same time, a vertical move at
-//!   up to `climb_rate`; each axis follows a trapezoidal speed profile (accelerate and
+//!   up to `climb_rate` (up) or `descent_rate` (down), and a landing's last
+//!   `land_speed_below` metres at `land_speed`; each axis follows a trapezoidal speed profile (accelerate and
 //!   brake at most `acceleration`). A path (`Sweep`, `FollowPath`, `ReturnToLaunch`) stops
 //!   at each corner. Orbits fly clockwise at up to `max_speed`, slow enough that the
 //!   centripetal acceleration stays within half of `acceleration`.
@@ -38,7 +39,8 @@
 //! # Functions
 //! `Arm`/`Disarm` (landed only), `TakeOff(alt)` (armed; or, in the air, a climb or
 //! descent to `alt`), `Land` (lands and disarms), `ReturnToLaunch` (climbs to at least
-//! 10 m, or the site's `max_altitude` if lower, flies home and lands; done at once when
+//! `return_altitude`, or the site's `max_altitude` if lower, flies home, waits
+//! `return_loiter` above home and lands; done at once when
 //! landed at home), `FlyToPosition(pos[, speed])` (a position without z keeps the
 //! altitude), `DescendTo(alt)`/`AscendTo(alt)` (either direction), `Hover(duration)`
 //! (also on the ground, as a wait), `Orbit(center, radius[, laps])` (from the nearest point
@@ -109,7 +111,8 @@
 //! emergency landing), is not timed.
 //!
 //! # Battery and faults
-//! With `need` = (distance home / `max_speed` + altitude / `climb_rate`) / `endurance`,
+//! With `need` = the time home (`aviary_api::flight::time_home`: the distance at
+//! `max_speed`, the wait above home and the landing) / `endurance`,
 //! `BatteryLow` is signalled once when the charge falls under `2 × need + 10 %`, and
 //! `BatteryCritical` raised once under `need + 10 %` (ending the drone's calls in
 //! progress `Interrupted`); at zero the drone falls (`Lost`, `DroneLost`). The world's

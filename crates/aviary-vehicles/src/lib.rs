@@ -18,20 +18,27 @@
 //! `crash` says "Crash: ..." and turns the state to EMERGENCY.
 
 mod autopilot;
+mod client;
 mod commands;
+mod dispatch;
+mod guided;
+mod params;
+mod reports;
 mod server;
 mod telemetry;
+mod udp;
+mod wire;
 
 use std::net::SocketAddr;
 use std::sync::{Arc, Mutex};
 
 use aviary_world::World;
 use tokio::net::{TcpListener, UdpSocket};
-use tokio::sync::broadcast;
 use tokio::task::JoinHandle;
 
 pub use autopilot::Behaviour;
 pub use server::{parse_listen, Listen};
+pub use udp::{MAX_PEERS, PEER_EXPIRY};
 
 #[derive(Clone, Copy, Debug)]
 pub struct Options {
@@ -59,7 +66,7 @@ pub struct Vehicles {
     /// Each drone's MAVLink system id, in world order.
     pub systems: Vec<u8>,
     tasks: Vec<JoinHandle<()>>,
-    clients: server::Clients,
+    clients: Arc<client::Registry>,
 }
 
 /// Binds `listen` and starts serving `world`'s drones. Call inside a tokio runtime with
@@ -68,44 +75,37 @@ pub async fn serve(world: &World, listen: Listen, options: Options) -> std::io::
     let ap = autopilot::Autopilot::new(world, options.behaviour);
     let systems = ap.copters.iter().map(|c| c.system).collect();
     let ap = Arc::new(Mutex::new(ap));
-    let (out, _) = broadcast::channel(4096);
     let speed = if options.speed.is_finite() && options.speed > 0.0 {
         options.speed
     } else {
         1.0
     };
-    let pace = tokio::spawn(server::pace(Arc::clone(&ap), out.clone(), 0.05, speed));
-    let clients = server::Clients::default();
+    let clients = Arc::new(client::Registry::default());
     let (address, serve) = match listen {
         Listen::Tcp(addr) => {
             let listener = TcpListener::bind(addr).await?;
             let address = listener.local_addr()?;
-            (
-                address,
-                tokio::spawn(server::tcp(
-                    listener,
-                    ap,
-                    out,
-                    options.signing_key,
-                    Arc::clone(&clients),
-                )),
-            )
+            let task = server::tcp(
+                listener,
+                Arc::clone(&ap),
+                Arc::clone(&clients),
+                options.signing_key,
+            );
+            (address, tokio::spawn(task))
         }
         Listen::Udp(addr) => {
             let socket = UdpSocket::bind(addr).await?;
             let address = socket.local_addr()?;
-            (
-                address,
-                tokio::spawn(server::udp(
-                    socket,
-                    ap,
-                    out,
-                    options.signing_key,
-                    Arc::clone(&clients),
-                )),
-            )
+            let task = udp::udp(
+                socket,
+                Arc::clone(&ap),
+                Arc::clone(&clients),
+                options.signing_key,
+            );
+            (address, tokio::spawn(task))
         }
     };
+    let pace = tokio::spawn(server::pace(ap, Arc::clone(&clients), 0.05, speed));
     Ok(Vehicles {
         address,
         systems,
@@ -115,17 +115,19 @@ pub async fn serve(world: &World, listen: Listen, options: Options) -> std::io::
 }
 
 impl Vehicles {
+    /// Stops serving: the listener, the simulation and every client's connection close,
+    /// as a killed process's would.
     pub fn stop(&self) {
         for t in &self.tasks {
             t.abort();
         }
-        for c in self
-            .clients
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .iter()
-        {
+        for c in self.clients.all() {
             c.abort();
         }
+    }
+
+    /// The ground stations connected now (TCP connections, UDP peers heard lately).
+    pub fn clients(&self) -> usize {
+        self.clients.len()
     }
 }

@@ -2,7 +2,9 @@
 //! SET_MODE and REQUEST_DATA_STREAM are deprecated, but pymavlink's `set_mode`, MAVProxy
 //! and older ground stations still send them, and ArduPilot still takes them.
 
-use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavCmd, MavMessage, MavResult};
+use aviary_mavlink::mavlink::dialects::ardupilotmega::{
+    MavCmd, MavMessage, MavResult, FILE_TRANSFER_PROTOCOL_DATA,
+};
 
 use crate::autopilot::{ack, Autopilot, Reply, To};
 use crate::client::Client;
@@ -73,6 +75,7 @@ pub fn dispatch(
         MavMessage::PARAM_REQUEST_LIST(r) => (r.target_system, Some(r.target_component), None),
         MavMessage::PARAM_REQUEST_READ(r) => (r.target_system, Some(r.target_component), None),
         MavMessage::PARAM_SET(r) => (r.target_system, Some(r.target_component), None),
+        MavMessage::FILE_TRANSFER_PROTOCOL(f) => (f.target_system, Some(f.target_component), None),
         _ => return Vec::new(),
     };
     let mut out = Vec::new();
@@ -114,6 +117,9 @@ pub fn dispatch(
             (MavMessage::PARAM_REQUEST_READ(r), _) => {
                 out.extend(ap.param_read(i, r.param_id.to_str().unwrap_or(""), r.param_index));
             }
+            (MavMessage::FILE_TRANSFER_PROTOCOL(f), _) => {
+                out.push(Reply::asker(me, ftp_refusal(&f.payload, from)));
+            }
             (MavMessage::PARAM_SET(r), _) => {
                 out.extend(ap.param_set(i, r.param_id.to_str().unwrap_or(""), r.param_value));
             }
@@ -121,6 +127,29 @@ pub fn dispatch(
         }
     }
     out
+}
+
+/// The vehicle has no files (AUTOPILOT_VERSION does not claim MAVLink FTP): every FTP
+/// request is answered, as the FTP protocol asks of a server without an operation, by a
+/// NAK with ERR_UnknownCommand, so that a ground station that tries FTP first (MAVProxy,
+/// for the parameters) falls back at once instead of waiting for its timeouts.
+fn ftp_refusal(request: &[u8; 251], from: (u8, u8)) -> MavMessage {
+    const NAK: u8 = 129;
+    const ERR_UNKNOWN_COMMAND: u8 = 7;
+    let seq = u16::from_le_bytes([request[0], request[1]]).wrapping_add(1);
+    let mut payload = [0u8; 251];
+    payload[..2].copy_from_slice(&seq.to_le_bytes());
+    payload[2] = request[2]; // session
+    payload[3] = NAK;
+    payload[4] = 1; // size of the data: the error code
+    payload[5] = request[3]; // the opcode refused
+    payload[12] = ERR_UNKNOWN_COMMAND;
+    MavMessage::FILE_TRANSFER_PROTOCOL(FILE_TRANSFER_PROTOCOL_DATA {
+        target_network: 0,
+        target_system: from.0,
+        target_component: from.1,
+        payload,
+    })
 }
 
 /// MAV_CMD_SET_MESSAGE_INTERVAL for this client's link (as ArduPilot's, per link): an

@@ -45,6 +45,9 @@ impl Autopilot {
         let c = &self.copters[i];
         let (polygon, ceiling) = self.fence;
         let mut t = vec![
+            // 1, "all": the simulated vehicle makes every pre-arm check it has (boot, the
+            // GPS fix and position estimate, an armable mode); none can be skipped.
+            param("ARMING_CHECK", MAV_PARAM_TYPE_INT32, 1.0),
             // FENCE_TYPE's bits: 1 altitude limit, 4 polygon.
             param(
                 "FENCE_ENABLE",

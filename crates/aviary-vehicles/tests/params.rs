@@ -89,6 +89,7 @@ async fn the_list_reads_and_sets_answer_as_arducopter() {
         ("FENCE_ENABLE", (1.0, MAV_PARAM_TYPE_INT8)),
         ("FENCE_TYPE", (1.0, MAV_PARAM_TYPE_INT8)),
         ("FENCE_ALT_MAX", (60.0, MAV_PARAM_TYPE_REAL32)),
+        ("ARMING_CHECK", (1.0, MAV_PARAM_TYPE_INT32)),
     ] {
         assert_eq!(by_name.get(id), Some(&want), "{id}");
     }

@@ -1,6 +1,6 @@
 //! Commands and requests answered as ArduCopter answers them: ACKs addressed to the
 //! asker, UNSUPPORTED for unknown commands, AUTOPILOT_VERSION, HOME_POSITION and the
-//! health a ground station arms by.
+//! health a ground station arms by, FTP refused at once.
 
 mod common;
 
@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
     GpsFixType, MavCmd, MavMessage, MavProtocolCapability as Cap, MavResult,
-    MavSysStatusSensor as S, COMMAND_INT_DATA, COMMAND_LONG_DATA,
+    MavSysStatusSensor as S, COMMAND_INT_DATA, COMMAND_LONG_DATA, FILE_TRANSFER_PROTOCOL_DATA,
 };
 use aviary_mavlink::mavlink::{calculate_crc, MAVLinkV2MessageRaw, MavHeader, Message};
 use aviary_mavlink::Origin;
@@ -311,5 +311,50 @@ async fn home_gps_and_health_turn_ready_at_the_pre_arm_time() {
         )
         .await;
     assert_eq!(ack.result, MavResult::MAV_RESULT_DENIED);
+    vehicles.stop();
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn ftp_requests_are_refused_at_once() {
+    let vehicles = serve(&fleet(1, ""), 5.0, quick()).await;
+    let mut gcs = Gcs::connect(vehicles.address).await;
+    // OpenFileRO of MAVProxy's parameter file, sequence 41, session 3.
+    let mut payload = [0u8; 251];
+    payload[..2].copy_from_slice(&41u16.to_le_bytes());
+    payload[2] = 3;
+    payload[3] = 4;
+    let path = b"@PARAM/param.pck";
+    payload[4] = path.len() as u8;
+    payload[12..12 + path.len()].copy_from_slice(path);
+    gcs.send(&MavMessage::FILE_TRANSFER_PROTOCOL(
+        FILE_TRANSFER_PROTOCOL_DATA {
+            target_network: 0,
+            target_system: 1,
+            target_component: 1,
+            payload,
+        },
+    ))
+    .await;
+    let nak = gcs
+        .wait(1, SECOND, |m| match m {
+            MavMessage::FILE_TRANSFER_PROTOCOL(f) => Some(f.clone()),
+            _ => None,
+        })
+        .await
+        .expect("an FTP answer");
+    assert_eq!((nak.target_system, nak.target_component), (255, 190));
+    let p = nak.payload;
+    // Sequence 42, session 3, NAK (129) of OpenFileRO (4), one byte: ERR_UnknownCommand.
+    assert_eq!(
+        (
+            u16::from_le_bytes([p[0], p[1]]),
+            p[2],
+            p[3],
+            p[4],
+            p[5],
+            p[12]
+        ),
+        (42, 3, 129, 1, 4, 7)
+    );
     vehicles.stop();
 }

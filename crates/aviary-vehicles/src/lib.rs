@@ -2,20 +2,31 @@
 //!
 //! Every drone of a world becomes its own MAVLink system (its `system_id`, or its place
 //! in the world: 1, 2, ...), component 1, with the behaviour of an ArduCopter-like
-//! autopilot (`autopilot`): HEARTBEAT with the ArduCopter mode number and the system
-//! state (BOOT, then as ArduCopter: STANDBY on the ground, ACTIVE in the air, CRITICAL
-//! after a failsafe), the command protocol with COMMAND_ACK
-//! and STATUSTEXT reasons (arm with pre-arm checks, NAV_TAKEOFF only in GUIDED, LAND,
-//! RTL, DO_SET_MODE and SET_MODE, DO_CHANGE_SPEED, DO_REPOSITION, DO_GRIPPER,
-//! SET_MESSAGE_INTERVAL), SET_POSITION_TARGET_GLOBAL_INT in GUIDED, and the telemetry
-//! streams (`telemetry`). Underneath is the same [`aviary_sim::Fleet`] as `aviary run`,
-//! stepped in whole 0.05 s ticks at `speed` times real time.
+//! autopilot, checked against ArduCopter SITL (docs/REAL_DRONES.md lists it all):
+//! - `autopilot`, `guided`, `commands`: modes, arming with pre-arm checks, the command
+//!   protocol (COMMAND_ACK addressed to the asker, the reason first as STATUSTEXT,
+//!   UNSUPPORTED for anything else, `wire` for command numbers the dialect has no name
+//!   for), DO_REPOSITION in every global frame ArduCopter takes, GUIDED targets.
+//! - `telemetry`, `reports`: HEARTBEAT and the streams (SYS_STATUS with the health bits
+//!   ground stations arm by, GPS_RAW_INT, GLOBAL_POSITION_INT, BATTERY_STATUS,
+//!   EKF_STATUS_REPORT, EXTENDED_SYS_STATE, HOME_POSITION), AUTOPILOT_VERSION.
+//! - `params`: the parameter protocol over what the simulated vehicle uses, under
+//!   ArduCopter's names (WPNAV_SPEED settable, the rest read-only).
+//! - `dispatch`: which vehicles a message is for, and who gets each answer.
+//! - `client`, `server`, `udp`: one queue, one set of stream rates and one sequence per
+//!   vehicle for each client (TCP connection or UDP peer); heartbeats never dropped,
+//!   telemetry coalesced for a lagging client; accept errors survived, silent UDP peers
+//!   expired.
 //!
-//! Not simulated: parameters, missions (MISSION_ITEM), RC input, manual modes (STABILIZE
-//! is accepted and does nothing), more than one component per vehicle. A world
-//! `link_loss` fault silences the drone (no messages either way) for its duration; a
-//! `battery_critical` fault is ArduCopter's battery failsafe (STATUSTEXT, then RTL); a
-//! `crash` says "Crash: ..." and turns the state to EMERGENCY.
+//! Underneath is the same [`aviary_sim::Fleet`] as `aviary run`, stepped in whole 0.05 s
+//! ticks at `speed` times real time.
+//!
+//! Not simulated: missions (MISSION_ITEM), fences and rally points as missions, MAVLink
+//! FTP (refused at once), RC input, manual modes (STABILIZE is accepted and does
+//! nothing), more than one component per vehicle. A world `link_loss` fault silences the
+//! drone (no messages either way) for its duration; a `battery_critical` fault is
+//! ArduCopter's battery failsafe (STATUSTEXT, then RTL); a `crash` says "Crash: ..." and
+//! turns the state to EMERGENCY.
 
 mod autopilot;
 mod client;

@@ -109,6 +109,9 @@ impl Autopilot {
                     Some((3 | 6, _, _, z)) => z,
                     Some(_) => return Answer::of(MAV_RESULT_DENIED),
                 };
+                if !alt.is_finite() {
+                    return Answer::of(MAV_RESULT_DENIED);
+                }
                 if self.copters[i].mode != COPTER_GUIDED {
                     return refused("Takeoff: not in GUIDED mode");
                 }

@@ -98,7 +98,8 @@ pub fn dispatch(
             (MavMessage::SET_POSITION_TARGET_GLOBAL_INT(t), _) => {
                 // Ignored outside GUIDED, on the ground, or in a frame that is not global,
                 // silently, as ArduCopter does.
-                if let Some(z) = ap.frame_z(t.coordinate_frame as u32, t.alt) {
+                let z = ap.frame_z(t.coordinate_frame as u32, t.alt);
+                if let Some(z) = z.filter(|z| z.is_finite()) {
                     let _ = ap.goto(i, t.lat_int, t.lon_int, z);
                 }
             }

@@ -77,7 +77,9 @@ impl Autopilot {
             return Answer::of(MAV_RESULT_DENIED);
         }
         let (lat, lon, z) = at;
-        if lat.unsigned_abs() > 900_000_000 || lon.unsigned_abs() > 1_800_000_000 {
+        // A height that is not a number is no place to fly to.
+        if lat.unsigned_abs() > 900_000_000 || lon.unsigned_abs() > 1_800_000_000 || !z.is_finite()
+        {
             return Answer::of(MAV_RESULT_DENIED);
         }
         let Some(z) = self.frame_z(frame, z) else {

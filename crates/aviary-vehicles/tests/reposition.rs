@@ -135,13 +135,18 @@ async fn do_reposition_flies_in_every_global_frame_and_is_refused_as_arducopter_
     );
     arrives(&mut gcs, 0.0, 0.0, 15.0).await;
 
-    // Refused: a local frame (with ArduPilot's words), a latitude out of range.
+    // Refused: a local frame (with ArduPilot's words), a latitude out of range, a height
+    // that is not a number.
     assert_eq!(
         reposition(&mut gcs, 1, 0.0, (north.0, north.1, 10.0)).await,
         MAV_RESULT_DENIED
     );
     assert_eq!(
         reposition(&mut gcs, 6, 0.0, (950_000_000, north.1, 10.0)).await,
+        MAV_RESULT_DENIED
+    );
+    assert_eq!(
+        reposition(&mut gcs, 6, 0.0, (north.0, north.1, f32::NAN)).await,
         MAV_RESULT_DENIED
     );
     // Outside GUIDED: refused, unless asked to change mode (MAVSDK and MAVProxy ask).

@@ -157,7 +157,7 @@ async fn a_flood_of_commands_is_answered_to_its_sender_alone_and_heartbeats_go_o
         );
         let gaps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
         assert!(
-            gaps.iter().all(|g| *g < 1.5),
+            gaps.iter().all(|g| *g < 2.0),
             "watcher: heartbeats of {system} at {t:?} (flood sent by {flooded:.1} s)"
         );
         // The flooder's heartbeats waited behind its answers, but none was lost...

@@ -301,7 +301,8 @@ async fn home_gps_and_health_turn_ready_at_the_pre_arm_time() {
             n += 1;
         }
     }
-    assert!((6..=9).contains(&n), "{n} HOME_POSITION in 1.5 s at 5 Hz");
+    // 7 or 8 on an idle machine; a loaded one may pace a tick late.
+    assert!((5..=9).contains(&n), "{n} HOME_POSITION in 1.5 s at 5 Hz");
     // A message the vehicle does not send has no rate.
     let ack = gcs
         .command(

@@ -3,14 +3,16 @@
 //! targets, and the telemetry messages. No IO and no clock: the server feeds it
 //! messages and simulated seconds, and sends what it returns.
 
-use aviary_api::{CallEnd, CallId, DroneEvent, FlightState, Point, Value};
+use aviary_api::{CallEnd, CallId, DroneEvent, FlightState, Value};
 use aviary_mavlink::geo::Origin;
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
     MavCmd, MavMessage, MavResult, MavSeverity, COMMAND_ACK_DATA, STATUSTEXT_DATA,
 };
-use aviary_mavlink::mode::{COPTER_BRAKE, COPTER_GUIDED, COPTER_LAND, COPTER_LOITER, COPTER_RTL};
+use aviary_mavlink::mode::COPTER_RTL;
 use aviary_sim::{Fleet, Report};
 use aviary_world::World;
+
+use crate::wire::Wire;
 
 /// How the simulated autopilots behave.
 #[derive(Clone, Copy, Debug)]
@@ -37,19 +39,58 @@ pub struct Copter {
     /// A failsafe has triggered (HEARTBEAT says CRITICAL from then on).
     pub failsafe: bool,
     /// The motion call in progress (a new command replaces it).
-    call: Option<CallId>,
+    pub(crate) call: Option<CallId>,
+    /// The speed of GUIDED flights now (DO_CHANGE_SPEED), m/s.
     pub(crate) speed: f64,
+    /// WPNAV_SPEED, m/s: the speed GUIDED flights start with.
+    pub(crate) wpnav_speed: f64,
     pub(crate) max_speed: f64,
-    target: Option<[f64; 3]>,
+    pub(crate) climb_rate: f64,
+    pub(crate) acceleration: f64,
+    pub(crate) target: Option<[f64; 3]>,
+    /// Home is set (the GPS has its fix): HOME_POSITION can be sent.
+    pub(crate) home_set: bool,
+    /// The world's home, local metres.
+    pub(crate) home: [f64; 2],
     pub(crate) payload: Option<String>,
     was_airborne: bool,
 }
 
 /// A message for the ground stations, from one vehicle.
-#[derive(Clone)]
+#[derive(Clone, Debug)]
 pub struct Out {
     pub system: u8,
-    pub msg: MavMessage,
+    pub msg: Wire,
+}
+
+/// Who gets an answer: the client that asked (ACKs, reads, requested messages) or every
+/// client (what ArduPilot sends on all links: STATUSTEXT, a changed parameter, a new home).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum To {
+    Asker,
+    All,
+}
+
+#[derive(Clone, Debug)]
+pub struct Reply {
+    pub to: To,
+    pub out: Out,
+}
+
+impl Reply {
+    pub fn asker(system: u8, msg: impl Into<Wire>) -> Reply {
+        Reply {
+            to: To::Asker,
+            out: Out {
+                system,
+                msg: msg.into(),
+            },
+        }
+    }
+
+    pub fn all(out: Out) -> Reply {
+        Reply { to: To::All, out }
+    }
 }
 
 pub struct Autopilot {
@@ -57,11 +98,11 @@ pub struct Autopilot {
     pub origin: Origin,
     pub copters: Vec<Copter>,
     pub(crate) behaviour: Behaviour,
-    /// GLOBAL_POSITION_INT per second, as the ground station last asked.
-    pub position_hz: f64,
+    /// The site's geofence and altitude limit, which the simulator enforces.
+    pub(crate) fence: (bool, Option<f64>),
 }
 
-const STABILIZE: u32 = 0;
+pub(crate) const STABILIZE: u32 = 0;
 
 impl Autopilot {
     /// Every drone of the world, with its `system_id` when it has one, else its place
@@ -84,8 +125,13 @@ impl Autopilot {
                     failsafe: false,
                     call: None,
                     speed: d.max_speed,
+                    wpnav_speed: d.max_speed,
                     max_speed: d.max_speed,
+                    climb_rate: d.climb_rate,
+                    acceleration: d.acceleration,
                     target: None,
+                    home_set: false,
+                    home: [d.home[0], d.home[1]],
                     payload: d.payload.first().cloned(),
                     was_airborne: false,
                 }
@@ -105,7 +151,7 @@ impl Autopilot {
             origin,
             copters,
             behaviour,
-            position_hz: 4.0,
+            fence: (world.site.geofence.is_some(), world.site.max_altitude),
         }
     }
 
@@ -113,8 +159,16 @@ impl Autopilot {
         self.fleet.time() < self.behaviour.boot_time
     }
 
-    pub fn index(&self, system: u8) -> Option<usize> {
-        self.copters.iter().position(|c| c.system == system)
+    /// The pre-arm checks pass (GPS fix and position estimate) from this time on.
+    pub fn ready(&self) -> bool {
+        self.fleet.time() >= self.behaviour.prearm_time
+    }
+
+    /// The drone's flight state (Lost when the simulator has no such drone).
+    pub(crate) fn state(&self, i: usize) -> FlightState {
+        self.fleet
+            .telemetry(i)
+            .map_or(FlightState::Lost, |t| t.state)
     }
 
     /// Whether the drone's radio works (a world `link_loss` fault silences it).
@@ -122,7 +176,8 @@ impl Autopilot {
         self.fleet.telemetry(i).is_some_and(|t| t.link)
     }
 
-    /// Advances the simulation; returns the STATUSTEXTs that tell what happened.
+    /// Advances the simulation; returns what every client is told: the STATUSTEXTs that
+    /// say what happened, and HOME_POSITION once home is set.
     pub fn step(&mut self, dt: f64) -> Vec<Out> {
         let mut out = Vec::new();
         for report in self.fleet.step(dt) {
@@ -170,6 +225,20 @@ impl Autopilot {
                 Report::Event(_) => {}
             }
         }
+        if self.ready() {
+            // The GPS has its fix: home is set, and said, as ArduCopter does.
+            for i in 0..self.copters.len() {
+                if !self.copters[i].home_set {
+                    self.copters[i].home_set = true;
+                    if let Some(home) = self.home_position(i) {
+                        out.push(Out {
+                            system: self.copters[i].system,
+                            msg: home.into(),
+                        });
+                    }
+                }
+            }
+        }
         for (i, c) in self.copters.iter_mut().enumerate() {
             let state = self
                 .fleet
@@ -204,88 +273,6 @@ impl Autopilot {
             Some(_) => Ok(()),
         }
     }
-
-    /// Flies to a GUIDED target (SET_POSITION_TARGET_GLOBAL_INT, DO_REPOSITION). The same
-    /// target again, while it is being flown to, changes nothing.
-    pub fn goto(&mut self, i: usize, lat: i32, lon: i32, z: f64) -> Result<(), String> {
-        let xy = self.origin.from_e7(lat, lon);
-        let to = [xy[0], xy[1], z];
-        let c = &self.copters[i];
-        if c.mode != COPTER_GUIDED {
-            return Err("position target ignored: not in GUIDED".into());
-        }
-        let state = self
-            .fleet
-            .telemetry(i)
-            .map_or(FlightState::Lost, |t| t.state);
-        // As ArduCopter: a target during the take-off replaces the climb.
-        if !matches!(state, FlightState::Flying | FlightState::TakingOff) {
-            return Err("position target ignored: not flying".into());
-        }
-        let same = c
-            .target
-            .is_some_and(|t| (0..3).all(|k| (t[k] - to[k]).abs() < 0.01));
-        if same && c.call.is_some() {
-            return Ok(());
-        }
-        self.copters[i].target = Some(to);
-        let speed = self.copters[i].speed;
-        self.motion(
-            i,
-            "FlyToPosition",
-            &[
-                Value::Position(Point {
-                    x: to[0],
-                    y: to[1],
-                    z: Some(to[2]),
-                }),
-                Value::Number(speed),
-            ],
-        )
-    }
-
-    /// Stops where it is (GUIDED, LOITER or BRAKE entered in the air).
-    fn hold(&mut self, i: usize) {
-        if let Some(call) = self.copters[i].call.take() {
-            self.fleet.interrupt(call, aviary_api::Interrupt::Abort);
-        }
-        self.copters[i].target = None;
-    }
-
-    /// A mode change (DO_SET_MODE or SET_MODE).
-    pub fn set_mode(&mut self, i: usize, mode: u32) -> (MavResult, Option<String>) {
-        if self.booting() {
-            return (
-                MavResult::MAV_RESULT_TEMPORARILY_REJECTED,
-                Some("Mode change refused: still booting".into()),
-            );
-        }
-        let airborne = self.fleet.telemetry(i).is_some_and(|t| t.state.airborne());
-        let outcome = match mode {
-            STABILIZE | COPTER_GUIDED | COPTER_LOITER | COPTER_BRAKE => {
-                if airborne {
-                    self.hold(i);
-                }
-                Ok(())
-            }
-            COPTER_RTL if airborne => self.motion(i, "ReturnToLaunch", &[]),
-            COPTER_LAND if airborne => self.motion(i, "Land", &[]),
-            COPTER_RTL | COPTER_LAND => Ok(()),
-            other => {
-                return (
-                    MavResult::MAV_RESULT_DENIED,
-                    Some(format!("Mode {other} is not simulated")),
-                )
-            }
-        };
-        match outcome {
-            Ok(()) => {
-                self.copters[i].mode = mode;
-                (MavResult::MAV_RESULT_ACCEPTED, None)
-            }
-            Err(why) => (MavResult::MAV_RESULT_FAILED, Some(why)),
-        }
-    }
 }
 
 pub fn text(system: u8, severity: MavSeverity, s: &str) -> Out {
@@ -294,13 +281,23 @@ pub fn text(system: u8, severity: MavSeverity, s: &str) -> Out {
         msg: MavMessage::STATUSTEXT(STATUSTEXT_DATA {
             severity,
             text: s.into(),
-        }),
+            ..STATUSTEXT_DATA::default()
+        })
+        .into(),
     }
 }
 
-pub fn ack(system: u8, command: MavCmd, result: MavResult) -> Out {
+/// A COMMAND_ACK addressed, as ArduPilot's, to the system and component that asked.
+pub fn ack(system: u8, command: MavCmd, result: MavResult, to: (u8, u8)) -> Out {
     Out {
         system,
-        msg: MavMessage::COMMAND_ACK(COMMAND_ACK_DATA { command, result }),
+        msg: MavMessage::COMMAND_ACK(COMMAND_ACK_DATA {
+            command,
+            result,
+            target_system: to.0,
+            target_component: to.1,
+            ..COMMAND_ACK_DATA::default()
+        })
+        .into(),
     }
 }

@@ -1,63 +1,117 @@
 //! The command protocol of the simulated autopilots: each COMMAND_LONG or COMMAND_INT
-//! answered with the result ArduCopter would give, and the reason it says first.
+//! answered with the result ArduCopter would give, the reason it says first, and what a
+//! request asks for (AUTOPILOT_VERSION, HOME_POSITION, a telemetry message).
 
 use aviary_api::{CallEnd, FlightState, Value};
-use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavCmd, MavResult};
+use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavCmd, MavResult, MavSeverity};
 use aviary_mavlink::mode::{COPTER_GUIDED, COPTER_LAND, COPTER_RTL};
 
-use crate::autopilot::Autopilot;
+use crate::autopilot::{text, Autopilot, Out, Reply};
+
+/// A command's answer: the result for the COMMAND_ACK, what goes before it (a reason,
+/// HOME_POSITION for MAV_CMD_GET_HOME_POSITION) and after it (what a request asked for).
+pub struct Answer {
+    pub result: MavResult,
+    pub before: Vec<Reply>,
+    pub after: Vec<Reply>,
+}
+
+impl Answer {
+    pub fn of(result: MavResult) -> Answer {
+        Answer {
+            result,
+            before: Vec::new(),
+            after: Vec::new(),
+        }
+    }
+
+    /// A refusal with the autopilot's reason, a STATUSTEXT every ground station sees (as
+    /// ArduPilot's, sent on all links) just before the ACK.
+    pub fn failed(system: u8, result: MavResult, why: Option<String>) -> Answer {
+        let mut a = Answer::of(result);
+        if let Some(why) = why {
+            a.before.push(Reply::all(text(
+                system,
+                MavSeverity::MAV_SEVERITY_WARNING,
+                &why,
+            )));
+        }
+        a
+    }
+}
+
+/// A command as it came: COMMAND_LONG's seven parameters, or COMMAND_INT's four with its
+/// frame and position (`x`, `y` as degrees × 10⁷, `z`).
+pub struct Command {
+    pub id: MavCmd,
+    pub p: [f32; 7],
+    pub int: Option<(u32, i32, i32, f32)>,
+}
 
 impl Autopilot {
-    /// One COMMAND_LONG or COMMAND_INT (positions already in `at`): the ACK and any
-    /// reason (sent first, as ArduPilot does).
-    pub fn command(
-        &mut self,
-        i: usize,
-        cmd: MavCmd,
-        p: [f32; 7],
-        at: Option<(i32, i32, f32)>,
-    ) -> (MavResult, Option<String>) {
+    /// One command to vehicle `i`. GET_HOME_POSITION and REQUEST_AUTOPILOT_CAPABILITIES are
+    /// superseded by REQUEST_MESSAGE, but MAVSDK, MAVProxy and ArduPilot still use them.
+    #[allow(deprecated)]
+    pub fn command(&mut self, i: usize, c: &Command) -> Answer {
         use MavResult::*;
-        let state = self
-            .fleet
-            .telemetry(i)
-            .map_or(FlightState::Lost, |t| t.state);
-        let refused = |why: &str| (MAV_RESULT_FAILED, Some(why.to_owned()));
+        let system = self.copters[i].system;
+        let p = c.p;
+        let simple =
+            |(result, why): (MavResult, Option<String>)| Answer::failed(system, result, why);
+        let refused = |why: &str| Answer::failed(system, MAV_RESULT_FAILED, Some(why.to_owned()));
         let done = |r: Result<(), String>| match r {
-            Ok(()) => (MAV_RESULT_ACCEPTED, None),
-            Err(why) => (MAV_RESULT_FAILED, Some(why)),
+            Ok(()) => Answer::of(MAV_RESULT_ACCEPTED),
+            Err(why) => Answer::failed(system, MAV_RESULT_FAILED, Some(why)),
         };
-        match cmd {
-            MavCmd::MAV_CMD_DO_SET_MODE => self.set_mode(i, p[1] as u32),
+        let state = self.state(i);
+        match c.id {
+            MavCmd::MAV_CMD_DO_SET_MODE => simple(self.set_mode(i, p[1] as u32)),
             MavCmd::MAV_CMD_COMPONENT_ARM_DISARM if p[0] >= 0.5 => {
                 if self.booting() {
-                    return (
+                    return simple((
                         MAV_RESULT_TEMPORARILY_REJECTED,
                         Some("Arm: still booting".into()),
-                    );
+                    ));
                 }
-                if self.fleet.time() < self.behaviour.prearm_time {
+                if !self.ready() {
                     return refused("PreArm: GPS: waiting for 3D fix");
                 }
                 if matches!(self.copters[i].mode, COPTER_RTL | COPTER_LAND) {
                     return refused("Arm: Mode not armable");
                 }
                 if self.copters[i].armed {
-                    return (MAV_RESULT_ACCEPTED, None);
+                    return Answer::of(MAV_RESULT_ACCEPTED);
                 }
-                let r = done(self.instant(i, "Arm", &[]));
-                self.copters[i].armed = r.0 == MAV_RESULT_ACCEPTED;
-                r
+                let mut a = done(self.instant(i, "Arm", &[]));
+                self.copters[i].armed = a.result == MAV_RESULT_ACCEPTED;
+                // ArduCopter sets home where it arms, and says so on every link; the
+                // simulator's home does not move, so the same home is said again.
+                if let Some(home) = self.home_position(i).filter(|_| self.copters[i].armed) {
+                    a.after.push(Reply::all(Out {
+                        system,
+                        msg: home.into(),
+                    }));
+                }
+                a
             }
             MavCmd::MAV_CMD_COMPONENT_ARM_DISARM => {
                 if state.airborne() {
                     return refused("Disarm: vehicle is flying");
                 }
-                let r = done(self.instant(i, "Disarm", &[]));
-                self.copters[i].armed &= r.0 != MAV_RESULT_ACCEPTED;
-                r
+                let a = done(self.instant(i, "Disarm", &[]));
+                self.copters[i].armed &= a.result != MAV_RESULT_ACCEPTED;
+                a
             }
             MavCmd::MAV_CMD_NAV_TAKEOFF => {
+                // COMMAND_INT carries the altitude in z, and only above home (as ArduCopter).
+                let alt = match c.int {
+                    None => p[6],
+                    Some((3 | 6, _, _, z)) => z,
+                    Some(_) => return Answer::of(MAV_RESULT_DENIED),
+                };
+                if !alt.is_finite() {
+                    return Answer::of(MAV_RESULT_DENIED);
+                }
                 if self.copters[i].mode != COPTER_GUIDED {
                     return refused("Takeoff: not in GUIDED mode");
                 }
@@ -67,18 +121,21 @@ impl Autopilot {
                 if state != FlightState::Landed {
                     return refused("Takeoff: already flying");
                 }
-                done(self.motion(i, "TakeOff", &[Value::Number(f64::from(p[6]))]))
+                done(self.motion(i, "TakeOff", &[Value::Number(f64::from(alt))]))
             }
-            MavCmd::MAV_CMD_NAV_LAND => self.set_mode(i, COPTER_LAND),
-            MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH => self.set_mode(i, COPTER_RTL),
+            MavCmd::MAV_CMD_NAV_LAND => simple(self.set_mode(i, COPTER_LAND)),
+            MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH => simple(self.set_mode(i, COPTER_RTL)),
             MavCmd::MAV_CMD_DO_CHANGE_SPEED if p[1] > 0.0 => {
                 let c = &mut self.copters[i];
                 c.speed = f64::from(p[1]).min(c.max_speed);
-                (MAV_RESULT_ACCEPTED, None)
+                Answer::of(MAV_RESULT_ACCEPTED)
             }
-            MavCmd::MAV_CMD_DO_REPOSITION => match at {
-                Some((lat, lon, z)) => done(self.goto(i, lat, lon, f64::from(z))),
-                None => (MAV_RESULT_COMMAND_INT_ONLY, None),
+            MavCmd::MAV_CMD_DO_CHANGE_SPEED => Answer::of(MAV_RESULT_DENIED),
+            // ArduCopter takes DO_REPOSITION only as COMMAND_INT (a COMMAND_LONG is
+            // answered UNSUPPORTED, as below).
+            MavCmd::MAV_CMD_DO_REPOSITION => match c.int {
+                Some((frame, x, y, z)) => self.reposition(i, p[1], frame, (x, y, z)),
+                None => Answer::of(MAV_RESULT_UNSUPPORTED),
             },
             MavCmd::MAV_CMD_DO_GRIPPER => {
                 if p[1] >= 0.5 {
@@ -88,14 +145,29 @@ impl Autopilot {
                     done(self.instant(i, "ReleasePayload", &[]))
                 }
             }
-            MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL => {
-                // Only GLOBAL_POSITION_INT's rate changes; the rest go at 1 Hz.
-                if p[0] as u32 == 33 && p[1] > 0.0 {
-                    self.position_hz = (1e6 / f64::from(p[1])).clamp(0.2, 50.0);
-                }
-                (MAV_RESULT_ACCEPTED, None)
-            }
-            _ => (MAV_RESULT_UNSUPPORTED, None),
+            MavCmd::MAV_CMD_GET_HOME_POSITION => match self.home_position(i) {
+                Some(home) => Answer {
+                    result: MAV_RESULT_ACCEPTED,
+                    before: vec![Reply::asker(system, home)],
+                    after: Vec::new(),
+                },
+                None => Answer::of(MAV_RESULT_FAILED),
+            },
+            MavCmd::MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES if p[0] >= 0.5 => Answer {
+                result: MAV_RESULT_ACCEPTED,
+                before: Vec::new(),
+                after: vec![Reply::asker(system, self.autopilot_version(i))],
+            },
+            MavCmd::MAV_CMD_REQUEST_MESSAGE => match self.message(i, p[0] as u32) {
+                Some(msg) => Answer {
+                    result: MAV_RESULT_ACCEPTED,
+                    before: Vec::new(),
+                    after: vec![Reply::asker(system, msg)],
+                },
+                // ArduPilot's answer for a message it cannot send.
+                None => Answer::of(MAV_RESULT_FAILED),
+            },
+            _ => Answer::of(MAV_RESULT_UNSUPPORTED),
         }
     }
 

@@ -2,36 +2,54 @@
 //!
 //! Every drone of a world becomes its own MAVLink system (its `system_id`, or its place
 //! in the world: 1, 2, ...), component 1, with the behaviour of an ArduCopter-like
-//! autopilot (`autopilot`): HEARTBEAT with the ArduCopter mode number and the system
-//! state (BOOT, then as ArduCopter: STANDBY on the ground, ACTIVE in the air, CRITICAL
-//! after a failsafe), the command protocol with COMMAND_ACK
-//! and STATUSTEXT reasons (arm with pre-arm checks, NAV_TAKEOFF only in GUIDED, LAND,
-//! RTL, DO_SET_MODE and SET_MODE, DO_CHANGE_SPEED, DO_REPOSITION, DO_GRIPPER,
-//! SET_MESSAGE_INTERVAL), SET_POSITION_TARGET_GLOBAL_INT in GUIDED, and the telemetry
-//! streams (`telemetry`). Underneath is the same [`aviary_sim::Fleet`] as `aviary run`,
-//! stepped in whole 0.05 s ticks at `speed` times real time.
+//! autopilot, checked against ArduCopter SITL (docs/REAL_DRONES.md lists it all):
+//! - `autopilot`, `guided`, `commands`: modes, arming with pre-arm checks, the command
+//!   protocol (COMMAND_ACK addressed to the asker, the reason first as STATUSTEXT,
+//!   UNSUPPORTED for anything else, `wire` for command numbers the dialect has no name
+//!   for), DO_REPOSITION in every global frame ArduCopter takes, GUIDED targets.
+//! - `telemetry`, `reports`: HEARTBEAT and the streams (SYS_STATUS with the health bits
+//!   ground stations arm by, GPS_RAW_INT, GLOBAL_POSITION_INT, BATTERY_STATUS,
+//!   EKF_STATUS_REPORT, EXTENDED_SYS_STATE, HOME_POSITION), AUTOPILOT_VERSION.
+//! - `params`: the parameter protocol over what the simulated vehicle uses, under
+//!   ArduCopter's names (WPNAV_SPEED settable, the rest read-only).
+//! - `dispatch`: which vehicles a message is for, and who gets each answer.
+//! - `client`, `server`, `udp`: one queue, one set of stream rates and one sequence per
+//!   vehicle for each client (TCP connection or UDP peer); heartbeats never dropped,
+//!   telemetry coalesced for a lagging client; accept errors survived, silent UDP peers
+//!   expired.
 //!
-//! Not simulated: parameters, missions (MISSION_ITEM), RC input, manual modes (STABILIZE
-//! is accepted and does nothing), more than one component per vehicle. A world
-//! `link_loss` fault silences the drone (no messages either way) for its duration; a
-//! `battery_critical` fault is ArduCopter's battery failsafe (STATUSTEXT, then RTL); a
-//! `crash` says "Crash: ..." and turns the state to EMERGENCY.
+//! Underneath is the same [`aviary_sim::Fleet`] as `aviary run`, stepped in whole 0.05 s
+//! ticks at `speed` times real time.
+//!
+//! Not simulated: missions (MISSION_ITEM), fences and rally points as missions, MAVLink
+//! FTP (refused at once), RC input, manual modes (STABILIZE is accepted and does
+//! nothing), more than one component per vehicle. A world `link_loss` fault silences the
+//! drone (no messages either way) for its duration; a `battery_critical` fault is
+//! ArduCopter's battery failsafe (STATUSTEXT, then RTL); a `crash` says "Crash: ..." and
+//! turns the state to EMERGENCY.
 
 mod autopilot;
+mod client;
 mod commands;
+mod dispatch;
+mod guided;
+mod params;
+mod reports;
 mod server;
 mod telemetry;
+mod udp;
+mod wire;
 
 use std::net::SocketAddr;
 use std::sync::{Arc, Mutex};
 
 use aviary_world::World;
 use tokio::net::{TcpListener, UdpSocket};
-use tokio::sync::broadcast;
 use tokio::task::JoinHandle;
 
 pub use autopilot::Behaviour;
 pub use server::{parse_listen, Listen};
+pub use udp::{MAX_PEERS, PEER_EXPIRY};
 
 #[derive(Clone, Copy, Debug)]
 pub struct Options {
@@ -59,7 +77,7 @@ pub struct Vehicles {
     /// Each drone's MAVLink system id, in world order.
     pub systems: Vec<u8>,
     tasks: Vec<JoinHandle<()>>,
-    clients: server::Clients,
+    clients: Arc<client::Registry>,
 }
 
 /// Binds `listen` and starts serving `world`'s drones. Call inside a tokio runtime with
@@ -68,44 +86,37 @@ pub async fn serve(world: &World, listen: Listen, options: Options) -> std::io::
     let ap = autopilot::Autopilot::new(world, options.behaviour);
     let systems = ap.copters.iter().map(|c| c.system).collect();
     let ap = Arc::new(Mutex::new(ap));
-    let (out, _) = broadcast::channel(4096);
     let speed = if options.speed.is_finite() && options.speed > 0.0 {
         options.speed
     } else {
         1.0
     };
-    let pace = tokio::spawn(server::pace(Arc::clone(&ap), out.clone(), 0.05, speed));
-    let clients = server::Clients::default();
+    let clients = Arc::new(client::Registry::default());
     let (address, serve) = match listen {
         Listen::Tcp(addr) => {
             let listener = TcpListener::bind(addr).await?;
             let address = listener.local_addr()?;
-            (
-                address,
-                tokio::spawn(server::tcp(
-                    listener,
-                    ap,
-                    out,
-                    options.signing_key,
-                    Arc::clone(&clients),
-                )),
-            )
+            let task = server::tcp(
+                listener,
+                Arc::clone(&ap),
+                Arc::clone(&clients),
+                options.signing_key,
+            );
+            (address, tokio::spawn(task))
         }
         Listen::Udp(addr) => {
             let socket = UdpSocket::bind(addr).await?;
             let address = socket.local_addr()?;
-            (
-                address,
-                tokio::spawn(server::udp(
-                    socket,
-                    ap,
-                    out,
-                    options.signing_key,
-                    Arc::clone(&clients),
-                )),
-            )
+            let task = udp::udp(
+                socket,
+                Arc::clone(&ap),
+                Arc::clone(&clients),
+                options.signing_key,
+            );
+            (address, tokio::spawn(task))
         }
     };
+    let pace = tokio::spawn(server::pace(ap, Arc::clone(&clients), 0.05, speed));
     Ok(Vehicles {
         address,
         systems,
@@ -115,17 +126,19 @@ pub async fn serve(world: &World, listen: Listen, options: Options) -> std::io::
 }
 
 impl Vehicles {
+    /// Stops serving: the listener, the simulation and every client's connection close,
+    /// as a killed process's would.
     pub fn stop(&self) {
         for t in &self.tasks {
             t.abort();
         }
-        for c in self
-            .clients
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .iter()
-        {
+        for c in self.clients.all() {
             c.abort();
         }
+    }
+
+    /// The ground stations connected now (TCP connections, UDP peers heard lately).
+    pub fn clients(&self) -> usize {
+        self.clients.len()
     }
 }

@@ -1,5 +1,8 @@
-//! The messages each simulated vehicle sends on its own: HEARTBEAT, GLOBAL_POSITION_INT,
-//! SYS_STATUS, BATTERY_STATUS and EXTENDED_SYS_STATE, from the simulator's telemetry.
+//! The messages each simulated vehicle sends on its own (the streams, each at a rate every
+//! client can change with SET_MESSAGE_INTERVAL or REQUEST_DATA_STREAM): HEARTBEAT,
+//! SYS_STATUS, GPS_RAW_INT, GLOBAL_POSITION_INT, BATTERY_STATUS, EKF_STATUS_REPORT,
+//! EXTENDED_SYS_STATE, and HOME_POSITION (off unless asked for, as on ArduPilot), from the
+//! simulator's telemetry.
 
 use aviary_api::FlightState;
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
@@ -11,7 +14,50 @@ use aviary_mavlink::mode::COPTER_GUIDED;
 
 use crate::autopilot::Autopilot;
 
+/// (message id, default rate in Hz) of every stream. ArduPilot streams nothing but
+/// HEARTBEAT until a ground station asks; these defaults let a client that asks for
+/// nothing (pymavlink, `aviary run` before its SET_MESSAGE_INTERVAL) see the vehicle.
+pub const STREAMS: [(u32, f64); 8] = [
+    (0, 1.0),   // HEARTBEAT
+    (1, 1.0),   // SYS_STATUS
+    (24, 1.0),  // GPS_RAW_INT
+    (33, 4.0),  // GLOBAL_POSITION_INT
+    (147, 1.0), // BATTERY_STATUS
+    (193, 1.0), // EKF_STATUS_REPORT
+    (242, 0.0), // HOME_POSITION: sent when home is set, on request, or at an asked rate
+    (245, 1.0), // EXTENDED_SYS_STATE
+];
+
+/// The streams of REQUEST_DATA_STREAM's groups, as ArduPilot groups them (MAV_DATA_STREAM
+/// ALL 0, EXTENDED_STATUS 2, POSITION 6, EXTRA3 12).
+pub fn stream_group(group: u8) -> &'static [u32] {
+    match group {
+        0 => &[1, 24, 33, 147, 193, 245],
+        2 => &[1, 24],
+        6 => &[33],
+        12 => &[147, 193, 245],
+        _ => &[],
+    }
+}
+
 impl Autopilot {
+    /// Any message the vehicle can send, by id: a stream, HOME_POSITION once home is set,
+    /// AUTOPILOT_VERSION (for MAV_CMD_REQUEST_MESSAGE).
+    pub fn message(&self, i: usize, id: u32) -> Option<MavMessage> {
+        match id {
+            0 => Some(self.heartbeat(i)),
+            1 => self.sys_status(i),
+            24 => self.gps_raw_int(i),
+            33 => self.position(i),
+            147 => self.battery_status(i),
+            148 => Some(self.autopilot_version(i)),
+            193 => Some(self.ekf_status(i)),
+            242 => self.home_position(i),
+            245 => self.extended_sys_state(i),
+            _ => None,
+        }
+    }
+
     pub fn heartbeat(&self, i: usize) -> MavMessage {
         let c = &self.copters[i];
         let state = self
@@ -69,51 +115,84 @@ impl Autopilot {
         }))
     }
 
-    /// SYS_STATUS, BATTERY_STATUS and EXTENDED_SYS_STATE.
-    pub fn status(&self, i: usize) -> Vec<MavMessage> {
-        let Some(t) = self.fleet.telemetry(i) else {
-            return Vec::new();
-        };
-        let remaining = (t.battery * 100.0).round().clamp(0.0, 100.0) as i8;
-        let sensors = MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_GPS
-            | MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_3D_GYRO;
+    /// SYS_STATUS with the sensor bits ground stations judge a vehicle by (MAVSDK's health:
+    /// GPS present, enabled and healthy is a global position; PREARM_CHECK healthy is
+    /// armable). The simulated sensors are perfect; what is not ready until the pre-arm
+    /// time is the GPS fix, the attitude and position estimate (AHRS) and so the pre-arm
+    /// checks. The geofence is present always (as ArduPilot's), enabled when the world has
+    /// one or an altitude limit, healthy always (the simulator refuses to cross it); the
+    /// battery turns unhealthy with its failsafe.
+    pub fn sys_status(&self, i: usize) -> Option<MavMessage> {
+        use MavSysStatusSensor as S;
+        let t = self.fleet.telemetry(i)?;
+        let always = S::MAV_SYS_STATUS_SENSOR_3D_GYRO
+            | S::MAV_SYS_STATUS_SENSOR_3D_ACCEL
+            | S::MAV_SYS_STATUS_SENSOR_3D_MAG
+            | S::MAV_SYS_STATUS_SENSOR_ABSOLUTE_PRESSURE
+            | S::MAV_SYS_STATUS_SENSOR_ANGULAR_RATE_CONTROL
+            | S::MAV_SYS_STATUS_SENSOR_ATTITUDE_STABILIZATION
+            | S::MAV_SYS_STATUS_SENSOR_YAW_POSITION
+            | S::MAV_SYS_STATUS_SENSOR_Z_ALTITUDE_CONTROL
+            | S::MAV_SYS_STATUS_SENSOR_XY_POSITION_CONTROL
+            | S::MAV_SYS_STATUS_SENSOR_MOTOR_OUTPUTS;
+        let fixed =
+            S::MAV_SYS_STATUS_SENSOR_GPS | S::MAV_SYS_STATUS_AHRS | S::MAV_SYS_STATUS_PREARM_CHECK;
+        let present =
+            always | fixed | S::MAV_SYS_STATUS_SENSOR_BATTERY | S::MAV_SYS_STATUS_GEOFENCE;
+        let mut enabled = present;
+        if !self.fence_enabled() {
+            enabled.remove(S::MAV_SYS_STATUS_GEOFENCE);
+        }
+        let mut health = always | S::MAV_SYS_STATUS_GEOFENCE;
+        if self.ready() {
+            health |= fixed;
+        }
+        if !self.copters[i].failsafe {
+            health |= S::MAV_SYS_STATUS_SENSOR_BATTERY;
+        }
+        Some(MavMessage::SYS_STATUS(SYS_STATUS_DATA {
+            onboard_control_sensors_present: present,
+            onboard_control_sensors_enabled: enabled,
+            onboard_control_sensors_health: health,
+            // A simulated 3S battery: 12.6 V full, 10.5 V empty.
+            voltage_battery: (10_500.0 + 2_100.0 * t.battery) as u16,
+            current_battery: -1,
+            battery_remaining: remaining(t.battery),
+            ..SYS_STATUS_DATA::default()
+        }))
+    }
+
+    pub fn battery_status(&self, i: usize) -> Option<MavMessage> {
+        let t = self.fleet.telemetry(i)?;
+        Some(MavMessage::BATTERY_STATUS(BATTERY_STATUS_DATA {
+            current_consumed: -1,
+            energy_consumed: -1,
+            temperature: i16::MAX,
+            voltages: [u16::MAX; 10],
+            current_battery: -1,
+            id: 0,
+            battery_function: MavBatteryFunction::MAV_BATTERY_FUNCTION_ALL,
+            mavtype: MavBatteryType::MAV_BATTERY_TYPE_LIPO,
+            battery_remaining: remaining(t.battery),
+            ..BATTERY_STATUS_DATA::default()
+        }))
+    }
+
+    pub fn extended_sys_state(&self, i: usize) -> Option<MavMessage> {
+        let t = self.fleet.telemetry(i)?;
         let landed = match t.state {
             FlightState::Landed | FlightState::Lost => MavLandedState::MAV_LANDED_STATE_ON_GROUND,
             FlightState::TakingOff => MavLandedState::MAV_LANDED_STATE_TAKEOFF,
             FlightState::Flying => MavLandedState::MAV_LANDED_STATE_IN_AIR,
             FlightState::Landing => MavLandedState::MAV_LANDED_STATE_LANDING,
         };
-        vec![
-            MavMessage::SYS_STATUS(SYS_STATUS_DATA {
-                onboard_control_sensors_present: sensors,
-                onboard_control_sensors_enabled: sensors,
-                onboard_control_sensors_health: sensors,
-                load: 0,
-                voltage_battery: (10_500.0 + 2_100.0 * t.battery) as u16,
-                current_battery: -1,
-                drop_rate_comm: 0,
-                errors_comm: 0,
-                errors_count1: 0,
-                errors_count2: 0,
-                errors_count3: 0,
-                errors_count4: 0,
-                battery_remaining: remaining,
-            }),
-            MavMessage::BATTERY_STATUS(BATTERY_STATUS_DATA {
-                current_consumed: -1,
-                energy_consumed: -1,
-                temperature: i16::MAX,
-                voltages: [u16::MAX; 10],
-                current_battery: -1,
-                id: 0,
-                battery_function: MavBatteryFunction::MAV_BATTERY_FUNCTION_ALL,
-                mavtype: MavBatteryType::MAV_BATTERY_TYPE_LIPO,
-                battery_remaining: remaining,
-            }),
-            MavMessage::EXTENDED_SYS_STATE(EXTENDED_SYS_STATE_DATA {
-                vtol_state: MavVtolState::MAV_VTOL_STATE_UNDEFINED,
-                landed_state: landed,
-            }),
-        ]
+        Some(MavMessage::EXTENDED_SYS_STATE(EXTENDED_SYS_STATE_DATA {
+            vtol_state: MavVtolState::MAV_VTOL_STATE_UNDEFINED,
+            landed_state: landed,
+        }))
     }
+}
+
+fn remaining(battery: f64) -> i8 {
+    (battery * 100.0).round().clamp(0.0, 100.0) as i8
 }

@@ -46,6 +46,13 @@ pub struct Copter {
     pub(crate) wpnav_speed: f64,
     pub(crate) max_speed: f64,
     pub(crate) climb_rate: f64,
+    /// How it comes down, and how it returns: the world's figures, which its simulated
+    /// drone flies and its parameters report.
+    pub(crate) descent: aviary_api::flight::Descent,
+    pub(crate) return_altitude: f64,
+    pub(crate) return_loiter: f64,
+    /// mAh, when the world gives it.
+    pub(crate) battery_capacity: Option<f64>,
     pub(crate) acceleration: f64,
     pub(crate) target: Option<[f64; 3]>,
     /// Home is set (the GPS has its fix): HOME_POSITION can be sent.
@@ -128,6 +135,10 @@ impl Autopilot {
                     wpnav_speed: d.max_speed,
                     max_speed: d.max_speed,
                     climb_rate: d.climb_rate,
+                    descent: d.descent(),
+                    return_altitude: d.return_altitude,
+                    return_loiter: d.return_loiter,
+                    battery_capacity: d.battery_capacity,
                     acceleration: d.acceleration,
                     target: None,
                     home_set: false,

@@ -13,7 +13,6 @@ use aviary_mavlink::mavlink::dialects::ardupilotmega::MavMessage;
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
     MavParamType, MavSeverity, PARAM_VALUE_DATA,
 };
-use aviary_sim::RETURN_ALTITUDE;
 
 use crate::autopilot::{text, Autopilot, Out, Reply};
 
@@ -59,29 +58,24 @@ impl Autopilot {
                 MAV_PARAM_TYPE_INT8,
                 f64::from(u8::from(ceiling.is_some()) | (4 * u8::from(polygon))),
             ),
-            // The simulator lands, as it climbs and descends, at up to climb_rate.
-            param(
-                "LAND_SPEED",
-                MAV_PARAM_TYPE_INT16,
-                (c.climb_rate * 100.0).round(),
-            ),
+            // The simulator lands at land_speed in the last land_speed_below metres.
+            param("LAND_ALT_LOW", MAV_PARAM_TYPE_INT16, (c.descent.slow_below * 100.0).round()),
+            param("LAND_SPEED", MAV_PARAM_TYPE_INT16, (c.descent.land_speed * 100.0).round()),
             param("MAV_SYSID", MAV_PARAM_TYPE_INT16, f64::from(c.system)),
             // An RTL climbs to at least this (cm), or to the site's ceiling if lower.
             param(
                 "RTL_ALT",
                 MAV_PARAM_TYPE_INT32,
-                (RETURN_ALTITUDE.min(ceiling.unwrap_or(f64::INFINITY)) * 100.0).round(),
+                (c.return_altitude.min(ceiling.unwrap_or(f64::INFINITY)) * 100.0).round(),
             ),
+            // The wait above home before an RTL lands (ms).
+            param("RTL_LOIT_TIME", MAV_PARAM_TYPE_INT32, (c.return_loiter * 1000.0).round()),
             param("WPNAV_ACCEL", MAV_PARAM_TYPE_REAL32, c.acceleration * 100.0),
             Param {
                 writable: true,
                 ..param("WPNAV_SPEED", MAV_PARAM_TYPE_REAL32, c.wpnav_speed * 100.0)
             },
-            param(
-                "WPNAV_SPEED_DN",
-                MAV_PARAM_TYPE_REAL32,
-                c.climb_rate * 100.0,
-            ),
+            param("WPNAV_SPEED_DN", MAV_PARAM_TYPE_REAL32, c.descent.rate * 100.0),
             param(
                 "WPNAV_SPEED_UP",
                 MAV_PARAM_TYPE_REAL32,
@@ -90,6 +84,11 @@ impl Autopilot {
         ];
         if let Some(max) = ceiling {
             t.push(param("FENCE_ALT_MAX", MAV_PARAM_TYPE_REAL32, max));
+        }
+        // Only a world that gives the capacity has one: the simulated battery is a flight
+        // time (`endurance`), which with `flight_current` the capacity sets.
+        if let Some(mah) = c.battery_capacity {
+            t.push(param("BATT_CAPACITY", MAV_PARAM_TYPE_INT32, mah.round()));
         }
         t.sort_by_key(|p| p.name);
         t

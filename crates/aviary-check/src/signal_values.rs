@@ -22,7 +22,7 @@ pub(crate) fn signal_values(program: &Program, api: &Descriptor) -> BTreeMap<Str
         out.insert(s.name.to_string(), s.values.iter().map(|(_, k)| Some(*k)).collect());
     }
     let builtin = |name: &str| api.signal(name).is_some();
-    let mut learn = |out: &mut BTreeMap<String, Vec<Option<Kind>>>, name: &str, i: usize, kind: Option<Kind>| {
+    let learn = |out: &mut BTreeMap<String, Vec<Option<Kind>>>, name: &str, i: usize, kind: Option<Kind>| {
         let values = out.entry(name.to_string()).or_default();
         if values.len() <= i {
             values.resize(i + 1, None);

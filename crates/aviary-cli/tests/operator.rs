@@ -4,6 +4,8 @@
 //! may call (`guard.rs`) and of what an operator may send (`args.rs`).
 
 mod common;
+#[path = "operator/args.rs"]
+mod args;
 #[path = "operator/guard.rs"]
 mod guard;
 #[path = "operator/serve.rs"]

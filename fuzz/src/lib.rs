@@ -2,6 +2,10 @@
 //! these functions; a test runs the seed corpus through them without AFL. Every
 //! function panics when a property does not hold, which AFL records as a crash.
 
+mod operator;
+
+pub use operator::operator;
+
 use aviary_api::Descriptor;
 use aviary_check::SourceProvider;
 use aviary_diagnostics::{render_json, render_text, FileId, SourceMap};

@@ -30,3 +30,9 @@ fn seeds_and_regressions_of_fuzz_world() {
     assert!(each_file("in/world", aviary_fuzz::world) > 0);
     each_file("regressions/world", aviary_fuzz::world);
 }
+
+#[test]
+fn seeds_and_regressions_of_fuzz_operator() {
+    assert!(each_file("in/operator", aviary_fuzz::operator) > 0);
+    each_file("regressions/operator", aviary_fuzz::operator);
+}

@@ -12,6 +12,7 @@ mod inputs;
 pub mod generate;
 mod infer;
 mod load;
+mod signal_values;
 mod signals;
 mod suggest;
 mod walk;
@@ -46,6 +47,9 @@ pub struct Program {
     pub param_kinds: BTreeMap<String, Vec<Option<Kind>>>,
     /// Where each of those kinds was fixed: the chain an E107 report shows.
     pub param_origins: BTreeMap<String, Vec<Option<KindOrigin>>>,
+    /// The values each signal carries, by name, with each one's kind where it is known
+    /// (see `signal_values.rs`): what an operator's signal is checked against.
+    pub signal_values: BTreeMap<String, Vec<Option<Kind>>>,
     /// The paths of `USE`s that could not be read (reported as E113).
     pub unreadable: Vec<String>,
 }
@@ -93,6 +97,7 @@ pub fn check(sources: &mut SourceMap, root: FileId, world: Option<&World>, provi
     // Checks on a file that did not parse would only repeat its syntax errors.
     let syntax_ok = !diagnostics.iter().any(|d: &Diagnostic| d.is_error() && d.code.as_str().starts_with("E0"));
     (program.param_kinds, program.param_origins) = infer::parameter_kinds(&program, api);
+    program.signal_values = signal_values::signal_values(&program, api);
     if syntax_ok {
         walk::check_program(&program, world, api, root, &mut diagnostics);
         signals::check_signals(&program, api, &mut diagnostics);

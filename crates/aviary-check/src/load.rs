@@ -64,7 +64,7 @@ pub(crate) fn load(sources: &mut SourceMap, root: FileId, provider: &dyn SourceP
         }
         files.push((id, tree));
     }
-    let mut program = Program { files, mission: None, capabilities: BTreeMap::new(), param_kinds: BTreeMap::new(), param_origins: BTreeMap::new(), unreadable };
+    let mut program = Program { files, mission: None, capabilities: BTreeMap::new(), param_kinds: BTreeMap::new(), param_origins: BTreeMap::new(), signal_values: BTreeMap::new(), unreadable };
     index_definitions(&mut program, std_id, diagnostics);
     program
 }

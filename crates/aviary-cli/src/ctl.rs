@@ -1,7 +1,7 @@
 //! `aviary ctl`: the command-line client of the operator API that `aviary run --serve`
 //! starts (docs/OPERATOR_API.md).
 
-use aviary_syntax::ast::Unit;
+use aviary_syntax::ast::{Expr, ExprKind};
 use clap::Subcommand;
 use serde_json::{json, Value};
 
@@ -12,8 +12,9 @@ pub enum CtlCommand {
     /// Print every event as it happens, one JSON object per line
     Events,
     /// A leash on a running activity: `leash FlyCircle-C1 PAUSE`, `leash FlyCircle-C1 Widen radius=200m`
+    /// (values as the language writes them: 200m, 2min, (100, 50), Body, "text")
     Leash { activity: String, action: String, args: Vec<String> },
-    /// Raise a signal the mission hears: `signal Go`
+    /// Raise a signal the mission hears: `signal Go`, `signal Found (120, 40) Body`
     Signal { name: String, values: Vec<String> },
     /// Hold every drone where it is
     Pause,
@@ -26,8 +27,8 @@ pub enum CtlCommand {
 pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
     let base = url.trim_end_matches('/');
     let result = match command {
-        CtlCommand::State => get(&format!("{base}/api/state")),
-        CtlCommand::Events => return events(base),
+        CtlCommand::State => get(&format!("{base}/api/state"), token),
+        CtlCommand::Events => return events(base, token),
         CtlCommand::Leash { activity, action, args } => {
             let mut named = serde_json::Map::new();
             for a in &args {
@@ -35,11 +36,23 @@ pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
                     eprintln!("aviary: `{a}` is not `name=value`");
                     return 2;
                 };
-                named.insert(k.to_string(), value(v));
+                match value(v) {
+                    Ok(v) => named.insert(k.to_string(), v),
+                    Err(why) => return refuse_value(v, &why),
+                };
             }
             post(base, "leash", token, json!({ "activity": activity, "action": action, "args": named }))
         }
-        CtlCommand::Signal { name, values } => post(base, "signal", token, json!({ "name": name, "args": values.iter().map(|v| value(v)).collect::<Vec<_>>() })),
+        CtlCommand::Signal { name, values } => {
+            let mut args = Vec::new();
+            for v in &values {
+                match value(v) {
+                    Ok(v) => args.push(v),
+                    Err(why) => return refuse_value(v, &why),
+                }
+            }
+            post(base, "signal", token, json!({ "name": name, "args": args }))
+        }
         CtlCommand::Pause => post(base, "pause", token, json!({})),
         CtlCommand::Resume => post(base, "resume", token, json!({})),
         CtlCommand::Abort => post(base, "abort", token, json!({})),
@@ -65,8 +78,14 @@ fn agent() -> ureq::Agent {
     ureq::Agent::config_builder().http_status_as_error(false).build().into()
 }
 
-fn get(url: &str) -> Result<(u16, String), String> {
-    let mut response = agent().get(url).call().map_err(|e| e.to_string())?;
+fn get(url: &str, token: Option<&str>) -> Result<(u16, String), String> {
+    let mut request = agent().get(url);
+    // Reading needs the token only when the server is reachable beyond its machine;
+    // sending it whenever it is known costs nothing.
+    if let Some(token) = token {
+        request = request.header("Authorization", format!("Bearer {token}"));
+    }
+    let mut response = request.call().map_err(|e| e.to_string())?;
     let status = response.status().as_u16();
     let body = response.body_mut().read_to_string().map_err(|e| e.to_string())?;
     Ok((status, body))
@@ -84,10 +103,27 @@ fn post(base: &str, call: &str, token: Option<&str>, body: Value) -> Result<(u16
 }
 
 /// Prints each event as a JSON line until the mission ends.
-fn events(base: &str) -> u8 {
+fn events(base: &str, token: Option<&str>) -> u8 {
+    use tungstenite::client::IntoClientRequest;
     let ws = format!("{}/api/events", base.replacen("http://", "ws://", 1));
-    let (mut socket, _) = match tungstenite::connect(ws.as_str()) {
+    let mut request = match ws.as_str().into_client_request() {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("aviary: `{ws}` is not an address for the event stream: {e}");
+            return 2;
+        }
+    };
+    if let Some(Ok(value)) = token.map(|t| format!("Bearer {t}").parse()) {
+        request.headers_mut().insert("Authorization", value);
+    }
+    let (mut socket, _) = match tungstenite::connect(request) {
         Ok(s) => s,
+        Err(tungstenite::Error::Http(response)) => {
+            let body = response.body().as_deref().map(String::from_utf8_lossy).unwrap_or_default();
+            let why = serde_json::from_str::<Value>(&body).ok().and_then(|v| v["error"].as_str().map(str::to_string)).unwrap_or(body.into_owned());
+            eprintln!("aviary: refused ({}): {why}", response.status().as_u16());
+            return 1;
+        }
         Err(e) => {
             eprintln!("aviary: cannot open the event stream at {ws}: {e}");
             return 2;
@@ -107,14 +143,43 @@ fn events(base: &str) -> u8 {
     }
 }
 
-/// `40m` is 40 (SI), `2min` is 120, `(1, 2)`-free forms only: a number, a quantity, or a symbol.
-fn value(text: &str) -> Value {
-    if let Ok(n) = text.parse::<f64>() {
-        return json!(n);
+fn refuse_value(text: &str, why: &str) -> u8 {
+    eprintln!("aviary: cannot read `{text}` as a value: {why}");
+    eprintln!("  write a number with its unit (200m, 2min, 5m/s, 25%), a position (100, 50) or (100, 50, 20m), a name (Body), or a string in quotes");
+    2
+}
+
+/// A value read by the language's rules (`aviary_syntax::parse_value`), as the operator
+/// API takes it: a number keeps its unit (`{"number": 10, "unit": "s"}`), so that the
+/// server can refuse `10s` where a length is expected; a position is `[x, y(, z)]` in
+/// metres; a name or a string is a string.
+fn value(text: &str) -> Result<Value, String> {
+    let expr = aviary_syntax::parse_value(text).map_err(|d| d.first().map(|d| d.message.clone()).unwrap_or_default())?;
+    to_json(&expr)
+}
+
+fn to_json(expr: &Expr) -> Result<Value, String> {
+    match &expr.kind {
+        ExprKind::Number { value, unit: Some(unit), .. } => Ok(json!({ "number": value, "unit": unit.as_str() })),
+        ExprKind::Number { value, unit: None, .. } => Ok(json!({ "number": value })),
+        ExprKind::String(s) => Ok(json!(s)),
+        ExprKind::Name(id) => Ok(json!(id.name)),
+        ExprKind::Bool(b) => Ok(json!(b)),
+        ExprKind::Paren(inner) => to_json(inner),
+        ExprKind::Coordinates(parts) => {
+            let mut metres = Vec::new();
+            for p in parts {
+                match &p.kind {
+                    // A coordinate is a number of metres, with or without its unit (as the checker reads it).
+                    ExprKind::Number { value, unit: None, .. } => metres.push(*value),
+                    ExprKind::Number { value, unit: Some(u), .. } if matches!(u, aviary_syntax::ast::Unit::Metre | aviary_syntax::ast::Unit::Kilometre) => {
+                        metres.push(value * u.to_si())
+                    }
+                    _ => return Err("a coordinate is a number of metres".into()),
+                }
+            }
+            Ok(json!(metres))
+        }
+        _ => Err("only a number, a position, a name or a string can be sent".into()),
     }
-    let split = text.find(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-')).unwrap_or(text.len());
-    if let (Ok(n), Some(unit)) = (text[..split].parse::<f64>(), Unit::parse(&text[split..])) {
-        return json!(n * unit.to_si());
-    }
-    json!(text)
 }

@@ -14,6 +14,7 @@ mod cores;
 mod fmt;
 mod mixed;
 mod run;
+mod serve;
 mod trace_file;
 mod vehicles;
 
@@ -86,6 +87,10 @@ enum Command {
         /// unless --speed says otherwise
         #[arg(long, value_name = "[HOST:]PORT")]
         serve: Option<String>,
+        /// With --serve: also answer to this host name (the name a reverse proxy forwards,
+        /// or this machine's name on the network); may be repeated
+        #[arg(long, value_name = "NAME", requires = "serve")]
+        allow_host: Vec<String>,
     },
     /// Talk to a running mission's operator API (see `aviary run --serve`)
     Ctl {
@@ -144,11 +149,14 @@ fn command(cli: Cli) -> u8 {
     let code = match cli.command {
         Command::Check { files, world, format, plan } => check::run(&files, world.as_deref(), format, plan),
         Command::Fmt { files, check } => fmt::run(&files, check),
-        Command::Run { file, world, speed, seed, trace, telemetry_hz, quiet, serve } => {
+        Command::Run { file, world, speed, seed, trace, telemetry_hz, quiet, serve, allow_host } => {
             // Served to an operator, a mission runs in real time unless told otherwise.
             let speed = speed.unwrap_or_else(|| if serve.is_some() { "1".into() } else { "max".into() });
             match (run::parse_speed(&speed), serve.as_deref().map(run::parse_serve).transpose()) {
-                (Ok(speed), Ok(serve)) => run::run(&run::RunArgs { file, world, speed, seed, trace, telemetry_hz, quiet, serve }),
+                (Ok(speed), Ok(serve)) => {
+                    let serve = serve.map(|address| serve::Serve { address, allowed_hosts: allow_host });
+                    run::run(&run::RunArgs { file, world, speed, seed, trace, telemetry_hz, quiet, serve })
+                }
                 (Err(why), _) | (_, Err(why)) => {
                     eprintln!("aviary: {why}");
                     2

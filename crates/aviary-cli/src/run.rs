@@ -23,7 +23,7 @@ pub struct RunArgs {
     pub telemetry_hz: Option<f64>,
     pub quiet: bool,
     /// Where to serve the operator API.
-    pub serve: Option<std::net::SocketAddr>,
+    pub serve: Option<crate::serve::Serve>,
 }
 
 /// `7878` is loopback port 7878; `HOST:PORT` binds exactly that.
@@ -120,16 +120,13 @@ pub fn run(args: &RunArgs) -> u8 {
     // The first stop signal, also seen before the engine runs (while vehicles connect).
     let (stop_tx, stop_rx) = tokio::sync::watch::channel(None::<&'static str>);
     on_stop_signals(controller.clone(), stop_tx, trace.clone());
-    let server = match args.serve.map(|addr| aviary_server::start(addr, controller.clone())).transpose() {
+    let server = match args.serve.as_ref().map(|serve| crate::serve::start(serve, &mission, controller.clone())).transpose() {
         Ok(s) => s,
         Err(why) => {
             eprintln!("aviary: {why}");
             return 2;
         }
     };
-    if let Some(s) = &server {
-        eprintln!("aviary: operator API on http://{}  token {}", s.address, s.token);
-    }
     let feed = server.as_ref().map(|s| s.feed.clone());
     // The operator's view of the drones comes from telemetry events.
     let telemetry_hz = args.telemetry_hz.or(server.as_ref().map(|_| 2.0));

@@ -1,8 +1,15 @@
 //! The operator API through the real server and `aviary ctl`: a leash round trip (pause
 //! holds the drone, resume goes on, abort ends the activity `aborted`), the state, the
-//! event stream, and refusal without the token.
+//! event stream, and refusal without the token. `operator/` holds the checks of who
+//! may call (`guard.rs`) and of what an operator may send (`args.rs`).
 
 mod common;
+#[path = "operator/args.rs"]
+mod args;
+#[path = "operator/guard.rs"]
+mod guard;
+#[path = "operator/serve.rs"]
+mod serve;
 
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};

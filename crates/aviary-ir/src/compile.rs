@@ -27,6 +27,7 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
     c.scopes.clear();
     c.frame_size = 0;
     let body = c.body(&mission.body, &mission.name.name, BlockKind::Sequential, true);
+    let signal_values = c.signals.names.iter().map(|s| program.signal_values.get(s).cloned().unwrap_or_default()).collect();
     let mut out = Mission {
         name: mission.name.name.clone(),
         body,
@@ -34,6 +35,7 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
         capabilities,
         drones: aviary_api::Names::new(world.drones.iter().map(|d| d.name.as_str())),
         signals: c.signals.names,
+        signal_values,
         exceptions: c.exceptions.names,
         tags: c.tags.names,
         functions: api.functions.iter().map(|f| (f.name.to_string(), f.resource)).collect(),
@@ -202,6 +204,7 @@ impl<'a> Compiler<'a> {
             name: name.clone(),
             actors: cap.actors.len(),
             params: cap.params.iter().map(|p| p.name.clone()).collect(),
+            param_kinds: self.program.param_kinds.get(name).cloned().unwrap_or_else(|| vec![None; cap.params.len()]),
             frame_size: 0,
             requirements: Vec::new(),
             perform: empty_block(name),

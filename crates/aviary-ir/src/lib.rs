@@ -14,7 +14,7 @@ mod geo;
 pub use compile::compile;
 pub use geo::to_local;
 
-use aviary_api::{DroneId, Resource, Value};
+use aviary_api::{DroneId, Kind, Resource, Value};
 use aviary_diagnostics::{FileId, Span};
 
 /// Indices into the tables of [`Mission`].
@@ -43,6 +43,10 @@ pub struct Mission {
     /// Drone names, by `DroneId`.
     pub drones: aviary_api::Names,
     pub signals: Vec<String>,
+    /// By `SignalId`: the values the signal carries, each one's kind where the checker
+    /// knows it. The engine does not need them; the operator API checks a signal raised
+    /// from outside against them.
+    pub signal_values: Vec<Vec<Option<Kind>>>,
     pub exceptions: Vec<String>,
     /// `Capability-Tag` names, as written after the dash.
     pub tags: Vec<String>,
@@ -91,6 +95,9 @@ pub struct Capability {
     /// Slots 0..actors hold the `BY` actors; the next `params.len()` slots the parameters.
     pub actors: usize,
     pub params: Vec<String>,
+    /// Each parameter's kind, as the checker inferred it (`None`: any). The engine does
+    /// not need them; the operator API checks a leash's arguments against them.
+    pub param_kinds: Vec<Option<Kind>>,
     pub frame_size: usize,
     pub requirements: Vec<Expr>,
     pub perform: Block,
@@ -362,6 +369,7 @@ mod column_tests {
             capabilities: vec![],
             drones: aviary_api::Names::new(["a", "b", "c"].into_iter()),
             signals: vec![],
+            signal_values: vec![],
             exceptions: vec![],
             tags: vec![],
             functions: vec![],

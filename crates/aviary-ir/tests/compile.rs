@@ -154,3 +154,20 @@ fn leashes_resolve_their_section_and_tag() {
     let Node::Leash(abort) = &seq.items[2] else { panic!() };
     assert_eq!(abort.action, LeashAction::Abort);
 }
+
+/// The operator API checks a leash's arguments and a signal's values against these.
+#[test]
+fn the_inferred_kinds_of_parameters_and_signal_values_are_kept() {
+    use aviary_api::Kind;
+    let m = compiled(
+        "MISSION M:\n    PARALLEL:\n        a FlyCircle-C1 WITH Far, 40m\n        ON Go WITH where:\n            a FlyTo WITH where\n",
+        "[places]\nFar = [0, 400]\n[drones.a]\nhome = [0, 0]\n",
+    );
+    let circle = cap(&m, "FlyCircle");
+    assert_eq!(circle.params, ["center", "radius", "laps"]);
+    assert_eq!(circle.param_kinds, [Some(Kind::Position), Some(Kind::Length), Some(Kind::Number)]);
+    let go = m.signals.iter().position(|s| s == "Go").expect("Go is a signal");
+    assert_eq!(m.signal_values[go], [Some(Kind::Position)]);
+    let detected = m.signals.iter().position(|s| s == "Detected").expect("a built-in signal");
+    assert_eq!(m.signal_values[detected], [Some(Kind::Symbol), Some(Kind::Position)]);
+}

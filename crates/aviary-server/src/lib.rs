@@ -6,11 +6,22 @@
 //! simulated clock. It knows the mission only through the trace events it is fed
 //! ([`Feed::publish`]) and the [`Controller`] it sends controls with.
 //!
-//! Invariants: every control call needs the run's token; reading needs none. The server
-//! binds the address it is given; the CLI gives loopback unless told otherwise.
+//! Invariants: every request names this server (`Host`) and comes from no other site's
+//! page (`Origin`); every control call needs the run's token, and so does reading when
+//! the server is bound beyond loopback (`guard.rs`); an operator's arguments are checked
+//! against the mission's kinds before it hears them (`args.rs`); every error is JSON
+//! (`reply.rs`). The server binds the address it is given; the CLI gives loopback unless
+//! told otherwise.
 
+mod args;
+mod guard;
+mod reply;
 mod routes;
 mod state;
+
+pub use args::{Kinds, MAX_MAGNITUDE};
+pub use guard::TOKEN_PROTOCOL;
+pub use reply::BODY_LIMIT;
 
 use std::net::SocketAddr;
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -31,6 +42,18 @@ pub(crate) struct Shared {
     pub controller: Controller,
     pub state: Mutex<MissionState>,
     pub events: broadcast::Sender<Arc<str>>,
+    pub kinds: Kinds,
+    pub access: guard::Access,
+}
+
+/// How to serve, beyond where.
+#[derive(Clone, Debug, Default)]
+pub struct Options {
+    /// What the mission's leash arguments and signal values must be.
+    pub kinds: Kinds,
+    /// Host names to answer to besides loopback and the bound address (`--allow-host`):
+    /// the name a reverse proxy forwards, or this machine's name on the network.
+    pub allowed_hosts: Vec<String>,
 }
 
 impl Shared {
@@ -70,15 +93,24 @@ impl Server {
     }
 }
 
+/// The routes of a server bound at `bound`, without a socket: what [`start`] serves, and
+/// what a fuzz target or a test drives request by request.
+pub fn router(bound: SocketAddr, token: String, controller: Controller, options: Options) -> (axum::Router, Feed) {
+    let (events, _) = broadcast::channel(BACKLOG);
+    let allowed = options.allowed_hosts.iter().map(|h| h.trim_end_matches('.').to_ascii_lowercase()).collect();
+    let access = guard::Access { bound, allowed, scheme: "http" };
+    let state = Mutex::new(MissionState::default());
+    let shared = Arc::new(Shared { streams: Default::default(), token, controller, state, events, kinds: options.kinds, access });
+    (routes::router(shared.clone()), Feed { shared })
+}
+
 /// Binds `address` and serves in the background. The token is new for each run.
-pub fn start(address: SocketAddr, controller: Controller) -> Result<Server, String> {
+pub fn start(address: SocketAddr, controller: Controller, options: Options) -> Result<Server, String> {
     let listener = std::net::TcpListener::bind(address).map_err(|e| format!("cannot listen on {address}: {e}"))?;
     listener.set_nonblocking(true).map_err(|e| e.to_string())?;
     let bound = listener.local_addr().map_err(|e| e.to_string())?;
     let token = new_token()?;
-    let (events, _) = broadcast::channel(BACKLOG);
-    let shared = Arc::new(Shared { streams: Default::default(), token: token.clone(), controller, state: Mutex::new(MissionState::default()), events });
-    let app = routes::router(shared.clone());
+    let (app, feed) = router(bound, token.clone(), controller, options);
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(1).enable_all().build().map_err(|e| e.to_string())?;
     std::thread::Builder::new()
         .name("aviary-server".into())
@@ -95,7 +127,7 @@ pub fn start(address: SocketAddr, controller: Controller) -> Result<Server, Stri
             })
         })
         .map_err(|e| e.to_string())?;
-    Ok(Server { address: bound, token, feed: Feed { shared } })
+    Ok(Server { address: bound, token, feed })
 }
 
 fn new_token() -> Result<String, String> {

@@ -56,6 +56,28 @@ pub fn parse(file: FileId, text: &str) -> Parse {
     Parse { tree, diagnostics, line_starts: layout.line_starts }
 }
 
+/// Reads one value by the language's rules for literals and names: a number with its
+/// unit (`20m`, `-3.5km`, `2min`), coordinates `(x, y)` or `(x, y, z)`, a name (a symbol
+/// or a place), a string in quotes, `TRUE` or `FALSE`. Errors are what was wrong, the
+/// first one first. Never panics.
+pub fn parse_value(text: &str) -> Result<ast::Expr, Vec<Diagnostic>> {
+    let file = FileId::default();
+    let mut diagnostics = Vec::new();
+    // Leading blanks would read as an indented line.
+    let text = text.trim();
+    if text.contains(['\n', '\r', '\0']) {
+        return Err(vec![Diagnostic::new(Code::Syntax, file, Span::point(0), "a value is one line of text")]);
+    }
+    let lexed = lexer::lex(file, text, &mut diagnostics);
+    let layout = layout::layout(file, &lexed, text.len(), &mut diagnostics);
+    let value = parser::parse_value_tokens(file, text, layout.tokens, &mut diagnostics);
+    match diagnostics.iter().any(Diagnostic::is_error) || matches!(value.kind, ast::ExprKind::Error) {
+        false => Ok(value),
+        true if diagnostics.is_empty() => Err(vec![Diagnostic::new(Code::Syntax, file, value.span, "not a value")]),
+        true => Err(diagnostics),
+    }
+}
+
 /// Decodes bytes first: text that is not UTF-8 is reported where it stops being UTF-8,
 /// and is not parsed further (its meaning would be a guess).
 pub fn parse_bytes(file: FileId, bytes: &[u8]) -> (String, Parse) {

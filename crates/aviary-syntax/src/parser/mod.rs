@@ -33,6 +33,18 @@ pub(crate) fn parse_tokens(file: FileId, text: &str, tokens: Vec<Token>, diagnos
     parser.file()
 }
 
+/// One value alone (`20m`, `(1, 2)`, `Body`, `"text"`), as an argument would be written:
+/// what the operator's client reads from its command line. Anything after the value is
+/// reported.
+pub(crate) fn parse_value_tokens(file: FileId, text: &str, tokens: Vec<Token>, diagnostics: &mut Vec<Diagnostic>) -> crate::ast::Expr {
+    let mut parser = Parser { file, text, tokens, pos: 0, depth: 0, last_end: 0, errors: 0, gave_up: false, diagnostics };
+    let value = parser.value();
+    if !parser.at_line_end() {
+        parser.expected("the end of the value", Some("write one value: a number with its unit (20m), (x, y), a name, or a string in quotes"));
+    }
+    value
+}
+
 impl<'a> Parser<'a> {
     fn peek(&self) -> TokenKind {
         self.peek_at(0)

@@ -1,6 +1,8 @@
 //! The MAVLink 2 backend: flies ArduPilot and PX4 vehicles, and the simulated vehicles of
 //! `aviary vehicles`, from the engine's middle layer.
 //!
+//! - [`facts::ask`] reads each vehicle's own figures (climb, descent, landing, return,
+//!   battery capacity and charge), for `aviary check --plan`.
 //! - [`connect`] opens every `mavlink =` address of the world (one [`link::Link`] per
 //!   address, shared by the vehicles on it and routed by system id), waits for each
 //!   vehicle's HEARTBEAT and first position, and asks for the telemetry streams
@@ -18,6 +20,7 @@
 
 mod backend;
 mod craft;
+pub mod facts;
 mod flight;
 pub mod geo;
 pub mod link;
@@ -35,6 +38,7 @@ use sha2::{Digest, Sha256};
 use tokio::sync::mpsc;
 
 pub use backend::MavlinkBackend;
+pub use facts::Facts;
 pub use geo::Origin;
 pub use mavlink;
 
@@ -71,6 +75,8 @@ pub struct Tuning {
     pub home_tolerance: f64,
     /// ... and how long to wait for its HOME_POSITION after its first fix.
     pub home_wait: Duration,
+    /// How long the vehicles' facts (parameters and charge) are waited for, all at once.
+    pub facts_wait: Duration,
 }
 
 impl Default for Tuning {
@@ -90,6 +96,7 @@ impl Default for Tuning {
             position_hz: 10.0,
             home_tolerance: 5.0,
             home_wait: Duration::from_secs(30),
+            facts_wait: Duration::from_secs(5),
         }
     }
 }
@@ -133,6 +140,31 @@ pub fn bindings(world: &World) -> Vec<(usize, String, u8, Option<String>)> {
         }
     }
     out
+}
+
+/// The links the world's MAVLink drones need: each address with its signing key. Two
+/// drones on one system id of an address, or one address with two keys, cannot work.
+pub(crate) fn link_keys(world: &World, bound: &[(usize, String, u8, Option<String>)]) -> Result<BTreeMap<String, Option<String>>, String> {
+    let mut links: BTreeMap<String, Option<String>> = BTreeMap::new();
+    let mut used: BTreeMap<(String, u8), usize> = BTreeMap::new();
+    for (i, address, system, key) in bound {
+        if let Some(other) = used.insert((address.clone(), *system), *i) {
+            return Err(format!(
+                "drones `{}` and `{}` both use system id {system} on {address}: give each its own `system_id`",
+                world.drones[other].name, world.drones[*i].name
+            ));
+        }
+        match links.get(address) {
+            Some(k) if k != key => {
+                return Err(format!("drone `{}` on {address} has another `signing_key` than the drones before it on that address: one link, one key", world.drones[*i].name));
+            }
+            Some(_) => {}
+            None => {
+                links.insert(address.clone(), key.clone());
+            }
+        }
+    }
+    Ok(links)
 }
 
 /// Connects to every MAVLink drone of `world`. Errors are sentences for the operator:

@@ -1,14 +1,14 @@
 //! What the backend knows of one vehicle: the last of each message it sent, the answers
 //! commands wait for, and detection (a geometric sensor over the reported track).
 
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, VecDeque};
 use std::sync::{Mutex, MutexGuard};
 
 use aviary_api::geometry::dist_to_segment;
 use aviary_api::{DroneEvent, DroneId, Failure};
 use aviary_world::Target;
 use mavlink::dialects::ardupilotmega::{
-    MavCmd, MavLandedState, MavMessage, MavModeFlag, MavResult, MavState, MavSysStatusSensor,
+    MavCmd, MavLandedState, MavMessage, MavModeFlag, MavParamType, MavResult, MavState, MavSysStatusSensor,
 };
 use tokio::sync::{mpsc, oneshot};
 use tokio::time::Instant;
@@ -47,6 +47,10 @@ pub struct Seen {
     pub home: Option<[f64; 3]>,
     /// Fraction of a full battery, when the vehicle reports one.
     pub battery: Option<f64>,
+    /// Whether SYS_STATUS or BATTERY_STATUS came (a vehicle may report no charge in them).
+    pub battery_reported: bool,
+    /// Answers to the facts' PARAM_REQUEST_READs, as sent (value, type), by name.
+    pub params: BTreeMap<String, (f32, MavParamType)>,
     pub landed: Option<MavLandedState>,
     /// Recent STATUSTEXTs (the autopilot's reasons), newest last.
     pub texts: VecDeque<(Instant, String)>,
@@ -224,6 +228,7 @@ impl Vehicle {
                 self.scan(&mut seen, from, xy);
             }
             MavMessage::SYS_STATUS(s) => {
+                seen.battery_reported = true;
                 if s.battery_remaining >= 0 {
                     seen.battery = Some(f64::from(s.battery_remaining) / 100.0);
                 }
@@ -235,8 +240,17 @@ impl Vehicle {
                 seen.battery_failing = failing(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_BATTERY);
                 seen.fence_unhealthy = failing(MavSysStatusSensor::MAV_SYS_STATUS_GEOFENCE);
             }
-            MavMessage::BATTERY_STATUS(b) if b.battery_remaining >= 0 && b.id == 0 => {
-                seen.battery = Some(f64::from(b.battery_remaining) / 100.0);
+            MavMessage::BATTERY_STATUS(b) if b.id == 0 => {
+                seen.battery_reported = true;
+                if b.battery_remaining >= 0 {
+                    seen.battery = Some(f64::from(b.battery_remaining) / 100.0);
+                }
+            }
+            MavMessage::PARAM_VALUE(p) => {
+                let name = p.param_id.to_str().unwrap_or("").trim_end_matches('\0');
+                if crate::facts::wanted(name) {
+                    seen.params.insert(name.to_owned(), (p.param_value, p.param_type));
+                }
             }
             MavMessage::EXTENDED_SYS_STATE(e) => seen.landed = Some(e.landed_state),
             MavMessage::FENCE_STATUS(f) => seen.fence_breached = f.breach_status != 0,

@@ -13,6 +13,7 @@ use mavlink::dialects::ardupilotmega::{
 use tokio::sync::{mpsc, oneshot};
 use tokio::time::Instant;
 
+use crate::battery::{self, Draw};
 use crate::geo::Origin;
 use crate::mode::{self, Flavour, Mode};
 
@@ -49,6 +50,8 @@ pub struct Seen {
     pub battery: Option<f64>,
     /// Whether SYS_STATUS or BATTERY_STATUS came (a vehicle may report no charge in them).
     pub battery_reported: bool,
+    /// The current it draws in the air, for the battery rule.
+    pub draw: Draw,
     /// Answers to the facts' PARAM_REQUEST_READs, as sent (value, type), by name.
     pub params: BTreeMap<String, (f32, MavParamType)>,
     pub landed: Option<MavLandedState>,
@@ -85,6 +88,8 @@ pub struct Vehicle {
 }
 
 const TEXTS_KEPT: usize = 16;
+/// Armed and this high (m): in the air, for the flight time and the measured draw.
+const AIRBORNE_ABOVE: f64 = 0.3;
 
 impl Vehicle {
     pub fn new(
@@ -219,7 +224,7 @@ impl Vehicle {
                 if let (Some(before), Some(at), true) = (seen.fix, seen.fix_at, seen.armed) {
                     let d: f64 = (0..3).map(|k| (fix.pos[k] - before.pos[k]).powi(2)).sum();
                     seen.odometer += d.sqrt();
-                    if before.pos[2] > 0.3 {
+                    if before.pos[2] > AIRBORNE_ABOVE {
                         seen.flight_time += now.duration_since(at).as_secs_f64();
                     }
                 }
@@ -232,6 +237,8 @@ impl Vehicle {
                 if s.battery_remaining >= 0 {
                     seen.battery = Some(f64::from(s.battery_remaining) / 100.0);
                 }
+                let airborne = seen.armed && seen.fix.is_some_and(|f| f.pos[2] > AIRBORNE_ABOVE);
+                seen.draw.record(now, battery::amps(s.current_battery), airborne);
                 // A sensor the vehicle has and uses but calls unhealthy (ArduPilot clears
                 // the battery's bit with its battery failsafe, the fence's on a breach).
                 let failing = |bit: MavSysStatusSensor| {
@@ -245,6 +252,8 @@ impl Vehicle {
                 if b.battery_remaining >= 0 {
                     seen.battery = Some(f64::from(b.battery_remaining) / 100.0);
                 }
+                let airborne = seen.armed && seen.fix.is_some_and(|f| f.pos[2] > AIRBORNE_ABOVE);
+                seen.draw.record(now, battery::amps(b.current_battery), airborne);
             }
             MavMessage::PARAM_VALUE(p) => {
                 let name = p.param_id.to_str().unwrap_or("").trim_end_matches('\0');

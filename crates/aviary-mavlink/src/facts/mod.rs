@@ -23,6 +23,7 @@ use crate::mode::Flavour;
 
 pub use params::{decode, table, wanted, Figure, Param, ARDUPILOT, PX4};
 pub use read::ask;
+pub(crate) use read::read;
 
 /// What one vehicle answered.
 #[derive(Clone, Debug, PartialEq)]

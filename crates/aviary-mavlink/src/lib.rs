@@ -24,6 +24,7 @@ pub mod battery;
 mod connect;
 mod craft;
 pub mod facts;
+mod failsafe;
 mod flight;
 pub mod geo;
 pub mod link;

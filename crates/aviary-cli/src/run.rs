@@ -79,9 +79,16 @@ pub fn run(args: &RunArgs) -> u8 {
         return 2;
     }
     // The source texts are needed only to show errors: they go before the mission is
-    // compiled (a large world's text is megabytes).
-    drop(sources);
-    crate::alloc::give_back();
+    // compiled (a large world's text is megabytes). With MAVLink drones the plan is made
+    // again with the vehicles' figures, and its warnings point into them.
+    let mavlink = checked.world.as_ref().is_some_and(|w| !aviary_mavlink::bindings(w).is_empty());
+    let sources = if mavlink {
+        Some(sources)
+    } else {
+        drop(sources);
+        crate::alloc::give_back();
+        None
+    };
     let (Some(program), Some(world)) = (checked.program, checked.world) else { return 2 };
     let Some(mission) = aviary_ir::compile(&program, &world, &api) else {
         eprintln!("aviary: {} has no MISSION to run (it holds only capabilities)", args.file.display());
@@ -135,12 +142,19 @@ pub fn run(args: &RunArgs) -> u8 {
     let ran = runtime.block_on(async {
         let sim = SimBackend::start_with(fleet, SimOptions { speed: args.speed, ..SimOptions::default() });
         let mixed = match &world {
-            Some(world) => Some(crate::mixed::Mixed::new(sim.clone(), aviary_mavlink::connect(world, aviary_mavlink::Tuning::default()).await?)),
+            Some(world) => {
+                let mavlink = aviary_mavlink::connect(world, aviary_mavlink::Tuning::default()).await?;
+                if let Some(sources) = &sources {
+                    crate::figures::before_flight(&mission, world, mavlink.facts(), sources, args.quiet);
+                }
+                Some(crate::mixed::Mixed::new(sim.clone(), mavlink))
+            }
             None => None,
         };
         // The backends keep what they need of the world: a large fleet's is not held
         // through the flight.
         drop(world);
+        drop(sources);
         let backend: &dyn Backend = match &mixed {
             Some(m) => m,
             None => &*sim,

@@ -5,7 +5,16 @@ use aviary_diagnostics::{render_json, render_text, summary_line, Diagnostic, Sou
 use crate::files::{color_wanted, world_beside, DiskProvider};
 use crate::Format;
 
-pub fn run(files: &[std::path::PathBuf], world: Option<&Path>, format: Format, plan: bool) -> u8 {
+/// What `--plan` asks for: the plan, and whether to ask MAVLink vehicles for their
+/// figures first (not with `--offline`; never without `--plan`, which must stay fast and
+/// offline for editors).
+#[derive(Clone, Copy)]
+pub struct Plan {
+    pub plan: bool,
+    pub ask: bool,
+}
+
+pub fn run(files: &[std::path::PathBuf], world: Option<&Path>, format: Format, plan: Plan) -> u8 {
     let mut worst = 0;
     for file in files {
         worst = worst.max(check_one(file, world, format, plan));
@@ -13,7 +22,8 @@ pub fn run(files: &[std::path::PathBuf], world: Option<&Path>, format: Format, p
     worst
 }
 
-fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want_plan: bool) -> u8 {
+fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want: Plan) -> u8 {
+    let want_plan = want.plan;
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
         Err(e) => {
@@ -37,7 +47,14 @@ fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want_plan: 
     let world = world_name.as_deref().zip(world_bytes.as_deref());
     let name = path.display().to_string();
     let api = aviary_sim::descriptor();
-    let checked = aviary_check::check_sources(&mut sources, (&name, &bytes), world, &DiskProvider, &api);
+    let mut checked = aviary_check::check_sources(&mut sources, (&name, &bytes), world, &DiskProvider, &api);
+    // MAVLink drones fly with their vehicles' figures: the plan is made with them.
+    let mut figures = None;
+    if want.ask && !checked.has_errors() {
+        if let Some(world) = checked.world.as_mut() {
+            figures = Some(crate::figures::ask(world));
+        }
+    }
     let verified = aviary_verify::preflight(&checked, &api);
     let mut diagnostics = checked.diagnostics;
     let mut plan = None;
@@ -63,11 +80,21 @@ fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want_plan: 
     match format {
         Format::Text => {
             print(&sources, &diagnostics, format, path);
+            match &figures {
+                Some(Ok(f)) if !f.is_empty() => out!("\nfigures of the MAVLink drones:\n{}", crate::figures::render(f)),
+                Some(Err(why)) => out!("\nfigures of the MAVLink drones: not asked ({why}); planned with the world's figures\n"),
+                _ => {}
+            }
             out!("\n{}", plan.render_text());
         }
         Format::Json => {
             let diagnostics: Vec<serde_json::Value> = diagnostics.iter().map(|d| render_json(&sources, d)).collect();
-            let doc = serde_json::json!({ "file": path.display().to_string(), "plan": plan, "diagnostics": diagnostics });
+            let mut doc = serde_json::json!({ "file": path.display().to_string(), "plan": plan, "diagnostics": diagnostics });
+            match &figures {
+                Some(Ok(f)) if !f.is_empty() => doc["vehicles"] = f.iter().map(crate::figures::Source::json).collect(),
+                Some(Err(why)) => doc["vehicles_not_asked"] = why.as_str().into(),
+                _ => {}
+            }
             outln!("{doc}");
         }
     }

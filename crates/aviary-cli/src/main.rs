@@ -9,6 +9,7 @@ mod alloc;
 mod bench;
 mod check;
 mod ctl;
+mod figures;
 mod files;
 mod cores;
 mod fmt;
@@ -50,9 +51,13 @@ enum Command {
         world: Option<PathBuf>,
         #[arg(long, value_enum, default_value = "text")]
         format: Format,
-        /// Also print the energy and time plan: per drone, a timeline, distance, flight time and battery left
+        /// Also print the energy and time plan: per drone, a timeline, distance, flight time and battery left.
+        /// MAVLink drones are planned with their vehicles' own figures (asked for, at most 5 s)
         #[arg(long)]
         plan: bool,
+        /// With --plan: do not ask MAVLink vehicles for their figures; plan with the world's
+        #[arg(long, requires = "plan")]
+        offline: bool,
     },
     /// Rewrite missions in the one canonical layout
     Fmt {
@@ -147,7 +152,7 @@ fn main() -> ExitCode {
 
 fn command(cli: Cli) -> u8 {
     let code = match cli.command {
-        Command::Check { files, world, format, plan } => check::run(&files, world.as_deref(), format, plan),
+        Command::Check { files, world, format, plan, offline } => check::run(&files, world.as_deref(), format, check::Plan { plan, ask: plan && !offline }),
         Command::Fmt { files, check } => fmt::run(&files, check),
         Command::Run { file, world, speed, seed, trace, telemetry_hz, quiet, serve, allow_host } => {
             // Served to an operator, a mission runs in real time unless told otherwise.

@@ -79,9 +79,16 @@ pub fn run(args: &RunArgs) -> u8 {
         return 2;
     }
     // The source texts are needed only to show errors: they go before the mission is
-    // compiled (a large world's text is megabytes).
-    drop(sources);
-    crate::alloc::give_back();
+    // compiled (a large world's text is megabytes). With MAVLink drones the plan is made
+    // again with the vehicles' figures, and its warnings point into them.
+    let mavlink = checked.world.as_ref().is_some_and(|w| !aviary_mavlink::bindings(w).is_empty());
+    let sources = if mavlink {
+        Some(sources)
+    } else {
+        drop(sources);
+        crate::alloc::give_back();
+        None
+    };
     let (Some(program), Some(world)) = (checked.program, checked.world) else { return 2 };
     let Some(mission) = aviary_ir::compile(&program, &world, &api) else {
         eprintln!("aviary: {} has no MISSION to run (it holds only capabilities)", args.file.display());
@@ -138,7 +145,7 @@ pub fn run(args: &RunArgs) -> u8 {
                 let mut stop = stop_rx.clone();
                 // A stop while the vehicles connect is answered at once: nothing has
                 // flown, so there is nothing to bring home.
-                let connected = tokio::select! {
+                let mavlink = tokio::select! {
                     connected = aviary_mavlink::connect(world, aviary_mavlink::Tuning::default()) => connected?,
                     by = stop.wait_for(Option::is_some) => {
                         let by = by.ok().and_then(|b| *b).unwrap_or("a stop signal");
@@ -147,13 +154,17 @@ pub fn run(args: &RunArgs) -> u8 {
                         return Ok((Outcome { status: Status::Aborted, reason: Some(reason) }, String::new()));
                     }
                 };
-                Some(crate::mixed::Mixed::new(sim.clone(), connected))
+                if let Some(sources) = &sources {
+                    crate::figures::before_flight(&mission, world, mavlink.facts(), sources, args.quiet);
+                }
+                Some(crate::mixed::Mixed::new(sim.clone(), mavlink))
             }
             None => None,
         };
         // The backends keep what they need of the world: a large fleet's is not held
         // through the flight.
         drop(world);
+        drop(sources);
         let backend: &dyn Backend = match &mixed {
             Some(m) => m,
             None => &*sim,

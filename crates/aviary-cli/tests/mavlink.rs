@@ -447,3 +447,65 @@ fn bad_vehicles_and_speed_arguments_are_usage_errors() {
         "{err}"
     );
 }
+
+/// `aviary check` asks MAVLink vehicles for their figures only with `--plan`, and not
+/// with `--offline`: a listener that never answers counts who connects. With `--plan`
+/// the silent vehicle costs a bounded wait and the plan is made with the world's figures.
+#[test]
+fn check_asks_the_vehicles_only_for_a_plan_and_waits_for_them_a_bounded_time() {
+    let dir = scratch("mavlink_check_asks");
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").expect("listen");
+    listener.set_nonblocking(true).expect("nonblocking");
+    let port = listener.local_addr().expect("address").port();
+    std::fs::write(dir.join("m.world.toml"), bind(SMALL_WORLD, port, &["scout"])).expect("world");
+    std::fs::write(dir.join("m.mission"), SMALL_MISSION).expect("mission");
+    let connected = || match listener.accept() {
+        Ok(_) => true,
+        Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => false,
+        Err(e) => panic!("accept: {e}"),
+    };
+    for args in [&["check", "m.mission"][..], &["check", "--plan", "--offline", "m.mission"]] {
+        let (code, out, err) = aviary(args, &dir);
+        assert_eq!(code, 0, "{args:?}: {out}{err}");
+        assert!(!out.contains("figures of the MAVLink drones"), "{args:?}: {out}");
+        assert!(!connected(), "{args:?} connected to the vehicle");
+    }
+    let start = Instant::now();
+    let (code, out, err) = aviary(&["check", "--plan", "m.mission"], &dir);
+    let took = start.elapsed();
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(connected(), "check --plan asked the vehicle");
+    let said = format!("scout: no answer from tcp:127.0.0.1:{port} (system 1): no HEARTBEAT; planned with the world's figures");
+    assert!(out.contains(&said), "{out}");
+    assert!(out.contains("plan: the mission takes about"), "{out}");
+    assert!(took < Duration::from_secs(8), "check --plan took {took:?} on a silent vehicle");
+}
+
+/// Against `aviary vehicles`, which serves the world's drones: check --plan hears each
+/// vehicle, takes its charge from SYS_STATUS, and names where each drone's figures come
+/// from, within the bounded wait. (Whether it serves parameters or not: a vehicle that
+/// answers none keeps the world's figures, and the line says so.)
+#[test]
+fn check_plan_hears_aviary_vehicles_and_says_where_the_figures_come_from() {
+    let dir = scratch("mavlink_check_vehicles");
+    std::fs::write(dir.join("vehicles.world.toml"), SMALL_WORLD).expect("world");
+    let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "1");
+    std::fs::write(dir.join("m.world.toml"), bind(SMALL_WORLD, vehicles.port, &["scout", "buddy"])).expect("world");
+    std::fs::write(dir.join("m.mission"), SMALL_MISSION).expect("mission");
+    let start = Instant::now();
+    let (code, out, err) = aviary(&["check", "--plan", "--format", "json", "m.mission"], &dir);
+    let took = start.elapsed();
+    assert_eq!(code, 0, "{out}{err}");
+    let doc: Value = serde_json::from_str(&out).expect("one JSON document");
+    let sources = doc["vehicles"].as_array().unwrap_or_else(|| panic!("no vehicles in {doc}"));
+    assert_eq!(sources.len(), 2, "{doc}");
+    for (s, (name, system)) in sources.iter().zip([("scout", 1), ("buddy", 2)]) {
+        let line = s["source"].as_str().expect("source");
+        assert_eq!(s["drone"].as_str(), Some(name));
+        assert!(line.starts_with(&format!("{name}: ")) && line.contains(&format!("tcp:127.0.0.1:{} (system {system})", vehicles.port)), "{line}");
+        assert!(!line.contains("no answer from"), "the vehicle was heard: {line}");
+        assert!(line.contains("charge 100%"), "the charge from SYS_STATUS: {line}");
+    }
+    assert!(doc["plan"]["drones"].as_array().is_some_and(|d| d.len() == 2), "{doc}");
+    assert!(took < Duration::from_secs(8), "check --plan took {took:?}");
+}

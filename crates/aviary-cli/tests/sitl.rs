@@ -4,6 +4,8 @@
 //! - `fleet::`: the paper's mission on seven SITL copters, and on two SITL copters with
 //!   five simulated drones. These are the long ones (10 minutes of real flight); their
 //!   module sorts first so that the test harness starts them first and side by side.
+//! - `facts::`: the paper's mission checked (`aviary check --plan`, no flight) on seven
+//!   copters that say their own battery: too small by default, enough with 16.5 Ah.
 //! - `single::`: one copter: a flight with an orbit whose trace agrees with what SITL
 //!   reports to a second ground station; each autopilot failsafe (battery, geofence, GPS,
 //!   link) reaching the mission as the language's exception; a refused command; a vehicle
@@ -95,9 +97,17 @@ fn one_copter_world(sitl: &Sitl, extra: &str) -> String {
 
 /// The example world with `mavlink` and `system_id` for the drones `sitls` names.
 fn example_world(sitls: &[(&str, &Sitl)]) -> String {
-    common::example_world_with(|name| match sitls.iter().find(|(n, _)| *n == name) {
-        Some((_, s)) => format!("mavlink = \"{}\"\nsystem_id = {}\n", s.address(), s.system),
-        None => String::new(),
+    example_world_with(sitls, "")
+}
+
+/// As [`example_world`], with `extra` (keys) added to every drone.
+fn example_world_with(sitls: &[(&str, &Sitl)], extra: &str) -> String {
+    common::example_world_with(|name| {
+        let link = match sitls.iter().find(|(n, _)| *n == name) {
+            Some((_, s)) => format!("mavlink = \"{}\"\nsystem_id = {}\n", s.address(), s.system),
+            None => String::new(),
+        };
+        format!("{extra}{link}")
     })
 }
 
@@ -204,6 +214,123 @@ mod fleet {
     #[test]
     fn paper_mission_on_two_sitl_copters_and_five_simulated() {
         super::paper_mission("sitl_mixed", 10, &["flir_drone2", "beacon_drone2"]);
+    }
+}
+
+/// What the vehicles say of themselves plans the mission: `aviary check --plan` reads each
+/// copter's BATT_CAPACITY (and its other figures) before flight. No flight: the copters
+/// only boot and answer.
+mod facts {
+    use super::*;
+
+    const PAPER: [&str; 7] = ["video_drone1", "video_drone2", "flir_drone1", "flir_drone2", "sensor_drone", "beacon_drone1", "beacon_drone2"];
+
+    /// The paper's mission on seven copters with ArduPilot's default battery (3300 mAh),
+    /// in a world whose drones draw SITL's 30 A: 6.6 minutes of flight for a mission whose
+    /// longest drone flies about 8. The check warns before flight, naming the drones; with
+    /// BATT_CAPACITY 16500 set on the same running vehicles it does not.
+    #[test]
+    fn check_plan_warns_when_the_vehicles_batteries_cannot_finish_the_paper_mission() {
+        let dir = scratch("sitl_facts");
+        let sitls: Vec<(&str, Sitl)> = PAPER.iter().enumerate().map(|(i, n)| (*n, Sitl::start(&dir, 30, i as u8 + 1, home_of(n), &[]))).collect();
+        let refs: Vec<(&str, &Sitl)> = sitls.iter().map(|(n, s)| (*n, s)).collect();
+        std::fs::copy(repo().join("examples/search_and_rescue.mission"), dir.join("m.mission")).expect("mission");
+        std::fs::write(dir.join("m.world.toml"), example_world_with(&refs, "flight_current = 30\n")).expect("world");
+        let warned = |out: &str| -> Vec<&str> { PAPER.iter().copied().filter(|n| out.contains(&format!("{n}'s battery is estimated to fall under 20%"))).collect() };
+
+        // The world alone knows the draw but not the capacity: its 30 minutes, no warning.
+        let (code, out, err) = aviary(&["check", "--plan", "--offline", "m.mission"], &dir);
+        assert_eq!(code, 0, "{out}{err}");
+        assert!(warned(&out).is_empty() && !out.contains("W204"), "offline, the world's endurance suffices:\n{out}");
+
+        let start = Instant::now();
+        let (code, out, err) = aviary(&["check", "--plan", "m.mission"], &dir);
+        let took = start.elapsed();
+        std::fs::write(dir.join("check-default.txt"), &out).expect("keep the output");
+        assert_eq!(code, 0, "a warning is no error:\n{out}{err}");
+        for (name, s) in &refs {
+            let source = format!("{name}: figures from the vehicle on {} (system {}), charge 100%", s.address(), s.system);
+            assert!(out.contains(&source), "{source:?} in:\n{out}");
+            assert!(out.contains(&format!("{name}: battery 3300 mAh (the vehicle's BATT_CAPACITY); the world gave none")), "{out}");
+            assert!(out.contains(&format!("{name}: endurance 6.6 min (3300 mAh at the world's flight_current 30 A)")), "{out}");
+            assert!(out.contains(&format!("{name}: descent 1.5 m/s (the vehicle's WPNAV_SPEED_DN), not the world's 3 m/s")), "{out}");
+        }
+        let short = warned(&out);
+        assert!(!short.is_empty() && out.contains("W204") && out.contains("runs out before the end"), "the default battery cannot finish:\n{out}");
+        eprintln!("check --plan with seven vehicles booting took {took:?}; warned: {short:?}");
+        assert!(took < Duration::from_secs(12), "check --plan took {took:?}");
+
+        // A battery that suffices, on the same vehicles (and SITL's simulated one to match).
+        for (_, s) in &sitls {
+            let gcs = s.gcs(Duration::from_secs(10));
+            for (name, value) in BIG_BATTERY {
+                gcs.set_param(name, *value as f32);
+            }
+        }
+        let (code, out, err) = aviary(&["check", "--plan", "m.mission"], &dir);
+        std::fs::write(dir.join("check-16500.txt"), &out).expect("keep the output");
+        assert_eq!(code, 0, "{out}{err}");
+        for name in PAPER {
+            assert!(out.contains(&format!("{name}: battery 16500 mAh (the vehicle's BATT_CAPACITY)")), "{out}");
+        }
+        assert!(warned(&out).is_empty() && !out.contains("W204"), "16.5 Ah suffices:\n{out}");
+    }
+
+    /// `aviary run` plans again with what the vehicle said at connect and, before anything
+    /// flies, warns that the battery runs out (10 minutes of hover on 6.6); then it flies
+    /// anyway (the choice: handlers and the autopilot's failsafe may cover it). The run is
+    /// stopped once the take-off is under way.
+    #[test]
+    fn run_warns_before_flight_that_the_battery_runs_out_and_flies() {
+        let dir = scratch("sitl_facts_run");
+        let sitl = Sitl::start(&dir, 30, 1, [0.0, 0.0], &[]);
+        std::fs::write(dir.join("m.world.toml"), one_copter_world(&sitl, "") + "flight_current = 30\n").expect("world");
+        std::fs::write(dir.join("m.mission"), "MISSION Long:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d Hover WITH 600s\n").expect("mission");
+        let _run = start_run(&dir, "m.mission");
+        let stderr = || std::fs::read_to_string(dir.join("stderr.txt")).unwrap_or_default();
+        wait_until(Duration::from_secs(120), "the warning", || stderr().contains("WARNING"));
+        let said = stderr();
+        assert!(said.contains("d: figures from the vehicle on") && said.contains("d: endurance 6.6 min"), "{said}");
+        assert!(said.contains("warning[W204]: d's battery") && said.contains("runs out before the end"), "{said}");
+        assert!(said.contains("the plan says d's battery runs out before the mission ends") && said.contains("Flying anyway"), "{said}");
+        // 10 minutes on 6.6: about 150 % (the plan adds the take-off and the way home).
+        let needs: f64 = said.split("it needs about ").nth(1).and_then(|t| t.split('%').next()).and_then(|n| n.parse().ok()).unwrap_or_else(|| panic!("no need in {said}"));
+        assert!((140.0..170.0).contains(&needs) && said.contains("starts with 100%"), "{said}");
+        // Said before the take-off, which waits for SITL's GPS and EKF (tens of seconds).
+        assert!(!events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_done"), "the warning comes before anything flies");
+        wait_until(Duration::from_secs(120), "the take-off", || events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_call" && e["function"] == "TakeOff"));
+    }
+
+    /// In flight the battery rule takes the share of the way home from the current the
+    /// vehicle measures (SITL's ~30 A) against its BATT_CAPACITY, here 600 mAh (SITL's
+    /// simulated battery stays 3.3 Ah, so its voltage stays healthy and no failsafe of
+    /// its own starts). Hovering at home, 10 m up: 5 s above home and 20 s down at
+    /// 0.5 m/s, 25 s at 30 A = 35 % of 600 mAh, so BatteryLow comes under ~79 % and
+    /// BatteryCritical under ~45 %. On the world's figures alone (30 minutes, no capacity)
+    /// both would wait until ~13 % and ~11 %.
+    #[test]
+    fn the_battery_rule_uses_the_draw_the_vehicle_measures() {
+        let dir = scratch("sitl_facts_draw");
+        let sitl = Sitl::start(&dir, 30, 1, [0.0, 0.0], &[("BATT_CAPACITY", 600.0)]);
+        std::fs::write(dir.join("m.world.toml"), one_copter_world(&sitl, "")).expect("world");
+        let mission = "MISSION Drain:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d Hover WITH 120s\n    ON EXCEPTION BatteryCritical BY d:\n        SIGNAL Caught\n    ON BatteryLow BY d:\n        SIGNAL Low\n";
+        std::fs::write(dir.join("m.mission"), mission).expect("mission");
+        let mut run = start_run(&dir, "m.mission");
+        let (_, out) = finish(&mut run, &dir, Duration::from_secs(300));
+        let flown = events(&dir.join("t.jsonl"));
+        // The charge the drone reported last before `event`.
+        let charge_before = |event: &Value| -> f64 {
+            let t = event["t"].as_f64().expect("t");
+            named(&flown, "telemetry").filter(|e| e["actor"] == "d" && e["t"].as_f64() <= Some(t)).last().and_then(|e| e["battery"].as_f64()).expect("telemetry before")
+        };
+        let low = named(&flown, "signal").find(|e| e["name"] == "BatteryLow").unwrap_or_else(|| panic!("no BatteryLow:\n{out}"));
+        let critical = named(&flown, "exception").find(|e| e["name"] == "BatteryCritical").unwrap_or_else(|| panic!("no BatteryCritical:\n{out}"));
+        let (at_low, at_critical) = (charge_before(low), charge_before(critical));
+        eprintln!("BatteryLow at {:.0} %, BatteryCritical at {:.0} %", at_low * 100.0, at_critical * 100.0);
+        assert!((0.60..=0.85).contains(&at_low), "BatteryLow at {at_low}:\n{out}");
+        assert!((0.30..=0.55).contains(&at_critical), "BatteryCritical at {at_critical}:\n{out}");
+        assert_eq!(critical["handled"].as_bool(), Some(true));
+        assert!(critical["args"].to_string().contains("about what it needs to get home"), "the backend's rule, not SITL's failsafe: {critical}");
     }
 }
 

@@ -17,6 +17,7 @@ use tokio::sync::{mpsc, oneshot, watch};
 use tokio::task::AbortHandle;
 
 use crate::craft::{failed, Craft, Doing};
+use crate::facts::Facts;
 use crate::flight;
 
 struct Slot {
@@ -46,11 +47,13 @@ fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
 /// not served here (calls on them fail); `aviary run` sends those to the simulator.
 pub struct MavlinkBackend {
     inner: Arc<Inner>,
+    facts: Vec<Facts>,
 }
 
 impl MavlinkBackend {
     pub(crate) fn new(
         crafts: Vec<Option<Arc<Craft>>>,
+        facts: Vec<Facts>,
         sensors: Vec<Sensor>,
         events: (
             mpsc::UnboundedSender<DroneEvent>,
@@ -72,7 +75,14 @@ impl MavlinkBackend {
         });
         tokio::spawn(alarms_task(Arc::downgrade(&inner), alarms));
         tokio::spawn(watchdog(Arc::downgrade(&inner), heartbeat_timeout));
-        MavlinkBackend { inner }
+        MavlinkBackend { inner, facts }
+    }
+
+    /// What each vehicle said of itself at connect, one per MAVLink drone in the world's
+    /// order: already applied to the figures the backend flies it with (the battery
+    /// rule's, the acceleration). Apply them to the world's drones to plan with them.
+    pub fn facts(&self) -> &[Facts] {
+        &self.facts
     }
 
     /// Whether `drone` is one of this backend's.
@@ -134,13 +144,15 @@ impl Inner {
 }
 
 impl Inner {
-    /// The battery rule of docs/WORLD.md, on the charge the vehicle reports: with `need` the share
-    /// of a full battery it takes to fly home at `max_speed` and descend at `climb_rate`,
+    /// The battery rule of docs/WORLD.md, on the charge the vehicle reports and its own
+    /// figures (`battery`): with `need` the share of a full battery it takes to fly home at
+    /// `max_speed`, wait and land as the vehicle does, at the current it has been drawing,
     /// `BatteryLow` under `2 × need + 10 %`, `BatteryCritical` under `need + 10 %`.
     fn battery_rule(&self, drone: DroneId, c: &Craft) {
-        let (fix, battery) = {
+        let now = tokio::time::Instant::now();
+        let (fix, battery, drawn) = {
             let seen = c.v.seen();
-            (seen.fix, seen.battery)
+            (seen.fix, seen.battery, seen.draw.average(now))
         };
         let (Some(fix), Some(battery)) = (fix, battery) else {
             return;
@@ -149,16 +161,17 @@ impl Inner {
             return;
         }
         let home = aviary_api::geometry::dist([fix.pos[0], fix.pos[1]], c.home);
-        let need = (home / c.max_speed + fix.pos[2].max(0.0) / c.climb_rate) / c.endurance;
+        let need = c.battery.need(home, fix.pos[2], drawn);
+        let (is_low, is_critical) = crate::battery::alarms(battery, need);
         let (low, critical) = lock(&self.battery)[drone];
-        if !low && battery < 2.0 * need + 0.10 {
+        if !low && is_low {
             lock(&self.battery)[drone].0 = true;
             let _ = self.events.send(DroneEvent::Signal {
                 drone,
                 name: "BatteryLow",
             });
         }
-        if !critical && battery < need + 0.10 {
+        if !critical && is_critical {
             let reason = format!(
                 "{}: {:.0}% left, about what it needs to get home",
                 c.name,

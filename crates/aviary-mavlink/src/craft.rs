@@ -33,11 +33,11 @@ pub struct Craft {
     pub link: Arc<Link>,
     pub v: Arc<Vehicle>,
     pub max_speed: f64,
-    pub climb_rate: f64,
-    /// The world's `acceleration` (m/s²): orbit speeds and where a path's points are passed.
+    /// The `acceleration` (m/s², the vehicle's WPNAV_ACCEL when it answered): orbit speeds
+    /// and where a path's points are passed.
     pub acceleration: f64,
-    /// Seconds of flight on a full battery (the world's), for the battery alarms.
-    pub endurance: f64,
+    /// The battery rule's figures: the world's, with the vehicle's applied (`facts`).
+    pub battery: crate::battery::Figures,
     pub home: [f64; 2],
     pub sensors: Vec<String>,
     pub payload: Vec<String>,

@@ -1,18 +1,20 @@
 //! What the backend knows of one vehicle: the last of each message it sent, the answers
 //! commands wait for, and detection (a geometric sensor over the reported track).
 
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, VecDeque};
 use std::sync::{Mutex, MutexGuard};
 
 use aviary_api::geometry::dist_to_segment;
 use aviary_api::{DroneEvent, DroneId, Failure};
 use aviary_world::Target;
 use mavlink::dialects::ardupilotmega::{
-    MavCmd, MavLandedState, MavMessage, MavModeFlag, MavResult, MavState, MavSysStatusSensor,
+    MavCmd, MavLandedState, MavMessage, MavModeFlag, MavParamType, MavResult, MavState, MavSysStatusSensor,
 };
 use tokio::sync::{mpsc, oneshot};
 use tokio::time::Instant;
 
+use crate::battery::{self, Draw};
+use crate::failsafe::{failsafe, FAILSAFE_WAIT};
 use crate::geo::Origin;
 use crate::mode::{self, Flavour, Mode};
 
@@ -47,6 +49,12 @@ pub struct Seen {
     pub home: Option<[f64; 3]>,
     /// Fraction of a full battery, when the vehicle reports one.
     pub battery: Option<f64>,
+    /// Whether SYS_STATUS or BATTERY_STATUS came (a vehicle may report no charge in them).
+    pub battery_reported: bool,
+    /// The current it draws in the air, for the battery rule.
+    pub draw: Draw,
+    /// Answers to the facts' PARAM_REQUEST_READs, as sent (value, type), by name.
+    pub params: BTreeMap<String, (f32, MavParamType)>,
     pub landed: Option<MavLandedState>,
     /// Recent STATUSTEXTs (the autopilot's reasons), newest last.
     pub texts: VecDeque<(Instant, String)>,
@@ -81,6 +89,8 @@ pub struct Vehicle {
 }
 
 const TEXTS_KEPT: usize = 16;
+/// Armed and this high (m): in the air, for the flight time and the measured draw.
+const AIRBORNE_ABOVE: f64 = 0.3;
 
 impl Vehicle {
     pub fn new(
@@ -215,7 +225,7 @@ impl Vehicle {
                 if let (Some(before), Some(at), true) = (seen.fix, seen.fix_at, seen.armed) {
                     let d: f64 = (0..3).map(|k| (fix.pos[k] - before.pos[k]).powi(2)).sum();
                     seen.odometer += d.sqrt();
-                    if before.pos[2] > 0.3 {
+                    if before.pos[2] > AIRBORNE_ABOVE {
                         seen.flight_time += now.duration_since(at).as_secs_f64();
                     }
                 }
@@ -224,9 +234,12 @@ impl Vehicle {
                 self.scan(&mut seen, from, xy);
             }
             MavMessage::SYS_STATUS(s) => {
+                seen.battery_reported = true;
                 if s.battery_remaining >= 0 {
                     seen.battery = Some(f64::from(s.battery_remaining) / 100.0);
                 }
+                let airborne = seen.armed && seen.fix.is_some_and(|f| f.pos[2] > AIRBORNE_ABOVE);
+                seen.draw.record(now, battery::amps(s.current_battery), airborne);
                 // A sensor the vehicle has and uses but calls unhealthy (ArduPilot clears
                 // the battery's bit with its battery failsafe, the fence's on a breach).
                 let failing = |bit: MavSysStatusSensor| {
@@ -235,8 +248,19 @@ impl Vehicle {
                 seen.battery_failing = failing(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_BATTERY);
                 seen.fence_unhealthy = failing(MavSysStatusSensor::MAV_SYS_STATUS_GEOFENCE);
             }
-            MavMessage::BATTERY_STATUS(b) if b.battery_remaining >= 0 && b.id == 0 => {
-                seen.battery = Some(f64::from(b.battery_remaining) / 100.0);
+            MavMessage::BATTERY_STATUS(b) if b.id == 0 => {
+                seen.battery_reported = true;
+                if b.battery_remaining >= 0 {
+                    seen.battery = Some(f64::from(b.battery_remaining) / 100.0);
+                }
+                let airborne = seen.armed && seen.fix.is_some_and(|f| f.pos[2] > AIRBORNE_ABOVE);
+                seen.draw.record(now, battery::amps(b.current_battery), airborne);
+            }
+            MavMessage::PARAM_VALUE(p) => {
+                let name = p.param_id.to_str().unwrap_or("").trim_end_matches('\0');
+                if crate::facts::wanted(name) {
+                    seen.params.insert(name.to_owned(), (p.param_value, p.param_type));
+                }
             }
             MavMessage::EXTENDED_SYS_STATE(e) => seen.landed = Some(e.landed_state),
             MavMessage::FENCE_STATUS(f) => seen.fence_breached = f.breach_status != 0,
@@ -317,63 +341,5 @@ impl Vehicle {
 
     pub fn target_count(&self) -> usize {
         self.targets.len()
-    }
-}
-
-/// How long a failsafe mode change waits for the vehicle to say why.
-const FAILSAFE_WAIT: std::time::Duration = std::time::Duration::from_millis(2500);
-
-/// The exception a failsafe RTL or LAND stands for: from what the vehicle reports of
-/// itself (`state`: its battery, fence or GPS), else from its own words.
-fn failsafe(name: &str, mode: &str, why: &str, state: Option<&'static str>) -> Failure {
-    let lower = why.to_ascii_lowercase();
-    let exception = if let Some(e) = state {
-        e
-    } else if lower.contains("battery") {
-        "BatteryCritical"
-    } else if ["gps", "ekf", "position"].iter().any(|w| lower.contains(w)) {
-        "PositionLost"
-    } else if lower.contains("fence") {
-        "GeofenceViolation"
-    } else if ["radio", "gcs", "link", "telemetry", "rc "]
-        .iter()
-        .any(|w| lower.contains(w))
-    {
-        "ConnectionLost"
-    } else {
-        "CommandFailed"
-    };
-    let said = if why.is_empty() {
-        "no reason given".to_owned()
-    } else {
-        format!("it said: {why}")
-    };
-    Failure {
-        exception,
-        reason: format!("{name}: the autopilot switched to {mode} by itself ({said})"),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::failsafe;
-
-    #[test]
-    fn failsafe_reasons_pick_the_exception() {
-        assert_eq!(
-            failsafe("a", "RTL", "Battery 1 is critical", None).exception,
-            "BatteryCritical"
-        );
-        assert_eq!(
-            failsafe("a", "LAND", "EKF variance", None).exception,
-            "PositionLost"
-        );
-        assert_eq!(
-            failsafe("a", "RTL", "Radio Failsafe", None).exception,
-            "ConnectionLost"
-        );
-        assert_eq!(failsafe("a", "RTL", "", None).exception, "CommandFailed");
-        // What the vehicle reports of itself comes before its words.
-        assert_eq!(failsafe("a", "RTL", "Fence breached", Some("BatteryCritical")).exception, "BatteryCritical");
     }
 }

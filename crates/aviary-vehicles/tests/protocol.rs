@@ -347,7 +347,9 @@ async fn the_battery_rule_signals_low_then_raises_critical_once() {
 
 #[tokio::test]
 async fn a_crash_raises_drone_lost() {
-    let faults = "\n[[faults]]\ndrone = \"scout\"\nat = 60\nkind = \"crash\"\n";
+    // At 10× real time the crash comes 12 s after the vehicles start: after connect (which
+    // waits up to 2.5 s for parameters a vehicle may not serve), arming and the take-off.
+    let faults = "\n[[faults]]\ndrone = \"scout\"\nat = 120\nkind = \"crash\"\n";
     let vehicles = aviary_vehicles::serve(
         &world(&scout("tcp:x:1", faults)),
         Listen::Tcp("127.0.0.1:0".parse().unwrap()),
@@ -370,7 +372,7 @@ async fn a_crash_raises_drone_lost() {
         call(&backend, "TakeOff", &[Value::Number(10.0)]).await,
         CallEnd::Done
     );
-    let hover = backend.call(0, "Hover", &[Value::Number(60.0)]);
+    let hover = backend.call(0, "Hover", &[Value::Number(300.0)]);
     match tokio::time::timeout(Duration::from_secs(15), events.recv())
         .await
         .expect("an event")

@@ -103,12 +103,14 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
             let end = if p.battery_left > 0.0 {
                 format!("{:.0}% left at the end", p.battery_left * 100.0)
             } else {
-                format!("it runs out before the end: the mission needs {:.0}% of a full battery", (1.0 - p.battery_left) * 100.0)
+                // What it uses is what it starts with less what is left.
+                let start = est.s.drones[d].battery_start;
+                format!("it runs out before the end: the mission needs {:.0}% of a full battery", (start - p.battery_left) * 100.0)
             };
             diagnostics.push(
                 Diagnostic::new(Code::LowReserve, o.file, o.span, format!("{}'s battery is estimated to fall under 20% {} ({end})", p.drone, if after_end { "on its way home after the mission ends; this is its last statement" } else { "during this statement" }))
                     .label("the reserve is crossed here")
-                    .with_help("shorten the drone's work, split it with another drone, or raise its `battery` or `endurance` in the world file if they are wrong; `aviary check --plan` shows the estimate"),
+                    .with_help("shorten the drone's work or split it with another drone; if the figures are wrong, correct the drone's `battery` and `endurance` (or `battery_capacity` and `flight_current`) in the world file, or for a MAVLink drone its vehicle's battery; `aviary check --plan` shows the estimate and where the figures came from"),
             );
         }
     }

@@ -30,6 +30,7 @@ pub mod geo;
 pub mod link;
 pub mod mode;
 mod motion;
+mod plausible;
 mod vehicle;
 
 use std::collections::BTreeMap;

@@ -8,7 +8,7 @@ use aviary_api::geometry::dist_to_segment;
 use aviary_api::{DroneEvent, DroneId, Failure};
 use aviary_world::Target;
 use mavlink::dialects::ardupilotmega::{
-    MavCmd, MavLandedState, MavMessage, MavModeFlag, MavParamType, MavResult, MavState, MavSysStatusSensor,
+    MavCmd, MavLandedState, MavMessage, GLOBAL_POSITION_INT_DATA, MavModeFlag, MavParamType, MavResult, MavState, MavSysStatusSensor,
 };
 use tokio::sync::{mpsc, oneshot};
 use tokio::time::Instant;
@@ -17,6 +17,7 @@ use crate::battery::{self, Draw};
 use crate::failsafe::{failsafe, FAILSAFE_WAIT};
 use crate::geo::Origin;
 use crate::mode::{self, Flavour, Mode};
+use crate::plausible;
 
 /// The last fix a vehicle reported, in the local frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,6 +74,10 @@ pub struct Seen {
     pub odometer: f64,
     pub flight_time: f64,
     fix_at: Option<Instant>,
+    /// Since when the positions reported have been ones the vehicle could not have
+    /// reached (`plausible`), and whether that was raised as `PositionLost`.
+    doubted_since: Option<Instant>,
+    doubt_raised: bool,
     acks: Vec<(MavCmd, oneshot::Sender<MavResult>)>,
 }
 
@@ -209,34 +214,13 @@ impl Vehicle {
                 let xy = self.origin.from_e7(h.latitude, h.longitude);
                 seen.home = Some([xy[0], xy[1], f64::from(h.altitude) / 1000.0 - self.origin.alt]);
             }
-            MavMessage::GLOBAL_POSITION_INT(p) => {
-                let xy = self.origin.from_e7(p.lat, p.lon);
-                let fix = Fix {
-                    pos: [xy[0], xy[1], f64::from(p.relative_alt) / 1000.0],
-                    speed: f64::from(p.vx).hypot(f64::from(p.vy)) / 100.0,
-                    heading: if p.hdg == u16::MAX {
-                        0.0
-                    } else {
-                        f64::from(p.hdg) / 100.0
-                    },
-                    home_amsl: (f64::from(p.alt) - f64::from(p.relative_alt)) / 1000.0,
-                };
-                let from = seen.fix.map_or(xy, |f| [f.pos[0], f.pos[1]]);
-                if let (Some(before), Some(at), true) = (seen.fix, seen.fix_at, seen.armed) {
-                    let d: f64 = (0..3).map(|k| (fix.pos[k] - before.pos[k]).powi(2)).sum();
-                    seen.odometer += d.sqrt();
-                    if before.pos[2] > AIRBORNE_ABOVE {
-                        seen.flight_time += now.duration_since(at).as_secs_f64();
-                    }
-                }
-                seen.fix_at = Some(now);
-                seen.fix = Some(fix);
-                self.scan(&mut seen, from, xy);
-            }
+            MavMessage::GLOBAL_POSITION_INT(p) => self.take_position(&mut seen, now, p),
             MavMessage::SYS_STATUS(s) => {
                 seen.battery_reported = true;
-                if s.battery_remaining >= 0 {
-                    seen.battery = Some(f64::from(s.battery_remaining) / 100.0);
+                // -1 is "unknown", and no battery holds more than 100 %: the last
+                // believable charge stands.
+                if let Some(charge) = plausible::charge(s.battery_remaining) {
+                    seen.battery = Some(charge);
                 }
                 let airborne = seen.armed && seen.fix.is_some_and(|f| f.pos[2] > AIRBORNE_ABOVE);
                 seen.draw.record(now, battery::amps(s.current_battery), airborne);
@@ -250,8 +234,10 @@ impl Vehicle {
             }
             MavMessage::BATTERY_STATUS(b) if b.id == 0 => {
                 seen.battery_reported = true;
-                if b.battery_remaining >= 0 {
-                    seen.battery = Some(f64::from(b.battery_remaining) / 100.0);
+                // -1 is "unknown", and no battery holds more than 100 %: the last
+                // believable charge stands.
+                if let Some(charge) = plausible::charge(b.battery_remaining) {
+                    seen.battery = Some(charge);
                 }
                 let airborne = seen.armed && seen.fix.is_some_and(|f| f.pos[2] > AIRBORNE_ABOVE);
                 seen.draw.record(now, battery::amps(b.current_battery), airborne);
@@ -293,6 +279,60 @@ impl Vehicle {
             _ => {}
         }
         self.name_failsafe(&mut seen, now);
+    }
+
+    /// GLOBAL_POSITION_INT: the fix, the odometer and detection, unless the vehicle could
+    /// not have got there.
+    fn take_position(&self, seen: &mut Seen, now: Instant, p: &GLOBAL_POSITION_INT_DATA) {
+        let xy = self.origin.from_e7(p.lat, p.lon);
+        let fix = Fix {
+            pos: [xy[0], xy[1], f64::from(p.relative_alt) / 1000.0],
+            speed: f64::from(p.vx).hypot(f64::from(p.vy)) / 100.0,
+            heading: if p.hdg == u16::MAX {
+                0.0
+            } else {
+                f64::from(p.hdg) / 100.0
+            },
+            home_amsl: (f64::from(p.alt) - f64::from(p.relative_alt)) / 1000.0,
+        };
+        if let (Some(before), Some(at)) = (seen.fix, seen.fix_at) {
+            let dt = now.duration_since(at).as_secs_f64();
+            if !plausible::reachable(before.pos, fix.pos, dt) {
+                self.doubt(seen, now, before.pos, fix.pos, dt);
+                return;
+            }
+        }
+        seen.doubted_since = None;
+        seen.doubt_raised = false;
+        let from = seen.fix.map_or(xy, |f| [f.pos[0], f.pos[1]]);
+        if let (Some(before), Some(at), true) = (seen.fix, seen.fix_at, seen.armed) {
+            let d: f64 = (0..3).map(|k| (fix.pos[k] - before.pos[k]).powi(2)).sum();
+            seen.odometer += d.sqrt();
+            if before.pos[2] > AIRBORNE_ABOVE {
+                seen.flight_time += now.duration_since(at).as_secs_f64();
+            }
+        }
+        seen.fix_at = Some(now);
+        seen.fix = Some(fix);
+        self.scan(seen, from, xy);
+    }
+
+    /// A position the vehicle could not have reached: not taken. Once such positions have
+    /// come for [`plausible::DOUBT_FOR`], the drone has lost its position (`PositionLost`).
+    fn doubt(&self, seen: &mut Seen, now: Instant, before: [f64; 3], after: [f64; 3], dt: f64) {
+        let since = *seen.doubted_since.get_or_insert(now);
+        if seen.doubt_raised || now.duration_since(since) < plausible::DOUBT_FOR {
+            return;
+        }
+        seen.doubt_raised = true;
+        let jump = (0..3).map(|k| (after[k] - before[k]).powi(2)).sum::<f64>().sqrt();
+        let reason = format!(
+            "{}: its reported position jumps {} in {:.1} s, farther than any drone flies: not believed",
+            self.name,
+            if jump >= 1000.0 { format!("{:.0} km", jump / 1000.0) } else { format!("{jump:.0} m") },
+            dt
+        );
+        let _ = self.alarms.send((self.drone, Failure { exception: "PositionLost", reason }));
     }
 
     /// Names a pending failsafe once the vehicle's state or words say what it was, or

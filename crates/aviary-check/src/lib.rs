@@ -12,6 +12,7 @@ mod inputs;
 pub mod generate;
 mod infer;
 mod load;
+mod recursion;
 mod signals;
 mod suggest;
 mod walk;
@@ -100,6 +101,7 @@ pub fn check(sources: &mut SourceMap, root: FileId, world: Option<&World>, provi
             geofence::check_geofence(&program, world, &mut diagnostics);
         }
         chains::check_chains(&program, api, &mut diagnostics);
+        recursion::check_recursion(&program, &mut diagnostics);
     }
     aviary_diagnostics::sort(&mut diagnostics);
     diagnostics.dedup();

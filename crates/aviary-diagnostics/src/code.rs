@@ -79,6 +79,7 @@ codes! {
     ApiCallOnNonActor = "E123", Error, "an API call on something that is not the capability's actor";
     LeavesGeofence = "E124", Error, "a flight to a place, area, orbit or sweep that leaves the geofence";
     AboveCeiling = "E125", Error, "an altitude above the site's max_altitude";
+    UnboundedRecursion = "E126", Error, "a capability that calls itself, directly or through others, with nothing to stop it";
     // Warnings.
     HandlerNeverFires = "W201", Warning, "a handler for a signal that nothing raises";
     UnknownException = "W202", Warning, "an ON EXCEPTION for a name neither built in nor thrown";

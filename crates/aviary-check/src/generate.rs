@@ -365,8 +365,8 @@ mod tests {
 
     struct NoFiles;
     impl SourceProvider for NoFiles {
-        fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), String> {
-            Err(format!("no files here ({path})"))
+        fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), crate::LoadError> {
+            Err(format!("no files here ({path})").into())
         }
     }
 

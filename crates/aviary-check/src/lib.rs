@@ -13,6 +13,7 @@ pub mod generate;
 mod infer;
 mod load;
 mod recursion;
+pub mod uses;
 mod signals;
 mod suggest;
 mod walk;
@@ -28,6 +29,7 @@ pub use env::{bind_args, ArgBinding, BindProblem};
 pub use inputs::{check_sources, check_sources_joined, normalize_path, Checked};
 pub use infer::KindOrigin;
 pub use load::{SourceProvider, STD_NAME, STD_SOURCE};
+pub use uses::LoadError;
 
 /// Where a definition lives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

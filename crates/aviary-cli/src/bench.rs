@@ -20,8 +20,8 @@ use clap::Subcommand;
 pub(crate) struct NoFiles;
 
 impl SourceProvider for NoFiles {
-    fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
-        Err(format!("the benchmark reads no files ({path})"))
+    fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
+        Err(format!("the benchmark reads no files ({path})").into())
     }
 }
 

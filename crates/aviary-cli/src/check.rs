@@ -1,23 +1,37 @@
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use aviary_diagnostics::{render_json, render_text, summary_line, Diagnostic, SourceMap};
 
-use crate::files::{color_wanted, world_beside, DiskProvider};
+use crate::files::{color_wanted, use_roots as use_roots_of, world_beside, DiskProvider};
 use crate::Format;
 
-pub fn run(files: &[std::path::PathBuf], world: Option<&Path>, format: Format, plan: bool) -> u8 {
+pub fn run(files: &[PathBuf], world: Option<&Path>, format: Format, plan: bool, use_roots: &[PathBuf]) -> u8 {
+    let roots = match use_roots_of(use_roots) {
+        Ok(r) => r,
+        Err(why) => {
+            eprintln!("aviary: {why}");
+            return 2;
+        }
+    };
     let mut worst = 0;
     for file in files {
-        worst = worst.max(check_one(file, world, format, plan));
+        worst = worst.max(check_one(file, world, format, plan, &roots));
     }
     worst
 }
 
-fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want_plan: bool) -> u8 {
+fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want_plan: bool, use_roots: &[PathBuf]) -> u8 {
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
         Err(e) => {
             eprintln!("aviary: cannot read {}: {e}", path.display());
+            return 2;
+        }
+    };
+    let provider = match DiskProvider::new(path, use_roots) {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("aviary: {why}");
             return 2;
         }
     };
@@ -37,7 +51,7 @@ fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want_plan: 
     let world = world_name.as_deref().zip(world_bytes.as_deref());
     let name = path.display().to_string();
     let api = aviary_sim::descriptor();
-    let checked = aviary_check::check_sources(&mut sources, (&name, &bytes), world, &DiskProvider, &api);
+    let checked = aviary_check::check_sources(&mut sources, (&name, &bytes), world, &provider, &api);
     let verified = aviary_verify::preflight(&checked, &api);
     let mut diagnostics = checked.diagnostics;
     let mut plan = None;

@@ -11,8 +11,8 @@ use serde_json::Value as Json;
 
 struct NoFiles;
 impl SourceProvider for NoFiles {
-    fn load(&self, _: &str, p: &str) -> Result<(String, Vec<u8>), String> {
-        Err(p.to_string())
+    fn load(&self, _: &str, p: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
+        Err(p.to_string().into())
     }
 }
 

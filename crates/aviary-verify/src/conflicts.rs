@@ -182,8 +182,8 @@ mod tests {
     struct NoFiles;
 
     impl aviary_check::SourceProvider for NoFiles {
-        fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
-            Err(format!("no files here ({path})"))
+        fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
+            Err(format!("no files here ({path})").into())
         }
     }
 

@@ -23,7 +23,7 @@ type Edge<'a> = (usize, &'a Statement);
 
 pub(crate) fn check_recursion(program: &Program, diagnostics: &mut Vec<Diagnostic>) {
     let caps: Vec<(FileId, &Capability)> = program.active_capabilities().collect();
-    let index: HashMap<&str, usize> = caps.iter().enumerate().map(|(i, (_, c))| (c.name.name.as_str(), i)).collect();
+    let index: foldhash::HashMap<&str, usize> = caps.iter().enumerate().map(|(i, (_, c))| (c.name.name.as_str(), i)).collect();
     let edges: Vec<Vec<Edge>> = caps
         .iter()
         .map(|(_, c)| {

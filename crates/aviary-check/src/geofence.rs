@@ -9,6 +9,7 @@
 use std::collections::BTreeMap;
 
 use aviary_api::geometry::{circle_inside, contains, segment_inside};
+use aviary_api::show::number;
 use aviary_diagnostics::{Code, Diagnostic, FileId, Label, Span};
 use aviary_syntax::ast::*;
 use aviary_world::World;
@@ -144,7 +145,7 @@ impl Walker<'_> {
             "Orbit" => {
                 if let (Some(center), Some(Known::Number(radius)), Some(fence)) = (arg(0).and_then(|k| ground(&k)), arg(1), self.fence) {
                     if !circle_inside(fence, center, radius) {
-                        let what = format!("the circle of {radius} m around {} leaves the geofence", shown(center));
+                        let what = format!("the circle of {} m around {} leaves the geofence", number(radius), shown(center));
                         self.report(Code::LeavesGeofence, what, call, site, file);
                     }
                 }
@@ -185,7 +186,7 @@ impl Walker<'_> {
     fn altitude(&mut self, alt: f64, call: &ApiCall, site: Option<(FileId, Span)>, file: FileId) {
         if let Some(ceiling) = self.ceiling {
             if alt > ceiling {
-                self.report(Code::AboveCeiling, format!("this flies at {alt} m, above the site's max_altitude of {ceiling} m"), call, site, file);
+                self.report(Code::AboveCeiling, format!("this flies at {} m, above the site's max_altitude of {} m", number(alt), number(ceiling)), call, site, file);
             }
         }
     }
@@ -213,7 +214,7 @@ fn ground(k: &Known) -> Option<[f64; 2]> {
 }
 
 fn shown(p: [f64; 2]) -> String {
-    format!("({}, {})", p[0], p[1])
+    format!("({}, {})", number(p[0]), number(p[1]))
 }
 
 fn without(values: &Values, bound: &[Ident]) -> Values {

@@ -6,6 +6,7 @@
 //! (the CLI reads the disk; tests use a map), as in typst's `World`.
 
 mod chains;
+mod endurance;
 mod env;
 mod geofence;
 mod inputs;
@@ -101,6 +102,7 @@ pub fn check(sources: &mut SourceMap, root: FileId, world: Option<&World>, provi
         signals::check_signals(&program, api, &mut diagnostics);
         if let Some(world) = world {
             geofence::check_geofence(&program, world, &mut diagnostics);
+            endurance::check_endurance(&program, world, api, &mut diagnostics);
         }
         chains::check_chains(&program, api, &mut diagnostics);
         recursion::check_recursion(&program, &mut diagnostics);

@@ -86,6 +86,7 @@ codes! {
     UnknownException = "W202", Warning, "an ON EXCEPTION for a name neither built in nor thrown";
     CommandsMayCollide = "W203", Warning, "one drone commanded from two places that may run at once";
     LowReserve = "W204", Warning, "a drone's estimated battery reserve falls under 20%";
+    PastEndurance = "W205", Warning, "a duration (such as Hover's) longer than the drone's endurance";
     // Notes.
     SignalNeverHandled = "N301", Note, "a signal raised but never handled";
     NoWorld = "N302", Note, "no world file, so actors, places and areas were not checked";

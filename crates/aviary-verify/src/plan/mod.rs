@@ -9,6 +9,7 @@ mod eval;
 mod flight;
 mod model;
 
+use aviary_api::show::fixed;
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 use aviary_ir::{Block, Handler, Mission, Node, Origin};
 use aviary_world::World;
@@ -101,9 +102,9 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
         if let Some(o) = at {
             let p = &drones[d];
             let end = if p.battery_left > 0.0 {
-                format!("{:.0}% left at the end", p.battery_left * 100.0)
+                format!("{}% left at the end", fixed(p.battery_left * 100.0, 0))
             } else {
-                format!("it runs out before the end: the mission needs {:.0}% of a full battery", (1.0 - p.battery_left) * 100.0)
+                format!("it runs out before the end: the mission needs {}% of a full battery", fixed((1.0 - p.battery_left) * 100.0, 0))
             };
             diagnostics.push(
                 Diagnostic::new(Code::LowReserve, o.file, o.span, format!("{}'s battery is estimated to fall under 20% {} ({end})", p.drone, if after_end { "on its way home after the mission ends; this is its last statement" } else { "during this statement" }))
@@ -164,23 +165,23 @@ impl Plan {
         let mut out = format!("plan: the mission takes about {} (estimate)\n", clock(self.mission_time));
         for d in &self.drones {
             out.push_str(&format!(
-                "\n{}: {:.0} m, {} in the air, {:.0}% battery left{}\n",
+                "\n{}: {} m, {} in the air, {}% battery left{}\n",
                 d.drone,
-                d.distance,
+                fixed(d.distance, 0),
                 clock(d.flight_time),
-                d.battery_left * 100.0,
+                fixed(d.battery_left * 100.0, 0),
                 if d.battery_left < RESERVE { "  (under the 20% reserve)" } else { "" }
             ));
             for a in &d.activities {
-                out.push_str(&format!("  {:>7.1} – {:>7.1} s  {}{}\n", a.start, a.end, a.what, a.at.as_ref().map(|p| format!("  ({p})")).unwrap_or_default()));
+                out.push_str(&format!("  {:>7} – {:>7} s  {}{}\n", fixed(a.start, 1), fixed(a.end, 1), a.what, a.at.as_ref().map(|p| format!("  ({p})")).unwrap_or_default()));
             }
             for b in &d.worst_case {
                 out.push_str(&format!(
-                    "  worst case per firing of {} (its trigger is unknown before flight): +{:.0} m, +{}, {:.0}% battery left\n",
+                    "  worst case per firing of {} (its trigger is unknown before flight): +{} m, +{}, {}% battery left\n",
                     b.handler,
-                    b.distance,
+                    fixed(b.distance, 0),
                     clock(b.flight_time),
-                    b.battery_left * 100.0
+                    fixed(b.battery_left * 100.0, 0)
                 ));
             }
         }

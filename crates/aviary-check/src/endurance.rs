@@ -10,7 +10,7 @@
 //! at the number as written, with the call as a second place when it is elsewhere.
 
 use std::cell::OnceCell;
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{HashMap, HashSet};
 use std::rc::Rc;
 
 use aviary_api::show::number;
@@ -59,8 +59,8 @@ pub(crate) fn check_endurance(program: &Program, world: &World, api: &Descriptor
 
 /// The capabilities that make, themselves or through those they call, a middle-layer
 /// call with a duration: only statements of these are followed.
-fn timed_capabilities<'p>(program: &'p Program, api: &Descriptor) -> HashSet<&'p str> {
-    let mut callers: HashMap<&str, Vec<&str>> = HashMap::new();
+fn timed_capabilities<'p>(program: &'p Program, api: &Descriptor) -> foldhash::HashSet<&'p str> {
+    let mut callers: foldhash::HashMap<&str, Vec<&str>> = foldhash::HashMap::default();
     let mut pending: Vec<&str> = Vec::new();
     for (_, c) in program.active_capabilities() {
         for body in capability_bodies(c) {
@@ -71,7 +71,7 @@ fn timed_capabilities<'p>(program: &'p Program, api: &Descriptor) -> HashSet<&'p
             });
         }
     }
-    let mut timed = HashSet::new();
+    let mut timed = foldhash::HashSet::default();
     while let Some(name) = pending.pop() {
         if timed.insert(name) {
             pending.extend(callers.get(name).into_iter().flatten());
@@ -84,9 +84,9 @@ struct Walker<'a> {
     program: &'a Program,
     world: &'a World,
     api: &'a Descriptor,
-    timed: HashSet<&'a str>,
+    timed: foldhash::HashSet<&'a str>,
     /// Drones by name, made when first asked (a mission naming no drone needs none).
-    by_name: OnceCell<HashMap<&'a str, usize>>,
+    by_name: OnceCell<foldhash::HashMap<&'a str, usize>>,
     /// Each written number once, however many statements reach it.
     reported: HashSet<(FileId, u32)>,
     out: Vec<Diagnostic>,
@@ -149,20 +149,11 @@ impl Walker<'_> {
                 inner.actors.insert(by.name.clone(), set);
             }
         }
-        let defaults: BTreeMap<&str, &Expr> = callee
-            .sections
-            .iter()
-            .filter_map(|sec| match sec {
-                Section::Defaults { entries, .. } => Some(entries.iter().map(|e| (e.name.name.as_str(), &e.value))),
-                _ => None,
-            })
-            .flatten()
-            .collect();
         let binding = bind_args(&callee.params, &s.args);
         for (i, p) in callee.params.iter().enumerate() {
             let known = match binding.bound[i] {
                 Some(e) => self.duration(e, env, file),
-                None => defaults.get(p.name.as_str()).and_then(|e| self.duration(e, &Env::default(), callee_file)),
+                None => crate::geofence::default_of(callee, &p.name).and_then(|e| self.duration(e, &Env::default(), callee_file)),
             };
             if let Some(w) = known {
                 inner.durations.insert(p.name.clone(), w);

@@ -105,20 +105,11 @@ impl Walker<'_> {
             return;
         }
         let binding = bind_args(&callee.params, &s.args);
-        let defaults: BTreeMap<&str, &Expr> = callee
-            .sections
-            .iter()
-            .filter_map(|sec| match sec {
-                Section::Defaults { entries, .. } => Some(entries.iter().map(|e| (e.name.name.as_str(), &e.value))),
-                _ => None,
-            })
-            .flatten()
-            .collect();
         let mut inner = Values::new();
         for (i, p) in callee.params.iter().enumerate() {
             let known = match binding.bound[i] {
                 Some(e) => self.value(e, values),
-                None => defaults.get(p.name.as_str()).and_then(|e| self.value(e, &Values::new())),
+                None => default_of(callee, &p.name).and_then(|e| self.value(e, &Values::new())),
             };
             if let Some(k) = known {
                 inner.insert(p.name.clone(), k);
@@ -203,6 +194,15 @@ impl Walker<'_> {
         }
         self.diagnostics.push(d);
     }
+}
+
+/// The default a capability's `DEFAULTS` gives parameter `name`, if any (the last, if
+/// written twice), looked up only for a parameter the call leaves out.
+pub(crate) fn default_of<'c>(callee: &'c Capability, name: &str) -> Option<&'c Expr> {
+    callee.sections.iter().rev().find_map(|sec| match sec {
+        Section::Defaults { entries, .. } => entries.iter().rev().find(|e| e.name.name == name).map(|e| &e.value),
+        _ => None,
+    })
 }
 
 fn ground(k: &Known) -> Option<[f64; 2]> {

@@ -52,6 +52,10 @@ pub struct Program {
     pub param_origins: BTreeMap<String, Vec<Option<KindOrigin>>>,
     /// The paths of `USE`s that could not be read (reported as E113).
     pub unreadable: Vec<String>,
+    /// `capabilities` by hash: every pass looks names up, and a mission may have tens of
+    /// thousands of capabilities (string comparisons down a tree were a tenth of checking
+    /// a long chain).
+    index: foldhash::HashMap<Box<str>, DefRef>,
 }
 
 impl Program {
@@ -59,7 +63,7 @@ impl Program {
         self.files.iter().find(|(f, _)| *f == id).map(|(_, t)| t)
     }
     pub fn capability(&self, name: &str) -> Option<&Capability> {
-        let r = self.capabilities.get(name)?;
+        let r = self.index.get(name)?;
         match self.file(r.file)?.items.get(r.index)? {
             aviary_syntax::ast::Item::Capability(c) => Some(c),
             _ => None,
@@ -83,10 +87,10 @@ impl Program {
     }
     /// Whether this definition is the one its name means (not overridden, not a duplicate).
     pub fn is_active(&self, file: FileId, c: &Capability) -> bool {
-        self.capabilities.get(&c.name.name).map(|r| r.file) == Some(file)
+        self.index.get(c.name.name.as_str()).map(|r| r.file) == Some(file)
     }
     pub fn capability_file(&self, name: &str) -> Option<FileId> {
-        self.capabilities.get(name).map(|r| r.file)
+        self.index.get(name).map(|r| r.file)
     }
 }
 

@@ -77,8 +77,9 @@ pub(crate) fn load(sources: &mut SourceMap, root: FileId, provider: &dyn SourceP
         }
         files.push((id, tree));
     }
-    let mut program = Program { files, mission: None, capabilities: BTreeMap::new(), param_kinds: BTreeMap::new(), param_origins: BTreeMap::new(), unreadable };
+    let mut program = Program { files, mission: None, capabilities: BTreeMap::new(), param_kinds: BTreeMap::new(), param_origins: BTreeMap::new(), unreadable, index: Default::default() };
     index_definitions(&mut program, std_id, diagnostics);
+    program.index = program.capabilities.iter().map(|(name, r)| (name.as_str().into(), *r)).collect();
     program
 }
 

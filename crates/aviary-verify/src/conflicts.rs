@@ -139,9 +139,28 @@ impl Bucket<'_> {
     /// handler, whose firings then order what is inside (only parallel constructs still
     /// make it overlap).
     fn split(&self, group: &[usize], depth: usize, every: bool, best: &mut Best) {
-        // By construct, then child, each in position order: sorted, then cut into runs.
+        let step = |pos: usize| self.path(pos).get(depth).copied();
+        // Sites are in the order of a depth-first walk that visits a construct's children
+        // in key order, so a group's steps come sorted, each child's statements together.
+        // Under a SEQUENTIAL block without handlers nothing overlaps at this step: only
+        // children of two or more statements are looked into, and nothing is allocated
+        // (a block of a million statements is one pass).
+        let sorted = group.first().is_some_and(|&p| step(p).is_some()) && group.windows(2).all(|w| step(w[0]) <= step(w[1]));
+        if let (true, Some(Some((id, _)))) = (sorted, group.first().map(|&p| step(p))) {
+            let one_construct = group.last().and_then(|&p| step(p)).is_some_and(|(last, _)| last == id);
+            let plain = matches!(self.sites.constructs[id], Construct::Block(BlockKind::Sequential)) && group.iter().all(|&p| !matches!(step(p), Some((_, Key::Handler(_)))));
+            if one_construct && plain {
+                for child in group.chunk_by(|&a, &b| step(a) == step(b)).filter(|g| g.len() > 1) {
+                    self.split(child, depth + 1, every, best);
+                }
+                return;
+            }
+        }
+        // Otherwise: by construct, then child, each in position order, cut into runs.
         let mut steps: Vec<((usize, Key), usize)> = group.iter().filter_map(|&pos| self.path(pos).get(depth).map(|&step| (step, pos))).collect();
-        steps.sort_unstable();
+        if !steps.windows(2).all(|w| w[0] <= w[1]) {
+            steps.sort_unstable();
+        }
         let positions: Vec<usize> = steps.iter().map(|&(_, pos)| pos).collect();
         let mut children: Vec<((usize, Key), &[usize])> = Vec::new();
         let mut from = 0;

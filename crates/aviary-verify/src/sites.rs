@@ -152,6 +152,16 @@ impl Walk<'_> {
 
     fn call(&mut self, call: &Call) {
         let cap = &self.mission.capabilities[call.capability];
+        // The common case, one drone for a one-actor capability: its claims on slot 0
+        // (each once already: the compiler sorts and dedups them).
+        if let ([ActorRef::Drone(d)], 1) = (call.actors.as_slice(), cap.actors) {
+            let claims = cap.claims.iter().filter(|(slot, _)| *slot == 0).map(|&(_, r)| (*d, r)).collect();
+            self.out.claims.push(ClaimSite { origin: call.origin, path: self.path.clone(), claims, capability: call.capability });
+            for &signal in &self.raises_of[call.capability] {
+                self.out.raises.push(RaiseSite { signal, path: self.path.clone() });
+            }
+            return;
+        }
         // `a b Cap` binds actors to BY slots in order; a one-actor capability given
         // several actors runs once per actor.
         let slots: Vec<Vec<DroneId>> = if cap.actors == 1 && call.actors.len() > 1 {

@@ -95,6 +95,8 @@ pub struct Estimator<'m> {
     /// The capabilities being walked, by index: a flag each, so that a chain of N
     /// capabilities asks N times in O(1), not in O(depth).
     calling: Vec<bool>,
+    /// Per capability, the actor slots whose motion it claims (asked at every call).
+    motion: Vec<std::rc::Rc<[usize]>>,
     /// The built-in `Detected` signal, when the mission can hear it.
     detected: Option<SignalId>,
 }
@@ -111,6 +113,7 @@ impl<'m> Estimator<'m> {
             world,
             known,
             calling: vec![false; mission.capabilities.len()],
+            motion: mission.capabilities.iter().map(|cap| cap.claims.iter().filter(|(_, r)| *r == Resource::Motion).map(|(slot, _)| *slot).collect::<Vec<_>>().into()).collect(),
             detected: mission.signals.iter().position(|s| s == "Detected"),
             s: State { drones, activities: vec![Vec::new(); n], raised: vec![None; mission.signals.len()], reserve: vec![None; n], assumptions: BTreeSet::new(), fired: BTreeSet::new() },
         }
@@ -337,6 +340,12 @@ impl<'m> Estimator<'m> {
             return (t, Vec::new());
         }
         let args: Vec<Option<Value>> = c.args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
+        // The common case, one drone for a one-actor capability, without the lists of
+        // lists the general case builds.
+        if let ([a @ (ActorRef::Drone(_) | ActorRef::Slot(_))], 1) = (c.actors.as_slice(), cap.actors) {
+            let Some(d) = self.scope(ctx, t).actor(a) else { return (t, Vec::new()) };
+            return self.run_call(c, &[d], &args, ctx, t);
+        }
         let sets: Vec<Vec<DroneId>> = c
             .actors
             .iter()
@@ -346,13 +355,25 @@ impl<'m> Estimator<'m> {
             })
             .collect();
         let runs: Vec<Vec<DroneId>> = if cap.actors == 1 { sets.concat().into_iter().map(|d| vec![d]).collect() } else { vec![sets.iter().filter_map(|s| s.first().copied()).collect()] };
-        let top = ctx.statement.is_none();
-        let motion: Vec<usize> = cap.claims.iter().filter(|(_, r)| *r == Resource::Motion).map(|(slot, _)| *slot).collect();
         let (mut end, mut raises) = (t, Vec::new());
         for actors in runs {
+            let (e, r) = self.run_call(c, &actors, &args, ctx, t);
+            end = end.max(e);
+            raises.extend(r);
+        }
+        (end, raises)
+    }
+
+    /// One run of a called capability on `actors`.
+    fn run_call(&mut self, c: &Call, actors: &[DroneId], args: &[Option<Value>], ctx: &Ctx, t: f64) -> (f64, Vec<Raise>) {
+        let cap = &self.mission.capabilities[c.capability];
+        let top = ctx.statement.is_none();
+        let motion = self.motion[c.capability].clone();
+        let (mut end, mut raises) = (t, Vec::new());
+        {
             let mut start = t;
             if top {
-                for &slot in &motion {
+                for &slot in motion.iter() {
                     if let Some(&d) = actors.get(slot) {
                         start = start.max(self.s.drones[d].free_at);
                     }
@@ -367,12 +388,12 @@ impl<'m> Estimator<'m> {
             let (e, r) = self.block(&cap.perform, &mut cctx, start);
             self.calling[c.capability] = false;
             if top {
-                for &slot in &motion {
+                for &slot in motion.iter() {
                     if let Some(&d) = actors.get(slot) {
                         self.s.drones[d].free_at = self.s.drones[d].free_at.max(e);
                     }
                 }
-                for &d in &actors {
+                for &d in actors {
                     self.s.activities[d].push(Activity { start, end: e, what: cap.name.clone(), at: None, origin: Some(c.origin) });
                 }
             }

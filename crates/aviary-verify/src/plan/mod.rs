@@ -88,12 +88,16 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
         est = Estimator::new(mission, world, known.clone());
         end = est.run();
     }
+    // The activities are moved into the plan, not copied (a long mission has millions);
+    // the worst-case walks below go on with empty lists, which the plan does not read.
+    let empty = vec![Vec::new(); est.s.activities.len()];
+    let activities = std::mem::replace(&mut est.s.activities, empty);
     let mut drones: Vec<DronePlan> = world
         .drones
         .iter()
         .zip(&est.s.drones)
-        .zip(&est.s.activities)
-        .map(|((w, f), acts)| DronePlan { drone: w.name.clone(), distance: f.distance, flight_time: f.flight_time, battery_left: f.battery_at(end), activities: acts.clone(), worst_case: Vec::new() })
+        .zip(activities)
+        .map(|((w, f), activities)| DronePlan { drone: w.name.clone(), distance: f.distance, flight_time: f.flight_time, battery_left: f.battery_at(end), activities, worst_case: Vec::new() })
         .collect();
     for (d, at) in est.s.reserve.iter().enumerate() {
         // Crossed on the way home after the mission's end: at the drone's last statement.

@@ -103,6 +103,12 @@ pub fn check_conflicts(mission: &Mission, diagnostics: &mut Vec<Diagnostic>) {
     diagnostics.extend(found.into_values());
 }
 
+/// A statement's place in the source (file, byte), then the later position first.
+type SourceOrder = (u32, u32, std::cmp::Reverse<usize>);
+
+/// A statement seen by a sweep: its position and its group.
+type Seen = (usize, usize);
+
 /// The statements that claim one resource of one drone, by position (site order).
 struct Bucket<'a> {
     sites: &'a Sites,
@@ -216,7 +222,8 @@ impl Bucket<'_> {
         if groups.len() < 2 {
             return;
         }
-        let mut order: Vec<((u32, u32, std::cmp::Reverse<usize>), usize, usize)> = Vec::new();
+        // (source place, then later position first; position; group)
+        let mut order: Vec<(SourceOrder, usize, usize)> = Vec::new();
         for (g, members) in groups.iter().enumerate() {
             for &pos in members.iter() {
                 let o = &self.sites.claims[self.members[pos]].origin;
@@ -226,7 +233,7 @@ impl Bucket<'_> {
         }
         order.sort_unstable();
         // The first two positions seen, from two different groups.
-        let (mut first, mut second): (Option<(usize, usize)>, Option<(usize, usize)>) = (None, None);
+        let (mut first, mut second): (Option<Seen>, Option<Seen>) = (None, None);
         for (_, pos, g) in order {
             let other = match first {
                 Some((p, fg)) if fg != g => Some(p),

@@ -110,7 +110,7 @@ pub(super) fn targets(cx: &mut Ctx, node: &Node, fence: Option<&[[f64; 2]]>) -> 
         };
         let at = match get(keys, "at") {
             Some(a) => cx.point(&"`at` of a target", &a.node).filter(|(p, _)| {
-                let (inside, grounded) = (fence.map_or(true, |f| aviary_api::geometry::contains(f, [p[0], p[1]])), cx.above_ground(&"a target", &a.node, p[2]));
+                let (inside, grounded) = (fence.is_none_or(|f| aviary_api::geometry::contains(f, [p[0], p[1]])), cx.above_ground(&"a target", &a.node, p[2]));
                 if !inside {
                     let msg = format!("the target at {} is outside the geofence, where no drone may fly to find it", crate::read::shown([p[0], p[1]]));
                     cx.error(a.node.span, msg, "move the target inside the geofence, or remove it");

@@ -17,8 +17,8 @@ pub const EXAMPLE_WORLD: &str = include_str!("../../examples/search_and_rescue.w
 struct NoFiles;
 
 impl SourceProvider for NoFiles {
-    fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
-        Err(format!("no files while fuzzing ({path})"))
+    fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
+        Err(format!("no files while fuzzing ({path})").into())
     }
 }
 

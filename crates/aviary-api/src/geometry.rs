@@ -126,6 +126,46 @@ pub fn segment_inside(polygon: &[[f64; 2]], p: [f64; 2], q: [f64; 2]) -> bool {
         && !edges(polygon).any(|(a, b)| crosses(p, q, a, b))
 }
 
+/// The polygon's area, positive when its corners go counter-clockwise (the shoelace
+/// formula).
+pub fn signed_area(polygon: &[[f64; 2]]) -> f64 {
+    edges(polygon).map(|(a, b)| a[0] * b[1] - b[0] * a[1]).sum::<f64>() / 2.0
+}
+
+/// Two edges of the polygon that cross each other (by index: edge `i` runs from corner
+/// `i` to the next), if any: a polygon whose outline crosses itself. Edges are compared
+/// only when their extents along x overlap (sorted by their left end), so an outline of
+/// many corners costs far less than every pair.
+pub fn self_crossing(polygon: &[[f64; 2]]) -> Option<(usize, usize)> {
+    let n = polygon.len();
+    if n < 4 {
+        return None;
+    }
+    let edge = |i: usize| (polygon[i], polygon[(i + 1) % n]);
+    let mut by_left: Vec<(f64, f64, usize)> = (0..n)
+        .map(|i| {
+            let (a, b) = edge(i);
+            (a[0].min(b[0]), a[0].max(b[0]), i)
+        })
+        .collect();
+    by_left.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.2.cmp(&y.2)));
+    for (k, &(_, right, i)) in by_left.iter().enumerate() {
+        for &(left, _, j) in &by_left[k + 1..] {
+            if left > right + ON_EDGE {
+                break;
+            }
+            // Neighbouring edges share a corner; they cannot cross properly.
+            let adjacent = (i + 1) % n == j || (j + 1) % n == i;
+            let (p, q) = edge(i);
+            let (a, b) = edge(j);
+            if !adjacent && crosses(p, q, a, b) {
+                return Some((i.min(j), i.max(j)));
+            }
+        }
+    }
+    None
+}
+
 /// Whether the whole circle (its inside and its line) lies in the polygon.
 pub fn circle_inside(polygon: &[[f64; 2]], center: [f64; 2], radius: f64) -> bool {
     contains(polygon, center) && dist_to_boundary(polygon, center) >= radius - ON_EDGE
@@ -135,6 +175,25 @@ pub fn circle_inside(polygon: &[[f64; 2]], center: [f64; 2], radius: f64) -> boo
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_outline_that_crosses_itself_is_found_and_a_simple_one_is_not() {
+        let square = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]];
+        assert_eq!(self_crossing(&square), None);
+        assert_eq!(signed_area(&square), 100.0);
+        let bowtie = [[0.0, 0.0], [10.0, 10.0], [10.0, 0.0], [0.0, 10.0]];
+        assert_eq!(self_crossing(&bowtie), Some((0, 2)));
+        assert_eq!(signed_area(&[[0.0, 0.0], [5.0, 5.0], [10.0, 10.0]]), 0.0);
+        // A star of many corners: every corner on a circle, each edge jumping 3 ahead.
+        let n = 2000;
+        let circle: Vec<[f64; 2]> = (0..n).map(|i| {
+            let a = i as f64 / n as f64 * std::f64::consts::TAU;
+            [a.cos() * 100.0, a.sin() * 100.0]
+        }).collect();
+        assert_eq!(self_crossing(&circle), None);
+        let star: Vec<[f64; 2]> = (0..7).map(|i| circle[(i * 3 * n / 7) % n]).collect();
+        assert!(self_crossing(&star).is_some());
+    }
 
     #[test]
     fn hypot_is_libms_bit_for_bit() {

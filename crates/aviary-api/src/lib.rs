@@ -17,6 +17,7 @@ pub mod sweep;
 mod kind;
 mod names;
 mod runtime;
+pub mod show;
 
 pub use geometry::centroid;
 pub use kind::Kind;

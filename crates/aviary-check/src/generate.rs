@@ -11,11 +11,13 @@
 //! every signal raised is heard and every handler can fire, so `aviary check` reports
 //! nothing on it. The output is a function of `target_bytes` only.
 
+mod front;
 mod swarm;
 mod w;
 
 use std::fmt::Write;
 
+pub use front::{chain_mission, front_world, sequential_mission};
 pub use swarm::{swarm_mission, swarm_world};
 pub use w::{w_mission, w_world};
 
@@ -365,8 +367,8 @@ mod tests {
 
     struct NoFiles;
     impl SourceProvider for NoFiles {
-        fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), String> {
-            Err(format!("no files here ({path})"))
+        fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), crate::LoadError> {
+            Err(format!("no files here ({path})").into())
         }
     }
 

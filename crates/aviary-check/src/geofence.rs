@@ -9,6 +9,7 @@
 use std::collections::BTreeMap;
 
 use aviary_api::geometry::{circle_inside, contains, segment_inside};
+use aviary_api::show::number;
 use aviary_diagnostics::{Code, Diagnostic, FileId, Label, Span};
 use aviary_syntax::ast::*;
 use aviary_world::World;
@@ -104,20 +105,11 @@ impl Walker<'_> {
             return;
         }
         let binding = bind_args(&callee.params, &s.args);
-        let defaults: BTreeMap<&str, &Expr> = callee
-            .sections
-            .iter()
-            .filter_map(|sec| match sec {
-                Section::Defaults { entries, .. } => Some(entries.iter().map(|e| (e.name.name.as_str(), &e.value))),
-                _ => None,
-            })
-            .flatten()
-            .collect();
         let mut inner = Values::new();
         for (i, p) in callee.params.iter().enumerate() {
             let known = match binding.bound[i] {
                 Some(e) => self.value(e, values),
-                None => defaults.get(p.name.as_str()).and_then(|e| self.value(e, &Values::new())),
+                None => default_of(callee, &p.name).and_then(|e| self.value(e, &Values::new())),
             };
             if let Some(k) = known {
                 inner.insert(p.name.clone(), k);
@@ -144,7 +136,7 @@ impl Walker<'_> {
             "Orbit" => {
                 if let (Some(center), Some(Known::Number(radius)), Some(fence)) = (arg(0).and_then(|k| ground(&k)), arg(1), self.fence) {
                     if !circle_inside(fence, center, radius) {
-                        let what = format!("the circle of {radius} m around {} leaves the geofence", shown(center));
+                        let what = format!("the circle of {} m around {} leaves the geofence", number(radius), shown(center));
                         self.report(Code::LeavesGeofence, what, call, site, file);
                     }
                 }
@@ -185,7 +177,7 @@ impl Walker<'_> {
     fn altitude(&mut self, alt: f64, call: &ApiCall, site: Option<(FileId, Span)>, file: FileId) {
         if let Some(ceiling) = self.ceiling {
             if alt > ceiling {
-                self.report(Code::AboveCeiling, format!("this flies at {alt} m, above the site's max_altitude of {ceiling} m"), call, site, file);
+                self.report(Code::AboveCeiling, format!("this flies at {} m, above the site's max_altitude of {} m", number(alt), number(ceiling)), call, site, file);
             }
         }
     }
@@ -204,6 +196,15 @@ impl Walker<'_> {
     }
 }
 
+/// The default a capability's `DEFAULTS` gives parameter `name`, if any (the last, if
+/// written twice), looked up only for a parameter the call leaves out.
+pub(crate) fn default_of<'c>(callee: &'c Capability, name: &str) -> Option<&'c Expr> {
+    callee.sections.iter().rev().find_map(|sec| match sec {
+        Section::Defaults { entries, .. } => entries.iter().rev().find(|e| e.name.name == name).map(|e| &e.value),
+        _ => None,
+    })
+}
+
 fn ground(k: &Known) -> Option<[f64; 2]> {
     match k {
         Known::Point(p, _) => Some(*p),
@@ -213,7 +214,7 @@ fn ground(k: &Known) -> Option<[f64; 2]> {
 }
 
 fn shown(p: [f64; 2]) -> String {
-    format!("({}, {})", p[0], p[1])
+    format!("({}, {})", number(p[0]), number(p[1]))
 }
 
 fn without(values: &Values, bound: &[Ident]) -> Values {

@@ -3,7 +3,7 @@
 //! The first use that fixes a kind wins; a conflicting use is then reported at its call,
 //! with the chain of uses that fixed the kind (`KindOrigin`).
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 use aviary_api::{Descriptor, Kind};
 use aviary_diagnostics::Span;
@@ -24,31 +24,43 @@ pub struct KindOrigin {
 pub(crate) type Origins = BTreeMap<String, Vec<Option<KindOrigin>>>;
 
 pub(crate) fn parameter_kinds(program: &Program, api: &Descriptor) -> (BTreeMap<String, Vec<Option<Kind>>>, Origins) {
-    let mut kinds: BTreeMap<String, Vec<Option<Kind>>> = BTreeMap::new();
-    let mut origins: Origins = BTreeMap::new();
-    for name in program.capabilities.keys() {
-        if let Some(c) = program.capability(name) {
-            let mut k = vec![None; c.params.len()];
-            let mut o = vec![None; c.params.len()];
-            for section in &c.sections {
-                let Section::Defaults { entries, .. } = section else { continue };
-                for e in entries {
-                    if let Some(i) = c.params.iter().position(|p| p.name == e.name.name) {
-                        k[i] = literal_kind(&e.value);
-                        o[i] = k[i].map(|kind| KindOrigin { span: e.value.span, why: format!("`{}` is {} because of its default", e.name.name, kind.describe()), from: None });
-                    }
+    // The capabilities in name order, by index; names are looked up by hash.
+    let names: Vec<&String> = program.capabilities.keys().collect();
+    let caps: Vec<Option<&Capability>> = names.iter().map(|n| program.capability(n)).collect();
+    let index: foldhash::HashMap<&str, usize> = names.iter().enumerate().map(|(i, n)| (n.as_str(), i)).collect();
+    let mut kinds: Vec<Option<Vec<Option<Kind>>>> = vec![None; names.len()];
+    let mut origins: Vec<Option<Vec<Option<KindOrigin>>>> = vec![None; names.len()];
+    for (ci, c) in caps.iter().enumerate() {
+        let Some(c) = c else { continue };
+        let mut k = vec![None; c.params.len()];
+        let mut o = vec![None; c.params.len()];
+        for section in &c.sections {
+            let Section::Defaults { entries, .. } = section else { continue };
+            for e in entries {
+                if let Some(i) = c.params.iter().position(|p| p.name == e.name.name) {
+                    k[i] = literal_kind(&e.value);
+                    o[i] = k[i].map(|kind| KindOrigin { span: e.value.span, why: format!("`{}` is {} because of its default", e.name.name, kind.describe()), from: None });
                 }
             }
-            kinds.insert(name.clone(), k);
-            origins.insert(name.clone(), o);
         }
+        kinds[ci] = Some(k);
+        origins[ci] = Some(o);
     }
     // Each round fixes at least one more kind or stops; bounded by the parameter count.
-    let total: usize = kinds.values().map(Vec::len).sum();
+    // A round visits the capabilities in name order, each seeing what the ones before it
+    // learned. Only those that can learn anything are visited: all in the first round,
+    // then a capability when a callee of it learned a kind since its last visit (one
+    // later in the order is visited in the same round, as the full scan would; one
+    // earlier, in the next). A visit with nothing new learns what it learned before, so
+    // the result is the full scan's; a chain of N capabilities costs N visits, not N².
+    let callers = callers(&caps, &index);
+    let mut round: BTreeSet<usize> = (0..names.len()).collect();
+    let total: usize = kinds.iter().flatten().map(Vec::len).sum();
     for _ in 0..=total {
         let mut changed = false;
-        for name in program.capabilities.keys() {
-            let Some(c) = program.capability(name) else { continue };
+        let mut next_round: BTreeSet<usize> = BTreeSet::new();
+        while let Some(ci) = round.pop_first() {
+            let Some(c) = caps[ci] else { continue };
             let mut learned: Vec<(usize, Kind, KindOrigin)> = Vec::new();
             let param_index = |e: &Expr| match &e.kind {
                 ExprKind::Name(id) => c.params.iter().position(|p| p.name == id.name),
@@ -67,8 +79,12 @@ pub(crate) fn parameter_kinds(program: &Program, api: &Descriptor) -> (BTreeMap<
                         }
                     }
                     Stmt::Statement(s) => {
-                        let Some(callee) = program.capability(&s.capability.name) else { return };
-                        let Some(callee_kinds) = kinds.get(&s.capability.name) else { return };
+                        let Some(&callee_index) = index.get(s.capability.name.as_str()) else { return };
+                        let (Some(callee), Some(callee_kinds)) = (caps[callee_index], &kinds[callee_index]) else { return };
+                        // Only a parameter passed on can learn anything here.
+                        if !s.args.iter().any(|a| param_index(&a.value).is_some()) {
+                            return;
+                        }
                         let binding = bind_args(&callee.params, &s.args);
                         for (k, arg) in binding.bound.iter().enumerate() {
                             if let (Some(arg), Some(Some(kind))) = (arg, callee_kinds.get(k)) {
@@ -82,12 +98,23 @@ pub(crate) fn parameter_kinds(program: &Program, api: &Descriptor) -> (BTreeMap<
                     _ => {}
                 });
             }
-            if let (Some(k), Some(o)) = (kinds.get_mut(name), origins.get_mut(name)) {
+            let mut grew = false;
+            if let (Some(k), Some(o)) = (kinds[ci].as_mut(), origins[ci].as_mut()) {
                 for (i, kind, origin) in learned {
                     if k[i].is_none() {
                         k[i] = Some(kind);
                         o[i] = Some(origin);
-                        changed = true;
+                        grew = true;
+                    }
+                }
+            }
+            if grew {
+                changed = true;
+                for &caller in &callers[ci] {
+                    if caller > ci {
+                        round.insert(caller);
+                    } else {
+                        next_round.insert(caller);
                     }
                 }
             }
@@ -95,6 +122,66 @@ pub(crate) fn parameter_kinds(program: &Program, api: &Descriptor) -> (BTreeMap<
         if !changed {
             break;
         }
+        round = next_round;
     }
-    (kinds, origins)
+    (by_name(&names, kinds), by_name(&names, origins))
+}
+
+/// Values by index as a map by name (the names are sorted: the map is built in one go).
+fn by_name<T>(names: &[&String], values: Vec<Option<T>>) -> BTreeMap<String, T> {
+    names.iter().zip(values).filter_map(|(n, v)| Some(((*n).clone(), v?))).collect()
+}
+
+/// For each capability (by index), the capabilities whose bodies call it.
+fn callers(caps: &[Option<&Capability>], index: &foldhash::HashMap<&str, usize>) -> Vec<Vec<usize>> {
+    let mut out = vec![Vec::new(); caps.len()];
+    for (ci, c) in caps.iter().enumerate() {
+        let Some(c) = c else { continue };
+        for body in capability_bodies(c) {
+            visit_stmts(body, &mut |stmt| {
+                if let Stmt::Statement(s) = stmt {
+                    if let Some(&callee) = index.get(s.capability.name.as_str()) {
+                        out[callee].push(ci);
+                    }
+                }
+            });
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use aviary_api::{Descriptor, Kind};
+    use aviary_diagnostics::SourceMap;
+
+    struct NoFiles;
+    impl crate::SourceProvider for NoFiles {
+        fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), crate::LoadError> {
+            Err(format!("no files here ({path})").into())
+        }
+    }
+
+    /// A parameter passed down a chain of capabilities to a middle-layer call gets its
+    /// kind at every link, and a wrong argument at the top is reported with the chain.
+    /// (Names are chosen so that each link is learned one round after the next: in name
+    /// order, `C00000` calls `C00001`, which learns its kind only from `C00002`, ...)
+    #[test]
+    fn a_kind_travels_up_a_long_chain() {
+        let n = 3000;
+        let mut text = String::from("MISSION M:\n    scout C00000 WITH 5m\n");
+        for i in 0..n {
+            let body = if i + 1 < n { format!("d C{:05} WITH x", i + 1) } else { "d.Hover(x)".into() };
+            text.push_str(&format!("\nCAPABILITY C{i:05} BY d WITH x:\n    PERFORM:\n        {body}\n"));
+        }
+        let mut sources = SourceMap::new();
+        let world = "[drones.scout]\nhome = [0, 0]\n";
+        let checked = crate::check_sources(&mut sources, ("m.mission", text.as_bytes()), Some(("w.toml", world.as_bytes())), &NoFiles, &Descriptor::standard());
+        let program = checked.program.expect("program");
+        for i in [0, 1, n / 2, n - 1] {
+            assert_eq!(program.param_kinds[&format!("C{i:05}")], vec![Some(Kind::Duration)], "C{i:05}");
+        }
+        let wrong: Vec<_> = checked.diagnostics.iter().filter(|d| d.code == aviary_diagnostics::Code::WrongKind).collect();
+        assert_eq!(wrong.len(), 1, "{:?}", checked.diagnostics);
+    }
 }

@@ -6,6 +6,7 @@
 //! (the CLI reads the disk; tests use a map), as in typst's `World`.
 
 mod chains;
+mod endurance;
 mod env;
 mod geofence;
 mod inputs;
@@ -13,6 +14,8 @@ pub mod generate;
 mod infer;
 mod load;
 mod signal_values;
+mod recursion;
+pub mod uses;
 mod signals;
 mod suggest;
 mod walk;
@@ -28,6 +31,7 @@ pub use env::{bind_args, ArgBinding, BindProblem};
 pub use inputs::{check_sources, check_sources_joined, normalize_path, Checked};
 pub use infer::KindOrigin;
 pub use load::{SourceProvider, STD_NAME, STD_SOURCE};
+pub use uses::LoadError;
 
 /// Where a definition lives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -52,6 +56,10 @@ pub struct Program {
     pub signal_values: BTreeMap<String, Vec<Option<Kind>>>,
     /// The paths of `USE`s that could not be read (reported as E113).
     pub unreadable: Vec<String>,
+    /// `capabilities` by hash: every pass looks names up, and a mission may have tens of
+    /// thousands of capabilities (string comparisons down a tree were a tenth of checking
+    /// a long chain).
+    index: foldhash::HashMap<Box<str>, DefRef>,
 }
 
 impl Program {
@@ -59,7 +67,7 @@ impl Program {
         self.files.iter().find(|(f, _)| *f == id).map(|(_, t)| t)
     }
     pub fn capability(&self, name: &str) -> Option<&Capability> {
-        let r = self.capabilities.get(name)?;
+        let r = self.index.get(name)?;
         match self.file(r.file)?.items.get(r.index)? {
             aviary_syntax::ast::Item::Capability(c) => Some(c),
             _ => None,
@@ -83,10 +91,10 @@ impl Program {
     }
     /// Whether this definition is the one its name means (not overridden, not a duplicate).
     pub fn is_active(&self, file: FileId, c: &Capability) -> bool {
-        self.capabilities.get(&c.name.name).map(|r| r.file) == Some(file)
+        self.index.get(c.name.name.as_str()).map(|r| r.file) == Some(file)
     }
     pub fn capability_file(&self, name: &str) -> Option<FileId> {
-        self.capabilities.get(name).map(|r| r.file)
+        self.index.get(name).map(|r| r.file)
     }
 }
 
@@ -103,8 +111,10 @@ pub fn check(sources: &mut SourceMap, root: FileId, world: Option<&World>, provi
         signals::check_signals(&program, api, &mut diagnostics);
         if let Some(world) = world {
             geofence::check_geofence(&program, world, &mut diagnostics);
+            endurance::check_endurance(&program, world, api, &mut diagnostics);
         }
         chains::check_chains(&program, api, &mut diagnostics);
+        recursion::check_recursion(&program, &mut diagnostics);
     }
     aviary_diagnostics::sort(&mut diagnostics);
     diagnostics.dedup();

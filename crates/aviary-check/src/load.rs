@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use aviary_diagnostics::{Code, Diagnostic, FileId, SourceMap};
 use aviary_syntax::ast::Item;
 
+use crate::uses::{self, LoadError};
 use crate::{DefRef, Program};
 
 /// The standard capability library, compiled into the binary.
@@ -15,8 +16,10 @@ pub const STD_NAME: &str = "<std>/standard.mission";
 /// Supplies the files a mission `USE`s.
 pub trait SourceProvider {
     /// The file that `path`, written in a USE inside the file named `from`, refers to:
-    /// its name (used to read it only once) and its bytes, or why it cannot be read.
-    fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), String>;
+    /// its name (used to read it only once) and its bytes, or why it cannot be read or
+    /// may not be (`crate::uses`). Only paths that pass [`uses::check_written`] are asked
+    /// for.
+    fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), LoadError>;
 }
 
 pub(crate) fn load(sources: &mut SourceMap, root: FileId, provider: &dyn SourceProvider, diagnostics: &mut Vec<Diagnostic>) -> Program {
@@ -34,7 +37,7 @@ pub(crate) fn load(sources: &mut SourceMap, root: FileId, provider: &dyn SourceP
         for item in &tree.items {
             let Item::Use(u) = item else { continue };
             let from = sources.name(id).to_string();
-            match provider.load(&from, &u.path) {
+            match uses::check_written(&u.path).and_then(|()| provider.load(&from, &u.path)) {
                 Ok((name, _)) if seen.contains(&name) => {}
                 Ok((name, bytes)) => {
                     seen.push(name.clone());
@@ -53,19 +56,30 @@ pub(crate) fn load(sources: &mut SourceMap, root: FileId, provider: &dyn SourceP
                     };
                     queue.push((file, tree));
                 }
-                Err(why) => {
+                Err(LoadError::Unreadable(why)) => {
                     unreadable.push(u.path.clone());
                     diagnostics.push(
-                    Diagnostic::new(Code::UseNotFound, id, u.path_span, format!("cannot read `{}`: {why}", u.path))
-                        .with_help("the path is relative to the file that holds the USE"),
+                        Diagnostic::new(Code::UseNotFound, id, u.path_span, format!("cannot read `{}`: {why}", u.path))
+                            .with_help("the path is relative to the file that holds the USE"),
+                    );
+                }
+                // Said without a word of what the file holds.
+                Err(LoadError::Refused { why, help }) => {
+                    unreadable.push(u.path.clone());
+                    let message = if u.path.trim().is_empty() { why } else { format!("this USE of `{}` is refused: {why}", u.path) };
+                    diagnostics.push(
+                        Diagnostic::new(Code::UseRefused, id, u.path_span, message)
+                            .label("not read")
+                            .with_help(help),
                     );
                 }
             }
         }
         files.push((id, tree));
     }
-    let mut program = Program { files, mission: None, capabilities: BTreeMap::new(), param_kinds: BTreeMap::new(), param_origins: BTreeMap::new(), signal_values: BTreeMap::new(), unreadable };
+    let mut program = Program { files, mission: None, capabilities: BTreeMap::new(), param_kinds: BTreeMap::new(), param_origins: BTreeMap::new(), signal_values: BTreeMap::new(), unreadable, index: Default::default() };
     index_definitions(&mut program, std_id, diagnostics);
+    program.index = program.capabilities.iter().map(|(name, r)| (name.as_str().into(), *r)).collect();
     program
 }
 

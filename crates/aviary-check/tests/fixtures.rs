@@ -43,14 +43,14 @@ fn fixtures(folder: &str) -> Vec<String> {
 struct FixtureProvider;
 
 impl SourceProvider for FixtureProvider {
-    fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+    fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
         let base = Path::new(from).parent().unwrap_or(Path::new(""));
         let relative = aviary_check::normalize_path(&base.join(path));
         let name = relative.components().map(|c| c.as_os_str().to_string_lossy().into_owned()).collect::<Vec<_>>().join("/");
         match std::fs::read(fixtures_dir().join(&relative)) {
             Ok(bytes) => Ok((name, bytes)),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(format!("there is no file {name}")),
-            Err(e) => Err(format!("{} ({name})", e.kind().to_string().to_lowercase())),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(format!("there is no file {name}").into()),
+            Err(e) => Err(format!("{} ({name})", e.kind().to_string().to_lowercase()).into()),
         }
     }
 }

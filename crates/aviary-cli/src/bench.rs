@@ -5,6 +5,7 @@
 //! `aviary bench w` and `aviary bench swarm` (in `bench/`) run generated missions
 //! through the whole pipeline.
 
+mod front;
 mod pipeline;
 mod swarm;
 mod w;
@@ -20,12 +21,12 @@ use clap::Subcommand;
 pub(crate) struct NoFiles;
 
 impl SourceProvider for NoFiles {
-    fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
-        Err(format!("the benchmark reads no files ({path})"))
+    fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
+        Err(format!("the benchmark reads no files ({path})").into())
     }
 }
 
-const MB: f64 = 1_000_000.0;
+pub(crate) const MB: f64 = 1_000_000.0;
 
 #[derive(Subcommand)]
 pub enum BenchCommand {
@@ -57,6 +58,20 @@ pub enum BenchCommand {
         #[arg(long)]
         full_trace: bool,
     },
+    /// All of `aviary check` (parse, check, compile, conflicts, plan) on a generated
+    /// mission of a shape that once made the analyses quadratic; prints MB/s
+    Front {
+        /// `sequential`: N statements in one SEQUENTIAL block on one drone; `chain`: N
+        /// capabilities, each calling the next
+        #[arg(long, value_enum, default_value = "sequential")]
+        shape: front::Shape,
+        /// Statements or capabilities
+        #[arg(long, default_value_t = 100_000)]
+        n: usize,
+        /// How many timed runs; the median is reported
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+    },
     /// N simulated drones, each sweeping its own area with detection on; prints
     /// simulated seconds per wall second
     Swarm {
@@ -76,6 +91,7 @@ pub fn run(which: BenchCommand) -> u8 {
         BenchCommand::Parse { mb, runs } => parse(mb, runs),
         BenchCommand::W { n, k, emit, emit_world, full_trace } => w::run(n, k, emit, emit_world, full_trace),
         BenchCommand::Swarm { drones, emit, emit_world } => swarm::run(drones, emit, emit_world),
+        BenchCommand::Front { shape, n, runs } => front::run(shape, n, runs),
     }
 }
 
@@ -155,11 +171,11 @@ fn parse_and_check(mission: &str, world_text: &str) -> (usize, usize) {
     (errors, checked.diagnostics.len() - errors)
 }
 
-fn rate(bytes: usize, time: Duration) -> f64 {
+pub(crate) fn rate(bytes: usize, time: Duration) -> f64 {
     bytes as f64 / MB / time.as_secs_f64().max(1e-9)
 }
 
-fn median(times: &mut [Duration]) -> Duration {
+pub(crate) fn median(times: &mut [Duration]) -> Duration {
     times.sort_unstable();
     let n = times.len();
     if n % 2 == 1 {

@@ -1,8 +1,8 @@
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use aviary_diagnostics::{render_json, render_text, summary_line, Diagnostic, SourceMap};
 
-use crate::files::{color_wanted, world_beside, DiskProvider};
+use crate::files::{color_wanted, use_roots as use_roots_of, world_beside, DiskProvider};
 use crate::Format;
 
 /// What `--plan` asks for: the plan, and whether to ask MAVLink vehicles for their
@@ -14,20 +14,34 @@ pub struct Plan {
     pub ask: bool,
 }
 
-pub fn run(files: &[std::path::PathBuf], world: Option<&Path>, format: Format, plan: Plan) -> u8 {
+pub fn run(files: &[PathBuf], world: Option<&Path>, format: Format, plan: Plan, use_roots: &[PathBuf]) -> u8 {
+    let roots = match use_roots_of(use_roots) {
+        Ok(r) => r,
+        Err(why) => {
+            eprintln!("aviary: {why}");
+            return 2;
+        }
+    };
     let mut worst = 0;
     for file in files {
-        worst = worst.max(check_one(file, world, format, plan));
+        worst = worst.max(check_one(file, world, format, plan, &roots));
     }
     worst
 }
 
-fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want: Plan) -> u8 {
+fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want: Plan, use_roots: &[PathBuf]) -> u8 {
     let want_plan = want.plan;
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
         Err(e) => {
             eprintln!("aviary: cannot read {}: {e}", path.display());
+            return 2;
+        }
+    };
+    let provider = match DiskProvider::new(path, use_roots) {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("aviary: {why}");
             return 2;
         }
     };
@@ -47,7 +61,7 @@ fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want: Plan)
     let world = world_name.as_deref().zip(world_bytes.as_deref());
     let name = path.display().to_string();
     let api = aviary_sim::descriptor();
-    let mut checked = aviary_check::check_sources(&mut sources, (&name, &bytes), world, &DiskProvider, &api);
+    let mut checked = aviary_check::check_sources(&mut sources, (&name, &bytes), world, &provider, &api);
     // MAVLink drones fly with their vehicles' figures: the plan is made with them.
     let mut figures = None;
     if want.ask && !checked.has_errors() {

@@ -1,23 +1,99 @@
 //! Reading from disk: missions, the files they USE, and world files.
 
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use aviary_check::SourceProvider;
+use aviary_check::uses::{is_mission_name, not_a_mission, within_roots, MAX_USE_BYTES, OUTSIDE_HELP};
+use aviary_check::{LoadError, SourceProvider};
 
-/// Reads USEd files relative to the file that holds the USE.
-pub struct DiskProvider;
+/// Reads USEd files relative to the file that holds the USE, and only those the rules
+/// of `aviary_check::uses` allow: `.mission` files under `roots` (resolved, so a symlink
+/// that leads out counts as outside), regular files of at most 16 MiB.
+pub struct DiskProvider {
+    roots: Vec<PathBuf>,
+}
+
+impl DiskProvider {
+    /// For the mission `mission` (read already, so its folder exists): its own folder,
+    /// and the folders of [`use_roots`].
+    pub fn new(mission: &Path, use_roots: &[PathBuf]) -> Result<DiskProvider, String> {
+        let folder = match mission.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        let own = std::fs::canonicalize(folder).map_err(|e| format!("cannot find the folder of {}: {e}", mission.display()))?;
+        Ok(DiskProvider { roots: std::iter::once(own).chain(use_roots.iter().cloned()).collect() })
+    }
+}
+
+/// The `--use-root DIR`s, resolved; each must be a folder.
+pub fn use_roots(dirs: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
+    dirs.iter()
+        .map(|dir| {
+            match std::fs::canonicalize(dir) {
+                Ok(p) if p.is_dir() => Ok(p),
+                Ok(_) => Err(format!("--use-root {}: not a folder", dir.display())),
+                Err(e) => Err(format!("--use-root {}: {e}", dir.display())),
+            }
+        })
+        .collect()
+}
 
 impl SourceProvider for DiskProvider {
-    fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
+    fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), LoadError> {
         let base = Path::new(from).parent().unwrap_or(Path::new(""));
         let full = aviary_check::normalize_path(&base.join(path));
         let name = full.to_string_lossy().into_owned();
-        match std::fs::read(&full) {
-            Ok(bytes) => Ok((name, bytes)),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(format!("there is no file {name}")),
-            Err(e) => Err(format!("{} ({name})", e.kind().to_string().to_lowercase())),
+        let resolved = match std::fs::canonicalize(&full) {
+            Ok(p) => p,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(format!("there is no file {name}").into()),
+            Err(e) => return Err(format!("{} ({name})", e.kind().to_string().to_lowercase()).into()),
+        };
+        if !within_roots(&resolved, &self.roots) {
+            let shown: Vec<String> = self.roots.iter().map(|r| r.display().to_string()).collect();
+            let leads = if resolved != std::path::absolute(&full).unwrap_or_default() { format!(" (it leads to {})", resolved.display()) } else { String::new() };
+            let why = format!("{name}{leads} is outside the mission's folder{} {}", if shown.len() > 1 { " and the --use-root folders" } else { "" }, shown.join(", "));
+            return Err(LoadError::Refused { why, help: OUTSIDE_HELP.into() });
         }
+        // A symlink `a.mission` to `notes.txt` is no mission file either.
+        if !is_mission_name(&resolved) {
+            return Err(not_a_mission());
+        }
+        read_bounded(&resolved, &name)
     }
+}
+
+/// The bytes of a regular file of at most `MAX_USE_BYTES`. Opened without blocking, so a
+/// FIFO does not wait for a writer, and judged by what was opened, so nothing can be
+/// swapped in between.
+fn read_bounded(path: &Path, name: &str) -> Result<(String, Vec<u8>), LoadError> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path).map_err(|e| LoadError::Unreadable(format!("{} ({name})", e.kind().to_string().to_lowercase())))?;
+    let meta = file.metadata().map_err(|e| LoadError::Unreadable(format!("{} ({name})", e.kind().to_string().to_lowercase())))?;
+    if !meta.is_file() {
+        let what = if meta.is_dir() { "a folder" } else { "a device, pipe or socket" };
+        return Err(LoadError::Refused { why: format!("{name} is {what}, not a regular file"), help: "USE a .mission file".into() });
+    }
+    let too_large = |size: u64| LoadError::Refused {
+        why: format!("{name} has {size} bytes, more than the {} MiB a USEd file may have", MAX_USE_BYTES >> 20),
+        help: "split the library into several files, each USEd".into(),
+    };
+    if meta.len() > MAX_USE_BYTES {
+        return Err(too_large(meta.len()));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    // One byte past the limit tells a file that grew since.
+    file.take(MAX_USE_BYTES + 1).read_to_end(&mut bytes).map_err(|e| LoadError::Unreadable(format!("{} ({name})", e.kind().to_string().to_lowercase())))?;
+    if bytes.len() as u64 > MAX_USE_BYTES {
+        return Err(too_large(bytes.len() as u64));
+    }
+    Ok((name.to_string(), bytes))
 }
 
 /// `NAME.world.toml` beside `NAME.mission`, if it exists.

@@ -44,10 +44,10 @@ pub enum Format {
 enum Command {
     /// Parse, resolve and check missions; print every problem found
     Check {
-        #[arg(required = true)]
+        #[arg(value_parser = mission_file, required = true)]
         files: Vec<PathBuf>,
         /// The world file (default: NAME.world.toml beside NAME.mission, if it exists)
-        #[arg(long)]
+        #[arg(long, value_parser = world_file)]
         world: Option<PathBuf>,
         #[arg(long, value_enum, default_value = "text")]
         format: Format,
@@ -58,10 +58,13 @@ enum Command {
         /// With --plan: do not ask MAVLink vehicles for their figures; plan with the world's
         #[arg(long, requires = "plan")]
         offline: bool,
+        /// A folder whose .mission files USE may read, besides the mission's own (repeatable)
+        #[arg(long, value_name = "DIR", value_parser = folder)]
+        use_root: Vec<PathBuf>,
     },
     /// Rewrite missions in the one canonical layout
     Fmt {
-        #[arg(required = true)]
+        #[arg(value_parser = mission_file, required = true)]
         files: Vec<PathBuf>,
         /// Change nothing; exit 1 if a file is not formatted
         #[arg(long)]
@@ -69,9 +72,10 @@ enum Command {
     },
     /// Compile a mission and fly it on the drones its world binds (the simulator by default)
     Run {
+        #[arg(value_parser = mission_file)]
         file: PathBuf,
         /// The world file (default: NAME.world.toml beside NAME.mission)
-        #[arg(long)]
+        #[arg(long, value_parser = world_file)]
         world: Option<PathBuf>,
         /// `max` (as fast as possible; the default) or times real time, such as 1 or 10
         #[arg(long)]
@@ -80,7 +84,7 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         seed: u64,
         /// Write every event to this JSON Lines file
-        #[arg(long)]
+        #[arg(long, value_parser = trace_file)]
         trace: Option<PathBuf>,
         /// Telemetry events per second of mission time (default: none)
         #[arg(long)]
@@ -96,6 +100,9 @@ enum Command {
         /// or this machine's name on the network); may be repeated
         #[arg(long, value_name = "NAME", requires = "serve")]
         allow_host: Vec<String>,
+        /// A folder whose .mission files USE may read, besides the mission's own (repeatable)
+        #[arg(long, value_name = "DIR", value_parser = folder)]
+        use_root: Vec<PathBuf>,
     },
     /// Talk to a running mission's operator API (see `aviary run --serve`)
     Ctl {
@@ -111,7 +118,7 @@ enum Command {
     /// Serve the world's drones as simulated MAVLink vehicles (ArduCopter-like) until Ctrl-C
     Vehicles {
         /// The world file whose drones to serve
-        #[arg(long)]
+        #[arg(long, value_parser = world_file)]
         world: PathBuf,
         /// tcp:HOST:PORT or udp:HOST:PORT (port 0: any free port; the first line printed says which)
         #[arg(long)]
@@ -130,6 +137,31 @@ enum Command {
         #[command(subcommand)]
         which: bench::BenchCommand,
     },
+}
+
+/// A file name from the command line: not empty. (An empty one would read as "no such
+/// file", or as clap's "none was supplied", neither of which says what was empty.)
+fn nonempty(s: &str, what: &str) -> Result<PathBuf, String> {
+    if s.is_empty() {
+        return Err(format!("the name is empty: write the path of {what}"));
+    }
+    Ok(PathBuf::from(s))
+}
+
+fn mission_file(s: &str) -> Result<PathBuf, String> {
+    nonempty(s, "a .mission file")
+}
+
+fn world_file(s: &str) -> Result<PathBuf, String> {
+    nonempty(s, "a world file (NAME.world.toml)")
+}
+
+fn trace_file(s: &str) -> Result<PathBuf, String> {
+    nonempty(s, "the file to write the trace to")
+}
+
+fn folder(s: &str) -> Result<PathBuf, String> {
+    nonempty(s, "a folder")
 }
 
 /// The stack the command runs on. The checker, the plan and the engine follow capability
@@ -152,15 +184,15 @@ fn main() -> ExitCode {
 
 fn command(cli: Cli) -> u8 {
     let code = match cli.command {
-        Command::Check { files, world, format, plan, offline } => check::run(&files, world.as_deref(), format, check::Plan { plan, ask: plan && !offline }),
+        Command::Check { files, world, format, plan, offline, use_root } => check::run(&files, world.as_deref(), format, check::Plan { plan, ask: plan && !offline }, &use_root),
         Command::Fmt { files, check } => fmt::run(&files, check),
-        Command::Run { file, world, speed, seed, trace, telemetry_hz, quiet, serve, allow_host } => {
+        Command::Run { file, world, speed, seed, trace, telemetry_hz, quiet, serve, allow_host, use_root } => {
             // Served to an operator, a mission runs in real time unless told otherwise.
             let speed = speed.unwrap_or_else(|| if serve.is_some() { "1".into() } else { "max".into() });
             match (run::parse_speed(&speed), serve.as_deref().map(run::parse_serve).transpose()) {
                 (Ok(speed), Ok(serve)) => {
                     let serve = serve.map(|address| serve::Serve { address, allowed_hosts: allow_host });
-                    run::run(&run::RunArgs { file, world, speed, seed, trace, telemetry_hz, quiet, serve })
+                    run::run(&run::RunArgs { file, world, speed, seed, trace, telemetry_hz, quiet, serve, use_root })
                 }
                 (Err(why), _) | (_, Err(why)) => {
                     eprintln!("aviary: {why}");

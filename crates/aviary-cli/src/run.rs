@@ -10,7 +10,7 @@ use aviary_engine::{Control, Controller, Outcome, RunOptions, Status};
 use aviary_sim::{Fleet, SimBackend, SimOptions};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::files::{color_wanted, world_beside, DiskProvider};
+use crate::files::{color_wanted, use_roots, world_beside, DiskProvider};
 use crate::trace_file::{lock, SharedTrace, TraceFile};
 
 pub struct RunArgs {
@@ -24,6 +24,8 @@ pub struct RunArgs {
     pub quiet: bool,
     /// Where to serve the operator API.
     pub serve: Option<crate::serve::Serve>,
+    /// Folders whose .mission files USE may read, besides the mission's own.
+    pub use_root: Vec<PathBuf>,
 }
 
 /// `7878` is loopback port 7878; `HOST:PORT` binds exactly that.
@@ -46,10 +48,24 @@ pub fn parse_speed(text: &str) -> Result<Option<f64>, String> {
 }
 
 pub fn run(args: &RunArgs) -> u8 {
+    let roots = match use_roots(&args.use_root) {
+        Ok(r) => r,
+        Err(why) => {
+            eprintln!("aviary: {why}");
+            return 2;
+        }
+    };
     let bytes = match std::fs::read(&args.file) {
         Ok(b) => b,
         Err(e) => {
             eprintln!("aviary: cannot read {}: {e}", args.file.display());
+            return 2;
+        }
+    };
+    let provider = match DiskProvider::new(&args.file, &roots) {
+        Ok(p) => p,
+        Err(why) => {
+            eprintln!("aviary: {why}");
             return 2;
         }
     };
@@ -70,7 +86,7 @@ pub fn run(args: &RunArgs) -> u8 {
     let world_name = world_path.display().to_string();
     // A large world is read on two threads, as `aviary bench w` does.
     let api = aviary_sim::descriptor();
-    let checked = aviary_check::check_sources_joined(&mut sources, (&name, &bytes), Some((&world_name, &world_bytes)), &DiskProvider, &api, &crate::cores::join);
+    let checked = aviary_check::check_sources_joined(&mut sources, (&name, &bytes), Some((&world_name, &world_bytes)), &provider, &api, &crate::cores::join);
     if checked.has_errors() {
         for d in checked.diagnostics.iter().filter(|d| d.is_error()) {
             eprint!("{}", render_text(&sources, d, color_wanted()));

@@ -98,6 +98,71 @@ fn used_files_are_read_relative_to_the_using_file_once_each() {
 }
 
 #[test]
+fn a_use_reads_only_mission_files_under_the_missions_folder_and_never_shows_another_file() {
+    let dir = scratch("use_rules");
+    let (home, shared) = (dir.join("home"), dir.join("shared"));
+    std::fs::create_dir_all(&home).unwrap();
+    std::fs::create_dir_all(&shared).unwrap();
+    std::fs::write(home.join("m.world.toml"), WORLD).unwrap();
+    std::fs::write(shared.join("lib.mission"), "CAPABILITY Patrol BY drone:\n    PERFORM:\n        drone.Hover(1s)\n").unwrap();
+    let check = |used: &str, extra: &[&str]| {
+        std::fs::write(home.join("m.mission"), format!("USE \"{used}\"\nMISSION M:\n    d1 Patrol\n")).unwrap();
+        let mut args = vec!["check", "home/m.mission"];
+        args.extend(extra);
+        aviary(&args, &dir)
+    };
+    let refused = |used: &str, why: &str| {
+        let (code, out, _) = check(used, &[]);
+        assert_eq!(code, 1, "{out}");
+        assert!(out.starts_with(&format!("home/m.mission:1:5: error[E127]: this USE of `{used}` is refused: ")), "{out}");
+        assert!(out.contains(why), "{used}: {out}");
+        out
+    };
+    // The environment and the password file are not mission files: nothing of them shows.
+    let out = refused("/proc/self/environ", "it is not a mission file");
+    assert!(!out.contains("PATH="), "{out}");
+    let out = refused("../../../../../../../../etc/passwd", "it is not a mission file");
+    assert!(!out.contains("root:"), "{out}");
+    refused("/dev/zero", "it is not a mission file");
+    // Outside the mission's folder, directly or through a symlink, until named a root.
+    refused("../shared/lib.mission", "is outside the mission's folder");
+    std::os::unix::fs::symlink(shared.join("lib.mission"), home.join("link.mission")).unwrap();
+    refused("link.mission", "leads to");
+    let (code, out, _) = check("../shared/lib.mission", &["--use-root", "shared"]);
+    assert_eq!(code, 0, "{out}");
+    let (code, out, _) = check("link.mission", &["--use-root", "shared"]);
+    assert_eq!(code, 0, "{out}");
+    // Not a regular file, or too large: refused without being read (a FIFO would block).
+    assert!(std::process::Command::new("mkfifo").arg(home.join("pipe.mission")).status().unwrap().success());
+    refused("pipe.mission", "is a device, pipe or socket, not a regular file");
+    std::fs::create_dir(home.join("folder.mission")).unwrap();
+    refused("folder.mission", "is a folder, not a regular file");
+    std::fs::File::create(home.join("big.mission")).unwrap().set_len(17 << 20).unwrap();
+    refused("big.mission", "has 17825792 bytes, more than the 16 MiB a USEd file may have");
+    let (code, out, _) = check("", &[]);
+    assert_eq!(code, 1);
+    assert!(out.starts_with("home/m.mission:1:5: error[E127]: this USE names no file: its path is empty"), "{out}");
+    let (code, _, err) = aviary(&["check", "home/m.mission", "--use-root", "nowhere"], &dir);
+    assert_eq!(code, 2);
+    assert!(err.starts_with("aviary: --use-root nowhere: "), "{err}");
+}
+
+#[test]
+fn an_empty_file_name_says_what_was_empty() {
+    let dir = scratch("empty_names");
+    for (args, what) in [
+        (&["check", ""][..], "invalid value '' for '<FILES>...': the name is empty: write the path of a .mission file"),
+        (&["check", "m.mission", "--world", ""][..], "invalid value '' for '--world <WORLD>': the name is empty: write the path of a world file"),
+        (&["run", ""][..], "invalid value '' for '<FILE>': the name is empty: write the path of a .mission file"),
+        (&["check", "m.mission", "--use-root", ""][..], "invalid value '' for '--use-root <DIR>': the name is empty: write the path of a folder"),
+    ] {
+        let (code, _, err) = aviary(args, &dir);
+        assert_eq!(code, 2, "{args:?}");
+        assert!(err.contains(what), "{args:?}: {err}");
+    }
+}
+
+#[test]
 fn several_files_are_checked_and_the_worst_exit_wins() {
     let dir = scratch("several");
     std::fs::write(dir.join("good.mission"), "CAPABILITY Go BY drone:\n    PERFORM:\n        drone.Land()\n").unwrap();

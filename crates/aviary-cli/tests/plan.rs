@@ -183,11 +183,44 @@ fn a_long_chain_of_capabilities_checks_plans_and_runs_without_overflowing() {
 }
 
 #[test]
-fn a_capability_that_calls_itself_is_planned_once_with_a_note() {
+fn a_capability_that_calls_itself_behind_a_condition_is_planned_once_with_a_note() {
     let dir = scratch("recursive_plan");
-    std::fs::write(dir.join("rec.mission"), "MISSION M:\n    scout Loop\n\nCAPABILITY Loop BY drone:\n    PERFORM:\n        drone.Hover(1s)\n        drone Loop\n").expect("write");
+    std::fs::write(dir.join("rec.mission"), "MISSION M:\n    scout Loop\n\nCAPABILITY Loop BY drone:\n    PERFORM:\n        drone.Hover(1s)\n        IF drone.battery > 50%:\n            drone Loop\n").expect("write");
     std::fs::write(dir.join("rec.world.toml"), "[drones.scout]\nhome = [0, 0]\n").expect("write");
     let (code, out, err) = aviary(&["check", "--plan", "rec.mission"], &dir);
     assert_eq!(code, 0, "{out}{err}");
-    assert!(out.contains("rec.mission:7:9: `Loop` calls itself; the estimate counts one round of it"), "{out}");
+    assert!(out.contains("rec.mission:8:13: `Loop` calls itself; the estimate counts one round of it"), "{out}");
+}
+
+#[test]
+fn a_capability_that_calls_itself_unconditionally_is_an_error_with_no_plan() {
+    let dir = scratch("recursive_error");
+    std::fs::write(dir.join("rec.mission"), "MISSION M:\n    scout A\n\nCAPABILITY A BY d:\n    PERFORM:\n        d B\n\nCAPABILITY B BY d:\n    PERFORM:\n        d.Hover(1s)\n        d A\n").expect("write");
+    std::fs::write(dir.join("rec.world.toml"), "[drones.scout]\nhome = [0, 0]\n").expect("write");
+    let (code, out, err) = aviary(&["check", "--plan", "rec.mission"], &dir);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(out.starts_with("rec.mission:6:11: error[E126]: `A` calls itself through `B` with nothing to stop it: A → B → A"), "{out}");
+    assert!(err.contains("no plan for rec.mission: fix its errors first"), "{err}");
+    let (code, _, err) = aviary(&["run", "rec.mission"], &dir);
+    assert_eq!(code, 2, "a mission with errors is not flown: {err}");
+    assert!(err.contains("error[E126]") && err.contains("rec.mission has errors, so it was not run"), "{err}");
+    let (code, out, _) = aviary(&["explain", "E126"], &dir);
+    assert_eq!(code, 0);
+    assert!(out.starts_with("E126 (error): a capability that calls itself"), "{out}");
+}
+
+#[test]
+fn a_recursion_that_never_ends_in_flight_fails_the_mission_with_command_failed_not_a_crash() {
+    let dir = scratch("recursive_run");
+    // Allowed (behind a condition), and the condition never turns false: no time passes.
+    std::fs::write(dir.join("rec.mission"), "MISSION M:\n    scout Loop\n\nCAPABILITY Loop BY drone:\n    PERFORM:\n        IF drone.battery > 50%:\n            drone Loop\n").expect("write");
+    std::fs::write(dir.join("rec.world.toml"), "[drones.scout]\nhome = [0, 0]\n").expect("write");
+    let (code, out, err) = aviary(&["run", "rec.mission", "--trace", "rec.jsonl"], &dir);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(out.contains("calling `Loop` would nest capability calls 10001 deep, past the limit of 10000"), "{out}{err}");
+    let trace = std::fs::read_to_string(dir.join("rec.jsonl")).expect("trace");
+    let events: Vec<serde_json::Value> = trace.lines().map(|l| serde_json::from_str(l).expect("JSON")).collect();
+    assert_eq!(events.iter().filter(|e| e["event"] == "capability_start").count(), 10_000);
+    let last = events.last().expect("events");
+    assert_eq!((last["event"].as_str(), last["status"].as_str()), (Some("mission_end"), Some("failed")), "{last}");
 }

@@ -79,11 +79,14 @@ codes! {
     ApiCallOnNonActor = "E123", Error, "an API call on something that is not the capability's actor";
     LeavesGeofence = "E124", Error, "a flight to a place, area, orbit or sweep that leaves the geofence";
     AboveCeiling = "E125", Error, "an altitude above the site's max_altitude";
+    UnboundedRecursion = "E126", Error, "a capability that calls itself, directly or through others, with nothing to stop it";
+    UseRefused = "E127", Error, "a USE of a file that is not a .mission file under the mission's folder (or a --use-root), or not a regular file of at most 16 MiB";
     // Warnings.
     HandlerNeverFires = "W201", Warning, "a handler for a signal that nothing raises";
     UnknownException = "W202", Warning, "an ON EXCEPTION for a name neither built in nor thrown";
     CommandsMayCollide = "W203", Warning, "one drone commanded from two places that may run at once";
     LowReserve = "W204", Warning, "a drone's estimated battery reserve falls under 20%";
+    PastEndurance = "W205", Warning, "a duration (such as Hover's) longer than the drone's endurance";
     // Notes.
     SignalNeverHandled = "N301", Note, "a signal raised but never handled";
     NoWorld = "N302", Note, "no world file, so actors, places and areas were not checked";

@@ -61,6 +61,9 @@ impl<'m> Engine<'m> {
     /// recorded, its requirements met. `None` if it ends there.
     async fn start(&self, call: &'m Call, actors: Actors, args: Vec<Value>, ctx: &Ctx<'m>) -> Option<Started> {
         let cap = &self.m.capabilities[call.capability];
+        if self.too_deep(call, &actors, ctx) {
+            return None;
+        }
         let frame: Frame = frame_values(cap, &actors, &args).collect();
         let instance = self.new_instance(self.new_id(), call, actors, ctx);
         let actor = instance.actors.first().copied();
@@ -179,6 +182,27 @@ impl<'m> Engine<'m> {
             "aborted"
         };
         self.capability_end(call, &instance.actors, &args, status);
+    }
+
+    /// Whether this call would nest deeper than the limit: then it does not start, and
+    /// raises `CommandFailed` of its actor where it stands, as a refused command does.
+    /// Only a capability that calls itself (behind a condition the checker cannot judge)
+    /// gets here; without the limit it would overflow the stack.
+    fn too_deep(&self, call: &'m Call, actors: &[DroneId], ctx: &Ctx<'m>) -> bool {
+        let depth = ctx.instance.as_ref().map_or(0, |p| p.depth + 1);
+        if depth < self.max_call_depth {
+            return false;
+        }
+        let cap = &self.m.capabilities[call.capability];
+        let id = self.m.exceptions.iter().position(|e| e == "CommandFailed").unwrap_or(0);
+        let why = format!(
+            "calling `{}` would nest capability calls {} deep, past the limit of {}: a capability that keeps calling itself",
+            cap.name,
+            depth + 1,
+            self.max_call_depth
+        );
+        self.throw(id, vec![Value::Text(why)], actors.first().copied(), &ctx.scope);
+        true
     }
 
     pub(crate) fn new_id(&self) -> u64 {

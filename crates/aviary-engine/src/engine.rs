@@ -127,6 +127,8 @@ pub(crate) struct Engine<'m> {
     pub next_id: Cell<u64>,
     /// Which capabilities may run as instant activities (`instant.rs`).
     pub instant: Vec<bool>,
+    /// [`crate::RunOptions::max_call_depth`].
+    pub max_call_depth: usize,
 }
 
 impl<'m> Engine<'m> {
@@ -152,6 +154,7 @@ impl<'m> Engine<'m> {
             mission_scope: RefCell::new(None),
             next_id: Cell::new(0),
             instant: if options.instant_activities { crate::instant::instant_capabilities(m) } else { vec![false; m.capabilities.len()] },
+            max_call_depth: options.max_call_depth,
         }
     }
 

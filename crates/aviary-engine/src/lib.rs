@@ -61,11 +61,22 @@ pub struct RunOptions {
     /// waits (`instant.rs`). On by default; off, every activity takes the general path,
     /// which gives the same trace: tests compare the two.
     pub instant_activities: bool,
+    /// How deep capability calls may nest (a capability that calls one that calls ...):
+    /// a call that would go deeper raises `CommandFailed` where it stands instead of
+    /// starting. Each level is a future inside its caller's, polled on the stack, so the
+    /// thread that runs the engine must hold this many: about 30 KB a level in a debug
+    /// build and 6 KB in release (`aviary` runs on a 1 GiB stack). A recursion the
+    /// checker allows (one behind a condition) ends here, never in a stack overflow.
+    pub max_call_depth: usize,
 }
+
+/// The default [`RunOptions::max_call_depth`]: twice the 5,000-deep chain the CLI's tests
+/// run, and 300 MB of stack in a debug build.
+pub const MAX_CALL_DEPTH: usize = 10_000;
 
 impl Default for RunOptions {
     fn default() -> Self {
-        RunOptions { telemetry_hz: None, instant_activities: true }
+        RunOptions { telemetry_hz: None, instant_activities: true, max_call_depth: MAX_CALL_DEPTH }
     }
 }
 

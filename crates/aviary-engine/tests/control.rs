@@ -11,8 +11,8 @@ use serde_json::Value as Json;
 
 struct NoFiles;
 impl SourceProvider for NoFiles {
-    fn load(&self, _: &str, p: &str) -> Result<(String, Vec<u8>), String> {
-        Err(p.to_string())
+    fn load(&self, _: &str, p: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
+        Err(p.to_string().into())
     }
 }
 
@@ -122,7 +122,7 @@ fn an_activity_started_while_the_mission_is_paused_starts_held_on_either_path() 
     let mission = "CAPABILITY Ping BY d:\n    PERFORM:\n        d.StartStreaming()\n        d.StopStreaming()\n\nMISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        SEQUENTIAL:\n            WAITFOR ELAPSED >= 18s\n            b Ping\n";
     let controls = || vec![(15.0, Control::Pause), (25.0, Control::Resume)];
     let (outcome, trace, _) = run_with_controls(mission, controls());
-    let general = run_with_controls_and(mission, controls(), RunOptions { telemetry_hz: Some(10.0), instant_activities: false });
+    let general = run_with_controls_and(mission, controls(), RunOptions { telemetry_hz: Some(10.0), instant_activities: false, ..RunOptions::default() });
     assert_eq!((&outcome, &trace), (&general.0, &general.1), "the same trace both ways");
     let start = trace.iter().find(|e| e["event"] == "capability_start" && e["capability"] == "Ping").unwrap();
     let call = trace.iter().find(|e| e["event"] == "api_call" && e["function"] == "StartStreaming").unwrap();

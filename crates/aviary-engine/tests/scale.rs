@@ -12,8 +12,8 @@ use aviary_engine::Status;
 
 struct NoFiles;
 impl SourceProvider for NoFiles {
-    fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), String> {
-        Err(format!("no files here ({path})"))
+    fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
+        Err(format!("no files here ({path})").into())
     }
 }
 

@@ -232,7 +232,9 @@ impl<'a> Compiler<'a> {
     }
 
     fn body(&mut self, body: &ast::Body, path: &str, kind: BlockKind, traced: bool) -> Block {
-        let mut block = Block { kind, path: path.to_string(), traced, items: Vec::new(), handlers: Vec::new(), exception_handlers: Vec::new() };
+        // Room for every statement at once: a long block would otherwise grow (and copy)
+        // its vector a score of times.
+        let mut block = Block { kind, path: path.to_string(), traced, items: Vec::with_capacity(body.items.len()), handlers: Vec::new(), exception_handlers: Vec::new() };
         for stmt in &body.items {
             match stmt {
                 ast::Stmt::Handler(h) => {
@@ -519,33 +521,45 @@ fn attribute_table(world: &World, names: &[String]) -> Vec<Column> {
 
 /// What each capability claims: the resources its own API calls use on its actors, and,
 /// through every statement it makes on its actors, what the called capabilities claim.
+/// A worklist: when a capability's claims grow, only its callers are looked at again, so
+/// a chain of N capabilities costs N steps, not N rounds of N.
 fn compute_claims(caps: &mut [Capability], functions: &[(String, Option<aviary_api::Resource>)]) {
     let mut claims: Vec<Vec<(usize, aviary_api::Resource)>> = caps.iter().map(|c| direct_claims(c, functions)).collect();
-    // Through calls, to a fixpoint: each round adds at least one claim or stops.
-    loop {
-        let mut changed = false;
-        for i in 0..caps.len() {
-            let mut calls = Vec::new();
-            for block in caps[i].bodies() {
-                visit_calls(block, &mut calls);
+    // Who calls each capability: (caller, the call), in caller order.
+    let mut callers: Vec<Vec<(usize, &Call)>> = vec![Vec::new(); caps.len()];
+    for (i, cap) in caps.iter().enumerate() {
+        let mut calls = Vec::new();
+        for block in cap.bodies() {
+            visit_calls(block, &mut calls);
+        }
+        for call in calls {
+            if let Some(list) = callers.get_mut(call.capability) {
+                list.push((i, call));
             }
-            for call in calls {
-                let callee = claims.get(call.capability).cloned().unwrap_or_default();
-                for (j, resource) in callee {
-                    let targets: Vec<&ActorRef> = if caps[call.capability].actors == 1 { call.actors.iter().collect() } else { call.actors.get(j).into_iter().collect() };
-                    for target in targets {
-                        if let ActorRef::Slot(slot) = target {
-                            if *slot < caps[i].actors && !claims[i].contains(&(*slot, resource)) {
-                                claims[i].push((*slot, resource));
-                                changed = true;
-                            }
+        }
+    }
+    let mut pending: Vec<usize> = (0..caps.len()).filter(|&c| !claims[c].is_empty()).collect();
+    let mut queued: Vec<bool> = (0..caps.len()).map(|c| !claims[c].is_empty()).collect();
+    while let Some(callee) = pending.pop() {
+        queued[callee] = false;
+        for &(i, call) in &callers[callee] {
+            let mut grew = false;
+            for k in 0..claims[callee].len() {
+                let (j, resource) = claims[callee][k];
+                let targets: &[ActorRef] = if caps[callee].actors == 1 { &call.actors } else { call.actors.get(j..=j).unwrap_or(&[]) };
+                for target in targets {
+                    if let ActorRef::Slot(slot) = target {
+                        if *slot < caps[i].actors && !claims[i].contains(&(*slot, resource)) {
+                            claims[i].push((*slot, resource));
+                            grew = true;
                         }
                     }
                 }
             }
-        }
-        if !changed {
-            break;
+            if grew && !queued[i] {
+                queued[i] = true;
+                pending.push(i);
+            }
         }
     }
     for (c, mut cl) in caps.iter_mut().zip(claims) {

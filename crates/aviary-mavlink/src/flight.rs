@@ -41,7 +41,7 @@ pub async fn run(
                 Some(Value::Number(s)) if *s > 0.0 => s.min(c.max_speed),
                 Some(other) => {
                     return Err(failed(format!(
-                        "`speed` must be above 0 m/s, not {other:?}"
+                        "`speed` must be above 0 m/s, not {other}"
                     )))
                 }
                 None => c.max_speed,
@@ -156,7 +156,8 @@ fn number(args: &[Value], i: usize, name: &str) -> Result<f64, Failure> {
     match args.get(i) {
         Some(Value::Number(n)) if n.is_finite() => Ok(*n),
         other => Err(failed(format!(
-            "`{name}` must be a finite number, not {other:?}"
+            "`{name}` must be a finite number, not {}",
+            given(other)
         ))),
     }
 }
@@ -175,7 +176,8 @@ fn point(c: &Craft, v: Option<&Value>, name: &str) -> Result<[f64; 3], Failure> 
             Ok([m[0], m[1], if name == "points" { f64::NAN } else { here_z }])
         }
         other => Err(failed(format!(
-            "`{name}` must be a position, not {other:?}"
+            "`{name}` must be a position, not {}",
+            given(other)
         ))),
     }
 }
@@ -190,7 +192,8 @@ fn detection(
         Some(Value::Symbol(s) | Value::Text(s)) => s.clone(),
         other => {
             return Err(failed(format!(
-                "`kind` must be a kind such as Body, not {other:?}"
+                "`kind` must be a kind such as Body, not {}",
+                given(other)
             )))
         }
     };
@@ -219,7 +222,8 @@ async fn load(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> 
         Some(Value::Symbol(s) | Value::Text(s)) => s.clone(),
         other => {
             return Err(failed(format!(
-                "`kind` must be a kind such as Body, not {other:?}"
+                "`kind` must be a kind such as Body, not {}",
+                given(other)
             )))
         }
     };
@@ -252,4 +256,9 @@ async fn load(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> 
     hover(LOAD_TIME, paused).await?;
     *c.carrying.lock().unwrap_or_else(|p| p.into_inner()) = Some(kind);
     Ok(())
+}
+
+/// An argument as a refusal shows it: in the language's notation, or that it is missing.
+fn given(v: Option<&Value>) -> String {
+    v.map_or_else(|| "nothing (the argument is missing)".into(), Value::to_string)
 }

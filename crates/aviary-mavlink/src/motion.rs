@@ -4,6 +4,7 @@
 use std::time::Duration;
 
 use aviary_api::geometry::{contains, dist};
+use aviary_api::show::fixed;
 use aviary_api::Failure;
 use mavlink::dialects::ardupilotmega::MavCmd;
 use tokio::time::Instant;
@@ -211,8 +212,11 @@ pub(crate) async fn fly(
             }
             if left.is_zero() {
                 return Err(timeout(format!(
-                    "{} did not reach ({:.1}, {:.1}, {:.1}) in time",
-                    c.name, to[0], to[1], to[2]
+                    "{} did not reach ({}, {}, {}) in time",
+                    c.name,
+                    fixed(to[0], 1),
+                    fixed(to[1], 1),
+                    fixed(to[2], 1)
                 )));
             }
             tokio::time::sleep(c.tuning.poll).await;
@@ -232,15 +236,17 @@ pub(crate) fn fenced(c: &Craft, path: &[[f64; 3]]) -> Result<(), Failure> {
     for p in path {
         if let Some(max) = c.max_altitude.filter(|m| p[2] > m + 1e-9) {
             return Err(violation(format!(
-                "altitude {:.1} m is above the site's max_altitude of {max:.1} m",
-                p[2]
+                "altitude {} m is above the site's max_altitude of {} m",
+                fixed(p[2], 1),
+                fixed(max, 1)
             )));
         }
         if let Some(fence) = c.fence.as_deref().filter(|f| !contains(f, [p[0], p[1]])) {
             let _ = fence;
             return Err(violation(format!(
-                "({:.1}, {:.1}) is outside the geofence",
-                p[0], p[1]
+                "({}, {}) is outside the geofence",
+                fixed(p[0], 1),
+                fixed(p[1], 1)
             )));
         }
     }

@@ -1,5 +1,6 @@
 //! Reading a call's arguments, and the refusals a call can meet before it starts.
 
+use aviary_api::show::fixed;
 use aviary_api::{Failure, Point, Value};
 
 use crate::geom::{self, circle_inside, contains, segment_inside};
@@ -27,7 +28,7 @@ fn number_value(v: &Value, name: &str) -> Result<f64, Failure> {
     match v {
         Value::Number(n) if n.is_finite() => Ok(*n),
         other => Err(failed(format!(
-            "`{name}` must be a finite number, not {other:?}"
+            "`{name}` must be a finite number, not {other}"
         ))),
     }
 }
@@ -53,7 +54,7 @@ pub(crate) fn point_value(v: &Value, name: &str) -> Result<Point, Failure> {
             Ok(Point::flat(c[0], c[1]))
         }
         other => Err(failed(format!(
-            "`{name}` must be a position, not {other:?}"
+            "`{name}` must be a position, not {other}"
         ))),
     }
 }
@@ -73,7 +74,7 @@ pub(crate) fn polygon(args: &[Value], i: usize, name: &str) -> Result<Vec<[f64; 
             Ok(p.clone())
         }
         other => Err(failed(format!(
-            "`{name}` must be an area of at least 3 corners, not {other:?}"
+            "`{name}` must be an area of at least 3 corners, not {other}"
         ))),
     }
 }
@@ -83,7 +84,7 @@ pub(crate) fn kind(args: &[Value], i: usize, name: &str) -> Result<String, Failu
     match arg(args, i, name)? {
         Value::Symbol(s) | Value::Text(s) => Ok(s.clone()),
         other => Err(failed(format!(
-            "`{name}` must be a kind such as Body, not {other:?}"
+            "`{name}` must be a kind such as Body, not {other}"
         ))),
     }
 }
@@ -98,7 +99,9 @@ impl Limits<'_> {
     pub fn altitude(&self, z: f64) -> Result<(), Failure> {
         match self.max_altitude {
             Some(max) if z > max + 1e-9 => Err(fence_violation(format!(
-                "altitude {z:.1} m is above the site's max_altitude of {max:.1} m"
+                "altitude {} m is above the site's max_altitude of {} m",
+                fixed(z, 1),
+                fixed(max, 1)
             ))),
             _ => Ok(()),
         }
@@ -120,14 +123,18 @@ impl Limits<'_> {
             let q = [p[0], p[1]];
             if !contains(fence, q) {
                 return Err(fence_violation(format!(
-                    "({:.1}, {:.1}) is outside the geofence",
-                    q[0], q[1]
+                    "({}, {}) is outside the geofence",
+                    fixed(q[0], 1),
+                    fixed(q[1], 1)
                 )));
             }
             if check && !segment_inside(fence, prev, q) {
                 return Err(fence_violation(format!(
-                    "the way from ({:.1}, {:.1}) to ({:.1}, {:.1}) leaves the geofence",
-                    prev[0], prev[1], q[0], q[1]
+                    "the way from ({}, {}) to ({}, {}) leaves the geofence",
+                    fixed(prev[0], 1),
+                    fixed(prev[1], 1),
+                    fixed(q[0], 1),
+                    fixed(q[1], 1)
                 )));
             }
             prev = q;
@@ -139,8 +146,10 @@ impl Limits<'_> {
     pub fn circle(&self, center: [f64; 2], radius: f64) -> Result<(), Failure> {
         match self.fence {
             Some(fence) if !circle_inside(fence, center, radius) => Err(fence_violation(format!(
-                "a circle of {radius:.1} m around ({:.1}, {:.1}) leaves the geofence",
-                center[0], center[1]
+                "a circle of {} m around ({}, {}) leaves the geofence",
+                fixed(radius, 1),
+                fixed(center[0], 1),
+                fixed(center[1], 1)
             ))),
             _ => Ok(()),
         }

@@ -1,6 +1,6 @@
 //! What each middle-layer function does when called (docs/LANGUAGE.md, section 19).
 
-use aviary_api::{CallId, DroneId, Failure, FlightState, Value};
+use aviary_api::{show, CallId, DroneId, Failure, FlightState, Value};
 
 use crate::args::{failed, kind, number, opt_number, point, point_value, polygon, Limits};
 use crate::drone::{Loading, SimDrone};
@@ -170,14 +170,14 @@ impl Fleet {
                 let p = point(args, 0, "pos")?;
                 let speed = match opt_number(args, 1, "speed")? {
                     Some(s) if s <= 0.0 => {
-                        return Err(failed(format!("speed must be above 0 m/s, not {s} m/s")))
+                        return Err(failed(format!("speed must be above 0 m/s, not {} m/s", show::number(s))))
                     }
                     Some(s) => s.min(d.spec.max_speed),
                     None => d.spec.max_speed,
                 };
                 let to = [p.x, p.y, p.z.unwrap_or(level)];
                 if to[2] < 0.0 {
-                    return Err(failed(format!("altitude {} m is below the ground", to[2])));
+                    return Err(failed(format!("altitude {} m is below the ground", show::number(to[2]))));
                 }
                 limits.path(here, &[to])?;
                 vec![fly(to, speed)]
@@ -186,7 +186,7 @@ impl Fleet {
                 in_air()?;
                 let alt = number(args, 0, "alt")?;
                 if alt < 0.0 {
-                    return Err(failed(format!("altitude {alt} m is below the ground")));
+                    return Err(failed(format!("altitude {} m is below the ground", show::number(alt))));
                 }
                 limits.altitude(alt)?;
                 vec![fly([here[0], here[1], alt], d.spec.max_speed)]
@@ -194,7 +194,7 @@ impl Fleet {
             "Hover" => {
                 let duration = number(args, 0, "duration")?;
                 if duration < 0.0 {
-                    return Err(failed(format!("a hover cannot last {duration} s")));
+                    return Err(failed(format!("a hover cannot last {} s", show::number(duration))));
                 }
                 vec![Leg::Hold { left: duration }]
             }
@@ -239,7 +239,7 @@ impl Fleet {
                     let p = point_value(v, &format!("points[{i}]"))?;
                     z = p.z.unwrap_or(z);
                     if z < 0.0 {
-                        return Err(failed(format!("altitude {z} m is below the ground")));
+                        return Err(failed(format!("altitude {} m is below the ground", show::number(z))));
                     }
                     path.push([p.x, p.y, z]);
                 }
@@ -310,8 +310,9 @@ impl Fleet {
                 }
                 if d.state != FlightState::Landed && d.pos[2] >= LOAD_MAX_ALTITUDE {
                     return Err(failed(format!(
-                        "{} is at {:.1} m: load while landed or below {LOAD_MAX_ALTITUDE} m",
-                        &self.names[id], d.pos[2]
+                        "{} is at {} m: load while landed or below {LOAD_MAX_ALTITUDE} m",
+                        &self.names[id],
+                        show::fixed(d.pos[2], 1)
                     )));
                 }
                 d.rare_mut().loading = Some(Loading {

@@ -10,7 +10,7 @@ use aviary_api::{DroneId, Resource};
 use aviary_ir::{ActorFilter, ActorRef, Block, BlockKind, Call, CapId, Mission, Node, Origin, SignalId};
 
 /// Which child of a construct a step goes to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Key {
     Item(usize),
     Handler(usize),
@@ -152,6 +152,16 @@ impl Walk<'_> {
 
     fn call(&mut self, call: &Call) {
         let cap = &self.mission.capabilities[call.capability];
+        // The common case, one drone for a one-actor capability: its claims on slot 0
+        // (each once already: the compiler sorts and dedups them).
+        if let ([ActorRef::Drone(d)], 1) = (call.actors.as_slice(), cap.actors) {
+            let claims = cap.claims.iter().filter(|(slot, _)| *slot == 0).map(|&(_, r)| (*d, r)).collect();
+            self.out.claims.push(ClaimSite { origin: call.origin, path: self.path.clone(), claims, capability: call.capability });
+            for &signal in &self.raises_of[call.capability] {
+                self.out.raises.push(RaiseSite { signal, path: self.path.clone() });
+            }
+            return;
+        }
         // `a b Cap` binds actors to BY slots in order; a one-actor capability given
         // several actors runs once per actor.
         let slots: Vec<Vec<DroneId>> = if cap.actors == 1 && call.actors.len() > 1 {
@@ -198,17 +208,27 @@ fn capability_raises(mission: &Mission) -> Vec<BTreeSet<SignalId>> {
         direct.push(raised);
         calls.push(called);
     }
-    // To a fixpoint: each round adds a signal somewhere or stops.
-    loop {
-        let mut grew = false;
-        for i in 0..direct.len() {
-            let inherited: BTreeSet<SignalId> = calls[i].iter().flat_map(|&c| direct[c].iter().copied()).collect();
-            for s in inherited {
-                grew |= direct[i].insert(s);
-            }
-        }
-        if !grew {
-            return direct;
+    // To a fixpoint, by a worklist: when a capability's signals grow, only its callers
+    // take them up, so a chain of N capabilities costs N steps, not N rounds of N.
+    let mut callers: Vec<Vec<CapId>> = vec![Vec::new(); direct.len()];
+    for (i, called) in calls.iter().enumerate() {
+        for &c in called {
+            callers[c].push(i);
         }
     }
+    let mut pending: Vec<CapId> = (0..direct.len()).filter(|&c| !direct[c].is_empty()).collect();
+    while let Some(callee) = pending.pop() {
+        for &caller in &callers[callee] {
+            if caller == callee {
+                continue;
+            }
+            let before = direct[caller].len();
+            let inherited: Vec<SignalId> = direct[callee].iter().copied().collect();
+            direct[caller].extend(inherited);
+            if direct[caller].len() > before {
+                pending.push(caller);
+            }
+        }
+    }
+    direct
 }

@@ -20,8 +20,8 @@ fn dir() -> PathBuf {
 struct NoFiles;
 
 impl SourceProvider for NoFiles {
-    fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), String> {
-        Err(format!("the fixtures USE no files ({path})"))
+    fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
+        Err(format!("the fixtures USE no files ({path})").into())
     }
 }
 

@@ -213,7 +213,7 @@ fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Dia
     }
     drones.finish(cx, &sensor_kinds);
     if let Some(e) = table("targets") {
-        world.targets = sim::targets(cx, &e.node);
+        world.targets = sim::targets(cx, &e.node, world.site.geofence.as_deref());
     }
     if let Some(e) = table("faults") {
         world.faults = sim::faults(cx, &e.node, &drones.names());
@@ -221,6 +221,7 @@ fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Dia
     let group_spans = std::mem::take(&mut drones.group_spans);
     world.groups = std::mem::take(&mut drones.groups);
     world.drones = std::mem::take(&mut drones.out);
+    homes_in_fence(cx, &world);
     unique_names(cx, &world, &group_spans);
     (world, std::mem::take(&mut cx.diags))
 }
@@ -245,11 +246,11 @@ fn site(cx: &mut Ctx, node: &Node) -> Site {
         match e.key.as_str() {
             "name" => site.name = cx.string(&"`name` in [site]", n),
             "origin" => site.origin = origin(cx, e),
-            "geofence" => site.geofence = cx.polygon(&"the geofence", n),
+            "geofence" => site.geofence = cx.polygon(&"the geofence", n).filter(|fence| cx.outline(&"the geofence", n, fence)),
             "max_altitude" => site.max_altitude = cx.positive(&"`max_altitude`", n),
             "min_separation" => match cx.number(&"`min_separation`", n) {
                 Some(v) if v < 0.0 => {
-                    let msg = format!("`min_separation` must be zero or more metres, found {v}");
+                    let msg = format!("`min_separation` must be zero or more metres, found {}", aviary_api::show::number(v));
                     cx.error(
                         n.span,
                         msg,
@@ -305,7 +306,8 @@ fn places(cx: &mut Ctx, node: &Node) -> Vec<Place> {
     let mut out = Vec::new();
     for e in entries {
         cx.identifier("place", &e.key, e.key_span);
-        if let Some((at, has_z)) = cx.point(&format!("place `{}`", e.key), &e.node) {
+        let what = format!("place `{}`", e.key);
+        if let Some((at, has_z)) = cx.point(&what, &e.node).filter(|(at, _)| cx.above_ground(&what, &e.node, at[2])) {
             out.push(Place {
                 name: e.key.clone(),
                 at,
@@ -325,12 +327,47 @@ fn areas(cx: &mut Ctx, node: &Node) -> Vec<Area> {
     let mut out = Vec::new();
     for e in entries {
         cx.identifier("area", &e.key, e.key_span);
-        if let Some(polygon) = cx.polygon(&format!("area `{}`", e.key), &e.node) {
+        let what = format!("area `{}`", e.key);
+        if let Some(polygon) = cx.polygon(&what, &e.node).filter(|p| cx.outline(&what, &e.node, p)) {
             out.push(Area {
                 name: e.key.clone(),
                 polygon,
                 span: e.key_span,
             });
+        }
+    }
+    out
+}
+
+/// Every drone starts and lands at its home: one outside the geofence (its line counts as
+/// inside, as for a flight) would take off outside it (and the simulator would fly it back in from there). Reported at the
+/// `home` value; its place is looked up again only when a home is outside, so a valid
+/// world of a million drones keeps no span per home.
+fn homes_in_fence(cx: &mut Ctx, world: &World) {
+    let Some(fence) = world.site.geofence.as_deref() else { return };
+    let outside: Vec<&crate::Drone> = world.drones.iter().filter(|d| !aviary_api::geometry::contains(fence, [d.home[0], d.home[1]])).collect();
+    if outside.is_empty() {
+        return;
+    }
+    let spans = home_spans(cx.text);
+    for d in outside {
+        let at = spans.get(d.name.as_str()).copied().unwrap_or(d.span);
+        let msg = format!("drone `{}`'s home {} is outside the geofence", d.name, crate::read::shown([d.home[0], d.home[1]]));
+        cx.error(at, msg, "move the home inside the geofence, or widen `geofence` in [site]: a drone takes off and lands at its home");
+    }
+}
+
+/// Where each drone's `home` value is written, by drone name (the file parses: its world
+/// was built).
+fn home_spans(text: &str) -> std::collections::HashMap<String, Span> {
+    let mut out = std::collections::HashMap::new();
+    let Ok(root) = Node::parse_serde(text) else { return out };
+    let Value::Table(top) = &root.value else { return out };
+    let Some(Entry { node: Node { value: Value::Table(drones), .. }, .. }) = get(top, "drones") else { return out };
+    for d in drones {
+        let Value::Table(keys) = &d.node.value else { continue };
+        if let Some(home) = get(keys, "home") {
+            out.insert(d.key.clone(), home.node.span);
         }
     }
     out

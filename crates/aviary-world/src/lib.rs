@@ -14,6 +14,8 @@ mod hash;
 mod node;
 mod read;
 #[cfg(test)]
+mod place_tests;
+#[cfg(test)]
 mod tests;
 
 use std::sync::Arc;

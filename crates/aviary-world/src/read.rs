@@ -1,6 +1,7 @@
 //! Typed readers over the spanned tree: each one either returns the value or records a
 //! located diagnostic and returns `None`, so that one pass reports every problem.
 
+use aviary_api::show::number;
 use std::fmt::Display;
 
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
@@ -89,7 +90,7 @@ impl Ctx<'_> {
     pub fn positive(&mut self, what: &dyn Display, node: &Node) -> Option<f64> {
         let value = self.number(what, node)?;
         if value <= 0.0 {
-            let msg = format!("{what} must be greater than zero, found {value}");
+            let msg = format!("{what} must be greater than zero, found {}", number(value));
             self.error(node.span, msg, "write a positive number");
             return None;
         }
@@ -100,7 +101,7 @@ impl Ctx<'_> {
     pub fn non_negative(&mut self, what: &dyn Display, node: &Node) -> Option<f64> {
         let value = self.number(what, node)?;
         if value < 0.0 {
-            let msg = format!("{what} must not be below zero, found {value}");
+            let msg = format!("{what} must not be below zero, found {}", number(value));
             self.error(node.span, msg, "write zero or a positive number");
             return None;
         }
@@ -111,11 +112,11 @@ impl Ctx<'_> {
     pub fn within(&mut self, what: &dyn Display, node: &Node, min: f64, max: f64) -> Option<f64> {
         let value = self.number(what, node)?;
         if !(min..=max).contains(&value) {
-            let msg = format!("{what} must be between {min} and {max}, found {value}");
+            let msg = format!("{what} must be between {} and {}, found {}", number(min), number(max), number(value));
             self.error(
                 node.span,
                 msg,
-                format!("write a number from {min} to {max}"),
+                format!("write a number from {} to {}", number(min), number(max)),
             );
             return None;
         }
@@ -157,6 +158,41 @@ impl Ctx<'_> {
             }
         }
         out
+    }
+
+    /// A polygon's outline must enclose an area and not cross itself: a fence or area
+    /// whose corners lie on one line holds nothing, and one whose edges cross (corners
+    /// listed out of order) has no clear inside. Reported at the polygon; false then.
+    pub fn outline(&mut self, what: &dyn Display, node: &Node, polygon: &[[f64; 2]]) -> bool {
+        let help = "list the corners in order around the area, clockwise or counter-clockwise, e.g. `[[0, 0], [100, 0], [100, 100], [0, 100]]`";
+        if let Some((i, j)) = aviary_api::geometry::self_crossing(polygon) {
+            let n = polygon.len();
+            let msg = format!(
+                "{what} crosses itself: its edge from {} to {} crosses its edge from {} to {}",
+                shown(polygon[i]),
+                shown(polygon[(i + 1) % n]),
+                shown(polygon[j]),
+                shown(polygon[(j + 1) % n])
+            );
+            self.error(node.span, msg, help);
+            return false;
+        }
+        // Square metres: less than this is a line, whatever the units' rounding.
+        if aviary_api::geometry::signed_area(polygon).abs() < 1e-6 {
+            self.error(node.span, format!("{what} encloses no area: its corners lie on one line"), help);
+            return false;
+        }
+        true
+    }
+
+    /// A height `z` that is below the ground: reported at `node` (the position).
+    pub fn above_ground(&mut self, what: &dyn Display, node: &Node, z: f64) -> bool {
+        if z < 0.0 {
+            let msg = format!("{what} is below the ground: z = {} m", number(z));
+            self.error(node.span, msg, "heights are metres above the ground, 0 or more; write `[x, y]` for a point on the ground");
+            return false;
+        }
+        true
     }
 
     /// A position: `[x, y]` (z = 0) or `[x, y, z]`. Returns the point and whether z was given.
@@ -336,6 +372,11 @@ fn distance(a: &str, b: &str) -> usize {
         }
     }
     d[a.len()][b.len()]
+}
+
+/// A ground point as messages show it: `(x, y)`.
+pub(crate) fn shown(p: [f64; 2]) -> String {
+    format!("({}, {})", number(p[0]), number(p[1]))
 }
 
 /// The TOML text of a value, for attributes that are lists or tables.

@@ -12,8 +12,8 @@ use serde_json::Value;
 
 struct NoFiles;
 impl SourceProvider for NoFiles {
-    fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), String> {
-        Err(format!("no file {path}"))
+    fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
+        Err(format!("no file {path}").into())
     }
 }
 

@@ -24,6 +24,45 @@ pub struct Raise {
     pub args: Vec<Option<Value>>,
 }
 
+/// Raises waiting for a block's handlers, taken earliest first and, at one time, in the
+/// order they came (a heap: a block that raises N signals costs N log N, not N²).
+#[derive(Default)]
+struct Pending {
+    heap: std::collections::BinaryHeap<std::cmp::Reverse<(Time, usize)>>,
+    /// By arrival; taken ones are `None`.
+    raises: Vec<Option<Raise>>,
+}
+
+/// A time ordered as `f64::total_cmp` orders it.
+#[derive(Clone, Copy, PartialEq)]
+struct Time(f64);
+
+impl Eq for Time {}
+
+impl PartialOrd for Time {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Time {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}
+
+impl Pending {
+    fn push(&mut self, r: Raise) {
+        self.heap.push(std::cmp::Reverse((Time(r.t), self.raises.len())));
+        self.raises.push(Some(r));
+    }
+
+    fn pop(&mut self) -> Option<Raise> {
+        let std::cmp::Reverse((_, n)) = self.heap.pop()?;
+        self.raises[n].take()
+    }
+}
+
 /// Everything a walk changes; cloned to try both sides of an `IF` it cannot decide.
 #[derive(Clone)]
 pub struct State {
@@ -53,8 +92,11 @@ pub struct Estimator<'m> {
     /// First raise times from the previous pass, for `WAITFOR RECEIVED` ahead of its signal.
     pub known: Vec<Option<f64>>,
     pub s: State,
-    /// The capabilities being walked, innermost last.
-    calling: Vec<usize>,
+    /// The capabilities being walked, by index: a flag each, so that a chain of N
+    /// capabilities asks N times in O(1), not in O(depth).
+    calling: Vec<bool>,
+    /// Per capability, the actor slots whose motion it claims (asked at every call).
+    motion: Vec<std::rc::Rc<[usize]>>,
     /// The built-in `Detected` signal, when the mission can hear it.
     detected: Option<SignalId>,
 }
@@ -70,7 +112,8 @@ impl<'m> Estimator<'m> {
             mission,
             world,
             known,
-            calling: Vec::new(),
+            calling: vec![false; mission.capabilities.len()],
+            motion: mission.capabilities.iter().map(|cap| cap.claims.iter().filter(|(_, r)| *r == Resource::Motion).map(|(slot, _)| *slot).collect::<Vec<_>>().into()).collect(),
             detected: mission.signals.iter().position(|s| s == "Detected"),
             s: State { drones, activities: vec![Vec::new(); n], raised: vec![None; mission.signals.len()], reserve: vec![None; n], assumptions: BTreeSet::new(), fired: BTreeSet::new() },
         }
@@ -140,9 +183,11 @@ impl<'m> Estimator<'m> {
         }
         let items_end = end;
         let mut once = vec![false; b.handlers.len()];
-        let (mut pending, mut heard) = (raises, Vec::new());
-        while let Some(i) = (0..pending.len()).min_by(|&x, &y| pending[x].t.total_cmp(&pending[y].t)) {
-            let r = pending.remove(i);
+        let (mut pending, mut heard) = (Pending::default(), Vec::new());
+        for r in raises {
+            pending.push(r);
+        }
+        while let Some(r) = pending.pop() {
             for (hi, h) in b.handlers.iter().enumerate() {
                 if h.signal != r.signal || (!h.every && once[hi]) || !matches(h, &ctx.frame, r.actor) {
                     continue;
@@ -156,7 +201,9 @@ impl<'m> Estimator<'m> {
                 let start = if h.sequential { items_end.max(r.t) } else { r.t };
                 let (e, more) = self.block(&h.body, &mut hctx, start);
                 end = end.max(e);
-                pending.extend(more);
+                for r in more {
+                    pending.push(r);
+                }
             }
             heard.push(r);
         }
@@ -288,11 +335,17 @@ impl<'m> Estimator<'m> {
     fn call(&mut self, c: &Call, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
         let cap = &self.mission.capabilities[c.capability];
         // A capability that calls itself, directly or not, would never end here.
-        if self.calling.contains(&c.capability) {
+        if self.calling[c.capability] {
             self.note(Some(c.origin), format!("`{}` calls itself; the estimate counts one round of it", cap.name));
             return (t, Vec::new());
         }
         let args: Vec<Option<Value>> = c.args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
+        // The common case, one drone for a one-actor capability, without the lists of
+        // lists the general case builds.
+        if let ([a @ (ActorRef::Drone(_) | ActorRef::Slot(_))], 1) = (c.actors.as_slice(), cap.actors) {
+            let Some(d) = self.scope(ctx, t).actor(a) else { return (t, Vec::new()) };
+            return self.run_call(c, &[d], &args, ctx, t);
+        }
         let sets: Vec<Vec<DroneId>> = c
             .actors
             .iter()
@@ -302,13 +355,25 @@ impl<'m> Estimator<'m> {
             })
             .collect();
         let runs: Vec<Vec<DroneId>> = if cap.actors == 1 { sets.concat().into_iter().map(|d| vec![d]).collect() } else { vec![sets.iter().filter_map(|s| s.first().copied()).collect()] };
-        let top = ctx.statement.is_none();
-        let motion: Vec<usize> = cap.claims.iter().filter(|(_, r)| *r == Resource::Motion).map(|(slot, _)| *slot).collect();
         let (mut end, mut raises) = (t, Vec::new());
         for actors in runs {
+            let (e, r) = self.run_call(c, &actors, &args, ctx, t);
+            end = end.max(e);
+            raises.extend(r);
+        }
+        (end, raises)
+    }
+
+    /// One run of a called capability on `actors`.
+    fn run_call(&mut self, c: &Call, actors: &[DroneId], args: &[Option<Value>], ctx: &Ctx, t: f64) -> (f64, Vec<Raise>) {
+        let cap = &self.mission.capabilities[c.capability];
+        let top = ctx.statement.is_none();
+        let motion = self.motion[c.capability].clone();
+        let (mut end, mut raises) = (t, Vec::new());
+        {
             let mut start = t;
             if top {
-                for &slot in &motion {
+                for &slot in motion.iter() {
                     if let Some(&d) = actors.get(slot) {
                         start = start.max(self.s.drones[d].free_at);
                     }
@@ -319,16 +384,16 @@ impl<'m> Estimator<'m> {
                 *slot = v;
             }
             let mut cctx = Ctx { frame, actor: actors.first().copied(), statement: Some(ctx.statement.unwrap_or(c.origin)) };
-            self.calling.push(c.capability);
+            self.calling[c.capability] = true;
             let (e, r) = self.block(&cap.perform, &mut cctx, start);
-            self.calling.pop();
+            self.calling[c.capability] = false;
             if top {
-                for &slot in &motion {
+                for &slot in motion.iter() {
                     if let Some(&d) = actors.get(slot) {
                         self.s.drones[d].free_at = self.s.drones[d].free_at.max(e);
                     }
                 }
-                for &d in &actors {
+                for &d in actors {
                     self.s.activities[d].push(Activity { start, end: e, what: cap.name.clone(), at: None, origin: Some(c.origin) });
                 }
             }

@@ -9,6 +9,7 @@ mod eval;
 mod flight;
 mod model;
 
+use aviary_api::show::fixed;
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 use aviary_ir::{Block, Handler, Mission, Node, Origin};
 use aviary_world::World;
@@ -87,12 +88,16 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
         est = Estimator::new(mission, world, known.clone());
         end = est.run();
     }
+    // The activities are moved into the plan, not copied (a long mission has millions);
+    // the worst-case walks below go on with empty lists, which the plan does not read.
+    let empty = vec![Vec::new(); est.s.activities.len()];
+    let activities = std::mem::replace(&mut est.s.activities, empty);
     let mut drones: Vec<DronePlan> = world
         .drones
         .iter()
         .zip(&est.s.drones)
-        .zip(&est.s.activities)
-        .map(|((w, f), acts)| DronePlan { drone: w.name.clone(), distance: f.distance, flight_time: f.flight_time, battery_left: f.battery_at(end), activities: acts.clone(), worst_case: Vec::new() })
+        .zip(activities)
+        .map(|((w, f), activities)| DronePlan { drone: w.name.clone(), distance: f.distance, flight_time: f.flight_time, battery_left: f.battery_at(end), activities, worst_case: Vec::new() })
         .collect();
     for (d, at) in est.s.reserve.iter().enumerate() {
         // Crossed on the way home after the mission's end: at the drone's last statement.
@@ -101,11 +106,11 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
         if let Some(o) = at {
             let p = &drones[d];
             let end = if p.battery_left > 0.0 {
-                format!("{:.0}% left at the end", p.battery_left * 100.0)
+                format!("{}% left at the end", fixed(p.battery_left * 100.0, 0))
             } else {
                 // What it uses is what it starts with less what is left.
                 let start = est.s.drones[d].battery_start;
-                format!("it runs out before the end: the mission needs {:.0}% of a full battery", (start - p.battery_left) * 100.0)
+                format!("it runs out before the end: the mission needs {}% of a full battery", fixed((start - p.battery_left) * 100.0, 0))
             };
             diagnostics.push(
                 Diagnostic::new(Code::LowReserve, o.file, o.span, format!("{}'s battery is estimated to fall under 20% {} ({end})", p.drone, if after_end { "on its way home after the mission ends; this is its last statement" } else { "during this statement" }))
@@ -166,23 +171,23 @@ impl Plan {
         let mut out = format!("plan: the mission takes about {} (estimate)\n", clock(self.mission_time));
         for d in &self.drones {
             out.push_str(&format!(
-                "\n{}: {:.0} m, {} in the air, {:.0}% battery left{}\n",
+                "\n{}: {} m, {} in the air, {}% battery left{}\n",
                 d.drone,
-                d.distance,
+                fixed(d.distance, 0),
                 clock(d.flight_time),
-                d.battery_left * 100.0,
+                fixed(d.battery_left * 100.0, 0),
                 if d.battery_left < RESERVE { "  (under the 20% reserve)" } else { "" }
             ));
             for a in &d.activities {
-                out.push_str(&format!("  {:>7.1} – {:>7.1} s  {}{}\n", a.start, a.end, a.what, a.at.as_ref().map(|p| format!("  ({p})")).unwrap_or_default()));
+                out.push_str(&format!("  {:>7} – {:>7} s  {}{}\n", fixed(a.start, 1), fixed(a.end, 1), a.what, a.at.as_ref().map(|p| format!("  ({p})")).unwrap_or_default()));
             }
             for b in &d.worst_case {
                 out.push_str(&format!(
-                    "  worst case per firing of {} (its trigger is unknown before flight): +{:.0} m, +{}, {:.0}% battery left\n",
+                    "  worst case per firing of {} (its trigger is unknown before flight): +{} m, +{}, {}% battery left\n",
                     b.handler,
-                    b.distance,
+                    fixed(b.distance, 0),
                     clock(b.flight_time),
-                    b.battery_left * 100.0
+                    fixed(b.battery_left * 100.0, 0)
                 ));
             }
         }

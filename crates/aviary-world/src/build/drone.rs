@@ -148,7 +148,7 @@ impl Drones {
             let what = KeyOf(&k.key, name);
             let n = &k.node;
             match k.key.as_str() {
-                "home" => d.home = cx.point(&what, n).map_or(d.home, |(p, _)| p),
+                "home" => d.home = cx.point(&what, n).filter(|(p, _)| cx.above_ground(&what, n, p[2])).map_or(d.home, |(p, _)| p),
                 "group" => {
                     // Read in place: most drones name a group that exists already.
                     let Value::Str(group) = &n.value else {

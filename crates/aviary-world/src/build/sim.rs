@@ -89,7 +89,8 @@ fn entries<'n>(
     out
 }
 
-pub(super) fn targets(cx: &mut Ctx, node: &Node) -> Vec<Target> {
+/// `fence`: the site's geofence; a target outside it can never be flown to.
+pub(super) fn targets(cx: &mut Ctx, node: &Node, fence: Option<&[[f64; 2]]>) -> Vec<Target> {
     let help = "write each target as `[[targets]]` followed by `kind = \"Body\"` and `at = [x, y]`";
     let mut out = Vec::new();
     for (keys, head) in entries(cx, "targets", node, help) {
@@ -108,7 +109,14 @@ pub(super) fn targets(cx: &mut Ctx, node: &Node) -> Vec<Target> {
             }
         };
         let at = match get(keys, "at") {
-            Some(a) => cx.point(&"`at` of a target", &a.node),
+            Some(a) => cx.point(&"`at` of a target", &a.node).filter(|(p, _)| {
+                let (inside, grounded) = (fence.is_none_or(|f| aviary_api::geometry::contains(f, [p[0], p[1]])), cx.above_ground(&"a target", &a.node, p[2]));
+                if !inside {
+                    let msg = format!("the target at {} is outside the geofence, where no drone may fly to find it", crate::read::shown([p[0], p[1]]));
+                    cx.error(a.node.span, msg, "move the target inside the geofence, or remove it");
+                }
+                inside && grounded
+            }),
             None => {
                 cx.error(
                     head,
@@ -154,7 +162,7 @@ pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[&str]) -> Vec<Fault> {
         let at = match get(keys, "at") {
             Some(a) => cx.number(&"`at` of a fault", &a.node).filter(|&t| {
                 if t < 0.0 {
-                    let msg = format!("`at` of a fault must be zero or more seconds, found {t}");
+                    let msg = format!("`at` of a fault must be zero or more seconds, found {}", aviary_api::show::number(t));
                     cx.error(
                         a.node.span,
                         msg,

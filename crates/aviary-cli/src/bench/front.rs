@@ -1,0 +1,93 @@
+//! `aviary bench front`: the whole of `aviary check` on a generated mission of a shape
+//! that once made the pre-flight analyses quadratic (`aviary_check::generate::front`):
+//! N statements in one SEQUENTIAL block on one drone, or a chain of N capabilities.
+//! Times parse + check, compile, and the analyses (conflicts and the plan), and prints
+//! each run and the median throughput of the whole. MB is 10^6 bytes.
+
+use std::time::{Duration, Instant};
+
+use aviary_diagnostics::SourceMap;
+use clap::ValueEnum;
+
+use super::{median, rate, NoFiles, MB};
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum Shape {
+    /// N statements in one SEQUENTIAL block, all on one drone
+    Sequential,
+    /// N capabilities, each calling the next
+    Chain,
+}
+
+/// One run's stages: parse + check, compile, analyses; and the diagnostics found.
+struct Timed {
+    check: Duration,
+    compile: Duration,
+    analyses: Duration,
+    errors: usize,
+    others: usize,
+}
+
+pub fn run(shape: Shape, n: usize, runs: usize) -> u8 {
+    if n == 0 || n > 50_000_000 {
+        eprintln!("aviary: --n must be from 1 to 50000000");
+        return 2;
+    }
+    let runs = runs.max(1);
+    let (mission, what) = match shape {
+        Shape::Sequential => (aviary_check::generate::sequential_mission(n), "statements in one SEQUENTIAL block"),
+        Shape::Chain => (aviary_check::generate::chain_mission(n), "capabilities in a chain"),
+    };
+    let world = aviary_check::generate::front_world();
+    let size = mission.len();
+    outln!("generated a mission of {n} {what}: {:.2} MB ({size} bytes)", size as f64 / MB);
+    let mut totals = Vec::with_capacity(runs);
+    for r in 1..=runs {
+        let t = once(&mission, &world);
+        let total = t.check + t.compile + t.analyses;
+        outln!(
+            "run {r}: parse + check {:.3} s, compile {:.3} s, analyses {:.3} s; all {:.3} s ({:.1} MB/s); {} error(s), {} other diagnostic(s)",
+            t.check.as_secs_f64(),
+            t.compile.as_secs_f64(),
+            t.analyses.as_secs_f64(),
+            total.as_secs_f64(),
+            rate(size, total),
+            t.errors,
+            t.others
+        );
+        if t.errors > 0 {
+            eprintln!("aviary: the generated mission has errors; the generator is wrong");
+            return 1;
+        }
+        totals.push(total);
+    }
+    let m = median(&mut totals);
+    outln!("median of {runs} run(s) over {:.2} MB: parse + check + analyses {:.1} MB/s ({:.3} s)", size as f64 / MB, rate(size, m), m.as_secs_f64());
+    0
+}
+
+/// What `aviary check` does with the mission, minus reading and printing: the front end,
+/// then `aviary_verify::preflight`'s two steps, each timed.
+fn once(mission: &str, world: &str) -> Timed {
+    let api = aviary_sim::descriptor();
+    let start = Instant::now();
+    let mut sources = SourceMap::new();
+    let checked = aviary_check::check_sources(&mut sources, ("front.mission", mission.as_bytes()), Some(("front.world.toml", world.as_bytes())), &NoFiles, &api);
+    let check = start.elapsed();
+    let mut errors = checked.diagnostics.iter().filter(|d| d.is_error()).count();
+    let mut others = checked.diagnostics.len() - errors;
+    let (mut compile, mut analyses) = (Duration::ZERO, Duration::ZERO);
+    if let (false, Some(program), Some(w)) = (checked.has_errors(), &checked.program, &checked.world) {
+        let start = Instant::now();
+        let compiled = aviary_ir::compile(program, w, &api);
+        compile = start.elapsed();
+        if let Some(compiled) = compiled {
+            let start = Instant::now();
+            let v = std::hint::black_box(aviary_verify::verify(&compiled, w));
+            analyses = start.elapsed();
+            errors += v.diagnostics.iter().filter(|d| d.is_error()).count();
+            others += v.diagnostics.iter().filter(|d| !d.is_error()).count();
+        }
+    }
+    Timed { check, compile, analyses, errors, others }
+}

@@ -107,8 +107,8 @@ mod tests {
 
     struct NoFiles;
     impl SourceProvider for NoFiles {
-        fn load(&self, _: &str, _: &str) -> Result<(String, Vec<u8>), String> {
-            Err("no files here".into())
+        fn load(&self, _: &str, _: &str) -> Result<(String, Vec<u8>), crate::uses::LoadError> {
+            Err(crate::uses::LoadError::Unreadable("no files here".into()))
         }
     }
 

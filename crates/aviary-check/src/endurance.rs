@@ -52,7 +52,8 @@ pub(crate) fn check_endurance(program: &Program, world: &World, api: &Descriptor
     if timed.is_empty() {
         return;
     }
-    let mut walker = Walker { program, world, api, timed, by_name: OnceCell::new(), reported: HashSet::new(), out: Vec::new() };
+    let budget = crate::geofence::follow_budget(&mission.body);
+    let mut walker = Walker { program, world, api, timed, by_name: OnceCell::new(), reported: HashSet::new(), out: Vec::new(), budget };
     walker.body(&mission.body, &Env::default(), file, 0);
     diagnostics.extend(walker.out);
 }
@@ -90,6 +91,8 @@ struct Walker<'a> {
     /// Each written number once, however many statements reach it.
     reported: HashSet<(FileId, u32)>,
     out: Vec<Diagnostic>,
+    /// Calls into capabilities the walk may still follow (as the geofence check's).
+    budget: usize,
 }
 
 impl Walker<'_> {
@@ -134,9 +137,10 @@ impl Walker<'_> {
     }
 
     fn statement(&mut self, s: &Statement, env: &Env, file: FileId, depth: usize) {
-        if depth >= MAX_CALLS || !self.timed.contains(s.capability.name.as_str()) {
+        if depth >= MAX_CALLS || self.budget == 0 || !self.timed.contains(s.capability.name.as_str()) {
             return;
         }
+        self.budget -= 1;
         let (Some(callee), Some(callee_file)) = (self.program.capability(&s.capability.name), self.program.capability_file(&s.capability.name)) else { return };
         let mut inner = Env::default();
         // `a b Cap` on a one-actor capability runs it once per actor: any of them.

@@ -35,7 +35,7 @@ pub(crate) fn check_geofence(program: &Program, world: &World, diagnostics: &mut
         return;
     }
     let (Some(mission), Some(file)) = (program.mission(), program.mission.map(|r| r.file)) else { return };
-    let mut walker = Walker { program, world, fence, ceiling, diagnostics };
+    let mut walker = Walker { program, world, fence, ceiling, diagnostics, budget: follow_budget(&mission.body) };
     walker.body(&mission.body, &Values::new(), None, file, 0);
 }
 
@@ -45,6 +45,20 @@ struct Walker<'a> {
     fence: Option<&'a [[f64; 2]]>,
     ceiling: Option<f64>,
     diagnostics: &'a mut Vec<Diagnostic>,
+    /// Calls into capabilities the walk may still follow ([`follow_budget`]).
+    budget: usize,
+}
+
+/// How many calls into capabilities a walk from the mission follows: 64 per mission
+/// statement and a million more, generous for any mission's size but finite. Each call is
+/// followed where it is made, so capabilities that each call the next ten times make
+/// 10^depth calls (up to [`MAX_CALLS`] deep): a mission of a few hundred bytes would
+/// otherwise keep `aviary check` busy for years. What is not followed is not checked
+/// before flight; the simulator still refuses such a flight (`GeofenceViolation`).
+pub(crate) fn follow_budget(mission: &Body) -> usize {
+    let mut statements = 0usize;
+    crate::env::visit_stmts(mission, &mut |s| statements += usize::from(matches!(s, Stmt::Statement(_))));
+    statements.saturating_mul(64).saturating_add(1_000_000)
 }
 
 impl Walker<'_> {
@@ -101,9 +115,10 @@ impl Walker<'_> {
 
     fn statement(&mut self, s: &Statement, values: &Values, site: Option<(FileId, Span)>, depth: usize) {
         let (Some(callee), Some(file)) = (self.program.capability(&s.capability.name), self.program.capability_file(&s.capability.name)) else { return };
-        if depth >= MAX_CALLS {
+        if depth >= MAX_CALLS || self.budget == 0 {
             return;
         }
+        self.budget -= 1;
         let binding = bind_args(&callee.params, &s.args);
         let mut inner = Values::new();
         for (i, p) in callee.params.iter().enumerate() {

@@ -224,3 +224,23 @@ fn a_recursion_that_never_ends_in_flight_fails_the_mission_with_command_failed_n
     let last = events.last().expect("events");
     assert_eq!((last["event"].as_str(), last["status"].as_str()), (Some("mission_end"), Some("failed")), "{last}");
 }
+
+#[test]
+fn capabilities_that_fan_out_are_checked_and_planned_in_bounded_time() {
+    let dir = scratch("fan_out");
+    // Each capability calls the next ten times, twelve deep: 10^12 flights if every
+    // call were followed. A few hundred bytes; it must not keep `aviary check` busy.
+    let depth = 12;
+    let mut text = String::from("MISSION M:\n    scout TakeOff WITH 20m\n    scout D0\n");
+    for i in 0..depth {
+        text.push_str(&format!("\nCAPABILITY D{i} BY drone:\n    PERFORM:\n"));
+        for _ in 0..10 {
+            text.push_str(&if i + 1 < depth { format!("        drone D{}\n", i + 1) } else { "        drone.FlyToPosition((10, 10))\n".into() });
+        }
+    }
+    std::fs::write(dir.join("fan.mission"), text).expect("write");
+    std::fs::write(dir.join("fan.world.toml"), "[site]\ngeofence = [[-100, -100], [100, -100], [100, 100], [-100, 100]]\n[drones.scout]\nhome = [0, 0]\n").expect("write");
+    let (code, out, err) = aviary(&["check", "--plan", "fan.mission"], &dir);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("the capability calls fan out past what the estimate follows"), "{out}");
+}

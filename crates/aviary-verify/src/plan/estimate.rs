@@ -6,7 +6,6 @@
 //! queueing follows program order. Handlers run after their block's items, in the order
 //! of their signals' times. Detections come from the world's targets (simulation data).
 
-use std::collections::BTreeSet;
 
 use aviary_api::{DroneId, Resource, Value};
 use aviary_ir::{ActorFilter, ActorRef, ApiCall, Block, BlockKind, Call, Expr, Handler, Mission, Node, Origin, SignalId};
@@ -63,19 +62,7 @@ impl Pending {
     }
 }
 
-/// Everything a walk changes; cloned to try both sides of an `IF` it cannot decide.
-#[derive(Clone)]
-pub struct State {
-    pub drones: Vec<Flyer>,
-    pub activities: Vec<Vec<Activity>>,
-    pub raised: Vec<Option<f64>>,
-    /// Per drone: the mission-level statement during which the reserve fell under 20%.
-    pub reserve: Vec<Option<Origin>>,
-    /// What the estimate had to assume, with where.
-    pub assumptions: BTreeSet<(Option<(u32, u32)>, String)>,
-    /// Handlers that fired, by address.
-    pub fired: BTreeSet<usize>,
-}
+pub use super::state::State;
 
 #[derive(Clone)]
 struct Ctx {
@@ -99,6 +86,25 @@ pub struct Estimator<'m> {
     motion: Vec<std::rc::Rc<[usize]>>,
     /// The built-in `Detected` signal, when the mission can hear it.
     detected: Option<SignalId>,
+    /// Capability calls the walk may still follow ([`call_budget`]), and whether it ran out.
+    budget: usize,
+    cut_short: bool,
+}
+
+/// How many capability calls a walk follows: generous for any mission's size (64 per
+/// call written, and a million more), but finite. Each call is walked where it is made,
+/// so capabilities that each call the next twice make 2^depth calls: a mission of a few
+/// hundred bytes could otherwise keep `aviary check` busy for years.
+fn call_budget(mission: &Mission) -> usize {
+    let mut written = 0usize;
+    let mut count = |n: &Node| written += usize::from(matches!(n, Node::Call(_)));
+    mission.body.visit(&mut count);
+    for cap in &mission.capabilities {
+        for b in cap.bodies() {
+            b.visit(&mut count);
+        }
+    }
+    written.saturating_mul(64).saturating_add(1_000_000)
 }
 
 /// More rounds than any mission flies: a loop past it is taken as endless.
@@ -115,7 +121,9 @@ impl<'m> Estimator<'m> {
             calling: vec![false; mission.capabilities.len()],
             motion: mission.capabilities.iter().map(|cap| cap.claims.iter().filter(|(_, r)| *r == Resource::Motion).map(|(slot, _)| *slot).collect::<Vec<_>>().into()).collect(),
             detected: mission.signals.iter().position(|s| s == "Detected"),
-            s: State { drones, activities: vec![Vec::new(); n], raised: vec![None; mission.signals.len()], reserve: vec![None; n], assumptions: BTreeSet::new(), fired: BTreeSet::new() },
+            budget: call_budget(mission),
+            cut_short: false,
+            s: State { drones, activities: vec![Vec::new(); n], raised: vec![None; mission.signals.len()], reserve: vec![None; n], assumptions: Vec::new(), fired: Vec::new() },
         }
     }
 
@@ -140,7 +148,8 @@ impl<'m> Estimator<'m> {
     /// What one firing of `h` at `t` would add, per drone it flies: (metres, seconds in
     /// the air, battery left at the end). The state is left as it was.
     pub fn bound(&mut self, h: &Handler, t: f64) -> Vec<(DroneId, (f64, f64, f64))> {
-        let before = self.s.clone();
+        let mark = self.s.mark();
+        let before = self.s.drones.clone();
         let mut ctx = Ctx { frame: vec![None; self.mission.frame_size], actor: None, statement: None };
         let (end, _) = self.block(&h.body, &mut ctx, t);
         let mut out = Vec::new();
@@ -150,19 +159,19 @@ impl<'m> Estimator<'m> {
                 let took = f.return_home(self.world.site.max_altitude);
                 f.land(end.max(f.free_at) + took);
             }
-            let (now, then) = (&self.s.drones[d], &before.drones[d]);
+            let (now, then) = (&self.s.drones[d], &before[d]);
             if now.distance > then.distance {
                 out.push((d, (now.distance - then.distance, now.flight_time - then.flight_time, now.battery_start - now.flight_time / now.endurance)));
             }
         }
-        let notes = std::mem::take(&mut self.s.assumptions);
-        self.s = before;
-        self.s.assumptions.extend(notes);
+        // Back to before the firing, keeping what it had to assume.
+        let tail = self.s.cut(&mark);
+        self.s.assumptions.extend(tail.into_notes());
         out
     }
 
     pub fn note(&mut self, at: Option<Origin>, text: String) {
-        self.s.assumptions.insert((at.map(|o| (o.file.0, o.span.start)), text));
+        self.s.assumptions.push((at.map(|o| (o.file.0, o.span.start)), text));
     }
 
     fn scope<'a>(&'a self, ctx: &'a Ctx, t: f64) -> Scope<'a> {
@@ -193,7 +202,7 @@ impl<'m> Estimator<'m> {
                     continue;
                 }
                 once[hi] = true;
-                self.s.fired.insert(h as *const Handler as usize);
+                self.s.fired.push(h as *const Handler as usize);
                 let mut hctx = ctx.clone();
                 for (slot, v) in h.bindings.iter().zip(&r.args) {
                     set(&mut hctx.frame, *slot, v.clone());
@@ -276,12 +285,12 @@ impl<'m> Estimator<'m> {
             Some(true) => self.block(body, ctx, t),
             Some(false) => self.choose(rest, otherwise, ctx, t),
             None => {
-                let before = self.s.clone();
+                let mark = self.s.mark();
                 let taken = self.block(body, &mut ctx.clone(), t);
-                let after_taken = std::mem::replace(&mut self.s, before);
+                let after_taken = self.s.cut(&mark);
                 let skipped = self.choose(rest, otherwise, ctx, t);
                 if taken.0 > skipped.0 {
-                    self.s = after_taken;
+                    self.s.redo(&mark, after_taken);
                     return taken;
                 }
                 skipped
@@ -339,6 +348,14 @@ impl<'m> Estimator<'m> {
             self.note(Some(c.origin), format!("`{}` calls itself; the estimate counts one round of it", cap.name));
             return (t, Vec::new());
         }
+        if self.budget == 0 {
+            if !self.cut_short {
+                self.cut_short = true;
+                self.note(Some(c.origin), "the capability calls fan out past what the estimate follows (64 per call written and a million more); from here on, calls are counted as taking no time".into());
+            }
+            return (t, Vec::new());
+        }
+        self.budget -= 1;
         let args: Vec<Option<Value>> = c.args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
         // The common case, one drone for a one-actor capability, without the lists of
         // lists the general case builds.

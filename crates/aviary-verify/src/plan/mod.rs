@@ -8,6 +8,7 @@ mod estimate;
 mod eval;
 mod flight;
 mod model;
+mod state;
 
 use aviary_api::show::fixed;
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
@@ -125,12 +126,13 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
             drones[d].worst_case.push(Bound { handler: label.clone(), distance: b.0, flight_time: b.1, battery_left: b.2 });
         }
     }
-    let assumptions = est.s.assumptions.iter().map(|(o, text)| Assumption { at: None, text: text.clone(), origin: *o }).collect();
+    let assumptions = est.s.notes().into_iter().map(|(o, text)| Assumption { at: None, text: text.clone(), origin: *o }).collect();
     Plan { mission_time: end, drones, assumptions }
 }
 
 /// The mission-level handlers (not those inside capabilities) that never fired.
-fn unfired<'m>(block: &'m Block, fired: &std::collections::BTreeSet<usize>) -> Vec<&'m Handler> {
+fn unfired<'m>(block: &'m Block, fired: &[usize]) -> Vec<&'m Handler> {
+    let fired: std::collections::HashSet<usize> = fired.iter().copied().collect();
     let mut out = Vec::new();
     let mut visit = |b: &'m Block| {
         for h in &b.handlers {

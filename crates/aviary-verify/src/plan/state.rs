@@ -1,0 +1,149 @@
+//! What a walk of the estimate changes, and how an `IF` it cannot decide tries both ways
+//! without copying it all. The per-drone and per-signal figures are copied (their size is
+//! the fleet's and the signals', not the mission's); what grows with the mission (the
+//! activities, the assumptions, the handlers that fired) only grows during a walk, so a
+//! [`Mark`] remembers its lengths, and going back is cutting there. Trying both sides of
+//! N undecidable `IF`s in a row so costs what the walks cost, not N copies of everything.
+
+use aviary_ir::Origin;
+
+use super::model::Flyer;
+use super::Activity;
+
+/// An assumption: where (file, byte), and what.
+pub type Note = (Option<(u32, u32)>, String);
+
+#[derive(Clone)]
+pub struct State {
+    pub drones: Vec<Flyer>,
+    /// Per drone; only ever pushed to.
+    pub activities: Vec<Vec<Activity>>,
+    pub raised: Vec<Option<f64>>,
+    /// Per drone: the mission-level statement during which the reserve fell under 20%.
+    pub reserve: Vec<Option<Origin>>,
+    /// What the estimate had to assume, with where, as noted (each may come more than
+    /// once: [`State::notes`] gives them sorted, each once).
+    pub assumptions: Vec<Note>,
+    /// Handlers that fired, by address, as they fired.
+    pub fired: Vec<usize>,
+}
+
+/// The state at a moment: the small parts, and the lengths of the growing ones.
+pub struct Mark {
+    drones: Vec<Flyer>,
+    raised: Vec<Option<f64>>,
+    reserve: Vec<Option<Origin>>,
+    activities: Vec<usize>,
+    assumptions: usize,
+    fired: usize,
+}
+
+/// What a walk changed since a [`Mark`]: the small parts as they are after it, and what
+/// the growing ones gained.
+pub struct Tail {
+    drones: Vec<Flyer>,
+    raised: Vec<Option<f64>>,
+    reserve: Vec<Option<Origin>>,
+    activities: Vec<Vec<Activity>>,
+    assumptions: Vec<Note>,
+    fired: Vec<usize>,
+}
+
+impl Tail {
+    /// What the walk assumed, alone.
+    pub fn into_notes(self) -> Vec<Note> {
+        self.assumptions
+    }
+}
+
+impl State {
+    pub fn mark(&self) -> Mark {
+        Mark {
+            drones: self.drones.clone(),
+            raised: self.raised.clone(),
+            reserve: self.reserve.clone(),
+            activities: self.activities.iter().map(Vec::len).collect(),
+            assumptions: self.assumptions.len(),
+            fired: self.fired.len(),
+        }
+    }
+
+    /// Takes what changed since `mark` out, leaving the state as it was at `mark`.
+    pub fn cut(&mut self, mark: &Mark) -> Tail {
+        Tail {
+            drones: std::mem::replace(&mut self.drones, mark.drones.clone()),
+            raised: std::mem::replace(&mut self.raised, mark.raised.clone()),
+            reserve: std::mem::replace(&mut self.reserve, mark.reserve.clone()),
+            activities: self.activities.iter_mut().zip(&mark.activities).map(|(a, &n)| a.split_off(n)).collect(),
+            assumptions: self.assumptions.split_off(mark.assumptions),
+            fired: self.fired.split_off(mark.fired),
+        }
+    }
+
+    /// Back to `mark`, then on with `tail`: the state the walk that made `tail` left.
+    pub fn redo(&mut self, mark: &Mark, tail: Tail) {
+        for (a, &n) in self.activities.iter_mut().zip(&mark.activities) {
+            a.truncate(n);
+        }
+        self.assumptions.truncate(mark.assumptions);
+        self.fired.truncate(mark.fired);
+        self.drones = tail.drones;
+        self.raised = tail.raised;
+        self.reserve = tail.reserve;
+        for (a, more) in self.activities.iter_mut().zip(tail.activities) {
+            a.extend(more);
+        }
+        self.assumptions.extend(tail.assumptions);
+        self.fired.extend(tail.fired);
+    }
+
+    /// The assumptions, sorted, each once.
+    pub fn notes(&self) -> Vec<&Note> {
+        let mut out: Vec<&Note> = self.assumptions.iter().collect();
+        out.sort();
+        out.dedup();
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    struct NoFiles;
+
+    impl aviary_check::SourceProvider for NoFiles {
+        fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
+            Err(format!("no files here ({path})").into())
+        }
+    }
+
+    fn plan(text: &str) -> crate::Plan {
+        let world = "[drones.scout]\nhome = [0, 0]\nendurance = 100000\n";
+        let mut sources = aviary_diagnostics::SourceMap::new();
+        let api = aviary_api::Descriptor::standard();
+        let checked = aviary_check::check_sources(&mut sources, ("m.mission", text.as_bytes()), Some(("w.toml", world.as_bytes())), &NoFiles, &api);
+        assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
+        let mission = aviary_ir::compile(checked.program.as_ref().expect("program"), checked.world.as_ref().expect("world"), &api).expect("mission");
+        crate::verify(&mission, checked.world.as_ref().expect("world")).plan
+    }
+
+    /// Many `IF`s the estimate cannot decide, in a row, each with a longer and a shorter
+    /// side: each takes its longer side, with what that side did (its activities), and
+    /// nothing of the side it dropped; each assumption is listed once.
+    #[test]
+    fn undecidable_ifs_take_their_longer_side_with_its_activities_only() {
+        let n = 2000;
+        let mut text = String::from("MISSION M:\n    scout TakeOff WITH 20m\n");
+        for i in 0..n {
+            let (then, otherwise) = if i % 2 == 0 { ("5s", "1s") } else { ("1s", "3s") };
+            text.push_str(&format!("    IF scout.link = Lost:\n        scout Hover WITH {then}\n    ELSE:\n        scout Hover WITH {otherwise}\n"));
+        }
+        let p = plan(&text);
+        let hovers: Vec<f64> = p.drones[0].activities.iter().filter(|a| a.what == "Hover").map(|a| a.end - a.start).collect();
+        assert_eq!(hovers.len(), n);
+        assert!(hovers.iter().enumerate().all(|(i, d)| (d - if i % 2 == 0 { 5.0 } else { 3.0 }).abs() < 1e-9), "{:?}", &hovers[..6]);
+        let mut seen: Vec<(Option<(u32, u32)>, &str)> = p.assumptions.iter().map(|a| (a.origin, a.text.as_str())).collect();
+        let all = seen.len();
+        seen.dedup();
+        assert_eq!(seen.len(), all, "each assumption once");
+    }
+}

@@ -196,9 +196,16 @@ impl<'m> Estimator<'m> {
         for r in raises {
             pending.push(r);
         }
+        // The block's handlers by signal, each list in handler order: a raise looks only
+        // at its own (a block of N handlers for N signals was N² here).
+        let mut by_signal: std::collections::HashMap<SignalId, Vec<usize>> = std::collections::HashMap::new();
+        for (hi, h) in b.handlers.iter().enumerate() {
+            by_signal.entry(h.signal).or_default().push(hi);
+        }
         while let Some(r) = pending.pop() {
-            for (hi, h) in b.handlers.iter().enumerate() {
-                if h.signal != r.signal || (!h.every && once[hi]) || !matches(h, &ctx.frame, r.actor) {
+            for &hi in by_signal.get(&r.signal).map_or(&[][..], Vec::as_slice) {
+                let h = &b.handlers[hi];
+                if (!h.every && once[hi]) || !matches(h, &ctx.frame, r.actor) {
                     continue;
                 }
                 once[hi] = true;

@@ -153,13 +153,13 @@ impl<'m> Estimator<'m> {
         let mut ctx = Ctx { frame: vec![None; self.mission.frame_size], actor: None, statement: None };
         let (end, _) = self.block(&h.body, &mut ctx, t);
         let mut out = Vec::new();
-        for d in 0..self.s.drones.len() {
+        for (d, then) in before.iter().enumerate() {
             let f = &mut self.s.drones[d];
             if f.airborne {
                 let took = f.return_home(self.world.site.max_altitude);
                 f.land(end.max(f.free_at) + took);
             }
-            let (now, then) = (&self.s.drones[d], &before[d]);
+            let now = &self.s.drones[d];
             if now.distance > then.distance {
                 out.push((d, (now.distance - then.distance, now.flight_time - then.flight_time, now.battery_start - now.flight_time / now.endurance)));
             }

@@ -142,8 +142,9 @@ mod tests {
         while x < 1e300 {
             for v in [x, -x, x * 0.7, x * 3.3] {
                 let text = number(v);
-                // At most the digits, a sign, a point and an exponent of three digits.
-                assert!(text.len() <= DIGITS + 7, "{text}");
+                // At most the digits and a sign, with a point and an exponent of four
+                // characters, or with `0.` and the five zeros of the smallest written out.
+                assert!(text.len() <= DIGITS + 8, "{text}");
                 let back: f64 = text.parse().expect("a number Rust reads");
                 assert!(((back - v) / v).abs() < 1e-11, "{v:e} -> {text}");
             }

@@ -47,20 +47,22 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
     Some(out)
 }
 
+/// Names (signals, exceptions, tags) to indices, in order of first use. Looked up by
+/// hash: a scan of the names so far made a mission of N signals cost N².
 #[derive(Default)]
 struct Interner {
     names: Vec<String>,
+    index: foldhash::HashMap<String, usize>,
 }
 
 impl Interner {
     fn id(&mut self, name: &str) -> usize {
-        match self.names.iter().position(|n| n == name) {
-            Some(i) => i,
-            None => {
-                self.names.push(name.to_string());
-                self.names.len() - 1
-            }
+        if let Some(&i) = self.index.get(name) {
+            return i;
         }
+        self.names.push(name.to_string());
+        self.index.insert(name.to_string(), self.names.len() - 1);
+        self.names.len() - 1
     }
 }
 
@@ -68,7 +70,7 @@ struct Compiler<'a> {
     program: &'a Program,
     world: &'a World,
     api: &'a Descriptor,
-    caps: BTreeMap<String, CapId>,
+    caps: foldhash::HashMap<String, CapId>,
     defaults: Vec<Vec<Option<Expr>>>,
     signals: Interner,
     exceptions: Interner,
@@ -107,7 +109,7 @@ impl<'a> Compiler<'a> {
             program,
             world,
             api,
-            caps: BTreeMap::new(),
+            caps: foldhash::HashMap::default(),
             defaults: Vec::new(),
             signals,
             exceptions,

@@ -153,13 +153,13 @@ impl<'m> Estimator<'m> {
         let mut ctx = Ctx { frame: vec![None; self.mission.frame_size], actor: None, statement: None };
         let (end, _) = self.block(&h.body, &mut ctx, t);
         let mut out = Vec::new();
-        for d in 0..self.s.drones.len() {
+        for (d, then) in before.iter().enumerate() {
             let f = &mut self.s.drones[d];
             if f.airborne {
                 let took = f.return_home(self.world.site.max_altitude);
                 f.land(end.max(f.free_at) + took);
             }
-            let (now, then) = (&self.s.drones[d], &before[d]);
+            let now = &self.s.drones[d];
             if now.distance > then.distance {
                 out.push((d, (now.distance - then.distance, now.flight_time - then.flight_time, now.battery_start - now.flight_time / now.endurance)));
             }
@@ -196,9 +196,16 @@ impl<'m> Estimator<'m> {
         for r in raises {
             pending.push(r);
         }
+        // The block's handlers by signal, each list in handler order: a raise looks only
+        // at its own (a block of N handlers for N signals was N² here).
+        let mut by_signal: std::collections::HashMap<SignalId, Vec<usize>> = std::collections::HashMap::new();
+        for (hi, h) in b.handlers.iter().enumerate() {
+            by_signal.entry(h.signal).or_default().push(hi);
+        }
         while let Some(r) = pending.pop() {
-            for (hi, h) in b.handlers.iter().enumerate() {
-                if h.signal != r.signal || (!h.every && once[hi]) || !matches(h, &ctx.frame, r.actor) {
+            for &hi in by_signal.get(&r.signal).map_or(&[][..], Vec::as_slice) {
+                let h = &b.handlers[hi];
+                if (!h.every && once[hi]) || !matches(h, &ctx.frame, r.actor) {
                     continue;
                 }
                 once[hi] = true;

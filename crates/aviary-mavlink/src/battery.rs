@@ -1,4 +1,4 @@
-//! The battery rule's numbers for a MAVLink drone (RUNTIME.md's rule, on the vehicle's
+//! The battery rule's numbers for a MAVLink drone (docs/WORLD.md's rule, on the vehicle's
 //! own figures): how much of a full battery the way home takes, and the current the
 //! vehicle measures in flight.
 //!
@@ -50,7 +50,7 @@ impl Figures {
     }
 }
 
-/// RUNTIME.md's thresholds: `BatteryLow` under `2 × need + 10 %`, `BatteryCritical` under
+/// The thresholds of docs/WORLD.md's rule: `BatteryLow` under `2 × need + 10 %`, `BatteryCritical` under
 /// `need + 10 %` (charge and need as fractions of a full battery).
 pub fn alarms(charge: f64, need: f64) -> (bool, bool) {
     (charge < 2.0 * need + 0.10, charge < need + 0.10)

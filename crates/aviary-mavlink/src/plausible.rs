@@ -20,6 +20,18 @@ pub fn reachable(before: [f64; 3], after: [f64; 3], dt: f64) -> bool {
     d.is_finite() && d <= MAX_SPEED * dt.max(0.0) + JITTER
 }
 
+/// Seconds between two positions: by the vehicle's own clock (`time_boot_ms`) when it
+/// went forward, since a simulated vehicle may run faster than real time (SITL's
+/// `--speedup`, `aviary vehicles --speed`); by the wall clock when the vehicle sends no
+/// clock (0) or it went back (a reboot).
+pub fn elapsed(boot_ms_before: u32, boot_ms_after: u32, wall: f64) -> f64 {
+    if boot_ms_before > 0 && boot_ms_after > boot_ms_before {
+        f64::from(boot_ms_after - boot_ms_before) / 1000.0
+    } else {
+        wall
+    }
+}
+
 /// A reported `battery_remaining` as a fraction: `None` for -1 (MAVLink's "unknown") and
 /// for anything outside 0–100, which no battery has.
 pub fn charge(remaining: i8) -> Option<f64> {
@@ -37,6 +49,14 @@ mod tests {
         assert!(!reachable([0.0; 3], [300_000.0, 0.0, 0.0], 0.1), "hundreds of km");
         assert!(!reachable([0.0; 3], [0.0, 0.0, 50_000.0], 1.0), "50 km up");
         assert!(!reachable([0.0; 3], [f64::NAN, 0.0, 0.0], 1.0));
+    }
+
+    #[test]
+    fn time_is_the_vehicles_own_when_it_keeps_one() {
+        assert_eq!(elapsed(1_000, 3_000, 0.1), 2.0, "a vehicle 20 times faster than real time");
+        assert_eq!(elapsed(0, 0, 0.1), 0.1, "no clock sent");
+        assert_eq!(elapsed(9_000, 200, 0.1), 0.1, "rebooted");
+        assert_eq!(elapsed(5_000, 5_000, 0.1), 0.1, "the same instant twice");
     }
 
     #[test]
@@ -100,6 +120,22 @@ mod tests {
             v.observe(&at(8.0, 0.0, 10.0));
             assert_eq!(x(&v), Some(8.0));
             assert!(v.seen().odometer < 10.0);
+        }
+
+        #[tokio::test(start_paused = true)]
+        async fn a_vehicle_faster_than_real_time_is_believed_by_its_own_clock() {
+            let (v, mut alarms) = vehicle();
+            // 300 m per wall-clock tenth of a second, 15 m/s by the vehicle's clock.
+            for k in 0..40u32 {
+                let mut m = at(f64::from(k) * 300.0, 0.0, 10.0);
+                if let MavMessage::GLOBAL_POSITION_INT(p) = &mut m {
+                    p.time_boot_ms = 1_000 + k * 20_000;
+                }
+                v.observe(&m);
+                tokio::time::advance(std::time::Duration::from_millis(100)).await;
+            }
+            assert_eq!(x(&v), Some(39.0 * 300.0));
+            assert!(alarms.try_recv().is_err(), "no PositionLost");
         }
 
         #[tokio::test(start_paused = true)]

@@ -74,6 +74,9 @@ pub struct Seen {
     pub odometer: f64,
     pub flight_time: f64,
     fix_at: Option<Instant>,
+    /// The vehicle's own clock (`time_boot_ms`) at that fix: a SITL or `aviary vehicles`
+    /// running faster than real time flies farther per wall-clock second than any drone.
+    fix_boot_ms: u32,
     /// Since when the positions reported have been ones the vehicle could not have
     /// reached (`plausible`), and whether that was raised as `PositionLost`.
     doubted_since: Option<Instant>,
@@ -296,7 +299,8 @@ impl Vehicle {
             home_amsl: (f64::from(p.alt) - f64::from(p.relative_alt)) / 1000.0,
         };
         if let (Some(before), Some(at)) = (seen.fix, seen.fix_at) {
-            let dt = now.duration_since(at).as_secs_f64();
+            let wall = now.duration_since(at).as_secs_f64();
+            let dt = plausible::elapsed(seen.fix_boot_ms, p.time_boot_ms, wall);
             if !plausible::reachable(before.pos, fix.pos, dt) {
                 self.doubt(seen, now, before.pos, fix.pos, dt);
                 return;
@@ -313,6 +317,7 @@ impl Vehicle {
             }
         }
         seen.fix_at = Some(now);
+        seen.fix_boot_ms = p.time_boot_ms;
         seen.fix = Some(fix);
         self.scan(seen, from, xy);
     }

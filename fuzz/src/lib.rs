@@ -2,8 +2,10 @@
 //! these functions; a test runs the seed corpus through them without AFL. Every
 //! function panics when a property does not hold, which AFL records as a crash.
 
+mod mavlink;
 mod operator;
 
+pub use mavlink::{answers_of_the_vehicles, heard_on_a_link, link, vehicles};
 pub use operator::operator;
 
 use aviary_api::Descriptor;

@@ -27,6 +27,7 @@ pub mod facts;
 mod failsafe;
 mod flight;
 pub mod geo;
+pub mod hear;
 pub mod link;
 pub mod mode;
 mod motion;

@@ -21,7 +21,7 @@ type Conn = mavlink::AsyncConnection<MavMessage>;
 pub const GCS_SYSTEM: u8 = 255;
 pub const GCS_COMPONENT: u8 = 190;
 /// Messages from other components (cameras, gimbals) carry no vehicle state.
-const AUTOPILOT_COMPONENT: u8 = 1;
+pub(crate) const AUTOPILOT_COMPONENT: u8 = 1;
 const REOPEN_EVERY: Duration = Duration::from_secs(1);
 const CONNECT_TIMEOUT: Duration = Duration::from_secs(5);
 

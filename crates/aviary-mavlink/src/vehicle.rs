@@ -79,7 +79,8 @@ pub struct Seen {
     fix_boot_ms: u32,
     /// Since when the positions reported have been ones the vehicle could not have
     /// reached (`plausible`), and whether that was raised as `PositionLost`.
-    doubted_since: Option<Instant>,
+    /// When positions began to jump: the wall clock and the vehicle's (`time_boot_ms`).
+    doubted_since: Option<(Instant, u32)>,
     doubt_raised: bool,
     acks: Vec<(MavCmd, oneshot::Sender<MavResult>)>,
 }
@@ -298,22 +299,24 @@ impl Vehicle {
             },
             home_amsl: (f64::from(p.alt) - f64::from(p.relative_alt)) / 1000.0,
         };
-        if let (Some(before), Some(at)) = (seen.fix, seen.fix_at) {
-            let wall = now.duration_since(at).as_secs_f64();
-            let dt = plausible::elapsed(seen.fix_boot_ms, p.time_boot_ms, wall);
+        // Seconds since the last believed position, by the vehicle's clock when it keeps one.
+        let dt = seen.fix_at.map(|at| {
+            plausible::elapsed(seen.fix_boot_ms, p.time_boot_ms, now.duration_since(at).as_secs_f64())
+        });
+        if let (Some(before), Some(dt)) = (seen.fix, dt) {
             if !plausible::reachable(before.pos, fix.pos, dt) {
-                self.doubt(seen, now, before.pos, fix.pos, dt);
+                self.doubt(seen, now, p.time_boot_ms, before.pos, fix.pos, dt);
                 return;
             }
         }
         seen.doubted_since = None;
         seen.doubt_raised = false;
         let from = seen.fix.map_or(xy, |f| [f.pos[0], f.pos[1]]);
-        if let (Some(before), Some(at), true) = (seen.fix, seen.fix_at, seen.armed) {
+        if let (Some(before), Some(dt), true) = (seen.fix, dt, seen.armed) {
             let d: f64 = (0..3).map(|k| (fix.pos[k] - before.pos[k]).powi(2)).sum();
             seen.odometer += d.sqrt();
             if before.pos[2] > AIRBORNE_ABOVE {
-                seen.flight_time += now.duration_since(at).as_secs_f64();
+                seen.flight_time += dt;
             }
         }
         seen.fix_at = Some(now);
@@ -323,10 +326,12 @@ impl Vehicle {
     }
 
     /// A position the vehicle could not have reached: not taken. Once such positions have
-    /// come for [`plausible::DOUBT_FOR`], the drone has lost its position (`PositionLost`).
-    fn doubt(&self, seen: &mut Seen, now: Instant, before: [f64; 3], after: [f64; 3], dt: f64) {
-        let since = *seen.doubted_since.get_or_insert(now);
-        if seen.doubt_raised || now.duration_since(since) < plausible::DOUBT_FOR {
+    /// come for [`plausible::DOUBT_FOR`] (by the vehicle's clock when it keeps one), the
+    /// drone has lost its position (`PositionLost`).
+    fn doubt(&self, seen: &mut Seen, now: Instant, boot_ms: u32, before: [f64; 3], after: [f64; 3], dt: f64) {
+        let (since, since_boot_ms) = *seen.doubted_since.get_or_insert((now, boot_ms));
+        let doubted_for = plausible::elapsed(since_boot_ms, boot_ms, now.duration_since(since).as_secs_f64());
+        if seen.doubt_raised || doubted_for < plausible::DOUBT_FOR.as_secs_f64() {
             return;
         }
         seen.doubt_raised = true;

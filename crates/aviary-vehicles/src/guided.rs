@@ -42,6 +42,14 @@ impl Autopilot {
         if !matches!(self.state(i), FlightState::Flying | FlightState::TakingOff) {
             return Err("position target ignored: not flying".into());
         }
+        // The simulator flies to a place only from the air: a take-off still on the ground
+        // (commanded in this very tick) would be cancelled by the flight that then fails,
+        // so the target is refused and the take-off goes on.
+        if self.state(i) == FlightState::TakingOff
+            && self.fleet.telemetry(i).is_some_and(|t| t.position[2] <= 0.0)
+        {
+            return Err("position target ignored: still taking off".into());
+        }
         let same = c
             .target
             .is_some_and(|t| (0..3).all(|k| (t[k] - to[k]).abs() < 0.01));

@@ -116,13 +116,43 @@ pub async fn serve(world: &World, listen: Listen, options: Options) -> std::io::
             (address, tokio::spawn(task))
         }
     };
-    let pace = tokio::spawn(server::pace(ap, Arc::clone(&clients), 0.05, speed));
+    let pace = tokio::spawn(server::pace(ap, Arc::clone(&clients), tick(), speed));
     Ok(Vehicles {
         address,
         systems,
         tasks: vec![pace, serve],
         clients,
     })
+}
+
+/// What one ground station's `bytes` get from `world`'s vehicles, without a socket: the
+/// server's own reader and dispatch answer them as a TCP connection's are, then the
+/// simulation flies `seconds` (in whole ticks) with whatever was commanded, and the
+/// frames sent back are returned in order, streams included. The fuzz target
+/// `fuzz_vehicles` drives it with untrusted bytes.
+pub async fn answer(world: &World, behaviour: Behaviour, bytes: &[u8], seconds: f64) -> Vec<Vec<u8>> {
+    let ap = Arc::new(Mutex::new(autopilot::Autopilot::new(world, behaviour)));
+    let clients = client::Registry::default();
+    let me = Arc::new(client::Client::new());
+    clients.add(Arc::clone(&me));
+    server::read_all(bytes, None, &ap, &me, &clients).await;
+    let tick = tick();
+    let ticks = (seconds.clamp(0.0, 3600.0) / tick).round() as usize;
+    for k in 1..=ticks {
+        let mut ap = server::lock(&ap);
+        let events = ap.step(tick);
+        // Streams are due by the simulated time here, as if it passed in real time.
+        server::tell(&ap, &clients.all(), events, k as f64 * tick);
+    }
+    let mut sequences = client::Sequences::new();
+    std::iter::from_fn(|| me.pop())
+        .filter_map(|o| server::frame(&mut sequences, &o, None))
+        .collect()
+}
+
+/// The physics tick: `aviary run`'s, so the simulator behaves as it does there.
+fn tick() -> f64 {
+    aviary_sim::SimOptions::default().tick
 }
 
 impl Vehicles {

@@ -63,30 +63,35 @@ pub(crate) async fn pace(ap: Shared, clients: Arc<Registry>, tick: f64, speed: f
             events.extend(ap.step(tick));
             ticks += 1;
         }
-        let up: Vec<usize> = (0..ap.copters.len()).filter(|i| ap.link(*i)).collect();
-        // A vehicle whose radio is down says nothing.
-        events.retain(|e: &Out| up.iter().any(|i| ap.copters[*i].system == e.system));
-        for c in clients.all() {
-            for e in &events {
-                c.event(e.clone());
-            }
-            let mut schedule = c.schedule.lock().unwrap_or_else(|p| p.into_inner());
-            for &i in &up {
-                let system = ap.copters[i].system;
-                for (id, hz) in STREAMS {
-                    if !schedule.due(system, id, hz, wall) {
-                        continue;
-                    }
-                    if let Some(msg) = ap.message(i, id) {
-                        let o = Out {
-                            system,
-                            msg: msg.into(),
-                        };
-                        if id == 0 {
-                            c.heartbeat(o);
-                        } else {
-                            c.telemetry(o);
-                        }
+        tell(&ap, &clients.all(), events, wall);
+    }
+}
+
+/// Tells each client what happened (`events`) and queues it the streams due for it at
+/// `wall` seconds, at the rates it asked for. A vehicle whose radio is down says nothing.
+pub(crate) fn tell(ap: &Autopilot, clients: &[Arc<Client>], mut events: Vec<Out>, wall: f64) {
+    let up: Vec<usize> = (0..ap.copters.len()).filter(|i| ap.link(*i)).collect();
+    events.retain(|e: &Out| up.iter().any(|i| ap.copters[*i].system == e.system));
+    for c in clients {
+        for e in &events {
+            c.event(e.clone());
+        }
+        let mut schedule = c.schedule.lock().unwrap_or_else(|p| p.into_inner());
+        for &i in &up {
+            let system = ap.copters[i].system;
+            for (id, hz) in STREAMS {
+                if !schedule.due(system, id, hz, wall) {
+                    continue;
+                }
+                if let Some(msg) = ap.message(i, id) {
+                    let o = Out {
+                        system,
+                        msg: msg.into(),
+                    };
+                    if id == 0 {
+                        c.heartbeat(o);
+                    } else {
+                        c.telemetry(o);
                     }
                 }
             }

@@ -207,3 +207,68 @@ async fn an_unknown_frame_is_denied_with_arducopters_words() {
     );
     vehicles.stop();
 }
+
+/// A take-off and a reposition in one read, before the simulation steps (a fast client,
+/// or one packet holding both): the reposition is refused and the take-off goes on. It
+/// used to cancel the take-off, whose flight to the place then failed on the ground.
+#[tokio::test]
+async fn a_reposition_in_the_take_offs_own_tick_leaves_the_take_off_flying() {
+    use aviary_mavlink::mavlink::dialects::ardupilotmega::{COMMAND_LONG_DATA, MavModeFlag};
+    use aviary_mavlink::mavlink::{self, MavHeader};
+    let behaviour = aviary_vehicles::Behaviour { boot_time: 0.0, prearm_time: 0.0 };
+    let long = |command, p: [f32; 7]| {
+        MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
+            target_system: 1,
+            target_component: 1,
+            command,
+            param1: p[0],
+            param2: p[1],
+            param7: p[6],
+            ..Default::default()
+        })
+    };
+    let (lat, lon) = ORIGIN_GEO.to_e7(0.0, 30.0);
+    let asked = [
+        long(MavCmd::MAV_CMD_DO_SET_MODE, [1.0, 4.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        long(MavCmd::MAV_CMD_COMPONENT_ARM_DISARM, [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        long(MavCmd::MAV_CMD_NAV_TAKEOFF, [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 10.0]),
+        MavMessage::COMMAND_INT(COMMAND_INT_DATA {
+            param1: -1.0,
+            x: lat,
+            y: lon,
+            z: 15.0,
+            command: MavCmd::MAV_CMD_DO_REPOSITION,
+            target_system: 1,
+            target_component: 1,
+            frame: frame_of(6),
+            ..Default::default()
+        }),
+    ];
+    let mut bytes = Vec::new();
+    for (k, m) in asked.iter().enumerate() {
+        let header = MavHeader { system_id: 255, component_id: 190, sequence: k as u8 };
+        mavlink::write_v2_msg(&mut bytes, header, m).expect("into a Vec");
+    }
+    let answers = aviary_vehicles::answer(&fleet(1, ""), behaviour, &bytes, 10.0).await;
+    let heard: Vec<MavMessage> = answers
+        .iter()
+        .map(|f| mavlink::MavlinkReader::new(f.as_slice()).read_any_message::<MavMessage>().expect("a frame").1)
+        .collect();
+    let result = |command| {
+        heard.iter().find_map(|m| match m {
+            MavMessage::COMMAND_ACK(a) if a.command == command => Some(a.result),
+            _ => None,
+        })
+    };
+    assert_eq!(result(MavCmd::MAV_CMD_NAV_TAKEOFF), Some(MavResult::MAV_RESULT_ACCEPTED));
+    assert_eq!(result(MavCmd::MAV_CMD_DO_REPOSITION), Some(MavResult::MAV_RESULT_FAILED));
+    let armed = heard.iter().any(|m| {
+        matches!(m, MavMessage::HEARTBEAT(h) if h.base_mode.contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED))
+    });
+    let height = heard.iter().rev().find_map(|m| match m {
+        MavMessage::GLOBAL_POSITION_INT(p) => Some(f64::from(p.relative_alt) / 1000.0),
+        _ => None,
+    });
+    assert!(armed, "never armed");
+    assert!(height.is_some_and(|h| (h - 10.0).abs() < 0.5), "took off to {height:?} m, not 10 m");
+}

@@ -1,5 +1,19 @@
 //! How a drone comes home and down: one rule for the simulator, the plan and the MAVLink
-//! backend's battery alarms, with the world's figures or a vehicle's own.
+//! backend's battery alarms, with the world's figures or a vehicle's own. And the other
+//! figures of the middle layer that every backend and the plan must share.
+
+/// Seconds `LoadPayload` takes: the crew's time to hook the payload on (the simulator
+/// waits it, the MAVLink backend waits it after closing the gripper, the plan counts it).
+pub const LOAD_TIME: f64 = 2.0;
+/// `LoadPayload` needs the drone landed or below this height (metres).
+pub const LOAD_MAX_ALTITUDE: f64 = 5.0;
+
+/// The height a `ReturnToLaunch` from `height` flies home at: the drone's
+/// `return_altitude`, kept under the geofence's `ceiling`, and never lower than where it
+/// is (an autopilot's RTL climbs, it does not descend, before going home).
+pub fn return_height(height: f64, return_altitude: f64, ceiling: Option<f64>) -> f64 {
+    height.max(return_altitude.min(ceiling.unwrap_or(f64::INFINITY)))
+}
 
 /// How a drone lands: at `rate` down, and at `land_speed` in the last `slow_below` metres
 /// (autopilots touch down slowly: ArduCopter's LAND_SPEED under LAND_ALT_LOW).

@@ -12,6 +12,7 @@
 //! Invariant: this crate knows no engine, no backend and no syntax.
 
 pub mod flight;
+pub mod geo;
 pub mod geometry;
 pub mod sweep;
 mod kind;

@@ -46,8 +46,8 @@ impl Env<'_> {
             }
             Expr::Geo(parts) => {
                 let n: Vec<f64> = parts.iter().map(|p| number(&self.eval(p))).collect();
-                let origin = self.mission.origin.unwrap_or((0.0, 0.0, 0.0));
-                let [x, y, z] = aviary_ir::to_local(origin, n[0], n.get(1).copied().unwrap_or(0.0), n.get(2).copied());
+                let origin = self.mission.origin.unwrap_or_default();
+                let [x, y, z] = origin.place(n[0], n.get(1).copied().unwrap_or(0.0), n.get(2).copied());
                 Value::Position(Point { x, y, z: (!z.is_nan()).then_some(z) })
             }
             Expr::Distance(a, b) => {

@@ -41,7 +41,7 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
         functions: api.functions.iter().map(|f| (f.name.to_string(), f.resource)).collect(),
         attribute_names: c.attribute_names.clone(),
         attributes: attribute_table(world, &c.attribute_names),
-        origin: world.site.origin.as_ref().map(|o| (o.lat, o.lon, o.alt)),
+        origin: world.site.origin.as_ref().map(|o| aviary_api::geo::Origin { lat: o.lat, lon: o.lon, alt: o.alt }),
     };
     compute_claims(&mut out.capabilities, &out.functions);
     Some(out)
@@ -412,7 +412,8 @@ impl<'a> Compiler<'a> {
                 let parts: Vec<Expr> = parts.iter().map(|p| self.expr(p)).collect();
                 match (literal_numbers(&parts), self.world.site.origin.as_ref()) {
                     (Some(n), Some(o)) => {
-                        let [x, y, z] = to_local((o.lat, o.lon, o.alt), n[0], n.get(1).copied().unwrap_or(0.0), n.get(2).copied());
+                        let o = aviary_api::geo::Origin { lat: o.lat, lon: o.lon, alt: o.alt };
+                        let [x, y, z] = o.place(n[0], n.get(1).copied().unwrap_or(0.0), n.get(2).copied());
                         Expr::Const(Value::Position(Point { x, y, z: (!z.is_nan()).then_some(z) }))
                     }
                     _ => Expr::Geo(parts),

@@ -9,10 +9,8 @@
 //! Invariant: no IO; `compile` takes a checked program and never panics.
 
 mod compile;
-mod geo;
 
 pub use compile::compile;
-pub use geo::to_local;
 
 use aviary_api::{DroneId, Kind, Resource, Value};
 use aviary_diagnostics::{FileId, Span};
@@ -55,8 +53,8 @@ pub struct Mission {
     /// `attributes[a][d]`: attribute `a` of drone `d`, from the world file.
     pub attribute_names: Vec<String>,
     pub attributes: Vec<Column>,
-    /// The world's geodetic origin `(lat, lon, alt)`, for `GEO(...)` evaluated at run time.
-    pub origin: Option<(f64, f64, f64)>,
+    /// The world's geodetic origin, for `GEO(...)` evaluated at run time.
+    pub origin: Option<aviary_api::geo::Origin>,
 }
 
 impl Mission {

@@ -10,8 +10,7 @@ use crate::craft::{failed, Craft, Paused};
 use crate::motion::{arm, fly, here, hover, land, orbit, rtl, take_off};
 use crate::vehicle::Activation;
 
-/// Seconds `LoadPayload` waits after closing the gripper, as the simulator does.
-pub const LOAD_TIME: f64 = 2.0;
+use aviary_api::flight::LOAD_TIME;
 
 /// Runs one call to its end.
 pub async fn run(

@@ -11,7 +11,7 @@ use mavlink::error::MessageReadError;
 use mavlink::MavlinkReader;
 use tokio::sync::mpsc;
 
-use crate::geo::Origin;
+use aviary_api::geo::Origin;
 use crate::link::AUTOPILOT_COMPONENT;
 use crate::vehicle::{Activation, Fix, Vehicle};
 

@@ -26,7 +26,6 @@ mod craft;
 pub mod facts;
 mod failsafe;
 mod flight;
-pub mod geo;
 pub mod hear;
 pub mod link;
 pub mod mode;
@@ -43,7 +42,7 @@ use sha2::{Digest, Sha256};
 pub use backend::MavlinkBackend;
 pub use connect::connect;
 pub use facts::Facts;
-pub use geo::Origin;
+pub use aviary_api::geo::Origin;
 pub use mavlink;
 
 /// Timeouts and tolerances. The defaults suit ArduCopter SITL and small real copters.

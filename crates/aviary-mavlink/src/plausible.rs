@@ -74,7 +74,7 @@ mod tests {
         use mavlink::dialects::ardupilotmega::{MavMessage, GLOBAL_POSITION_INT_DATA, SYS_STATUS_DATA};
         use tokio::sync::mpsc;
 
-        use crate::geo::Origin;
+        use aviary_api::geo::Origin;
         use crate::vehicle::Vehicle;
 
         const ORIGIN: Origin = Origin { lat: 46.6167, lon: 14.265, alt: 440.0 };

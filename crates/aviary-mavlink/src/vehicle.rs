@@ -15,7 +15,7 @@ use tokio::time::Instant;
 
 use crate::battery::{self, Draw};
 use crate::failsafe::{failsafe, FAILSAFE_WAIT};
-use crate::geo::Origin;
+use aviary_api::geo::Origin;
 use crate::mode::{self, Flavour, Mode};
 use crate::plausible;
 

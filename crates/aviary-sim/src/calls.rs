@@ -10,10 +10,7 @@ use crate::motion::{orbit_legs, Leg, MotionTask};
 use crate::sensors::{detection_range, Activation};
 use crate::sweep::lawnmower;
 
-/// Seconds `LoadPayload` takes.
-pub const LOAD_TIME: f64 = 2.0;
-/// `LoadPayload` needs the drone below this altitude (metres), or landed.
-pub const LOAD_MAX_ALTITUDE: f64 = 5.0;
+use aviary_api::flight::{LOAD_MAX_ALTITUDE, LOAD_TIME};
 /// A landed drone this close to home (metres) is home.
 const AT_HOME: f64 = 0.5;
 
@@ -357,7 +354,7 @@ pub(crate) fn return_legs(
         )));
     }
     let z = d.pos[2];
-    let safe = z.max(d.spec.return_altitude.min(max_altitude.unwrap_or(f64::INFINITY)));
+    let safe = aviary_api::flight::return_height(z, d.spec.return_altitude, max_altitude);
     let mut legs = Vec::new();
     if safe > z {
         legs.push(Leg::Move {

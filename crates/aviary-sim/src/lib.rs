@@ -156,5 +156,5 @@ pub use backend::{SimBackend, SimOptions};
 pub fn descriptor() -> aviary_api::Descriptor {
     aviary_api::Descriptor::standard()
 }
-pub use calls::{LOAD_MAX_ALTITUDE, LOAD_TIME};
+pub use aviary_api::flight::{LOAD_MAX_ALTITUDE, LOAD_TIME};
 pub use fleet::{Fleet, Release, Report};

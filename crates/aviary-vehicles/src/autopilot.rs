@@ -4,7 +4,7 @@
 //! messages and simulated seconds, and sends what it returns.
 
 use aviary_api::{CallEnd, CallId, DroneEvent, FlightState, Value};
-use aviary_mavlink::geo::Origin;
+use aviary_mavlink::Origin;
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
     MavCmd, MavMessage, MavResult, MavSeverity, COMMAND_ACK_DATA, STATUSTEXT_DATA,
 };

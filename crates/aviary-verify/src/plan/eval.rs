@@ -43,7 +43,7 @@ impl Scope<'_> {
             }
             Expr::Geo(parts) => {
                 let n: Vec<f64> = parts.iter().map(|p| number(&self.eval(p)?)).collect::<Option<_>>()?;
-                let p = aviary_ir::to_local(self.mission.origin?, *n.first()?, *n.get(1)?, n.get(2).copied());
+                let p = self.mission.origin?.place(*n.first()?, *n.get(1)?, n.get(2).copied());
                 Value::Position(Point { x: p[0], y: p[1], z: n.get(2).map(|_| p[2]) })
             }
             Expr::Distance(a, b) => {

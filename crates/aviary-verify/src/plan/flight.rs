@@ -5,7 +5,7 @@ use aviary_api::{DroneId, Value};
 use aviary_ir::Origin;
 
 use super::estimate::{number_arg, Estimator, Raise};
-use super::model::LOAD_TIME;
+use aviary_api::flight::LOAD_TIME;
 
 /// How long `function` takes on drone `d` from time `t`, and the detections on the way.
 pub fn fly(e: &mut Estimator, d: DroneId, function: &str, args: &[Option<Value>], at: Option<Origin>, t: f64) -> (f64, Vec<Raise>) {

@@ -7,9 +7,6 @@ use aviary_api::flight::Descent;
 use aviary_api::geometry::dist_to_segment;
 use aviary_world::Drone;
 
-/// `LoadPayload` takes this long (the simulator's figure).
-pub const LOAD_TIME: f64 = 2.0;
-
 /// A drone as the estimate follows it.
 #[derive(Clone, Debug)]
 pub struct Flyer {
@@ -125,7 +122,7 @@ impl Flyer {
         if !self.airborne {
             return 0.0;
         }
-        let safe = self.pos[2].max(self.return_altitude.min(max_altitude.unwrap_or(f64::INFINITY)));
+        let safe = aviary_api::flight::return_height(self.pos[2], self.return_altitude, max_altitude);
         let up = self.leg([self.pos[0], self.pos[1], safe]);
         let across = self.leg([self.home[0], self.home[1], safe]);
         up + across + self.return_loiter + self.land_here()

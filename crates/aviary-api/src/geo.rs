@@ -1,10 +1,12 @@
-//! Geodetic ↔ local conversion about the world's `origin`.
+//! Geodetic ↔ local conversion about the world's `origin`: the one projection of the
+//! project, used by `GEO(...)` (compiled or evaluated at run time, and by the plan) and by
+//! the MAVLink backend, so a place written as `GEO(lat, lon)` and the position a vehicle
+//! reports agree.
 //!
-//! The same equirectangular projection as `aviary-ir`'s `GEO(...)` (so a place written
-//! as `GEO(lat, lon)` and the position a vehicle reports agree): exact enough for a
-//! mission site, under 0.1% of the distance within 10 km of the origin. Heights are
-//! relative: local z is metres above the origin's altitude, which is the ground of the
-//! site and, for a vehicle, its home (MAVLink's `relative_alt`).
+//! An equirectangular projection: exact enough for a mission site, under 0.1% of the
+//! distance within 10 km of the origin. Heights are relative: local z is metres above the
+//! origin's altitude, which is the ground of the site and, for a vehicle, its home
+//! (MAVLink's `relative_alt`).
 
 const EARTH_RADIUS: f64 = 6_371_000.0;
 
@@ -22,6 +24,13 @@ impl Origin {
         let x = (lon - self.lon).to_radians() * EARTH_RADIUS * self.lat.to_radians().cos();
         let y = (lat - self.lat).to_radians() * EARTH_RADIUS;
         [x, y]
+    }
+
+    /// `GEO(lat, lon[, alt])`: degrees and metres above sea level → local `[x, y, z]`;
+    /// z is NaN when no altitude is given.
+    pub fn place(&self, lat: f64, lon: f64, alt: Option<f64>) -> [f64; 3] {
+        let [x, y] = self.to_local(lat, lon);
+        [x, y, alt.map_or(f64::NAN, |a| a - self.alt)]
     }
 
     /// Local `[x, y]` metres → `(lat, lon)` degrees.
@@ -79,6 +88,16 @@ mod tests {
                 "{p:?} -> {q:?}"
             );
         }
+    }
+
+    #[test]
+    fn a_place_is_above_the_origins_altitude_and_east_shrinks_with_latitude() {
+        let o = Origin { lat: 46.6167, lon: 14.2650, alt: 440.0 };
+        assert!((o.place(46.6167, 14.2650, Some(460.0))[2] - 20.0).abs() < 1e-9);
+        let north = Origin { lat: 60.0, lon: 10.0, alt: 0.0 };
+        let p = north.place(60.0, 10.001, None);
+        assert!((p[0] - 55.6).abs() < 0.1, "{}", p[0]);
+        assert!(p[2].is_nan());
     }
 
     #[test]

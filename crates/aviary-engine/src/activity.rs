@@ -104,7 +104,7 @@ impl<'m> Engine<'m> {
             self.instances.borrow_mut().remove(&instance);
             self.capability_end(call, &instance.actors, &args, "failed");
             drop(held);
-            let id = self.m.exceptions.iter().position(|e| e == "RequirementNotMet").unwrap_or(0);
+            let id = self.m.builtins.requirement_not_met;
             let why = format!("a requirement of {} does not hold", cap.name);
             self.throw(id, vec![Value::Text(why)], actor, &ctx.scope);
             return None;
@@ -168,7 +168,7 @@ impl<'m> Engine<'m> {
         self.instances.borrow_mut().remove(&instance);
         if !finished && instance.by_leash.get() {
             // `PERFORM ABORT:` says what aborting this activity also does.
-            if let Some((_, section)) = cap.sections.iter().find(|(n, _)| n == "ABORT") {
+            if let Some((_, section)) = cap.abort_section.map(|k| &cap.sections[k]) {
                 let after = Ctx { instance: None, ..inner.clone() };
                 self.block(section, &after).await;
             }
@@ -194,7 +194,7 @@ impl<'m> Engine<'m> {
             return false;
         }
         let cap = &self.m.capabilities[call.capability];
-        let id = self.m.exceptions.iter().position(|e| e == "CommandFailed").unwrap_or(0);
+        let id = self.m.builtins.command_failed;
         let why = format!(
             "calling `{}` would nest capability calls {} deep, past the limit of {}: a capability that keeps calling itself",
             cap.name,

@@ -95,8 +95,8 @@ impl<'m> Engine<'m> {
         match end {
             CallEnd::Done => self.after_call(function, drone, args, ctx),
             CallEnd::Failed(f) => {
-                let id = self.m.exceptions.iter().position(|e| e == f.exception).unwrap_or(0);
-                self.throw(id, vec![Value::Text(f.reason)], Some(drone), &ctx.scope);
+                let (id, why) = self.exception_of(f);
+                self.throw(id, vec![Value::Text(why)], Some(drone), &ctx.scope);
             }
             CallEnd::Interrupted => {
                 // A fault interrupted it: raise that first, while this activity still runs.

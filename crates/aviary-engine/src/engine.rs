@@ -331,7 +331,8 @@ impl<'m> Engine<'m> {
             DroneEvent::Detected { drone, kind, location } => {
                 self.trace(Kind::Detection, || [("actor", Field::Str(self.name(drone))), ("kind", Field::Str(&kind)), ("location", Field::Json(json!(location)))]);
                 let scope = self.detections.borrow().get(&(drone, kind.clone())).cloned();
-                if let (Some(scope), Some(id)) = (scope, self.signal_id("Detected")) {
+                if let Some(scope) = scope {
+                    let id = self.m.builtins.detected;
                     // A find is a point on the ground: flying to it keeps the altitude.
                     let args = vec![Value::Symbol(kind), Value::Position(aviary_api::Point::flat(location[0], location[1]))];
                     self.raise(id, args, Some(drone), &scope);
@@ -345,9 +346,22 @@ impl<'m> Engine<'m> {
             }
             DroneEvent::Fault { drone, failure } => {
                 let scope = self.actor_scope(drone);
-                let id = self.m.exceptions.iter().position(|e| e == failure.exception).unwrap_or(0);
-                self.throw(id, vec![Value::Text(failure.reason)], Some(drone), &scope);
+                let (id, why) = self.exception_of(failure);
+                self.throw(id, vec![Value::Text(why)], Some(drone), &scope);
             }
+        }
+    }
+
+    /// The exception a backend's failure names, and its reason. The backend names it (the
+    /// contract's names are text); one the mission does not know is a backend's mistake,
+    /// raised as `CommandFailed` that says so, never as another exception.
+    pub(crate) fn exception_of(&self, failure: aviary_api::Failure) -> (usize, String) {
+        match self.m.exceptions.iter().position(|e| e == failure.exception) {
+            Some(id) => (id, failure.reason),
+            None => (
+                self.m.builtins.command_failed,
+                format!("{} (the backend raised `{}`, an exception the mission does not know)", failure.reason, failure.exception),
+            ),
         }
     }
 

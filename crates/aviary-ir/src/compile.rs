@@ -27,6 +27,13 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
     c.scopes.clear();
     c.frame_size = 0;
     let body = c.body(&mission.body, &mission.name.name, BlockKind::Sequential, true);
+    // Interned (as the descriptor's built-ins are, first), so never missing: a backend's
+    // descriptor without them gets them added, not another name's id.
+    let builtins = Builtins {
+        detected: c.signals.id("Detected"),
+        command_failed: c.exceptions.id("CommandFailed"),
+        requirement_not_met: c.exceptions.id("RequirementNotMet"),
+    };
     let signal_values = c.signals.names.iter().map(|s| program.signal_values.get(s).cloned().unwrap_or_default()).collect();
     let mut out = Mission {
         name: mission.name.name.clone(),
@@ -42,6 +49,7 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
         attribute_names: c.attribute_names.clone(),
         attributes: attribute_table(world, &c.attribute_names),
         origin: world.site.origin.as_ref().map(|o| aviary_api::geo::Origin { lat: o.lat, lon: o.lon, alt: o.alt }),
+        builtins,
     };
     compute_claims(&mut out.capabilities, &out.functions);
     Some(out)
@@ -211,6 +219,7 @@ impl<'a> Compiler<'a> {
             requirements: Vec::new(),
             perform: empty_block(name),
             sections: Vec::new(),
+            abort_section: None,
             exception_handlers: Vec::new(),
             claims: Vec::new(),
         };
@@ -222,6 +231,9 @@ impl<'a> Compiler<'a> {
                 ast::Section::Perform { name: Some(section), body, .. } => {
                     let path = format!("{name}/PERFORM {}", section.name);
                     let block = self.body(body, &path, BlockKind::Sequential, false);
+                    if section.name == "ABORT" {
+                        out.abort_section = Some(out.sections.len());
+                    }
                     out.sections.push((section.name.clone(), block));
                 }
                 ast::Section::Exceptions { handlers, .. } => {

@@ -55,6 +55,19 @@ pub struct Mission {
     pub attributes: Vec<Column>,
     /// The world's geodetic origin, for `GEO(...)` evaluated at run time.
     pub origin: Option<aviary_api::geo::Origin>,
+    /// What the engine raises by itself, resolved here so that it looks up no name.
+    pub builtins: Builtins,
+}
+
+/// The signal and exceptions the engine raises by itself (not the backend): their ids.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Builtins {
+    /// A find of a sensor that a `StartDetection` of the drone's activity asked for.
+    pub detected: SignalId,
+    /// A capability call nested too deep (one that keeps calling itself).
+    pub command_failed: ExceptionId,
+    /// A capability's REQUIREMENTS that do not hold when it is called.
+    pub requirement_not_met: ExceptionId,
 }
 
 impl Mission {
@@ -101,6 +114,9 @@ pub struct Capability {
     pub perform: Block,
     /// Named `PERFORM X:` sections (leashes), by name as written.
     pub sections: Vec<(String, Block)>,
+    /// The `PERFORM ABORT:` section (an index in `sections`): what aborting the activity
+    /// by its leash also does.
+    pub abort_section: Option<usize>,
     pub exception_handlers: Vec<ExceptionHandler>,
     /// Every resource of every `BY` actor that the body can use, through the capabilities
     /// it calls: what a statement claims when it starts (docs/LANGUAGE.md, section 6).
@@ -374,6 +390,7 @@ mod column_tests {
             attribute_names: vec![],
             attributes,
             origin: None,
+            builtins: Builtins { detected: 0, command_failed: 0, requirement_not_met: 0 },
         }
     }
 

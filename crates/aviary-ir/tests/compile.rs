@@ -171,3 +171,20 @@ fn the_inferred_kinds_of_parameters_and_signal_values_are_kept() {
     let detected = m.signals.iter().position(|s| s == "Detected").expect("a built-in signal");
     assert_eq!(m.signal_values[detected], [Some(Kind::Symbol), Some(Kind::Position)]);
 }
+
+/// What the engine raises by itself, and the section an abort runs, are resolved here:
+/// the engine looks up no name for them (a missing one used to become index 0).
+#[test]
+fn builtins_and_the_abort_section_are_resolved_when_compiling() {
+    let m = compiled(
+        "CAPABILITY Watch BY d:\n    PERFORM:\n        d.Hover(100s)\n    PERFORM Look:\n        d.Hover(1s)\n    PERFORM ABORT:\n        SIGNAL Stopped\n\nMISSION M:\n    d1 Watch\n",
+        "[drones.d1]\nhome = [0, 0]\n",
+    );
+    assert_eq!(m.signals[m.builtins.detected], "Detected");
+    assert_eq!(m.exceptions[m.builtins.command_failed], "CommandFailed");
+    assert_eq!(m.exceptions[m.builtins.requirement_not_met], "RequirementNotMet");
+    let watch = cap(&m, "Watch");
+    assert_eq!(watch.abort_section.map(|k| watch.sections[k].0.as_str()), Some("ABORT"));
+    let paper = paper();
+    assert!(paper.capabilities.iter().all(|c| c.abort_section.is_none()), "the paper's mission has no ABORT section");
+}

@@ -10,14 +10,14 @@ use std::time::Duration;
 
 use aviary_api::{DroneId, Interrupt, Value};
 use aviary_ir::{ActorRef, Block, BlockKind, Call, Expr, For, Leash, LeashAction, Node};
-use futures_util::future::{join_all, Either, LocalBoxFuture};
+use futures_util::future::{Either, LocalBoxFuture};
 use futures_util::stream::{FuturesUnordered, StreamExt};
 use tokio::sync::Notify;
 
 use crate::arbiter::Claims;
 use crate::engine::{Actors, Ctx, Engine, Frame, Instance, Job, Scope};
 use crate::jobs::Jobs;
-use crate::join::{join_eager, SMALL};
+use crate::join::{join_eager, join_in_order, join_woken, SMALL};
 use crate::trace::{Field, Kind};
 
 /// Conditions are looked at again at least this often (docs/LANGUAGE.md, section 7).
@@ -137,7 +137,12 @@ impl<'m> Engine<'m> {
         match block.kind {
             BlockKind::Sequential => self.sequence(&block.items, ctx).await,
             BlockKind::Parallel => {
-                join_all(block.items.iter().map(|n| self.node(n, ctx))).await;
+                let branches = block.items.iter().map(|n| self.node(n, ctx));
+                if block.items.len() <= SMALL {
+                    join_in_order(branches).await;
+                } else {
+                    join_woken(branches).await;
+                }
             }
         }
     }
@@ -321,7 +326,7 @@ impl<'m> Engine<'m> {
         let body = &f.body;
         if f.parallel && count <= SMALL {
             let runs: Vec<Ctx<'m>> = runs.collect();
-            join_all(runs.iter().map(|c| self.block(body, c))).await;
+            join_in_order(runs.iter().map(|c| self.block(body, c))).await;
         } else if f.parallel {
             join_eager(runs.map(|c| async move { self.block(body, &c).await })).await;
         } else {
@@ -371,7 +376,7 @@ impl<'m> Engine<'m> {
             _ => Either::Right(self.instance(call, actors, args.clone(), ctx)),
         });
         if runs.len() <= SMALL {
-            join_all(runs).await;
+            join_in_order(runs).await;
         } else {
             join_eager(runs).await;
         }

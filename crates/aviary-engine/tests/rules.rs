@@ -260,3 +260,23 @@ fn for_aliases_read_attributes_and_telemetry() {
         .collect();
     assert_eq!(durations, [("a".to_string(), 2.0), ("b".to_string(), 1.0)]);
 }
+
+/// Branches of a `PARALLEL` block that wake at one instant go on in the order they are
+/// written, and so raise their signals in that order: for a small block (polled in index
+/// order) and a large one (polled as woken: they were woken in that order). The engine
+/// defines this order (`join.rs`), not a size private to futures-util.
+#[test]
+fn parallel_branches_woken_at_one_instant_go_on_in_written_order() {
+    for n in [3, 30, 31, 80] {
+        let mut mission = String::from("MISSION M:\n    PARALLEL:\n");
+        for i in 0..n {
+            mission += &format!("        SEQUENTIAL:\n            WAITFOR ELAPSED >= 1s\n            SIGNAL S{i}\n");
+        }
+        let r = run(&mission);
+        assert_eq!(r.outcome.status, Status::Ok);
+        let raised: Vec<String> = r.trace.iter().filter(|e| e["event"] == "signal").map(|e| e["name"].as_str().unwrap_or("").to_string()).collect();
+        let written: Vec<String> = (0..n).map(|i| format!("S{i}")).collect();
+        assert_eq!(raised, written, "{n} branches");
+        assert!(r.trace.iter().filter(|e| e["event"] == "signal").all(|e| close(e["t"].as_f64().unwrap_or(0.0), 1.0)));
+    }
+}

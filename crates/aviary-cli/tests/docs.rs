@@ -295,7 +295,8 @@ fn every_world_key_documented_is_read_and_every_key_read_is_documented() {
     let doc = documented_world_keys();
     // Tables that reject an unknown key: each documented key is accepted, and the
     // reader's own list of known keys is the documented one.
-    let tables: [(&str, &dyn Fn(&str) -> String); 5] = [
+    type KeyInTable<'a> = (&'a str, &'a dyn Fn(&str) -> String);
+    let tables: [KeyInTable; 5] = [
         ("`[site]`", &|k| format!("[site]\n{k} = 1\n")),
         ("`origin`", &|k| format!("[site]\norigin = {{ {k} = 1 }}\n")),
         ("`[sensors.KIND]`", &|k| format!("[sensors.thermal]\n{k} = 1\n")),

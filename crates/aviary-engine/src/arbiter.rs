@@ -214,7 +214,7 @@ mod tests {
     fn granted_at_once_only_when_free_and_nobody_waits() {
         let arbiter = Rc::new(RefCell::new(Arbiter::default()));
         let m = |d| (d, Resource::Motion);
-        let a = try_acquire(&arbiter, smallvec::smallvec![m(0)]).ok().expect("free");
+        let Ok(a) = try_acquire(&arbiter, smallvec::smallvec![m(0)]) else { panic!("free") };
         let refused = try_acquire(&arbiter, smallvec::smallvec![m(0), m(1)]).err().expect("0 is held");
         assert_eq!(refused.as_slice(), &[m(0), m(1)], "given back whole");
         // Someone waits for 0 and 1: 1 alone is free but not granted past the waiter.

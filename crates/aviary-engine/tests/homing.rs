@@ -19,7 +19,7 @@ fn with_faults(faults: &[&str]) -> String {
 }
 
 /// The calls made to drone `a` after `t`, in order: (function, status, t).
-fn calls_after<'a>(r: &'a harness::Run, t: f64) -> Vec<(&'a str, &'a str, f64)> {
+fn calls_after(r: &harness::Run, t: f64) -> Vec<(&str, &str, f64)> {
     r.trace
         .iter()
         .filter(|e| e["event"] == "api_done" && e["actor"] == "a" && e["t"].as_f64().unwrap() > t)

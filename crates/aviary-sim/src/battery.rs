@@ -36,6 +36,8 @@ fn time_home(ground: f64, d: &SimDrone) -> f64 {
 }
 
 /// Drains `dt` seconds of flight (when `airborne`) and raises each alarm at most once.
+// `!(a >= b)` on purpose: a NaN charge or bound counts as "may be due", never as safe.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 pub(crate) fn drain(d: &mut SimDrone, dt: f64, airborne: bool) -> Alarms {
     let mut alarms = Alarms {
         low: false,
@@ -53,7 +55,8 @@ pub(crate) fn drain(d: &mut SimDrone, dt: f64, airborne: bool) -> Alarms {
     // Most ticks the bound shows that neither alarm can be due: no square root.
     let bound = energy_home_bound(d);
     let may = |k: f64| !(d.battery >= k * bound + 0.10);
-    if !((!d.low_sent && may(2.0)) || (!d.critical_sent && may(1.0))) {
+    let maybe_due = (!d.low_sent && may(2.0)) || (!d.critical_sent && may(1.0));
+    if !maybe_due {
         return alarms;
     }
     let need = energy_home(d);

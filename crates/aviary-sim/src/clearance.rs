@@ -59,6 +59,8 @@ impl Clearance {
     }
 
     /// Records that `i` is now at `p`; returns whether it is a member.
+    // `!(m <= drift)` on purpose: a NaN move must take over the bound (below).
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     pub fn moved(&mut self, i: usize, p: [f64; 2]) -> bool {
         let Some(Some(base)) = self.base.get(i) else { return false };
         let m = cheb(p, *base);

@@ -11,6 +11,7 @@
 //!   branches, few and small); [`join_eager`] starts them one after another and keeps only
 //!   those still pending, so a FOR over N drones never holds N suspended block futures
 //!   at once when each finishes in its first poll (as W's instant steps do).
+
 use std::future::{poll_fn, Future};
 use std::pin::Pin;
 use std::task::Poll;

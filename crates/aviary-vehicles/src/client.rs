@@ -142,7 +142,7 @@ impl Client {
         self.ready.notify_one();
     }
 
-    pub fn pop(&self) -> Option<Out> {
+    pub(crate) fn pop(&self) -> Option<Out> {
         let mut l = lock(&self.lanes);
         l.events.pop_front().or_else(|| l.telemetry.pop_front())
     }

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs W(N, K) side by side: the paper's Go design (../shared/anchors/go) and Aviary's
+# Runs W(N, K) side by side: the paper's Go design (bench/anchors/go) and Aviary's
 # `aviary bench w` (the same workload written in the language, through the whole
 # pipeline), pair by pair in alternation so that both see the same machine load.
 # Prints each pair, then the medians of wall time and peak RSS, and Aviary / Go.
@@ -15,7 +15,7 @@ cd "$(dirname "$0")/.."
 N=${1:-100000}
 K=${2:-10}
 PAIRS=${3:-7}
-ANCHOR=${ANCHOR:-../shared/anchors/go}
+ANCHOR=${ANCHOR:-bench/anchors/go}
 
 if ! command -v go >/dev/null 2>&1; then
     echo "installing golang-go (Debian) ..." >&2

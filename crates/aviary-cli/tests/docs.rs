@@ -425,10 +425,10 @@ fn files_under(dir: &Path, keep: &dyn Fn(&Path) -> bool, out: &mut Vec<PathBuf>)
     }
 }
 
-/// External programs that tests and scripts look for beside the repository (the
-/// ArduCopter SITL binary, the paper's Go design for the benchmark): where a program is
-/// found, not documentation to read.
-const EXTERNAL_PROGRAMS: &[&str] = &["../shared/sitl", "../shared/anchors/go"];
+/// The external program the tests look for beside the repository when `AVIARY_SITL` is
+/// not set (the ArduCopter SITL binary): where a program is found, not documentation to
+/// read.
+const EXTERNAL_PROGRAMS: &[&str] = &["../shared/sitl"];
 
 #[test]
 fn nothing_in_the_repository_points_outside_it() {

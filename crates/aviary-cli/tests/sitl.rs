@@ -1,4 +1,4 @@
-//! Aviary against a real autopilot: ArduCopter SITL (`../shared/sitl/arducopter`), each
+//! Aviary against a real autopilot: ArduCopter SITL (`AVIARY_SITL`, or `../shared/sitl/arducopter`), each
 //! vehicle a process of its own, flown by `aviary run` over MAVLink on TCP.
 //!
 //! - `fleet::`: the paper's mission on seven SITL copters, and on two SITL copters with

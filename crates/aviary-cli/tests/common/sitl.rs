@@ -4,8 +4,10 @@
 //! test's "ground station") changes parameters mid-flight and records what the vehicle
 //! reports, independently of `aviary run`.
 //!
-//! The binary is `../shared/sitl/arducopter` beside the repository, or `AVIARY_SITL`.
-//! A missing binary fails the test with what to do; it is never skipped.
+//! The binary is `AVIARY_SITL`, or `../shared/sitl/arducopter` beside the repository
+//! (where CI keeps one), with ArduPilot's `copter.parm` beside it. The gripper's
+//! parameters are ours (`tests/sitl/gripper.parm`). A missing binary fails the test with
+//! what to do; it is never skipped.
 
 use std::io::Write;
 use std::net::TcpListener;
@@ -36,14 +38,12 @@ pub fn files() -> Files {
     let binary = std::env::var_os("AVIARY_SITL").map_or_else(|| dir.join("arducopter"), PathBuf::from);
     assert!(
         binary.is_file(),
-        "ArduCopter SITL not found at {}: the SITL tests need it. Put `arducopter`, `copter.parm` and `gripper.parm` in ../shared/sitl beside the repository, or set AVIARY_SITL to the binary (docs/REAL_DRONES.md says how to build it)",
+        "ArduCopter SITL not found at {}: the SITL tests need it. Build it from ArduPilot's source and set AVIARY_SITL to the binary, with ArduPilot's Tools/autotest/default_params/copter.parm beside it (docs/REAL_DRONES.md says how), or put both in ../shared/sitl beside the repository",
         binary.display()
     );
     let copter_parm = dir.join("copter.parm");
-    let gripper_parm = dir.join("gripper.parm");
-    for p in [&copter_parm, &gripper_parm] {
-        assert!(p.is_file(), "{} not found beside the SITL binary", p.display());
-    }
+    assert!(copter_parm.is_file(), "{} not found beside the SITL binary: ArduPilot's Tools/autotest/default_params/copter.parm", copter_parm.display());
+    let gripper_parm = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/sitl/gripper.parm");
     Files { binary, copter_parm, gripper_parm }
 }
 

@@ -1,16 +1,22 @@
 //! MAVLink from the network, both ways: the bytes a vehicle sends the ground station
 //! (`link`), and the bytes a ground station sends `aviary vehicles` (`vehicles`).
 
+use std::sync::LazyLock;
+
 use aviary_diagnostics::FileId;
 use aviary_mavlink::mavlink::dialects::ardupilotmega::MavMessage;
 use aviary_mavlink::mavlink::MavlinkReader;
 use aviary_mavlink::Origin;
 use aviary_world::World;
 
-fn example_world() -> World {
-    let (world, diagnostics) = aviary_world::parse_world(FileId(0), crate::EXAMPLE_WORLD);
-    assert!(diagnostics.is_empty(), "the example world has problems");
-    world.expect("the example world")
+/// Read once per process: AFL runs many inputs in one (persistent mode).
+fn example_world() -> &'static World {
+    static WORLD: LazyLock<World> = LazyLock::new(|| {
+        let (world, diagnostics) = aviary_world::parse_world(FileId(0), crate::EXAMPLE_WORLD);
+        assert!(diagnostics.is_empty(), "the example world has problems");
+        world.expect("the example world")
+    });
+    &WORLD
 }
 
 fn origin(world: &World) -> Origin {
@@ -38,7 +44,7 @@ pub fn link(data: &[u8]) {
 /// example world, looking for its targets with a 40 m sensor.
 pub fn heard_on_a_link(data: &[u8]) -> aviary_mavlink::hear::Heard {
     let world = example_world();
-    aviary_mavlink::hear::hear(data, origin(&world), world.targets.clone(), 40.0)
+    aviary_mavlink::hear::hear(data, origin(world), world.targets.clone(), 40.0)
 }
 
 /// What the example world's `aviary vehicles` answers to `data` from a ground station
@@ -50,7 +56,7 @@ pub fn answers_of_the_vehicles(data: &[u8]) -> Vec<Vec<u8>> {
         .build()
         .expect("a runtime");
     runtime.block_on(aviary_vehicles::answer(
-        &world,
+        world,
         aviary_vehicles::Behaviour { boot_time: 0.0, prearm_time: 0.0 },
         data,
         10.0,

@@ -36,6 +36,7 @@ pub fn hear(bytes: &[u8], origin: Origin, targets: Vec<Target>, range: f64) -> H
     let (events_tx, mut events) = mpsc::unbounded_channel::<DroneEvent>();
     let (alarms_tx, mut alarms) = mpsc::unbounded_channel();
     let mut kinds: Vec<String> = targets.iter().map(|t| t.kind.clone()).collect();
+    kinds.sort();
     kinds.dedup();
     let n = targets.len();
     let vehicle = Vehicle::new(0, "heard".into(), 1, origin, targets, events_tx, alarms_tx);

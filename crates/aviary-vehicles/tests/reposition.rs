@@ -213,20 +213,10 @@ async fn an_unknown_frame_is_denied_with_arducopters_words() {
 /// used to cancel the take-off, whose flight to the place then failed on the ground.
 #[tokio::test]
 async fn a_reposition_in_the_take_offs_own_tick_leaves_the_take_off_flying() {
-    use aviary_mavlink::mavlink::dialects::ardupilotmega::{COMMAND_LONG_DATA, MavModeFlag};
+    use aviary_mavlink::mavlink::dialects::ardupilotmega::MavModeFlag;
     use aviary_mavlink::mavlink::{self, MavHeader};
     let behaviour = aviary_vehicles::Behaviour { boot_time: 0.0, prearm_time: 0.0 };
-    let long = |command, p: [f32; 7]| {
-        MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
-            target_system: 1,
-            target_component: 1,
-            command,
-            param1: p[0],
-            param2: p[1],
-            param7: p[6],
-            ..Default::default()
-        })
-    };
+    let long = |command, p| common::command_long(1, command, p);
     let (lat, lon) = ORIGIN_GEO.to_e7(0.0, 30.0);
     let asked = [
         long(MavCmd::MAV_CMD_DO_SET_MODE, [1.0, 4.0, 0.0, 0.0, 0.0, 0.0, 0.0]),

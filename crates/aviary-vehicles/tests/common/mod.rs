@@ -142,20 +142,7 @@ impl Gcs {
     }
 
     pub async fn command(&mut self, system: u8, command: MavCmd, p: [f32; 7]) -> COMMAND_ACK_DATA {
-        self.send(&MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
-            param1: p[0],
-            param2: p[1],
-            param3: p[2],
-            param4: p[3],
-            param5: p[4],
-            param6: p[5],
-            param7: p[6],
-            command,
-            target_system: system,
-            target_component: 1,
-            confirmation: 0,
-        }))
-        .await;
+        self.send(&command_long(system, command, p)).await;
         self.ack(system, command).await
     }
 
@@ -218,4 +205,21 @@ impl Gcs {
 /// A quick boot: tests wait for the pre-arm time in simulated seconds.
 pub fn quick() -> Behaviour {
     Behaviour::default()
+}
+
+/// A COMMAND_LONG to `system`'s autopilot with parameters `p` (1 to 7).
+pub fn command_long(system: u8, command: MavCmd, p: [f32; 7]) -> MavMessage {
+    MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
+        param1: p[0],
+        param2: p[1],
+        param3: p[2],
+        param4: p[3],
+        param5: p[4],
+        param6: p[5],
+        param7: p[6],
+        command,
+        target_system: system,
+        target_component: 1,
+        confirmation: 0,
+    })
 }

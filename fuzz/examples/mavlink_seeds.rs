@@ -16,7 +16,8 @@ const ORIGIN: Origin = Origin { lat: 46.6167, lon: 14.265, alt: 440.0 };
 fn frames(system: u8, component: u8, messages: &[MavMessage]) -> Vec<u8> {
     let mut out = Vec::new();
     for (k, m) in messages.iter().enumerate() {
-        let header = MavHeader { system_id: u32::from(system), component_id: component, sequence: k as u8 };
+        let header =
+            MavHeader { system_id: u32::from(system), component_id: component, sequence: k as u8 };
         mavlink::write_v2_msg(&mut out, header, m).expect("into a Vec");
     }
     out
@@ -27,7 +28,11 @@ fn heartbeat(armed: bool) -> MavMessage {
         custom_mode: 4,
         mavtype: MavType::MAV_TYPE_QUADROTOR,
         autopilot: MavAutopilot::MAV_AUTOPILOT_ARDUPILOTMEGA,
-        base_mode: if armed { MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED | MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED } else { MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED },
+        base_mode: if armed {
+            MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED | MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
+        } else {
+            MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
+        },
         system_status: if armed { MavState::MAV_STATE_ACTIVE } else { MavState::MAV_STATE_STANDBY },
         mavlink_version: 3,
     })
@@ -49,11 +54,17 @@ fn position(x: f64, y: f64, z: f64, ms: u32) -> MavMessage {
 }
 
 fn sys_status(remaining: i8) -> MavMessage {
-    MavMessage::SYS_STATUS(SYS_STATUS_DATA { battery_remaining: remaining, voltage_battery: 12_600, current_battery: 2_500, ..Default::default() })
+    MavMessage::SYS_STATUS(SYS_STATUS_DATA {
+        battery_remaining: remaining,
+        voltage_battery: 12_600,
+        current_battery: 2_500,
+        ..Default::default()
+    })
 }
 
 fn text(s: &str) -> MavMessage {
-    let mut t = STATUSTEXT_DATA { severity: MavSeverity::MAV_SEVERITY_CRITICAL, ..Default::default() };
+    let mut t =
+        STATUSTEXT_DATA { severity: MavSeverity::MAV_SEVERITY_CRITICAL, ..Default::default() };
     t.text = s.into();
     MavMessage::STATUSTEXT(t)
 }
@@ -68,11 +79,20 @@ fn telemetry() -> Vec<MavMessage> {
         if k % 10 == 0 {
             m.push(heartbeat(true));
             m.push(sys_status(100 - (k / 2) as i8));
-            m.push(MavMessage::EXTENDED_SYS_STATE(EXTENDED_SYS_STATE_DATA { landed_state: MavLandedState::MAV_LANDED_STATE_IN_AIR, ..Default::default() }));
+            m.push(MavMessage::EXTENDED_SYS_STATE(EXTENDED_SYS_STATE_DATA {
+                landed_state: MavLandedState::MAV_LANDED_STATE_IN_AIR,
+                ..Default::default()
+            }));
         }
     }
     m.push(text("Battery 1 is critical"));
-    m.push(MavMessage::HEARTBEAT(HEARTBEAT_DATA { custom_mode: 6, ..match heartbeat(true) { MavMessage::HEARTBEAT(h) => h, _ => unreachable!() } }));
+    m.push(MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+        custom_mode: 6,
+        ..match heartbeat(true) {
+            MavMessage::HEARTBEAT(h) => h,
+            _ => unreachable!(),
+        }
+    }));
     m
 }
 
@@ -106,13 +126,33 @@ fn command(system: u8, command: MavCmd, p: [f32; 7]) -> MavMessage {
 /// tick, a speed.
 fn session() -> Vec<MavMessage> {
     let (lat, lon) = ORIGIN.to_e7(100.0, 50.0);
-    let mut param = PARAM_SET_DATA { target_system: 1, target_component: 1, param_value: 12.0, param_type: MavParamType::MAV_PARAM_TYPE_REAL32, ..Default::default() };
+    let mut param = PARAM_SET_DATA {
+        target_system: 1,
+        target_component: 1,
+        param_value: 12.0,
+        param_type: MavParamType::MAV_PARAM_TYPE_REAL32,
+        ..Default::default()
+    };
     param.param_id = "WPNAV_SPEED".into();
     vec![
-        MavMessage::HEARTBEAT(HEARTBEAT_DATA { mavtype: MavType::MAV_TYPE_GCS, autopilot: MavAutopilot::MAV_AUTOPILOT_INVALID, mavlink_version: 3, ..Default::default() }),
-        MavMessage::PARAM_REQUEST_LIST(PARAM_REQUEST_LIST_DATA { target_system: 1, target_component: 1 }),
+        MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+            mavtype: MavType::MAV_TYPE_GCS,
+            autopilot: MavAutopilot::MAV_AUTOPILOT_INVALID,
+            mavlink_version: 3,
+            ..Default::default()
+        }),
+        MavMessage::PARAM_REQUEST_LIST(PARAM_REQUEST_LIST_DATA {
+            target_system: 1,
+            target_component: 1,
+        }),
         MavMessage::PARAM_SET(param),
-        MavMessage::REQUEST_DATA_STREAM(REQUEST_DATA_STREAM_DATA { req_message_rate: 4, target_system: 0, target_component: 0, req_stream_id: MavDataStream::MAV_DATA_STREAM_ALL, start_stop: 1 }),
+        MavMessage::REQUEST_DATA_STREAM(REQUEST_DATA_STREAM_DATA {
+            req_message_rate: 4,
+            target_system: 0,
+            target_component: 0,
+            req_stream_id: MavDataStream::MAV_DATA_STREAM_ALL,
+            start_stop: 1,
+        }),
         command(1, MavCmd::MAV_CMD_REQUEST_MESSAGE, [148.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
         command(1, MavCmd::MAV_CMD_GET_HOME_POSITION, [0.0; 7]),
         command(1, MavCmd::MAV_CMD_DO_SET_MODE, [1.0, 4.0, 0.0, 0.0, 0.0, 0.0, 0.0]),

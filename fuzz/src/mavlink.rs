@@ -51,10 +51,8 @@ pub fn heard_on_a_link(data: &[u8]) -> aviary_mavlink::hear::Heard {
 /// (booted and ready to arm at once, so commands take effect), over 10 s of flight.
 pub fn answers_of_the_vehicles(data: &[u8]) -> Vec<Vec<u8>> {
     let world = example_world();
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .expect("a runtime");
+    let runtime =
+        tokio::runtime::Builder::new_current_thread().enable_all().build().expect("a runtime");
     runtime.block_on(aviary_vehicles::answer(
         world,
         aviary_vehicles::Behaviour { boot_time: 0.0, prearm_time: 0.0 },

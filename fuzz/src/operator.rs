@@ -60,8 +60,10 @@ pub fn operator(data: &[u8]) {
         Some(i) => (&rest[..i], &rest[i + 2..]),
         None => (&[][..], rest),
     };
-    let bound: SocketAddr = if flags & 2 != 0 { "0.0.0.0:7878" } else { "127.0.0.1:7878" }.parse().unwrap();
-    let mut request = Request::builder().method(route.0).uri(route.1).body(Body::from(body.to_vec())).unwrap();
+    let bound: SocketAddr =
+        if flags & 2 != 0 { "0.0.0.0:7878" } else { "127.0.0.1:7878" }.parse().unwrap();
+    let mut request =
+        Request::builder().method(route.0).uri(route.1).body(Body::from(body.to_vec())).unwrap();
     let headers = request.headers_mut();
     headers.insert("host", HeaderValue::from_static("127.0.0.1:7878"));
     if flags & 1 != 0 {
@@ -72,14 +74,23 @@ pub fn operator(data: &[u8]) {
     }
     for line in head.split(|b| *b == b'\n') {
         let Some(colon) = line.iter().position(|b| *b == b':') else { continue };
-        if let (Ok(name), Ok(value)) = (HeaderName::from_bytes(&line[..colon]), HeaderValue::from_bytes(line[colon + 1..].trim_ascii())) {
+        if let (Ok(name), Ok(value)) = (
+            HeaderName::from_bytes(&line[..colon]),
+            HeaderValue::from_bytes(line[colon + 1..].trim_ascii()),
+        ) {
             headers.append(name, value);
         }
     }
-    let carries_token = headers.values().any(|v| v.as_bytes().windows(TOKEN.len()).any(|w| w == TOKEN.as_bytes()));
+    let carries_token =
+        headers.values().any(|v| v.as_bytes().windows(TOKEN.len()).any(|w| w == TOKEN.as_bytes()));
 
     let (controller, mut rx) = Controller::new();
-    let (app, _feed) = aviary_server::router(bound, TOKEN.to_string(), controller, Options { kinds: kinds(), allowed_hosts: vec!["ops.example.org".into()] });
+    let (app, _feed) = aviary_server::router(
+        bound,
+        TOKEN.to_string(),
+        controller,
+        Options { kinds: kinds(), allowed_hosts: vec!["ops.example.org".into()] },
+    );
     let reached = Cell::new(0);
     let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
     let (status, bytes) = runtime.block_on(async {
@@ -96,11 +107,17 @@ pub fn operator(data: &[u8]) {
             _ = engine => unreachable!("the engine's loop never ends while the router lives"),
         };
         let status = response.status();
-        (status, axum::body::to_bytes(response.into_body(), usize::MAX).await.expect("the answer's body"))
+        (
+            status,
+            axum::body::to_bytes(response.into_body(), usize::MAX)
+                .await
+                .expect("the answer's body"),
+        )
     });
 
-    let json: serde_json::Value =
-        serde_json::from_slice(&bytes).unwrap_or_else(|e| panic!("{status} is not JSON ({e}): {:?}", String::from_utf8_lossy(&bytes)));
+    let json: serde_json::Value = serde_json::from_slice(&bytes).unwrap_or_else(|e| {
+        panic!("{status} is not JSON ({e}): {:?}", String::from_utf8_lossy(&bytes))
+    });
     if status.is_client_error() || status.is_server_error() {
         assert!(json["error"].is_string(), "{status} without an error message: {json}");
         assert_eq!(reached.get(), 0, "a refused call ({status}) reached the engine");
@@ -123,7 +140,9 @@ fn checked(control: &Control) {
     for v in values {
         match v {
             Value::Number(x) => assert!(fine(*x), "{x} reached the engine"),
-            Value::Position(p) => assert!(fine(p.x) && fine(p.y) && p.z.is_none_or(fine), "{p:?} reached the engine"),
+            Value::Position(p) => {
+                assert!(fine(p.x) && fine(p.y) && p.z.is_none_or(fine), "{p:?} reached the engine")
+            }
             Value::Area(_) | Value::Actor(_) => panic!("{v:?} reached the engine from outside"),
             Value::Text(_) | Value::Symbol(_) | Value::Bool(_) => {}
         }

@@ -55,7 +55,9 @@ fn seeds_and_regressions_of_fuzz_vehicles() {
 /// ground station's session arms drone 1 and flies it.
 #[test]
 fn the_mavlink_seeds_reach_past_the_framing() {
-    let read = |name: &str| std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join(name)).expect("a seed");
+    let read = |name: &str| {
+        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join(name)).expect("a seed")
+    };
     let flight = aviary_fuzz::heard_on_a_link(&read("in/link/flight_over_a_target.bin"));
     assert!(flight.fix.is_some() && flight.battery.is_some(), "{flight:?}");
     assert!(flight.events > 0, "{flight:?}");
@@ -76,8 +78,8 @@ fn the_mavlink_seeds_reach_past_the_framing() {
     let armed = messages.iter().any(|(s, m)| {
         *s == 1 && matches!(m, MavMessage::HEARTBEAT(h) if h.base_mode.contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED))
     });
-    let climbed = messages
-        .iter()
-        .any(|(s, m)| *s == 1 && matches!(m, MavMessage::GLOBAL_POSITION_INT(p) if p.relative_alt > 5_000));
+    let climbed = messages.iter().any(|(s, m)| {
+        *s == 1 && matches!(m, MavMessage::GLOBAL_POSITION_INT(p) if p.relative_alt > 5_000)
+    });
     assert!(armed && climbed, "drone 1 did not arm and climb: {} answers", answers.len());
 }

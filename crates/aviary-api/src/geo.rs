@@ -56,11 +56,7 @@ impl Default for Origin {
     /// A world without `origin`: the local frame sits at 0°N 0°E, sea level, so that a
     /// vehicle still gets coordinates (a real flight needs a real origin; see REAL_DRONES.md).
     fn default() -> Origin {
-        Origin {
-            lat: 0.0,
-            lon: 0.0,
-            alt: 0.0,
-        }
+        Origin { lat: 0.0, lon: 0.0, alt: 0.0 }
     }
 }
 
@@ -70,23 +66,11 @@ mod tests {
 
     #[test]
     fn there_and_back_within_a_centimetre() {
-        let o = Origin {
-            lat: 46.6167,
-            lon: 14.2650,
-            alt: 440.0,
-        };
-        for p in [
-            [0.0, 0.0],
-            [350.0, -450.0],
-            [-600.0, 600.0],
-            [5000.0, 2000.0],
-        ] {
+        let o = Origin { lat: 46.6167, lon: 14.2650, alt: 440.0 };
+        for p in [[0.0, 0.0], [350.0, -450.0], [-600.0, 600.0], [5000.0, 2000.0]] {
             let (lat, lon) = o.to_e7(p[0], p[1]);
             let q = o.from_e7(lat, lon);
-            assert!(
-                (q[0] - p[0]).abs() < 0.01 && (q[1] - p[1]).abs() < 0.01,
-                "{p:?} -> {q:?}"
-            );
+            assert!((q[0] - p[0]).abs() < 0.01 && (q[1] - p[1]).abs() < 0.01, "{p:?} -> {q:?}");
         }
     }
 
@@ -102,11 +86,7 @@ mod tests {
 
     #[test]
     fn one_thousandth_degree_north_is_about_111_metres() {
-        let o = Origin {
-            lat: 46.6167,
-            lon: 14.2650,
-            alt: 440.0,
-        };
+        let o = Origin { lat: 46.6167, lon: 14.2650, alt: 440.0 };
         let p = o.to_local(46.6177, 14.2650);
         assert!(p[0].abs() < 1e-9);
         assert!((p[1] - 111.19).abs() < 0.01, "{}", p[1]);

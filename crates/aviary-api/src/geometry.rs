@@ -27,10 +27,7 @@ pub fn centroid(polygon: &[[f64; 2]]) -> [f64; 2] {
     if !twice_area.is_finite() || twice_area.abs() <= 1e-12 * extent * extent {
         return mean;
     }
-    [
-        mean[0] + cx / (3.0 * twice_area),
-        mean[1] + cy / (3.0 * twice_area),
-    ]
+    [mean[0] + cx / (3.0 * twice_area), mean[1] + cy / (3.0 * twice_area)]
 }
 
 /// Points this close to a polygon's edge count as inside it (metres).
@@ -74,17 +71,12 @@ pub fn dist_to_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 }
 
 pub fn edges(polygon: &[[f64; 2]]) -> impl Iterator<Item = ([f64; 2], [f64; 2])> + '_ {
-    polygon
-        .iter()
-        .enumerate()
-        .map(|(i, &a)| (a, polygon[(i + 1) % polygon.len()]))
+    polygon.iter().enumerate().map(|(i, &a)| (a, polygon[(i + 1) % polygon.len()]))
 }
 
 /// Distance from `p` to the polygon's boundary.
 pub fn dist_to_boundary(polygon: &[[f64; 2]], p: [f64; 2]) -> f64 {
-    edges(polygon)
-        .map(|(a, b)| dist_to_segment(p, a, b))
-        .fold(f64::INFINITY, f64::min)
+    edges(polygon).map(|(a, b)| dist_to_segment(p, a, b)).fold(f64::INFINITY, f64::min)
 }
 
 /// Even-odd containment; a point on the boundary (within a micrometre) is inside.
@@ -171,7 +163,6 @@ pub fn circle_inside(polygon: &[[f64; 2]], center: [f64; 2], radius: f64) -> boo
     contains(polygon, center) && dist_to_boundary(polygon, center) >= radius - ON_EDGE
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -186,10 +177,12 @@ mod tests {
         assert_eq!(signed_area(&[[0.0, 0.0], [5.0, 5.0], [10.0, 10.0]]), 0.0);
         // A star of many corners: every corner on a circle, each edge jumping 3 ahead.
         let n = 2000;
-        let circle: Vec<[f64; 2]> = (0..n).map(|i| {
-            let a = i as f64 / n as f64 * std::f64::consts::TAU;
-            [a.cos() * 100.0, a.sin() * 100.0]
-        }).collect();
+        let circle: Vec<[f64; 2]> = (0..n)
+            .map(|i| {
+                let a = i as f64 / n as f64 * std::f64::consts::TAU;
+                [a.cos() * 100.0, a.sin() * 100.0]
+            })
+            .collect();
         assert_eq!(self_crossing(&circle), None);
         let star: Vec<[f64; 2]> = (0..7).map(|i| circle[(i * 3 * n / 7) % n]).collect();
         assert!(self_crossing(&star).is_some());
@@ -197,11 +190,26 @@ mod tests {
 
     #[test]
     fn hypot_is_libms_bit_for_bit() {
-        let xs = [0.0, -0.0, 1e-300, 3.0, -4.5, 1e300, f64::INFINITY, f64::NEG_INFINITY, f64::NAN, 0.1, -7e-320];
+        let xs = [
+            0.0,
+            -0.0,
+            1e-300,
+            3.0,
+            -4.5,
+            1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            0.1,
+            -7e-320,
+        ];
         for x in xs {
             for y in xs {
                 let (a, b) = (hypot(x, y), x.hypot(y));
-                assert!(a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()), "{x} {y}: {a} {b}");
+                assert!(
+                    a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                    "{x} {y}: {a} {b}"
+                );
             }
         }
     }

@@ -43,7 +43,9 @@ impl Kind {
         self == value
             || matches!(
                 (self, value),
-                (Kind::Position, Kind::Area) | (Kind::Symbol, Kind::Text) | (Kind::Text, Kind::Symbol)
+                (Kind::Position, Kind::Area)
+                    | (Kind::Symbol, Kind::Text)
+                    | (Kind::Text, Kind::Symbol)
             )
     }
 

@@ -14,11 +14,11 @@
 pub mod flight;
 pub mod geo;
 pub mod geometry;
-pub mod sweep;
 mod kind;
 mod names;
 mod runtime;
 pub mod show;
+pub mod sweep;
 
 pub use geometry::centroid;
 pub use kind::Kind;
@@ -127,24 +127,65 @@ impl Descriptor {
         use Resource::*;
         let p = |name, kind| Param { name, kind, optional: false };
         let opt = |name, kind| Param { name, kind, optional: true };
-        let f = |name, params: Vec<Param>, resource, summary| Function { name, params, variadic: false, resource, summary };
+        let f = |name, params: Vec<Param>, resource, summary| Function {
+            name,
+            params,
+            variadic: false,
+            resource,
+            summary,
+        };
         let mut functions = vec![
             f("Arm", vec![], Some(Motion), "arm the motors"),
             f("Disarm", vec![], Some(Motion), "disarm the motors (landed only)"),
-            f("TakeOff", vec![p("alt", Length)], Some(Motion), "climb from the ground to an altitude"),
+            f(
+                "TakeOff",
+                vec![p("alt", Length)],
+                Some(Motion),
+                "climb from the ground to an altitude",
+            ),
             f("Land", vec![], Some(Motion), "land where the drone is"),
             f("ReturnToLaunch", vec![], Some(Motion), "fly home and land"),
-            f("FlyToPosition", vec![p("pos", Position), opt("speed", Speed)], Some(Motion), "fly to a position"),
+            f(
+                "FlyToPosition",
+                vec![p("pos", Position), opt("speed", Speed)],
+                Some(Motion),
+                "fly to a position",
+            ),
             f("DescendTo", vec![p("alt", Length)], Some(Motion), "descend to an altitude"),
             f("AscendTo", vec![p("alt", Length)], Some(Motion), "climb to an altitude"),
             f("Hover", vec![p("duration", Duration)], Some(Motion), "hold position for a time"),
-            f("Orbit", vec![p("center", Position), p("radius", Length), opt("laps", Number)], Some(Motion), "circle a point"),
-            f("Sweep", vec![p("area", Area), p("spacing", Length)], Some(Motion), "fly a lawnmower path over an area"),
+            f(
+                "Orbit",
+                vec![p("center", Position), p("radius", Length), opt("laps", Number)],
+                Some(Motion),
+                "circle a point",
+            ),
+            f(
+                "Sweep",
+                vec![p("area", Area), p("spacing", Length)],
+                Some(Motion),
+                "fly a lawnmower path over an area",
+            ),
             f("StartStreaming", vec![], Some(Camera), "start the video stream"),
             f("StopStreaming", vec![], Some(Camera), "stop the video stream"),
-            f("StartDetection", vec![p("kind", Symbol)], Some(Detection), "start detecting a kind of target"),
-            f("StopDetection", vec![p("kind", Symbol)], Some(Detection), "stop detecting a kind of target"),
-            f("LoadPayload", vec![p("kind", Symbol)], Some(Payload), "load a payload (landed or below 5 m)"),
+            f(
+                "StartDetection",
+                vec![p("kind", Symbol)],
+                Some(Detection),
+                "start detecting a kind of target",
+            ),
+            f(
+                "StopDetection",
+                vec![p("kind", Symbol)],
+                Some(Detection),
+                "stop detecting a kind of target",
+            ),
+            f(
+                "LoadPayload",
+                vec![p("kind", Symbol)],
+                Some(Payload),
+                "load a payload (landed or below 5 m)",
+            ),
             f("ReleasePayload", vec![], Some(Payload), "release the payload carried"),
         ];
         functions.push(Function {
@@ -166,7 +207,10 @@ impl Descriptor {
                 ("link", Symbol),
             ],
             signals: vec![
-                BuiltinSignal { name: "Detected", values: vec![("kind", Symbol), ("location", Position)] },
+                BuiltinSignal {
+                    name: "Detected",
+                    values: vec![("kind", Symbol), ("location", Position)],
+                },
                 BuiltinSignal { name: "BatteryLow", values: vec![] },
                 BuiltinSignal { name: "ConnectionRestored", values: vec![] },
             ],
@@ -193,15 +237,34 @@ mod tests {
     fn standard_set_covers_language_section_4() {
         let d = Descriptor::standard();
         for name in [
-            "Arm", "Disarm", "TakeOff", "Land", "ReturnToLaunch", "FlyToPosition", "DescendTo", "AscendTo", "Hover", "Orbit", "Sweep",
-            "FollowPath", "StartStreaming", "StopStreaming", "StartDetection", "StopDetection", "LoadPayload", "ReleasePayload",
+            "Arm",
+            "Disarm",
+            "TakeOff",
+            "Land",
+            "ReturnToLaunch",
+            "FlyToPosition",
+            "DescendTo",
+            "AscendTo",
+            "Hover",
+            "Orbit",
+            "Sweep",
+            "FollowPath",
+            "StartStreaming",
+            "StopStreaming",
+            "StartDetection",
+            "StopDetection",
+            "LoadPayload",
+            "ReleasePayload",
         ] {
             assert!(d.function(name).is_some(), "{name} missing");
         }
         for field in ["position", "altitude", "speed", "heading", "battery", "state", "link"] {
             assert!(d.telemetry(field).is_some(), "{field} missing");
         }
-        assert_eq!(d.function("FlyToPosition").map(|f| f.signature()).as_deref(), Some("FlyToPosition(pos[, speed])"));
+        assert_eq!(
+            d.function("FlyToPosition").map(|f| f.signature()).as_deref(),
+            Some("FlyToPosition(pos[, speed])")
+        );
         assert_eq!(d.function("FlyToPosition").map(|f| f.required()), Some(1));
     }
 
@@ -209,8 +272,20 @@ mod tests {
     fn a_backend_function_replaces_one_of_the_same_name() {
         let mut d = Descriptor::standard();
         let before = d.functions.len();
-        d.extend([Function { name: "Winch", params: vec![], variadic: false, resource: Some(Resource::Payload), summary: "" }]);
-        d.extend([Function { name: "Land", params: vec![], variadic: false, resource: Some(Resource::Motion), summary: "soft" }]);
+        d.extend([Function {
+            name: "Winch",
+            params: vec![],
+            variadic: false,
+            resource: Some(Resource::Payload),
+            summary: "",
+        }]);
+        d.extend([Function {
+            name: "Land",
+            params: vec![],
+            variadic: false,
+            resource: Some(Resource::Motion),
+            summary: "soft",
+        }]);
         assert_eq!(d.functions.len(), before + 1);
         assert_eq!(d.function("Land").map(|f| f.summary), Some("soft"));
     }

@@ -75,7 +75,14 @@ pub struct Telemetry {
 
 impl Telemetry {
     /// What a backend reports for a drone it does not know, or no longer hears from.
-    pub const LOST: Telemetry = Telemetry { position: [0.0; 3], speed: 0.0, heading: 0.0, battery: 0.0, state: FlightState::Lost, link: false };
+    pub const LOST: Telemetry = Telemetry {
+        position: [0.0; 3],
+        speed: 0.0,
+        heading: 0.0,
+        battery: 0.0,
+        state: FlightState::Lost,
+        link: false,
+    };
 }
 
 /// A built-in exception (docs/LANGUAGE.md, section 17), by the name a mission handles it with.

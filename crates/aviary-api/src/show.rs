@@ -166,7 +166,10 @@ mod tests {
         assert_eq!(Value::Symbol("abc".into()).to_string(), "abc");
         assert_eq!(Value::Text("abc".into()).to_string(), "\"abc\"");
         assert_eq!(Value::Position(Point { x: 1.0, y: 2.5, z: None }).to_string(), "(1, 2.5)");
-        assert_eq!(Value::Position(Point { x: 1.0, y: 2.0, z: Some(0.1 + 0.2) }).to_string(), "(1, 2, 0.3)");
+        assert_eq!(
+            Value::Position(Point { x: 1.0, y: 2.0, z: Some(0.1 + 0.2) }).to_string(),
+            "(1, 2, 0.3)"
+        );
         assert_eq!(Value::Number(f64::NAN).to_string(), "NaN");
         assert_eq!(Value::Number(1e308).to_string(), "1e308");
         assert_eq!(Value::Area(vec![[0.0, 0.0], [1.0, 0.0]]).to_string(), "an area of 2 corners");

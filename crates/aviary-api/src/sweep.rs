@@ -26,11 +26,7 @@ pub fn lawnmower(polygon: &[[f64; 2]], spacing: f64) -> Vec<[f64; 2]> {
     let along_x = hi[0] - lo[0] >= hi[1] - lo[1];
     let to_uw = |p: [f64; 2]| if along_x { p } else { [p[1], p[0]] };
     let uw: Vec<[f64; 2]> = polygon.iter().map(|&p| to_uw(p)).collect();
-    let (w_min, w_max) = if along_x {
-        (lo[1], hi[1])
-    } else {
-        (lo[0], hi[0])
-    };
+    let (w_min, w_max) = if along_x { (lo[1], hi[1]) } else { (lo[0], hi[0]) };
     let extent = w_max - w_min;
     let passes = ((extent / spacing) - 1e-9).ceil().max(1.0) as usize;
     let first = w_min + (extent - (passes - 1) as f64 * spacing) / 2.0;
@@ -39,10 +35,7 @@ pub fn lawnmower(polygon: &[[f64; 2]], spacing: f64) -> Vec<[f64; 2]> {
     let mut forward = true;
     for i in 0..passes {
         let w = first + i as f64 * spacing;
-        let band = (
-            (w - spacing / 2.0).max(w_min),
-            (w + spacing / 2.0).min(w_max),
-        );
+        let band = ((w - spacing / 2.0).max(w_min), (w + spacing / 2.0).min(w_max));
         let mut pieces = projection(&uw, band.0, band.1);
         if pieces.is_empty() {
             continue;

@@ -50,7 +50,14 @@ struct Walk<'a> {
     filtered: Vec<(&'a Ident, &'a Ident)>,
 }
 
-fn walk<'a>(body: &'a Body, parallel: bool, copies: bool, in_for: bool, path: &mut Vec<Step>, out: &mut Walk<'a>) {
+fn walk<'a>(
+    body: &'a Body,
+    parallel: bool,
+    copies: bool,
+    in_for: bool,
+    path: &mut Vec<Step>,
+    out: &mut Walk<'a>,
+) {
     for (index, stmt) in body.items.iter().enumerate() {
         let handler = matches!(stmt, Stmt::Handler(_) | Stmt::ExceptionHandler(_));
         path.push(Step { body, index, parallel, copies, handler });
@@ -111,7 +118,12 @@ fn later_in_chain(wait: &[Step], signal: &[Step]) -> bool {
         return true;
     }
     let (Some(w), Some(s)) = (wait.get(k), signal.get(k)) else { return false };
-    std::ptr::eq(w.body, s.body) && !w.parallel && !w.copies && w.index < s.index && !w.handler && !s.handler
+    std::ptr::eq(w.body, s.body)
+        && !w.parallel
+        && !w.copies
+        && w.index < s.index
+        && !w.handler
+        && !s.handler
 }
 
 pub(crate) fn check_chains(program: &Program, api: &Descriptor, diagnostics: &mut Vec<Diagnostic>) {
@@ -147,7 +159,11 @@ pub(crate) fn check_chains(program: &Program, api: &Descriptor, diagnostics: &mu
     let in_for: HashSet<&str> = found.in_for.iter().copied().collect();
     for (signal, by) in &found.filtered {
         let name = signal.name.as_str();
-        if api.signal(name).is_some() || !raisers.contains_key(name) || in_capabilities.contains(name) || in_for.contains(name) {
+        if api.signal(name).is_some()
+            || !raisers.contains_key(name)
+            || in_capabilities.contains(name)
+            || in_for.contains(name)
+        {
             continue;
         }
         diagnostics.push(

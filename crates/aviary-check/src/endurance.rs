@@ -46,14 +46,30 @@ struct Env {
     actors: HashMap<String, Drones>,
 }
 
-pub(crate) fn check_endurance(program: &Program, world: &World, api: &Descriptor, diagnostics: &mut Vec<Diagnostic>) {
-    let (Some(mission), Some(file)) = (program.mission(), program.mission.map(|r| r.file)) else { return };
+pub(crate) fn check_endurance(
+    program: &Program,
+    world: &World,
+    api: &Descriptor,
+    diagnostics: &mut Vec<Diagnostic>,
+) {
+    let (Some(mission), Some(file)) = (program.mission(), program.mission.map(|r| r.file)) else {
+        return;
+    };
     let timed = timed_capabilities(program, api);
     if timed.is_empty() {
         return;
     }
     let budget = crate::geofence::follow_budget(&mission.body);
-    let mut walker = Walker { program, world, api, timed, by_name: OnceCell::new(), reported: HashSet::new(), out: Vec::new(), budget };
+    let mut walker = Walker {
+        program,
+        world,
+        api,
+        timed,
+        by_name: OnceCell::new(),
+        reported: HashSet::new(),
+        out: Vec::new(),
+        budget,
+    };
     walker.body(&mission.body, &Env::default(), file, 0);
     diagnostics.extend(walker.out);
 }
@@ -66,8 +82,17 @@ fn timed_capabilities<'p>(program: &'p Program, api: &Descriptor) -> foldhash::H
     for (_, c) in program.active_capabilities() {
         for body in capability_bodies(c) {
             crate::env::visit_stmts(body, &mut |stmt| match stmt {
-                Stmt::Statement(s) => callers.entry(s.capability.name.as_str()).or_default().push(c.name.name.as_str()),
-                Stmt::Api(a) if api.function(&a.function.name).is_some_and(|f| f.params.iter().any(|p| p.kind == Kind::Duration)) => pending.push(c.name.name.as_str()),
+                Stmt::Statement(s) => callers
+                    .entry(s.capability.name.as_str())
+                    .or_default()
+                    .push(c.name.name.as_str()),
+                Stmt::Api(a)
+                    if api
+                        .function(&a.function.name)
+                        .is_some_and(|f| f.params.iter().any(|p| p.kind == Kind::Duration)) =>
+                {
+                    pending.push(c.name.name.as_str())
+                }
                 _ => {}
             });
         }
@@ -103,7 +128,8 @@ impl Walker<'_> {
                 Stmt::Api(a) => self.api_call(a, env, file),
                 Stmt::For(f) => {
                     let mut inner = env.clone();
-                    let sets: Option<Vec<Rc<[usize]>>> = f.instances.iter().map(|i| self.drones(&i.actor, env)).collect();
+                    let sets: Option<Vec<Rc<[usize]>>> =
+                        f.instances.iter().map(|i| self.drones(&i.actor, env)).collect();
                     inner.actors.insert(f.alias.name.clone(), sets.map(|v| v.concat().into()));
                     for p in &f.params {
                         inner.durations.remove(&p.name);
@@ -123,13 +149,19 @@ impl Walker<'_> {
         if let Some(g) = self.world.group(&actor.name) {
             return Some(g.members.as_slice().into());
         }
-        let by_name = self.by_name.get_or_init(|| self.world.drones.iter().enumerate().map(|(i, d)| (d.name.as_str(), i)).collect());
+        let by_name = self.by_name.get_or_init(|| {
+            self.world.drones.iter().enumerate().map(|(i, d)| (d.name.as_str(), i)).collect()
+        });
         by_name.get(actor.name.as_str()).map(|&i| Rc::from([i].as_slice()))
     }
 
     fn duration(&self, e: &Expr, env: &Env, file: FileId) -> Option<Written> {
         match &e.kind {
-            ExprKind::Number { value, unit: Some(unit @ (Unit::Second | Unit::Minute | Unit::Hour)), .. } => Some(Written { seconds: value * unit.to_si(), file, span: e.span }),
+            ExprKind::Number {
+                value,
+                unit: Some(unit @ (Unit::Second | Unit::Minute | Unit::Hour)),
+                ..
+            } => Some(Written { seconds: value * unit.to_si(), file, span: e.span }),
             ExprKind::Name(id) => env.durations.get(&id.name).copied(),
             ExprKind::Paren(inner) => self.duration(inner, env, file),
             _ => None,
@@ -137,11 +169,19 @@ impl Walker<'_> {
     }
 
     fn statement(&mut self, s: &Statement, env: &Env, file: FileId, depth: usize) {
-        if depth >= MAX_CALLS || self.budget == 0 || !self.timed.contains(s.capability.name.as_str()) {
+        if depth >= MAX_CALLS
+            || self.budget == 0
+            || !self.timed.contains(s.capability.name.as_str())
+        {
             return;
         }
         self.budget -= 1;
-        let (Some(callee), Some(callee_file)) = (self.program.capability(&s.capability.name), self.program.capability_file(&s.capability.name)) else { return };
+        let (Some(callee), Some(callee_file)) = (
+            self.program.capability(&s.capability.name),
+            self.program.capability_file(&s.capability.name),
+        ) else {
+            return;
+        };
         let mut inner = Env::default();
         // `a b Cap` on a one-actor capability runs it once per actor: any of them.
         let sets: Vec<Drones> = s.actors.iter().map(|a| self.drones(a, env)).collect();
@@ -157,7 +197,8 @@ impl Walker<'_> {
         for (i, p) in callee.params.iter().enumerate() {
             let known = match binding.bound[i] {
                 Some(e) => self.duration(e, env, file),
-                None => crate::geofence::default_of(callee, &p.name).and_then(|e| self.duration(e, &Env::default(), callee_file)),
+                None => crate::geofence::default_of(callee, &p.name)
+                    .and_then(|e| self.duration(e, &Env::default(), callee_file)),
             };
             if let Some(w) = known {
                 inner.durations.insert(p.name.clone(), w);
@@ -171,18 +212,36 @@ impl Walker<'_> {
     fn api_call(&mut self, call: &ApiCall, env: &Env, file: FileId) {
         let Some(f) = self.api.function(&call.function.name) else { return };
         for (j, arg) in call.args.iter().enumerate() {
-            let Some(p) = f.params.get(j).or(if f.variadic { f.params.last() } else { None }) else { continue };
+            let Some(p) = f.params.get(j).or(if f.variadic { f.params.last() } else { None })
+            else {
+                continue;
+            };
             if p.kind != Kind::Duration {
                 continue;
             }
             let Some(w) = self.duration(arg, env, file) else { continue };
             // The longest any drone the actor can be flies; with nobody known, the fleet's.
-            let drones: Rc<[usize]> = self.drones(&call.actor, env).unwrap_or_else(|| (0..self.world.drones.len()).collect());
-            let Some(longest) = drones.iter().filter_map(|&d| self.world.drones.get(d)).max_by(|a, b| a.endurance.total_cmp(&b.endurance)) else { continue };
+            let drones: Rc<[usize]> = self
+                .drones(&call.actor, env)
+                .unwrap_or_else(|| (0..self.world.drones.len()).collect());
+            let Some(longest) = drones
+                .iter()
+                .filter_map(|&d| self.world.drones.get(d))
+                .max_by(|a, b| a.endurance.total_cmp(&b.endurance))
+            else {
+                continue;
+            };
             if w.seconds <= longest.endurance || !self.reported.insert((w.file, w.span.start)) {
                 continue;
             }
-            let who = if drones.len() == 1 { format!("{} can stay in the air ({} s)", longest.name, number(longest.endurance)) } else { format!("any of its drones can stay in the air (at most {} s)", number(longest.endurance)) };
+            let who = if drones.len() == 1 {
+                format!("{} can stay in the air ({} s)", longest.name, number(longest.endurance))
+            } else {
+                format!(
+                    "any of its drones can stay in the air (at most {} s)",
+                    number(longest.endurance)
+                )
+            };
             let mut d = Diagnostic::new(Code::PastEndurance, w.file, w.span, format!("`{}` for {} s ({}) is longer than {who}", f.name, number(w.seconds), human(w.seconds)))
                 .label("longer than the battery lasts")
                 .with_help("give a duration the drone can fly (its `endurance` in the world file); in the air the battery runs out long before this ends, and on the ground the wait outlasts any mission");
@@ -196,7 +255,13 @@ impl Walker<'_> {
 
 /// A long duration in the unit people think of it in.
 fn human(seconds: f64) -> String {
-    const UNITS: [(f64, &str); 5] = [(365.25 * 86400.0, "years"), (86400.0, "days"), (3600.0, "hours"), (60.0, "minutes"), (1.0, "seconds")];
+    const UNITS: [(f64, &str); 5] = [
+        (365.25 * 86400.0, "years"),
+        (86400.0, "days"),
+        (3600.0, "hours"),
+        (60.0, "minutes"),
+        (1.0, "seconds"),
+    ];
     let (size, name) = UNITS.iter().copied().find(|(size, _)| seconds >= *size).unwrap_or(UNITS[4]);
     format!("about {} {name}", number((seconds / size * 10.0).round() / 10.0))
 }

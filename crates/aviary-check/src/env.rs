@@ -48,7 +48,9 @@ pub(crate) fn capability_bodies(c: &Capability) -> Vec<&Body> {
 pub(crate) fn visit_exprs<'a>(expr: &'a Expr, f: &mut dyn FnMut(&'a Expr)) {
     f(expr);
     match &expr.kind {
-        ExprKind::Coordinates(parts) | ExprKind::Geo(parts) => parts.iter().for_each(|p| visit_exprs(p, f)),
+        ExprKind::Coordinates(parts) | ExprKind::Geo(parts) => {
+            parts.iter().for_each(|p| visit_exprs(p, f))
+        }
         ExprKind::Distance(a, b) | ExprKind::Binary(a, _, b) => {
             visit_exprs(a, f);
             visit_exprs(b, f);

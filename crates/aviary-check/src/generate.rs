@@ -317,10 +317,7 @@ fn world() -> String {
     }
     w.push_str("\n[areas]\n");
     for z in 0..ZONES {
-        let (x, y) = (
-            rng.range(0, 7000) as i64 - 3500,
-            rng.range(0, 7000) as i64 - 3500,
-        );
+        let (x, y) = (rng.range(0, 7000) as i64 - 3500, rng.range(0, 7000) as i64 - 3500);
         let (dx, dy) = (rng.range(200, 800) as i64, rng.range(200, 800) as i64);
         let _ = writeln!(
             w,
@@ -375,11 +372,7 @@ mod tests {
     #[test]
     fn a_generated_mission_checks_clean() {
         let (mission, world_text) = large_mission(200_000);
-        assert!(
-            mission.len() >= 200_000 && mission.len() < 260_000,
-            "{} bytes",
-            mission.len()
-        );
+        assert!(mission.len() >= 200_000 && mission.len() < 260_000, "{} bytes", mission.len());
         let mut sources = SourceMap::new();
         let wid = sources.add("generated.world.toml", world_text);
         let (world, wdiags) = aviary_world::parse_world(wid, sources.text(wid));
@@ -388,8 +381,13 @@ mod tests {
         assert_eq!(world.drones.len(), DRONES);
         assert_eq!(world.groups.len(), GROUPS);
         let root = sources.add("generated.mission", mission);
-        let (program, diagnostics) = crate::check(&mut sources, root, Some(&world), &NoFiles, &Descriptor::standard());
-        let shown: Vec<String> = diagnostics.iter().take(10).map(|d| format!("{} {} at {:?}", d.code, d.message, d.primary.span)).collect();
+        let (program, diagnostics) =
+            crate::check(&mut sources, root, Some(&world), &NoFiles, &Descriptor::standard());
+        let shown: Vec<String> = diagnostics
+            .iter()
+            .take(10)
+            .map(|d| format!("{} {} at {:?}", d.code, d.message, d.primary.span))
+            .collect();
         assert!(diagnostics.is_empty(), "{} diagnostics, first: {shown:#?}", diagnostics.len());
         assert!(program.mission().is_some());
     }

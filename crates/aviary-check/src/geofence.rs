@@ -34,8 +34,17 @@ pub(crate) fn check_geofence(program: &Program, world: &World, diagnostics: &mut
     if fence.is_none() && ceiling.is_none() {
         return;
     }
-    let (Some(mission), Some(file)) = (program.mission(), program.mission.map(|r| r.file)) else { return };
-    let mut walker = Walker { program, world, fence, ceiling, diagnostics, budget: follow_budget(&mission.body) };
+    let (Some(mission), Some(file)) = (program.mission(), program.mission.map(|r| r.file)) else {
+        return;
+    };
+    let mut walker = Walker {
+        program,
+        world,
+        fence,
+        ceiling,
+        diagnostics,
+        budget: follow_budget(&mission.body),
+    };
     walker.body(&mission.body, &Values::new(), None, file, 0);
 }
 
@@ -57,19 +66,26 @@ struct Walker<'a> {
 /// before flight; the simulator still refuses such a flight (`GeofenceViolation`).
 pub(crate) fn follow_budget(mission: &Body) -> usize {
     let mut statements = 0usize;
-    crate::env::visit_stmts(mission, &mut |s| statements += usize::from(matches!(s, Stmt::Statement(_))));
+    crate::env::visit_stmts(mission, &mut |s| {
+        statements += usize::from(matches!(s, Stmt::Statement(_)))
+    });
     statements.saturating_mul(64).saturating_add(1_000_000)
 }
 
 impl Walker<'_> {
     fn value(&self, e: &Expr, values: &Values) -> Option<Known> {
         match &e.kind {
-            ExprKind::Number { value, unit, .. } => Some(Known::Number(value * unit.map_or(1.0, |u| u.to_si()))),
+            ExprKind::Number { value, unit, .. } => {
+                Some(Known::Number(value * unit.map_or(1.0, |u| u.to_si())))
+            }
             ExprKind::Coordinates(parts) => {
-                let n: Option<Vec<f64>> = parts.iter().map(|p| match self.value(p, values) {
-                    Some(Known::Number(n)) => Some(n),
-                    _ => None,
-                }).collect();
+                let n: Option<Vec<f64>> = parts
+                    .iter()
+                    .map(|p| match self.value(p, values) {
+                        Some(Known::Number(n)) => Some(n),
+                        _ => None,
+                    })
+                    .collect();
                 let n = n?;
                 Some(Known::Point([n[0], *n.get(1)?], n.get(2).copied()))
             }
@@ -88,10 +104,19 @@ impl Walker<'_> {
     }
 
     /// `site`: the mission statement this body runs for, if inside a capability.
-    fn body(&mut self, body: &Body, values: &Values, site: Option<(FileId, Span)>, file: FileId, depth: usize) {
+    fn body(
+        &mut self,
+        body: &Body,
+        values: &Values,
+        site: Option<(FileId, Span)>,
+        file: FileId,
+        depth: usize,
+    ) {
         for stmt in &body.items {
             match stmt {
-                Stmt::Statement(s) => self.statement(s, values, site.or(Some((file, s.span))), depth),
+                Stmt::Statement(s) => {
+                    self.statement(s, values, site.or(Some((file, s.span))), depth)
+                }
                 Stmt::Api(a) => self.api(a, values, site, file),
                 Stmt::For(f) => {
                     for inst in &f.instances {
@@ -106,15 +131,30 @@ impl Walker<'_> {
                         self.body(&f.body, &inner, site, file, depth);
                     }
                 }
-                Stmt::Handler(h) => self.body(&h.body, &without(values, &h.bindings), site, file, depth),
-                Stmt::ExceptionHandler(h) => self.body(&h.body, &without(values, &h.bindings), site, file, depth),
+                Stmt::Handler(h) => {
+                    self.body(&h.body, &without(values, &h.bindings), site, file, depth)
+                }
+                Stmt::ExceptionHandler(h) => {
+                    self.body(&h.body, &without(values, &h.bindings), site, file, depth)
+                }
                 other => other.for_each_body(|b| self.body(b, values, site, file, depth)),
             }
         }
     }
 
-    fn statement(&mut self, s: &Statement, values: &Values, site: Option<(FileId, Span)>, depth: usize) {
-        let (Some(callee), Some(file)) = (self.program.capability(&s.capability.name), self.program.capability_file(&s.capability.name)) else { return };
+    fn statement(
+        &mut self,
+        s: &Statement,
+        values: &Values,
+        site: Option<(FileId, Span)>,
+        depth: usize,
+    ) {
+        let (Some(callee), Some(file)) = (
+            self.program.capability(&s.capability.name),
+            self.program.capability_file(&s.capability.name),
+        ) else {
+            return;
+        };
         if depth >= MAX_CALLS || self.budget == 0 {
             return;
         }
@@ -149,9 +189,15 @@ impl Walker<'_> {
                 }
             }
             "Orbit" => {
-                if let (Some(center), Some(Known::Number(radius)), Some(fence)) = (arg(0).and_then(|k| ground(&k)), arg(1), self.fence) {
+                if let (Some(center), Some(Known::Number(radius)), Some(fence)) =
+                    (arg(0).and_then(|k| ground(&k)), arg(1), self.fence)
+                {
                     if !circle_inside(fence, center, radius) {
-                        let what = format!("the circle of {} m around {} leaves the geofence", number(radius), shown(center));
+                        let what = format!(
+                            "the circle of {} m around {} leaves the geofence",
+                            number(radius),
+                            shown(center)
+                        );
                         self.report(Code::LeavesGeofence, what, call, site, file);
                     }
                 }
@@ -160,9 +206,17 @@ impl Walker<'_> {
                 if let (Some(Known::Area(area)), Some(fence)) = (arg(0), self.fence) {
                     // A corner outside, or else an edge that crosses the fence.
                     let corner = area.iter().find(|p| !contains(fence, **p));
-                    let crossing = || area.iter().zip(area.iter().cycle().skip(1)).find(|(p, q)| !segment_inside(fence, **p, **q)).map(|(p, _)| p);
+                    let crossing = || {
+                        area.iter()
+                            .zip(area.iter().cycle().skip(1))
+                            .find(|(p, q)| !segment_inside(fence, **p, **q))
+                            .map(|(p, _)| p)
+                    };
                     if let Some(p) = corner.or_else(crossing) {
-                        let what = format!("the area swept reaches outside the geofence, at {}", shown(*p));
+                        let what = format!(
+                            "the area swept reaches outside the geofence, at {}",
+                            shown(*p)
+                        );
                         self.report(Code::LeavesGeofence, what, call, site, file);
                     }
                 }
@@ -181,7 +235,13 @@ impl Walker<'_> {
     fn point(&mut self, k: &Known, call: &ApiCall, site: Option<(FileId, Span)>, file: FileId) {
         if let (Some(p), Some(fence)) = (ground(k), self.fence) {
             if !contains(fence, p) {
-                self.report(Code::LeavesGeofence, format!("this flies to {}, outside the geofence", shown(p)), call, site, file);
+                self.report(
+                    Code::LeavesGeofence,
+                    format!("this flies to {}, outside the geofence", shown(p)),
+                    call,
+                    site,
+                    file,
+                );
             }
         }
         if let Known::Point(_, Some(z)) = k {
@@ -192,20 +252,43 @@ impl Walker<'_> {
     fn altitude(&mut self, alt: f64, call: &ApiCall, site: Option<(FileId, Span)>, file: FileId) {
         if let Some(ceiling) = self.ceiling {
             if alt > ceiling {
-                self.report(Code::AboveCeiling, format!("this flies at {} m, above the site's max_altitude of {} m", number(alt), number(ceiling)), call, site, file);
+                self.report(
+                    Code::AboveCeiling,
+                    format!(
+                        "this flies at {} m, above the site's max_altitude of {} m",
+                        number(alt),
+                        number(ceiling)
+                    ),
+                    call,
+                    site,
+                    file,
+                );
             }
         }
     }
 
-    fn report(&mut self, code: Code, message: String, call: &ApiCall, site: Option<(FileId, Span)>, file: FileId) {
+    fn report(
+        &mut self,
+        code: Code,
+        message: String,
+        call: &ApiCall,
+        site: Option<(FileId, Span)>,
+        file: FileId,
+    ) {
         let (at_file, at) = site.unwrap_or((file, call.span));
         let help = match code {
             Code::AboveCeiling => "fly lower, or raise `max_altitude` in the world file's [site]",
-            _ => "choose a place inside the geofence, or widen `geofence` in the world file's [site]",
+            _ => {
+                "choose a place inside the geofence, or widen `geofence` in the world file's [site]"
+            }
         };
         let mut d = Diagnostic::new(code, at_file, at, message).with_help(help);
         if site.is_some() {
-            d.secondary.push(Label { file, span: call.span, message: format!("{} is called here", call.function.name) });
+            d.secondary.push(Label {
+                file,
+                span: call.span,
+                message: format!("{} is called here", call.function.name),
+            });
         }
         self.diagnostics.push(d);
     }
@@ -215,7 +298,9 @@ impl Walker<'_> {
 /// written twice), looked up only for a parameter the call leaves out.
 pub(crate) fn default_of<'c>(callee: &'c Capability, name: &str) -> Option<&'c Expr> {
     callee.sections.iter().rev().find_map(|sec| match sec {
-        Section::Defaults { entries, .. } => entries.iter().rev().find(|e| e.name.name == name).map(|e| &e.value),
+        Section::Defaults { entries, .. } => {
+            entries.iter().rev().find(|e| e.name.name == name).map(|e| &e.value)
+        }
         _ => None,
     })
 }

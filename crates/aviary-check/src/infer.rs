@@ -23,11 +23,15 @@ pub struct KindOrigin {
 
 pub(crate) type Origins = BTreeMap<String, Vec<Option<KindOrigin>>>;
 
-pub(crate) fn parameter_kinds(program: &Program, api: &Descriptor) -> (BTreeMap<String, Vec<Option<Kind>>>, Origins) {
+pub(crate) fn parameter_kinds(
+    program: &Program,
+    api: &Descriptor,
+) -> (BTreeMap<String, Vec<Option<Kind>>>, Origins) {
     // The capabilities in name order, by index; names are looked up by hash.
     let names: Vec<&String> = program.capabilities.keys().collect();
     let caps: Vec<Option<&Capability>> = names.iter().map(|n| program.capability(n)).collect();
-    let index: foldhash::HashMap<&str, usize> = names.iter().enumerate().map(|(i, n)| (n.as_str(), i)).collect();
+    let index: foldhash::HashMap<&str, usize> =
+        names.iter().enumerate().map(|(i, n)| (n.as_str(), i)).collect();
     let mut kinds: Vec<Option<Vec<Option<Kind>>>> = vec![None; names.len()];
     let mut origins: Vec<Option<Vec<Option<KindOrigin>>>> = vec![None; names.len()];
     for (ci, c) in caps.iter().enumerate() {
@@ -39,7 +43,15 @@ pub(crate) fn parameter_kinds(program: &Program, api: &Descriptor) -> (BTreeMap<
             for e in entries {
                 if let Some(i) = c.params.iter().position(|p| p.name == e.name.name) {
                     k[i] = literal_kind(&e.value);
-                    o[i] = k[i].map(|kind| KindOrigin { span: e.value.span, why: format!("`{}` is {} because of its default", e.name.name, kind.describe()), from: None });
+                    o[i] = k[i].map(|kind| KindOrigin {
+                        span: e.value.span,
+                        why: format!(
+                            "`{}` is {} because of its default",
+                            e.name.name,
+                            kind.describe()
+                        ),
+                        from: None,
+                    });
                 }
             }
         }
@@ -71,16 +83,32 @@ pub(crate) fn parameter_kinds(program: &Program, api: &Descriptor) -> (BTreeMap<
                     Stmt::Api(call) => {
                         let Some(f) = api.function(&call.function.name) else { return };
                         for (j, arg) in call.args.iter().enumerate() {
-                            let p = f.params.get(j).or(if f.variadic { f.params.last() } else { None });
+                            let p =
+                                f.params.get(j).or(if f.variadic { f.params.last() } else { None });
                             if let (Some(i), Some(p)) = (param_index(arg), p) {
-                                let why = format!("`{}` goes to the middle layer's {}: {}", c.params[i].name, f.signature(), p.kind.describe());
-                                learned.push((i, p.kind, KindOrigin { span: arg.span, why, from: None }));
+                                let why = format!(
+                                    "`{}` goes to the middle layer's {}: {}",
+                                    c.params[i].name,
+                                    f.signature(),
+                                    p.kind.describe()
+                                );
+                                learned.push((
+                                    i,
+                                    p.kind,
+                                    KindOrigin { span: arg.span, why, from: None },
+                                ));
                             }
                         }
                     }
                     Stmt::Statement(s) => {
-                        let Some(&callee_index) = index.get(s.capability.name.as_str()) else { return };
-                        let (Some(callee), Some(callee_kinds)) = (caps[callee_index], &kinds[callee_index]) else { return };
+                        let Some(&callee_index) = index.get(s.capability.name.as_str()) else {
+                            return;
+                        };
+                        let (Some(callee), Some(callee_kinds)) =
+                            (caps[callee_index], &kinds[callee_index])
+                        else {
+                            return;
+                        };
                         // Only a parameter passed on can learn anything here.
                         if !s.args.iter().any(|a| param_index(&a.value).is_some()) {
                             return;
@@ -89,8 +117,22 @@ pub(crate) fn parameter_kinds(program: &Program, api: &Descriptor) -> (BTreeMap<
                         for (k, arg) in binding.bound.iter().enumerate() {
                             if let (Some(arg), Some(Some(kind))) = (arg, callee_kinds.get(k)) {
                                 if let Some(i) = param_index(arg) {
-                                    let why = format!("`{}` goes to `{}`'s `{}`: {}", c.params[i].name, callee.name.name, callee.params[k].name, kind.describe());
-                                    learned.push((i, *kind, KindOrigin { span: arg.span, why, from: Some((callee.name.name.clone(), k)) }));
+                                    let why = format!(
+                                        "`{}` goes to `{}`'s `{}`: {}",
+                                        c.params[i].name,
+                                        callee.name.name,
+                                        callee.params[k].name,
+                                        kind.describe()
+                                    );
+                                    learned.push((
+                                        i,
+                                        *kind,
+                                        KindOrigin {
+                                            span: arg.span,
+                                            why,
+                                            from: Some((callee.name.name.clone(), k)),
+                                        },
+                                    ));
                                 }
                             }
                         }
@@ -133,7 +175,10 @@ fn by_name<T>(names: &[&String], values: Vec<Option<T>>) -> BTreeMap<String, T> 
 }
 
 /// For each capability (by index), the capabilities whose bodies call it.
-fn callers(caps: &[Option<&Capability>], index: &foldhash::HashMap<&str, usize>) -> Vec<Vec<usize>> {
+fn callers(
+    caps: &[Option<&Capability>],
+    index: &foldhash::HashMap<&str, usize>,
+) -> Vec<Vec<usize>> {
     let mut out = vec![Vec::new(); caps.len()];
     for (ci, c) in caps.iter().enumerate() {
         let Some(c) = c else { continue };
@@ -171,17 +216,34 @@ mod tests {
         let n = 3000;
         let mut text = String::from("MISSION M:\n    scout C00000 WITH 5m\n");
         for i in 0..n {
-            let body = if i + 1 < n { format!("d C{:05} WITH x", i + 1) } else { "d.Hover(x)".into() };
-            text.push_str(&format!("\nCAPABILITY C{i:05} BY d WITH x:\n    PERFORM:\n        {body}\n"));
+            let body =
+                if i + 1 < n { format!("d C{:05} WITH x", i + 1) } else { "d.Hover(x)".into() };
+            text.push_str(&format!(
+                "\nCAPABILITY C{i:05} BY d WITH x:\n    PERFORM:\n        {body}\n"
+            ));
         }
         let mut sources = SourceMap::new();
         let world = "[drones.scout]\nhome = [0, 0]\n";
-        let checked = crate::check_sources(&mut sources, ("m.mission", text.as_bytes()), Some(("w.toml", world.as_bytes())), &NoFiles, &Descriptor::standard());
+        let checked = crate::check_sources(
+            &mut sources,
+            ("m.mission", text.as_bytes()),
+            Some(("w.toml", world.as_bytes())),
+            &NoFiles,
+            &Descriptor::standard(),
+        );
         let program = checked.program.expect("program");
         for i in [0, 1, n / 2, n - 1] {
-            assert_eq!(program.param_kinds[&format!("C{i:05}")], vec![Some(Kind::Duration)], "C{i:05}");
+            assert_eq!(
+                program.param_kinds[&format!("C{i:05}")],
+                vec![Some(Kind::Duration)],
+                "C{i:05}"
+            );
         }
-        let wrong: Vec<_> = checked.diagnostics.iter().filter(|d| d.code == aviary_diagnostics::Code::WrongKind).collect();
+        let wrong: Vec<_> = checked
+            .diagnostics
+            .iter()
+            .filter(|d| d.code == aviary_diagnostics::Code::WrongKind)
+            .collect();
         assert_eq!(wrong.len(), 1, "{:?}", checked.diagnostics);
     }
 }

@@ -8,16 +8,16 @@
 mod chains;
 mod endurance;
 mod env;
-mod geofence;
-mod inputs;
 pub mod generate;
+mod geofence;
 mod infer;
+mod inputs;
 mod load;
-mod signal_values;
 mod recursion;
-pub mod uses;
+mod signal_values;
 mod signals;
 mod suggest;
+pub mod uses;
 mod walk;
 
 use std::collections::BTreeMap;
@@ -28,8 +28,8 @@ use aviary_syntax::ast::{Capability, Mission, SourceFile};
 use aviary_world::World;
 
 pub use env::{bind_args, ArgBinding, BindProblem};
-pub use inputs::{check_sources, check_sources_joined, normalize_path, Checked};
 pub use infer::KindOrigin;
+pub use inputs::{check_sources, check_sources_joined, normalize_path, Checked};
 pub use load::{SourceProvider, STD_NAME, STD_SOURCE};
 pub use uses::LoadError;
 
@@ -84,7 +84,9 @@ impl Program {
     pub fn active_capabilities(&self) -> impl Iterator<Item = (FileId, &Capability)> {
         self.files.iter().flat_map(move |(file, tree)| {
             tree.items.iter().filter_map(move |item| match item {
-                aviary_syntax::ast::Item::Capability(c) if self.is_active(*file, c) => Some((*file, c)),
+                aviary_syntax::ast::Item::Capability(c) if self.is_active(*file, c) => {
+                    Some((*file, c))
+                }
                 _ => None,
             })
         })
@@ -99,11 +101,18 @@ impl Program {
 }
 
 /// Checks the mission file `root` (already in `sources`): its program, and every problem.
-pub fn check(sources: &mut SourceMap, root: FileId, world: Option<&World>, provider: &dyn SourceProvider, api: &Descriptor) -> (Program, Vec<Diagnostic>) {
+pub fn check(
+    sources: &mut SourceMap,
+    root: FileId,
+    world: Option<&World>,
+    provider: &dyn SourceProvider,
+    api: &Descriptor,
+) -> (Program, Vec<Diagnostic>) {
     let mut diagnostics = Vec::new();
     let mut program = load::load(sources, root, provider, &mut diagnostics);
     // Checks on a file that did not parse would only repeat its syntax errors.
-    let syntax_ok = !diagnostics.iter().any(|d: &Diagnostic| d.is_error() && d.code.as_str().starts_with("E0"));
+    let syntax_ok =
+        !diagnostics.iter().any(|d: &Diagnostic| d.is_error() && d.code.as_str().starts_with("E0"));
     (program.param_kinds, program.param_origins) = infer::parameter_kinds(&program, api);
     program.signal_values = signal_values::signal_values(&program, api);
     if syntax_ok {

@@ -22,7 +22,12 @@ pub trait SourceProvider {
     fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), LoadError>;
 }
 
-pub(crate) fn load(sources: &mut SourceMap, root: FileId, provider: &dyn SourceProvider, diagnostics: &mut Vec<Diagnostic>) -> Program {
+pub(crate) fn load(
+    sources: &mut SourceMap,
+    root: FileId,
+    provider: &dyn SourceProvider,
+    diagnostics: &mut Vec<Diagnostic>,
+) -> Program {
     let std_id = sources.add(STD_NAME, STD_SOURCE);
     let std_parse = aviary_syntax::parse(std_id, STD_SOURCE);
     diagnostics.extend(std_parse.diagnostics);
@@ -59,14 +64,23 @@ pub(crate) fn load(sources: &mut SourceMap, root: FileId, provider: &dyn SourceP
                 Err(LoadError::Unreadable(why)) => {
                     unreadable.push(u.path.clone());
                     diagnostics.push(
-                        Diagnostic::new(Code::UseNotFound, id, u.path_span, format!("cannot read `{}`: {why}", u.path))
-                            .with_help("the path is relative to the file that holds the USE"),
+                        Diagnostic::new(
+                            Code::UseNotFound,
+                            id,
+                            u.path_span,
+                            format!("cannot read `{}`: {why}", u.path),
+                        )
+                        .with_help("the path is relative to the file that holds the USE"),
                     );
                 }
                 // Said without a word of what the file holds.
                 Err(LoadError::Refused { why, help }) => {
                     unreadable.push(u.path.clone());
-                    let message = if u.path.trim().is_empty() { why } else { format!("this USE of `{}` is refused: {why}", u.path) };
+                    let message = if u.path.trim().is_empty() {
+                        why
+                    } else {
+                        format!("this USE of `{}` is refused: {why}", u.path)
+                    };
                     diagnostics.push(
                         Diagnostic::new(Code::UseRefused, id, u.path_span, message)
                             .label("not read")
@@ -77,9 +91,19 @@ pub(crate) fn load(sources: &mut SourceMap, root: FileId, provider: &dyn SourceP
         }
         files.push((id, tree));
     }
-    let mut program = Program { files, mission: None, capabilities: BTreeMap::new(), param_kinds: BTreeMap::new(), param_origins: BTreeMap::new(), signal_values: BTreeMap::new(), unreadable, index: Default::default() };
+    let mut program = Program {
+        files,
+        mission: None,
+        capabilities: BTreeMap::new(),
+        param_kinds: BTreeMap::new(),
+        param_origins: BTreeMap::new(),
+        signal_values: BTreeMap::new(),
+        unreadable,
+        index: Default::default(),
+    };
     index_definitions(&mut program, std_id, diagnostics);
-    program.index = program.capabilities.iter().map(|(name, r)| (name.as_str().into(), *r)).collect();
+    program.index =
+        program.capabilities.iter().map(|(name, r)| (name.as_str().into(), *r)).collect();
     program
 }
 
@@ -96,9 +120,14 @@ fn index_definitions(program: &mut Program, std_id: FileId, diagnostics: &mut Ve
                 Item::Capability(c) => {
                     if let Some((first, span)) = user.get(&c.name.name) {
                         diagnostics.push(
-                            Diagnostic::new(Code::DuplicateCapability, *file, c.name.span, format!("capability `{}` is defined twice", c.name.name))
-                                .also(first.file, *span, "first defined here")
-                                .with_help("rename one of them, or remove one"),
+                            Diagnostic::new(
+                                Code::DuplicateCapability,
+                                *file,
+                                c.name.span,
+                                format!("capability `{}` is defined twice", c.name.name),
+                            )
+                            .also(first.file, *span, "first defined here")
+                            .with_help("rename one of them, or remove one"),
                         );
                         continue;
                     }

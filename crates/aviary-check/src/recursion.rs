@@ -23,7 +23,8 @@ type Edge<'a> = (usize, &'a Statement);
 
 pub(crate) fn check_recursion(program: &Program, diagnostics: &mut Vec<Diagnostic>) {
     let caps: Vec<(FileId, &Capability)> = program.active_capabilities().collect();
-    let index: foldhash::HashMap<&str, usize> = caps.iter().enumerate().map(|(i, (_, c))| (c.name.name.as_str(), i)).collect();
+    let index: foldhash::HashMap<&str, usize> =
+        caps.iter().enumerate().map(|(i, (_, c))| (c.name.name.as_str(), i)).collect();
     let edges: Vec<Vec<Edge>> = caps
         .iter()
         .map(|(_, c)| {
@@ -44,7 +45,10 @@ pub(crate) fn check_recursion(program: &Program, diagnostics: &mut Vec<Diagnosti
 
 /// Calls `f` on every statement of `c`'s nameless PERFORM that runs whenever `c` runs.
 fn unconditional_calls<'a>(c: &'a Capability, f: &mut dyn FnMut(&'a Statement)) {
-    let guarded = c.sections.iter().any(|s| matches!(s, Section::Requirements { conditions, .. } if !conditions.is_empty()));
+    let guarded = c
+        .sections
+        .iter()
+        .any(|s| matches!(s, Section::Requirements { conditions, .. } if !conditions.is_empty()));
     if guarded {
         return;
     }
@@ -61,7 +65,9 @@ fn visit<'a>(body: &'a Body, f: &mut dyn FnMut(&'a Statement)) {
             Stmt::Statement(s) => f(s),
             Stmt::Block(b) => visit(&b.body, f),
             Stmt::For(x) => visit(&x.body, f),
-            Stmt::Requirement(r) if r.kind == RequirementKind::WaitFor => r.body.iter().for_each(|b| visit(b, f)),
+            Stmt::Requirement(r) if r.kind == RequirementKind::WaitFor => {
+                r.body.iter().for_each(|b| visit(b, f))
+            }
             _ => {}
         }
     }
@@ -129,7 +135,10 @@ fn strongly_connected(edges: &[Vec<Edge>]) -> Vec<Vec<usize>> {
 
 /// The shortest cycle through the component's first capability, as the calls that make
 /// it, in order.
-fn shortest_cycle<'a>(edges: &[Vec<Edge<'a>>], component: &[usize]) -> Option<Vec<(usize, Edge<'a>)>> {
+fn shortest_cycle<'a>(
+    edges: &[Vec<Edge<'a>>],
+    component: &[usize],
+) -> Option<Vec<(usize, Edge<'a>)>> {
     let start = *component.first()?;
     let inside = |v: usize| component.binary_search(&v).is_ok();
     // How each capability was first reached: (caller, the call).
@@ -167,8 +176,14 @@ fn report(caps: &[(FileId, &Capability)], cycle: &[(usize, Edge)]) -> Diagnostic
     let message = if cycle.len() == 1 {
         format!("`{}` calls itself with nothing to stop it: {}", name(first), names.join(" → "))
     } else {
-        let through: Vec<String> = names[1..names.len() - 1].iter().map(|n| format!("`{n}`")).collect();
-        format!("`{}` calls itself through {} with nothing to stop it: {}", name(first), through.join(", "), names.join(" → "))
+        let through: Vec<String> =
+            names[1..names.len() - 1].iter().map(|n| format!("`{n}`")).collect();
+        format!(
+            "`{}` calls itself through {} with nothing to stop it: {}",
+            name(first),
+            through.join(", "),
+            names.join(" → ")
+        )
     };
     let mut d = Diagnostic::new(Code::UnboundedRecursion, caps[first].0, call.capability.span, message)
         .label(format!("every run of `{}` makes this call", name(first)))
@@ -177,7 +192,11 @@ fn report(caps: &[(FileId, &Capability)], cycle: &[(usize, Edge)]) -> Diagnostic
              to repeat something, use DOWHILE instead of a call. (A run fails a call nested too deep with CommandFailed.)",
         );
     for &(caller, (callee, stmt)) in &cycle[1..] {
-        d = d.also(caps[caller].0, stmt.capability.span, format!("`{}` calls `{}` here, every time", name(caller), name(callee)));
+        d = d.also(
+            caps[caller].0,
+            stmt.capability.span,
+            format!("`{}` calls `{}` here, every time", name(caller), name(callee)),
+        );
     }
     d
 }
@@ -197,9 +216,16 @@ mod tests {
     }
 
     fn components(n: usize, pairs: &[(usize, usize)]) -> Vec<Vec<usize>> {
-        let stmt = Statement { actors: Vec::new(), capability: aviary_syntax::ast::Ident { name: String::new(), span: Default::default() }, tag: None, args: Vec::new(), span: Default::default() };
+        let stmt = Statement {
+            actors: Vec::new(),
+            capability: aviary_syntax::ast::Ident { name: String::new(), span: Default::default() },
+            tag: None,
+            args: Vec::new(),
+            span: Default::default(),
+        };
         let owned = graph(n, pairs, &stmt);
-        let edges: Vec<Vec<Edge>> = owned.iter().map(|es| es.iter().map(|(w, s)| (*w, s)).collect()).collect();
+        let edges: Vec<Vec<Edge>> =
+            owned.iter().map(|es| es.iter().map(|(w, s)| (*w, s)).collect()).collect();
         strongly_connected(&edges)
     }
 
@@ -207,7 +233,10 @@ mod tests {
     fn components_with_a_cycle_and_only_those() {
         assert_eq!(components(3, &[(0, 1), (1, 2)]), Vec::<Vec<usize>>::new());
         assert_eq!(components(2, &[(1, 1)]), vec![vec![1]]);
-        assert_eq!(components(4, &[(0, 1), (1, 2), (2, 1), (2, 3), (3, 3)]), vec![vec![1, 2], vec![3]]);
+        assert_eq!(
+            components(4, &[(0, 1), (1, 2), (2, 1), (2, 3), (3, 3)]),
+            vec![vec![1, 2], vec![3]]
+        );
         assert_eq!(components(3, &[(2, 0), (0, 1), (1, 2)]), vec![vec![0, 1, 2]]);
     }
 

@@ -16,13 +16,19 @@ use aviary_syntax::ast::*;
 use crate::env::{bind_args, capability_bodies, literal_kind, visit_stmts};
 use crate::Program;
 
-pub(crate) fn signal_values(program: &Program, api: &Descriptor) -> BTreeMap<String, Vec<Option<Kind>>> {
+pub(crate) fn signal_values(
+    program: &Program,
+    api: &Descriptor,
+) -> BTreeMap<String, Vec<Option<Kind>>> {
     let mut out: BTreeMap<String, Vec<Option<Kind>>> = BTreeMap::new();
     for s in &api.signals {
         out.insert(s.name.to_string(), s.values.iter().map(|(_, k)| Some(*k)).collect());
     }
     let builtin = |name: &str| api.signal(name).is_some();
-    let learn = |out: &mut BTreeMap<String, Vec<Option<Kind>>>, name: &str, i: usize, kind: Option<Kind>| {
+    let learn = |out: &mut BTreeMap<String, Vec<Option<Kind>>>,
+                 name: &str,
+                 i: usize,
+                 kind: Option<Kind>| {
         let values = out.entry(name.to_string()).or_default();
         if values.len() <= i {
             values.resize(i + 1, None);
@@ -35,7 +41,9 @@ pub(crate) fn signal_values(program: &Program, api: &Descriptor) -> BTreeMap<Str
         for item in &tree.items {
             let (bodies, capability) = match item {
                 Item::Mission(m) => (vec![&m.body], None),
-                Item::Capability(c) if program.is_active(*file, c) => (capability_bodies(c), Some(c)),
+                Item::Capability(c) if program.is_active(*file, c) => {
+                    (capability_bodies(c), Some(c))
+                }
                 _ => continue,
             };
             // A parameter of the capability being read, with the kind inference gave it.
@@ -50,12 +58,22 @@ pub(crate) fn signal_values(program: &Program, api: &Descriptor) -> BTreeMap<Str
                 visit_stmts(body, &mut |stmt| match stmt {
                     Stmt::Signal(r) if !builtin(&r.name.name) => {
                         for (i, a) in r.args.iter().enumerate() {
-                            learn(&mut out, &r.name.name, i, literal_kind(&a.value).or_else(|| param_kind(&a.value)));
+                            learn(
+                                &mut out,
+                                &r.name.name,
+                                i,
+                                literal_kind(&a.value).or_else(|| param_kind(&a.value)),
+                            );
                         }
                     }
                     Stmt::Handler(h) if !builtin(&h.signal.name) => {
                         for (i, b) in h.bindings.iter().enumerate() {
-                            learn(&mut out, &h.signal.name, i, binding_kind(program, api, &b.name, &h.body));
+                            learn(
+                                &mut out,
+                                &h.signal.name,
+                                i,
+                                binding_kind(program, api, &b.name, &h.body),
+                            );
                         }
                     }
                     _ => {}
@@ -77,11 +95,18 @@ fn binding_kind(program: &Program, api: &Descriptor, name: &str, body: &Body) ->
         }
         match stmt {
             Stmt::Statement(s) => {
-                let (Some(callee), Some(kinds)) = (program.capability(&s.capability.name), program.param_kinds.get(&s.capability.name)) else {
+                let (Some(callee), Some(kinds)) = (
+                    program.capability(&s.capability.name),
+                    program.param_kinds.get(&s.capability.name),
+                ) else {
                     return;
                 };
                 let binding = bind_args(&callee.params, &s.args);
-                found = binding.bound.iter().zip(kinds).find_map(|(arg, kind)| arg.filter(|a| is_binding(a)).and(*kind));
+                found = binding
+                    .bound
+                    .iter()
+                    .zip(kinds)
+                    .find_map(|(arg, kind)| arg.filter(|a| is_binding(a)).and(*kind));
             }
             Stmt::Api(call) => {
                 let Some(f) = api.function(&call.function.name) else {
@@ -115,7 +140,8 @@ mod tests {
     fn values(mission: &str) -> BTreeMap<String, Vec<Option<Kind>>> {
         let mut sources = SourceMap::default();
         let root = sources.add("m.mission", mission);
-        let (program, _) = crate::check(&mut sources, root, None, &NoFiles, &Descriptor::standard());
+        let (program, _) =
+            crate::check(&mut sources, root, None, &NoFiles, &Descriptor::standard());
         program.signal_values
     }
 

@@ -20,7 +20,11 @@ struct Uses<'a> {
     received: Vec<(FileId, &'a Ident)>,
 }
 
-pub(crate) fn check_signals(program: &Program, api: &Descriptor, diagnostics: &mut Vec<Diagnostic>) {
+pub(crate) fn check_signals(
+    program: &Program,
+    api: &Descriptor,
+    diagnostics: &mut Vec<Diagnostic>,
+) {
     let mut uses = Uses::default();
     for (file, tree) in &program.files {
         for item in &tree.items {
@@ -32,7 +36,8 @@ pub(crate) fn check_signals(program: &Program, api: &Descriptor, diagnostics: &m
             if let Item::Capability(c) = item {
                 for s in &c.sections {
                     if let Section::Exceptions { handlers, .. } = s {
-                        uses.exception_handlers.extend(handlers.iter().map(|h| (*file, &h.exception)));
+                        uses.exception_handlers
+                            .extend(handlers.iter().map(|h| (*file, &h.exception)));
                     }
                     if let Section::Requirements { conditions, .. } = s {
                         for c in conditions {
@@ -47,7 +52,9 @@ pub(crate) fn check_signals(program: &Program, api: &Descriptor, diagnostics: &m
                         Stmt::Signal(r) => uses.raised.push((*file, &r.name)),
                         Stmt::Throw(r) => uses.thrown.push(&r.name.name),
                         Stmt::Handler(h) => uses.handlers.push((*file, &h.signal)),
-                        Stmt::ExceptionHandler(h) => uses.exception_handlers.push((*file, &h.exception)),
+                        Stmt::ExceptionHandler(h) => {
+                            uses.exception_handlers.push((*file, &h.exception))
+                        }
                         _ => {}
                     }
                     for e in stmt_exprs(stmt) {
@@ -59,49 +66,92 @@ pub(crate) fn check_signals(program: &Program, api: &Descriptor, diagnostics: &m
     }
     // The lists keep their order for the "did you mean" help; the sets answer membership
     // in constant time, so a large mission is not checked in quadratic time.
-    let raised: Vec<&str> = uses.raised.iter().map(|(_, i)| i.name.as_str()).chain(api.signals.iter().map(|s| s.name)).collect();
+    let raised: Vec<&str> = uses
+        .raised
+        .iter()
+        .map(|(_, i)| i.name.as_str())
+        .chain(api.signals.iter().map(|s| s.name))
+        .collect();
     let raised_set: HashSet<&str> = raised.iter().copied().collect();
     for (file, h) in &uses.handlers {
         if !raised_set.contains(h.name.as_str()) {
-            let help = did_you_mean(&h.name, raised.iter().copied()).unwrap_or_else(|| format!("raise it somewhere with `SIGNAL {}`", h.name));
+            let help = did_you_mean(&h.name, raised.iter().copied())
+                .unwrap_or_else(|| format!("raise it somewhere with `SIGNAL {}`", h.name));
             diagnostics.push(
-                Diagnostic::new(Code::HandlerNeverFires, *file, h.span, format!("nothing raises `{}`, so this handler never runs", h.name)).with_help(help),
+                Diagnostic::new(
+                    Code::HandlerNeverFires,
+                    *file,
+                    h.span,
+                    format!("nothing raises `{}`, so this handler never runs", h.name),
+                )
+                .with_help(help),
             );
         }
     }
     for (file, r) in &uses.received {
         if !raised_set.contains(r.name.as_str()) {
-            let help = did_you_mean(&r.name, raised.iter().copied()).unwrap_or_else(|| format!("raise it somewhere with `SIGNAL {}`", r.name));
+            let help = did_you_mean(&r.name, raised.iter().copied())
+                .unwrap_or_else(|| format!("raise it somewhere with `SIGNAL {}`", r.name));
             diagnostics.push(
-                Diagnostic::new(Code::SignalNeverRaised, *file, r.span, format!("nothing raises `{}`, so RECEIVED({}) is never true", r.name, r.name))
-                    .with_help(help),
+                Diagnostic::new(
+                    Code::SignalNeverRaised,
+                    *file,
+                    r.span,
+                    format!("nothing raises `{}`, so RECEIVED({}) is never true", r.name, r.name),
+                )
+                .with_help(help),
             );
         }
     }
-    let exceptions: Vec<&str> = api.exceptions.iter().copied().chain(uses.thrown.iter().copied()).collect();
+    let exceptions: Vec<&str> =
+        api.exceptions.iter().copied().chain(uses.thrown.iter().copied()).collect();
     let exception_set: HashSet<&str> = exceptions.iter().copied().collect();
     for (file, e) in &uses.exception_handlers {
         if !exception_set.contains(e.name.as_str()) && raised_set.contains(e.name.as_str()) {
             // `ON EXCEPTION BatteryLow`: a signal, not an exception.
             diagnostics.push(
-                Diagnostic::new(Code::UnknownException, *file, e.span, format!("`{}` is a signal, not an exception, so this handler never runs", e.name))
-                    .with_help(format!("handle a signal with `ON {}:`", e.name)),
+                Diagnostic::new(
+                    Code::UnknownException,
+                    *file,
+                    e.span,
+                    format!(
+                        "`{}` is a signal, not an exception, so this handler never runs",
+                        e.name
+                    ),
+                )
+                .with_help(format!("handle a signal with `ON {}:`", e.name)),
             );
         } else if !exception_set.contains(e.name.as_str()) {
-            let help = did_you_mean(&e.name, exceptions.iter().copied())
-                .unwrap_or_else(|| format!("the built-in exceptions are {}; or throw it with `THROW EXCEPTION {}`", api.exceptions.join(", "), e.name));
+            let help = did_you_mean(&e.name, exceptions.iter().copied()).unwrap_or_else(|| {
+                format!(
+                    "the built-in exceptions are {}; or throw it with `THROW EXCEPTION {}`",
+                    api.exceptions.join(", "),
+                    e.name
+                )
+            });
             diagnostics.push(
-                Diagnostic::new(Code::UnknownException, *file, e.span, format!("`{}` is neither a built-in exception nor thrown anywhere", e.name))
-                    .with_help(help),
+                Diagnostic::new(
+                    Code::UnknownException,
+                    *file,
+                    e.span,
+                    format!("`{}` is neither a built-in exception nor thrown anywhere", e.name),
+                )
+                .with_help(help),
             );
         }
     }
-    let heard: HashSet<&str> = uses.handlers.iter().chain(&uses.received).map(|(_, h)| h.name.as_str()).collect();
+    let heard: HashSet<&str> =
+        uses.handlers.iter().chain(&uses.received).map(|(_, h)| h.name.as_str()).collect();
     for (file, s) in &uses.raised {
         if !heard.contains(s.name.as_str()) {
             diagnostics.push(
-                Diagnostic::new(Code::SignalNeverHandled, *file, s.span, format!("nothing handles `{}`; it is only recorded in the trace", s.name))
-                    .with_help(format!("handle it with `ON {}:` where it should be heard", s.name)),
+                Diagnostic::new(
+                    Code::SignalNeverHandled,
+                    *file,
+                    s.span,
+                    format!("nothing handles `{}`; it is only recorded in the trace", s.name),
+                )
+                .with_help(format!("handle it with `ON {}:` where it should be heard", s.name)),
             );
         }
     }

@@ -56,7 +56,8 @@ pub fn check_written(path: &str) -> Result<(), LoadError> {
 
 /// Whether a file's name ends in `.mission` (and is more than that).
 pub fn is_mission_name(path: &Path) -> bool {
-    path.extension().is_some_and(|e| e == MISSION_EXTENSION) && path.file_stem().is_some_and(|s| !s.is_empty())
+    path.extension().is_some_and(|e| e == MISSION_EXTENSION)
+        && path.file_stem().is_some_and(|s| !s.is_empty())
 }
 
 /// The refusal of a file that is not a mission file.
@@ -81,8 +82,22 @@ mod tests {
     fn only_mission_files_may_be_written() {
         assert_eq!(check_written("lib/beacons.mission"), Ok(()));
         assert_eq!(check_written("../common/a.mission"), Ok(()));
-        for refused in ["", "  ", "/proc/self/environ", "../../../../etc/passwd", "world.toml", "fifo", "/dev/zero", ".mission", "lib/", "a.mission.txt"] {
-            assert!(matches!(check_written(refused), Err(LoadError::Refused { .. })), "{refused:?}");
+        for refused in [
+            "",
+            "  ",
+            "/proc/self/environ",
+            "../../../../etc/passwd",
+            "world.toml",
+            "fifo",
+            "/dev/zero",
+            ".mission",
+            "lib/",
+            "a.mission.txt",
+        ] {
+            assert!(
+                matches!(check_written(refused), Err(LoadError::Refused { .. })),
+                "{refused:?}"
+            );
         }
     }
 

@@ -46,10 +46,16 @@ impl SourceProvider for FixtureProvider {
     fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
         let base = Path::new(from).parent().unwrap_or(Path::new(""));
         let relative = aviary_check::normalize_path(&base.join(path));
-        let name = relative.components().map(|c| c.as_os_str().to_string_lossy().into_owned()).collect::<Vec<_>>().join("/");
+        let name = relative
+            .components()
+            .map(|c| c.as_os_str().to_string_lossy().into_owned())
+            .collect::<Vec<_>>()
+            .join("/");
         match std::fs::read(fixtures_dir().join(&relative)) {
             Ok(bytes) => Ok((name, bytes)),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(format!("there is no file {name}").into()),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                Err(format!("there is no file {name}").into())
+            }
             Err(e) => Err(format!("{} ({name})", e.kind().to_string().to_lowercase()).into()),
         }
     }
@@ -81,12 +87,21 @@ fn world_of(rel: &str, bytes: &[u8]) -> Option<String> {
 
 /// Checks one fixture as `aviary check` does: world first, then the mission.
 fn check_fixture(rel: &str) -> Outcome {
-    let bytes = std::fs::read(fixtures_dir().join(rel)).unwrap_or_else(|e| panic!("cannot read {rel}: {e}"));
+    let bytes = std::fs::read(fixtures_dir().join(rel))
+        .unwrap_or_else(|e| panic!("cannot read {rel}: {e}"));
     let mut sources = SourceMap::new();
     let world_rel = world_of(rel, &bytes);
-    let world_bytes = world_rel.as_ref().map(|w| std::fs::read(fixtures_dir().join(w)).unwrap_or_else(|e| panic!("cannot read {w}: {e}")));
+    let world_bytes = world_rel.as_ref().map(|w| {
+        std::fs::read(fixtures_dir().join(w)).unwrap_or_else(|e| panic!("cannot read {w}: {e}"))
+    });
     let world = world_rel.as_deref().zip(world_bytes.as_deref());
-    let checked = aviary_check::check_sources(&mut sources, (rel, &bytes), world, &FixtureProvider, &Descriptor::standard());
+    let checked = aviary_check::check_sources(
+        &mut sources,
+        (rel, &bytes),
+        world,
+        &FixtureProvider,
+        &Descriptor::standard(),
+    );
     let diagnostics = checked.diagnostics;
     Outcome { sources, diagnostics }
 }
@@ -110,7 +125,10 @@ fn render(rel: &str, outcome: &Outcome) -> String {
 
 fn relative(path: &Path) -> String {
     let rel = path.strip_prefix(fixtures_dir()).expect("a fixture under tests/fixtures");
-    rel.components().map(|c| c.as_os_str().to_string_lossy().into_owned()).collect::<Vec<_>>().join("/")
+    rel.components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect::<Vec<_>>()
+        .join("/")
 }
 
 /// The code an invalid fixture's name starts with: `e107_takeoff...` is E107.
@@ -146,7 +164,11 @@ fn every_code_is_produced_by_some_invalid_fixture() {
         seen.extend(check_fixture(&rel).codes());
     }
     // The pre-flight codes come after compilation; aviary-verify's fixtures cover them.
-    let missing: Vec<&str> = Code::ALL.iter().filter(|c| !seen.contains(c) && !Code::PREFLIGHT.contains(c)).map(|c| c.as_str()).collect();
+    let missing: Vec<&str> = Code::ALL
+        .iter()
+        .filter(|c| !seen.contains(c) && !Code::PREFLIGHT.contains(c))
+        .map(|c| c.as_str())
+        .collect();
     assert!(missing.is_empty(), "no invalid fixture produces {}", missing.join(", "));
 }
 
@@ -160,8 +182,10 @@ fn every_invalid_fixture_produces_the_code_it_is_named_after() {
         };
         let outcome = check_fixture(&rel);
         // The code's own severity: an error or warning for E and W codes, a note for N codes.
-        let found = outcome.diagnostics.iter().any(|d| d.code == code && d.severity == code.severity());
-        let counts = outcome.diagnostics.iter().any(|d| d.severity != Severity::Note) || code.severity() == Severity::Note;
+        let found =
+            outcome.diagnostics.iter().any(|d| d.code == code && d.severity == code.severity());
+        let counts = outcome.diagnostics.iter().any(|d| d.severity != Severity::Note)
+            || code.severity() == Severity::Note;
         if !found || !counts {
             let got: Vec<&str> = outcome.codes().iter().map(|c| c.as_str()).collect();
             wrong.push(format!("{rel}: expected {code}, got [{}]", got.join(", ")));
@@ -194,7 +218,8 @@ fn the_standard_library_parses_clean_and_is_canonically_formatted() {
     let parse = aviary_syntax::parse(aviary_diagnostics::FileId(0), text);
     let mut sources = SourceMap::new();
     sources.add(aviary_check::STD_NAME, text);
-    let rendered: Vec<String> = parse.diagnostics.iter().map(|d| render_text(&sources, d, false)).collect();
+    let rendered: Vec<String> =
+        parse.diagnostics.iter().map(|d| render_text(&sources, d, false)).collect();
     assert!(rendered.is_empty(), "std/standard.mission has diagnostics:\n{}", rendered.join(""));
     let formatted = aviary_syntax::format(&parse.tree, text, &parse.line_starts);
     assert!(formatted == text, "std/standard.mission is not in the canonical layout; `aviary fmt` would write:\n{formatted}");
@@ -203,9 +228,17 @@ fn the_standard_library_parses_clean_and_is_canonically_formatted() {
 #[test]
 fn every_code_has_a_section_in_diagnostics_md() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/DIAGNOSTICS.md");
-    let doc = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    let doc = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
     let headings: Vec<&str> = doc.lines().filter_map(|l| l.strip_prefix("## ")).collect();
-    let missing: Vec<&str> =
-        Code::ALL.iter().map(|c| c.as_str()).filter(|c| !headings.iter().any(|h| h.split_whitespace().next() == Some(*c))).collect();
-    assert!(missing.is_empty(), "docs/DIAGNOSTICS.md has no `## CODE` heading for {}", missing.join(", "));
+    let missing: Vec<&str> = Code::ALL
+        .iter()
+        .map(|c| c.as_str())
+        .filter(|c| !headings.iter().any(|h| h.split_whitespace().next() == Some(*c)))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "docs/DIAGNOSTICS.md has no `## CODE` heading for {}",
+        missing.join(", ")
+    );
 }

@@ -102,7 +102,13 @@ mod tests {
     fn the_options_set_are_the_ones_meant() {
         tune();
         // SAFETY: getters of mimalloc's option table.
-        let (purge, eager, errors) = unsafe { (mi::mi_option_get(PURGE_DELAY), mi::mi_option_get(ARENA_EAGER_COMMIT), mi::mi_option_get(mi::mi_option_show_errors)) };
+        let (purge, eager, errors) = unsafe {
+            (
+                mi::mi_option_get(PURGE_DELAY),
+                mi::mi_option_get(ARENA_EAGER_COMMIT),
+                mi::mi_option_get(mi::mi_option_show_errors),
+            )
+        };
         if std::env::var_os("MIMALLOC_PURGE_DELAY").is_none() {
             assert_eq!(purge, 10);
         }

@@ -89,7 +89,9 @@ pub enum BenchCommand {
 pub fn run(which: BenchCommand) -> u8 {
     match which {
         BenchCommand::Parse { mb, runs } => parse(mb, runs),
-        BenchCommand::W { n, k, emit, emit_world, full_trace } => w::run(n, k, emit, emit_world, full_trace),
+        BenchCommand::W { n, k, emit, emit_world, full_trace } => {
+            w::run(n, k, emit, emit_world, full_trace)
+        }
         BenchCommand::Swarm { drones, emit, emit_world } => swarm::run(drones, emit, emit_world),
         BenchCommand::Front { shape, n, runs } => front::run(shape, n, runs),
     }

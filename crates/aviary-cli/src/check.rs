@@ -14,7 +14,13 @@ pub struct Plan {
     pub ask: bool,
 }
 
-pub fn run(files: &[PathBuf], world: Option<&Path>, format: Format, plan: Plan, use_roots: &[PathBuf]) -> u8 {
+pub fn run(
+    files: &[PathBuf],
+    world: Option<&Path>,
+    format: Format,
+    plan: Plan,
+    use_roots: &[PathBuf],
+) -> u8 {
     let roots = match use_roots_of(use_roots) {
         Ok(r) => r,
         Err(why) => {
@@ -29,7 +35,13 @@ pub fn run(files: &[PathBuf], world: Option<&Path>, format: Format, plan: Plan, 
     worst
 }
 
-fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want: Plan, use_roots: &[PathBuf]) -> u8 {
+fn check_one(
+    path: &Path,
+    world_path: Option<&Path>,
+    format: Format,
+    want: Plan,
+    use_roots: &[PathBuf],
+) -> u8 {
     let want_plan = want.plan;
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
@@ -61,7 +73,8 @@ fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want: Plan,
     let world = world_name.as_deref().zip(world_bytes.as_deref());
     let name = path.display().to_string();
     let api = aviary_sim::descriptor();
-    let mut checked = aviary_check::check_sources(&mut sources, (&name, &bytes), world, &provider, &api);
+    let mut checked =
+        aviary_check::check_sources(&mut sources, (&name, &bytes), world, &provider, &api);
     // MAVLink drones fly with their vehicles' figures: the plan is made with them.
     let mut figures = None;
     if want.ask && !checked.has_errors() {
@@ -84,7 +97,11 @@ fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want: Plan,
     }
     let Some(mut plan) = plan else {
         print(&sources, &diagnostics, format, path);
-        eprintln!("aviary: no plan for {}: {}", path.display(), why_no_plan(failed == 1, world_name.is_some()));
+        eprintln!(
+            "aviary: no plan for {}: {}",
+            path.display(),
+            why_no_plan(failed == 1, world_name.is_some())
+        );
         return failed.max(1);
     };
     plan.locate(|o| {
@@ -102,10 +119,13 @@ fn check_one(path: &Path, world_path: Option<&Path>, format: Format, want: Plan,
             out!("\n{}", plan.render_text());
         }
         Format::Json => {
-            let diagnostics: Vec<serde_json::Value> = diagnostics.iter().map(|d| render_json(&sources, d)).collect();
+            let diagnostics: Vec<serde_json::Value> =
+                diagnostics.iter().map(|d| render_json(&sources, d)).collect();
             let mut doc = serde_json::json!({ "file": path.display().to_string(), "plan": plan, "diagnostics": diagnostics });
             match &figures {
-                Some(Ok(f)) if !f.is_empty() => doc["vehicles"] = f.iter().map(crate::figures::Source::json).collect(),
+                Some(Ok(f)) if !f.is_empty() => {
+                    doc["vehicles"] = f.iter().map(crate::figures::Source::json).collect()
+                }
                 Some(Err(why)) => doc["vehicles_not_asked"] = why.as_str().into(),
                 _ => {}
             }

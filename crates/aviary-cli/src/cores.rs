@@ -14,7 +14,9 @@ pub fn join(a: &mut (dyn FnMut() + Send), b: &mut (dyn FnMut() + Send)) {
     let beside = std::thread::scope(|s| {
         let other = std::thread::Builder::new().name("world".into()).spawn_scoped(s, &mut *b);
         a();
-        other.map(|handle| handle.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))).is_ok()
+        other
+            .map(|handle| handle.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
+            .is_ok()
     });
     if !beside {
         b();

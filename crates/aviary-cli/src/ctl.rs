@@ -41,7 +41,12 @@ pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
                     Err(why) => return refuse_value(v, &why),
                 };
             }
-            post(base, "leash", token, json!({ "activity": activity, "action": action, "args": named }))
+            post(
+                base,
+                "leash",
+                token,
+                json!({ "activity": activity, "action": action, "args": named }),
+            )
         }
         CtlCommand::Signal { name, values } => {
             let mut args = Vec::new();
@@ -63,7 +68,10 @@ pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
             0
         }
         Ok((status, body)) => {
-            let why = serde_json::from_str::<Value>(&body).ok().and_then(|v| v["error"].as_str().map(str::to_string)).unwrap_or(body);
+            let why = serde_json::from_str::<Value>(&body)
+                .ok()
+                .and_then(|v| v["error"].as_str().map(str::to_string))
+                .unwrap_or(body);
             eprintln!("aviary: refused ({status}): {why}");
             1
         }
@@ -92,7 +100,8 @@ fn get(url: &str, token: Option<&str>) -> Result<(u16, String), String> {
 }
 
 fn post(base: &str, call: &str, token: Option<&str>, body: Value) -> Result<(u16, String), String> {
-    let mut request = agent().post(format!("{base}/api/{call}")).header("Content-Type", "application/json");
+    let mut request =
+        agent().post(format!("{base}/api/{call}")).header("Content-Type", "application/json");
     if let Some(token) = token {
         request = request.header("Authorization", format!("Bearer {token}"));
     }
@@ -120,7 +129,10 @@ fn events(base: &str, token: Option<&str>) -> u8 {
         Ok(s) => s,
         Err(tungstenite::Error::Http(response)) => {
             let body = response.body().as_deref().map(String::from_utf8_lossy).unwrap_or_default();
-            let why = serde_json::from_str::<Value>(&body).ok().and_then(|v| v["error"].as_str().map(str::to_string)).unwrap_or(body.into_owned());
+            let why = serde_json::from_str::<Value>(&body)
+                .ok()
+                .and_then(|v| v["error"].as_str().map(str::to_string))
+                .unwrap_or(body.into_owned());
             eprintln!("aviary: refused ({}): {why}", response.status().as_u16());
             return 1;
         }
@@ -154,13 +166,16 @@ fn refuse_value(text: &str, why: &str) -> u8 {
 /// server can refuse `10s` where a length is expected; a position is `[x, y(, z)]` in
 /// metres; a name or a string is a string.
 fn value(text: &str) -> Result<Value, String> {
-    let expr = aviary_syntax::parse_value(text).map_err(|d| d.first().map(|d| d.message.clone()).unwrap_or_default())?;
+    let expr = aviary_syntax::parse_value(text)
+        .map_err(|d| d.first().map(|d| d.message.clone()).unwrap_or_default())?;
     to_json(&expr)
 }
 
 fn to_json(expr: &Expr) -> Result<Value, String> {
     match &expr.kind {
-        ExprKind::Number { value, unit: Some(unit), .. } => Ok(json!({ "number": value, "unit": unit.as_str() })),
+        ExprKind::Number { value, unit: Some(unit), .. } => {
+            Ok(json!({ "number": value, "unit": unit.as_str() }))
+        }
         ExprKind::Number { value, unit: None, .. } => Ok(json!({ "number": value })),
         ExprKind::String(s) => Ok(json!(s)),
         ExprKind::Name(id) => Ok(json!(id.name)),
@@ -172,7 +187,12 @@ fn to_json(expr: &Expr) -> Result<Value, String> {
                 match &p.kind {
                     // A coordinate is a number of metres, with or without its unit (as the checker reads it).
                     ExprKind::Number { value, unit: None, .. } => metres.push(*value),
-                    ExprKind::Number { value, unit: Some(u), .. } if matches!(u, aviary_syntax::ast::Unit::Metre | aviary_syntax::ast::Unit::Kilometre) => {
+                    ExprKind::Number { value, unit: Some(u), .. }
+                        if matches!(
+                            u,
+                            aviary_syntax::ast::Unit::Metre | aviary_syntax::ast::Unit::Kilometre
+                        ) =>
+                    {
                         metres.push(value * u.to_si())
                     }
                     _ => return Err("a coordinate is a number of metres".into()),

@@ -70,7 +70,13 @@ pub fn render(sources: &[Source]) -> String {
 /// and the autopilot's failsafe may bring it home, and only the operator knows whether
 /// the estimate is too cautious. So it is said loudly, even with `--quiet`, and the
 /// operator can stop (Ctrl-C) before take-off. Returns the drones that run out.
-pub fn before_flight(mission: &aviary_ir::Mission, world: &World, facts: &[Facts], sources: &SourceMap, quiet: bool) -> Vec<String> {
+pub fn before_flight(
+    mission: &aviary_ir::Mission,
+    world: &World,
+    facts: &[Facts],
+    sources: &SourceMap,
+    quiet: bool,
+) -> Vec<String> {
     let mut world = world.clone();
     let applied = apply(&mut world, facts);
     let verification = aviary_verify::verify(mission, &world);
@@ -80,7 +86,8 @@ pub fn before_flight(mission: &aviary_ir::Mission, world: &World, facts: &[Facts
             eprint!("{}", render_text(sources, d, color_wanted()));
         }
     }
-    let empty: Vec<&aviary_verify::plan::DronePlan> = verification.plan.drones.iter().filter(|p| p.battery_left <= 0.0).collect();
+    let empty: Vec<&aviary_verify::plan::DronePlan> =
+        verification.plan.drones.iter().filter(|p| p.battery_left <= 0.0).collect();
     for p in &empty {
         let start = world.drones.iter().find(|d| d.name == p.drone).map_or(100.0, |d| d.battery);
         eprintln!(

@@ -3,7 +3,9 @@
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use aviary_check::uses::{is_mission_name, not_a_mission, within_roots, MAX_USE_BYTES, OUTSIDE_HELP};
+use aviary_check::uses::{
+    is_mission_name, not_a_mission, within_roots, MAX_USE_BYTES, OUTSIDE_HELP,
+};
 use aviary_check::{LoadError, SourceProvider};
 
 /// Reads USEd files relative to the file that holds the USE, and only those the rules
@@ -21,7 +23,8 @@ impl DiskProvider {
             Some(p) if !p.as_os_str().is_empty() => p,
             _ => Path::new("."),
         };
-        let own = std::fs::canonicalize(folder).map_err(|e| format!("cannot find the folder of {}: {e}", mission.display()))?;
+        let own = std::fs::canonicalize(folder)
+            .map_err(|e| format!("cannot find the folder of {}: {e}", mission.display()))?;
         Ok(DiskProvider { roots: std::iter::once(own).chain(use_roots.iter().cloned()).collect() })
     }
 }
@@ -29,12 +32,10 @@ impl DiskProvider {
 /// The `--use-root DIR`s, resolved; each must be a folder.
 pub fn use_roots(dirs: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
     dirs.iter()
-        .map(|dir| {
-            match std::fs::canonicalize(dir) {
-                Ok(p) if p.is_dir() => Ok(p),
-                Ok(_) => Err(format!("--use-root {}: not a folder", dir.display())),
-                Err(e) => Err(format!("--use-root {}: {e}", dir.display())),
-            }
+        .map(|dir| match std::fs::canonicalize(dir) {
+            Ok(p) if p.is_dir() => Ok(p),
+            Ok(_) => Err(format!("--use-root {}: not a folder", dir.display())),
+            Err(e) => Err(format!("--use-root {}: {e}", dir.display())),
         })
         .collect()
 }
@@ -46,13 +47,25 @@ impl SourceProvider for DiskProvider {
         let name = full.to_string_lossy().into_owned();
         let resolved = match std::fs::canonicalize(&full) {
             Ok(p) => p,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(format!("there is no file {name}").into()),
-            Err(e) => return Err(format!("{} ({name})", e.kind().to_string().to_lowercase()).into()),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                return Err(format!("there is no file {name}").into())
+            }
+            Err(e) => {
+                return Err(format!("{} ({name})", e.kind().to_string().to_lowercase()).into())
+            }
         };
         if !within_roots(&resolved, &self.roots) {
             let shown: Vec<String> = self.roots.iter().map(|r| r.display().to_string()).collect();
-            let leads = if resolved != std::path::absolute(&full).unwrap_or_default() { format!(" (it leads to {})", resolved.display()) } else { String::new() };
-            let why = format!("{name}{leads} is outside the mission's folder{} {}", if shown.len() > 1 { " and the --use-root folders" } else { "" }, shown.join(", "));
+            let leads = if resolved != std::path::absolute(&full).unwrap_or_default() {
+                format!(" (it leads to {})", resolved.display())
+            } else {
+                String::new()
+            };
+            let why = format!(
+                "{name}{leads} is outside the mission's folder{} {}",
+                if shown.len() > 1 { " and the --use-root folders" } else { "" },
+                shown.join(", ")
+            );
             return Err(LoadError::Refused { why, help: OUTSIDE_HELP.into() });
         }
         // A symlink `a.mission` to `notes.txt` is no mission file either.
@@ -74,14 +87,24 @@ fn read_bounded(path: &Path, name: &str) -> Result<(String, Vec<u8>), LoadError>
         use std::os::unix::fs::OpenOptionsExt;
         options.custom_flags(libc::O_NONBLOCK);
     }
-    let file = options.open(path).map_err(|e| LoadError::Unreadable(format!("{} ({name})", e.kind().to_string().to_lowercase())))?;
-    let meta = file.metadata().map_err(|e| LoadError::Unreadable(format!("{} ({name})", e.kind().to_string().to_lowercase())))?;
+    let file = options.open(path).map_err(|e| {
+        LoadError::Unreadable(format!("{} ({name})", e.kind().to_string().to_lowercase()))
+    })?;
+    let meta = file.metadata().map_err(|e| {
+        LoadError::Unreadable(format!("{} ({name})", e.kind().to_string().to_lowercase()))
+    })?;
     if !meta.is_file() {
         let what = if meta.is_dir() { "a folder" } else { "a device, pipe or socket" };
-        return Err(LoadError::Refused { why: format!("{name} is {what}, not a regular file"), help: "USE a .mission file".into() });
+        return Err(LoadError::Refused {
+            why: format!("{name} is {what}, not a regular file"),
+            help: "USE a .mission file".into(),
+        });
     }
     let too_large = |size: u64| LoadError::Refused {
-        why: format!("{name} has {size} bytes, more than the {} MiB a USEd file may have", MAX_USE_BYTES >> 20),
+        why: format!(
+            "{name} has {size} bytes, more than the {} MiB a USEd file may have",
+            MAX_USE_BYTES >> 20
+        ),
         help: "split the library into several files, each USEd".into(),
     };
     if meta.len() > MAX_USE_BYTES {
@@ -89,7 +112,9 @@ fn read_bounded(path: &Path, name: &str) -> Result<(String, Vec<u8>), LoadError>
     }
     let mut bytes = Vec::with_capacity(meta.len() as usize);
     // One byte past the limit tells a file that grew since.
-    file.take(MAX_USE_BYTES + 1).read_to_end(&mut bytes).map_err(|e| LoadError::Unreadable(format!("{} ({name})", e.kind().to_string().to_lowercase())))?;
+    file.take(MAX_USE_BYTES + 1).read_to_end(&mut bytes).map_err(|e| {
+        LoadError::Unreadable(format!("{} ({name})", e.kind().to_string().to_lowercase()))
+    })?;
     if bytes.len() as u64 > MAX_USE_BYTES {
         return Err(too_large(bytes.len() as u64));
     }

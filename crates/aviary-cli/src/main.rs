@@ -8,10 +8,10 @@ mod out;
 mod alloc;
 mod bench;
 mod check;
+mod cores;
 mod ctl;
 mod figures;
 mod files;
-mod cores;
 mod fmt;
 mod mixed;
 mod run;
@@ -171,7 +171,10 @@ const STACK: usize = 1 << 30;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let worker = std::thread::Builder::new().name("aviary".into()).stack_size(STACK).spawn(move || command(cli));
+    let worker = std::thread::Builder::new()
+        .name("aviary".into())
+        .stack_size(STACK)
+        .spawn(move || command(cli));
     match worker.map(|w| w.join()) {
         Ok(Ok(code)) => ExitCode::from(code),
         Ok(Err(_)) => ExitCode::from(101),
@@ -184,15 +187,44 @@ fn main() -> ExitCode {
 
 fn command(cli: Cli) -> u8 {
     let code = match cli.command {
-        Command::Check { files, world, format, plan, offline, use_root } => check::run(&files, world.as_deref(), format, check::Plan { plan, ask: plan && !offline }, &use_root),
+        Command::Check { files, world, format, plan, offline, use_root } => check::run(
+            &files,
+            world.as_deref(),
+            format,
+            check::Plan { plan, ask: plan && !offline },
+            &use_root,
+        ),
         Command::Fmt { files, check } => fmt::run(&files, check),
-        Command::Run { file, world, speed, seed, trace, telemetry_hz, quiet, serve, allow_host, use_root } => {
+        Command::Run {
+            file,
+            world,
+            speed,
+            seed,
+            trace,
+            telemetry_hz,
+            quiet,
+            serve,
+            allow_host,
+            use_root,
+        } => {
             // Served to an operator, a mission runs in real time unless told otherwise.
-            let speed = speed.unwrap_or_else(|| if serve.is_some() { "1".into() } else { "max".into() });
+            let speed =
+                speed.unwrap_or_else(|| if serve.is_some() { "1".into() } else { "max".into() });
             match (run::parse_speed(&speed), serve.as_deref().map(run::parse_serve).transpose()) {
                 (Ok(speed), Ok(serve)) => {
-                    let serve = serve.map(|address| serve::Serve { address, allowed_hosts: allow_host });
-                    run::run(&run::RunArgs { file, world, speed, seed, trace, telemetry_hz, quiet, serve, use_root })
+                    let serve =
+                        serve.map(|address| serve::Serve { address, allowed_hosts: allow_host });
+                    run::run(&run::RunArgs {
+                        file,
+                        world,
+                        speed,
+                        seed,
+                        trace,
+                        telemetry_hz,
+                        quiet,
+                        serve,
+                        use_root,
+                    })
                 }
                 (Err(why), _) | (_, Err(why)) => {
                     eprintln!("aviary: {why}");
@@ -202,7 +234,12 @@ fn command(cli: Cli) -> u8 {
         }
         Command::Ctl { url, token, command } => ctl::run(&url, token.as_deref(), command),
         Command::Vehicles { world, listen, speed, signing_key } => {
-            vehicles::run(&vehicles::VehiclesArgs { world: &world, listen: &listen, speed, signing_key: signing_key.as_deref() })
+            vehicles::run(&vehicles::VehiclesArgs {
+                world: &world,
+                listen: &listen,
+                speed,
+                signing_key: signing_key.as_deref(),
+            })
         }
         Command::Explain { code } => explain(&code),
         Command::Bench { which } => bench::run(which),
@@ -218,7 +255,9 @@ fn explain(code: &str) -> u8 {
             0
         }
         None => {
-            eprintln!("aviary: no diagnostic has the code `{code}`; codes look like E107, W201 or N301");
+            eprintln!(
+                "aviary: no diagnostic has the code `{code}`; codes look like E107, W201 or N301"
+            );
             2
         }
     }

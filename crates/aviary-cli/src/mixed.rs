@@ -6,7 +6,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 use aviary_api::{
-    Backend, CallId, Descriptor, DroneEvent, DroneId, Ending, Interrupt, PendingCall, Telemetry, Value,
+    Backend, CallId, Descriptor, DroneEvent, DroneId, Ending, Interrupt, PendingCall, Telemetry,
+    Value,
 };
 use aviary_mavlink::MavlinkBackend;
 use aviary_sim::SimBackend;
@@ -34,9 +35,8 @@ impl Mixed {
     /// Call inside the tokio runtime (it starts the task that merges the event streams).
     pub fn new(sim: Arc<SimBackend>, mavlink: MavlinkBackend) -> Mixed {
         let (tx, rx) = mpsc::unbounded_channel();
-        let served: Vec<bool> = (0..sim.with_fleet(|f| f.len()))
-            .map(|d| mavlink.serves(d))
-            .collect();
+        let served: Vec<bool> =
+            (0..sim.with_fleet(|f| f.len())).map(|d| mavlink.serves(d)).collect();
         if let Some(mut from_sim) = sim.events() {
             let tx = tx.clone();
             let served = served.clone();
@@ -86,10 +86,7 @@ impl Backend for Mixed {
             Ending::Now(end) => return PendingCall { id, end: Ending::Now(end) },
             Ending::Later(rx) => rx,
         };
-        self.calls
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .insert(id, (by_mavlink, inner.id));
+        self.calls.lock().unwrap_or_else(|p| p.into_inner()).insert(id, (by_mavlink, inner.id));
         // Pass the end on, and forget the call once it has ended.
         let (tx, rx) = oneshot::channel();
         let calls = Arc::clone(&self.calls);
@@ -104,12 +101,8 @@ impl Backend for Mixed {
     }
 
     fn interrupt(&self, call: CallId, how: Interrupt) {
-        let Some((by_mavlink, inner)) = self
-            .calls
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .get(&call)
-            .copied()
+        let Some((by_mavlink, inner)) =
+            self.calls.lock().unwrap_or_else(|p| p.into_inner()).get(&call).copied()
         else {
             return;
         };
@@ -136,7 +129,5 @@ impl Backend for Mixed {
 /// The runtime of a run with MAVLink drones: one thread as in a simulated run (the engine
 /// relies on it), but the wall clock and sockets.
 pub fn live_runtime() -> std::io::Result<tokio::runtime::Runtime> {
-    tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
+    tokio::runtime::Builder::new_current_thread().enable_all().build()
 }

@@ -33,7 +33,9 @@ pub fn parse_serve(text: &str) -> Result<std::net::SocketAddr, String> {
     if let Ok(port) = text.parse::<u16>() {
         return Ok(std::net::SocketAddr::from(([127, 0, 0, 1], port)));
     }
-    text.parse().map_err(|_| format!("`{text}` is not a port or HOST:PORT for --serve: write 7878 or 127.0.0.1:7878"))
+    text.parse().map_err(|_| {
+        format!("`{text}` is not a port or HOST:PORT for --serve: write 7878 or 127.0.0.1:7878")
+    })
 }
 
 /// `max` or a positive number of times real time.
@@ -43,7 +45,9 @@ pub fn parse_speed(text: &str) -> Result<Option<f64>, String> {
     }
     match text.parse::<f64>() {
         Ok(x) if x > 0.0 && x.is_finite() => Ok(Some(x)),
-        _ => Err(format!("`{text}` is not a speed: write `max` or a positive number such as 1 or 10")),
+        _ => Err(format!(
+            "`{text}` is not a speed: write `max` or a positive number such as 1 or 10"
+        )),
     }
 }
 
@@ -70,8 +74,12 @@ pub fn run(args: &RunArgs) -> u8 {
         }
     };
     let Some(world_path) = args.world.clone().or_else(|| world_beside(&args.file)) else {
-        let stem = args.file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-        eprintln!("aviary: {} has no world file: put {stem}.world.toml beside it, or pass --world FILE", args.file.display());
+        let stem =
+            args.file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        eprintln!(
+            "aviary: {} has no world file: put {stem}.world.toml beside it, or pass --world FILE",
+            args.file.display()
+        );
         return 2;
     };
     let world_bytes = match std::fs::read(&world_path) {
@@ -86,7 +94,14 @@ pub fn run(args: &RunArgs) -> u8 {
     let world_name = world_path.display().to_string();
     // A large world is read on two threads, as `aviary bench w` does.
     let api = aviary_sim::descriptor();
-    let checked = aviary_check::check_sources_joined(&mut sources, (&name, &bytes), Some((&world_name, &world_bytes)), &provider, &api, &crate::cores::join);
+    let checked = aviary_check::check_sources_joined(
+        &mut sources,
+        (&name, &bytes),
+        Some((&world_name, &world_bytes)),
+        &provider,
+        &api,
+        &crate::cores::join,
+    );
     if checked.has_errors() {
         for d in checked.diagnostics.iter().filter(|d| d.is_error()) {
             eprint!("{}", render_text(&sources, d, color_wanted()));
@@ -107,7 +122,10 @@ pub fn run(args: &RunArgs) -> u8 {
     };
     let (Some(program), Some(world)) = (checked.program, checked.world) else { return 2 };
     let Some(mission) = aviary_ir::compile(&program, &world, &api) else {
-        eprintln!("aviary: {} has no MISSION to run (it holds only capabilities)", args.file.display());
+        eprintln!(
+            "aviary: {} has no MISSION to run (it holds only capabilities)",
+            args.file.display()
+        );
         return 2;
     };
     drop(program);
@@ -121,18 +139,30 @@ pub fn run(args: &RunArgs) -> u8 {
         },
         None => Box::new(std::io::sink()),
     };
-    let trace = TraceFile::new(out, args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default(), mission.name.clone());
+    let trace = TraceFile::new(
+        out,
+        args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default(),
+        mission.name.clone(),
+    );
     let _ = args.seed; // The simulator has no randomness yet; the seed is kept for it.
-    // Any MAVLink drone: the wall clock, and the simulated drones in real time with it.
+                       // Any MAVLink drone: the wall clock, and the simulated drones in real time with it.
     let live = !aviary_mavlink::bindings(&world).is_empty();
     if live && args.speed.is_some() {
-        eprintln!("aviary: {} has MAVLink drones, which fly in real time: leave out --speed", world_path.display());
+        eprintln!(
+            "aviary: {} has MAVLink drones, which fly in real time: leave out --speed",
+            world_path.display()
+        );
         return 2;
     }
     // Simulated drones only: the fleet takes the world's drones where they lie. With
     // MAVLink drones the world is kept to connect them.
-    let (fleet, world) = if live { (Fleet::new(&world), Some(world)) } else { (Fleet::from_world(world), None) };
-    let runtime = match if live { crate::mixed::live_runtime() } else { tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build() } {
+    let (fleet, world) =
+        if live { (Fleet::new(&world), Some(world)) } else { (Fleet::from_world(world), None) };
+    let runtime = match if live {
+        crate::mixed::live_runtime()
+    } else {
+        tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build()
+    } {
         Ok(r) => r,
         Err(e) => {
             eprintln!("aviary: cannot start the runtime: {e}");
@@ -143,7 +173,12 @@ pub fn run(args: &RunArgs) -> u8 {
     // The first stop signal, also seen before the engine runs (while vehicles connect).
     let (stop_tx, stop_rx) = tokio::sync::watch::channel(None::<&'static str>);
     on_stop_signals(controller.clone(), stop_tx, trace.clone());
-    let server = match args.serve.as_ref().map(|serve| crate::serve::start(serve, &mission, controller.clone())).transpose() {
+    let server = match args
+        .serve
+        .as_ref()
+        .map(|serve| crate::serve::start(serve, &mission, controller.clone()))
+        .transpose()
+    {
         Ok(s) => s,
         Err(why) => {
             eprintln!("aviary: {why}");
@@ -229,7 +264,10 @@ pub fn run(args: &RunArgs) -> u8 {
         }
     }
     if let Some(why) = lock(&trace).failed() {
-        eprintln!("aviary: the trace {} is not whole: {why}", args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default());
+        eprintln!(
+            "aviary: the trace {} is not whole: {why}",
+            args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default()
+        );
         return 3;
     }
     u8::from(outcome.status != Status::Ok)
@@ -241,7 +279,11 @@ pub fn run(args: &RunArgs) -> u8 {
 /// a logout, a service manager): with MAVLink drones, stopping at once would leave them
 /// without a ground station. A second signal of any of the three stops at once, still
 /// closing the trace.
-fn on_stop_signals(controller: Controller, stop: tokio::sync::watch::Sender<Option<&'static str>>, trace: SharedTrace) {
+fn on_stop_signals(
+    controller: Controller,
+    stop: tokio::sync::watch::Sender<Option<&'static str>>,
+    trace: SharedTrace,
+) {
     use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     let mut signals = match signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
         Ok(s) => s,
@@ -279,7 +321,9 @@ async fn watch_backend(driver: Option<tokio::task::JoinHandle<()>>, controller: 
     if let Some(handle) = driver {
         if let Err(e) = handle.await {
             if e.is_panic() {
-                controller.send(Control::BackendLost { reason: "the simulator stopped: its task panicked".into() });
+                controller.send(Control::BackendLost {
+                    reason: "the simulator stopped: its task panicked".into(),
+                });
             }
         }
     }
@@ -291,7 +335,10 @@ fn progress_bar(quiet: bool) -> ProgressBar {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::new_spinner();
-    bar.set_style(ProgressStyle::with_template("{spinner} {msg}").unwrap_or_else(|_| ProgressStyle::default_spinner()));
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
     bar
 }
 
@@ -306,7 +353,13 @@ struct Stats {
 }
 
 impl Stats {
-    fn observe(&mut self, event: &serde_json::Value, progress: &ProgressBar, backend: &dyn Backend, drones: usize) {
+    fn observe(
+        &mut self,
+        event: &serde_json::Value,
+        progress: &ProgressBar,
+        backend: &dyn Backend,
+        drones: usize,
+    ) {
         let kind = event["event"].as_str().unwrap_or("");
         match kind {
             "capability_start" => self.running += 1,
@@ -319,22 +372,36 @@ impl Stats {
                     None => self.signals.push((name, 1)),
                 }
             }
-            "exception" => self.exceptions.push((event["name"].as_str().unwrap_or("").to_string(), event["handled"].as_bool().unwrap_or(false))),
+            "exception" => self.exceptions.push((
+                event["name"].as_str().unwrap_or("").to_string(),
+                event["handled"].as_bool().unwrap_or(false),
+            )),
             _ => {}
         }
         let t = event["t"].as_f64().unwrap_or(0.0);
         if t - self.last_shown >= 1.0 || kind == "mission_end" {
             self.last_shown = t;
             let flying = (0..drones).filter(|d| backend.telemetry(*d).state.airborne()).count();
-            progress.set_message(format!("t = {t:7.1} s   activities running: {:3}   drones in the air: {flying}", self.running));
+            progress.set_message(format!(
+                "t = {t:7.1} s   activities running: {:3}   drones in the air: {flying}",
+                self.running
+            ));
             progress.tick();
         }
     }
 }
 
-fn summary(mission: &aviary_ir::Mission, backend: &dyn Backend, odometry: &dyn Fn(usize) -> Option<(f64, f64)>, stats: &Stats) -> String {
+fn summary(
+    mission: &aviary_ir::Mission,
+    backend: &dyn Backend,
+    odometry: &dyn Fn(usize) -> Option<(f64, f64)>,
+    stats: &Stats,
+) -> String {
     let mut out = String::new();
-    out.push_str(&format!("{:<16} {:>12} {:>12} {:>9}  {}\n", "drone", "distance m", "flight s", "battery", "state"));
+    out.push_str(&format!(
+        "{:<16} {:>12} {:>12} {:>9}  {}\n",
+        "drone", "distance m", "flight s", "battery", "state"
+    ));
     for (d, name) in mission.drones.iter().enumerate() {
         let t = backend.telemetry(d);
         let (distance, airborne) = match odometry(d) {
@@ -347,15 +414,37 @@ fn summary(mission: &aviary_ir::Mission, backend: &dyn Backend, odometry: &dyn F
             t.state.as_str().to_owned()
         } else {
             let p = t.position;
-            format!("no link: last seen {} at ({:.0}, {:.0}, {:.0})", t.state.as_str(), p[0], p[1], p[2])
+            format!(
+                "no link: last seen {} at ({:.0}, {:.0}, {:.0})",
+                t.state.as_str(),
+                p[0],
+                p[1],
+                p[2]
+            )
         };
-        out.push_str(&format!("{name:<16} {distance:>12} {airborne:>12} {:>8.0}%  {state}\n", t.battery * 100.0));
+        out.push_str(&format!(
+            "{name:<16} {distance:>12} {airborne:>12} {:>8.0}%  {state}\n",
+            t.battery * 100.0
+        ));
     }
-    let signals: Vec<String> = stats.signals.iter().map(|(n, c)| if *c == 1 { n.clone() } else { format!("{n} ×{c}") }).collect();
-    out.push_str(&format!("signals: {}\n", if signals.is_empty() { "none".to_string() } else { signals.join(", ") }));
+    let signals: Vec<String> = stats
+        .signals
+        .iter()
+        .map(|(n, c)| if *c == 1 { n.clone() } else { format!("{n} ×{c}") })
+        .collect();
+    out.push_str(&format!(
+        "signals: {}\n",
+        if signals.is_empty() { "none".to_string() } else { signals.join(", ") }
+    ));
     out.push_str(&format!("detections: {}\n", stats.detections));
-    let exceptions: Vec<String> = stats.exceptions.iter().map(|(n, h)| format!("{n} ({})", if *h { "handled" } else { "unhandled" })).collect();
-    out.push_str(&format!("exceptions: {}\n", if exceptions.is_empty() { "none".to_string() } else { exceptions.join(", ") }));
+    let exceptions: Vec<String> = stats
+        .exceptions
+        .iter()
+        .map(|(n, h)| format!("{n} ({})", if *h { "handled" } else { "unhandled" }))
+        .collect();
+    out.push_str(&format!(
+        "exceptions: {}\n",
+        if exceptions.is_empty() { "none".to_string() } else { exceptions.join(", ") }
+    ));
     out
 }
-

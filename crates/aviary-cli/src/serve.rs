@@ -18,7 +18,10 @@ pub struct Serve {
 pub fn kinds(mission: &Mission) -> Kinds {
     let mut kinds = Kinds::default();
     for c in &mission.capabilities {
-        kinds.capability(&c.name, c.params.iter().cloned().zip(c.param_kinds.iter().copied()).collect());
+        kinds.capability(
+            &c.name,
+            c.params.iter().cloned().zip(c.param_kinds.iter().copied()).collect(),
+        );
     }
     for (name, values) in mission.signals.iter().zip(&mission.signal_values) {
         kinds.signal(name, values.clone());

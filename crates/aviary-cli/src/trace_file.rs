@@ -30,7 +30,15 @@ pub fn lock(trace: &SharedTrace) -> MutexGuard<'_, TraceFile> {
 
 impl TraceFile {
     pub fn new(out: Box<dyn Write + Send>, name: String, mission: String) -> SharedTrace {
-        Arc::new(Mutex::new(TraceFile { out, name, mission, started: false, last_t: 0.0, closed: false, failed: None }))
+        Arc::new(Mutex::new(TraceFile {
+            out,
+            name,
+            mission,
+            started: false,
+            last_t: 0.0,
+            closed: false,
+            failed: None,
+        }))
     }
 
     /// Why the trace is not whole, if it is not.
@@ -65,7 +73,8 @@ impl TraceFile {
     /// whenever it is cut.
     pub fn close_now(&mut self, reason: &str) {
         if !self.started {
-            let start = serde_json::json!({ "t": 0.0, "event": "mission_start", "mission": self.mission });
+            let start =
+                serde_json::json!({ "t": 0.0, "event": "mission_start", "mission": self.mission });
             self.write(&start);
         }
         let end = serde_json::json!({ "t": self.last_t, "event": "mission_end", "status": "aborted", "reason": reason });

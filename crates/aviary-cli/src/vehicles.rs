@@ -29,10 +29,7 @@ pub fn run(args: &VehiclesArgs) -> u8 {
     let bytes = match std::fs::read(args.world) {
         Ok(b) => b,
         Err(e) => {
-            eprintln!(
-                "aviary: cannot read the world file {}: {e}",
-                args.world.display()
-            );
+            eprintln!("aviary: cannot read the world file {}: {e}", args.world.display());
             return 2;
         }
     };
@@ -49,17 +46,14 @@ pub fn run(args: &VehiclesArgs) -> u8 {
         eprintln!("aviary: {name} has errors");
         return 2;
     };
-    let runtime = match tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        .enable_all()
-        .build()
-    {
-        Ok(r) => r,
-        Err(e) => {
-            eprintln!("aviary: cannot start the runtime: {e}");
-            return 2;
-        }
-    };
+    let runtime =
+        match tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build() {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("aviary: cannot start the runtime: {e}");
+                return 2;
+            }
+        };
     let options = aviary_vehicles::Options {
         speed: args.speed,
         signing_key: args.signing_key.map(aviary_mavlink::signing_key),
@@ -73,20 +67,12 @@ pub fn run(args: &VehiclesArgs) -> u8 {
                 return 2;
             }
         };
-        let scheme = if matches!(listen, aviary_vehicles::Listen::Tcp(_)) {
-            "tcp"
-        } else {
-            "udp"
-        };
+        let scheme = if matches!(listen, aviary_vehicles::Listen::Tcp(_)) { "tcp" } else { "udp" };
         // The first line says where: tests and scripts read the port from it.
         // Written without println!, which would panic once a reader closes the pipe.
         use std::io::Write;
         let mut out = std::io::stdout();
-        let _ = writeln!(
-            out,
-            "aviary vehicles: listening on {scheme}:{}",
-            server.address
-        );
+        let _ = writeln!(out, "aviary vehicles: listening on {scheme}:{}", server.address);
         for (i, d) in world.drones.iter().enumerate() {
             let _ = writeln!(out, "  {} = system {}", d.name, server.systems[i]);
         }

@@ -10,11 +10,7 @@ fn bench_parse_runs_and_reports_the_median() {
         .expect("the aviary binary runs");
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "stdout:\n{stdout}\nstderr:\n{stderr}"
-    );
+    assert_eq!(out.status.code(), Some(0), "stdout:\n{stdout}\nstderr:\n{stderr}");
     assert!(stdout.contains("run 1: parse "), "{stdout}");
     assert!(stdout.contains("median of 1 run(s)"), "{stdout}");
     assert!(stdout.contains("MB/s"), "{stdout}");
@@ -34,10 +30,21 @@ fn bench_parse_refuses_a_size_of_zero() {
 #[test]
 fn bench_front_checks_both_shapes_clean_and_reports_the_median() {
     for shape in ["sequential", "chain"] {
-        let out = Command::new(env!("CARGO_BIN_EXE_aviary")).args(["bench", "front", "--shape", shape, "--n", "300", "--runs", "1"]).output().expect("the aviary binary runs");
+        let out = Command::new(env!("CARGO_BIN_EXE_aviary"))
+            .args(["bench", "front", "--shape", shape, "--n", "300", "--runs", "1"])
+            .output()
+            .expect("the aviary binary runs");
         let stdout = String::from_utf8_lossy(&out.stdout);
-        assert_eq!(out.status.code(), Some(0), "{shape}: {stdout}{}", String::from_utf8_lossy(&out.stderr));
-        assert!(stdout.contains("run 1: parse + check ") && stdout.contains(" 0 error(s)"), "{shape}: {stdout}");
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{shape}: {stdout}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(
+            stdout.contains("run 1: parse + check ") && stdout.contains(" 0 error(s)"),
+            "{shape}: {stdout}"
+        );
         assert!(stdout.contains("median of 1 run(s)"), "{shape}: {stdout}");
     }
 }

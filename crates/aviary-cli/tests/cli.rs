@@ -32,11 +32,13 @@ fn errors_give_exit_1_and_the_runtime_md_first_line() {
 #[test]
 fn json_gives_one_object_per_diagnostic() {
     let dir = scratch("json");
-    std::fs::write(dir.join("m.mission"), "MISSION M:\n    d1 TakeOff WITH 20s\n    d2 Land\n").unwrap();
+    std::fs::write(dir.join("m.mission"), "MISSION M:\n    d1 TakeOff WITH 20s\n    d2 Land\n")
+        .unwrap();
     std::fs::write(dir.join("m.world.toml"), WORLD).unwrap();
     let (code, out, _) = aviary(&["check", "m.mission", "--format", "json"], &dir);
     assert_eq!(code, 1);
-    let objects: Vec<serde_json::Value> = out.lines().map(|l| serde_json::from_str(l).expect("each line is JSON")).collect();
+    let objects: Vec<serde_json::Value> =
+        out.lines().map(|l| serde_json::from_str(l).expect("each line is JSON")).collect();
     assert_eq!(objects.len(), 2, "{out}");
     assert_eq!(objects[0]["code"], "E107");
     assert_eq!(objects[0]["line"], 2);
@@ -85,16 +87,28 @@ fn a_broken_world_file_is_reported_in_the_world_file() {
 fn used_files_are_read_relative_to_the_using_file_once_each() {
     let dir = scratch("use");
     std::fs::create_dir_all(dir.join("lib")).unwrap();
-    std::fs::write(dir.join("m.mission"), "USE \"lib/a.mission\"\nUSE \"lib/b.mission\"\nMISSION M:\n    d1 Patrol\n").unwrap();
+    std::fs::write(
+        dir.join("m.mission"),
+        "USE \"lib/a.mission\"\nUSE \"lib/b.mission\"\nMISSION M:\n    d1 Patrol\n",
+    )
+    .unwrap();
     std::fs::write(dir.join("m.world.toml"), WORLD).unwrap();
-    std::fs::write(dir.join("lib/a.mission"), "USE \"b.mission\"\nCAPABILITY Patrol BY drone:\n    PERFORM:\n        drone Circle\n").unwrap();
+    std::fs::write(
+        dir.join("lib/a.mission"),
+        "USE \"b.mission\"\nCAPABILITY Patrol BY drone:\n    PERFORM:\n        drone Circle\n",
+    )
+    .unwrap();
     std::fs::write(dir.join("lib/b.mission"), "USE \"a.mission\"\nCAPABILITY Circle BY drone:\n    PERFORM:\n        drone.Orbit((0, 0), 10m)\n").unwrap();
     let (code, out, _) = aviary(&["check", "m.mission"], &dir);
     assert_eq!(code, 0, "a USE cycle is fine and each file is read once: {out}");
-    std::fs::write(dir.join("m.mission"), "USE \"lib/missing.mission\"\nMISSION M:\n    d1 Land\n").unwrap();
+    std::fs::write(dir.join("m.mission"), "USE \"lib/missing.mission\"\nMISSION M:\n    d1 Land\n")
+        .unwrap();
     let (code, out, _) = aviary(&["check", "m.mission"], &dir);
     assert_eq!(code, 1);
-    assert!(out.starts_with("m.mission:1:5: error[E113]: cannot read `lib/missing.mission`"), "{out}");
+    assert!(
+        out.starts_with("m.mission:1:5: error[E113]: cannot read `lib/missing.mission`"),
+        "{out}"
+    );
 }
 
 #[test]
@@ -104,9 +118,17 @@ fn a_use_reads_only_mission_files_under_the_missions_folder_and_never_shows_anot
     std::fs::create_dir_all(&home).unwrap();
     std::fs::create_dir_all(&shared).unwrap();
     std::fs::write(home.join("m.world.toml"), WORLD).unwrap();
-    std::fs::write(shared.join("lib.mission"), "CAPABILITY Patrol BY drone:\n    PERFORM:\n        drone.Hover(1s)\n").unwrap();
+    std::fs::write(
+        shared.join("lib.mission"),
+        "CAPABILITY Patrol BY drone:\n    PERFORM:\n        drone.Hover(1s)\n",
+    )
+    .unwrap();
     let check = |used: &str, extra: &[&str]| {
-        std::fs::write(home.join("m.mission"), format!("USE \"{used}\"\nMISSION M:\n    d1 Patrol\n")).unwrap();
+        std::fs::write(
+            home.join("m.mission"),
+            format!("USE \"{used}\"\nMISSION M:\n    d1 Patrol\n"),
+        )
+        .unwrap();
         let mut args = vec!["check", "home/m.mission"];
         args.extend(extra);
         aviary(&args, &dir)
@@ -114,7 +136,12 @@ fn a_use_reads_only_mission_files_under_the_missions_folder_and_never_shows_anot
     let refused = |used: &str, why: &str| {
         let (code, out, _) = check(used, &[]);
         assert_eq!(code, 1, "{out}");
-        assert!(out.starts_with(&format!("home/m.mission:1:5: error[E127]: this USE of `{used}` is refused: ")), "{out}");
+        assert!(
+            out.starts_with(&format!(
+                "home/m.mission:1:5: error[E127]: this USE of `{used}` is refused: "
+            )),
+            "{out}"
+        );
         assert!(out.contains(why), "{used}: {out}");
         out
     };
@@ -133,7 +160,11 @@ fn a_use_reads_only_mission_files_under_the_missions_folder_and_never_shows_anot
     let (code, out, _) = check("link.mission", &["--use-root", "shared"]);
     assert_eq!(code, 0, "{out}");
     // Not a regular file, or too large: refused without being read (a FIFO would block).
-    assert!(std::process::Command::new("mkfifo").arg(home.join("pipe.mission")).status().unwrap().success());
+    assert!(std::process::Command::new("mkfifo")
+        .arg(home.join("pipe.mission"))
+        .status()
+        .unwrap()
+        .success());
     refused("pipe.mission", "is a device, pipe or socket, not a regular file");
     std::fs::create_dir(home.join("folder.mission")).unwrap();
     refused("folder.mission", "is a folder, not a regular file");
@@ -141,7 +172,12 @@ fn a_use_reads_only_mission_files_under_the_missions_folder_and_never_shows_anot
     refused("big.mission", "has 17825792 bytes, more than the 16 MiB a USEd file may have");
     let (code, out, _) = check("", &[]);
     assert_eq!(code, 1);
-    assert!(out.starts_with("home/m.mission:1:5: error[E127]: this USE names no file: its path is empty"), "{out}");
+    assert!(
+        out.starts_with(
+            "home/m.mission:1:5: error[E127]: this USE names no file: its path is empty"
+        ),
+        "{out}"
+    );
     let (code, _, err) = aviary(&["check", "home/m.mission", "--use-root", "nowhere"], &dir);
     assert_eq!(code, 2);
     assert!(err.starts_with("aviary: --use-root nowhere: "), "{err}");
@@ -165,7 +201,11 @@ fn an_empty_file_name_says_what_was_empty() {
 #[test]
 fn several_files_are_checked_and_the_worst_exit_wins() {
     let dir = scratch("several");
-    std::fs::write(dir.join("good.mission"), "CAPABILITY Go BY drone:\n    PERFORM:\n        drone.Land()\n").unwrap();
+    std::fs::write(
+        dir.join("good.mission"),
+        "CAPABILITY Go BY drone:\n    PERFORM:\n        drone.Land()\n",
+    )
+    .unwrap();
     std::fs::write(dir.join("bad.mission"), "MISSION M:\n    d1 TakeOff WITH 5s\n").unwrap();
     std::fs::write(dir.join("bad.world.toml"), WORLD).unwrap();
     let (code, out, _) = aviary(&["check", "good.mission", "bad.mission"], &dir);
@@ -192,7 +232,11 @@ fn fmt_rewrites_checks_and_never_touches_a_file_with_errors() {
     std::fs::write(dir.join("m.mission"), messy).unwrap();
     let (code, out, _) = aviary(&["fmt", "--check", "m.mission"], &dir);
     assert_eq!(code, 1, "{out}");
-    assert_eq!(std::fs::read_to_string(dir.join("m.mission")).unwrap(), messy, "--check changes nothing");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("m.mission")).unwrap(),
+        messy,
+        "--check changes nothing"
+    );
     let (code, _, _) = aviary(&["fmt", "m.mission"], &dir);
     assert_eq!(code, 0);
     let formatted = std::fs::read_to_string(dir.join("m.mission")).unwrap();
@@ -207,7 +251,11 @@ fn fmt_rewrites_checks_and_never_touches_a_file_with_errors() {
     assert_eq!(code, 1, "{out}");
     assert!(out.contains("not formatted, because it has syntax errors"), "{out}");
     assert_eq!(std::fs::read_to_string(dir.join("broken.mission")).unwrap(), broken);
-    let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().contains("tmp")).collect();
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains("tmp"))
+        .collect();
     assert!(leftovers.is_empty(), "no temporary files are left behind");
 }
 

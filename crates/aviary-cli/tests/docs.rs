@@ -48,7 +48,11 @@ impl Block {
     /// The values of `// KEY: value` comment lines.
     fn directives(&self, key: &str) -> Vec<String> {
         let prefix = format!("// {key}:");
-        self.text.lines().filter_map(|l| l.trim().strip_prefix(prefix.as_str())).map(|v| v.trim().to_string()).collect()
+        self.text
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix(prefix.as_str()))
+            .map(|v| v.trim().to_string())
+            .collect()
     }
 }
 
@@ -61,7 +65,12 @@ fn blocks(rel: &str) -> Vec<Block> {
         match &mut open {
             None => {
                 if let Some(lang) = trimmed.strip_prefix("```") {
-                    open = Some(Block { file: rel.to_string(), line: i + 1, lang: lang.trim().to_string(), text: String::new() });
+                    open = Some(Block {
+                        file: rel.to_string(),
+                        line: i + 1,
+                        lang: lang.trim().to_string(),
+                        text: String::new(),
+                    });
                 }
             }
             Some(b) => {
@@ -107,7 +116,10 @@ fn world_of(all: &[Block], index: usize) -> Option<WorldOf> {
 }
 
 fn json_lines(text: &str) -> Vec<serde_json::Value> {
-    text.lines().filter(|l| !l.trim().is_empty()).map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}"))).collect()
+    text.lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}")))
+        .collect()
 }
 
 /// Checks (and runs) one mission block; the problems found, in words.
@@ -125,7 +137,8 @@ fn check_mission(dir: &Path, all: &[Block], index: usize) -> Vec<String> {
         }
         None => return vec![format!("{}: no world for this mission", b.place())],
     };
-    let (mission, world) = (mission.to_string_lossy().into_owned(), world.to_string_lossy().into_owned());
+    let (mission, world) =
+        (mission.to_string_lossy().into_owned(), world.to_string_lossy().into_owned());
     let mut problems = Vec::new();
     let (code, out, err) = aviary(&["check", &mission, "--world", &world, "--format", "json"], dir);
     let diagnostics = json_lines(&out);
@@ -133,11 +146,22 @@ fn check_mission(dir: &Path, all: &[Block], index: usize) -> Vec<String> {
     let mut warned = BTreeSet::new();
     for d in &diagnostics {
         match d["severity"].as_str() {
-            Some("error") => problems.push(format!("{}: error {} at line {}: {}", b.place(), d["code"], d["line"], d["message"])),
+            Some("error") => problems.push(format!(
+                "{}: error {} at line {}: {}",
+                b.place(),
+                d["code"],
+                d["line"],
+                d["message"]
+            )),
             Some("warning") => {
                 let code = d["code"].as_str().unwrap_or_default().to_string();
                 if !expected.contains(&code) {
-                    problems.push(format!("{}: warning {code} at line {}: {}", b.place(), d["line"], d["message"]));
+                    problems.push(format!(
+                        "{}: warning {code} at line {}: {}",
+                        b.place(),
+                        d["line"],
+                        d["message"]
+                    ));
                 }
                 warned.insert(code);
             }
@@ -145,7 +169,8 @@ fn check_mission(dir: &Path, all: &[Block], index: usize) -> Vec<String> {
         }
     }
     for code in expected.difference(&warned) {
-        problems.push(format!("{}: expects warning {code}, which the check does not give", b.place()));
+        problems
+            .push(format!("{}: expects warning {code}, which the check does not give", b.place()));
     }
     if code != 0 && problems.is_empty() {
         problems.push(format!("{}: aviary check exits {code}: {err}", b.place()));
@@ -180,9 +205,19 @@ fn every_mission_in_the_docs_checks_clean_and_runs_to_its_end() {
             }
         }
     }
-    assert!(problems.is_empty(), "{} problems in the docs' missions:\n{}", problems.len(), problems.join("\n"));
+    assert!(
+        problems.is_empty(),
+        "{} problems in the docs' missions:\n{}",
+        problems.len(),
+        problems.join("\n")
+    );
     // The docs that teach the language show missions, and each one was checked.
-    for (doc, at_least) in [("docs/LANGUAGE.md", 20), ("docs/TUTORIAL.md", 3), ("docs/PATTERNS.md", 5), ("docs/TRACE.md", 1)] {
+    for (doc, at_least) in [
+        ("docs/LANGUAGE.md", 20),
+        ("docs/TUTORIAL.md", 3),
+        ("docs/PATTERNS.md", 5),
+        ("docs/TRACE.md", 1),
+    ] {
         let n = missions.get(doc).copied().unwrap_or(0);
         assert!(n >= at_least, "{doc} shows {n} missions, expected at least {at_least}");
     }
@@ -195,9 +230,20 @@ fn every_fragment_in_the_docs_reads_without_a_syntax_error() {
     for doc in documents() {
         for b in blocks(&doc).into_iter().filter(|b| b.lang == "aviary-fragment") {
             count += 1;
-            let first = b.text.lines().find(|l| !l.trim().is_empty() && !l.trim_start().starts_with("//")).unwrap_or("");
+            let first = b
+                .text
+                .lines()
+                .find(|l| !l.trim().is_empty() && !l.trim_start().starts_with("//"))
+                .unwrap_or("");
             let whole = ["MISSION", "CAPABILITY", "USE"].iter().any(|k| first.starts_with(k));
-            let text = if whole { b.text.clone() } else { format!("MISSION Fragment:\n{}", b.text.lines().map(|l| format!("    {l}\n")).collect::<String>()) };
+            let text = if whole {
+                b.text.clone()
+            } else {
+                format!(
+                    "MISSION Fragment:\n{}",
+                    b.text.lines().map(|l| format!("    {l}\n")).collect::<String>()
+                )
+            };
             let parse = aviary_syntax::parse(FileId(0), &text);
             for d in parse.diagnostics.iter().filter(|d| d.is_error()) {
                 problems.push(format!("{}: {:?}: {}", b.place(), d.code, d.message));
@@ -217,9 +263,16 @@ fn every_mission_shown_in_the_docs_is_marked_for_checking() {
     let mut problems = Vec::new();
     for doc in documents().into_iter().filter(|d| d != WRONG_ON_PURPOSE) {
         for b in blocks(&doc) {
-            let mission = b.text.lines().any(|l| ["MISSION ", "CAPABILITY "].iter().any(|k| l.trim_start().starts_with(k)));
+            let mission = b
+                .text
+                .lines()
+                .any(|l| ["MISSION ", "CAPABILITY "].iter().any(|k| l.trim_start().starts_with(k)));
             if mission && b.lang != "aviary" && b.lang != "aviary-fragment" {
-                problems.push(format!("{}: a mission in a block tagged `{}`: tag it `aviary` (or `aviary-fragment`)", b.place(), b.lang));
+                problems.push(format!(
+                    "{}: a mission in a block tagged `{}`: tag it `aviary` (or `aviary-fragment`)",
+                    b.place(),
+                    b.lang
+                ));
             }
         }
     }
@@ -271,7 +324,8 @@ fn backticked(text: &str) -> Vec<String> {
 
 fn keys_under(all: &BTreeMap<String, BTreeSet<String>>, heading: &str) -> BTreeSet<String> {
     let keys = all.iter().find(|(h, _)| h.contains(heading)).map(|(_, k)| k.clone());
-    let keys = keys.unwrap_or_else(|| panic!("docs/WORLD.md has no table under a heading with {heading}"));
+    let keys =
+        keys.unwrap_or_else(|| panic!("docs/WORLD.md has no table under a heading with {heading}"));
     assert!(!keys.is_empty(), "docs/WORLD.md: no keys under {heading}");
     keys
 }
@@ -284,10 +338,17 @@ fn read_world(text: &str) -> (Option<aviary_world::World>, Vec<aviary_diagnostic
 /// for an unknown key lists.
 fn known_keys(world_with_unknown: &str) -> BTreeSet<String> {
     let (_, diagnostics) = read_world(world_with_unknown);
-    let d = diagnostics.iter().find(|d| d.message.contains("zz_not_a_key")).unwrap_or_else(|| panic!("no message for an unknown key in:\n{world_with_unknown}\n{diagnostics:?}"));
+    let d = diagnostics.iter().find(|d| d.message.contains("zz_not_a_key")).unwrap_or_else(|| {
+        panic!("no message for an unknown key in:\n{world_with_unknown}\n{diagnostics:?}")
+    });
     let help = d.help.clone().unwrap_or_default();
     let list = help.split("are ").last().unwrap_or("");
-    backticked(list).into_iter().map(|k| k.trim_start_matches("[[").trim_start_matches('[').trim_end_matches(']').to_string()).collect()
+    backticked(list)
+        .into_iter()
+        .map(|k| {
+            k.trim_start_matches("[[").trim_start_matches('[').trim_end_matches(']').to_string()
+        })
+        .collect()
 }
 
 #[test]
@@ -307,7 +368,11 @@ fn every_world_key_documented_is_read_and_every_key_read_is_documented() {
         let keys = keys_under(&doc, heading);
         for key in &keys {
             let (_, diagnostics) = read_world(&world(key));
-            let unknown: Vec<&String> = diagnostics.iter().map(|d| &d.message).filter(|m| m.contains("unknown key")).collect();
+            let unknown: Vec<&String> = diagnostics
+                .iter()
+                .map(|d| &d.message)
+                .filter(|m| m.contains("unknown key"))
+                .collect();
             assert!(unknown.is_empty(), "docs/WORLD.md documents `{key}` under {heading}, and the reader does not know it: {unknown:?}");
         }
         let read = known_keys(&world("zz_not_a_key"));
@@ -315,22 +380,36 @@ fn every_world_key_documented_is_read_and_every_key_read_is_documented() {
     }
     // The top level: the tables.
     let (_, diagnostics) = read_world("[zz_not_a_key]\n");
-    let d = diagnostics.iter().find(|d| d.message.contains("zz_not_a_key")).expect("an unknown table is an error");
-    let tables: BTreeSet<String> = backticked(d.help.as_deref().unwrap_or("")).into_iter().filter(|t| t.starts_with('[')).collect();
+    let d = diagnostics
+        .iter()
+        .find(|d| d.message.contains("zz_not_a_key"))
+        .expect("an unknown table is an error");
+    let tables: BTreeSet<String> = backticked(d.help.as_deref().unwrap_or(""))
+        .into_iter()
+        .filter(|t| t.starts_with('['))
+        .collect();
     let text = std::fs::read_to_string(repo().join("docs/WORLD.md")).unwrap();
     for t in &tables {
         let name = t.trim_matches(['[', ']']);
-        assert!(text.contains(&format!("[{name}")), "the world file's table {t} is not in docs/WORLD.md");
+        assert!(
+            text.contains(&format!("[{name}")),
+            "the world file's table {t} is not in docs/WORLD.md"
+        );
     }
     assert!(tables.len() >= 7, "{tables:?}");
 
     // Drones: an unknown key is an attribute, so a documented key must not become one.
     let drone_keys = keys_under(&doc, "`[drones.NAME]`");
     for key in &drone_keys {
-        let text = if key == "home" { "[drones.d]\nhome = [0, 0]\n".to_string() } else { format!("[drones.d]\nhome = [0, 0]\n{key} = 1\n") };
+        let text = if key == "home" {
+            "[drones.d]\nhome = [0, 0]\n".to_string()
+        } else {
+            format!("[drones.d]\nhome = [0, 0]\n{key} = 1\n")
+        };
         match read_world(&text) {
             (Some(world), _) => {
-                let attributes: Vec<&str> = world.drones[0].attributes.iter().map(|(k, _)| &**k).collect();
+                let attributes: Vec<&str> =
+                    world.drones[0].attributes.iter().map(|(k, _)| &**k).collect();
                 assert!(!attributes.contains(&key.as_str()), "docs/WORLD.md documents the drone key `{key}`, and the reader takes it for an attribute");
             }
             // A value of the wrong kind for a key the reader knows is an error about that key.
@@ -342,20 +421,33 @@ fn every_world_key_documented_is_read_and_every_key_read_is_documented() {
     }
     // The method works: a key the reader does not know is an attribute.
     let (world, _) = read_world("[drones.d]\nhome = [0, 0]\ncall_sign = 1\n");
-    assert_eq!(world.unwrap().drones[0].attributes.first().map(|(k, _)| k.to_string()).as_deref(), Some("call_sign"));
+    assert_eq!(
+        world.unwrap().drones[0].attributes.first().map(|(k, _)| k.to_string()).as_deref(),
+        Some("call_sign")
+    );
     // And every key the reader matches by name is documented.
-    let source = std::fs::read_to_string(repo().join("crates/aviary-world/src/build/drone.rs")).unwrap();
+    let source =
+        std::fs::read_to_string(repo().join("crates/aviary-world/src/build/drone.rs")).unwrap();
     let mut read: BTreeSet<String> = source
         .lines()
         .filter_map(|l| l.trim_start().strip_prefix('"'))
         .filter_map(|l| l.split_once("\" =>").map(|(k, _)| k.to_string()))
         .filter(|k| k.chars().all(|c| c.is_ascii_lowercase() || c == '_'))
         .collect();
-    let backends = source.lines().find(|l| l.contains("const BACKEND_KEYS")).expect("BACKEND_KEYS in drone.rs");
+    let backends = source
+        .lines()
+        .find(|l| l.contains("const BACKEND_KEYS"))
+        .expect("BACKEND_KEYS in drone.rs");
     read.extend(backends.split('"').skip(1).step_by(2).map(str::to_string));
-    assert!(read.contains("home") && read.contains("endurance") && read.contains("mavlink"), "{read:?}");
+    assert!(
+        read.contains("home") && read.contains("endurance") && read.contains("mavlink"),
+        "{read:?}"
+    );
     let missing: Vec<&String> = read.difference(&drone_keys).collect();
-    assert!(missing.is_empty(), "drone keys the reader reads and docs/WORLD.md does not document: {missing:?}");
+    assert!(
+        missing.is_empty(),
+        "drone keys the reader reads and docs/WORLD.md does not document: {missing:?}"
+    );
 }
 
 // ---- docs/TRACE.md against the engine ----
@@ -382,7 +474,8 @@ fn documented_events() -> BTreeMap<String, (BTreeSet<String>, BTreeSet<String>)>
 #[test]
 fn the_trace_events_documented_are_the_engines_with_their_fields() {
     let doc = documented_events();
-    let engine: BTreeSet<String> = aviary_engine::Kind::ALL.iter().map(|k| k.as_str().to_string()).collect();
+    let engine: BTreeSet<String> =
+        aviary_engine::Kind::ALL.iter().map(|k| k.as_str().to_string()).collect();
     let documented: BTreeSet<String> = doc.keys().cloned().collect();
     assert_eq!(documented, engine, "docs/TRACE.md's events (left) and the engine's (right)");
 
@@ -392,19 +485,27 @@ fn the_trace_events_documented_are_the_engines_with_their_fields() {
     let dir = scratch("docs_trace");
     let mission = dir.join("example.mission");
     std::fs::write(&mission, &all[index].text).unwrap();
-    let Some(WorldOf::Block(world)) = world_of(&all, index) else { panic!("docs/TRACE.md's mission has no world block") };
+    let Some(WorldOf::Block(world)) = world_of(&all, index) else {
+        panic!("docs/TRACE.md's mission has no world block")
+    };
     std::fs::write(dir.join("example.world.toml"), &world.text).unwrap();
-    let (code, out, err) = aviary(&["run", "example.mission", "--trace", "trace.jsonl", "--telemetry-hz", "0.2"], &dir);
+    let (code, out, err) = aviary(
+        &["run", "example.mission", "--trace", "trace.jsonl", "--telemetry-hz", "0.2"],
+        &dir,
+    );
     assert_eq!(code, 0, "{out}{err}");
     let events = json_lines(&std::fs::read_to_string(dir.join("trace.jsonl")).unwrap());
     let mut seen = BTreeSet::new();
     for e in &events {
         let kind = e["event"].as_str().unwrap().to_string();
-        let (always, sometimes) = doc.get(&kind).unwrap_or_else(|| panic!("an event TRACE.md does not list: {e}"));
-        let keys: BTreeSet<String> = e.as_object().unwrap().keys().filter(|k| *k != "t" && *k != "event").cloned().collect();
+        let (always, sometimes) =
+            doc.get(&kind).unwrap_or_else(|| panic!("an event TRACE.md does not list: {e}"));
+        let keys: BTreeSet<String> =
+            e.as_object().unwrap().keys().filter(|k| *k != "t" && *k != "event").cloned().collect();
         let missing: Vec<&String> = always.difference(&keys).collect();
         assert!(missing.is_empty(), "{kind} without {missing:?}: {e}");
-        let extra: Vec<&String> = keys.iter().filter(|k| !always.contains(*k) && !sometimes.contains(*k)).collect();
+        let extra: Vec<&String> =
+            keys.iter().filter(|k| !always.contains(*k) && !sometimes.contains(*k)).collect();
         assert!(extra.is_empty(), "{kind} has fields TRACE.md does not list, {extra:?}: {e}");
         seen.insert(kind);
     }
@@ -434,7 +535,9 @@ const EXTERNAL_PROGRAMS: &[&str] = &["../shared/sitl"];
 fn nothing_in_the_repository_points_outside_it() {
     let root = repo();
     let mut files = vec![root.join("README.md")];
-    let ext = |wanted: &'static [&'static str]| move |p: &Path| p.extension().is_some_and(|e| wanted.iter().any(|w| e == *w));
+    let ext = |wanted: &'static [&'static str]| {
+        move |p: &Path| p.extension().is_some_and(|e| wanted.iter().any(|w| e == *w))
+    };
     files_under(&root.join("docs"), &ext(&["md", "yaml", "json"]), &mut files);
     files_under(&root.join("std"), &ext(&["mission"]), &mut files);
     files_under(&root.join("examples"), &ext(&["mission", "toml"]), &mut files);
@@ -454,10 +557,17 @@ fn nothing_in_the_repository_points_outside_it() {
             for allowed in EXTERNAL_PROGRAMS {
                 rest = rest.replace(allowed, "");
             }
-            if rest.contains("../shared") || rest.contains("shared/LANGUAGE") || rest.contains("shared/RUNTIME") {
+            if rest.contains("../shared")
+                || rest.contains("shared/LANGUAGE")
+                || rest.contains("shared/RUNTIME")
+            {
                 problems.push(format!("{at}: points outside the repository: {line}"));
             }
-            if line.contains(".md §") || line.contains("RUNTIME.md") || line.contains("STYLE.md") || line.contains("paper/") {
+            if line.contains(".md §")
+                || line.contains("RUNTIME.md")
+                || line.contains("STYLE.md")
+                || line.contains("paper/")
+            {
                 problems.push(format!("{at}: names the outside reference: {line}"));
             }
             // Every `NAME.md` named is a file of the repository: as written, beside the
@@ -467,9 +577,17 @@ fn nothing_in_the_repository_points_outside_it() {
                 if !word.ends_with(".md") || word.len() <= 3 {
                     continue;
                 }
-                let found = [root.join(word), dir.join(word), root.join("docs").join(word)].iter().any(|p| p.is_file() && p.canonicalize().is_ok_and(|p| p.starts_with(root.canonicalize().unwrap())));
+                let found = [root.join(word), dir.join(word), root.join("docs").join(word)]
+                    .iter()
+                    .any(|p| {
+                        p.is_file()
+                            && p.canonicalize()
+                                .is_ok_and(|p| p.starts_with(root.canonicalize().unwrap()))
+                    });
                 if !found {
-                    problems.push(format!("{at}: names `{word}`, which is not a file of the repository"));
+                    problems.push(format!(
+                        "{at}: names `{word}`, which is not a file of the repository"
+                    ));
                 }
             }
             // Markdown links lead to files of the repository.
@@ -480,8 +598,14 @@ fn nothing_in_the_repository_points_outside_it() {
                     continue;
                 }
                 let resolved = dir.join(target);
-                if !resolved.exists() || !resolved.canonicalize().is_ok_and(|p| p.starts_with(root.canonicalize().unwrap())) {
-                    problems.push(format!("{at}: a link to `{target}`, which is not in the repository"));
+                if !resolved.exists()
+                    || !resolved
+                        .canonicalize()
+                        .is_ok_and(|p| p.starts_with(root.canonicalize().unwrap()))
+                {
+                    problems.push(format!(
+                        "{at}: a link to `{target}`, which is not in the repository"
+                    ));
                 }
             }
         }

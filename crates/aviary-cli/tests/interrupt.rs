@@ -12,7 +12,15 @@ use common::{aviary, repo, scratch};
 
 fn spawn(trace: &std::path::Path, speed: &str) -> Child {
     Command::new(env!("CARGO_BIN_EXE_aviary"))
-        .args(["run", "examples/search_and_rescue.mission", "--quiet", "--speed", speed, "--trace", &trace.to_string_lossy()])
+        .args([
+            "run",
+            "examples/search_and_rescue.mission",
+            "--quiet",
+            "--speed",
+            speed,
+            "--trace",
+            &trace.to_string_lossy(),
+        ])
         .current_dir(repo())
         .stdout(Stdio::null())
         .stderr(Stdio::null())
@@ -31,7 +39,10 @@ fn interrupt(child: &Child) {
 }
 
 fn send(child: &Child, signal: &str) {
-    let status = Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().expect("kill");
+    let status = Command::new("kill")
+        .args([&format!("-{signal}"), &child.id().to_string()])
+        .status()
+        .expect("kill");
     assert!(status.success());
 }
 
@@ -52,7 +63,16 @@ fn cut_points(seed: u64, n: usize) -> Vec<u64> {
 fn a_killed_run_keeps_every_event_before_the_cut() {
     let dir = scratch("killed");
     let full = dir.join("full.jsonl");
-    let (code, _, err) = aviary(&["run", "examples/search_and_rescue.mission", "--quiet", "--trace", &full.to_string_lossy()], &repo());
+    let (code, _, err) = aviary(
+        &[
+            "run",
+            "examples/search_and_rescue.mission",
+            "--quiet",
+            "--trace",
+            &full.to_string_lossy(),
+        ],
+        &repo(),
+    );
     assert_eq!(code, 0, "{err}");
     let reference = lines(&full);
     for (i, ms) in cut_points(0x5eed, 4).into_iter().enumerate() {
@@ -64,10 +84,15 @@ fn a_killed_run_keeps_every_event_before_the_cut() {
         child.wait().expect("wait");
         let written = lines(&cut);
         for (n, line) in written.iter().enumerate() {
-            serde_json::from_str::<serde_json::Value>(line).unwrap_or_else(|e| panic!("cut at {ms} ms, line {}: {e}", n + 1));
+            serde_json::from_str::<serde_json::Value>(line)
+                .unwrap_or_else(|e| panic!("cut at {ms} ms, line {}: {e}", n + 1));
         }
         assert!(written.len() < reference.len(), "cut at {ms} ms: the run was cut before its end");
-        assert_eq!(written[..], reference[..written.len()], "cut at {ms} ms: no event before the cut is lost or changed");
+        assert_eq!(
+            written[..],
+            reference[..written.len()],
+            "cut at {ms} ms: no event before the cut is lost or changed"
+        );
     }
 }
 
@@ -81,18 +106,40 @@ fn ends_gracefully_on(signal: &str, reason: &str) {
     send(&child, signal);
     let status = child.wait().expect("wait");
     assert_eq!(status.code(), Some(1), "an aborted mission exits 1");
-    let events: Vec<serde_json::Value> = lines(&trace).iter().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let events: Vec<serde_json::Value> =
+        lines(&trace).iter().map(|l| serde_json::from_str(l).unwrap()).collect();
     let end = events.last().unwrap();
-    assert_eq!((end["event"].as_str(), end["status"].as_str(), end["reason"].as_str()), (Some("mission_end"), Some("aborted"), Some(reason)));
+    assert_eq!(
+        (end["event"].as_str(), end["status"].as_str(), end["reason"].as_str()),
+        (Some("mission_end"), Some("aborted"), Some(reason))
+    );
     assert_eq!(events.iter().filter(|e| e["event"] == "mission_end").count(), 1);
-    let home: Vec<&str> = events.iter().filter(|e| e["event"] == "api_done" && e["function"] == "ReturnToLaunch" && e["status"] == "ok").map(|e| e["actor"].as_str().unwrap()).collect();
+    let home: Vec<&str> = events
+        .iter()
+        .filter(|e| {
+            e["event"] == "api_done" && e["function"] == "ReturnToLaunch" && e["status"] == "ok"
+        })
+        .map(|e| e["actor"].as_str().unwrap())
+        .collect();
     assert!(home.contains(&"video_drone1"), "the drones in the air were brought home: {home:?}");
     // Ordering: the running activities are aborted first, then the drones are sent home,
     // and the trace ends only once every return has ended.
-    let aborted = events.iter().position(|e| e["event"] == "api_done" && e["status"] == "aborted").expect("activities were aborted");
-    let first_home = events.iter().position(|e| e["event"] == "api_call" && e["function"] == "ReturnToLaunch").expect("a return");
-    let last_home = events.iter().rposition(|e| e["event"] == "api_done" && e["function"] == "ReturnToLaunch").expect("a return ended");
-    assert!(aborted < first_home && last_home < events.len() - 1, "abort, then returns, then mission_end");
+    let aborted = events
+        .iter()
+        .position(|e| e["event"] == "api_done" && e["status"] == "aborted")
+        .expect("activities were aborted");
+    let first_home = events
+        .iter()
+        .position(|e| e["event"] == "api_call" && e["function"] == "ReturnToLaunch")
+        .expect("a return");
+    let last_home = events
+        .iter()
+        .rposition(|e| e["event"] == "api_done" && e["function"] == "ReturnToLaunch")
+        .expect("a return ended");
+    assert!(
+        aborted < first_home && last_home < events.len() - 1,
+        "abort, then returns, then mission_end"
+    );
 }
 
 #[test]
@@ -123,15 +170,23 @@ fn a_second_ctrl_c_stops_at_once_and_still_closes_the_trace() {
     assert_eq!(status.code(), Some(130));
     let written = lines(&trace);
     let end: serde_json::Value = serde_json::from_str(written.last().unwrap()).unwrap();
-    assert_eq!((end["event"].as_str(), end["reason"].as_str()), (Some("mission_end"), Some("stopped at once by a second Ctrl-C")));
+    assert_eq!(
+        (end["event"].as_str(), end["reason"].as_str()),
+        (Some("mission_end"), Some("stopped at once by a second Ctrl-C"))
+    );
     assert_eq!(written.iter().filter(|l| l.contains("\"mission_end\"")).count(), 1);
 }
 
 /// A run whose one drone is a MAVLink vehicle that never answers (a UDP address nobody
 /// sends to): it waits up to 15 s for it before the mission starts.
 fn connecting(dir: &std::path::Path) -> Child {
-    let port = std::net::UdpSocket::bind("127.0.0.1:0").expect("a free port").local_addr().expect("addr").port();
-    std::fs::write(dir.join("m.mission"), "MISSION Waiting:\n    d TakeOff WITH 10m\n").expect("mission");
+    let port = std::net::UdpSocket::bind("127.0.0.1:0")
+        .expect("a free port")
+        .local_addr()
+        .expect("addr")
+        .port();
+    std::fs::write(dir.join("m.mission"), "MISSION Waiting:\n    d TakeOff WITH 10m\n")
+        .expect("mission");
     std::fs::write(dir.join("m.world.toml"), format!("[site]\norigin = {{ lat = 46.6, lon = 14.2, alt = 440 }}\n[drones.d]\nhome = [0, 0]\nmavlink = \"udp:127.0.0.1:{port}\"\n")).expect("world");
     Command::new(env!("CARGO_BIN_EXE_aviary"))
         .args(["run", "m.mission", "--trace", "t.jsonl"])
@@ -164,11 +219,23 @@ fn ctrl_c_while_the_vehicles_connect_stops_at_once_with_a_whole_trace() {
     assert_eq!(status.code(), Some(1));
     let out = child.wait_with_output().expect("output");
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("mission aborted: stopped by Ctrl-C while the vehicles connected; nothing flew"), "{stdout}");
+    assert!(
+        stdout.contains(
+            "mission aborted: stopped by Ctrl-C while the vehicles connected; nothing flew"
+        ),
+        "{stdout}"
+    );
     let trace = lines(&dir.join("t.jsonl"));
-    let events: Vec<serde_json::Value> = trace.iter().map(|l| serde_json::from_str(l).expect("JSON")).collect();
-    assert_eq!(events.iter().map(|e| e["event"].as_str().unwrap()).collect::<Vec<_>>(), ["mission_start", "mission_end"]);
-    assert_eq!((events[0]["mission"].as_str(), events[1]["status"].as_str()), (Some("Waiting"), Some("aborted")));
+    let events: Vec<serde_json::Value> =
+        trace.iter().map(|l| serde_json::from_str(l).expect("JSON")).collect();
+    assert_eq!(
+        events.iter().map(|e| e["event"].as_str().unwrap()).collect::<Vec<_>>(),
+        ["mission_start", "mission_end"]
+    );
+    assert_eq!(
+        (events[0]["mission"].as_str(), events[1]["status"].as_str()),
+        (Some("Waiting"), Some("aborted"))
+    );
 }
 
 #[test]
@@ -180,7 +247,10 @@ fn two_quick_stops_while_the_vehicles_connect_leave_a_whole_trace() {
     std::thread::sleep(Duration::from_millis(5));
     let _ = Command::new("kill").args(["-TERM", &child.id().to_string()]).status();
     wait_at_most(&mut child, Duration::from_secs(3));
-    let events: Vec<serde_json::Value> = lines(&dir.join("t.jsonl")).iter().map(|l| serde_json::from_str(l).expect("JSON")).collect();
+    let events: Vec<serde_json::Value> = lines(&dir.join("t.jsonl"))
+        .iter()
+        .map(|l| serde_json::from_str(l).expect("JSON"))
+        .collect();
     let kinds: Vec<&str> = events.iter().map(|e| e["event"].as_str().unwrap()).collect();
     assert_eq!(kinds, ["mission_start", "mission_end"], "whole, whichever stop came first");
 }

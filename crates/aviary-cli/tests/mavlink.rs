@@ -49,11 +49,7 @@ impl Vehicles {
             .next()
             .and_then(|p| p.parse().ok())
             .unwrap_or_else(|| panic!("no port in {first:?}"));
-        Vehicles {
-            child,
-            port,
-            _stdout: stdout,
-        }
+        Vehicles { child, port, _stdout: stdout }
     }
 }
 
@@ -70,9 +66,7 @@ fn bind(world: &str, port: u16, drones: &[&str]) -> String {
     for line in world.lines() {
         out.push_str(line);
         out.push('\n');
-        let name = line
-            .strip_prefix("[drones.")
-            .and_then(|l| l.strip_suffix(']'));
+        let name = line.strip_prefix("[drones.").and_then(|l| l.strip_suffix(']'));
         if name.is_some_and(|n| drones.is_empty() || drones.contains(&n)) {
             out.push_str(&format!("mavlink = \"tcp:127.0.0.1:{port}\"\n"));
         }
@@ -119,19 +113,12 @@ fn facts(trace: &[Value], event: &str, key: &str) -> Vec<(String, String, Vec<f6
         .filter(|e| e["event"] == event)
         .map(|e| {
             // A detection's location; a call's arguments; where a call ended.
-            let numbers = match e
-                .get("location")
-                .or_else(|| e.get("position"))
-                .or_else(|| e.get("args"))
-            {
-                Some(v) => flatten(v),
-                None => Vec::new(),
-            };
-            (
-                e["actor"].as_str().unwrap_or("").to_owned(),
-                e[key].to_string(),
-                numbers,
-            )
+            let numbers =
+                match e.get("location").or_else(|| e.get("position")).or_else(|| e.get("args")) {
+                    Some(v) => flatten(v),
+                    None => Vec::new(),
+                };
+            (e["actor"].as_str().unwrap_or("").to_owned(), e[key].to_string(), numbers)
         })
         .collect();
     out.sort_by(|a, b| {
@@ -157,11 +144,7 @@ fn agree(
     mavlink: &[(String, String, Vec<f64>)],
     tolerance: f64,
 ) {
-    assert_eq!(
-        direct.len(),
-        mavlink.len(),
-        "{what}: {direct:?}\nvs\n{mavlink:?}"
-    );
+    assert_eq!(direct.len(), mavlink.len(), "{what}: {direct:?}\nvs\n{mavlink:?}");
     for (a, b) in direct.iter().zip(mavlink) {
         assert_eq!((&a.0, &a.1), (&b.0, &b.1), "{what}");
         assert_eq!(a.2.len(), b.2.len(), "{what}: {a:?} vs {b:?}");
@@ -177,26 +160,16 @@ fn the_paper_mission_over_mavlink_agrees_with_a_simulated_run() {
     let examples = repo().join("examples");
     let world =
         std::fs::read_to_string(examples.join("search_and_rescue.world.toml")).expect("world");
-    std::fs::copy(
-        examples.join("search_and_rescue.mission"),
-        dir.join("m.mission"),
-    )
-    .expect("copy");
+    std::fs::copy(examples.join("search_and_rescue.mission"), dir.join("m.mission")).expect("copy");
     std::fs::write(dir.join("m.world.toml"), &world).expect("world");
-    let (code, _, err) = aviary(
-        &["run", "m.mission", "--quiet", "--trace", "direct.jsonl"],
-        &dir,
-    );
+    let (code, _, err) = aviary(&["run", "m.mission", "--quiet", "--trace", "direct.jsonl"], &dir);
     assert_eq!(code, 0, "{err}");
 
     let vehicles = Vehicles::start(&examples.join("search_and_rescue.world.toml"), "20");
     let live = dir.join("live");
     std::fs::create_dir_all(&live).expect("dir");
-    std::fs::copy(
-        examples.join("search_and_rescue.mission"),
-        live.join("m.mission"),
-    )
-    .expect("copy");
+    std::fs::copy(examples.join("search_and_rescue.mission"), live.join("m.mission"))
+        .expect("copy");
     std::fs::write(live.join("m.world.toml"), bind(&world, vehicles.port, &[])).expect("world");
     let code = run_within(
         &live,
@@ -205,24 +178,11 @@ fn the_paper_mission_over_mavlink_agrees_with_a_simulated_run() {
     );
     let direct = events(&dir.join("direct.jsonl"));
     let mavlink = events(&live.join("t.jsonl"));
-    assert_eq!(
-        code,
-        0,
-        "the mission ends ok over MAVLink: {:?}",
-        mavlink.last()
-    );
-    assert_eq!(
-        mavlink.last().map(|e| e["status"].clone()),
-        Some(Value::from("ok"))
-    );
+    assert_eq!(code, 0, "the mission ends ok over MAVLink: {:?}", mavlink.last());
+    assert_eq!(mavlink.last().map(|e| e["status"].clone()), Some(Value::from("ok")));
     // The same signals, the same finds at the same places, the same calls with the
     // same positions (the beacons fly to where the bodies were found).
-    agree(
-        "signals",
-        &facts(&direct, "signal", "name"),
-        &facts(&mavlink, "signal", "name"),
-        0.0,
-    );
+    agree("signals", &facts(&direct, "signal", "name"), &facts(&mavlink, "signal", "name"), 0.0);
     agree(
         "detections",
         &facts(&direct, "detection", "kind"),
@@ -243,10 +203,7 @@ fn the_paper_mission_over_mavlink_agrees_with_a_simulated_run() {
         &facts(&mavlink, "api_done", "function"),
         1.5,
     );
-    assert!(
-        mavlink.iter().all(|e| e["event"] != "exception"),
-        "no exception over MAVLink"
-    );
+    assert!(mavlink.iter().all(|e| e["event"] != "exception"), "no exception over MAVLink");
 }
 
 const SMALL_MISSION: &str = "\
@@ -285,11 +242,8 @@ fn a_killed_vehicle_raises_connection_lost_within_the_heartbeat_timeout() {
     std::fs::write(dir.join("vehicles.world.toml"), SMALL_WORLD).expect("world");
     let mut vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
     std::fs::write(dir.join("m.mission"), SMALL_MISSION).expect("mission");
-    std::fs::write(
-        dir.join("m.world.toml"),
-        bind(SMALL_WORLD, vehicles.port, &["scout", "buddy"]),
-    )
-    .expect("world");
+    std::fs::write(dir.join("m.world.toml"), bind(SMALL_WORLD, vehicles.port, &["scout", "buddy"]))
+        .expect("world");
     let mut run = Command::new(env!("CARGO_BIN_EXE_aviary"))
         .args(["run", "m.mission", "--quiet", "--trace", "t.jsonl"])
         .current_dir(&dir)
@@ -325,16 +279,9 @@ fn a_killed_vehicle_raises_connection_lost_within_the_heartbeat_timeout() {
         std::thread::sleep(Duration::from_millis(20));
     };
     let reason = exception["args"][0].as_str().unwrap_or("");
-    assert!(
-        reason.contains("no HEARTBEAT from system 1 for 3.0 s"),
-        "{exception}"
-    );
+    assert!(reason.contains("no HEARTBEAT from system 1 for 3.0 s"), "{exception}");
     let status = run.wait().expect("wait");
-    assert_eq!(
-        status.code(),
-        Some(1),
-        "unhandled, ConnectionLost fails the mission"
-    );
+    assert_eq!(status.code(), Some(1), "unhandled, ConnectionLost fails the mission");
 }
 
 #[test]
@@ -344,11 +291,8 @@ fn a_mixed_fleet_flies_one_drone_over_mavlink_and_one_simulated() {
     let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
     let mission = SMALL_MISSION.replace("scout Hover WITH 60s", "scout ReturnHome");
     std::fs::write(dir.join("m.mission"), mission).expect("mission");
-    std::fs::write(
-        dir.join("m.world.toml"),
-        bind(SMALL_WORLD, vehicles.port, &["scout"]),
-    )
-    .expect("world");
+    std::fs::write(dir.join("m.world.toml"), bind(SMALL_WORLD, vehicles.port, &["scout"]))
+        .expect("world");
     let code = run_within(
         &dir,
         &["run", "m.mission", "--quiet", "--trace", "t.jsonl"],
@@ -378,41 +322,19 @@ fn an_unreachable_vehicle_is_a_clear_error() {
     std::fs::write(dir.join("m.mission"), SMALL_MISSION).expect("mission");
     let (code, _, err) = aviary(&["run", "m.mission", "--quiet"], &dir);
     assert_eq!(code, 2, "{err}");
-    assert!(
-        err.contains("cannot reach the MAVLink address `tcp:127.0.0.1:1`"),
-        "{err}"
-    );
+    assert!(err.contains("cannot reach the MAVLink address `tcp:127.0.0.1:1`"), "{err}");
 }
 
 #[test]
 fn bad_vehicles_and_speed_arguments_are_usage_errors() {
     let dir = scratch("mavlink_usage");
     std::fs::write(dir.join("w.world.toml"), SMALL_WORLD).expect("world");
-    let (code, _, err) = aviary(
-        &[
-            "vehicles",
-            "--world",
-            "w.world.toml",
-            "--listen",
-            "carrier-pigeon",
-        ],
-        &dir,
-    );
+    let (code, _, err) =
+        aviary(&["vehicles", "--world", "w.world.toml", "--listen", "carrier-pigeon"], &dir);
     assert_eq!(code, 2, "{err}");
-    assert!(
-        err.contains("`carrier-pigeon` is not an address to listen on"),
-        "{err}"
-    );
+    assert!(err.contains("`carrier-pigeon` is not an address to listen on"), "{err}");
     let (code, _, err) = aviary(
-        &[
-            "vehicles",
-            "--world",
-            "w.world.toml",
-            "--listen",
-            "tcp:127.0.0.1:0",
-            "--speed",
-            "0",
-        ],
+        &["vehicles", "--world", "w.world.toml", "--listen", "tcp:127.0.0.1:0", "--speed", "0"],
         &dir,
     );
     assert_eq!(code, 2, "{err}");
@@ -422,30 +344,16 @@ fn bad_vehicles_and_speed_arguments_are_usage_errors() {
         "[drones.a]\nhome = [0, 0]\nmavlink = \"udp:127.0.0.1:99999\"\n",
     )
     .expect("world");
-    let (code, _, err) = aviary(
-        &[
-            "vehicles",
-            "--world",
-            "bad.world.toml",
-            "--listen",
-            "tcp:127.0.0.1:0",
-        ],
-        &dir,
-    );
+    let (code, _, err) =
+        aviary(&["vehicles", "--world", "bad.world.toml", "--listen", "tcp:127.0.0.1:0"], &dir);
     assert_eq!(code, 2, "{err}");
-    assert!(
-        err.contains("bad.world.toml:3:11: error[E119]") && err.contains("99999"),
-        "{err}"
-    );
+    assert!(err.contains("bad.world.toml:3:11: error[E119]") && err.contains("99999"), "{err}");
     // MAVLink drones fly in real time: --speed is refused, before any connection.
     std::fs::write(dir.join("m.world.toml"), bind(SMALL_WORLD, 1, &["scout"])).expect("world");
     std::fs::write(dir.join("m.mission"), SMALL_MISSION).expect("mission");
     let (code, _, err) = aviary(&["run", "m.mission", "--speed", "10"], &dir);
     assert_eq!(code, 2, "{err}");
-    assert!(
-        err.contains("MAVLink drones, which fly in real time: leave out --speed"),
-        "{err}"
-    );
+    assert!(err.contains("MAVLink drones, which fly in real time: leave out --speed"), "{err}");
 }
 
 /// `aviary check` asks MAVLink vehicles for their figures only with `--plan`, and not
@@ -490,7 +398,8 @@ fn check_plan_hears_aviary_vehicles_and_says_where_the_figures_come_from() {
     let dir = scratch("mavlink_check_vehicles");
     std::fs::write(dir.join("vehicles.world.toml"), SMALL_WORLD).expect("world");
     let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "1");
-    std::fs::write(dir.join("m.world.toml"), bind(SMALL_WORLD, vehicles.port, &["scout", "buddy"])).expect("world");
+    std::fs::write(dir.join("m.world.toml"), bind(SMALL_WORLD, vehicles.port, &["scout", "buddy"]))
+        .expect("world");
     std::fs::write(dir.join("m.mission"), SMALL_MISSION).expect("mission");
     let start = Instant::now();
     let (code, out, err) = aviary(&["check", "--plan", "--format", "json", "m.mission"], &dir);
@@ -502,7 +411,11 @@ fn check_plan_hears_aviary_vehicles_and_says_where_the_figures_come_from() {
     for (s, (name, system)) in sources.iter().zip([("scout", 1), ("buddy", 2)]) {
         let line = s["source"].as_str().expect("source");
         assert_eq!(s["drone"].as_str(), Some(name));
-        assert!(line.starts_with(&format!("{name}: ")) && line.contains(&format!("tcp:127.0.0.1:{} (system {system})", vehicles.port)), "{line}");
+        assert!(
+            line.starts_with(&format!("{name}: "))
+                && line.contains(&format!("tcp:127.0.0.1:{} (system {system})", vehicles.port)),
+            "{line}"
+        );
         assert!(!line.contains("no answer from"), "the vehicle was heard: {line}");
         assert!(line.contains("charge 100%"), "the charge from SYS_STATUS: {line}");
     }

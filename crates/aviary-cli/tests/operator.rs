@@ -3,9 +3,9 @@
 //! event stream, and refusal without the token. `operator/` holds the checks of who
 //! may call (`guard.rs`) and of what an operator may send (`args.rs`).
 
-mod common;
 #[path = "operator/args.rs"]
 mod args;
+mod common;
 #[path = "operator/guard.rs"]
 mod guard;
 #[path = "operator/serve.rs"]
@@ -17,15 +17,29 @@ use std::time::Duration;
 
 use common::{aviary, scratch};
 
-const WORLD: &str = "[places]\nFar = [0, 400]\n[drones.a]\nhome = [0, 0]\n[drones.b]\nhome = [10, 0]\n";
-const MISSION: &str = "MISSION M:\n    PARALLEL:\n        a FlyTo-F1 WITH Far\n        b Hover WITH 40s\n";
+const WORLD: &str =
+    "[places]\nFar = [0, 400]\n[drones.a]\nhome = [0, 0]\n[drones.b]\nhome = [10, 0]\n";
+const MISSION: &str =
+    "MISSION M:\n    PARALLEL:\n        a FlyTo-F1 WITH Far\n        b Hover WITH 40s\n";
 
 /// Starts a served run at 10 times real time; returns it with its URL and token.
 fn served(dir: &std::path::Path) -> (Child, String, String) {
     std::fs::write(dir.join("m.mission"), MISSION).unwrap();
     std::fs::write(dir.join("m.world.toml"), WORLD).unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
-        .args(["run", "m.mission", "--serve", "0", "--speed", "10", "--telemetry-hz", "5", "--quiet", "--trace", "t.jsonl"])
+        .args([
+            "run",
+            "m.mission",
+            "--serve",
+            "0",
+            "--speed",
+            "10",
+            "--telemetry-hz",
+            "5",
+            "--quiet",
+            "--trace",
+            "t.jsonl",
+        ])
         .current_dir(dir)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -39,7 +53,12 @@ fn served(dir: &std::path::Path) -> (Child, String, String) {
     (child, url, token)
 }
 
-fn ctl(url: &str, token: Option<&str>, args: &[&str], dir: &std::path::Path) -> (i32, String, String) {
+fn ctl(
+    url: &str,
+    token: Option<&str>,
+    args: &[&str],
+    dir: &std::path::Path,
+) -> (i32, String, String) {
     let mut all = vec!["ctl", "--url", url];
     if let Some(t) = token {
         all.extend(["--token", t]);
@@ -62,7 +81,12 @@ fn a_leash_round_trip_through_the_server() {
     std::thread::sleep(Duration::from_millis(300));
     let (_, state, _) = ctl(&url, None, &["state"], &dir);
     let state: serde_json::Value = serde_json::from_str(&state).expect("state is JSON");
-    let fly = state["activities"].as_array().unwrap().iter().find(|a| a["tag"] == "F1").expect("the tagged activity is listed");
+    let fly = state["activities"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["tag"] == "F1")
+        .expect("the tagged activity is listed");
     assert_eq!((fly["capability"].as_str(), fly["paused"].as_bool()), (Some("FlyTo"), Some(true)));
     assert!(state["drones"].as_array().unwrap().iter().any(|d| d["name"] == "a"));
     std::thread::sleep(Duration::from_millis(700));
@@ -71,24 +95,57 @@ fn a_leash_round_trip_through_the_server() {
     assert_eq!(ctl(&url, Some(&token), &["leash", "FlyTo-F1", "ABORT"], &dir).0, 0);
     assert_eq!(child.wait().unwrap().code(), Some(0), "an aborted activity leaves the mission ok");
 
-    let trace: Vec<serde_json::Value> = std::fs::read_to_string(dir.join("t.jsonl")).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
-    let at = |action: &str| trace.iter().find(|e| e["event"] == "leash" && e["action"] == action).unwrap_or_else(|| panic!("no {action}"))["t"].as_f64().unwrap();
+    let trace: Vec<serde_json::Value> = std::fs::read_to_string(dir.join("t.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let at = |action: &str| {
+        trace
+            .iter()
+            .find(|e| e["event"] == "leash" && e["action"] == action)
+            .unwrap_or_else(|| panic!("no {action}"))["t"]
+            .as_f64()
+            .unwrap()
+    };
     let (paused, resumed, aborted) = (at("PAUSE"), at("RESUME"), at("ABORT"));
     let held: Vec<&serde_json::Value> = trace
         .iter()
-        .filter(|e| e["event"] == "telemetry" && e["actor"] == "a" && e["t"].as_f64().unwrap() > paused + 0.3 && e["t"].as_f64().unwrap() < resumed)
+        .filter(|e| {
+            e["event"] == "telemetry"
+                && e["actor"] == "a"
+                && e["t"].as_f64().unwrap() > paused + 0.3
+                && e["t"].as_f64().unwrap() < resumed
+        })
         .map(|e| &e["position"])
         .collect();
-    assert!(held.len() >= 10 && held.iter().all(|p| *p == held[0]), "pause holds the drone: {held:?}");
-    let moved = trace.iter().filter(|e| e["event"] == "telemetry" && e["actor"] == "a" && e["t"].as_f64().unwrap() > resumed + 0.5 && e["t"].as_f64().unwrap() < aborted).any(|e| e["position"] != *held[0]);
+    assert!(
+        held.len() >= 10 && held.iter().all(|p| *p == held[0]),
+        "pause holds the drone: {held:?}"
+    );
+    let moved = trace
+        .iter()
+        .filter(|e| {
+            e["event"] == "telemetry"
+                && e["actor"] == "a"
+                && e["t"].as_f64().unwrap() > resumed + 0.5
+                && e["t"].as_f64().unwrap() < aborted
+        })
+        .any(|e| e["position"] != *held[0]);
     assert!(moved, "resume goes on");
-    let end = trace.iter().find(|e| e["event"] == "capability_end" && e["capability"] == "FlyTo").unwrap();
+    let end = trace
+        .iter()
+        .find(|e| e["event"] == "capability_end" && e["capability"] == "FlyTo")
+        .unwrap();
     assert_eq!(end["status"], "aborted");
     assert!(end["t"].as_f64().unwrap() >= aborted);
 
     let (code, streamed, _) = events.join().unwrap();
     assert_eq!(code, 0);
-    assert!(streamed.lines().any(|l| l.contains("\"event\":\"leash\"")), "the live stream carries the same events");
+    assert!(
+        streamed.lines().any(|l| l.contains("\"event\":\"leash\"")),
+        "the live stream carries the same events"
+    );
     assert!(streamed.lines().last().unwrap_or("").contains("mission_end"));
 }
 
@@ -104,7 +161,10 @@ fn control_calls_without_the_token_are_refused() {
     assert!(err.contains("refused (401)"), "{err}");
     let (code, _, err) = ctl(&url, Some(&token), &["leash", "FlyTo-F9", "ABORT"], &dir);
     assert_eq!(code, 1, "a leash on a tag no statement starts is refused");
-    assert!(err.contains("refused (409): no statement starts an activity tagged FlyTo-F9"), "{err}");
+    assert!(
+        err.contains("refused (409): no statement starts an activity tagged FlyTo-F9"),
+        "{err}"
+    );
     assert_eq!(ctl(&url, Some(&token), &["abort"], &dir).0, 0);
     assert_eq!(child.wait().unwrap().code(), Some(1), "an aborted mission exits 1");
     let trace = std::fs::read_to_string(dir.join("t.jsonl")).unwrap();

@@ -14,7 +14,8 @@ fn simulated(mission: &str, world: &[&str]) -> Vec<(String, f64, f64)> {
 }
 
 fn planned(mission: &str, world: &[&str]) -> serde_json::Value {
-    let (code, out, err) = aviary(&[&["check", "--plan", "--format", "json", mission], world].concat(), &repo());
+    let (code, out, err) =
+        aviary(&[&["check", "--plan", "--format", "json", mission], world].concat(), &repo());
     assert_eq!(code, 0, "check --plan failed: {err}");
     serde_json::from_str(&out).expect("one JSON document")
 }
@@ -27,7 +28,10 @@ fn agrees_within_15_percent(mission: &str, world: &[&str]) {
     let mut off = Vec::new();
     for (d, (name, distance, flight)) in drones.iter().zip(&sim) {
         assert_eq!(d["drone"].as_str(), Some(name.as_str()));
-        for (what, est, real) in [("distance", d["distance"].as_f64().expect("distance"), *distance), ("flight time", d["flight_time"].as_f64().expect("flight time"), *flight)] {
+        for (what, est, real) in [
+            ("distance", d["distance"].as_f64().expect("distance"), *distance),
+            ("flight time", d["flight_time"].as_f64().expect("flight time"), *flight),
+        ] {
             // The summary rounds to whole metres and seconds.
             if (est - real).abs() > 0.15 * real + 1.0 {
                 off.push(format!("{name}: {what} planned {est:.0}, simulated {real:.0}"));
@@ -58,8 +62,12 @@ fn the_plan_agrees_with_a_simulated_run_of_drones_with_arducopters_figures() {
     // home: the plan follows each as the simulator flies it.
     let dir = scratch("plan_arducopter");
     let world = dir.join("arducopter.world.toml");
-    std::fs::write(&world, common::example_world_with(|_| common::ARDUCOPTER.to_owned())).expect("world");
-    agrees_within_15_percent("examples/search_and_rescue.mission", &["--world", &world.to_string_lossy()]);
+    std::fs::write(&world, common::example_world_with(|_| common::ARDUCOPTER.to_owned()))
+        .expect("world");
+    agrees_within_15_percent(
+        "examples/search_and_rescue.mission",
+        &["--world", &world.to_string_lossy()],
+    );
 }
 
 const FIXTURES: &str = "crates/aviary-verify/tests/fixtures";
@@ -67,17 +75,39 @@ const FIXTURES: &str = "crates/aviary-verify/tests/fixtures";
 #[test]
 fn the_plan_agrees_with_simulated_runs_of_the_preflight_fixtures() {
     let world = format!("{FIXTURES}/world.toml");
-    for fixture in ["n303_every_firing", "n303_after_signal", "ok_no_conflicts", "w203_two_handlers", "w203_parallel_branches"] {
+    for fixture in [
+        "n303_every_firing",
+        "n303_after_signal",
+        "ok_no_conflicts",
+        "w203_two_handlers",
+        "w203_parallel_branches",
+    ] {
         agrees_within_15_percent(&format!("{FIXTURES}/{fixture}.mission"), &["--world", &world]);
     }
 }
 
 /// `(start, end)` of each activity of `actor` running `capability` with `args`, in order.
-fn activities(trace: &str, actor: &str, capability: &str, args: &serde_json::Value) -> Vec<(f64, f64)> {
-    let events: Vec<serde_json::Value> = trace.lines().map(|l| serde_json::from_str(l).expect("JSON line")).collect();
-    let mine = |e: &&serde_json::Value| e["actor"] == actor && e["capability"] == capability && e["args"] == *args;
-    let starts = events.iter().filter(|e| e["event"] == "capability_start").filter(mine).map(|e| e["t"].as_f64().expect("t"));
-    let ends = events.iter().filter(|e| e["event"] == "capability_end").filter(mine).map(|e| e["t"].as_f64().expect("t"));
+fn activities(
+    trace: &str,
+    actor: &str,
+    capability: &str,
+    args: &serde_json::Value,
+) -> Vec<(f64, f64)> {
+    let events: Vec<serde_json::Value> =
+        trace.lines().map(|l| serde_json::from_str(l).expect("JSON line")).collect();
+    let mine = |e: &&serde_json::Value| {
+        e["actor"] == actor && e["capability"] == capability && e["args"] == *args
+    };
+    let starts = events
+        .iter()
+        .filter(|e| e["event"] == "capability_start")
+        .filter(mine)
+        .map(|e| e["t"].as_f64().expect("t"));
+    let ends = events
+        .iter()
+        .filter(|e| e["event"] == "capability_end")
+        .filter(mine)
+        .map(|e| e["t"].as_f64().expect("t"));
     starts.zip(ends).collect()
 }
 
@@ -86,18 +116,38 @@ fn what_n303_says_waits_does_wait_in_the_engine() {
     let dir = scratch("n303_engine");
     let trace = dir.join("trace.jsonl");
     let world = format!("{FIXTURES}/world.toml");
-    let (code, _, err) = aviary(&["run", &format!("{FIXTURES}/n303_after_signal.mission"), "--world", &world, "--trace", trace.to_str().expect("path")], &repo());
+    let (code, _, err) = aviary(
+        &[
+            "run",
+            &format!("{FIXTURES}/n303_after_signal.mission"),
+            "--world",
+            &world,
+            "--trace",
+            trace.to_str().expect("path"),
+        ],
+        &repo(),
+    );
     assert_eq!(code, 0, "{err}");
     let trace = std::fs::read_to_string(&trace).expect("trace");
-    let flow = activities(&trace, "scout1", "FlyTo", &serde_json::json!({ "target": [300.0, 0.0] }));
-    let handler = activities(&trace, "scout1", "FlyTo", &serde_json::json!({ "target": [0.0, 300.0] }));
+    let flow =
+        activities(&trace, "scout1", "FlyTo", &serde_json::json!({ "target": [300.0, 0.0] }));
+    let handler =
+        activities(&trace, "scout1", "FlyTo", &serde_json::json!({ "target": [0.0, 300.0] }));
     assert_eq!((flow.len(), handler.len()), (1, 1), "{trace}");
-    assert!(handler[0].0 >= flow[0].1, "the handler's flight starts at {} before the flow's ends at {}", handler[0].0, flow[0].1);
+    assert!(
+        handler[0].0 >= flow[0].1,
+        "the handler's flight starts at {} before the flow's ends at {}",
+        handler[0].0,
+        flow[0].1
+    );
     // And the plan puts them in the same order.
     let plan = planned(&format!("{FIXTURES}/n303_after_signal.mission"), &["--world", &world]);
     let acts = plan["plan"]["drones"][0]["activities"].as_array().expect("activities").clone();
     let lines: Vec<&str> = acts.iter().map(|a| a["at"].as_str().expect("at")).collect();
-    assert_eq!(lines.iter().map(|l| l.rsplit(':').nth(1).expect("line")).collect::<Vec<_>>(), ["5", "7", "9", "10"]);
+    assert_eq!(
+        lines.iter().map(|l| l.rsplit(':').nth(1).expect("line")).collect::<Vec<_>>(),
+        ["5", "7", "9", "10"]
+    );
 }
 
 #[test]
@@ -105,14 +155,36 @@ fn each_on_every_firing_waits_for_the_last_one_in_the_engine() {
     let dir = scratch("n303_every_engine");
     let trace = dir.join("trace.jsonl");
     let world = format!("{FIXTURES}/world.toml");
-    let (code, _, err) = aviary(&["run", &format!("{FIXTURES}/n303_every_firing.mission"), "--world", &world, "--trace", trace.to_str().expect("path")], &repo());
+    let (code, _, err) = aviary(
+        &[
+            "run",
+            &format!("{FIXTURES}/n303_every_firing.mission"),
+            "--world",
+            &world,
+            "--trace",
+            trace.to_str().expect("path"),
+        ],
+        &repo(),
+    );
     assert_eq!(code, 0, "{err}");
     let trace = std::fs::read_to_string(&trace).expect("trace");
-    let events: Vec<serde_json::Value> = trace.lines().map(|l| serde_json::from_str(l).expect("JSON line")).collect();
-    let of = |kind: &str| -> Vec<f64> { events.iter().filter(|e| e["event"] == kind && e["capability"] == "Deliver").map(|e| e["t"].as_f64().expect("t")).collect() };
+    let events: Vec<serde_json::Value> =
+        trace.lines().map(|l| serde_json::from_str(l).expect("JSON line")).collect();
+    let of = |kind: &str| -> Vec<f64> {
+        events
+            .iter()
+            .filter(|e| e["event"] == kind && e["capability"] == "Deliver")
+            .map(|e| e["t"].as_f64().expect("t"))
+            .collect()
+    };
     let (starts, ends) = (of("capability_start"), of("capability_end"));
     assert_eq!(starts.len(), 2, "one delivery per target: {starts:?}");
-    assert!(starts[1] >= ends[0], "the second delivery starts at {} before the first ends at {}", starts[1], ends[0]);
+    assert!(
+        starts[1] >= ends[0],
+        "the second delivery starts at {} before the first ends at {}",
+        starts[1],
+        ends[0]
+    );
 }
 
 #[test]
@@ -120,19 +192,38 @@ fn the_papers_mission_checks_clean_apart_from_notes() {
     let (code, out, _) = aviary(&["check", "examples/search_and_rescue.mission"], &repo());
     assert_eq!(code, 0);
     assert!(!out.contains("warning["), "{out}");
-    assert!(out.contains("note[N303]"), "the queueing of video_drone2 and the beacons is noted:\n{out}");
+    assert!(
+        out.contains("note[N303]"),
+        "the queueing of video_drone2 and the beacons is noted:\n{out}"
+    );
 }
 
 #[test]
 fn the_text_plan_lists_every_drone_with_its_timeline() {
-    let (code, out, _) = aviary(&["check", "--plan", "examples/search_and_rescue.mission"], &repo());
+    let (code, out, _) =
+        aviary(&["check", "--plan", "examples/search_and_rescue.mission"], &repo());
     assert_eq!(code, 0);
     assert!(out.contains("plan: the mission takes about"), "{out}");
-    for drone in ["video_drone1", "video_drone2", "flir_drone1", "flir_drone2", "sensor_drone", "beacon_drone1", "beacon_drone2"] {
-        assert!(out.lines().any(|l| l.starts_with(&format!("{drone}: ")) && l.contains("battery left")), "no line for {drone}:\n{out}");
+    for drone in [
+        "video_drone1",
+        "video_drone2",
+        "flir_drone1",
+        "flir_drone2",
+        "sensor_drone",
+        "beacon_drone1",
+        "beacon_drone2",
+    ] {
+        assert!(
+            out.lines().any(|l| l.starts_with(&format!("{drone}: ")) && l.contains("battery left")),
+            "no line for {drone}:\n{out}"
+        );
     }
     // beacon_drone2 flies one beacon per body the world holds.
-    assert_eq!(out.matches("DeployBeacon  (examples/search_and_rescue.mission:43:13)").count(), 2, "{out}");
+    assert_eq!(
+        out.matches("DeployBeacon  (examples/search_and_rescue.mission:43:13)").count(),
+        2,
+        "{out}"
+    );
 }
 
 #[test]
@@ -143,7 +234,8 @@ fn a_plan_needs_a_world_and_a_mission_without_errors() {
     assert_eq!(code, 1);
     assert!(err.contains("no plan for alone.mission: a plan needs the world file"), "{err}");
     std::fs::write(dir.join("broken.mission"), "MISSION M:\n    scout TakeOf\n").expect("write");
-    std::fs::write(dir.join("broken.world.toml"), "[drones.scout]\nhome = [0, 0]\n").expect("write");
+    std::fs::write(dir.join("broken.world.toml"), "[drones.scout]\nhome = [0, 0]\n")
+        .expect("write");
     let (code, out, err) = aviary(&["check", "--plan", "broken.mission"], &dir);
     assert_eq!(code, 1);
     assert!(out.contains("error[E101]") || out.contains("error["), "{out}");
@@ -153,8 +245,16 @@ fn a_plan_needs_a_world_and_a_mission_without_errors() {
 #[test]
 fn a_low_reserve_is_a_warning_in_check_and_flagged_in_the_plan() {
     let dir = scratch("plan_reserve");
-    std::fs::write(dir.join("long.mission"), "MISSION Long:\n    spare TakeOff\n    spare Hover WITH 25min\n    spare ReturnHome\n").expect("write");
-    std::fs::write(dir.join("long.world.toml"), "[drones.spare]\nhome = [0, 0]\nendurance = 1800\n").expect("write");
+    std::fs::write(
+        dir.join("long.mission"),
+        "MISSION Long:\n    spare TakeOff\n    spare Hover WITH 25min\n    spare ReturnHome\n",
+    )
+    .expect("write");
+    std::fs::write(
+        dir.join("long.world.toml"),
+        "[drones.spare]\nhome = [0, 0]\nendurance = 1800\n",
+    )
+    .expect("write");
     let (code, out, _) = aviary(&["check", "--plan", "--format", "json", "long.mission"], &dir);
     assert_eq!(code, 0, "a warning does not fail the check");
     let doc: serde_json::Value = serde_json::from_str(&out).expect("JSON");
@@ -167,9 +267,11 @@ fn a_low_reserve_is_a_warning_in_check_and_flagged_in_the_plan() {
 fn a_long_chain_of_capabilities_checks_plans_and_runs_without_overflowing() {
     let dir = scratch("deep_chain");
     let n = 5000;
-    let mut text = String::from("MISSION M:\n    scout TakeOff\n    scout C0\n    scout ReturnHome\n");
+    let mut text =
+        String::from("MISSION M:\n    scout TakeOff\n    scout C0\n    scout ReturnHome\n");
     for i in 0..n {
-        let body = if i + 1 < n { format!("drone C{}", i + 1) } else { "drone.Hover(1s)".to_string() };
+        let body =
+            if i + 1 < n { format!("drone C{}", i + 1) } else { "drone.Hover(1s)".to_string() };
         text.push_str(&format!("\nCAPABILITY C{i} BY drone:\n    PERFORM:\n        {body}\n"));
     }
     std::fs::write(dir.join("deep.mission"), text).expect("write");
@@ -189,7 +291,10 @@ fn a_capability_that_calls_itself_behind_a_condition_is_planned_once_with_a_note
     std::fs::write(dir.join("rec.world.toml"), "[drones.scout]\nhome = [0, 0]\n").expect("write");
     let (code, out, err) = aviary(&["check", "--plan", "rec.mission"], &dir);
     assert_eq!(code, 0, "{out}{err}");
-    assert!(out.contains("rec.mission:8:13: `Loop` calls itself; the estimate counts one round of it"), "{out}");
+    assert!(
+        out.contains("rec.mission:8:13: `Loop` calls itself; the estimate counts one round of it"),
+        "{out}"
+    );
 }
 
 #[test]
@@ -203,7 +308,10 @@ fn a_capability_that_calls_itself_unconditionally_is_an_error_with_no_plan() {
     assert!(err.contains("no plan for rec.mission: fix its errors first"), "{err}");
     let (code, _, err) = aviary(&["run", "rec.mission"], &dir);
     assert_eq!(code, 2, "a mission with errors is not flown: {err}");
-    assert!(err.contains("error[E126]") && err.contains("rec.mission has errors, so it was not run"), "{err}");
+    assert!(
+        err.contains("error[E126]") && err.contains("rec.mission has errors, so it was not run"),
+        "{err}"
+    );
     let (code, out, _) = aviary(&["explain", "E126"], &dir);
     assert_eq!(code, 0);
     assert!(out.starts_with("E126 (error): a capability that calls itself"), "{out}");
@@ -217,12 +325,22 @@ fn a_recursion_that_never_ends_in_flight_fails_the_mission_with_command_failed_n
     std::fs::write(dir.join("rec.world.toml"), "[drones.scout]\nhome = [0, 0]\n").expect("write");
     let (code, out, err) = aviary(&["run", "rec.mission", "--trace", "rec.jsonl"], &dir);
     assert_eq!(code, 1, "{out}{err}");
-    assert!(out.contains("calling `Loop` would nest capability calls 10001 deep, past the limit of 10000"), "{out}{err}");
+    assert!(
+        out.contains(
+            "calling `Loop` would nest capability calls 10001 deep, past the limit of 10000"
+        ),
+        "{out}{err}"
+    );
     let trace = std::fs::read_to_string(dir.join("rec.jsonl")).expect("trace");
-    let events: Vec<serde_json::Value> = trace.lines().map(|l| serde_json::from_str(l).expect("JSON")).collect();
+    let events: Vec<serde_json::Value> =
+        trace.lines().map(|l| serde_json::from_str(l).expect("JSON")).collect();
     assert_eq!(events.iter().filter(|e| e["event"] == "capability_start").count(), 10_000);
     let last = events.last().expect("events");
-    assert_eq!((last["event"].as_str(), last["status"].as_str()), (Some("mission_end"), Some("failed")), "{last}");
+    assert_eq!(
+        (last["event"].as_str(), last["status"].as_str()),
+        (Some("mission_end"), Some("failed")),
+        "{last}"
+    );
 }
 
 #[test]
@@ -235,7 +353,11 @@ fn capabilities_that_fan_out_are_checked_and_planned_in_bounded_time() {
     for i in 0..depth {
         text.push_str(&format!("\nCAPABILITY D{i} BY drone:\n    PERFORM:\n"));
         for _ in 0..10 {
-            text.push_str(&if i + 1 < depth { format!("        drone D{}\n", i + 1) } else { "        drone.FlyToPosition((10, 10))\n".into() });
+            text.push_str(&if i + 1 < depth {
+                format!("        drone D{}\n", i + 1)
+            } else {
+                "        drone.FlyToPosition((10, 10))\n".into()
+            });
         }
     }
     std::fs::write(dir.join("fan.mission"), text).expect("write");

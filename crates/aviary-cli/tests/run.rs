@@ -10,7 +10,9 @@ use common::{aviary, repo, scratch};
 fn schema() -> serde_json::Value {
     let shared = repo().join("../shared/trace.schema.json");
     let ours = repo().join("docs/trace.schema.json");
-    let text = std::fs::read_to_string(&shared).or_else(|_| std::fs::read_to_string(&ours)).expect("trace.schema.json");
+    let text = std::fs::read_to_string(&shared)
+        .or_else(|_| std::fs::read_to_string(&ours))
+        .expect("trace.schema.json");
     serde_json::from_str(&text).expect("the schema is JSON")
 }
 
@@ -19,12 +21,25 @@ fn the_paper_mission_runs_and_its_trace_fits_the_schema() {
     let dir = scratch("paper_run");
     let trace = dir.join("trace.jsonl");
     let trace_arg = trace.to_string_lossy().into_owned();
-    let (code, out, err) = aviary(&["run", "examples/search_and_rescue.mission", "--trace", &trace_arg, "--telemetry-hz", "1"], &repo());
+    let (code, out, err) = aviary(
+        &[
+            "run",
+            "examples/search_and_rescue.mission",
+            "--trace",
+            &trace_arg,
+            "--telemetry-hz",
+            "1",
+        ],
+        &repo(),
+    );
     assert_eq!(code, 0, "{out}\n{err}");
     assert!(out.contains("mission ok"), "{out}");
     assert!(out.contains("detections: 3"), "{out}");
     for drone in ["video_drone1", "flir_drone2", "beacon_drone2"] {
-        let line = out.lines().find(|l| l.starts_with(drone)).unwrap_or_else(|| panic!("{drone} in the summary: {out}"));
+        let line = out
+            .lines()
+            .find(|l| l.starts_with(drone))
+            .unwrap_or_else(|| panic!("{drone} in the summary: {out}"));
         assert!(line.ends_with("Landed"), "{line}");
     }
     let validator = jsonschema::validator_for(&schema()).expect("a valid schema");
@@ -32,7 +47,8 @@ fn the_paper_mission_runs_and_its_trace_fits_the_schema() {
     let mut last_t = 0.0;
     let mut kinds = std::collections::BTreeSet::new();
     for (n, line) in text.lines().enumerate() {
-        let event: serde_json::Value = serde_json::from_str(line).unwrap_or_else(|e| panic!("line {}: {e}", n + 1));
+        let event: serde_json::Value =
+            serde_json::from_str(line).unwrap_or_else(|e| panic!("line {}: {e}", n + 1));
         let errors: Vec<String> = validator.iter_errors(&event).map(|e| e.to_string()).collect();
         assert!(errors.is_empty(), "line {}: {line}\n{errors:#?}", n + 1);
         let t = event["t"].as_f64().unwrap();
@@ -40,7 +56,21 @@ fn the_paper_mission_runs_and_its_trace_fits_the_schema() {
         last_t = t;
         kinds.insert(event["event"].as_str().unwrap().to_string());
     }
-    for kind in ["mission_start", "block_start", "block_end", "capability_start", "capability_end", "api_call", "api_done", "signal", "handler_start", "handler_end", "detection", "telemetry", "mission_end"] {
+    for kind in [
+        "mission_start",
+        "block_start",
+        "block_end",
+        "capability_start",
+        "capability_end",
+        "api_call",
+        "api_done",
+        "signal",
+        "handler_start",
+        "handler_end",
+        "detection",
+        "telemetry",
+        "mission_end",
+    ] {
         assert!(kinds.contains(kind), "the paper's trace has {kind} events");
     }
 }
@@ -50,7 +80,18 @@ fn the_same_files_and_seed_give_the_same_trace_byte_for_byte() {
     let dir = scratch("determinism");
     let (a, b) = (dir.join("a.jsonl"), dir.join("b.jsonl"));
     for t in [&a, &b] {
-        let (code, _, err) = aviary(&["run", "examples/search_and_rescue.mission", "--seed", "7", "--quiet", "--trace", &t.to_string_lossy()], &repo());
+        let (code, _, err) = aviary(
+            &[
+                "run",
+                "examples/search_and_rescue.mission",
+                "--seed",
+                "7",
+                "--quiet",
+                "--trace",
+                &t.to_string_lossy(),
+            ],
+            &repo(),
+        );
         assert_eq!(code, 0, "{err}");
     }
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
@@ -60,7 +101,11 @@ fn the_same_files_and_seed_give_the_same_trace_byte_for_byte() {
 fn exit_codes_follow_runtime_md() {
     let dir = scratch("run_exits");
     std::fs::write(dir.join("m.world.toml"), "[drones.d1]\nhome = [0, 0]\n").unwrap();
-    std::fs::write(dir.join("m.mission"), "MISSION M:\n    d1 TakeOff WITH 20m\n    THROW EXCEPTION Broken\n").unwrap();
+    std::fs::write(
+        dir.join("m.mission"),
+        "MISSION M:\n    d1 TakeOff WITH 20m\n    THROW EXCEPTION Broken\n",
+    )
+    .unwrap();
     let (code, out, _) = aviary(&["run", "m.mission"], &dir);
     assert_eq!(code, 1, "an unhandled exception fails the mission: {out}");
     assert!(out.contains("mission failed: unhandled exception Broken on the mission"), "{out}");
@@ -68,7 +113,11 @@ fn exit_codes_follow_runtime_md() {
     let (code, _, err) = aviary(&["run", "m.mission"], &dir);
     assert_eq!(code, 2, "a mission with errors is not run");
     assert!(err.contains("error[E107]") && err.contains("was not run"), "{err}");
-    std::fs::write(dir.join("lib.mission"), "CAPABILITY Up BY d:\n    PERFORM:\n        d.TakeOff(5m)\n").unwrap();
+    std::fs::write(
+        dir.join("lib.mission"),
+        "CAPABILITY Up BY d:\n    PERFORM:\n        d.TakeOff(5m)\n",
+    )
+    .unwrap();
     let (code, _, err) = aviary(&["run", "lib.mission", "--world", "m.world.toml"], &dir);
     assert_eq!(code, 2);
     assert!(err.contains("no MISSION to run"), "{err}");
@@ -97,12 +146,21 @@ fn a_speed_paces_the_run_against_the_wall_clock() {
 fn an_unhandled_crash_exits_1_with_the_others_home() {
     let dir = scratch("unhandled_crash");
     std::fs::write(dir.join("m.world.toml"), "[places]\nFar = [0, 300]\n[drones.a]\nhome = [0, 0]\n[drones.b]\nhome = [10, 0]\n[[faults]]\ndrone = \"a\"\nat = 10.0\nkind = \"crash\"\n").unwrap();
-    std::fs::write(dir.join("m.mission"), "MISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        b FlyTo WITH Far\n").unwrap();
+    std::fs::write(
+        dir.join("m.mission"),
+        "MISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        b FlyTo WITH Far\n",
+    )
+    .unwrap();
     let (code, out, _) = aviary(&["run", "m.mission", "--trace", "t.jsonl"], &dir);
     assert_eq!(code, 1, "{out}");
     assert!(out.contains("mission failed: unhandled exception DroneLost on a"), "{out}");
     let trace = std::fs::read_to_string(dir.join("t.jsonl")).unwrap();
-    assert!(trace.lines().any(|l| l.contains("\"function\":\"ReturnToLaunch\"") && l.contains("\"actor\":\"b\"") && l.contains("\"status\":\"ok\"")), "b is brought home");
+    assert!(
+        trace.lines().any(|l| l.contains("\"function\":\"ReturnToLaunch\"")
+            && l.contains("\"actor\":\"b\"")
+            && l.contains("\"status\":\"ok\"")),
+        "b is brought home"
+    );
     let b = out.lines().find(|l| l.starts_with("b ")).unwrap();
     assert!(b.ends_with("Landed"), "{b}");
     let a = out.lines().find(|l| l.starts_with("a ")).unwrap();
@@ -113,14 +171,26 @@ fn an_unhandled_crash_exits_1_with_the_others_home() {
 fn in_the_trace_no_two_airborne_drones_come_closer_than_min_separation() {
     let dir = scratch("separation");
     let trace = dir.join("t.jsonl");
-    let (code, _, err) = aviary(&["run", "examples/search_and_rescue.mission", "--quiet", "--telemetry-hz", "20", "--trace", &trace.to_string_lossy()], &repo());
+    let (code, _, err) = aviary(
+        &[
+            "run",
+            "examples/search_and_rescue.mission",
+            "--quiet",
+            "--telemetry-hz",
+            "20",
+            "--trace",
+            &trace.to_string_lossy(),
+        ],
+        &repo(),
+    );
     assert_eq!(code, 0, "{err}");
     let mut by_time: std::collections::BTreeMap<String, Vec<[f64; 3]>> = Default::default();
     for line in std::fs::read_to_string(&trace).unwrap().lines() {
         let e: serde_json::Value = serde_json::from_str(line).unwrap();
         let airborne = matches!(e["state"].as_str(), Some("TakingOff" | "Flying" | "Landing"));
         if e["event"] == "telemetry" && airborne && e["position"][2].as_f64().unwrap() > 0.0 {
-            let p: Vec<f64> = e["position"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+            let p: Vec<f64> =
+                e["position"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
             by_time.entry(e["t"].to_string()).or_default().push([p[0], p[1], p[2]]);
         }
     }
@@ -129,7 +199,9 @@ fn in_the_trace_no_two_airborne_drones_come_closer_than_min_separation() {
     for drones in by_time.values() {
         for (i, a) in drones.iter().enumerate() {
             for b in &drones[i + 1..] {
-                closest = closest.min(((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt());
+                closest = closest.min(
+                    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt(),
+                );
             }
         }
     }
@@ -139,9 +211,13 @@ fn in_the_trace_no_two_airborne_drones_come_closer_than_min_separation() {
 #[test]
 fn a_trace_that_cannot_be_written_is_said_at_once_and_exits_3_after_a_whole_flight() {
     // /dev/full takes the open and refuses every write, as a full disk does.
-    let (code, out, err) = aviary(&["run", "examples/search_and_rescue.mission", "--trace", "/dev/full"], &repo());
+    let (code, out, err) =
+        aviary(&["run", "examples/search_and_rescue.mission", "--trace", "/dev/full"], &repo());
     assert_eq!(code, 3, "{out}\n{err}");
-    assert!(err.contains("cannot write the trace /dev/full") && err.contains("No space left"), "{err}");
+    assert!(
+        err.contains("cannot write the trace /dev/full") && err.contains("No space left"),
+        "{err}"
+    );
     // Said once, not once per event.
     assert_eq!(err.matches("cannot write the trace").count(), 1, "{err}");
     // The fleet flew the mission to its end all the same.

@@ -57,15 +57,25 @@ fn finish(run: &mut Run, dir: &Path, limit: Duration) -> (i32, String) {
         if let Some(s) = run.0.try_wait().expect("wait") {
             break s;
         }
-        assert!(start.elapsed() < limit, "aviary run took more than {} s; see {}", limit.as_secs(), dir.display());
+        assert!(
+            start.elapsed() < limit,
+            "aviary run took more than {} s; see {}",
+            limit.as_secs(),
+            dir.display()
+        );
         std::thread::sleep(Duration::from_millis(250));
     };
-    let out = std::fs::read_to_string(dir.join("stdout.txt")).unwrap_or_default() + &std::fs::read_to_string(dir.join("stderr.txt")).unwrap_or_default();
+    let out = std::fs::read_to_string(dir.join("stdout.txt")).unwrap_or_default()
+        + &std::fs::read_to_string(dir.join("stderr.txt")).unwrap_or_default();
     (status.code().unwrap_or(-1), out)
 }
 
 fn events(path: &Path) -> Vec<Value> {
-    std::fs::read_to_string(path).unwrap_or_default().lines().map(|l| serde_json::from_str(l).expect("a whole JSON event")).collect()
+    std::fs::read_to_string(path)
+        .unwrap_or_default()
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("a whole JSON event"))
+        .collect()
 }
 
 fn named<'a>(events: &'a [Value], event: &str) -> impl Iterator<Item = &'a Value> {
@@ -127,7 +137,8 @@ fn home_of(name: &str) -> [f64; 2] {
 /// The signals (with their counts) and finds of a trace, which must not depend on
 /// whether the drones are real or simulated.
 fn outcome(events: &[Value]) -> (Vec<String>, Vec<(String, i64, i64)>) {
-    let mut signals: Vec<String> = named(events, "signal").map(|e| e["name"].as_str().unwrap_or("").to_owned()).collect();
+    let mut signals: Vec<String> =
+        named(events, "signal").map(|e| e["name"].as_str().unwrap_or("").to_owned()).collect();
     signals.sort();
     let mut finds: Vec<(String, i64, i64)> = named(events, "detection")
         .map(|e| {
@@ -148,20 +159,54 @@ fn paper_mission(tag: &str, first_instance: u16, real: &[&str]) {
     let sitls: Vec<(&str, Sitl)> = real
         .iter()
         .enumerate()
-        .map(|(i, name)| (*name, Sitl::start(&dir, first_instance, i as u8 + 1, home_of(name), BIG_BATTERY)))
+        .map(|(i, name)| {
+            (*name, Sitl::start(&dir, first_instance, i as u8 + 1, home_of(name), BIG_BATTERY))
+        })
         .collect();
     let refs: Vec<(&str, &Sitl)> = sitls.iter().map(|(n, s)| (*n, s)).collect();
-    std::fs::copy(repo().join("examples/search_and_rescue.mission"), dir.join("m.mission")).expect("mission");
+    std::fs::copy(repo().join("examples/search_and_rescue.mission"), dir.join("m.mission"))
+        .expect("mission");
     std::fs::write(dir.join("m.world.toml"), example_world(&refs)).expect("world");
     // The same drones in the simulator: those on SITL with ArduCopter's figures.
     let sim_world = dir.join("sim.world.toml");
-    std::fs::write(&sim_world, common::example_world_with(|name| if real.contains(&name) { common::ARDUCOPTER.to_owned() } else { String::new() })).expect("world");
+    std::fs::write(
+        &sim_world,
+        common::example_world_with(|name| {
+            if real.contains(&name) {
+                common::ARDUCOPTER.to_owned()
+            } else {
+                String::new()
+            }
+        }),
+    )
+    .expect("world");
     let sim_world = sim_world.to_string_lossy().into_owned();
 
-    let (code, sim_out, err) = aviary(&["run", "examples/search_and_rescue.mission", "--world", &sim_world, "--trace", &dir.join("sim.jsonl").to_string_lossy()], &repo());
+    let (code, sim_out, err) = aviary(
+        &[
+            "run",
+            "examples/search_and_rescue.mission",
+            "--world",
+            &sim_world,
+            "--trace",
+            &dir.join("sim.jsonl").to_string_lossy(),
+        ],
+        &repo(),
+    );
     assert_eq!(code, 0, "the simulated run: {err}");
     let simulated = events(&dir.join("sim.jsonl"));
-    let (code, plan, err) = aviary(&["check", "--plan", "--format", "json", "examples/search_and_rescue.mission", "--world", &sim_world], &repo());
+    let (code, plan, err) = aviary(
+        &[
+            "check",
+            "--plan",
+            "--format",
+            "json",
+            "examples/search_and_rescue.mission",
+            "--world",
+            &sim_world,
+        ],
+        &repo(),
+    );
     assert_eq!(code, 0, "the plan: {err}");
     let plan: Value = serde_json::from_str(&plan).expect("the plan's JSON");
 
@@ -169,14 +214,23 @@ fn paper_mission(tag: &str, first_instance: u16, real: &[&str]) {
     let (code, out) = finish(&mut run, &dir, Duration::from_secs(1500));
     assert_eq!(code, 0, "the mission on SITL ended badly:\n{out}\nsee {}", dir.display());
     let flown = events(&dir.join("t.jsonl"));
-    assert_eq!(outcome(&flown), outcome(&simulated), "the same signals and finds as the simulated run");
+    assert_eq!(
+        outcome(&flown),
+        outcome(&simulated),
+        "the same signals and finds as the simulated run"
+    );
     let finds: Vec<[f64; 3]> = named(&flown, "detection").map(|e| pos(&e["location"])).collect();
-    let drops: Vec<&Value> = named(&flown, "api_done").filter(|e| e["function"] == "ReleasePayload").collect();
+    let drops: Vec<&Value> =
+        named(&flown, "api_done").filter(|e| e["function"] == "ReleasePayload").collect();
     assert_eq!(drops.len(), finds.len(), "a beacon for every find");
     for drop in drops {
         let at = pos(&drop["position"]);
         let near = finds.iter().map(|f| dist2(*f, at)).fold(f64::INFINITY, f64::min);
-        assert!(near <= 5.0, "{} dropped its beacon {near:.1} m from the nearest find", drop["actor"]);
+        assert!(
+            near <= 5.0,
+            "{} dropped its beacon {near:.1} m from the nearest find",
+            drop["actor"]
+        );
     }
     let end = flown.last().expect("events");
     assert_eq!((end["event"].as_str(), end["status"].as_str()), (Some("mission_end"), Some("ok")));
@@ -185,9 +239,17 @@ fn paper_mission(tag: &str, first_instance: u16, real: &[&str]) {
     // plan's for the same drone.
     let sitl = common::summary_rows(&out);
     let sim = common::summary_rows(&sim_out);
-    let flight = |rows: &[(String, f64, f64)], name: &str| rows.iter().find(|r| r.0 == name).map(|r| r.2).expect("a summary row");
+    let flight = |rows: &[(String, f64, f64)], name: &str| {
+        rows.iter().find(|r| r.0 == name).map(|r| r.2).expect("a summary row")
+    };
     let planned = |name: &str| {
-        plan["plan"]["drones"].as_array().expect("drones").iter().find(|d| d["drone"] == name).and_then(|d| d["flight_time"].as_f64()).expect("a planned flight time")
+        plan["plan"]["drones"]
+            .as_array()
+            .expect("drones")
+            .iter()
+            .find(|d| d["drone"] == name)
+            .and_then(|d| d["flight_time"].as_f64())
+            .expect("a planned flight time")
     };
     let mut off = Vec::new();
     for name in real {
@@ -207,7 +269,15 @@ mod fleet {
         super::paper_mission(
             "sitl_paper",
             0,
-            &["video_drone1", "video_drone2", "flir_drone1", "flir_drone2", "sensor_drone", "beacon_drone1", "beacon_drone2"],
+            &[
+                "video_drone1",
+                "video_drone2",
+                "flir_drone1",
+                "flir_drone2",
+                "sensor_drone",
+                "beacon_drone1",
+                "beacon_drone2",
+            ],
         );
     }
 
@@ -223,7 +293,15 @@ mod fleet {
 mod facts {
     use super::*;
 
-    const PAPER: [&str; 7] = ["video_drone1", "video_drone2", "flir_drone1", "flir_drone2", "sensor_drone", "beacon_drone1", "beacon_drone2"];
+    const PAPER: [&str; 7] = [
+        "video_drone1",
+        "video_drone2",
+        "flir_drone1",
+        "flir_drone2",
+        "sensor_drone",
+        "beacon_drone1",
+        "beacon_drone2",
+    ];
 
     /// The paper's mission on seven copters with ArduPilot's default battery (3300 mAh),
     /// in a world whose drones draw SITL's 30 A: 6.6 minutes of flight for a mission whose
@@ -232,16 +310,34 @@ mod facts {
     #[test]
     fn check_plan_warns_when_the_vehicles_batteries_cannot_finish_the_paper_mission() {
         let dir = scratch("sitl_facts");
-        let sitls: Vec<(&str, Sitl)> = PAPER.iter().enumerate().map(|(i, n)| (*n, Sitl::start(&dir, 30, i as u8 + 1, home_of(n), &[]))).collect();
+        let sitls: Vec<(&str, Sitl)> = PAPER
+            .iter()
+            .enumerate()
+            .map(|(i, n)| (*n, Sitl::start(&dir, 30, i as u8 + 1, home_of(n), &[])))
+            .collect();
         let refs: Vec<(&str, &Sitl)> = sitls.iter().map(|(n, s)| (*n, s)).collect();
-        std::fs::copy(repo().join("examples/search_and_rescue.mission"), dir.join("m.mission")).expect("mission");
-        std::fs::write(dir.join("m.world.toml"), example_world_with(&refs, "flight_current = 30\n")).expect("world");
-        let warned = |out: &str| -> Vec<&str> { PAPER.iter().copied().filter(|n| out.contains(&format!("{n}'s battery is estimated to fall under 20%"))).collect() };
+        std::fs::copy(repo().join("examples/search_and_rescue.mission"), dir.join("m.mission"))
+            .expect("mission");
+        std::fs::write(
+            dir.join("m.world.toml"),
+            example_world_with(&refs, "flight_current = 30\n"),
+        )
+        .expect("world");
+        let warned = |out: &str| -> Vec<&str> {
+            PAPER
+                .iter()
+                .copied()
+                .filter(|n| out.contains(&format!("{n}'s battery is estimated to fall under 20%")))
+                .collect()
+        };
 
         // The world alone knows the draw but not the capacity: its 30 minutes, no warning.
         let (code, out, err) = aviary(&["check", "--plan", "--offline", "m.mission"], &dir);
         assert_eq!(code, 0, "{out}{err}");
-        assert!(warned(&out).is_empty() && !out.contains("W204"), "offline, the world's endurance suffices:\n{out}");
+        assert!(
+            warned(&out).is_empty() && !out.contains("W204"),
+            "offline, the world's endurance suffices:\n{out}"
+        );
 
         let start = Instant::now();
         let (code, out, err) = aviary(&["check", "--plan", "m.mission"], &dir);
@@ -249,14 +345,36 @@ mod facts {
         std::fs::write(dir.join("check-default.txt"), &out).expect("keep the output");
         assert_eq!(code, 0, "a warning is no error:\n{out}{err}");
         for (name, s) in &refs {
-            let source = format!("{name}: figures from the vehicle on {} (system {}), charge 100%", s.address(), s.system);
+            let source = format!(
+                "{name}: figures from the vehicle on {} (system {}), charge 100%",
+                s.address(),
+                s.system
+            );
             assert!(out.contains(&source), "{source:?} in:\n{out}");
-            assert!(out.contains(&format!("{name}: battery 3300 mAh (the vehicle's BATT_CAPACITY); the world gave none")), "{out}");
-            assert!(out.contains(&format!("{name}: endurance 6.6 min (3300 mAh at the world's flight_current 30 A)")), "{out}");
-            assert!(out.contains(&format!("{name}: descent 1.5 m/s (the vehicle's WPNAV_SPEED_DN), not the world's 3 m/s")), "{out}");
+            assert!(
+                out.contains(&format!(
+                    "{name}: battery 3300 mAh (the vehicle's BATT_CAPACITY); the world gave none"
+                )),
+                "{out}"
+            );
+            assert!(
+                out.contains(&format!(
+                    "{name}: endurance 6.6 min (3300 mAh at the world's flight_current 30 A)"
+                )),
+                "{out}"
+            );
+            assert!(
+                out.contains(&format!(
+                    "{name}: descent 1.5 m/s (the vehicle's WPNAV_SPEED_DN), not the world's 3 m/s"
+                )),
+                "{out}"
+            );
         }
         let short = warned(&out);
-        assert!(!short.is_empty() && out.contains("W204") && out.contains("runs out before the end"), "the default battery cannot finish:\n{out}");
+        assert!(
+            !short.is_empty() && out.contains("W204") && out.contains("runs out before the end"),
+            "the default battery cannot finish:\n{out}"
+        );
         eprintln!("check --plan with seven vehicles booting took {took:?}; warned: {short:?}");
         assert!(took < Duration::from_secs(12), "check --plan took {took:?}");
 
@@ -271,7 +389,10 @@ mod facts {
         std::fs::write(dir.join("check-16500.txt"), &out).expect("keep the output");
         assert_eq!(code, 0, "{out}{err}");
         for name in PAPER {
-            assert!(out.contains(&format!("{name}: battery 16500 mAh (the vehicle's BATT_CAPACITY)")), "{out}");
+            assert!(
+                out.contains(&format!("{name}: battery 16500 mAh (the vehicle's BATT_CAPACITY)")),
+                "{out}"
+            );
         }
         assert!(warned(&out).is_empty() && !out.contains("W204"), "16.5 Ah suffices:\n{out}");
     }
@@ -284,21 +405,48 @@ mod facts {
     fn run_warns_before_flight_that_the_battery_runs_out_and_flies() {
         let dir = scratch("sitl_facts_run");
         let sitl = Sitl::start(&dir, 30, 1, [0.0, 0.0], &[]);
-        std::fs::write(dir.join("m.world.toml"), one_copter_world(&sitl, "") + "flight_current = 30\n").expect("world");
+        std::fs::write(
+            dir.join("m.world.toml"),
+            one_copter_world(&sitl, "") + "flight_current = 30\n",
+        )
+        .expect("world");
         std::fs::write(dir.join("m.mission"), "MISSION Long:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d Hover WITH 600s\n").expect("mission");
         let _run = start_run(&dir, "m.mission");
         let stderr = || std::fs::read_to_string(dir.join("stderr.txt")).unwrap_or_default();
         wait_until(Duration::from_secs(120), "the warning", || stderr().contains("WARNING"));
         let said = stderr();
-        assert!(said.contains("d: figures from the vehicle on") && said.contains("d: endurance 6.6 min"), "{said}");
-        assert!(said.contains("warning[W204]: d's battery") && said.contains("runs out before the end"), "{said}");
-        assert!(said.contains("the plan says d's battery runs out before the mission ends") && said.contains("Flying anyway"), "{said}");
+        assert!(
+            said.contains("d: figures from the vehicle on")
+                && said.contains("d: endurance 6.6 min"),
+            "{said}"
+        );
+        assert!(
+            said.contains("warning[W204]: d's battery") && said.contains("runs out before the end"),
+            "{said}"
+        );
+        assert!(
+            said.contains("the plan says d's battery runs out before the mission ends")
+                && said.contains("Flying anyway"),
+            "{said}"
+        );
         // 10 minutes on 6.6: about 150 % (the plan adds the take-off and the way home).
-        let needs: f64 = said.split("it needs about ").nth(1).and_then(|t| t.split('%').next()).and_then(|n| n.parse().ok()).unwrap_or_else(|| panic!("no need in {said}"));
+        let needs: f64 = said
+            .split("it needs about ")
+            .nth(1)
+            .and_then(|t| t.split('%').next())
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("no need in {said}"));
         assert!((140.0..170.0).contains(&needs) && said.contains("starts with 100%"), "{said}");
         // Said before the take-off, which waits for SITL's GPS and EKF (tens of seconds).
-        assert!(!events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_done"), "the warning comes before anything flies");
-        wait_until(Duration::from_secs(120), "the take-off", || events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_call" && e["function"] == "TakeOff"));
+        assert!(
+            !events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_done"),
+            "the warning comes before anything flies"
+        );
+        wait_until(Duration::from_secs(120), "the take-off", || {
+            events(&dir.join("t.jsonl"))
+                .iter()
+                .any(|e| e["event"] == "api_call" && e["function"] == "TakeOff")
+        });
     }
 
     /// In flight the battery rule takes the share of the way home from the current the
@@ -321,16 +469,31 @@ mod facts {
         // The charge the drone reported last before `event`.
         let charge_before = |event: &Value| -> f64 {
             let t = event["t"].as_f64().expect("t");
-            named(&flown, "telemetry").filter(|e| e["actor"] == "d" && e["t"].as_f64() <= Some(t)).last().and_then(|e| e["battery"].as_f64()).expect("telemetry before")
+            named(&flown, "telemetry")
+                .filter(|e| e["actor"] == "d" && e["t"].as_f64() <= Some(t))
+                .last()
+                .and_then(|e| e["battery"].as_f64())
+                .expect("telemetry before")
         };
-        let low = named(&flown, "signal").find(|e| e["name"] == "BatteryLow").unwrap_or_else(|| panic!("no BatteryLow:\n{out}"));
-        let critical = named(&flown, "exception").find(|e| e["name"] == "BatteryCritical").unwrap_or_else(|| panic!("no BatteryCritical:\n{out}"));
+        let low = named(&flown, "signal")
+            .find(|e| e["name"] == "BatteryLow")
+            .unwrap_or_else(|| panic!("no BatteryLow:\n{out}"));
+        let critical = named(&flown, "exception")
+            .find(|e| e["name"] == "BatteryCritical")
+            .unwrap_or_else(|| panic!("no BatteryCritical:\n{out}"));
         let (at_low, at_critical) = (charge_before(low), charge_before(critical));
-        eprintln!("BatteryLow at {:.0} %, BatteryCritical at {:.0} %", at_low * 100.0, at_critical * 100.0);
+        eprintln!(
+            "BatteryLow at {:.0} %, BatteryCritical at {:.0} %",
+            at_low * 100.0,
+            at_critical * 100.0
+        );
         assert!((0.60..=0.85).contains(&at_low), "BatteryLow at {at_low}:\n{out}");
         assert!((0.30..=0.55).contains(&at_critical), "BatteryCritical at {at_critical}:\n{out}");
         assert_eq!(critical["handled"].as_bool(), Some(true));
-        assert!(critical["args"].to_string().contains("about what it needs to get home"), "the backend's rule, not SITL's failsafe: {critical}");
+        assert!(
+            critical["args"].to_string().contains("about what it needs to get home"),
+            "the backend's rule, not SITL's failsafe: {critical}"
+        );
     }
 }
 
@@ -338,10 +501,16 @@ mod single {
     use super::*;
 
     /// One copter, and the test's own ground station on the vehicle's second port.
-    fn one(tag: &str, params: &[(&str, f64)], world_extra: &str, mission: &str) -> (PathBuf, Sitl, Run) {
+    fn one(
+        tag: &str,
+        params: &[(&str, f64)],
+        world_extra: &str,
+        mission: &str,
+    ) -> (PathBuf, Sitl, Run) {
         let dir = scratch(tag);
         let sitl = Sitl::start(&dir, 20, 1, [0.0, 0.0], params);
-        std::fs::write(dir.join("m.world.toml"), one_copter_world(&sitl, world_extra)).expect("world");
+        std::fs::write(dir.join("m.world.toml"), one_copter_world(&sitl, world_extra))
+            .expect("world");
         std::fs::write(dir.join("m.mission"), mission).expect("mission");
         let run = start_run(&dir, "m.mission");
         (dir, sitl, run)
@@ -354,7 +523,9 @@ mod single {
     /// Waits until the trace shows the drone in the air (after GPS lock and take-off).
     fn airborne(dir: &Path) {
         wait_until(Duration::from_secs(150), "the take-off", || {
-            events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_done" && e["function"] == "TakeOff")
+            events(&dir.join("t.jsonl"))
+                .iter()
+                .any(|e| e["event"] == "api_done" && e["function"] == "TakeOff")
         });
     }
 
@@ -370,21 +541,38 @@ mod single {
         // station (10 Hz, so within a metre or two of some point of it).
         let track = gcs.seen.lock().unwrap().track.clone();
         assert!(track.len() > 100, "the ground station saw the flight");
-        let points: Vec<[f64; 3]> = named(&flown, "telemetry").map(|e| pos(&e["position"])).collect();
+        let points: Vec<[f64; 3]> =
+            named(&flown, "telemetry").map(|e| pos(&e["position"])).collect();
         assert!(points.len() > 50, "telemetry in the trace");
         for p in &points {
-            let near = track.iter().map(|(_, q)| dist2(*p, *q).hypot(p[2] - q[2])).fold(f64::INFINITY, f64::min);
+            let near = track
+                .iter()
+                .map(|(_, q)| dist2(*p, *q).hypot(p[2] - q[2]))
+                .fold(f64::INFINITY, f64::min);
             assert!(near < 2.5, "trace position {p:?} is {near:.1} m from anything SITL reported");
         }
         // The orbit went round: points in all four quadrants about North at ~20 m.
-        let circle: Vec<[f64; 3]> = track.iter().map(|t| t.1).filter(|q| (dist2(*q, [0.0, 40.0, 0.0]) - 20.0).abs() < 3.0).collect();
+        let circle: Vec<[f64; 3]> = track
+            .iter()
+            .map(|t| t.1)
+            .filter(|q| (dist2(*q, [0.0, 40.0, 0.0]) - 20.0).abs() < 3.0)
+            .collect();
         for (sx, sy) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
-            assert!(circle.iter().any(|q| q[0] * sx > 5.0 && (q[1] - 40.0) * sy > 5.0), "the orbit passed the ({sx}, {sy}) quadrant");
+            assert!(
+                circle.iter().any(|q| q[0] * sx > 5.0 && (q[1] - 40.0) * sy > 5.0),
+                "the orbit passed the ({sx}, {sy}) quadrant"
+            );
         }
         // It landed where the trace says, and SITL agrees.
-        let end = named(&flown, "api_done").filter(|e| e["function"] == "Land").last().expect("Land ended");
+        let end = named(&flown, "api_done")
+            .filter(|e| e["function"] == "Land")
+            .last()
+            .expect("Land ended");
         let landed = gcs.last().expect("a last position");
-        assert!(dist2(pos(&end["position"]), landed) < 1.0 && landed[2].abs() < 0.5, "landed at {landed:?}");
+        assert!(
+            dist2(pos(&end["position"]), landed) < 1.0 && landed[2].abs() < 0.5,
+            "landed at {landed:?}"
+        );
         // Orbit legs are flown through: the lap (126 m) takes nowhere near the ~5 s a stop
         // at each of its 24 points would add.
         let orbit = named(&flown, "api_call").find(|e| e["function"] == "Orbit").expect("orbit");
@@ -403,7 +591,8 @@ mod single {
         sitl.gcs(Duration::from_secs(10)).set_param("SIM_BATT_VOLTAGE", 10.0);
         let (_, out) = finish(&mut run, &dir, Duration::from_secs(200));
         let flown = events(&dir.join("t.jsonl"));
-        let e = exception(&flown, "BatteryCritical").unwrap_or_else(|| panic!("no BatteryCritical:\n{out}"));
+        let e = exception(&flown, "BatteryCritical")
+            .unwrap_or_else(|| panic!("no BatteryCritical:\n{out}"));
         assert_eq!((e["actor"].as_str(), e["handled"].as_bool()), (Some("d"), Some(true)));
         assert!(named(&flown, "signal").any(|s| s["name"] == "Caught"));
     }
@@ -418,12 +607,15 @@ mod single {
         let mission = "MISSION Drill:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d FlyTo WITH Far\n        d Hover WITH 120s\n    ON EXCEPTION GeofenceViolation BY d:\n        SIGNAL Caught\n";
         let (dir, sitl, mut run) = one("sitl_fence", &params, "[places]\nFar = [0, 80]\n", mission);
         wait_until(Duration::from_secs(200), "the flight out", || {
-            events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_done" && e["function"] == "FlyToPosition")
+            events(&dir.join("t.jsonl"))
+                .iter()
+                .any(|e| e["event"] == "api_done" && e["function"] == "FlyToPosition")
         });
         sitl.gcs(Duration::from_secs(10)).set_param("FENCE_ENABLE", 1.0);
         let (_, out) = finish(&mut run, &dir, Duration::from_secs(200));
         let flown = events(&dir.join("t.jsonl"));
-        let e = exception(&flown, "GeofenceViolation").unwrap_or_else(|| panic!("no GeofenceViolation:\n{out}"));
+        let e = exception(&flown, "GeofenceViolation")
+            .unwrap_or_else(|| panic!("no GeofenceViolation:\n{out}"));
         assert_eq!((e["actor"].as_str(), e["handled"].as_bool()), (Some("d"), Some(true)));
         assert!(named(&flown, "signal").any(|s| s["name"] == "Caught"));
     }
@@ -436,7 +628,8 @@ mod single {
         sitl.gcs(Duration::from_secs(10)).set_param("SIM_GPS1_ENABLE", 0.0);
         let (_, out) = finish(&mut run, &dir, Duration::from_secs(300));
         let flown = events(&dir.join("t.jsonl"));
-        let e = exception(&flown, "PositionLost").unwrap_or_else(|| panic!("no PositionLost:\n{out}"));
+        let e =
+            exception(&flown, "PositionLost").unwrap_or_else(|| panic!("no PositionLost:\n{out}"));
         assert_eq!(e["actor"].as_str(), Some("d"));
     }
 
@@ -445,11 +638,14 @@ mod single {
         // Lost: later statements on the drone raise ConnectionLost, which a handler
         // catches; restarted: ConnectionRestored is heard.
         let mission = "MISSION Drill:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d Hover WITH 200s\n    ON EXCEPTION ConnectionLost BY d:\n        SIGNAL Offline\n        SEQUENTIAL Again:\n            d FlyTo WITH North\n        ON EXCEPTION ConnectionLost BY d:\n            SIGNAL Still_Offline\n        WAITFOR RECEIVED(Back)\n    ON ConnectionRestored BY d:\n        SIGNAL Back\n";
-        let (dir, mut sitl, mut run) = one("sitl_link", &[], "[places]\nNorth = [0, 30]\n", mission);
+        let (dir, mut sitl, mut run) =
+            one("sitl_link", &[], "[places]\nNorth = [0, 30]\n", mission);
         airborne(&dir);
         sitl.kill();
         let lost_at = Instant::now();
-        wait_until(Duration::from_secs(20), "ConnectionLost", || exception(&events(&dir.join("t.jsonl")), "ConnectionLost").is_some());
+        wait_until(Duration::from_secs(20), "ConnectionLost", || {
+            exception(&events(&dir.join("t.jsonl")), "ConnectionLost").is_some()
+        });
         let noticed = lost_at.elapsed();
         assert!(noticed < Duration::from_secs(8), "the lost link was noticed after {noticed:?}");
         wait_until(Duration::from_secs(20), "the second ConnectionLost", || {
@@ -458,13 +654,21 @@ mod single {
         sitl.restart();
         let (code, out) = finish(&mut run, &dir, Duration::from_secs(120));
         let flown = events(&dir.join("t.jsonl"));
-        let signals: Vec<&str> = named(&flown, "signal").filter_map(|s| s["name"].as_str()).collect();
+        let signals: Vec<&str> =
+            named(&flown, "signal").filter_map(|s| s["name"].as_str()).collect();
         for s in ["Offline", "Still_Offline", "ConnectionRestored", "Back"] {
             assert!(signals.contains(&s), "{s} in {signals:?}:\n{out}");
         }
-        let lost: Vec<&Value> = named(&flown, "exception").filter(|e| e["name"] == "ConnectionLost").collect();
-        assert!(lost.len() >= 2 && lost.iter().all(|e| e["handled"] == true), "both ConnectionLost handled: {lost:?}");
-        assert!(!named(&flown, "exception").any(|e| e["name"] == "CommandFailed"), "no CommandFailed on a lost drone");
+        let lost: Vec<&Value> =
+            named(&flown, "exception").filter(|e| e["name"] == "ConnectionLost").collect();
+        assert!(
+            lost.len() >= 2 && lost.iter().all(|e| e["handled"] == true),
+            "both ConnectionLost handled: {lost:?}"
+        );
+        assert!(
+            !named(&flown, "exception").any(|e| e["name"] == "CommandFailed"),
+            "no CommandFailed on a lost drone"
+        );
         assert_eq!(code, 0, "{out}");
     }
 
@@ -477,10 +681,14 @@ mod single {
         let (code, out) = finish(&mut run, &dir, Duration::from_secs(300));
         assert_eq!(code, 1, "{out}");
         let flown = events(&dir.join("t.jsonl"));
-        let e = exception(&flown, "CommandFailed").unwrap_or_else(|| panic!("no CommandFailed:\n{out}"));
+        let e = exception(&flown, "CommandFailed")
+            .unwrap_or_else(|| panic!("no CommandFailed:\n{out}"));
         let reason = e["args"].to_string();
         assert!(reason.to_ascii_lowercase().contains("arm"), "ArduPilot's reason in {reason}");
-        assert!(reason.contains("PreArm") || reason.contains("Arm:"), "ArduPilot's own text in {reason}");
+        assert!(
+            reason.contains("PreArm") || reason.contains("Arm:"),
+            "ArduPilot's own text in {reason}"
+        );
     }
 
     #[test]
@@ -489,12 +697,15 @@ mod single {
         // SITL stands 40 m east of where the world puts it.
         let sitl = Sitl::start(&dir, 20, 1, [40.0, 0.0], &[]);
         std::fs::write(dir.join("m.world.toml"), one_copter_world(&sitl, "")).expect("world");
-        std::fs::write(dir.join("m.mission"), "MISSION M:\n    d TakeOff WITH 10m\n").expect("mission");
+        std::fs::write(dir.join("m.mission"), "MISSION M:\n    d TakeOff WITH 10m\n")
+            .expect("mission");
         let mut run = start_run(&dir, "m.mission");
         let (code, out) = finish(&mut run, &dir, Duration::from_secs(120));
         assert_eq!(code, 2, "{out}");
         assert!(out.contains("40") && out.contains("home"), "says how far from home: {out}");
-        assert!(!events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_call"), "nothing flew");
+        assert!(
+            !events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_call"),
+            "nothing flew"
+        );
     }
 }
-

@@ -96,7 +96,8 @@ codes! {
 impl Code {
     /// The codes of the pre-flight analyses that run on the compiled mission
     /// (`aviary-verify`), not in the checker.
-    pub const PREFLIGHT: &'static [Code] = &[Code::CommandsMayCollide, Code::LowReserve, Code::CommandsQueue];
+    pub const PREFLIGHT: &'static [Code] =
+        &[Code::CommandsMayCollide, Code::LowReserve, Code::CommandsQueue];
 }
 
 impl std::fmt::Display for Code {

@@ -37,11 +37,7 @@ pub fn render_text(sources: &SourceMap, diagnostic: &Diagnostic, color: bool) ->
         .with_labels(labels)
         .with_notes(diagnostic.help.iter().map(|h| format!("help: {h}")).collect());
     let config = term::Config { chars: term::Chars::ascii(), ..term::Config::default() };
-    let mut buffer = if color {
-        termcolor::Buffer::ansi()
-    } else {
-        termcolor::Buffer::no_color()
-    };
+    let mut buffer = if color { termcolor::Buffer::ansi() } else { termcolor::Buffer::no_color() };
     if term::emit_to_write_style(&mut buffer, &config, sources.files(), &rich).is_ok() {
         let body = String::from_utf8_lossy(buffer.as_slice());
         // Our first line replaces codespan's own title line.
@@ -99,7 +95,9 @@ pub fn summary_line(diagnostics: &[Diagnostic]) -> String {
     let count = |s| diagnostics.iter().filter(|d| d.severity == s).count();
     let plural = |n: usize, word: &str| format!("{n} {word}{}", if n == 1 { "" } else { "s" });
     let mut parts = Vec::new();
-    for (severity, word) in [(Severity::Error, "error"), (Severity::Warning, "warning"), (Severity::Note, "note")] {
+    for (severity, word) in
+        [(Severity::Error, "error"), (Severity::Warning, "warning"), (Severity::Note, "note")]
+    {
         let n = count(severity);
         if n > 0 {
             parts.push(plural(n, word));

@@ -36,7 +36,8 @@ struct Text {
 
 impl Text {
     fn line_starts(&self) -> &[usize] {
-        self.line_starts.get_or_init(|| codespan_reporting::files::line_starts(&self.text).collect())
+        self.line_starts
+            .get_or_init(|| codespan_reporting::files::line_starts(&self.text).collect())
     }
 
     /// As `SimpleFile::line_start`.
@@ -45,7 +46,9 @@ impl Text {
         match line_index.cmp(&starts.len()) {
             std::cmp::Ordering::Less => Ok(starts[line_index]),
             std::cmp::Ordering::Equal => Ok(self.text.len()),
-            std::cmp::Ordering::Greater => Err(Error::LineTooLarge { given: line_index, max: starts.len() - 1 }),
+            std::cmp::Ordering::Greater => {
+                Err(Error::LineTooLarge { given: line_index, max: starts.len() - 1 })
+            }
         }
     }
 }
@@ -137,10 +140,18 @@ mod tests {
         }
         for (id, text) in sources.iter().enumerate() {
             for at in 0..=text.len() + 1 {
-                assert_eq!(ours.line_index(id, at).ok(), theirs.line_index(id, at).ok(), "{text:?} at {at}");
+                assert_eq!(
+                    ours.line_index(id, at).ok(),
+                    theirs.line_index(id, at).ok(),
+                    "{text:?} at {at}"
+                );
             }
             for line in 0..text.len() + 3 {
-                assert_eq!(ours.line_range(id, line).ok(), theirs.line_range(id, line).ok(), "{text:?} line {line}");
+                assert_eq!(
+                    ours.line_range(id, line).ok(),
+                    theirs.line_range(id, line).ok(),
+                    "{text:?} line {line}"
+                );
             }
             assert_eq!(ours.source(id).ok(), theirs.source(id).ok());
         }

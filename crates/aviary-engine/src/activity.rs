@@ -39,7 +39,11 @@ struct Started {
 }
 
 /// An instance's frame: actors, then arguments, then the body's own slots.
-pub(crate) fn frame_values<'a>(cap: &'a Capability, actors: &'a [DroneId], args: &'a [Value]) -> impl ExactSizeIterator<Item = Value> + 'a {
+pub(crate) fn frame_values<'a>(
+    cap: &'a Capability,
+    actors: &'a [DroneId],
+    args: &'a [Value],
+) -> impl ExactSizeIterator<Item = Value> + 'a {
     let size = cap.frame_size.max(cap.actors + cap.params.len());
     (0..size).map(move |i| match i.checked_sub(cap.actors) {
         None => actors.get(i).map_or(Value::Bool(false), |d| Value::Actor(*d)),
@@ -48,10 +52,18 @@ pub(crate) fn frame_values<'a>(cap: &'a Capability, actors: &'a [DroneId], args:
 }
 
 impl<'m> Engine<'m> {
-    pub(crate) async fn instance(&self, call: &'m Call, actors: Actors, args: Vec<Value>, ctx: &Ctx<'m>) {
+    pub(crate) async fn instance(
+        &self,
+        call: &'m Call,
+        actors: Actors,
+        args: Vec<Value>,
+        ctx: &Ctx<'m>,
+    ) {
         // What `start` made is handed to `perform` and not kept beside its future.
         let rest = match self.start(call, actors, args, ctx).await {
-            Some(Started { instance, held, frame, claims, listed, args }) => self.perform(call, instance, held, frame, claims, listed, args, ctx, Resume::Start),
+            Some(Started { instance, held, frame, claims, listed, args }) => {
+                self.perform(call, instance, held, frame, claims, listed, args, ctx, Resume::Start)
+            }
             None => return,
         };
         rest.await;
@@ -59,7 +71,13 @@ impl<'m> Engine<'m> {
 
     /// An instance up to its start: its claims held (waited for if need be), `capability_start`
     /// recorded, its requirements met. `None` if it ends there.
-    async fn start(&self, call: &'m Call, actors: Actors, args: Vec<Value>, ctx: &Ctx<'m>) -> Option<Started> {
+    async fn start(
+        &self,
+        call: &'m Call,
+        actors: Actors,
+        args: Vec<Value>,
+        ctx: &Ctx<'m>,
+    ) -> Option<Started> {
         let cap = &self.m.capabilities[call.capability];
         if self.too_deep(call, &actors, ctx) {
             return None;
@@ -115,7 +133,18 @@ impl<'m> Engine<'m> {
     /// The rest of an instance, once it holds its claims and has started: its body in its
     /// own scope until it ends or is aborted, then its end.
     #[allow(clippy::too_many_arguments)]
-    pub(crate) async fn perform(&self, call: &'m Call, instance: Rc<Instance>, held: Held, frame: Frame, claims: Claims, listed: bool, args: Vec<Value>, ctx: &Ctx<'m>, resume: Resume<'m>) {
+    pub(crate) async fn perform(
+        &self,
+        call: &'m Call,
+        instance: Rc<Instance>,
+        held: Held,
+        frame: Frame,
+        claims: Claims,
+        listed: bool,
+        args: Vec<Value>,
+        ctx: &Ctx<'m>,
+        resume: Resume<'m>,
+    ) {
         let cap = &self.m.capabilities[call.capability];
         *instance.claims.borrow_mut() = claims.clone();
         let scope = Rc::new(Scope {
@@ -139,11 +168,14 @@ impl<'m> Engine<'m> {
             self.instances.borrow_mut().insert(instance.clone(), scope.clone());
         }
         let actor = instance.actors.first().copied();
-        let inner = Ctx { scope: scope.clone(), frame, actor, instance: Some(instance.clone()), claims };
+        let inner =
+            Ctx { scope: scope.clone(), frame, actor, instance: Some(instance.clone()), claims };
         // A PERFORM body that declares no handlers, in a capability without exception
         // handlers, runs its statements in the instance's own scope: a scope of its own
         // would hear nothing and catch nothing, and an exception unwinds both alike.
-        let own_scope = !cap.perform.handlers.is_empty() || !cap.perform.exception_handlers.is_empty() || cap.perform.traced;
+        let own_scope = !cap.perform.handlers.is_empty()
+            || !cap.perform.exception_handlers.is_empty()
+            || cap.perform.traced;
         let body = pin!(async {
             match resume {
                 Resume::Start => match &instance.perform {
@@ -153,7 +185,11 @@ impl<'m> Engine<'m> {
                 },
                 // Only for a sequence run in the instance's scope (`instant.rs`).
                 Resume::At(at, begun) => {
-                    debug_assert!(cap.perform.kind == BlockKind::Sequential && !own_scope && instance.perform.is_none());
+                    debug_assert!(
+                        cap.perform.kind == BlockKind::Sequential
+                            && !own_scope
+                            && instance.perform.is_none()
+                    );
                     let next = at + usize::from(begun.is_some());
                     if let Some(begun) = begun {
                         self.api_end(*begun, &inner).await;
@@ -211,7 +247,13 @@ impl<'m> Engine<'m> {
         id
     }
 
-    pub(crate) fn new_instance(&self, id: u64, call: &'m Call, actors: Actors, ctx: &Ctx<'m>) -> Rc<Instance> {
+    pub(crate) fn new_instance(
+        &self,
+        id: u64,
+        call: &'m Call,
+        actors: Actors,
+        ctx: &Ctx<'m>,
+    ) -> Rc<Instance> {
         let cap = &self.m.capabilities[call.capability];
         Rc::new(Instance {
             id,
@@ -219,7 +261,10 @@ impl<'m> Engine<'m> {
             tag: call.tag,
             actors,
             root: ctx.instance.as_ref().map(|p| p.root().clone()),
-            token: ctx.instance.as_ref().map_or_else(|| self.stop.child_token(), |p| p.token.child_token()),
+            token: ctx
+                .instance
+                .as_ref()
+                .map_or_else(|| self.stop.child_token(), |p| p.token.child_token()),
             // Only the capability's own exception handler cancels its PERFORM body.
             perform: (!cap.exception_handlers.is_empty()).then(CancellationToken::new),
             by_leash: Cell::new(false),
@@ -235,22 +280,43 @@ impl<'m> Engine<'m> {
 
     /// What an instance claims beyond what its caller already holds.
     pub(crate) fn needs(&self, cap: &Capability, actors: &[DroneId], ctx: &Ctx<'m>) -> Needs {
-        cap.claims.iter().filter_map(|(i, r)| actors.get(*i).map(|d| (*d, *r))).filter(|c| !ctx.claims.contains(c)).collect()
+        cap.claims
+            .iter()
+            .filter_map(|(i, r)| actors.get(*i).map(|d| (*d, *r)))
+            .filter(|c| !ctx.claims.contains(c))
+            .collect()
     }
 
     /// The fields of `capability_start` (built only when the trace wants them).
-    pub(crate) fn capability_fields(&self, call: &Call, actors: &[DroneId], args: &[Value]) -> [(&'static str, Field<'m>); 4] {
+    pub(crate) fn capability_fields(
+        &self,
+        call: &Call,
+        actors: &[DroneId],
+        args: &[Value],
+    ) -> [(&'static str, Field<'m>); 4] {
         let cap = &self.m.capabilities[call.capability];
         let tag = Field::name(call.tag.map(|t| self.m.tags[t].as_str()));
-        let shown_args: Map<String, Json> = cap.params.iter().zip(args).map(|(p, v)| (p.clone(), to_json(self.m, v))).collect();
+        let shown_args: Map<String, Json> =
+            cap.params.iter().zip(args).map(|(p, v)| (p.clone(), to_json(self.m, v))).collect();
         let who = match actors {
             [one] => Field::Str(self.name(*one)),
             all => Field::Text(all.iter().map(|d| self.name(*d)).collect::<Vec<_>>().join(" ")),
         };
-        [("actor", who), ("capability", Field::Str(&cap.name)), ("tag", tag), ("args", Field::Json(Json::Object(shown_args)))]
+        [
+            ("actor", who),
+            ("capability", Field::Str(&cap.name)),
+            ("tag", tag),
+            ("args", Field::Json(Json::Object(shown_args))),
+        ]
     }
 
-    pub(crate) fn capability_end(&self, call: &Call, actors: &[DroneId], args: &[Value], status: &'static str) {
+    pub(crate) fn capability_end(
+        &self,
+        call: &Call,
+        actors: &[DroneId],
+        args: &[Value],
+        status: &'static str,
+    ) {
         self.trace(Kind::CapabilityEnd, || {
             let [actor, capability, tag, args] = self.capability_fields(call, actors, args);
             [actor, capability, tag, args, ("status", Field::Str(status))]

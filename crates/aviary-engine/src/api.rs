@@ -64,7 +64,13 @@ impl<'m> Engine<'m> {
             a.args.iter().map(|e| env.eval(e)).collect::<Vec<_>>()
         };
         let function = self.m.functions[a.function].0.as_str();
-        self.trace(Kind::ApiCall, || [("actor", Field::Str(self.name(drone))), ("function", Field::Str(function)), ("args", Field::Json(self.values(&args)))]);
+        self.trace(Kind::ApiCall, || {
+            [
+                ("actor", Field::Str(self.name(drone))),
+                ("function", Field::Str(function)),
+                ("args", Field::Json(self.values(&args))),
+            ]
+        });
         let pending = self.backend.call(drone, function, &args);
         Begun { call: Made { drone, function, args, id: pending.id }, end: pending.end }
     }

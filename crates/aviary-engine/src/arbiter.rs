@@ -215,7 +215,8 @@ mod tests {
         let arbiter = Rc::new(RefCell::new(Arbiter::default()));
         let m = |d| (d, Resource::Motion);
         let Ok(a) = try_acquire(&arbiter, smallvec::smallvec![m(0)]) else { panic!("free") };
-        let refused = try_acquire(&arbiter, smallvec::smallvec![m(0), m(1)]).err().expect("0 is held");
+        let refused =
+            try_acquire(&arbiter, smallvec::smallvec![m(0), m(1)]).err().expect("0 is held");
         assert_eq!(refused.as_slice(), &[m(0), m(1)], "given back whole");
         // Someone waits for 0 and 1: 1 alone is free but not granted past the waiter.
         let mut waiter = pin!(acquire(&arbiter, refused));

@@ -11,16 +11,28 @@ use crate::engine::Engine;
 #[derive(Clone, Debug, PartialEq)]
 pub enum Control {
     /// A leash by tag, as a mission would write it: `FlyCircle-C1 PAUSE`.
-    Leash { capability: String, tag: String, action: String, args: Vec<(String, Value)> },
+    Leash {
+        capability: String,
+        tag: String,
+        action: String,
+        args: Vec<(String, Value)>,
+    },
     /// Raises a signal at mission level (no actor), as the mission's own `SIGNAL` would.
-    Signal { name: String, args: Vec<Value> },
+    Signal {
+        name: String,
+        args: Vec<Value>,
+    },
     /// Holds every drone's activity where it is, until `Resume`.
     Pause,
     Resume,
     /// Ends the mission: the fleet returns home, and the mission ends `aborted`.
-    Abort { reason: String },
+    Abort {
+        reason: String,
+    },
     /// The backend can no longer answer (its task panicked): end at once, `failed`.
-    BackendLost { reason: String },
+    BackendLost {
+        reason: String,
+    },
 }
 
 /// A control and where to send its answer (`Err` says why it was refused).
@@ -71,38 +83,62 @@ impl<'m> Engine<'m> {
         }
         match control {
             Control::Leash { capability, tag, action, args } => {
-                let cap = self.m.capabilities.iter().position(|c| c.name == capability).ok_or_else(|| format!("no capability is called {capability}"))?;
+                let cap = self
+                    .m
+                    .capabilities
+                    .iter()
+                    .position(|c| c.name == capability)
+                    .ok_or_else(|| format!("no capability is called {capability}"))?;
                 let action_kind = match action.as_str() {
                     "ABORT" => LeashAction::Abort,
                     "PAUSE" => LeashAction::Pause,
                     "RESUME" => LeashAction::Resume,
                     name => LeashAction::Section(
-                        self.m.capabilities[cap].sections.iter().position(|(n, _)| n == name).ok_or_else(|| format!("{capability} has no section PERFORM {name}"))?,
+                        self.m.capabilities[cap]
+                            .sections
+                            .iter()
+                            .position(|(n, _)| n == name)
+                            .ok_or_else(|| format!("{capability} has no section PERFORM {name}"))?,
                     ),
                 };
                 let params = &self.m.capabilities[cap].params;
                 let mut values = Vec::new();
                 for (name, value) in args {
-                    let p = params.iter().position(|p| *p == name).ok_or_else(|| format!("{capability} has no parameter {name}"))?;
+                    let p = params
+                        .iter()
+                        .position(|p| *p == name)
+                        .ok_or_else(|| format!("{capability} has no parameter {name}"))?;
                     values.push((p, value));
                 }
                 // A tag no statement defines can never match: refuse it, as the checker would.
-                let tag_id = self.m.tags.iter().position(|t| *t == tag).ok_or_else(|| format!("no statement starts an activity tagged {capability}-{tag}"))?;
+                let tag_id = self.m.tags.iter().position(|t| *t == tag).ok_or_else(|| {
+                    format!("no statement starts an activity tagged {capability}-{tag}")
+                })?;
                 self.leash_by_id(cap, tag_id, action_kind, &action, values);
                 Ok(())
             }
             Control::Signal { name, args } => {
-                let id = self.m.signals.iter().position(|s| *s == name).ok_or_else(|| format!("the mission neither raises nor hears {name}"))?;
+                let id = self
+                    .m
+                    .signals
+                    .iter()
+                    .position(|s| *s == name)
+                    .ok_or_else(|| format!("the mission neither raises nor hears {name}"))?;
                 self.raise_from_outside(id, args);
                 Ok(())
             }
             Control::Pause | Control::Resume => {
                 let pause = control == Control::Pause;
                 self.mission_paused.set(pause);
-                for (instance, _) in self.instances.borrow().all().iter().filter(|(i, _)| i.root.is_none()) {
+                for (instance, _) in
+                    self.instances.borrow().all().iter().filter(|(i, _)| i.root.is_none())
+                {
                     instance.paused.set(pause);
                     for call in instance.calls.borrow().iter() {
-                        self.backend.interrupt(*call, if pause { Interrupt::Pause } else { Interrupt::Resume });
+                        self.backend.interrupt(
+                            *call,
+                            if pause { Interrupt::Pause } else { Interrupt::Resume },
+                        );
                     }
                     instance.resumed.notify_waiters();
                 }

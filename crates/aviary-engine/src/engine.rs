@@ -10,10 +10,10 @@ use aviary_ir::{ActorFilter, ExceptionHandler, Handler, Mission};
 use serde_json::{json, Value as Json};
 use tokio::sync::{mpsc, Notify};
 
+use crate::cancel::Token as CancellationToken;
 use crate::jobs::Jobs;
 use crate::registry::Registry;
 use tokio::time::Instant;
-use crate::cancel::Token as CancellationToken;
 
 use crate::arbiter::{Arbiter, Claims};
 use crate::trace::{Event, Field, Kind};
@@ -132,7 +132,12 @@ pub(crate) struct Engine<'m> {
 }
 
 impl<'m> Engine<'m> {
-    pub fn new(m: &'m Mission, backend: &'m dyn Backend, sink: &'m mut dyn TraceSink, options: &RunOptions) -> Self {
+    pub fn new(
+        m: &'m Mission,
+        backend: &'m dyn Backend,
+        sink: &'m mut dyn TraceSink,
+        options: &RunOptions,
+    ) -> Self {
         Engine {
             m,
             backend,
@@ -153,7 +158,11 @@ impl<'m> Engine<'m> {
             root: RefCell::new(None),
             mission_scope: RefCell::new(None),
             next_id: Cell::new(0),
-            instant: if options.instant_activities { crate::instant::instant_capabilities(m) } else { vec![false; m.capabilities.len()] },
+            instant: if options.instant_activities {
+                crate::instant::instant_capabilities(m)
+            } else {
+                vec![false; m.capabilities.len()]
+            },
             max_call_depth: options.max_call_depth,
         }
     }
@@ -168,7 +177,11 @@ impl<'m> Engine<'m> {
     }
 
     /// Records an event, if the sink wants its kind: `fields` is built only then.
-    pub fn trace<'a, const N: usize>(&self, kind: Kind, fields: impl FnOnce() -> [(&'static str, Field<'a>); N]) {
+    pub fn trace<'a, const N: usize>(
+        &self,
+        kind: Kind,
+        fields: impl FnOnce() -> [(&'static str, Field<'a>); N],
+    ) {
         if !self.wanted[kind as usize] {
             return;
         }
@@ -189,7 +202,11 @@ impl<'m> Engine<'m> {
         Env { mission: self.m, backend: self.backend, frame, received, start: self.start }
     }
 
-    pub async fn run(&self, options: &RunOptions, controls: Option<mpsc::UnboundedReceiver<crate::ControlRequest>>) -> Outcome {
+    pub async fn run(
+        &self,
+        options: &RunOptions,
+        controls: Option<mpsc::UnboundedReceiver<crate::ControlRequest>>,
+    ) -> Outcome {
         self.trace(Kind::MissionStart, || [("mission", Field::Str(&self.m.name))]);
         let root = Rc::new(Scope {
             parent: None,
@@ -207,7 +224,13 @@ impl<'m> Engine<'m> {
             instance: None,
         });
         *self.root.borrow_mut() = Some(root.clone());
-        let ctx = Ctx { scope: root.clone(), frame: root.frame.clone(), actor: None, instance: None, claims: Claims::default() };
+        let ctx = Ctx {
+            scope: root.clone(),
+            frame: root.frame.clone(),
+            actor: None,
+            instance: None,
+            claims: Claims::default(),
+        };
         let body = self.drive(&root, self.block(&self.m.body, &ctx));
         let controls = async {
             match controls {
@@ -232,7 +255,8 @@ impl<'m> Engine<'m> {
         }
         let ending = self.ending.borrow().clone();
         // Drones still flying go home: at the end of the mission, or as the failsafe.
-        let home = if self.backend_alive.get() { self.all_home().await } else { Default::default() };
+        let home =
+            if self.backend_alive.get() { self.all_home().await } else { Default::default() };
         let (mut status, mut reason) = match ending {
             Some((status, reason)) => (status, Some(reason)),
             None => (Status::Ok, None),
@@ -244,7 +268,9 @@ impl<'m> Engine<'m> {
         }
         let said: Vec<String> = reason.into_iter().chain(home.stranded).chain(home.notes).collect();
         reason = (!said.is_empty()).then(|| said.join("; "));
-        self.trace(Kind::MissionEnd, || [("status", Field::Str(status.as_str())), ("reason", Field::name(reason.as_deref()))]);
+        self.trace(Kind::MissionEnd, || {
+            [("status", Field::Str(status.as_str())), ("reason", Field::name(reason.as_deref()))]
+        });
         Outcome { status, reason }
     }
 
@@ -261,7 +287,13 @@ impl<'m> Engine<'m> {
         self.root.borrow().clone().expect("the run has a root scope")
     }
 
-    pub fn trace_done(&self, d: DroneId, function: &str, args: &[Value], end: &aviary_api::CallEnd) {
+    pub fn trace_done(
+        &self,
+        d: DroneId,
+        function: &str,
+        args: &[Value],
+        end: &aviary_api::CallEnd,
+    ) {
         let status = match end {
             aviary_api::CallEnd::Done => "ok",
             aviary_api::CallEnd::Failed(_) => "failed",
@@ -285,7 +317,14 @@ impl<'m> Engine<'m> {
         loop {
             for d in 0..self.m.drones.len() {
                 let t = self.backend.telemetry(d);
-                self.trace(Kind::Telemetry, || [("actor", Field::Str(self.name(d))), ("position", Field::Json(json!(t.position))), ("battery", Field::Json(json!(t.battery))), ("state", Field::Str(t.state.as_str()))]);
+                self.trace(Kind::Telemetry, || {
+                    [
+                        ("actor", Field::Str(self.name(d))),
+                        ("position", Field::Json(json!(t.position))),
+                        ("battery", Field::Json(json!(t.battery))),
+                        ("state", Field::Str(t.state.as_str())),
+                    ]
+                });
             }
             next += period;
             tokio::time::sleep_until(next).await;
@@ -329,12 +368,21 @@ impl<'m> Engine<'m> {
     fn on_event(&self, event: DroneEvent) {
         match event {
             DroneEvent::Detected { drone, kind, location } => {
-                self.trace(Kind::Detection, || [("actor", Field::Str(self.name(drone))), ("kind", Field::Str(&kind)), ("location", Field::Json(json!(location)))]);
+                self.trace(Kind::Detection, || {
+                    [
+                        ("actor", Field::Str(self.name(drone))),
+                        ("kind", Field::Str(&kind)),
+                        ("location", Field::Json(json!(location))),
+                    ]
+                });
                 let scope = self.detections.borrow().get(&(drone, kind.clone())).cloned();
                 if let Some(scope) = scope {
                     let id = self.m.builtins.detected;
                     // A find is a point on the ground: flying to it keeps the altitude.
-                    let args = vec![Value::Symbol(kind), Value::Position(aviary_api::Point::flat(location[0], location[1]))];
+                    let args = vec![
+                        Value::Symbol(kind),
+                        Value::Position(aviary_api::Point::flat(location[0], location[1])),
+                    ];
                     self.raise(id, args, Some(drone), &scope);
                 }
             }
@@ -360,7 +408,10 @@ impl<'m> Engine<'m> {
             Some(id) => (id, failure.reason),
             None => (
                 self.m.builtins.command_failed,
-                format!("{} (the backend raised `{}`, an exception the mission does not know)", failure.reason, failure.exception),
+                format!(
+                    "{} (the backend raised `{}`, an exception the mission does not know)",
+                    failure.reason, failure.exception
+                ),
             ),
         }
     }
@@ -384,31 +435,52 @@ impl<'m> Engine<'m> {
         match by {
             None => true,
             Some(ActorFilter::Drones(ds)) => actor.is_some_and(|a| ds.contains(&a)),
-            Some(ActorFilter::Slot(s)) => matches!((frame.get(*s), actor), (Some(Value::Actor(d)), Some(a)) if *d == a),
+            Some(ActorFilter::Slot(s)) => {
+                matches!((frame.get(*s), actor), (Some(Value::Actor(d)), Some(a)) if *d == a)
+            }
         }
     }
 
     /// A signal from outside the mission (the operator): heard by every running handler
     /// that matches, at once (there is no signalling block to wait for).
     pub fn raise_from_outside(&self, signal: usize, args: Vec<Value>) {
-        self.trace(Kind::Signal, || [("name", Field::Str(&self.m.signals[signal])), ("actor", Field::Null), ("args", Field::Json(self.values(&args)))]);
+        self.trace(Kind::Signal, || {
+            [
+                ("name", Field::Str(&self.m.signals[signal])),
+                ("actor", Field::Null),
+                ("args", Field::Json(self.values(&args))),
+            ]
+        });
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {
             *r = true;
         }
         self.changed.notify_waiters();
         self.listeners.borrow_mut().retain(|w| w.strong_count() > 0);
-        let scopes: Vec<Rc<Scope<'m>>> = self.listeners.borrow().iter().filter_map(|w| w.upgrade()).collect();
+        let scopes: Vec<Rc<Scope<'m>>> =
+            self.listeners.borrow().iter().filter_map(|w| w.upgrade()).collect();
         for scope in scopes {
             self.deliver(&scope, signal, &args, None, None);
         }
     }
 
     /// `SIGNAL`: recorded, then heard by every matching handler of every scope up the chain.
-    pub fn raise(&self, signal: usize, args: Vec<Value>, actor: Option<DroneId>, from: &Rc<Scope<'m>>) {
+    pub fn raise(
+        &self,
+        signal: usize,
+        args: Vec<Value>,
+        actor: Option<DroneId>,
+        from: &Rc<Scope<'m>>,
+    ) {
         if self.stopped() {
             return;
         }
-        self.trace(Kind::Signal, || [("name", Field::Str(&self.m.signals[signal])), ("actor", Field::name(actor.map(|a| self.name(a)))), ("args", Field::Json(self.values(&args)))]);
+        self.trace(Kind::Signal, || {
+            [
+                ("name", Field::Str(&self.m.signals[signal])),
+                ("actor", Field::name(actor.map(|a| self.name(a)))),
+                ("args", Field::Json(self.values(&args))),
+            ]
+        });
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {
             *r = true;
         }
@@ -421,7 +493,14 @@ impl<'m> Engine<'m> {
 
     /// Starts (or, for `SEQUENTIAL ON`, defers to the signalling block's end) each handler
     /// of `scope` that hears this signal.
-    fn deliver(&self, scope: &Rc<Scope<'m>>, signal: usize, args: &[Value], actor: Option<DroneId>, signalling_block: Option<&Rc<Scope<'m>>>) {
+    fn deliver(
+        &self,
+        scope: &Rc<Scope<'m>>,
+        signal: usize,
+        args: &[Value],
+        actor: Option<DroneId>,
+        signalling_block: Option<&Rc<Scope<'m>>>,
+    ) {
         let handlers: &'m [Handler] = scope.handlers;
         for (i, h) in handlers.iter().enumerate() {
             if h.signal != signal || !self.matches(&h.by, &scope.frame, actor) {
@@ -446,13 +525,21 @@ impl<'m> Engine<'m> {
 
     /// `THROW EXCEPTION` (or a drone fault): abort the thrower's chain up to the nearest
     /// handler, abort its other activities, and start the handler in that place.
-    pub fn throw(&self, exception: usize, args: Vec<Value>, actor: Option<DroneId>, from: &Rc<Scope<'m>>) {
+    pub fn throw(
+        &self,
+        exception: usize,
+        args: Vec<Value>,
+        actor: Option<DroneId>,
+        from: &Rc<Scope<'m>>,
+    ) {
         if self.stopped() {
             return;
         }
         let name = self.m.exceptions.get(exception).cloned().unwrap_or_default();
         let found = from.chain().find_map(|scope| {
-            let i = scope.exception_handlers.iter().position(|h| h.exception == exception && self.matches(&h.by, &scope.frame, actor))?;
+            let i = scope.exception_handlers.iter().position(|h| {
+                h.exception == exception && self.matches(&h.by, &scope.frame, actor)
+            })?;
             Some((scope.clone(), i))
         });
         self.trace(Kind::Exception, || {

@@ -3,9 +3,9 @@
 
 use std::cell::{Cell, RefCell};
 use std::future::Future;
-use std::task::Poll;
 use std::pin::pin;
 use std::rc::Rc;
+use std::task::Poll;
 use std::time::Duration;
 
 use aviary_api::{DroneId, Interrupt, Value};
@@ -29,7 +29,10 @@ impl<'m> Engine<'m> {
         // Jobs come only to a scope that declares handlers or exception handlers (signals,
         // exceptions, `SEQUENTIAL ON` starting) or that tops an instance of a capability
         // with leash sections. Any other scope, most of them, just runs its items.
-        let takes_sections = scope.instance.as_ref().is_some_and(|i| !self.m.capabilities[i.capability].sections.is_empty());
+        let takes_sections = scope
+            .instance
+            .as_ref()
+            .is_some_and(|i| !self.m.capabilities[i.capability].sections.is_empty());
         if scope.handlers.is_empty() && scope.exception_handlers.is_empty() && !takes_sections {
             items.await;
             for (target, job) in scope.deferred.take() {
@@ -53,7 +56,11 @@ impl<'m> Engine<'m> {
             if took_jobs {
                 if let Poll::Ready(job) = jobs.poll_recv(cx) {
                     unstarted.set(true);
-                    running.get_or_insert_with(FuturesUnordered::new).push(self.start_job(job, scope.clone(), &unstarted));
+                    running.get_or_insert_with(FuturesUnordered::new).push(self.start_job(
+                        job,
+                        scope.clone(),
+                        &unstarted,
+                    ));
                     continue;
                 }
             }
@@ -90,7 +97,12 @@ impl<'m> Engine<'m> {
         Box::pin(self.job(job, scope)).await;
     }
 
-    fn new_scope(&self, ctx: &Ctx<'m>, block: &'m Block, instance: Option<Rc<Instance>>) -> Rc<Scope<'m>> {
+    fn new_scope(
+        &self,
+        ctx: &Ctx<'m>,
+        block: &'m Block,
+        instance: Option<Rc<Instance>>,
+    ) -> Rc<Scope<'m>> {
         let scope = Rc::new(Scope {
             parent: Some(ctx.scope.clone()),
             path: &block.path,
@@ -115,7 +127,11 @@ impl<'m> Engine<'m> {
         scope
     }
 
-    pub(crate) fn block<'a>(&'a self, block: &'m Block, ctx: &'a Ctx<'m>) -> LocalBoxFuture<'a, ()> {
+    pub(crate) fn block<'a>(
+        &'a self,
+        block: &'m Block,
+        ctx: &'a Ctx<'m>,
+    ) -> LocalBoxFuture<'a, ()> {
         Box::pin(async move {
             let scope = self.new_scope(ctx, block, None);
             if block.traced {
@@ -128,7 +144,9 @@ impl<'m> Engine<'m> {
             self.drive(&scope, items).await;
             if block.traced {
                 let status = if scope.unwinding.get() { "aborted" } else { "ok" };
-                self.trace(Kind::BlockEnd, || [("block", Field::Str(&block.path)), ("status", Field::Str(status))]);
+                self.trace(Kind::BlockEnd, || {
+                    [("block", Field::Str(&block.path)), ("status", Field::Str(status))]
+                });
             }
         })
     }
@@ -186,7 +204,8 @@ impl<'m> Engine<'m> {
             }
             Node::Call(c) if self.instant[c.capability] => self.instant_statement(c, ctx).await,
             // A wait that is over before it starts (`wait_until` looks first): no box.
-            Node::WaitFor { condition, body: None } if self.stopped() || self.truth(condition, ctx) => {}
+            Node::WaitFor { condition, body: None }
+                if self.stopped() || self.truth(condition, ctx) => {}
             _ => self.node(node, ctx).await,
         }
     }
@@ -225,7 +244,9 @@ impl<'m> Engine<'m> {
         {
             match node {
                 Node::Block(b) => self.block(b, ctx).await,
-                Node::Call(_) | Node::Api(_) | Node::For(_) => unreachable!("boxed apart in `node`"),
+                Node::Call(_) | Node::Api(_) | Node::For(_) => {
+                    unreachable!("boxed apart in `node`")
+                }
                 Node::Leash(l) => self.leash(l, ctx),
                 Node::Signal { signal, args, .. } => self.signal(*signal, args, ctx),
                 Node::Throw { exception, args, .. } => {
@@ -254,7 +275,11 @@ impl<'m> Engine<'m> {
                     }
                 }
                 Node::If { branches, otherwise } => {
-                    let chosen = branches.iter().find(|(c, _)| self.truth(c, ctx)).map(|(_, b)| b).or(otherwise.as_ref());
+                    let chosen = branches
+                        .iter()
+                        .find(|(c, _)| self.truth(c, ctx))
+                        .map(|(_, b)| b)
+                        .or(otherwise.as_ref());
                     if let Some(b) = chosen {
                         self.block(b, ctx).await;
                     }
@@ -347,7 +372,9 @@ impl<'m> Engine<'m> {
         // The common case, one actor for a one-actor capability: no join.
         if let ([actor], 1) = (call.actors.as_slice(), capability.actors) {
             match actor {
-                ActorRef::Drone(d) => return self.instance(call, Actors::from_elem(*d, 1), args, ctx).await,
+                ActorRef::Drone(d) => {
+                    return self.instance(call, Actors::from_elem(*d, 1), args, ctx).await
+                }
                 ActorRef::Slot(s) => {
                     if let Some(Value::Actor(d)) = ctx.frame.get(*s) {
                         self.instance(call, Actors::from_elem(*d, 1), args, ctx).await;
@@ -357,7 +384,8 @@ impl<'m> Engine<'m> {
                 ActorRef::Group(_) => {}
             }
         }
-        let per_actor: Vec<Vec<DroneId>> = call.actors.iter().map(|a| self.drones(a, ctx)).collect();
+        let per_actor: Vec<Vec<DroneId>> =
+            call.actors.iter().map(|a| self.drones(a, ctx)).collect();
         let sets: Vec<Actors> = if capability.actors == 1 {
             per_actor.into_iter().flatten().map(|d| Actors::from_elem(d, 1)).collect()
         } else {
@@ -391,10 +419,22 @@ impl<'m> Engine<'m> {
                 }
                 let who = actor.map(|a| self.name(a));
                 let signal_name = &self.m.signals[signal];
-                self.trace(Kind::HandlerStart, || [("signal", Field::Str(signal_name)), ("handler", Field::Str(&handler.body.path)), ("actor", Field::name(who))]);
+                self.trace(Kind::HandlerStart, || {
+                    [
+                        ("signal", Field::Str(signal_name)),
+                        ("handler", Field::Str(&handler.body.path)),
+                        ("actor", Field::name(who)),
+                    ]
+                });
                 let ctx = self.scope_ctx(&scope, Rc::from(frame));
                 self.block(&handler.body, &ctx).await;
-                self.trace(Kind::HandlerEnd, || [("signal", Field::Str(signal_name)), ("handler", Field::Str(&handler.body.path)), ("actor", Field::name(who))]);
+                self.trace(Kind::HandlerEnd, || {
+                    [
+                        ("signal", Field::Str(signal_name)),
+                        ("handler", Field::Str(&handler.body.path)),
+                        ("actor", Field::name(who)),
+                    ]
+                });
             }
             Job::Exception { handler, args } => {
                 let mut frame = scope.frame.to_vec();
@@ -432,10 +472,24 @@ impl<'m> Engine<'m> {
 
     /// A leash on every running activity of `capability` tagged `tag`; recorded even when
     /// none runs (docs/LANGUAGE.md, section 14).
-    pub(crate) fn leash_by_id(&self, capability: usize, tag: usize, action: LeashAction, action_name: &str, values: Vec<(usize, Value)>) {
+    pub(crate) fn leash_by_id(
+        &self,
+        capability: usize,
+        tag: usize,
+        action: LeashAction,
+        action_name: &str,
+        values: Vec<(usize, Value)>,
+    ) {
         let cap = &self.m.capabilities[capability];
-        self.trace(Kind::Leash, || [("capability", Field::Str(&cap.name)), ("tag", Field::Str(&self.m.tags[tag])), ("action", Field::Str(action_name))]);
-        let targets: Vec<(Rc<Instance>, Rc<Scope<'m>>)> = self.instances.borrow().tagged(capability, tag).cloned().collect();
+        self.trace(Kind::Leash, || {
+            [
+                ("capability", Field::Str(&cap.name)),
+                ("tag", Field::Str(&self.m.tags[tag])),
+                ("action", Field::Str(action_name)),
+            ]
+        });
+        let targets: Vec<(Rc<Instance>, Rc<Scope<'m>>)> =
+            self.instances.borrow().tagged(capability, tag).cloned().collect();
         for (instance, scope) in targets {
             match action {
                 LeashAction::Abort => {
@@ -460,7 +514,9 @@ impl<'m> Engine<'m> {
                     for (p, v) in &values {
                         set(&mut frame, cap.actors + p, v.clone());
                     }
-                    scope.jobs.send(Job::Section { block: &cap.sections[i].1, frame: Rc::from(frame) });
+                    scope
+                        .jobs
+                        .send(Job::Section { block: &cap.sections[i].1, frame: Rc::from(frame) });
                 }
             }
         }

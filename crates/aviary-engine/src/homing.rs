@@ -61,12 +61,15 @@ impl<'m> Engine<'m> {
     /// Returns what the outcome must say: the drones that did not come down safely
     /// (which fail the mission), and the faults of those that did.
     pub(crate) async fn all_home(&self) -> Homecoming {
-        let flying: Vec<DroneId> = (0..self.m.drones.len()).filter(|&d| self.backend.telemetry(d).state.airborne()).collect();
+        let flying: Vec<DroneId> = (0..self.m.drones.len())
+            .filter(|&d| self.backend.telemetry(d).state.airborne())
+            .collect();
         if flying.is_empty() {
             return Homecoming::default();
         }
         let faults = Faults::default();
-        let homes = futures_util::future::join_all(flying.into_iter().map(|d| self.bring_down(d, &faults)));
+        let homes =
+            futures_util::future::join_all(flying.into_iter().map(|d| self.bring_down(d, &faults)));
         let stranded: Vec<(DroneId, String)> = tokio::select! {
             biased;
             stranded = homes => stranded.into_iter().flatten().collect(),
@@ -75,7 +78,10 @@ impl<'m> Engine<'m> {
         let mut notes = Vec::new();
         for (d, exception) in faults.seen.borrow().iter() {
             if !stranded.iter().any(|(s, _)| s == d) {
-                notes.push(format!("{exception} on {} on its way down, which it survived", self.name(*d)));
+                notes.push(format!(
+                    "{exception} on {} on its way down, which it survived",
+                    self.name(*d)
+                ));
             }
         }
         Homecoming { stranded: stranded.into_iter().map(|(_, why)| why).collect(), notes }
@@ -99,8 +105,18 @@ impl<'m> Engine<'m> {
                 }
                 continue;
             }
-            let function = if faults.last(d).is_some_and(lands_where_it_is) { "Land" } else { "ReturnToLaunch" };
-            self.trace(Kind::ApiCall, || [("actor", Field::Str(name)), ("function", Field::Str(function)), ("args", Field::Json(json!([])))]);
+            let function = if faults.last(d).is_some_and(lands_where_it_is) {
+                "Land"
+            } else {
+                "ReturnToLaunch"
+            };
+            self.trace(Kind::ApiCall, || {
+                [
+                    ("actor", Field::Str(name)),
+                    ("function", Field::Str(function)),
+                    ("args", Field::Json(json!([]))),
+                ]
+            });
             let pending = self.backend.call(d, function, &[]);
             let end = pending.end.wait().await.unwrap_or(CallEnd::Interrupted);
             self.trace_done(d, function, &[], &end);
@@ -110,7 +126,13 @@ impl<'m> Engine<'m> {
             }
             let since = *refused_since.get_or_insert_with(Instant::now);
             if since.elapsed() >= REFUSED_FOR && self.backend.telemetry(d).state.airborne() {
-                return Some((d, format!("{name} refused to come down for {} s: left to its autopilot's failsafe", REFUSED_FOR.as_secs())));
+                return Some((
+                    d,
+                    format!(
+                        "{name} refused to come down for {} s: left to its autopilot's failsafe",
+                        REFUSED_FOR.as_secs()
+                    ),
+                ));
             }
             tokio::time::sleep(RETRY).await;
         }
@@ -150,10 +172,22 @@ impl<'m> Engine<'m> {
                     });
                 }
                 Some(DroneEvent::Signal { drone, name }) => {
-                    self.trace(Kind::Signal, || [("name", Field::Str(name)), ("actor", Field::Str(self.name(drone))), ("args", Field::Json(json!([])))]);
+                    self.trace(Kind::Signal, || {
+                        [
+                            ("name", Field::Str(name)),
+                            ("actor", Field::Str(self.name(drone))),
+                            ("args", Field::Json(json!([]))),
+                        ]
+                    });
                 }
                 Some(DroneEvent::Detected { drone, kind, location }) => {
-                    self.trace(Kind::Detection, || [("actor", Field::Str(self.name(drone))), ("kind", Field::Str(&kind)), ("location", Field::Json(json!(location)))]);
+                    self.trace(Kind::Detection, || {
+                        [
+                            ("actor", Field::Str(self.name(drone))),
+                            ("kind", Field::Str(&kind)),
+                            ("location", Field::Json(json!(location))),
+                        ]
+                    });
                 }
                 None => std::future::pending().await,
             }

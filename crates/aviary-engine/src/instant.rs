@@ -50,7 +50,14 @@ enum Stopped<'m> {
     /// Before anything of it happened.
     Start(Vec<Value>),
     /// Started, at statement `at` of its body.
-    At { id: u64, needs: Needs, frame: LocalFrame, args: Vec<Value>, at: usize, begun: Option<Begun<'m>> },
+    At {
+        id: u64,
+        needs: Needs,
+        frame: LocalFrame,
+        args: Vec<Value>,
+        at: usize,
+        begun: Option<Begun<'m>>,
+    },
 }
 
 /// An instant activity's frame: on the stack when it is small, as nearly all are.
@@ -70,7 +77,11 @@ impl<'m> Engine<'m> {
     /// and gives the rest, if any, to be awaited. Not `async`: a future holding what this
     /// makes along the way would hold it as long as the activity waits, in every block
     /// that waits on it.
-    pub(crate) fn instant_call<'a>(&'a self, call: &'m Call, ctx: &'a Ctx<'m>) -> Option<LocalBoxFuture<'a, ()>> {
+    pub(crate) fn instant_call<'a>(
+        &'a self,
+        call: &'m Call,
+        ctx: &'a Ctx<'m>,
+    ) -> Option<LocalBoxFuture<'a, ()>> {
         let drone = match call.actors.as_slice() {
             [ActorRef::Drone(d)] => *d,
             // Not an actor here: `call` does nothing either.
@@ -90,13 +101,25 @@ impl<'m> Engine<'m> {
     }
 
     /// One instance of a capability that may be instant, on `drone`: as `instant_call`.
-    pub(crate) fn instant_instance<'a>(&'a self, call: &'m Call, drone: DroneId, args: Vec<Value>, ctx: &'a Ctx<'m>) -> Option<LocalBoxFuture<'a, ()>> {
+    pub(crate) fn instant_instance<'a>(
+        &'a self,
+        call: &'m Call,
+        drone: DroneId,
+        args: Vec<Value>,
+        ctx: &'a Ctx<'m>,
+    ) -> Option<LocalBoxFuture<'a, ()>> {
         let stopped = self.run_instant(call, drone, args, ctx)?;
         Some(self.go_on(call, drone, stopped, ctx))
     }
 
     /// Runs the activity as far as it goes at once; `None` when it ended.
-    fn run_instant(&self, call: &'m Call, drone: DroneId, args: Vec<Value>, ctx: &Ctx<'m>) -> Option<Stopped<'m>> {
+    fn run_instant(
+        &self,
+        call: &'m Call,
+        drone: DroneId,
+        args: Vec<Value>,
+        ctx: &Ctx<'m>,
+    ) -> Option<Stopped<'m>> {
         let cap = &self.m.capabilities[call.capability];
         let parent = ctx.instance.as_ref().map_or(&self.stop, |p| &p.token);
         if parent.is_cancelled() {
@@ -124,7 +147,10 @@ impl<'m> Engine<'m> {
             let Some(to) = self.api_drone(a, &frame) else { continue };
             // The activity's root: the caller's, or this one, which starts held while the
             // operator holds the mission.
-            let paused = ctx.instance.as_ref().map_or_else(|| self.mission_paused.get(), |p| p.root().paused.get());
+            let paused = ctx
+                .instance
+                .as_ref()
+                .map_or_else(|| self.mission_paused.get(), |p| p.root().paused.get());
             if paused {
                 return Some(Stopped::At { id, needs, frame, args, at, begun: None });
             }
@@ -132,7 +158,12 @@ impl<'m> Engine<'m> {
             if !matches!(begun.end, Ending::Now(CallEnd::Done)) {
                 return Some(Stopped::At { id, needs, frame, args, at, begun: Some(begun) });
             }
-            self.trace_done(begun.call.drone, begun.call.function, &begun.call.args, &CallEnd::Done);
+            self.trace_done(
+                begun.call.drone,
+                begun.call.function,
+                &begun.call.args,
+                &CallEnd::Done,
+            );
         }
         self.capability_end(call, &actors, &args, "ok");
         None
@@ -141,16 +172,34 @@ impl<'m> Engine<'m> {
     /// The rest of an activity that had to wait, on the general path. Boxed, each way at
     /// its own size: the future is an instance's, far larger than the statement's that
     /// holds it, and it lives as long as the activity.
-    fn go_on<'a>(&'a self, call: &'m Call, drone: DroneId, stopped: Stopped<'m>, ctx: &'a Ctx<'m>) -> LocalBoxFuture<'a, ()> {
+    fn go_on<'a>(
+        &'a self,
+        call: &'m Call,
+        drone: DroneId,
+        stopped: Stopped<'m>,
+        ctx: &'a Ctx<'m>,
+    ) -> LocalBoxFuture<'a, ()> {
         match stopped {
-            Stopped::Start(args) => Box::pin(self.instance(call, Actors::from_elem(drone, 1), args, ctx)),
+            Stopped::Start(args) => {
+                Box::pin(self.instance(call, Actors::from_elem(drone, 1), args, ctx))
+            }
             Stopped::At { id, needs, frame, args, at, begun } => {
                 // Free when the activity started, and nothing has run since.
                 let claims = ctx.claims.with(&needs);
                 let held = take(&self.arbiter, needs);
                 let instance = self.new_instance(id, call, Actors::from_elem(drone, 1), ctx);
                 let frame = frame.into_iter().collect();
-                Box::pin(self.perform(call, instance, held, frame, claims, false, args, ctx, Resume::At(at, begun.map(Box::new))))
+                Box::pin(self.perform(
+                    call,
+                    instance,
+                    held,
+                    frame,
+                    claims,
+                    false,
+                    args,
+                    ctx,
+                    Resume::At(at, begun.map(Box::new)),
+                ))
             }
         }
     }

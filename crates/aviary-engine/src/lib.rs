@@ -26,9 +26,9 @@ mod value;
 
 use aviary_api::Backend;
 
+use aviary_ir::Mission;
 pub use control::{Control, ControlRequest, Controller};
 pub use trace::{Event, Field, Kind};
-use aviary_ir::Mission;
 
 /// Where trace events go, one JSON object per event, in order.
 pub trait TraceSink {
@@ -104,7 +104,12 @@ pub struct Outcome {
 }
 
 /// Runs `mission` to its end. Must be polled inside a tokio runtime (current-thread).
-pub async fn run(mission: &Mission, backend: &dyn Backend, sink: &mut dyn TraceSink, options: &RunOptions) -> Outcome {
+pub async fn run(
+    mission: &Mission,
+    backend: &dyn Backend,
+    sink: &mut dyn TraceSink,
+    options: &RunOptions,
+) -> Outcome {
     engine::Engine::new(mission, backend, sink, options).run(options, None).await
 }
 

@@ -74,7 +74,9 @@ impl<'m> Registry<'m> {
             entry.1 = scope.clone();
         }
         for d in &instance.actors {
-            if let Some(entry) = self.by_actor.get_mut(*d).and_then(|l| l.iter_mut().rfind(|(i, _)| i.id == id)) {
+            if let Some(entry) =
+                self.by_actor.get_mut(*d).and_then(|l| l.iter_mut().rfind(|(i, _)| i.id == id))
+            {
                 entry.1 = scope.clone();
             }
         }
@@ -88,7 +90,8 @@ impl<'m> Registry<'m> {
     /// Every running instance once, in the order they started (for the operator's pause
     /// and resume of the whole mission, not for events).
     pub fn all(&self) -> Vec<Entry<'m>> {
-        let mut all: Vec<&Entry<'m>> = self.by_actor.iter().flatten().chain(self.loose.values()).collect();
+        let mut all: Vec<&Entry<'m>> =
+            self.by_actor.iter().flatten().chain(self.loose.values()).collect();
         all.sort_by_key(|(i, _)| i.id);
         all.dedup_by_key(|(i, _)| i.id);
         all.into_iter().cloned().collect()

@@ -29,7 +29,23 @@ pub enum Kind {
 }
 
 impl Kind {
-    pub const ALL: [Kind; 15] = [Kind::MissionStart, Kind::MissionEnd, Kind::BlockStart, Kind::BlockEnd, Kind::CapabilityStart, Kind::CapabilityEnd, Kind::HandlerStart, Kind::HandlerEnd, Kind::ApiCall, Kind::ApiDone, Kind::Signal, Kind::Exception, Kind::Leash, Kind::Detection, Kind::Telemetry];
+    pub const ALL: [Kind; 15] = [
+        Kind::MissionStart,
+        Kind::MissionEnd,
+        Kind::BlockStart,
+        Kind::BlockEnd,
+        Kind::CapabilityStart,
+        Kind::CapabilityEnd,
+        Kind::HandlerStart,
+        Kind::HandlerEnd,
+        Kind::ApiCall,
+        Kind::ApiDone,
+        Kind::Signal,
+        Kind::Exception,
+        Kind::Leash,
+        Kind::Detection,
+        Kind::Telemetry,
+    ];
 
     pub fn as_str(self) -> &'static str {
         match self {

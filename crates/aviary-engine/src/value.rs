@@ -42,19 +42,26 @@ impl Env<'_> {
             }
             Expr::Point(parts) => {
                 let n: Vec<f64> = parts.iter().map(|p| number(&self.eval(p))).collect();
-                Value::Position(Point { x: n[0], y: n.get(1).copied().unwrap_or(0.0), z: n.get(2).copied() })
+                Value::Position(Point {
+                    x: n[0],
+                    y: n.get(1).copied().unwrap_or(0.0),
+                    z: n.get(2).copied(),
+                })
             }
             Expr::Geo(parts) => {
                 let n: Vec<f64> = parts.iter().map(|p| number(&self.eval(p))).collect();
                 let origin = self.mission.origin.unwrap_or_default();
-                let [x, y, z] = origin.place(n[0], n.get(1).copied().unwrap_or(0.0), n.get(2).copied());
+                let [x, y, z] =
+                    origin.place(n[0], n.get(1).copied().unwrap_or(0.0), n.get(2).copied());
                 Value::Position(Point { x, y, z: (!z.is_nan()).then_some(z) })
             }
             Expr::Distance(a, b) => {
                 let (a, b) = (self.position(&self.eval(a)), self.position(&self.eval(b)));
                 Value::Number(((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt())
             }
-            Expr::Elapsed => Value::Number((tokio::time::Instant::now() - self.start).as_secs_f64()),
+            Expr::Elapsed => {
+                Value::Number((tokio::time::Instant::now() - self.start).as_secs_f64())
+            }
             Expr::Received(s) => Value::Bool(self.received.get(*s).copied().unwrap_or(false)),
             Expr::Not(x) => Value::Bool(!truth(&self.eval(x))),
             Expr::And(a, b) => Value::Bool(truth(&self.eval(a)) && truth(&self.eval(b))),
@@ -84,7 +91,9 @@ impl Env<'_> {
 fn telemetry(backend: &dyn Backend, d: usize, field: Field) -> Value {
     let t = backend.telemetry(d);
     match field {
-        Field::Position => Value::Position(Point { x: t.position[0], y: t.position[1], z: Some(t.position[2]) }),
+        Field::Position => {
+            Value::Position(Point { x: t.position[0], y: t.position[1], z: Some(t.position[2]) })
+        }
         Field::Altitude => Value::Number(t.position[2]),
         Field::Speed => Value::Number(t.speed),
         Field::Heading => Value::Number(t.heading),

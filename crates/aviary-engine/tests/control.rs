@@ -18,17 +18,39 @@ impl SourceProvider for NoFiles {
 
 /// Runs `mission`, sending each control at its mission time; returns the outcome, the
 /// trace and the engine's answers.
-fn run_with_controls(mission: &str, controls: Vec<(f64, Control)>) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
-    run_with_controls_and(mission, controls, RunOptions { telemetry_hz: Some(10.0), ..RunOptions::default() })
+fn run_with_controls(
+    mission: &str,
+    controls: Vec<(f64, Control)>,
+) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
+    run_with_controls_and(
+        mission,
+        controls,
+        RunOptions { telemetry_hz: Some(10.0), ..RunOptions::default() },
+    )
 }
 
-fn run_with_controls_and(mission: &str, controls: Vec<(f64, Control)>, options: RunOptions) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
+fn run_with_controls_and(
+    mission: &str,
+    controls: Vec<(f64, Control)>,
+    options: RunOptions,
+) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
     let mut sources = SourceMap::new();
-    let checked = aviary_check::check_sources(&mut sources, ("m.mission", mission.as_bytes()), Some(("w.toml", harness::WORLD.as_bytes())), &NoFiles, &Descriptor::standard());
+    let checked = aviary_check::check_sources(
+        &mut sources,
+        ("m.mission", mission.as_bytes()),
+        Some(("w.toml", harness::WORLD.as_bytes())),
+        &NoFiles,
+        &Descriptor::standard(),
+    );
     assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
     let world = checked.world.unwrap();
-    let compiled = aviary_ir::compile(&checked.program.unwrap(), &world, &Descriptor::standard()).unwrap();
-    let rt = tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build().unwrap();
+    let compiled =
+        aviary_ir::compile(&checked.program.unwrap(), &world, &Descriptor::standard()).unwrap();
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_time()
+        .start_paused(true)
+        .build()
+        .unwrap();
     rt.block_on(async {
         let sim = SimBackend::start(&world, SimOptions::default());
         let (controller, rx) = Controller::new();
@@ -51,7 +73,16 @@ fn run_with_controls_and(mission: &str, controls: Vec<(f64, Control)>, options: 
 }
 
 fn positions(trace: &[Json], actor: &str, from: f64, to: f64) -> Vec<Json> {
-    trace.iter().filter(|e| e["event"] == "telemetry" && e["actor"] == actor && e["t"].as_f64().unwrap() > from && e["t"].as_f64().unwrap() < to).map(|e| e["position"].clone()).collect()
+    trace
+        .iter()
+        .filter(|e| {
+            e["event"] == "telemetry"
+                && e["actor"] == actor
+                && e["t"].as_f64().unwrap() > from
+                && e["t"].as_f64().unwrap() < to
+        })
+        .map(|e| e["position"].clone())
+        .collect()
 }
 
 #[test]
@@ -59,15 +90,38 @@ fn an_operator_leash_pauses_and_resumes_by_tag() {
     let (outcome, trace, answers) = run_with_controls(
         "MISSION M:\n    a FlyTo-F1 WITH Far\n",
         vec![
-            (10.0, Control::Leash { capability: "FlyTo".into(), tag: "F1".into(), action: "PAUSE".into(), args: vec![] }),
-            (20.0, Control::Leash { capability: "FlyTo".into(), tag: "F1".into(), action: "RESUME".into(), args: vec![] }),
+            (
+                10.0,
+                Control::Leash {
+                    capability: "FlyTo".into(),
+                    tag: "F1".into(),
+                    action: "PAUSE".into(),
+                    args: vec![],
+                },
+            ),
+            (
+                20.0,
+                Control::Leash {
+                    capability: "FlyTo".into(),
+                    tag: "F1".into(),
+                    action: "RESUME".into(),
+                    args: vec![],
+                },
+            ),
         ],
     );
     assert_eq!(outcome.status, Status::Ok);
     assert_eq!(answers, [Ok(()), Ok(())]);
     let held = positions(&trace, "a", 10.2, 19.9);
-    assert!(held.len() > 50 && held.iter().all(|p| *p == held[0]), "paused by the operator, a holds");
-    let leashes: Vec<&str> = trace.iter().filter(|e| e["event"] == "leash").map(|e| e["action"].as_str().unwrap()).collect();
+    assert!(
+        held.len() > 50 && held.iter().all(|p| *p == held[0]),
+        "paused by the operator, a holds"
+    );
+    let leashes: Vec<&str> = trace
+        .iter()
+        .filter(|e| e["event"] == "leash")
+        .map(|e| e["action"].as_str().unwrap())
+        .collect();
     assert_eq!(leashes, ["PAUSE", "RESUME"]);
 }
 
@@ -76,9 +130,33 @@ fn operator_controls_that_cannot_apply_are_refused_with_a_reason() {
     let (_, _, answers) = run_with_controls(
         "MISSION M:\n    a FlyTo-F1 WITH North\n    ON Go:\n        b Hover WITH 1s\n",
         vec![
-            (1.0, Control::Leash { capability: "FlyTo".into(), tag: "F9".into(), action: "PAUSE".into(), args: vec![] }),
-            (1.0, Control::Leash { capability: "Fly".into(), tag: "F1".into(), action: "PAUSE".into(), args: vec![] }),
-            (1.0, Control::Leash { capability: "FlyTo".into(), tag: "F1".into(), action: "Widen".into(), args: vec![] }),
+            (
+                1.0,
+                Control::Leash {
+                    capability: "FlyTo".into(),
+                    tag: "F9".into(),
+                    action: "PAUSE".into(),
+                    args: vec![],
+                },
+            ),
+            (
+                1.0,
+                Control::Leash {
+                    capability: "Fly".into(),
+                    tag: "F1".into(),
+                    action: "PAUSE".into(),
+                    args: vec![],
+                },
+            ),
+            (
+                1.0,
+                Control::Leash {
+                    capability: "FlyTo".into(),
+                    tag: "F1".into(),
+                    action: "Widen".into(),
+                    args: vec![],
+                },
+            ),
             (1.0, Control::Signal { name: "Nobody".into(), args: vec![] }),
         ],
     );
@@ -97,8 +175,12 @@ fn an_operator_signal_is_heard_by_the_mission() {
     assert_eq!(answers, [Ok(())]);
     assert_eq!(outcome.status, Status::Ok);
     let signal = trace.iter().find(|e| e["event"] == "signal").unwrap();
-    assert_eq!((signal["actor"].clone(), signal["args"][0].clone()), (Json::Null, Json::from("now")));
-    let hover = trace.iter().find(|e| e["event"] == "capability_start" && e["actor"] == "b").unwrap();
+    assert_eq!(
+        (signal["actor"].clone(), signal["args"][0].clone()),
+        (Json::Null, Json::from("now"))
+    );
+    let hover =
+        trace.iter().find(|e| e["event"] == "capability_start" && e["actor"] == "b").unwrap();
     assert_eq!(hover["t"].as_f64().unwrap(), 7.0);
 }
 
@@ -111,7 +193,10 @@ fn pausing_the_mission_holds_every_drone_and_resuming_goes_on() {
     assert_eq!(outcome.status, Status::Ok);
     for drone in ["a", "b"] {
         let held = positions(&trace, drone, 15.2, 24.9);
-        assert!(held.len() > 50 && held.iter().all(|p| *p == held[0]), "{drone} holds while the mission is paused");
+        assert!(
+            held.len() > 50 && held.iter().all(|p| *p == held[0]),
+            "{drone} holds while the mission is paused"
+        );
     }
 }
 
@@ -122,10 +207,20 @@ fn an_activity_started_while_the_mission_is_paused_starts_held_on_either_path() 
     let mission = "CAPABILITY Ping BY d:\n    PERFORM:\n        d.StartStreaming()\n        d.StopStreaming()\n\nMISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        SEQUENTIAL:\n            WAITFOR ELAPSED >= 18s\n            b Ping\n";
     let controls = || vec![(15.0, Control::Pause), (25.0, Control::Resume)];
     let (outcome, trace, _) = run_with_controls(mission, controls());
-    let general = run_with_controls_and(mission, controls(), RunOptions { telemetry_hz: Some(10.0), instant_activities: false, ..RunOptions::default() });
+    let general = run_with_controls_and(
+        mission,
+        controls(),
+        RunOptions { telemetry_hz: Some(10.0), instant_activities: false, ..RunOptions::default() },
+    );
     assert_eq!((&outcome, &trace), (&general.0, &general.1), "the same trace both ways");
-    let start = trace.iter().find(|e| e["event"] == "capability_start" && e["capability"] == "Ping").unwrap();
-    let call = trace.iter().find(|e| e["event"] == "api_call" && e["function"] == "StartStreaming").unwrap();
+    let start = trace
+        .iter()
+        .find(|e| e["event"] == "capability_start" && e["capability"] == "Ping")
+        .unwrap();
+    let call = trace
+        .iter()
+        .find(|e| e["event"] == "api_call" && e["function"] == "StartStreaming")
+        .unwrap();
     assert!((start["t"].as_f64().unwrap() - 18.0).abs() < 0.11, "{start}");
     assert_eq!(call["t"].as_f64().unwrap(), 25.0, "held until the resume");
     assert_eq!(outcome.status, Status::Ok);
@@ -139,23 +234,45 @@ fn aborting_the_mission_sends_the_fleet_home() {
     );
     assert_eq!(outcome.status, Status::Aborted);
     assert_eq!(outcome.reason.as_deref(), Some("aborted by the operator"));
-    let home: Vec<&str> = trace.iter().filter(|e| e["event"] == "api_done" && e["function"] == "ReturnToLaunch").map(|e| e["actor"].as_str().unwrap()).collect();
+    let home: Vec<&str> = trace
+        .iter()
+        .filter(|e| e["event"] == "api_done" && e["function"] == "ReturnToLaunch")
+        .map(|e| e["actor"].as_str().unwrap())
+        .collect();
     assert!(home.contains(&"a") && home.contains(&"b"), "both drones were sent home: {home:?}");
     let last = trace.last().unwrap();
-    assert_eq!((last["event"].as_str(), last["status"].as_str()), (Some("mission_end"), Some("aborted")));
-    let aborted = trace.iter().filter(|e| e["event"] == "capability_end" && e["capability"] == "FlyTo").count();
-    assert_eq!(aborted, 0, "the activities were cut off with the mission: no end is invented for them");
+    assert_eq!(
+        (last["event"].as_str(), last["status"].as_str()),
+        (Some("mission_end"), Some("aborted"))
+    );
+    let aborted = trace
+        .iter()
+        .filter(|e| e["event"] == "capability_end" && e["capability"] == "FlyTo")
+        .count();
+    assert_eq!(
+        aborted, 0,
+        "the activities were cut off with the mission: no end is invented for them"
+    );
 }
 
 #[test]
 fn a_lost_backend_ends_the_mission_at_once_without_commanding_anyone() {
     let (outcome, trace, _) = run_with_controls(
         "MISSION M:\n    a FlyTo WITH Far\n",
-        vec![(10.0, Control::BackendLost { reason: "the simulator stopped: its task panicked".into() })],
+        vec![(
+            10.0,
+            Control::BackendLost { reason: "the simulator stopped: its task panicked".into() },
+        )],
     );
     assert_eq!(outcome.status, Status::Failed);
     let last = trace.last().unwrap();
-    assert_eq!((last["event"].as_str(), last["reason"].as_str()), (Some("mission_end"), Some("the simulator stopped: its task panicked")));
+    assert_eq!(
+        (last["event"].as_str(), last["reason"].as_str()),
+        (Some("mission_end"), Some("the simulator stopped: its task panicked"))
+    );
     assert_eq!(last["t"].as_f64().unwrap(), 10.0, "at once");
-    assert!(!trace.iter().any(|e| e["event"] == "api_call" && e["function"] == "ReturnToLaunch"), "nobody can be commanded");
+    assert!(
+        !trace.iter().any(|e| e["event"] == "api_call" && e["function"] == "ReturnToLaunch"),
+        "nobody can be commanded"
+    );
 }

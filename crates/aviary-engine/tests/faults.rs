@@ -29,7 +29,12 @@ fn a_crash_is_drone_lost_and_the_others_carry_on() {
     assert!(close(r.t("capability_start", "actor", "c"), 8.0), "the handler runs at once");
     assert_eq!(r.ends("FlyTo", "a")[0]["status"], "failed", "the crashed drone's activity ends");
     assert_eq!(r.ends("Hover", "b")[0]["status"], "ok");
-    assert!(!r.trace.iter().any(|e| e["event"] == "api_call" && e["function"] == "ReturnToLaunch" && e["actor"] == "a"), "a lost drone is not sent home");
+    assert!(
+        !r.trace.iter().any(|e| e["event"] == "api_call"
+            && e["function"] == "ReturnToLaunch"
+            && e["actor"] == "a"),
+        "a lost drone is not sent home"
+    );
 }
 
 #[test]
@@ -39,8 +44,18 @@ fn an_unhandled_crash_fails_the_mission_and_sends_the_others_home() {
         &with_fault("at = 8.0\nkind = \"crash\""),
     );
     assert_eq!(r.outcome.status, Status::Failed);
-    assert!(r.outcome.reason.as_deref().unwrap().starts_with("unhandled exception DroneLost on a"), "{:?}", r.outcome.reason);
-    let home = r.trace.iter().find(|e| e["event"] == "api_done" && e["function"] == "ReturnToLaunch" && e["actor"] == "b").expect("b is sent home");
+    assert!(
+        r.outcome.reason.as_deref().unwrap().starts_with("unhandled exception DroneLost on a"),
+        "{:?}",
+        r.outcome.reason
+    );
+    let home = r
+        .trace
+        .iter()
+        .find(|e| {
+            e["event"] == "api_done" && e["function"] == "ReturnToLaunch" && e["actor"] == "b"
+        })
+        .expect("b is sent home");
     assert_eq!(home["status"], "ok");
     assert_eq!(r.trace.last().unwrap()["status"], "failed");
 }
@@ -84,7 +99,16 @@ fn a_link_loss_is_connection_lost_and_its_return_is_connection_restored() {
     let restored = r.first("signal", "name", "ConnectionRestored");
     assert_eq!(restored["actor"], "a");
     assert!(close(restored["t"].as_f64().unwrap(), 9.0), "when the link is back");
-    let again = r.trace.iter().find(|e| e["event"] == "capability_start" && e["actor"] == "a" && e["capability"] == "FlyTo" && e["args"]["target"] == serde_json::json!([0.0, 100.0])).expect("a flies again");
+    let again = r
+        .trace
+        .iter()
+        .find(|e| {
+            e["event"] == "capability_start"
+                && e["actor"] == "a"
+                && e["capability"] == "FlyTo"
+                && e["args"]["target"] == serde_json::json!([0.0, 100.0])
+        })
+        .expect("a flies again");
     assert!(close(again["t"].as_f64().unwrap(), 9.0));
     assert_eq!(r.ends("Hover", "b")[0]["status"], "ok");
 }
@@ -98,8 +122,15 @@ fn a_geofence_refusal_is_geofence_violation() {
     );
     let e = r.first("exception", "name", "GeofenceViolation");
     assert_eq!(e["handled"], true);
-    let refused = r.trace.iter().find(|e| e["event"] == "api_done" && e["function"] == "FlyToPosition").unwrap();
+    let refused = r
+        .trace
+        .iter()
+        .find(|e| e["event"] == "api_done" && e["function"] == "FlyToPosition")
+        .unwrap();
     assert_eq!(refused["status"], "failed");
-    assert!(refused["position"][0].as_f64().unwrap().abs() < 0.01, "refused before it was sent: the drone did not move");
+    assert!(
+        refused["position"][0].as_f64().unwrap().abs() < 0.01,
+        "refused before it was sent: the drone did not move"
+    );
     assert_eq!(r.outcome.status, Status::Ok);
 }

@@ -21,12 +21,21 @@ fn pause_holds_the_drone_and_resume_goes_on() {
         "MISSION M:\n    PARALLEL:\n        a FlyTo-F1 WITH Far\n        SEQUENTIAL:\n            b Hover WITH 10s\n            FlyTo-F1 PAUSE\n            b Hover WITH 10s\n            FlyTo-F1 RESUME\n",
     );
     assert_eq!(r.outcome.status, Status::Ok);
-    let held: Vec<[f64; 3]> = r.positions("a").into_iter().filter(|(t, _)| *t > 10.2 && *t < 19.9).map(|(_, p)| p).collect();
+    let held: Vec<[f64; 3]> = r
+        .positions("a")
+        .into_iter()
+        .filter(|(t, _)| *t > 10.2 && *t < 19.9)
+        .map(|(_, p)| p)
+        .collect();
     assert!(held.len() > 50);
     assert!(held.iter().all(|p| *p == held[0]), "paused: the drone holds its position");
     let fly = r.ends("FlyTo", "a")[0];
     assert_eq!(fly["status"], "ok", "resumed, it arrives");
-    let arrived = r.trace.iter().rfind(|e| e["event"] == "api_done" && e["function"] == "FlyToPosition").unwrap();
+    let arrived = r
+        .trace
+        .iter()
+        .rfind(|e| e["event"] == "api_done" && e["function"] == "FlyToPosition")
+        .unwrap();
     assert!((arrived["position"][1].as_f64().unwrap() - 400.0).abs() < 0.6);
 }
 
@@ -39,13 +48,31 @@ fn abort_stops_the_drone_and_frees_the_resource_at_once() {
     let aborted_at = r.ends("FlyTo", "a")[0]["t"].as_f64().unwrap();
     assert!(close(aborted_at, 20.0));
     // The Hover waiting for a's motion starts in the same instant the claim is given back.
-    let hover = r.trace.iter().find(|e| e["event"] == "capability_start" && e["actor"] == "a" && e["capability"] == "Hover").unwrap();
+    let hover = r
+        .trace
+        .iter()
+        .find(|e| {
+            e["event"] == "capability_start" && e["actor"] == "a" && e["capability"] == "Hover"
+        })
+        .unwrap();
     assert_eq!(hover["t"].as_f64().unwrap(), aborted_at);
     // The flight call was interrupted, not left running: a stays where it was stopped.
-    let interrupted = r.trace.iter().find(|e| e["event"] == "api_done" && e["function"] == "FlyToPosition").unwrap();
+    let interrupted = r
+        .trace
+        .iter()
+        .find(|e| e["event"] == "api_done" && e["function"] == "FlyToPosition")
+        .unwrap();
     assert_eq!(interrupted["status"], "aborted");
-    let after: Vec<[f64; 3]> = r.positions("a").into_iter().filter(|(t, _)| *t > aborted_at + 0.1 && *t < aborted_at + 1.0).map(|(_, p)| p).collect();
-    assert!(after.windows(2).all(|w| w[0] == w[1]), "the drone hovers where the abort found it: {after:?}");
+    let after: Vec<[f64; 3]> = r
+        .positions("a")
+        .into_iter()
+        .filter(|(t, _)| *t > aborted_at + 0.1 && *t < aborted_at + 1.0)
+        .map(|(_, p)| p)
+        .collect();
+    assert!(
+        after.windows(2).all(|w| w[0] == w[1]),
+        "the drone hovers where the abort found it: {after:?}"
+    );
 }
 
 #[test]
@@ -53,12 +80,22 @@ fn a_queued_activity_that_is_aborted_never_starts_and_holds_nothing() {
     let r = run(
         "MISSION M:\n    PARALLEL:\n        a Hover WITH 10s\n        a Hover-Queued WITH 5s\n        SEQUENTIAL:\n            b Hover WITH 3s\n            Hover-Queued ABORT\n            a FlyTo WITH North\n",
     );
-    let queued = r.trace.iter().find(|e| e["event"] == "capability_end" && e["tag"] == "Queued").unwrap();
+    let queued =
+        r.trace.iter().find(|e| e["event"] == "capability_end" && e["tag"] == "Queued").unwrap();
     assert_eq!(queued["status"], "aborted");
     assert!(close(queued["t"].as_f64().unwrap(), 3.0));
-    assert!(!r.trace.iter().any(|e| e["event"] == "api_call" && e["actor"] == "a" && e["args"][0] == 5.0), "its body never ran");
+    assert!(
+        !r.trace
+            .iter()
+            .any(|e| e["event"] == "api_call" && e["actor"] == "a" && e["args"][0] == 5.0),
+        "its body never ran"
+    );
     // FlyTo then queues behind the first Hover only, and starts when it ends.
-    let fly = r.trace.iter().find(|e| e["event"] == "capability_start" && e["capability"] == "FlyTo").unwrap();
+    let fly = r
+        .trace
+        .iter()
+        .find(|e| e["event"] == "capability_start" && e["capability"] == "FlyTo")
+        .unwrap();
     assert!(close(fly["t"].as_f64().unwrap(), 10.0), "{}", r.dump());
 }
 
@@ -69,8 +106,17 @@ fn abort_in_the_instant_a_call_ends_is_clean() {
     assert_eq!(r.outcome.status, Status::Ok);
     let h = r.trace.iter().find(|e| e["event"] == "capability_end" && e["tag"] == "H").unwrap();
     assert!(h["status"] == "ok" || h["status"] == "aborted");
-    assert_eq!(r.find("capability_end", "actor", "a").len(), 2, "both of a's activities end exactly once");
-    let second = r.trace.iter().filter(|e| e["event"] == "capability_start" && e["actor"] == "a").nth(1).unwrap();
+    assert_eq!(
+        r.find("capability_end", "actor", "a").len(),
+        2,
+        "both of a's activities end exactly once"
+    );
+    let second = r
+        .trace
+        .iter()
+        .filter(|e| e["event"] == "capability_start" && e["actor"] == "a")
+        .nth(1)
+        .unwrap();
     assert!(close(second["t"].as_f64().unwrap(), 5.0));
 }
 

@@ -23,30 +23,59 @@ fn calls_after(r: &harness::Run, t: f64) -> Vec<(&str, &str, f64)> {
     r.trace
         .iter()
         .filter(|e| e["event"] == "api_done" && e["actor"] == "a" && e["t"].as_f64().unwrap() > t)
-        .map(|e| (e["function"].as_str().unwrap(), e["status"].as_str().unwrap(), e["t"].as_f64().unwrap()))
+        .map(|e| {
+            (
+                e["function"].as_str().unwrap(),
+                e["status"].as_str().unwrap(),
+                e["t"].as_f64().unwrap(),
+            )
+        })
         .collect()
 }
 
 fn last_position(r: &harness::Run) -> [f64; 3] {
-    let done: &Value = r.trace.iter().rev().find(|e| e["event"] == "api_done" && e["actor"] == "a").expect("a call");
+    let done: &Value = r
+        .trace
+        .iter()
+        .rev()
+        .find(|e| e["event"] == "api_done" && e["actor"] == "a")
+        .expect("a call");
     let p = &done["position"];
     [p[0].as_f64().unwrap(), p[1].as_f64().unwrap(), p[2].as_f64().unwrap()]
 }
 
 #[test]
 fn a_battery_fault_on_the_way_home_is_recorded_and_the_drone_sent_again() {
-    let r = harness::run_in(OUT, &with_faults(&["drone = \"a\"\nat = 60.0\nkind = \"battery_critical\""]));
+    let r = harness::run_in(
+        OUT,
+        &with_faults(&["drone = \"a\"\nat = 60.0\nkind = \"battery_critical\""]),
+    );
     let e = r.first("exception", "name", "BatteryCritical");
-    assert_eq!((e["actor"].as_str(), e["handled"].as_bool(), e["during"].as_str()), (Some("a"), Some(false), Some("return home")));
+    assert_eq!(
+        (e["actor"].as_str(), e["handled"].as_bool(), e["during"].as_str()),
+        (Some("a"), Some(false), Some("return home"))
+    );
     // The return it cut short, then a new one that brings the drone home.
     let after = calls_after(&r, 48.0);
-    assert_eq!(after.iter().map(|c| (c.0, c.1)).collect::<Vec<_>>(), [("ReturnToLaunch", "interrupted"), ("ReturnToLaunch", "ok")], "{}", r.dump());
-    assert!(r.index("exception", "name", "BatteryCritical") < r.index("mission_end", "event", "mission_end"));
+    assert_eq!(
+        after.iter().map(|c| (c.0, c.1)).collect::<Vec<_>>(),
+        [("ReturnToLaunch", "interrupted"), ("ReturnToLaunch", "ok")],
+        "{}",
+        r.dump()
+    );
+    assert!(
+        r.index("exception", "name", "BatteryCritical")
+            < r.index("mission_end", "event", "mission_end")
+    );
     let home = last_position(&r);
     assert!(home[0].hypot(home[1]) < 0.5 && home[2] == 0.0, "down at home: {home:?}");
     // It came down: the mission's outcome stands, and says what happened.
     assert_eq!(r.outcome.status, Status::Ok);
-    assert!(r.outcome.reason.as_deref().is_some_and(|why| why.contains("BatteryCritical on a")), "{:?}", r.outcome.reason);
+    assert!(
+        r.outcome.reason.as_deref().is_some_and(|why| why.contains("BatteryCritical on a")),
+        "{:?}",
+        r.outcome.reason
+    );
 }
 
 #[test]
@@ -62,12 +91,23 @@ fn a_crash_on_the_way_home_fails_the_mission() {
 #[test]
 fn a_return_cut_by_a_lost_link_is_sent_again_when_the_link_is_back() {
     // Lost at 60 s for 15 s: nothing is sent while it is lost; at 75 s it is sent home.
-    let r = harness::run_in(OUT, &with_faults(&["drone = \"a\"\nat = 60.0\nkind = \"link_loss\"\nduration = 15.0"]));
+    let r = harness::run_in(
+        OUT,
+        &with_faults(&["drone = \"a\"\nat = 60.0\nkind = \"link_loss\"\nduration = 15.0"]),
+    );
     assert_eq!(r.first("exception", "name", "ConnectionLost")["during"], "return home");
     let after = calls_after(&r, 60.5);
     let (function, status, t) = *after.last().expect("sent again");
     assert_eq!((function, status), ("ReturnToLaunch", "ok"), "{}", r.dump());
-    let sent = r.trace.iter().filter(|e| e["event"] == "api_call" && e["actor"] == "a" && e["t"].as_f64().unwrap() > 60.5).map(|e| e["t"].as_f64().unwrap()).next().unwrap();
+    let sent = r
+        .trace
+        .iter()
+        .filter(|e| {
+            e["event"] == "api_call" && e["actor"] == "a" && e["t"].as_f64().unwrap() > 60.5
+        })
+        .map(|e| e["t"].as_f64().unwrap())
+        .next()
+        .unwrap();
     assert!((75.0..76.1).contains(&sent), "sent again at {sent} s, as the link came back at 75 s");
     assert!(t > sent);
     assert_eq!(r.outcome.status, Status::Ok);
@@ -78,12 +118,18 @@ fn a_return_cut_by_a_lost_link_is_sent_again_when_the_link_is_back() {
 #[test]
 fn a_drone_that_lost_its_position_on_the_way_home_is_landed_where_it_is() {
     // No position for 10 s: it cannot fly home by it, so once it can move it lands.
-    let r = harness::run_in(OUT, &with_faults(&["drone = \"a\"\nat = 60.0\nkind = \"gps_loss\"\nduration = 10.0"]));
+    let r = harness::run_in(
+        OUT,
+        &with_faults(&["drone = \"a\"\nat = 60.0\nkind = \"gps_loss\"\nduration = 10.0"]),
+    );
     assert_eq!(r.first("exception", "name", "PositionLost")["during"], "return home");
     let after = calls_after(&r, 59.9);
     assert_eq!(after.first().map(|c| c.0), Some("ReturnToLaunch"), "the return it was flying");
     assert_eq!(after.last().map(|c| (c.0, c.1)), Some(("Land", "ok")), "{}", r.dump());
-    assert!(after.iter().skip(1).all(|c| c.0 == "Land"), "never sent home without a position: {after:?}");
+    assert!(
+        after.iter().skip(1).all(|c| c.0 == "Land"),
+        "never sent home without a position: {after:?}"
+    );
     let down = last_position(&r);
     assert!(down[2] == 0.0 && down[1] > 50.0, "landed on the way, not at home: {down:?}");
 }
@@ -94,13 +140,25 @@ fn a_fault_on_the_failsafes_own_return_is_recorded_too() {
     // battery fault is an exception of its own, and it is sent again.
     let r = harness::run_in(
         "MISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        b FlyTo WITH North\n",
-        &with_faults(&["drone = \"b\"\nat = 20.0\nkind = \"crash\"", "drone = \"a\"\nat = 25.0\nkind = \"battery_critical\""]),
+        &with_faults(&[
+            "drone = \"b\"\nat = 20.0\nkind = \"crash\"",
+            "drone = \"a\"\nat = 25.0\nkind = \"battery_critical\"",
+        ]),
     );
     assert_eq!(r.outcome.status, Status::Failed);
     let e = r.first("exception", "name", "BatteryCritical");
     assert_eq!((e["actor"].as_str(), e["during"].as_str()), (Some("a"), Some("return home")));
     let after = calls_after(&r, 20.0);
-    assert_eq!(after.iter().map(|c| (c.0, c.1)).collect::<Vec<_>>(), [("ReturnToLaunch", "interrupted"), ("ReturnToLaunch", "ok")], "{}", r.dump());
+    assert_eq!(
+        after.iter().map(|c| (c.0, c.1)).collect::<Vec<_>>(),
+        [("ReturnToLaunch", "interrupted"), ("ReturnToLaunch", "ok")],
+        "{}",
+        r.dump()
+    );
     let reason = r.outcome.reason.as_deref().unwrap();
-    assert!(reason.starts_with("unhandled exception DroneLost on b") && reason.contains("BatteryCritical on a"), "{reason}");
+    assert!(
+        reason.starts_with("unhandled exception DroneLost on b")
+            && reason.contains("BatteryCritical on a"),
+        "{reason}"
+    );
 }

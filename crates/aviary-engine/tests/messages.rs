@@ -16,8 +16,17 @@ fn refused(value: &str, call: &str) -> String {
 
 #[test]
 fn refused_values_are_written_as_the_language_writes_them() {
-    assert_eq!(refused("abc", "FlyToPosition"), "unhandled exception CommandFailed on a: `pos` must be a position, not abc");
-    assert_eq!(refused("\"abc\"", "FlyToPosition"), "unhandled exception CommandFailed on a: `pos` must be a position, not \"abc\"");
-    assert_eq!(refused("(1, 2.5)", "Hover"), "unhandled exception CommandFailed on a: `duration` must be a finite number, not (1, 2.5)");
+    assert_eq!(
+        refused("abc", "FlyToPosition"),
+        "unhandled exception CommandFailed on a: `pos` must be a position, not abc"
+    );
+    assert_eq!(
+        refused("\"abc\"", "FlyToPosition"),
+        "unhandled exception CommandFailed on a: `pos` must be a position, not \"abc\""
+    );
+    assert_eq!(
+        refused("(1, 2.5)", "Hover"),
+        "unhandled exception CommandFailed on a: `duration` must be a finite number, not (1, 2.5)"
+    );
     assert_eq!(refused("Field", "Hover"), "unhandled exception CommandFailed on a: `duration` must be a finite number, not an area of 4 corners");
 }

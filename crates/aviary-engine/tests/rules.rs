@@ -12,7 +12,8 @@ fn close(a: f64, b: f64) -> bool {
 
 #[test]
 fn sequential_runs_children_one_after_another() {
-    let r = run("MISSION M:\n    SEQUENTIAL S:\n        a Hover WITH 5s\n        b Hover WITH 3s\n");
+    let r =
+        run("MISSION M:\n    SEQUENTIAL S:\n        a Hover WITH 5s\n        b Hover WITH 3s\n");
     assert_eq!(r.outcome.status, Status::Ok);
     let a_end = r.ends("Hover", "a")[0]["t"].as_f64().unwrap();
     let b_start = r.t("capability_start", "actor", "b");
@@ -36,7 +37,8 @@ fn on_fires_once_and_on_every_each_time() {
     );
     assert_eq!(r.find("signal", "name", "Ping").len(), 3);
     assert_eq!(r.find("capability_start", "actor", "b").len(), 1, "ON takes the first signal only");
-    let c: Vec<f64> = r.find("capability_start", "actor", "c").iter().map(|e| e["t"].as_f64().unwrap()).collect();
+    let c: Vec<f64> =
+        r.find("capability_start", "actor", "c").iter().map(|e| e["t"].as_f64().unwrap()).collect();
     assert_eq!(c.len(), 3, "ON EVERY takes each");
     assert!(close(c[0], 0.0) && close(c[1], 1.0) && close(c[2], 2.0), "{c:?}");
     assert!(close(r.t("block_end", "block", "P"), 3.0), "the block waits for its started handlers");
@@ -51,12 +53,32 @@ fn a_burst_of_signals_starts_its_handlers_one_after_another_in_signal_order() {
         "MISSION M:\n    PARALLEL P:\n{raise}        WAITFOR RECEIVED(Pong)\n    ON EVERY Ping WITH i:\n        STARTIF i = 1s:\n            SIGNAL Pong\n        WAITFOR ELAPSED >= i\n    ON Pong:\n        WAITFOR RECEIVED(Pong)\n"
     );
     let r = run(&mission);
-    let starts: Vec<(usize, f64)> = r.trace.iter().enumerate().filter(|(_, e)| e["event"] == "handler_start" && e["signal"] == "Ping").map(|(at, e)| (at, e["t"].as_f64().unwrap())).collect();
-    let signals: Vec<usize> = r.trace.iter().enumerate().filter(|(_, e)| e["event"] == "signal" && e["name"] == "Ping").map(|(at, _)| at).collect();
+    let starts: Vec<(usize, f64)> = r
+        .trace
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e["event"] == "handler_start" && e["signal"] == "Ping")
+        .map(|(at, e)| (at, e["t"].as_f64().unwrap()))
+        .collect();
+    let signals: Vec<usize> = r
+        .trace
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e["event"] == "signal" && e["name"] == "Ping")
+        .map(|(at, _)| at)
+        .collect();
     assert_eq!(starts.len(), 12);
     assert!(starts.iter().all(|(_, t)| *t == 0.0), "all in the instant of their signals");
-    assert!(signals.iter().max() < starts.iter().map(|(at, _)| at).min(), "raised in one poll of the block, then started");
-    let ends: Vec<f64> = r.trace.iter().filter(|e| e["event"] == "handler_end" && e["signal"] == "Ping").map(|e| e["t"].as_f64().unwrap()).collect();
+    assert!(
+        signals.iter().max() < starts.iter().map(|(at, _)| at).min(),
+        "raised in one poll of the block, then started"
+    );
+    let ends: Vec<f64> = r
+        .trace
+        .iter()
+        .filter(|e| e["event"] == "handler_end" && e["signal"] == "Ping")
+        .map(|e| e["t"].as_f64().unwrap())
+        .collect();
     assert_eq!(ends.len(), 12);
     assert!(ends.windows(2).all(|w| w[0] <= w[1]), "in signal order: {ends:?}");
     assert!(close(ends[11], 12.0), "each waits its own time, concurrently: {ends:?}");
@@ -74,7 +96,10 @@ fn sequential_on_waits_for_the_signalling_block_and_parallel_on_does_not() {
     assert_eq!(r.t("capability_start", "actor", "c"), 0.0, "PARALLEL ON starts at once");
     let b = r.t("capability_start", "actor", "b");
     assert!(b >= signaller_end, "SEQUENTIAL ON starts when the signalling block has ended: {b}");
-    assert!(r.index("block_end", "block", "Signaller") < r.index("capability_start", "actor", "b"), "in causal order");
+    assert!(
+        r.index("block_end", "block", "Signaller") < r.index("capability_start", "actor", "b"),
+        "in causal order"
+    );
 }
 
 #[test]
@@ -124,14 +149,18 @@ fn a_capability_handles_its_own_exceptions_first() {
     assert!(r.find("capability_start", "actor", "c").is_empty(), "the outer handler is not needed");
     let careful = r.ends("Careful", "a")[0];
     assert_eq!(careful["status"], "ok");
-    assert!(close(careful["t"].as_f64().unwrap(), 3.0), "its handler took the place of the rest: 1 s + 2 s");
+    assert!(
+        close(careful["t"].as_f64().unwrap(), 3.0),
+        "its handler took the place of the rest: 1 s + 2 s"
+    );
     assert!(close(r.t("capability_start", "actor", "b"), 3.0));
 }
 
 #[test]
 fn two_motion_capabilities_on_one_drone_queue() {
     let r = run("MISSION M:\n    PARALLEL:\n        a Hover WITH 3s\n        a Hover WITH 2s\n        b Hover WITH 1s\n");
-    let starts: Vec<f64> = r.find("capability_start", "actor", "a").iter().map(|e| e["t"].as_f64().unwrap()).collect();
+    let starts: Vec<f64> =
+        r.find("capability_start", "actor", "a").iter().map(|e| e["t"].as_f64().unwrap()).collect();
     let ends: Vec<f64> = r.ends("Hover", "a").iter().map(|e| e["t"].as_f64().unwrap()).collect();
     assert_eq!(starts[0], 0.0);
     assert!(close(starts[1], 3.0), "the second waits for the motion resource: {starts:?}");
@@ -145,7 +174,11 @@ fn waitfor_startif_and_dowhile() {
         "MISSION M:\n    PARALLEL:\n        SEQUENTIAL:\n            WAITFOR RECEIVED(Go)\n            a Hover WITH 1s\n        SEQUENTIAL:\n            b Hover WITH 2s\n            SIGNAL Go\n            STARTIF b.battery < 10%:\n                b Hover WITH 100s\n            DOWHILE ELAPSED < 5s:\n                c Hover WITH 1s\n",
     );
     assert!(close(r.t("capability_start", "actor", "a"), 2.0), "WAITFOR ends when Go is raised");
-    assert_eq!(r.find("capability_start", "actor", "b").len(), 1, "STARTIF with a false condition skips its body");
+    assert_eq!(
+        r.find("capability_start", "actor", "b").len(),
+        1,
+        "STARTIF with a false condition skips its body"
+    );
     let rounds = r.find("capability_start", "actor", "c").len();
     assert_eq!(rounds, 3, "DOWHILE checks before each round: 2 s, 3 s, 4 s, then stops at 5 s");
 }
@@ -154,8 +187,16 @@ fn waitfor_startif_and_dowhile() {
 fn groups_and_for_instances() {
     let r = run("MISSION M:\n    SEQUENTIAL FOR team AS d:\n        d Hover WITH 1s\n    team Hover WITH 2s\n");
     assert_eq!(r.t("capability_start", "actor", "a"), 0.0);
-    assert!(close(r.t("capability_start", "actor", "b"), 1.0), "SEQUENTIAL FOR runs instances one after another");
-    let second: Vec<f64> = r.trace.iter().filter(|e| e["event"] == "capability_start" && e["args"]["duration"] == 2.0).map(|e| e["t"].as_f64().unwrap()).collect();
+    assert!(
+        close(r.t("capability_start", "actor", "b"), 1.0),
+        "SEQUENTIAL FOR runs instances one after another"
+    );
+    let second: Vec<f64> = r
+        .trace
+        .iter()
+        .filter(|e| e["event"] == "capability_start" && e["args"]["duration"] == 2.0)
+        .map(|e| e["t"].as_f64().unwrap())
+        .collect();
     assert_eq!(second.len(), 2, "a group as actor means each member");
     assert!(close(second[0], 2.0) && close(second[1], 2.0), "in parallel: {second:?}");
 }
@@ -167,7 +208,9 @@ fn an_unhandled_exception_fails_the_mission_and_sends_the_fleet_home() {
     assert!(r.outcome.reason.as_deref().unwrap_or("").contains("Broken"), "{:?}", r.outcome.reason);
     assert_eq!(r.first("exception", "name", "Broken")["handled"], false);
     assert!(r.find("capability_start", "actor", "b").is_empty());
-    let rtl = r.trace.iter().position(|e| e["event"] == "api_call" && e["function"] == "ReturnToLaunch" && e["actor"] == "a");
+    let rtl = r.trace.iter().position(|e| {
+        e["event"] == "api_call" && e["function"] == "ReturnToLaunch" && e["actor"] == "a"
+    });
     assert!(rtl.is_some(), "the drone in the air is sent home");
     let end = r.trace.last().unwrap();
     assert_eq!(end["event"], "mission_end");
@@ -179,8 +222,17 @@ fn leashes_pause_resume_and_abort_an_activity() {
     let r = run(
         "MISSION M:\n    PARALLEL:\n        a FlyTo-F1 WITH Far\n        SEQUENTIAL:\n            b Hover WITH 10s\n            FlyTo-F1 PAUSE\n            b Hover WITH 10s\n            FlyTo-F1 RESUME\n            b Hover WITH 5s\n            FlyTo-F1 ABORT\n            FlyTo-F1 ABORT\n",
     );
-    let actions: Vec<&str> = r.trace.iter().filter(|e| e["event"] == "leash").map(|e| e["action"].as_str().unwrap()).collect();
-    assert_eq!(actions, ["PAUSE", "RESUME", "ABORT", "ABORT"], "every leash is recorded, even one on an ended activity");
+    let actions: Vec<&str> = r
+        .trace
+        .iter()
+        .filter(|e| e["event"] == "leash")
+        .map(|e| e["action"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        actions,
+        ["PAUSE", "RESUME", "ABORT", "ABORT"],
+        "every leash is recorded, even one on an ended activity"
+    );
     let fly = r.ends("FlyTo", "a")[0];
     assert_eq!(fly["status"], "aborted");
     assert!(close(fly["t"].as_f64().unwrap(), 25.0));
@@ -196,7 +248,6 @@ fn the_same_mission_gives_the_same_trace() {
     assert!(first.trace.len() > 20);
 }
 
-
 #[test]
 fn a_failed_command_is_an_exception_of_its_actor() {
     let r = run("MISSION M:\n    SEQUENTIAL:\n        b FlyCircle WITH center=North, radius=30m\n        c TakeOff\n");
@@ -204,7 +255,10 @@ fn a_failed_command_is_an_exception_of_its_actor() {
     assert_eq!(e["actor"], "b");
     assert_eq!(e["args"][0], "b is on the ground: take off first");
     assert_eq!(r.ends("FlyCircle", "b")[0]["status"], "failed");
-    assert!(r.find("capability_start", "actor", "c").is_empty(), "nothing starts after the failure");
+    assert!(
+        r.find("capability_start", "actor", "c").is_empty(),
+        "nothing starts after the failure"
+    );
     assert!(r.find("signal", "name", "Up").is_empty());
     assert_eq!(r.outcome.status, Status::Failed);
 }
@@ -216,20 +270,32 @@ fn several_actors_bind_in_order_and_one_actor_capabilities_run_once_each() {
     );
     let pair = r.first("capability_start", "capability", "Pair");
     assert_eq!(pair["actor"], "a b");
-    let hovers: Vec<(String, f64)> =
-        r.trace.iter().filter(|e| e["event"] == "api_call" && e["function"] == "Hover").map(|e| (e["actor"].as_str().unwrap().to_string(), e["t"].as_f64().unwrap())).collect();
+    let hovers: Vec<(String, f64)> = r
+        .trace
+        .iter()
+        .filter(|e| e["event"] == "api_call" && e["function"] == "Hover")
+        .map(|e| (e["actor"].as_str().unwrap().to_string(), e["t"].as_f64().unwrap()))
+        .collect();
     assert_eq!(hovers[0].0, "a", "lead is a");
     assert_eq!(hovers[1].0, "b", "wing is b");
     assert!(close(hovers[1].1, 2.0));
     // Hover has one actor: `a c Hover` runs it once for each, in parallel.
-    let last: Vec<f64> = r.trace.iter().filter(|e| e["event"] == "capability_start" && e["capability"] == "Hover").map(|e| e["t"].as_f64().unwrap()).collect();
+    let last: Vec<f64> = r
+        .trace
+        .iter()
+        .filter(|e| e["event"] == "capability_start" && e["capability"] == "Hover")
+        .map(|e| e["t"].as_f64().unwrap())
+        .collect();
     assert_eq!(last.len(), 2);
     assert!(close(last[0], 3.0) && last[0] == last[1], "{last:?}");
 }
 
 #[test]
 fn a_drone_fault_reaches_the_capability_that_was_flying_it() {
-    let world = format!("{}\n[[faults]]\ndrone = \"a\"\nat = 5.0\nkind = \"battery_critical\"\n", harness::WORLD);
+    let world = format!(
+        "{}\n[[faults]]\ndrone = \"a\"\nat = 5.0\nkind = \"battery_critical\"\n",
+        harness::WORLD
+    );
     let r = harness::run_in(
         "CAPABILITY Deliver BY d:\n    PERFORM:\n        d TakeOff WITH 20m\n        d.FlyToPosition(Far)\n    EXCEPTIONS:\n        ON EXCEPTION BatteryCritical:\n            d.ReturnToLaunch()\n\nMISSION M:\n    PARALLEL:\n        a Deliver\n        b Hover WITH 10s\n",
         &world,
@@ -239,7 +305,13 @@ fn a_drone_fault_reaches_the_capability_that_was_flying_it() {
     assert_eq!((e["actor"].as_str(), e["handled"].as_bool()), (Some("a"), Some(true)));
     assert_eq!(e["handler"], "Deliver/ON EXCEPTION BatteryCritical");
     assert!(close(e["t"].as_f64().unwrap(), 5.0));
-    let rtl = r.trace.iter().find(|e| e["event"] == "api_call" && e["function"] == "ReturnToLaunch" && e["actor"] == "a").unwrap();
+    let rtl = r
+        .trace
+        .iter()
+        .find(|e| {
+            e["event"] == "api_call" && e["function"] == "ReturnToLaunch" && e["actor"] == "a"
+        })
+        .unwrap();
     assert!(close(rtl["t"].as_f64().unwrap(), 5.0), "the handler starts at once");
     assert_eq!(r.find("exception", "name", "BatteryCritical").len(), 1, "one fault, one exception");
     assert_eq!(r.ends("Hover", "b")[0]["status"], "ok", "the other drone carries on");
@@ -247,7 +319,9 @@ fn a_drone_fault_reaches_the_capability_that_was_flying_it() {
 
 #[test]
 fn for_aliases_read_attributes_and_telemetry() {
-    let world = harness::WORLD.replace("[drones.b]\n", "[drones.b]\nrole = \"scout\"\n").replace("[drones.a]\n", "[drones.a]\nrole = \"carrier\"\n");
+    let world = harness::WORLD
+        .replace("[drones.b]\n", "[drones.b]\nrole = \"scout\"\n")
+        .replace("[drones.a]\n", "[drones.a]\nrole = \"carrier\"\n");
     let r = harness::run_in(
         "MISSION M:\n    PARALLEL FOR team AS d:\n        IF d.role = \"scout\" AND d.state = Landed:\n            d Hover WITH 1s\n        ELSE:\n            d Hover WITH 2s\n",
         &world,
@@ -256,7 +330,9 @@ fn for_aliases_read_attributes_and_telemetry() {
         .trace
         .iter()
         .filter(|e| e["event"] == "capability_start")
-        .map(|e| (e["actor"].as_str().unwrap().to_string(), e["args"]["duration"].as_f64().unwrap()))
+        .map(|e| {
+            (e["actor"].as_str().unwrap().to_string(), e["args"]["duration"].as_f64().unwrap())
+        })
         .collect();
     assert_eq!(durations, [("a".to_string(), 2.0), ("b".to_string(), 1.0)]);
 }
@@ -270,13 +346,24 @@ fn parallel_branches_woken_at_one_instant_go_on_in_written_order() {
     for n in [3, 30, 31, 80] {
         let mut mission = String::from("MISSION M:\n    PARALLEL:\n");
         for i in 0..n {
-            mission += &format!("        SEQUENTIAL:\n            WAITFOR ELAPSED >= 1s\n            SIGNAL S{i}\n");
+            mission += &format!(
+                "        SEQUENTIAL:\n            WAITFOR ELAPSED >= 1s\n            SIGNAL S{i}\n"
+            );
         }
         let r = run(&mission);
         assert_eq!(r.outcome.status, Status::Ok);
-        let raised: Vec<String> = r.trace.iter().filter(|e| e["event"] == "signal").map(|e| e["name"].as_str().unwrap_or("").to_string()).collect();
+        let raised: Vec<String> = r
+            .trace
+            .iter()
+            .filter(|e| e["event"] == "signal")
+            .map(|e| e["name"].as_str().unwrap_or("").to_string())
+            .collect();
         let written: Vec<String> = (0..n).map(|i| format!("S{i}")).collect();
         assert_eq!(raised, written, "{n} branches");
-        assert!(r.trace.iter().filter(|e| e["event"] == "signal").all(|e| close(e["t"].as_f64().unwrap_or(0.0), 1.0)));
+        assert!(r
+            .trace
+            .iter()
+            .filter(|e| e["event"] == "signal")
+            .all(|e| close(e["t"].as_f64().unwrap_or(0.0), 1.0)));
     }
 }

@@ -22,7 +22,8 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
         c.caps.insert(cap.name.name.clone(), i);
     }
     c.defaults = actives.iter().map(|(_, cap)| c.defaults_of(cap)).collect();
-    let capabilities: Vec<Capability> = actives.iter().map(|(file, cap)| c.capability(*file, cap)).collect();
+    let capabilities: Vec<Capability> =
+        actives.iter().map(|(file, cap)| c.capability(*file, cap)).collect();
     c.file = mission_file;
     c.scopes.clear();
     c.frame_size = 0;
@@ -34,7 +35,12 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
         command_failed: c.exceptions.id("CommandFailed"),
         requirement_not_met: c.exceptions.id("RequirementNotMet"),
     };
-    let signal_values = c.signals.names.iter().map(|s| program.signal_values.get(s).cloned().unwrap_or_default()).collect();
+    let signal_values = c
+        .signals
+        .names
+        .iter()
+        .map(|s| program.signal_values.get(s).cloned().unwrap_or_default())
+        .collect();
     let mut out = Mission {
         name: mission.name.name.clone(),
         body,
@@ -48,7 +54,11 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
         functions: api.functions.iter().map(|f| (f.name.to_string(), f.resource)).collect(),
         attribute_names: c.attribute_names.clone(),
         attributes: attribute_table(world, &c.attribute_names),
-        origin: world.site.origin.as_ref().map(|o| aviary_api::geo::Origin { lat: o.lat, lon: o.lon, alt: o.alt }),
+        origin: world.site.origin.as_ref().map(|o| aviary_api::geo::Origin {
+            lat: o.lat,
+            lon: o.lon,
+            alt: o.alt,
+        }),
         builtins,
     };
     compute_claims(&mut out.capabilities, &out.functions);
@@ -141,7 +151,12 @@ impl<'a> Compiler<'a> {
     }
 
     fn local(&self, name: &str) -> Option<(Slot, bool)> {
-        self.scopes.iter().rev().flat_map(|s| s.iter().rev()).find(|(n, _, _)| n == name).map(|&(_, s, a)| (s, a))
+        self.scopes
+            .iter()
+            .rev()
+            .flat_map(|s| s.iter().rev())
+            .find(|(n, _, _)| n == name)
+            .map(|&(_, s, a)| (s, a))
     }
 
     fn collect_aliases(&mut self, body: &ast::Body) {
@@ -205,8 +220,14 @@ impl<'a> Compiler<'a> {
 
     fn capability(&mut self, file: FileId, cap: &ast::Capability) -> Capability {
         self.file = file;
-        let mut scope: Vec<(String, Slot, bool)> = cap.actors.iter().enumerate().map(|(i, a)| (a.name.clone(), i, true)).collect();
-        scope.extend(cap.params.iter().enumerate().map(|(i, p)| (p.name.clone(), cap.actors.len() + i, false)));
+        let mut scope: Vec<(String, Slot, bool)> =
+            cap.actors.iter().enumerate().map(|(i, a)| (a.name.clone(), i, true)).collect();
+        scope.extend(
+            cap.params
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (p.name.clone(), cap.actors.len() + i, false)),
+        );
         self.frame_size = scope.len();
         self.scopes = vec![scope];
         let name = &cap.name.name;
@@ -214,7 +235,12 @@ impl<'a> Compiler<'a> {
             name: name.clone(),
             actors: cap.actors.len(),
             params: cap.params.iter().map(|p| p.name.clone()).collect(),
-            param_kinds: self.program.param_kinds.get(name).cloned().unwrap_or_else(|| vec![None; cap.params.len()]),
+            param_kinds: self
+                .program
+                .param_kinds
+                .get(name)
+                .cloned()
+                .unwrap_or_else(|| vec![None; cap.params.len()]),
             frame_size: 0,
             requirements: Vec::new(),
             perform: empty_block(name),
@@ -225,9 +251,13 @@ impl<'a> Compiler<'a> {
         };
         for section in &cap.sections {
             match section {
-                ast::Section::Requirements { conditions, .. } => out.requirements = conditions.iter().map(|c| self.expr(c)).collect(),
+                ast::Section::Requirements { conditions, .. } => {
+                    out.requirements = conditions.iter().map(|c| self.expr(c)).collect()
+                }
                 ast::Section::Defaults { .. } => {}
-                ast::Section::Perform { name: None, body, .. } => out.perform = self.body(body, name, BlockKind::Sequential, false),
+                ast::Section::Perform { name: None, body, .. } => {
+                    out.perform = self.body(body, name, BlockKind::Sequential, false)
+                }
                 ast::Section::Perform { name: Some(section), body, .. } => {
                     let path = format!("{name}/PERFORM {}", section.name);
                     let block = self.body(body, &path, BlockKind::Sequential, false);
@@ -237,7 +267,8 @@ impl<'a> Compiler<'a> {
                     out.sections.push((section.name.clone(), block));
                 }
                 ast::Section::Exceptions { handlers, .. } => {
-                    out.exception_handlers = handlers.iter().map(|h| self.exception_handler(h, name)).collect();
+                    out.exception_handlers =
+                        handlers.iter().map(|h| self.exception_handler(h, name)).collect();
                 }
             }
         }
@@ -248,7 +279,14 @@ impl<'a> Compiler<'a> {
     fn body(&mut self, body: &ast::Body, path: &str, kind: BlockKind, traced: bool) -> Block {
         // Room for every statement at once: a long block would otherwise grow (and copy)
         // its vector a score of times.
-        let mut block = Block { kind, path: path.to_string(), traced, items: Vec::with_capacity(body.items.len()), handlers: Vec::new(), exception_handlers: Vec::new() };
+        let mut block = Block {
+            kind,
+            path: path.to_string(),
+            traced,
+            items: Vec::with_capacity(body.items.len()),
+            handlers: Vec::new(),
+            exception_handlers: Vec::new(),
+        };
         for stmt in &body.items {
             match stmt {
                 ast::Stmt::Handler(h) => {
@@ -269,7 +307,11 @@ impl<'a> Compiler<'a> {
         block
     }
 
-    fn bound_scope<T>(&mut self, names: impl IntoIterator<Item = (String, bool)>, f: impl FnOnce(&mut Self, Vec<Slot>) -> T) -> T {
+    fn bound_scope<T>(
+        &mut self,
+        names: impl IntoIterator<Item = (String, bool)>,
+        f: impl FnOnce(&mut Self, Vec<Slot>) -> T,
+    ) -> T {
         let mut scope = Vec::new();
         let mut slots = Vec::new();
         for (name, actor) in names {
@@ -303,13 +345,22 @@ impl<'a> Compiler<'a> {
         let by = self.filter(&h.by);
         let path = format!("{parent}/ON EXCEPTION {}", h.exception.name);
         let names = h.bindings.iter().map(|b| (b.name.clone(), false));
-        self.bound_scope(names, |c, bindings| ExceptionHandler { exception, by, bindings, body: c.body(&h.body, &path, BlockKind::Sequential, false) })
+        self.bound_scope(names, |c, bindings| ExceptionHandler {
+            exception,
+            by,
+            bindings,
+            body: c.body(&h.body, &path, BlockKind::Sequential, false),
+        })
     }
 
     fn node(&mut self, stmt: &ast::Stmt, parent: &str) -> Option<Node> {
         Some(match stmt {
             ast::Stmt::Block(b) => {
-                let kind = if b.kind == ast::BlockKind::Parallel { BlockKind::Parallel } else { BlockKind::Sequential };
+                let kind = if b.kind == ast::BlockKind::Parallel {
+                    BlockKind::Parallel
+                } else {
+                    BlockKind::Sequential
+                };
                 let path = match &b.name {
                     Some(n) => n.name.clone(),
                     None => format!("{parent}/{}", b.kind.as_str()),
@@ -324,22 +375,44 @@ impl<'a> Compiler<'a> {
                 args: a.args.iter().map(|e| self.expr(e)).collect(),
                 origin: self.origin(a.span),
             }),
-            ast::Stmt::Signal(r) => Node::Signal { signal: self.signals.id(&r.name.name), args: self.args(&r.args), origin: self.origin(r.span) },
-            ast::Stmt::Throw(r) => Node::Throw { exception: self.exceptions.id(&r.name.name), args: self.args(&r.args), origin: self.origin(r.span) },
+            ast::Stmt::Signal(r) => Node::Signal {
+                signal: self.signals.id(&r.name.name),
+                args: self.args(&r.args),
+                origin: self.origin(r.span),
+            },
+            ast::Stmt::Throw(r) => Node::Throw {
+                exception: self.exceptions.id(&r.name.name),
+                args: self.args(&r.args),
+                origin: self.origin(r.span),
+            },
             ast::Stmt::Requirement(r) => {
                 let condition = self.expr(&r.condition);
                 let path = format!("{parent}/{}", r.kind.as_str());
-                let body = r.body.as_ref().map(|b| self.body(b, &path, BlockKind::Sequential, false));
+                let body =
+                    r.body.as_ref().map(|b| self.body(b, &path, BlockKind::Sequential, false));
                 match r.kind {
-                    ast::RequirementKind::StartIf => Node::StartIf { condition, body: body.unwrap_or_else(|| empty_block(&path)) },
+                    ast::RequirementKind::StartIf => Node::StartIf {
+                        condition,
+                        body: body.unwrap_or_else(|| empty_block(&path)),
+                    },
                     ast::RequirementKind::WaitFor => Node::WaitFor { condition, body },
-                    ast::RequirementKind::DoWhile => Node::DoWhile { condition, body: body.unwrap_or_else(|| empty_block(&path)) },
+                    ast::RequirementKind::DoWhile => Node::DoWhile {
+                        condition,
+                        body: body.unwrap_or_else(|| empty_block(&path)),
+                    },
                 }
             }
             ast::Stmt::For(f) => {
-                let instances = f.instances.iter().map(|i| (self.actor(&i.actor.name), i.values.iter().map(|v| self.expr(v)).collect())).collect();
+                let instances = f
+                    .instances
+                    .iter()
+                    .map(|i| {
+                        (self.actor(&i.actor.name), i.values.iter().map(|v| self.expr(v)).collect())
+                    })
+                    .collect();
                 let path = format!("{parent}/FOR {}", f.alias.name);
-                let names = std::iter::once((f.alias.name.clone(), true)).chain(f.params.iter().map(|p| (p.name.clone(), false)));
+                let names = std::iter::once((f.alias.name.clone(), true))
+                    .chain(f.params.iter().map(|p| (p.name.clone(), false)));
                 self.bound_scope(names, |c, slots| {
                     Node::For(For {
                         parallel: f.kind == ast::BlockKind::Parallel,
@@ -352,11 +425,20 @@ impl<'a> Compiler<'a> {
             }
             ast::Stmt::If(i) => {
                 let path = format!("{parent}/IF");
-                let branches = i.branches.iter().map(|(c, b)| (self.expr(c), self.body(b, &path, BlockKind::Sequential, false))).collect();
-                let otherwise = i.otherwise.as_ref().map(|b| self.body(b, &format!("{parent}/ELSE"), BlockKind::Sequential, false));
+                let branches = i
+                    .branches
+                    .iter()
+                    .map(|(c, b)| (self.expr(c), self.body(b, &path, BlockKind::Sequential, false)))
+                    .collect();
+                let otherwise = i
+                    .otherwise
+                    .as_ref()
+                    .map(|b| self.body(b, &format!("{parent}/ELSE"), BlockKind::Sequential, false));
                 Node::If { branches, otherwise }
             }
-            ast::Stmt::Handler(_) | ast::Stmt::ExceptionHandler(_) | ast::Stmt::Error(_) => return None,
+            ast::Stmt::Handler(_) | ast::Stmt::ExceptionHandler(_) | ast::Stmt::Error(_) => {
+                return None
+            }
         })
     }
 
@@ -375,7 +457,9 @@ impl<'a> Compiler<'a> {
             .enumerate()
             .map(|(i, e)| match e {
                 Some(e) => self.expr(e),
-                None => defaults.get(i).cloned().flatten().unwrap_or(Expr::Const(Value::Bool(false))),
+                None => {
+                    defaults.get(i).cloned().flatten().unwrap_or(Expr::Const(Value::Bool(false)))
+                }
             })
             .collect();
         Some(Call {
@@ -403,20 +487,38 @@ impl<'a> Compiler<'a> {
             }
         };
         let binding = bind_args(&callee.params, &l.args);
-        let args = binding.bound.iter().enumerate().filter_map(|(i, e)| e.map(|e| (i, self.expr(e)))).collect();
-        Some(Leash { capability, tag: self.tags.id(&l.tag.name), action, action_name: l.action.name.clone(), args, origin: self.origin(l.span) })
+        let args = binding
+            .bound
+            .iter()
+            .enumerate()
+            .filter_map(|(i, e)| e.map(|e| (i, self.expr(e))))
+            .collect();
+        Some(Leash {
+            capability,
+            tag: self.tags.id(&l.tag.name),
+            action,
+            action_name: l.action.name.clone(),
+            args,
+            origin: self.origin(l.span),
+        })
     }
 
     fn expr(&mut self, e: &ast::Expr) -> Expr {
         use ast::ExprKind as K;
         match &e.kind {
-            K::Number { value, unit, .. } => Expr::Const(Value::Number(value * unit.map_or(1.0, |u| u.to_si()))),
+            K::Number { value, unit, .. } => {
+                Expr::Const(Value::Number(value * unit.map_or(1.0, |u| u.to_si())))
+            }
             K::String(s) => Expr::Const(Value::Text(s.clone())),
             K::Bool(b) => Expr::Const(Value::Bool(*b)),
             K::Coordinates(parts) => {
                 let parts: Vec<Expr> = parts.iter().map(|p| self.expr(p)).collect();
                 match literal_numbers(&parts) {
-                    Some(n) => Expr::Const(Value::Position(Point { x: n[0], y: n.get(1).copied().unwrap_or(0.0), z: n.get(2).copied() })),
+                    Some(n) => Expr::Const(Value::Position(Point {
+                        x: n[0],
+                        y: n.get(1).copied().unwrap_or(0.0),
+                        z: n.get(2).copied(),
+                    })),
                     None => Expr::Point(parts),
                 }
             }
@@ -425,7 +527,8 @@ impl<'a> Compiler<'a> {
                 match (literal_numbers(&parts), self.world.site.origin.as_ref()) {
                     (Some(n), Some(o)) => {
                         let o = aviary_api::geo::Origin { lat: o.lat, lon: o.lon, alt: o.alt };
-                        let [x, y, z] = o.place(n[0], n.get(1).copied().unwrap_or(0.0), n.get(2).copied());
+                        let [x, y, z] =
+                            o.place(n[0], n.get(1).copied().unwrap_or(0.0), n.get(2).copied());
                         Expr::Const(Value::Position(Point { x, y, z: (!z.is_nan()).then_some(z) }))
                     }
                     _ => Expr::Geo(parts),
@@ -437,7 +540,11 @@ impl<'a> Compiler<'a> {
                 match telemetry_field(&field.name) {
                     Some(f) => Expr::Telemetry(actor, f),
                     None => {
-                        let index = self.attribute_names.iter().position(|n| n == &field.name).unwrap_or(usize::MAX);
+                        let index = self
+                            .attribute_names
+                            .iter()
+                            .position(|n| n == &field.name)
+                            .unwrap_or(usize::MAX);
                         Expr::Attribute(actor, index)
                     }
                 }
@@ -477,7 +584,11 @@ impl<'a> Compiler<'a> {
             return Expr::Actor(self.actor(name));
         }
         if let Some(p) = w.places.get(name) {
-            return Expr::Const(Value::Position(Point { x: p.at[0], y: p.at[1], z: p.has_z.then_some(p.at[2]) }));
+            return Expr::Const(Value::Position(Point {
+                x: p.at[0],
+                y: p.at[1],
+                z: p.has_z.then_some(p.at[2]),
+            }));
         }
         if let Some(a) = w.areas.get(name) {
             return Expr::Const(Value::Area(a.polygon.clone()));
@@ -487,7 +598,14 @@ impl<'a> Compiler<'a> {
 }
 
 fn empty_block(path: &str) -> Block {
-    Block { kind: BlockKind::Sequential, path: path.to_string(), traced: false, items: Vec::new(), handlers: Vec::new(), exception_handlers: Vec::new() }
+    Block {
+        kind: BlockKind::Sequential,
+        path: path.to_string(),
+        traced: false,
+        items: Vec::new(),
+        handlers: Vec::new(),
+        exception_handlers: Vec::new(),
+    }
 }
 
 fn literal_numbers(parts: &[Expr]) -> Option<Vec<f64>> {
@@ -539,7 +657,8 @@ fn attribute_table(world: &World, names: &[String]) -> Vec<Column> {
 /// A worklist: when a capability's claims grow, only its callers are looked at again, so
 /// a chain of N capabilities costs N steps, not N rounds of N.
 fn compute_claims(caps: &mut [Capability], functions: &[(String, Option<aviary_api::Resource>)]) {
-    let mut claims: Vec<Vec<(usize, aviary_api::Resource)>> = caps.iter().map(|c| direct_claims(c, functions)).collect();
+    let mut claims: Vec<Vec<(usize, aviary_api::Resource)>> =
+        caps.iter().map(|c| direct_claims(c, functions)).collect();
     // Who calls each capability: (caller, the call), in caller order.
     let mut callers: Vec<Vec<(usize, &Call)>> = vec![Vec::new(); caps.len()];
     for (i, cap) in caps.iter().enumerate() {
@@ -561,7 +680,11 @@ fn compute_claims(caps: &mut [Capability], functions: &[(String, Option<aviary_a
             let mut grew = false;
             for k in 0..claims[callee].len() {
                 let (j, resource) = claims[callee][k];
-                let targets: &[ActorRef] = if caps[callee].actors == 1 { &call.actors } else { call.actors.get(j..=j).unwrap_or(&[]) };
+                let targets: &[ActorRef] = if caps[callee].actors == 1 {
+                    &call.actors
+                } else {
+                    call.actors.get(j..=j).unwrap_or(&[])
+                };
                 for target in targets {
                     if let ActorRef::Slot(slot) = target {
                         if *slot < caps[i].actors && !claims[i].contains(&(*slot, resource)) {
@@ -584,12 +707,17 @@ fn compute_claims(caps: &mut [Capability], functions: &[(String, Option<aviary_a
     }
 }
 
-fn direct_claims(cap: &Capability, functions: &[(String, Option<aviary_api::Resource>)]) -> Vec<(usize, aviary_api::Resource)> {
+fn direct_claims(
+    cap: &Capability,
+    functions: &[(String, Option<aviary_api::Resource>)],
+) -> Vec<(usize, aviary_api::Resource)> {
     let mut out = Vec::new();
     for block in cap.bodies() {
         block.visit(&mut |n| {
             if let Node::Api(a) = n {
-                if let (ActorRef::Slot(s), Some((_, Some(r)))) = (&a.actor, functions.get(a.function)) {
+                if let (ActorRef::Slot(s), Some((_, Some(r)))) =
+                    (&a.actor, functions.get(a.function))
+                {
                     if *s < cap.actors {
                         out.push((*s, *r));
                     }
@@ -599,7 +727,6 @@ fn direct_claims(cap: &Capability, functions: &[(String, Option<aviary_api::Reso
     }
     out
 }
-
 
 fn visit_calls<'b>(block: &'b Block, out: &mut Vec<&'b Call>) {
     block.visit(&mut |n| {
@@ -622,8 +749,11 @@ struct WorldIndex<'w> {
 
 impl<'w> WorldIndex<'w> {
     fn new(w: &'w World) -> Self {
-        fn first<'w, T>(items: impl ExactSizeIterator<Item = (&'w str, T)>) -> foldhash::HashMap<&'w str, T> {
-            let mut map = foldhash::HashMap::with_capacity_and_hasher(items.len(), Default::default());
+        fn first<'w, T>(
+            items: impl ExactSizeIterator<Item = (&'w str, T)>,
+        ) -> foldhash::HashMap<&'w str, T> {
+            let mut map =
+                foldhash::HashMap::with_capacity_and_hasher(items.len(), Default::default());
             for (name, item) in items {
                 map.entry(name).or_insert(item);
             }

@@ -74,7 +74,9 @@ impl Mission {
     /// Attribute `a` of drone `d`, if the world gives the drone one.
     pub fn attribute(&self, a: usize, d: DroneId) -> Option<Value> {
         match self.attributes.get(a)? {
-            Column::Numbers { values, present } => present.get(d)?.then(|| Value::Number(values[d])),
+            Column::Numbers { values, present } => {
+                present.get(d)?.then(|| Value::Number(values[d]))
+            }
             Column::Values(values) => values.get(d)?.clone(),
         }
     }
@@ -85,7 +87,10 @@ impl Mission {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Column {
     /// Every drone that has the attribute has a number.
-    Numbers { values: Vec<f64>, present: Vec<bool> },
+    Numbers {
+        values: Vec<f64>,
+        present: Vec<bool>,
+    },
     Values(Vec<Option<Value>>),
 }
 
@@ -95,7 +100,8 @@ impl Column {
             return Column::Values(values);
         }
         let present = values.iter().map(Option::is_some).collect();
-        let values = values.iter().map(|v| if let Some(Value::Number(n)) = v { *n } else { 0.0 }).collect();
+        let values =
+            values.iter().map(|v| if let Some(Value::Number(n)) = v { *n } else { 0.0 }).collect();
         Column::Numbers { values, present }
     }
 }
@@ -126,7 +132,9 @@ pub struct Capability {
 impl Capability {
     /// Every body: PERFORM, its named sections, its exception handlers.
     pub fn bodies(&self) -> impl Iterator<Item = &Block> {
-        std::iter::once(&self.perform).chain(self.sections.iter().map(|(_, b)| b)).chain(self.exception_handlers.iter().map(|h| &h.body))
+        std::iter::once(&self.perform)
+            .chain(self.sections.iter().map(|(_, b)| b))
+            .chain(self.exception_handlers.iter().map(|h| &h.body))
     }
 }
 
@@ -155,13 +163,21 @@ impl Block {
     /// Calls `f` on every node below this block: items, nested bodies, and the bodies of
     /// its handlers and exception handlers.
     pub fn visit<'b>(&'b self, f: &mut dyn FnMut(&'b Node)) {
-        for body in self.handlers.iter().map(|h| &h.body).chain(self.exception_handlers.iter().map(|h| &h.body)) {
+        for body in self
+            .handlers
+            .iter()
+            .map(|h| &h.body)
+            .chain(self.exception_handlers.iter().map(|h| &h.body))
+        {
             body.visit(f);
         }
         for node in &self.items {
             f(node);
             match node {
-                Node::Block(b) | Node::StartIf { body: b, .. } | Node::DoWhile { body: b, .. } | Node::WaitFor { body: Some(b), .. } => b.visit(f),
+                Node::Block(b)
+                | Node::StartIf { body: b, .. }
+                | Node::DoWhile { body: b, .. }
+                | Node::WaitFor { body: Some(b), .. } => b.visit(f),
                 Node::For(x) => x.body.visit(f),
                 Node::If { branches, otherwise } => {
                     for (_, b) in branches {
@@ -378,7 +394,14 @@ mod column_tests {
     fn mission(attributes: Vec<Column>) -> Mission {
         Mission {
             name: "M".into(),
-            body: Block { kind: BlockKind::Sequential, path: "M".into(), traced: false, items: vec![], handlers: vec![], exception_handlers: vec![] },
+            body: Block {
+                kind: BlockKind::Sequential,
+                path: "M".into(),
+                traced: false,
+                items: vec![],
+                handlers: vec![],
+                exception_handlers: vec![],
+            },
             frame_size: 0,
             capabilities: vec![],
             drones: aviary_api::Names::new(["a", "b", "c"].into_iter()),
@@ -406,6 +429,10 @@ mod column_tests {
             assert_eq!(m.attribute(0, d), numbers[d]);
             assert_eq!(m.attribute(1, d), mixed[d]);
         }
-        assert_eq!((m.attribute(0, 3), m.attribute(2, 0)), (None, None), "no such drone, no such attribute");
+        assert_eq!(
+            (m.attribute(0, 3), m.attribute(2, 0)),
+            (None, None),
+            "no such drone, no such attribute"
+        );
     }
 }

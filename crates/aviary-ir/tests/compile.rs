@@ -15,10 +15,22 @@ impl SourceProvider for NoFiles {
 
 fn compiled(mission: &str, world: &str) -> Mission {
     let mut sources = SourceMap::new();
-    let checked = aviary_check::check_sources(&mut sources, ("m.mission", mission.as_bytes()), Some(("w.toml", world.as_bytes())), &NoFiles, &Descriptor::standard());
-    let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).map(|d| d.message.clone()).collect();
+    let checked = aviary_check::check_sources(
+        &mut sources,
+        ("m.mission", mission.as_bytes()),
+        Some(("w.toml", world.as_bytes())),
+        &NoFiles,
+        &Descriptor::standard(),
+    );
+    let errors: Vec<_> =
+        checked.diagnostics.iter().filter(|d| d.is_error()).map(|d| d.message.clone()).collect();
     assert!(errors.is_empty(), "{errors:#?}");
-    compile(&checked.program.expect("program"), &checked.world.expect("world"), &Descriptor::standard()).expect("a mission")
+    compile(
+        &checked.program.expect("program"),
+        &checked.world.expect("world"),
+        &Descriptor::standard(),
+    )
+    .expect("a mission")
 }
 
 fn paper() -> Mission {
@@ -50,8 +62,11 @@ fn the_paper_mission_compiles_with_handlers_on_their_block() {
     assert_eq!(start.kind, BlockKind::Parallel);
     let children: Vec<&str> = start.items.iter().map(|n| block(n).path.as_str()).collect();
     assert_eq!(children, ["Launch_Video1", "Launch_Video2", "Radiation_Detection"]);
-    let handlers: Vec<(&str, bool, &str)> =
-        start.handlers.iter().map(|h| (m.signals[h.signal].as_str(), h.every, h.body.path.as_str())).collect();
+    let handlers: Vec<(&str, bool, &str)> = start
+        .handlers
+        .iter()
+        .map(|h| (m.signals[h.signal].as_str(), h.every, h.body.path.as_str()))
+        .collect();
     assert_eq!(
         handlers,
         [
@@ -64,7 +79,8 @@ fn the_paper_mission_compiles_with_handlers_on_their_block() {
     let sensor = m.drones.position("sensor_drone").unwrap();
     assert_eq!(start.handlers[2].by, Some(ActorFilter::Drones(vec![sensor])));
     // `BY flir_drone` names the FOR alias of a sibling handler: any of its instances.
-    let flirs: Vec<usize> = ["flir_drone1", "flir_drone2"].iter().map(|n| m.drones.position(n).unwrap()).collect();
+    let flirs: Vec<usize> =
+        ["flir_drone1", "flir_drone2"].iter().map(|n| m.drones.position(n).unwrap()).collect();
     assert_eq!(start.handlers[3].by, Some(ActorFilter::Drones(flirs)));
 }
 
@@ -78,11 +94,19 @@ fn defaults_fill_missing_arguments_in_si_units() {
     assert_eq!(first.args, [Expr::Const(Value::Number(20.0))]);
     let radiation = block(&block(&m.body.items[0]).items[2]);
     let Node::Call(sensor_takeoff) = &radiation.items[0] else { panic!() };
-    assert_eq!(sensor_takeoff.args, [Expr::Const(Value::Number(10.0))], "TakeOff's default alt is 10m");
+    assert_eq!(
+        sensor_takeoff.args,
+        [Expr::Const(Value::Number(10.0))],
+        "TakeOff's default alt is 10m"
+    );
     let Node::Call(patrol) = &radiation.items[1] else { panic!() };
     assert_eq!(
         patrol.args,
-        [Expr::Const(Value::Position(Point { x: 0.0, y: -300.0, z: None })), Expr::Const(Value::Number(30.0)), Expr::Const(Value::Number(1.0))],
+        [
+            Expr::Const(Value::Position(Point { x: 0.0, y: -300.0, z: None })),
+            Expr::Const(Value::Number(30.0)),
+            Expr::Const(Value::Number(1.0))
+        ],
         "the place StartPos, then FlyToAndPatrol's defaults"
     );
 }
@@ -93,7 +117,11 @@ fn claims_reach_through_called_capabilities() {
     assert_eq!(cap(&m, "DeployBeacon").claims, [(0, Resource::Motion), (0, Resource::Payload)]);
     assert_eq!(cap(&m, "Search").claims, [(0, Resource::Motion), (0, Resource::Detection)]);
     assert_eq!(cap(&m, "StartStreaming").claims, [(0, Resource::Camera)]);
-    assert_eq!(cap(&m, "FlyTo").claims, [(0, Resource::Motion)], "FlyTo's own call, and TakeOff's through it");
+    assert_eq!(
+        cap(&m, "FlyTo").claims,
+        [(0, Resource::Motion)],
+        "FlyTo's own call, and TakeOff's through it"
+    );
 }
 
 #[test]
@@ -108,12 +136,22 @@ fn units_become_si_and_geo_becomes_local() {
     assert_eq!(h.args, [Expr::Const(Value::Number(5400.0))]);
     let Node::StartIf { condition, body } = &m.body.items[2] else { panic!() };
     let Expr::And(battery, speed) = condition else { panic!("{condition:?}") };
-    assert_eq!(**battery, Expr::Compare(Box::new(Expr::Telemetry(ActorRef::Drone(0), Field::Battery)), Compare::Gt, Box::new(Expr::Const(Value::Number(0.25)))));
+    assert_eq!(
+        **battery,
+        Expr::Compare(
+            Box::new(Expr::Telemetry(ActorRef::Drone(0), Field::Battery)),
+            Compare::Gt,
+            Box::new(Expr::Const(Value::Number(0.25)))
+        )
+    );
     let Expr::Compare(_, Compare::Lt, limit) = &**speed else { panic!() };
     assert_eq!(**limit, Expr::Const(Value::Number(10.0)));
     let Node::Call(fly) = &body.items[0] else { panic!() };
     let [Expr::Const(Value::Position(p))] = fly.args.as_slice() else { panic!("{:?}", fly.args) };
-    assert!(p.x.abs() < 1e-9 && (p.y - 111.19).abs() < 0.01 && (p.z.unwrap() - 20.0).abs() < 1e-9, "{p:?}");
+    assert!(
+        p.x.abs() < 1e-9 && (p.y - 111.19).abs() < 0.01 && (p.z.unwrap() - 20.0).abs() < 1e-9,
+        "{p:?}"
+    );
 }
 
 #[test]
@@ -130,7 +168,11 @@ fn for_instances_groups_and_slots() {
     assert_eq!(fly.actors, [ActorRef::Slot(f.alias)]);
     assert_eq!(fly.args, [Expr::Slot(f.params[0])]);
     let handler = &m.body.handlers[0];
-    assert_eq!(handler.by, Some(ActorFilter::Drones(vec![0, 1, 2])), "the alias stands for every instance");
+    assert_eq!(
+        handler.by,
+        Some(ActorFilter::Drones(vec![0, 1, 2])),
+        "the alias stands for every instance"
+    );
     let Node::Call(land) = &handler.body.items[0] else { panic!() };
     assert_eq!(land.actors, [ActorRef::Slot(handler.bindings[0])]);
     assert!(m.frame_size >= 3);
@@ -186,5 +228,8 @@ fn builtins_and_the_abort_section_are_resolved_when_compiling() {
     let watch = cap(&m, "Watch");
     assert_eq!(watch.abort_section.map(|k| watch.sections[k].0.as_str()), Some("ABORT"));
     let paper = paper();
-    assert!(paper.capabilities.iter().all(|c| c.abort_section.is_none()), "the paper's mission has no ABORT section");
+    assert!(
+        paper.capabilities.iter().all(|c| c.abort_section.is_none()),
+        "the paper's mission has no ABORT section"
+    );
 }

@@ -9,8 +9,8 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
 use aviary_api::{
-    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Failure, Interrupt,
-    Ending, PendingCall, Telemetry, Value,
+    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Ending, Failure, Interrupt,
+    PendingCall, Telemetry, Value,
 };
 use aviary_world::Sensor;
 use tokio::sync::{mpsc, oneshot, watch};
@@ -55,10 +55,7 @@ impl MavlinkBackend {
         crafts: Vec<Option<Arc<Craft>>>,
         facts: Vec<Facts>,
         sensors: Vec<Sensor>,
-        events: (
-            mpsc::UnboundedSender<DroneEvent>,
-            mpsc::UnboundedReceiver<DroneEvent>,
-        ),
+        events: (mpsc::UnboundedSender<DroneEvent>, mpsc::UnboundedReceiver<DroneEvent>),
         alarms: mpsc::UnboundedReceiver<(DroneId, Failure)>,
         heartbeat_timeout: Duration,
     ) -> MavlinkBackend {
@@ -126,11 +123,8 @@ impl Inner {
         let _ = self.events.send(DroneEvent::Fault { drone, failure });
         let cut: Vec<Slot> = {
             let mut calls = lock(&self.calls);
-            let ids: Vec<CallId> = calls
-                .iter()
-                .filter(|(_, s)| s.drone == drone)
-                .map(|(id, _)| *id)
-                .collect();
+            let ids: Vec<CallId> =
+                calls.iter().filter(|(_, s)| s.drone == drone).map(|(id, _)| *id).collect();
             ids.into_iter().filter_map(|id| calls.remove(&id)).collect()
         };
         for slot in cut {
@@ -166,10 +160,7 @@ impl Inner {
         let (low, critical) = lock(&self.battery)[drone];
         if !low && is_low {
             lock(&self.battery)[drone].0 = true;
-            let _ = self.events.send(DroneEvent::Signal {
-                drone,
-                name: "BatteryLow",
-            });
+            let _ = self.events.send(DroneEvent::Signal { drone, name: "BatteryLow" });
         }
         if !critical && is_critical {
             let reason = format!(
@@ -177,13 +168,7 @@ impl Inner {
                 c.name,
                 battery * 100.0
             );
-            self.fault(
-                drone,
-                Failure {
-                    exception: "BatteryCritical",
-                    reason,
-                },
-            );
+            self.fault(drone, Failure { exception: "BatteryCritical", reason });
         }
     }
 }
@@ -209,18 +194,13 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
         for (drone, craft) in inner.crafts.iter().enumerate() {
             let Some(c) = craft else { continue };
             inner.battery_rule(drone, c);
-            let fresh =
-                c.v.seen()
-                    .heartbeat
-                    .is_some_and(|t| now.duration_since(t) < limit);
+            let fresh = c.v.seen().heartbeat.is_some_and(|t| now.duration_since(t) < limit);
             let was_lost = lock(&inner.lost)[drone];
             if was_lost == fresh {
                 lock(&inner.lost)[drone] = !fresh;
                 if fresh {
-                    let _ = inner.events.send(DroneEvent::Signal {
-                        drone,
-                        name: "ConnectionRestored",
-                    });
+                    let _ =
+                        inner.events.send(DroneEvent::Signal { drone, name: "ConnectionRestored" });
                 } else {
                     let reason = format!(
                         "{}: no HEARTBEAT from system {} for {:.1} s on {}",
@@ -229,13 +209,7 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
                         limit.as_secs_f64(),
                         c.link.address
                     );
-                    inner.fault(
-                        drone,
-                        Failure {
-                            exception: "ConnectionLost",
-                            reason,
-                        },
-                    );
+                    inner.fault(drone, Failure { exception: "ConnectionLost", reason });
                 }
             }
         }
@@ -261,7 +235,10 @@ impl Backend for MavlinkBackend {
             // of it meanwhile raises the exception a handler of the loss already knows.
             let _ = tx.send(CallEnd::Failed(Failure {
                 exception: "ConnectionLost",
-                reason: format!("{}: no link since its HEARTBEATs stopped; `{function}` was not sent", craft.name),
+                reason: format!(
+                    "{}: no link since its HEARTBEATs stopped; `{function}` was not sent",
+                    craft.name
+                ),
             }));
             return PendingCall { id, end: Ending::Later(rx) };
         }
@@ -278,15 +255,7 @@ impl Backend for MavlinkBackend {
             };
             inner.finish(id, end);
         });
-        calls.insert(
-            id,
-            Slot {
-                drone,
-                task: task.abort_handle(),
-                paused: paused_tx,
-                end: tx,
-            },
-        );
+        calls.insert(id, Slot { drone, task: task.abort_handle(), paused: paused_tx, end: tx });
         PendingCall { id, end: Ending::Later(rx) }
     }
 

@@ -77,7 +77,8 @@ impl Draw {
         if let Some(a) = amps.filter(|a| a.is_finite() && *a >= 0.0) {
             self.samples.push_back((now, a));
         }
-        while self.samples.front().is_some_and(|(t, _)| now.saturating_duration_since(*t) > WINDOW) {
+        while self.samples.front().is_some_and(|(t, _)| now.saturating_duration_since(*t) > WINDOW)
+        {
             self.samples.pop_front();
         }
     }

@@ -23,11 +23,9 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
     let bound = bindings(world);
     // The world's frame must be pinned to the Earth: without an origin, local metres
     // would be sent as if the site were at 0°N 0°E.
-    let Some(origin) = world.site.origin.as_ref().map(|g| Origin {
-        lat: g.lat,
-        lon: g.lon,
-        alt: g.alt,
-    }) else {
+    let Some(origin) =
+        world.site.origin.as_ref().map(|g| Origin { lat: g.lat, lon: g.lon, alt: g.alt })
+    else {
         return Err("a world with MAVLink drones needs `origin = { lat, lon, alt }` in [site]: where the local frame sits on the Earth".into());
     };
     let mut links = BTreeMap::new();
@@ -116,7 +114,14 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
 
 /// One drone as the backend flies it: `d` is the world's drone with its vehicle's facts
 /// applied, `landing` how the vehicle comes down.
-fn craft(d: &Drone, landing: Descent, link: Arc<link::Link>, v: Arc<Vehicle>, world: &World, tuning: Tuning) -> Craft {
+fn craft(
+    d: &Drone,
+    landing: Descent,
+    link: Arc<link::Link>,
+    v: Arc<Vehicle>,
+    world: &World,
+    tuning: Tuning,
+) -> Craft {
     Craft {
         name: d.name.clone(),
         link,
@@ -150,9 +155,17 @@ fn craft(d: &Drone, landing: Descent, link: Arc<link::Link>, v: Arc<Vehicle>, wo
 /// set home), within [`Tuning::home_tolerance`] of the drone's `home`. Otherwise the
 /// world's places, areas and fence would be flown at an offset: the run is refused with
 /// the distance and the coordinates to write.
-async fn check_home(c: &Arc<Craft>, tuning: Tuning, by: tokio::time::Instant) -> Result<(), String> {
+async fn check_home(
+    c: &Arc<Craft>,
+    tuning: Tuning,
+    by: tokio::time::Instant,
+) -> Result<(), String> {
     // HOME_POSITION was asked for with the streams; a moment for its first one.
-    let _ = c.wait_for(tuning.home_wait.min(std::time::Duration::from_secs(2)), "", |c| c.v.seen().home.is_some()).await;
+    let _ = c
+        .wait_for(tuning.home_wait.min(std::time::Duration::from_secs(2)), "", |c| {
+            c.v.seen().home.is_some()
+        })
+        .await;
     if c.v.seen().armed {
         // Already flying: only its home says where it started.
         let left = by.saturating_duration_since(tokio::time::Instant::now());
@@ -162,7 +175,9 @@ async fn check_home(c: &Arc<Craft>, tuning: Tuning, by: tokio::time::Instant) ->
         let seen = c.v.seen();
         match (seen.home, seen.fix) {
             (Some(h), _) => ([h[0], h[1]], "its home (HOME_POSITION)"),
-            (None, Some(f)) if !seen.armed => ([f.pos[0], f.pos[1]], "where it stands on the ground"),
+            (None, Some(f)) if !seen.armed => {
+                ([f.pos[0], f.pos[1]], "where it stands on the ground")
+            }
             _ => return Ok(()),
         }
     };

@@ -55,17 +55,11 @@ pub struct Craft {
 }
 
 pub fn failed(reason: impl Into<String>) -> Failure {
-    Failure {
-        exception: "CommandFailed",
-        reason: reason.into(),
-    }
+    Failure { exception: "CommandFailed", reason: reason.into() }
 }
 
 pub fn timeout(reason: impl Into<String>) -> Failure {
-    Failure {
-        exception: "Timeout",
-        reason: reason.into(),
-    }
+    Failure { exception: "Timeout", reason: reason.into() }
 }
 
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
@@ -79,9 +73,7 @@ impl Craft {
 
     /// The altitude a flight without one keeps.
     pub fn level(&self) -> f64 {
-        lock(&self.level)
-            .or_else(|| self.fix().map(|f| f.pos[2]))
-            .unwrap_or(f64::NAN)
+        lock(&self.level).or_else(|| self.fix().map(|f| f.pos[2])).unwrap_or(f64::NAN)
     }
 
     pub fn set_level(&self, z: Option<f64>) {
@@ -172,10 +164,8 @@ impl Craft {
                 Ok(Ok(result)) => {
                     // The reason usually comes just before the ACK; give a late one a moment.
                     tokio::time::sleep(Duration::from_millis(50)).await;
-                    let why = self
-                        .v
-                        .texts_since(started)
-                        .unwrap_or_else(|| "no reason given".into());
+                    let why =
+                        self.v.texts_since(started).unwrap_or_else(|| "no reason given".into());
                     return Err(failed(format!(
                         "{} refused {command:?} ({result:?}): {why}",
                         self.name
@@ -250,11 +240,7 @@ impl Craft {
                 return Ok(());
             }
             let custom = MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED.bits() as f32;
-            self.command(
-                MavCmd::MAV_CMD_DO_SET_MODE,
-                [custom, p2, p3, 0.0, 0.0, 0.0, 0.0],
-            )
-            .await?;
+            self.command(MavCmd::MAV_CMD_DO_SET_MODE, [custom, p2, p3, 0.0, 0.0, 0.0, 0.0]).await?;
             if self.wait_for(Duration::from_secs(3), "", is).await.is_ok() {
                 return Ok(());
             }

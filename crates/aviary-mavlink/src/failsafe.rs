@@ -18,19 +18,13 @@ pub fn failsafe(name: &str, mode: &str, why: &str, state: Option<&'static str>) 
         "PositionLost"
     } else if lower.contains("fence") {
         "GeofenceViolation"
-    } else if ["radio", "gcs", "link", "telemetry", "rc "]
-        .iter()
-        .any(|w| lower.contains(w))
-    {
+    } else if ["radio", "gcs", "link", "telemetry", "rc "].iter().any(|w| lower.contains(w)) {
         "ConnectionLost"
     } else {
         "CommandFailed"
     };
-    let said = if why.is_empty() {
-        "no reason given".to_owned()
-    } else {
-        format!("it said: {why}")
-    };
+    let said =
+        if why.is_empty() { "no reason given".to_owned() } else { format!("it said: {why}") };
     Failure {
         exception,
         reason: format!("{name}: the autopilot switched to {mode} by itself ({said})"),
@@ -47,16 +41,13 @@ mod tests {
             failsafe("a", "RTL", "Battery 1 is critical", None).exception,
             "BatteryCritical"
         );
-        assert_eq!(
-            failsafe("a", "LAND", "EKF variance", None).exception,
-            "PositionLost"
-        );
-        assert_eq!(
-            failsafe("a", "RTL", "Radio Failsafe", None).exception,
-            "ConnectionLost"
-        );
+        assert_eq!(failsafe("a", "LAND", "EKF variance", None).exception, "PositionLost");
+        assert_eq!(failsafe("a", "RTL", "Radio Failsafe", None).exception, "ConnectionLost");
         assert_eq!(failsafe("a", "RTL", "", None).exception, "CommandFailed");
         // What the vehicle reports of itself comes before its words.
-        assert_eq!(failsafe("a", "RTL", "Fence breached", Some("BatteryCritical")).exception, "BatteryCritical");
+        assert_eq!(
+            failsafe("a", "RTL", "Fence breached", Some("BatteryCritical")).exception,
+            "BatteryCritical"
+        );
     }
 }

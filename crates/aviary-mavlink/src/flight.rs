@@ -26,10 +26,8 @@ pub async fn run(
             if c.state().airborne() {
                 return Err(failed(format!("{} can only disarm on the ground", c.name)));
             }
-            c.command(MavCmd::MAV_CMD_COMPONENT_ARM_DISARM, [0.0; 7])
-                .await?;
-            c.wait_for(c.tuning.ready_timeout, "disarming", |c| !c.v.seen().armed)
-                .await
+            c.command(MavCmd::MAV_CMD_COMPONENT_ARM_DISARM, [0.0; 7]).await?;
+            c.wait_for(c.tuning.ready_timeout, "disarming", |c| !c.v.seen().armed).await
         }
         "TakeOff" => take_off(c, number(args, 0, "alt")?, paused).await,
         "Land" => land(c).await,
@@ -39,9 +37,7 @@ pub async fn run(
             let speed = match args.get(1) {
                 Some(Value::Number(s)) if *s > 0.0 => s.min(c.max_speed),
                 Some(other) => {
-                    return Err(failed(format!(
-                        "`speed` must be above 0 m/s, not {other}"
-                    )))
+                    return Err(failed(format!("`speed` must be above 0 m/s, not {other}")))
                 }
                 None => c.max_speed,
             };
@@ -49,13 +45,7 @@ pub async fn run(
         }
         "DescendTo" | "AscendTo" => {
             let here = here(c)?;
-            fly(
-                c,
-                &[[here[0], here[1], number(args, 0, "alt")?]],
-                c.max_speed,
-                paused,
-            )
-            .await
+            fly(c, &[[here[0], here[1], number(args, 0, "alt")?]], c.max_speed, paused).await
         }
         "Hover" => hover(number(args, 0, "duration")?, paused).await,
         "Orbit" => {
@@ -73,13 +63,7 @@ pub async fn run(
             let here = here(c)?;
             fly(
                 c,
-                &orbit(
-                    here,
-                    [center[0], center[1]],
-                    radius,
-                    laps,
-                    c.tuning.arrive_xy,
-                ),
+                &orbit(here, [center[0], center[1]], radius, laps, c.tuning.arrive_xy),
                 aviary_api::geometry::orbit_speed(c.max_speed, c.acceleration, radius),
                 paused,
             )
@@ -91,9 +75,7 @@ pub async fn run(
             };
             let spacing = number(args, 1, "spacing")?;
             if spacing <= 0.0 {
-                return Err(failed(format!(
-                    "sweep spacing must be above 0 m, not {spacing} m"
-                )));
+                return Err(failed(format!("sweep spacing must be above 0 m, not {spacing} m")));
             }
             here(c)?;
             let z = c.level();
@@ -121,10 +103,7 @@ pub async fn run(
             if !c.sensors.iter().any(|s| s == "camera") {
                 return Err(failed(format!("{} has no camera", c.name)));
             }
-            c.streaming.store(
-                function == "StartStreaming",
-                std::sync::atomic::Ordering::SeqCst,
-            );
+            c.streaming.store(function == "StartStreaming", std::sync::atomic::Ordering::SeqCst);
             Ok(())
         }
         "StartDetection" | "StopDetection" => {
@@ -132,18 +111,10 @@ pub async fn run(
         }
         "LoadPayload" => load(c, args, paused).await,
         "ReleasePayload" => {
-            if c.carrying
-                .lock()
-                .unwrap_or_else(|p| p.into_inner())
-                .is_none()
-            {
+            if c.carrying.lock().unwrap_or_else(|p| p.into_inner()).is_none() {
                 return Err(failed(format!("{} carries nothing to release", c.name)));
             }
-            c.command(
-                MavCmd::MAV_CMD_DO_GRIPPER,
-                [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-            )
-            .await?;
+            c.command(MavCmd::MAV_CMD_DO_GRIPPER, [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]).await?;
             *c.carrying.lock().unwrap_or_else(|p| p.into_inner()) = None;
             Ok(())
         }
@@ -154,10 +125,7 @@ pub async fn run(
 fn number(args: &[Value], i: usize, name: &str) -> Result<f64, Failure> {
     match args.get(i) {
         Some(Value::Number(n)) if n.is_finite() => Ok(*n),
-        other => Err(failed(format!(
-            "`{name}` must be a finite number, not {}",
-            given(other)
-        ))),
+        other => Err(failed(format!("`{name}` must be a finite number, not {}", given(other)))),
     }
 }
 
@@ -165,19 +133,14 @@ fn number(args: &[Value], i: usize, name: &str) -> Result<f64, Failure> {
 fn point(c: &Craft, v: Option<&Value>, name: &str) -> Result<[f64; 3], Failure> {
     let here_z = c.level();
     match v {
-        Some(Value::Position(p)) if p.x.is_finite() && p.y.is_finite() => Ok([
-            p.x,
-            p.y,
-            p.z.unwrap_or(if name == "points" { f64::NAN } else { here_z }),
-        ]),
+        Some(Value::Position(p)) if p.x.is_finite() && p.y.is_finite() => {
+            Ok([p.x, p.y, p.z.unwrap_or(if name == "points" { f64::NAN } else { here_z })])
+        }
         Some(Value::Area(a)) if !a.is_empty() => {
             let m = centroid(a);
             Ok([m[0], m[1], if name == "points" { f64::NAN } else { here_z }])
         }
-        other => Err(failed(format!(
-            "`{name}` must be a position, not {}",
-            given(other)
-        ))),
+        other => Err(failed(format!("`{name}` must be a position, not {}", given(other)))),
     }
 }
 
@@ -190,10 +153,7 @@ fn detection(
     let kind = match args.first() {
         Some(Value::Symbol(s) | Value::Text(s)) => s.clone(),
         other => {
-            return Err(failed(format!(
-                "`kind` must be a kind such as Body, not {}",
-                given(other)
-            )))
+            return Err(failed(format!("`kind` must be a kind such as Body, not {}", given(other))))
         }
     };
     let range = sensors
@@ -206,11 +166,7 @@ fn detection(
     let mut seen = c.v.seen();
     seen.detecting.retain(|a| a.kind != kind);
     if start {
-        seen.detecting.push(Activation {
-            kind,
-            range,
-            found: vec![false; n],
-        });
+        seen.detecting.push(Activation { kind, range, found: vec![false; n] });
     }
     Ok(())
 }
@@ -220,38 +176,20 @@ async fn load(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> 
     let kind = match args.first() {
         Some(Value::Symbol(s) | Value::Text(s)) => s.clone(),
         other => {
-            return Err(failed(format!(
-                "`kind` must be a kind such as Body, not {}",
-                given(other)
-            )))
+            return Err(failed(format!("`kind` must be a kind such as Body, not {}", given(other))))
         }
     };
     if !c.payload.contains(&kind) {
         return Err(failed(format!("{} cannot carry {kind}", c.name)));
     }
-    if let Some(held) = c
-        .carrying
-        .lock()
-        .unwrap_or_else(|p| p.into_inner())
-        .as_ref()
-    {
-        return Err(failed(format!(
-            "{} already carries {held}: release it first",
-            c.name
-        )));
+    if let Some(held) = c.carrying.lock().unwrap_or_else(|p| p.into_inner()).as_ref() {
+        return Err(failed(format!("{} already carries {held}: release it first", c.name)));
     }
     let z = c.fix().map_or(0.0, |f| f.pos[2]);
     if c.state().airborne() && z >= 5.0 {
-        return Err(failed(format!(
-            "{} is at {z:.1} m: load while landed or below 5 m",
-            c.name
-        )));
+        return Err(failed(format!("{} is at {z:.1} m: load while landed or below 5 m", c.name)));
     }
-    c.command(
-        MavCmd::MAV_CMD_DO_GRIPPER,
-        [1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-    )
-    .await?;
+    c.command(MavCmd::MAV_CMD_DO_GRIPPER, [1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0]).await?;
     hover(LOAD_TIME, paused).await?;
     *c.carrying.lock().unwrap_or_else(|p| p.into_inner()) = Some(kind);
     Ok(())

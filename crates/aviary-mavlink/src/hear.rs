@@ -11,9 +11,9 @@ use mavlink::error::MessageReadError;
 use mavlink::MavlinkReader;
 use tokio::sync::mpsc;
 
-use aviary_api::geo::Origin;
 use crate::link::AUTOPILOT_COMPONENT;
 use crate::vehicle::{Activation, Fix, Vehicle};
+use aviary_api::geo::Origin;
 
 /// What was believed of the vehicle once every frame was read.
 #[derive(Debug)]

@@ -39,10 +39,10 @@ use std::time::Duration;
 use aviary_world::{Backend as Binding, World};
 use sha2::{Digest, Sha256};
 
+pub use aviary_api::geo::Origin;
 pub use backend::MavlinkBackend;
 pub use connect::connect;
 pub use facts::Facts;
-pub use aviary_api::geo::Origin;
 pub use mavlink;
 
 /// Timeouts and tolerances. The defaults suit ArduCopter SITL and small real copters.
@@ -124,19 +124,10 @@ pub fn bindings(world: &World) -> Vec<(usize, String, u8, Option<String>)> {
     let mut out = Vec::new();
     for (i, d) in world.drones.iter().enumerate() {
         if let Binding::Mavlink(link) = &d.backend {
-            let aviary_world::Mavlink {
-                address,
-                system_id,
-                signing_key,
-            } = &**link;
+            let aviary_world::Mavlink { address, system_id, signing_key } = &**link;
             let n = count.entry(address.clone()).or_insert(0);
             *n = n.saturating_add(1);
-            out.push((
-                i,
-                address.clone(),
-                system_id.unwrap_or(*n),
-                signing_key.clone(),
-            ));
+            out.push((i, address.clone(), system_id.unwrap_or(*n), signing_key.clone()));
         }
     }
     out
@@ -144,7 +135,10 @@ pub fn bindings(world: &World) -> Vec<(usize, String, u8, Option<String>)> {
 
 /// The links the world's MAVLink drones need: each address with its signing key. Two
 /// drones on one system id of an address, or one address with two keys, cannot work.
-pub(crate) fn link_keys(world: &World, bound: &[(usize, String, u8, Option<String>)]) -> Result<BTreeMap<String, Option<String>>, String> {
+pub(crate) fn link_keys(
+    world: &World,
+    bound: &[(usize, String, u8, Option<String>)],
+) -> Result<BTreeMap<String, Option<String>>, String> {
     let mut links: BTreeMap<String, Option<String>> = BTreeMap::new();
     let mut used: BTreeMap<(String, u8), usize> = BTreeMap::new();
     for (i, address, system, key) in bound {

@@ -105,19 +105,12 @@ impl Link {
     }
 
     pub fn add(&self, vehicle: Arc<Vehicle>) {
-        self.vehicles
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .insert(vehicle.system, vehicle);
+        self.vehicles.lock().unwrap_or_else(|p| p.into_inner()).insert(vehicle.system, vehicle);
     }
 
     fn vehicle(&self, system: u32) -> Option<Arc<Vehicle>> {
         let system = u8::try_from(system).ok()?;
-        self.vehicles
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .get(&system)
-            .cloned()
+        self.vehicles.lock().unwrap_or_else(|p| p.into_inner()).get(&system).cloned()
     }
 
     /// Sends one message as the ground station. Without a connection (it is being
@@ -189,20 +182,9 @@ mod tests {
 
     #[test]
     fn world_addresses_map_to_the_crate_s() {
-        assert_eq!(
-            crate_address("tcp:127.0.0.1:5760").unwrap(),
-            "tcpout:127.0.0.1:5760"
-        );
-        assert_eq!(
-            crate_address("udp:0.0.0.0:14550").unwrap(),
-            "udpin:0.0.0.0:14550"
-        );
-        assert_eq!(
-            crate_address("udpout:10.0.0.2:14555").unwrap(),
-            "udpout:10.0.0.2:14555"
-        );
-        assert!(crate_address("serial:/dev/ttyUSB0:57600")
-            .unwrap_err()
-            .contains("libudev"));
+        assert_eq!(crate_address("tcp:127.0.0.1:5760").unwrap(), "tcpout:127.0.0.1:5760");
+        assert_eq!(crate_address("udp:0.0.0.0:14550").unwrap(), "udpin:0.0.0.0:14550");
+        assert_eq!(crate_address("udpout:10.0.0.2:14555").unwrap(), "udpout:10.0.0.2:14555");
+        assert!(crate_address("serial:/dev/ttyUSB0:57600").unwrap_err().contains("libudev"));
     }
 }

@@ -16,19 +16,14 @@ use crate::mode::Mode;
 const ORBIT_POINTS: usize = 24;
 
 pub(crate) fn here(c: &Craft) -> Result<[f64; 3], Failure> {
-    c.fix()
-        .map(|f| f.pos)
-        .ok_or_else(|| failed(format!("{} has reported no position yet", c.name)))
+    c.fix().map(|f| f.pos).ok_or_else(|| failed(format!("{} has reported no position yet", c.name)))
 }
 
 pub(crate) fn in_air(c: &Craft) -> Result<(), Failure> {
     if c.state().airborne() {
         Ok(())
     } else {
-        Err(failed(format!(
-            "{} is on the ground: take off first",
-            c.name
-        )))
+        Err(failed(format!("{} is on the ground: take off first", c.name)))
     }
 }
 
@@ -43,10 +38,7 @@ pub(crate) async fn arm(c: &Craft) -> Result<(), Failure> {
     let deadline = Instant::now() + c.tuning.arm_timeout;
     loop {
         match c
-            .command(
-                MavCmd::MAV_CMD_COMPONENT_ARM_DISARM,
-                [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-            )
+            .command(MavCmd::MAV_CMD_COMPONENT_ARM_DISARM, [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
             .await
         {
             Ok(()) => break,
@@ -56,25 +48,19 @@ pub(crate) async fn arm(c: &Craft) -> Result<(), Failure> {
             Err(f) => return Err(f),
         }
     }
-    c.wait_for(Duration::from_secs(5), "arming", |c| c.v.seen().armed)
-        .await
+    c.wait_for(Duration::from_secs(5), "arming", |c| c.v.seen().armed).await
 }
 
 pub(crate) async fn take_off(c: &Craft, alt: f64, paused: Paused) -> Result<(), Failure> {
     if alt <= 0.0 {
-        return Err(failed(format!(
-            "take-off altitude must be above 0 m, not {alt} m"
-        )));
+        return Err(failed(format!("take-off altitude must be above 0 m, not {alt} m")));
     }
     if c.state().airborne() {
         let here = here(c)?;
         return fly(c, &[[here[0], here[1], alt]], c.max_speed, paused).await;
     }
     if !c.v.seen().armed {
-        return Err(failed(format!(
-            "{} is not armed: call Arm() before TakeOff",
-            c.name
-        )));
+        return Err(failed(format!("{} is not armed: call Arm() before TakeOff", c.name)));
     }
     // NAV_TAKEOFF is refused outside GUIDED, so make sure of it first.
     c.set_mode(Mode::Guided).await?;
@@ -112,16 +98,10 @@ pub(crate) async fn land(c: &Craft) -> Result<(), Failure> {
     c.set_doing(Doing::Landing);
     let z = here(c).map_or(0.0, |p| p[2]);
     let result = async {
-        c.command(
-            MavCmd::MAV_CMD_NAV_LAND,
-            [0.0, 0.0, 0.0, f32::NAN, f32::NAN, f32::NAN, 0.0],
-        )
-        .await?;
+        c.command(MavCmd::MAV_CMD_NAV_LAND, [0.0, 0.0, 0.0, f32::NAN, f32::NAN, f32::NAN, 0.0])
+            .await?;
         // ArduCopter disarms by itself once down.
-        c.wait_for(Duration::from_secs_f64(z / 0.5 + 60.0), "landing", |c| {
-            !c.v.seen().armed
-        })
-        .await
+        c.wait_for(Duration::from_secs_f64(z / 0.5 + 60.0), "landing", |c| !c.v.seen().armed).await
     }
     .await;
     c.set_doing(Doing::Other);
@@ -137,19 +117,14 @@ pub(crate) async fn rtl(c: &Craft) -> Result<(), Failure> {
         if away <= 2.0 {
             return Ok(());
         }
-        return Err(failed(format!(
-            "{} is on the ground away from home: take off first",
-            c.name
-        )));
+        return Err(failed(format!("{} is on the ground away from home: take off first", c.name)));
     }
     c.v.seen().expected = Some(Mode::Rtl);
     c.set_level(None);
-    c.command(MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH, [0.0; 7])
-        .await?;
+    c.command(MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH, [0.0; 7]).await?;
     let limit =
         Duration::from_secs_f64(away / c.max_speed.max(1.0) * 2.0 + (here[2] + 20.0) / 0.5 + 60.0);
-    c.wait_for(limit, "returning to launch", |c| !c.v.seen().armed)
-        .await
+    c.wait_for(limit, "returning to launch", |c| !c.v.seen().armed).await
 }
 
 /// How close to a point of a path, not its last, the drone may come before the next
@@ -229,10 +204,7 @@ pub(crate) async fn fly(
 /// The world's geofence and ceiling hold for MAVLink drones too: a path that leaves them
 /// is refused before anything is sent (`GeofenceViolation`).
 pub(crate) fn fenced(c: &Craft, path: &[[f64; 3]]) -> Result<(), Failure> {
-    let violation = |reason: String| Failure {
-        exception: "GeofenceViolation",
-        reason,
-    };
+    let violation = |reason: String| Failure { exception: "GeofenceViolation", reason };
     for p in path {
         if let Some(max) = c.max_altitude.filter(|m| p[2] > m + 1e-9) {
             return Err(violation(format!(
@@ -279,21 +251,13 @@ pub(crate) fn orbit(
     at_center: f64,
 ) -> Vec<[f64; 3]> {
     let (dx, dy) = (here[0] - center[0], here[1] - center[1]);
-    let start = if dx.hypot(dy) <= at_center {
-        0.0
-    } else {
-        dy.atan2(dx)
-    };
+    let start = if dx.hypot(dy) <= at_center { 0.0 } else { dy.atan2(dx) };
     let n = (laps * ORBIT_POINTS as f64).ceil() as usize;
     let step = laps * std::f64::consts::TAU / n as f64;
     (0..=n)
         .map(|i| {
             let a = start - step * i as f64;
-            [
-                center[0] + radius * a.cos(),
-                center[1] + radius * a.sin(),
-                here[2],
-            ]
+            [center[0] + radius * a.cos(), center[1] + radius * a.sin(), here[2]]
         })
         .collect()
 }
@@ -324,6 +288,8 @@ mod tests {
         assert_eq!(path.len(), 49);
         let (a, b) = (path[0], path[48]);
         assert!((a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9);
-        assert!(path.iter().all(|p| ((p[0] - 100.0).hypot(p[1]) - 20.0).abs() < 1e-9 && p[2] == 10.0));
+        assert!(path
+            .iter()
+            .all(|p| ((p[0] - 100.0).hypot(p[1]) - 20.0).abs() < 1e-9 && p[2] == 10.0));
     }
 }

@@ -71,21 +71,32 @@ mod tests {
     /// A vehicle fed messages by hand, as its link would.
     mod vehicle {
         use aviary_api::DroneEvent;
-        use mavlink::dialects::ardupilotmega::{MavMessage, GLOBAL_POSITION_INT_DATA, SYS_STATUS_DATA};
+        use mavlink::dialects::ardupilotmega::{
+            MavMessage, GLOBAL_POSITION_INT_DATA, SYS_STATUS_DATA,
+        };
         use tokio::sync::mpsc;
 
-        use aviary_api::geo::Origin;
         use crate::vehicle::Vehicle;
+        use aviary_api::geo::Origin;
 
         const ORIGIN: Origin = Origin { lat: 46.6167, lon: 14.265, alt: 440.0 };
 
         fn at(x: f64, y: f64, z: f64) -> MavMessage {
             let (lat, lon) = ORIGIN.to_e7(x, y);
-            MavMessage::GLOBAL_POSITION_INT(GLOBAL_POSITION_INT_DATA { lat, lon, relative_alt: (z * 1000.0) as i32, alt: ((440.0 + z) * 1000.0) as i32, ..Default::default() })
+            MavMessage::GLOBAL_POSITION_INT(GLOBAL_POSITION_INT_DATA {
+                lat,
+                lon,
+                relative_alt: (z * 1000.0) as i32,
+                alt: ((440.0 + z) * 1000.0) as i32,
+                ..Default::default()
+            })
         }
 
         fn charge(remaining: i8) -> MavMessage {
-            MavMessage::SYS_STATUS(SYS_STATUS_DATA { battery_remaining: remaining, ..Default::default() })
+            MavMessage::SYS_STATUS(SYS_STATUS_DATA {
+                battery_remaining: remaining,
+                ..Default::default()
+            })
         }
 
         /// The x of the vehicle's fix, to a decimetre (1e-7° is about a centimetre).

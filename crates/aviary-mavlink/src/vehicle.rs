@@ -8,16 +8,17 @@ use aviary_api::geometry::dist_to_segment;
 use aviary_api::{DroneEvent, DroneId, Failure};
 use aviary_world::Target;
 use mavlink::dialects::ardupilotmega::{
-    MavCmd, MavLandedState, MavMessage, GLOBAL_POSITION_INT_DATA, MavModeFlag, MavParamType, MavResult, MavState, MavSysStatusSensor,
+    MavCmd, MavLandedState, MavMessage, MavModeFlag, MavParamType, MavResult, MavState,
+    MavSysStatusSensor, GLOBAL_POSITION_INT_DATA,
 };
 use tokio::sync::{mpsc, oneshot};
 use tokio::time::Instant;
 
 use crate::battery::{self, Draw};
 use crate::failsafe::{failsafe, FAILSAFE_WAIT};
-use aviary_api::geo::Origin;
 use crate::mode::{self, Flavour, Mode};
 use crate::plausible;
+use aviary_api::geo::Origin;
 
 /// The last fix a vehicle reported, in the local frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -145,12 +146,8 @@ impl Vehicle {
     /// STATUSTEXTs received since `since`, joined: the autopilot's reason for a refusal.
     pub fn texts_since(&self, since: Instant) -> Option<String> {
         let seen = self.seen();
-        let texts: Vec<&str> = seen
-            .texts
-            .iter()
-            .filter(|(t, _)| *t >= since)
-            .map(|(_, s)| s.as_str())
-            .collect();
+        let texts: Vec<&str> =
+            seen.texts.iter().filter(|(t, _)| *t >= since).map(|(_, s)| s.as_str()).collect();
         (!texts.is_empty()).then(|| texts.join("; "))
     }
 
@@ -161,15 +158,11 @@ impl Vehicle {
         match msg {
             MavMessage::HEARTBEAT(hb) => {
                 let flavour = Flavour::of(hb.autopilot);
-                let before = seen
-                    .heartbeat
-                    .map(|_| mode::classify(flavour, seen.custom_mode));
+                let before = seen.heartbeat.map(|_| mode::classify(flavour, seen.custom_mode));
                 seen.heartbeat = Some(now);
                 seen.flavour = Some(flavour);
                 seen.custom_mode = hb.custom_mode;
-                seen.armed = hb
-                    .base_mode
-                    .contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);
+                seen.armed = hb.base_mode.contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);
                 let was = seen.status.replace(hb.system_status);
                 let gone = |s: Option<MavState>| {
                     matches!(
@@ -183,21 +176,13 @@ impl Vehicle {
                 };
                 if gone(Some(hb.system_status)) && !gone(was) {
                     // The vehicle says it is going down (or gone): it is lost to the mission.
-                    let why = seen
-                        .texts
-                        .back()
-                        .map_or("no reason given", |(_, s)| s.as_str());
+                    let why = seen.texts.back().map_or("no reason given", |(_, s)| s.as_str());
                     let reason = format!(
                         "{}: the autopilot reports {:?} ({why})",
                         self.name, hb.system_status
                     );
-                    let _ = self.alarms.send((
-                        self.drone,
-                        Failure {
-                            exception: "DroneLost",
-                            reason,
-                        },
-                    ));
+                    let _ =
+                        self.alarms.send((self.drone, Failure { exception: "DroneLost", reason }));
                 }
                 let after = mode::classify(flavour, hb.custom_mode);
                 let changed = before.is_some_and(|b| b != after);
@@ -231,7 +216,8 @@ impl Vehicle {
                 // A sensor the vehicle has and uses but calls unhealthy (ArduPilot clears
                 // the battery's bit with its battery failsafe, the fence's on a breach).
                 let failing = |bit: MavSysStatusSensor| {
-                    s.onboard_control_sensors_enabled.contains(bit) && !s.onboard_control_sensors_health.contains(bit)
+                    s.onboard_control_sensors_enabled.contains(bit)
+                        && !s.onboard_control_sensors_health.contains(bit)
                 };
                 seen.battery_failing = failing(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_BATTERY);
                 seen.fence_unhealthy = failing(MavSysStatusSensor::MAV_SYS_STATUS_GEOFENCE);
@@ -258,22 +244,15 @@ impl Vehicle {
                 seen.no_gps = (g.fix_type as u8) < 3;
             }
             MavMessage::STATUSTEXT(t) => {
-                let text = t
-                    .text
-                    .to_str()
-                    .unwrap_or("")
-                    .trim_end_matches('\0')
-                    .to_owned();
+                let text = t.text.to_str().unwrap_or("").trim_end_matches('\0').to_owned();
                 seen.texts.push_back((now, text));
                 while seen.texts.len() > TEXTS_KEPT {
                     seen.texts.pop_front();
                 }
             }
             MavMessage::COMMAND_ACK(ack) if ack.result != MavResult::MAV_RESULT_IN_PROGRESS => {
-                if let Some(i) = seen
-                    .acks
-                    .iter()
-                    .position(|(c, tx)| *c == ack.command && !tx.is_closed())
+                if let Some(i) =
+                    seen.acks.iter().position(|(c, tx)| *c == ack.command && !tx.is_closed())
                 {
                     let (_, tx) = seen.acks.remove(i);
                     let _ = tx.send(ack.result);
@@ -292,16 +271,16 @@ impl Vehicle {
         let fix = Fix {
             pos: [xy[0], xy[1], f64::from(p.relative_alt) / 1000.0],
             speed: f64::from(p.vx).hypot(f64::from(p.vy)) / 100.0,
-            heading: if p.hdg == u16::MAX {
-                0.0
-            } else {
-                f64::from(p.hdg) / 100.0
-            },
+            heading: if p.hdg == u16::MAX { 0.0 } else { f64::from(p.hdg) / 100.0 },
             home_amsl: (f64::from(p.alt) - f64::from(p.relative_alt)) / 1000.0,
         };
         // Seconds since the last believed position, by the vehicle's clock when it keeps one.
         let dt = seen.fix_at.map(|at| {
-            plausible::elapsed(seen.fix_boot_ms, p.time_boot_ms, now.duration_since(at).as_secs_f64())
+            plausible::elapsed(
+                seen.fix_boot_ms,
+                p.time_boot_ms,
+                now.duration_since(at).as_secs_f64(),
+            )
         });
         if let (Some(before), Some(dt)) = (seen.fix, dt) {
             if !plausible::reachable(before.pos, fix.pos, dt) {
@@ -328,9 +307,18 @@ impl Vehicle {
     /// A position the vehicle could not have reached: not taken. Once such positions have
     /// come for [`plausible::DOUBT_FOR`] (by the vehicle's clock when it keeps one), the
     /// drone has lost its position (`PositionLost`).
-    fn doubt(&self, seen: &mut Seen, now: Instant, boot_ms: u32, before: [f64; 3], after: [f64; 3], dt: f64) {
+    fn doubt(
+        &self,
+        seen: &mut Seen,
+        now: Instant,
+        boot_ms: u32,
+        before: [f64; 3],
+        after: [f64; 3],
+        dt: f64,
+    ) {
         let (since, since_boot_ms) = *seen.doubted_since.get_or_insert((now, boot_ms));
-        let doubted_for = plausible::elapsed(since_boot_ms, boot_ms, now.duration_since(since).as_secs_f64());
+        let doubted_for =
+            plausible::elapsed(since_boot_ms, boot_ms, now.duration_since(since).as_secs_f64());
         if seen.doubt_raised || doubted_for < plausible::DOUBT_FOR.as_secs_f64() {
             return;
         }
@@ -350,7 +338,8 @@ impl Vehicle {
     fn name_failsafe(&self, seen: &mut Seen, now: Instant) {
         let Some((at, mode)) = seen.failsafe.clone() else { return };
         let since = at - std::time::Duration::from_secs(3);
-        let why: Vec<&str> = seen.texts.iter().filter(|(t, _)| *t >= since).map(|(_, s)| s.as_str()).collect();
+        let why: Vec<&str> =
+            seen.texts.iter().filter(|(t, _)| *t >= since).map(|(_, s)| s.as_str()).collect();
         let state = if seen.battery_failing {
             Some("BatteryCritical")
         } else if seen.fence_unhealthy || seen.fence_breached {

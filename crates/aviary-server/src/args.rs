@@ -37,7 +37,12 @@ impl Kinds {
 
     /// A leash's arguments as the engine takes them. A capability the mission does not
     /// have is left to the engine to refuse (409), as it refuses an unknown tag.
-    pub(crate) fn leash_args(&self, capability: &str, action: &str, args: &Map<String, JsonValue>) -> Result<Vec<(String, Value)>, String> {
+    pub(crate) fn leash_args(
+        &self,
+        capability: &str,
+        action: &str,
+        args: &Map<String, JsonValue>,
+    ) -> Result<Vec<(String, Value)>, String> {
         if matches!(action, "PAUSE" | "RESUME" | "ABORT") {
             return match args.is_empty() {
                 true => Ok(Vec::new()),
@@ -52,7 +57,10 @@ impl Kinds {
                     Some((_, kind)) => *kind,
                     None => {
                         let names: Vec<&str> = params.iter().map(|(p, _)| p.as_str()).collect();
-                        return Err(format!("{capability} has no parameter `{name}`; its parameters are: {}", names.join(", ")));
+                        return Err(format!(
+                            "{capability} has no parameter `{name}`; its parameters are: {}",
+                            names.join(", ")
+                        ));
                     }
                 },
                 None => None,
@@ -66,14 +74,28 @@ impl Kinds {
     pub(crate) fn signal_args(&self, name: &str, args: &[JsonValue]) -> Result<Vec<Value>, String> {
         let Some(kinds) = self.signals.get(name) else {
             // Unknown to the mission: the engine refuses it by name (409).
-            return args.iter().enumerate().map(|(i, v)| value(v, None, &format!("value {} of {name}", i + 1))).collect();
+            return args
+                .iter()
+                .enumerate()
+                .map(|(i, v)| value(v, None, &format!("value {} of {name}", i + 1)))
+                .collect();
         };
         if args.len() != kinds.len() {
-            let wanted: Vec<&str> = kinds.iter().map(|k| k.map_or("any value", Kind::describe)).collect();
-            let wanted = if wanted.is_empty() { String::new() } else { format!(": {}", wanted.join("; ")) };
-            return Err(format!("{name} carries {} value(s), and {} were given{wanted}", kinds.len(), args.len()));
+            let wanted: Vec<&str> =
+                kinds.iter().map(|k| k.map_or("any value", Kind::describe)).collect();
+            let wanted =
+                if wanted.is_empty() { String::new() } else { format!(": {}", wanted.join("; ")) };
+            return Err(format!(
+                "{name} carries {} value(s), and {} were given{wanted}",
+                kinds.len(),
+                args.len()
+            ));
         }
-        args.iter().zip(kinds).enumerate().map(|(i, (v, kind))| value(v, *kind, &format!("value {} of {name}", i + 1))).collect()
+        args.iter()
+            .zip(kinds)
+            .enumerate()
+            .map(|(i, (v, kind))| value(v, *kind, &format!("value {} of {name}", i + 1)))
+            .collect()
     }
 }
 
@@ -90,16 +112,25 @@ enum Given {
 fn read(v: &JsonValue) -> Result<Given, String> {
     let form = "write a number in SI units, {\"number\": 20, \"unit\": \"m\"}, a string, true or false, or [x, y]";
     match v {
-        JsonValue::Number(n) => n.as_f64().map(|x| Given::Number(x, None)).ok_or_else(|| format!("{n} is not a number that can be used")),
+        JsonValue::Number(n) => n
+            .as_f64()
+            .map(|x| Given::Number(x, None))
+            .ok_or_else(|| format!("{n} is not a number that can be used")),
         JsonValue::Object(o) => {
-            let (Some(number), true) = (o.get("number").and_then(JsonValue::as_f64), o.keys().all(|k| k == "number" || k == "unit")) else {
+            let (Some(number), true) = (
+                o.get("number").and_then(JsonValue::as_f64),
+                o.keys().all(|k| k == "number" || k == "unit"),
+            ) else {
                 return Err(format!("{v} is not a value: {form}"));
             };
             match o.get("unit") {
                 None | Some(JsonValue::Null) => Ok(Given::Number(number, Some(Kind::Number))),
                 Some(JsonValue::String(u)) => match Unit::parse(u) {
                     Some(unit) => Ok(Given::Number(number * unit.to_si(), Some(unit_kind(unit)))),
-                    None => Err(format!("`{u}` is not a unit; the units are {}", Unit::ALL.iter().map(|u| u.as_str()).collect::<Vec<_>>().join(" "))),
+                    None => Err(format!(
+                        "`{u}` is not a unit; the units are {}",
+                        Unit::ALL.iter().map(|u| u.as_str()).collect::<Vec<_>>().join(" ")
+                    )),
                 },
                 Some(other) => Err(format!("the unit {other} is not a string such as \"m\"")),
             }
@@ -110,7 +141,9 @@ fn read(v: &JsonValue) -> Result<Given, String> {
             let n: Vec<f64> = a.iter().filter_map(JsonValue::as_f64).collect();
             Ok(Given::Position(Point { x: n[0], y: n[1], z: n.get(2).copied() }))
         }
-        JsonValue::Array(_) => Err(format!("{v} is not a position: write [x, y] or [x, y, z] in metres")),
+        JsonValue::Array(_) => {
+            Err(format!("{v} is not a position: write [x, y] or [x, y, z] in metres"))
+        }
         JsonValue::Null => Err(format!("null is not a value: {form}")),
     }
 }
@@ -127,7 +160,10 @@ fn unit_kind(unit: Unit) -> Kind {
 }
 
 fn numeric(kind: Kind) -> bool {
-    matches!(kind, Kind::Length | Kind::Duration | Kind::Speed | Kind::Angle | Kind::Ratio | Kind::Number)
+    matches!(
+        kind,
+        Kind::Length | Kind::Duration | Kind::Speed | Kind::Angle | Kind::Ratio | Kind::Number
+    )
 }
 
 /// `what` (such as "`radius` of FlyCircle") takes `kind`: the engine's value, or why not.
@@ -136,8 +172,21 @@ pub(crate) fn value(v: &JsonValue, kind: Option<Kind>, what: &str) -> Result<Val
     match (kind, given) {
         (Some(k), Given::Number(x, written)) if numeric(k) => {
             match written {
-                Some(Kind::Number) if k != Kind::Number => return Err(format!("{what} is {}, and {v} has no unit: {}", k.describe(), example(k))),
-                Some(w) if w != k => return Err(format!("{what} is {}, and {v} is {}: {}", k.describe(), w.describe(), example(k))),
+                Some(Kind::Number) if k != Kind::Number => {
+                    return Err(format!(
+                        "{what} is {}, and {v} has no unit: {}",
+                        k.describe(),
+                        example(k)
+                    ))
+                }
+                Some(w) if w != k => {
+                    return Err(format!(
+                        "{what} is {}, and {v} is {}: {}",
+                        k.describe(),
+                        w.describe(),
+                        example(k)
+                    ))
+                }
                 _ => {}
             }
             // The middle layer takes no negative length, duration or speed (an altitude,
@@ -157,7 +206,9 @@ pub(crate) fn value(v: &JsonValue, kind: Option<Kind>, what: &str) -> Result<Val
         (Some(Kind::Symbol) | None, Given::Word(s)) => Ok(Value::Symbol(s)),
         (Some(Kind::Text), Given::Word(s)) => Ok(Value::Text(s)),
         (Some(Kind::Bool) | None, Given::Bool(b)) => Ok(Value::Bool(b)),
-        (Some(k @ (Kind::Area | Kind::Actor)), _) => Err(format!("{what} is {}, which the operator API cannot send", k.describe())),
+        (Some(k @ (Kind::Area | Kind::Actor)), _) => {
+            Err(format!("{what} is {}, which the operator API cannot send", k.describe()))
+        }
         (Some(k), _) => Err(format!("{what} is {}, and {v} is not: {}", k.describe(), example(k))),
     }
 }
@@ -166,7 +217,9 @@ pub(crate) fn value(v: &JsonValue, kind: Option<Kind>, what: &str) -> Result<Val
 fn number(x: f64, v: &JsonValue, what: &str) -> Result<f64, String> {
     match x.is_finite() && x.abs() <= MAX_MAGNITUDE {
         true => Ok(x),
-        false => Err(format!("{what} must be a finite number of at most {MAX_MAGNITUDE:e} in SI units, not {v}")),
+        false => Err(format!(
+            "{what} must be a finite number of at most {MAX_MAGNITUDE:e} in SI units, not {v}"
+        )),
     }
 }
 

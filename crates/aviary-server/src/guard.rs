@@ -79,11 +79,13 @@ impl Access {
         let Some(origin) = headers.get(header::ORIGIN) else { return Ok(()) };
         let text = origin.to_str().unwrap_or("");
         let fits = match text.split_once("://") {
-            Some((scheme @ ("http" | "https"), rest)) => match split_host(rest, if scheme == "https" { 443 } else { 80 }) {
-                Some((name, _)) if self.allowed.contains(&name) => true,
-                Some((name, port)) => scheme == self.scheme && self.is_ours(&name, port),
-                None => false,
-            },
+            Some((scheme @ ("http" | "https"), rest)) => {
+                match split_host(rest, if scheme == "https" { 443 } else { 80 }) {
+                    Some((name, _)) if self.allowed.contains(&name) => true,
+                    Some((name, port)) => scheme == self.scheme && self.is_ours(&name, port),
+                    None => false,
+                }
+            }
             _ => false,
         };
         match fits {
@@ -122,7 +124,11 @@ fn shown(text: &str) -> String {
 }
 
 /// Every request: Host and Origin.
-pub(crate) async fn same_origin(State(shared): State<Arc<Shared>>, request: Request, next: Next) -> Response {
+pub(crate) async fn same_origin(
+    State(shared): State<Arc<Shared>>,
+    request: Request,
+    next: Next,
+) -> Response {
     match shared.access.check(request.headers(), request.uri()) {
         Ok(()) => next.run(request).await,
         Err(why) => error(StatusCode::FORBIDDEN, why),
@@ -130,16 +136,26 @@ pub(crate) async fn same_origin(State(shared): State<Arc<Shared>>, request: Requ
 }
 
 /// Control calls: the token, always.
-pub(crate) async fn token(State(shared): State<Arc<Shared>>, request: Request, next: Next) -> Response {
+pub(crate) async fn token(
+    State(shared): State<Arc<Shared>>,
+    request: Request,
+    next: Next,
+) -> Response {
     match given(request.headers()) {
         Some(t) if shared.token_is(&t) => next.run(request).await,
         Some(_) => unauthorized("that is not this run's token"),
-        None => unauthorized("this call needs the token the run printed: send `Authorization: Bearer TOKEN`"),
+        None => unauthorized(
+            "this call needs the token the run printed: send `Authorization: Bearer TOKEN`",
+        ),
     }
 }
 
 /// Reads: the token beyond loopback; on loopback none is needed, but a wrong one is refused.
-pub(crate) async fn read_token(State(shared): State<Arc<Shared>>, request: Request, next: Next) -> Response {
+pub(crate) async fn read_token(
+    State(shared): State<Arc<Shared>>,
+    request: Request,
+    next: Next,
+) -> Response {
     match given(request.headers()) {
         Some(t) if !shared.token_is(&t) => unauthorized("that is not this run's token"),
         None if shared.access.beyond_loopback() => {
@@ -161,9 +177,17 @@ fn given(headers: &HeaderMap) -> Option<String> {
         let text = value.to_str().unwrap_or("");
         let (scheme, token) = text.trim().split_once(' ').unwrap_or((text, ""));
         // A malformed header counts as a wrong token, never as no token.
-        return Some(if scheme.eq_ignore_ascii_case("bearer") { token.trim().to_string() } else { String::new() });
+        return Some(if scheme.eq_ignore_ascii_case("bearer") {
+            token.trim().to_string()
+        } else {
+            String::new()
+        });
     }
-    let protocols = headers.get_all(header::SEC_WEBSOCKET_PROTOCOL).iter().filter_map(|v| v.to_str().ok()).flat_map(|v| v.split(','));
+    let protocols = headers
+        .get_all(header::SEC_WEBSOCKET_PROTOCOL)
+        .iter()
+        .filter_map(|v| v.to_str().ok())
+        .flat_map(|v| v.split(','));
     protocols.map(str::trim).find_map(|p| p.strip_prefix(TOKEN_PROTOCOL)).map(str::to_string)
 }
 

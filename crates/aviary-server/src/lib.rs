@@ -87,7 +87,9 @@ impl Server {
     /// delivered it, so that no client misses how the mission ended.
     pub fn finish(&self, limit: std::time::Duration) {
         let start = std::time::Instant::now();
-        while self.feed.shared.streams.load(std::sync::atomic::Ordering::SeqCst) > 0 && start.elapsed() < limit {
+        while self.feed.shared.streams.load(std::sync::atomic::Ordering::SeqCst) > 0
+            && start.elapsed() < limit
+        {
             std::thread::sleep(std::time::Duration::from_millis(10));
         }
     }
@@ -95,23 +97,49 @@ impl Server {
 
 /// The routes of a server bound at `bound`, without a socket: what [`start`] serves, and
 /// what a fuzz target or a test drives request by request.
-pub fn router(bound: SocketAddr, token: String, controller: Controller, options: Options) -> (axum::Router, Feed) {
+pub fn router(
+    bound: SocketAddr,
+    token: String,
+    controller: Controller,
+    options: Options,
+) -> (axum::Router, Feed) {
     let (events, _) = broadcast::channel(BACKLOG);
-    let allowed = options.allowed_hosts.iter().map(|h| h.trim_end_matches('.').to_ascii_lowercase()).collect();
+    let allowed = options
+        .allowed_hosts
+        .iter()
+        .map(|h| h.trim_end_matches('.').to_ascii_lowercase())
+        .collect();
     let access = guard::Access { bound, allowed, scheme: "http" };
     let state = Mutex::new(MissionState::default());
-    let shared = Arc::new(Shared { streams: Default::default(), token, controller, state, events, kinds: options.kinds, access });
+    let shared = Arc::new(Shared {
+        streams: Default::default(),
+        token,
+        controller,
+        state,
+        events,
+        kinds: options.kinds,
+        access,
+    });
     (routes::router(shared.clone()), Feed { shared })
 }
 
 /// Binds `address` and serves in the background. The token is new for each run.
-pub fn start(address: SocketAddr, controller: Controller, options: Options) -> Result<Server, String> {
-    let listener = std::net::TcpListener::bind(address).map_err(|e| format!("cannot listen on {address}: {e}"))?;
+pub fn start(
+    address: SocketAddr,
+    controller: Controller,
+    options: Options,
+) -> Result<Server, String> {
+    let listener = std::net::TcpListener::bind(address)
+        .map_err(|e| format!("cannot listen on {address}: {e}"))?;
     listener.set_nonblocking(true).map_err(|e| e.to_string())?;
     let bound = listener.local_addr().map_err(|e| e.to_string())?;
     let token = new_token()?;
     let (app, feed) = router(bound, token.clone(), controller, options);
-    let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(1).enable_all().build().map_err(|e| e.to_string())?;
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(1)
+        .enable_all()
+        .build()
+        .map_err(|e| e.to_string())?;
     std::thread::Builder::new()
         .name("aviary-server".into())
         .spawn(move || {

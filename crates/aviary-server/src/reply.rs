@@ -26,14 +26,22 @@ impl<S: Send + Sync> FromRequest<S> for Object {
     async fn from_request(request: Request, state: &S) -> Result<Self, Response> {
         match Json::<Value>::from_request(request, state).await {
             Ok(Json(Value::Object(o))) => Ok(Object(o)),
-            Ok(Json(other)) => Err(error(StatusCode::BAD_REQUEST, format!("the body must be a JSON object, not {}", kind_of(&other)))),
-            Err(JsonRejection::MissingJsonContentType(_)) => {
-                Err(error(StatusCode::UNSUPPORTED_MEDIA_TYPE, "send the body as JSON, with `Content-Type: application/json`"))
-            }
-            Err(JsonRejection::JsonSyntaxError(e)) => Err(error(StatusCode::BAD_REQUEST, format!("the body is not JSON: {}", e.body_text()))),
-            Err(rejection) if rejection.status() == StatusCode::PAYLOAD_TOO_LARGE => {
-                Err(error(StatusCode::PAYLOAD_TOO_LARGE, format!("the body is larger than {} KiB", BODY_LIMIT / 1024)))
-            }
+            Ok(Json(other)) => Err(error(
+                StatusCode::BAD_REQUEST,
+                format!("the body must be a JSON object, not {}", kind_of(&other)),
+            )),
+            Err(JsonRejection::MissingJsonContentType(_)) => Err(error(
+                StatusCode::UNSUPPORTED_MEDIA_TYPE,
+                "send the body as JSON, with `Content-Type: application/json`",
+            )),
+            Err(JsonRejection::JsonSyntaxError(e)) => Err(error(
+                StatusCode::BAD_REQUEST,
+                format!("the body is not JSON: {}", e.body_text()),
+            )),
+            Err(rejection) if rejection.status() == StatusCode::PAYLOAD_TOO_LARGE => Err(error(
+                StatusCode::PAYLOAD_TOO_LARGE,
+                format!("the body is larger than {} KiB", BODY_LIMIT / 1024),
+            )),
             Err(rejection) => Err(error(rejection.status(), rejection.body_text())),
         }
     }
@@ -54,13 +62,23 @@ fn kind_of(v: &Value) -> &'static str {
 /// failed WebSocket handshake) becomes `{"error": its text}`, keeping status and headers.
 pub(crate) async fn json_errors(response: Response) -> Response {
     let status = response.status();
-    let is_json = response.headers().get(header::CONTENT_TYPE).is_some_and(|v| v.as_bytes().starts_with(b"application/json"));
+    let is_json = response
+        .headers()
+        .get(header::CONTENT_TYPE)
+        .is_some_and(|v| v.as_bytes().starts_with(b"application/json"));
     if !(status.is_client_error() || status.is_server_error()) || is_json {
         return response;
     }
     let (mut parts, body) = response.into_parts();
-    let text = axum::body::to_bytes(body, BODY_LIMIT).await.map(|b| String::from_utf8_lossy(&b).trim().to_string()).unwrap_or_default();
-    let message = if text.is_empty() { status.canonical_reason().unwrap_or("error").to_string() } else { text };
+    let text = axum::body::to_bytes(body, BODY_LIMIT)
+        .await
+        .map(|b| String::from_utf8_lossy(&b).trim().to_string())
+        .unwrap_or_default();
+    let message = if text.is_empty() {
+        status.canonical_reason().unwrap_or("error").to_string()
+    } else {
+        text
+    };
     let body = json!({ "error": message }).to_string();
     parts.headers.insert(header::CONTENT_TYPE, HeaderValue::from_static("application/json"));
     parts.headers.remove(header::CONTENT_LENGTH);

@@ -51,10 +51,18 @@ async fn state(State(shared): State<Arc<Shared>>) -> Json<JsonValue> {
     Json(shared.state().to_json())
 }
 
-async fn events(State(shared): State<Arc<Shared>>, ws: Result<WebSocketUpgrade, WebSocketUpgradeRejection>) -> Response {
+async fn events(
+    State(shared): State<Arc<Shared>>,
+    ws: Result<WebSocketUpgrade, WebSocketUpgradeRejection>,
+) -> Response {
     let ws = match ws {
         Ok(ws) => ws,
-        Err(rejection) => return error(rejection.status(), format!("{}: open it as a WebSocket", rejection.body_text())),
+        Err(rejection) => {
+            return error(
+                rejection.status(),
+                format!("{}: open it as a WebSocket", rejection.body_text()),
+            )
+        }
     };
     let rx = shared.events.subscribe();
     // Counted from the handshake on, so that a stream opened just before the mission
@@ -101,21 +109,42 @@ async fn leash(State(shared): State<Arc<Shared>>, Object(body): Object) -> Respo
     let (capability, tag) = match (text("activity"), text("capability"), text("tag")) {
         (Some(activity), _, _) => match activity.split_once('-') {
             Some((c, t)) => (c.to_string(), t.to_string()),
-            None => return error(StatusCode::BAD_REQUEST, format!("`{activity}` is not `Capability-Tag`")),
+            None => {
+                return error(
+                    StatusCode::BAD_REQUEST,
+                    format!("`{activity}` is not `Capability-Tag`"),
+                )
+            }
         },
         (None, Some(c), Some(t)) => (c.to_string(), t.to_string()),
-        _ => return error(StatusCode::BAD_REQUEST, "name the activity: {\"activity\": \"FlyCircle-C1\", \"action\": \"PAUSE\"}"),
+        _ => {
+            return error(
+                StatusCode::BAD_REQUEST,
+                "name the activity: {\"activity\": \"FlyCircle-C1\", \"action\": \"PAUSE\"}",
+            )
+        }
     };
     let Some(action) = text("action") else {
-        return error(StatusCode::BAD_REQUEST, "say what to do: \"action\": \"PAUSE\", \"RESUME\", \"ABORT\" or a section's name");
+        return error(
+            StatusCode::BAD_REQUEST,
+            "say what to do: \"action\": \"PAUSE\", \"RESUME\", \"ABORT\" or a section's name",
+        );
     };
     let args = match body.get("args") {
         None | Some(JsonValue::Null) => serde_json::Map::new(),
         Some(JsonValue::Object(o)) => o.clone(),
-        Some(_) => return error(StatusCode::BAD_REQUEST, "\"args\" is an object of the section's parameters: {\"radius\": 200}"),
+        Some(_) => {
+            return error(
+                StatusCode::BAD_REQUEST,
+                "\"args\" is an object of the section's parameters: {\"radius\": 200}",
+            )
+        }
     };
     match shared.kinds.leash_args(&capability, action, &args) {
-        Ok(args) => control(&shared, Control::Leash { capability, tag, action: action.to_string(), args }).await,
+        Ok(args) => {
+            control(&shared, Control::Leash { capability, tag, action: action.to_string(), args })
+                .await
+        }
         Err(why) => error(StatusCode::BAD_REQUEST, why),
     }
 }
@@ -128,7 +157,12 @@ async fn signal(State(shared): State<Arc<Shared>>, Object(body): Object) -> Resp
     let args = match body.get("args") {
         None | Some(JsonValue::Null) => Vec::new(),
         Some(JsonValue::Array(a)) => a.clone(),
-        Some(_) => return error(StatusCode::BAD_REQUEST, "\"args\" is an array of the signal's values: [[100, 50]]"),
+        Some(_) => {
+            return error(
+                StatusCode::BAD_REQUEST,
+                "\"args\" is an array of the signal's values: [[100, 50]]",
+            )
+        }
     };
     match shared.kinds.signal_args(name, &args) {
         Ok(args) => control(&shared, Control::Signal { name: name.to_string(), args }).await,

@@ -6,30 +6,21 @@ use aviary_api::{Failure, Point, Value};
 use crate::geom::{self, circle_inside, contains, segment_inside};
 
 pub(crate) fn failed(reason: impl Into<String>) -> Failure {
-    Failure {
-        exception: "CommandFailed",
-        reason: reason.into(),
-    }
+    Failure { exception: "CommandFailed", reason: reason.into() }
 }
 
 pub(crate) fn fence_violation(reason: impl Into<String>) -> Failure {
-    Failure {
-        exception: "GeofenceViolation",
-        reason: reason.into(),
-    }
+    Failure { exception: "GeofenceViolation", reason: reason.into() }
 }
 
 fn arg<'a>(args: &'a [Value], i: usize, name: &str) -> Result<&'a Value, Failure> {
-    args.get(i)
-        .ok_or_else(|| failed(format!("missing argument `{name}`")))
+    args.get(i).ok_or_else(|| failed(format!("missing argument `{name}`")))
 }
 
 fn number_value(v: &Value, name: &str) -> Result<f64, Failure> {
     match v {
         Value::Number(n) if n.is_finite() => Ok(*n),
-        other => Err(failed(format!(
-            "`{name}` must be a finite number, not {other}"
-        ))),
+        other => Err(failed(format!("`{name}` must be a finite number, not {other}"))),
     }
 }
 
@@ -53,9 +44,7 @@ pub(crate) fn point_value(v: &Value, name: &str) -> Result<Point, Failure> {
             let c = geom::centroid(polygon);
             Ok(Point::flat(c[0], c[1]))
         }
-        other => Err(failed(format!(
-            "`{name}` must be a position, not {other}"
-        ))),
+        other => Err(failed(format!("`{name}` must be a position, not {other}"))),
     }
 }
 
@@ -73,9 +62,9 @@ pub(crate) fn polygon(args: &[Value], i: usize, name: &str) -> Result<Vec<[f64; 
             }
             Ok(p.clone())
         }
-        other => Err(failed(format!(
-            "`{name}` must be an area of at least 3 corners, not {other}"
-        ))),
+        other => {
+            Err(failed(format!("`{name}` must be an area of at least 3 corners, not {other}")))
+        }
     }
 }
 
@@ -83,9 +72,7 @@ pub(crate) fn polygon(args: &[Value], i: usize, name: &str) -> Result<Vec<[f64; 
 pub(crate) fn kind(args: &[Value], i: usize, name: &str) -> Result<String, Failure> {
     match arg(args, i, name)? {
         Value::Symbol(s) | Value::Text(s) => Ok(s.clone()),
-        other => Err(failed(format!(
-            "`{name}` must be a kind such as Body, not {other}"
-        ))),
+        other => Err(failed(format!("`{name}` must be a kind such as Body, not {other}"))),
     }
 }
 

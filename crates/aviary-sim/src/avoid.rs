@@ -120,11 +120,7 @@ pub(crate) fn closest(a: &Track, b: &Track) -> f64 {
             let len2 = dr[0] * dr[0] + dr[1] * dr[1] + dr[2] * dr[2];
             if len2 > 0.0 {
                 let t = (-(r0[0] * dr[0] + r0[1] * dr[1] + r0[2] * dr[2]) / len2).clamp(0.0, 1.0);
-                best = best.min(norm([
-                    r0[0] + t * dr[0],
-                    r0[1] + t * dr[1],
-                    r0[2] + t * dr[2],
-                ]));
+                best = best.min(norm([r0[0] + t * dr[0], r0[1] + t * dr[1], r0[2] + t * dr[2]]));
             }
         }
     }
@@ -133,10 +129,7 @@ pub(crate) fn closest(a: &Track, b: &Track) -> f64 {
 
 /// The distance between two tracks at their first common point.
 fn first_gap(a: &Track, b: &Track) -> f64 {
-    a.iter()
-        .zip(b)
-        .find_map(|(p, q)| Some(norm(sub((*p)?, (*q)?))))
-        .unwrap_or(f64::INFINITY)
+    a.iter().zip(b).find_map(|(p, q)| Some(norm(sub((*p)?, (*q)?)))).unwrap_or(f64::INFINITY)
 }
 
 /// The altitude the drone's own plan holds it at: the leg's, or where it came from.
@@ -157,7 +150,10 @@ fn on_the_move(d: &SimDrone) -> bool {
 /// How far from drone `d` another drone can be and still matter to its planning: at
 /// least `range` below for every drone of the fleet.
 pub(crate) fn reach(fleet: &Fleet, d: &SimDrone) -> f64 {
-    fleet.min_separation + MARGIN + HORIZON * (d.spec.max_speed + d.spec.climb_rate + fleet.fastest) + 1.0
+    fleet.min_separation
+        + MARGIN
+        + HORIZON * (d.spec.max_speed + d.spec.climb_rate + fleet.fastest)
+        + 1.0
 }
 
 impl Fleet {
@@ -213,11 +209,8 @@ impl Fleet {
             let mut close = Vec::new();
             for (k, t) in theirs.iter().enumerate() {
                 let c = closest(&mine, t);
-                let need = if strict {
-                    sep
-                } else {
-                    (sep + MARGIN).min(first_gap(&mine, t)).max(sep)
-                };
+                let need =
+                    if strict { sep } else { (sep + MARGIN).min(first_gap(&mine, t)).max(sep) };
                 worst = worst.min(c - need);
                 if c < sep + MARGIN {
                     close.push(k);
@@ -226,9 +219,7 @@ impl Fleet {
             (worst, free, close)
         };
         let current = d.avoid;
-        let back_to = current
-            .filter(|y| y.alt.is_some())
-            .map_or(d.pos[2], |y| y.back_to);
+        let back_to = current.filter(|y| y.alt.is_some()).map_or(d.pos[2], |y| y.back_to);
         let nominal = match current.filter(|y| y.alt.is_some()) {
             None => None,
             Some(_) => {
@@ -265,28 +256,12 @@ impl Fleet {
         let mut ways: Vec<Option<Yield>> = Vec::new();
         if on_the_move(d) {
             if held.is_some() {
-                ways.push(Some(Yield {
-                    scale: 1.0,
-                    alt: held,
-                    back_to,
-                }));
+                ways.push(Some(Yield { scale: 1.0, alt: held, back_to }));
             }
-            ways.push(Some(Yield {
-                scale: 1.0,
-                alt: Some(d.pos[2]),
-                back_to,
-            }));
-            ways.push(Some(Yield {
-                scale: 0.5,
-                alt: held,
-                back_to,
-            }));
+            ways.push(Some(Yield { scale: 1.0, alt: Some(d.pos[2]), back_to }));
+            ways.push(Some(Yield { scale: 0.5, alt: held, back_to }));
             if moving {
-                ways.push(Some(Yield {
-                    scale: 0.0,
-                    alt: held,
-                    back_to,
-                }));
+                ways.push(Some(Yield { scale: 0.0, alt: held, back_to }));
             }
         }
         let ceiling = self.max_altitude.unwrap_or(f64::INFINITY);
@@ -304,11 +279,7 @@ impl Fleet {
         }
         for &scale in &[1.0, 0.0] {
             for &alt in &levels {
-                ways.push(Some(Yield {
-                    scale,
-                    alt: Some(alt),
-                    back_to,
-                }));
+                ways.push(Some(Yield { scale, alt: Some(alt), back_to }));
             }
         }
         // The first way that is clear and can be flown now; else the one that keeps the most

@@ -32,10 +32,7 @@ pub struct SimOptions {
 
 impl Default for SimOptions {
     fn default() -> SimOptions {
-        SimOptions {
-            tick: 0.05,
-            speed: None,
-        }
+        SimOptions { tick: 0.05, speed: None }
     }
 }
 
@@ -94,11 +91,7 @@ impl SimBackend {
         );
         let (tx, rx) = mpsc::unbounded_channel();
         let backend = Arc::new(SimBackend {
-            state: Mutex::new(State {
-                fleet,
-                waiting: BTreeMap::new(),
-                events: tx,
-            }),
+            state: Mutex::new(State { fleet, waiting: BTreeMap::new(), events: tx }),
             events: Mutex::new(Some(rx)),
             stopped: AtomicBool::new(false),
             driver: Mutex::new(None),
@@ -213,10 +206,7 @@ impl Backend for SimBackend {
     }
 
     fn telemetry(&self, drone: DroneId) -> Telemetry {
-        lock(&self.state)
-            .fleet
-            .telemetry(drone)
-            .unwrap_or(Telemetry::LOST)
+        lock(&self.state).fleet.telemetry(drone).unwrap_or(Telemetry::LOST)
     }
 
     fn events(&self) -> Option<mpsc::UnboundedReceiver<DroneEvent>> {

@@ -24,7 +24,11 @@ pub(crate) fn energy_home(d: &SimDrone) -> f64 {
 /// At least [`energy_home`] (or NaN), bit for bit: `|dx| + |dy|`, widened far beyond the
 /// rounding of both, bounds the distance, and rounding keeps the order of the rest.
 pub(crate) fn energy_home_bound(d: &SimDrone) -> f64 {
-    if !(d.spec.max_speed > 0.0 && d.spec.descent.rate > 0.0 && d.spec.descent.land_speed > 0.0 && d.spec.endurance > 0.0) {
+    if !(d.spec.max_speed > 0.0
+        && d.spec.descent.rate > 0.0
+        && d.spec.descent.land_speed > 0.0
+        && d.spec.endurance > 0.0)
+    {
         return f64::NAN;
     }
     let far = ((d.home[0] - d.pos[0]).abs() + (d.home[1] - d.pos[1]).abs()) * (1.0 + 1e-12);
@@ -32,18 +36,20 @@ pub(crate) fn energy_home_bound(d: &SimDrone) -> f64 {
 }
 
 fn time_home(ground: f64, d: &SimDrone) -> f64 {
-    aviary_api::flight::time_home(ground, d.spec.max_speed, d.pos[2], d.spec.return_loiter, &d.spec.descent)
+    aviary_api::flight::time_home(
+        ground,
+        d.spec.max_speed,
+        d.pos[2],
+        d.spec.return_loiter,
+        &d.spec.descent,
+    )
 }
 
 /// Drains `dt` seconds of flight (when `airborne`) and raises each alarm at most once.
 // `!(a >= b)` on purpose: a NaN charge or bound counts as "may be due", never as safe.
 #[allow(clippy::neg_cmp_op_on_partial_ord)]
 pub(crate) fn drain(d: &mut SimDrone, dt: f64, airborne: bool) -> Alarms {
-    let mut alarms = Alarms {
-        low: false,
-        critical: false,
-        empty: false,
-    };
+    let mut alarms = Alarms { low: false, critical: false, empty: false };
     if !airborne {
         return alarms;
     }

@@ -38,10 +38,7 @@ enum Start {
 
 impl Fleet {
     fn limits(&self) -> Limits<'_> {
-        Limits {
-            fence: self.fence.as_deref(),
-            max_altitude: self.max_altitude,
-        }
+        Limits { fence: self.fence.as_deref(), max_altitude: self.max_altitude }
     }
 
     /// Starts a call; `Ok(true)` when it is in progress, `Ok(false)` when already done.
@@ -52,10 +49,8 @@ impl Fleet {
         function: &str,
         args: &[Value],
     ) -> Result<bool, Failure> {
-        let d = self
-            .drones
-            .get(id)
-            .ok_or_else(|| failed(format!("there is no drone number {id}")))?;
+        let d =
+            self.drones.get(id).ok_or_else(|| failed(format!("there is no drone number {id}")))?;
         if d.state == FlightState::Lost {
             return Err(failed(format!("{} is lost", &self.names[id])));
         }
@@ -69,10 +64,7 @@ impl Fleet {
         // A return the drone started on its own (after a link loss) gives way to a command.
         let own_return = d.motion.as_ref().is_some_and(|t| t.call.is_none());
         if motion && d.motion.is_some() && !own_return {
-            return Err(failed(format!(
-                "{} is busy with another motion call",
-                &self.names[id]
-            )));
+            return Err(failed(format!("{} is busy with another motion call", &self.names[id])));
         }
         if motion && d.gps_loss().is_some() {
             return Err(failed(format!("{} has no position fix", &self.names[id])));
@@ -106,19 +98,12 @@ impl Fleet {
         let landed = d.state == FlightState::Landed;
         let in_air = || {
             if landed {
-                Err(failed(format!(
-                    "{} is on the ground: take off first",
-                    &self.names[id]
-                )))
+                Err(failed(format!("{} is on the ground: take off first", &self.names[id])))
             } else {
                 Ok(())
             }
         };
-        let fly = |to: [f64; 3], speed: f64| Leg::Move {
-            to,
-            speed,
-            state: FlightState::Flying,
-        };
+        let fly = |to: [f64; 3], speed: f64| Leg::Move { to, speed, state: FlightState::Flying };
         let legs = match function {
             "Arm" | "Disarm" => {
                 if !landed {
@@ -148,11 +133,7 @@ impl Fleet {
                         &self.names[id]
                     )));
                 } else {
-                    vec![Leg::Move {
-                        to,
-                        speed: d.spec.max_speed,
-                        state: FlightState::TakingOff,
-                    }]
+                    vec![Leg::Move { to, speed: d.spec.max_speed, state: FlightState::TakingOff }]
                 }
             }
             "Land" => {
@@ -167,14 +148,20 @@ impl Fleet {
                 let p = point(args, 0, "pos")?;
                 let speed = match opt_number(args, 1, "speed")? {
                     Some(s) if s <= 0.0 => {
-                        return Err(failed(format!("speed must be above 0 m/s, not {} m/s", show::number(s))))
+                        return Err(failed(format!(
+                            "speed must be above 0 m/s, not {} m/s",
+                            show::number(s)
+                        )))
                     }
                     Some(s) => s.min(d.spec.max_speed),
                     None => d.spec.max_speed,
                 };
                 let to = [p.x, p.y, p.z.unwrap_or(level)];
                 if to[2] < 0.0 {
-                    return Err(failed(format!("altitude {} m is below the ground", show::number(to[2]))));
+                    return Err(failed(format!(
+                        "altitude {} m is below the ground",
+                        show::number(to[2])
+                    )));
                 }
                 limits.path(here, &[to])?;
                 vec![fly(to, speed)]
@@ -183,7 +170,10 @@ impl Fleet {
                 in_air()?;
                 let alt = number(args, 0, "alt")?;
                 if alt < 0.0 {
-                    return Err(failed(format!("altitude {} m is below the ground", show::number(alt))));
+                    return Err(failed(format!(
+                        "altitude {} m is below the ground",
+                        show::number(alt)
+                    )));
                 }
                 limits.altitude(alt)?;
                 vec![fly([here[0], here[1], alt], d.spec.max_speed)]
@@ -191,7 +181,10 @@ impl Fleet {
             "Hover" => {
                 let duration = number(args, 0, "duration")?;
                 if duration < 0.0 {
-                    return Err(failed(format!("a hover cannot last {} s", show::number(duration))));
+                    return Err(failed(format!(
+                        "a hover cannot last {} s",
+                        show::number(duration)
+                    )));
                 }
                 vec![Leg::Hold { left: duration }]
             }
@@ -221,10 +214,8 @@ impl Fleet {
                         "sweep spacing must be above 0 m, not {spacing} m"
                     )));
                 }
-                let path: Vec<[f64; 3]> = lawnmower(&area, spacing)
-                    .into_iter()
-                    .map(|p| [p[0], p[1], level])
-                    .collect();
+                let path: Vec<[f64; 3]> =
+                    lawnmower(&area, spacing).into_iter().map(|p| [p[0], p[1], level]).collect();
                 limits.path(here, &path)?;
                 path.into_iter().map(|to| fly(to, d.spec.max_speed)).collect()
             }
@@ -236,7 +227,10 @@ impl Fleet {
                     let p = point_value(v, &format!("points[{i}]"))?;
                     z = p.z.unwrap_or(z);
                     if z < 0.0 {
-                        return Err(failed(format!("altitude {} m is below the ground", show::number(z))));
+                        return Err(failed(format!(
+                            "altitude {} m is below the ground",
+                            show::number(z)
+                        )));
                     }
                     path.push([p.x, p.y, z]);
                 }
@@ -245,11 +239,7 @@ impl Fleet {
             }
             other => return Err(failed(format!("unknown function {other}"))),
         };
-        Ok(if legs.is_empty() {
-            Start::Done
-        } else {
-            Start::Moves(legs)
-        })
+        Ok(if legs.is_empty() { Start::Done } else { Start::Moves(legs) })
     }
 
     fn other(
@@ -279,11 +269,7 @@ impl Fleet {
                 let detections = &mut d.rare_mut().detections;
                 detections.retain(|a| a.kind != kind);
                 if function == "StartDetection" {
-                    detections.push(Activation {
-                        kind,
-                        range,
-                        found: Vec::new(),
-                    });
+                    detections.push(Activation { kind, range, found: Vec::new() });
                 }
             }
             "LoadPayload" => {
@@ -312,24 +298,14 @@ impl Fleet {
                         show::fixed(d.pos[2], 1)
                     )));
                 }
-                d.rare_mut().loading = Some(Loading {
-                    call,
-                    kind,
-                    left: LOAD_TIME,
-                    paused: false,
-                });
+                d.rare_mut().loading = Some(Loading { call, kind, left: LOAD_TIME, paused: false });
                 return Ok(Start::Pending);
             }
             "ReleasePayload" => {
                 let Some(kind) = d.rare.as_mut().and_then(|r| r.carrying.take()) else {
                     return Err(failed(format!("{} carries nothing to release", &self.names[id])));
                 };
-                self.releases.push(Release {
-                    drone: id,
-                    kind,
-                    position: d.pos,
-                    time,
-                });
+                self.releases.push(Release { drone: id, kind, position: d.pos, time });
             }
             other => return Err(failed(format!("unknown function {other}"))),
         }
@@ -349,9 +325,7 @@ pub(crate) fn return_legs(
         if home_dist <= AT_HOME {
             return Ok(Vec::new());
         }
-        return Err(failed(format!(
-            "{name} is on the ground away from home: take off first"
-        )));
+        return Err(failed(format!("{name} is on the ground away from home: take off first")));
     }
     let z = d.pos[2];
     let safe = aviary_api::flight::return_height(z, d.spec.return_altitude, max_altitude);

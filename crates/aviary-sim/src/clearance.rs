@@ -54,7 +54,8 @@ impl Clearance {
             let p = grid.at(i);
             self.base[i] = Some(p);
             // A NaN gap (a NaN position anywhere near) never clears anything.
-            self.gap[i] = if p.iter().all(|x| x.is_finite()) { grid.nearest(p, cap, i) } else { f64::NAN };
+            self.gap[i] =
+                if p.iter().all(|x| x.is_finite()) { grid.nearest(p, cap, i) } else { f64::NAN };
         }
     }
 

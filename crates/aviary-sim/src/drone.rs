@@ -69,7 +69,14 @@ impl Eq for Spec {}
 
 impl Hash for Spec {
     fn hash<H: Hasher>(&self, h: &mut H) {
-        let figures = [self.max_speed, self.climb_rate, self.accel, self.endurance, self.return_altitude, self.return_loiter];
+        let figures = [
+            self.max_speed,
+            self.climb_rate,
+            self.accel,
+            self.endurance,
+            self.return_altitude,
+            self.return_loiter,
+        ];
         let descent = [self.descent.rate, self.descent.land_speed, self.descent.slow_below];
         for x in figures.into_iter().chain(descent) {
             x.to_bits().hash(h);
@@ -181,11 +188,7 @@ impl SimDrone {
     /// to let another drone pass, where it came from.
     pub fn level(&self) -> f64 {
         match self.avoid {
-            Some(Yield {
-                alt: Some(_),
-                back_to,
-                ..
-            }) => back_to,
+            Some(Yield { alt: Some(_), back_to, .. }) => back_to,
             _ => self.pos[2],
         }
     }
@@ -235,11 +238,7 @@ impl SimDrone {
     pub fn settle(&mut self) {
         self.vel = [0.0; 3];
         if matches!(self.state, FlightState::TakingOff | FlightState::Landing) {
-            self.state = if self.pos[2] > 0.01 {
-                FlightState::Flying
-            } else {
-                FlightState::Landed
-            };
+            self.state = if self.pos[2] > 0.01 { FlightState::Flying } else { FlightState::Landed };
         }
     }
 

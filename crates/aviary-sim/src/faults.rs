@@ -68,11 +68,8 @@ impl Fleet {
                     d.rare_mut().disabled = Some(format!("{name} had a motor failure"));
                     if d.state.airborne() {
                         let to = [d.pos[0], d.pos[1], 0.0];
-                        let leg = Leg::Move {
-                            to,
-                            speed: d.spec.max_speed,
-                            state: FlightState::Landing,
-                        };
+                        let leg =
+                            Leg::Move { to, speed: d.spec.max_speed, state: FlightState::Landing };
                         d.motion = Some(Box::new(MotionTask::new(None, vec![leg])));
                         d.begin_leg();
                     }
@@ -84,11 +81,8 @@ impl Fleet {
                         format!("{name}: link lost (simulated fault)"),
                         out,
                     );
-                    self.drones[id].rare_mut().link_loss = Some(Outage {
-                        since: at,
-                        until,
-                        returned: false,
-                    });
+                    self.drones[id].rare_mut().link_loss =
+                        Some(Outage { since: at, until, returned: false });
                     self.outage(id);
                 }
                 FaultKind::GpsLoss => {
@@ -98,11 +92,8 @@ impl Fleet {
                         format!("{name}: GPS lost (simulated fault)"),
                         out,
                     );
-                    self.drones[id].rare_mut().gps_loss = Some(Outage {
-                        since: at,
-                        until,
-                        returned: false,
-                    });
+                    self.drones[id].rare_mut().gps_loss =
+                        Some(Outage { since: at, until, returned: false });
                     self.outage(id);
                 }
             }
@@ -144,7 +135,9 @@ impl Fleet {
             }
         }
         let drones = &self.drones;
-        self.outages.retain(|&id| drones[id].rare.as_ref().is_some_and(|r| r.link_loss.is_some() || r.gps_loss.is_some()));
+        self.outages.retain(|&id| {
+            drones[id].rare.as_ref().is_some_and(|r| r.link_loss.is_some() || r.gps_loss.is_some())
+        });
     }
 
     /// Notes that drone `id` has an outage (the list stays ascending, without repeats).

@@ -4,10 +4,10 @@
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::sync::Arc;
 
+use aviary_api::geometry::hypot;
 use aviary_api::{
     CallEnd, CallId, DroneEvent, DroneId, Failure, FlightState, Interrupt, Telemetry, Value,
 };
-use aviary_api::geometry::hypot;
 use aviary_world::{FaultKind, Sensor, Target, World};
 
 use crate::avoid::Track;
@@ -17,9 +17,9 @@ use crate::drone::{SimDrone, Spec};
 use crate::geom::heading;
 use crate::grid::Grid;
 use crate::hot::Hot;
-use aviary_api::Names;
 use crate::nearby::Nearby;
 use crate::sensors::scan;
+use aviary_api::Names;
 
 /// Something that happened during a [`Fleet::step`], in the order it happened.
 #[derive(Clone, Debug, PartialEq)]
@@ -120,7 +120,8 @@ const TARGET_CELL: f64 = 50.0;
 fn target_grid(targets: &[Target]) -> Grid {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for t in targets {
-        (lo, hi) = ([lo[0].min(t.at[0]), lo[1].min(t.at[1])], [hi[0].max(t.at[0]), hi[1].max(t.at[1])]);
+        (lo, hi) =
+            ([lo[0].min(t.at[0]), lo[1].min(t.at[1])], [hi[0].max(t.at[0]), hi[1].max(t.at[1])]);
     }
     let area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
     let size = match (area / targets.len() as f64).sqrt() {
@@ -178,7 +179,10 @@ impl Fleet {
     pub fn from_world(mut world: World) -> Fleet {
         let fleet = Fleet::around(&world);
         let mut specs = Specs::default();
-        let drones = std::mem::take(&mut world.drones).into_iter().map(|d| SimDrone::new(&d, specs.of(&d))).collect();
+        let drones = std::mem::take(&mut world.drones)
+            .into_iter()
+            .map(|d| SimDrone::new(&d, specs.of(&d)))
+            .collect();
         Fleet { drones, ..fleet }
     }
 
@@ -249,9 +253,7 @@ impl Fleet {
     /// (metres flown, seconds in the air) of the drone so far; zeros for an index the
     /// world does not have.
     pub fn odometry(&self, drone: DroneId) -> (f64, f64) {
-        self.drones
-            .get(drone)
-            .map_or((0.0, 0.0), |d| (d.odometer, d.flight_time))
+        self.drones.get(drone).map_or((0.0, 0.0), |d| (d.odometer, d.flight_time))
     }
 
     /// Every `ReleasePayload` so far, in order.
@@ -337,7 +339,8 @@ impl Fleet {
                 return None;
             }
             let rare = d.rare.as_deref_mut();
-            if let Some(rare) = rare.filter(|r| r.loading.as_ref().is_some_and(|l| l.call == call)) {
+            if let Some(rare) = rare.filter(|r| r.loading.as_ref().is_some_and(|l| l.call == call))
+            {
                 match how {
                     Interrupt::Abort => {
                         rare.loading = None;
@@ -385,7 +388,8 @@ impl Fleet {
                 continue;
             }
             self.aloft.push(id);
-            joined |= !if fresh { self.clearance.moved(id, h.xy) } else { self.clearance.is_member(id) };
+            joined |=
+                !if fresh { self.clearance.moved(id, h.xy) } else { self.clearance.is_member(id) };
             self.max_extent = self.max_extent.max(h.extent);
         }
         if joined || !(self.clearance.drift() <= REMEASURE) {
@@ -445,7 +449,10 @@ impl Fleet {
     /// How far [`Fleet::clearance`] measures: twice the planner's longest reach, plus the
     /// drift allowed (farther gaps would tell nothing more).
     fn clearance_cap(&self) -> f64 {
-        let reach = self.min_separation + crate::avoid::MARGIN + crate::avoid::HORIZON * 2.0 * self.fastest + 1.0;
+        let reach = self.min_separation
+            + crate::avoid::MARGIN
+            + crate::avoid::HORIZON * 2.0 * self.fastest
+            + 1.0;
         2.0 * reach + 2.0 * REMEASURE
     }
 
@@ -465,10 +472,7 @@ impl Fleet {
         let d = &mut self.drones[id];
         if let Some(task) = finished {
             if let Some(call) = task.call {
-                out.push(Report::Ended {
-                    call,
-                    end: CallEnd::Done,
-                });
+                out.push(Report::Ended { call, end: CallEnd::Done });
             }
         }
         if hypot(d.vel[0], d.vel[1]) > 1e-9 {
@@ -480,26 +484,24 @@ impl Fleet {
                 if load.left <= 1e-9 {
                     let call = load.call;
                     rare.carrying = rare.loading.take().map(|l| l.kind);
-                    out.push(Report::Ended {
-                        call,
-                        end: CallEnd::Done,
-                    });
+                    out.push(Report::Ended { call, end: CallEnd::Done });
                 }
             }
         }
         let to = d.xy();
-        let moved = [
-            d.pos[0] - before[0],
-            d.pos[1] - before[1],
-            d.pos[2] - before[2],
-        ];
+        let moved = [d.pos[0] - before[0], d.pos[1] - before[1], d.pos[2] - before[2]];
         d.odometer += (moved[0] * moved[0] + moved[1] * moved[1] + moved[2] * moved[2]).sqrt();
         if airborne {
             d.flight_time += dt;
         }
         // Only the targets near the way flown, in their order.
         let nearby = match d.detections().iter().map(|a| a.range).reduce(f64::max) {
-            Some(range) => self.near_targets[id].get_or_insert_with(Box::default).around(&self.target_grid, from, to, range),
+            Some(range) => self.near_targets[id].get_or_insert_with(Box::default).around(
+                &self.target_grid,
+                from,
+                to,
+                range,
+            ),
             None => &[],
         };
         if let Some(rare) = d.rare.as_deref_mut() {
@@ -510,10 +512,7 @@ impl Fleet {
         }
         let alarms = battery::drain(d, dt, airborne);
         if alarms.low {
-            out.push(Report::Event(DroneEvent::Signal {
-                drone: id,
-                name: "BatteryLow",
-            }));
+            out.push(Report::Event(DroneEvent::Signal { drone: id, name: "BatteryLow" }));
         }
         if alarms.critical {
             let reason = format!(
@@ -542,10 +541,7 @@ impl Fleet {
             failure: Failure { exception, reason },
         }));
         for call in self.drones[id].cut_calls() {
-            out.push(Report::Ended {
-                call,
-                end: CallEnd::Interrupted,
-            });
+            out.push(Report::Ended { call, end: CallEnd::Interrupted });
         }
     }
 

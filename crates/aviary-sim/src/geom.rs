@@ -3,7 +3,9 @@
 
 // Containment, distances and the geofence checks of a path live in `aviary_api::geometry`,
 // shared with the checker's pre-flight geofence analysis.
-pub(crate) use aviary_api::geometry::{circle_inside, contains, dist, dist_to_segment, edges, segment_inside};
+pub(crate) use aviary_api::geometry::{
+    circle_inside, contains, dist, dist_to_segment, edges, segment_inside,
+};
 
 /// Distance from `p` to a polyline (to the point itself when the polyline has one point).
 #[cfg(test)]
@@ -11,20 +13,13 @@ pub(crate) fn dist_to_polyline(p: [f64; 2], line: &[[f64; 2]]) -> f64 {
     match line {
         [] => f64::INFINITY,
         [only] => dist(p, *only),
-        _ => line
-            .windows(2)
-            .map(|w| dist_to_segment(p, w[0], w[1]))
-            .fold(f64::INFINITY, f64::min),
+        _ => line.windows(2).map(|w| dist_to_segment(p, w[0], w[1])).fold(f64::INFINITY, f64::min),
     }
 }
 
 /// The polygon's area (positive either way round).
 pub(crate) fn area(polygon: &[[f64; 2]]) -> f64 {
-    edges(polygon)
-        .map(|(a, b)| a[0] * b[1] - b[0] * a[1])
-        .sum::<f64>()
-        .abs()
-        / 2.0
+    edges(polygon).map(|(a, b)| a[0] * b[1] - b[0] * a[1]).sum::<f64>().abs() / 2.0
 }
 
 /// The area centroid; the corners' mean when the polygon encloses no area.
@@ -58,7 +53,8 @@ pub(crate) fn heading(vx: f64, vy: f64) -> f64 {
 
 /// A non-convex polygon for tests: an L, 100 m on its long sides.
 #[cfg(test)]
-pub(crate) const L_SHAPE: [[f64; 2]; 6] = [[0.0, 0.0], [100.0, 0.0], [100.0, 40.0], [40.0, 40.0], [40.0, 100.0], [0.0, 100.0]];
+pub(crate) const L_SHAPE: [[f64; 2]; 6] =
+    [[0.0, 0.0], [100.0, 0.0], [100.0, 40.0], [40.0, 40.0], [40.0, 100.0], [0.0, 100.0]];
 
 #[cfg(test)]
 mod tests {
@@ -72,30 +68,35 @@ mod tests {
         assert!(!contains(&L, [90.0, 90.0]));
         assert!(contains(&L, [100.0, 20.0]), "the boundary is inside");
         assert!(segment_inside(&L, [10.0, 10.0], [90.0, 10.0]));
-        assert!(
-            !segment_inside(&L, [10.0, 90.0], [90.0, 10.0]),
-            "cuts across the notch"
-        );
-        assert!(
-            segment_inside(&L, [0.0, 0.0], [100.0, 0.0]),
-            "along an edge"
-        );
+        assert!(!segment_inside(&L, [10.0, 90.0], [90.0, 10.0]), "cuts across the notch");
+        assert!(segment_inside(&L, [0.0, 0.0], [100.0, 0.0]), "along an edge");
         assert!(circle_inside(&L, [20.0, 20.0], 20.0));
         assert!(!circle_inside(&L, [20.0, 20.0], 21.0));
         assert_eq!(area(&L), 100.0 * 40.0 + 40.0 * 60.0);
-        assert_eq!(
-            centroid(&[[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]),
-            [1.0, 1.0]
-        );
+        assert_eq!(centroid(&[[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]), [1.0, 1.0]);
     }
 
     #[test]
     fn atan2_is_libms_bit_for_bit() {
-        let xs = [0.0, -0.0, 1e-300, 3.0, -4.5, 1e300, f64::INFINITY, f64::NEG_INFINITY, f64::NAN, -7e-320];
+        let xs = [
+            0.0,
+            -0.0,
+            1e-300,
+            3.0,
+            -4.5,
+            1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            -7e-320,
+        ];
         for y in xs {
             for x in xs {
                 let (a, b) = (atan2(y, x), y.atan2(x));
-                assert!(a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()), "{y} {x}: {a} {b}");
+                assert!(
+                    a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                    "{y} {x}: {a} {b}"
+                );
             }
         }
     }

@@ -73,7 +73,17 @@ pub(crate) struct Grid {
 impl Grid {
     /// An empty grid of cells `size` metres on a side.
     pub fn new(size: f64) -> Grid {
-        Grid { size, x0: 0, y0: 0, w: 0, h: 0, dense: Vec::new(), cells: Cells::default(), at: Vec::new(), pos: Vec::new() }
+        Grid {
+            size,
+            x0: 0,
+            y0: 0,
+            w: 0,
+            h: 0,
+            dense: Vec::new(),
+            cells: Cells::default(),
+            at: Vec::new(),
+            pos: Vec::new(),
+        }
     }
 
     fn cell(&self, p: [f64; 2]) -> Cell {
@@ -111,13 +121,16 @@ impl Grid {
         self.at.iter_mut().for_each(|c| *c = None);
         // No window for an empty box (no items: `lo` is +inf) or an absurd one.
         let sane = |x: f64| x.abs() < 1e12;
-        let window = (lo[0] <= hi[0] && lo[1] <= hi[1] && lo.iter().chain(&hi).all(|&x| sane(x))).then(|| {
-            let (a, b) = (self.cell(lo), self.cell(hi));
-            (a, b.0 - a.0 + 1, b.1 - a.1 + 1)
-        });
+        let window = (lo[0] <= hi[0] && lo[1] <= hi[1] && lo.iter().chain(&hi).all(|&x| sane(x)))
+            .then(|| {
+                let (a, b) = (self.cell(lo), self.cell(hi));
+                (a, b.0 - a.0 + 1, b.1 - a.1 + 1)
+            });
         let limit = (n as i64).saturating_mul(DENSE_PER_ITEM).saturating_add(DENSE_SLACK);
         (self.x0, self.y0, self.w, self.h) = match window {
-            Some((a, w, h)) if w <= limit && h <= limit && w.saturating_mul(h) <= limit => (a.0, a.1, w, h),
+            Some((a, w, h)) if w <= limit && h <= limit && w.saturating_mul(h) <= limit => {
+                (a.0, a.1, w, h)
+            }
             _ => (0, 0, 0, 0),
         };
         self.dense.iter_mut().for_each(Vec::clear);
@@ -259,7 +272,9 @@ mod tests {
             dense.put(i, q);
         }
         let (mut a, mut b) = (Vec::new(), Vec::new());
-        for (c, r) in [([0.0, 0.0], 15.0), ([-120.0, 30.0], 40.0), ([90.0, -80.0], 5.0), ([0.0, 0.0], 1e6)] {
+        for (c, r) in
+            [([0.0, 0.0], 15.0), ([-120.0, 30.0], 40.0), ([90.0, -80.0], 5.0), ([0.0, 0.0], 1e6)]
+        {
             sparse.around(c, c, r, &mut a);
             dense.around(c, c, r, &mut b);
             assert_eq!(a, b);

@@ -22,11 +22,18 @@ pub(crate) struct Hot {
 }
 
 impl Hot {
-    pub const UNKNOWN: Hot = Hot { known: false, up: false, idle: false, xy: [0.0; 2], extent: f64::NAN };
+    pub const UNKNOWN: Hot =
+        Hot { known: false, up: false, idle: false, xy: [0.0; 2], extent: f64::NAN };
 
     pub fn of(d: &SimDrone) -> Hot {
         let up = d.state.airborne();
-        Hot { known: true, up, idle: idle(d), xy: d.xy(), extent: if up { extent_bound(d) } else { f64::NAN } }
+        Hot {
+            known: true,
+            up,
+            idle: idle(d),
+            xy: d.xy(),
+            extent: if up { extent_bound(d) } else { f64::NAN },
+        }
     }
 }
 
@@ -52,7 +59,11 @@ impl crate::fleet::Fleet {
             let now = Hot::of(d);
             if h.known {
                 assert!(
-                    h.up == now.up && h.idle == now.idle && same(h.xy[0], now.xy[0]) && same(h.xy[1], now.xy[1]) && same(h.extent, now.extent),
+                    h.up == now.up
+                        && h.idle == now.idle
+                        && same(h.xy[0], now.xy[0])
+                        && same(h.xy[1], now.xy[1])
+                        && same(h.extent, now.extent),
                     "drone {id}: kept {h:?}, now {now:?}"
                 );
             }
@@ -64,6 +75,9 @@ impl crate::fleet::Fleet {
         for &j in &self.aloft {
             sky.put(j, self.drones[j].xy());
         }
-        assert!(!sky.any_within(self.drones[id].xy(), r, id), "drone {id} is not clear within {r} m");
+        assert!(
+            !sky.any_within(self.drones[id].xy(), r, id),
+            "drone {id} is not clear within {r} m"
+        );
     }
 }

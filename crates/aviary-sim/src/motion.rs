@@ -17,22 +17,12 @@ pub(crate) enum Leg {
     /// a vertical move to `to[2]` at up to the climb rate. `state` is the flight state
     /// while it lasts: `TakingOff` becomes `Flying` at the end, `Landing` becomes `Landed`
     /// (and disarmed).
-    Move {
-        to: [f64; 3],
-        speed: f64,
-        state: FlightState,
-    },
+    Move { to: [f64; 3], speed: f64, state: FlightState },
     /// Hold position for `left` seconds.
     Hold { left: f64 },
     /// `total` radians of a circle, clockwise seen from above, from angle `start`
     /// (counter-clockwise from east), at up to `speed`.
-    Arc {
-        center: [f64; 2],
-        radius: f64,
-        start: f64,
-        total: f64,
-        speed: f64,
-    },
+    Arc { center: [f64; 2], radius: f64, start: f64, total: f64, speed: f64 },
 }
 
 /// A motion call in progress (or, with no call, something the drone does on its own, such
@@ -166,29 +156,15 @@ impl SimDrone {
                     h.arrived && v.arrived
                 }
             }
-            Some(Leg::Arc {
-                center,
-                radius,
-                start,
-                total,
-                speed,
-            }) => {
+            Some(Leg::Arc { center, radius, start, total, speed }) => {
                 let (center, radius, start, total, speed) =
                     (*center, *radius, *start, *total, *speed);
                 let left = (total - task.arc_done) * radius;
-                let step = advance(
-                    left,
-                    task.arc_speed,
-                    limit(speed),
-                    arc_accel(self.spec.accel),
-                    dt,
-                );
+                let step =
+                    advance(left, task.arc_speed, limit(speed), arc_accel(self.spec.accel), dt);
                 task.arc_speed = step.speed;
-                task.arc_done = if step.arrived {
-                    total
-                } else {
-                    task.arc_done + step.moved / radius
-                };
+                task.arc_done =
+                    if step.arrived { total } else { task.arc_done + step.moved / radius };
                 let theta = start - task.arc_done;
                 self.pos[0] = center[0] + radius * theta.cos();
                 self.pos[1] = center[1] + radius * theta.sin();
@@ -224,22 +200,10 @@ impl SimDrone {
 /// The legs of `Orbit`: to the nearest point of the circle, then `laps` turns.
 pub(crate) fn orbit_legs(d: &SimDrone, center: [f64; 2], radius: f64, laps: f64) -> Vec<Leg> {
     let (dx, dy) = (d.pos[0] - center[0], d.pos[1] - center[1]);
-    let start = if dx == 0.0 && dy == 0.0 {
-        0.0
-    } else {
-        dy.atan2(dx)
-    };
-    let entry = [
-        center[0] + radius * start.cos(),
-        center[1] + radius * start.sin(),
-        d.level(),
-    ];
+    let start = if dx == 0.0 && dy == 0.0 { 0.0 } else { dy.atan2(dx) };
+    let entry = [center[0] + radius * start.cos(), center[1] + radius * start.sin(), d.level()];
     vec![
-        Leg::Move {
-            to: entry,
-            speed: d.spec.max_speed,
-            state: FlightState::Flying,
-        },
+        Leg::Move { to: entry, speed: d.spec.max_speed, state: FlightState::Flying },
         Leg::Arc {
             center,
             radius,

@@ -37,7 +37,11 @@ impl Nearby {
     pub fn around(&mut self, grid: &Grid, a: [f64; 2], b: [f64; 2], r: f64) -> &[usize] {
         let lo = [a[0].min(b[0]) - r, a[1].min(b[1]) - r];
         let hi = [a[0].max(b[0]) + r, a[1].max(b[1]) + r];
-        let inside = r <= self.range && lo[0] >= self.lo[0] && lo[1] >= self.lo[1] && hi[0] <= self.hi[0] && hi[1] <= self.hi[1];
+        let inside = r <= self.range
+            && lo[0] >= self.lo[0]
+            && lo[1] >= self.lo[1]
+            && hi[0] <= self.hi[0]
+            && hi[1] <= self.hi[1];
         if !inside {
             let m = WIDEN * r + WIDEN_M;
             (self.lo, self.hi, self.range) = ([lo[0] - m, lo[1] - m], [hi[0] + m, hi[1] + m], r);

@@ -26,11 +26,7 @@ pub(crate) struct Advance {
 /// within the bound.
 pub(crate) fn advance(remaining: f64, speed: f64, vmax: f64, a: f64, dt: f64) -> Advance {
     if remaining <= EPS {
-        return Advance {
-            moved: remaining.max(0.0),
-            speed: 0.0,
-            arrived: true,
-        };
+        return Advance { moved: remaining.max(0.0), speed: 0.0, arrived: true };
     }
     // v1^2 / (2a) + (speed + v1) / 2 * dt <= remaining, solved for v1.
     let c = remaining - speed * dt / 2.0;
@@ -43,17 +39,9 @@ pub(crate) fn advance(remaining: f64, speed: f64, vmax: f64, a: f64, dt: f64) ->
     let v1 = brake.min(vmax).min(speed + a * dt).max(lowest);
     let moved = (speed + v1) / 2.0 * dt;
     if moved >= remaining - SNAP {
-        Advance {
-            moved: remaining,
-            speed: 0.0,
-            arrived: true,
-        }
+        Advance { moved: remaining, speed: 0.0, arrived: true }
     } else {
-        Advance {
-            moved,
-            speed: v1,
-            arrived: false,
-        }
+        Advance { moved, speed: v1, arrived: false }
     }
 }
 

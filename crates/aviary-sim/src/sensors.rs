@@ -52,7 +52,10 @@ pub(crate) fn scan(
         // Far outside the box of the way widened by the range: out of range, without the
         // kind's string or the found list (the margin is far above rounding).
         let slack = act.range * (1.0 + 1e-9) + 1e-9;
-        let (lo, hi) = ([from[0].min(to[0]) - slack, from[1].min(to[1]) - slack], [from[0].max(to[0]) + slack, from[1].max(to[1]) + slack]);
+        let (lo, hi) = (
+            [from[0].min(to[0]) - slack, from[1].min(to[1]) - slack],
+            [from[0].max(to[0]) + slack, from[1].max(to[1]) + slack],
+        );
         for (i, target) in candidates.iter().map(|&i| (i, &targets[i])) {
             let at = [target.at[0], target.at[1]];
             if at[0] < lo[0] || at[0] > hi[0] || at[1] < lo[1] || at[1] > hi[1] {

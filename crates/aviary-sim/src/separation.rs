@@ -64,10 +64,7 @@ pub(crate) struct Envelope {
 
 /// The current leg, when the task is moving along it.
 fn current_leg(d: &SimDrone) -> Option<&Leg> {
-    d.motion
-        .as_ref()
-        .filter(|t| !t.paused)
-        .and_then(|t| t.legs.front())
+    d.motion.as_ref().filter(|t| !t.paused).and_then(|t| t.legs.front())
 }
 
 pub(crate) fn envelope(d: &SimDrone) -> Envelope {
@@ -88,20 +85,11 @@ pub(crate) fn envelope(d: &SimDrone) -> Envelope {
     let to = if vh == 0.0 {
         here
     } else {
-        [
-            here[0] + d.vel[0] / vh * stop,
-            here[1] + d.vel[1] / vh * stop,
-        ]
+        [here[0] + d.vel[0] / vh * stop, here[1] + d.vel[1] / vh * stop]
     };
     let z = d.pos[2];
     let stop = z + d.vel[2] * d.vel[2].abs() / (2.0 * d.spec.accel);
-    Envelope {
-        from: here,
-        to,
-        pad,
-        low: z.min(stop).max(0.0),
-        high: z.max(stop),
-    }
+    Envelope { from: here, to, pad, low: z.min(stop).max(0.0), high: z.max(stop) }
 }
 
 fn cross(o: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -237,13 +225,7 @@ impl SimDrone {
                     return;
                 }
             }
-            Some(Leg::Arc {
-                center,
-                radius,
-                start,
-                total,
-                ..
-            }) => {
+            Some(Leg::Arc { center, radius, start, total, .. }) => {
                 let (moved, after) = brake(task.arc_speed, arc_accel(a), dt);
                 task.arc_done = (task.arc_done + moved / radius).min(*total);
                 task.arc_speed = after;
@@ -457,12 +439,6 @@ impl Fleet {
         d.humble = false;
         d.stalled = 0.0;
         d.settle();
-        Some(Report::Ended {
-            call,
-            end: CallEnd::Failed(Failure {
-                exception: "Timeout",
-                reason,
-            }),
-        })
+        Some(Report::Ended { call, end: CallEnd::Failed(Failure { exception: "Timeout", reason }) })
     }
 }

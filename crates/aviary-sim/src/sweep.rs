@@ -22,10 +22,8 @@ mod tests {
         let ny = ((hi[1] - lo[1]) / step).ceil() as usize;
         for i in 0..=nx {
             for j in 0..=ny {
-                let p = [
-                    (lo[0] + i as f64 * step).min(hi[0]),
-                    (lo[1] + j as f64 * step).min(hi[1]),
-                ];
+                let p =
+                    [(lo[0] + i as f64 * step).min(hi[0]), (lo[1] + j as f64 * step).min(hi[1])];
                 if contains(polygon, p) {
                     worst = worst.max(dist_to_polyline(p, path));
                 }
@@ -58,11 +56,7 @@ mod tests {
     fn covers_an_l_shape() {
         let l = crate::geom::L_SHAPE;
         let path = lawnmower(&l, 15.0);
-        assert!(
-            worst_gap(&l, &path, 0.5) <= 7.5 + 1e-6,
-            "gap {}",
-            worst_gap(&l, &path, 0.5)
-        );
+        assert!(worst_gap(&l, &path, 0.5) <= 7.5 + 1e-6, "gap {}", worst_gap(&l, &path, 0.5));
     }
 
     #[test]

@@ -71,12 +71,28 @@ pub struct Capability {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Section {
-    Requirements { conditions: Vec<Expr>, body_header_end: u32, span: Span },
-    Defaults { entries: Vec<DefaultEntry>, body_header_end: u32, span: Span },
+    Requirements {
+        conditions: Vec<Expr>,
+        body_header_end: u32,
+        span: Span,
+    },
+    Defaults {
+        entries: Vec<DefaultEntry>,
+        body_header_end: u32,
+        span: Span,
+    },
     /// `PERFORM:` has no name; `PERFORM X:` is a leash section (`ABORT`, `PAUSE`,
     /// `RESUME` or a name of the user's).
-    Perform { name: Option<Ident>, body: Body, span: Span },
-    Exceptions { handlers: Vec<ExceptionHandler>, body_header_end: u32, span: Span },
+    Perform {
+        name: Option<Ident>,
+        body: Body,
+        span: Span,
+    },
+    Exceptions {
+        handlers: Vec<ExceptionHandler>,
+        body_header_end: u32,
+        span: Span,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -131,7 +147,12 @@ impl Stmt {
                 i.branches.iter().for_each(|(_, b)| f(b));
                 i.otherwise.iter().for_each(f);
             }
-            Stmt::Statement(_) | Stmt::Leash(_) | Stmt::Api(_) | Stmt::Signal(_) | Stmt::Throw(_) | Stmt::Error(_) => {}
+            Stmt::Statement(_)
+            | Stmt::Leash(_)
+            | Stmt::Api(_)
+            | Stmt::Signal(_)
+            | Stmt::Throw(_)
+            | Stmt::Error(_) => {}
         }
     }
 }
@@ -349,7 +370,11 @@ pub struct Expr {
 #[derive(Clone, Debug, PartialEq)]
 pub enum ExprKind {
     /// `digits` is the number as written, sign included, without its unit.
-    Number { digits: String, value: f64, unit: Option<Unit> },
+    Number {
+        digits: String,
+        value: f64,
+        unit: Option<Unit>,
+    },
     String(String),
     Bool(bool),
     /// `(x, y)` or `(x, y, z)`, local metres.

@@ -18,14 +18,22 @@ pub struct Layout {
     pub line_starts: Vec<u32>,
 }
 
-pub fn layout(file: FileId, lexed: &Lexed, text_len: usize, diagnostics: &mut Vec<Diagnostic>) -> Layout {
+pub fn layout(
+    file: FileId,
+    lexed: &Lexed,
+    text_len: usize,
+    diagnostics: &mut Vec<Diagnostic>,
+) -> Layout {
     let lines = &lexed.lines;
     let line_tokens = |i: usize| -> &[RawToken] {
         let start = lines[i].first_token as usize;
         let end = lines.get(i + 1).map_or(lexed.tokens.len(), |l| l.first_token as usize);
         &lexed.tokens[start..end]
     };
-    let mut out = Layout { tokens: Vec::with_capacity(lexed.tokens.len() + lines.len() * 2), line_starts: Vec::new() };
+    let mut out = Layout {
+        tokens: Vec::with_capacity(lexed.tokens.len() + lines.len() * 2),
+        line_starts: Vec::new(),
+    };
     let mut stack: Vec<u32> = vec![0];
     let mut i = 0;
     while i < lines.len() {
@@ -36,7 +44,10 @@ pub fn layout(file: FileId, lexed: &Lexed, text_len: usize, diagnostics: &mut Ve
         let top = *stack.last().unwrap_or(&0);
         if indent > top {
             stack.push(indent);
-            out.tokens.push(Token { kind: TokenKind::Indent, span: Span::point(first.span.start as usize) });
+            out.tokens.push(Token {
+                kind: TokenKind::Indent,
+                span: Span::point(first.span.start as usize),
+            });
         } else if indent < top && !stack.contains(&indent) {
             // Between two levels: reported, and read as a line of the current block,
             // so that the lines after it, at the right depth, read as written.
@@ -56,7 +67,10 @@ pub fn layout(file: FileId, lexed: &Lexed, text_len: usize, diagnostics: &mut Ve
         } else {
             while *stack.last().unwrap_or(&0) > indent {
                 stack.pop();
-                out.tokens.push(Token { kind: TokenKind::Dedent, span: Span::point(first.span.start as usize) });
+                out.tokens.push(Token {
+                    kind: TokenKind::Dedent,
+                    span: Span::point(first.span.start as usize),
+                });
             }
         }
         out.line_starts.push(first.span.start);
@@ -90,7 +104,13 @@ fn logical_end<'t>(
     let first = tokens_of(i);
     let header = matches!(
         first[0].kind,
-        TokenKind::Keyword(Keyword::Mission | Keyword::Capability | Keyword::Sequential | Keyword::Parallel | Keyword::On)
+        TokenKind::Keyword(
+            Keyword::Mission
+                | Keyword::Capability
+                | Keyword::Sequential
+                | Keyword::Parallel
+                | Keyword::On
+        )
     );
     let ends_in_colon = |k: usize| tokens_of(k).last().map(|t| t.kind) == Some(TokenKind::Colon);
     let mut depth = paren_delta(first);
@@ -120,8 +140,12 @@ fn paren_delta(tokens: &[RawToken]) -> i32 {
 /// Whether `line` may continue the header whose previous line is `before`: a line that
 /// starts a construct never does, except `ON ...` after a lone `SEQUENTIAL`/`PARALLEL`.
 fn continues(before: &[RawToken], line: &[RawToken]) -> bool {
-    let after_mode = matches!(before.last().map(|t| t.kind), Some(TokenKind::Keyword(Keyword::Sequential | Keyword::Parallel)));
-    !starts_construct(line[0].kind) || (after_mode && line[0].kind == TokenKind::Keyword(Keyword::On))
+    let after_mode = matches!(
+        before.last().map(|t| t.kind),
+        Some(TokenKind::Keyword(Keyword::Sequential | Keyword::Parallel))
+    );
+    !starts_construct(line[0].kind)
+        || (after_mode && line[0].kind == TokenKind::Keyword(Keyword::On))
 }
 
 /// A line that starts with one of these is a construct of its own, never a continuation.
@@ -130,8 +154,23 @@ fn starts_construct(kind: TokenKind) -> bool {
     matches!(
         kind,
         TokenKind::Keyword(
-            Mission | Capability | Sequential | Parallel | On | Signal | Throw | StartIf | WaitFor | DoWhile | If
-                | Else | Requirements | Defaults | Perform | Exceptions | Use
+            Mission
+                | Capability
+                | Sequential
+                | Parallel
+                | On
+                | Signal
+                | Throw
+                | StartIf
+                | WaitFor
+                | DoWhile
+                | If
+                | Else
+                | Requirements
+                | Defaults
+                | Perform
+                | Exceptions
+                | Use
         )
     )
 }

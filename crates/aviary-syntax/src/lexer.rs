@@ -27,7 +27,16 @@ pub struct Lexed {
 }
 
 pub fn lex(file: FileId, text: &str, diagnostics: &mut Vec<Diagnostic>) -> Lexed {
-    let mut lexer = Lexer { file, text, bytes: text.as_bytes(), pos: 0, line_start: 0, line_has_token: false, out: Lexed { tokens: Vec::new(), lines: Vec::new(), comments: Vec::new() }, diagnostics };
+    let mut lexer = Lexer {
+        file,
+        text,
+        bytes: text.as_bytes(),
+        pos: 0,
+        line_start: 0,
+        line_has_token: false,
+        out: Lexed { tokens: Vec::new(), lines: Vec::new(), comments: Vec::new() },
+        diagnostics,
+    };
     lexer.run();
     lexer.out
 }
@@ -87,9 +96,14 @@ impl Lexer<'_> {
         loop {
             if self.pos >= self.bytes.len() {
                 self.diagnostics.push(
-                    Diagnostic::new(Code::UnterminatedComment, self.file, Span::new(start, start + 2), "this comment is never closed")
-                        .label("opened here")
-                        .with_help("end the comment with `*/`"),
+                    Diagnostic::new(
+                        Code::UnterminatedComment,
+                        self.file,
+                        Span::new(start, start + 2),
+                        "this comment is never closed",
+                    )
+                    .label("opened here")
+                    .with_help("end the comment with `*/`"),
                 );
                 break;
             }
@@ -102,7 +116,9 @@ impl Lexer<'_> {
             }
             self.pos += 1;
         }
-        self.out.comments.push(Comment { span: Span::new(start, self.pos), kind: CommentKind::Block });
+        self.out
+            .comments
+            .push(Comment { span: Span::new(start, self.pos), kind: CommentKind::Block });
     }
 
     fn push(&mut self, kind: TokenKind, start: usize) {
@@ -126,9 +142,14 @@ impl Lexer<'_> {
                     if !reported {
                         reported = true;
                         self.diagnostics.push(
-                            Diagnostic::new(Code::TabIndent, self.file, Span::new(at, at + 1), "a tab in the indentation")
-                                .label("tab")
-                                .with_help("indent with spaces only: 4 spaces for each level"),
+                            Diagnostic::new(
+                                Code::TabIndent,
+                                self.file,
+                                Span::new(at, at + 1),
+                                "a tab in the indentation",
+                            )
+                            .label("tab")
+                            .with_help("indent with spaces only: 4 spaces for each level"),
                         );
                     }
                     columns += 4;
@@ -156,8 +177,13 @@ impl Lexer<'_> {
             b'=' if self.peek(1) == b'=' => {
                 self.pos += 2;
                 self.diagnostics.push(
-                    Diagnostic::new(Code::Syntax, self.file, Span::new(start, self.pos), "`==` is not an operator here")
-                        .with_help("compare with a single `=`, as in `type = Body`"),
+                    Diagnostic::new(
+                        Code::Syntax,
+                        self.file,
+                        Span::new(start, self.pos),
+                        "`==` is not an operator here",
+                    )
+                    .with_help("compare with a single `=`, as in `type = Body`"),
                 );
                 TokenKind::Eq
             }
@@ -214,7 +240,10 @@ impl Lexer<'_> {
         }
         // A glued unit: `20m`, `5m/s`, `30km/h`, `25%`.
         if self.peek(0).is_ascii_alphabetic() || self.peek(0) == b'%' {
-            while self.peek(0).is_ascii_alphanumeric() || self.peek(0) == b'%' || self.peek(0) == b'_' {
+            while self.peek(0).is_ascii_alphanumeric()
+                || self.peek(0) == b'%'
+                || self.peek(0) == b'_'
+            {
                 self.pos += 1;
             }
             if self.peek(0) == b'/' && self.peek(1).is_ascii_alphabetic() {
@@ -230,7 +259,10 @@ impl Lexer<'_> {
     fn string(&mut self) {
         let start = self.pos;
         self.pos += 1;
-        while self.pos < self.bytes.len() && self.bytes[self.pos] != b'"' && self.bytes[self.pos] != b'\n' {
+        while self.pos < self.bytes.len()
+            && self.bytes[self.pos] != b'"'
+            && self.bytes[self.pos] != b'\n'
+        {
             self.pos += 1;
         }
         if self.peek(0) == b'"' {
@@ -238,8 +270,13 @@ impl Lexer<'_> {
         } else {
             let end = trim_cr(self.bytes, start, self.pos);
             self.diagnostics.push(
-                Diagnostic::new(Code::UnterminatedString, self.file, Span::new(start, end), "this string has no closing quote")
-                    .with_help("end the string with `\"` on the same line"),
+                Diagnostic::new(
+                    Code::UnterminatedString,
+                    self.file,
+                    Span::new(start, end),
+                    "this string has no closing quote",
+                )
+                .with_help("end the string with `\"` on the same line"),
             );
             self.pos = end;
         }
@@ -262,12 +299,18 @@ impl Lexer<'_> {
         let help = if first.is_alphabetic() {
             "names use only the letters A-Z and a-z, digits and `_`".to_string()
         } else {
-            "remove it; the language uses only `: , ( ) . = != < <= > >= -` between words".to_string()
+            "remove it; the language uses only `: , ( ) . = != < <= > >= -` between words"
+                .to_string()
         };
         let shown: String = first.escape_debug().collect();
         self.diagnostics.push(
-            Diagnostic::new(Code::UnknownCharacter, self.file, Span::new(start, self.pos), format!("unexpected character `{shown}`"))
-                .with_help(help),
+            Diagnostic::new(
+                Code::UnknownCharacter,
+                self.file,
+                Span::new(start, self.pos),
+                format!("unexpected character `{shown}`"),
+            )
+            .with_help(help),
         );
         self.push(TokenKind::Unknown, start);
     }

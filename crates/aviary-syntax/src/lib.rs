@@ -36,9 +36,14 @@ pub fn parse(file: FileId, text: &str) -> Parse {
     let mut diagnostics = Vec::new();
     if let Some(nul) = text.find('\0') {
         diagnostics.push(
-            Diagnostic::new(Code::BinaryFile, file, Span::new(nul, nul + 1), "this file holds binary data, not mission text")
-                .label("NUL byte")
-                .with_help("check that this is the .mission file you meant"),
+            Diagnostic::new(
+                Code::BinaryFile,
+                file,
+                Span::new(nul, nul + 1),
+                "this file holds binary data, not mission text",
+            )
+            .label("NUL byte")
+            .with_help("check that this is the .mission file you meant"),
         );
         return Parse { tree: ast::SourceFile::default(), diagnostics, line_starts: Vec::new() };
     }
@@ -66,14 +71,22 @@ pub fn parse_value(text: &str) -> Result<ast::Expr, Vec<Diagnostic>> {
     // Leading blanks would read as an indented line.
     let text = text.trim();
     if text.contains(['\n', '\r', '\0']) {
-        return Err(vec![Diagnostic::new(Code::Syntax, file, Span::point(0), "a value is one line of text")]);
+        return Err(vec![Diagnostic::new(
+            Code::Syntax,
+            file,
+            Span::point(0),
+            "a value is one line of text",
+        )]);
     }
     let lexed = lexer::lex(file, text, &mut diagnostics);
     let layout = layout::layout(file, &lexed, text.len(), &mut diagnostics);
     let value = parser::parse_value_tokens(file, text, layout.tokens, &mut diagnostics);
-    match diagnostics.iter().any(Diagnostic::is_error) || matches!(value.kind, ast::ExprKind::Error) {
+    match diagnostics.iter().any(Diagnostic::is_error) || matches!(value.kind, ast::ExprKind::Error)
+    {
         false => Ok(value),
-        true if diagnostics.is_empty() => Err(vec![Diagnostic::new(Code::Syntax, file, value.span, "not a value")]),
+        true if diagnostics.is_empty() => {
+            Err(vec![Diagnostic::new(Code::Syntax, file, value.span, "not a value")])
+        }
         true => Err(diagnostics),
     }
 }
@@ -87,7 +100,11 @@ pub fn parse_bytes(file: FileId, bytes: &[u8]) -> (String, Parse) {
             (text, parse)
         }
         (text, Some(at)) => {
-            let parse = Parse { tree: ast::SourceFile::default(), diagnostics: vec![invalid_utf8(file, at)], line_starts: Vec::new() };
+            let parse = Parse {
+                tree: ast::SourceFile::default(),
+                diagnostics: vec![invalid_utf8(file, at)],
+                line_starts: Vec::new(),
+            };
             (text, parse)
         }
     }
@@ -103,7 +120,12 @@ pub fn decode(bytes: &[u8]) -> (String, Option<usize>) {
 }
 
 pub fn invalid_utf8(file: FileId, at: usize) -> Diagnostic {
-    Diagnostic::new(Code::InvalidUtf8, file, Span::new(at, at + 1), "this file is not valid UTF-8 text")
-        .label("the first byte that is not UTF-8")
-        .with_help("save the file as UTF-8")
+    Diagnostic::new(
+        Code::InvalidUtf8,
+        file,
+        Span::new(at, at + 1),
+        "this file is not valid UTF-8 text",
+    )
+    .label("the first byte that is not UTF-8")
+    .with_help("save the file as UTF-8")
 }

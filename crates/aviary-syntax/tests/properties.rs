@@ -13,11 +13,7 @@ use proptest::prelude::*;
 /// a long hunt.
 fn config() -> ProptestConfig {
     let cases = std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(256);
-    ProptestConfig {
-        cases,
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    }
+    ProptestConfig { cases, failure_persistence: None, ..ProptestConfig::default() }
 }
 
 /// Every span the parse reports lies inside the text; and a parse without errors formats
@@ -56,7 +52,9 @@ fn check_parse(len: usize, text: &str, parse: &Parse) {
 /// Every `Span { start, end }` in a tree's `Debug` text, and every `header_end` (as an
 /// empty span).
 fn tree_spans(debug: &str) -> Vec<(usize, usize)> {
-    let number = |text: &str| -> Option<usize> { text[..text.find(|c: char| !c.is_ascii_digit()).unwrap_or(text.len())].parse().ok() };
+    let number = |text: &str| -> Option<usize> {
+        text[..text.find(|c: char| !c.is_ascii_digit()).unwrap_or(text.len())].parse().ok()
+    };
     let mut spans = Vec::new();
     for (at, _) in debug.match_indices("Span { start: ") {
         let rest = &debug[at + "Span { start: ".len()..];
@@ -155,7 +153,8 @@ const INSERTED: &[u8] = b" \n\t:(),.=-/*\"%<>!ABZamz09_\0\xc3\xff";
 fn mutation() -> impl Strategy<Value = Mutation> {
     prop_oneof![
         any::<usize>().prop_map(Mutation::DeleteChar),
-        (any::<usize>(), prop::sample::select(INSERTED)).prop_map(|(i, b)| Mutation::InsertChar(i, b)),
+        (any::<usize>(), prop::sample::select(INSERTED))
+            .prop_map(|(i, b)| Mutation::InsertChar(i, b)),
         any::<usize>().prop_map(Mutation::DuplicateChar),
         any::<usize>().prop_map(Mutation::SwapChars),
         any::<usize>().prop_map(Mutation::DeleteLine),
@@ -197,7 +196,8 @@ fn apply(bytes: &mut Vec<u8>, m: &Mutation) {
             if by >= 0 {
                 line.splice(0..0, std::iter::repeat_n(b' ', by as usize));
             } else {
-                let spaces = line.iter().take_while(|&&b| b == b' ').count().min(by.unsigned_abs() as usize);
+                let spaces =
+                    line.iter().take_while(|&&b| b == b' ').count().min(by.unsigned_abs() as usize);
                 line.drain(..spaces);
             }
             *bytes = lines.join(&b'\n');
@@ -233,23 +233,19 @@ struct Gen {
     newline: &'static str,
 }
 
-const NAMES: &[&str] = &[
-    "drone1", "drone2", "d", "lead", "area", "Home", "Body", "x_1", "_tmp", "Area2", "where",
-];
+const NAMES: &[&str] =
+    &["drone1", "drone2", "d", "lead", "area", "Home", "Body", "x_1", "_tmp", "Area2", "where"];
 const CAPS: &[&str] = &["TakeOff", "FlyTo", "Search", "Hover", "Land", "FlyCircle", "DeployBeacon"];
 const SIGNALS: &[&str] = &["Ready", "Found", "Done", "Detected", "BatteryCritical", "Lost"];
 const UNITS: &[&str] = &["", "m", "km", "s", "min", "h", "m/s", "km/h", "deg", "%"];
 const SPACED_UNITS: &[&str] = &["m", "km", "s", "min", "h", "deg", "m/s", "km/h"];
 const DIGITS: &[&str] = &["0", "1", "20", "2.5", "100", "007", "3.14159", "46.61"];
-const COMMENTS: &[&str] = &["note", "TODO: check this", "a / b * c", "ÄÖÜ 🚁", "", "WITH AND OR: (x)"];
+const COMMENTS: &[&str] =
+    &["note", "TODO: check this", "a / b * c", "ÄÖÜ 🚁", "", "WITH AND OR: (x)"];
 
 impl Gen {
     fn new(seed: u64) -> Gen {
-        let mut g = Gen {
-            state: seed ^ 0x9E37_79B9_7F4A_7C15,
-            out: String::new(),
-            newline: "\n",
-        };
+        let mut g = Gen { state: seed ^ 0x9E37_79B9_7F4A_7C15, out: String::new(), newline: "\n" };
         g.next();
         if g.chance(10) {
             g.newline = "\r\n";
@@ -313,7 +309,11 @@ impl Gen {
         match choice {
             0 | 1 => self.number(),
             2 => self.name(),
-            3 => format!("{}.{}", self.name(), self.pick(&["position", "battery", "altitude", "kind"])),
+            3 => format!(
+                "{}.{}",
+                self.name(),
+                self.pick(&["position", "battery", "altitude", "kind"])
+            ),
             4 => self.pick(&["\"hello, world\"", "\"\"", "TRUE", "FALSE", "\"a  b\""]).to_string(),
             5 | 6 => {
                 let n = 2 + self.below(2);
@@ -692,7 +692,8 @@ impl Gen {
         for _ in 0..self.below(2) {
             self.capability(2);
         }
-        let text = format!("MISSION{}{}{}:", self.sp(), self.pick(&["Rescue", "M", "Test_1"]), self.osp());
+        let text =
+            format!("MISSION{}{}{}:", self.sp(), self.pick(&["Rescue", "M", "Test_1"]), self.osp());
         self.line(0, &text);
         self.body(0, 4, false);
         for _ in 0..self.below(2) {
@@ -737,7 +738,8 @@ fn ten_thousand_parentheses() {
 
 #[test]
 fn ten_thousand_parentheses_in_a_value() {
-    let text = format!("MISSION M:\n    d FlyTo WITH {}1, 2{}\n", "(".repeat(10_000), ")".repeat(10_000));
+    let text =
+        format!("MISSION M:\n    d FlyTo WITH {}1, 2{}\n", "(".repeat(10_000), ")".repeat(10_000));
     assert!(codes(&text).contains(&Code::NestingTooDeep));
 }
 
@@ -811,7 +813,8 @@ fn tab_is_e004() {
 fn inconsistent_dedent_is_e005() {
     let text = "MISSION M:\n    SEQUENTIAL:\n        a Land\n      b Land\n";
     let parse = parse(FileId(0), text);
-    let dedent = parse.diagnostics.iter().find(|d| d.code == Code::InconsistentDedent).expect("E005");
+    let dedent =
+        parse.diagnostics.iter().find(|d| d.code == Code::InconsistentDedent).expect("E005");
     assert_eq!(&text[dedent.primary.span.range()], "b");
 }
 

@@ -4,11 +4,11 @@
 //! messages and simulated seconds, and sends what it returns.
 
 use aviary_api::{CallEnd, CallId, DroneEvent, FlightState, Value};
-use aviary_mavlink::Origin;
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
     MavCmd, MavMessage, MavResult, MavSeverity, COMMAND_ACK_DATA, STATUSTEXT_DATA,
 };
 use aviary_mavlink::mode::COPTER_RTL;
+use aviary_mavlink::Origin;
 use aviary_sim::{Fleet, Report};
 use aviary_world::World;
 
@@ -25,10 +25,7 @@ pub struct Behaviour {
 
 impl Default for Behaviour {
     fn default() -> Behaviour {
-        Behaviour {
-            boot_time: 1.0,
-            prearm_time: 3.0,
-        }
+        Behaviour { boot_time: 1.0, prearm_time: 3.0 }
     }
 }
 
@@ -86,13 +83,7 @@ pub struct Reply {
 
 impl Reply {
     pub fn asker(system: u8, msg: impl Into<Wire>) -> Reply {
-        Reply {
-            to: To::Asker,
-            out: Out {
-                system,
-                msg: msg.into(),
-            },
-        }
+        Reply { to: To::Asker, out: Out { system, msg: msg.into() } }
     }
 
     pub fn all(out: Out) -> Reply {
@@ -148,15 +139,11 @@ impl Autopilot {
                 }
             })
             .collect();
-        let origin = world
-            .site
-            .origin
-            .as_ref()
-            .map_or(Origin::default(), |g| Origin {
-                lat: g.lat,
-                lon: g.lon,
-                alt: g.alt,
-            });
+        let origin = world.site.origin.as_ref().map_or(Origin::default(), |g| Origin {
+            lat: g.lat,
+            lon: g.lon,
+            alt: g.alt,
+        });
         Autopilot {
             fleet: Fleet::new(world),
             origin,
@@ -177,9 +164,7 @@ impl Autopilot {
 
     /// The drone's flight state (Lost when the simulator has no such drone).
     pub(crate) fn state(&self, i: usize) -> FlightState {
-        self.fleet
-            .telemetry(i)
-            .map_or(FlightState::Lost, |t| t.state)
+        self.fleet.telemetry(i).map_or(FlightState::Lost, |t| t.state)
     }
 
     /// Whether the drone's radio works (a world `link_loss` fault silences it).
@@ -242,19 +227,13 @@ impl Autopilot {
                 if !self.copters[i].home_set {
                     self.copters[i].home_set = true;
                     if let Some(home) = self.home_position(i) {
-                        out.push(Out {
-                            system: self.copters[i].system,
-                            msg: home.into(),
-                        });
+                        out.push(Out { system: self.copters[i].system, msg: home.into() });
                     }
                 }
             }
         }
         for (i, c) in self.copters.iter_mut().enumerate() {
-            let state = self
-                .fleet
-                .telemetry(i)
-                .map_or(FlightState::Lost, |t| t.state);
+            let state = self.fleet.telemetry(i).map_or(FlightState::Lost, |t| t.state);
             if c.was_airborne && !state.airborne() {
                 // Down (landed, or fallen): the motors stop, as ArduCopter's auto-disarm.
                 c.armed = false;

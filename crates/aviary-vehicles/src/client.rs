@@ -130,11 +130,7 @@ impl Client {
     pub fn telemetry(&self, o: Out) {
         let mut l = lock(&self.lanes);
         let id = o.msg.message_id();
-        match l
-            .telemetry
-            .iter_mut()
-            .find(|t| t.system == o.system && t.msg.message_id() == id)
-        {
+        match l.telemetry.iter_mut().find(|t| t.system == o.system && t.msg.message_id() == id) {
             Some(waiting) => *waiting = o,
             None => l.telemetry.push_back(o),
         }
@@ -176,11 +172,7 @@ impl Sequences {
         let s = &mut self.0[usize::from(system)];
         let sequence = *s;
         *s = s.wrapping_add(1);
-        MavHeader {
-            system_id: u32::from(system),
-            component_id: 1,
-            sequence,
-        }
+        MavHeader { system_id: u32::from(system), component_id: 1, sequence }
     }
 }
 
@@ -213,10 +205,7 @@ mod tests {
     use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavMessage, HEARTBEAT_DATA};
 
     fn out(system: u8, msg: MavMessage) -> Out {
-        Out {
-            system,
-            msg: msg.into(),
-        }
+        Out { system, msg: msg.into() }
     }
 
     #[test]
@@ -241,11 +230,7 @@ mod tests {
         assert_eq!(order.len(), 4);
         assert_eq!((order[0].0, order[0].1), (1, "STATUSTEXT"));
         assert_eq!((order[1].0, order[1].1), (1, "HEARTBEAT"));
-        assert_eq!(
-            order[2].2,
-            pos(2).into(),
-            "the newer position replaced the older"
-        );
+        assert_eq!(order[2].2, pos(2).into(), "the newer position replaced the older");
         assert_eq!(order[3].0, 2);
     }
 
@@ -256,10 +241,7 @@ mod tests {
             c.event(out(1, MavMessage::STATUSTEXT(Default::default())));
         }
         for t in 0..BEAT_BACKLOG as u32 + 5 {
-            let hb = HEARTBEAT_DATA {
-                custom_mode: t,
-                ..Default::default()
-            };
+            let hb = HEARTBEAT_DATA { custom_mode: t, ..Default::default() };
             c.heartbeat(out(1, MavMessage::HEARTBEAT(hb)));
         }
         let all: Vec<_> = std::iter::from_fn(|| c.pop()).collect();
@@ -270,11 +252,7 @@ mod tests {
                 _ => None,
             })
             .collect();
-        assert_eq!(
-            all.len() - beats.len(),
-            EVENTS_MAX,
-            "events past the limit dropped"
-        );
+        assert_eq!(all.len() - beats.len(), EVENTS_MAX, "events past the limit dropped");
         assert_eq!(beats.len(), BEAT_BACKLOG);
         assert_eq!(beats[0], 5, "the oldest heartbeats went first");
         assert_eq!(*beats.last().unwrap(), BEAT_BACKLOG as u32 + 4);

@@ -18,11 +18,7 @@ pub struct Answer {
 
 impl Answer {
     pub fn of(result: MavResult) -> Answer {
-        Answer {
-            result,
-            before: Vec::new(),
-            after: Vec::new(),
-        }
+        Answer { result, before: Vec::new(), after: Vec::new() }
     }
 
     /// A refusal with the autopilot's reason, a STATUSTEXT every ground station sees (as
@@ -30,11 +26,7 @@ impl Answer {
     pub fn failed(system: u8, result: MavResult, why: Option<String>) -> Answer {
         let mut a = Answer::of(result);
         if let Some(why) = why {
-            a.before.push(Reply::all(text(
-                system,
-                MavSeverity::MAV_SEVERITY_WARNING,
-                &why,
-            )));
+            a.before.push(Reply::all(text(system, MavSeverity::MAV_SEVERITY_WARNING, &why)));
         }
         a
     }
@@ -87,10 +79,7 @@ impl Autopilot {
                 // ArduCopter sets home where it arms, and says so on every link; the
                 // simulator's home does not move, so the same home is said again.
                 if let Some(home) = self.home_position(i).filter(|_| self.copters[i].armed) {
-                    a.after.push(Reply::all(Out {
-                        system,
-                        msg: home.into(),
-                    }));
+                    a.after.push(Reply::all(Out { system, msg: home.into() }));
                 }
                 a
             }

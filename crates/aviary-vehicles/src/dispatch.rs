@@ -30,10 +30,7 @@ fn targets(ap: &Autopilot, system: u8, component: Option<u8>) -> Vec<usize> {
 
 fn answered(system: u8, command: MavCmd, a: Answer, from: (u8, u8)) -> Vec<Reply> {
     let mut out = a.before;
-    out.push(Reply {
-        to: To::Asker,
-        out: ack(system, command, a.result, from),
-    });
+    out.push(Reply { to: To::Asker, out: ack(system, command, a.result, from) });
     out.extend(a.after);
     out
 }
@@ -52,9 +49,7 @@ pub fn dispatch(
             Some(c.target_component),
             Some(Command {
                 id: c.command,
-                p: [
-                    c.param1, c.param2, c.param3, c.param4, c.param5, c.param6, c.param7,
-                ],
+                p: [c.param1, c.param2, c.param3, c.param4, c.param5, c.param6, c.param7],
                 int: None,
             }),
         ),
@@ -84,10 +79,7 @@ pub fn dispatch(
         match (msg, &command) {
             (_, Some(c)) if c.id == MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL => {
                 let result = set_interval(client, me, c.p[0], c.p[1]);
-                out.push(Reply {
-                    to: To::Asker,
-                    out: ack(me, c.id, result, from),
-                });
+                out.push(Reply { to: To::Asker, out: ack(me, c.id, result, from) });
             }
             (_, Some(c)) => out.extend(answered(me, c.id, ap.command(i, c), from)),
             (MavMessage::SET_MODE(m), _) => {
@@ -104,11 +96,8 @@ pub fn dispatch(
                 }
             }
             (MavMessage::REQUEST_DATA_STREAM(r), _) => {
-                let hz = if r.start_stop == 1 {
-                    f64::from(r.req_message_rate).min(MAX_HZ)
-                } else {
-                    0.0
-                };
+                let hz =
+                    if r.start_stop == 1 { f64::from(r.req_message_rate).min(MAX_HZ) } else { 0.0 };
                 let mut s = client.schedule.lock().unwrap_or_else(|p| p.into_inner());
                 for id in stream_group(r.req_stream_id as u8) {
                     s.set(me, *id, Some(hz));

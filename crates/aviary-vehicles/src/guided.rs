@@ -50,9 +50,7 @@ impl Autopilot {
         {
             return Err("position target ignored: still taking off".into());
         }
-        let same = c
-            .target
-            .is_some_and(|t| (0..3).all(|k| (t[k] - to[k]).abs() < 0.01));
+        let same = c.target.is_some_and(|t| (0..3).all(|k| (t[k] - to[k]).abs() < 0.01));
         if same && c.call.is_some() {
             return Ok(());
         }
@@ -61,14 +59,7 @@ impl Autopilot {
         self.motion(
             i,
             "FlyToPosition",
-            &[
-                Value::Position(Point {
-                    x: to[0],
-                    y: to[1],
-                    z: Some(to[2]),
-                }),
-                Value::Number(speed),
-            ],
+            &[Value::Position(Point { x: to[0], y: to[1], z: Some(to[2]) }), Value::Number(speed)],
         )
     }
 
@@ -93,11 +84,7 @@ impl Autopilot {
         let Some(z) = self.frame_z(frame, z) else {
             let why = format!("Unknown mavlink coordinate frame {frame}");
             let mut a = Answer::of(MAV_RESULT_DENIED);
-            a.before.push(Reply::all(text(
-                system,
-                MavSeverity::MAV_SEVERITY_INFO,
-                &why,
-            )));
+            a.before.push(Reply::all(text(system, MavSeverity::MAV_SEVERITY_INFO, &why)));
             return a;
         };
         if self.copters[i].mode != COPTER_GUIDED {

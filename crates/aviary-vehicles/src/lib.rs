@@ -62,11 +62,7 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Options {
-        Options {
-            speed: 1.0,
-            behaviour: Behaviour::default(),
-            signing_key: None,
-        }
+        Options { speed: 1.0, behaviour: Behaviour::default(), signing_key: None }
     }
 }
 
@@ -86,43 +82,25 @@ pub async fn serve(world: &World, listen: Listen, options: Options) -> std::io::
     let ap = autopilot::Autopilot::new(world, options.behaviour);
     let systems = ap.copters.iter().map(|c| c.system).collect();
     let ap = Arc::new(Mutex::new(ap));
-    let speed = if options.speed.is_finite() && options.speed > 0.0 {
-        options.speed
-    } else {
-        1.0
-    };
+    let speed = if options.speed.is_finite() && options.speed > 0.0 { options.speed } else { 1.0 };
     let clients = Arc::new(client::Registry::default());
     let (address, serve) = match listen {
         Listen::Tcp(addr) => {
             let listener = TcpListener::bind(addr).await?;
             let address = listener.local_addr()?;
-            let task = server::tcp(
-                listener,
-                Arc::clone(&ap),
-                Arc::clone(&clients),
-                options.signing_key,
-            );
+            let task =
+                server::tcp(listener, Arc::clone(&ap), Arc::clone(&clients), options.signing_key);
             (address, tokio::spawn(task))
         }
         Listen::Udp(addr) => {
             let socket = UdpSocket::bind(addr).await?;
             let address = socket.local_addr()?;
-            let task = udp::udp(
-                socket,
-                Arc::clone(&ap),
-                Arc::clone(&clients),
-                options.signing_key,
-            );
+            let task = udp::udp(socket, Arc::clone(&ap), Arc::clone(&clients), options.signing_key);
             (address, tokio::spawn(task))
         }
     };
     let pace = tokio::spawn(server::pace(ap, Arc::clone(&clients), tick(), speed));
-    Ok(Vehicles {
-        address,
-        systems,
-        tasks: vec![pace, serve],
-        clients,
-    })
+    Ok(Vehicles { address, systems, tasks: vec![pace, serve], clients })
 }
 
 /// What one ground station's `bytes` get from `world`'s vehicles, without a socket: the
@@ -130,7 +108,12 @@ pub async fn serve(world: &World, listen: Listen, options: Options) -> std::io::
 /// simulation flies `seconds` (in whole ticks) with whatever was commanded, and the
 /// frames sent back are returned in order, streams included. The fuzz target
 /// `fuzz_vehicles` drives it with untrusted bytes.
-pub async fn answer(world: &World, behaviour: Behaviour, bytes: &[u8], seconds: f64) -> Vec<Vec<u8>> {
+pub async fn answer(
+    world: &World,
+    behaviour: Behaviour,
+    bytes: &[u8],
+    seconds: f64,
+) -> Vec<Vec<u8>> {
     let ap = Arc::new(Mutex::new(autopilot::Autopilot::new(world, behaviour)));
     let clients = client::Registry::default();
     let me = Arc::new(client::Client::new());

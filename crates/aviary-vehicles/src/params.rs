@@ -24,12 +24,7 @@ pub struct Param {
 }
 
 fn param(name: &'static str, kind: MavParamType, value: f64) -> Param {
-    Param {
-        name,
-        kind,
-        value: value as f32,
-        writable: false,
-    }
+    Param { name, kind, value: value as f32, writable: false }
 }
 
 impl Autopilot {
@@ -48,11 +43,7 @@ impl Autopilot {
             // GPS fix and position estimate, an armable mode); none can be skipped.
             param("ARMING_CHECK", MAV_PARAM_TYPE_INT32, 1.0),
             // FENCE_TYPE's bits: 1 altitude limit, 4 polygon.
-            param(
-                "FENCE_ENABLE",
-                MAV_PARAM_TYPE_INT8,
-                f64::from(u8::from(self.fence_enabled())),
-            ),
+            param("FENCE_ENABLE", MAV_PARAM_TYPE_INT8, f64::from(u8::from(self.fence_enabled()))),
             param(
                 "FENCE_TYPE",
                 MAV_PARAM_TYPE_INT8,
@@ -76,11 +67,7 @@ impl Autopilot {
                 ..param("WPNAV_SPEED", MAV_PARAM_TYPE_REAL32, c.wpnav_speed * 100.0)
             },
             param("WPNAV_SPEED_DN", MAV_PARAM_TYPE_REAL32, c.descent.rate * 100.0),
-            param(
-                "WPNAV_SPEED_UP",
-                MAV_PARAM_TYPE_REAL32,
-                c.climb_rate * 100.0,
-            ),
+            param("WPNAV_SPEED_UP", MAV_PARAM_TYPE_REAL32, c.climb_rate * 100.0),
         ];
         if let Some(max) = ceiling {
             t.push(param("FENCE_ALT_MAX", MAV_PARAM_TYPE_REAL32, max));
@@ -99,10 +86,7 @@ impl Autopilot {
         let system = self.copters[i].system;
         let t = self.params(i);
         let count = t.len();
-        t.iter()
-            .enumerate()
-            .map(|(k, p)| Reply::asker(system, value(p, count, k as u16)))
-            .collect()
+        t.iter().enumerate().map(|(k, p)| Reply::asker(system, value(p, count, k as u16))).collect()
     }
 
     /// PARAM_REQUEST_READ, by index when it is not negative, else by name.
@@ -113,10 +97,7 @@ impl Autopilot {
             Ok(k) => t.get(k).map(|p| (p, k as u16)),
             Err(_) => t.iter().find(|p| p.name == name).map(|p| (p, u16::MAX)),
         };
-        found
-            .map(|(p, k)| Reply::asker(system, value(p, t.len(), k)))
-            .into_iter()
-            .collect()
+        found.map(|(p, k)| Reply::asker(system, value(p, t.len(), k))).into_iter().collect()
     }
 
     /// PARAM_SET: what every client is told.
@@ -132,11 +113,7 @@ impl Autopilot {
         let mut out = Vec::new();
         if !p.writable {
             let why = format!("Param write denied ({name})");
-            out.push(Reply::all(text(
-                system,
-                MavSeverity::MAV_SEVERITY_WARNING,
-                &why,
-            )));
+            out.push(Reply::all(text(system, MavSeverity::MAV_SEVERITY_WARNING, &why)));
         } else if name == "WPNAV_SPEED" {
             // At least 0.2 m/s, at most what the airframe can fly (the world's max_speed):
             // the value answered is the one flown.
@@ -146,10 +123,7 @@ impl Autopilot {
         }
         let t = self.params(i);
         if let Some(p) = t.iter().find(|p| p.name == name) {
-            out.push(Reply::all(Out {
-                system,
-                msg: value(p, t.len(), u16::MAX).into(),
-            }));
+            out.push(Reply::all(Out { system, msg: value(p, t.len(), u16::MAX).into() }));
         }
         out
     }

@@ -84,10 +84,7 @@ pub(crate) fn tell(ap: &Autopilot, clients: &[Arc<Client>], mut events: Vec<Out>
                     continue;
                 }
                 if let Some(msg) = ap.message(i, id) {
-                    let o = Out {
-                        system,
-                        msg: msg.into(),
-                    };
+                    let o = Out { system, msg: msg.into() };
                     if id == 0 {
                         c.heartbeat(o);
                     } else {
@@ -105,10 +102,7 @@ pub(crate) fn signing(key: Option<[u8; 32]>) -> Option<SigningData> {
 
 /// What a raw frame from `client` asks, answered: to `client`, or to every client.
 fn receive(ap: &Shared, client: &Client, clients: &Registry, raw: &MAVLinkMessageRaw) {
-    let from = (
-        u8::try_from(raw.system_id()).unwrap_or(0),
-        raw.component_id(),
-    );
+    let from = (u8::try_from(raw.system_id()).unwrap_or(0), raw.component_id());
     let replies = {
         let mut ap = lock(ap);
         match MavMessage::parse(raw.version(), raw.message_id(), raw.payload()) {
@@ -123,11 +117,7 @@ fn receive(ap: &Shared, client: &Client, clients: &Registry, raw: &MAVLinkMessag
 }
 
 fn route(replies: Vec<Reply>, asker: &Client, clients: &Registry) {
-    let everyone = if replies.iter().any(|r| r.to == To::All) {
-        clients.all()
-    } else {
-        Vec::new()
-    };
+    let everyone = if replies.iter().any(|r| r.to == To::All) { clients.all() } else { Vec::new() };
     for r in replies {
         match r.to {
             To::Asker => asker.event(r.out),
@@ -167,9 +157,7 @@ pub(crate) fn frame(
     let mut buf = Vec::with_capacity(64);
     let header = sequences.header(o.system);
     // Writing into a Vec cannot fail.
-    mavlink::write_v2_msg_signed(&mut buf, header, &o.msg, sign)
-        .ok()
-        .map(|_| buf)
+    mavlink::write_v2_msg_signed(&mut buf, header, &o.msg, sign).ok().map(|_| buf)
 }
 
 pub(crate) async fn tcp(
@@ -184,12 +172,7 @@ pub(crate) async fn tcp(
         match listener.accept().await {
             Ok((stream, _)) => {
                 backoff = Duration::from_millis(10);
-                connection(
-                    stream,
-                    Arc::clone(&ap),
-                    Arc::clone(&clients),
-                    Arc::clone(&sign),
-                );
+                connection(stream, Arc::clone(&ap), Arc::clone(&clients), Arc::clone(&sign));
             }
             Err(e) => {
                 // Out of file descriptors, a connection reset before it was taken: the
@@ -220,10 +203,7 @@ fn connection(
             let Some(bytes) = frame(&mut sequences, &o, sign_w.as_ref().as_ref()) else {
                 continue;
             };
-            if tokio::io::AsyncWriteExt::write_all(&mut write, &bytes)
-                .await
-                .is_err()
-            {
+            if tokio::io::AsyncWriteExt::write_all(&mut write, &bytes).await.is_err() {
                 return;
             }
         }

@@ -60,10 +60,7 @@ impl Autopilot {
 
     pub fn heartbeat(&self, i: usize) -> MavMessage {
         let c = &self.copters[i];
-        let state = self
-            .fleet
-            .telemetry(i)
-            .map_or(FlightState::Lost, |t| t.state);
+        let state = self.fleet.telemetry(i).map_or(FlightState::Lost, |t| t.state);
         let mut base = MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
             | MavModeFlag::MAV_MODE_FLAG_STABILIZE_ENABLED;
         if c.mode == COPTER_GUIDED {

@@ -55,13 +55,7 @@ pub(crate) async fn udp(
             }
             let client = peer(from, Arc::clone(&socket), Arc::clone(&sign));
             clients.add(Arc::clone(&client));
-            peers.insert(
-                from,
-                Peer {
-                    client,
-                    heard: Instant::now(),
-                },
-            );
+            peers.insert(from, Peer { client, heard: Instant::now() });
         }
         let Some(p) = peers.get_mut(&from) else {
             continue;
@@ -85,11 +79,7 @@ fn peer(to: SocketAddr, socket: Arc<UdpSocket>, sign: Arc<Option<SigningData>>) 
             }
         }
     });
-    client
-        .tasks
-        .lock()
-        .unwrap_or_else(|p| p.into_inner())
-        .push(writer.abort_handle());
+    client.tasks.lock().unwrap_or_else(|p| p.into_inner()).push(writer.abort_handle());
     client
 }
 

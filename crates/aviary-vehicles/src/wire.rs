@@ -77,12 +77,7 @@ impl Message for Wire {
     fn ser(&self, version: MavlinkVersion, bytes: &mut [u8]) -> usize {
         match self {
             Wire::Mav(m) => m.ser(version, bytes),
-            Wire::UnknownAck {
-                command,
-                result,
-                target_system,
-                target_component,
-            } => {
+            Wire::UnknownAck { command, result, target_system, target_component } => {
                 // An ACK of any known command, then its first two payload bytes (the
                 // command, a little-endian u16 on the wire) replaced by the real number.
                 let known = COMMAND_ACK_DATA {
@@ -99,9 +94,7 @@ impl Message for Wire {
                     // MAVLink 2 drops trailing zero bytes, and keeps at least one.
                     MavlinkVersion::V2 => {
                         let full = &bytes[..COMMAND_ACK_DATA::ENCODED_LEN];
-                        full.iter()
-                            .rposition(|b| *b != 0)
-                            .map_or(1, |last| last + 1)
+                        full.iter().rposition(|b| *b != 0).map_or(1, |last| last + 1)
                     }
                 }
             }
@@ -182,10 +175,7 @@ mod tests {
         let mut p = vec![0u8; 30];
         p[28..30].copy_from_slice(&42_000u16.to_le_bytes());
         let u = unparsed_command(COMMAND_LONG_DATA::ID, &p).unwrap();
-        assert_eq!(
-            (u.command, u.target_system, u.target_component),
-            (42_000, 0, 0)
-        );
+        assert_eq!((u.command, u.target_system, u.target_component), (42_000, 0, 0));
         assert_eq!(unparsed_command(0, &p), None);
         assert!(unparsed_command(COMMAND_INT_DATA::ID, &[]).is_some());
         assert!(known_command(MavCmd::MAV_CMD_NAV_TAKEOFF as u16));

@@ -11,10 +11,7 @@ use aviary_mavlink::mavlink::dialects::ardupilotmega::MavMessage;
 use common::{fleet, quick, serve, Gcs};
 
 fn limit() -> libc::rlimit {
-    let mut l = libc::rlimit {
-        rlim_cur: 0,
-        rlim_max: 0,
-    };
+    let mut l = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
     // SAFETY: getrlimit writes the struct it is given.
     assert_eq!(unsafe { libc::getrlimit(libc::RLIMIT_NOFILE, &mut l) }, 0);
     l
@@ -29,10 +26,7 @@ fn set_limit(l: libc::rlimit) {
 async fn an_accept_that_fails_for_want_of_descriptors_is_survived() {
     let vehicles = serve(&fleet(1, ""), 5.0, quick()).await;
     let original = limit();
-    set_limit(libc::rlimit {
-        rlim_cur: original.rlim_cur.min(256),
-        ..original
-    });
+    set_limit(libc::rlimit { rlim_cur: original.rlim_cur.min(256), ..original });
     // Every descriptor taken but one, which the client's socket takes: the server's
     // accept then fails with EMFILE.
     let mut hold = Vec::new();
@@ -44,31 +38,23 @@ async fn an_accept_that_fails_for_want_of_descriptors_is_survived() {
         }
     }
     hold.pop();
-    let stream = tokio::net::TcpStream::connect(vehicles.address)
-        .await
-        .expect("connected (in the backlog)");
+    let stream =
+        tokio::net::TcpStream::connect(vehicles.address).await.expect("connected (in the backlog)");
     let mut gcs = Gcs::over(stream, 255, 190);
     let early = gcs.frame(Duration::from_secs(2)).await;
     let accepted_without_a_descriptor = early.is_some();
     // Descriptors back: the connection that waited is taken, and served.
     drop(hold);
     set_limit(original);
-    assert!(
-        !accepted_without_a_descriptor,
-        "the server had a descriptor to accept with"
-    );
+    assert!(!accepted_without_a_descriptor, "the server had a descriptor to accept with");
     let beat = gcs
-        .wait(1, Duration::from_secs(5), |m| {
-            matches!(m, MavMessage::HEARTBEAT(_)).then_some(())
-        })
+        .wait(1, Duration::from_secs(5), |m| matches!(m, MavMessage::HEARTBEAT(_)).then_some(()))
         .await;
     assert!(beat.is_some(), "the waiting connection was never served");
     // And later ones too.
     let mut later = Gcs::connect(vehicles.address).await;
     let beat = later
-        .wait(1, Duration::from_secs(3), |m| {
-            matches!(m, MavMessage::HEARTBEAT(_)).then_some(())
-        })
+        .wait(1, Duration::from_secs(3), |m| matches!(m, MavMessage::HEARTBEAT(_)).then_some(()))
         .await;
     assert!(beat.is_some(), "a new connection was not served");
     vehicles.stop();

@@ -57,21 +57,14 @@ async fn each_vehicle_numbers_its_messages_one_by_one_on_each_link() {
     let by = sequences(&frames);
     for system in [1u8, 2, 3] {
         let seqs = &by[&system];
-        assert!(
-            seqs.len() > 100,
-            "system {system}: only {} messages",
-            seqs.len()
-        );
+        assert!(seqs.len() > 100, "system {system}: only {} messages", seqs.len());
         assert_consecutive(system, seqs);
     }
     // A second link starts its own numbering: each vehicle's first message on it is 0.
     let mut second = Gcs::connect(vehicles.address).await;
     let mut first_seen = HashMap::new();
     while first_seen.len() < 3 {
-        let f = second
-            .frame(Duration::from_secs(3))
-            .await
-            .expect("a message");
+        let f = second.frame(Duration::from_secs(3)).await.expect("a message");
         first_seen.entry(f.system()).or_insert(f.raw.sequence());
     }
     assert!(first_seen.values().all(|s| *s == 0), "{first_seen:?}");
@@ -88,24 +81,17 @@ async fn record(mut gcs: Gcs, start: Instant, until: Instant) -> Seen {
         let Some(f) = gcs.frame(left).await else {
             break;
         };
-        let name = f.msg.as_ref().map_or("?".into(), |m| {
-            aviary_mavlink::mavlink::Message::message_name(m).to_owned()
-        });
-        seen.push((
-            start.elapsed().as_secs_f64(),
-            f.system(),
-            f.raw.sequence(),
-            name,
-        ));
+        let name = f
+            .msg
+            .as_ref()
+            .map_or("?".into(), |m| aviary_mavlink::mavlink::Message::message_name(m).to_owned());
+        seen.push((start.elapsed().as_secs_f64(), f.system(), f.raw.sequence(), name));
     }
     seen
 }
 
 fn beats(seen: &Seen, system: u8) -> Vec<f64> {
-    seen.iter()
-        .filter(|(_, s, _, n)| *s == system && n == "HEARTBEAT")
-        .map(|(t, ..)| *t)
-        .collect()
+    seen.iter().filter(|(_, s, _, n)| *s == system && n == "HEARTBEAT").map(|(t, ..)| *t).collect()
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -134,27 +120,13 @@ async fn a_flood_of_commands_is_answered_to_its_sender_alone_and_heartbeats_go_o
     let theirs = watching.await.unwrap();
 
     let answers = |seen: &Seen| {
-        seen.iter()
-            .filter(|(.., n)| n == "COMMAND_ACK" || n == "AUTOPILOT_VERSION")
-            .count()
+        seen.iter().filter(|(.., n)| n == "COMMAND_ACK" || n == "AUTOPILOT_VERSION").count()
     };
-    assert_eq!(
-        answers(&theirs),
-        0,
-        "the watcher was sent the flooder's answers"
-    );
-    assert!(
-        answers(&mine) > 100,
-        "the flooder got {} answers",
-        answers(&mine)
-    );
+    assert_eq!(answers(&theirs), 0, "the watcher was sent the flooder's answers");
+    assert!(answers(&mine) > 100, "the flooder got {} answers", answers(&mine));
     for system in [1u8, 2] {
         let t = beats(&theirs, system);
-        assert!(
-            t.len() >= 8,
-            "watcher: {} heartbeats of {system} in 9 s: {t:?}",
-            t.len()
-        );
+        assert!(t.len() >= 8, "watcher: {} heartbeats of {system} in 9 s: {t:?}", t.len());
         let gaps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
         assert!(
             gaps.iter().all(|g| *g < 2.0),
@@ -162,11 +134,7 @@ async fn a_flood_of_commands_is_answered_to_its_sender_alone_and_heartbeats_go_o
         );
         // The flooder's heartbeats waited behind its answers, but none was lost...
         let m = beats(&mine, system);
-        assert!(
-            m.len() >= 8,
-            "flooder: {} heartbeats of {system}: {m:?}",
-            m.len()
-        );
+        assert!(m.len() >= 8, "flooder: {} heartbeats of {system}: {m:?}", m.len());
     }
     // ... and neither was anything numbered: each vehicle's sequence has no gap.
     for (system, seqs) in sequences(&mine.iter().map(|(_, s, q, _)| (*s, *q)).collect::<Vec<_>>()) {

@@ -58,24 +58,15 @@ async fn the_list_reads_and_sets_answer_as_arducopter() {
     .await;
     let mut list: BTreeMap<u16, PARAM_VALUE_DATA> = BTreeMap::new();
     while let Some(v) = gcs.wait(1, SECOND, value).await {
-        assert!(
-            list.insert(v.param_index, v.clone()).is_none(),
-            "index {} twice",
-            v.param_index
-        );
+        assert!(list.insert(v.param_index, v.clone()).is_none(), "index {} twice", v.param_index);
         if list.len() == usize::from(v.param_count) {
             break;
         }
     }
     let count = list.values().next().expect("a PARAM_VALUE").param_count;
-    assert_eq!(
-        list.keys().copied().collect::<Vec<_>>(),
-        (0..count).collect::<Vec<_>>()
-    );
-    let by_name: BTreeMap<String, (f32, MavParamType)> = list
-        .values()
-        .map(|v| (name(v), (v.param_value, v.param_type)))
-        .collect();
+    assert_eq!(list.keys().copied().collect::<Vec<_>>(), (0..count).collect::<Vec<_>>());
+    let by_name: BTreeMap<String, (f32, MavParamType)> =
+        list.values().map(|v| (name(v), (v.param_value, v.param_type))).collect();
     use MavParamType::*;
     // The world's drone: max_speed 8, the default climb_rate and acceleration of 3;
     // RTL climbs to 10 m; the site has a ceiling of 60 m and no polygon.
@@ -99,14 +90,8 @@ async fn the_list_reads_and_sets_answer_as_arducopter() {
     assert_eq!((name(&third), third.param_index), (name(&list[&2]), 2));
     let rtl = read(&mut gcs, "RTL_ALT", -1).await.expect("by name");
     assert_eq!((rtl.param_value, rtl.param_index), (1000.0, u16::MAX));
-    assert!(
-        read(&mut gcs, "NO_SUCH_PARAM", -1).await.is_none(),
-        "unknown: no answer"
-    );
-    assert!(
-        read(&mut gcs, "", count as i16).await.is_none(),
-        "past the end: no answer"
-    );
+    assert!(read(&mut gcs, "NO_SUCH_PARAM", -1).await.is_none(), "unknown: no answer");
+    assert!(read(&mut gcs, "", count as i16).await.is_none(), "past the end: no answer");
 
     // Read-only: refused in ArduPilot's words, the value unchanged.
     set(&mut gcs, "WPNAV_ACCEL", 100.0, MAV_PARAM_TYPE_REAL32).await;
@@ -132,45 +117,20 @@ async fn a_new_wpnav_speed_is_told_to_every_client_and_flown() {
     let mut gcs = Gcs::connect(vehicles.address).await;
     let mut other = Gcs::connect(vehicles.address).await;
     gcs.take_off(1, 10.0).await;
-    set(
-        &mut gcs,
-        "WPNAV_SPEED",
-        300.0,
-        MavParamType::MAV_PARAM_TYPE_REAL32,
-    )
-    .await;
+    set(&mut gcs, "WPNAV_SPEED", 300.0, MavParamType::MAV_PARAM_TYPE_REAL32).await;
     for g in [&mut gcs, &mut other] {
         let v = g.wait(1, SECOND, value).await.expect("the new value");
         assert_eq!((name(&v), v.param_value), ("WPNAV_SPEED".into(), 300.0));
     }
     // Above the airframe's max_speed (8 m/s): what is answered is what is flown.
-    set(
-        &mut other,
-        "WPNAV_SPEED",
-        5000.0,
-        MavParamType::MAV_PARAM_TYPE_REAL32,
-    )
-    .await;
+    set(&mut other, "WPNAV_SPEED", 5000.0, MavParamType::MAV_PARAM_TYPE_REAL32).await;
     let v = other.wait(1, SECOND, value).await.expect("the value");
     assert_eq!(v.param_value, 800.0);
-    set(
-        &mut other,
-        "WPNAV_SPEED",
-        300.0,
-        MavParamType::MAV_PARAM_TYPE_REAL32,
-    )
-    .await;
-    assert_eq!(
-        other.wait(1, SECOND, value).await.map(|v| v.param_value),
-        Some(300.0)
-    );
+    set(&mut other, "WPNAV_SPEED", 300.0, MavParamType::MAV_PARAM_TYPE_REAL32).await;
+    assert_eq!(other.wait(1, SECOND, value).await.map(|v| v.param_value), Some(300.0));
 
     // 60 m north in GUIDED: flown at 3 m/s, not the world's 8.
-    let o = Origin {
-        lat: ORIGIN.0,
-        lon: ORIGIN.1,
-        alt: ORIGIN.2,
-    };
+    let o = Origin { lat: ORIGIN.0, lon: ORIGIN.1, alt: ORIGIN.2 };
     let to = o.to_e7(0.0, 60.0);
     gcs.send(&MavMessage::COMMAND_INT(COMMAND_INT_DATA {
         x: to.0,
@@ -198,9 +158,6 @@ async fn a_new_wpnav_speed_is_told_to_every_client_and_flown() {
         })
         .await;
     assert!(arrived.is_some(), "did not arrive");
-    assert!(
-        (2.9..=3.05).contains(&fastest),
-        "flew at up to {fastest} m/s"
-    );
+    assert!((2.9..=3.05).contains(&fastest), "flew at up to {fastest} m/s");
     vehicles.stop();
 }

@@ -42,35 +42,22 @@ async fn call(backend: &dyn Backend, function: &str, args: &[Value]) -> CallEnd 
 
 #[tokio::test]
 async fn arming_refused_by_pre_arm_checks_says_why() {
-    let behaviour = Behaviour {
-        prearm_time: 1e9,
-        ..Behaviour::default()
-    };
+    let behaviour = Behaviour { prearm_time: 1e9, ..Behaviour::default() };
     let vehicles = aviary_vehicles::serve(
         &world(&scout("tcp:x:1", "")),
         Listen::Tcp("127.0.0.1:0".parse().unwrap()),
-        Options {
-            speed: 10.0,
-            behaviour,
-            ..Options::default()
-        },
+        Options { speed: 10.0, behaviour, ..Options::default() },
     )
     .await
     .unwrap();
-    let backend = aviary_mavlink::connect(
-        &world(&scout(&format!("tcp:{}", vehicles.address), "")),
-        quick(),
-    )
-    .await
-    .unwrap();
+    let backend =
+        aviary_mavlink::connect(&world(&scout(&format!("tcp:{}", vehicles.address), "")), quick())
+            .await
+            .unwrap();
     match call(&backend, "Arm", &[]).await {
         CallEnd::Failed(f) => {
             assert_eq!(f.exception, "CommandFailed");
-            assert!(
-                f.reason.contains("PreArm: GPS: waiting for 3D fix"),
-                "{}",
-                f.reason
-            );
+            assert!(f.reason.contains("PreArm: GPS: waiting for 3D fix"), "{}", f.reason);
         }
         other => panic!("{other:?}"),
     }
@@ -83,19 +70,14 @@ async fn a_battery_failsafe_rtl_raises_battery_critical() {
     let vehicles = aviary_vehicles::serve(
         &world(&scout("tcp:x:1", faults)),
         Listen::Tcp("127.0.0.1:0".parse().unwrap()),
-        Options {
-            speed: 10.0,
-            ..Options::default()
-        },
+        Options { speed: 10.0, ..Options::default() },
     )
     .await
     .unwrap();
-    let backend = aviary_mavlink::connect(
-        &world(&scout(&format!("tcp:{}", vehicles.address), "")),
-        quick(),
-    )
-    .await
-    .unwrap();
+    let backend =
+        aviary_mavlink::connect(&world(&scout(&format!("tcp:{}", vehicles.address), "")), quick())
+            .await
+            .unwrap();
     let mut events = backend.events().unwrap();
     let armed = call(&backend, "Arm", &[]).await;
     assert_eq!(armed, CallEnd::Done, "{:?}", events.try_recv());
@@ -129,10 +111,7 @@ async fn take_off_and_land_over_udp() {
     let vehicles = aviary_vehicles::serve(
         &world(&scout("tcp:x:1", "")),
         Listen::Udp("127.0.0.1:0".parse().unwrap()),
-        Options {
-            speed: 10.0,
-            ..Options::default()
-        },
+        Options { speed: 10.0, ..Options::default() },
     )
     .await
     .unwrap();
@@ -143,10 +122,7 @@ async fn take_off_and_land_over_udp() {
     .await
     .unwrap();
     assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
-    assert_eq!(
-        call(&backend, "TakeOff", &[Value::Number(5.0)]).await,
-        CallEnd::Done
-    );
+    assert_eq!(call(&backend, "TakeOff", &[Value::Number(5.0)]).await, CallEnd::Done);
     let t = backend.telemetry(0);
     assert!(
         (t.position[2] - 5.0).abs() <= 0.5 && t.state == aviary_api::FlightState::Flying,
@@ -161,11 +137,7 @@ async fn take_off_and_land_over_udp() {
 #[tokio::test]
 async fn signed_links_take_only_the_right_key() {
     let key = aviary_mavlink::signing_key("correct horse battery staple");
-    let options = Options {
-        speed: 10.0,
-        signing_key: Some(key),
-        ..Options::default()
-    };
+    let options = Options { speed: 10.0, signing_key: Some(key), ..Options::default() };
     let vehicles = aviary_vehicles::serve(
         &world(&scout("tcp:x:1", "")),
         Listen::Tcp("127.0.0.1:0".parse().unwrap()),
@@ -174,19 +146,12 @@ async fn signed_links_take_only_the_right_key() {
     .await
     .unwrap();
     let address = format!("tcp:{}", vehicles.address);
-    let right = world(&scout(
-        &address,
-        "signing_key = \"correct horse battery staple\"\n",
-    ));
-    let backend = aviary_mavlink::connect(&right, quick())
-        .await
-        .expect("the right key connects");
+    let right = world(&scout(&address, "signing_key = \"correct horse battery staple\"\n"));
+    let backend = aviary_mavlink::connect(&right, quick()).await.expect("the right key connects");
     assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
     let wrong = world(&scout(&address, "signing_key = \"wrong\"\n"));
-    let err = aviary_mavlink::connect(&wrong, quick())
-        .await
-        .err()
-        .expect("a wrong key hears nothing");
+    let err =
+        aviary_mavlink::connect(&wrong, quick()).await.err().expect("a wrong key hears nothing");
     assert!(err.contains("no answer"), "{err}");
     vehicles.stop();
 }
@@ -196,29 +161,17 @@ async fn pause_holds_resume_goes_on_and_abort_stops() {
     let vehicles = aviary_vehicles::serve(
         &world(&scout("tcp:x:1", "")),
         Listen::Tcp("127.0.0.1:0".parse().unwrap()),
-        Options {
-            speed: 5.0,
-            ..Options::default()
-        },
+        Options { speed: 5.0, ..Options::default() },
     )
     .await
     .unwrap();
-    let backend = aviary_mavlink::connect(
-        &world(&scout(&format!("tcp:{}", vehicles.address), "")),
-        quick(),
-    )
-    .await
-    .unwrap();
+    let backend =
+        aviary_mavlink::connect(&world(&scout(&format!("tcp:{}", vehicles.address), "")), quick())
+            .await
+            .unwrap();
     assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
-    assert_eq!(
-        call(&backend, "TakeOff", &[Value::Number(5.0)]).await,
-        CallEnd::Done
-    );
-    let far = Value::Position(aviary_api::Point {
-        x: 300.0,
-        y: 0.0,
-        z: None,
-    });
+    assert_eq!(call(&backend, "TakeOff", &[Value::Number(5.0)]).await, CallEnd::Done);
+    let far = Value::Position(aviary_api::Point { x: 300.0, y: 0.0, z: None });
     let flight = backend.call(0, "FlyToPosition", &[far]);
     tokio::time::sleep(Duration::from_secs(2)).await;
     backend.interrupt(flight.id, aviary_api::Interrupt::Pause);
@@ -227,17 +180,11 @@ async fn pause_holds_resume_goes_on_and_abort_stops() {
     let held = backend.telemetry(0).position;
     tokio::time::sleep(Duration::from_secs(1)).await;
     let still = backend.telemetry(0).position;
-    assert!(
-        held[0] > 1.0 && (still[0] - held[0]).abs() < 0.5,
-        "paused: {held:?} then {still:?}"
-    );
+    assert!(held[0] > 1.0 && (still[0] - held[0]).abs() < 0.5, "paused: {held:?} then {still:?}");
     backend.interrupt(flight.id, aviary_api::Interrupt::Resume);
     tokio::time::sleep(Duration::from_secs(2)).await;
     let moved = backend.telemetry(0).position;
-    assert!(
-        moved[0] > still[0] + 1.0,
-        "resumed: {still:?} then {moved:?}"
-    );
+    assert!(moved[0] > still[0] + 1.0, "resumed: {still:?} then {moved:?}");
     backend.interrupt(flight.id, aviary_api::Interrupt::Abort);
     assert_eq!(flight.end.wait().await.unwrap(), CallEnd::Interrupted);
     tokio::time::sleep(Duration::from_secs(2)).await;
@@ -255,13 +202,8 @@ async fn pause_holds_resume_goes_on_and_abort_stops() {
 async fn a_vehicle_that_goes_and_comes_back_raises_lost_then_restored() {
     let scout_world = world(&scout("tcp:x:1", ""));
     let tcp = Listen::Tcp("127.0.0.1:0".parse().unwrap());
-    let options = Options {
-        speed: 5.0,
-        ..Options::default()
-    };
-    let first = aviary_vehicles::serve(&scout_world, tcp, options)
-        .await
-        .unwrap();
+    let options = Options { speed: 5.0, ..Options::default() };
+    let first = aviary_vehicles::serve(&scout_world, tcp, options).await.unwrap();
     let address = first.address;
     let backend = aviary_mavlink::connect(&world(&scout(&format!("tcp:{address}"), "")), quick())
         .await
@@ -282,20 +224,12 @@ async fn a_vehicle_that_goes_and_comes_back_raises_lost_then_restored() {
         other => panic!("{other:?}"),
     }
     // The same port again: the backend opens the connection anew and hears HEARTBEAT.
-    let second = aviary_vehicles::serve(&scout_world, Listen::Tcp(address), options)
-        .await
-        .unwrap();
+    let second = aviary_vehicles::serve(&scout_world, Listen::Tcp(address), options).await.unwrap();
     let back = tokio::time::timeout(Duration::from_secs(6), events.recv())
         .await
         .expect("an event")
         .unwrap();
-    assert_eq!(
-        back,
-        DroneEvent::Signal {
-            drone: 0,
-            name: "ConnectionRestored"
-        }
-    );
+    assert_eq!(back, DroneEvent::Signal { drone: 0, name: "ConnectionRestored" });
     assert!(backend.telemetry(0).link);
     assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
     second.stop();
@@ -308,18 +242,12 @@ async fn the_battery_rule_signals_low_then_raises_critical_once() {
     let vehicles = aviary_vehicles::serve(
         &world(&text),
         Listen::Tcp("127.0.0.1:0".parse().unwrap()),
-        Options {
-            speed: 5.0,
-            ..Options::default()
-        },
+        Options { speed: 5.0, ..Options::default() },
     )
     .await
     .unwrap();
     let backend = aviary_mavlink::connect(
-        &world(&scout(
-            &format!("tcp:{}", vehicles.address),
-            "battery = 10.3\n",
-        )),
+        &world(&scout(&format!("tcp:{}", vehicles.address), "battery = 10.3\n")),
         quick(),
     )
     .await
@@ -353,25 +281,17 @@ async fn a_crash_raises_drone_lost() {
     let vehicles = aviary_vehicles::serve(
         &world(&scout("tcp:x:1", faults)),
         Listen::Tcp("127.0.0.1:0".parse().unwrap()),
-        Options {
-            speed: 10.0,
-            ..Options::default()
-        },
+        Options { speed: 10.0, ..Options::default() },
     )
     .await
     .unwrap();
-    let backend = aviary_mavlink::connect(
-        &world(&scout(&format!("tcp:{}", vehicles.address), "")),
-        quick(),
-    )
-    .await
-    .unwrap();
+    let backend =
+        aviary_mavlink::connect(&world(&scout(&format!("tcp:{}", vehicles.address), "")), quick())
+            .await
+            .unwrap();
     let mut events = backend.events().unwrap();
     assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
-    assert_eq!(
-        call(&backend, "TakeOff", &[Value::Number(10.0)]).await,
-        CallEnd::Done
-    );
+    assert_eq!(call(&backend, "TakeOff", &[Value::Number(10.0)]).await, CallEnd::Done);
     let hover = backend.call(0, "Hover", &[Value::Number(300.0)]);
     match tokio::time::timeout(Duration::from_secs(15), events.recv())
         .await

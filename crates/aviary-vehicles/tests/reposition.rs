@@ -11,11 +11,7 @@ use aviary_mavlink::mavlink::dialects::ardupilotmega::{
 use aviary_mavlink::Origin;
 use common::{fleet, quick, serve, Gcs, ORIGIN};
 
-const ORIGIN_GEO: Origin = Origin {
-    lat: ORIGIN.0,
-    lon: ORIGIN.1,
-    alt: ORIGIN.2,
-};
+const ORIGIN_GEO: Origin = Origin { lat: ORIGIN.0, lon: ORIGIN.1, alt: ORIGIN.2 };
 
 async fn reposition(gcs: &mut Gcs, frame: u8, p2: f32, at: (i32, i32, f32)) -> MavResult {
     let frame = frame_of(frame);
@@ -74,11 +70,7 @@ async fn do_reposition_flies_in_every_global_frame_and_is_refused_as_arducopter_
     // In GUIDED on the ground: taken, and nothing flies before a take-off (as ArduCopter).
     let until = tokio::time::Instant::now() + Duration::from_secs(10);
     while gcs
-        .command(
-            1,
-            MavCmd::MAV_CMD_DO_SET_MODE,
-            [1.0, 4.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-        )
+        .command(1, MavCmd::MAV_CMD_DO_SET_MODE, [1.0, 4.0, 0.0, 0.0, 0.0, 0.0, 0.0])
         .await
         .result
         != MAV_RESULT_ACCEPTED
@@ -86,10 +78,7 @@ async fn do_reposition_flies_in_every_global_frame_and_is_refused_as_arducopter_
         assert!(tokio::time::Instant::now() < until, "GUIDED refused");
         tokio::time::sleep(Duration::from_millis(200)).await;
     }
-    assert_eq!(
-        reposition(&mut gcs, 6, 0.0, (north.0, north.1, 10.0)).await,
-        MAV_RESULT_ACCEPTED
-    );
+    assert_eq!(reposition(&mut gcs, 6, 0.0, (north.0, north.1, 10.0)).await, MAV_RESULT_ACCEPTED);
     let rose = gcs
         .wait(1, Duration::from_secs(1), |m| match m {
             MavMessage::GLOBAL_POSITION_INT(p) if p.relative_alt > 100 => Some(()),
@@ -101,71 +90,35 @@ async fn do_reposition_flies_in_every_global_frame_and_is_refused_as_arducopter_
 
     // As COMMAND_LONG: ArduCopter answers UNSUPPORTED.
     let ack = gcs
-        .command(
-            1,
-            MavCmd::MAV_CMD_DO_REPOSITION,
-            [-1.0, 0.0, 0.0, 0.0, 46.6, 14.2, 20.0],
-        )
+        .command(1, MavCmd::MAV_CMD_DO_REPOSITION, [-1.0, 0.0, 0.0, 0.0, 46.6, 14.2, 20.0])
         .await;
     assert_eq!(ack.result, MAV_RESULT_UNSUPPORTED);
     // Above sea level (MAV_FRAME_GLOBAL_INT, MAVSDK's goto_location): 15 m above home.
     let amsl = ORIGIN.2 as f32 + 15.0;
-    assert_eq!(
-        reposition(&mut gcs, 5, 0.0, (north.0, north.1, amsl)).await,
-        MAV_RESULT_ACCEPTED
-    );
+    assert_eq!(reposition(&mut gcs, 5, 0.0, (north.0, north.1, amsl)).await, MAV_RESULT_ACCEPTED);
     arrives(&mut gcs, 0.0, 30.0, 15.0).await;
     // Above home (MAVProxy's `guided LAT LON ALT`).
     let east = ORIGIN_GEO.to_e7(30.0, 30.0);
-    assert_eq!(
-        reposition(&mut gcs, 3, 0.0, (east.0, east.1, 12.0)).await,
-        MAV_RESULT_ACCEPTED
-    );
+    assert_eq!(reposition(&mut gcs, 3, 0.0, (east.0, east.1, 12.0)).await, MAV_RESULT_ACCEPTED);
     arrives(&mut gcs, 30.0, 30.0, 12.0).await;
     // Above the terrain, which is flat at home's height; and MAV_FRAME_GLOBAL.
-    assert_eq!(
-        reposition(&mut gcs, 11, 0.0, (north.0, north.1, 8.0)).await,
-        MAV_RESULT_ACCEPTED
-    );
+    assert_eq!(reposition(&mut gcs, 11, 0.0, (north.0, north.1, 8.0)).await, MAV_RESULT_ACCEPTED);
     arrives(&mut gcs, 0.0, 30.0, 8.0).await;
     let back = ORIGIN_GEO.to_e7(0.0, 0.0);
-    assert_eq!(
-        reposition(&mut gcs, 0, 0.0, (back.0, back.1, amsl)).await,
-        MAV_RESULT_ACCEPTED
-    );
+    assert_eq!(reposition(&mut gcs, 0, 0.0, (back.0, back.1, amsl)).await, MAV_RESULT_ACCEPTED);
     arrives(&mut gcs, 0.0, 0.0, 15.0).await;
 
     // Refused: a local frame (with ArduPilot's words), a latitude out of range, a height
     // that is not a number.
-    assert_eq!(
-        reposition(&mut gcs, 1, 0.0, (north.0, north.1, 10.0)).await,
-        MAV_RESULT_DENIED
-    );
-    assert_eq!(
-        reposition(&mut gcs, 6, 0.0, (950_000_000, north.1, 10.0)).await,
-        MAV_RESULT_DENIED
-    );
-    assert_eq!(
-        reposition(&mut gcs, 6, 0.0, (north.0, north.1, f32::NAN)).await,
-        MAV_RESULT_DENIED
-    );
+    assert_eq!(reposition(&mut gcs, 1, 0.0, (north.0, north.1, 10.0)).await, MAV_RESULT_DENIED);
+    assert_eq!(reposition(&mut gcs, 6, 0.0, (950_000_000, north.1, 10.0)).await, MAV_RESULT_DENIED);
+    assert_eq!(reposition(&mut gcs, 6, 0.0, (north.0, north.1, f32::NAN)).await, MAV_RESULT_DENIED);
     // Outside GUIDED: refused, unless asked to change mode (MAVSDK and MAVProxy ask).
-    let ack = gcs
-        .command(
-            1,
-            MavCmd::MAV_CMD_DO_SET_MODE,
-            [1.0, 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-        )
-        .await;
+    let ack =
+        gcs.command(1, MavCmd::MAV_CMD_DO_SET_MODE, [1.0, 5.0, 0.0, 0.0, 0.0, 0.0, 0.0]).await;
     assert_eq!(ack.result, MAV_RESULT_ACCEPTED, "LOITER");
-    assert_eq!(
-        reposition(&mut gcs, 6, 0.0, (north.0, north.1, 10.0)).await,
-        MAV_RESULT_DENIED
-    );
-    assert_eq!(
-        reposition(&mut gcs, 6, 1.0, (north.0, north.1, 10.0)).await,
-        MAV_RESULT_ACCEPTED
-    );
+    assert_eq!(reposition(&mut gcs, 6, 0.0, (north.0, north.1, 10.0)).await, MAV_RESULT_DENIED);
+    assert_eq!(reposition(&mut gcs, 6, 1.0, (north.0, north.1, 10.0)).await, MAV_RESULT_ACCEPTED);
     let mode = gcs
         .wait(1, Duration::from_secs(3), |m| match m {
             MavMessage::HEARTBEAT(h) => Some(h.custom_mode),
@@ -242,7 +195,12 @@ async fn a_reposition_in_the_take_offs_own_tick_leaves_the_take_off_flying() {
     let answers = aviary_vehicles::answer(&fleet(1, ""), behaviour, &bytes, 10.0).await;
     let heard: Vec<MavMessage> = answers
         .iter()
-        .map(|f| mavlink::MavlinkReader::new(f.as_slice()).read_any_message::<MavMessage>().expect("a frame").1)
+        .map(|f| {
+            mavlink::MavlinkReader::new(f.as_slice())
+                .read_any_message::<MavMessage>()
+                .expect("a frame")
+                .1
+        })
         .collect();
     let result = |command| {
         heard.iter().find_map(|m| match m {

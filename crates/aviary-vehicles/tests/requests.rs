@@ -22,18 +22,9 @@ async fn acks_are_addressed_to_the_asker_and_sent_to_it_alone() {
     let vehicles = serve(&fleet(1, ""), 5.0, quick()).await;
     let mut asker = Gcs::connect_as(vehicles.address, 200, 42).await;
     let mut other = Gcs::connect(vehicles.address).await;
-    let ack = asker
-        .command(
-            1,
-            MavCmd::MAV_CMD_DO_SET_MODE,
-            [1.0, 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-        )
-        .await;
-    assert_eq!(
-        (ack.target_system, ack.target_component),
-        (200, 42),
-        "{ack:?}"
-    );
+    let ack =
+        asker.command(1, MavCmd::MAV_CMD_DO_SET_MODE, [1.0, 5.0, 0.0, 0.0, 0.0, 0.0, 0.0]).await;
+    assert_eq!((ack.target_system, ack.target_component), (200, 42), "{ack:?}");
     // A broadcast (target system 0) is taken by every vehicle, and answered likewise.
     asker.system = 7;
     asker
@@ -47,16 +38,9 @@ async fn acks_are_addressed_to_the_asker_and_sent_to_it_alone() {
         }))
         .await;
     let ack = asker.ack(1, MavCmd::MAV_CMD_DO_SET_MODE).await;
-    assert_eq!(
-        (ack.target_system, ack.target_component),
-        (7, 42),
-        "{ack:?}"
-    );
-    let seen = other
-        .wait(1, 2 * SECOND, |m| {
-            matches!(m, MavMessage::COMMAND_ACK(_)).then_some(())
-        })
-        .await;
+    assert_eq!((ack.target_system, ack.target_component), (7, 42), "{ack:?}");
+    let seen =
+        other.wait(1, 2 * SECOND, |m| matches!(m, MavMessage::COMMAND_ACK(_)).then_some(())).await;
     assert!(seen.is_none(), "another client was sent the ACK");
     vehicles.stop();
 }
@@ -79,11 +63,7 @@ fn unknown_command(msgid: u32, number: u16) -> Vec<u8> {
             ..Default::default()
         })
     };
-    let header = MavHeader {
-        system_id: 255,
-        component_id: 190,
-        sequence: 0,
-    };
+    let header = MavHeader { system_id: 255, component_id: 190, sequence: 0 };
     let mut raw = MAVLinkV2MessageRaw::new();
     raw.serialize_message(header, &msg);
     let len = usize::from(raw.payload_length());
@@ -112,22 +92,13 @@ async fn unknown_and_unhandled_commands_are_answered_unsupported() {
         let p = answer.expect("a COMMAND_ACK");
         let mut full = [0u8; 10];
         full[..p.len()].copy_from_slice(&p);
-        assert_eq!(
-            u16::from_le_bytes([full[0], full[1]]),
-            31_999,
-            "msg {msgid}"
-        );
+        assert_eq!(u16::from_le_bytes([full[0], full[1]]), 31_999, "msg {msgid}");
         assert_eq!(full[2], MavResult::MAV_RESULT_UNSUPPORTED as u8);
         assert_eq!(&full[8..10], &[255, 190]);
     }
     // A command the dialect knows that the vehicle does not handle.
-    let ack = gcs
-        .command(
-            1,
-            MavCmd::MAV_CMD_DO_SET_SERVO,
-            [8.0, 1500.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-        )
-        .await;
+    let ack =
+        gcs.command(1, MavCmd::MAV_CMD_DO_SET_SERVO, [8.0, 1500.0, 0.0, 0.0, 0.0, 0.0, 0.0]).await;
     assert_eq!(ack.result, MavResult::MAV_RESULT_UNSUPPORTED);
     vehicles.stop();
 }
@@ -147,15 +118,10 @@ async fn autopilot_version_is_sent_on_request_to_the_asker() {
         (MavCmd::MAV_CMD_REQUEST_MESSAGE, 148.0),
     ];
     for (command, p1) in asks {
-        let ack = gcs
-            .command(2, command, [p1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-            .await;
+        let ack = gcs.command(2, command, [p1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]).await;
         assert_eq!(ack.result, MavResult::MAV_RESULT_ACCEPTED, "{command:?}");
         // After the ACK, as ArduPilot sends it.
-        let v = gcs
-            .wait(2, SECOND, version)
-            .await
-            .expect("AUTOPILOT_VERSION");
+        let v = gcs.wait(2, SECOND, version).await.expect("AUTOPILOT_VERSION");
         #[allow(deprecated)]
         let served = Cap::MAV_PROTOCOL_CAPABILITY_MAVLINK2
             | Cap::MAV_PROTOCOL_CAPABILITY_COMMAND_INT
@@ -164,20 +130,14 @@ async fn autopilot_version_is_sent_on_request_to_the_asker() {
         assert_eq!(v.capabilities, served, "only what is served");
         assert_eq!(v.uid, 2);
     }
-    assert!(
-        other.wait(2, SECOND, version).await.is_none(),
-        "sent to a client that did not ask"
-    );
+    assert!(other.wait(2, SECOND, version).await.is_none(), "sent to a client that did not ask");
     vehicles.stop();
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn home_gps_and_health_turn_ready_at_the_pre_arm_time() {
     // Ready after 8 simulated seconds, 4 s of wall time.
-    let behaviour = Behaviour {
-        boot_time: 1.0,
-        prearm_time: 8.0,
-    };
+    let behaviour = Behaviour { boot_time: 1.0, prearm_time: 8.0 };
     let fence = "geofence = [[-100, -100], [100, -100], [100, 100], [-100, 100]]";
     let vehicles = serve(&fleet(2, fence), 2.0, behaviour).await;
     let mut gcs = Gcs::connect(vehicles.address).await;
@@ -202,59 +162,25 @@ async fn home_gps_and_health_turn_ready_at_the_pre_arm_time() {
         | S::MAV_SYS_STATUS_GEOFENCE;
 
     // Before: no fix, no home, the GPS and the pre-arm checks unhealthy.
-    let s = gcs
-        .wait(2, 2 * SECOND, sys_status)
-        .await
-        .expect("SYS_STATUS");
+    let s = gcs.wait(2, 2 * SECOND, sys_status).await.expect("SYS_STATUS");
     assert!(s.onboard_control_sensors_present.contains(needed));
-    assert!(
-        s.onboard_control_sensors_enabled.contains(needed),
-        "the world has a geofence"
-    );
-    assert!(!s
-        .onboard_control_sensors_health
-        .contains(S::MAV_SYS_STATUS_SENSOR_GPS));
-    assert!(!s
-        .onboard_control_sensors_health
-        .contains(S::MAV_SYS_STATUS_PREARM_CHECK));
-    assert_eq!(
-        gcs.wait(2, 2 * SECOND, gps).await,
-        Some(GpsFixType::GPS_FIX_TYPE_NO_FIX)
-    );
+    assert!(s.onboard_control_sensors_enabled.contains(needed), "the world has a geofence");
+    assert!(!s.onboard_control_sensors_health.contains(S::MAV_SYS_STATUS_SENSOR_GPS));
+    assert!(!s.onboard_control_sensors_health.contains(S::MAV_SYS_STATUS_PREARM_CHECK));
+    assert_eq!(gcs.wait(2, 2 * SECOND, gps).await, Some(GpsFixType::GPS_FIX_TYPE_NO_FIX));
     #[allow(deprecated)]
     let get_home = MavCmd::MAV_CMD_GET_HOME_POSITION;
     let ack = gcs.command(2, get_home, [0.0; 7]).await;
-    assert_eq!(
-        ack.result,
-        MavResult::MAV_RESULT_FAILED,
-        "no home before the fix"
-    );
+    assert_eq!(ack.result, MavResult::MAV_RESULT_FAILED, "no home before the fix");
 
     // Home is set once, unasked, when the fix comes.
-    let h = gcs
-        .wait(2, 6 * SECOND, home)
-        .await
-        .expect("HOME_POSITION when home is set");
-    let origin = Origin {
-        lat: ORIGIN.0,
-        lon: ORIGIN.1,
-        alt: ORIGIN.2,
-    };
-    assert_eq!(
-        (h.latitude, h.longitude),
-        origin.to_e7(10.0, 0.0),
-        "drone d1 stands at (10, 0)"
-    );
+    let h = gcs.wait(2, 6 * SECOND, home).await.expect("HOME_POSITION when home is set");
+    let origin = Origin { lat: ORIGIN.0, lon: ORIGIN.1, alt: ORIGIN.2 };
+    assert_eq!((h.latitude, h.longitude), origin.to_e7(10.0, 0.0), "drone d1 stands at (10, 0)");
     assert_eq!(h.altitude, 400_000, "at the origin's altitude, in mm");
-    let s = gcs
-        .wait(2, 2 * SECOND, sys_status)
-        .await
-        .expect("SYS_STATUS");
+    let s = gcs.wait(2, 2 * SECOND, sys_status).await.expect("SYS_STATUS");
     assert!(s.onboard_control_sensors_health.contains(needed), "{s:?}");
-    assert_eq!(
-        gcs.wait(2, 2 * SECOND, gps).await,
-        Some(GpsFixType::GPS_FIX_TYPE_3D_FIX)
-    );
+    assert_eq!(gcs.wait(2, 2 * SECOND, gps).await, Some(GpsFixType::GPS_FIX_TYPE_3D_FIX));
 
     // On request: HOME_POSITION then the ACK for GET_HOME_POSITION; the ACK first for
     // REQUEST_MESSAGE (both as ArduCopter SITL).
@@ -276,11 +202,7 @@ async fn home_gps_and_health_turn_ready_at_the_pre_arm_time() {
     }
     assert_eq!(order, ["HOME_POSITION", "ACK"]);
     let ack = gcs
-        .command(
-            2,
-            MavCmd::MAV_CMD_REQUEST_MESSAGE,
-            [242.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-        )
+        .command(2, MavCmd::MAV_CMD_REQUEST_MESSAGE, [242.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
         .await;
     assert_eq!(ack.result, MavResult::MAV_RESULT_ACCEPTED);
     assert!(gcs.wait(2, SECOND, home).await.is_some());
@@ -327,14 +249,12 @@ async fn ftp_requests_are_refused_at_once() {
     let path = b"@PARAM/param.pck";
     payload[4] = path.len() as u8;
     payload[12..12 + path.len()].copy_from_slice(path);
-    gcs.send(&MavMessage::FILE_TRANSFER_PROTOCOL(
-        FILE_TRANSFER_PROTOCOL_DATA {
-            target_network: 0,
-            target_system: 1,
-            target_component: 1,
-            payload,
-        },
-    ))
+    gcs.send(&MavMessage::FILE_TRANSFER_PROTOCOL(FILE_TRANSFER_PROTOCOL_DATA {
+        target_network: 0,
+        target_system: 1,
+        target_component: 1,
+        payload,
+    }))
     .await;
     let nak = gcs
         .wait(1, SECOND, |m| match m {
@@ -347,14 +267,7 @@ async fn ftp_requests_are_refused_at_once() {
     let p = nak.payload;
     // Sequence 42, session 3, NAK (129) of OpenFileRO (4), one byte: ERR_UnknownCommand.
     assert_eq!(
-        (
-            u16::from_le_bytes([p[0], p[1]]),
-            p[2],
-            p[3],
-            p[4],
-            p[5],
-            p[12]
-        ),
+        (u16::from_le_bytes([p[0], p[1]]), p[2], p[3], p[4], p[5], p[12]),
         (42, 3, 129, 1, 4, 7)
     );
     vehicles.stop();

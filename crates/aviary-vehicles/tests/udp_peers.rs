@@ -24,11 +24,7 @@ fn heartbeat() -> Vec<u8> {
         system_status: MavState::MAV_STATE_ACTIVE,
         mavlink_version: 3,
     });
-    let header = MavHeader {
-        system_id: 255,
-        component_id: 190,
-        sequence: 0,
-    };
+    let header = MavHeader { system_id: 255, component_id: 190, sequence: 0 };
     let mut buf = Vec::new();
     mavlink::write_v2_msg(&mut buf, header, &msg).unwrap();
     buf
@@ -48,10 +44,7 @@ async fn serve_udp() -> aviary_vehicles::Vehicles {
     aviary_vehicles::serve(
         &fleet(1, ""),
         Listen::Udp("127.0.0.1:0".parse().unwrap()),
-        Options {
-            speed: 5.0,
-            ..Options::default()
-        },
+        Options { speed: 5.0, ..Options::default() },
     )
     .await
     .unwrap()

@@ -88,8 +88,10 @@ pub fn check_conflicts(mission: &Mission, diagnostics: &mut Vec<Diagnostic>) {
         for (&w, slots) in &best {
             for f in slots.iter().flatten() {
                 let origin = &sites.claims[members[w]].origin;
-                let code = if f.why.slot() == 0 { Code::CommandsMayCollide } else { Code::CommandsQueue };
-                let entry = first.entry((origin.file.0, origin.span.start, code)).or_insert((w, *f));
+                let code =
+                    if f.why.slot() == 0 { Code::CommandsMayCollide } else { Code::CommandsQueue };
+                let entry =
+                    first.entry((origin.file.0, origin.span.start, code)).or_insert((w, *f));
                 // The map's order is arbitrary: the pair's order alone decides.
                 if (f.at, w) < (entry.1.at, entry.0) {
                     *entry = (w, *f);
@@ -97,7 +99,16 @@ pub fn check_conflicts(mission: &Mission, diagnostics: &mut Vec<Diagnostic>) {
             }
         }
         for (key, (w, f)) in first {
-            found.entry(key).or_insert_with(|| report(mission, &sites.claims[members[w]], &sites.claims[members[f.other]], drone, resource, &f.why));
+            found.entry(key).or_insert_with(|| {
+                report(
+                    mission,
+                    &sites.claims[members[w]],
+                    &sites.claims[members[f.other]],
+                    drone,
+                    resource,
+                    &f.why,
+                )
+            });
         }
     }
     diagnostics.extend(found.into_values());
@@ -151,10 +162,14 @@ impl Bucket<'_> {
         // Under a SEQUENTIAL block without handlers nothing overlaps at this step: only
         // children of two or more statements are looked into, and nothing is allocated
         // (a block of a million statements is one pass).
-        let sorted = group.first().is_some_and(|&p| step(p).is_some()) && group.windows(2).all(|w| step(w[0]) <= step(w[1]));
+        let sorted = group.first().is_some_and(|&p| step(p).is_some())
+            && group.windows(2).all(|w| step(w[0]) <= step(w[1]));
         if let (true, Some(Some((id, _)))) = (sorted, group.first().map(|&p| step(p))) {
-            let one_construct = group.last().and_then(|&p| step(p)).is_some_and(|(last, _)| last == id);
-            let plain = matches!(self.sites.constructs[id], Construct::Block(BlockKind::Sequential)) && group.iter().all(|&p| !matches!(step(p), Some((_, Key::Handler(_)))));
+            let one_construct =
+                group.last().and_then(|&p| step(p)).is_some_and(|(last, _)| last == id);
+            let plain =
+                matches!(self.sites.constructs[id], Construct::Block(BlockKind::Sequential))
+                    && group.iter().all(|&p| !matches!(step(p), Some((_, Key::Handler(_)))));
             if one_construct && plain {
                 for child in group.chunk_by(|&a, &b| step(a) == step(b)).filter(|g| g.len() > 1) {
                     self.split(child, depth + 1, every, best);
@@ -163,7 +178,10 @@ impl Bucket<'_> {
             }
         }
         // Otherwise: by construct, then child, each in position order, cut into runs.
-        let mut steps: Vec<((usize, Key), usize)> = group.iter().filter_map(|&pos| self.path(pos).get(depth).map(|&step| (step, pos))).collect();
+        let mut steps: Vec<((usize, Key), usize)> = group
+            .iter()
+            .filter_map(|&pos| self.path(pos).get(depth).map(|&step| (step, pos)))
+            .collect();
         if !steps.windows(2).all(|w| w[0] <= w[1]) {
             steps.sort_unstable();
         }
@@ -176,17 +194,36 @@ impl Bucket<'_> {
         }
         for same in children.chunk_by(|a, b| a.0 .0 == b.0 .0) {
             let id = same[0].0 .0;
-            let parallel = matches!(self.sites.constructs[id], Construct::Block(BlockKind::Parallel) | Construct::For { parallel: true });
+            let parallel = matches!(
+                self.sites.constructs[id],
+                Construct::Block(BlockKind::Parallel) | Construct::For { parallel: true }
+            );
             match self.sites.constructs[id] {
                 // A SEQUENTIAL block without handlers orders all it holds: nothing here.
-                Construct::Block(kind) if kind == BlockKind::Parallel || same.iter().any(|(s, _)| matches!(s.1, Key::Handler(_))) => {
-                    let items: Vec<&[usize]> = same.iter().filter(|(s, _)| matches!(s.1, Key::Item(_))).map(|(_, g)| *g).collect();
-                    let handlers: Vec<(usize, &[usize])> = same.iter().filter_map(|(s, g)| if let Key::Handler(h) = s.1 { Some((h, *g)) } else { None }).collect();
+                Construct::Block(kind)
+                    if kind == BlockKind::Parallel
+                        || same.iter().any(|(s, _)| matches!(s.1, Key::Handler(_))) =>
+                {
+                    let items: Vec<&[usize]> = same
+                        .iter()
+                        .filter(|(s, _)| matches!(s.1, Key::Item(_)))
+                        .map(|(_, g)| *g)
+                        .collect();
+                    let handlers: Vec<(usize, &[usize])> = same
+                        .iter()
+                        .filter_map(
+                            |(s, g)| if let Key::Handler(h) = s.1 { Some((h, *g)) } else { None },
+                        )
+                        .collect();
                     if kind == BlockKind::Parallel {
                         self.later_waits(&items, Overlap::Branches, best);
                     }
                     if !every || parallel {
-                        self.later_waits(&handlers.iter().map(|(_, g)| *g).collect::<Vec<_>>(), Overlap::Handlers, best);
+                        self.later_waits(
+                            &handlers.iter().map(|(_, g)| *g).collect::<Vec<_>>(),
+                            Overlap::Handlers,
+                            best,
+                        );
                         self.handlers_and_items(id, depth, &handlers, &items, best);
                     }
                 }
@@ -249,7 +286,9 @@ impl Bucket<'_> {
                     }
                     first = Some((pos, g));
                 }
-                Some((_, fg)) if fg != g && second.map_or(true, |(p, _)| pos < p) => second = Some((pos, g)),
+                Some((_, fg)) if fg != g && second.map_or(true, |(p, _)| pos < p) => {
+                    second = Some((pos, g))
+                }
                 None => first = Some((pos, g)),
                 _ => {}
             }
@@ -258,7 +297,14 @@ impl Bucket<'_> {
 
     /// A handler of block `id` against the block's own statements: the handler's
     /// statement waits, unless they end before every raise of its signal.
-    fn handlers_and_items(&self, id: usize, depth: usize, handlers: &[(usize, &[usize])], items: &[&[usize]], best: &mut Best) {
+    fn handlers_and_items(
+        &self,
+        id: usize,
+        depth: usize,
+        handlers: &[(usize, &[usize])],
+        items: &[&[usize]],
+        best: &mut Best,
+    ) {
         if handlers.is_empty() || items.is_empty() {
             return;
         }
@@ -272,10 +318,13 @@ impl Bucket<'_> {
             let signal = info.signal;
             // A drone's link comes back only after it was lost, and the loss aborted what
             // the drone was doing: its own restore handler does not race with that.
-            if self.mission.signals[signal] == "ConnectionRestored" && info.by.as_deref() == Some(&[self.drone]) {
+            if self.mission.signals[signal] == "ConnectionRestored"
+                && info.by.as_deref() == Some(&[self.drone])
+            {
                 continue;
             }
-            let (race, queue) = *memo.entry(signal).or_insert_with(|| self.first_of_flow(id, depth, signal, &flow));
+            let (race, queue) =
+                *memo.entry(signal).or_insert_with(|| self.first_of_flow(id, depth, signal, &flow));
             for &w in g.iter() {
                 if let Some(x) = race {
                     offer(best, w, x, Overlap::HandlerAndFlow(signal));
@@ -287,7 +336,13 @@ impl Bucket<'_> {
         }
     }
 
-    fn first_of_flow(&self, id: usize, depth: usize, signal: SignalId, flow: &[usize]) -> (Option<usize>, Option<usize>) {
+    fn first_of_flow(
+        &self,
+        id: usize,
+        depth: usize,
+        signal: SignalId,
+        flow: &[usize],
+    ) -> (Option<usize>, Option<usize>) {
         if sites::untimed(self.mission, signal) {
             return (flow.first().copied(), None);
         }
@@ -309,7 +364,14 @@ impl Bucket<'_> {
     }
 }
 
-fn report(mission: &Mission, waiting: &ClaimSite, other: &ClaimSite, drone: DroneId, resource: Resource, why: &Overlap) -> Diagnostic {
+fn report(
+    mission: &Mission,
+    waiting: &ClaimSite,
+    other: &ClaimSite,
+    drone: DroneId,
+    resource: Resource,
+    why: &Overlap,
+) -> Diagnostic {
     let name = &mission.drones[drone];
     let cap = |s: &ClaimSite| mission.capabilities[s.capability].name.clone();
     let signal = |s: &SignalId| mission.signals[*s].clone();
@@ -343,9 +405,15 @@ fn report(mission: &Mission, waiting: &ClaimSite, other: &ClaimSite, drone: Dron
             )
         }
     };
-    let mut d = Diagnostic::new(code, waiting.origin.file, waiting.origin.span, message).label(format!("waits for {name}'s {res}")).with_help(help);
+    let mut d = Diagnostic::new(code, waiting.origin.file, waiting.origin.span, message)
+        .label(format!("waits for {name}'s {res}"))
+        .with_help(help);
     if waiting.origin != other.origin {
-        d = d.also(other.origin.file, other.origin.span, format!("holds {name}'s {res} meanwhile: `{name} {}`", cap(other)));
+        d = d.also(
+            other.origin.file,
+            other.origin.span,
+            format!("holds {name}'s {res} meanwhile: `{name} {}`", cap(other)),
+        );
     }
     d
 }

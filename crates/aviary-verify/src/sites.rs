@@ -7,7 +7,9 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use aviary_api::{DroneId, Resource};
-use aviary_ir::{ActorFilter, ActorRef, Block, BlockKind, Call, CapId, Mission, Node, Origin, SignalId};
+use aviary_ir::{
+    ActorFilter, ActorRef, Block, BlockKind, Call, CapId, Mission, Node, Origin, SignalId,
+};
 
 /// Which child of a construct a step goes to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -69,7 +71,18 @@ pub fn untimed(mission: &Mission, signal: SignalId) -> bool {
 
 pub fn collect(mission: &Mission) -> Sites {
     let raises = capability_raises(mission);
-    let mut walk = Walk { mission, raises_of: raises, env: vec![Vec::new(); mission.frame_size], path: Vec::new(), out: Sites { constructs: Vec::new(), handlers: BTreeMap::new(), claims: Vec::new(), raises: Vec::new() } };
+    let mut walk = Walk {
+        mission,
+        raises_of: raises,
+        env: vec![Vec::new(); mission.frame_size],
+        path: Vec::new(),
+        out: Sites {
+            constructs: Vec::new(),
+            handlers: BTreeMap::new(),
+            claims: Vec::new(),
+            raises: Vec::new(),
+        },
+    };
     walk.block(&mission.body);
     walk.out
 }
@@ -115,8 +128,12 @@ impl Walk<'_> {
         match node {
             Node::Block(b) => self.block(b),
             Node::Call(call) => self.call(call),
-            Node::Signal { signal, .. } => self.out.raises.push(RaiseSite { signal: *signal, path: self.path.clone() }),
-            Node::StartIf { body, .. } | Node::DoWhile { body, .. } | Node::WaitFor { body: Some(body), .. } => {
+            Node::Signal { signal, .. } => {
+                self.out.raises.push(RaiseSite { signal: *signal, path: self.path.clone() })
+            }
+            Node::StartIf { body, .. }
+            | Node::DoWhile { body, .. }
+            | Node::WaitFor { body: Some(body), .. } => {
                 let id = self.construct(Construct::Wrapper);
                 self.under(id, Key::Body, |w| w.block(body));
             }
@@ -138,7 +155,10 @@ impl Walk<'_> {
                     self.env[f.alias] = saved;
                 }
             }
-            Node::WaitFor { body: None, .. } | Node::Leash(_) | Node::Api(_) | Node::Throw { .. } => {}
+            Node::WaitFor { body: None, .. }
+            | Node::Leash(_)
+            | Node::Api(_)
+            | Node::Throw { .. } => {}
         }
     }
 
@@ -155,8 +175,14 @@ impl Walk<'_> {
         // The common case, one drone for a one-actor capability: its claims on slot 0
         // (each once already: the compiler sorts and dedups them).
         if let ([ActorRef::Drone(d)], 1) = (call.actors.as_slice(), cap.actors) {
-            let claims = cap.claims.iter().filter(|(slot, _)| *slot == 0).map(|&(_, r)| (*d, r)).collect();
-            self.out.claims.push(ClaimSite { origin: call.origin, path: self.path.clone(), claims, capability: call.capability });
+            let claims =
+                cap.claims.iter().filter(|(slot, _)| *slot == 0).map(|&(_, r)| (*d, r)).collect();
+            self.out.claims.push(ClaimSite {
+                origin: call.origin,
+                path: self.path.clone(),
+                claims,
+                capability: call.capability,
+            });
             for &signal in &self.raises_of[call.capability] {
                 self.out.raises.push(RaiseSite { signal, path: self.path.clone() });
             }
@@ -177,7 +203,12 @@ impl Walk<'_> {
                 }
             }
         }
-        self.out.claims.push(ClaimSite { origin: call.origin, path: self.path.clone(), claims, capability: call.capability });
+        self.out.claims.push(ClaimSite {
+            origin: call.origin,
+            path: self.path.clone(),
+            claims,
+            capability: call.capability,
+        });
         for &signal in &self.raises_of[call.capability] {
             self.out.raises.push(RaiseSite { signal, path: self.path.clone() });
         }

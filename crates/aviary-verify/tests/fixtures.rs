@@ -31,7 +31,8 @@ struct Outcome {
 }
 
 fn verify_fixture(name: &str) -> Outcome {
-    let read = |f: &str| std::fs::read(dir().join(f)).unwrap_or_else(|e| panic!("cannot read {f}: {e}"));
+    let read =
+        |f: &str| std::fs::read(dir().join(f)).unwrap_or_else(|e| panic!("cannot read {f}: {e}"));
     let world_name = match name.strip_suffix(".mission").map(|stem| format!("{stem}.world.toml")) {
         Some(beside) if dir().join(&beside).is_file() => beside,
         _ => "world.toml".to_string(),
@@ -39,7 +40,13 @@ fn verify_fixture(name: &str) -> Outcome {
     let (mission, world) = (read(name), read(&world_name));
     let mut sources = SourceMap::new();
     let api = Descriptor::standard();
-    let checked = aviary_check::check_sources(&mut sources, (name, &mission), Some((&world_name, &world)), &NoFiles, &api);
+    let checked = aviary_check::check_sources(
+        &mut sources,
+        (name, &mission),
+        Some((&world_name, &world)),
+        &NoFiles,
+        &api,
+    );
     let verified = aviary_verify::preflight(&checked, &api);
     let mut diagnostics: Vec<Diagnostic> = checked.diagnostics;
     let mut text = String::new();
@@ -88,16 +95,27 @@ fn each_fixture_produces_what_its_name_says() {
     let mut seen = BTreeSet::new();
     for name in fixtures() {
         let outcome = verify_fixture(&name);
-        assert!(!outcome.codes.iter().any(|c| c.severity() == aviary_diagnostics::Severity::Error), "{name} has errors:\n{}", outcome.text);
+        assert!(
+            !outcome.codes.iter().any(|c| c.severity() == aviary_diagnostics::Severity::Error),
+            "{name} has errors:\n{}",
+            outcome.text
+        );
         seen.extend(outcome.codes.iter().copied());
         let code = name.get(..4).and_then(|p| Code::from_str(&p.to_ascii_uppercase()));
         match code {
-            Some(code) if !outcome.codes.contains(&code) => wrong.push(format!("{name}: no {code}")),
-            None if name.starts_with("ok_") && outcome.codes.iter().any(|c| Code::PREFLIGHT.contains(c)) => wrong.push(format!("{name}: a pre-flight finding where none is expected")),
+            Some(code) if !outcome.codes.contains(&code) => {
+                wrong.push(format!("{name}: no {code}"))
+            }
+            None if name.starts_with("ok_")
+                && outcome.codes.iter().any(|c| Code::PREFLIGHT.contains(c)) =>
+            {
+                wrong.push(format!("{name}: a pre-flight finding where none is expected"))
+            }
             _ => {}
         }
     }
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));
-    let missing: Vec<&str> = Code::PREFLIGHT.iter().filter(|c| !seen.contains(c)).map(|c| c.as_str()).collect();
+    let missing: Vec<&str> =
+        Code::PREFLIGHT.iter().filter(|c| !seen.contains(c)).map(|c| c.as_str()).collect();
     assert!(missing.is_empty(), "no fixture produces {}", missing.join(", "));
 }

@@ -13,9 +13,7 @@ mod sim;
 
 use drone::Drones;
 
-const TABLES: &[&str] = &[
-    "site", "places", "areas", "drones", "sensors", "targets", "faults",
-];
+const TABLES: &[&str] = &["site", "places", "areas", "drones", "sensors", "targets", "faults"];
 const SITE_KEYS: &[&str] = &[
     "name",
     "origin",
@@ -68,9 +66,15 @@ pub type Join<'j> = &'j dyn Fn(&mut (dyn FnMut() + Send), &mut (dyn FnMut() + Se
 pub(crate) const JOIN_FROM: usize = 1 << 16;
 
 /// As [`parse`], reading a large file in two parts through `join` when it can.
-pub(crate) fn parse_joined(file: FileId, text: &str, join: Join) -> (Option<World>, Vec<Diagnostic>) {
+pub(crate) fn parse_joined(
+    file: FileId,
+    text: &str,
+    join: Join,
+) -> (Option<World>, Vec<Diagnostic>) {
     let in_two = match text.len() >= JOIN_FROM {
-        true => split_point(text, text.len() / 2).and_then(|at| read_fast_in_two(file, text, at, join)),
+        true => {
+            split_point(text, text.len() / 2).and_then(|at| read_fast_in_two(file, text, at, join))
+        }
         false => None,
     };
     let (world, mut diags) = match in_two {
@@ -99,17 +103,21 @@ pub(crate) fn split_point(text: &str, near: usize) -> Option<usize> {
 /// of [`read_fast`]: the drones of the tail, their groups and their problems come
 /// after the head's, as the whole file's reader meets them. (A group named in both
 /// parts has its name in two allocations, not one.)
-pub(crate) fn read_fast_in_two(file: FileId, text: &str, at: usize, join: Join) -> Option<(World, Vec<Diagnostic>)> {
+pub(crate) fn read_fast_in_two(
+    file: FileId,
+    text: &str,
+    at: usize,
+    join: Join,
+) -> Option<(World, Vec<Diagnostic>)> {
     if !text.get(at..)?.starts_with("[drones.") || at == 0 {
         return None;
     }
     let (mut head, mut tail) = (None, None);
     // The head's drones get room for the tail's, which are moved in after them.
     let everyone = count_drones(text);
-    join(
-        &mut || head = read_part(file, text, 0..at, fast::Part::Head, everyone),
-        &mut || tail = read_part(file, text, at..text.len(), fast::Part::Tail, 0),
-    );
+    join(&mut || head = read_part(file, text, 0..at, fast::Part::Head, everyone), &mut || {
+        tail = read_part(file, text, at..text.len(), fast::Part::Tail, 0)
+    });
     let ((head, mut cx, mut drones), (tail, tail_cx, tail_drones)) = (head?, tail?);
     let root = fast::join(head, tail)?;
     cx.diags.extend(tail_cx.diags);
@@ -119,7 +127,13 @@ pub(crate) fn read_fast_in_two(file: FileId, text: &str, at: usize, join: Join) 
 
 /// One part of a file read in two, its diagnostics and its drones.
 /// `room`: for at least that many drones.
-fn read_part(file: FileId, text: &str, range: std::ops::Range<usize>, part: fast::Part, room: usize) -> Option<(fast::Read, Ctx<'_>, Drones)> {
+fn read_part(
+    file: FileId,
+    text: &str,
+    range: std::ops::Range<usize>,
+    part: fast::Part,
+    room: usize,
+) -> Option<(fast::Read, Ctx<'_>, Drones)> {
     let mut cx = Ctx { file, text, diags: Vec::new() };
     let count = count_drones(text.get(range.clone())?);
     let mut drones = Drones::with_capacity(count.max(room));
@@ -129,7 +143,8 @@ fn read_part(file: FileId, text: &str, range: std::ops::Range<usize>, part: fast
 
 /// About how many drones `lines` hold: the lines that start `[drones.`.
 fn count_drones(lines: &str) -> usize {
-    memchr::memmem::find_iter(lines.as_bytes(), b"\n[drones.").count() + usize::from(lines.starts_with("[drones."))
+    memchr::memmem::find_iter(lines.as_bytes(), b"\n[drones.").count()
+        + usize::from(lines.starts_with("[drones."))
 }
 
 /// The serde path's way, from the whole tree.
@@ -137,7 +152,9 @@ pub(crate) fn read_tree(file: FileId, text: &str, mut root: Node) -> (World, Vec
     let mut cx = Ctx { file, text, diags: Vec::new() };
     let mut drones = Drones::default();
     if let Value::Table(top) = &mut root.value {
-        if let Some(Entry { node: Node { value: Value::Table(entries), .. }, .. }) = top.iter_mut().find(|e| e.key == "drones") {
+        if let Some(Entry { node: Node { value: Value::Table(entries), .. }, .. }) =
+            top.iter_mut().find(|e| e.key == "drones")
+        {
             for e in std::mem::take(entries) {
                 drones.entry(&mut cx, e);
             }
@@ -183,11 +200,7 @@ fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Dia
             Value::Table(_) => format!("unknown table `[{}]` in the world file", e.key),
             _ => format!("unknown key `{}` at the top of the world file", e.key),
         };
-        let list = TABLES
-            .iter()
-            .map(|t| format!("`[{t}]`"))
-            .collect::<Vec<_>>()
-            .join(", ");
+        let list = TABLES.iter().map(|t| format!("`[{t}]`")).collect::<Vec<_>>().join(", ");
         let help = match suggest(&e.key, TABLES.iter().copied()) {
             Some(s) => format!("did you mean `[{s}]`? The world file's tables are {list}"),
             None => format!("remove it; the world file's tables are {list}"),
@@ -246,16 +259,19 @@ fn site(cx: &mut Ctx, node: &Node) -> Site {
         match e.key.as_str() {
             "name" => site.name = cx.string(&"`name` in [site]", n),
             "origin" => site.origin = origin(cx, e),
-            "geofence" => site.geofence = cx.polygon(&"the geofence", n).filter(|fence| cx.outline(&"the geofence", n, fence)),
+            "geofence" => {
+                site.geofence = cx
+                    .polygon(&"the geofence", n)
+                    .filter(|fence| cx.outline(&"the geofence", n, fence))
+            }
             "max_altitude" => site.max_altitude = cx.positive(&"`max_altitude`", n),
             "min_separation" => match cx.number(&"`min_separation`", n) {
                 Some(v) if v < 0.0 => {
-                    let msg = format!("`min_separation` must be zero or more metres, found {}", aviary_api::show::number(v));
-                    cx.error(
-                        n.span,
-                        msg,
-                        "write a distance in metres, e.g. `min_separation = 5`",
+                    let msg = format!(
+                        "`min_separation` must be zero or more metres, found {}",
+                        aviary_api::show::number(v)
                     );
+                    cx.error(n.span, msg, "write a distance in metres, e.g. `min_separation = 5`");
                 }
                 Some(v) => site.min_separation = v,
                 None => {}
@@ -291,11 +307,7 @@ fn origin(cx: &mut Ctx, e: &Entry) -> Option<Geo> {
     let lat = read("lat", -90.0, 90.0);
     let lon = read("lon", -180.0, 180.0);
     let alt = read("alt", -1e6, 1e6);
-    Some(Geo {
-        lat: lat?,
-        lon: lon?,
-        alt: alt?,
-    })
+    Some(Geo { lat: lat?, lon: lon?, alt: alt? })
 }
 
 fn places(cx: &mut Ctx, node: &Node) -> Vec<Place> {
@@ -307,13 +319,10 @@ fn places(cx: &mut Ctx, node: &Node) -> Vec<Place> {
     for e in entries {
         cx.identifier("place", &e.key, e.key_span);
         let what = format!("place `{}`", e.key);
-        if let Some((at, has_z)) = cx.point(&what, &e.node).filter(|(at, _)| cx.above_ground(&what, &e.node, at[2])) {
-            out.push(Place {
-                name: e.key.clone(),
-                at,
-                has_z,
-                span: e.key_span,
-            });
+        if let Some((at, has_z)) =
+            cx.point(&what, &e.node).filter(|(at, _)| cx.above_ground(&what, &e.node, at[2]))
+        {
+            out.push(Place { name: e.key.clone(), at, has_z, span: e.key_span });
         }
     }
     out
@@ -328,12 +337,9 @@ fn areas(cx: &mut Ctx, node: &Node) -> Vec<Area> {
     for e in entries {
         cx.identifier("area", &e.key, e.key_span);
         let what = format!("area `{}`", e.key);
-        if let Some(polygon) = cx.polygon(&what, &e.node).filter(|p| cx.outline(&what, &e.node, p)) {
-            out.push(Area {
-                name: e.key.clone(),
-                polygon,
-                span: e.key_span,
-            });
+        if let Some(polygon) = cx.polygon(&what, &e.node).filter(|p| cx.outline(&what, &e.node, p))
+        {
+            out.push(Area { name: e.key.clone(), polygon, span: e.key_span });
         }
     }
     out
@@ -345,14 +351,22 @@ fn areas(cx: &mut Ctx, node: &Node) -> Vec<Area> {
 /// world of a million drones keeps no span per home.
 fn homes_in_fence(cx: &mut Ctx, world: &World) {
     let Some(fence) = world.site.geofence.as_deref() else { return };
-    let outside: Vec<&crate::Drone> = world.drones.iter().filter(|d| !aviary_api::geometry::contains(fence, [d.home[0], d.home[1]])).collect();
+    let outside: Vec<&crate::Drone> = world
+        .drones
+        .iter()
+        .filter(|d| !aviary_api::geometry::contains(fence, [d.home[0], d.home[1]]))
+        .collect();
     if outside.is_empty() {
         return;
     }
     let spans = home_spans(cx.text);
     for d in outside {
         let at = spans.get(d.name.as_str()).copied().unwrap_or(d.span);
-        let msg = format!("drone `{}`'s home {} is outside the geofence", d.name, crate::read::shown([d.home[0], d.home[1]]));
+        let msg = format!(
+            "drone `{}`'s home {} is outside the geofence",
+            d.name,
+            crate::read::shown([d.home[0], d.home[1]])
+        );
         cx.error(at, msg, "move the home inside the geofence, or widen `geofence` in [site]: a drone takes off and lands at its home");
     }
 }
@@ -363,7 +377,10 @@ fn home_spans(text: &str) -> std::collections::HashMap<String, Span> {
     let mut out = std::collections::HashMap::new();
     let Ok(root) = Node::parse_serde(text) else { return out };
     let Value::Table(top) = &root.value else { return out };
-    let Some(Entry { node: Node { value: Value::Table(drones), .. }, .. }) = get(top, "drones") else { return out };
+    let Some(Entry { node: Node { value: Value::Table(drones), .. }, .. }) = get(top, "drones")
+    else {
+        return out;
+    };
     for d in drones {
         let Value::Table(keys) = &d.node.value else { continue };
         if let Some(home) = get(keys, "home") {
@@ -380,7 +397,8 @@ fn unique_names(cx: &mut Ctx, world: &World, group_spans: &[Span]) {
     let mut named: QuickMap<&str, Vec<(&str, Span)>> = QuickMap::default();
     let places = world.places.iter().map(|p| (p.name.as_str(), "a place", p.span));
     let areas = world.areas.iter().map(|a| (a.name.as_str(), "an area", a.span));
-    let groups = world.groups.iter().zip(group_spans).map(|(g, span)| (g.name.as_str(), "a group", *span));
+    let groups =
+        world.groups.iter().zip(group_spans).map(|(g, span)| (g.name.as_str(), "a group", *span));
     for (name, what, span) in places.chain(areas).chain(groups) {
         named.entry(name).or_default().push((what, span));
     }
@@ -389,7 +407,8 @@ fn unique_names(cx: &mut Ctx, world: &World, group_spans: &[Span]) {
             uses.push(("a drone", d.span));
         }
     }
-    let mut clashes: Vec<(&str, Vec<(&str, Span)>)> = named.into_iter().filter(|(_, uses)| uses.len() > 1).collect();
+    let mut clashes: Vec<(&str, Vec<(&str, Span)>)> =
+        named.into_iter().filter(|(_, uses)| uses.len() > 1).collect();
     clashes.sort_by_key(|(_, uses)| uses.iter().map(|(_, s)| (s.start, s.end)).min());
     for (name, mut uses) in clashes {
         uses.sort_by_key(|(_, span)| (span.start, span.end));
@@ -398,14 +417,13 @@ fn unique_names(cx: &mut Ctx, world: &World, group_spans: &[Span]) {
             let msg = format!(
                 "the name `{name}` is used for {first} and for {what}, so mission code could not tell which is meant"
             );
-            let help = "rename one of them: drones, groups, places and areas share one set of names";
-            let d = Diagnostic::new(Code::WorldFile, cx.file, span, msg)
-                .with_help(help)
-                .also(
-                    cx.file,
-                    first_span,
-                    format!("{first} `{name}` is defined here"),
-                );
+            let help =
+                "rename one of them: drones, groups, places and areas share one set of names";
+            let d = Diagnostic::new(Code::WorldFile, cx.file, span, msg).with_help(help).also(
+                cx.file,
+                first_span,
+                format!("{first} `{name}` is defined here"),
+            );
             cx.push(d);
         }
     }

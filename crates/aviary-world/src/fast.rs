@@ -35,7 +35,9 @@ pub(crate) fn parse(text: &str) -> Option<Node> {
     let mut drones = Vec::new();
     let mut root = parse_with(text, 0, &mut |e| drones.push(e))?;
     if let Value::Table(top) = &mut root.value {
-        if let Some(Entry { node: Node { value: Value::Table(entries), .. }, .. }) = top.iter_mut().find(|e| e.key == "drones") {
+        if let Some(Entry { node: Node { value: Value::Table(entries), .. }, .. }) =
+            top.iter_mut().find(|e| e.key == "drones")
+        {
             *entries = drones;
         }
     }
@@ -46,7 +48,11 @@ pub(crate) fn parse(text: &str) -> Option<Node> {
 /// soon as it has been read, and the tree's `drones` table is left empty. When this
 /// returns `None`, some tables may have gone to `on_drone` already. `drones`: about how
 /// many there are.
-pub(crate) fn parse_with(text: &str, drones: usize, on_drone: &mut dyn FnMut(Entry)) -> Option<Node> {
+pub(crate) fn parse_with(
+    text: &str,
+    drones: usize,
+    on_drone: &mut dyn FnMut(Entry),
+) -> Option<Node> {
     let part = parse_part(text, 0..text.len(), Part::Whole, drones, on_drone)?;
     Some(part.root.into_node())
 }
@@ -79,7 +85,13 @@ pub(crate) struct Read {
 /// across tables: the tree and the names of the drones, which [`join`] puts together.
 /// `None`: the serde path reads the file (for a head or a tail: the whole file is read
 /// in one part, which decides).
-pub(crate) fn parse_part(text: &str, range: std::ops::Range<usize>, part: Part, drones: usize, on_drone: &mut dyn FnMut(Entry)) -> Option<Read> {
+pub(crate) fn parse_part(
+    text: &str,
+    range: std::ops::Range<usize>,
+    part: Part,
+    drones: usize,
+    on_drone: &mut dyn FnMut(Entry),
+) -> Option<Read> {
     let whole = text;
     let base = range.start;
     let text = text.get(range)?;
@@ -125,7 +137,11 @@ pub(crate) fn parse_part(text: &str, range: std::ops::Range<usize>, part: Part, 
                 }
             }
             // `toml` reads a CRLF inside a multi-line string as LF; `toml_parser` keeps it.
-            TokenKind::MlLiteralString if text.get(token.span().start()..token.span().end())?.contains('\r') => return None,
+            TokenKind::MlLiteralString
+                if text.get(token.span().start()..token.span().end())?.contains('\r') =>
+            {
+                return None
+            }
             TokenKind::LeftCurlyBracket => inline += 1,
             TokenKind::RightCurlyBracket => inline -= 1,
             // A head is a piece of the file: its end is not the file's.
@@ -159,7 +175,9 @@ pub(crate) fn parse_part(text: &str, range: std::ops::Range<usize>, part: Part, 
     if part == Part::Head {
         // The whole file's lexer, too, ends a token at the end of the head: its last
         // token is a line break (a string or comment running on would have taken it).
-        let ends_line = tokens.last().is_some_and(|t| t.kind() == TokenKind::Newline && t.span().end() == text.len());
+        let ends_line = tokens
+            .last()
+            .is_some_and(|t| t.kind() == TokenKind::Newline && t.span().end() == text.len());
         if !(ends_line && depth == 0 && inline == 0) {
             return None;
         }
@@ -188,7 +206,11 @@ pub(crate) fn join(head: Read, tail: Read) -> Option<Node> {
     // The tail holds only `[drones.NAME]` tables, all handed over: its tree is one empty
     // table `drones`, made by its first header.
     let mut tail_entries = tail.root.entries.into_iter();
-    let (Some((key, key_span, Item::Table(drones))), None) = (tail_entries.next(), tail_entries.next()) else { return None };
+    let (Some((key, key_span, Item::Table(drones))), None) =
+        (tail_entries.next(), tail_entries.next())
+    else {
+        return None;
+    };
     if key != "drones" || !drones.entries.is_empty() {
         return None;
     }
@@ -241,7 +263,10 @@ fn plain_scalar(text: &str, encoding: Option<Encoding>) -> Option<Value> {
         None => match text {
             "true" => Some(Value::Bool(true)),
             "false" => Some(Value::Bool(false)),
-            _ if (1..=18).contains(&text.len()) && text.bytes().all(|b| b.is_ascii_digit()) && (text.len() == 1 || !text.starts_with('0')) => {
+            _ if (1..=18).contains(&text.len())
+                && text.bytes().all(|b| b.is_ascii_digit())
+                && (text.len() == 1 || !text.starts_with('0')) =>
+            {
                 text.parse().ok().map(Value::Int)
             }
             _ => None,
@@ -296,7 +321,9 @@ impl Table {
         }
         self.entries.push((key, key_span, item));
         if self.index.is_none() && self.entries.len() > INDEX_FROM {
-            self.index = Some(self.entries.iter().enumerate().map(|(i, (k, _, _))| (k.clone(), i)).collect());
+            self.index = Some(
+                self.entries.iter().enumerate().map(|(i, (k, _, _))| (k.clone(), i)).collect(),
+            );
         }
         at
     }
@@ -313,7 +340,10 @@ impl Table {
                         let start = ts.first().map_or(key_span.start, |t| t.span.start);
                         let end = ts.last().map_or(key_span.end, |t| t.span.end);
                         let items = ts.into_iter().map(Table::into_node).collect();
-                        Node { span: Span::new(start as usize, end as usize), value: Value::Array(items) }
+                        Node {
+                            span: Span::new(start as usize, end as usize),
+                            value: Value::Array(items),
+                        }
                     }
                 };
                 Entry { key, key_span, node }
@@ -380,7 +410,9 @@ impl<'i> Builder<'i, '_> {
         if !std::mem::take(&mut self.open_drone) {
             return Some(());
         }
-        let Item::Table(drones) = &mut self.root.entries.get_mut(self.drones_at?)?.2 else { return None };
+        let Item::Table(drones) = &mut self.root.entries.get_mut(self.drones_at?)?.2 else {
+            return None;
+        };
         let (key, key_span, Item::Table(table)) = drones.entries.pop()? else { return None };
         self.current = None;
         (self.on_drone)(Entry { key, key_span, node: table.into_node() });
@@ -418,7 +450,13 @@ impl<'i> Builder<'i, '_> {
     }
 
     /// `[a.b.c]` or `[[a.b.c]]`, from `start` to `end`.
-    fn header(&mut self, array: bool, start: usize, end: usize, keys: Vec<(String, Span)>) -> Option<()> {
+    fn header(
+        &mut self,
+        array: bool,
+        start: usize,
+        end: usize,
+        keys: Vec<(String, Span)>,
+    ) -> Option<()> {
         self.hand_over_drone()?;
         let drone = self.drone_header(array, &keys)?;
         if self.only_drones && !drone {
@@ -442,7 +480,9 @@ impl<'i> Builder<'i, '_> {
         let whole = Span::new(start, end);
         let i = match (table.find(&last.0), array) {
             (None, false) => table.push(last.0.clone(), last.1, Item::Table(Table::new(whole))),
-            (None, true) => table.push(last.0.clone(), last.1, Item::Tables(vec![Table::new(whole)])),
+            (None, true) => {
+                table.push(last.0.clone(), last.1, Item::Tables(vec![Table::new(whole)]))
+            }
             (Some(i), true) => match &mut table.entries[i].2 {
                 Item::Tables(ts) => {
                     ts.push(Table::new(whole));
@@ -509,7 +549,9 @@ impl<'i> Builder<'i, '_> {
             ScalarKind::Integer(IntegerRadix::Dec) => Value::Int(out.parse().ok()?),
             // A literal too large for an f64 (`14E2650`) reads as infinity here and is an
             // error for the serde path: not finite, it takes that path (as do `inf`, `nan`).
-            ScalarKind::Float if encoding.is_none() => Value::Float(out.parse::<f64>().ok().filter(|f| f.is_finite())?),
+            ScalarKind::Float if encoding.is_none() => {
+                Value::Float(out.parse::<f64>().ok().filter(|f| f.is_finite())?)
+            }
             _ => return None,
         };
         self.value(Node { span: self.span(at), value })
@@ -567,12 +609,19 @@ impl EventReceiver for Builder<'_, '_> {
         self.close_header(at);
     }
     fn inline_table_open(&mut self, at: toml_parser::Span, _: &mut dyn ErrorSink) -> bool {
-        self.stack.push(Open::Inline { start: self.base + at.start(), entries: Vec::new(), key: None });
+        self.stack.push(Open::Inline {
+            start: self.base + at.start(),
+            entries: Vec::new(),
+            key: None,
+        });
         true
     }
     fn inline_table_close(&mut self, at: toml_parser::Span, _: &mut dyn ErrorSink) {
         let ok = match self.stack.pop() {
-            Some(Open::Inline { start, entries, key: None }) => self.value(Node { span: Span::new(start, self.base + at.end()), value: Value::Table(entries) }),
+            Some(Open::Inline { start, entries, key: None }) => self.value(Node {
+                span: Span::new(start, self.base + at.end()),
+                value: Value::Table(entries),
+            }),
             _ => None,
         };
         self.check(ok);
@@ -583,12 +632,20 @@ impl EventReceiver for Builder<'_, '_> {
     }
     fn array_close(&mut self, at: toml_parser::Span, _: &mut dyn ErrorSink) {
         let ok = match self.stack.pop() {
-            Some(Open::Array { start, items }) => self.value(Node { span: Span::new(start, self.base + at.end()), value: Value::Array(items) }),
+            Some(Open::Array { start, items }) => self.value(Node {
+                span: Span::new(start, self.base + at.end()),
+                value: Value::Array(items),
+            }),
             _ => None,
         };
         self.check(ok);
     }
-    fn simple_key(&mut self, at: toml_parser::Span, encoding: Option<Encoding>, _: &mut dyn ErrorSink) {
+    fn simple_key(
+        &mut self,
+        at: toml_parser::Span,
+        encoding: Option<Encoding>,
+        _: &mut dyn ErrorSink,
+    ) {
         let ok = self.key(at, encoding);
         self.check(ok);
     }

@@ -59,7 +59,8 @@ mod tests {
     #[test]
     fn similar_names_spread_over_buckets() {
         let build = BuildHasherDefault::<Quick>::default();
-        let buckets: HashSet<u64> = (0..4096).map(|i| build.hash_one(format!("a{i}")) & 4095).collect();
+        let buckets: HashSet<u64> =
+            (0..4096).map(|i| build.hash_one(format!("a{i}")) & 4095).collect();
         assert!(buckets.len() > 2400, "{} of 4096 buckets", buckets.len());
     }
 }

@@ -12,9 +12,9 @@ mod build;
 mod fast;
 mod hash;
 mod node;
-mod read;
 #[cfg(test)]
 mod place_tests;
+mod read;
 #[cfg(test)]
 mod tests;
 
@@ -36,17 +36,28 @@ pub const BUILTIN_SENSORS: &[&str] = &["camera"];
 pub fn assert_fast_reader_agrees(text: &str) {
     if let Some(fast) = fast::parse(text) {
         match node::Node::parse_serde(text) {
-            Ok(slow) => assert!(fast == slow, "the fast reader and serde read {text:?} differently:\n{fast:#?}\n{slow:#?}"),
+            Ok(slow) => assert!(
+                fast == slow,
+                "the fast reader and serde read {text:?} differently:\n{fast:#?}\n{slow:#?}"
+            ),
             Err(e) => panic!("the fast reader accepts {text:?}, which serde refuses: {e}"),
         }
     }
     if let Some((world, mut diags)) = build::read_fast(FileId::default(), text) {
-        let slow = node::Node::parse_serde(text).unwrap_or_else(|e| panic!("the fast reader accepts {text:?}, which serde refuses: {e}"));
+        let slow = node::Node::parse_serde(text).unwrap_or_else(|e| {
+            panic!("the fast reader accepts {text:?}, which serde refuses: {e}")
+        });
         let (slow_world, mut slow_diags) = build::read_tree(FileId::default(), text, slow);
         aviary_diagnostics::sort(&mut diags);
         aviary_diagnostics::sort(&mut slow_diags);
-        assert!(world == slow_world, "the fast reader builds another world from {text:?}:\n{world:#?}\n{slow_world:#?}");
-        assert!(diags == slow_diags, "the fast reader finds other problems in {text:?}:\n{diags:#?}\n{slow_diags:#?}");
+        assert!(
+            world == slow_world,
+            "the fast reader builds another world from {text:?}:\n{world:#?}\n{slow_world:#?}"
+        );
+        assert!(
+            diags == slow_diags,
+            "the fast reader finds other problems in {text:?}:\n{diags:#?}\n{slow_diags:#?}"
+        );
     }
     assert_split_reader_agrees(text);
 }
@@ -60,9 +71,21 @@ pub fn assert_split_reader_agrees(text: &str) {
     while let Some(at) = build::split_point(text, near) {
         near = at + 1;
         if let Some(parts) = build::read_fast_in_two(FileId::default(), text, at, &join_in_turn) {
-            let Some(whole) = &whole else { panic!("{text:?} cut at {at} reads in two parts, but not whole") };
-            assert!(parts.0 == whole.0, "{text:?} cut at {at} gives another world:\n{:#?}\n{:#?}", parts.0, whole.0);
-            assert!(parts.1 == whole.1, "{text:?} cut at {at} gives other problems:\n{:#?}\n{:#?}", parts.1, whole.1);
+            let Some(whole) = &whole else {
+                panic!("{text:?} cut at {at} reads in two parts, but not whole")
+            };
+            assert!(
+                parts.0 == whole.0,
+                "{text:?} cut at {at} gives another world:\n{:#?}\n{:#?}",
+                parts.0,
+                whole.0
+            );
+            assert!(
+                parts.1 == whole.1,
+                "{text:?} cut at {at} gives other problems:\n{:#?}\n{:#?}",
+                parts.1,
+                whole.1
+            );
         }
     }
 }
@@ -80,7 +103,11 @@ pub use build::Join;
 /// the two parts read exactly as the whole would (the second holds nothing but
 /// `[drones.NAME]` tables, no drone is in both, the first ends between tables), and
 /// otherwise the file is read in one part.
-pub fn parse_world_joined(file: FileId, text: &str, join: Join) -> (Option<World>, Vec<Diagnostic>) {
+pub fn parse_world_joined(
+    file: FileId,
+    text: &str,
+    join: Join,
+) -> (Option<World>, Vec<Diagnostic>) {
     build::parse_joined(file, text, join)
 }
 
@@ -240,21 +267,24 @@ impl Drone {
     /// The endurance that capacity and draw give, when both are known.
     pub fn endurance_from_battery(capacity: Option<f64>, current: Option<f64>) -> Option<f64> {
         match (capacity, current) {
-            (Some(mah), Some(amps)) if mah > 0.0 && amps > 0.0 => Some(mah / 1000.0 / amps * 3600.0),
+            (Some(mah), Some(amps)) if mah > 0.0 && amps > 0.0 => {
+                Some(mah / 1000.0 / amps * 3600.0)
+            }
             _ => None,
         }
     }
 
     /// How the drone comes down.
     pub fn descent(&self) -> aviary_api::flight::Descent {
-        aviary_api::flight::Descent { rate: self.descent_rate, land_speed: self.land_speed, slow_below: self.land_speed_below }
+        aviary_api::flight::Descent {
+            rate: self.descent_rate,
+            land_speed: self.land_speed,
+            slow_below: self.land_speed_below,
+        }
     }
 
     pub fn attribute(&self, key: &str) -> Option<&AttributeValue> {
-        self.attributes
-            .iter()
-            .find(|(k, _)| &**k == key)
-            .map(|(_, v)| v)
+        self.attributes.iter().find(|(k, _)| &**k == key).map(|(_, v)| v)
     }
 }
 

@@ -118,11 +118,7 @@ impl RawNode {
                             .or_else(|| node.span.clone())
                             .map(to_span)
                             .unwrap_or(span);
-                        Entry {
-                            key: key.name,
-                            key_span,
-                            node: node.finish(key_span),
-                        }
+                        Entry { key: key.name, key_span, node: node.finish(key_span) }
                     })
                     .collect(),
             ),
@@ -148,17 +144,11 @@ impl<'de> Visitor<'de> for KeyVisitor {
         f.write_str("a key")
     }
     fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<RawKey, E> {
-        Ok(RawKey {
-            name: v.to_owned(),
-            span: None,
-        })
+        Ok(RawKey { name: v.to_owned(), span: None })
     }
     fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<RawKey, A::Error> {
         let (span, name) = read_spanned(&mut map, std::marker::PhantomData::<String>)?;
-        Ok(RawKey {
-            name,
-            span: Some(span),
-        })
+        Ok(RawKey { name, span: Some(span) })
     }
 }
 

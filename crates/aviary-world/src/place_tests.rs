@@ -19,7 +19,13 @@ const FENCE: &str = "[site]\ngeofence = [[-100, -100], [100, -100], [100, 100], 
 #[test]
 fn a_home_outside_the_fence_is_an_error_at_the_home() {
     let text = format!("{FENCE}[drones.far]\nhome = [5000, 0]\n[drones.near]\nhome = [100, 100]\n");
-    assert_eq!(problems(&text), vec![("drone `far`'s home (5000, 0) is outside the geofence".to_string(), "[5000, 0]".to_string())]);
+    assert_eq!(
+        problems(&text),
+        vec![(
+            "drone `far`'s home (5000, 0) is outside the geofence".to_string(),
+            "[5000, 0]".to_string()
+        )]
+    );
 }
 
 #[test]
@@ -28,7 +34,11 @@ fn a_target_outside_the_fence_or_below_the_ground_is_an_error() {
     assert_eq!(
         problems(&text),
         vec![
-            ("the target at (0, 300) is outside the geofence, where no drone may fly to find it".to_string(), "[0, 300]".to_string()),
+            (
+                "the target at (0, 300) is outside the geofence, where no drone may fly to find it"
+                    .to_string(),
+                "[0, 300]".to_string()
+            ),
             ("a target is below the ground: z = -1 m".to_string(), "[0, 0, -1]".to_string()),
         ]
     );
@@ -40,8 +50,14 @@ fn a_place_or_home_below_the_ground_is_an_error_and_on_it_is_fine() {
     assert_eq!(
         problems(text),
         vec![
-            ("place `Deep` is below the ground: z = -0.5 m".to_string(), "[0, 0, -0.5]".to_string()),
-            ("`home` of drone `d` is below the ground: z = -3 m".to_string(), "[0, 0, -3]".to_string()),
+            (
+                "place `Deep` is below the ground: z = -0.5 m".to_string(),
+                "[0, 0, -0.5]".to_string()
+            ),
+            (
+                "`home` of drone `d` is below the ground: z = -3 m".to_string(),
+                "[0, 0, -3]".to_string()
+            ),
         ]
     );
 }
@@ -49,11 +65,23 @@ fn a_place_or_home_below_the_ground_is_an_error_and_on_it_is_fine() {
 #[test]
 fn a_fence_must_enclose_an_area_and_not_cross_itself() {
     let line = "[site]\ngeofence = [[0, 0], [50, 50], [100, 100]]\n[drones.d]\nhome = [0, 0]\n";
-    assert_eq!(problems(line), vec![("the geofence encloses no area: its corners lie on one line".to_string(), "[[0, 0], [50, 50], [100, 100]]".to_string())]);
-    let bowtie = "[site]\ngeofence = [[0, 0], [100, 100], [100, 0], [0, 100]]\n[drones.d]\nhome = [0, 0]\n";
+    assert_eq!(
+        problems(line),
+        vec![(
+            "the geofence encloses no area: its corners lie on one line".to_string(),
+            "[[0, 0], [50, 50], [100, 100]]".to_string()
+        )]
+    );
+    let bowtie =
+        "[site]\ngeofence = [[0, 0], [100, 100], [100, 0], [0, 100]]\n[drones.d]\nhome = [0, 0]\n";
     let found = problems(bowtie);
     assert_eq!(found.len(), 1, "{found:?}");
-    assert!(found[0].0.starts_with("the geofence crosses itself: its edge from (0, 0) to (100, 100) crosses"), "{found:?}");
+    assert!(
+        found[0]
+            .0
+            .starts_with("the geofence crosses itself: its edge from (0, 0) to (100, 100) crosses"),
+        "{found:?}"
+    );
     // Without a valid fence, homes are not held to it: one problem, not one per drone.
     let ok = "[site]\ngeofence = [[0, 0], [100, 0], [100, 100], [0, 100]]\n[areas]\nA = [[10, 10], [20, 10], [20, 20]]\n[drones.d]\nhome = [100, 50]\n";
     assert!(problems(ok).is_empty());

@@ -37,7 +37,12 @@ impl Ctx<'_> {
         Span::new(span.start as usize, span.start as usize + len)
     }
 
-    pub fn table<'n>(&mut self, what: &dyn Display, node: &'n Node, help: &str) -> Option<&'n [Entry]> {
+    pub fn table<'n>(
+        &mut self,
+        what: &dyn Display,
+        node: &'n Node,
+        help: &str,
+    ) -> Option<&'n [Entry]> {
         match &node.value {
             Value::Table(entries) => Some(entries),
             _ => {
@@ -56,11 +61,7 @@ impl Ctx<'_> {
                 Some(s) => format!("did you mean `{s}`? The known keys are {list}"),
                 None => format!("remove it; the known keys are {list}"),
             };
-            self.error(
-                e.key_span,
-                format!("unknown key `{}` in {place}", e.key),
-                help,
-            );
+            self.error(e.key_span, format!("unknown key `{}` in {place}", e.key), help);
         }
     }
 
@@ -76,11 +77,7 @@ impl Ctx<'_> {
         };
         if !value.is_finite() {
             let msg = format!("{what} must be a finite number");
-            self.error(
-                node.span,
-                msg,
-                "write a number such as `10` or `2.5`, not inf or nan",
-            );
+            self.error(node.span, msg, "write a number such as `10` or `2.5`, not inf or nan");
             return None;
         }
         Some(value)
@@ -112,7 +109,12 @@ impl Ctx<'_> {
     pub fn within(&mut self, what: &dyn Display, node: &Node, min: f64, max: f64) -> Option<f64> {
         let value = self.number(what, node)?;
         if !(min..=max).contains(&value) {
-            let msg = format!("{what} must be between {} and {}, found {}", number(min), number(max), number(value));
+            let msg = format!(
+                "{what} must be between {} and {}, found {}",
+                number(min),
+                number(max),
+                number(value)
+            );
             self.error(
                 node.span,
                 msg,
@@ -138,10 +140,7 @@ impl Ctx<'_> {
     pub fn strings(&mut self, what: &dyn Display, node: &Node) -> Option<Vec<(String, Span)>> {
         let help = "write a list of strings, e.g. `[\"Body\", \"Radiation\"]`";
         let Value::Array(items) = &node.value else {
-            let msg = format!(
-                "{what} must be a list of strings, found {}",
-                node.describe()
-            );
+            let msg = format!("{what} must be a list of strings, found {}", node.describe());
             self.error(node.span, msg, help);
             return None;
         };
@@ -179,7 +178,11 @@ impl Ctx<'_> {
         }
         // Square metres: less than this is a line, whatever the units' rounding.
         if aviary_api::geometry::signed_area(polygon).abs() < 1e-6 {
-            self.error(node.span, format!("{what} encloses no area: its corners lie on one line"), help);
+            self.error(
+                node.span,
+                format!("{what} encloses no area: its corners lie on one line"),
+                help,
+            );
             return false;
         }
         true
@@ -199,18 +202,14 @@ impl Ctx<'_> {
     pub fn point(&mut self, what: &dyn Display, node: &Node) -> Option<([f64; 3], bool)> {
         let help = "write `[x, y]` or `[x, y, z]` in metres, e.g. `[150, 100]`";
         let Value::Array(items) = &node.value else {
-            let msg = format!(
-                "{what} must be a position [x, y] or [x, y, z], found {}",
-                node.describe()
-            );
+            let msg =
+                format!("{what} must be a position [x, y] or [x, y, z], found {}", node.describe());
             self.error(node.span, msg, help);
             return None;
         };
         if !(2..=3).contains(&items.len()) {
-            let msg = format!(
-                "{what} must be 2 or 3 numbers, found {}",
-                count(items.len(), "number")
-            );
+            let msg =
+                format!("{what} must be 2 or 3 numbers, found {}", count(items.len(), "number"));
             self.error(node.span, msg, help);
             return None;
         }
@@ -229,10 +228,7 @@ impl Ctx<'_> {
     pub fn polygon(&mut self, what: &dyn Display, node: &Node) -> Option<Vec<[f64; 2]>> {
         let help = "write at least three corners, e.g. `[[0, 0], [100, 0], [100, 100]]`";
         let Value::Array(items) = &node.value else {
-            let msg = format!(
-                "{what} must be a polygon [[x, y], ...], found {}",
-                node.describe()
-            );
+            let msg = format!("{what} must be a polygon [[x, y], ...], found {}", node.describe());
             self.error(node.span, msg, help);
             return None;
         };
@@ -253,10 +249,8 @@ impl Ctx<'_> {
                     None
                 }
                 _ => {
-                    let msg = format!(
-                        "a corner of {what} must be [x, y], found {}",
-                        item.describe()
-                    );
+                    let msg =
+                        format!("a corner of {what} must be [x, y], found {}", item.describe());
                     self.error(item.span, msg, "write each corner as `[x, y]`");
                     None
                 }
@@ -268,10 +262,8 @@ impl Ctx<'_> {
             }
         }
         if items.len() < 3 {
-            let msg = format!(
-                "{what} has {}; a polygon needs at least 3",
-                count(items.len(), "point")
-            );
+            let msg =
+                format!("{what} has {}; a polygon needs at least 3", count(items.len(), "point"));
             self.error(node.span, msg, help);
             return None;
         }
@@ -303,10 +295,8 @@ pub(crate) fn is_identifier(name: &str) -> bool {
 }
 
 fn to_identifier(name: &str) -> String {
-    let mut out: String = name
-        .chars()
-        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
-        .collect();
+    let mut out: String =
+        name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect();
     if !out.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_') {
         out.insert(0, '_');
     }
@@ -324,11 +314,7 @@ pub(crate) fn count(n: usize, noun: &str) -> String {
 
 /// "`a`, `b`, `c`".
 pub(crate) fn quoted<'a>(names: impl IntoIterator<Item = &'a &'a str>) -> String {
-    names
-        .into_iter()
-        .map(|n| format!("`{n}`"))
-        .collect::<Vec<_>>()
-        .join(", ")
+    names.into_iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
 }
 
 /// The closest of `candidates` to `name`, if it is close enough to be a likely typo.
@@ -362,9 +348,7 @@ fn distance(a: &str, b: &str) -> usize {
     for i in 1..=a.len() {
         for j in 1..=b.len() {
             let cost = usize::from(a[i - 1] != b[j - 1]);
-            let mut best = (d[i - 1][j] + 1)
-                .min(d[i][j - 1] + 1)
-                .min(d[i - 1][j - 1] + cost);
+            let mut best = (d[i - 1][j] + 1).min(d[i][j - 1] + 1).min(d[i - 1][j - 1] + cost);
             if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
                 best = best.min(d[i - 2][j - 2] + 1);
             }
@@ -390,10 +374,7 @@ pub(crate) fn toml_text(node: &Node) -> String {
         Value::Bool(b) => b.to_string(),
         Value::Datetime(d) => d.clone(),
         Value::Array(items) => {
-            format!(
-                "[{}]",
-                items.iter().map(toml_text).collect::<Vec<_>>().join(", ")
-            )
+            format!("[{}]", items.iter().map(toml_text).collect::<Vec<_>>().join(", "))
         }
         Value::Table(entries) if entries.is_empty() => "{}".into(),
         Value::Table(entries) => {
@@ -407,10 +388,8 @@ pub(crate) fn toml_text(node: &Node) -> String {
 }
 
 fn key_text(key: &str) -> String {
-    let bare = !key.is_empty()
-        && key
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+    let bare =
+        !key.is_empty() && key.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
     if bare {
         key.to_owned()
     } else {

@@ -25,15 +25,8 @@ fn errors(text: &str) -> Vec<(String, String, String)> {
         .map(|d| {
             assert_eq!(d.code, Code::WorldFile);
             assert_eq!(d.primary.file, FileId(7));
-            let help = d
-                .help
-                .clone()
-                .expect("every diagnostic says what to write instead");
-            (
-                d.message.clone(),
-                text[d.primary.span.range()].to_owned(),
-                help,
-            )
+            let help = d.help.clone().expect("every diagnostic says what to write instead");
+            (d.message.clone(), text[d.primary.span.range()].to_owned(), help)
         })
         .collect()
 }
@@ -66,12 +59,7 @@ fn example_world() {
     let groups: Vec<(&str, Vec<&str>)> = w
         .groups
         .iter()
-        .map(|g| {
-            (
-                g.name.as_str(),
-                g.members.iter().map(|&m| w.drones[m].name.as_str()).collect(),
-            )
-        })
+        .map(|g| (g.name.as_str(), g.members.iter().map(|&m| w.drones[m].name.as_str()).collect()))
         .collect();
     assert_eq!(
         groups,
@@ -87,39 +75,20 @@ fn example_world() {
     assert_eq!(&EXAMPLE[a.span.range()], "BuildingA");
     assert_eq!(w.area("Area1").unwrap().centroid(), [200.0, 325.0]);
     assert_eq!(w.site.name.as_deref(), Some("Crash site"));
-    assert_eq!(
-        w.site.origin,
-        Some(Geo {
-            lat: 46.6167,
-            lon: 14.2650,
-            alt: 440.0
-        })
-    );
+    assert_eq!(w.site.origin, Some(Geo { lat: 46.6167, lon: 14.2650, alt: 440.0 }));
     assert_eq!(w.site.max_altitude, Some(120.0));
     assert_eq!(w.site.min_separation, 5.0);
     assert_eq!(w.site.geofence.as_ref().map(Vec::len), Some(4));
     let d = w.drone("flir_drone2").unwrap();
     assert_eq!(d.home, [5.0, 5.0, 0.0]);
     assert_eq!(*d.sensors, ["thermal"]);
-    assert_eq!(
-        (d.max_speed, d.climb_rate, d.acceleration),
-        (10.0, 3.0, 3.0)
-    );
-    assert_eq!(
-        (d.battery, d.endurance, &d.backend),
-        (100.0, 1800.0, &Backend::Sim)
-    );
+    assert_eq!((d.max_speed, d.climb_rate, d.acceleration), (10.0, 3.0, 3.0));
+    assert_eq!((d.battery, d.endurance, &d.backend), (100.0, 1800.0, &Backend::Sim));
     assert_eq!(&EXAMPLE[d.span.range()], "flir_drone2");
     assert_eq!(*w.drone("beacon_drone2").unwrap().payload, ["Body"]);
     assert_eq!(w.sensor("thermal").unwrap().detects, ["Body"]);
     assert_eq!(w.sensor("radiation").unwrap().range, 25.0);
-    assert_eq!(
-        w.targets[2],
-        Target {
-            kind: "Radiation".into(),
-            at: [260.0, -300.0, 0.0]
-        }
-    );
+    assert_eq!(w.targets[2], Target { kind: "Radiation".into(), at: [260.0, -300.0, 0.0] });
     assert!(w.faults.is_empty());
     assert_eq!(w.group("video").unwrap().members.len(), 2);
     assert_eq!(w.names().count(), 7 + 4 + 6 + 3);
@@ -159,32 +128,16 @@ fn empty_text_is_the_empty_world() {
 
 #[test]
 fn separation_timeout_is_positive_seconds() {
-    assert_eq!(
-        ok("[site]\nseparation_timeout = 12.5\n")
-            .site
-            .separation_timeout,
-        12.5
-    );
-    assert_eq!(
-        ok("[site]\nseparation_timeout = 60\n")
-            .site
-            .separation_timeout,
-        60.0
-    );
+    assert_eq!(ok("[site]\nseparation_timeout = 12.5\n").site.separation_timeout, 12.5);
+    assert_eq!(ok("[site]\nseparation_timeout = 60\n").site.separation_timeout, 60.0);
     for bad in ["0", "-1"] {
         let (msg, at, help) = error(&format!("[site]\nseparation_timeout = {bad}\n"));
-        assert_eq!(
-            msg,
-            format!("`separation_timeout` must be greater than zero, found {bad}")
-        );
+        assert_eq!(msg, format!("`separation_timeout` must be greater than zero, found {bad}"));
         assert_eq!(at, bad);
         assert_eq!(help, "write a positive number");
     }
     let (msg, _, _) = error("[site]\nseparation_timeout = \"long\"\n");
-    assert!(
-        msg.starts_with("`separation_timeout` must be a number"),
-        "{msg}"
-    );
+    assert!(msg.starts_with("`separation_timeout` must be a number"), "{msg}");
     let (_, _, help) = error("[site]\nseparation_time = 3\n");
     assert!(help.contains("separation_timeout"), "{help}");
 }
@@ -193,26 +146,15 @@ fn separation_timeout_is_positive_seconds() {
 fn link_loss_rtl_after_is_positive_seconds() {
     let w = ok("[site]\nlink_loss_rtl_after = 4.5\n");
     assert_eq!(w.site.link_loss_rtl_after, 4.5);
-    assert_eq!(
-        ok("[site]\nlink_loss_rtl_after = 30\n")
-            .site
-            .link_loss_rtl_after,
-        30.0
-    );
+    assert_eq!(ok("[site]\nlink_loss_rtl_after = 30\n").site.link_loss_rtl_after, 30.0);
     for bad in ["0", "-2"] {
         let (msg, at, help) = error(&format!("[site]\nlink_loss_rtl_after = {bad}\n"));
-        assert_eq!(
-            msg,
-            format!("`link_loss_rtl_after` must be greater than zero, found {bad}")
-        );
+        assert_eq!(msg, format!("`link_loss_rtl_after` must be greater than zero, found {bad}"));
         assert_eq!(at, bad);
         assert_eq!(help, "write a positive number");
     }
     let (msg, _, _) = error("[site]\nlink_loss_rtl_after = \"soon\"\n");
-    assert!(
-        msg.starts_with("`link_loss_rtl_after` must be a number"),
-        "{msg}"
-    );
+    assert!(msg.starts_with("`link_loss_rtl_after` must be a number"), "{msg}");
     let (_, _, help) = error("[site]\nlink_loss_rtl = 3\n");
     assert!(help.contains("link_loss_rtl_after"), "{help}");
 }
@@ -222,10 +164,7 @@ fn other_forms_and_defaults() {
     let w = ok("drones.a = { home = [1, 2, 3], max_speed = 4, battery = 50 }\n\
          [site]\nmin_separation = 0\n[places]\nTop = [1, 2, 30]\n[areas]\nT = [[0, 0], [3, 0], [0, 3]]\n");
     let a = w.drone("a").unwrap();
-    assert_eq!(
-        (a.home, a.max_speed, a.battery),
-        ([1.0, 2.0, 3.0], 4.0, 50.0)
-    );
+    assert_eq!((a.home, a.max_speed, a.battery), ([1.0, 2.0, 3.0], 4.0, 50.0));
     assert!(w.place("Top").unwrap().has_z);
     assert_eq!(w.area("T").unwrap().centroid(), [1.0, 1.0]);
     assert_eq!(w.site.min_separation, 0.0);
@@ -239,11 +178,7 @@ fn centroid_of_degenerate_polygons_is_the_mean_of_corners() {
         span: Default::default(),
     };
     assert_eq!(line.centroid(), [2.0, 0.0]);
-    let point = Area {
-        name: "P".into(),
-        polygon: vec![[1.0, 1.0]; 3],
-        span: Default::default(),
-    };
+    let point = Area { name: "P".into(), polygon: vec![[1.0, 1.0]; 3], span: Default::default() };
     assert_eq!(point.centroid(), [1.0, 1.0]);
     let square = Area {
         name: "S".into(),
@@ -255,21 +190,13 @@ fn centroid_of_degenerate_polygons_is_the_mean_of_corners() {
 
 #[test]
 fn attributes_and_mavlink() {
-    let w = ok(
-        "[drones.a]\nhome = [0, 0]\ncolour = \"red\"\nweight = 2.5\nlights = true\n\
-         tags = [\"x\", 1]\nmavlink = \"udp:127.0.0.1:14550\"\nsystem_id = 3\n",
-    );
+    let w = ok("[drones.a]\nhome = [0, 0]\ncolour = \"red\"\nweight = 2.5\nlights = true\n\
+         tags = [\"x\", 1]\nmavlink = \"udp:127.0.0.1:14550\"\nsystem_id = 3\n");
     let a = w.drone("a").unwrap();
-    assert_eq!(
-        a.attribute("colour"),
-        Some(&AttributeValue::Text("red".into()))
-    );
+    assert_eq!(a.attribute("colour"), Some(&AttributeValue::Text("red".into())));
     assert_eq!(a.attribute("weight"), Some(&AttributeValue::Number(2.5)));
     assert_eq!(a.attribute("lights"), Some(&AttributeValue::Bool(true)));
-    assert_eq!(
-        a.attribute("tags"),
-        Some(&AttributeValue::Other("[\"x\", 1]".into()))
-    );
+    assert_eq!(a.attribute("tags"), Some(&AttributeValue::Other("[\"x\", 1]".into())));
     assert_eq!(a.attributes.len(), 4);
     assert_eq!(
         a.backend,
@@ -281,10 +208,7 @@ fn attributes_and_mavlink() {
     );
     let w = ok("[drones.c]\nhome = [0, 0]\nsince = 1979-05-27T07:32:00Z\n");
     let since = w.drones[0].attribute("since");
-    assert_eq!(
-        since,
-        Some(&AttributeValue::Other("1979-05-27T07:32:00Z".into()))
-    );
+    assert_eq!(since, Some(&AttributeValue::Other("1979-05-27T07:32:00Z".into())));
     let w =
         ok("[drones.b]\nhome = [0, 0]\nbackend = \"mavlink\"\nmavlink = \"tcp:10.0.0.2:5760\"\n");
     assert!(matches!(w.drones[0].backend, Backend::Mavlink(_)));
@@ -297,10 +221,7 @@ fn faults_that_are_right() {
          [[faults]]\ndrone = \"d\"\nat = 60.5\nkind = \"crash\"\n"
     ));
     assert_eq!(w.faults.len(), 2);
-    assert_eq!(
-        (w.faults[0].kind, w.faults[0].duration),
-        (FaultKind::LinkLoss, Some(5.0))
-    );
+    assert_eq!((w.faults[0].kind, w.faults[0].duration), (FaultKind::LinkLoss, Some(5.0)));
     assert_eq!((w.faults[1].kind, w.faults[1].at), (FaultKind::Crash, 60.5));
 }
 
@@ -319,23 +240,14 @@ fn syntax_errors() {
 #[test]
 fn wrong_types() {
     let (msg, at, help) = error("[drones.d]\nhome = \"x\"\n");
-    assert_eq!(
-        msg,
-        "`home` of drone `d` must be a position [x, y] or [x, y, z], found a string"
-    );
+    assert_eq!(msg, "`home` of drone `d` must be a position [x, y] or [x, y, z], found a string");
     assert_eq!(at, "\"x\"");
     assert!(help.contains("[x, y]"));
     let (msg, at, _) = error(&format!("{HOME}group = 3\n"));
-    assert_eq!(
-        msg,
-        "`group` of drone `d` must be a string, found an integer"
-    );
+    assert_eq!(msg, "`group` of drone `d` must be a string, found an integer");
     assert_eq!(at, "3");
     let (msg, at, _) = error(&format!("{HOME}sensors = [\"camera\", true]\n"));
-    assert_eq!(
-        msg,
-        "`sensors` of drone `d` must hold strings, found a boolean"
-    );
+    assert_eq!(msg, "`sensors` of drone `d` must hold strings, found a boolean");
     assert_eq!(at, "true");
     let (msg, at, _) = error("site = 3\n");
     assert_eq!(msg, "`site` must be a table, found an integer");
@@ -365,10 +277,7 @@ fn areas_need_three_points() {
     assert_eq!(at, "[[0, 0], [1, 1]]");
     assert!(help.contains("at least three"));
     let (msg, at, _) = error("[areas]\nZ = [[0, 0], [1, 1], [2]]\n");
-    assert_eq!(
-        msg,
-        "a corner of area `Z` must be 2 numbers [x, y], found 1 number"
-    );
+    assert_eq!(msg, "a corner of area `Z` must be 2 numbers [x, y], found 1 number");
     assert_eq!(at, "[2]");
     let (msg, at, _) = error("[site]\ngeofence = [[0, 0], [1, 0]]\n");
     assert_eq!(msg, "the geofence has 2 points; a polygon needs at least 3");
@@ -388,10 +297,7 @@ fn undefined_sensor() {
     let text = "[sensors.thermal]\ndetects = [\"Body\"]\nrange = 20\n[drones.d]\nhome = [0, 0]\nsensors = [\"thermel\", \"lidar\"]\n";
     let all = errors(text);
     assert_eq!(all.len(), 2);
-    assert_eq!(
-        all[0].0,
-        "drone `d` has sensor `thermel`, but no `[sensors.thermel]` defines it"
-    );
+    assert_eq!(all[0].0, "drone `d` has sensor `thermel`, but no `[sensors.thermel]` defines it");
     assert_eq!(all[0].1, "\"thermel\"");
     assert_eq!(all[0].2, "did you mean `thermal`?");
     assert_eq!(all[1].1, "\"lidar\"");
@@ -409,18 +315,14 @@ fn sensor_problems() {
     assert_eq!(msg, "sensor `sonar` has no `detects`");
     assert_eq!(at, "sonar");
     let (msg, at, _) = error("[sensors.sonar]\ndetects = []\nrange = 0\n");
-    assert_eq!(
-        msg,
-        "`range` of sensor `sonar` must be greater than zero, found 0"
-    );
+    assert_eq!(msg, "`range` of sensor `sonar` must be greater than zero, found 0");
     assert_eq!(at, "0");
 }
 
 #[test]
 fn fault_for_an_unknown_drone() {
-    let (msg, at, help) = error(&format!(
-        "{HOME}[[faults]]\ndrone = \"e\"\nat = 1\nkind = \"crash\"\n"
-    ));
+    let (msg, at, help) =
+        error(&format!("{HOME}[[faults]]\ndrone = \"e\"\nat = 1\nkind = \"crash\"\n"));
     assert_eq!(msg, "the fault names drone `e`, which is not in `[drones]`");
     assert_eq!(at, "\"e\"");
     assert_eq!(help, "name one of the drones: `d`");
@@ -431,18 +333,16 @@ fn fault_for_an_unknown_drone() {
 
 #[test]
 fn unknown_fault_kind() {
-    let (msg, at, help) = error(&format!(
-        "{HOME}[[faults]]\ndrone = \"d\"\nat = 1\nkind = \"explode\"\n"
-    ));
+    let (msg, at, help) =
+        error(&format!("{HOME}[[faults]]\ndrone = \"d\"\nat = 1\nkind = \"explode\"\n"));
     assert_eq!(msg, "unknown fault kind `explode`");
     assert_eq!(at, "\"explode\"");
     assert_eq!(
         help,
         "write one of `battery_critical`, `link_loss`, `crash`, `gps_loss`, `motor_failure`"
     );
-    let (_, _, help) = error(&format!(
-        "{HOME}[[faults]]\ndrone = \"d\"\nat = 1\nkind = \"link-loss\"\n"
-    ));
+    let (_, _, help) =
+        error(&format!("{HOME}[[faults]]\ndrone = \"d\"\nat = 1\nkind = \"link-loss\"\n"));
     assert!(help.starts_with("did you mean `link_loss`?"));
 }
 
@@ -457,41 +357,35 @@ fn durations_of_faults() {
     }
     let text = format!("{HOME}[[faults]]\ndrone = \"d\"\nat = 1\nkind = \"crash\"\nduration = 3\n");
     let (msg, at, _) = error(&text);
-    assert_eq!(
-        msg,
-        "`duration` applies only to `link_loss` and `gps_loss` faults, not to `crash`"
-    );
+    assert_eq!(msg, "`duration` applies only to `link_loss` and `gps_loss` faults, not to `crash`");
     assert_eq!(at, "duration");
-    let (msg, at, _) = error(&format!(
-        "{HOME}[[faults]]\ndrone = \"d\"\nat = -1\nkind = \"crash\"\n"
-    ));
-    assert_eq!(
-        msg,
-        "`at` of a fault must be zero or more seconds, found -1"
-    );
+    let (msg, at, _) =
+        error(&format!("{HOME}[[faults]]\ndrone = \"d\"\nat = -1\nkind = \"crash\"\n"));
+    assert_eq!(msg, "`at` of a fault must be zero or more seconds, found -1");
     assert_eq!(at, "-1");
-    let (msg, at, _) = error(&format!(
-        "{HOME}[[faults]]\ndrone = \"d\"\nkind = \"crash\"\n"
-    ));
+    let (msg, at, _) = error(&format!("{HOME}[[faults]]\ndrone = \"d\"\nkind = \"crash\"\n"));
     assert_eq!(msg, "a fault has no `at`");
     assert_eq!(at, "[[faults]]");
 }
 
 #[test]
 fn speeds_and_endurance_must_be_positive() {
-    for key in ["max_speed", "climb_rate", "acceleration", "endurance", "descent_rate", "land_speed", "battery_capacity", "flight_current"] {
+    for key in [
+        "max_speed",
+        "climb_rate",
+        "acceleration",
+        "endurance",
+        "descent_rate",
+        "land_speed",
+        "battery_capacity",
+        "flight_current",
+    ] {
         let (msg, at, _) = error(&format!("{HOME}{key} = -2\n"));
-        assert_eq!(
-            msg,
-            format!("`{key}` of drone `d` must be greater than zero, found -2")
-        );
+        assert_eq!(msg, format!("`{key}` of drone `d` must be greater than zero, found -2"));
         assert_eq!(at, "-2");
     }
     let (msg, at, _) = error(&format!("{HOME}endurance = 0.0\n"));
-    assert_eq!(
-        msg,
-        "`endurance` of drone `d` must be greater than zero, found 0"
-    );
+    assert_eq!(msg, "`endurance` of drone `d` must be greater than zero, found 0");
     assert_eq!(at, "0.0");
 }
 
@@ -508,10 +402,16 @@ fn heights_and_waits_may_be_zero_but_not_below() {
 fn descent_and_landing_follow_the_climb_unless_given() {
     let w = ok(&format!("{HOME}climb_rate = 2\n"));
     let d = &w.drones[0];
-    assert_eq!((d.descent_rate, d.land_speed, d.land_speed_below, d.return_altitude, d.return_loiter), (2.0, 2.0, 10.0, 10.0, 0.0));
+    assert_eq!(
+        (d.descent_rate, d.land_speed, d.land_speed_below, d.return_altitude, d.return_loiter),
+        (2.0, 2.0, 10.0, 10.0, 0.0)
+    );
     let w = ok(&format!("{HOME}climb_rate = 2.5\ndescent_rate = 1.5\nland_speed = 0.5\nreturn_altitude = 15\nreturn_loiter = 5\n"));
     let d = &w.drones[0];
-    assert_eq!((d.descent_rate, d.land_speed, d.return_altitude, d.return_loiter), (1.5, 0.5, 15.0, 5.0));
+    assert_eq!(
+        (d.descent_rate, d.land_speed, d.return_altitude, d.return_loiter),
+        (1.5, 0.5, 15.0, 5.0)
+    );
     assert!(d.attributes.is_empty(), "figures are not attributes");
 }
 
@@ -527,10 +427,7 @@ fn capacity_and_draw_give_the_endurance() {
 #[test]
 fn battery_in_percent() {
     let (msg, at, help) = error(&format!("{HOME}battery = 150\n"));
-    assert_eq!(
-        msg,
-        "`battery` of drone `d` must be between 0 and 100, found 150"
-    );
+    assert_eq!(msg, "`battery` of drone `d` must be between 0 and 100, found 150");
     assert_eq!(at, "150");
     assert_eq!(help, "write a number from 0 to 100");
     ok(&format!("{HOME}battery = 0\n"));
@@ -597,32 +494,17 @@ fn one_name_one_meaning() {
 #[test]
 fn names_must_be_identifiers() {
     let (msg, at, help) = error("[places]\n\"my-place\" = [0, 0]\n");
-    assert_eq!(
-        msg,
-        "place `my-place` is not a valid name, so mission code could not refer to it"
-    );
+    assert_eq!(msg, "place `my-place` is not a valid name, so mission code could not refer to it");
     assert_eq!(at, "\"my-place\"");
-    assert_eq!(
-        help,
-        "use letters, digits and `_`, not starting with a digit, e.g. `my_place`"
-    );
+    assert_eq!(help, "use letters, digits and `_`, not starting with a digit, e.g. `my_place`");
     let (msg, at, _) = error("[drones.2fast]\nhome = [0, 0]\n");
-    assert_eq!(
-        msg,
-        "drone `2fast` is not a valid name, so mission code could not refer to it"
-    );
+    assert_eq!(msg, "drone `2fast` is not a valid name, so mission code could not refer to it");
     assert_eq!(at, "2fast");
     let (msg, at, _) = error(&format!("{HOME}group = \"red team\"\n"));
-    assert_eq!(
-        msg,
-        "group `red team` is not a valid name, so mission code could not refer to it"
-    );
+    assert_eq!(msg, "group `red team` is not a valid name, so mission code could not refer to it");
     assert_eq!(at, "\"red team\"");
     let (msg, _, _) = error("[areas]\n\"\" = [[0, 0], [1, 0], [0, 1]]\n");
-    assert_eq!(
-        msg,
-        "area `` is not a valid name, so mission code could not refer to it"
-    );
+    assert_eq!(msg, "area `` is not a valid name, so mission code could not refer to it");
 }
 
 #[test]
@@ -642,27 +524,15 @@ fn backend_problems() {
     assert_eq!(msg, "unknown backend `px4` for drone `d`");
     assert_eq!(at, "\"px4\"");
     let (msg, at, _) = error(&format!("{HOME}backend = \"mavlink\"\n"));
-    assert_eq!(
-        msg,
-        "drone `d` has `backend = \"mavlink\"` but no `mavlink` address"
-    );
+    assert_eq!(msg, "drone `d` has `backend = \"mavlink\"` but no `mavlink` address");
     assert_eq!(at, "\"mavlink\"");
     let (msg, _, _) = error(&format!("{HOME}backend = \"sim\"\nmavlink = \"udp:h:1\"\n"));
-    assert_eq!(
-        msg,
-        "drone `d` has `backend = \"sim\"` and a `mavlink` address"
-    );
+    assert_eq!(msg, "drone `d` has `backend = \"sim\"` and a `mavlink` address");
     let (msg, at, _) = error(&format!("{HOME}system_id = 1\n"));
-    assert_eq!(
-        msg,
-        "`system_id` of drone `d` applies only to a MAVLink drone"
-    );
+    assert_eq!(msg, "`system_id` of drone `d` applies only to a MAVLink drone");
     assert_eq!(at, "system_id");
     let (msg, _, _) = error(&format!("{HOME}mavlink = \"udp:h:1\"\nsystem_id = 300\n"));
-    assert_eq!(
-        msg,
-        "`system_id` of drone `d` must be a whole number from 1 to 255, found 300"
-    );
+    assert_eq!(msg, "`system_id` of drone `d` must be a whole number from 1 to 255, found 300");
 }
 
 #[test]
@@ -690,19 +560,13 @@ fn targets_and_site_values() {
     assert_eq!(msg, "`targets` must be a list of tables, found a table");
     assert_eq!(at, "[targets]\nkind = \"Body\"");
     let (msg, at, _) = error("[site]\norigin = { lat = 91, lon = 0 }\n");
-    assert_eq!(
-        msg,
-        "`lat` of `origin` must be between -90 and 90, found 91"
-    );
+    assert_eq!(msg, "`lat` of `origin` must be between -90 and 90, found 91");
     assert_eq!(at, "91");
     let (msg, at, _) = error("[site]\norigin = { lat = 1 }\n");
     assert_eq!(msg, "`origin` has no `lon`");
     assert_eq!(at, "origin");
     let (msg, at, _) = error("[site]\nmin_separation = -1\n");
-    assert_eq!(
-        msg,
-        "`min_separation` must be zero or more metres, found -1"
-    );
+    assert_eq!(msg, "`min_separation` must be zero or more metres, found -1");
     assert_eq!(at, "-1");
     let (msg, at, _) = error("[site]\nmax_altitude = inf\n");
     assert_eq!(msg, "`max_altitude` must be a finite number");
@@ -715,10 +579,7 @@ fn every_problem_in_one_pass() {
         [drones.x]\nbattery = 101\nsensors = [\"nope\"]\n[[faults]]\ndrone = \"y\"\nat = 1\nkind = \"boom\"\n";
     let all = errors(text);
     let spans: Vec<&str> = all.iter().map(|(_, at, _)| at.as_str()).collect();
-    assert_eq!(
-        spans,
-        ["foo", "[1]", "[[0, 0]]", "x", "101", "\"nope\"", "\"y\"", "\"boom\""]
-    );
+    assert_eq!(spans, ["foo", "[1]", "[[0, 0]]", "x", "101", "\"nope\"", "\"y\"", "\"boom\""]);
 }
 
 #[test]
@@ -748,10 +609,7 @@ fn garbage_gives_diagnostics_not_panics() {
     for text in garbage {
         let (world, diags) = parse(text);
         for d in &diags {
-            assert!(
-                text.get(d.primary.span.range()).is_some(),
-                "{text:?}: {d:?}"
-            );
+            assert!(text.get(d.primary.span.range()).is_some(), "{text:?}: {d:?}");
         }
         if text.starts_with("[places]") || text.starts_with("[areas]") {
             assert!(world.is_some(), "{text:?}: {diags:?}");
@@ -781,15 +639,11 @@ fn random_inputs_never_panic() {
         seed ^= seed << 17;
         seed
     };
-    let alphabet: Vec<char> = "[]{}=,.\"'#\n \t0123456789-+eE_abcxyzAB:\\\u{0}é"
-        .chars()
-        .collect();
+    let alphabet: Vec<char> = "[]{}=,.\"'#\n \t0123456789-+eE_abcxyzAB:\\\u{0}é".chars().collect();
     for round in 0..3000 {
         let text: String = if round % 2 == 0 {
             let len = (next() % 80) as usize;
-            (0..len)
-                .map(|_| alphabet[(next() % alphabet.len() as u64) as usize])
-                .collect()
+            (0..len).map(|_| alphabet[(next() % alphabet.len() as u64) as usize]).collect()
         } else {
             let mut chars: Vec<char> = EXAMPLE.chars().collect();
             for _ in 0..(next() % 4 + 1) {
@@ -808,10 +662,7 @@ fn random_inputs_never_panic() {
         let (world, diags) = parse(&text);
         assert_eq!(world.is_some(), diags.is_empty(), "{text:?}");
         for d in &diags {
-            assert!(
-                text.get(d.primary.span.range()).is_some(),
-                "{text:?}: {d:?}"
-            );
+            assert!(text.get(d.primary.span.range()).is_some(), "{text:?}: {d:?}");
         }
     }
 }
@@ -835,15 +686,19 @@ fn the_fast_reader_gives_the_same_tree_as_serde() {
         "[a]\nk-1 = 1\n_k = 2\n3 = 3\n",
     ];
     for text in examples {
-        let fast = crate::fast::parse(text).unwrap_or_else(|| panic!("the fast reader reads {text:?}"));
+        let fast =
+            crate::fast::parse(text).unwrap_or_else(|| panic!("the fast reader reads {text:?}"));
         assert_eq!(fast, Node::parse_serde(text).unwrap(), "{text:?}");
     }
     let mut faults = String::new();
-    for entry in std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/faults")).unwrap() {
+    for entry in
+        std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/faults")).unwrap()
+    {
         let path = entry.unwrap().path();
         if path.to_string_lossy().ends_with(".world.toml") {
             faults = std::fs::read_to_string(&path).unwrap();
-            let fast = crate::fast::parse(&faults).unwrap_or_else(|| panic!("the fast reader reads {path:?}"));
+            let fast = crate::fast::parse(&faults)
+                .unwrap_or_else(|| panic!("the fast reader reads {path:?}"));
             assert_eq!(fast, Node::parse_serde(&faults).unwrap(), "{path:?}");
         }
     }
@@ -945,7 +800,11 @@ fn drones_read_table_by_table_give_the_serde_paths_world() {
 fn a_large_fleet_is_read_table_by_table() {
     let mut text = String::from("[site]\nname = \"W\"\n");
     for i in 0..500 {
-        text.push_str(&format!("\n[drones.a{i}]\nhome = [{}, 0]\ngroup = \"fleet{}\"\nindex = {i}\n", i * 5, i % 3));
+        text.push_str(&format!(
+            "\n[drones.a{i}]\nhome = [{}, 0]\ngroup = \"fleet{}\"\nindex = {i}\n",
+            i * 5,
+            i % 3
+        ));
     }
     assert_fast_reader_agrees(&text);
     let world = ok(&text);
@@ -1004,7 +863,9 @@ fn a_file_read_in_two_parts_is_read_as_whole() {
     // Some cuts are taken: every cut of a plain fleet.
     let text = &texts[1];
     let whole = crate::build::read_fast(FileId(7), text).unwrap();
-    let cuts = (1..text.len()).filter_map(|near| crate::build::split_point(text, near)).collect::<std::collections::BTreeSet<_>>();
+    let cuts = (1..text.len())
+        .filter_map(|near| crate::build::split_point(text, near))
+        .collect::<std::collections::BTreeSet<_>>();
     assert_eq!(cuts.len(), 6);
     for at in cuts {
         let parts = crate::build::read_fast_in_two(FileId(7), text, at, &join_in_turn).unwrap();
@@ -1013,14 +874,18 @@ fn a_file_read_in_two_parts_is_read_as_whole() {
     // ... and none where the tail is not all drones, or a drone is in both parts.
     for (text, line) in [(&texts[4], "[drones.x]"), (&texts[6], "[drones.d1]\nhome = [1, 1]")] {
         let at = text.find(line).unwrap();
-        assert!(crate::build::read_fast_in_two(FileId(7), text, at, &join_in_turn).is_none(), "{text}");
+        assert!(
+            crate::build::read_fast_in_two(FileId(7), text, at, &join_in_turn).is_none(),
+            "{text}"
+        );
     }
 }
 
 /// A large world is read in two parts, on two threads, into the world read whole.
 #[test]
 fn a_large_fleet_read_on_two_threads_is_the_fleet_read_whole() {
-    let mut text = String::from("[site]\nname = \"W\"\n[sensors.ir]\ndetects = [\"P\"]\nrange = 9\n");
+    let mut text =
+        String::from("[site]\nname = \"W\"\n[sensors.ir]\ndetects = [\"P\"]\nrange = 9\n");
     for i in 0..3000 {
         text.push_str(&format!("\n[drones.a{i}]\nhome = [{}, 0]\ngroup = \"fleet{}\"\nindex = {i}\nsensors = [\"ir\"]\n", i * 5, i * 7 / 3000));
     }
@@ -1034,7 +899,9 @@ fn a_large_fleet_read_on_two_threads_is_the_fleet_read_whole() {
     assert_eq!(world.groups.len(), 7);
     assert_eq!(world.groups[3].members.first(), Some(&1286));
     // The same problems, with their spans, in both parts.
-    let broken = text.replace("index = 7\n", "index = 7\nspeed = 1\n").replace("index = 2900\n", "index = 2900\nbattery = -1\n");
+    let broken = text
+        .replace("index = 7\n", "index = 7\nspeed = 1\n")
+        .replace("index = 2900\n", "index = 2900\nbattery = -1\n");
     let (none, diags) = parse_on_two_threads(&broken);
     assert!(none.is_none());
     assert_eq!(diags.len(), 2);

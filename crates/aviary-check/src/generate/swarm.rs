@@ -52,16 +52,29 @@ pub fn swarm_world(n: usize) -> String {
     for i in 0..n {
         let (x, y) = corner(i);
         let (x1, y1) = (x + CELL - 10, y + CELL - 10);
-        let _ = writeln!(w, "Cell_{i} = [[{}, {}], [{x1}, {}], [{x1}, {y1}], [{}, {y1}]]", x + 10, y + 10, y + 10, x + 10);
+        let _ = writeln!(
+            w,
+            "Cell_{i} = [[{}, {}], [{x1}, {}], [{x1}, {y1}], [{}, {y1}]]",
+            x + 10,
+            y + 10,
+            y + 10,
+            x + 10
+        );
     }
     for i in 0..n {
         let (x, y) = corner(i);
-        let _ = write!(w, "\n[drones.s{i}]\nhome = [{}, {}]\nsensors = [\"thermal\"]\n", x + 5, y + 5);
+        let _ =
+            write!(w, "\n[drones.s{i}]\nhome = [{}, {}]\nsensors = [\"thermal\"]\n", x + 5, y + 5);
     }
     w.push_str("\n[sensors.thermal]\ndetects = [\"Body\"]\nrange = 15.0\n");
     for i in (0..n).step_by(3) {
         let (x, y) = corner(i);
-        let _ = write!(w, "\n[[targets]]\nkind = \"Body\"\nat = [{}, {}]\n", x + 30 + (i * 7) % 40, y + 30 + (i * 13) % 40);
+        let _ = write!(
+            w,
+            "\n[[targets]]\nkind = \"Body\"\nat = [{}, {}]\n",
+            x + 30 + (i * 7) % 40,
+            y + 30 + (i * 13) % 40
+        );
     }
     w
 }

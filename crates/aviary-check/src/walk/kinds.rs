@@ -15,14 +15,24 @@ impl<'a> Checker<'a> {
         let k = self.value(e, None, "a condition");
         if let Some(k) = k {
             if k != Kind::Bool {
-                let d = self.report(Code::WrongKind, e.span, format!("a condition must be true or false, and this is {}", k.describe()));
-                d.help = Some("compare it with something: `drone.battery > 25%`, `type = Body`".into());
+                let d = self.report(
+                    Code::WrongKind,
+                    e.span,
+                    format!("a condition must be true or false, and this is {}", k.describe()),
+                );
+                d.help =
+                    Some("compare it with something: `drone.battery > 25%`, `type = Body`".into());
             }
         }
     }
 
     /// The kind of a value, checked against `expected` when given. Reports what is wrong.
-    pub(super) fn value(&mut self, e: &'a Expr, expected: Option<Kind>, what: &str) -> Option<Kind> {
+    pub(super) fn value(
+        &mut self,
+        e: &'a Expr,
+        expected: Option<Kind>,
+        what: &str,
+    ) -> Option<Kind> {
         let actual = self.kind_of(e);
         let (Some(expected), Some(actual)) = (expected, actual) else { return actual };
         if expected.accepts(actual) {
@@ -41,21 +51,33 @@ impl<'a> Checker<'a> {
                 });
                 let help = did_you_mean(&id.name, candidates.iter().copied())
                     .unwrap_or_else(|| format!("define it in the world file's [{noun}s], or use coordinates such as (100, 50)"));
-                let d = self.report(Code::UnknownPlace, id.span, format!("unknown {noun} `{}`", id.name));
+                let d = self.report(
+                    Code::UnknownPlace,
+                    id.span,
+                    format!("unknown {noun} `{}`", id.name),
+                );
                 d.help = Some(help);
                 return Some(actual);
             }
         }
         if actual == Kind::Number {
             if let (Some(unit), ExprKind::Number { digits, .. }) = (unit_for(expected), &e.kind) {
-                let d = self.report(Code::WrongKind, e.span, format!("`{digits}` has no unit, and {what} is {}", expected.describe()));
+                let d = self.report(
+                    Code::WrongKind,
+                    e.span,
+                    format!("`{digits}` has no unit, and {what} is {}", expected.describe()),
+                );
                 d.help = Some(format!("write `{digits}{unit}`"));
                 return Some(actual);
             }
         }
         let origin = self.parameter_origin(e);
         let file = self.file;
-        let d = self.report(Code::WrongKind, e.span, format!("{what} is {}, but this is {}", expected.describe(), actual.describe()));
+        let d = self.report(
+            Code::WrongKind,
+            e.span,
+            format!("{what} is {}, but this is {}", expected.describe(), actual.describe()),
+        );
         d.primary.message = format!("expected {}", expected.describe());
         d.help = Some(format!("write {}, such as `{}`", expected.describe(), expected.example()));
         if let Some((name, cap, default)) = origin {
@@ -85,11 +107,15 @@ impl<'a> Checker<'a> {
     pub(super) fn parameter_origin(&self, e: &Expr) -> Option<(String, String, Option<&'a Expr>)> {
         let ExprKind::Name(id) = &e.kind else { return None };
         let cap = self.capability?;
-        if !cap.params.iter().any(|p| p.name == id.name) || !matches!(self.lookup(&id.name), Meaning::Local(Binding::Value(_))) {
+        if !cap.params.iter().any(|p| p.name == id.name)
+            || !matches!(self.lookup(&id.name), Meaning::Local(Binding::Value(_)))
+        {
             return None;
         }
         let default = cap.sections.iter().find_map(|s| match s {
-            Section::Defaults { entries, .. } => entries.iter().find(|d| d.name.name == id.name).map(|d| &d.value),
+            Section::Defaults { entries, .. } => {
+                entries.iter().find(|d| d.name.name == id.name).map(|d| &d.value)
+            }
             _ => None,
         });
         Some((id.name.clone(), cap.name.name.clone(), default))
@@ -99,7 +125,9 @@ impl<'a> Checker<'a> {
     pub(super) fn kind_of_quietly(&self, e: &Expr) -> Option<Kind> {
         match &e.kind {
             ExprKind::Name(id) => match self.lookup(&id.name) {
-                Meaning::Local(Binding::Actor) | Meaning::Drone | Meaning::Group => Some(Kind::Actor),
+                Meaning::Local(Binding::Actor) | Meaning::Drone | Meaning::Group => {
+                    Some(Kind::Actor)
+                }
                 _ => None,
             },
             _ => None,
@@ -109,7 +137,9 @@ impl<'a> Checker<'a> {
     pub(super) fn kind_of(&mut self, e: &'a Expr) -> Option<Kind> {
         match &e.kind {
             ExprKind::Name(id) => match self.lookup(&id.name) {
-                Meaning::Local(Binding::Actor) | Meaning::Drone | Meaning::Group => Some(Kind::Actor),
+                Meaning::Local(Binding::Actor) | Meaning::Drone | Meaning::Group => {
+                    Some(Kind::Actor)
+                }
                 Meaning::Local(Binding::Value(k)) => k,
                 Meaning::Place => Some(Kind::Position),
                 Meaning::Area => Some(Kind::Area),
@@ -121,8 +151,17 @@ impl<'a> Checker<'a> {
                 for p in parts {
                     if let Some(k) = self.kind_of(p) {
                         if !matches!(k, Kind::Number | Kind::Length) {
-                            let d = self.report(Code::WrongKind, p.span, format!("a coordinate is a number of metres, and this is {}", k.describe()));
-                            d.help = Some("write coordinates as `(x, y)` or `(x, y, z)` in metres".into());
+                            let d = self.report(
+                                Code::WrongKind,
+                                p.span,
+                                format!(
+                                    "a coordinate is a number of metres, and this is {}",
+                                    k.describe()
+                                ),
+                            );
+                            d.help = Some(
+                                "write coordinates as `(x, y)` or `(x, y, z)` in metres".into(),
+                            );
                         }
                     }
                 }
@@ -136,7 +175,8 @@ impl<'a> Checker<'a> {
             }
             ExprKind::Distance(a, b) => {
                 // A drone stands for where it is now: `distance(drone, Home) < 10m`.
-                for (e, what) in [(a, "`distance`'s first place"), (b, "`distance`'s second place")] {
+                for (e, what) in [(a, "`distance`'s first place"), (b, "`distance`'s second place")]
+                {
                     if self.kind_of_quietly(e) != Some(Kind::Actor) {
                         self.value(e, Some(Kind::Position), what);
                     }
@@ -158,7 +198,10 @@ impl<'a> Checker<'a> {
                 match lk {
                     // A symbol on the left (`x = Hoem` reads fine either way): check the right against it.
                     Some(k) => {
-                        let what = shown(l).map_or_else(|| format!("the other side of `{}`", op.as_str()), |l| format!("`{l}`"));
+                        let what = shown(l).map_or_else(
+                            || format!("the other side of `{}`", op.as_str()),
+                            |l| format!("`{l}`"),
+                        );
                         self.value(r, Some(k), &what);
                     }
                     None => {
@@ -180,7 +223,10 @@ impl<'a> Checker<'a> {
             return Some(k);
         }
         let world = self.world?;
-        let found = world.drones.iter().find_map(|d| d.attributes.iter().find(|(k, _)| **k == *field.name).map(|(_, v)| v));
+        let found = world
+            .drones
+            .iter()
+            .find_map(|d| d.attributes.iter().find(|(k, _)| **k == *field.name).map(|(_, v)| v));
         match found {
             Some(AttributeValue::Number(_)) => Some(Kind::Number),
             Some(AttributeValue::Text(_)) => Some(Kind::Text),
@@ -193,8 +239,16 @@ impl<'a> Checker<'a> {
                 }
                 names.sort_unstable();
                 names.dedup();
-                let help = did_you_mean(&field.name, names.iter().copied()).unwrap_or_else(|| format!("telemetry and attributes: {}", names.join(", ")));
-                let d = self.report(Code::UnknownTelemetry, field.span, format!("`{}` is no telemetry field and no attribute of `{}`", field.name, a.name));
+                let help = did_you_mean(&field.name, names.iter().copied())
+                    .unwrap_or_else(|| format!("telemetry and attributes: {}", names.join(", ")));
+                let d = self.report(
+                    Code::UnknownTelemetry,
+                    field.span,
+                    format!(
+                        "`{}` is no telemetry field and no attribute of `{}`",
+                        field.name, a.name
+                    ),
+                );
                 d.help = Some(help);
                 None
             }

@@ -13,7 +13,13 @@ use crate::Program;
 
 mod kinds;
 
-pub(crate) fn check_program(program: &Program, world: Option<&World>, api: &Descriptor, root: FileId, diagnostics: &mut Vec<Diagnostic>) {
+pub(crate) fn check_program(
+    program: &Program,
+    world: Option<&World>,
+    api: &Descriptor,
+    root: FileId,
+    diagnostics: &mut Vec<Diagnostic>,
+) {
     let mut tags = Vec::new();
     let mut aliases = HashSet::new();
     for (_, tree) in &program.files {
@@ -25,7 +31,9 @@ pub(crate) fn check_program(program: &Program, world: Option<&World>, api: &Desc
             };
             for body in bodies {
                 visit_stmts(body, &mut |stmt| match stmt {
-                    Stmt::Statement(Statement { capability, tag: Some(tag), .. }) => tags.push((capability.name.as_str(), tag.name.as_str())),
+                    Stmt::Statement(Statement { capability, tag: Some(tag), .. }) => {
+                        tags.push((capability.name.as_str(), tag.name.as_str()))
+                    }
                     Stmt::For(f) => {
                         aliases.insert(f.alias.name.as_str());
                     }
@@ -36,23 +44,43 @@ pub(crate) fn check_program(program: &Program, world: Option<&World>, api: &Desc
     }
     let tag_set = tags.iter().copied().collect();
     let world_names = world.map(world_names).unwrap_or_default();
-    let mut checker =
-        Checker { program, world, api, diagnostics, file: root, capability: None, scopes: Vec::new(), tags, tag_set, aliases, world_names };
+    let mut checker = Checker {
+        program,
+        world,
+        api,
+        diagnostics,
+        file: root,
+        capability: None,
+        scopes: Vec::new(),
+        tags,
+        tag_set,
+        aliases,
+        world_names,
+    };
     for (file, tree) in &program.files {
         checker.file = *file;
         for item in &tree.items {
             match item {
                 Item::Mission(m) if program.mission().map(|x| x.span) == Some(m.span) => {
                     if world.is_none() {
-                        let d = Diagnostic::new(Code::NoWorld, *file, m.name.span, "no world file, so actors, places and areas were not checked")
-                            .with_help("put NAME.world.toml beside the mission, or pass `--world FILE`");
+                        let d = Diagnostic::new(
+                            Code::NoWorld,
+                            *file,
+                            m.name.span,
+                            "no world file, so actors, places and areas were not checked",
+                        )
+                        .with_help(
+                            "put NAME.world.toml beside the mission, or pass `--world FILE`",
+                        );
                         checker.diagnostics.push(d);
                     }
                     checker.capability = None;
                     checker.body(&m.body);
                 }
                 // Overridden library capabilities are never run, so never checked here.
-                Item::Capability(c) if program.is_active(*file, c) || checker.is_user_file(*file) => {
+                Item::Capability(c)
+                    if program.is_active(*file, c) || checker.is_user_file(*file) =>
+                {
                     checker.capability_def(c);
                 }
                 _ => {}
@@ -148,19 +176,35 @@ impl<'a> Checker<'a> {
             if let Some(first) = declared.iter().find(|d| d.name == p.name) {
                 let first = first.span;
                 let file = self.file;
-                let d = self.report(Code::DuplicateParameter, p.span, format!("`{}` is declared twice in `{}`", p.name, c.name.name));
-                d.secondary.push(aviary_diagnostics::Label { file, span: first, message: "first declared here".into() });
+                let d = self.report(
+                    Code::DuplicateParameter,
+                    p.span,
+                    format!("`{}` is declared twice in `{}`", p.name, c.name.name),
+                );
+                d.secondary.push(aviary_diagnostics::Label {
+                    file,
+                    span: first,
+                    message: "first declared here".into(),
+                });
                 d.help = Some("give each actor and parameter of a capability its own name".into());
             }
             declared.push(p);
         }
         let kinds = self.program.param_kinds.get(&c.name.name).cloned().unwrap_or_default();
-        let mut scope: Vec<(&str, Binding)> = c.actors.iter().map(|a| (a.name.as_str(), Binding::Actor)).collect();
-        scope.extend(c.params.iter().enumerate().map(|(i, p)| (p.name.as_str(), Binding::Value(kinds.get(i).copied().flatten()))));
+        let mut scope: Vec<(&str, Binding)> =
+            c.actors.iter().map(|a| (a.name.as_str(), Binding::Actor)).collect();
+        scope.extend(
+            c.params
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (p.name.as_str(), Binding::Value(kinds.get(i).copied().flatten()))),
+        );
         self.scopes.push(scope);
         for section in &c.sections {
             match section {
-                Section::Requirements { conditions, .. } => conditions.iter().for_each(|e| self.condition(e)),
+                Section::Requirements { conditions, .. } => {
+                    conditions.iter().for_each(|e| self.condition(e))
+                }
                 Section::Defaults { entries, .. } => {
                     for e in entries {
                         match c.params.iter().position(|p| p.name == e.name.name) {
@@ -171,14 +215,23 @@ impl<'a> Checker<'a> {
                             None => {
                                 let help = did_you_mean(&e.name.name, c.params.iter().map(|p| p.name.as_str()))
                                     .unwrap_or_else(|| format!("add `{}` to the parameters after WITH in the CAPABILITY header", e.name.name));
-                                let d = self.report(Code::UnknownParameter, e.name.span, format!("`{}` is not a parameter of `{}`", e.name.name, c.name.name));
+                                let d = self.report(
+                                    Code::UnknownParameter,
+                                    e.name.span,
+                                    format!(
+                                        "`{}` is not a parameter of `{}`",
+                                        e.name.name, c.name.name
+                                    ),
+                                );
                                 d.help = Some(help);
                             }
                         }
                     }
                 }
                 Section::Perform { body, .. } => self.body(body),
-                Section::Exceptions { handlers, .. } => handlers.iter().for_each(|h| self.exception_handler(h)),
+                Section::Exceptions { handlers, .. } => {
+                    handlers.iter().for_each(|h| self.exception_handler(h))
+                }
             }
         }
         self.scopes.pop();
@@ -211,8 +264,14 @@ impl<'a> Checker<'a> {
                 if let Some(by) = &h.by {
                     self.by_filter(by);
                 }
-                let values = self.api.signal(&h.signal.name).map(|s| s.values.clone()).unwrap_or_default();
-                let scope = h.bindings.iter().enumerate().map(|(i, b)| (b.name.as_str(), Binding::Value(values.get(i).map(|v| v.1)))).collect();
+                let values =
+                    self.api.signal(&h.signal.name).map(|s| s.values.clone()).unwrap_or_default();
+                let scope = h
+                    .bindings
+                    .iter()
+                    .enumerate()
+                    .map(|(i, b)| (b.name.as_str(), Binding::Value(values.get(i).map(|v| v.1))))
+                    .collect();
                 self.scopes.push(scope);
                 self.body(&h.body);
                 self.scopes.pop();
@@ -235,7 +294,8 @@ impl<'a> Checker<'a> {
         if let Some(by) = &h.by {
             self.by_filter(by);
         }
-        self.scopes.push(h.bindings.iter().map(|b| (b.name.as_str(), Binding::Value(None))).collect());
+        self.scopes
+            .push(h.bindings.iter().map(|b| (b.name.as_str(), Binding::Value(None))).collect());
         self.body(&h.body);
         self.scopes.pop();
     }
@@ -246,9 +306,17 @@ impl<'a> Checker<'a> {
             self.actor(&inst.actor);
             if inst.values.len() != f.params.len() {
                 let names: Vec<&str> = f.params.iter().map(|p| p.name.as_str()).collect();
-                let code = if inst.values.len() > f.params.len() { Code::TooManyArguments } else { Code::MissingArgument };
+                let code = if inst.values.len() > f.params.len() {
+                    Code::TooManyArguments
+                } else {
+                    Code::MissingArgument
+                };
                 let message = if names.is_empty() {
-                    format!("`{}` is given {}, but the FOR names no parameters after its alias", inst.actor.name, count(inst.values.len(), "value"))
+                    format!(
+                        "`{}` is given {}, but the FOR names no parameters after its alias",
+                        inst.actor.name,
+                        count(inst.values.len(), "value")
+                    )
                 } else {
                     format!(
                         "`{}` is given {}, but the FOR names {} ({})",
@@ -263,8 +331,14 @@ impl<'a> Checker<'a> {
                     "name the parameters after the alias: `AS d WITH p:`".into()
                 } else {
                     match names.as_slice() {
-                        [one] => format!("give each instance a value for `{one}`: `{} WITH ...`", inst.actor.name),
-                        _ => format!("give each instance one value for each of {}, in that order", quoted(&names)),
+                        [one] => format!(
+                            "give each instance a value for `{one}`: `{} WITH ...`",
+                            inst.actor.name
+                        ),
+                        _ => format!(
+                            "give each instance one value for each of {}, in that order",
+                            quoted(&names)
+                        ),
                     }
                 });
             }
@@ -300,7 +374,8 @@ impl<'a> Checker<'a> {
         let mut candidates = self.actor_candidates();
         candidates.extend(self.local_names(|b| *b == Binding::Actor));
         let help = did_you_mean(&id.name, candidates.iter().copied()).or_else(|| {
-            (!candidates.is_empty()).then(|| format!("the actors here are: {}", candidates.join(", ")))
+            (!candidates.is_empty())
+                .then(|| format!("the actors here are: {}", candidates.join(", ")))
         });
         let d = self.report(Code::UnknownActor, id.span, format!("`{}` is {what}", id.name));
         Self::help(d, help);
@@ -317,47 +392,89 @@ impl<'a> Checker<'a> {
     fn statement(&mut self, s: &'a Statement) {
         let Some(cap) = self.program.capability(&s.capability.name) else {
             // The paper's `drone FlyTo Body_Beacon_Inventory`: the arguments lack WITH.
-            if let Some(i) = s.actors.iter().rposition(|a| self.program.capability(&a.name).is_some()) {
+            if let Some(i) =
+                s.actors.iter().rposition(|a| self.program.capability(&a.name).is_some())
+            {
                 let real = &s.actors[i];
                 let actors: Vec<&str> = s.actors[..i].iter().map(|a| a.name.as_str()).collect();
-                let rest: Vec<&str> = s.actors[i + 1..].iter().map(|a| a.name.as_str()).chain([s.capability.name.as_str()]).collect();
-                let span = s.actors[i + 1..].first().map_or(s.capability.span, |a| a.span).to(s.capability.span);
+                let rest: Vec<&str> = s.actors[i + 1..]
+                    .iter()
+                    .map(|a| a.name.as_str())
+                    .chain([s.capability.name.as_str()])
+                    .collect();
+                let span = s.actors[i + 1..]
+                    .first()
+                    .map_or(s.capability.span, |a| a.span)
+                    .to(s.capability.span);
                 let all: Vec<&str> = s.actors.iter().map(|a| a.name.as_str()).collect();
                 let d = self.report(
                     Code::ArgumentsWithoutWith,
                     span,
-                    format!("this reads as actors `{}` and capability `{}`", all.join(" "), s.capability.name),
+                    format!(
+                        "this reads as actors `{}` and capability `{}`",
+                        all.join(" "),
+                        s.capability.name
+                    ),
                 );
                 let more = if s.args.is_empty() { "" } else { ", ..." };
-                d.help = Some(format!("arguments follow WITH: write `{} {} WITH {}{more}`", actors.join(" "), real.name, rest.join(", ")));
+                d.help = Some(format!(
+                    "arguments follow WITH: write `{} {} WITH {}{more}`",
+                    actors.join(" "),
+                    real.name,
+                    rest.join(", ")
+                ));
                 return;
             }
-            let help = did_you_mean(&s.capability.name, self.program.capabilities.keys().map(String::as_str)).unwrap_or_else(|| {
-                match self.program.unreadable.as_slice() {
-                    [] => "define it with `CAPABILITY Name BY drone:`, or USE the file that does".into(),
-                    [one] => format!("it may be defined in `{one}`, which could not be read"),
-                    many => format!("it may be defined in one of {}, which could not be read", many.iter().map(|m| format!("`{m}`")).collect::<Vec<_>>().join(", ")),
+            let help = did_you_mean(
+                &s.capability.name,
+                self.program.capabilities.keys().map(String::as_str),
+            )
+            .unwrap_or_else(|| match self.program.unreadable.as_slice() {
+                [] => {
+                    "define it with `CAPABILITY Name BY drone:`, or USE the file that does".into()
                 }
+                [one] => format!("it may be defined in `{one}`, which could not be read"),
+                many => format!(
+                    "it may be defined in one of {}, which could not be read",
+                    many.iter().map(|m| format!("`{m}`")).collect::<Vec<_>>().join(", ")
+                ),
             });
             // The last name is something else of the world: say what, and what is missing.
             let actors: Vec<&str> = s.actors.iter().map(|a| a.name.as_str()).collect();
             let all = format!("{} {}", actors.join(" "), s.capability.name);
-            let fly_there = format!("to fly there, write `{} FlyTo WITH {}`", actors.join(" "), s.capability.name);
-            let names_no_capability = format!("a statement ends with the capability: `{all} FlyTo WITH ...`");
+            let fly_there = format!(
+                "to fly there, write `{} FlyTo WITH {}`",
+                actors.join(" "),
+                s.capability.name
+            );
+            let names_no_capability =
+                format!("a statement ends with the capability: `{all} FlyTo WITH ...`");
             let what = match self.lookup(&s.capability.name) {
                 Meaning::Drone => Some(("a drone, not a capability", names_no_capability)),
-                Meaning::Group => Some(("a group of drones, not a capability", names_no_capability)),
-                Meaning::Local(Binding::Actor) => Some(("an actor, not a capability", names_no_capability)),
+                Meaning::Group => {
+                    Some(("a group of drones, not a capability", names_no_capability))
+                }
+                Meaning::Local(Binding::Actor) => {
+                    Some(("an actor, not a capability", names_no_capability))
+                }
                 Meaning::Place => Some(("a place, not a capability", fly_there)),
                 Meaning::Area => Some(("an area, not a capability", fly_there)),
                 _ => None,
             };
             if let Some((what, help)) = what {
-                let d = self.report(Code::UnknownCapability, s.capability.span, format!("`{}` is {what}", s.capability.name));
+                let d = self.report(
+                    Code::UnknownCapability,
+                    s.capability.span,
+                    format!("`{}` is {what}", s.capability.name),
+                );
                 d.help = Some(help);
                 return;
             }
-            let d = self.report(Code::UnknownCapability, s.capability.span, format!("no capability is called `{}`", s.capability.name));
+            let d = self.report(
+                Code::UnknownCapability,
+                s.capability.span,
+                format!("no capability is called `{}`", s.capability.name),
+            );
             d.help = Some(help);
             return;
         };
@@ -370,7 +487,13 @@ impl<'a> Checker<'a> {
             let d = self.report(
                 Code::ActorCount,
                 span,
-                format!("`{}` takes {} actors (BY {}), this statement names {}", cap.name.name, by.len(), by.join(", "), s.actors.len()),
+                format!(
+                    "`{}` takes {} actors (BY {}), this statement names {}",
+                    cap.name.name,
+                    by.len(),
+                    by.join(", "),
+                    s.actors.len()
+                ),
             );
             d.help = Some(format!("name one actor for each of {}", by.join(", ")));
         }
@@ -388,19 +511,39 @@ impl<'a> Checker<'a> {
                         if params.is_empty() {
                             format!("`{}` takes no arguments", cap.name.name)
                         } else {
-                            format!("the parameters of `{}` are {}", cap.name.name, params.join(", "))
+                            format!(
+                                "the parameters of `{}` are {}",
+                                cap.name.name,
+                                params.join(", ")
+                            )
                         }
                     });
-                    let d = self.report(Code::UnknownArgument, n.span, format!("`{}` has no parameter `{}`", cap.name.name, n.name));
+                    let d = self.report(
+                        Code::UnknownArgument,
+                        n.span,
+                        format!("`{}` has no parameter `{}`", cap.name.name, n.name),
+                    );
                     d.help = Some(help);
                 }
                 BindProblem::Twice(n) => {
                     // The first argument stays bound; the second is the one reported.
-                    let first = params.iter().position(|p| *p == n.name).and_then(|i| binding.bound[i]).map(|e| e.span);
+                    let first = params
+                        .iter()
+                        .position(|p| *p == n.name)
+                        .and_then(|i| binding.bound[i])
+                        .map(|e| e.span);
                     let file = self.file;
-                    let d = self.report(Code::DuplicateArgument, n.span, format!("`{}` is given twice", n.name));
+                    let d = self.report(
+                        Code::DuplicateArgument,
+                        n.span,
+                        format!("`{}` is given twice", n.name),
+                    );
                     if let Some(span) = first {
-                        d.secondary.push(aviary_diagnostics::Label { file, span, message: format!("`{}` is already given here", n.name) });
+                        d.secondary.push(aviary_diagnostics::Label {
+                            file,
+                            span,
+                            message: format!("`{}` is already given here", n.name),
+                        });
                     }
                     d.help = Some("give each parameter one argument; positional arguments fill the parameters in order".into());
                 }
@@ -408,10 +551,18 @@ impl<'a> Checker<'a> {
                     let message = if params.is_empty() {
                         format!("`{}` takes no arguments", cap.name.name)
                     } else {
-                        format!("`{}` takes {}, and this is one too many", cap.name.name, count(params.len(), "argument"))
+                        format!(
+                            "`{}` takes {}, and this is one too many",
+                            cap.name.name,
+                            count(params.len(), "argument")
+                        )
                     };
                     let d = self.report(Code::TooManyArguments, e.span, message);
-                    d.help = Some(if params.is_empty() { "remove the arguments".into() } else { format!("its parameters are {}", quoted(&params)) });
+                    d.help = Some(if params.is_empty() {
+                        "remove the arguments".into()
+                    } else {
+                        format!("its parameters are {}", quoted(&params))
+                    });
                 }
             }
         }
@@ -420,7 +571,9 @@ impl<'a> Checker<'a> {
                 let what = format!("`{}`'s `{}`", cap.name.name, params[i]);
                 let before = self.diagnostics.len();
                 self.value(v, kinds.get(i).copied().flatten(), &what);
-                if self.diagnostics.len() > before && self.diagnostics[before].code == Code::WrongKind {
+                if self.diagnostics.len() > before
+                    && self.diagnostics[before].code == Code::WrongKind
+                {
                     let chain = self.kind_chain(&cap.name.name, i);
                     self.diagnostics[before].secondary.extend(chain);
                 }
@@ -433,7 +586,9 @@ impl<'a> Checker<'a> {
             .sections
             .iter()
             .filter_map(|s| match s {
-                Section::Defaults { entries, .. } => Some(entries.iter().map(|e| e.name.name.as_str())),
+                Section::Defaults { entries, .. } => {
+                    Some(entries.iter().map(|e| e.name.name.as_str()))
+                }
                 _ => None,
             })
             .flatten()
@@ -441,7 +596,11 @@ impl<'a> Checker<'a> {
         for (i, p) in params.iter().enumerate() {
             if binding.bound[i].is_none() && !defaults.contains(p) {
                 let example = kinds.get(i).copied().flatten().map_or("...", |k| k.example());
-                let d = self.report(Code::MissingArgument, at, format!("`{}` needs an argument for `{p}`", cap.name.name));
+                let d = self.report(
+                    Code::MissingArgument,
+                    at,
+                    format!("`{}` needs an argument for `{p}`", cap.name.name),
+                );
                 d.help = Some(format!("add `{p}={example}` after WITH, or give `{p}` a default in the capability's DEFAULTS"));
             }
         }
@@ -453,8 +612,11 @@ impl<'a> Checker<'a> {
         let mut labels = Vec::new();
         let mut at = Some((capability.to_string(), index));
         while let Some((cap, i)) = at.take() {
-            let origin = self.program.param_origins.get(&cap).and_then(|o| o.get(i)).cloned().flatten();
-            let (Some(origin), Some(file)) = (origin, self.program.capability_file(&cap)) else { break };
+            let origin =
+                self.program.param_origins.get(&cap).and_then(|o| o.get(i)).cloned().flatten();
+            let (Some(origin), Some(file)) = (origin, self.program.capability_file(&cap)) else {
+                break;
+            };
             labels.push(aviary_diagnostics::Label { file, span: origin.span, message: origin.why });
             // Bounded: a chain never passes through more capabilities than there are.
             if labels.len() > self.program.capabilities.len() {
@@ -469,10 +631,16 @@ impl<'a> Checker<'a> {
         let tagged = format!("{}-{}", l.capability.name, l.tag.name);
         if !self.tag_set.contains(&(l.capability.name.as_str(), l.tag.name.as_str())) {
             let known: Vec<String> = self.tags.iter().map(|(c, t)| format!("{c}-{t}")).collect();
-            let help = did_you_mean(&tagged, known.iter().map(String::as_str))
-                .unwrap_or_else(|| format!("tag the statement that starts the activity: `drone {tagged} WITH ...`"));
+            let help =
+                did_you_mean(&tagged, known.iter().map(String::as_str)).unwrap_or_else(|| {
+                    format!("tag the statement that starts the activity: `drone {tagged} WITH ...`")
+                });
             let span = l.capability.span.to(l.tag.span);
-            let d = self.report(Code::UnknownTag, span, format!("no statement starts an activity tagged `{tagged}`"));
+            let d = self.report(
+                Code::UnknownTag,
+                span,
+                format!("no statement starts an activity tagged `{tagged}`"),
+            );
             d.help = Some(help);
         }
         let Some(cap) = self.program.capability(&l.capability.name) else { return };
@@ -485,10 +653,20 @@ impl<'a> Checker<'a> {
             })
             .collect();
         let builtin = ["ABORT", "PAUSE", "RESUME"];
-        if !builtin.contains(&l.action.name.as_str()) && !sections.contains(&l.action.name.as_str()) {
-            let all: Vec<&str> = builtin.iter().copied().chain(sections.iter().copied().filter(|s| !builtin.contains(s))).collect();
-            let help = did_you_mean(&l.action.name, all.iter().copied()).unwrap_or_else(|| format!("`{}` can be told: {}", cap.name.name, all.join(", ")));
-            let d = self.report(Code::UnknownLeashSection, l.action.span, format!("`{}` has no section `PERFORM {}`", cap.name.name, l.action.name));
+        if !builtin.contains(&l.action.name.as_str()) && !sections.contains(&l.action.name.as_str())
+        {
+            let all: Vec<&str> = builtin
+                .iter()
+                .copied()
+                .chain(sections.iter().copied().filter(|s| !builtin.contains(s)))
+                .collect();
+            let help = did_you_mean(&l.action.name, all.iter().copied())
+                .unwrap_or_else(|| format!("`{}` can be told: {}", cap.name.name, all.join(", ")));
+            let d = self.report(
+                Code::UnknownLeashSection,
+                l.action.span,
+                format!("`{}` has no section `PERFORM {}`", cap.name.name, l.action.name),
+            );
             d.help = Some(help);
         }
         self.arguments(cap, &l.args, l.action.span, false);
@@ -499,7 +677,10 @@ impl<'a> Checker<'a> {
             let d = self.report(
                 Code::ApiCallOutsideCapability,
                 call.span,
-                format!("`{}.{}(...)` calls the middle layer, which only capabilities may do", call.actor.name, call.function.name),
+                format!(
+                    "`{}.{}(...)` calls the middle layer, which only capabilities may do",
+                    call.actor.name, call.function.name
+                ),
             );
             d.help = Some(format!(
                 "call a capability instead (`{} {}`), or put this call in a CAPABILITY's PERFORM section",
@@ -509,39 +690,70 @@ impl<'a> Checker<'a> {
         };
         if !matches!(self.lookup(&call.actor.name), Meaning::Local(Binding::Actor)) {
             let actors: Vec<&str> = cap.actors.iter().map(|a| a.name.as_str()).collect();
-            let d = self.report(Code::ApiCallOnNonActor, call.actor.span, format!("`{}` is not an actor of `{}`", call.actor.name, cap.name.name));
-            d.help = Some(format!("call the API on the capability's actor: `{}.{}(...)`", actors.first().unwrap_or(&"drone"), call.function.name));
+            let d = self.report(
+                Code::ApiCallOnNonActor,
+                call.actor.span,
+                format!("`{}` is not an actor of `{}`", call.actor.name, cap.name.name),
+            );
+            d.help = Some(format!(
+                "call the API on the capability's actor: `{}.{}(...)`",
+                actors.first().unwrap_or(&"drone"),
+                call.function.name
+            ));
         }
         let Some(f) = self.api.function(&call.function.name) else {
             let names: Vec<&str> = self.api.functions.iter().map(|f| f.name).collect();
             let help = did_you_mean(&call.function.name, names.iter().copied())
-                .or_else(|| same_start(&call.function.name, names.iter().copied()).map(|c| format!("did you mean `{c}`?")))
-                .unwrap_or_else(|| format!("the middle layer's functions are {}", names.join(", ")));
-            let d = self.report(Code::UnknownApiFunction, call.function.span, format!("the middle layer has no function `{}`", call.function.name));
+                .or_else(|| {
+                    same_start(&call.function.name, names.iter().copied())
+                        .map(|c| format!("did you mean `{c}`?"))
+                })
+                .unwrap_or_else(|| {
+                    format!("the middle layer's functions are {}", names.join(", "))
+                });
+            let d = self.report(
+                Code::UnknownApiFunction,
+                call.function.span,
+                format!("the middle layer has no function `{}`", call.function.name),
+            );
             d.help = Some(help);
             return;
         };
         let n = call.args.len();
         if n < f.required() {
-            let d = self.report(Code::MissingArgument, call.span, format!("`{}` needs {}, and this call gives {}", f.name, count(f.required(), "argument"), count_bare(n)));
+            let d = self.report(
+                Code::MissingArgument,
+                call.span,
+                format!(
+                    "`{}` needs {}, and this call gives {}",
+                    f.name,
+                    count(f.required(), "argument"),
+                    count_bare(n)
+                ),
+            );
             d.help = Some(format!("call it as `{}.{}`", call.actor.name, f.signature()));
         } else if n > f.params.len() && !f.variadic {
             let extra = call.args[f.params.len()].span;
             let message = if f.params.is_empty() {
                 format!("`{}` takes no arguments", f.name)
             } else {
-                format!("`{}` takes at most {}, and this call gives {n}", f.name, count(f.params.len(), "argument"))
+                format!(
+                    "`{}` takes at most {}, and this call gives {n}",
+                    f.name,
+                    count(f.params.len(), "argument")
+                )
             };
             let d = self.report(Code::TooManyArguments, extra, message);
             d.help = Some(format!("call it as `{}.{}`", call.actor.name, f.signature()));
         }
         for (j, arg) in call.args.iter().enumerate() {
             let p = f.params.get(j).or(if f.variadic { f.params.last() } else { None });
-            let what = p.map_or(format!("`{}`'s argument", f.name), |p| format!("`{}`'s `{}`", f.name, p.name));
+            let what = p.map_or(format!("`{}`'s argument", f.name), |p| {
+                format!("`{}`'s `{}`", f.name, p.name)
+            });
             self.value(arg, p.map(|p| p.kind), &what);
         }
     }
-
 }
 
 /// `1 argument`, `2 arguments`, `no arguments`.
@@ -584,7 +796,9 @@ fn shown(e: &Expr) -> Option<String> {
         ExprKind::Name(id) => Some(id.name.clone()),
         ExprKind::Path(a, f) => Some(format!("{}.{}", a.name, f.name)),
         ExprKind::Elapsed => Some("ELAPSED".into()),
-        ExprKind::Number { digits, unit, .. } => Some(format!("{digits}{}", unit.map_or("", |u| u.as_str()))),
+        ExprKind::Number { digits, unit, .. } => {
+            Some(format!("{digits}{}", unit.map_or("", |u| u.as_str())))
+        }
         ExprKind::Received(id) => Some(format!("RECEIVED({})", id.name)),
         ExprKind::Distance(a, b) => Some(format!("distance({}, {})", shown(a)?, shown(b)?)),
         ExprKind::Paren(inner) => shown(inner).map(|s| format!("({s})")),

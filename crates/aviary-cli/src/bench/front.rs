@@ -35,7 +35,9 @@ pub fn run(shape: Shape, n: usize, runs: usize) -> u8 {
     }
     let runs = runs.max(1);
     let (mission, what) = match shape {
-        Shape::Sequential => (aviary_check::generate::sequential_mission(n), "statements in one SEQUENTIAL block"),
+        Shape::Sequential => {
+            (aviary_check::generate::sequential_mission(n), "statements in one SEQUENTIAL block")
+        }
         Shape::Chain => (aviary_check::generate::chain_mission(n), "capabilities in a chain"),
     };
     let world = aviary_check::generate::front_world();
@@ -62,7 +64,12 @@ pub fn run(shape: Shape, n: usize, runs: usize) -> u8 {
         totals.push(total);
     }
     let m = median(&mut totals);
-    outln!("median of {runs} run(s) over {:.2} MB: parse + check + analyses {:.1} MB/s ({:.3} s)", size as f64 / MB, rate(size, m), m.as_secs_f64());
+    outln!(
+        "median of {runs} run(s) over {:.2} MB: parse + check + analyses {:.1} MB/s ({:.3} s)",
+        size as f64 / MB,
+        rate(size, m),
+        m.as_secs_f64()
+    );
     0
 }
 
@@ -72,12 +79,20 @@ fn once(mission: &str, world: &str) -> Timed {
     let api = aviary_sim::descriptor();
     let start = Instant::now();
     let mut sources = SourceMap::new();
-    let checked = aviary_check::check_sources(&mut sources, ("front.mission", mission.as_bytes()), Some(("front.world.toml", world.as_bytes())), &NoFiles, &api);
+    let checked = aviary_check::check_sources(
+        &mut sources,
+        ("front.mission", mission.as_bytes()),
+        Some(("front.world.toml", world.as_bytes())),
+        &NoFiles,
+        &api,
+    );
     let check = start.elapsed();
     let mut errors = checked.diagnostics.iter().filter(|d| d.is_error()).count();
     let mut others = checked.diagnostics.len() - errors;
     let (mut compile, mut analyses) = (Duration::ZERO, Duration::ZERO);
-    if let (false, Some(program), Some(w)) = (checked.has_errors(), &checked.program, &checked.world) {
+    if let (false, Some(program), Some(w)) =
+        (checked.has_errors(), &checked.program, &checked.world)
+    {
         let start = Instant::now();
         let compiled = aviary_ir::compile(program, w, &api);
         compile = start.elapsed();

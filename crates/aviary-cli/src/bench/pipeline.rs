@@ -24,7 +24,11 @@ impl Stages {
 
     /// `world 0.012 s (peak 20.1 MiB), check 0.030 s (peak ...), ...`
     pub fn show(&self) -> String {
-        self.0.iter().map(|(n, d, p)| format!("{n} {:.3} s (peak {})", d.as_secs_f64(), mib(*p))).collect::<Vec<_>>().join(", ")
+        self.0
+            .iter()
+            .map(|(n, d, p)| format!("{n} {:.3} s (peak {})", d.as_secs_f64(), mib(*p)))
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 
     pub fn get(&self, name: &str) -> Option<Duration> {
@@ -46,14 +50,22 @@ pub struct Ran {
 /// lie ([`aviary_sim::Fleet::from_world`]).
 /// The texts are handed over (to the source map), not copied: a large world's text is
 /// megabytes.
-pub fn run(mission: String, world: String, sink: &mut dyn TraceSink, stages: &mut Stages) -> Result<Ran, String> {
+pub fn run(
+    mission: String,
+    world: String,
+    sink: &mut dyn TraceSink,
+    stages: &mut Stages,
+) -> Result<Ran, String> {
     let api = aviary_sim::descriptor();
     let mut sources = SourceMap::new();
     let wid = sources.add("bench.world.toml", world);
-    let (world, diags) = stages.time("world", || aviary_world::parse_world_joined(wid, sources.text(wid), &crate::cores::join));
+    let (world, diags) = stages.time("world", || {
+        aviary_world::parse_world_joined(wid, sources.text(wid), &crate::cores::join)
+    });
     let Some(world) = world else { return Err(render(&sources, &diags)) };
     let root = sources.add("bench.mission", mission);
-    let (program, diags) = stages.time("check", || aviary_check::check(&mut sources, root, Some(&world), &NoFiles, &api));
+    let (program, diags) = stages
+        .time("check", || aviary_check::check(&mut sources, root, Some(&world), &NoFiles, &api));
     if diags.iter().any(|d| d.is_error()) {
         return Err(render(&sources, &diags));
     }
@@ -74,7 +86,9 @@ pub fn run(mission: String, world: String, sink: &mut dyn TraceSink, stages: &mu
         .build()
         .map_err(|e| format!("cannot start the runtime: {e}"))?;
     runtime.block_on(async {
-        let sim = stages.time("sim start", || SimBackend::start_with(Fleet::from_world(world), SimOptions::default()));
+        let sim = stages.time("sim start", || {
+            SimBackend::start_with(Fleet::from_world(world), SimOptions::default())
+        });
         let outcome = {
             let start = Instant::now();
             let outcome = aviary_engine::run(&compiled, &*sim, sink, &RunOptions::default()).await;

@@ -50,7 +50,8 @@ pub fn run(drones: usize, emit: bool, emit_world: bool) -> u8 {
         }
     };
     let flying = stages.get("engine + sim").map_or(0.0, |d| d.as_secs_f64());
-    let ok = ran.outcome.status == aviary_engine::Status::Ok && tally.found_handled == tally.detections;
+    let ok =
+        ran.outcome.status == aviary_engine::Status::Ok && tally.found_handled == tally.detections;
     outln!(
         "aviary swarm drones={drones} status={} simulated={:.1}s engine+sim wall={flying:.3}s speed={:.1}x real time; detections={} handled={} ok={ok}; whole process {:.3}s peak={}",
         ran.outcome.status.as_str(),

@@ -63,7 +63,9 @@ impl Tally {
                 self.index_sum += event["args"][0].as_f64().unwrap_or(f64::NAN) as u64;
             }
             Some("handler_start") if event["signal"] == "Done" => self.handled += 1,
-            Some("capability_end") if event["capability"] == "Step" && event["status"] == "ok" => self.steps += 1,
+            Some("capability_end") if event["capability"] == "Step" && event["status"] == "ok" => {
+                self.steps += 1
+            }
             _ => {}
         }
     }

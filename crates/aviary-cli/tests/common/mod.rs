@@ -8,8 +8,17 @@ use std::process::Command;
 
 /// Runs `aviary ARGS` in `dir`: exit code, stdout, stderr.
 pub fn aviary(args: &[&str], dir: &Path) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_aviary")).args(args).current_dir(dir).env("NO_COLOR", "1").output().expect("run aviary");
-    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+    let out = Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(args)
+        .current_dir(dir)
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("run aviary");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
 }
 
 pub fn repo() -> PathBuf {
@@ -32,7 +41,8 @@ pub const ARDUCOPTER: &str = "climb_rate = 2.5\ndescent_rate = 1.5\nacceleration
 
 /// The paper's example world with `keys(name)` added to each drone's table.
 pub fn example_world_with(keys: impl Fn(&str) -> String) -> String {
-    let text = std::fs::read_to_string(repo().join("examples/search_and_rescue.world.toml")).expect("example world");
+    let text = std::fs::read_to_string(repo().join("examples/search_and_rescue.world.toml"))
+        .expect("example world");
     let mut out = String::new();
     for line in text.lines() {
         out.push_str(line);

@@ -35,7 +35,8 @@ pub fn files() -> Files {
         Some(bin) => PathBuf::from(bin).parent().map(Path::to_path_buf).unwrap_or_default(),
         None => super::repo().join("../shared/sitl"),
     };
-    let binary = std::env::var_os("AVIARY_SITL").map_or_else(|| dir.join("arducopter"), PathBuf::from);
+    let binary =
+        std::env::var_os("AVIARY_SITL").map_or_else(|| dir.join("arducopter"), PathBuf::from);
     assert!(
         binary.is_file(),
         "ArduCopter SITL not found at {}: the SITL tests need it. Build it from ArduPilot's source and set AVIARY_SITL to the binary, with ArduPilot's Tools/autotest/default_params/copter.parm beside it (docs/REAL_DRONES.md says how), or put both in ../shared/sitl beside the repository",
@@ -78,12 +79,19 @@ pub struct Sitl {
 impl Sitl {
     /// Starts a copter at `home` (local metres about [`ORIGIN`]) with `params` added to
     /// ArduPilot's defaults, and waits until it listens on SERIAL0.
-    pub fn start(scratch: &Path, first: u16, system: u8, home: [f64; 2], params: &[(&str, f64)]) -> Sitl {
+    pub fn start(
+        scratch: &Path,
+        first: u16,
+        system: u8,
+        home: [f64; 2],
+        params: &[(&str, f64)],
+    ) -> Sitl {
         let files = files();
         let instance = instance(first);
         let dir = scratch.join(format!("sitl{instance}"));
         std::fs::create_dir_all(&dir).expect("SITL dir");
-        let mut defaults = format!("{},{}", files.copter_parm.display(), files.gripper_parm.display());
+        let mut defaults =
+            format!("{},{}", files.copter_parm.display(), files.gripper_parm.display());
         if !params.is_empty() {
             let mut f = std::fs::File::create(dir.join("extra.parm")).expect("extra.parm");
             for (name, value) in params {
@@ -130,9 +138,16 @@ impl Sitl {
                 return;
             }
             if let Some(Some(status)) = self.child.as_mut().map(|c| c.try_wait().ok().flatten()) {
-                panic!("SITL instance {} exited ({status}) before it listened:\n{log}", self.instance);
+                panic!(
+                    "SITL instance {} exited ({status}) before it listened:\n{log}",
+                    self.instance
+                );
             }
-            assert!(Instant::now() < deadline, "SITL instance {} did not listen within 30 s:\n{log}", self.instance);
+            assert!(
+                Instant::now() < deadline,
+                "SITL instance {} did not listen within 30 s:\n{log}",
+                self.instance
+            );
             std::thread::sleep(Duration::from_millis(100));
         }
     }
@@ -192,7 +207,10 @@ impl Gcs {
             match mavlink::connect::<mav::MavMessage>(&format!("tcpout:127.0.0.1:{port}")) {
                 Ok(c) => break c,
                 Err(e) => {
-                    assert!(Instant::now() < deadline, "no ground station link on port {port}: {e}");
+                    assert!(
+                        Instant::now() < deadline,
+                        "no ground station link on port {port}: {e}"
+                    );
                     std::thread::sleep(Duration::from_millis(250));
                 }
             }
@@ -208,7 +226,10 @@ impl Gcs {
                     Ok(m) => m,
                     // The connection reads with a timeout: waiting is not an end.
                     Err(mavlink::error::MessageReadError::Io(e))
-                        if !matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut) =>
+                        if !matches!(
+                            e.kind(),
+                            std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                        ) =>
                     {
                         break
                     }
@@ -223,12 +244,18 @@ impl Gcs {
                     mav::MavMessage::GLOBAL_POSITION_INT(p) if p.lat == 0 && p.lon == 0 => {}
                     mav::MavMessage::GLOBAL_POSITION_INT(p) => {
                         let xy = ORIGIN.from_e7(p.lat, p.lon);
-                        seen.track.push((start.elapsed().as_secs_f64(), [xy[0], xy[1], f64::from(p.relative_alt) / 1000.0]));
+                        seen.track.push((
+                            start.elapsed().as_secs_f64(),
+                            [xy[0], xy[1], f64::from(p.relative_alt) / 1000.0],
+                        ));
                     }
-                    mav::MavMessage::STATUSTEXT(t) => seen.texts.push(t.text.to_str().unwrap_or("").trim_end_matches('\0').to_owned()),
-                    mav::MavMessage::PARAM_VALUE(v) => {
-                        seen.params.push((v.param_id.to_str().unwrap_or("").trim_end_matches('\0').to_owned(), v.param_value))
-                    }
+                    mav::MavMessage::STATUSTEXT(t) => seen
+                        .texts
+                        .push(t.text.to_str().unwrap_or("").trim_end_matches('\0').to_owned()),
+                    mav::MavMessage::PARAM_VALUE(v) => seen.params.push((
+                        v.param_id.to_str().unwrap_or("").trim_end_matches('\0').to_owned(),
+                        v.param_value,
+                    )),
                     _ => {}
                 }
             }
@@ -246,7 +273,10 @@ impl Gcs {
                     target_component: 1,
                     ..Default::default()
                 });
-                let _ = c.send(&mavlink::MavHeader { system_id: 250, component_id: 190, sequence: 0 }, &ask);
+                let _ = c.send(
+                    &mavlink::MavHeader { system_id: 250, component_id: 190, sequence: 0 },
+                    &ask,
+                );
                 std::thread::sleep(Duration::from_secs(2));
             }
         });
@@ -270,7 +300,14 @@ impl Gcs {
                 param_type: mav::MavParamType::MAV_PARAM_TYPE_REAL32,
             }));
             std::thread::sleep(Duration::from_millis(300));
-            if self.seen.lock().unwrap().params.iter().any(|(n, v)| n == name && (*v - value).abs() < 1e-3) {
+            if self
+                .seen
+                .lock()
+                .unwrap()
+                .params
+                .iter()
+                .any(|(n, v)| n == name && (*v - value).abs() < 1e-3)
+            {
                 return;
             }
             assert!(Instant::now() < deadline, "the vehicle did not confirm {name} = {value}");

@@ -32,14 +32,28 @@ MISSION M:
 const WORLD: &str = "[drones.a]\nhome = [0, 0]\n[drones.b]\nhome = [10, 0]\n";
 
 fn widen(run: &Run, radius: &str) -> (u16, String) {
-    let body = format!("{{\"activity\": \"Watch-W1\", \"action\": \"Widen\", \"args\": {{\"radius\": {radius}}}}}");
-    let a = http(run, "POST", "/api/leash", &[("Authorization", &bearer(run)), ("Content-Type", "application/json")], &body);
+    let body = format!(
+        "{{\"activity\": \"Watch-W1\", \"action\": \"Widen\", \"args\": {{\"radius\": {radius}}}}}"
+    );
+    let a = http(
+        run,
+        "POST",
+        "/api/leash",
+        &[("Authorization", &bearer(run)), ("Content-Type", "application/json")],
+        &body,
+    );
     (a.status, if a.status == 200 { a.body } else { a.error() })
 }
 
 fn go(run: &Run, args: &str) -> (u16, String) {
     let body = format!("{{\"name\": \"Go\", \"args\": {args}}}");
-    let a = http(run, "POST", "/api/signal", &[("Authorization", &bearer(run)), ("Content-Type", "application/json")], &body);
+    let a = http(
+        run,
+        "POST",
+        "/api/signal",
+        &[("Authorization", &bearer(run)), ("Content-Type", "application/json")],
+        &body,
+    );
     (a.status, if a.status == 200 { a.body } else { a.error() })
 }
 
@@ -48,20 +62,43 @@ fn leash_arguments_and_signal_values_are_checked_against_the_mission_kinds() {
     let dir = scratch("operator_args");
     let mut run = serve(&dir, MISSION, WORLD, "0", &[]);
     std::thread::sleep(std::time::Duration::from_millis(500));
-    for bad in ["\"abc\"", "[1, 2]", "true", "null", "{\"number\": 10, \"unit\": \"s\"}", "{\"number\": 10}"] {
+    for bad in [
+        "\"abc\"",
+        "[1, 2]",
+        "true",
+        "null",
+        "{\"number\": 10, \"unit\": \"s\"}",
+        "{\"number\": 10}",
+    ] {
         let (status, why) = widen(&run, bad);
         assert_eq!(status, 400, "radius {bad}: {why}");
-        assert!(why.starts_with("`radius` of Watch is a length (m, km)") || why.contains("null is not a value"), "radius {bad}: {why}");
+        assert!(
+            why.starts_with("`radius` of Watch is a length (m, km)")
+                || why.contains("null is not a value"),
+            "radius {bad}: {why}"
+        );
     }
-    assert_eq!(widen(&run, "-50"), (400, "`radius` of Watch is a length (m, km) and cannot be negative, not -50".into()));
+    assert_eq!(
+        widen(&run, "-50"),
+        (400, "`radius` of Watch is a length (m, km) and cannot be negative, not -50".into())
+    );
     let (status, why) = widen(&run, "1e308");
     assert_eq!(status, 400);
     assert!(why.contains("must be a finite number of at most 1e9"), "{why}");
     let (status, why) = widen(&run, "1e999");
     assert_eq!(status, 400, "a number JSON cannot hold: {why}");
     let body = "{\"activity\": \"Watch-W1\", \"action\": \"Widen\", \"args\": {\"radios\": 5}}";
-    let a = http(&run, "POST", "/api/leash", &[("Authorization", &bearer(&run)), ("Content-Type", "application/json")], body);
-    assert_eq!((a.status, a.error().as_str()), (400, "Watch has no parameter `radios`; its parameters are: radius"));
+    let a = http(
+        &run,
+        "POST",
+        "/api/leash",
+        &[("Authorization", &bearer(&run)), ("Content-Type", "application/json")],
+        body,
+    );
+    assert_eq!(
+        (a.status, a.error().as_str()),
+        (400, "Watch has no parameter `radios`; its parameters are: radius")
+    );
 
     let (status, why) = go(&run, "[]");
     assert_eq!(status, 400);
@@ -86,7 +123,10 @@ fn leash_arguments_and_signal_values_are_checked_against_the_mission_kinds() {
     assert!(err.contains("refused (400)"), "{err}");
     let (code, _, err) = ctl(&["signal", "Go", "(1, 2"]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("cannot read `(1, 2` as a value: expected `)` to close the coordinates"), "{err}");
+    assert!(
+        err.contains("cannot read `(1, 2` as a value: expected `)` to close the coordinates"),
+        "{err}"
+    );
     let (code, _, err) = ctl(&["signal", "Go", "10 parsecs"]);
     assert_eq!(code, 2, "{err}");
 
@@ -100,10 +140,19 @@ fn leash_arguments_and_signal_values_are_checked_against_the_mission_kinds() {
 
     // Only the good calls reached the mission, with their values in SI.
     let trace = std::fs::read_to_string(dir.join("t.jsonl")).unwrap();
-    let events: Vec<serde_json::Value> = trace.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
-    let signals: Vec<String> = events.iter().filter(|e| e["event"] == "signal" && e["actor"].is_null()).map(|e| e["args"].to_string()).collect();
+    let events: Vec<serde_json::Value> =
+        trace.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let signals: Vec<String> = events
+        .iter()
+        .filter(|e| e["event"] == "signal" && e["actor"].is_null())
+        .map(|e| e["args"].to_string())
+        .collect();
     assert_eq!(signals, ["[[100.0,-50.0],120.0]", "[[3.0,4.0,5.0],7.0]"]);
-    let widened: Vec<String> = events.iter().filter(|e| e["event"] == "signal" && e["name"] == "Widened").map(|e| e["args"].to_string()).collect();
+    let widened: Vec<String> = events
+        .iter()
+        .filter(|e| e["event"] == "signal" && e["name"] == "Widened")
+        .map(|e| e["args"].to_string())
+        .collect();
     assert_eq!(widened, ["[200.0]", "[30.0]"]);
     assert_eq!(events.iter().filter(|e| e["event"] == "leash").count(), 2);
 }

@@ -41,7 +41,11 @@ pub fn serve(dir: &Path, mission: &str, world: &str, serve: &str, extra: &[&str]
     let mut line = String::new();
     stderr.read_line(&mut line).unwrap();
     // aviary: operator API on http://127.0.0.1:PORT  token TOKEN
-    let url = line.split_whitespace().find(|w| w.starts_with("http://")).unwrap_or_else(|| panic!("no URL in {line:?}")).to_string();
+    let url = line
+        .split_whitespace()
+        .find(|w| w.starts_with("http://"))
+        .unwrap_or_else(|| panic!("no URL in {line:?}"))
+        .to_string();
     let token = line.split_whitespace().last().expect("token").to_string();
     let addr = url.trim_start_matches("http://").to_string();
     let port = addr.rsplit(':').next().unwrap().parse().unwrap();
@@ -57,11 +61,15 @@ pub struct Answer {
 impl Answer {
     /// The body as JSON: every answer of the API is JSON, errors included.
     pub fn json(&self) -> serde_json::Value {
-        serde_json::from_str(&self.body).unwrap_or_else(|e| panic!("not JSON ({e}): {} {}", self.status, self.body))
+        serde_json::from_str(&self.body)
+            .unwrap_or_else(|e| panic!("not JSON ({e}): {} {}", self.status, self.body))
     }
     /// The `error` of a JSON error answer.
     pub fn error(&self) -> String {
-        self.json()["error"].as_str().unwrap_or_else(|| panic!("no error in {}", self.body)).to_string()
+        self.json()["error"]
+            .as_str()
+            .unwrap_or_else(|| panic!("no error in {}", self.body))
+            .to_string()
     }
 }
 
@@ -91,7 +99,14 @@ pub fn http(run: &Run, method: &str, path: &str, headers: &[(&str, &str)], body:
     }
     let head = String::from_utf8_lossy(&got).into_owned();
     let status = head.split_whitespace().nth(1).and_then(|s| s.parse().ok()).expect("a status");
-    let length = head.lines().find_map(|l| l.to_ascii_lowercase().strip_prefix("content-length:").map(|n| n.trim().parse::<usize>().unwrap())).unwrap_or(0);
+    let length = head
+        .lines()
+        .find_map(|l| {
+            l.to_ascii_lowercase()
+                .strip_prefix("content-length:")
+                .map(|n| n.trim().parse::<usize>().unwrap())
+        })
+        .unwrap_or(0);
     let mut body = vec![0u8; length];
     stream.read_exact(&mut body).expect("the body");
     Answer { status, head, body: String::from_utf8_lossy(&body).into_owned() }
@@ -99,7 +114,12 @@ pub fn http(run: &Run, method: &str, path: &str, headers: &[(&str, &str)], body:
 
 /// A WebSocket handshake on `/api/events`, with `headers` besides the handshake's own.
 pub fn upgrade(run: &Run, headers: &[(&str, &str)]) -> Answer {
-    let mut all = vec![("Connection", "Upgrade"), ("Upgrade", "websocket"), ("Sec-WebSocket-Version", "13"), ("Sec-WebSocket-Key", "dGhlIHNhbXBsZSBub25jZQ==")];
+    let mut all = vec![
+        ("Connection", "Upgrade"),
+        ("Upgrade", "websocket"),
+        ("Sec-WebSocket-Version", "13"),
+        ("Sec-WebSocket-Key", "dGhlIHNhbXBsZSBub25jZQ=="),
+    ];
     all.extend_from_slice(headers);
     http(run, "GET", "/api/events", &all, "")
 }

@@ -64,12 +64,29 @@ pub fn run_in(mission: &str, world: &str) -> Run {
 
 pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
     let mut sources = SourceMap::new();
-    let checked = aviary_check::check_sources(&mut sources, ("m.mission", mission.as_bytes()), Some(("w.toml", world.as_bytes())), &NoFiles, &Descriptor::standard());
-    let errors: Vec<String> = checked.diagnostics.iter().filter(|d| d.is_error()).map(|d| format!("{}: {}", d.code, d.message)).collect();
+    let checked = aviary_check::check_sources(
+        &mut sources,
+        ("m.mission", mission.as_bytes()),
+        Some(("w.toml", world.as_bytes())),
+        &NoFiles,
+        &Descriptor::standard(),
+    );
+    let errors: Vec<String> = checked
+        .diagnostics
+        .iter()
+        .filter(|d| d.is_error())
+        .map(|d| format!("{}: {}", d.code, d.message))
+        .collect();
     assert!(errors.is_empty(), "{errors:#?}");
     let world = checked.world.expect("world");
-    let mission = aviary_ir::compile(&checked.program.expect("program"), &world, &Descriptor::standard()).expect("mission");
-    let runtime = tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build().expect("runtime");
+    let mission =
+        aviary_ir::compile(&checked.program.expect("program"), &world, &Descriptor::standard())
+            .expect("mission");
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_time()
+        .start_paused(true)
+        .build()
+        .expect("runtime");
     runtime.block_on(async {
         let sim = SimBackend::start(&world, SimOptions::default());
         let mut trace = Vec::new();
@@ -91,15 +108,28 @@ impl Run {
         self.first(event, field, value)["t"].as_f64().expect("t")
     }
     pub fn first(&self, event: &str, field: &str, value: &str) -> &Value {
-        self.find(event, field, value).into_iter().next().unwrap_or_else(|| panic!("no {event} with {field} = {value}:\n{}", self.dump()))
+        self.find(event, field, value)
+            .into_iter()
+            .next()
+            .unwrap_or_else(|| panic!("no {event} with {field} = {value}:\n{}", self.dump()))
     }
     /// The index of the first such event in the trace.
     pub fn index(&self, event: &str, field: &str, value: &str) -> usize {
-        self.trace.iter().position(|e| e["event"] == event && e[field] == value).unwrap_or_else(|| panic!("no {event} with {field} = {value}:\n{}", self.dump()))
+        self.trace
+            .iter()
+            .position(|e| e["event"] == event && e[field] == value)
+            .unwrap_or_else(|| panic!("no {event} with {field} = {value}:\n{}", self.dump()))
     }
     /// Capability ends of `capability` on `actor`.
     pub fn ends(&self, capability: &str, actor: &str) -> Vec<&Value> {
-        self.trace.iter().filter(|e| e["event"] == "capability_end" && e["capability"] == capability && e["actor"] == actor).collect()
+        self.trace
+            .iter()
+            .filter(|e| {
+                e["event"] == "capability_end"
+                    && e["capability"] == capability
+                    && e["actor"] == actor
+            })
+            .collect()
     }
     /// Telemetry positions of a drone, by time.
     pub fn positions(&self, actor: &str) -> Vec<(f64, [f64; 3])> {
@@ -108,7 +138,10 @@ impl Run {
             .filter(|e| e["event"] == "telemetry" && e["actor"] == actor)
             .map(|e| {
                 let p = &e["position"];
-                (e["t"].as_f64().unwrap(), [p[0].as_f64().unwrap(), p[1].as_f64().unwrap(), p[2].as_f64().unwrap()])
+                (
+                    e["t"].as_f64().unwrap(),
+                    [p[0].as_f64().unwrap(), p[1].as_f64().unwrap(), p[2].as_f64().unwrap()],
+                )
             })
             .collect()
     }

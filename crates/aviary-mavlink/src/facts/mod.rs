@@ -71,9 +71,20 @@ impl Facts {
     ) -> Facts {
         let answers = table(flavour)
             .iter()
-            .map(|p| (p, params.get(p.name).map(|(value, ty)| decode(flavour, *value, *ty) * p.scale)))
+            .map(|p| {
+                (p, params.get(p.name).map(|(value, ty)| decode(flavour, *value, *ty) * p.scale))
+            })
             .collect();
-        Facts { drone, name: name.to_owned(), address: address.to_owned(), system, flavour: Some(flavour), unheard: None, answers, charge }
+        Facts {
+            drone,
+            name: name.to_owned(),
+            address: address.to_owned(),
+            system,
+            flavour: Some(flavour),
+            unheard: None,
+            answers,
+            charge,
+        }
     }
 
     fn answer(&self, figure: Figure) -> Option<(&'static Param, f64)> {
@@ -89,7 +100,10 @@ impl Facts {
     pub fn source(&self) -> String {
         let at = format!("{} (system {})", self.address, self.system);
         if let Some(why) = &self.unheard {
-            return format!("{}: no answer from {at}: {why}; planned with the world's figures", self.name);
+            return format!(
+                "{}: no answer from {at}: {why}; planned with the world's figures",
+                self.name
+            );
         }
         let (k, n) = (self.answered(), self.answers.len());
         let charge = self.charge.map(|c| format!(", charge {}%", num(c))).unwrap_or_default();
@@ -117,7 +131,13 @@ impl Facts {
             };
             if !p.figure.usable(value) {
                 let raw = value / p.scale;
-                lines.push(format!("{name}: the vehicle's {} is {} {}, no usable {}: the world's kept", p.name, num(raw), p.unit, what(p.figure)));
+                lines.push(format!(
+                    "{name}: the vehicle's {} is {} {}, no usable {}: the world's kept",
+                    p.name,
+                    num(raw),
+                    p.unit,
+                    what(p.figure)
+                ));
                 continue;
             }
             let slot = match p.figure {
@@ -148,25 +168,43 @@ impl Facts {
                 }
             };
             if !same(*slot, value) {
-                lines.push(format!("{name}: {} {} {unit} (the vehicle's {}), not the world's {} {unit}", what(p.figure), num(value), p.name, num(*slot)));
+                lines.push(format!(
+                    "{name}: {} {} {unit} (the vehicle's {}), not the world's {} {unit}",
+                    what(p.figure),
+                    num(value),
+                    p.name,
+                    num(*slot)
+                ));
             }
             *slot = value;
         }
         match self.charge {
             Some(c) if !same(c, d.battery) => {
-                lines.push(format!("{name}: charge {}% (the vehicle's battery_remaining), not the world's {}%", num(c), num(d.battery)));
+                lines.push(format!(
+                    "{name}: charge {}% (the vehicle's battery_remaining), not the world's {}%",
+                    num(c),
+                    num(d.battery)
+                ));
                 d.battery = c;
             }
             Some(_) => {}
-            None => lines.push(format!("{name}: the vehicle reports no charge: the world's {}% kept", num(d.battery))),
+            None => lines.push(format!(
+                "{name}: the vehicle reports no charge: the world's {}% kept",
+                num(d.battery)
+            )),
         }
         if self.answer(Figure::Capacity).is_some_and(|(_, c)| Figure::Capacity.usable(c)) {
             lines.extend(self.endurance(d));
         }
         if !missing.is_empty() {
             let names: Vec<&str> = missing.iter().map(|m| m.0).collect();
-            let keys: Vec<&str> = missing.iter().map(|m| m.1).filter(|k| !k.contains(' ')).collect();
-            let kept = if keys.is_empty() { String::new() } else { format!(": the world's {} kept", keys.join(", ")) };
+            let keys: Vec<&str> =
+                missing.iter().map(|m| m.1).filter(|k| !k.contains(' ')).collect();
+            let kept = if keys.is_empty() {
+                String::new()
+            } else {
+                format!(": the world's {} kept", keys.join(", "))
+            };
             lines.push(format!("{name}: no answer for {}{kept}", names.join(", ")));
         }
         lines
@@ -201,7 +239,9 @@ impl Facts {
     /// LAND_SPEED_HIGH for the upper part when the vehicle sets one.
     pub fn landing(&self, d: &Drone) -> Descent {
         let mut descent = d.descent();
-        if let Some((_, high)) = self.answer(Figure::LandSpeedHigh).filter(|(_, v)| *v > 0.0 && v.is_finite()) {
+        if let Some((_, high)) =
+            self.answer(Figure::LandSpeedHigh).filter(|(_, v)| *v > 0.0 && v.is_finite())
+        {
             descent.rate = high;
         }
         descent
@@ -230,5 +270,9 @@ fn same(a: f64, b: f64) -> bool {
 pub fn num(x: f64) -> String {
     let s = format!("{:.2}", x + 0.0);
     let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" { "0".into() } else { s.into() }
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.into()
+    }
 }

@@ -42,8 +42,15 @@ impl Figure {
     pub fn usable(self, value: f64) -> bool {
         value.is_finite()
             && match self {
-                Figure::Climb | Figure::Descent | Figure::Acceleration | Figure::LandSpeed | Figure::Capacity => value > 0.0,
-                Figure::LandSpeedBelow | Figure::ReturnAltitude | Figure::ReturnLoiter | Figure::LandSpeedHigh => value >= 0.0,
+                Figure::Climb
+                | Figure::Descent
+                | Figure::Acceleration
+                | Figure::LandSpeed
+                | Figure::Capacity => value > 0.0,
+                Figure::LandSpeedBelow
+                | Figure::ReturnAltitude
+                | Figure::ReturnLoiter
+                | Figure::LandSpeedHigh => value >= 0.0,
             }
     }
 }
@@ -115,12 +122,16 @@ pub fn decode(flavour: Flavour, value: f32, ty: MavParamType) -> f64 {
     use MavParamType::*;
     let bits = value.to_bits();
     match (flavour, ty) {
-        (_, MAV_PARAM_TYPE_REAL32 | MAV_PARAM_TYPE_REAL64) | (Flavour::ArduPilot, _) => f64::from(value),
+        (_, MAV_PARAM_TYPE_REAL32 | MAV_PARAM_TYPE_REAL64) | (Flavour::ArduPilot, _) => {
+            f64::from(value)
+        }
         (Flavour::Px4, MAV_PARAM_TYPE_UINT8) => f64::from(bits as u8),
         (Flavour::Px4, MAV_PARAM_TYPE_INT8) => f64::from(bits as u8 as i8),
         (Flavour::Px4, MAV_PARAM_TYPE_UINT16) => f64::from(bits as u16),
         (Flavour::Px4, MAV_PARAM_TYPE_INT16) => f64::from(bits as u16 as i16),
         (Flavour::Px4, MAV_PARAM_TYPE_UINT32) => f64::from(bits),
-        (Flavour::Px4, MAV_PARAM_TYPE_INT32 | MAV_PARAM_TYPE_UINT64 | MAV_PARAM_TYPE_INT64) => f64::from(bits as i32),
+        (Flavour::Px4, MAV_PARAM_TYPE_INT32 | MAV_PARAM_TYPE_UINT64 | MAV_PARAM_TYPE_INT64) => {
+            f64::from(bits as i32)
+        }
     }
 }

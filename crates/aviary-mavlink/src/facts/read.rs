@@ -6,7 +6,9 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use aviary_world::World;
-use mavlink::dialects::ardupilotmega::{MavCmd, MavMessage, COMMAND_LONG_DATA, PARAM_REQUEST_READ_DATA};
+use mavlink::dialects::ardupilotmega::{
+    MavCmd, MavMessage, COMMAND_LONG_DATA, PARAM_REQUEST_READ_DATA,
+};
 use tokio::sync::mpsc;
 use tokio::time::Instant;
 
@@ -40,7 +42,11 @@ pub(crate) async fn read(drone: usize, link: &Link, v: &Vehicle, until: Instant)
     loop {
         let (missing, charge_known) = {
             let seen = v.seen();
-            let missing: Vec<&'static str> = table.iter().filter(|p| !seen.params.contains_key(p.name)).map(|p| p.name).collect();
+            let missing: Vec<&'static str> = table
+                .iter()
+                .filter(|p| !seen.params.contains_key(p.name))
+                .map(|p| p.name)
+                .collect();
             let charge_known = seen.battery.is_some() || seen.battery_reported;
             (missing, charge_known)
         };
@@ -76,7 +82,15 @@ pub(crate) async fn read(drone: usize, link: &Link, v: &Vehicle, until: Instant)
         tokio::time::sleep(POLL).await;
     }
     let seen = v.seen();
-    Facts::answered_by(drone, &v.name, &link.address, v.system, flavour, &seen.params, seen.battery.map(|b| b * 100.0))
+    Facts::answered_by(
+        drone,
+        &v.name,
+        &link.address,
+        v.system,
+        flavour,
+        &seen.params,
+        seen.battery.map(|b| b * 100.0),
+    )
 }
 
 /// Asks every MAVLink drone of `world` for its facts, all at once, and gives up on each
@@ -87,26 +101,51 @@ pub async fn ask(world: &World, wait: Duration) -> Result<Vec<Facts>, String> {
     let until = Instant::now() + wait;
     let bound = crate::bindings(world);
     let links = crate::link_keys(world, &bound)?;
-    let origin = world.site.origin.as_ref().map_or(Origin { lat: 0.0, lon: 0.0, alt: 0.0 }, |g| Origin { lat: g.lat, lon: g.lon, alt: g.alt });
+    let origin = world.site.origin.as_ref().map_or(Origin { lat: 0.0, lon: 0.0, alt: 0.0 }, |g| {
+        Origin { lat: g.lat, lon: g.lon, alt: g.alt }
+    });
     // Nobody listens: asking flies nothing, so nothing is detected or raised.
     let (events, _) = mpsc::unbounded_channel();
     let (alarms, _) = mpsc::unbounded_channel();
     let mut tasks = tokio::task::JoinSet::new();
     for (address, key) in links {
-        let drones: Vec<(usize, String, u8)> =
-            bound.iter().filter(|b| b.1 == address).map(|(i, _, system, _)| (*i, world.drones[*i].name.clone(), *system)).collect();
+        let drones: Vec<(usize, String, u8)> = bound
+            .iter()
+            .filter(|b| b.1 == address)
+            .map(|(i, _, system, _)| (*i, world.drones[*i].name.clone(), *system))
+            .collect();
         let (events, alarms) = (events.clone(), alarms.clone());
         tasks.spawn(async move {
             let key = key.as_deref().map(crate::signing_key);
             let opened = tokio::time::timeout_at(until, Link::open(&address, key)).await;
             let link = match opened {
                 Ok(Ok(link)) => link,
-                Ok(Err(why)) => return drones.iter().map(|(i, n, s)| Facts::unheard(*i, n, &address, *s, why.clone())).collect(),
-                Err(_) => return drones.iter().map(|(i, n, s)| Facts::unheard(*i, n, &address, *s, "no connection".into())).collect(),
+                Ok(Err(why)) => {
+                    return drones
+                        .iter()
+                        .map(|(i, n, s)| Facts::unheard(*i, n, &address, *s, why.clone()))
+                        .collect()
+                }
+                Err(_) => {
+                    return drones
+                        .iter()
+                        .map(|(i, n, s)| {
+                            Facts::unheard(*i, n, &address, *s, "no connection".into())
+                        })
+                        .collect()
+                }
             };
             let mut reads = tokio::task::JoinSet::new();
             for (i, name, system) in drones {
-                let v = Arc::new(Vehicle::new(i, name, system, origin, Vec::new(), events.clone(), alarms.clone()));
+                let v = Arc::new(Vehicle::new(
+                    i,
+                    name,
+                    system,
+                    origin,
+                    Vec::new(),
+                    events.clone(),
+                    alarms.clone(),
+                ));
                 link.add(Arc::clone(&v));
                 let link = Arc::clone(&link);
                 reads.spawn(async move { read(i, &link, &v, until).await });

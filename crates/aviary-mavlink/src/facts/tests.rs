@@ -15,7 +15,8 @@ fn drone(keys: &str) -> Drone {
 
 /// Answers as a vehicle sends them: (name, value, type).
 fn facts(flavour: Flavour, answers: &[(&str, f32, MavParamType)], charge: Option<f64>) -> Facts {
-    let params: BTreeMap<String, (f32, MavParamType)> = answers.iter().map(|(n, v, t)| ((*n).to_owned(), (*v, *t))).collect();
+    let params: BTreeMap<String, (f32, MavParamType)> =
+        answers.iter().map(|(n, v, t)| ((*n).to_owned(), (*v, *t))).collect();
     Facts::answered_by(0, "d", "tcp:127.0.0.1:5760", 1, flavour, &params, charge)
 }
 
@@ -47,7 +48,15 @@ fn sitl_s_parameters_become_the_drone_s_figures_in_si_units() {
     let mut d = drone("flight_current = 30");
     let lines = facts(Flavour::ArduPilot, SITL, Some(100.0)).apply(&mut d);
     assert_eq!(
-        (d.climb_rate, d.descent_rate, d.acceleration, d.land_speed, d.land_speed_below, d.return_altitude, d.return_loiter),
+        (
+            d.climb_rate,
+            d.descent_rate,
+            d.acceleration,
+            d.land_speed,
+            d.land_speed_below,
+            d.return_altitude,
+            d.return_loiter
+        ),
         (2.5, 1.5, 2.5, 0.5, 10.0, 15.0, 5.0)
     );
     assert_eq!(d.battery_capacity, Some(3300.0));
@@ -87,11 +96,19 @@ fn the_vehicle_s_charge_is_the_start_charge() {
     let mut d = drone("");
     let lines = facts(Flavour::ArduPilot, SITL, Some(87.0)).apply(&mut d);
     assert_eq!(d.battery, 87.0);
-    assert!(lines.contains(&"d: charge 87% (the vehicle's battery_remaining), not the world's 100%".to_owned()), "{lines:?}");
+    assert!(
+        lines.contains(
+            &"d: charge 87% (the vehicle's battery_remaining), not the world's 100%".to_owned()
+        ),
+        "{lines:?}"
+    );
     let mut d = drone("battery = 90");
     let lines = facts(Flavour::ArduPilot, SITL, None).apply(&mut d);
     assert_eq!(d.battery, 90.0);
-    assert!(lines.contains(&"d: the vehicle reports no charge: the world's 90% kept".to_owned()), "{lines:?}");
+    assert!(
+        lines.contains(&"d: the vehicle reports no charge: the world's 90% kept".to_owned()),
+        "{lines:?}"
+    );
 }
 
 #[test]
@@ -99,7 +116,10 @@ fn without_the_world_s_draw_the_capacity_does_not_change_the_endurance() {
     let mut d = drone("endurance = 900");
     let lines = facts(Flavour::ArduPilot, SITL, Some(100.0)).apply(&mut d);
     assert_eq!((d.endurance, d.battery_capacity), (900.0, Some(3300.0)));
-    assert!(lines.iter().any(|l| l.contains("no `flight_current`") && l.contains("15 min")), "{lines:?}");
+    assert!(
+        lines.iter().any(|l| l.contains("no `flight_current`") && l.contains("15 min")),
+        "{lines:?}"
+    );
 }
 
 #[test]
@@ -114,8 +134,19 @@ fn unanswered_and_unusable_parameters_keep_the_world_s_figures_and_say_so() {
     let lines = f.apply(&mut d);
     assert_eq!((d.climb_rate, d.acceleration, d.return_altitude), (3.0, 3.0, 10.0), "the world's");
     assert_eq!(d.descent_rate, 1.5, "the answered ones apply");
-    assert!(lines.contains(&"d: the vehicle's WPNAV_SPEED_UP is 0 cm/s, no usable climb: the world's kept".to_owned()), "{lines:?}");
-    assert_eq!(lines.last().map(String::as_str), Some("d: no answer for WPNAV_ACCEL, RTL_ALT: the world's acceleration, return_altitude kept"));
+    assert!(
+        lines.contains(
+            &"d: the vehicle's WPNAV_SPEED_UP is 0 cm/s, no usable climb: the world's kept"
+                .to_owned()
+        ),
+        "{lines:?}"
+    );
+    assert_eq!(
+        lines.last().map(String::as_str),
+        Some(
+            "d: no answer for WPNAV_ACCEL, RTL_ALT: the world's acceleration, return_altitude kept"
+        )
+    );
     assert!(f.source().contains("7 of 9 parameters answered"), "{}", f.source());
 }
 
@@ -136,13 +167,21 @@ fn a_vehicle_not_heard_changes_nothing() {
 
 #[test]
 fn land_speed_high_is_the_battery_rule_s_landing() {
-    let answers: Vec<_> = SITL.iter().map(|&(n, v, t)| if n == "LAND_SPEED_HIGH" { (n, 200.0, t) } else { (n, v, t) }).collect();
+    let answers: Vec<_> = SITL
+        .iter()
+        .map(|&(n, v, t)| if n == "LAND_SPEED_HIGH" { (n, 200.0, t) } else { (n, v, t) })
+        .collect();
     let mut d = drone("");
     let f = facts(Flavour::ArduPilot, &answers, Some(100.0));
     let lines = f.apply(&mut d);
     assert_eq!(d.descent_rate, 1.5, "the world's descents stay WPNAV_SPEED_DN");
     assert_eq!(f.landing(&d).rate, 2.0);
-    assert!(lines.iter().any(|l| l.contains("lands from high at 2 m/s (the vehicle's LAND_SPEED_HIGH)")), "{lines:?}");
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.contains("lands from high at 2 m/s (the vehicle's LAND_SPEED_HIGH)")),
+        "{lines:?}"
+    );
 }
 
 #[test]
@@ -173,5 +212,8 @@ fn only_the_facts_parameters_are_kept() {
 
 #[test]
 fn numbers_read_as_people_write_them() {
-    assert_eq!((num(3.0), num(1.5), num(0.25), num(6.6), num(-0.0)), ("3".into(), "1.5".into(), "0.25".into(), "6.6".into(), "0".into()));
+    assert_eq!(
+        (num(3.0), num(1.5), num(0.25), num(6.6), num(-0.0)),
+        ("3".into(), "1.5".into(), "0.25".into(), "6.6".into(), "0".into())
+    );
 }

@@ -15,10 +15,7 @@ async fn done(call: PendingCall) -> CallEnd {
 
 async fn take_off(sim: &Arc<SimBackend>, alt: f64) {
     assert_eq!(done(sim.call(0, "Arm", &[])).await, CallEnd::Done);
-    assert_eq!(
-        done(sim.call(0, "TakeOff", &[num(alt)])).await,
-        CallEnd::Done
-    );
+    assert_eq!(done(sim.call(0, "TakeOff", &[num(alt)])).await, CallEnd::Done);
 }
 
 #[tokio::test(flavor = "current_thread", start_paused = true)]
@@ -29,22 +26,13 @@ async fn calls_end_at_the_simulated_time_they_take() {
     take_off(&sim, 20.0).await;
     let took = t0.elapsed().as_secs_f64();
     assert!((took - (2.0 + 17.0 / 3.0)).abs() < 0.4, "{took}");
-    assert!(
-        (sim.time() - took).abs() < 1e-6,
-        "simulated time is tokio time"
-    );
+    assert!((sim.time() - took).abs() < 1e-6, "simulated time is tokio time");
     let t1 = Instant::now();
-    assert_eq!(
-        done(sim.call(0, "FlyToPosition", &[pos(300.0, 400.0)])).await,
-        CallEnd::Done
-    );
+    assert_eq!(done(sim.call(0, "FlyToPosition", &[pos(300.0, 400.0)])).await, CallEnd::Done);
     let took = t1.elapsed().as_secs_f64();
     assert!((took - (50.0 + 10.0 / 3.0)).abs() < 0.6, "{took}");
     let t = sim.telemetry(0);
-    assert_eq!(
-        (t.position, t.state, t.link),
-        ([300.0, 400.0, 20.0], FlightState::Flying, true)
-    );
+    assert_eq!((t.position, t.state, t.link), ([300.0, 400.0, 20.0], FlightState::Flying, true));
     assert_eq!(sim.telemetry(42).state, FlightState::Lost);
     match done(sim.call(0, "FlyToPosition", &[pos(5000.0, 0.0)])).await {
         CallEnd::Failed(f) => assert_eq!(f.exception, "GeofenceViolation"),
@@ -59,14 +47,8 @@ async fn events_are_taken_once_and_detections_arrive() {
     let mut events = sim.events().expect("the first taker gets the events");
     assert!(sim.events().is_none());
     take_off(&sim, 20.0).await;
-    assert_eq!(
-        done(sim.call(0, "StartDetection", &[sym("Body")])).await,
-        CallEnd::Done
-    );
-    assert_eq!(
-        done(sim.call(0, "FlyToPosition", &[pos(320.0, 0.0)])).await,
-        CallEnd::Done
-    );
+    assert_eq!(done(sim.call(0, "StartDetection", &[sym("Body")])).await, CallEnd::Done);
+    assert_eq!(done(sim.call(0, "FlyToPosition", &[pos(320.0, 0.0)])).await, CallEnd::Done);
     let mut found = Vec::new();
     while let Ok(e) = events.try_recv() {
         if let DroneEvent::Detected { location, .. } = e {
@@ -99,10 +81,7 @@ async fn pause_resume_and_abort_through_the_backend() {
     assert_eq!(done(call).await, CallEnd::Interrupted);
     let here = sim.telemetry(0);
     tokio::time::sleep(Duration::from_secs(3)).await;
-    assert_eq!(
-        (sim.telemetry(0).position, sim.telemetry(0).speed),
-        (here.position, 0.0)
-    );
+    assert_eq!((sim.telemetry(0).position, sim.telemetry(0).speed), (here.position, 0.0));
     sim.shutdown().await;
 }
 
@@ -129,9 +108,7 @@ async fn the_driver_ends_when_stopped_or_dropped() {
         .expect("no panic");
 
     let sim = SimBackend::start(&one_drone(), SimOptions::default());
-    tokio::time::timeout(Duration::from_secs(1), sim.shutdown())
-        .await
-        .expect("shutdown returns");
+    tokio::time::timeout(Duration::from_secs(1), sim.shutdown()).await.expect("shutdown returns");
 }
 
 #[test]
@@ -168,12 +145,8 @@ async fn scripted() -> Vec<Telemetry> {
     };
     take_off(&sim, 15.0).await;
     done(sim.call(0, "StartDetection", &[sym("Body")])).await;
-    let area = aviary_api::Value::Area(vec![
-        [50.0, -20.0],
-        [150.0, -20.0],
-        [150.0, 60.0],
-        [50.0, 60.0],
-    ]);
+    let area =
+        aviary_api::Value::Area(vec![[50.0, -20.0], [150.0, -20.0], [150.0, 60.0], [50.0, 60.0]]);
     done(sim.call(0, "Sweep", &[area, num(20.0)])).await;
     done(sim.call(0, "ReturnToLaunch", &[])).await;
     sampler.await.unwrap();
@@ -192,21 +165,11 @@ async fn the_backend_is_deterministic() {
 
 #[tokio::test(flavor = "current_thread", start_paused = true)]
 async fn speed_paces_against_the_wall_clock() {
-    let sim = SimBackend::start(
-        &one_drone(),
-        SimOptions {
-            tick: 0.05,
-            speed: Some(50.0),
-        },
-    );
+    let sim = SimBackend::start(&one_drone(), SimOptions { tick: 0.05, speed: Some(50.0) });
     let wall = std::time::Instant::now();
     done(sim.call(0, "Hover", &[num(2.0)])).await;
     // 2 s of simulated time at 50x: at least 40 ms of wall time.
-    assert!(
-        wall.elapsed() >= Duration::from_millis(39),
-        "{:?}",
-        wall.elapsed()
-    );
+    assert!(wall.elapsed() >= Duration::from_millis(39), "{:?}", wall.elapsed());
     sim.shutdown().await;
 }
 
@@ -215,13 +178,7 @@ async fn pacing_leaves_the_thread_free_and_the_clock_still() {
     // At a tenth of real time each 0.05 s tick waits 0.5 s of wall time. A message sent
     // from another thread 20 ms into that wait is taken at once by a task on the same
     // thread, not when the wait is over; and the simulated clock has not moved meanwhile.
-    let sim = SimBackend::start(
-        &one_drone(),
-        SimOptions {
-            tick: 0.05,
-            speed: Some(0.1),
-        },
-    );
+    let sim = SimBackend::start(&one_drone(), SimOptions { tick: 0.05, speed: Some(0.1) });
     let hover = sim.call(0, "Hover", &[num(10.0)]);
     tokio::time::sleep(Duration::from_millis(60)).await;
     let (tx, mut rx) = tokio::sync::mpsc::unbounded_channel();
@@ -235,8 +192,15 @@ async fn pacing_leaves_the_thread_free_and_the_clock_still() {
     let late = at.elapsed();
     // Blocked, it would be taken some 450 ms late.
     assert!(late < Duration::from_millis(200), "taken {late:?} after it was sent");
-    assert!(sent.elapsed() < Duration::from_millis(250), "not after a whole tick's wait: {:?}", sent.elapsed());
-    assert!(tokio::time::Instant::now() - simulated <= Duration::from_millis(50), "the clock moved by at most one tick");
+    assert!(
+        sent.elapsed() < Duration::from_millis(250),
+        "not after a whole tick's wait: {:?}",
+        sent.elapsed()
+    );
+    assert!(
+        tokio::time::Instant::now() - simulated <= Duration::from_millis(50),
+        "the clock moved by at most one tick"
+    );
     sim.interrupt(hover.id, aviary_api::Interrupt::Abort);
     sim.shutdown().await;
 }

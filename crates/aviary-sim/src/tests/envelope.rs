@@ -5,13 +5,7 @@ use super::*;
 use crate::separation::{brake, envelope, gap, Envelope};
 
 fn point(p: [f64; 3]) -> Envelope {
-    Envelope {
-        from: [p[0], p[1]],
-        to: [p[0], p[1]],
-        pad: 0.0,
-        low: p[2],
-        high: p[2],
-    }
+    Envelope { from: [p[0], p[1]], to: [p[0], p[1]], pad: 0.0, low: p[2], high: p[2] }
 }
 
 /// Brakes drone 0 of `fleet` to a stop, checking at every tick that its new envelope lies
@@ -24,13 +18,8 @@ fn brake_to_a_stop(fleet: &Fleet) -> usize {
     let probes: Vec<Envelope> = (-12..=12)
         .flat_map(|i| (-12..=12).map(move |j| (i, j)))
         .flat_map(|(i, j)| {
-            [-6.0, 0.0, 6.0].map(|dz| {
-                point([
-                    here[0] + 3.0 * i as f64,
-                    here[1] + 3.0 * j as f64,
-                    here[2] + dz,
-                ])
-            })
+            [-6.0, 0.0, 6.0]
+                .map(|dz| point([here[0] + 3.0 * i as f64, here[1] + 3.0 * j as f64, here[2] + dz]))
         })
         .collect();
     let mut before = first;
@@ -39,16 +28,9 @@ fn brake_to_a_stop(fleet: &Fleet) -> usize {
         d.brake_all(DT);
         let now = envelope(&d);
         for p in &probes {
-            assert!(
-                gap(&now, p) >= gap(&before, p) - 1e-9,
-                "{before:?} -> {now:?}"
-            );
+            assert!(gap(&now, p) >= gap(&before, p) - 1e-9, "{before:?} -> {now:?}");
         }
-        assert!(
-            gap(&point(d.pos), &first) < 1e-9,
-            "left its envelope: {:?}",
-            d.pos
-        );
+        assert!(gap(&point(d.pos), &first) < 1e-9, "left its envelope: {:?}", d.pos);
         before = now;
         ticks += 1;
         assert!(ticks < 1000);
@@ -102,30 +84,12 @@ fn one_braking_tick_moves_at_most_to_the_stopping_point() {
 
 #[test]
 fn the_distance_between_envelopes_combines_ground_and_height() {
-    let a = Envelope {
-        from: [0.0, 0.0],
-        to: [10.0, 0.0],
-        pad: 0.0,
-        low: 10.0,
-        high: 12.0,
-    };
+    let a = Envelope { from: [0.0, 0.0], to: [10.0, 0.0], pad: 0.0, low: 10.0, high: 12.0 };
     // Crossing tracks, 3 m and 4 m of height apart: 4 m.
-    let b = Envelope {
-        from: [5.0, -5.0],
-        to: [5.0, 5.0],
-        pad: 0.0,
-        low: 16.0,
-        high: 20.0,
-    };
+    let b = Envelope { from: [5.0, -5.0], to: [5.0, 5.0], pad: 0.0, low: 16.0, high: 20.0 };
     assert_eq!(gap(&a, &b), 4.0);
     // Parallel tracks 5 m apart at the same height, one of them 1 m wide: 4 m.
-    let c = Envelope {
-        from: [0.0, 5.0],
-        to: [10.0, 5.0],
-        pad: 1.0,
-        low: 11.0,
-        high: 11.0,
-    };
+    let c = Envelope { from: [0.0, 5.0], to: [10.0, 5.0], pad: 1.0, low: 11.0, high: 11.0 };
     assert_eq!(gap(&a, &c), 4.0);
     // 3 m over the ground and 4 m of height: 5 m.
     assert_eq!(gap(&point([13.0, 0.0, 16.0]), &a), 5.0);

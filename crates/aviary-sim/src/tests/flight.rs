@@ -47,11 +47,7 @@ fn a_long_flight_keeps_speed_and_acceleration_bounds() {
     assert!(dist([end.position[0], end.position[1]], [300.0, 400.0]) <= 0.5);
     assert_eq!(end.position[2], 20.0);
     assert_eq!(end.speed, 0.0);
-    assert!(
-        (end.heading - 36.869_897_645_844_02).abs() < 1e-6,
-        "heading {}",
-        end.heading
-    );
+    assert!((end.heading - 36.869_897_645_844_02).abs() < 1e-6, "heading {}", end.heading);
     let mut fastest: f64 = 0.0;
     for w in run.samples.windows(2) {
         assert!(w[1].speed <= 10.0 + 1e-9, "speed {}", w[1].speed);
@@ -65,18 +61,10 @@ fn a_long_flight_keeps_speed_and_acceleration_bounds() {
     assert!(fastest > 9.99);
     let (metres, seconds) = fleet.odometry(0);
     assert!((metres - 520.0).abs() < 1e-6, "{metres}");
-    assert!(
-        (seconds - fleet.time()).abs() < 1e-9,
-        "in the air since the take-off call"
-    );
+    assert!((seconds - fleet.time()).abs() < 1e-9, "in the air since the take-off call");
     assert_eq!(fleet.odometry(7), (0.0, 0.0));
     // A slower speed asked is kept.
-    let id = start(
-        &mut fleet,
-        0,
-        "FlyToPosition",
-        &[pos(300.0, 300.0), num(4.0)],
-    );
+    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(300.0, 300.0), num(4.0)]);
     let run = run_until(&mut fleet, 0, id, 200.0);
     assert!(run.samples.iter().all(|t| t.speed <= 4.0 + 1e-9));
     assert!((run.took - (100.0 / 4.0 + 4.0 / 3.0)).abs() < 0.3);
@@ -87,11 +75,7 @@ fn battery_drains_exactly_while_airborne_only() {
     let w = world("[drones.d]\nhome = [0, 0]\nbattery = 80\nendurance = 600\n");
     let mut fleet = Fleet::new(&w);
     run_for(&mut fleet, 10.0);
-    assert_eq!(
-        fleet.telemetry(0).unwrap().battery,
-        0.8,
-        "no drain on the ground"
-    );
+    assert_eq!(fleet.telemetry(0).unwrap().battery, 0.8, "no drain on the ground");
     instant(&mut fleet, 0, "Arm", &[]);
     start(&mut fleet, 0, "TakeOff", &[num(30.0)]);
     let steps = 2400; // 120 s
@@ -127,10 +111,7 @@ fn battery_low_comes_before_critical_each_once_then_the_drone_is_lost() {
     // The flight was cut by BatteryCritical: the drone held there and then fell.
     assert_eq!(ended.map(|e| e.0), Some(CallEnd::Interrupted));
     let t = fleet.telemetry(0).unwrap();
-    assert_eq!(
-        (t.state, t.battery, t.position[2]),
-        (FlightState::Lost, 0.0, 0.0)
-    );
+    assert_eq!((t.state, t.battery, t.position[2]), (FlightState::Lost, 0.0, 0.0));
     assert!(t.position[0] > 500.0 && t.position[0] < 700.0, "{t:?}");
     assert_eq!(refused(&mut fleet, 0, "Land", &[]).0, "CommandFailed");
 }
@@ -139,10 +120,7 @@ fn battery_low_comes_before_critical_each_once_then_the_drone_is_lost() {
 fn detection_fires_once_per_target_per_activation_and_only_in_range() {
     let w = one_drone();
     let mut fleet = airborne(&w, 20.0);
-    assert_eq!(
-        instant(&mut fleet, 0, "StartDetection", &[sym("Body")]),
-        CallEnd::Done
-    );
+    assert_eq!(instant(&mut fleet, 0, "StartDetection", &[sym("Body")]), CallEnd::Done);
     // Passes (100, 10) at 10 m, and (100, 50) at 50 m (out of the 20 m range).
     let id = start(&mut fleet, 0, "FlyToPosition", &[pos(200.0, 0.0)]);
     let run = run_until(&mut fleet, 0, id, 100.0);
@@ -150,11 +128,9 @@ fn detection_fires_once_per_target_per_activation_and_only_in_range() {
         events
             .iter()
             .filter_map(|e| match e {
-                DroneEvent::Detected {
-                    drone: 0,
-                    kind,
-                    location,
-                } if kind == "Body" => Some(*location),
+                DroneEvent::Detected { drone: 0, kind, location } if kind == "Body" => {
+                    Some(*location)
+                }
                 _ => None,
             })
             .collect()
@@ -164,17 +140,9 @@ fn detection_fires_once_per_target_per_activation_and_only_in_range() {
     let id = start(&mut fleet, 0, "FlyToPosition", &[pos(50.0, 0.0)]);
     assert!(found(&run_until(&mut fleet, 0, id, 100.0).events).is_empty());
     // A new activation finds it again.
-    instant(
-        &mut fleet,
-        0,
-        "StartDetection",
-        &[Value::Text("Body".into())],
-    );
+    instant(&mut fleet, 0, "StartDetection", &[Value::Text("Body".into())]);
     let id = start(&mut fleet, 0, "FlyToPosition", &[pos(150.0, 0.0)]);
-    assert_eq!(
-        found(&run_until(&mut fleet, 0, id, 100.0).events),
-        [[100.0, 10.0, 0.0]]
-    );
+    assert_eq!(found(&run_until(&mut fleet, 0, id, 100.0).events), [[100.0, 10.0, 0.0]]);
     // Stopped: nothing.
     instant(&mut fleet, 0, "StopDetection", &[sym("Body")]);
     assert!(fleet.detecting(0).is_empty());
@@ -186,12 +154,7 @@ fn detection_fires_once_per_target_per_activation_and_only_in_range() {
 fn orbit_keeps_its_radius_and_speed() {
     let w = one_drone();
     let mut fleet = airborne(&w, 20.0);
-    let id = start(
-        &mut fleet,
-        0,
-        "Orbit",
-        &[pos(100.0, 0.0), num(30.0), num(2.0)],
-    );
+    let id = start(&mut fleet, 0, "Orbit", &[pos(100.0, 0.0), num(30.0), num(2.0)]);
     let run = run_until(&mut fleet, 0, id, 300.0);
     // The approach ends at (70, 0), the nearest point of the circle.
     let on_circle: Vec<_> = run
@@ -210,10 +173,7 @@ fn orbit_keeps_its_radius_and_speed() {
     let laps_time = on_circle.len() as f64 * DT;
     assert!(laps_time >= 2.0 * std::f64::consts::TAU * 30.0 / 45f64.sqrt());
     let end = fleet.telemetry(0).unwrap();
-    assert!(
-        dist([end.position[0], end.position[1]], [70.0, 0.0]) < 1e-6,
-        "ends where it began"
-    );
+    assert!(dist([end.position[0], end.position[1]], [70.0, 0.0]) < 1e-6, "ends where it began");
 }
 
 #[test]
@@ -223,31 +183,18 @@ fn sweep_flies_the_lawnmower_path_and_covers_the_area() {
     let l = crate::geom::L_SHAPE.to_vec();
     let id = start(&mut fleet, 0, "Sweep", &[Value::Area(l.clone()), num(20.0)]);
     let run = run_until(&mut fleet, 0, id, 1000.0);
-    let flown: Vec<[f64; 2]> = run
-        .samples
-        .iter()
-        .map(|t| [t.position[0], t.position[1]])
-        .collect();
+    let flown: Vec<[f64; 2]> = run.samples.iter().map(|t| [t.position[0], t.position[1]]).collect();
     let path = lawnmower(&l, 20.0);
     for p in &path {
-        assert!(
-            dist_to_polyline(*p, &flown) < 1e-6,
-            "the drone passed {p:?}"
-        );
+        assert!(dist_to_polyline(*p, &flown) < 1e-6, "the drone passed {p:?}");
     }
     assert_eq!(flown.last(), path.last());
-    assert!(run
-        .samples
-        .iter()
-        .all(|t| t.position[2] == 15.0 && t.speed <= 10.0 + 1e-9));
+    assert!(run.samples.iter().all(|t| t.position[2] == 15.0 && t.speed <= 10.0 + 1e-9));
     for x in 0..=100 {
         for y in 0..=100 {
             let p = [x as f64, y as f64];
             if crate::geom::contains(&l, p) {
-                assert!(
-                    dist_to_polyline(p, &flown) <= 10.0 + 0.05,
-                    "{p:?} is far from the sweep"
-                );
+                assert!(dist_to_polyline(p, &flown) <= 10.0 + 0.05, "{p:?} is far from the sweep");
             }
         }
     }
@@ -263,10 +210,7 @@ fn pause_holds_the_drone_and_resume_completes_the_move() {
     let held = fleet.telemetry(0).unwrap();
     assert_eq!(held.speed, 0.0);
     for r in run_for(&mut fleet, 10.0) {
-        assert!(
-            !matches!(r, Report::Ended { call, .. } if call == id),
-            "a paused call goes on"
-        );
+        assert!(!matches!(r, Report::Ended { call, .. } if call == id), "a paused call goes on");
         assert_eq!(fleet.telemetry(0).unwrap().position, held.position);
     }
     let after = fleet.telemetry(0).unwrap();
@@ -284,10 +228,7 @@ fn abort_ends_the_call_interrupted_and_the_drone_hovers() {
     let mut fleet = airborne(&w, 20.0);
     let id = start(&mut fleet, 0, "FlyToPosition", &[pos(200.0, 0.0)]);
     run_for(&mut fleet, 5.0);
-    assert_eq!(
-        fleet.interrupt(id, Interrupt::Abort),
-        Some(CallEnd::Interrupted)
-    );
+    assert_eq!(fleet.interrupt(id, Interrupt::Abort), Some(CallEnd::Interrupted));
     assert_eq!(fleet.interrupt(id, Interrupt::Abort), None, "once");
     let here = fleet.telemetry(0).unwrap();
     run_for(&mut fleet, 5.0);
@@ -336,12 +277,7 @@ at = [120, 60]
                     0,
                     "Sweep",
                     &[
-                        Value::Area(vec![
-                            [50.0, 20.0],
-                            [200.0, 20.0],
-                            [200.0, 90.0],
-                            [50.0, 90.0],
-                        ]),
+                        Value::Area(vec![[50.0, 20.0], [200.0, 20.0], [200.0, 90.0], [50.0, 90.0]]),
                         num(15.0),
                     ],
                 );
@@ -371,7 +307,5 @@ fn the_same_calls_give_the_same_run_bit_for_bit() {
         assert_eq!(x.battery.to_bits(), y.battery.to_bits());
     }
     assert_eq!(ra, rb);
-    assert!(ra
-        .iter()
-        .any(|r| matches!(r, Report::Event(DroneEvent::Detected { .. }))));
+    assert!(ra.iter().any(|r| matches!(r, Report::Event(DroneEvent::Detected { .. }))));
 }

@@ -66,10 +66,16 @@ fn a_return_climbs_to_the_return_altitude_waits_above_home_and_lands() {
     let waiting = run
         .samples
         .iter()
-        .filter(|s| s.position[0].abs() < 1e-6 && (s.position[2] - 15.0).abs() < 1e-9 && s.speed == 0.0)
+        .filter(|s| {
+            s.position[0].abs() < 1e-6 && (s.position[2] - 15.0).abs() < 1e-9 && s.speed == 0.0
+        })
         .count() as f64
         * DT;
     assert!((waiting - 5.0).abs() <= 2.0 * DT, "waited {waiting} s above home");
-    let expected = trapezoid(10.0, 2.5, 2.5) + trapezoid(100.0, 10.0, 2.5) + 5.0 + trapezoid(5.0, 1.5, 2.5) + trapezoid(10.0, 0.5, 2.5);
+    let expected = trapezoid(10.0, 2.5, 2.5)
+        + trapezoid(100.0, 10.0, 2.5)
+        + 5.0
+        + trapezoid(5.0, 1.5, 2.5)
+        + trapezoid(10.0, 0.5, 2.5);
     assert!((run.took - expected).abs() < 0.5, "took {} s, expected {expected} s", run.took);
 }

@@ -51,10 +51,7 @@ fn cut_off(w: &World) -> Fleet {
     let id = start(&mut fleet, 0, "FlyToPosition", &[pos(400.0, 0.0)]);
     let reports = run_to(&mut fleet, 20.0);
     assert_eq!(names(&reports), ["ConnectionLost"]);
-    assert!(reports.contains(&Report::Ended {
-        call: id,
-        end: CallEnd::Interrupted
-    }));
+    assert!(reports.contains(&Report::Ended { call: id, end: CallEnd::Interrupted }));
     let t = fleet.telemetry(0).unwrap();
     assert!(!t.link && t.position[0] > 50.0, "{t:?}");
     fleet
@@ -81,10 +78,7 @@ fn link_loss_holds_then_returns_to_launch_after_the_timeout() {
     let reports = run_to(&mut fleet, 79.9);
     assert!(names(&reports).is_empty());
     let t = fleet.telemetry(0).unwrap();
-    assert_eq!(
-        (t.position, t.state, t.link),
-        ([0.0, 0.0, 0.0], FlightState::Landed, false)
-    );
+    assert_eq!((t.position, t.state, t.link), ([0.0, 0.0, 0.0], FlightState::Landed, false));
     // The link comes back when the fault's duration ends.
     assert!(comes_at(&mut fleet, "ConnectionRestored", 80.0));
     assert!(fleet.telemetry(0).unwrap().link);
@@ -105,19 +99,13 @@ fn a_short_loss_only_holds_and_the_default_timeout_is_ten_seconds() {
     let id = start(&mut fleet, 0, "FlyToPosition", &[pos(400.0, 0.0)]);
     let reports = run_to(&mut fleet, 40.0);
     assert_eq!(names(&reports), ["ConnectionLost"]);
-    assert!(reports.contains(&Report::Ended {
-        call: id,
-        end: CallEnd::Interrupted
-    }));
+    assert!(reports.contains(&Report::Ended { call: id, end: CallEnd::Interrupted }));
     let held = fleet.telemetry(0).unwrap().position;
     run_to(&mut fleet, 50.0 - DT);
     assert_eq!(fleet.telemetry(0).unwrap().position, held, "holds 10 s");
     fleet.step(DT);
     run_to(&mut fleet, 50.5);
-    assert!(
-        fleet.telemetry(0).unwrap().position[0] < held[0],
-        "returns after 10 s"
-    );
+    assert!(fleet.telemetry(0).unwrap().position[0] < held[0], "returns after 10 s");
 }
 
 #[test]
@@ -131,10 +119,7 @@ fn a_return_started_on_its_own_goes_on_after_the_link_is_back_until_commanded() 
     let mut alone = fleet.clone();
     run_to(&mut alone, 80.0);
     let t = alone.telemetry(0).unwrap();
-    assert_eq!(
-        (t.position, t.state),
-        ([0.0, 0.0, 0.0], FlightState::Landed)
-    );
+    assert_eq!((t.position, t.state), ([0.0, 0.0, 0.0], FlightState::Landed));
     // A command replaces the return (the drone stops where it is, then obeys).
     let id = start(&mut fleet, 0, "Hover", &[num(3.0)]);
     let here = fleet.telemetry(0).unwrap().position;
@@ -142,11 +127,7 @@ fn a_return_started_on_its_own_goes_on_after_the_link_is_back_until_commanded() 
     assert_eq!(run.end, CallEnd::Done);
     assert!(run.samples.iter().all(|t| t.position == here));
     run_to(&mut fleet, 80.0);
-    assert_eq!(
-        fleet.telemetry(0).unwrap().position,
-        here,
-        "the return is over"
-    );
+    assert_eq!(fleet.telemetry(0).unwrap().position, here, "the return is over");
 }
 
 #[test]
@@ -155,11 +136,7 @@ fn a_crash_during_a_link_loss_ends_the_drone() {
     let w = linked("", &(link_loss(20.0, 30.0) + crash));
     let mut fleet = cut_off(&w);
     let reports = run_to(&mut fleet, 70.0);
-    assert_eq!(
-        names(&reports),
-        ["DroneLost"],
-        "no return, no ConnectionRestored"
-    );
+    assert_eq!(names(&reports), ["DroneLost"], "no return, no ConnectionRestored");
     let t = fleet.telemetry(0).unwrap();
     assert_eq!((t.state, t.position[2]), (FlightState::Lost, 0.0));
 }
@@ -193,20 +170,10 @@ fn battery_critical_two_km_out_leaves_enough_to_get_home() {
     let home = run_until(&mut fleet, 0, id, 400.0);
     assert_eq!(home.end, CallEnd::Done);
     let t = fleet.telemetry(0).unwrap();
-    assert_eq!(
-        (t.position, t.state),
-        ([0.0, 0.0, 0.0], FlightState::Landed)
-    );
+    assert_eq!((t.position, t.state), ([0.0, 0.0, 0.0], FlightState::Landed));
     assert!(t.battery > 0.05, "landed with {:.3} left", t.battery);
     // Raised at "energy to get home + 10 %", and the way home took about that energy.
     let need = (2000.0 / 10.0 + 20.0 / 3.0) / 600.0;
-    assert!(
-        (critical.battery - (need + 0.10)).abs() < 0.01,
-        "{critical:?}"
-    );
-    assert!(
-        (home.took / 600.0 - need).abs() < 0.02,
-        "took {} s",
-        home.took
-    );
+    assert!((critical.battery - (need + 0.10)).abs() < 0.01, "{critical:?}");
+    assert!((home.took / 600.0 - need).abs() < 0.02, "took {} s", home.took);
 }

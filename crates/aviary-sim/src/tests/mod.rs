@@ -81,10 +81,7 @@ pub(crate) fn start(fleet: &mut Fleet, drone: usize, f: &str, args: &[Value]) ->
 
 /// A call that must end at once, with this end.
 pub(crate) fn instant(fleet: &mut Fleet, drone: usize, f: &str, args: &[Value]) -> CallEnd {
-    fleet
-        .call(drone, f, args)
-        .1
-        .unwrap_or_else(|| panic!("{f} did not end at once"))
+    fleet.call(drone, f, args).1.unwrap_or_else(|| panic!("{f} did not end at once"))
 }
 
 /// The exception of a refused call.
@@ -126,12 +123,7 @@ pub(crate) fn run_until(fleet: &mut Fleet, drone: usize, call: CallId, limit: f6
         }
         samples.push(fleet.telemetry(drone).unwrap());
         if let Some(end) = ended {
-            return Run {
-                end,
-                took: fleet.time() - t0,
-                samples,
-                events,
-            };
+            return Run { end, took: fleet.time() - t0, samples, events };
         }
     }
     panic!("call {call:?} did not end within {limit} s");

@@ -14,20 +14,9 @@ fn takeoff_needs_arming_and_flights_need_the_air() {
     assert!(reason.contains("not armed"), "{reason}");
     let (_, reason) = refused(&mut fleet, 0, "FlyToPosition", &[pos(10.0, 0.0)]);
     assert!(reason.contains("take off first"), "{reason}");
-    assert_eq!(
-        refused(&mut fleet, 0, "TakeOff", &[sym("high")]).0,
-        "CommandFailed"
-    );
-    assert_eq!(
-        instant(&mut fleet, 0, "Land", &[]),
-        CallEnd::Done,
-        "landed already"
-    );
-    assert_eq!(
-        instant(&mut fleet, 0, "ReturnToLaunch", &[]),
-        CallEnd::Done,
-        "at home already"
-    );
+    assert_eq!(refused(&mut fleet, 0, "TakeOff", &[sym("high")]).0, "CommandFailed");
+    assert_eq!(instant(&mut fleet, 0, "Land", &[]), CallEnd::Done, "landed already");
+    assert_eq!(instant(&mut fleet, 0, "ReturnToLaunch", &[]), CallEnd::Done, "at home already");
     assert_eq!(instant(&mut fleet, 0, "Arm", &[]), CallEnd::Done);
     assert_eq!(instant(&mut fleet, 0, "Disarm", &[]), CallEnd::Done);
     instant(&mut fleet, 0, "Arm", &[]);
@@ -46,10 +35,7 @@ fn takeoff_needs_arming_and_flights_need_the_air() {
     let id = start(&mut fleet, 0, "DescendTo", &[num(12.0)]);
     run_until(&mut fleet, 0, id, 60.0);
     assert_eq!(fleet.telemetry(0).unwrap().position, [0.0, 0.0, 12.0]);
-    assert_eq!(
-        refused(&mut fleet, 999, "Hover", &[num(1.0)]).0,
-        "CommandFailed"
-    );
+    assert_eq!(refused(&mut fleet, 999, "Hover", &[num(1.0)]).0, "CommandFailed");
     assert_eq!(refused(&mut fleet, 0, "Somersault", &[]).0, "CommandFailed");
 }
 
@@ -73,10 +59,7 @@ fn hover_waits_and_return_to_launch_lands_at_home_disarmed() {
     let run = run_until(&mut fleet, 0, id, 200.0);
     assert!(run.samples.iter().all(|t| t.position[2] <= 30.0));
     let t = fleet.telemetry(0).unwrap();
-    assert_eq!(
-        (t.position, t.state),
-        ([0.0, 0.0, 0.0], FlightState::Landed)
-    );
+    assert_eq!((t.position, t.state), ([0.0, 0.0, 0.0], FlightState::Landed));
     let (_, reason) = refused(&mut fleet, 0, "TakeOff", &[num(10.0)]);
     assert!(reason.contains("not armed"), "landing disarms: {reason}");
     // From low down, the return climbs to 10 m first.
@@ -85,11 +68,7 @@ fn hover_waits_and_return_to_launch_lands_at_home_disarmed() {
     run_until(&mut fleet, 0, id, 60.0);
     let id = start(&mut fleet, 0, "ReturnToLaunch", &[]);
     let run = run_until(&mut fleet, 0, id, 200.0);
-    let top = run
-        .samples
-        .iter()
-        .map(|t| t.position[2])
-        .fold(0.0, f64::max);
+    let top = run.samples.iter().map(|t| t.position[2]).fold(0.0, f64::max);
     assert_eq!(top, 10.0);
 }
 
@@ -133,10 +112,7 @@ fn payload_rules() {
     let mut fleet = Fleet::new(&w);
     let id = start(&mut fleet, 0, "LoadPayload", &[sym("Body")]);
     fleet.step(DT);
-    assert_eq!(
-        fleet.interrupt(id, Interrupt::Abort),
-        Some(CallEnd::Interrupted)
-    );
+    assert_eq!(fleet.interrupt(id, Interrupt::Abort), Some(CallEnd::Interrupted));
     assert_eq!(fleet.carrying(0), None);
 }
 
@@ -154,12 +130,7 @@ fn geofence_and_ceiling_refuse_at_once_without_moving() {
         (
             "Sweep",
             vec![
-                Value::Area(vec![
-                    [900.0, 0.0],
-                    [1100.0, 0.0],
-                    [1100.0, 100.0],
-                    [900.0, 100.0],
-                ]),
+                Value::Area(vec![[900.0, 0.0], [1100.0, 0.0], [1100.0, 100.0], [900.0, 100.0]]),
                 num(20.0),
             ],
         ),
@@ -185,10 +156,7 @@ fn geofence_and_ceiling_refuse_at_once_without_moving() {
     let mut fleet = airborne(&w, 20.0);
     let id = start(&mut fleet, 0, "FlyToPosition", &[pos(90.0, 0.0)]);
     run_until(&mut fleet, 0, id, 60.0);
-    assert_eq!(
-        refused(&mut fleet, 0, "FlyToPosition", &[pos(0.0, 90.0)]).0,
-        "GeofenceViolation"
-    );
+    assert_eq!(refused(&mut fleet, 0, "FlyToPosition", &[pos(0.0, 90.0)]).0, "GeofenceViolation");
 }
 
 #[test]
@@ -253,20 +221,11 @@ kind = "motor_failure"
     }
     assert_eq!(
         seen,
-        [
-            (0, "ConnectionLost"),
-            (1, "DroneLost"),
-            (2, "MotorFailure"),
-            (0, "ConnectionRestored")
-        ]
+        [(0, "ConnectionLost"), (1, "DroneLost"), (2, "MotorFailure"), (0, "ConnectionRestored")]
     );
     assert_eq!(fleet.telemetry(1).unwrap().state, FlightState::Lost);
     let c = fleet.telemetry(2).unwrap();
-    assert_eq!(
-        (c.state, c.position[2]),
-        (FlightState::Landed, 0.0),
-        "emergency landing"
-    );
+    assert_eq!((c.state, c.position[2]), (FlightState::Landed, 0.0), "emergency landing");
     assert_eq!(refused(&mut fleet, 2, "Arm", &[]).0, "CommandFailed");
     assert!(fleet.telemetry(0).unwrap().link);
 }

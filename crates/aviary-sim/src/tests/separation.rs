@@ -12,10 +12,7 @@ fn drones(list: &[(&str, [f64; 2], &str)]) -> World {
     let text: String = list
         .iter()
         .map(|(name, [x, y], extra)| {
-            format!(
-                "[drones.{name}]\nhome = [{x}, {y}]\n{}\n",
-                extra.replace(';', "\n")
-            )
+            format!("[drones.{name}]\nhome = [{x}, {y}]\n{}\n", extra.replace(';', "\n"))
         })
         .collect();
     world(&text)
@@ -103,11 +100,7 @@ fn crossing_at_right_angles_both_arrive() {
 #[test]
 fn three_converging_drones_all_arrive() {
     let (c, s) = (150.0 * 30f64.to_radians().cos(), 75.0);
-    let w = drones(&[
-        ("a", [0.0, -150.0], ""),
-        ("b", [c, s], ""),
-        ("c", [-c, s], ""),
-    ]);
+    let w = drones(&[("a", [0.0, -150.0], ""), ("b", [c, s], ""), ("c", [-c, s], "")]);
     let targets = [[0.0, 150.0], [-c, -s], [c, -s]];
     assert!(unseparated(w.clone(), 15.0, &targets) < 1.0);
     let f = go(&w, 15.0, &targets);
@@ -120,20 +113,14 @@ fn three_converging_drones_all_arrive() {
 #[test]
 fn different_speeds_head_on_crossing_and_overtaking() {
     // Head-on: slow first drone, fast second.
-    let w = drones(&[
-        ("a", [-60.0, 0.0], "max_speed = 4"),
-        ("b", [150.0, 0.0], "max_speed = 12"),
-    ]);
+    let w = drones(&[("a", [-60.0, 0.0], "max_speed = 4"), ("b", [150.0, 0.0], "max_speed = 12")]);
     let targets = [[60.0, 0.0], [-150.0, 0.0]];
     assert!(unseparated(w.clone(), 20.0, &targets) < 1.0);
     let f = go(&w, 20.0, &targets);
     assert!(f.closest >= 5.0);
     assert_arrived(&f, 20.0, &targets);
     // Crossing: the fast drone must give way to the slow one.
-    let w = drones(&[
-        ("a", [-60.0, 0.0], "max_speed = 4"),
-        ("b", [0.0, -165.0], "max_speed = 12"),
-    ]);
+    let w = drones(&[("a", [-60.0, 0.0], "max_speed = 4"), ("b", [0.0, -165.0], "max_speed = 12")]);
     let targets = [[60.0, 0.0], [0.0, 100.0]];
     assert!(unseparated(w.clone(), 20.0, &targets) < 5.0);
     let f = go(&w, 20.0, &targets);
@@ -141,10 +128,8 @@ fn different_speeds_head_on_crossing_and_overtaking() {
     assert_arrived(&f, 20.0, &targets);
     assert_tracks_kept(&w, &f, &targets);
     // Overtaking on the same line: the fast drone behind gives way and gets past.
-    let w = drones(&[
-        ("slow", [0.0, 0.0], "max_speed = 3"),
-        ("fast", [-60.0, 0.0], "max_speed = 12"),
-    ]);
+    let w =
+        drones(&[("slow", [0.0, 0.0], "max_speed = 3"), ("fast", [-60.0, 0.0], "max_speed = 12")]);
     let targets = [[150.0, 0.0], [300.0, 0.0]];
     assert!(unseparated(w.clone(), 20.0, &targets) < 1.0);
     let f = go(&w, 20.0, &targets);
@@ -155,23 +140,13 @@ fn different_speeds_head_on_crossing_and_overtaking() {
 
 #[test]
 fn take_off_side_by_side_at_exactly_the_separation() {
-    let w = drones(&[
-        ("a", [0.0, 0.0], ""),
-        ("b", [5.0, 0.0], ""),
-        ("c", [0.0, 5.0], ""),
-    ]);
-    let scripts = (0..3)
-        .map(|_| vec![call("Arm", &[]), call("TakeOff", &[num(20.0)])])
-        .collect();
+    let w = drones(&[("a", [0.0, 0.0], ""), ("b", [5.0, 0.0], ""), ("c", [0.0, 5.0], "")]);
+    let scripts = (0..3).map(|_| vec![call("Arm", &[]), call("TakeOff", &[num(20.0)])]).collect();
     let f = fly(&w, scripts, 60.0);
     assert_eq!(f.closest, 5.0);
     // Side by side climbs are not in each other's way: all three take the plain time.
     for d in 0..3 {
-        assert!(
-            (f.finished[d] - (2.0 + 17.0 / 3.0)).abs() < 0.1,
-            "{:?}",
-            f.finished
-        );
+        assert!((f.finished[d] - (2.0 + 17.0 / 3.0)).abs() < 0.1, "{:?}", f.finished);
     }
 }
 
@@ -197,14 +172,8 @@ fn paper_flight(world: &World) -> Flight {
         with(later(8.0, 10.0), &[to(200.0, 325.0)]),
         with(later(8.0, 10.0), &[to(-250.0, -25.0)]),
         with(up(10.0), &[to(0.0, -300.0)]),
-        with(
-            later(20.0, 10.0),
-            &[to(20.0, -20.0), call("DescendTo", &[num(3.0)])],
-        ),
-        with(
-            later(20.0, 10.0),
-            &[to(-20.0, -20.0), call("DescendTo", &[num(3.0)])],
-        ),
+        with(later(20.0, 10.0), &[to(20.0, -20.0), call("DescendTo", &[num(3.0)])]),
+        with(later(20.0, 10.0), &[to(-20.0, -20.0), call("DescendTo", &[num(3.0)])]),
     ];
     fly(world, scripts, 400.0)
 }
@@ -228,10 +197,7 @@ fn the_paper_world_keeps_separation_and_everyone_gets_home() {
     for (d, drone) in w.drones.iter().enumerate() {
         let t = f.fleet.telemetry(d).unwrap();
         assert_eq!(t.state, FlightState::Landed, "{}", drone.name);
-        assert_eq!(
-            [t.position[0], t.position[1]],
-            [drone.home[0], drone.home[1]]
-        );
+        assert_eq!([t.position[0], t.position[1]], [drone.home[0], drone.home[1]]);
     }
 }
 
@@ -263,10 +229,8 @@ struct Lcg(u64);
 impl Lcg {
     /// A number in [0, 1).
     fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
+        self.0 =
+            self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
         (self.0 >> 33) as f64 / (1u64 << 31) as f64
     }
 
@@ -299,10 +263,8 @@ fn random_crowds_keep_separation_and_all_finish() {
         let scripts = (0..n)
             .map(|_| {
                 let alt = [10.0, 10.0, 12.0][(rnd.next() * 3.0) as usize];
-                let (a, b) = (
-                    [rnd.metres(50.0), rnd.metres(50.0)],
-                    [rnd.metres(50.0), rnd.metres(50.0)],
-                );
+                let (a, b) =
+                    ([rnd.metres(50.0), rnd.metres(50.0)], [rnd.metres(50.0), rnd.metres(50.0)]);
                 let mut s = vec![
                     Act::At((rnd.next() * 20.0).round()),
                     call("Arm", &[]),
@@ -310,14 +272,8 @@ fn random_crowds_keep_separation_and_all_finish() {
                     call("FlyToPosition", &[pos(a[0], a[1])]),
                 ];
                 s.push(match (rnd.next() * 3.0) as usize {
-                    0 => call(
-                        "Orbit",
-                        &[pos(b[0], b[1]), num(20.0 + rnd.metres(10.0) + 10.0)],
-                    ),
-                    1 => call(
-                        "FollowPath",
-                        &[pos(b[0], b[1]), pos3(a[0], b[1], alt + 5.0)],
-                    ),
+                    0 => call("Orbit", &[pos(b[0], b[1]), num(20.0 + rnd.metres(10.0) + 10.0)]),
+                    1 => call("FollowPath", &[pos(b[0], b[1]), pos3(a[0], b[1], alt + 5.0)]),
                     _ => call("Hover", &[num(5.0)]),
                 });
                 s.push(call("ReturnToLaunch", &[]));
@@ -333,18 +289,15 @@ fn random_crowds_keep_separation_and_all_finish() {
 /// fleet, each call's end and when it came (simulated seconds), and the second drone's
 /// telemetry after every step from then on.
 fn same_point(site: &str) -> (Fleet, Vec<(CallEnd, f64)>, Vec<Telemetry>) {
-    let w = world(&format!(
-        "{site}\n[drones.a]\nhome = [0, 0]\n\n[drones.b]\nhome = [10, 0]\n"
-    ));
+    let w = world(&format!("{site}\n[drones.a]\nhome = [0, 0]\n\n[drones.b]\nhome = [10, 0]\n"));
     let mut fleet = Fleet::new(&w);
     for d in 0..2 {
         assert_eq!(instant(&mut fleet, d, "Arm", &[]), CallEnd::Done);
         start(&mut fleet, d, "TakeOff", &[num(20.0)]);
     }
     run_for(&mut fleet, 10.0);
-    let calls: Vec<CallId> = (0..2)
-        .map(|d| start(&mut fleet, d, "FlyToPosition", &[pos(0.0, 100.0)]))
-        .collect();
+    let calls: Vec<CallId> =
+        (0..2).map(|d| start(&mut fleet, d, "FlyToPosition", &[pos(0.0, 100.0)])).collect();
     let mut ends: Vec<Option<(CallEnd, f64)>> = vec![None, None];
     let mut log = Vec::new();
     while ends.iter().any(Option::is_none) && fleet.time() < 200.0 {
@@ -357,10 +310,7 @@ fn same_point(site: &str) -> (Fleet, Vec<(CallEnd, f64)>, Vec<Telemetry>) {
         }
         log.push(fleet.telemetry(1).unwrap());
     }
-    let ends = ends
-        .into_iter()
-        .map(|e| e.expect("the call ended"))
-        .collect();
+    let ends = ends.into_iter().map(|e| e.expect("the call ended")).collect();
     (fleet, ends, log)
 }
 
@@ -393,9 +343,7 @@ fn two_drones_sent_to_the_same_point_the_second_times_out_and_hovers() {
     // The second one passes above it and waits there, over the point; 30 s after it last
     // got nearer, its call ends with `Timeout`.
     let (end, at) = &ends[1];
-    let CallEnd::Failed(failure) = end else {
-        panic!("{end:?}")
-    };
+    let CallEnd::Failed(failure) = end else { panic!("{end:?}") };
     assert_eq!(failure.exception, "Timeout");
     assert_eq!(failure.reason, "b waited 30 s for a to make room");
     let waited = at - last_gain(&log, *at);

@@ -45,10 +45,8 @@ pub(crate) fn closest_pair(snapshot: &[Telemetry]) -> f64 {
     for (i, a) in snapshot.iter().enumerate() {
         for b in &snapshot[i + 1..] {
             if in_the_air(a) && in_the_air(b) {
-                let d: f64 = (0..3)
-                    .map(|k| (a.position[k] - b.position[k]).powi(2))
-                    .sum::<f64>()
-                    .sqrt();
+                let d: f64 =
+                    (0..3).map(|k| (a.position[k] - b.position[k]).powi(2)).sum::<f64>().sqrt();
                 best = best.min(d);
             }
         }
@@ -115,9 +113,8 @@ pub(crate) fn fly(world: &World, scripts: Vec<Vec<Act>>, limit: f64) -> Flight {
             }
             reports.push(r);
         }
-        let snapshot: Vec<Telemetry> = (0..fleet.len())
-            .map(|d| fleet.telemetry(d).unwrap())
-            .collect();
+        let snapshot: Vec<Telemetry> =
+            (0..fleet.len()).map(|d| fleet.telemetry(d).unwrap()).collect();
         let c = closest_pair(&snapshot);
         assert!(
             c >= sep - 1e-9,
@@ -127,11 +124,5 @@ pub(crate) fn fly(world: &World, scripts: Vec<Vec<Act>>, limit: f64) -> Flight {
         closest = closest.min(c);
         log.push(snapshot);
     }
-    Flight {
-        fleet,
-        log,
-        reports,
-        closest,
-        finished,
-    }
+    Flight { fleet, log, reports, closest, finished }
 }

@@ -43,7 +43,10 @@ fn fly(mut fleet: Fleet) -> Vec<String> {
         if step == 200 {
             for d in 0..fleet.len() {
                 seen.push(format!("{:?}", fleet.call(d, "StartDetection", &[sym("Body")])));
-                seen.push(format!("{:?}", fleet.call(d, "FlyToPosition", &[pos(d as f64 * 30.0, 150.0)])));
+                seen.push(format!(
+                    "{:?}",
+                    fleet.call(d, "FlyToPosition", &[pos(d as f64 * 30.0, 150.0)])
+                ));
             }
         }
         seen.extend(fleet.step(DT).iter().map(|r| format!("{r:?}")));

@@ -72,7 +72,9 @@ pub(super) fn write_expr(out: &mut String, e: &Expr, source: &str) {
             out.push(')');
         }
         // Only in trees with errors, which are never formatted: the text as written.
-        ExprKind::Error => out.push_str(&verbatim(source, e.span.start as usize, e.span.end as usize)),
+        ExprKind::Error => {
+            out.push_str(&verbatim(source, e.span.start as usize, e.span.end as usize))
+        }
     }
 }
 
@@ -116,10 +118,5 @@ pub(super) fn names(list: &[Ident]) -> String {
 
 /// Source text on one line, white space collapsed (for nodes that could not be read).
 pub(super) fn verbatim(source: &str, start: usize, end: usize) -> String {
-    source
-        .get(start..end)
-        .unwrap_or("")
-        .split_whitespace()
-        .collect::<Vec<_>>()
-        .join(" ")
+    source.get(start..end).unwrap_or("").split_whitespace().collect::<Vec<_>>().join(" ")
 }

@@ -115,7 +115,8 @@ impl<'a> Printer<'a> {
             // Code before it on its line: a non-blank byte that no earlier comment covers.
             let mut trailing = false;
             let mut pos = line_start;
-            let mut earlier = comments.iter().rev().take_while(|e| e.end > line_start).collect::<Vec<_>>();
+            let mut earlier =
+                comments.iter().rev().take_while(|e| e.end > line_start).collect::<Vec<_>>();
             earlier.reverse();
             let mut k = 0;
             while pos < start {
@@ -218,7 +219,10 @@ impl<'a> Printer<'a> {
     /// at `last_end`: the comments that belong to the end of that body (trailing, or
     /// indented deeper than the header's line), up to the next line of code.
     fn flush_body_end(&mut self, header: usize, last_end: usize, depth: usize) {
-        let column = indentation(self.source.as_bytes(), physical_line_start(self.source.as_bytes(), header));
+        let column = indentation(
+            self.source.as_bytes(),
+            physical_line_start(self.source.as_bytes(), header),
+        );
         let next_code = self.next_line_start(last_end);
         while self
             .comments

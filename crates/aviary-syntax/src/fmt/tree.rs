@@ -25,7 +25,13 @@ impl Printer<'_> {
             }
             Item::Mission(m) => {
                 let text = format!("MISSION {}:", m.name.name);
-                self.line(0, &text, Last::Header, m.span.start as usize, m.body.header_end as usize);
+                self.line(
+                    0,
+                    &text,
+                    Last::Header,
+                    m.span.start as usize,
+                    m.body.header_end as usize,
+                );
                 self.body(&m.body, 1, m.span.start);
             }
             Item::Capability(c) => self.capability(c, 0),
@@ -43,7 +49,8 @@ impl Printer<'_> {
             text.push_str(&names(&c.params));
         }
         text.push(':');
-        let header_end = c.params.last().or(c.actors.last()).map_or(c.name.span.end, |i| i.span.end) as usize;
+        let header_end =
+            c.params.last().or(c.actors.last()).map_or(c.name.span.end, |i| i.span.end) as usize;
         self.line(depth, &text, Last::Header, c.span.start as usize, header_end);
         for section in &c.sections {
             self.section(section, depth + 1);
@@ -55,29 +62,45 @@ impl Printer<'_> {
 
     fn section(&mut self, section: &Section, depth: usize) {
         match section {
-            Section::Requirements {
-                conditions,
-                body_header_end,
-                span,
-            } => {
-                self.line(depth, "REQUIREMENTS:", Last::Header, span.start as usize, *body_header_end as usize);
+            Section::Requirements { conditions, body_header_end, span } => {
+                self.line(
+                    depth,
+                    "REQUIREMENTS:",
+                    Last::Header,
+                    span.start as usize,
+                    *body_header_end as usize,
+                );
                 for c in conditions {
                     let text = expr_text(c, self.source);
-                    self.line(depth + 1, &text, Last::Code, c.span.start as usize, c.span.end as usize);
+                    self.line(
+                        depth + 1,
+                        &text,
+                        Last::Code,
+                        c.span.start as usize,
+                        c.span.end as usize,
+                    );
                 }
                 if let Some(last) = conditions.last() {
                     self.flush_body_end(span.start as usize, last.span.end as usize, depth + 1);
                 }
             }
-            Section::Defaults {
-                entries,
-                body_header_end,
-                span,
-            } => {
-                self.line(depth, "DEFAULTS:", Last::Header, span.start as usize, *body_header_end as usize);
+            Section::Defaults { entries, body_header_end, span } => {
+                self.line(
+                    depth,
+                    "DEFAULTS:",
+                    Last::Header,
+                    span.start as usize,
+                    *body_header_end as usize,
+                );
                 for e in entries {
                     let text = format!("{}: {}", e.name.name, expr_text(&e.value, self.source));
-                    self.line(depth + 1, &text, Last::Code, e.span.start as usize, e.span.end as usize);
+                    self.line(
+                        depth + 1,
+                        &text,
+                        Last::Code,
+                        e.span.start as usize,
+                        e.span.end as usize,
+                    );
                 }
                 if let Some(last) = entries.last() {
                     self.flush_body_end(span.start as usize, last.span.end as usize, depth + 1);
@@ -88,15 +111,23 @@ impl Printer<'_> {
                     Some(name) => format!("PERFORM {}:", name.name),
                     None => "PERFORM:".to_string(),
                 };
-                self.line(depth, &text, Last::Header, span.start as usize, body.header_end as usize);
+                self.line(
+                    depth,
+                    &text,
+                    Last::Header,
+                    span.start as usize,
+                    body.header_end as usize,
+                );
                 self.body(body, depth + 1, span.start);
             }
-            Section::Exceptions {
-                handlers,
-                body_header_end,
-                span,
-            } => {
-                self.line(depth, "EXCEPTIONS:", Last::Header, span.start as usize, *body_header_end as usize);
+            Section::Exceptions { handlers, body_header_end, span } => {
+                self.line(
+                    depth,
+                    "EXCEPTIONS:",
+                    Last::Header,
+                    span.start as usize,
+                    *body_header_end as usize,
+                );
                 for h in handlers {
                     self.exception_handler(h, depth + 1);
                 }
@@ -160,7 +191,8 @@ impl Printer<'_> {
                 self.line(depth, &text, Last::Code, start, end);
             }
             Stmt::Requirement(r) => {
-                let mut text = format!("{} {}", r.kind.as_str(), expr_text(&r.condition, self.source));
+                let mut text =
+                    format!("{} {}", r.kind.as_str(), expr_text(&r.condition, self.source));
                 match &r.body {
                     Some(body) => {
                         text.push(':');

@@ -9,13 +9,16 @@ use crate::token::{Keyword, TokenKind};
 const UNIT_WORDS: &[&str] = &["m", "km", "s", "min", "h", "deg"];
 /// Spelled-out units after a number: reported with the unit to write instead.
 const SPELLED_UNITS: &[&str] = &[
-    "sec", "secs", "second", "seconds", "mins", "minute", "minutes", "hr", "hrs", "hour", "hours", "meter", "meters", "metre",
-    "metres", "kmh", "kph", "mps", "degree", "degrees",
+    "sec", "secs", "second", "seconds", "mins", "minute", "minutes", "hr", "hrs", "hour", "hours",
+    "meter", "meters", "metre", "metres", "kmh", "kph", "mps", "degree", "degrees",
 ];
 
 impl Parser<'_> {
     fn expr(&mut self, kind: ExprKind, start: Span) -> Expr {
-        Expr { kind, span: Span::new(start.start as usize, (self.last_end as usize).max(start.end as usize)) }
+        Expr {
+            kind,
+            span: Span::new(start.start as usize, (self.last_end as usize).max(start.end as usize)),
+        }
     }
 
     fn error_expr(&mut self, what: &str, help: Option<&str>) -> Expr {
@@ -29,7 +32,11 @@ impl Parser<'_> {
         if self.depth >= MAX_DEPTH {
             let span = self.span();
             let d = self
-                .error(Code::NestingTooDeep, span, format!("an expression nested more than {MAX_DEPTH} levels deep"))
+                .error(
+                    Code::NestingTooDeep,
+                    span,
+                    format!("an expression nested more than {MAX_DEPTH} levels deep"),
+                )
                 .with_help("write the condition more simply");
             self.report(d);
             // Skip the rest, but keep a header's final `:` so the body still reads.
@@ -96,7 +103,11 @@ impl Parser<'_> {
         if let ExprKind::Coordinates(parts) = &e.kind {
             if !(2..=3).contains(&parts.len()) {
                 let d = self
-                    .error(Code::Syntax, e.span, format!("coordinates have 2 or 3 numbers, not {}", parts.len()))
+                    .error(
+                        Code::Syntax,
+                        e.span,
+                        format!("coordinates have 2 or 3 numbers, not {}", parts.len()),
+                    )
                     .with_help("write `(x, y)` or `(x, y, z)` in metres");
                 self.report(d);
             }
@@ -116,7 +127,9 @@ impl Parser<'_> {
             "RECEIVED" if call => {
                 self.bump();
                 self.bump();
-                let Some(signal) = self.ident() else { return self.error_expr("a signal name", Some("write `RECEIVED(SignalName)`")) };
+                let Some(signal) = self.ident() else {
+                    return self.error_expr("a signal name", Some("write `RECEIVED(SignalName)`"));
+                };
                 if self.eat(TokenKind::RParen).is_none() {
                     return self.error_expr("`)` after the signal name", None);
                 }
@@ -129,7 +142,10 @@ impl Parser<'_> {
                     |p| {
                         let a = p.value();
                         if p.eat(TokenKind::Comma).is_none() {
-                            return p.error_expr("`,` and a second place", Some("write `distance(a, b)`"));
+                            return p.error_expr(
+                                "`,` and a second place",
+                                Some("write `distance(a, b)`"),
+                            );
                         }
                         let b = p.value();
                         if p.eat(TokenKind::RParen).is_none() {
@@ -156,7 +172,13 @@ impl Parser<'_> {
                 let e = self.expr(ExprKind::Geo(parts), start);
                 if let ExprKind::Geo(parts) = &e.kind {
                     if !(2..=3).contains(&parts.len()) {
-                        let d = self.error(Code::Syntax, e.span, "GEO takes latitude, longitude and an optional altitude").with_help("write `GEO(46.61, 14.26)`");
+                        let d = self
+                            .error(
+                                Code::Syntax,
+                                e.span,
+                                "GEO takes latitude, longitude and an optional altitude",
+                            )
+                            .with_help("write `GEO(46.61, 14.26)`");
                         self.report(d);
                     }
                 }
@@ -167,7 +189,12 @@ impl Parser<'_> {
         let Some(name) = self.ident() else { return self.error_expr("a name", None) };
         if self.at(TokenKind::Dot) {
             self.bump();
-            let Some(field) = self.ident() else { return self.error_expr(&format!("a field after `{}.`", name.name), Some("for example `drone.battery`")) };
+            let Some(field) = self.ident() else {
+                return self.error_expr(
+                    &format!("a field after `{}.`", name.name),
+                    Some("for example `drone.battery`"),
+                );
+            };
             return self.expr(ExprKind::Path(name, field), start);
         }
         Expr { span: name.span, kind: ExprKind::Name(name) }
@@ -182,7 +209,13 @@ impl Parser<'_> {
         let value = match digits.parse::<f64>() {
             Ok(v) if v.is_finite() => v,
             _ => {
-                let d = self.error(Code::InvalidNumber, t.span, format!("`{}` is not a number that can be used", shorten(text))).with_help("write a number such as 20 or 2.5");
+                let d = self
+                    .error(
+                        Code::InvalidNumber,
+                        t.span,
+                        format!("`{}` is not a number that can be used", shorten(text)),
+                    )
+                    .with_help("write a number such as 20 or 2.5");
                 self.report(d);
                 return Expr { kind: ExprKind::Error, span: t.span };
             }
@@ -193,7 +226,8 @@ impl Parser<'_> {
             let unit_span = Span::new(t.span.start as usize + split, t.span.end as usize);
             unit = self.unit(unit_text, unit_span);
         } else if self.peek() == TokenKind::Ident
-            && (UNIT_WORDS.contains(&self.text_of(self.span())) || SPELLED_UNITS.contains(&self.text_of(self.span()).to_ascii_lowercase().as_str()))
+            && (UNIT_WORDS.contains(&self.text_of(self.span()))
+                || SPELLED_UNITS.contains(&self.text_of(self.span()).to_ascii_lowercase().as_str()))
         {
             // `20 m` reads as `20m`; fmt writes it glued.
             let first = self.bump().span;
@@ -229,7 +263,8 @@ impl Parser<'_> {
             Some(s) => format!("write `{s}`; the units are {}", known.join(" ")),
             None => format!("the units are {}", known.join(" ")),
         };
-        let d = self.error(Code::UnknownUnit, span, format!("unknown unit `{text}`")).with_help(help);
+        let d =
+            self.error(Code::UnknownUnit, span, format!("unknown unit `{text}`")).with_help(help);
         self.report(d);
         None
     }
@@ -246,7 +281,10 @@ impl Parser<'_> {
             self.bump();
             let right = self.and_expr();
             let span = left.span.to(right.span);
-            left = Expr { kind: ExprKind::Binary(Box::new(left), BinaryOp::Or, Box::new(right)), span };
+            left = Expr {
+                kind: ExprKind::Binary(Box::new(left), BinaryOp::Or, Box::new(right)),
+                span,
+            };
         }
         self.depth = base;
         left
@@ -259,7 +297,10 @@ impl Parser<'_> {
             self.bump();
             let right = self.not_expr();
             let span = left.span.to(right.span);
-            left = Expr { kind: ExprKind::Binary(Box::new(left), BinaryOp::And, Box::new(right)), span };
+            left = Expr {
+                kind: ExprKind::Binary(Box::new(left), BinaryOp::And, Box::new(right)),
+                span,
+            };
         }
         self.depth = base;
         left
@@ -273,8 +314,14 @@ impl Parser<'_> {
         if self.depth >= MAX_DEPTH {
             let span = self.span();
             let d = self
-                .error(Code::NestingTooDeep, span, format!("a condition that joins more than {MAX_DEPTH} parts with AND or OR"))
-                .with_help("split the condition: give parts of it their own WAITFOR, STARTIF or IF");
+                .error(
+                    Code::NestingTooDeep,
+                    span,
+                    format!("a condition that joins more than {MAX_DEPTH} parts with AND or OR"),
+                )
+                .with_help(
+                    "split the condition: give parts of it their own WAITFOR, STARTIF or IF",
+                );
             self.report(d);
             while !self.at_line_end() {
                 self.bump();

@@ -21,7 +21,9 @@ impl Parser<'_> {
                         file.items.push(Item::Use(u));
                     }
                 }
-                TokenKind::Keyword(Keyword::Mission) => file.items.push(Item::Mission(self.mission())),
+                TokenKind::Keyword(Keyword::Mission) => {
+                    file.items.push(Item::Mission(self.mission()))
+                }
                 TokenKind::Keyword(Keyword::Capability) => {
                     if let Some(c) = self.capability() {
                         file.items.push(Item::Capability(c));
@@ -30,7 +32,11 @@ impl Parser<'_> {
                 TokenKind::Indent => {
                     let span = self.span();
                     let d = self
-                        .error(Code::UnexpectedIndent, span, "an indented line where a MISSION, CAPABILITY or USE should start")
+                        .error(
+                            Code::UnexpectedIndent,
+                            span,
+                            "an indented line where a MISSION, CAPABILITY or USE should start",
+                        )
                         .with_help("top-level definitions start in the first column");
                     self.report(d);
                     self.skip_nested();
@@ -58,7 +64,11 @@ impl Parser<'_> {
             return None;
         };
         let raw = self.text_of(path);
-        let inner = raw.strip_prefix('"').map(|r| r.strip_suffix('"').unwrap_or(r)).unwrap_or(raw).to_string();
+        let inner = raw
+            .strip_prefix('"')
+            .map(|r| r.strip_suffix('"').unwrap_or(r))
+            .unwrap_or(raw)
+            .to_string();
         let span = start.to(path);
         if !self.at_line_end() {
             self.expected("the end of the line after the USE path", None);
@@ -84,7 +94,8 @@ impl Parser<'_> {
     /// After a broken header: the body under it is still read for its own errors.
     pub(super) fn recover_body(&mut self) -> Body {
         let header_end = self.last_end;
-        let items = if self.at(TokenKind::Indent) { self.indented_items(|p| p.stmt()) } else { Vec::new() };
+        let items =
+            if self.at(TokenKind::Indent) { self.indented_items(|p| p.stmt()) } else { Vec::new() };
         Body { items, header_end }
     }
 
@@ -119,11 +130,26 @@ impl Parser<'_> {
         } else {
             let span = self.span();
             let d = self
-                .error(Code::Syntax, span, format!("expected BY and the actor of `{}`, found {}", name.name, self.peek().describe()))
-                .with_help(format!("a capability names who performs it: `CAPABILITY {} BY drone:`", name.name));
+                .error(
+                    Code::Syntax,
+                    span,
+                    format!(
+                        "expected BY and the actor of `{}`, found {}",
+                        name.name,
+                        self.peek().describe()
+                    ),
+                )
+                .with_help(format!(
+                    "a capability names who performs it: `CAPABILITY {} BY drone:`",
+                    name.name
+                ));
             self.report(d);
         }
-        let params = if self.eat_keyword(Keyword::With).is_some() { self.name_list("a parameter name after WITH") } else { Vec::new() };
+        let params = if self.eat_keyword(Keyword::With).is_some() {
+            self.name_list("a parameter name after WITH")
+        } else {
+            Vec::new()
+        };
         let mut sections = Vec::new();
         let mut header_end = self.last_end;
         if self.header_colon(start, "the CAPABILITY header") {
@@ -138,7 +164,11 @@ impl Parser<'_> {
                 sections = self.indented_items(|p| p.section());
             } else {
                 let d = self
-                    .error(Code::ExpectedBlock, Span::point(header_end as usize), format!("capability `{}` has no sections", name.name))
+                    .error(
+                        Code::ExpectedBlock,
+                        Span::point(header_end as usize),
+                        format!("capability `{}` has no sections", name.name),
+                    )
                     .with_help("add an indented `PERFORM:` section with what the capability does");
                 self.report(d);
             }
@@ -166,14 +196,24 @@ impl Parser<'_> {
             Section::Exceptions { .. } => "EXCEPTIONS".to_string(),
         };
         let span_of = |s: &Section| match s {
-            Section::Requirements { span, .. } | Section::Defaults { span, .. } | Section::Perform { span, .. } | Section::Exceptions { span, .. } => *span,
+            Section::Requirements { span, .. }
+            | Section::Defaults { span, .. }
+            | Section::Perform { span, .. }
+            | Section::Exceptions { span, .. } => *span,
         };
         let mut highest = 0;
         for (i, section) in sections.iter().enumerate() {
-            let header = Span::new(span_of(section).start as usize, span_of(section).start as usize + title(section).len());
+            let header = Span::new(
+                span_of(section).start as usize,
+                span_of(section).start as usize + title(section).len(),
+            );
             if let Some(first) = sections[..i].iter().find(|s| title(s) == title(section)) {
                 let d = self
-                    .error(Code::MisplacedItem, header, format!("a second {} section in `{}`", title(section), name.name))
+                    .error(
+                        Code::MisplacedItem,
+                        header,
+                        format!("a second {} section in `{}`", title(section), name.name),
+                    )
                     .also(self.file, span_of(first), "the first one")
                     .with_help("merge the two sections into one");
                 self.report(d);
@@ -187,7 +227,11 @@ impl Parser<'_> {
         }
         if !sections.iter().any(|s| matches!(s, Section::Perform { name: None, .. })) {
             let d = self
-                .error(Code::MissingPerform, name.span, format!("capability `{}` has no PERFORM section", name.name))
+                .error(
+                    Code::MissingPerform,
+                    name.span,
+                    format!("capability `{}` has no PERFORM section", name.name),
+                )
                 .with_help("add `PERFORM:` with the statements that start the activity");
             self.report(d);
         }
@@ -215,8 +259,16 @@ impl Parser<'_> {
                     }
                     _ => None,
                 };
-                let body = if self.header_colon(start, "the PERFORM header") { self.body("PERFORM") } else { self.recover_body() };
-                Some(Section::Perform { name, body, span: Span::new(start.start as usize, self.last_end as usize) })
+                let body = if self.header_colon(start, "the PERFORM header") {
+                    self.body("PERFORM")
+                } else {
+                    self.recover_body()
+                };
+                Some(Section::Perform {
+                    name,
+                    body,
+                    span: Span::new(start.start as usize, self.last_end as usize),
+                })
             }
             TokenKind::Keyword(Keyword::Exceptions) => {
                 self.bump();
@@ -234,7 +286,11 @@ impl Parser<'_> {
                         self.report(d);
                     }
                 }
-                Some(Section::Exceptions { handlers, body_header_end, span: Span::new(start.start as usize, self.last_end as usize) })
+                Some(Section::Exceptions {
+                    handlers,
+                    body_header_end,
+                    span: Span::new(start.start as usize, self.last_end as usize),
+                })
             }
             _ => {
                 let d = self
@@ -248,12 +304,17 @@ impl Parser<'_> {
     }
 
     fn exception_section_item(&mut self) -> Option<ExceptionHandler> {
-        if self.at_keyword(Keyword::On) && self.peek_at(1) == TokenKind::Keyword(Keyword::Exception) {
+        if self.at_keyword(Keyword::On) && self.peek_at(1) == TokenKind::Keyword(Keyword::Exception)
+        {
             return self.exception_handler();
         }
         let span = self.span();
         let d = self
-            .error(Code::MisplacedItem, span, format!("expected `ON EXCEPTION`, found {}", self.peek().describe()))
+            .error(
+                Code::MisplacedItem,
+                span,
+                format!("expected `ON EXCEPTION`, found {}", self.peek().describe()),
+            )
             .with_help("the EXCEPTIONS section holds only `ON EXCEPTION Name:` handlers");
         self.report(d);
         self.recover_line();
@@ -274,7 +335,10 @@ impl Parser<'_> {
                 conditions.extend(self.indented_items(|p| {
                     let c = p.condition();
                     if !p.at_line_end() {
-                        p.expected("the end of the condition", Some("write one condition per line; join conditions with AND or OR"));
+                        p.expected(
+                            "the end of the condition",
+                            Some("write one condition per line; join conditions with AND or OR"),
+                        );
                     }
                     p.skip_line();
                     Some(c)
@@ -291,7 +355,11 @@ impl Parser<'_> {
                 self.report(d);
             }
         }
-        Section::Requirements { conditions, body_header_end, span: Span::new(start.start as usize, self.last_end as usize) }
+        Section::Requirements {
+            conditions,
+            body_header_end,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        }
     }
 
     fn defaults(&mut self, start: Span) -> Section {
@@ -301,7 +369,10 @@ impl Parser<'_> {
             body_header_end = self.last_end;
             if !self.at_line_end() {
                 // The paper's `DEFAULTS: type:Body`.
-                let shown = self.text_of(Span::new(self.span().start as usize, self.line_end_offset())).trim().to_string();
+                let shown = self
+                    .text_of(Span::new(self.span().start as usize, self.line_end_offset()))
+                    .trim()
+                    .to_string();
                 let first = self.span();
                 while !self.at_line_end() {
                     if let Some(e) = self.default_entry() {
@@ -313,7 +384,10 @@ impl Parser<'_> {
                 }
                 let d = self
                     .error(Code::PaperForm, first, "defaults on the DEFAULTS line")
-                    .with_help(format!("put each default on its own line below `DEFAULTS:`, indented: `{}`", shown.replace(':', ": ").replace(":  ", ": ")));
+                    .with_help(format!(
+                        "put each default on its own line below `DEFAULTS:`, indented: `{}`",
+                        shown.replace(':', ": ").replace(":  ", ": ")
+                    ));
                 self.report(d);
             }
             self.skip_line();
@@ -321,24 +395,37 @@ impl Parser<'_> {
                 entries.extend(self.indented_items(|p| {
                     let e = p.default_entry();
                     if e.is_some() && !p.at_line_end() {
-                        p.expected("the end of the line after the default", Some("write one default per line: `name: value`"));
+                        p.expected(
+                            "the end of the line after the default",
+                            Some("write one default per line: `name: value`"),
+                        );
                     }
                     p.skip_line();
                     e
                 }));
             } else if entries.is_empty() {
                 let d = self
-                    .error(Code::ExpectedBlock, Span::point(body_header_end as usize), "DEFAULTS has no entries")
+                    .error(
+                        Code::ExpectedBlock,
+                        Span::point(body_header_end as usize),
+                        "DEFAULTS has no entries",
+                    )
                     .with_help("add indented lines `name: value`, or leave the section out");
                 self.report(d);
             }
         }
-        Section::Defaults { entries, body_header_end, span: Span::new(start.start as usize, self.last_end as usize) }
+        Section::Defaults {
+            entries,
+            body_header_end,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        }
     }
 
     pub(super) fn line_end_offset(&self) -> usize {
         let mut i = self.pos;
-        while i < self.tokens.len() && !matches!(self.tokens[i].kind, TokenKind::Newline | TokenKind::Eof) {
+        while i < self.tokens.len()
+            && !matches!(self.tokens[i].kind, TokenKind::Newline | TokenKind::Eof)
+        {
             i += 1;
         }
         self.tokens.get(i).map_or(self.text.len(), |t| t.span.start as usize)
@@ -358,7 +445,10 @@ impl Parser<'_> {
                 self.report(d);
                 self.bump();
             } else {
-                self.expected(&format!("`:` after `{}`", name.name), Some("write a default as `name: value`"));
+                self.expected(
+                    &format!("`:` after `{}`", name.name),
+                    Some("write a default as `name: value`"),
+                );
                 return None;
             }
         }

@@ -28,16 +28,46 @@ pub(crate) struct Parser<'a> {
     diagnostics: &'a mut Vec<Diagnostic>,
 }
 
-pub(crate) fn parse_tokens(file: FileId, text: &str, tokens: Vec<Token>, diagnostics: &mut Vec<Diagnostic>) -> SourceFile {
-    let mut parser = Parser { file, text, tokens, pos: 0, depth: 0, last_end: 0, errors: 0, gave_up: false, diagnostics };
+pub(crate) fn parse_tokens(
+    file: FileId,
+    text: &str,
+    tokens: Vec<Token>,
+    diagnostics: &mut Vec<Diagnostic>,
+) -> SourceFile {
+    let mut parser = Parser {
+        file,
+        text,
+        tokens,
+        pos: 0,
+        depth: 0,
+        last_end: 0,
+        errors: 0,
+        gave_up: false,
+        diagnostics,
+    };
     parser.file()
 }
 
 /// One value alone (`20m`, `(1, 2)`, `Body`, `"text"`), as an argument would be written:
 /// what the operator's client reads from its command line. Anything after the value is
 /// reported.
-pub(crate) fn parse_value_tokens(file: FileId, text: &str, tokens: Vec<Token>, diagnostics: &mut Vec<Diagnostic>) -> crate::ast::Expr {
-    let mut parser = Parser { file, text, tokens, pos: 0, depth: 0, last_end: 0, errors: 0, gave_up: false, diagnostics };
+pub(crate) fn parse_value_tokens(
+    file: FileId,
+    text: &str,
+    tokens: Vec<Token>,
+    diagnostics: &mut Vec<Diagnostic>,
+) -> crate::ast::Expr {
+    let mut parser = Parser {
+        file,
+        text,
+        tokens,
+        pos: 0,
+        depth: 0,
+        last_end: 0,
+        errors: 0,
+        gave_up: false,
+        diagnostics,
+    };
     let value = parser.value();
     if !parser.at_line_end() {
         parser.expected("the end of the value", Some("write one value: a number with its unit (20m), (x, y), a name, or a string in quotes"));
@@ -74,11 +104,18 @@ impl<'a> Parser<'a> {
         matches!(self.peek(), TokenKind::Newline | TokenKind::Eof)
     }
     fn bump(&mut self) -> Token {
-        let token = self.tokens.get(self.pos).copied().unwrap_or(Token { kind: TokenKind::Eof, span: Span::point(self.text.len()) });
+        let token = self
+            .tokens
+            .get(self.pos)
+            .copied()
+            .unwrap_or(Token { kind: TokenKind::Eof, span: Span::point(self.text.len()) });
         if token.kind != TokenKind::Eof {
             self.pos += 1;
         }
-        if !matches!(token.kind, TokenKind::Newline | TokenKind::Indent | TokenKind::Dedent | TokenKind::Eof) {
+        if !matches!(
+            token.kind,
+            TokenKind::Newline | TokenKind::Indent | TokenKind::Dedent | TokenKind::Eof
+        ) {
             self.last_end = token.span.end;
         }
         token
@@ -107,8 +144,13 @@ impl<'a> Parser<'a> {
         if self.errors > MAX_ERRORS {
             let span = self.span();
             self.diagnostics.push(
-                Diagnostic::new(Code::TooManyErrors, self.file, span, format!("more than {MAX_ERRORS} syntax errors; stopped reading here"))
-                    .with_help("fix the errors above first; is this really a mission file?"),
+                Diagnostic::new(
+                    Code::TooManyErrors,
+                    self.file,
+                    span,
+                    format!("more than {MAX_ERRORS} syntax errors; stopped reading here"),
+                )
+                .with_help("fix the errors above first; is this really a mission file?"),
             );
             self.gave_up = true;
             return;
@@ -165,7 +207,9 @@ impl<'a> Parser<'a> {
         }
         if self.at_line_end() {
             let at = Span::point(self.last_end as usize);
-            let shown = self.text_of(Span::new(header_start.start as usize, self.last_end as usize)).replace('\n', " ");
+            let shown = self
+                .text_of(Span::new(header_start.start as usize, self.last_end as usize))
+                .replace('\n', " ");
             let d = self
                 .error(Code::MissingColon, at, format!("{what} must end with `:`"))
                 .label("`:` missing here")
@@ -184,7 +228,11 @@ impl<'a> Parser<'a> {
         if !self.at_line_end() {
             let span = self.span();
             let d = self
-                .error(Code::Syntax, span, format!("expected the end of the line after the `:` of {what}"))
+                .error(
+                    Code::Syntax,
+                    span,
+                    format!("expected the end of the line after the `:` of {what}"),
+                )
                 .with_help("put the body on the lines below, indented by 4 more spaces");
             self.report(d);
             self.skip_line();
@@ -212,7 +260,11 @@ impl<'a> Parser<'a> {
         if self.depth >= MAX_DEPTH {
             let span = self.span();
             let d = self
-                .error(Code::NestingTooDeep, span, format!("blocks are nested more than {MAX_DEPTH} levels deep"))
+                .error(
+                    Code::NestingTooDeep,
+                    span,
+                    format!("blocks are nested more than {MAX_DEPTH} levels deep"),
+                )
                 .with_help("split the mission into capabilities or flatter blocks");
             self.report(d);
             self.skip_nested();
@@ -263,13 +315,27 @@ impl<'a> Parser<'a> {
             return;
         }
         let Some(first) = Keyword::from_any_case(self.text_of(self.span())) else { return };
-        let line_end = (self.pos..self.tokens.len()).find(|&i| matches!(self.tokens[i].kind, TokenKind::Newline | TokenKind::Eof)).unwrap_or(self.pos);
-        let ends_in_colon = line_end > self.pos && self.tokens[line_end - 1].kind == TokenKind::Colon;
+        let line_end = (self.pos..self.tokens.len())
+            .find(|&i| matches!(self.tokens[i].kind, TokenKind::Newline | TokenKind::Eof))
+            .unwrap_or(self.pos);
+        let ends_in_colon =
+            line_end > self.pos && self.tokens[line_end - 1].kind == TokenKind::Colon;
         let header_start = matches!(
             first,
-            Keyword::Mission | Keyword::Capability | Keyword::Sequential | Keyword::Parallel | Keyword::On | Keyword::If
-                | Keyword::Else | Keyword::StartIf | Keyword::DoWhile | Keyword::WaitFor | Keyword::Requirements
-                | Keyword::Defaults | Keyword::Perform | Keyword::Exceptions
+            Keyword::Mission
+                | Keyword::Capability
+                | Keyword::Sequential
+                | Keyword::Parallel
+                | Keyword::On
+                | Keyword::If
+                | Keyword::Else
+                | Keyword::StartIf
+                | Keyword::DoWhile
+                | Keyword::WaitFor
+                | Keyword::Requirements
+                | Keyword::Defaults
+                | Keyword::Perform
+                | Keyword::Exceptions
         );
         let use_line = first == Keyword::Use && self.peek_at(1) == TokenKind::String;
         if !(use_line || (header_start && ends_in_colon)) {
@@ -283,13 +349,27 @@ impl<'a> Parser<'a> {
             let word = self.text_of(token.span);
             let structural = matches!(
                 Keyword::from_any_case(word),
-                Some(Keyword::Every | Keyword::By | Keyword::With | Keyword::For | Keyword::And | Keyword::As | Keyword::Exception | Keyword::If | Keyword::On)
+                Some(
+                    Keyword::Every
+                        | Keyword::By
+                        | Keyword::With
+                        | Keyword::For
+                        | Keyword::And
+                        | Keyword::As
+                        | Keyword::Exception
+                        | Keyword::If
+                        | Keyword::On
+                )
             );
             if i == self.pos || structural {
                 if let Some(k) = Keyword::from_any_case(word) {
                     self.tokens[i].kind = TokenKind::Keyword(k);
                     let d = self
-                        .error(Code::KeywordCase, token.span, format!("keywords are written in upper case: `{}`", k.as_str()))
+                        .error(
+                            Code::KeywordCase,
+                            token.span,
+                            format!("keywords are written in upper case: `{}`", k.as_str()),
+                        )
                         .with_help(format!("write `{}`", k.as_str()));
                     self.report(d);
                 }

@@ -12,7 +12,11 @@ impl Parser<'_> {
         let start = self.span();
         let stmt = match self.peek() {
             TokenKind::Keyword(k @ (Keyword::Sequential | Keyword::Parallel)) => {
-                let kind = if k == Keyword::Sequential { BlockKind::Sequential } else { BlockKind::Parallel };
+                let kind = if k == Keyword::Sequential {
+                    BlockKind::Sequential
+                } else {
+                    BlockKind::Parallel
+                };
                 match self.peek_at(1) {
                     TokenKind::Keyword(Keyword::For) => self.for_block(kind),
                     TokenKind::Keyword(Keyword::On) => {
@@ -44,7 +48,9 @@ impl Parser<'_> {
                 self.bump();
                 if self.eat_keyword(Keyword::Exception).is_none() {
                     let span = self.span();
-                    let d = self.error(Code::Syntax, span, "expected EXCEPTION after THROW").with_help("write `THROW EXCEPTION Name`");
+                    let d = self
+                        .error(Code::Syntax, span, "expected EXCEPTION after THROW")
+                        .with_help("write `THROW EXCEPTION Name`");
                     self.report(d);
                 }
                 self.raise(start).map(Stmt::Throw)?
@@ -66,7 +72,12 @@ impl Parser<'_> {
                 self.recover_line();
                 return None;
             }
-            TokenKind::Keyword(k @ (Keyword::Requirements | Keyword::Defaults | Keyword::Perform | Keyword::Exceptions)) => {
+            TokenKind::Keyword(
+                k @ (Keyword::Requirements
+                | Keyword::Defaults
+                | Keyword::Perform
+                | Keyword::Exceptions),
+            ) => {
                 let d = self
                     .error(Code::MisplacedItem, start, format!("{} is a capability section, and is not allowed here", k.as_str()))
                     .with_help("sections stand directly under `CAPABILITY Name BY drone:`, indented by 4 spaces");
@@ -77,7 +88,10 @@ impl Parser<'_> {
             TokenKind::Keyword(k @ (Keyword::Mission | Keyword::Capability | Keyword::Use)) => {
                 let d = self
                     .error(Code::MisplacedItem, start, format!("{} inside a block", k.as_str()))
-                    .with_help(format!("{} starts in the first column, outside every other definition", k.as_str()));
+                    .with_help(format!(
+                        "{} starts in the first column, outside every other definition",
+                        k.as_str()
+                    ));
                 self.report(d);
                 self.recover_line();
                 return None;
@@ -91,8 +105,14 @@ impl Parser<'_> {
             }
             _ => {
                 let d = self
-                    .error(Code::Syntax, start, format!("expected a statement, found {}", self.peek().describe()))
-                    .with_help("a statement names actors and a capability: `drone FlyTo WITH Home`");
+                    .error(
+                        Code::Syntax,
+                        start,
+                        format!("expected a statement, found {}", self.peek().describe()),
+                    )
+                    .with_help(
+                        "a statement names actors and a capability: `drone FlyTo WITH Home`",
+                    );
                 self.report(d);
                 self.recover_line();
                 return None;
@@ -107,7 +127,14 @@ impl Parser<'_> {
         if !self.at_line_end() && !self.at(TokenKind::Unknown) {
             let span = self.span();
             let d = self
-                .error(Code::Syntax, span, format!("expected the end of the line after {what}, found {}", self.peek().describe()))
+                .error(
+                    Code::Syntax,
+                    span,
+                    format!(
+                        "expected the end of the line after {what}, found {}",
+                        self.peek().describe()
+                    ),
+                )
                 .with_help("one statement per line; separate arguments with `,`");
             self.report(d);
         }
@@ -122,16 +149,25 @@ impl Parser<'_> {
         } else {
             self.recover_body()
         };
-        Stmt::Block(Block { kind, name, body, span: Span::new(start.start as usize, self.last_end as usize) })
+        Stmt::Block(Block {
+            kind,
+            name,
+            body,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        })
     }
 
     fn statement(&mut self) -> Stmt {
         let start = self.span();
         let mut names: Vec<(TokenKind, Span)> = Vec::new();
         while matches!(self.peek(), TokenKind::Ident | TokenKind::TaggedName) {
-            if self.peek() == TokenKind::Ident && self.text_of(self.span()).eq_ignore_ascii_case("with") {
+            if self.peek() == TokenKind::Ident
+                && self.text_of(self.span()).eq_ignore_ascii_case("with")
+            {
                 let span = self.span();
-                let d = self.error(Code::KeywordCase, span, "keywords are written in upper case: `WITH`").with_help("write `WITH`");
+                let d = self
+                    .error(Code::KeywordCase, span, "keywords are written in upper case: `WITH`")
+                    .with_help("write `WITH`");
                 self.report(d);
                 self.tokens[self.pos].kind = TokenKind::Keyword(Keyword::With);
                 break;
@@ -145,8 +181,16 @@ impl Parser<'_> {
             if let Some(&(TokenKind::Ident, name)) = names.last() {
                 let tag = self.span_at(1);
                 let d = self
-                    .error(Code::SpacedTag, name.to(tag), "an activity tag is glued to its capability's name")
-                    .with_help(format!("write `{}-{}`, without spaces", self.text_of(name), self.text_of(tag)));
+                    .error(
+                        Code::SpacedTag,
+                        name.to(tag),
+                        "an activity tag is glued to its capability's name",
+                    )
+                    .with_help(format!(
+                        "write `{}-{}`, without spaces",
+                        self.text_of(name),
+                        self.text_of(tag)
+                    ));
                 self.report(d);
                 self.bump();
                 self.bump();
@@ -155,18 +199,29 @@ impl Parser<'_> {
         }
         if names.len() == 1 && spaced_tag.is_some() {
             let (_, name) = names[0];
-            return self.leash_rest(self.ident_at(name), self.ident_at(spaced_tag.unwrap_or_default()), start);
+            return self.leash_rest(
+                self.ident_at(name),
+                self.ident_at(spaced_tag.unwrap_or_default()),
+                start,
+            );
         }
-        if let Some(&(_, span)) = names[..names.len().saturating_sub(1)].iter().find(|(k, _)| *k == TokenKind::TaggedName) {
+        if let Some(&(_, span)) =
+            names[..names.len().saturating_sub(1)].iter().find(|(k, _)| *k == TokenKind::TaggedName)
+        {
             let d = self
-                .error(Code::Syntax, span, "an activity tag belongs on the capability, the last name before WITH")
+                .error(
+                    Code::Syntax,
+                    span,
+                    "an activity tag belongs on the capability, the last name before WITH",
+                )
                 .with_help("write the actors first, then `Capability-Tag`");
             self.report(d);
         }
         if names.len() < 2 {
             let (_, span) = names.first().copied().unwrap_or((TokenKind::Ident, start));
             let word = self.text_of(span).to_string();
-            let mut d = self.error(Code::Syntax, span, format!("`{word}` alone is not a statement"));
+            let mut d =
+                self.error(Code::Syntax, span, format!("`{word}` alone is not a statement"));
             d = if matches!(self.peek(), TokenKind::Colon) {
                 d.with_help("block headers start with SEQUENTIAL, PARALLEL, ON, IF, STARTIF, WAITFOR or DOWHILE")
             } else {
@@ -177,14 +232,24 @@ impl Parser<'_> {
             return Stmt::Error(Span::new(start.start as usize, self.last_end as usize));
         }
         let (cap_kind, cap_span) = names.pop().unwrap_or((TokenKind::Ident, start));
-        let (capability, mut tag) = if cap_kind == TokenKind::TaggedName { self.split_tag(cap_span) } else { (self.ident_at(cap_span), None) };
+        let (capability, mut tag) = if cap_kind == TokenKind::TaggedName {
+            self.split_tag(cap_span)
+        } else {
+            (self.ident_at(cap_span), None)
+        };
         if let Some(t) = spaced_tag {
             tag = Some(self.ident_at(t));
         }
         let actors = names.into_iter().map(|(_, s)| self.ident_at(s)).collect();
         let args = self.args_after_names();
         self.end_line("the statement");
-        Stmt::Statement(Statement { actors, capability, tag, args, span: Span::new(start.start as usize, self.last_end as usize) })
+        Stmt::Statement(Statement {
+            actors,
+            capability,
+            tag,
+            args,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        })
     }
 
     /// `WITH args`, or nothing; values without WITH are the paper's form, reported.
@@ -192,11 +257,17 @@ impl Parser<'_> {
         if self.eat_keyword(Keyword::With).is_some() {
             return self.args();
         }
-        if matches!(self.peek(), TokenKind::Number | TokenKind::String | TokenKind::LParen | TokenKind::Minus) {
+        if matches!(
+            self.peek(),
+            TokenKind::Number | TokenKind::String | TokenKind::LParen | TokenKind::Minus
+        ) {
             let span = self.span();
             let d = self
                 .error(Code::ArgumentsWithoutWith, span, "arguments follow WITH")
-                .with_help(format!("write `WITH {}`", self.text_of(Span::new(span.start as usize, self.line_end_offset())).trim()));
+                .with_help(format!(
+                    "write `WITH {}`",
+                    self.text_of(Span::new(span.start as usize, self.line_end_offset())).trim()
+                ));
             self.report(d);
             return self.args();
         }
@@ -211,7 +282,8 @@ impl Parser<'_> {
         let text = self.text_of(span);
         let dash = text.find('-').unwrap_or(text.len());
         let name = Span::new(span.start as usize, span.start as usize + dash);
-        let tag = Span::new((span.start as usize + dash + 1).min(span.end as usize), span.end as usize);
+        let tag =
+            Span::new((span.start as usize + dash + 1).min(span.end as usize), span.end as usize);
         (self.ident_at(name), Some(self.ident_at(tag)))
     }
 
@@ -233,7 +305,10 @@ impl Parser<'_> {
             _ => {
                 self.expected(
                     "what to do with the activity",
-                    Some(&format!("write `{}-{} PAUSE` (or ABORT, RESUME, or a PERFORM section's name)", capability.name, tag.name)),
+                    Some(&format!(
+                        "write `{}-{} PAUSE` (or ABORT, RESUME, or a PERFORM section's name)",
+                        capability.name, tag.name
+                    )),
                 );
                 self.recover_line();
                 return Stmt::Error(Span::new(start.start as usize, self.last_end as usize));
@@ -241,7 +316,13 @@ impl Parser<'_> {
         };
         let args = if self.eat_keyword(Keyword::With).is_some() { self.args() } else { Vec::new() };
         self.end_line("the leash call");
-        Stmt::Leash(LeashCall { capability, tag, action, args, span: Span::new(start.start as usize, self.last_end as usize) })
+        Stmt::Leash(LeashCall {
+            capability,
+            tag,
+            action,
+            args,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        })
     }
 
     fn api_call(&mut self) -> Stmt {
@@ -249,7 +330,10 @@ impl Parser<'_> {
         let actor = self.ident().unwrap_or_else(|| self.ident_at(start));
         self.bump(); // `.`
         let Some(function) = self.ident() else {
-            self.expected("the name of a middle-layer function after `.`", Some("write `drone.Land()`"));
+            self.expected(
+                "the name of a middle-layer function after `.`",
+                Some("write `drone.Land()`"),
+            );
             self.recover_line();
             return Stmt::Error(Span::new(start.start as usize, self.last_end as usize));
         };
@@ -271,19 +355,34 @@ impl Parser<'_> {
         } else {
             let span = self.span();
             let d = self
-                .error(Code::Syntax, span, format!("`{}.{}` needs parentheses", actor.name, function.name))
-                .with_help(format!("write `{}.{}()`, with the arguments inside", actor.name, function.name));
+                .error(
+                    Code::Syntax,
+                    span,
+                    format!("`{}.{}` needs parentheses", actor.name, function.name),
+                )
+                .with_help(format!(
+                    "write `{}.{}()`, with the arguments inside",
+                    actor.name, function.name
+                ));
             self.report(d);
         }
         self.end_line("the API call");
-        Stmt::Api(ApiCall { actor, function, args, span: Span::new(start.start as usize, self.last_end as usize) })
+        Stmt::Api(ApiCall {
+            actor,
+            function,
+            args,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        })
     }
 
     pub(super) fn args(&mut self) -> Vec<Arg> {
         let mut args = Vec::new();
         loop {
             if self.at_line_end() {
-                self.expected("an argument after WITH or `,`", Some("write the arguments on the same line: `WITH center=Home, radius=50m`"));
+                self.expected(
+                    "an argument after WITH or `,`",
+                    Some("write the arguments on the same line: `WITH center=Home, radius=50m`"),
+                );
                 break;
             }
             let name = if self.peek() == TokenKind::Ident && self.peek_at(1) == TokenKind::Eq {
@@ -332,7 +431,12 @@ impl Parser<'_> {
                 Some(self.recover_body())
             }
         };
-        Stmt::Requirement(Requirement { kind, condition, body, span: Span::new(start.start as usize, self.last_end as usize) })
+        Stmt::Requirement(Requirement {
+            kind,
+            condition,
+            body,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        })
     }
 
     /// The paper writes `IF type:Body`; here it is `IF type = Body:`.
@@ -341,7 +445,11 @@ impl Parser<'_> {
             let value = self.text_of(self.span()).to_string();
             let span = condition.span.to(self.span());
             let d = self
-                .error(Code::PaperForm, span, format!("`{keyword} {}:{value}` is the paper's form", name.name))
+                .error(
+                    Code::PaperForm,
+                    span,
+                    format!("`{keyword} {}:{value}` is the paper's form", name.name),
+                )
                 .with_help(format!("write `{keyword} {} = {value}:`", name.name));
             self.report(d);
             while !self.at_line_end() {
@@ -364,12 +472,20 @@ impl Parser<'_> {
                 let body = self.if_body(else_span, "ELSE IF", &condition);
                 branches.push((condition, body));
             } else {
-                let body = if self.header_colon(else_span, "ELSE") { self.body("ELSE") } else { self.recover_body() };
+                let body = if self.header_colon(else_span, "ELSE") {
+                    self.body("ELSE")
+                } else {
+                    self.recover_body()
+                };
                 otherwise = Some(body);
                 break;
             }
         }
-        Stmt::If(IfChain { branches, otherwise, span: Span::new(start.start as usize, self.last_end as usize) })
+        Stmt::If(IfChain {
+            branches,
+            otherwise,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        })
     }
 
     fn if_body(&mut self, start: Span, keyword: &str, condition: &Expr) -> Body {
@@ -392,12 +508,17 @@ impl Parser<'_> {
         loop {
             if self.at_keyword(Keyword::As) && !instances.is_empty() {
                 let span = self.span();
-                let d = self.error(Code::Syntax, span, "AND is followed by AS, not by another instance").with_help("remove the last AND");
+                let d = self
+                    .error(Code::Syntax, span, "AND is followed by AS, not by another instance")
+                    .with_help("remove the last AND");
                 self.report(d);
                 break;
             }
             let Some(actor) = self.ident() else {
-                self.expected("an actor or group for the FOR", Some("write `PARALLEL FOR a WITH x AND b WITH y AS d WITH p:`"));
+                self.expected(
+                    "an actor or group for the FOR",
+                    Some("write `PARALLEL FOR a WITH x AND b WITH y AS d WITH p:`"),
+                );
                 self.recover_line();
                 return Stmt::Error(Span::new(start.start as usize, self.last_end as usize));
             };
@@ -417,7 +538,10 @@ impl Parser<'_> {
             }
         }
         if self.eat_keyword(Keyword::As).is_none() {
-            self.expected("AS and the alias for each instance", Some("write `... AS drone:` to name the actor of each instance"));
+            self.expected(
+                "AS and the alias for each instance",
+                Some("write `... AS drone:` to name the actor of each instance"),
+            );
             self.recover_line();
             return Stmt::Error(Span::new(start.start as usize, self.last_end as usize));
         }
@@ -425,9 +549,24 @@ impl Parser<'_> {
             self.expected("the alias after AS", None);
             Ident { name: String::new(), span: Span::point(self.last_end as usize) }
         });
-        let params = if self.eat_keyword(Keyword::With).is_some() { self.name_list("a parameter name after WITH") } else { Vec::new() };
-        let body = if self.header_colon(start, "the FOR header") { self.body("the FOR block") } else { self.recover_body() };
-        Stmt::For(ForBlock { kind, instances, alias, params, body, span: Span::new(start.start as usize, self.last_end as usize) })
+        let params = if self.eat_keyword(Keyword::With).is_some() {
+            self.name_list("a parameter name after WITH")
+        } else {
+            Vec::new()
+        };
+        let body = if self.header_colon(start, "the FOR header") {
+            self.body("the FOR block")
+        } else {
+            self.recover_body()
+        };
+        Stmt::For(ForBlock {
+            kind,
+            instances,
+            alias,
+            params,
+            body,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        })
     }
 
     /// Handler headers: `BY actor` and `WITH a, b` after the name.
@@ -441,7 +580,11 @@ impl Parser<'_> {
         } else {
             None
         };
-        let bindings = if self.eat_keyword(Keyword::With).is_some() { self.name_list("a name to bind after WITH") } else { Vec::new() };
+        let bindings = if self.eat_keyword(Keyword::With).is_some() {
+            self.name_list("a name to bind after WITH")
+        } else {
+            Vec::new()
+        };
         (by, bindings)
     }
 
@@ -454,20 +597,45 @@ impl Parser<'_> {
             return Stmt::Error(Span::new(start.start as usize, self.last_end as usize));
         };
         let (by, bindings) = self.handler_tail();
-        let body = if self.header_colon(start, "a handler's header") { self.body("the handler") } else { self.recover_body() };
-        Stmt::Handler(Handler { mode, every, signal, by, bindings, body, span: Span::new(start.start as usize, self.last_end as usize) })
+        let body = if self.header_colon(start, "a handler's header") {
+            self.body("the handler")
+        } else {
+            self.recover_body()
+        };
+        Stmt::Handler(Handler {
+            mode,
+            every,
+            signal,
+            by,
+            bindings,
+            body,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        })
     }
 
     pub(super) fn exception_handler(&mut self) -> Option<ExceptionHandler> {
         let start = self.bump().span; // ON
         self.bump(); // EXCEPTION
         let Some(exception) = self.ident() else {
-            self.expected("the name of the exception to handle", Some("write `ON EXCEPTION BatteryCritical:`"));
+            self.expected(
+                "the name of the exception to handle",
+                Some("write `ON EXCEPTION BatteryCritical:`"),
+            );
             self.recover_line();
             return None;
         };
         let (by, bindings) = self.handler_tail();
-        let body = if self.header_colon(start, "an exception handler's header") { self.body("the handler") } else { self.recover_body() };
-        Some(ExceptionHandler { exception, by, bindings, body, span: Span::new(start.start as usize, self.last_end as usize) })
+        let body = if self.header_colon(start, "an exception handler's header") {
+            self.body("the handler")
+        } else {
+            self.recover_body()
+        };
+        Some(ExceptionHandler {
+            exception,
+            by,
+            bindings,
+            body,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        })
     }
 }

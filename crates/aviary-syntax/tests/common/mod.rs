@@ -64,7 +64,9 @@ pub fn comment_texts(tree: &SourceFile, text: &str) -> Vec<String> {
             let raw = text.get(c.span.range()).unwrap_or("");
             match c.kind {
                 CommentKind::Line => raw.trim_end().to_string(),
-                CommentKind::Block => raw.split('\n').map(str::trim_end).collect::<Vec<_>>().join("\n"),
+                CommentKind::Block => {
+                    raw.split('\n').map(str::trim_end).collect::<Vec<_>>().join("\n")
+                }
             }
         })
         .collect()

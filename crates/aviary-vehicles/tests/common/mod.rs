@@ -41,11 +41,7 @@ pub async fn serve(world: &World, speed: f64, behaviour: Behaviour) -> Vehicles 
     aviary_vehicles::serve(
         world,
         Listen::Tcp("127.0.0.1:0".parse().unwrap()),
-        Options {
-            speed,
-            behaviour,
-            ..Options::default()
-        },
+        Options { speed, behaviour, ..Options::default() },
     )
     .await
     .unwrap()
@@ -84,13 +80,7 @@ impl Gcs {
     pub fn over(stream: TcpStream, system: u8, component: u8) -> Gcs {
         stream.set_nodelay(true).unwrap();
         let (read, write) = stream.into_split();
-        Gcs {
-            reader: AsyncMavlinkReader::new(read),
-            write,
-            sequence: 0,
-            system,
-            component,
-        }
+        Gcs { reader: AsyncMavlinkReader::new(read), write, sequence: 0, system, component }
     }
 
     pub async fn send(&mut self, msg: &MavMessage) {
@@ -100,15 +90,11 @@ impl Gcs {
             sequence: self.sequence,
         };
         self.sequence = self.sequence.wrapping_add(1);
-        mavlink::write_v2_msg_async(&mut self.write, header, msg)
-            .await
-            .unwrap();
+        mavlink::write_v2_msg_async(&mut self.write, header, msg).await.unwrap();
     }
 
     pub async fn send_bytes(&mut self, bytes: &[u8]) {
-        tokio::io::AsyncWriteExt::write_all(&mut self.write, bytes)
-            .await
-            .unwrap();
+        tokio::io::AsyncWriteExt::write_all(&mut self.write, bytes).await.unwrap();
     }
 
     /// The next frame, or `None` if nothing comes within `limit`.
@@ -161,11 +147,7 @@ impl Gcs {
         let until = Instant::now() + Duration::from_secs(20);
         loop {
             let mode = self
-                .command(
-                    system,
-                    MavCmd::MAV_CMD_DO_SET_MODE,
-                    [1.0, 4.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-                )
+                .command(system, MavCmd::MAV_CMD_DO_SET_MODE, [1.0, 4.0, 0.0, 0.0, 0.0, 0.0, 0.0])
                 .await;
             let arm = self
                 .command(
@@ -181,11 +163,7 @@ impl Gcs {
             tokio::time::sleep(Duration::from_millis(200)).await;
         }
         let ack = self
-            .command(
-                system,
-                MavCmd::MAV_CMD_NAV_TAKEOFF,
-                [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, alt],
-            )
+            .command(system, MavCmd::MAV_CMD_NAV_TAKEOFF, [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, alt])
             .await;
         assert_eq!(ack.result, MAV_RESULT_ACCEPTED, "take-off");
         let up = self

@@ -24,8 +24,17 @@ pub(super) fn check_conflicts_pairwise(mission: &Mission, diagnostics: &mut Vec<
     for (&(drone, resource), members) in &buckets {
         for (n, &a) in members.iter().enumerate() {
             for &b in &members[n..] {
-                let Some((waiting, other, overlap)) = overlap(&sites, mission, drone, a, b) else { continue };
-                let d = report(mission, &sites.claims[waiting], &sites.claims[other], drone, resource, &overlap);
+                let Some((waiting, other, overlap)) = overlap(&sites, mission, drone, a, b) else {
+                    continue;
+                };
+                let d = report(
+                    mission,
+                    &sites.claims[waiting],
+                    &sites.claims[other],
+                    drone,
+                    resource,
+                    &overlap,
+                );
                 let w = &sites.claims[waiting].origin;
                 found.entry((w.file.0, w.span.start, d.code)).or_insert(d);
             }
@@ -35,12 +44,21 @@ pub(super) fn check_conflicts_pairwise(mission: &Mission, diagnostics: &mut Vec<
 }
 
 /// Whether sites `a` and `b` may run at once: which one waits, which holds, and why.
-pub(super) fn overlap(sites: &Sites, mission: &Mission, drone: DroneId, a: usize, b: usize) -> Option<(usize, usize, Overlap)> {
+pub(super) fn overlap(
+    sites: &Sites,
+    mission: &Mission,
+    drone: DroneId,
+    a: usize,
+    b: usize,
+) -> Option<(usize, usize, Overlap)> {
     let (pa, pb) = (&sites.claims[a].path, &sites.claims[b].path);
-    let every = pa.iter().zip(pb).take_while(|(x, y)| x == y).find_map(|((id, key), _)| match key {
-        Key::Handler(h) => sites.handlers.get(&(*id, *h)).filter(|info| info.every).map(|info| info.signal),
-        _ => None,
-    });
+    let every =
+        pa.iter().zip(pb).take_while(|(x, y)| x == y).find_map(|((id, key), _)| match key {
+            Key::Handler(h) => {
+                sites.handlers.get(&(*id, *h)).filter(|info| info.every).map(|info| info.signal)
+            }
+            _ => None,
+        });
     if a == b {
         return every.map(|signal| (a, a, Overlap::Firings(signal)));
     }
@@ -49,7 +67,13 @@ pub(super) fn overlap(sites: &Sites, mission: &Mission, drone: DroneId, a: usize
     if id != idb {
         return None;
     }
-    let later = |x: usize, y: usize| if later_in_source(&sites.claims[x], &sites.claims[y]) { (x, y) } else { (y, x) };
+    let later = |x: usize, y: usize| {
+        if later_in_source(&sites.claims[x], &sites.claims[y]) {
+            (x, y)
+        } else {
+            (y, x)
+        }
+    };
     match (sites.constructs[id], ka, kb) {
         (Construct::Block(BlockKind::Parallel), Key::Item(_), Key::Item(_)) => {
             let (w, o) = later(a, b);
@@ -59,20 +83,38 @@ pub(super) fn overlap(sites: &Sites, mission: &Mission, drone: DroneId, a: usize
             let (w, o) = later(a, b);
             Some((w, o, Overlap::Handlers))
         }
-        (Construct::Block(_), Key::Item(_), Key::Handler(h)) => handler_and_item(sites, mission, drone, &pb[..=k], h, a, b),
-        (Construct::Block(_), Key::Handler(h), Key::Item(_)) => handler_and_item(sites, mission, drone, &pa[..=k], h, b, a),
+        (Construct::Block(_), Key::Item(_), Key::Handler(h)) => {
+            handler_and_item(sites, mission, drone, &pb[..=k], h, a, b)
+        }
+        (Construct::Block(_), Key::Handler(h), Key::Item(_)) => {
+            handler_and_item(sites, mission, drone, &pa[..=k], h, b, a)
+        }
         (Construct::For { parallel: true }, Key::Instance(i), Key::Instance(j)) => {
             let (w, o) = if i > j { (a, b) } else { (b, a) };
             Some((w, o, Overlap::Instances))
         }
         _ => None,
     }
-    .filter(|_| every.is_none() || matches!(sites.constructs[id], Construct::Block(BlockKind::Parallel) | Construct::For { parallel: true }))
+    .filter(|_| {
+        every.is_none()
+            || matches!(
+                sites.constructs[id],
+                Construct::Block(BlockKind::Parallel) | Construct::For { parallel: true }
+            )
+    })
 }
 
 /// A statement `item` of a block against statement `handler_site` of handler `h` there;
 /// `at` is the path down to the handler step.
-fn handler_and_item(sites: &Sites, mission: &Mission, drone: DroneId, at: &[Step], h: usize, item: usize, handler_site: usize) -> Option<(usize, usize, Overlap)> {
+fn handler_and_item(
+    sites: &Sites,
+    mission: &Mission,
+    drone: DroneId,
+    at: &[Step],
+    h: usize,
+    item: usize,
+    handler_site: usize,
+) -> Option<(usize, usize, Overlap)> {
     let (block, _) = *at.last()?;
     let info = sites.handlers.get(&(block, h))?;
     let signal = info.signal;
@@ -85,7 +127,12 @@ fn handler_and_item(sites: &Sites, mission: &Mission, drone: DroneId, at: &[Step
     let raises: Vec<&[Step]> = sites
         .raises
         .iter()
-        .filter(|r| r.signal == signal && r.path.len() > prefix.len() && r.path[..prefix.len()] == *prefix && r.path[prefix.len()].0 == block)
+        .filter(|r| {
+            r.signal == signal
+                && r.path.len() > prefix.len()
+                && r.path[..prefix.len()] == *prefix
+                && r.path[prefix.len()].0 == block
+        })
         .map(|r| r.path.as_slice())
         .collect();
     let x = sites.claims[item].path.as_slice();
@@ -123,7 +170,11 @@ mod tests {
     struct NoFiles;
 
     impl aviary_check::SourceProvider for NoFiles {
-        fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
+        fn load(
+            &self,
+            _from: &str,
+            path: &str,
+        ) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
             Err(format!("no files here ({path})").into())
         }
     }
@@ -131,9 +182,20 @@ mod tests {
     fn compiled(text: &str, world: &str) -> Mission {
         let mut sources = aviary_diagnostics::SourceMap::new();
         let api = aviary_api::Descriptor::standard();
-        let checked = aviary_check::check_sources(&mut sources, ("m.mission", text.as_bytes()), Some(("m.world.toml", world.as_bytes())), &NoFiles, &api);
+        let checked = aviary_check::check_sources(
+            &mut sources,
+            ("m.mission", text.as_bytes()),
+            Some(("m.world.toml", world.as_bytes())),
+            &NoFiles,
+            &api,
+        );
         assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
-        aviary_ir::compile(checked.program.as_ref().expect("program"), checked.world.as_ref().expect("world"), &api).expect("a mission")
+        aviary_ir::compile(
+            checked.program.as_ref().expect("program"),
+            checked.world.as_ref().expect("world"),
+            &api,
+        )
+        .expect("a mission")
     }
 
     /// Both ways of applying the rule, on one mission: the same diagnostics, in order.
@@ -182,7 +244,8 @@ mod tests {
         }
         let found = agree(&compiled(&text, &world));
         assert_eq!(found.len(), n - 1);
-        assert!(found.iter().all(|d| d.code == Code::CommandsMayCollide && d.secondary[0].span.start == found[0].secondary[0].span.start));
+        assert!(found.iter().all(|d| d.code == Code::CommandsMayCollide
+            && d.secondary[0].span.start == found[0].secondary[0].span.start));
         let many = aviary_check::generate::sequential_mission(100_000);
         let mut none = Vec::new();
         super::super::check_conflicts(&compiled(&many, &world), &mut none);
@@ -219,7 +282,13 @@ mod tests {
         *seed % n
     }
 
-    fn random_body(seed: &mut u64, out: &mut String, indent: usize, depth: usize, names: &mut usize) {
+    fn random_body(
+        seed: &mut u64,
+        out: &mut String,
+        indent: usize,
+        depth: usize,
+        names: &mut usize,
+    ) {
         let pad = "    ".repeat(indent);
         for _ in 0..1 + next(seed, 4) {
             let drone = if next(seed, 2) == 0 { "a" } else { "b" };
@@ -235,13 +304,16 @@ mod tests {
                     random_body(seed, out, indent + 1, depth + 1, names);
                 }
                 4 => {
-                    let kind = ["ON", "ON EVERY", "SEQUENTIAL ON", "PARALLEL ON EVERY"][next(seed, 4) as usize];
+                    let kind = ["ON", "ON EVERY", "SEQUENTIAL ON", "PARALLEL ON EVERY"]
+                        [next(seed, 4) as usize];
                     out.push_str(&format!("{pad}{kind} S{signal}:\n"));
                     random_body(seed, out, indent + 1, depth + 1, names);
                 }
                 5 => {
                     let kind = if next(seed, 2) == 0 { "SEQUENTIAL" } else { "PARALLEL" };
-                    out.push_str(&format!("{pad}{kind} FOR a AND b AS d{names}:\n{pad}    d{names} Hover WITH 1s\n"));
+                    out.push_str(&format!(
+                        "{pad}{kind} FOR a AND b AS d{names}:\n{pad}    d{names} Hover WITH 1s\n"
+                    ));
                     if next(seed, 2) == 0 {
                         random_body(seed, out, indent + 1, depth + 1, names);
                     }
@@ -271,13 +343,26 @@ mod tests {
         let (text, world) = aviary_check::generate::large_mission(150_000);
         let mut sources = aviary_diagnostics::SourceMap::new();
         let api = aviary_api::Descriptor::standard();
-        let checked = aviary_check::check_sources(&mut sources, ("gen.mission", text.as_bytes()), Some(("gen.world.toml", world.as_bytes())), &NoFiles, &api);
-        let mission = aviary_ir::compile(checked.program.as_ref().expect("program"), checked.world.as_ref().expect("world"), &api).expect("a mission");
+        let checked = aviary_check::check_sources(
+            &mut sources,
+            ("gen.mission", text.as_bytes()),
+            Some(("gen.world.toml", world.as_bytes())),
+            &NoFiles,
+            &api,
+        );
+        let mission = aviary_ir::compile(
+            checked.program.as_ref().expect("program"),
+            checked.world.as_ref().expect("world"),
+            &api,
+        )
+        .expect("a mission");
         let sites = sites::collect(&mission);
         let mut pairs = 0;
         for (i, x) in sites.claims.iter().enumerate() {
             for (j, y) in sites.claims.iter().enumerate().skip(i) {
-                let Some(&(drone, _)) = x.claims.iter().find(|c| y.claims.contains(c)) else { continue };
+                let Some(&(drone, _)) = x.claims.iter().find(|c| y.claims.contains(c)) else {
+                    continue;
+                };
                 let ab = overlap(&sites, &mission, drone, i, j).map(|(w, o, _)| (w, o));
                 let ba = overlap(&sites, &mission, drone, j, i).map(|(w, o, _)| (w, o));
                 assert_eq!(ab, ba, "sites {i} and {j}");

@@ -38,7 +38,9 @@ impl Raises {
             for &(construct, key) in &r.path {
                 let c = by.entry((construct, r.signal)).or_default();
                 c.keys.push(key);
-                let widen = |range: &mut Option<(usize, usize)>, i: usize| *range = Some(range.map_or((i, i), |(lo, hi)| (lo.min(i), hi.max(i))));
+                let widen = |range: &mut Option<(usize, usize)>, i: usize| {
+                    *range = Some(range.map_or((i, i), |(lo, hi)| (lo.min(i), hi.max(i))))
+                };
                 match key {
                     Key::Item(i) => widen(&mut c.items, i),
                     Key::Instance(i) => widen(&mut c.instances, i),

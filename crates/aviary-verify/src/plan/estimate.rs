@@ -6,9 +6,11 @@
 //! queueing follows program order. Handlers run after their block's items, in the order
 //! of their signals' times. Detections come from the world's targets (simulation data).
 
-
 use aviary_api::{DroneId, Resource, Value};
-use aviary_ir::{ActorFilter, ActorRef, ApiCall, Block, BlockKind, Call, Expr, Handler, Mission, Node, Origin, SignalId};
+use aviary_ir::{
+    ActorFilter, ActorRef, ApiCall, Block, BlockKind, Call, Expr, Handler, Mission, Node, Origin,
+    SignalId,
+};
 use aviary_world::World;
 
 use super::eval::{number, Frame, Scope};
@@ -119,17 +121,36 @@ impl<'m> Estimator<'m> {
             world,
             known,
             calling: vec![false; mission.capabilities.len()],
-            motion: mission.capabilities.iter().map(|cap| cap.claims.iter().filter(|(_, r)| *r == Resource::Motion).map(|(slot, _)| *slot).collect::<Vec<_>>().into()).collect(),
+            motion: mission
+                .capabilities
+                .iter()
+                .map(|cap| {
+                    cap.claims
+                        .iter()
+                        .filter(|(_, r)| *r == Resource::Motion)
+                        .map(|(slot, _)| *slot)
+                        .collect::<Vec<_>>()
+                        .into()
+                })
+                .collect(),
             detected: mission.signals.iter().position(|s| s == "Detected"),
             budget: call_budget(mission),
             cut_short: false,
-            s: State { drones, activities: vec![Vec::new(); n], raised: vec![None; mission.signals.len()], reserve: vec![None; n], assumptions: Vec::new(), fired: Vec::new() },
+            s: State {
+                drones,
+                activities: vec![Vec::new(); n],
+                raised: vec![None; mission.signals.len()],
+                reserve: vec![None; n],
+                assumptions: Vec::new(),
+                fired: Vec::new(),
+            },
         }
     }
 
     /// Walks the mission body, then sends home what is still in the air; the end time.
     pub fn run(&mut self) -> f64 {
-        let mut ctx = Ctx { frame: vec![None; self.mission.frame_size], actor: None, statement: None };
+        let mut ctx =
+            Ctx { frame: vec![None; self.mission.frame_size], actor: None, statement: None };
         let (end, _) = self.block(&self.mission.body, &mut ctx, 0.0);
         let mut last = end;
         for d in 0..self.s.drones.len() {
@@ -138,7 +159,13 @@ impl<'m> Estimator<'m> {
                 let start = end.max(f.free_at);
                 let done = start + f.return_home(self.world.site.max_altitude);
                 f.land(done);
-                self.s.activities[d].push(Activity { start, end: done, what: "ReturnToLaunch (mission end)".into(), at: None, origin: None });
+                self.s.activities[d].push(Activity {
+                    start,
+                    end: done,
+                    what: "ReturnToLaunch (mission end)".into(),
+                    at: None,
+                    origin: None,
+                });
                 last = last.max(done);
             }
         }
@@ -150,7 +177,8 @@ impl<'m> Estimator<'m> {
     pub fn bound(&mut self, h: &Handler, t: f64) -> Vec<(DroneId, (f64, f64, f64))> {
         let mark = self.s.mark();
         let before = self.s.drones.clone();
-        let mut ctx = Ctx { frame: vec![None; self.mission.frame_size], actor: None, statement: None };
+        let mut ctx =
+            Ctx { frame: vec![None; self.mission.frame_size], actor: None, statement: None };
         let (end, _) = self.block(&h.body, &mut ctx, t);
         let mut out = Vec::new();
         for (d, then) in before.iter().enumerate() {
@@ -161,7 +189,14 @@ impl<'m> Estimator<'m> {
             }
             let now = &self.s.drones[d];
             if now.distance > then.distance {
-                out.push((d, (now.distance - then.distance, now.flight_time - then.flight_time, now.battery_start - now.flight_time / now.endurance)));
+                out.push((
+                    d,
+                    (
+                        now.distance - then.distance,
+                        now.flight_time - then.flight_time,
+                        now.battery_start - now.flight_time / now.endurance,
+                    ),
+                ));
             }
         }
         // Back to before the firing, keeping what it had to assume.
@@ -175,7 +210,13 @@ impl<'m> Estimator<'m> {
     }
 
     fn scope<'a>(&'a self, ctx: &'a Ctx, t: f64) -> Scope<'a> {
-        Scope { mission: self.mission, frame: &ctx.frame, drones: &self.s.drones, raised: &self.s.raised, t }
+        Scope {
+            mission: self.mission,
+            frame: &ctx.frame,
+            drones: &self.s.drones,
+            raised: &self.s.raised,
+            t,
+        }
     }
 
     fn block(&mut self, b: &Block, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
@@ -198,7 +239,8 @@ impl<'m> Estimator<'m> {
         }
         // The block's handlers by signal, each list in handler order: a raise looks only
         // at its own (a block of N handlers for N signals was N² here).
-        let mut by_signal: std::collections::HashMap<SignalId, Vec<usize>> = std::collections::HashMap::new();
+        let mut by_signal: std::collections::HashMap<SignalId, Vec<usize>> =
+            std::collections::HashMap::new();
         for (hi, h) in b.handlers.iter().enumerate() {
             by_signal.entry(h.signal).or_default().push(hi);
         }
@@ -238,15 +280,17 @@ impl<'m> Estimator<'m> {
                 (t, vec![Raise { t, signal: *signal, actor: ctx.actor, args }])
             }
             Node::Leash(_) | Node::Throw { .. } => (t, Vec::new()),
-            Node::StartIf { condition, body } => match self.scope(ctx, t).condition(condition) {
-                Some(false) => (t, Vec::new()),
-                known => {
-                    if known.is_none() {
-                        self.note(ctx.statement, "a STARTIF whose condition is unknown before flight is counted as run".into());
+            Node::StartIf { condition, body } => {
+                match self.scope(ctx, t).condition(condition) {
+                    Some(false) => (t, Vec::new()),
+                    known => {
+                        if known.is_none() {
+                            self.note(ctx.statement, "a STARTIF whose condition is unknown before flight is counted as run".into());
+                        }
+                        self.block(body, ctx, t)
                     }
-                    self.block(body, ctx, t)
                 }
-            },
+            }
             Node::WaitFor { condition, body } => {
                 let t = self.wait(condition, ctx, t);
                 match body {
@@ -284,7 +328,13 @@ impl<'m> Estimator<'m> {
 
     /// The first branch whose condition holds; when one cannot be decided, the longer of
     /// taking it and not (the worst case).
-    fn choose(&mut self, branches: &[(Expr, Block)], otherwise: Option<&Block>, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
+    fn choose(
+        &mut self,
+        branches: &[(Expr, Block)],
+        otherwise: Option<&Block>,
+        ctx: &mut Ctx,
+        t: f64,
+    ) -> (f64, Vec<Raise>) {
         let Some(((cond, body), rest)) = branches.split_first() else {
             return otherwise.map_or((t, Vec::new()), |b| self.block(b, ctx, t));
         };
@@ -308,7 +358,13 @@ impl<'m> Estimator<'m> {
     /// A `DOWHILE`: rounds while its condition holds as far as the estimate knows it. A
     /// condition it cannot decide counts one round; a loop it never sees end is cut where
     /// the fleet's longest flight on a full battery would end, the physical worst case.
-    fn repeat(&mut self, condition: &Expr, body: &Block, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
+    fn repeat(
+        &mut self,
+        condition: &Expr,
+        body: &Block,
+        ctx: &mut Ctx,
+        t: f64,
+    ) -> (f64, Vec<Raise>) {
         let limit = t + self.s.drones.iter().map(|f| f.endurance).fold(0.0, f64::max);
         let (mut now, mut raises) = (t, Vec::new());
         for round in 0..MAX_ROUNDS {
@@ -352,7 +408,10 @@ impl<'m> Estimator<'m> {
         let cap = &self.mission.capabilities[c.capability];
         // A capability that calls itself, directly or not, would never end here.
         if self.calling[c.capability] {
-            self.note(Some(c.origin), format!("`{}` calls itself; the estimate counts one round of it", cap.name));
+            self.note(
+                Some(c.origin),
+                format!("`{}` calls itself; the estimate counts one round of it", cap.name),
+            );
             return (t, Vec::new());
         }
         if self.budget == 0 {
@@ -366,7 +425,9 @@ impl<'m> Estimator<'m> {
         let args: Vec<Option<Value>> = c.args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
         // The common case, one drone for a one-actor capability, without the lists of
         // lists the general case builds.
-        if let ([a @ (ActorRef::Drone(_) | ActorRef::Slot(_))], 1) = (c.actors.as_slice(), cap.actors) {
+        if let ([a @ (ActorRef::Drone(_) | ActorRef::Slot(_))], 1) =
+            (c.actors.as_slice(), cap.actors)
+        {
             let Some(d) = self.scope(ctx, t).actor(a) else { return (t, Vec::new()) };
             return self.run_call(c, &[d], &args, ctx, t);
         }
@@ -378,7 +439,11 @@ impl<'m> Estimator<'m> {
                 a => self.scope(ctx, t).actor(a).into_iter().collect(),
             })
             .collect();
-        let runs: Vec<Vec<DroneId>> = if cap.actors == 1 { sets.concat().into_iter().map(|d| vec![d]).collect() } else { vec![sets.iter().filter_map(|s| s.first().copied()).collect()] };
+        let runs: Vec<Vec<DroneId>> = if cap.actors == 1 {
+            sets.concat().into_iter().map(|d| vec![d]).collect()
+        } else {
+            vec![sets.iter().filter_map(|s| s.first().copied()).collect()]
+        };
         let (mut end, mut raises) = (t, Vec::new());
         for actors in runs {
             let (e, r) = self.run_call(c, &actors, &args, ctx, t);
@@ -389,7 +454,14 @@ impl<'m> Estimator<'m> {
     }
 
     /// One run of a called capability on `actors`.
-    fn run_call(&mut self, c: &Call, actors: &[DroneId], args: &[Option<Value>], ctx: &Ctx, t: f64) -> (f64, Vec<Raise>) {
+    fn run_call(
+        &mut self,
+        c: &Call,
+        actors: &[DroneId],
+        args: &[Option<Value>],
+        ctx: &Ctx,
+        t: f64,
+    ) -> (f64, Vec<Raise>) {
         let cap = &self.mission.capabilities[c.capability];
         let top = ctx.statement.is_none();
         let motion = self.motion[c.capability].clone();
@@ -404,10 +476,17 @@ impl<'m> Estimator<'m> {
                 }
             }
             let mut frame = vec![None; cap.frame_size];
-            for (slot, v) in frame.iter_mut().zip(actors.iter().map(|d| Some(Value::Actor(*d))).chain(args.iter().cloned())) {
+            for (slot, v) in frame
+                .iter_mut()
+                .zip(actors.iter().map(|d| Some(Value::Actor(*d))).chain(args.iter().cloned()))
+            {
                 *slot = v;
             }
-            let mut cctx = Ctx { frame, actor: actors.first().copied(), statement: Some(ctx.statement.unwrap_or(c.origin)) };
+            let mut cctx = Ctx {
+                frame,
+                actor: actors.first().copied(),
+                statement: Some(ctx.statement.unwrap_or(c.origin)),
+            };
             self.calling[c.capability] = true;
             let (e, r) = self.block(&cap.perform, &mut cctx, start);
             self.calling[c.capability] = false;
@@ -418,7 +497,13 @@ impl<'m> Estimator<'m> {
                     }
                 }
                 for &d in actors {
-                    self.s.activities[d].push(Activity { start, end: e, what: cap.name.clone(), at: None, origin: Some(c.origin) });
+                    self.s.activities[d].push(Activity {
+                        start,
+                        end: e,
+                        what: cap.name.clone(),
+                        at: None,
+                        origin: Some(c.origin),
+                    });
                 }
             }
             end = end.max(e);
@@ -442,7 +527,14 @@ impl<'m> Estimator<'m> {
 
     /// Targets of the kinds `d` detects that its ground track `from`→`to`, flown during
     /// `[t, t + duration]`, comes within range of: each is a `Detected` at that moment.
-    pub fn scan(&mut self, d: DroneId, from: [f64; 2], to: [f64; 2], t: f64, duration: f64) -> Vec<Raise> {
+    pub fn scan(
+        &mut self,
+        d: DroneId,
+        from: [f64; 2],
+        to: [f64; 2],
+        t: f64,
+        duration: f64,
+    ) -> Vec<Raise> {
         let Some(detected) = self.detected else { return Vec::new() };
         let mut out = Vec::new();
         for (kind, range, found) in self.s.drones[d].detecting.iter_mut() {
@@ -452,15 +544,29 @@ impl<'m> Estimator<'m> {
                 }
                 if let Some(s) = first_within(from, to, [target.at[0], target.at[1]], *range) {
                     found.push(i);
-                    let location = aviary_api::Point { x: target.at[0], y: target.at[1], z: Some(0.0) };
-                    out.push(Raise { t: t + s * duration, signal: detected, actor: Some(d), args: vec![Some(Value::Symbol(kind.clone())), Some(Value::Position(location))] });
+                    let location =
+                        aviary_api::Point { x: target.at[0], y: target.at[1], z: Some(0.0) };
+                    out.push(Raise {
+                        t: t + s * duration,
+                        signal: detected,
+                        actor: Some(d),
+                        args: vec![
+                            Some(Value::Symbol(kind.clone())),
+                            Some(Value::Position(location)),
+                        ],
+                    });
                 }
             }
         }
         out
     }
 
-    pub fn position_arg(&mut self, v: &Option<Value>, d: DroneId, at: Option<Origin>) -> Option<[f64; 3]> {
+    pub fn position_arg(
+        &mut self,
+        v: &Option<Value>,
+        d: DroneId,
+        at: Option<Origin>,
+    ) -> Option<[f64; 3]> {
         match v {
             Some(Value::Position(p)) => Some([p.x, p.y, p.z.unwrap_or(self.s.drones[d].pos[2])]),
             Some(Value::Actor(o)) => self.s.drones.get(*o).map(|f| f.pos),
@@ -498,7 +604,9 @@ fn matches(h: &Handler, frame: &Frame, actor: Option<DroneId>) -> bool {
     match &h.by {
         None => true,
         Some(ActorFilter::Drones(ds)) => actor.is_some_and(|a| ds.contains(&a)),
-        Some(ActorFilter::Slot(s)) => matches!((frame.get(*s), actor), (Some(Some(Value::Actor(d))), Some(a)) if *d == a),
+        Some(ActorFilter::Slot(s)) => {
+            matches!((frame.get(*s), actor), (Some(Some(Value::Actor(d))), Some(a)) if *d == a)
+        }
     }
 }
 

@@ -38,11 +38,13 @@ impl Scope<'_> {
             Expr::Telemetry(a, field) => self.telemetry(self.actor(a)?, *field)?,
             Expr::Attribute(a, i) => self.mission.attribute(*i, self.actor(a)?)?,
             Expr::Point(parts) => {
-                let n: Vec<f64> = parts.iter().map(|p| number(&self.eval(p)?)).collect::<Option<_>>()?;
+                let n: Vec<f64> =
+                    parts.iter().map(|p| number(&self.eval(p)?)).collect::<Option<_>>()?;
                 Value::Position(Point { x: *n.first()?, y: *n.get(1)?, z: n.get(2).copied() })
             }
             Expr::Geo(parts) => {
-                let n: Vec<f64> = parts.iter().map(|p| number(&self.eval(p)?)).collect::<Option<_>>()?;
+                let n: Vec<f64> =
+                    parts.iter().map(|p| number(&self.eval(p)?)).collect::<Option<_>>()?;
                 let p = self.mission.origin?.place(*n.first()?, *n.get(1)?, n.get(2).copied());
                 Value::Position(Point { x: p[0], y: p[1], z: n.get(2).map(|_| p[2]) })
             }
@@ -51,18 +53,26 @@ impl Scope<'_> {
                 Value::Number(((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt())
             }
             Expr::Elapsed => Value::Number(self.t),
-            Expr::Received(s) => Value::Bool(self.raised.get(*s).copied().flatten().is_some_and(|at| at <= self.t)),
+            Expr::Received(s) => {
+                Value::Bool(self.raised.get(*s).copied().flatten().is_some_and(|at| at <= self.t))
+            }
             Expr::Not(x) => Value::Bool(!truth(&self.eval(x)?)?),
-            Expr::And(x, y) => match (self.eval(x).as_ref().and_then(truth), self.eval(y).as_ref().and_then(truth)) {
-                (Some(false), _) | (_, Some(false)) => Value::Bool(false),
-                (Some(true), Some(true)) => Value::Bool(true),
-                _ => return None,
-            },
-            Expr::Or(x, y) => match (self.eval(x).as_ref().and_then(truth), self.eval(y).as_ref().and_then(truth)) {
-                (Some(true), _) | (_, Some(true)) => Value::Bool(true),
-                (Some(false), Some(false)) => Value::Bool(false),
-                _ => return None,
-            },
+            Expr::And(x, y) => {
+                match (self.eval(x).as_ref().and_then(truth), self.eval(y).as_ref().and_then(truth))
+                {
+                    (Some(false), _) | (_, Some(false)) => Value::Bool(false),
+                    (Some(true), Some(true)) => Value::Bool(true),
+                    _ => return None,
+                }
+            }
+            Expr::Or(x, y) => {
+                match (self.eval(x).as_ref().and_then(truth), self.eval(y).as_ref().and_then(truth))
+                {
+                    (Some(true), _) | (_, Some(true)) => Value::Bool(true),
+                    (Some(false), Some(false)) => Value::Bool(false),
+                    _ => return None,
+                }
+            }
             Expr::Compare(x, op, y) => Value::Bool(op.holds(&self.eval(x)?, &self.eval(y)?)),
         })
     }
@@ -82,10 +92,16 @@ impl Scope<'_> {
     fn telemetry(&self, d: DroneId, field: Field) -> Option<Value> {
         let f = self.drones.get(d)?;
         Some(match field {
-            Field::Position => Value::Position(Point { x: f.pos[0], y: f.pos[1], z: Some(f.pos[2]) }),
+            Field::Position => {
+                Value::Position(Point { x: f.pos[0], y: f.pos[1], z: Some(f.pos[2]) })
+            }
             Field::Altitude => Value::Number(f.pos[2]),
             Field::Battery => Value::Number(f.battery_at(self.t)),
-            Field::State => Value::Symbol(if f.airborne { FlightState::Flying } else { FlightState::Landed }.as_str().to_string()),
+            Field::State => Value::Symbol(
+                if f.airborne { FlightState::Flying } else { FlightState::Landed }
+                    .as_str()
+                    .to_string(),
+            ),
             // Between activities the estimate has the drone at rest.
             Field::Speed => Value::Number(0.0),
             Field::Heading | Field::Link => return None,

@@ -8,7 +8,14 @@ use super::estimate::{number_arg, Estimator, Raise};
 use aviary_api::flight::LOAD_TIME;
 
 /// How long `function` takes on drone `d` from time `t`, and the detections on the way.
-pub fn fly(e: &mut Estimator, d: DroneId, function: &str, args: &[Option<Value>], at: Option<Origin>, t: f64) -> (f64, Vec<Raise>) {
+pub fn fly(
+    e: &mut Estimator,
+    d: DroneId,
+    function: &str,
+    args: &[Option<Value>],
+    at: Option<Origin>,
+    t: f64,
+) -> (f64, Vec<Raise>) {
     let max_altitude = e.world.site.max_altitude;
     let mut raises = Vec::new();
     let duration = match function {
@@ -39,7 +46,9 @@ pub fn fly(e: &mut Estimator, d: DroneId, function: &str, args: &[Option<Value>]
         },
         "Hover" => number_arg(args, 0).unwrap_or(0.0),
         "FlyToPosition" => {
-            let Some(to) = e.position_arg(args.first().unwrap_or(&None), d, at) else { return (0.0, raises) };
+            let Some(to) = e.position_arg(args.first().unwrap_or(&None), d, at) else {
+                return (0.0, raises);
+            };
             let f = &e.s.drones[d];
             let speed = number_arg(args, 1).map_or(f.max_speed, |s| s.min(f.max_speed));
             leg(e, d, to, speed, t, &mut raises)
@@ -48,7 +57,9 @@ pub fn fly(e: &mut Estimator, d: DroneId, function: &str, args: &[Option<Value>]
             let center = e.position_arg(args.first().unwrap_or(&None), d, at);
             let radius = number_arg(args, 1);
             match (center, radius) {
-                (Some(c), Some(r)) => e.s.drones[d].orbit([c[0], c[1]], r, number_arg(args, 2).unwrap_or(1.0)),
+                (Some(c), Some(r)) => {
+                    e.s.drones[d].orbit([c[0], c[1]], r, number_arg(args, 2).unwrap_or(1.0))
+                }
                 _ => 0.0,
             }
         }
@@ -77,7 +88,13 @@ pub fn fly(e: &mut Estimator, d: DroneId, function: &str, args: &[Option<Value>]
         "StartDetection" => {
             if let Some(Some(Value::Symbol(kind))) = args.first() {
                 let f = &e.s.drones[d];
-                let range = e.world.sensors.iter().filter(|s| f.sensors.contains(&s.kind) && s.detects.contains(kind)).map(|s| s.range).reduce(f64::max);
+                let range = e
+                    .world
+                    .sensors
+                    .iter()
+                    .filter(|s| f.sensors.contains(&s.kind) && s.detects.contains(kind))
+                    .map(|s| s.range)
+                    .reduce(f64::max);
                 let f = &mut e.s.drones[d];
                 f.detecting.retain(|(k, _, _)| k != kind);
                 if let Some(range) = range {
@@ -100,7 +117,14 @@ pub fn fly(e: &mut Estimator, d: DroneId, function: &str, args: &[Option<Value>]
 }
 
 /// A straight leg, scanning for targets on the way.
-fn leg(e: &mut Estimator, d: DroneId, to: [f64; 3], speed: f64, t: f64, raises: &mut Vec<Raise>) -> f64 {
+fn leg(
+    e: &mut Estimator,
+    d: DroneId,
+    to: [f64; 3],
+    speed: f64,
+    t: f64,
+    raises: &mut Vec<Raise>,
+) -> f64 {
     let from = e.s.drones[d].pos;
     let took = e.s.drones[d].leg_at(to, speed);
     raises.extend(e.scan(d, [from[0], from[1]], [to[0], to[1]], t, took));

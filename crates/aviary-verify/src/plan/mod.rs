@@ -98,12 +98,23 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
         .iter()
         .zip(&est.s.drones)
         .zip(activities)
-        .map(|((w, f), activities)| DronePlan { drone: w.name.clone(), distance: f.distance, flight_time: f.flight_time, battery_left: f.battery_at(end), activities, worst_case: Vec::new() })
+        .map(|((w, f), activities)| DronePlan {
+            drone: w.name.clone(),
+            distance: f.distance,
+            flight_time: f.flight_time,
+            battery_left: f.battery_at(end),
+            activities,
+            worst_case: Vec::new(),
+        })
         .collect();
     for (d, at) in est.s.reserve.iter().enumerate() {
         // Crossed on the way home after the mission's end: at the drone's last statement.
         let after_end = at.is_none();
-        let at = at.or_else(|| (drones[d].battery_left < RESERVE).then(|| drones[d].activities.iter().rev().find_map(|a| a.origin)).flatten());
+        let at = at.or_else(|| {
+            (drones[d].battery_left < RESERVE)
+                .then(|| drones[d].activities.iter().rev().find_map(|a| a.origin))
+                .flatten()
+        });
         if let Some(o) = at {
             let p = &drones[d];
             let end = if p.battery_left > 0.0 {
@@ -111,7 +122,10 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
             } else {
                 // What it uses is what it starts with less what is left.
                 let start = est.s.drones[d].battery_start;
-                format!("it runs out before the end: the mission needs {}% of a full battery", fixed((start - p.battery_left) * 100.0, 0))
+                format!(
+                    "it runs out before the end: the mission needs {}% of a full battery",
+                    fixed((start - p.battery_left) * 100.0, 0)
+                )
             };
             diagnostics.push(
                 Diagnostic::new(Code::LowReserve, o.file, o.span, format!("{}'s battery is estimated to fall under 20% {} ({end})", p.drone, if after_end { "on its way home after the mission ends; this is its last statement" } else { "during this statement" }))
@@ -121,12 +135,23 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
         }
     }
     for h in unfired(&mission.body, &est.s.fired) {
-        let label = format!("ON {}{}", if h.every { "EVERY " } else { "" }, mission.signals[h.signal]);
+        let label =
+            format!("ON {}{}", if h.every { "EVERY " } else { "" }, mission.signals[h.signal]);
         for (d, b) in est.bound(h, end) {
-            drones[d].worst_case.push(Bound { handler: label.clone(), distance: b.0, flight_time: b.1, battery_left: b.2 });
+            drones[d].worst_case.push(Bound {
+                handler: label.clone(),
+                distance: b.0,
+                flight_time: b.1,
+                battery_left: b.2,
+            });
         }
     }
-    let assumptions = est.s.notes().into_iter().map(|(o, text)| Assumption { at: None, text: text.clone(), origin: *o }).collect();
+    let assumptions = est
+        .s
+        .notes()
+        .into_iter()
+        .map(|(o, text)| Assumption { at: None, text: text.clone(), origin: *o })
+        .collect();
     Plan { mission_time: end, drones, assumptions }
 }
 
@@ -144,7 +169,9 @@ fn unfired<'m>(block: &'m Block, fired: &[usize]) -> Vec<&'m Handler> {
     visit(block);
     block.visit(&mut |node| match node {
         Node::Block(b) => visit(b),
-        Node::StartIf { body, .. } | Node::DoWhile { body, .. } | Node::WaitFor { body: Some(body), .. } => visit(body),
+        Node::StartIf { body, .. }
+        | Node::DoWhile { body, .. }
+        | Node::WaitFor { body: Some(body), .. } => visit(body),
         Node::For(f) => visit(&f.body),
         Node::If { branches, otherwise } => {
             branches.iter().for_each(|(_, b)| visit(b));
@@ -164,13 +191,16 @@ impl Plan {
             }
         }
         for a in &mut self.assumptions {
-            a.at = a.origin.map(|(file, start)| place(Origin { file: FileId(file), span: Span::point(start as usize) }));
+            a.at = a.origin.map(|(file, start)| {
+                place(Origin { file: FileId(file), span: Span::point(start as usize) })
+            });
         }
     }
 
     /// The plan as a table per drone, for people.
     pub fn render_text(&self) -> String {
-        let mut out = format!("plan: the mission takes about {} (estimate)\n", clock(self.mission_time));
+        let mut out =
+            format!("plan: the mission takes about {} (estimate)\n", clock(self.mission_time));
         for d in &self.drones {
             out.push_str(&format!(
                 "\n{}: {} m, {} in the air, {}% battery left{}\n",
@@ -181,7 +211,13 @@ impl Plan {
                 if d.battery_left < RESERVE { "  (under the 20% reserve)" } else { "" }
             ));
             for a in &d.activities {
-                out.push_str(&format!("  {:>7} – {:>7} s  {}{}\n", fixed(a.start, 1), fixed(a.end, 1), a.what, a.at.as_ref().map(|p| format!("  ({p})")).unwrap_or_default()));
+                out.push_str(&format!(
+                    "  {:>7} – {:>7} s  {}{}\n",
+                    fixed(a.start, 1),
+                    fixed(a.end, 1),
+                    a.what,
+                    a.at.as_ref().map(|p| format!("  ({p})")).unwrap_or_default()
+                ));
             }
             for b in &d.worst_case {
                 out.push_str(&format!(
@@ -196,7 +232,11 @@ impl Plan {
         if !self.assumptions.is_empty() {
             out.push_str("\nassumed:\n");
             for a in &self.assumptions {
-                out.push_str(&format!("  {}{}\n", a.at.as_ref().map(|p| format!("{p}: ")).unwrap_or_default(), a.text));
+                out.push_str(&format!(
+                    "  {}{}\n",
+                    a.at.as_ref().map(|p| format!("{p}: ")).unwrap_or_default(),
+                    a.text
+                ));
             }
         }
         out

@@ -109,7 +109,8 @@ impl Flyer {
     pub fn orbit(&mut self, center: [f64; 2], radius: f64, laps: f64) -> f64 {
         let (dx, dy) = (self.pos[0] - center[0], self.pos[1] - center[1]);
         let angle = if dx == 0.0 && dy == 0.0 { 0.0 } else { dy.atan2(dx) };
-        let entry = [center[0] + radius * angle.cos(), center[1] + radius * angle.sin(), self.pos[2]];
+        let entry =
+            [center[0] + radius * angle.cos(), center[1] + radius * angle.sin(), self.pos[2]];
         let to_circle = self.leg(entry);
         let arc = laps * std::f64::consts::TAU * radius;
         let speed = aviary_api::geometry::orbit_speed(self.max_speed, self.accel, radius);
@@ -122,7 +123,8 @@ impl Flyer {
         if !self.airborne {
             return 0.0;
         }
-        let safe = aviary_api::flight::return_height(self.pos[2], self.return_altitude, max_altitude);
+        let safe =
+            aviary_api::flight::return_height(self.pos[2], self.return_altitude, max_altitude);
         let up = self.leg([self.pos[0], self.pos[1], safe]);
         let across = self.leg([self.home[0], self.home[1], safe]);
         up + across + self.return_loiter + self.land_here()

@@ -74,7 +74,12 @@ impl State {
             drones: std::mem::replace(&mut self.drones, mark.drones.clone()),
             raised: std::mem::replace(&mut self.raised, mark.raised.clone()),
             reserve: std::mem::replace(&mut self.reserve, mark.reserve.clone()),
-            activities: self.activities.iter_mut().zip(&mark.activities).map(|(a, &n)| a.split_off(n)).collect(),
+            activities: self
+                .activities
+                .iter_mut()
+                .zip(&mark.activities)
+                .map(|(a, &n)| a.split_off(n))
+                .collect(),
             assumptions: self.assumptions.split_off(mark.assumptions),
             fired: self.fired.split_off(mark.fired),
         }
@@ -111,7 +116,11 @@ mod tests {
     struct NoFiles;
 
     impl aviary_check::SourceProvider for NoFiles {
-        fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
+        fn load(
+            &self,
+            _from: &str,
+            path: &str,
+        ) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
             Err(format!("no files here ({path})").into())
         }
     }
@@ -120,9 +129,20 @@ mod tests {
         let world = "[drones.scout]\nhome = [0, 0]\nendurance = 100000\n";
         let mut sources = aviary_diagnostics::SourceMap::new();
         let api = aviary_api::Descriptor::standard();
-        let checked = aviary_check::check_sources(&mut sources, ("m.mission", text.as_bytes()), Some(("w.toml", world.as_bytes())), &NoFiles, &api);
+        let checked = aviary_check::check_sources(
+            &mut sources,
+            ("m.mission", text.as_bytes()),
+            Some(("w.toml", world.as_bytes())),
+            &NoFiles,
+            &api,
+        );
         assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
-        let mission = aviary_ir::compile(checked.program.as_ref().expect("program"), checked.world.as_ref().expect("world"), &api).expect("mission");
+        let mission = aviary_ir::compile(
+            checked.program.as_ref().expect("program"),
+            checked.world.as_ref().expect("world"),
+            &api,
+        )
+        .expect("mission");
         crate::verify(&mission, checked.world.as_ref().expect("world")).plan
     }
 
@@ -138,10 +158,23 @@ mod tests {
             text.push_str(&format!("    IF scout.link = Lost:\n        scout Hover WITH {then}\n    ELSE:\n        scout Hover WITH {otherwise}\n"));
         }
         let p = plan(&text);
-        let hovers: Vec<f64> = p.drones[0].activities.iter().filter(|a| a.what == "Hover").map(|a| a.end - a.start).collect();
+        let hovers: Vec<f64> = p.drones[0]
+            .activities
+            .iter()
+            .filter(|a| a.what == "Hover")
+            .map(|a| a.end - a.start)
+            .collect();
         assert_eq!(hovers.len(), n);
-        assert!(hovers.iter().enumerate().all(|(i, d)| (d - if i % 2 == 0 { 5.0 } else { 3.0 }).abs() < 1e-9), "{:?}", &hovers[..6]);
-        let mut seen: Vec<(Option<(u32, u32)>, &str)> = p.assumptions.iter().map(|a| (a.origin, a.text.as_str())).collect();
+        assert!(
+            hovers
+                .iter()
+                .enumerate()
+                .all(|(i, d)| (d - if i % 2 == 0 { 5.0 } else { 3.0 }).abs() < 1e-9),
+            "{:?}",
+            &hovers[..6]
+        );
+        let mut seen: Vec<(Option<(u32, u32)>, &str)> =
+            p.assumptions.iter().map(|a| (a.origin, a.text.as_str())).collect();
         let all = seen.len();
         seen.dedup();
         assert_eq!(seen.len(), all, "each assumption once");

@@ -11,9 +11,8 @@ use crate::read::{quoted, suggest, toml_text, Ctx};
 use crate::{AttributeValue, Backend, Drone, Group, Mavlink, BUILTIN_SENSORS};
 
 const BACKEND_KEYS: &[&str] = &["backend", "mavlink", "system_id", "signing_key"];
-const SCHEMES: &[&str] = &[
-    "tcp", "tcpin", "tcpout", "udp", "udpin", "udpout", "udpbcast", "serial",
-];
+const SCHEMES: &[&str] =
+    &["tcp", "tcpin", "tcpout", "udp", "udpin", "udpout", "udpbcast", "serial"];
 /// Telemetry fields: `d.speed` reads these, so no attribute may take their names.
 const TELEMETRY: &[&str] = &["position", "altitude", "speed", "heading", "state", "link"];
 const ADDRESS_HELP: &str =
@@ -39,7 +38,8 @@ pub(super) struct Drones {
     others: Vec<(usize, String)>,
 }
 
-pub(super) const HELP: &str = "write one table per drone: `[drones.NAME]` followed by `home = [x, y]`";
+pub(super) const HELP: &str =
+    "write one table per drone: `[drones.NAME]` followed by `home = [x, y]`";
 
 impl Drones {
     /// Room for about `n` drones.
@@ -55,7 +55,9 @@ impl Drones {
             self.others.push((self.out.len(), e.key));
             return;
         }
-        let Entry { key, key_span, node: Node { value: Value::Table(keys), .. } } = e else { return };
+        let Entry { key, key_span, node: Node { value: Value::Table(keys), .. } } = e else {
+            return;
+        };
         let d = self.drone(cx, key, key_span, &keys);
         self.out.push(d);
     }
@@ -71,7 +73,8 @@ impl Drones {
                 Some((g, _)) => self.groups[*g].members.extend(members),
                 None => {
                     let Some((_, shared)) = group_index.get(group.name.as_str()) else { continue };
-                    self.group_index.insert(group.name.clone(), (self.groups.len(), shared.clone()));
+                    self.group_index
+                        .insert(group.name.clone(), (self.groups.len(), shared.clone()));
                     self.groups.push(Group { name: group.name, members: members.collect() });
                     self.group_spans.push(span);
                 }
@@ -148,7 +151,12 @@ impl Drones {
             let what = KeyOf(&k.key, name);
             let n = &k.node;
             match k.key.as_str() {
-                "home" => d.home = cx.point(&what, n).filter(|(p, _)| cx.above_ground(&what, n, p[2])).map_or(d.home, |(p, _)| p),
+                "home" => {
+                    d.home = cx
+                        .point(&what, n)
+                        .filter(|(p, _)| cx.above_ground(&what, n, p[2]))
+                        .map_or(d.home, |(p, _)| p)
+                }
                 "group" => {
                     // Read in place: most drones name a group that exists already.
                     let Value::Str(group) = &n.value else {
@@ -160,8 +168,10 @@ impl Drones {
                             Some((g, shared)) => (*g, shared.clone()),
                             None => {
                                 let shared: Arc<str> = group.as_str().into();
-                                self.group_index.insert(group.clone(), (self.groups.len(), shared.clone()));
-                                self.groups.push(Group { name: group.clone(), members: Vec::new() });
+                                self.group_index
+                                    .insert(group.clone(), (self.groups.len(), shared.clone()));
+                                self.groups
+                                    .push(Group { name: group.clone(), members: Vec::new() });
                                 self.group_spans.push(n.span);
                                 (self.groups.len() - 1, shared)
                             }
@@ -193,10 +203,18 @@ impl Drones {
                 "battery" => d.battery = cx.within(&what, n, 0.0, 100.0).unwrap_or(d.battery),
                 "descent_rate" => d.descent_rate = cx.positive(&what, n).unwrap_or(d.descent_rate),
                 "land_speed" => d.land_speed = cx.positive(&what, n).unwrap_or(d.land_speed),
-                "land_speed_below" => d.land_speed_below = cx.non_negative(&what, n).unwrap_or(d.land_speed_below),
-                "return_altitude" => d.return_altitude = cx.non_negative(&what, n).unwrap_or(d.return_altitude),
-                "return_loiter" => d.return_loiter = cx.non_negative(&what, n).unwrap_or(d.return_loiter),
-                "battery_capacity" => d.battery_capacity = cx.positive(&what, n).or(d.battery_capacity),
+                "land_speed_below" => {
+                    d.land_speed_below = cx.non_negative(&what, n).unwrap_or(d.land_speed_below)
+                }
+                "return_altitude" => {
+                    d.return_altitude = cx.non_negative(&what, n).unwrap_or(d.return_altitude)
+                }
+                "return_loiter" => {
+                    d.return_loiter = cx.non_negative(&what, n).unwrap_or(d.return_loiter)
+                }
+                "battery_capacity" => {
+                    d.battery_capacity = cx.positive(&what, n).or(d.battery_capacity)
+                }
                 "flight_current" => d.flight_current = cx.positive(&what, n).or(d.flight_current),
                 key if BACKEND_KEYS.contains(&key) => {}
                 _ => {
@@ -221,7 +239,8 @@ impl Drones {
         if d.land_speed.is_nan() {
             d.land_speed = d.descent_rate;
         }
-        if let Some(endurance) = Drone::endurance_from_battery(d.battery_capacity, d.flight_current) {
+        if let Some(endurance) = Drone::endurance_from_battery(d.battery_capacity, d.flight_current)
+        {
             d.endurance = endurance;
         }
         d.backend = backend(cx, name, keys);
@@ -235,11 +254,8 @@ fn check_sensor(cx: &mut Ctx, drone: &str, kind: &str, span: Span, defined: &[St
     if defined.iter().any(|k| k == kind) || BUILTIN_SENSORS.contains(&kind) {
         return;
     }
-    let known: Vec<&str> = defined
-        .iter()
-        .map(String::as_str)
-        .chain(BUILTIN_SENSORS.iter().copied())
-        .collect();
+    let known: Vec<&str> =
+        defined.iter().map(String::as_str).chain(BUILTIN_SENSORS.iter().copied()).collect();
     let msg = format!("drone `{drone}` has sensor `{kind}`, but no `[sensors.{kind}]` defines it");
     let help = match suggest(kind, known.iter().copied()) {
         Some(s) => format!("did you mean `{s}`?"),
@@ -257,10 +273,7 @@ fn attribute<'e>(cx: &mut Ctx, drone: &str, e: &'e Entry) -> Option<(&'e str, At
         let msg = format!(
             "attribute `{key}` of drone `{drone}` has the name of a telemetry field, so `{drone}.{key}` could not read it"
         );
-        let help = format!(
-            "rename the attribute; the telemetry fields are {}",
-            quoted(TELEMETRY)
-        );
+        let help = format!("rename the attribute; the telemetry fields are {}", quoted(TELEMETRY));
         cx.error(e.key_span, msg, help);
         return None;
     }
@@ -321,11 +334,7 @@ fn backend(cx: &mut Ctx, drone: &str, keys: &[Entry]) -> Backend {
         return Backend::Sim;
     }
     let address = address.map(|(a, _)| a).unwrap_or_default();
-    Backend::Mavlink(Box::new(Mavlink {
-        address,
-        system_id,
-        signing_key,
-    }))
+    Backend::Mavlink(Box::new(Mavlink { address, system_id, signing_key }))
 }
 
 fn system_id(cx: &mut Ctx, drone: &str, e: &Entry) -> Option<u8> {
@@ -336,11 +345,7 @@ fn system_id(cx: &mut Ctx, drone: &str, e: &Entry) -> Option<u8> {
                 "`system_id` of drone `{drone}` must be a whole number from 1 to 255, found {}",
                 toml_text(&e.node)
             );
-            cx.error(
-                e.node.span,
-                msg,
-                "write the MAVLink system id, e.g. `system_id = 1`",
-            );
+            cx.error(e.node.span, msg, "write the MAVLink system id, e.g. `system_id = 1`");
             None
         }
     }

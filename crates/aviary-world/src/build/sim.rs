@@ -22,14 +22,12 @@ pub(super) fn sensors(cx: &mut Ctx, node: &Node) -> Vec<Sensor> {
         };
         cx.known_keys(keys, SENSOR_KEYS, &format!("[sensors.{kind}]"));
         let detects = match get(keys, "detects") {
-            Some(d) => cx
-                .strings(&format!("`detects` of sensor `{kind}`"), &d.node)
-                .map(|kinds| {
-                    for (name, span) in &kinds {
-                        cx.identifier("target kind", name, *span);
-                    }
-                    kinds.into_iter().map(|(name, _)| name).collect()
-                }),
+            Some(d) => cx.strings(&format!("`detects` of sensor `{kind}`"), &d.node).map(|kinds| {
+                for (name, span) in &kinds {
+                    cx.identifier("target kind", name, *span);
+                }
+                kinds.into_iter().map(|(name, _)| name).collect()
+            }),
             None => {
                 let msg = format!("sensor `{kind}` has no `detects`");
                 cx.error(
@@ -44,21 +42,12 @@ pub(super) fn sensors(cx: &mut Ctx, node: &Node) -> Vec<Sensor> {
             Some(r) => cx.positive(&format!("`range` of sensor `{kind}`"), &r.node),
             None => {
                 let msg = format!("sensor `{kind}` has no `range`");
-                cx.error(
-                    e.key_span,
-                    msg,
-                    "add `range = 20`: metres from the drone's ground point",
-                );
+                cx.error(e.key_span, msg, "add `range = 20`: metres from the drone's ground point");
                 None
             }
         };
         if let (Some(detects), Some(range)) = (detects, range) {
-            out.push(Sensor {
-                kind: kind.clone(),
-                detects,
-                range,
-                span: e.key_span,
-            });
+            out.push(Sensor { kind: kind.clone(), detects, range, span: e.key_span });
         }
     }
     out
@@ -72,10 +61,7 @@ fn entries<'n>(
     help: &str,
 ) -> Vec<(&'n [Entry], aviary_diagnostics::Span)> {
     let Value::Array(items) = &node.value else {
-        let msg = format!(
-            "`{name}` must be a list of tables, found {}",
-            node.describe()
-        );
+        let msg = format!("`{name}` must be a list of tables, found {}", node.describe());
         cx.error(node.span, msg, help);
         return Vec::new();
     };
@@ -151,32 +137,23 @@ pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[&str]) -> Vec<Fault> {
                 known
             }),
             None => {
-                missing(
-                    cx,
-                    "drone",
-                    "add `drone = \"NAME\"`: the drone it happens to".into(),
-                );
+                missing(cx, "drone", "add `drone = \"NAME\"`: the drone it happens to".into());
                 None
             }
         };
         let at = match get(keys, "at") {
             Some(a) => cx.number(&"`at` of a fault", &a.node).filter(|&t| {
                 if t < 0.0 {
-                    let msg = format!("`at` of a fault must be zero or more seconds, found {}", aviary_api::show::number(t));
-                    cx.error(
-                        a.node.span,
-                        msg,
-                        "write the mission time in seconds, e.g. `at = 60`",
+                    let msg = format!(
+                        "`at` of a fault must be zero or more seconds, found {}",
+                        aviary_api::show::number(t)
                     );
+                    cx.error(a.node.span, msg, "write the mission time in seconds, e.g. `at = 60`");
                 }
                 t >= 0.0
             }),
             None => {
-                missing(
-                    cx,
-                    "at",
-                    "add `at = 60`: when it happens, in mission seconds".into(),
-                );
+                missing(cx, "at", "add `at = 60`: when it happens, in mission seconds".into());
                 None
             }
         };
@@ -199,10 +176,7 @@ pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[&str]) -> Vec<Fault> {
                 missing(
                     cx,
                     "kind",
-                    format!(
-                        "add `kind = \"crash\"`; the fault kinds are {}",
-                        quoted(&kinds)
-                    ),
+                    format!("add `kind = \"crash\"`; the fault kinds are {}", quoted(&kinds)),
                 );
                 None
             }
@@ -212,11 +186,7 @@ pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[&str]) -> Vec<Fault> {
         match (kind, duration) {
             (Some((kind, k)), None) if kind.has_duration() => {
                 let msg = format!("a `{}` fault needs a `duration`", kind.as_str());
-                cx.error(
-                    k.node.span,
-                    msg,
-                    "add `duration = 10`: how many seconds it lasts",
-                );
+                cx.error(k.node.span, msg, "add `duration = 10`: how many seconds it lasts");
             }
             (Some((kind, _)), Some(d)) if !kind.has_duration() => {
                 let msg = format!(
@@ -228,13 +198,7 @@ pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[&str]) -> Vec<Fault> {
             _ => {}
         }
         if let (Some(drone), Some(at), Some((kind, _))) = (drone, at, kind) {
-            out.push(Fault {
-                drone,
-                at,
-                kind,
-                duration: seconds,
-                span: head,
-            });
+            out.push(Fault { drone, at, kind, duration: seconds, span: head });
         }
     }
     out

@@ -62,15 +62,22 @@ pub enum BenchCommand {
     /// mission of a shape that once made the analyses quadratic; prints MB/s
     Front {
         /// `sequential`: N statements in one SEQUENTIAL block on one drone; `chain`: N
-        /// capabilities, each calling the next
+        /// capabilities, each calling the next; `realistic`: the mission of `bench parse`, of
+        /// N MB
         #[arg(long, value_enum, default_value = "sequential")]
         shape: front::Shape,
-        /// Statements or capabilities
+        /// Statements, capabilities, or MB (realistic)
         #[arg(long, default_value_t = 100_000)]
         n: usize,
         /// How many timed runs; the median is reported
         #[arg(long, default_value_t = 3)]
         runs: usize,
+        /// Print the generated mission instead of timing it (for `aviary check` on a file)
+        #[arg(long)]
+        emit: bool,
+        /// Print the generated world instead of timing it
+        #[arg(long)]
+        emit_world: bool,
     },
     /// N simulated drones, each sweeping its own area with detection on; prints
     /// simulated seconds per wall second
@@ -93,7 +100,9 @@ pub fn run(which: BenchCommand) -> u8 {
             w::run(n, k, emit, emit_world, full_trace)
         }
         BenchCommand::Swarm { drones, emit, emit_world } => swarm::run(drones, emit, emit_world),
-        BenchCommand::Front { shape, n, runs } => front::run(shape, n, runs),
+        BenchCommand::Front { shape, n, runs, emit, emit_world } => {
+            front::run(shape, n, runs, emit, emit_world)
+        }
     }
 }
 

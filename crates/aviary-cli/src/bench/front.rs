@@ -1,4 +1,5 @@
-//! `aviary bench front`: the whole of `aviary check` on a generated mission of a shape
+//! `aviary bench front`: the whole of `aviary check` on a generated mission: the realistic
+//! mission of `aviary bench parse` (`aviary_check::generate::large_mission`), or a shape
 //! that once made the pre-flight analyses quadratic (`aviary_check::generate::front`):
 //! N statements in one SEQUENTIAL block on one drone, or a chain of N capabilities.
 //! Times parse + check, compile, and the analyses (conflicts and the plan), and prints
@@ -17,6 +18,8 @@ pub enum Shape {
     Sequential,
     /// N capabilities, each calling the next
     Chain,
+    /// The realistic mission of `aviary bench parse`, of N MB
+    Realistic,
 }
 
 /// One run's stages: parse + check, compile, analyses; and the diagnostics found.
@@ -28,19 +31,36 @@ struct Timed {
     others: usize,
 }
 
-pub fn run(shape: Shape, n: usize, runs: usize) -> u8 {
+pub fn run(shape: Shape, n: usize, runs: usize, emit: bool, emit_world: bool) -> u8 {
     if n == 0 || n > 50_000_000 {
         eprintln!("aviary: --n must be from 1 to 50000000");
         return 2;
     }
     let runs = runs.max(1);
-    let (mission, what) = match shape {
-        Shape::Sequential => {
-            (aviary_check::generate::sequential_mission(n), "statements in one SEQUENTIAL block")
+    let (mission, world, what) = match shape {
+        Shape::Sequential => (
+            aviary_check::generate::sequential_mission(n),
+            aviary_check::generate::front_world(),
+            "statements in one SEQUENTIAL block",
+        ),
+        Shape::Chain => (
+            aviary_check::generate::chain_mission(n),
+            aviary_check::generate::front_world(),
+            "capabilities in a chain",
+        ),
+        Shape::Realistic if n > 4000 => {
+            eprintln!("aviary: --n is in MB for the realistic shape: at most 4000");
+            return 2;
         }
-        Shape::Chain => (aviary_check::generate::chain_mission(n), "capabilities in a chain"),
+        Shape::Realistic => {
+            let (mission, world) = aviary_check::generate::large_mission(n * MB as usize);
+            (mission, world, "MB of the realistic mission (waves of sectors)")
+        }
     };
-    let world = aviary_check::generate::front_world();
+    if emit || emit_world {
+        out!("{}", if emit { &mission } else { &world });
+        return 0;
+    }
     let size = mission.len();
     outln!("generated a mission of {n} {what}: {:.2} MB ({size} bytes)", size as f64 / MB);
     let mut totals = Vec::with_capacity(runs);

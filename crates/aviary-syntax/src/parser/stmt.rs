@@ -399,6 +399,8 @@ impl Parser<'_> {
                 break;
             }
         }
+        // Most lists have one or two arguments; a vector grows to four at its first push.
+        args.shrink_to_fit();
         args
     }
 

@@ -66,7 +66,10 @@ impl Pending {
 
 pub use super::state::State;
 
-#[derive(Clone)]
+/// Where the walk is. One `Ctx` serves a whole walk of the mission body: a FOR instance
+/// or a handler sets its slots in place and puts back what they held ([`Estimator::with`]),
+/// because the mission's frame has a slot for every alias and binding of the mission, and
+/// a copy per instance or per firing made a long mission's walk quadratic.
 struct Ctx {
     frame: Frame,
     /// The signalling actor: of the capability or FOR instance.
@@ -80,6 +83,8 @@ pub struct Estimator<'m> {
     pub world: &'m World,
     /// First raise times from the previous pass, for `WAITFOR RECEIVED` ahead of its signal.
     pub known: Vec<Option<f64>>,
+    /// Whether the walk read `known`: a walk that did not would be the same again.
+    pub read_known: bool,
     pub s: State,
     /// The capabilities being walked, by index: a flag each, so that a chain of N
     /// capabilities asks N times in O(1), not in O(depth).
@@ -91,6 +96,9 @@ pub struct Estimator<'m> {
     /// Capability calls the walk may still follow ([`call_budget`]), and whether it ran out.
     budget: usize,
     cut_short: bool,
+    /// A mission frame with every slot empty, lent to each walk of [`Estimator::bound`]
+    /// and given back as empty as it was lent.
+    blank: Frame,
 }
 
 /// How many capability calls a walk follows: generous for any mission's size (64 per
@@ -115,11 +123,11 @@ const MAX_ROUNDS: usize = 10_000;
 impl<'m> Estimator<'m> {
     pub fn new(mission: &'m Mission, world: &'m World, known: Vec<Option<f64>>) -> Estimator<'m> {
         let drones: Vec<Flyer> = world.drones.iter().map(Flyer::new).collect();
-        let n = drones.len();
         Estimator {
             mission,
             world,
             known,
+            read_known: false,
             calling: vec![false; mission.capabilities.len()],
             motion: mission
                 .capabilities
@@ -136,14 +144,8 @@ impl<'m> Estimator<'m> {
             detected: mission.signals.iter().position(|s| s == "Detected"),
             budget: call_budget(mission),
             cut_short: false,
-            s: State {
-                drones,
-                activities: vec![Vec::new(); n],
-                raised: vec![None; mission.signals.len()],
-                reserve: vec![None; n],
-                assumptions: Vec::new(),
-                fired: Vec::new(),
-            },
+            blank: Vec::new(),
+            s: State::new(drones, mission.signals.len()),
         }
     }
 
@@ -176,12 +178,13 @@ impl<'m> Estimator<'m> {
     /// the air, battery left at the end). The state is left as it was.
     pub fn bound(&mut self, h: &Handler, t: f64) -> Vec<(DroneId, (f64, f64, f64))> {
         let mark = self.s.mark();
-        let before = self.s.drones.clone();
-        let mut ctx =
-            Ctx { frame: vec![None; self.mission.frame_size], actor: None, statement: None };
+        let mut blank = std::mem::take(&mut self.blank);
+        blank.resize(self.mission.frame_size, None);
+        let mut ctx = Ctx { frame: blank, actor: None, statement: None };
         let (end, _) = self.block(&h.body, &mut ctx, t);
+        self.blank = ctx.frame;
         let mut out = Vec::new();
-        for (d, then) in before.iter().enumerate() {
+        for (d, then) in mark.drones().iter().enumerate() {
             let f = &mut self.s.drones[d];
             if f.airborne {
                 let took = f.return_home(self.world.site.max_altitude);
@@ -199,9 +202,7 @@ impl<'m> Estimator<'m> {
                 ));
             }
         }
-        // Back to before the firing, keeping what it had to assume.
-        let tail = self.s.cut(&mark);
-        self.s.assumptions.extend(tail.into_notes());
+        self.s.back_keeping_notes(mark);
         out
     }
 
@@ -217,6 +218,31 @@ impl<'m> Estimator<'m> {
             raised: &self.s.raised,
             t,
         }
+    }
+
+    /// Walks with `slots` set and `actor` signalling, then puts back what the slots and
+    /// the actor were: the frame leaves as it came (in reverse, so a slot written twice
+    /// gets its first value back).
+    fn with<R>(
+        &mut self,
+        ctx: &mut Ctx,
+        slots: impl IntoIterator<Item = (usize, Option<Value>)>,
+        actor: Option<DroneId>,
+        walk: impl FnOnce(&mut Self, &mut Ctx) -> R,
+    ) -> R {
+        let mut held = Vec::new();
+        for (slot, value) in slots {
+            if let Some(s) = ctx.frame.get_mut(slot) {
+                held.push((slot, std::mem::replace(s, value)));
+            }
+        }
+        let outer = std::mem::replace(&mut ctx.actor, actor);
+        let r = walk(self, ctx);
+        ctx.actor = outer;
+        for (slot, value) in held.into_iter().rev() {
+            ctx.frame[slot] = value;
+        }
+        r
     }
 
     fn block(&mut self, b: &Block, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
@@ -252,12 +278,10 @@ impl<'m> Estimator<'m> {
                 }
                 once[hi] = true;
                 self.s.fired.push(h as *const Handler as usize);
-                let mut hctx = ctx.clone();
-                for (slot, v) in h.bindings.iter().zip(&r.args) {
-                    set(&mut hctx.frame, *slot, v.clone());
-                }
+                let bindings = h.bindings.iter().copied().zip(r.args.iter().cloned());
                 let start = if h.sequential { items_end.max(r.t) } else { r.t };
-                let (e, more) = self.block(&h.body, &mut hctx, start);
+                let (e, more) =
+                    self.with(ctx, bindings, ctx.actor, |est, ctx| est.block(&h.body, ctx, start));
                 end = end.max(e);
                 for r in more {
                     pending.push(r);
@@ -275,8 +299,7 @@ impl<'m> Estimator<'m> {
             Node::Api(a) => self.api(a, ctx, t),
             Node::Signal { signal, args, .. } => {
                 let args = args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
-                let first = &mut self.s.raised[*signal];
-                *first = Some(first.map_or(t, |f| f.min(t)));
+                self.s.raise(*signal, t);
                 (t, vec![Raise { t, signal: *signal, actor: ctx.actor, args }])
             }
             Node::Leash(_) | Node::Throw { .. } => (t, Vec::new()),
@@ -308,14 +331,14 @@ impl<'m> Estimator<'m> {
                         a => self.scope(ctx, t).actor(a).into_iter().collect(),
                     };
                     for d in members {
-                        let mut ictx = ctx.clone();
-                        set(&mut ictx.frame, f.alias, Some(Value::Actor(d)));
+                        // The values are read where the FOR stands, before its alias is set.
+                        let mut slots = vec![(f.alias, Some(Value::Actor(d)))];
                         for (slot, v) in f.params.iter().zip(values) {
-                            set(&mut ictx.frame, *slot, self.scope(ctx, t).eval(v));
+                            slots.push((*slot, self.scope(ctx, t).eval(v)));
                         }
-                        ictx.actor = Some(d);
                         let start = if f.parallel { t } else { end };
-                        let (e, r) = self.block(&f.body, &mut ictx, start);
+                        let (e, r) = self
+                            .with(ctx, slots, Some(d), |est, ctx| est.block(&f.body, ctx, start));
                         end = end.max(e);
                         raises.extend(r);
                     }
@@ -343,7 +366,7 @@ impl<'m> Estimator<'m> {
             Some(false) => self.choose(rest, otherwise, ctx, t),
             None => {
                 let mark = self.s.mark();
-                let taken = self.block(body, &mut ctx.clone(), t);
+                let taken = self.block(body, ctx, t);
                 let after_taken = self.s.cut(&mark);
                 let skipped = self.choose(rest, otherwise, ctx, t);
                 if taken.0 > skipped.0 {
@@ -390,7 +413,14 @@ impl<'m> Estimator<'m> {
 
     fn wait(&mut self, condition: &Expr, ctx: &Ctx, t: f64) -> f64 {
         if let Expr::Received(s) = condition {
-            if let Some(at) = self.s.raised[*s].or(self.known[*s]) {
+            let at = match self.s.raised[*s] {
+                Some(at) => Some(at),
+                None => {
+                    self.read_known = true;
+                    self.known[*s]
+                }
+            };
+            if let Some(at) = at {
                 return t.max(at);
             }
         }
@@ -587,12 +617,6 @@ impl<'m> Estimator<'m> {
                 far.map(|p| [p[0], p[1], here[2]])
             }
         }
-    }
-}
-
-fn set(frame: &mut Frame, slot: usize, value: Option<Value>) {
-    if let Some(s) = frame.get_mut(slot) {
-        *s = value;
     }
 }
 

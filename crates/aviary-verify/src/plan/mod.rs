@@ -82,7 +82,7 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
     let mut est = Estimator::new(mission, world, known.clone());
     let mut end = est.run();
     for _ in 1..PASSES {
-        if est.s.raised == known {
+        if !est.read_known || est.s.raised == known {
             break;
         }
         known = est.s.raised.clone();

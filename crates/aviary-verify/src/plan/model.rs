@@ -20,7 +20,8 @@ pub struct Flyer {
     pub accel: f64,
     pub endurance: f64,
     pub battery_start: f64,
-    pub sensors: Vec<String>,
+    /// Shared: a drone's copy is taken at every undecidable `IF` and unfired handler.
+    pub sensors: std::rc::Rc<[String]>,
     pub airborne: bool,
     /// When the drone last took off, while it is in the air.
     pub since: f64,
@@ -45,7 +46,7 @@ impl Flyer {
             accel: d.acceleration,
             endurance: d.endurance,
             battery_start: d.battery / 100.0,
-            sensors: d.sensors.to_vec(),
+            sensors: d.sensors.iter().cloned().collect(),
             airborne: false,
             since: 0.0,
             flight_time: 0.0,

@@ -1,9 +1,11 @@
-//! What a walk of the estimate changes, and how an `IF` it cannot decide tries both ways
-//! without copying it all. The per-drone and per-signal figures are copied (their size is
-//! the fleet's and the signals', not the mission's); what grows with the mission (the
-//! activities, the assumptions, the handlers that fired) only grows during a walk, so a
-//! [`Mark`] remembers its lengths, and going back is cutting there. Trying both sides of
-//! N undecidable `IF`s in a row so costs what the walks cost, not N copies of everything.
+//! What a walk of the estimate changes, and how an `IF` it cannot decide, or a handler's
+//! worst case, tries a walk and goes back without copying it all. The per-drone figures
+//! are copied (their size is the fleet's, not the mission's). What grows with the mission
+//! only grows during a walk (the activities, the assumptions, the handlers that fired) or
+//! changes with a log of what it held (the signals' first raise times), so a [`Mark`]
+//! remembers lengths, and going back is cutting there. Trying both sides of N undecidable
+//! `IF`s in a row, or N unfired handlers, so costs what the walks cost, not N copies of
+//! everything.
 
 use aviary_ir::Origin;
 
@@ -18,7 +20,10 @@ pub struct State {
     pub drones: Vec<Flyer>,
     /// Per drone; only ever pushed to.
     pub activities: Vec<Vec<Activity>>,
+    /// Per signal, when it is first raised; changed only by [`State::raise`].
     pub raised: Vec<Option<f64>>,
+    /// Each change to `raised`: the signal and what it held before.
+    raised_log: Vec<(usize, Option<f64>)>,
     /// Per drone: the mission-level statement during which the reserve fell under 20%.
     pub reserve: Vec<Option<Origin>>,
     /// What the estimate had to assume, with where, as noted (each may come more than
@@ -31,7 +36,7 @@ pub struct State {
 /// The state at a moment: the small parts, and the lengths of the growing ones.
 pub struct Mark {
     drones: Vec<Flyer>,
-    raised: Vec<Option<f64>>,
+    raised: usize,
     reserve: Vec<Option<Origin>>,
     activities: Vec<usize>,
     assumptions: usize,
@@ -42,25 +47,48 @@ pub struct Mark {
 /// the growing ones gained.
 pub struct Tail {
     drones: Vec<Flyer>,
-    raised: Vec<Option<f64>>,
+    /// The changes to `raised`, last first: the signal and what it held after.
+    raised: Vec<(usize, Option<f64>)>,
     reserve: Vec<Option<Origin>>,
     activities: Vec<Vec<Activity>>,
     assumptions: Vec<Note>,
     fired: Vec<usize>,
 }
 
-impl Tail {
-    /// What the walk assumed, alone.
-    pub fn into_notes(self) -> Vec<Note> {
-        self.assumptions
+impl Mark {
+    /// The drones as they were at the mark.
+    pub fn drones(&self) -> &[Flyer] {
+        &self.drones
     }
 }
 
 impl State {
+    pub fn new(drones: Vec<Flyer>, signals: usize) -> State {
+        let n = drones.len();
+        State {
+            drones,
+            activities: vec![Vec::new(); n],
+            raised: vec![None; signals],
+            raised_log: Vec::new(),
+            reserve: vec![None; n],
+            assumptions: Vec::new(),
+            fired: Vec::new(),
+        }
+    }
+
+    /// `signal` is raised at `t`: its first raise time becomes `t` if that is earlier.
+    pub fn raise(&mut self, signal: usize, t: f64) {
+        let first = self.raised[signal];
+        if first.is_none_or(|f| t < f) {
+            self.raised_log.push((signal, first));
+            self.raised[signal] = Some(t);
+        }
+    }
+
     pub fn mark(&self) -> Mark {
         Mark {
             drones: self.drones.clone(),
-            raised: self.raised.clone(),
+            raised: self.raised_log.len(),
             reserve: self.reserve.clone(),
             activities: self.activities.iter().map(Vec::len).collect(),
             assumptions: self.assumptions.len(),
@@ -72,7 +100,7 @@ impl State {
     pub fn cut(&mut self, mark: &Mark) -> Tail {
         Tail {
             drones: std::mem::replace(&mut self.drones, mark.drones.clone()),
-            raised: std::mem::replace(&mut self.raised, mark.raised.clone()),
+            raised: self.unraise(mark.raised),
             reserve: std::mem::replace(&mut self.reserve, mark.reserve.clone()),
             activities: self
                 .activities
@@ -85,6 +113,17 @@ impl State {
         }
     }
 
+    /// Back to `mark`, but keeping what the walk since had to assume.
+    pub fn back_keeping_notes(&mut self, mark: Mark) {
+        self.unraise(mark.raised);
+        for (a, &n) in self.activities.iter_mut().zip(&mark.activities) {
+            a.truncate(n);
+        }
+        self.fired.truncate(mark.fired);
+        self.drones = mark.drones;
+        self.reserve = mark.reserve;
+    }
+
     /// Back to `mark`, then on with `tail`: the state the walk that made `tail` left.
     pub fn redo(&mut self, mark: &Mark, tail: Tail) {
         for (a, &n) in self.activities.iter_mut().zip(&mark.activities) {
@@ -92,14 +131,28 @@ impl State {
         }
         self.assumptions.truncate(mark.assumptions);
         self.fired.truncate(mark.fired);
+        self.unraise(mark.raised);
         self.drones = tail.drones;
-        self.raised = tail.raised;
+        for (signal, after) in tail.raised.into_iter().rev() {
+            self.raised_log.push((signal, self.raised[signal]));
+            self.raised[signal] = after;
+        }
         self.reserve = tail.reserve;
         for (a, more) in self.activities.iter_mut().zip(tail.activities) {
             a.extend(more);
         }
         self.assumptions.extend(tail.assumptions);
         self.fired.extend(tail.fired);
+    }
+
+    /// Undoes the changes to `raised` past the log's length `to`; what each held after.
+    fn unraise(&mut self, to: usize) -> Vec<(usize, Option<f64>)> {
+        let undone = self.raised_log.split_off(to.min(self.raised_log.len()));
+        undone
+            .into_iter()
+            .rev()
+            .map(|(signal, before)| (signal, std::mem::replace(&mut self.raised[signal], before)))
+            .collect()
     }
 
     /// The assumptions, sorted, each once.

@@ -11,6 +11,10 @@
 //!
 //! Invariant: this crate knows no engine, no backend and no syntax.
 
+// A pure stage: no unsafe code, and no panic on any input (tests may unwrap).
+#![forbid(unsafe_code)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+
 pub mod flight;
 pub mod geo;
 pub mod geometry;

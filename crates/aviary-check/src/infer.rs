@@ -65,8 +65,11 @@ pub(crate) fn parameter_kinds(
     // later in the order is visited in the same round, as the full scan would; one
     // earlier, in the next). A visit with nothing new learns what it learned before, so
     // the result is the full scan's; a chain of N capabilities costs N visits, not N².
-    let callers = callers(&caps, &index);
-    let mut round: BTreeSet<usize> = (0..names.len()).collect();
+    // A capability without parameters has nothing to learn, and so never tells a caller
+    // anything: it is never visited (most capabilities of a long chain are such).
+    let learns = |ci: usize| caps[ci].is_some_and(|c| !c.params.is_empty());
+    let callers = callers(&caps, &index, learns);
+    let mut round: BTreeSet<usize> = (0..names.len()).filter(|&ci| learns(ci)).collect();
     let total: usize = kinds.iter().flatten().map(Vec::len).sum();
     for _ in 0..=total {
         let mut changed = false;
@@ -174,14 +177,16 @@ fn by_name<T>(names: &[&String], values: Vec<Option<T>>) -> BTreeMap<String, T> 
     names.iter().zip(values).filter_map(|(n, v)| Some(((*n).clone(), v?))).collect()
 }
 
-/// For each capability (by index), the capabilities whose bodies call it.
+/// For each capability (by index), the capabilities whose bodies call it, of those that
+/// `learns`.
 fn callers(
     caps: &[Option<&Capability>],
     index: &foldhash::HashMap<&str, usize>,
+    learns: impl Fn(usize) -> bool,
 ) -> Vec<Vec<usize>> {
     let mut out = vec![Vec::new(); caps.len()];
     for (ci, c) in caps.iter().enumerate() {
-        let Some(c) = c else { continue };
+        let Some(c) = c.filter(|_| learns(ci)) else { continue };
         for body in capability_bodies(c) {
             visit_stmts(body, &mut |stmt| {
                 if let Stmt::Statement(s) = stmt {

@@ -5,6 +5,10 @@
 //! Invariant: no IO. Files come through a [`SourceProvider`] that the caller supplies
 //! (the CLI reads the disk; tests use a map), as in typst's `World`.
 
+// A pure stage: no unsafe code, and no panic on any input (tests may unwrap).
+#![forbid(unsafe_code)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+
 mod chains;
 mod endurance;
 mod env;

@@ -108,7 +108,9 @@ pub(crate) fn load(
 }
 
 fn index_definitions(program: &mut Program, std_id: FileId, diagnostics: &mut Vec<Diagnostic>) {
-    let mut user: BTreeMap<String, (DefRef, aviary_diagnostics::Span)> = BTreeMap::new();
+    // By hash and borrowed: a mission may define tens of thousands of capabilities.
+    let mut user: foldhash::HashMap<&str, (DefRef, aviary_diagnostics::Span)> =
+        foldhash::HashMap::default();
     let mut mission: Option<(DefRef, aviary_diagnostics::Span)> = None;
     for (file, tree) in &program.files {
         for (index, item) in tree.items.iter().enumerate() {
@@ -118,7 +120,7 @@ fn index_definitions(program: &mut Program, std_id: FileId, diagnostics: &mut Ve
                     program.capabilities.insert(c.name.name.clone(), r);
                 }
                 Item::Capability(c) => {
-                    if let Some((first, span)) = user.get(&c.name.name) {
+                    if let Some((first, span)) = user.get(c.name.name.as_str()) {
                         diagnostics.push(
                             Diagnostic::new(
                                 Code::DuplicateCapability,
@@ -131,7 +133,7 @@ fn index_definitions(program: &mut Program, std_id: FileId, diagnostics: &mut Ve
                         );
                         continue;
                     }
-                    user.insert(c.name.name.clone(), (r, c.name.span));
+                    user.insert(&c.name.name, (r, c.name.span));
                     program.capabilities.insert(c.name.name.clone(), r);
                 }
                 Item::Mission(m) => {

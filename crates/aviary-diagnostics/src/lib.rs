@@ -2,6 +2,10 @@
 //!
 //! Invariant: this crate does no IO. Rendering produces strings; the CLI prints them.
 
+// A pure stage: no unsafe code, and no panic on any input (tests may unwrap).
+#![forbid(unsafe_code)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+
 mod code;
 mod render;
 mod source;

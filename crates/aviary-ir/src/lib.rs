@@ -8,6 +8,10 @@
 //!
 //! Invariant: no IO; `compile` takes a checked program and never panics.
 
+// A pure stage: no unsafe code, and no panic on any input (tests may unwrap).
+#![forbid(unsafe_code)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+
 mod compile;
 
 pub use compile::compile;

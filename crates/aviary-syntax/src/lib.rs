@@ -4,6 +4,10 @@
 //! Invariants: no IO; `parse` returns a tree for every input, plus diagnostics; every
 //! node carries the span of its source text; recursion is bounded by `MAX_DEPTH`.
 
+// A pure stage: no unsafe code, and no panic on any input (tests may unwrap).
+#![forbid(unsafe_code)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+
 pub mod ast;
 mod fmt;
 mod layout;

@@ -4,6 +4,10 @@
 //! Invariant: no IO. They run on the IR, after the checker found no error, so names are
 //! resolved, units are SI and every statement keeps its origin for the report.
 
+// A pure stage: no unsafe code, and no panic on any input (tests may unwrap).
+#![forbid(unsafe_code)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+
 mod conflicts;
 pub mod plan;
 mod sites;

@@ -79,7 +79,7 @@ impl State {
     /// `signal` is raised at `t`: its first raise time becomes `t` if that is earlier.
     pub fn raise(&mut self, signal: usize, t: f64) {
         let first = self.raised[signal];
-        if first.is_none_or(|f| t < f) {
+        if first.map_or(true, |f| t < f) {
             self.raised_log.push((signal, first));
             self.raised[signal] = Some(t);
         }

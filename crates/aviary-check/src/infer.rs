@@ -3,14 +3,14 @@
 //! The first use that fixes a kind wins; a conflicting use is then reported at its call,
 //! with the chain of uses that fixed the kind (`KindOrigin`).
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeSet;
 
 use aviary_api::{Descriptor, Kind};
 use aviary_diagnostics::Span;
 use aviary_syntax::ast::*;
 
 use crate::env::{bind_args, capability_bodies, literal_kind, visit_stmts};
-use crate::Program;
+use crate::{ByName, Program};
 
 /// Where a parameter's kind was fixed: the place in its capability, why, and the callee
 /// parameter it came from (whose own origin continues the chain).
@@ -21,17 +21,22 @@ pub struct KindOrigin {
     pub from: Option<(String, usize)>,
 }
 
-pub(crate) type Origins = BTreeMap<String, Vec<Option<KindOrigin>>>;
+pub(crate) type Origins = ByName<Vec<Option<KindOrigin>>>;
 
 pub(crate) fn parameter_kinds(
     program: &Program,
     api: &Descriptor,
-) -> (BTreeMap<String, Vec<Option<Kind>>>, Origins) {
-    // The capabilities in name order, by index; names are looked up by hash.
-    let names: Vec<&String> = program.capabilities.keys().collect();
-    let caps: Vec<Option<&Capability>> = names.iter().map(|n| program.capability(n)).collect();
+) -> (ByName<Vec<Option<Kind>>>, Origins) {
+    // The capabilities with parameters, in name order, by index; names are looked up by
+    // hash. One without parameters has nothing to learn, and so never tells a caller
+    // anything, nor gets an entry (most capabilities of a long chain are such).
+    let mut learners: Vec<(&str, &Capability)> =
+        program.capabilities().filter(|(_, c)| !c.params.is_empty()).collect();
+    learners.sort_unstable_by_key(|(name, _)| *name);
+    let names: Vec<&str> = learners.iter().map(|(name, _)| *name).collect();
+    let caps: Vec<Option<&Capability>> = learners.iter().map(|(_, c)| Some(*c)).collect();
     let index: foldhash::HashMap<&str, usize> =
-        names.iter().enumerate().map(|(i, n)| (n.as_str(), i)).collect();
+        names.iter().enumerate().map(|(i, n)| (*n, i)).collect();
     let mut kinds: Vec<Option<Vec<Option<Kind>>>> = vec![None; names.len()];
     let mut origins: Vec<Option<Vec<Option<KindOrigin>>>> = vec![None; names.len()];
     for (ci, c) in caps.iter().enumerate() {
@@ -65,11 +70,8 @@ pub(crate) fn parameter_kinds(
     // later in the order is visited in the same round, as the full scan would; one
     // earlier, in the next). A visit with nothing new learns what it learned before, so
     // the result is the full scan's; a chain of N capabilities costs N visits, not N².
-    // A capability without parameters has nothing to learn, and so never tells a caller
-    // anything: it is never visited (most capabilities of a long chain are such).
-    let learns = |ci: usize| caps[ci].is_some_and(|c| !c.params.is_empty());
-    let callers = callers(&caps, &index, learns);
-    let mut round: BTreeSet<usize> = (0..names.len()).filter(|&ci| learns(ci)).collect();
+    let callers = callers(&caps, &index);
+    let mut round: BTreeSet<usize> = (0..names.len()).collect();
     let total: usize = kinds.iter().flatten().map(Vec::len).sum();
     for _ in 0..=total {
         let mut changed = false;
@@ -172,21 +174,19 @@ pub(crate) fn parameter_kinds(
     (by_name(&names, kinds), by_name(&names, origins))
 }
 
-/// Values by index as a map by name (the names are sorted: the map is built in one go).
-fn by_name<T>(names: &[&String], values: Vec<Option<T>>) -> BTreeMap<String, T> {
-    names.iter().zip(values).filter_map(|(n, v)| Some(((*n).clone(), v?))).collect()
+/// Values by index as a map by name.
+fn by_name<T>(names: &[&str], values: Vec<Option<T>>) -> ByName<T> {
+    names.iter().zip(values).filter_map(|(n, v)| Some((n.to_string(), v?))).collect()
 }
 
-/// For each capability (by index), the capabilities whose bodies call it, of those that
-/// `learns`.
+/// For each capability (by index), the capabilities whose bodies call it.
 fn callers(
     caps: &[Option<&Capability>],
     index: &foldhash::HashMap<&str, usize>,
-    learns: impl Fn(usize) -> bool,
 ) -> Vec<Vec<usize>> {
     let mut out = vec![Vec::new(); caps.len()];
     for (ci, c) in caps.iter().enumerate() {
-        let Some(c) = c.filter(|_| learns(ci)) else { continue };
+        let Some(c) = c else { continue };
         for body in capability_bodies(c) {
             visit_stmts(body, &mut |stmt| {
                 if let Stmt::Statement(s) = stmt {

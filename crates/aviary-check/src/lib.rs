@@ -44,25 +44,28 @@ pub struct DefRef {
     pub index: usize,
 }
 
+/// Facts per capability, by name. By hash: every pass asks at every call, and a mission may
+/// have tens of thousands of capabilities.
+pub type ByName<T> = foldhash::HashMap<String, T>;
+
 /// A mission with everything it refers to, parsed and resolved.
 pub struct Program {
     /// Every file read, the standard library first, in load order.
     pub files: Vec<(FileId, SourceFile)>,
     pub mission: Option<DefRef>,
-    /// The capability each name means, after user definitions override the library.
-    pub capabilities: BTreeMap<String, DefRef>,
     /// The kind of each `WITH` parameter of each capability, where it could be inferred.
-    pub param_kinds: BTreeMap<String, Vec<Option<Kind>>>,
+    pub param_kinds: ByName<Vec<Option<Kind>>>,
     /// Where each of those kinds was fixed: the chain an E107 report shows.
-    pub param_origins: BTreeMap<String, Vec<Option<KindOrigin>>>,
+    pub param_origins: ByName<Vec<Option<KindOrigin>>>,
     /// The values each signal carries, by name, with each one's kind where it is known
     /// (see `signal_values.rs`): what an operator's signal is checked against.
     pub signal_values: BTreeMap<String, Vec<Option<Kind>>>,
     /// The paths of `USE`s that could not be read (reported as E113).
     pub unreadable: Vec<String>,
-    /// `capabilities` by hash: every pass looks names up, and a mission may have tens of
-    /// thousands of capabilities (string comparisons down a tree were a tenth of checking
-    /// a long chain).
+    /// The capability each name means, after user definitions override the library. By
+    /// hash: every pass looks names up, and a mission may have tens of thousands of
+    /// capabilities (string comparisons down a tree were a tenth of checking a long
+    /// chain); [`Program::capability_names`] gives them in order.
     index: foldhash::HashMap<Box<str>, DefRef>,
 }
 
@@ -98,6 +101,23 @@ impl Program {
     /// Whether this definition is the one its name means (not overridden, not a duplicate).
     pub fn is_active(&self, file: FileId, c: &Capability) -> bool {
         self.index.get(c.name.name.as_str()).map(|r| r.file) == Some(file)
+    }
+    /// The names of the capabilities, in name order.
+    pub fn capability_names(&self) -> Vec<&str> {
+        let mut names: Vec<&str> = self.index.keys().map(|n| &**n).collect();
+        names.sort_unstable();
+        names
+    }
+    /// Each name that means a capability, with the capability it means, in no order.
+    pub fn capabilities(&self) -> impl Iterator<Item = (&str, &Capability)> {
+        self.index.iter().filter_map(|(name, r)| match self.file(r.file)?.items.get(r.index)? {
+            aviary_syntax::ast::Item::Capability(c) => Some((&**name, c)),
+            _ => None,
+        })
+    }
+    /// How many names mean a capability.
+    pub fn capability_count(&self) -> usize {
+        self.index.len()
     }
     pub fn capability_file(&self, name: &str) -> Option<FileId> {
         self.index.get(name).map(|r| r.file)

@@ -94,16 +94,13 @@ pub(crate) fn load(
     let mut program = Program {
         files,
         mission: None,
-        capabilities: BTreeMap::new(),
-        param_kinds: BTreeMap::new(),
-        param_origins: BTreeMap::new(),
+        param_kinds: Default::default(),
+        param_origins: Default::default(),
         signal_values: BTreeMap::new(),
         unreadable,
         index: Default::default(),
     };
     index_definitions(&mut program, std_id, diagnostics);
-    program.index =
-        program.capabilities.iter().map(|(name, r)| (name.as_str().into(), *r)).collect();
     program
 }
 
@@ -117,7 +114,7 @@ fn index_definitions(program: &mut Program, std_id: FileId, diagnostics: &mut Ve
             let r = DefRef { file: *file, index };
             match item {
                 Item::Capability(c) if *file == std_id => {
-                    program.capabilities.insert(c.name.name.clone(), r);
+                    program.index.insert(c.name.name.as_str().into(), r);
                 }
                 Item::Capability(c) => {
                     if let Some((first, span)) = user.get(c.name.name.as_str()) {
@@ -134,7 +131,7 @@ fn index_definitions(program: &mut Program, std_id: FileId, diagnostics: &mut Ve
                         continue;
                     }
                     user.insert(&c.name.name, (r, c.name.span));
-                    program.capabilities.insert(c.name.name.clone(), r);
+                    program.index.insert(c.name.name.as_str().into(), r);
                 }
                 Item::Mission(m) => {
                     if let Some((first, span)) = mission {

@@ -425,20 +425,16 @@ impl<'a> Checker<'a> {
                 ));
                 return;
             }
-            let help = did_you_mean(
-                &s.capability.name,
-                self.program.capabilities.keys().map(String::as_str),
-            )
-            .unwrap_or_else(|| match self.program.unreadable.as_slice() {
-                [] => {
-                    "define it with `CAPABILITY Name BY drone:`, or USE the file that does".into()
-                }
-                [one] => format!("it may be defined in `{one}`, which could not be read"),
-                many => format!(
-                    "it may be defined in one of {}, which could not be read",
-                    many.iter().map(|m| format!("`{m}`")).collect::<Vec<_>>().join(", ")
-                ),
-            });
+            let help = did_you_mean(&s.capability.name, self.program.capability_names())
+                .unwrap_or_else(|| match self.program.unreadable.as_slice() {
+                    [] => "define it with `CAPABILITY Name BY drone:`, or USE the file that does"
+                        .into(),
+                    [one] => format!("it may be defined in `{one}`, which could not be read"),
+                    many => format!(
+                        "it may be defined in one of {}, which could not be read",
+                        many.iter().map(|m| format!("`{m}`")).collect::<Vec<_>>().join(", ")
+                    ),
+                });
             // The last name is something else of the world: say what, and what is missing.
             let actors: Vec<&str> = s.actors.iter().map(|a| a.name.as_str()).collect();
             let all = format!("{} {}", actors.join(" "), s.capability.name);
@@ -619,7 +615,7 @@ impl<'a> Checker<'a> {
             };
             labels.push(aviary_diagnostics::Label { file, span: origin.span, message: origin.why });
             // Bounded: a chain never passes through more capabilities than there are.
-            if labels.len() > self.program.capabilities.len() {
+            if labels.len() > self.program.capability_count() {
                 break;
             }
             at = origin.from;

@@ -186,6 +186,9 @@ fn main() -> ExitCode {
 }
 
 fn command(cli: Cli) -> u8 {
+    if matches!(cli.command, Command::Check { .. } | Command::Fmt { .. }) {
+        alloc::short_lived();
+    }
     let code = match cli.command {
         Command::Check { files, world, format, plan, offline, use_root } => check::run(
             &files,

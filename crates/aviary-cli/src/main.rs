@@ -8,7 +8,6 @@ mod out;
 mod alloc;
 mod bench;
 mod check;
-mod cores;
 mod ctl;
 mod figures;
 mod files;

@@ -92,15 +92,13 @@ pub fn run(args: &RunArgs) -> u8 {
     let mut sources = SourceMap::new();
     let name = args.file.display().to_string();
     let world_name = world_path.display().to_string();
-    // A large world is read on two threads, as `aviary bench w` does.
     let api = aviary_sim::descriptor();
-    let checked = aviary_check::check_sources_joined(
+    let checked = aviary_check::check_sources(
         &mut sources,
         (&name, &bytes),
         Some((&world_name, &world_bytes)),
         &provider,
         &api,
-        &crate::cores::join,
     );
     if checked.has_errors() {
         for d in checked.diagnostics.iter().filter(|d| d.is_error()) {

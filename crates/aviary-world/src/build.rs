@@ -6,7 +6,7 @@ use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 use crate::hash::QuickMap;
 use crate::node::{Entry, Node, Value};
 use crate::read::{suggest, Ctx};
-use crate::{fast, Area, Geo, Place, Site, World};
+use crate::{Area, Geo, Place, Site, World};
 
 mod drone;
 mod sim;
@@ -40,114 +40,10 @@ pub(crate) fn parse(file: FileId, text: &str) -> (Option<World>, Vec<Diagnostic>
 
 /// The world and its diagnostics (unsorted), or the TOML parser's error.
 pub(crate) fn read(file: FileId, text: &str) -> Result<(World, Vec<Diagnostic>), toml::de::Error> {
-    match read_fast(file, text) {
-        Some(read) => Ok(read),
-        None => Ok(read_tree(file, text, Node::parse_serde(text)?)),
-    }
+    Ok(read_tree(file, text, Node::parse_serde(text)?))
 }
 
-/// The fast reader's way: each drone is built as soon as its table has been read, and
-/// the table dropped. `None`: take the serde path.
-pub(crate) fn read_fast(file: FileId, text: &str) -> Option<(World, Vec<Diagnostic>)> {
-    let mut cx = Ctx { file, text, diags: Vec::new() };
-    // Room for the drones up front: doubling a vector of many drones costs more than
-    // counting their headers.
-    let count = count_drones(text);
-    let mut drones = Drones::with_capacity(count);
-    let root = fast::parse_with(text, count, &mut |e| drones.entry(&mut cx, e))?;
-    Some(build(cx, root, drones))
-}
-
-/// Runs two pieces of work and returns once both have run, perhaps at the same time
-/// on two threads: [`crate::parse_world_joined`]'s caller decides.
-pub type Join<'j> = &'j dyn Fn(&mut (dyn FnMut() + Send), &mut (dyn FnMut() + Send));
-
-/// Files shorter than this are read in one part: a thread costs more than it saves.
-pub(crate) const JOIN_FROM: usize = 1 << 16;
-
-/// As [`parse`], reading a large file in two parts through `join` when it can.
-pub(crate) fn parse_joined(
-    file: FileId,
-    text: &str,
-    join: Join,
-) -> (Option<World>, Vec<Diagnostic>) {
-    let in_two = match text.len() >= JOIN_FROM {
-        true => {
-            split_point(text, text.len() / 2).and_then(|at| read_fast_in_two(file, text, at, join))
-        }
-        false => None,
-    };
-    let (world, mut diags) = match in_two {
-        Some(read) => read,
-        None => return parse(file, text),
-    };
-    aviary_diagnostics::sort(&mut diags);
-    if diags.iter().any(Diagnostic::is_error) {
-        (None, diags)
-    } else {
-        (Some(world), diags)
-    }
-}
-
-/// The start of the first line at or after byte `near` that starts `[drones.`: where
-/// [`read_fast_in_two`] may cut (it checks that a table really starts there).
-pub(crate) fn split_point(text: &str, near: usize) -> Option<usize> {
-    let from = near.min(text.len()).saturating_sub(1);
-    memchr::memmem::find(&text.as_bytes()[from..], b"\n[drones.").map(|i| from + i + 1)
-}
-
-/// [`read_fast`], with the file cut at `at` (the start of a line that starts a
-/// `[drones.NAME]` table) and the two parts read through `join`. `None` unless both
-/// parts read as parts of the whole (see [`fast::parse_part`] and [`fast::join`]):
-/// then [`read_fast`] decides. The world and the diagnostics, in their order, are those
-/// of [`read_fast`]: the drones of the tail, their groups and their problems come
-/// after the head's, as the whole file's reader meets them. (A group named in both
-/// parts has its name in two allocations, not one.)
-pub(crate) fn read_fast_in_two(
-    file: FileId,
-    text: &str,
-    at: usize,
-    join: Join,
-) -> Option<(World, Vec<Diagnostic>)> {
-    if !text.get(at..)?.starts_with("[drones.") || at == 0 {
-        return None;
-    }
-    let (mut head, mut tail) = (None, None);
-    // The head's drones get room for the tail's, which are moved in after them.
-    let everyone = count_drones(text);
-    join(&mut || head = read_part(file, text, 0..at, fast::Part::Head, everyone), &mut || {
-        tail = read_part(file, text, at..text.len(), fast::Part::Tail, 0)
-    });
-    let ((head, mut cx, mut drones), (tail, tail_cx, tail_drones)) = (head?, tail?);
-    let root = fast::join(head, tail)?;
-    cx.diags.extend(tail_cx.diags);
-    drones.append(tail_drones);
-    Some(build(cx, root, drones))
-}
-
-/// One part of a file read in two, its diagnostics and its drones.
-/// `room`: for at least that many drones.
-fn read_part(
-    file: FileId,
-    text: &str,
-    range: std::ops::Range<usize>,
-    part: fast::Part,
-    room: usize,
-) -> Option<(fast::Read, Ctx<'_>, Drones)> {
-    let mut cx = Ctx { file, text, diags: Vec::new() };
-    let count = count_drones(text.get(range.clone())?);
-    let mut drones = Drones::with_capacity(count.max(room));
-    let read = fast::parse_part(text, range, part, count, &mut |e| drones.entry(&mut cx, e))?;
-    Some((read, cx, drones))
-}
-
-/// About how many drones `lines` hold: the lines that start `[drones.`.
-fn count_drones(lines: &str) -> usize {
-    memchr::memmem::find_iter(lines.as_bytes(), b"\n[drones.").count()
-        + usize::from(lines.starts_with("[drones."))
-}
-
-/// The serde path's way, from the whole tree.
+/// The world of the spanned tree of `text`.
 pub(crate) fn read_tree(file: FileId, text: &str, mut root: Node) -> (World, Vec<Diagnostic>) {
     let mut cx = Ctx { file, text, diags: Vec::new() };
     let mut drones = Drones::default();

@@ -18,9 +18,8 @@ const TELEMETRY: &[&str] = &["position", "altitude", "speed", "heading", "state"
 const ADDRESS_HELP: &str =
     "write `mavlink = \"udp:127.0.0.1:14550\"` or `\"tcp:HOST:PORT\"` (schemes: tcp, tcpin, tcpout, udp, udpin, udpout, udpbcast, serial)";
 
-/// The drones as their tables come: from the fast reader one by one while it reads,
-/// or from the serde path's tree. What needs other tables (the sensors' kinds) waits
-/// for [`Drones::finish`].
+/// The drones as their tables come, in file order. What needs other tables (the sensors'
+/// kinds) waits for [`Drones::finish`].
 #[derive(Default)]
 pub(super) struct Drones {
     pub out: Vec<Drone>,
@@ -42,11 +41,6 @@ pub(super) const HELP: &str =
     "write one table per drone: `[drones.NAME]` followed by `home = [x, y]`";
 
 impl Drones {
-    /// Room for about `n` drones.
-    pub fn with_capacity(n: usize) -> Drones {
-        Drones { out: Vec::with_capacity(n), ..Drones::default() }
-    }
-
     /// One entry of `[drones]`; its table is dropped once read.
     pub fn entry(&mut self, cx: &mut Ctx, e: Entry) {
         cx.identifier("drone", &e.key, e.key_span);
@@ -60,34 +54,6 @@ impl Drones {
         };
         let d = self.drone(cx, key, key_span, &keys);
         self.out.push(d);
-    }
-
-    /// Adds the drones of `tail`, read from the lines after this one's, as if this had
-    /// read them itself: groups, sensors and other entries with the drones' indices.
-    pub fn append(&mut self, tail: Drones) {
-        let offset = self.out.len();
-        let Drones { out, groups, group_spans, group_index, keys, sensors, others } = tail;
-        for (group, span) in groups.into_iter().zip(group_spans) {
-            let members = group.members.into_iter().map(|m| m + offset);
-            match self.group_index.get(group.name.as_str()) {
-                Some((g, _)) => self.groups[*g].members.extend(members),
-                None => {
-                    let Some((_, shared)) = group_index.get(group.name.as_str()) else { continue };
-                    self.group_index
-                        .insert(group.name.clone(), (self.groups.len(), shared.clone()));
-                    self.groups.push(Group { name: group.name, members: members.collect() });
-                    self.group_spans.push(span);
-                }
-            }
-        }
-        for key in keys {
-            if !self.keys.contains(&key) {
-                self.keys.insert(key);
-            }
-        }
-        self.sensors.extend(sensors.into_iter().map(|(d, i, span)| (d + offset, i, span)));
-        self.others.extend(others.into_iter().map(|(before, name)| (before + offset, name)));
-        self.out.extend(out);
     }
 
     /// Checks every drone's sensors against `[sensors]`.

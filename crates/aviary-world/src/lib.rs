@@ -9,6 +9,8 @@
 //! - No input makes it panic.
 
 mod build;
+#[cfg(test)]
+mod fleet_tests;
 mod hash;
 mod node;
 #[cfg(test)]

@@ -209,9 +209,12 @@ fn fault_drone(cx: &mut Ctx, name: &str, e: &Entry, drones: &[&str]) {
     let help = match suggest(name, drones.iter().copied()) {
         Some(s) => format!("did you mean `{s}`?"),
         None if drones.is_empty() => format!("define it as `[drones.{name}]`"),
-        None => {
-            format!("name one of the drones: {}", quoted(drones))
-        }
+        None if drones.len() <= 10 => format!("name one of the drones: {}", quoted(drones)),
+        None => format!(
+            "name one of the drones, such as {}, ... ({} in all)",
+            quoted(&drones[..10]),
+            drones.len()
+        ),
     };
     cx.error(e.node.span, msg, help);
 }

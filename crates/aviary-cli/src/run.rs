@@ -18,6 +18,7 @@ pub struct RunArgs {
     pub world: Option<PathBuf>,
     /// `None`: as fast as possible.
     pub speed: Option<f64>,
+    /// The simulator's seed: every chance the world asks for is drawn from it.
     pub seed: u64,
     pub trace: Option<PathBuf>,
     pub telemetry_hz: Option<f64>,
@@ -142,8 +143,7 @@ pub fn run(args: &RunArgs) -> u8 {
         args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default(),
         mission.name.clone(),
     );
-    let _ = args.seed; // The simulator has no randomness yet; the seed is kept for it.
-                       // Any MAVLink drone: the wall clock, and the simulated drones in real time with it.
+    // Any MAVLink drone: the wall clock, and the simulated drones in real time with it.
     let live = !aviary_mavlink::bindings(&world).is_empty();
     if live && args.speed.is_some() {
         eprintln!(
@@ -156,6 +156,9 @@ pub fn run(args: &RunArgs) -> u8 {
     // MAVLink drones the world is kept to connect them.
     let (fleet, world) =
         if live { (Fleet::new(&world), Some(world)) } else { (Fleet::from_world(world), None) };
+    // The chances the world asks for (a sensor's `probability`, a fault's range of
+    // times) are drawn from the seed.
+    let fleet = fleet.seeded(args.seed);
     let runtime = match if live {
         crate::mixed::live_runtime()
     } else {

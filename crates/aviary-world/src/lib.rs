@@ -242,6 +242,10 @@ pub struct Sensor {
     pub detects: Vec<String>,
     /// Metres from the drone's ground point.
     pub range: f64,
+    /// The chance, from 0 to 1, that the simulator's sensor finds a target of its kinds
+    /// that comes within range (once per target and detection): 1 by default, when it
+    /// always does and no chance is drawn.
+    pub probability: f64,
     /// The `KIND` of `[sensors.KIND]`.
     #[serde(skip)]
     pub span: Span,
@@ -256,8 +260,11 @@ pub struct Target {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Fault {
     pub drone: String,
-    /// Mission seconds.
+    /// Mission seconds; the earliest, when `latest` is given.
     pub at: f64,
+    /// With `at = [earliest, latest]`: the latest. The simulator draws the fault's time
+    /// uniformly from that range, from the run's seed.
+    pub latest: Option<f64>,
     pub kind: FaultKind,
     /// Seconds; given exactly for `link_loss` and `gps_loss`.
     pub duration: Option<f64>,

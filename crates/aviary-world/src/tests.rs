@@ -318,6 +318,45 @@ fn sensor_problems() {
     assert_eq!(at, "0");
 }
 
+/// What the simulator may draw from the run's seed: a sensor's chance of finding a
+/// target, and a fault's time within a range.
+#[test]
+fn chances_and_ranges_of_time() {
+    let w = ok("[sensors.sonar]\ndetects = [\"Body\"]\nrange = 5\nprobability = 0.25\n\
+                [sensors.eye]\ndetects = [\"Body\"]\nrange = 5\n");
+    assert_eq!((w.sensors[0].probability, w.sensors[1].probability), (0.25, 1.0));
+    let sensor =
+        |p: &str| error(&format!("[sensors.s]\ndetects = []\nrange = 5\nprobability = {p}\n"));
+    assert_eq!(sensor("1.5").0, "`probability` of sensor `s` must be between 0 and 1, found 1.5");
+    assert_eq!(
+        sensor("\"high\"").0,
+        "`probability` of sensor `s` must be a number, found a string"
+    );
+    ok("[sensors.s]\ndetects = []\nrange = 5\nprobability = 0\n");
+
+    let fault =
+        |at: &str| format!("{HOME}[[faults]]\ndrone = \"d\"\nat = {at}\nkind = \"crash\"\n");
+    let w = ok(&fault("[30, 90.5]"));
+    assert_eq!((w.faults[0].at, w.faults[0].latest), (30.0, Some(90.5)));
+    let w = ok(&fault("[30, 30]"));
+    assert_eq!((w.faults[0].at, w.faults[0].latest), (30.0, Some(30.0)));
+    assert_eq!(ok(&fault("12")).faults[0].latest, None);
+    let (msg, at, help) = error(&fault("[90, 30]"));
+    assert_eq!(msg, "the range `at` of a fault runs from 90 back to 30");
+    assert_eq!(at, "[90, 30]");
+    assert_eq!(help, "write the earlier time first, e.g. `at = [30, 90]`");
+    assert_eq!(
+        error(&fault("[1, 2, 3]")).0,
+        "`at` of a fault must be a time or a range [earliest, latest], found 3 numbers"
+    );
+    let (msg, at, _) = error(&fault("[-1, 2]"));
+    assert_eq!(
+        (msg.as_str(), at.as_str()),
+        ("`at` of a fault must be zero or more seconds, found -1", "-1")
+    );
+    assert_eq!(error(&fault("[1, \"x\"]")).0, "`at` of a fault must be a number, found a string");
+}
+
 #[test]
 fn fault_for_an_unknown_drone() {
     let (msg, at, help) =

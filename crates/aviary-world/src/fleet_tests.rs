@@ -337,6 +337,14 @@ fn areas_of_a_fleet() {
         problem(&fleet("{ names = \"A{i}\", polygon = [[0, 0], [1, 0], [2, 0]] }")).0,
         "`polygon` of `areas` of fleet `f` encloses no area: its corners lie on one line"
     );
+    assert_eq!(
+        problem(
+            "[fleets.f]\ncount = 2\nhomes = { grid = [1e308, 0], spacing = 5 }\n\
+             areas = { names = \"A{i}\", polygon = [[0, 0], [1e308, 0], [1e308, 1e308]] }\n"
+        )
+        .0,
+        "the areas of fleet `f` reach beyond the numbers a world can hold"
+    );
     let clashes = problems(&fleet("{ names = \"f{i}\", polygon = [[0, 0], [1, 0], [0, 1]] }"));
     assert_eq!(
         clashes[0].0,
@@ -372,4 +380,39 @@ fn a_fleet_is_the_tables_it_stands_for() {
         s.span = Default::default();
     }
     assert_eq!(one, other);
+}
+
+/// Random edits of a world with a fleet: never a panic, every span in the text, a world
+/// exactly when there is no diagnostic.
+#[test]
+fn random_edits_of_a_fleet_never_panic() {
+    let base = include_str!("../tests/fixtures/fleet_grid.world.toml");
+    let mut seed: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed
+    };
+    let alphabet: Vec<char> = "[]{}=,.\"#\n 0123456789-e_aiz:".chars().collect();
+    for _ in 0..1500 {
+        let mut chars: Vec<char> = base.chars().collect();
+        for _ in 0..(next() % 4 + 1) {
+            let at = (next() % chars.len() as u64) as usize;
+            let c = alphabet[(next() % alphabet.len() as u64) as usize];
+            match next() % 3 {
+                0 => {
+                    chars.remove(at);
+                }
+                1 => chars.insert(at, c),
+                _ => chars[at] = c,
+            }
+        }
+        let text: String = chars.into_iter().collect();
+        let (world, diags) = parse_world(FileId(0), &text);
+        assert_eq!(world.is_some(), diags.is_empty(), "{text}");
+        for d in &diags {
+            assert!(text.get(d.primary.span.range()).is_some(), "{text}: {d:?}");
+        }
+    }
 }

@@ -217,7 +217,22 @@ impl Drones {
         if let Some(g) = group {
             self.groups[g].members.extend(drones.clone());
         }
-        if let (Some(Some((pattern, polygon, span))), Some(homes)) = (areas, &homes) {
+        let areas = areas.flatten().filter(|(_, polygon, span)| {
+            let Some(homes) = &homes else { return false };
+            let (lo, hi) = homes.bounds(count);
+            let reach = polygon
+                .iter()
+                .flat_map(|p| [lo[0] + p[0], lo[1] + p[1], hi[0] + p[0], hi[1] + p[1]]);
+            let finite = reach.into_iter().all(f64::is_finite);
+            if !finite {
+                let msg = format!(
+                    "the areas of fleet `{fleet}` reach beyond the numbers a world can hold"
+                );
+                cx.error(*span, msg, "write corners nearer the homes, in metres");
+            }
+            finite
+        });
+        if let (Some((pattern, polygon, span)), Some(homes)) = (areas, &homes) {
             self.areas.reserve(count);
             for k in 0..count {
                 let home = homes.at(k, count);

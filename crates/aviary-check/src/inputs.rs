@@ -32,19 +32,6 @@ pub fn check_sources(
     provider: &dyn SourceProvider,
     api: &Descriptor,
 ) -> Checked {
-    check_sources_joined(sources, mission, world, provider, api, &aviary_world::join_in_turn)
-}
-
-/// As [`check_sources`], a large world file perhaps read in two parts run through
-/// `join` ([`aviary_world::parse_world_joined`]: the same world and diagnostics).
-pub fn check_sources_joined(
-    sources: &mut SourceMap,
-    mission: (&str, &[u8]),
-    world: Option<(&str, &[u8])>,
-    provider: &dyn SourceProvider,
-    api: &Descriptor,
-    join: aviary_world::Join,
-) -> Checked {
     let mut diagnostics = Vec::new();
     let mut parsed_world = None;
     if let Some((name, bytes)) = world {
@@ -53,7 +40,7 @@ pub fn check_sources_joined(
         match invalid {
             Some(at) => diagnostics.push(aviary_syntax::invalid_utf8(id, at)),
             None => {
-                let (w, d) = aviary_world::parse_world_joined(id, sources.text(id), join);
+                let (w, d) = aviary_world::parse_world(id, sources.text(id));
                 parsed_world = w;
                 diagnostics.extend(d);
             }

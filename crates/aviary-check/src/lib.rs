@@ -33,7 +33,7 @@ use aviary_world::World;
 
 pub use env::{bind_args, ArgBinding, BindProblem};
 pub use infer::KindOrigin;
-pub use inputs::{check_sources, check_sources_joined, normalize_path, Checked};
+pub use inputs::{check_sources, normalize_path, Checked};
 pub use load::{SourceProvider, STD_NAME, STD_SOURCE};
 pub use uses::LoadError;
 

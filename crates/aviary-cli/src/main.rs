@@ -8,7 +8,6 @@ mod out;
 mod alloc;
 mod bench;
 mod check;
-mod cores;
 mod ctl;
 mod figures;
 mod files;
@@ -80,7 +79,8 @@ enum Command {
         /// `max` (as fast as possible; the default) or times real time, such as 1 or 10
         #[arg(long)]
         speed: Option<String>,
-        /// The seed of the simulation: the same files and seed give the same trace
+        /// The seed of the simulation's chances (a sensor's `probability`, a fault's range
+        /// of times in the world file): the same files and seed give the same trace
         #[arg(long, default_value_t = 0)]
         seed: u64,
         /// Write every event to this JSON Lines file

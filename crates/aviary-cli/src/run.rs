@@ -18,6 +18,7 @@ pub struct RunArgs {
     pub world: Option<PathBuf>,
     /// `None`: as fast as possible.
     pub speed: Option<f64>,
+    /// The simulator's seed: every chance the world asks for is drawn from it.
     pub seed: u64,
     pub trace: Option<PathBuf>,
     pub telemetry_hz: Option<f64>,
@@ -92,15 +93,13 @@ pub fn run(args: &RunArgs) -> u8 {
     let mut sources = SourceMap::new();
     let name = args.file.display().to_string();
     let world_name = world_path.display().to_string();
-    // A large world is read on two threads, as `aviary bench w` does.
     let api = aviary_sim::descriptor();
-    let checked = aviary_check::check_sources_joined(
+    let checked = aviary_check::check_sources(
         &mut sources,
         (&name, &bytes),
         Some((&world_name, &world_bytes)),
         &provider,
         &api,
-        &crate::cores::join,
     );
     if checked.has_errors() {
         for d in checked.diagnostics.iter().filter(|d| d.is_error()) {
@@ -144,8 +143,7 @@ pub fn run(args: &RunArgs) -> u8 {
         args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default(),
         mission.name.clone(),
     );
-    let _ = args.seed; // The simulator has no randomness yet; the seed is kept for it.
-                       // Any MAVLink drone: the wall clock, and the simulated drones in real time with it.
+    // Any MAVLink drone: the wall clock, and the simulated drones in real time with it.
     let live = !aviary_mavlink::bindings(&world).is_empty();
     if live && args.speed.is_some() {
         eprintln!(
@@ -158,6 +156,9 @@ pub fn run(args: &RunArgs) -> u8 {
     // MAVLink drones the world is kept to connect them.
     let (fleet, world) =
         if live { (Fleet::new(&world), Some(world)) } else { (Fleet::from_world(world), None) };
+    // The chances the world asks for (a sensor's `probability`, a fault's range of
+    // times) are drawn from the seed.
+    let fleet = fleet.seeded(args.seed);
     let runtime = match if live {
         crate::mixed::live_runtime()
     } else {

@@ -398,6 +398,26 @@ fn every_world_key_documented_is_read_and_every_key_read_is_documented() {
     }
     assert!(tables.len() >= 7, "{tables:?}");
 
+    // Fleets: their own keys, and the keys of `homes` (which rejects unknown ones).
+    let fleet_keys = keys_under(&doc, "`[fleets.NAME]`");
+    let fleet_source =
+        std::fs::read_to_string(repo().join("crates/aviary-world/src/build/fleet.rs")).unwrap();
+    let own = fleet_source
+        .lines()
+        .find(|l| l.contains("const FLEET_KEYS"))
+        .expect("FLEET_KEYS in fleet.rs");
+    let own: BTreeSet<String> = own.split('"').skip(1).step_by(2).map(str::to_string).collect();
+    assert_eq!(
+        own, fleet_keys,
+        "the fleet's own keys (left) and those docs/WORLD.md documents (right)"
+    );
+    let homes = keys_under(&doc, "`homes`");
+    let read = known_keys("[fleets.f]\ncount = 1\nhomes = { zz_not_a_key = 1 }\n");
+    assert_eq!(
+        read, homes,
+        "the keys of `homes` the reader knows (left) and those docs/WORLD.md documents (right)"
+    );
+
     // Drones: an unknown key is an attribute, so a documented key must not become one.
     let drone_keys = keys_under(&doc, "`[drones.NAME]`");
     for key in &drone_keys {

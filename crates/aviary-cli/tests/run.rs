@@ -97,6 +97,66 @@ fn the_same_files_and_seed_give_the_same_trace_byte_for_byte() {
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
 }
 
+/// The trace of `mission` in `dir`, run with these extra arguments.
+fn trace_of(dir: &std::path::Path, mission: &str, extra: &[&str], name: &str) -> Vec<u8> {
+    let trace = dir.join(name);
+    let mut args = vec!["run", mission, "--quiet", "--trace"];
+    let trace_arg = trace.to_string_lossy().into_owned();
+    args.push(&trace_arg);
+    args.extend_from_slice(extra);
+    let (code, _, err) = aviary(&args, dir);
+    assert_eq!(code, 0, "{err}");
+    std::fs::read(&trace).unwrap()
+}
+
+#[test]
+fn a_world_without_chances_gives_one_trace_whatever_the_seed() {
+    let dir = scratch("seed_free");
+    let paper = repo().join("examples/search_and_rescue.mission");
+    let paper = paper.to_string_lossy();
+    let without = trace_of(&dir, &paper, &[], "none.jsonl");
+    for seed in ["0", "1", "18446744073709551615"] {
+        assert!(
+            without == trace_of(&dir, &paper, &["--seed", seed], "seeded.jsonl"),
+            "--seed {seed}"
+        );
+    }
+}
+
+/// A swarm whose thermal cameras find a body with a chance of one half: the seed decides
+/// what is found, the same seed the same, and no `--seed` is seed 0.
+#[test]
+fn the_seed_draws_the_chances_a_world_asks_for() {
+    let dir = scratch("seeded");
+    let (code, mission, _) = aviary(&["bench", "swarm", "--drones", "36", "--emit"], &dir);
+    assert_eq!(code, 0);
+    let (code, world, _) = aviary(&["bench", "swarm", "--drones", "36", "--emit-world"], &dir);
+    assert_eq!(code, 0);
+    assert!(world.contains("range = 15.0\n"), "{world}");
+    std::fs::write(dir.join("swarm.mission"), mission).unwrap();
+    std::fs::write(
+        dir.join("swarm.world.toml"),
+        world.replace("range = 15.0\n", "range = 15.0\nprobability = 0.5\n"),
+    )
+    .unwrap();
+    let found = |trace: &[u8]| {
+        String::from_utf8_lossy(trace)
+            .lines()
+            .filter(|l| l.contains("\"event\":\"detection\""))
+            .count()
+    };
+    let one = trace_of(&dir, "swarm.mission", &["--seed", "1"], "one.jsonl");
+    assert!(one == trace_of(&dir, "swarm.mission", &["--seed", "1"], "again.jsonl"));
+    let two = trace_of(&dir, "swarm.mission", &["--seed", "2"], "two.jsonl");
+    assert!(one != two, "seeds 1 and 2 give the same trace");
+    // 12 bodies, each found with a chance of one half.
+    for trace in [&one, &two] {
+        assert!((1..12).contains(&found(trace)), "{} found", found(trace));
+    }
+    let zero = trace_of(&dir, "swarm.mission", &["--seed", "0"], "zero.jsonl");
+    assert!(zero == trace_of(&dir, "swarm.mission", &[], "default.jsonl"), "no --seed is seed 0");
+}
+
 #[test]
 fn exit_codes_follow_runtime_md() {
     let dir = scratch("run_exits");

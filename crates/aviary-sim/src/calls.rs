@@ -260,7 +260,9 @@ impl Fleet {
             }
             "StartDetection" | "StopDetection" => {
                 let kind = kind(args, 0, "kind")?;
-                let Some(range) = detection_range(&self.sensors, &d.spec.sensors, &kind) else {
+                let Some((range, probability)) =
+                    detection_range(&self.sensors, &d.spec.sensors, &kind)
+                else {
                     return Err(failed(format!(
                         "{} has no sensor that detects {kind}",
                         &self.names[id]
@@ -269,7 +271,7 @@ impl Fleet {
                 let detections = &mut d.rare_mut().detections;
                 detections.retain(|a| a.kind != kind);
                 if function == "StartDetection" {
-                    detections.push(Activation { kind, range, found: Vec::new() });
+                    detections.push(Activation { kind, range, probability, found: Vec::new() });
                 }
             }
             "LoadPayload" => {

@@ -97,6 +97,8 @@ pub(crate) struct Rare {
     pub gps_loss: Option<Outage>,
     /// Why the drone takes no more commands (a motor failure).
     pub disabled: Option<String>,
+    /// The drone's stream for its sensors' chances, made at its first draw.
+    pub luck: Option<Box<crate::luck::Stream>>,
 }
 
 /// Every drone's state; its name is the fleet's ([`aviary_api::Names`]).

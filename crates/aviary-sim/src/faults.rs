@@ -1,5 +1,6 @@
 //! The world file's `[[faults]]`: injected at their mission time (simulated seconds since
-//! the fleet was made), each once.
+//! the fleet was made), each once. A fault whose `at` is a range `[earliest, latest]`
+//! happens at a time drawn uniformly from it, from the run's seed ([`Fleet::seeded`]).
 //!
 //! - `battery_critical`: `BatteryCritical` (counts as the drone's one battery alarm).
 //! - `crash`: the drone falls (`DroneLost`), as when its battery runs out.

@@ -1,5 +1,6 @@
 //! The physics core: every drone of the world, advanced tick by tick. Pure: no clock, no
-//! channels, no randomness; the same calls and steps give the same results bit for bit.
+//! channels, and no randomness but what the seed gives ([`crate::luck`]); the same seed,
+//! calls and steps give the same results bit for bit.
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::sync::Arc;
@@ -17,6 +18,7 @@ use crate::drone::{SimDrone, Spec};
 use crate::geom::heading;
 use crate::grid::Grid;
 use crate::hot::Hot;
+use crate::luck::{Purpose, Stream};
 use crate::nearby::Nearby;
 use crate::sensors::scan;
 use aviary_api::Names;
@@ -45,6 +47,8 @@ pub(crate) struct ScheduledFault {
     pub drone: DroneId,
     pub kind: FaultKind,
     pub at: f64,
+    /// `at = [earliest, latest]`: `at` is drawn from it.
+    pub window: Option<[f64; 2]>,
     pub duration: f64,
     pub fired: bool,
 }
@@ -65,6 +69,8 @@ pub struct Fleet {
     pub(crate) sensors: Vec<Sensor>,
     pub(crate) targets: Vec<Target>,
     pub(crate) faults: Vec<ScheduledFault>,
+    /// The run's seed: every chance the world asks for is drawn from it.
+    pub(crate) seed: u64,
     pub(crate) time: f64,
     pub(crate) next_call: u64,
     pub(crate) releases: Vec<Release>,
@@ -186,6 +192,21 @@ impl Fleet {
         Fleet { drones, ..fleet }
     }
 
+    /// The fleet, with `seed` the run's seed, from which every chance the world asks for
+    /// is drawn (a fault's time within its range now; a sensor's detections as the drones
+    /// fly). Without it, a fleet's seed is 0. A world that asks for no chance runs the same
+    /// whatever the seed.
+    pub fn seeded(mut self, seed: u64) -> Fleet {
+        self.seed = seed;
+        for (j, f) in self.faults.iter_mut().enumerate() {
+            if let Some([earliest, latest]) = f.window {
+                let u = Stream::new(seed, Purpose::FaultTime, j).uniform();
+                f.at = (earliest + u * (latest - earliest)).min(latest);
+            }
+        }
+        self
+    }
+
     /// Everything of a fleet but its drones.
     fn around(world: &World) -> Fleet {
         let faults = world
@@ -197,12 +218,13 @@ impl Fleet {
                     drone,
                     kind: f.kind,
                     at: f.at,
+                    window: f.latest.map(|latest| [f.at, latest]),
                     duration: f.duration.unwrap_or(0.0),
                     fired: false,
                 })
             })
             .collect();
-        Fleet {
+        let fleet = Fleet {
             drones: Vec::new(),
             names: Names::new(world.drones.iter().map(|d| d.name.as_str())),
             fence: world.site.geofence.clone(),
@@ -229,7 +251,9 @@ impl Fleet {
             target_grid: target_grid(&world.targets),
             near_targets: vec![None; world.drones.len()],
             calls: HashMap::new(),
-        }
+            seed: 0,
+        };
+        fleet.seeded(0)
     }
 
     /// Simulated seconds since the fleet was made (the sum of the steps).
@@ -505,7 +529,12 @@ impl Fleet {
             None => &[],
         };
         if let Some(rare) = d.rare.as_deref_mut() {
-            let found = scan(id, &mut rare.detections, &self.targets, nearby, from, to);
+            let (luck, seed) = (&mut rare.luck, self.seed);
+            let mut draw = || {
+                luck.get_or_insert_with(|| Box::new(Stream::new(seed, Purpose::Detection, id)))
+                    .uniform()
+            };
+            let found = scan(id, &mut rare.detections, &self.targets, nearby, from, to, &mut draw);
             if !found.is_empty() {
                 out.extend(found.into_iter().map(Report::Event));
             }

@@ -10,9 +10,11 @@
 //!   answering calls through their oneshot channels and sending drone events.
 //!
 //! # Invariants
-//! - Deterministic: the same world and the same calls, made between the same steps, give
-//!   the same telemetry, call ends and events, bit for bit. No randomness, no hash-map
-//!   iteration, drones and targets always in world-file order.
+//! - Deterministic: the same world, seed ([`Fleet::seeded`]; 0 unless given) and calls,
+//!   made between the same steps, give the same telemetry, call ends and events, bit for
+//!   bit. No randomness but the chances the world asks for, drawn from the seed in streams
+//!   of their own (the `luck` module); no hash-map iteration; drones and targets always in
+//!   world-file order. A world that asks for no chance runs the same whatever the seed.
 //! - The physics core is pure: nothing async, no clock, no IO. Simulated time is the sum
 //!   of the steps.
 //! - No wall clock, unless [`SimOptions::speed`] is set: then the driver only *waits* on
@@ -34,7 +36,9 @@
 //! - The battery drains only in the air, linearly in time (`1 / endurance` of a full
 //!   battery per second, whatever the drone does).
 //! - Sensors see every target of their kinds within their range of the drone's ground
-//!   point, whatever the altitude, checked along the way flown in each step.
+//!   point, whatever the altitude, checked along the way flown in each step; a sensor with
+//!   a `probability` below 1 finds each with that chance, drawn once as it comes within
+//!   range (the `sensors` module).
 //!
 //! # Functions
 //! `Arm`/`Disarm` (landed only), `TakeOff(alt)` (armed; or, in the air, a climb or
@@ -116,7 +120,8 @@
 //! `BatteryLow` is signalled once when the charge falls under `2 × need + 10 %`, and
 //! `BatteryCritical` raised once under `need + 10 %` (ending the drone's calls in
 //! progress `Interrupted`); at zero the drone falls (`Lost`, `DroneLost`). The world's
-//! `[[faults]]` fire at their time in simulated seconds (see the `faults` module). Under
+//! `[[faults]]` fire at their time in simulated seconds (see the `faults` module), or, for
+//! a fault whose `at` is a range, at a time drawn uniformly from it. Under
 //! link loss a drone holds (and refuses commands); if the link is still lost after
 //! `[site] link_loss_rtl_after` seconds (default 10) it returns to launch on its own and
 //! lands, and keeps at that after the link is back (`ConnectionRestored`) until it has
@@ -140,6 +145,7 @@ mod fleet;
 mod geom;
 mod grid;
 mod hot;
+mod luck;
 mod motion;
 mod nearby;
 mod profile;

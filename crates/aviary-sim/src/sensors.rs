@@ -1,5 +1,8 @@
 //! Detection: while `StartDetection(kind)` is on, every target of that kind that comes
-//! within the sensor's range of the drone's ground point is reported once.
+//! within the sensor's range of the drone's ground point is reported once. A sensor with a
+//! `probability` below 1 finds it only with that chance, drawn once, when the target first
+//! comes within range (a target missed stays missed until detection of its kind starts
+//! again); with 1, nothing is drawn.
 
 use aviary_api::{DroneEvent, DroneId};
 use aviary_world::{Sensor, Target};
@@ -13,29 +16,34 @@ pub(crate) struct Activation {
     pub kind: String,
     /// Metres from the drone's ground point.
     pub range: f64,
-    /// The world targets (their indices, ascending) found in this activation: few, where
-    /// a flag per target cost every drone as much memory as the world has targets.
+    /// The chance of finding a target that comes within range.
+    pub probability: f64,
+    /// The world targets (their indices, ascending) found, or missed, in this activation:
+    /// few, where a flag per target cost every drone as much memory as the world has
+    /// targets.
     pub found: Vec<usize>,
 }
 
-/// The range at which a drone with `sensors` detects `kind`: the largest range of its
-/// sensors whose `detects` lists the kind; `None` when none does.
+/// The range at which a drone with `sensors` detects `kind`, and the chance it finds a
+/// target there: those of its sensor whose `detects` lists the kind with the largest
+/// range (of equal ranges, the likeliest); `None` when none lists it.
 pub(crate) fn detection_range(
     world_sensors: &[Sensor],
     sensors: &[String],
     kind: &str,
-) -> Option<f64> {
+) -> Option<(f64, f64)> {
     world_sensors
         .iter()
         .filter(|s| sensors.contains(&s.kind) && s.detects.iter().any(|k| k == kind))
-        .map(|s| s.range)
-        .reduce(f64::max)
+        .map(|s| (s.range, s.probability))
+        .reduce(|a, b| if (b.0, b.1) > (a.0, a.1) { b } else { a })
 }
 
 /// The targets found while the drone flew from `from` to `to` (ground points) this tick,
 /// marking them found; events in activation order, then target order. Only `candidates`
 /// are looked at: ascending target indices, at least every target inside the way's box
-/// widened by the range and a metre (see [`crate::nearby`]).
+/// widened by the range and a metre (see [`crate::nearby`]). `draw` gives a number from
+/// [0, 1) of the drone's stream, for each target of a sensor that may miss it, in that order.
 pub(crate) fn scan(
     drone: DroneId,
     activations: &mut [Activation],
@@ -43,6 +51,7 @@ pub(crate) fn scan(
     candidates: &[usize],
     from: [f64; 2],
     to: [f64; 2],
+    draw: &mut dyn FnMut() -> f64,
 ) -> Vec<DroneEvent> {
     let mut events = Vec::new();
     if candidates.is_empty() {
@@ -67,6 +76,9 @@ pub(crate) fn scan(
             }
             if dist_to_segment(at, from, to) <= act.range {
                 act.found.insert(place, i);
+                if act.probability < 1.0 && draw() >= act.probability {
+                    continue;
+                }
                 events.push(DroneEvent::Detected {
                     drone,
                     kind: act.kind.clone(),

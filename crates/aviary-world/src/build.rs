@@ -6,14 +6,17 @@ use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 use crate::hash::QuickMap;
 use crate::node::{Entry, Node, Value};
 use crate::read::{suggest, Ctx};
-use crate::{fast, Area, Geo, Place, Site, World};
+use crate::{Area, Geo, Place, Site, World};
 
 mod drone;
+mod fleet;
 mod sim;
 
 use drone::Drones;
+use fleet::FleetInfo;
 
-const TABLES: &[&str] = &["site", "places", "areas", "drones", "sensors", "targets", "faults"];
+const TABLES: &[&str] =
+    &["site", "places", "areas", "drones", "fleets", "sensors", "targets", "faults"];
 const SITE_KEYS: &[&str] = &[
     "name",
     "origin",
@@ -40,124 +43,31 @@ pub(crate) fn parse(file: FileId, text: &str) -> (Option<World>, Vec<Diagnostic>
 
 /// The world and its diagnostics (unsorted), or the TOML parser's error.
 pub(crate) fn read(file: FileId, text: &str) -> Result<(World, Vec<Diagnostic>), toml::de::Error> {
-    match read_fast(file, text) {
-        Some(read) => Ok(read),
-        None => Ok(read_tree(file, text, Node::parse_serde(text)?)),
-    }
+    Ok(read_tree(file, text, Node::parse_serde(text)?))
 }
 
-/// The fast reader's way: each drone is built as soon as its table has been read, and
-/// the table dropped. `None`: take the serde path.
-pub(crate) fn read_fast(file: FileId, text: &str) -> Option<(World, Vec<Diagnostic>)> {
-    let mut cx = Ctx { file, text, diags: Vec::new() };
-    // Room for the drones up front: doubling a vector of many drones costs more than
-    // counting their headers.
-    let count = count_drones(text);
-    let mut drones = Drones::with_capacity(count);
-    let root = fast::parse_with(text, count, &mut |e| drones.entry(&mut cx, e))?;
-    Some(build(cx, root, drones))
-}
-
-/// Runs two pieces of work and returns once both have run, perhaps at the same time
-/// on two threads: [`crate::parse_world_joined`]'s caller decides.
-pub type Join<'j> = &'j dyn Fn(&mut (dyn FnMut() + Send), &mut (dyn FnMut() + Send));
-
-/// Files shorter than this are read in one part: a thread costs more than it saves.
-pub(crate) const JOIN_FROM: usize = 1 << 16;
-
-/// As [`parse`], reading a large file in two parts through `join` when it can.
-pub(crate) fn parse_joined(
-    file: FileId,
-    text: &str,
-    join: Join,
-) -> (Option<World>, Vec<Diagnostic>) {
-    let in_two = match text.len() >= JOIN_FROM {
-        true => {
-            split_point(text, text.len() / 2).and_then(|at| read_fast_in_two(file, text, at, join))
-        }
-        false => None,
-    };
-    let (world, mut diags) = match in_two {
-        Some(read) => read,
-        None => return parse(file, text),
-    };
-    aviary_diagnostics::sort(&mut diags);
-    if diags.iter().any(Diagnostic::is_error) {
-        (None, diags)
-    } else {
-        (Some(world), diags)
-    }
-}
-
-/// The start of the first line at or after byte `near` that starts `[drones.`: where
-/// [`read_fast_in_two`] may cut (it checks that a table really starts there).
-pub(crate) fn split_point(text: &str, near: usize) -> Option<usize> {
-    let from = near.min(text.len()).saturating_sub(1);
-    memchr::memmem::find(&text.as_bytes()[from..], b"\n[drones.").map(|i| from + i + 1)
-}
-
-/// [`read_fast`], with the file cut at `at` (the start of a line that starts a
-/// `[drones.NAME]` table) and the two parts read through `join`. `None` unless both
-/// parts read as parts of the whole (see [`fast::parse_part`] and [`fast::join`]):
-/// then [`read_fast`] decides. The world and the diagnostics, in their order, are those
-/// of [`read_fast`]: the drones of the tail, their groups and their problems come
-/// after the head's, as the whole file's reader meets them. (A group named in both
-/// parts has its name in two allocations, not one.)
-pub(crate) fn read_fast_in_two(
-    file: FileId,
-    text: &str,
-    at: usize,
-    join: Join,
-) -> Option<(World, Vec<Diagnostic>)> {
-    if !text.get(at..)?.starts_with("[drones.") || at == 0 {
-        return None;
-    }
-    let (mut head, mut tail) = (None, None);
-    // The head's drones get room for the tail's, which are moved in after them.
-    let everyone = count_drones(text);
-    join(&mut || head = read_part(file, text, 0..at, fast::Part::Head, everyone), &mut || {
-        tail = read_part(file, text, at..text.len(), fast::Part::Tail, 0)
-    });
-    let ((head, mut cx, mut drones), (tail, tail_cx, tail_drones)) = (head?, tail?);
-    let root = fast::join(head, tail)?;
-    cx.diags.extend(tail_cx.diags);
-    drones.append(tail_drones);
-    Some(build(cx, root, drones))
-}
-
-/// One part of a file read in two, its diagnostics and its drones.
-/// `room`: for at least that many drones.
-fn read_part(
-    file: FileId,
-    text: &str,
-    range: std::ops::Range<usize>,
-    part: fast::Part,
-    room: usize,
-) -> Option<(fast::Read, Ctx<'_>, Drones)> {
-    let mut cx = Ctx { file, text, diags: Vec::new() };
-    let count = count_drones(text.get(range.clone())?);
-    let mut drones = Drones::with_capacity(count.max(room));
-    let read = fast::parse_part(text, range, part, count, &mut |e| drones.entry(&mut cx, e))?;
-    Some((read, cx, drones))
-}
-
-/// About how many drones `lines` hold: the lines that start `[drones.`.
-fn count_drones(lines: &str) -> usize {
-    memchr::memmem::find_iter(lines.as_bytes(), b"\n[drones.").count()
-        + usize::from(lines.starts_with("[drones."))
-}
-
-/// The serde path's way, from the whole tree.
+/// The world of the spanned tree of `text`.
 pub(crate) fn read_tree(file: FileId, text: &str, mut root: Node) -> (World, Vec<Diagnostic>) {
     let mut cx = Ctx { file, text, diags: Vec::new() };
     let mut drones = Drones::default();
     if let Value::Table(top) = &mut root.value {
-        if let Some(Entry { node: Node { value: Value::Table(entries), .. }, .. }) =
-            top.iter_mut().find(|e| e.key == "drones")
-        {
-            for e in std::mem::take(entries) {
-                drones.entry(&mut cx, e);
+        let mut take = |name: &str| match top.iter_mut().find(|e| e.key == name) {
+            Some(Entry { node: Node { value: Value::Table(entries), .. }, .. }) => {
+                std::mem::take(entries)
             }
+            _ => Vec::new(),
+        };
+        let tables = take("drones");
+        let mut fleets = take("fleets").into_iter().peekable();
+        // In file order: a fleet's drones stand where its table does.
+        for e in tables {
+            while let Some(f) = fleets.next_if(|f| f.key_span.start < e.key_span.start) {
+                drones.fleet(&mut cx, &f);
+            }
+            drones.entry(&mut cx, e);
+        }
+        for f in fleets {
+            drones.fleet(&mut cx, &f);
         }
     }
     build(cx, root, drones)
@@ -221,8 +131,13 @@ fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Dia
     if let Some(e) = table("sensors") {
         world.sensors = sim::sensors(cx, &e.node);
     }
+    // Each drone of a fleet may have an area of its own.
+    world.areas.extend(std::mem::take(&mut drones.areas));
     if let Some(e) = table("drones") {
         cx.table(&"`drones`", &e.node, drone::HELP);
+    }
+    if let Some(e) = table("fleets") {
+        cx.table(&"`fleets`", &e.node, fleet::HELP);
     }
     drones.finish(cx, &sensor_kinds);
     if let Some(e) = table("targets") {
@@ -234,7 +149,8 @@ fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Dia
     let group_spans = std::mem::take(&mut drones.group_spans);
     world.groups = std::mem::take(&mut drones.groups);
     world.drones = std::mem::take(&mut drones.out);
-    homes_in_fence(cx, &world);
+    one_name_per_drone(cx, &world.drones, &drones.fleets);
+    homes_in_fence(cx, &world, &drones.fleets);
     unique_names(cx, &world, &group_spans);
     (world, std::mem::take(&mut cx.diags))
 }
@@ -346,15 +262,42 @@ fn areas(cx: &mut Ctx, node: &Node) -> Vec<Area> {
 }
 
 /// Every drone starts and lands at its home: one outside the geofence (its line counts as
-/// inside, as for a flight) would take off outside it (and the simulator would fly it back in from there). Reported at the
-/// `home` value; its place is looked up again only when a home is outside, so a valid
-/// world of a million drones keeps no span per home.
-fn homes_in_fence(cx: &mut Ctx, world: &World) {
+/// inside, as for a flight) would take off outside it (and the simulator would fly it back
+/// in from there). Reported at the `home` value, or once per fleet at its `homes`; the
+/// place of a table's `home` is looked up again only when one is outside, so a valid world
+/// keeps no span per home.
+fn homes_in_fence(cx: &mut Ctx, world: &World, fleets: &[FleetInfo]) {
     let Some(fence) = world.site.geofence.as_deref() else { return };
+    let outside =
+        |d: &&crate::Drone| !aviary_api::geometry::contains(fence, [d.home[0], d.home[1]]);
+    let mut in_fleets = 0;
+    for f in fleets {
+        let drones = &world.drones[f.drones.clone()];
+        in_fleets += drones.len();
+        let mut out = drones.iter().filter(outside);
+        let Some(first) = out.next() else { continue };
+        let at = crate::read::shown([first.home[0], first.home[1]]);
+        let msg = match out.count() {
+            0 => format!("drone `{}` of fleet `{}` has its home {at} outside the geofence", first.name, f.name),
+            more => format!(
+                "{} drones of fleet `{}` have their homes outside the geofence, the first `{}` at {at}",
+                more + 1,
+                f.name,
+                first.name
+            ),
+        };
+        cx.error(f.homes_span, msg, "move the homes inside the geofence, or widen `geofence` in [site]: a drone takes off and lands at its home");
+    }
+    if in_fleets == world.drones.len() {
+        return;
+    }
+    let in_fleet = |i: usize| fleets.iter().any(|f| f.drones.contains(&i));
     let outside: Vec<&crate::Drone> = world
         .drones
         .iter()
-        .filter(|d| !aviary_api::geometry::contains(fence, [d.home[0], d.home[1]]))
+        .enumerate()
+        .filter(|(i, d)| outside(d) && !in_fleet(*i))
+        .map(|(_, d)| d)
         .collect();
     if outside.is_empty() {
         return;
@@ -368,6 +311,58 @@ fn homes_in_fence(cx: &mut Ctx, world: &World) {
             crate::read::shown([d.home[0], d.home[1]])
         );
         cx.error(at, msg, "move the home inside the geofence, or widen `geofence` in [site]: a drone takes off and lands at its home");
+    }
+}
+
+/// Drone names are unique among the tables (TOML keys) and within a fleet (its numbers
+/// differ); a fleet's may still meet a table's or another fleet's. Reported at each
+/// table drone whose name was taken before, and once per fleet (with how many).
+fn one_name_per_drone(cx: &mut Ctx, drones: &[crate::Drone], fleets: &[FleetInfo]) {
+    if fleets.is_empty() || (fleets.len() == 1 && fleets[0].drones.len() == drones.len()) {
+        return;
+    }
+    let fleet_of = |i: usize| fleets.iter().position(|f| f.drones.contains(&i));
+    let described = |i: usize| match fleet_of(i) {
+        Some(f) => format!("a drone of fleet `{}`", fleets[f].name),
+        None => format!("`[drones.{}]`", drones[i].name),
+    };
+    let mut seen: QuickMap<&str, usize> = QuickMap::default();
+    seen.reserve(drones.len());
+    let mut taken: Vec<(usize, usize)> = Vec::new();
+    for (i, d) in drones.iter().enumerate() {
+        match seen.entry(d.name.as_str()) {
+            std::collections::hash_map::Entry::Occupied(first) => taken.push((i, *first.get())),
+            std::collections::hash_map::Entry::Vacant(v) => {
+                v.insert(i);
+            }
+        }
+    }
+    let mut fleet_told = vec![false; fleets.len()];
+    let help =
+        "rename one of them, or change a fleet's `names`: every drone needs a name of its own";
+    for &(i, first) in &taken {
+        let name = &drones[i].name;
+        let more = match fleet_of(i) {
+            Some(f) if fleet_told[f] => continue,
+            Some(f) => {
+                fleet_told[f] = true;
+                match taken.iter().filter(|(j, _)| fleet_of(*j) == Some(f)).count() - 1 {
+                    0 => String::new(),
+                    1 => " (1 more of its drones has a name taken as well)".to_owned(),
+                    n => format!(" ({n} more of its drones have names taken as well)"),
+                }
+            }
+            None => String::new(),
+        };
+        let msg = format!(
+            "the name `{name}` is used for two drones: {} and {}{more}",
+            described(first),
+            described(i)
+        );
+        let d = Diagnostic::new(Code::WorldFile, cx.file, drones[i].span, msg)
+            .with_help(help)
+            .also(cx.file, drones[first].span, format!("{} is defined here", described(first)));
+        cx.push(d);
     }
 }
 

@@ -9,7 +9,8 @@
 //! - No input makes it panic.
 
 mod build;
-mod fast;
+#[cfg(test)]
+mod fleet_tests;
 mod hash;
 mod node;
 #[cfg(test)]
@@ -29,92 +30,8 @@ pub const BUILTIN_SENSORS: &[&str] = &["camera"];
 
 /// Reads a world file. Returns the world only when there are no errors; the diagnostics
 /// are sorted by position.
-/// For the fuzz target and tests: panics when the fast reader accepts `text` but builds
-/// another tree than the serde path, or (reading drones as it goes) another world or
-/// other diagnostics (the fast path must only ever be a shortcut).
-#[doc(hidden)]
-pub fn assert_fast_reader_agrees(text: &str) {
-    if let Some(fast) = fast::parse(text) {
-        match node::Node::parse_serde(text) {
-            Ok(slow) => assert!(
-                fast == slow,
-                "the fast reader and serde read {text:?} differently:\n{fast:#?}\n{slow:#?}"
-            ),
-            Err(e) => panic!("the fast reader accepts {text:?}, which serde refuses: {e}"),
-        }
-    }
-    if let Some((world, mut diags)) = build::read_fast(FileId::default(), text) {
-        let slow = node::Node::parse_serde(text).unwrap_or_else(|e| {
-            panic!("the fast reader accepts {text:?}, which serde refuses: {e}")
-        });
-        let (slow_world, mut slow_diags) = build::read_tree(FileId::default(), text, slow);
-        aviary_diagnostics::sort(&mut diags);
-        aviary_diagnostics::sort(&mut slow_diags);
-        assert!(
-            world == slow_world,
-            "the fast reader builds another world from {text:?}:\n{world:#?}\n{slow_world:#?}"
-        );
-        assert!(
-            diags == slow_diags,
-            "the fast reader finds other problems in {text:?}:\n{diags:#?}\n{slow_diags:#?}"
-        );
-    }
-    assert_split_reader_agrees(text);
-}
-
-/// For the fuzz target and tests: panics when reading `text` in two parts, cut at any
-/// `[drones.NAME]` line, gives a world or diagnostics other than reading it whole.
-#[doc(hidden)]
-pub fn assert_split_reader_agrees(text: &str) {
-    let whole = build::read_fast(FileId::default(), text);
-    let mut near = 0;
-    while let Some(at) = build::split_point(text, near) {
-        near = at + 1;
-        if let Some(parts) = build::read_fast_in_two(FileId::default(), text, at, &join_in_turn) {
-            let Some(whole) = &whole else {
-                panic!("{text:?} cut at {at} reads in two parts, but not whole")
-            };
-            assert!(
-                parts.0 == whole.0,
-                "{text:?} cut at {at} gives another world:\n{:#?}\n{:#?}",
-                parts.0,
-                whole.0
-            );
-            assert!(
-                parts.1 == whole.1,
-                "{text:?} cut at {at} gives other problems:\n{:#?}\n{:#?}",
-                parts.1,
-                whole.1
-            );
-        }
-    }
-}
-
 pub fn parse_world(file: FileId, text: &str) -> (Option<World>, Vec<Diagnostic>) {
     build::parse(file, text)
-}
-
-pub use build::Join;
-
-/// As [`parse_world`], with the same world and diagnostics, but a large file may be
-/// read in two parts, each through one of the two pieces of work handed to `join`
-/// (which may run them at the same time, on two threads: the caller decides). The
-/// file is cut at a `[drones.NAME]` line near its middle; the cut is taken only when
-/// the two parts read exactly as the whole would (the second holds nothing but
-/// `[drones.NAME]` tables, no drone is in both, the first ends between tables), and
-/// otherwise the file is read in one part.
-pub fn parse_world_joined(
-    file: FileId,
-    text: &str,
-    join: Join,
-) -> (Option<World>, Vec<Diagnostic>) {
-    build::parse_joined(file, text, join)
-}
-
-/// A [`Join`] that runs the two pieces of work one after the other, on this thread.
-pub fn join_in_turn(a: &mut (dyn FnMut() + Send), b: &mut (dyn FnMut() + Send)) {
-    a();
-    b();
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -325,6 +242,10 @@ pub struct Sensor {
     pub detects: Vec<String>,
     /// Metres from the drone's ground point.
     pub range: f64,
+    /// The chance, from 0 to 1, that the simulator's sensor finds a target of its kinds
+    /// that comes within range (once per target and detection): 1 by default, when it
+    /// always does and no chance is drawn.
+    pub probability: f64,
     /// The `KIND` of `[sensors.KIND]`.
     #[serde(skip)]
     pub span: Span,
@@ -339,8 +260,11 @@ pub struct Target {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Fault {
     pub drone: String,
-    /// Mission seconds.
+    /// Mission seconds; the earliest, when `latest` is given.
     pub at: f64,
+    /// With `at = [earliest, latest]`: the latest. The simulator draws the fault's time
+    /// uniformly from that range, from the run's seed.
+    pub latest: Option<f64>,
     pub kind: FaultKind,
     /// Seconds; given exactly for `link_loss` and `gps_loss`.
     pub duration: Option<f64>,

@@ -114,7 +114,6 @@ fn every_key_and_value_of_the_example_has_its_own_span() {
         }
     }
     walk(&Node::parse_serde(EXAMPLE).unwrap(), EXAMPLE);
-    walk(&crate::fast::parse(EXAMPLE).unwrap(), EXAMPLE);
 }
 
 #[test]
@@ -317,6 +316,45 @@ fn sensor_problems() {
     let (msg, at, _) = error("[sensors.sonar]\ndetects = []\nrange = 0\n");
     assert_eq!(msg, "`range` of sensor `sonar` must be greater than zero, found 0");
     assert_eq!(at, "0");
+}
+
+/// What the simulator may draw from the run's seed: a sensor's chance of finding a
+/// target, and a fault's time within a range.
+#[test]
+fn chances_and_ranges_of_time() {
+    let w = ok("[sensors.sonar]\ndetects = [\"Body\"]\nrange = 5\nprobability = 0.25\n\
+                [sensors.eye]\ndetects = [\"Body\"]\nrange = 5\n");
+    assert_eq!((w.sensors[0].probability, w.sensors[1].probability), (0.25, 1.0));
+    let sensor =
+        |p: &str| error(&format!("[sensors.s]\ndetects = []\nrange = 5\nprobability = {p}\n"));
+    assert_eq!(sensor("1.5").0, "`probability` of sensor `s` must be between 0 and 1, found 1.5");
+    assert_eq!(
+        sensor("\"high\"").0,
+        "`probability` of sensor `s` must be a number, found a string"
+    );
+    ok("[sensors.s]\ndetects = []\nrange = 5\nprobability = 0\n");
+
+    let fault =
+        |at: &str| format!("{HOME}[[faults]]\ndrone = \"d\"\nat = {at}\nkind = \"crash\"\n");
+    let w = ok(&fault("[30, 90.5]"));
+    assert_eq!((w.faults[0].at, w.faults[0].latest), (30.0, Some(90.5)));
+    let w = ok(&fault("[30, 30]"));
+    assert_eq!((w.faults[0].at, w.faults[0].latest), (30.0, Some(30.0)));
+    assert_eq!(ok(&fault("12")).faults[0].latest, None);
+    let (msg, at, help) = error(&fault("[90, 30]"));
+    assert_eq!(msg, "the range `at` of a fault runs from 90 back to 30");
+    assert_eq!(at, "[90, 30]");
+    assert_eq!(help, "write the earlier time first, e.g. `at = [30, 90]`");
+    assert_eq!(
+        error(&fault("[1, 2, 3]")).0,
+        "`at` of a fault must be a time or a range [earliest, latest], found 3 numbers"
+    );
+    let (msg, at, _) = error(&fault("[-1, 2]"));
+    assert_eq!(
+        (msg.as_str(), at.as_str()),
+        ("`at` of a fault must be zero or more seconds, found -1", "-1")
+    );
+    assert_eq!(error(&fault("[1, \"x\"]")).0, "`at` of a fault must be a number, found a string");
 }
 
 #[test]
@@ -621,8 +659,8 @@ fn garbage_gives_diagnostics_not_panics() {
     assert!(parse(&deep).0.is_none());
     let deep = format!("a = {}", "{ b = ".repeat(5000));
     assert!(parse(&deep).0.is_none());
-    // A million open brackets on a test thread's small stack: neither reader recurses
-    // that deep (the fast one leaves deep nesting to serde, which has a limit).
+    // A million open brackets on a test thread's small stack: the reader does not
+    // recurse that deep (the TOML parser has a limit).
     for open in ["[", "{ b = ", "[{ b = "] {
         let (world, diags) = parse(&format!("a = {}", open.repeat(1_000_000)));
         assert!(world.is_none() && diags.iter().any(|d| d.is_error()), "{open}");
@@ -658,7 +696,6 @@ fn random_inputs_never_panic() {
             }
             chars.into_iter().collect()
         };
-        assert_fast_reader_agrees(&text);
         let (world, diags) = parse(&text);
         assert_eq!(world.is_some(), diags.is_empty(), "{text:?}");
         for d in &diags {
@@ -667,137 +704,28 @@ fn random_inputs_never_panic() {
     }
 }
 
-/// The fast reader (`fast.rs`) gives the serde path's tree, spans and all, for every
-/// world of the examples and for the forms around them; it leaves the rest to serde.
+/// Groups in order of first appearance, members in file order; one string for a group's
+/// name and for each attribute key, whatever the drones.
 #[test]
-fn the_fast_reader_gives_the_same_tree_as_serde() {
-    let examples = [
-        include_str!("../../../examples/search_and_rescue.world.toml"),
-        EXAMPLE,
-        "[site]\nname = \"X\"   # trailing\n# comment\n\n[empty]\n\n[drones.a]\nhome = [0, 0]\n[drones.b]\n",
-        "[a]\nx = 1\n[a.b]\ny = 2.5\n[a.c.d]\nz = -3\nw = true\n",
-        "[[t]]\n[[t]]\nk = 1\n[[t]]\nk = { a = [1, 2], b = 'lit' }\n",
-        "[areas]\nA = [\n  [0, 0],\n  [10, 0], # c\n  [10, 10],\n]\n[places]\nP = [1e3, 2_000]\n",
-        "[site]\norigin = { lat = 46.6, lon = 14.2, alt = 440.0 }\ngeofence = [[-600, -600], [600, -600], [600, 600]]\n",
-        "\n\n# only comments\n",
-        "",
-        // Scalars read without the decoder, and their neighbours read with it.
-        "[a]\ni = 0\nj = -0\nk = 123456789012345678\nl = 1234567890123456789\nm = +7\nn = 'lit \"q\"'\no = \"tab\there\"\np = \"\"\nq = ''\nb = false\nc = true\nu = 1_000\ne = \"\\u00e9\\\\\"\nf = -12\ng = 2.5\nh = \"\u{e9}t\u{e9}\"\n",
-        "[a]\nk-1 = 1\n_k = 2\n3 = 3\n",
-    ];
-    for text in examples {
-        let fast =
-            crate::fast::parse(text).unwrap_or_else(|| panic!("the fast reader reads {text:?}"));
-        assert_eq!(fast, Node::parse_serde(text).unwrap(), "{text:?}");
-    }
-    let mut faults = String::new();
-    for entry in
-        std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/faults")).unwrap()
-    {
-        let path = entry.unwrap().path();
-        if path.to_string_lossy().ends_with(".world.toml") {
-            faults = std::fs::read_to_string(&path).unwrap();
-            let fast = crate::fast::parse(&faults)
-                .unwrap_or_else(|| panic!("the fast reader reads {path:?}"));
-            assert_eq!(fast, Node::parse_serde(&faults).unwrap(), "{path:?}");
-        }
-    }
-    assert!(!faults.is_empty());
-    // Forms left to serde, which reports or reads them.
-    for text in [
-        "top = 1\n",
-        "[a]\nb.c = 1\n",
-        "[a]\n\"q\" = 1\n",
-        "[a]\nx = 1\nx = 2\n",
-        "[a]\n[a]\n",
-        "[a.b]\n[a]\n",
-        "[a]\nd = 1979-05-27\n",
-        "[a]\nx = \n",
-        "[a]\nx = 0x10\n",
-        "[a]\nx = 01\n",
-        "[a]\nx = \"open\n",
-        "[a]\nx = 'open\n",
-        "[a\n",
-        "[places]\nLookout@= [100, 40]\n",
-        "[drones.a]\nhom\u{e9} = [0, 0]\n",
-        "[a@b]\n",
-        "[a]\rx = 1\n",
-        "[a]\nx = 1\r",
-        "# a\u{7f}comment\n[a]\n",
-        "[a]\nx = \"tab\u{1}\"\n",
-        "[a]\nx = \"\\e\"\n",
-        "[a]\nx = \"\\x41\"\n",
-        "[a]\nx = { b = 1, }\n",
-        "[a]\nx = { b = 1,\n c = 2 }\n",
-        "[a]\nx = \'\'\'\r\nline\r\n\'\'\'\r\n",
-        "[a]\nx = \"\"\"\r\nline\r\n\"\"\"\r\n",
-    ] {
-        assert!(crate::fast::parse(text).is_none(), "{text:?}");
-    }
-}
-
-/// The fast reader builds each drone as its table ends: the same world and the same
-/// diagnostics as the serde path's whole tree, whatever the drones' tables hold and
-/// wherever the tables they refer to (`[sensors]`, `[[faults]]`) stand.
-#[test]
-fn drones_read_table_by_table_give_the_serde_paths_world() {
+fn groups_and_attribute_keys_are_shared() {
     let sensors = "[sensors.thermal]\ndetects = [\"Body\"]\nrange = 20\n";
     let fleet = "[drones.a]\nhome = [0, 0]\ngroup = \"g\"\nsensors = [\"thermal\", \"camera\"]\nindex = 0\n\
                  [drones.b]\nhome = [5, 0, 1]\ngroup = \"h\"\npayload = [\"kit\"]\nnote = \"x\"\nlist = [1, 2]\n\
                  [drones.c]\nhome = [9, 9]\ngroup = \"g\"\nmavlink = \"udp:127.0.0.1:14550\"\nsystem_id = 3\n";
-    let texts = [
-        EXAMPLE.to_owned(),
-        fleet.to_owned(),
-        format!("{sensors}{fleet}"),
-        // `[sensors]` after the drones that name them.
-        format!("{fleet}{sensors}"),
-        format!("[drones]\n{fleet}[[faults]]\ndrone = \"b\"\nat = 5\nkind = \"crash\"\n"),
-        format!("{fleet}[[faults]]\ndrone = \"bb\"\nat = 5\nkind = \"crash\"\n[[faults]]\ndrone = \"zz\"\nat = 1\nkind = \"crash\"\n"),
-        // Problems in the drones' tables, and names shared with other tables.
-        "[drones.a]\nsensors = [\"thermel\", 3]\nmax_speed = -1\nspeed = 2\n[drones.b]\nhome = \"x\"\ngroup = \"a\"\nbackend = \"warp\"\n[places]\nb = [1, 2]\n".to_owned(),
-        "[drones.a]\n[drones.b]\nhome = [0, 0]\n[site]\nname = \"S\"\n[drones.c]\nhome = [1, 1]\ngroup = \"b\"\n".to_owned(),
-        "[drones.x1]\nhome = [0, 0]\ngroup = \"9g\"\nmavlink = \"bad\"\nsigning_key = 1\n[drones.x2]\nhome = [0, 0]\nbattery = 101\n".to_owned(),
-        // Forms the fast reader leaves to serde: the same answer either way.
-        "[drones]\na = 5\n[drones.b]\nhome = [0, 0]\n".to_owned(),
-        "[drones.a]\nhome = [0, 0]\n[drones.a.home]\nx = 1\n".to_owned(),
-        "[drones.a]\nhome = [0, 0]\n[site]\n[drones.a.extra]\nx = 1\n".to_owned(),
-        "[drones.a.b]\nx = 1\n[drones.c]\nhome = [0, 0]\n".to_owned(),
-        "[[drones]]\nhome = [0, 0]\n".to_owned(),
-        "[drones.a]\nhome = [0, 0]\n[drones.a]\nhome = [1, 1]\n".to_owned(),
-    ];
-    for text in &texts {
-        assert_fast_reader_agrees(text);
-        let (world, diags) = parse(text);
-        let Ok(tree) = Node::parse_serde(text) else {
-            assert!(world.is_none() && diags.len() == 1, "{text}");
-            continue;
-        };
-        let (slow_world, mut slow_diags) = crate::build::read_tree(FileId(7), text, tree);
-        aviary_diagnostics::sort(&mut slow_diags);
-        assert_eq!(diags, slow_diags, "{text}");
-        if let Some(world) = world {
-            assert_eq!(world, slow_world, "{text}");
-        }
-    }
-    // Which of them the fast reader takes: the first nine.
-    for (i, text) in texts.iter().enumerate() {
-        assert_eq!(crate::build::read_fast(FileId(7), text).is_some(), i < 9, "{text}");
-    }
-    let (world, _) = parse(&texts[3]);
-    let world = world.unwrap();
+    // `[sensors]` after the drones that name them.
+    let world = ok(&format!("{fleet}{sensors}"));
     assert_eq!(world.groups.len(), 2);
     assert_eq!(world.groups[0].members, [0, 2]);
     assert_eq!(*world.drones[0].sensors, ["thermal", "camera"]);
-    // One string for a group's name and for each attribute key, whatever the drones.
     let (a, c) = (&world.drones[0], &world.drones[2]);
     assert!(std::sync::Arc::ptr_eq(a.group.as_ref().unwrap(), c.group.as_ref().unwrap()));
     let w = ok("[drones.d]\nhome = [0, 0]\nnote = 1\n[drones.e]\nhome = [0, 0]\nnote = \"x\"\n");
     assert!(std::sync::Arc::ptr_eq(&w.drones[0].attributes[0].0, &w.drones[1].attributes[0].0));
 }
 
-/// A large generated fleet: every drone table read by the fast reader as it goes.
+/// Many drone tables, in groups.
 #[test]
-fn a_large_fleet_is_read_table_by_table() {
+fn a_world_of_many_drone_tables() {
     let mut text = String::from("[site]\nname = \"W\"\n");
     for i in 0..500 {
         text.push_str(&format!(
@@ -806,145 +734,8 @@ fn a_large_fleet_is_read_table_by_table() {
             i % 3
         ));
     }
-    assert_fast_reader_agrees(&text);
     let world = ok(&text);
     assert_eq!(world.drones.len(), 500);
     assert_eq!(world.drones[499].name, "a499");
     assert_eq!(world.groups.iter().map(|g| g.members.len()).collect::<Vec<_>>(), [167, 167, 166]);
-}
-
-/// Reads `text` as `aviary` reads a large world: in two parts, on two threads.
-fn parse_on_two_threads(text: &str) -> (Option<World>, Vec<Diagnostic>) {
-    let join = |a: &mut (dyn FnMut() + Send), b: &mut (dyn FnMut() + Send)| {
-        std::thread::scope(|s| {
-            s.spawn(b);
-            a();
-        })
-    };
-    parse_world_joined(FileId(7), text, &join)
-}
-
-/// A file cut at any `[drones.NAME]` line and read in two parts gives the world and the
-/// diagnostics of the whole file, or is read whole: groups and problems on both sides,
-/// tables the drones refer to before and after, and cuts that are not between tables.
-#[test]
-fn a_file_read_in_two_parts_is_read_as_whole() {
-    let fleet = |from: usize, to: usize| -> String {
-        (from..to)
-            .map(|i| format!("[drones.d{i}]\nhome = [{i}, 0]\ngroup = \"g{}\"\nindex = {i}\nsensors = [\"thermal\"]\n", i % 3))
-            .collect()
-    };
-    let texts = [
-        fleet(0, 8),
-        format!("[site]\nname = \"S\"\n[sensors.thermal]\ndetects = [\"B\"]\nrange = 5\n{}", fleet(0, 6)),
-        format!("{}[sensors.thermol]\ndetects = [\"B\"]\nrange = 5\n", fleet(0, 6)),
-        format!("[drones]\n{}", fleet(0, 4)),
-        format!("{}[drones.x]\nhome = [0, 0]\n[[faults]]\ndrone = \"d5\"\nat = 1\nkind = \"crash\"\n{}", fleet(0, 3), fleet(3, 6)),
-        // Problems in both parts, names shared with places.
-        format!("[places]\ng1 = [0, 0]\n{}[drones.bad]\nhome = \"x\"\nspeed = 1\n{}[drones.9]\nbattery = 200\n", fleet(0, 3), fleet(3, 5)),
-        // One drone twice, on either side of a cut: the whole file's serde path.
-        format!("{}[drones.d1]\nhome = [1, 1]\n", fleet(0, 4)),
-        // A string that runs over lines that look like tables.
-        format!("{}[site]\nname = \"\"\"\n[drones.q]\nhome = [0, 0]\n\"\"\"\n{}", fleet(0, 2), fleet(2, 4)),
-        format!("{}[site]\nname = '''\n[drones.q]\n'''\n{}", fleet(0, 2), fleet(2, 4)),
-        format!("[areas]\nA = [\n[drones.x]\n]\n{}", fleet(0, 2)),
-        format!("{}[drones.x]\nhome = [0, 0\n[drones.y]\nhome = [0, 0]\n", fleet(0, 2)),
-        format!("{}[drones.x]\nhome = [0, 0]\nnote = \n[drones.y]\nhome = [0, 0]\n", fleet(0, 2)),
-        format!("{}[drones.x]\r\nhome = [0, 0]\r\n[drones.y]\r\nhome = [0, 0]\r\n", fleet(0, 2)),
-        format!("{}[drones.x.y]\nhome = [0, 0]\n{}", fleet(0, 2), fleet(2, 4)),
-        format!("[[drones]]\nhome = [0, 0]\n{}", fleet(0, 2)),
-        format!("[site]\ndrones = 1\n{}", fleet(0, 2)),
-        format!("{}# [drones.c]\n[drones.z] # [drones.c]\nhome = [0, 0]\n", fleet(0, 2)),
-    ];
-    for text in &texts {
-        assert_fast_reader_agrees(text);
-        assert_eq!(parse_on_two_threads(text), parse(text), "{text}");
-    }
-    // Some cuts are taken: every cut of a plain fleet.
-    let text = &texts[1];
-    let whole = crate::build::read_fast(FileId(7), text).unwrap();
-    let cuts = (1..text.len())
-        .filter_map(|near| crate::build::split_point(text, near))
-        .collect::<std::collections::BTreeSet<_>>();
-    assert_eq!(cuts.len(), 6);
-    for at in cuts {
-        let parts = crate::build::read_fast_in_two(FileId(7), text, at, &join_in_turn).unwrap();
-        assert_eq!(parts, whole, "cut at {at}");
-    }
-    // ... and none where the tail is not all drones, or a drone is in both parts.
-    for (text, line) in [(&texts[4], "[drones.x]"), (&texts[6], "[drones.d1]\nhome = [1, 1]")] {
-        let at = text.find(line).unwrap();
-        assert!(
-            crate::build::read_fast_in_two(FileId(7), text, at, &join_in_turn).is_none(),
-            "{text}"
-        );
-    }
-}
-
-/// A large world is read in two parts, on two threads, into the world read whole.
-#[test]
-fn a_large_fleet_read_on_two_threads_is_the_fleet_read_whole() {
-    let mut text =
-        String::from("[site]\nname = \"W\"\n[sensors.ir]\ndetects = [\"P\"]\nrange = 9\n");
-    for i in 0..3000 {
-        text.push_str(&format!("\n[drones.a{i}]\nhome = [{}, 0]\ngroup = \"fleet{}\"\nindex = {i}\nsensors = [\"ir\"]\n", i * 5, i * 7 / 3000));
-    }
-    assert!(text.len() > crate::build::JOIN_FROM);
-    let at = crate::build::split_point(&text, text.len() / 2).unwrap();
-    assert!(crate::build::read_fast_in_two(FileId(7), &text, at, &join_in_turn).is_some());
-    let (world, diags) = parse_on_two_threads(&text);
-    assert_eq!((world.as_ref(), &diags), (parse(&text).0.as_ref(), &parse(&text).1));
-    let world = world.unwrap();
-    assert_eq!(world.drones.len(), 3000);
-    assert_eq!(world.groups.len(), 7);
-    assert_eq!(world.groups[3].members.first(), Some(&1286));
-    // The same problems, with their spans, in both parts.
-    let broken = text
-        .replace("index = 7\n", "index = 7\nspeed = 1\n")
-        .replace("index = 2900\n", "index = 2900\nbattery = -1\n");
-    let (none, diags) = parse_on_two_threads(&broken);
-    assert!(none.is_none());
-    assert_eq!(diags.len(), 2);
-    assert_eq!((None, diags), parse(&broken));
-}
-
-mod split_props {
-    use proptest::prelude::*;
-
-    /// Pieces of world files, some of them odd, to be put together in any order.
-    const PIECES: &[&str] = &[
-        "[drones.a]\nhome = [0, 0]\ngroup = \"g\"\n",
-        "[drones.b]\nhome = [1, 0]\ngroup = \"h\"\nsensors = [\"ir\", \"camera\"]\n",
-        "[drones.c]\nhome = [2, 0, 3]\nnote = \"x\"\nlist = [1, {a = 2}]\n",
-        "[drones.a]\nhome = [9, 9]\n",
-        "[drones.d]\nhome = \"nowhere\"\nmax_speed = -2\n",
-        "[drones.e]\nmavlink = \"udp:1.2.3.4:5\"\nsystem_id = 2\nhome = [0, 0]\n",
-        "[drones.f]\nhome = [0, 0]\ngroup = \"a\"\n",
-        "[drones.g.h]\nx = 1\n",
-        "[drones]\n",
-        "[[drones]]\nx = 1\n",
-        "[sensors.ir]\ndetects = [\"P\"]\nrange = 3\n",
-        "[places]\nh = [0, 0]\n",
-        "[site]\nname = \"\"\"\n[drones.z]\n\"\"\"\n",
-        "[site]\nname = \"S\"\n",
-        "[[faults]]\ndrone = \"b\"\nat = 1\nkind = \"crash\"\n",
-        "[targets]\nx = 1\n",
-        "# [drones.y]\n\n",
-        "[drones.y]\r\nhome = [0, 0]\r\n",
-        "[drones.w]\nhome = [0,\n0]\n",
-        "[drones.v]\nhome = [0, 0\n",
-        "[drones.u]\nx = \n",
-        "x = 1\n",
-    ];
-
-    proptest! {
-        #![proptest_config(ProptestConfig::with_cases(400))]
-        /// Any file put together from the pieces, cut at any `[drones.NAME]` line.
-        #[test]
-        fn any_cut_reads_as_the_whole(pieces in proptest::collection::vec(0..PIECES.len(), 0..12)) {
-            let text: String = pieces.iter().map(|&i| PIECES[i]).collect();
-            crate::assert_split_reader_agrees(&text);
-            prop_assert_eq!(super::parse_on_two_threads(&text), super::parse(&text));
-        }
-    }
 }

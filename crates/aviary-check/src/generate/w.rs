@@ -32,19 +32,52 @@ pub fn w_mission(k: usize) -> String {
     m
 }
 
-/// The world of W(N, ·): N drones in one group, on a grid 5 m apart, each with its
-/// `index` (0 to N - 1) as an attribute.
+/// The world of W(N, ·): one fleet of N drones `a0` to `a{N-1}` in one group, on a
+/// square grid 5 m apart, each with its number (0 to N - 1) as its `index` attribute.
+/// A few lines whatever N: the world file describes the fleet, not each drone.
 pub fn w_world(n: usize) -> String {
-    let mut w = String::with_capacity(128 + 56 * n);
-    w.push_str("[site]\nname = \"W\"\norigin = { lat = 46.6, lon = 14.2, alt = 440.0 }\n");
     let side = (n as f64).sqrt().ceil().max(1.0) as usize;
-    for i in 0..n {
-        let _ = write!(
-            w,
-            "\n[drones.a{i}]\nhome = [{}, {}]\ngroup = \"{GROUP}\"\nindex = {i}\n",
-            (i % side) * 5,
-            (i / side) * 5
+    format!(
+        "[site]\nname = \"W\"\norigin = {{ lat = 46.6, lon = 14.2, alt = 440.0 }}\n\n\
+         [fleets.a]\ncount = {n}\nnames = \"a{{i}}\"\ngroup = \"{GROUP}\"\n\
+         homes = {{ grid = [0, 0], spacing = 5, columns = {side} }}\n"
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use aviary_diagnostics::FileId;
+
+    use super::*;
+
+    /// W's world as a table per drone: what the fleet stands for, drone for drone.
+    fn as_tables(n: usize) -> String {
+        let mut w = String::from(
+            "[site]\nname = \"W\"\norigin = { lat = 46.6, lon = 14.2, alt = 440.0 }\n",
         );
+        let side = (n as f64).sqrt().ceil().max(1.0) as usize;
+        for i in 0..n {
+            let _ = write!(
+                w,
+                "\n[drones.a{i}]\nhome = [{}, {}]\ngroup = \"{GROUP}\"\nindex = {i}\n",
+                (i % side) * 5,
+                (i / side) * 5
+            );
+        }
+        w
     }
-    w
+
+    #[test]
+    fn the_fleet_is_the_drones_of_a_table_each() {
+        for n in [1, 2, 40, 1000, 1001] {
+            let read = |text: &str| {
+                let (world, diags) = aviary_world::parse_world(FileId(0), text);
+                assert!(diags.is_empty(), "{diags:#?}");
+                let mut world = world.unwrap();
+                world.drones.iter_mut().for_each(|d| d.span = Default::default());
+                world
+            };
+            assert_eq!(read(&w_world(n)), read(&as_tables(n)), "{n} drones");
+        }
+    }
 }

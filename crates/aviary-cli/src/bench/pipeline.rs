@@ -44,10 +44,9 @@ pub struct Ran {
 
 /// Checks, compiles and runs `mission` in `world` on the simulator (at `--speed max`),
 /// feeding every trace event to `sink`. Every stage really runs; a mission with errors
-/// is refused, as `aviary run` refuses it. As in `aviary run`, the world is read on two
-/// threads when it is large ([`crate::cores::join`]), the source texts go once the
-/// mission checks clean, and the simulator's fleet takes the world's drones where they
-/// lie ([`aviary_sim::Fleet::from_world`]).
+/// is refused, as `aviary run` refuses it. As in `aviary run`, the source texts go once
+/// the mission checks clean, and the simulator's fleet takes the world's drones where
+/// they lie ([`aviary_sim::Fleet::from_world`]).
 /// The texts are handed over (to the source map), not copied: a large world's text is
 /// megabytes.
 pub fn run(
@@ -59,9 +58,7 @@ pub fn run(
     let api = aviary_sim::descriptor();
     let mut sources = SourceMap::new();
     let wid = sources.add("bench.world.toml", world);
-    let (world, diags) = stages.time("world", || {
-        aviary_world::parse_world_joined(wid, sources.text(wid), &crate::cores::join)
-    });
+    let (world, diags) = stages.time("world", || aviary_world::parse_world(wid, sources.text(wid)));
     let Some(world) = world else { return Err(render(&sources, &diags)) };
     let root = sources.add("bench.mission", mission);
     let (program, diags) = stages

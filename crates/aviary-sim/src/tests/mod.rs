@@ -5,6 +5,7 @@ mod envelope;
 mod flight;
 mod landing;
 mod link;
+mod luck;
 mod rules;
 mod separation;
 mod sky;

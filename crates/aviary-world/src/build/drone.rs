@@ -1,4 +1,6 @@
 //! `[drones.NAME]`: the known keys, the backend, and every other key as an attribute.
+//! A fleet's keys other than its own (`fleet.rs`) are read here too, once for all its
+//! drones.
 
 use aviary_diagnostics::Span;
 
@@ -18,12 +20,15 @@ const TELEMETRY: &[&str] = &["position", "altitude", "speed", "heading", "state"
 const ADDRESS_HELP: &str =
     "write `mavlink = \"udp:127.0.0.1:14550\"` or `\"tcp:HOST:PORT\"` (schemes: tcp, tcpin, tcpout, udp, udpin, udpout, udpbcast, serial)";
 
-/// The drones as their tables come: from the fast reader one by one while it reads,
-/// or from the serde path's tree. What needs other tables (the sensors' kinds) waits
-/// for [`Drones::finish`].
+/// The drones of `[drones.NAME]` and `[fleets.NAME]`, in file order. What needs other
+/// tables (the sensors' kinds) waits for [`Drones::finish`].
 #[derive(Default)]
 pub(super) struct Drones {
     pub out: Vec<Drone>,
+    /// The fleets, each with the range of its drones in `out`.
+    pub fleets: Vec<super::fleet::FleetInfo>,
+    /// The areas of fleets that give each drone one, in order.
+    pub areas: Vec<crate::Area>,
     /// In order of first appearance, members in the drones' file order.
     pub groups: Vec<Group>,
     /// Where each group of `groups` is first named.
@@ -32,8 +37,10 @@ pub(super) struct Drones {
     group_index: QuickMap<String, (usize, Arc<str>)>,
     /// Attribute keys, each kept once.
     keys: QuickSet<Arc<str>>,
-    /// (drone, its sensor's index, span) of every sensor named.
+    /// (drone, its sensor's index, span) of every sensor a drone's table names.
     sensors: Vec<(usize, usize, Span)>,
+    /// (fleet, sensor, span) of every sensor a fleet names.
+    pub(super) fleet_sensors: Vec<(String, String, Span)>,
     /// Entries that are not tables, each with the number of drones before it.
     others: Vec<(usize, String)>,
 }
@@ -42,59 +49,42 @@ pub(super) const HELP: &str =
     "write one table per drone: `[drones.NAME]` followed by `home = [x, y]`";
 
 impl Drones {
-    /// Room for about `n` drones.
-    pub fn with_capacity(n: usize) -> Drones {
-        Drones { out: Vec::with_capacity(n), ..Drones::default() }
-    }
-
     /// One entry of `[drones]`; its table is dropped once read.
     pub fn entry(&mut self, cx: &mut Ctx, e: Entry) {
         cx.identifier("drone", &e.key, e.key_span);
         if !matches!(e.node.value, Value::Table(_)) {
-            cx.table(&Named("drone", &e.key), &e.node, HELP);
+            cx.table(&Owner::Drone(&e.key), &e.node, HELP);
             self.others.push((self.out.len(), e.key));
             return;
         }
         let Entry { key, key_span, node: Node { value: Value::Table(keys), .. } } = e else {
             return;
         };
-        let d = self.drone(cx, key, key_span, &keys);
+        if get(&keys, "home").is_none() {
+            let msg = format!("drone `{key}` has no `home`");
+            cx.error(
+                key_span,
+                msg,
+                "add `home = [x, y]`: where the drone starts and lands, in metres",
+            );
+        }
+        let index = self.out.len();
+        let (mut d, group) = self.read_keys(cx, Owner::Drone(&key), key_span, &keys, index);
+        if let Some(g) = group {
+            self.groups[g].members.push(index);
+        }
+        d.name = key;
         self.out.push(d);
-    }
-
-    /// Adds the drones of `tail`, read from the lines after this one's, as if this had
-    /// read them itself: groups, sensors and other entries with the drones' indices.
-    pub fn append(&mut self, tail: Drones) {
-        let offset = self.out.len();
-        let Drones { out, groups, group_spans, group_index, keys, sensors, others } = tail;
-        for (group, span) in groups.into_iter().zip(group_spans) {
-            let members = group.members.into_iter().map(|m| m + offset);
-            match self.group_index.get(group.name.as_str()) {
-                Some((g, _)) => self.groups[*g].members.extend(members),
-                None => {
-                    let Some((_, shared)) = group_index.get(group.name.as_str()) else { continue };
-                    self.group_index
-                        .insert(group.name.clone(), (self.groups.len(), shared.clone()));
-                    self.groups.push(Group { name: group.name, members: members.collect() });
-                    self.group_spans.push(span);
-                }
-            }
-        }
-        for key in keys {
-            if !self.keys.contains(&key) {
-                self.keys.insert(key);
-            }
-        }
-        self.sensors.extend(sensors.into_iter().map(|(d, i, span)| (d + offset, i, span)));
-        self.others.extend(others.into_iter().map(|(before, name)| (before + offset, name)));
-        self.out.extend(out);
     }
 
     /// Checks every drone's sensors against `[sensors]`.
     pub fn finish(&self, cx: &mut Ctx, sensor_kinds: &[String]) {
         for &(d, i, span) in &self.sensors {
             let drone = &self.out[d];
-            check_sensor(cx, &drone.name, &drone.sensors[i], span, sensor_kinds);
+            check_sensor(cx, Owner::Drone(&drone.name), &drone.sensors[i], span, sensor_kinds);
+        }
+        for (fleet, kind, span) in &self.fleet_sensors {
+            check_sensor(cx, Owner::Fleet(fleet), kind, *span, sensor_kinds);
         }
     }
 
@@ -112,8 +102,29 @@ impl Drones {
         names
     }
 
-    fn drone(&mut self, cx: &mut Ctx, owned: String, key_span: Span, keys: &[Entry]) -> Drone {
-        let name = owned.as_str();
+    /// The attribute key `key`, shared with every drone that has it.
+    pub(super) fn key(&mut self, key: &str) -> Arc<str> {
+        match self.keys.get(key) {
+            Some(shared) => shared.clone(),
+            None => {
+                let shared: Arc<str> = key.into();
+                self.keys.insert(shared.clone());
+                shared
+            }
+        }
+    }
+
+    /// A drone as `keys` describe it, without its name, and the index of its group (the
+    /// caller makes it a member). `index`: where the drone (or a fleet's first) goes in
+    /// `out`. A fleet's own keys are not among `keys`.
+    pub(super) fn read_keys(
+        &mut self,
+        cx: &mut Ctx,
+        owner: Owner,
+        key_span: Span,
+        keys: &[Entry],
+        index: usize,
+    ) -> (Drone, Option<usize>) {
         let mut d = Drone {
             name: String::new(),
             home: [0.0; 3],
@@ -136,19 +147,11 @@ impl Drones {
             attributes: Box::default(),
             span: key_span,
         };
-        if get(keys, "home").is_none() {
-            let msg = format!("drone `{name}` has no `home`");
-            cx.error(
-                key_span,
-                msg,
-                "add `home = [x, y]`: where the drone starts and lands, in metres",
-            );
-        }
-        let index = self.out.len();
+        let mut group_index = None;
         let mut attributes = Vec::new();
         for k in keys {
             // Said only in a message: not formatted unless one is written.
-            let what = KeyOf(&k.key, name);
+            let what = KeyOf(&k.key, owner);
             let n = &k.node;
             match k.key.as_str() {
                 "home" => {
@@ -176,14 +179,19 @@ impl Drones {
                                 (self.groups.len() - 1, shared)
                             }
                         };
-                        self.groups[g].members.push(index);
+                        group_index = Some(g);
                         d.group = Some(shared);
                     }
                 }
                 "sensors" => {
                     let mut sensors = Vec::new();
                     for (kind, span) in cx.strings(&what, n).unwrap_or_default() {
-                        self.sensors.push((index, sensors.len(), span));
+                        match owner {
+                            Owner::Drone(_) => self.sensors.push((index, sensors.len(), span)),
+                            Owner::Fleet(fleet) => {
+                                self.fleet_sensors.push((fleet.to_owned(), kind.clone(), span))
+                            }
+                        }
                         sensors.push(kind);
                     }
                     d.sensors = sensors.into();
@@ -218,16 +226,8 @@ impl Drones {
                 "flight_current" => d.flight_current = cx.positive(&what, n).or(d.flight_current),
                 key if BACKEND_KEYS.contains(&key) => {}
                 _ => {
-                    if let Some((key, value)) = attribute(cx, name, k) {
-                        let key = match self.keys.get(key) {
-                            Some(shared) => shared.clone(),
-                            None => {
-                                let shared: Arc<str> = key.into();
-                                self.keys.insert(shared.clone());
-                                shared
-                            }
-                        };
-                        attributes.push((key, value));
+                    if let Some((key, value)) = attribute(cx, owner, k) {
+                        attributes.push((self.key(key), value));
                     }
                 }
             }
@@ -243,20 +243,19 @@ impl Drones {
         {
             d.endurance = endurance;
         }
-        d.backend = backend(cx, name, keys);
+        d.backend = backend(cx, owner, keys);
         d.attributes = attributes.into();
-        d.name = owned;
-        d
+        (d, group_index)
     }
 }
 
-fn check_sensor(cx: &mut Ctx, drone: &str, kind: &str, span: Span, defined: &[String]) {
+fn check_sensor(cx: &mut Ctx, owner: Owner, kind: &str, span: Span, defined: &[String]) {
     if defined.iter().any(|k| k == kind) || BUILTIN_SENSORS.contains(&kind) {
         return;
     }
     let known: Vec<&str> =
         defined.iter().map(String::as_str).chain(BUILTIN_SENSORS.iter().copied()).collect();
-    let msg = format!("drone `{drone}` has sensor `{kind}`, but no `[sensors.{kind}]` defines it");
+    let msg = format!("{owner} has sensor `{kind}`, but no `[sensors.{kind}]` defines it");
     let help = match suggest(kind, known.iter().copied()) {
         Some(s) => format!("did you mean `{s}`?"),
         None => format!(
@@ -267,12 +266,17 @@ fn check_sensor(cx: &mut Ctx, drone: &str, kind: &str, span: Span, defined: &[St
     cx.error(span, msg, help);
 }
 
-fn attribute<'e>(cx: &mut Ctx, drone: &str, e: &'e Entry) -> Option<(&'e str, AttributeValue)> {
+fn attribute<'e>(cx: &mut Ctx, owner: Owner, e: &'e Entry) -> Option<(&'e str, AttributeValue)> {
     let key = &e.key;
     if TELEMETRY.contains(&key.as_str()) {
-        let msg = format!(
-            "attribute `{key}` of drone `{drone}` has the name of a telemetry field, so `{drone}.{key}` could not read it"
-        );
+        let msg = match owner {
+            Owner::Drone(drone) => format!(
+                "attribute `{key}` of drone `{drone}` has the name of a telemetry field, so `{drone}.{key}` could not read it"
+            ),
+            Owner::Fleet(fleet) => format!(
+                "attribute `{key}` of fleet `{fleet}` has the name of a telemetry field, so `.{key}` of its drones could not read it"
+            ),
+        };
         let help = format!("rename the attribute; the telemetry fields are {}", quoted(TELEMETRY));
         cx.error(e.key_span, msg, help);
         return None;
@@ -291,34 +295,33 @@ fn attribute<'e>(cx: &mut Ctx, drone: &str, e: &'e Entry) -> Option<(&'e str, At
     Some((key, value))
 }
 
-fn backend(cx: &mut Ctx, drone: &str, keys: &[Entry]) -> Backend {
-    let what = |key: &str| format!("`{key}` of drone `{drone}`");
+fn backend(cx: &mut Ctx, owner: Owner, keys: &[Entry]) -> Backend {
+    let what = |key: &str| format!("{}", KeyOf(key, owner));
     let chosen =
         get(keys, "backend").and_then(|b| Some((cx.string(&what("backend"), &b.node)?, b)));
     let address =
         get(keys, "mavlink").and_then(|m| Some((cx.string(&what("mavlink"), &m.node)?, m)));
     if let Some((address, m)) = &address {
-        check_address(cx, drone, address, m.node.span);
+        check_address(cx, owner, address, m.node.span);
     }
-    let system_id = get(keys, "system_id").and_then(|s| system_id(cx, drone, s));
+    let system_id = get(keys, "system_id").and_then(|s| system_id(cx, owner, s));
     let signing_key =
         get(keys, "signing_key").and_then(|s| cx.string(&what("signing_key"), &s.node));
     let mavlink = match (&chosen, &address) {
         (Some((b, e)), _) if !["sim", "mavlink"].contains(&b.as_str()) => {
-            let msg = format!("unknown backend `{b}` for drone `{drone}`");
+            let msg = format!("unknown backend `{b}` for {owner}");
             let help = "write `backend = \"sim\"` (the default), or give a `mavlink = \"udp:HOST:PORT\"` address";
             cx.error(e.node.span, msg, help);
             false
         }
         (Some((b, e)), Some(_)) if b == "sim" => {
-            let msg = format!("drone `{drone}` has `backend = \"sim\"` and a `mavlink` address");
+            let msg = format!("{owner} has `backend = \"sim\"` and a `mavlink` address");
             let help = "remove `backend = \"sim\"` to fly it over MAVLink, or remove `mavlink` to simulate it";
             cx.error(e.node.span, msg, help);
             false
         }
         (Some((b, e)), None) if b == "mavlink" => {
-            let msg =
-                format!("drone `{drone}` has `backend = \"mavlink\"` but no `mavlink` address");
+            let msg = format!("{owner} has `backend = \"mavlink\"` but no `mavlink` address");
             cx.error(e.node.span, msg, ADDRESS_HELP);
             false
         }
@@ -327,7 +330,7 @@ fn backend(cx: &mut Ctx, drone: &str, keys: &[Entry]) -> Backend {
     if !mavlink {
         for key in ["system_id", "signing_key"] {
             let Some(e) = get(keys, key) else { continue };
-            let msg = format!("`{key}` of drone `{drone}` applies only to a MAVLink drone");
+            let msg = format!("{} applies only to a MAVLink drone", KeyOf(key, owner));
             let help = "add a `mavlink = \"udp:HOST:PORT\"` address, or remove this key";
             cx.error(e.key_span, msg, help);
         }
@@ -337,12 +340,13 @@ fn backend(cx: &mut Ctx, drone: &str, keys: &[Entry]) -> Backend {
     Backend::Mavlink(Box::new(Mavlink { address, system_id, signing_key }))
 }
 
-fn system_id(cx: &mut Ctx, drone: &str, e: &Entry) -> Option<u8> {
+fn system_id(cx: &mut Ctx, owner: Owner, e: &Entry) -> Option<u8> {
     match e.node.value {
         Value::Int(i) if (1..=255).contains(&i) => u8::try_from(i).ok(),
         _ => {
             let msg = format!(
-                "`system_id` of drone `{drone}` must be a whole number from 1 to 255, found {}",
+                "{} must be a whole number from 1 to 255, found {}",
+                KeyOf("system_id", owner),
                 toml_text(&e.node)
             );
             cx.error(e.node.span, msg, "write the MAVLink system id, e.g. `system_id = 1`");
@@ -352,7 +356,7 @@ fn system_id(cx: &mut Ctx, drone: &str, e: &Entry) -> Option<u8> {
 }
 
 /// `SCHEME:HOST:PORT` (for `serial`, `serial:DEVICE:BAUD`).
-fn check_address(cx: &mut Ctx, drone: &str, address: &str, span: Span) {
+fn check_address(cx: &mut Ctx, owner: Owner, address: &str, span: Span) {
     let parts = address.split_once(':').and_then(|(scheme, rest)| {
         let (host, port) = rest.rsplit_once(':')?;
         Some((scheme, host, port))
@@ -371,24 +375,40 @@ fn check_address(cx: &mut Ctx, drone: &str, address: &str, span: Span) {
         }
         Some(_) => return,
     };
-    let msg = format!("the `mavlink` address `{address}` of drone `{drone}` {problem}");
+    let msg = format!("the `mavlink` address `{address}` of {owner} {problem}");
     cx.error(span, msg, ADDRESS_HELP);
 }
 
-/// "drone `NAME`", for messages.
-struct Named<'a>(&'static str, &'a str);
+/// Whose keys are read, for messages: "drone `NAME`" or "fleet `NAME`".
+#[derive(Clone, Copy)]
+pub(super) enum Owner<'a> {
+    Drone(&'a str),
+    Fleet(&'a str),
+}
 
-impl std::fmt::Display for Named<'_> {
+impl std::fmt::Display for Owner<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{} `{}`", self.0, self.1)
+        match self {
+            Owner::Drone(name) => write!(f, "drone `{name}`"),
+            Owner::Fleet(name) => write!(f, "fleet `{name}`"),
+        }
     }
 }
 
 /// "`KEY` of drone `NAME`", for messages.
-struct KeyOf<'a>(&'a str, &'a str);
+pub(super) struct KeyOf<'a>(pub &'a str, pub Owner<'a>);
 
 impl std::fmt::Display for KeyOf<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "`{}` of drone `{}`", self.0, self.1)
+        write!(f, "`{}` of {}", self.0, self.1)
+    }
+}
+
+/// "attribute `NAME`", for messages.
+pub(super) struct Named<'a>(pub &'static str, pub &'a str);
+
+impl std::fmt::Display for Named<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} `{}`", self.0, self.1)
     }
 }

@@ -5,7 +5,7 @@ use crate::node::{Entry, Node, Value};
 use crate::read::{quoted, suggest, Ctx};
 use crate::{Fault, FaultKind, Sensor, Target};
 
-const SENSOR_KEYS: &[&str] = &["detects", "range"];
+const SENSOR_KEYS: &[&str] = &["detects", "range", "probability"];
 const TARGET_KEYS: &[&str] = &["kind", "at"];
 const FAULT_KEYS: &[&str] = &["drone", "at", "kind", "duration"];
 
@@ -46,8 +46,12 @@ pub(super) fn sensors(cx: &mut Ctx, node: &Node) -> Vec<Sensor> {
                 None
             }
         };
-        if let (Some(detects), Some(range)) = (detects, range) {
-            out.push(Sensor { kind: kind.clone(), detects, range, span: e.key_span });
+        let probability = match get(keys, "probability") {
+            Some(p) => cx.within(&format!("`probability` of sensor `{kind}`"), &p.node, 0.0, 1.0),
+            None => Some(1.0),
+        };
+        if let (Some(detects), Some(range), Some(probability)) = (detects, range, probability) {
+            out.push(Sensor { kind: kind.clone(), detects, range, probability, span: e.key_span });
         }
     }
     out
@@ -142,16 +146,7 @@ pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[&str]) -> Vec<Fault> {
             }
         };
         let at = match get(keys, "at") {
-            Some(a) => cx.number(&"`at` of a fault", &a.node).filter(|&t| {
-                if t < 0.0 {
-                    let msg = format!(
-                        "`at` of a fault must be zero or more seconds, found {}",
-                        aviary_api::show::number(t)
-                    );
-                    cx.error(a.node.span, msg, "write the mission time in seconds, e.g. `at = 60`");
-                }
-                t >= 0.0
-            }),
+            Some(a) => fault_time(cx, &a.node),
             None => {
                 missing(cx, "at", "add `at = 60`: when it happens, in mission seconds".into());
                 None
@@ -197,11 +192,49 @@ pub(super) fn faults(cx: &mut Ctx, node: &Node, drones: &[&str]) -> Vec<Fault> {
             }
             _ => {}
         }
-        if let (Some(drone), Some(at), Some((kind, _))) = (drone, at, kind) {
-            out.push(Fault { drone, at, kind, duration: seconds, span: head });
+        if let (Some(drone), Some((at, latest)), Some((kind, _))) = (drone, at, kind) {
+            out.push(Fault { drone, at, latest, kind, duration: seconds, span: head });
         }
     }
     out
+}
+
+/// `at`: a time, or a range `[earliest, latest]` to draw it from; seconds, 0 or more.
+fn fault_time(cx: &mut Ctx, node: &Node) -> Option<(f64, Option<f64>)> {
+    let help = "write the mission time in seconds, e.g. `at = 60`, or a range to draw it from, e.g. `at = [30, 90]`";
+    let seconds = |cx: &mut Ctx, node: &Node| {
+        cx.number(&"`at` of a fault", node).filter(|&t| {
+            if t < 0.0 {
+                let msg = format!(
+                    "`at` of a fault must be zero or more seconds, found {}",
+                    aviary_api::show::number(t)
+                );
+                cx.error(node.span, msg, help);
+            }
+            t >= 0.0
+        })
+    };
+    let Value::Array(items) = &node.value else { return seconds(cx, node).map(|t| (t, None)) };
+    if items.len() != 2 {
+        let msg = format!(
+            "`at` of a fault must be a time or a range [earliest, latest], found {}",
+            crate::read::count(items.len(), "number")
+        );
+        cx.error(node.span, msg, help);
+        return None;
+    }
+    let (earliest, latest) = (seconds(cx, &items[0]), seconds(cx, &items[1]));
+    let (earliest, latest) = (earliest?, latest?);
+    if earliest > latest {
+        let msg = format!(
+            "the range `at` of a fault runs from {} back to {}",
+            aviary_api::show::number(earliest),
+            aviary_api::show::number(latest)
+        );
+        cx.error(node.span, msg, "write the earlier time first, e.g. `at = [30, 90]`");
+        return None;
+    }
+    Some((earliest, Some(latest)))
 }
 
 fn fault_drone(cx: &mut Ctx, name: &str, e: &Entry, drones: &[&str]) {
@@ -209,9 +242,12 @@ fn fault_drone(cx: &mut Ctx, name: &str, e: &Entry, drones: &[&str]) {
     let help = match suggest(name, drones.iter().copied()) {
         Some(s) => format!("did you mean `{s}`?"),
         None if drones.is_empty() => format!("define it as `[drones.{name}]`"),
-        None => {
-            format!("name one of the drones: {}", quoted(drones))
-        }
+        None if drones.len() <= 10 => format!("name one of the drones: {}", quoted(drones)),
+        None => format!(
+            "name one of the drones, such as {}, ... ({} in all)",
+            quoted(&drones[..10]),
+            drones.len()
+        ),
     };
     cx.error(e.node.span, msg, help);
 }

@@ -1,0 +1,53 @@
+//! World files as `aviary check` shows them: every `*.world.toml` under `tests/fixtures/`
+//! is read, and what a user sees is compared with a snapshot (`tests/snapshots/`): each
+//! diagnostic rendered (`path:line:col`, the line, a caret, the help), or for a world
+//! without problems a summary of its drones, groups and areas.
+
+use std::fmt::Write;
+use std::path::Path;
+
+use aviary_diagnostics::{render_text, SourceMap};
+
+/// What a user sees of the world file at `path`.
+fn shown(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).expect("a readable fixture");
+    let name = format!("fixtures/{}", path.file_name().unwrap_or_default().to_string_lossy());
+    let mut sources = SourceMap::new();
+    let id = sources.add(&name, text);
+    let (world, diagnostics) = aviary_world::parse_world(id, sources.text(id));
+    let mut out = String::new();
+    for d in &diagnostics {
+        out.push_str(&render_text(&sources, d, false));
+    }
+    let Some(w) = world else { return out };
+    let _ = writeln!(out, "{} drones:", w.drones.len());
+    for d in w.drones.iter().take(4).chain(w.drones.iter().skip(4).last()) {
+        let attributes: Vec<String> =
+            d.attributes.iter().map(|(k, v)| format!("{k} = {v:?}")).collect();
+        let _ = writeln!(
+            out,
+            "  {} at ({}, {}) group {:?} sensors {:?} max_speed {} [{}]",
+            d.name,
+            d.home[0],
+            d.home[1],
+            d.group.as_deref(),
+            d.sensors,
+            d.max_speed,
+            attributes.join(", ")
+        );
+    }
+    for g in &w.groups {
+        let _ = writeln!(out, "group {}: {} members", g.name, g.members.len());
+    }
+    for a in w.areas.iter().take(3) {
+        let _ = writeln!(out, "area {}: {:?}", a.name, a.polygon);
+    }
+    out
+}
+
+#[test]
+fn fixtures() {
+    insta::glob!("fixtures/*.world.toml", |path| {
+        insta::assert_snapshot!(shown(path));
+    });
+}

@@ -5,7 +5,7 @@ use std::cell::{Cell, RefCell};
 use std::pin::pin;
 use std::rc::Rc;
 
-use aviary_api::{DroneId, Value};
+use aviary_api::{BuiltinException, DroneId, Value};
 use aviary_ir::{BlockKind, Call, Capability};
 use serde_json::{Map, Value as Json};
 use smallvec::SmallVec;
@@ -22,10 +22,10 @@ use crate::value::to_json;
 /// Where an instance's PERFORM body starts: at its beginning, or (an instant activity
 /// that has to wait, `instant.rs`) at a statement of its sequence, that statement's
 /// call perhaps already made.
-pub(crate) enum Resume<'m> {
+pub(crate) enum Resume {
     Start,
     /// The call is boxed: the future of every instance has room for its `Resume`.
-    At(usize, Option<Box<Begun<'m>>>),
+    At(usize, Option<Box<Begun>>),
 }
 
 /// An instance that has started, for `perform`.
@@ -122,7 +122,7 @@ impl<'m> Engine<'m> {
             self.instances.borrow_mut().remove(&instance);
             self.capability_end(call, &instance.actors, &args, "failed");
             drop(held);
-            let id = self.m.builtins.requirement_not_met;
+            let id = self.m.builtins.exception(BuiltinException::RequirementNotMet);
             let why = format!("a requirement of {} does not hold", cap.name);
             self.throw(id, vec![Value::Text(why)], actor, &ctx.scope);
             return None;
@@ -143,7 +143,7 @@ impl<'m> Engine<'m> {
         listed: bool,
         args: Vec<Value>,
         ctx: &Ctx<'m>,
-        resume: Resume<'m>,
+        resume: Resume,
     ) {
         let cap = &self.m.capabilities[call.capability];
         *instance.claims.borrow_mut() = claims.clone();
@@ -230,7 +230,7 @@ impl<'m> Engine<'m> {
             return false;
         }
         let cap = &self.m.capabilities[call.capability];
-        let id = self.m.builtins.command_failed;
+        let id = self.m.builtins.exception(BuiltinException::CommandFailed);
         let why = format!(
             "calling `{}` would nest capability calls {} deep, past the limit of {}: a capability that keeps calling itself",
             cap.name,

@@ -5,7 +5,7 @@ use std::cell::{Cell, RefCell};
 use std::collections::BTreeMap;
 use std::rc::Rc;
 
-use aviary_api::{Backend, DroneEvent, DroneId, Value};
+use aviary_api::{Backend, DroneEvent, DroneId, Function, Value};
 use aviary_ir::{ActorFilter, ExceptionHandler, Handler, Mission};
 use serde_json::{json, Value as Json};
 use tokio::sync::{mpsc, Notify};
@@ -290,7 +290,7 @@ impl<'m> Engine<'m> {
     pub fn trace_done(
         &self,
         d: DroneId,
-        function: &str,
+        function: Function,
         args: &[Value],
         end: &aviary_api::CallEnd,
     ) {
@@ -302,7 +302,7 @@ impl<'m> Engine<'m> {
         self.trace(Kind::ApiDone, || {
             [
                 ("actor", Field::Str(self.name(d))),
-                ("function", Field::Str(function)),
+                ("function", Field::Str(function.name())),
                 ("args", Field::Json(self.values(args))),
                 ("status", Field::Str(status)),
                 ("position", Field::Json(json!(self.backend.telemetry(d).position))),
@@ -377,7 +377,7 @@ impl<'m> Engine<'m> {
                 });
                 let scope = self.detections.borrow().get(&(drone, kind.clone())).cloned();
                 if let Some(scope) = scope {
-                    let id = self.m.builtins.detected;
+                    let id = self.m.builtins.signal(aviary_api::BuiltinSignal::Detected);
                     // A find is a point on the ground: flying to it keeps the altitude.
                     let args = vec![
                         Value::Symbol(kind),
@@ -386,38 +386,21 @@ impl<'m> Engine<'m> {
                     self.raise(id, args, Some(drone), &scope);
                 }
             }
-            DroneEvent::Signal { drone, name } => {
-                if let Some(id) = self.signal_id(name) {
-                    let scope = self.actor_scope(drone);
-                    self.raise(id, Vec::new(), Some(drone), &scope);
-                }
+            DroneEvent::Signal { drone, signal } => {
+                let scope = self.actor_scope(drone);
+                self.raise(self.m.builtins.signal(signal), Vec::new(), Some(drone), &scope);
             }
             DroneEvent::Fault { drone, failure } => {
                 let scope = self.actor_scope(drone);
-                let (id, why) = self.exception_of(failure);
-                self.throw(id, vec![Value::Text(why)], Some(drone), &scope);
+                self.fail(failure, drone, &scope);
             }
         }
     }
 
-    /// The exception a backend's failure names, and its reason. The backend names it (the
-    /// contract's names are text); one the mission does not know is a backend's mistake,
-    /// raised as `CommandFailed` that says so, never as another exception.
-    pub(crate) fn exception_of(&self, failure: aviary_api::Failure) -> (usize, String) {
-        match self.m.exceptions.iter().position(|e| e == failure.exception) {
-            Some(id) => (id, failure.reason),
-            None => (
-                self.m.builtins.command_failed,
-                format!(
-                    "{} (the backend raised `{}`, an exception the mission does not know)",
-                    failure.reason, failure.exception
-                ),
-            ),
-        }
-    }
-
-    fn signal_id(&self, name: &str) -> Option<usize> {
-        self.m.signals.iter().position(|s| s == name)
+    /// Raises a backend's failure on `drone` as its built-in exception, with the reason.
+    pub(crate) fn fail(&self, failure: aviary_api::Failure, drone: DroneId, from: &Rc<Scope<'m>>) {
+        let id = self.m.builtins.exception(failure.exception);
+        self.throw(id, vec![Value::Text(failure.reason)], Some(drone), from);
     }
 
     /// Where an actor's built-in events are raised: in its innermost running capability

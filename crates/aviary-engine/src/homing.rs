@@ -11,7 +11,7 @@
 
 use std::time::Duration;
 
-use aviary_api::{CallEnd, DroneEvent, DroneId, FlightState};
+use aviary_api::{BuiltinException, CallEnd, DroneEvent, DroneId, FlightState, Function};
 use serde_json::json;
 use tokio::time::Instant;
 
@@ -42,18 +42,18 @@ pub(crate) struct Homecoming {
 /// The faults seen after the mission's handlers ended, in order.
 #[derive(Default)]
 struct Faults {
-    seen: std::cell::RefCell<Vec<(DroneId, &'static str)>>,
+    seen: std::cell::RefCell<Vec<(DroneId, BuiltinException)>>,
 }
 
 impl Faults {
-    fn last(&self, d: DroneId) -> Option<&'static str> {
+    fn last(&self, d: DroneId) -> Option<BuiltinException> {
         self.seen.borrow().iter().rev().find(|(x, _)| *x == d).map(|(_, e)| *e)
     }
 }
 
 /// Faults that leave a drone unable to fly home: it comes straight down instead.
-fn lands_where_it_is(exception: &str) -> bool {
-    matches!(exception, "PositionLost" | "MotorFailure")
+fn lands_where_it_is(exception: BuiltinException) -> bool {
+    matches!(exception, BuiltinException::PositionLost | BuiltinException::MotorFailure)
 }
 
 impl<'m> Engine<'m> {
@@ -106,14 +106,14 @@ impl<'m> Engine<'m> {
                 continue;
             }
             let function = if faults.last(d).is_some_and(lands_where_it_is) {
-                "Land"
+                Function::Land
             } else {
-                "ReturnToLaunch"
+                Function::ReturnToLaunch
             };
             self.trace(Kind::ApiCall, || {
                 [
                     ("actor", Field::Str(name)),
-                    ("function", Field::Str(function)),
+                    ("function", Field::Str(function.name())),
                     ("args", Field::Json(json!([]))),
                 ]
             });
@@ -162,7 +162,7 @@ impl<'m> Engine<'m> {
                     let args = json!([failure.reason]);
                     self.trace(Kind::Exception, || {
                         [
-                            ("name", Field::Str(failure.exception)),
+                            ("name", Field::Str(failure.exception.name())),
                             ("actor", Field::Str(self.name(drone))),
                             ("args", Field::Json(args)),
                             ("handled", Field::Bool(false)),
@@ -171,10 +171,10 @@ impl<'m> Engine<'m> {
                         ]
                     });
                 }
-                Some(DroneEvent::Signal { drone, name }) => {
+                Some(DroneEvent::Signal { drone, signal }) => {
                     self.trace(Kind::Signal, || {
                         [
-                            ("name", Field::Str(name)),
+                            ("name", Field::Str(signal.name())),
                             ("actor", Field::Str(self.name(drone))),
                             ("args", Field::Json(json!([]))),
                         ]

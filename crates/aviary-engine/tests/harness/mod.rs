@@ -62,7 +62,8 @@ pub fn run_in(mission: &str, world: &str) -> Run {
     run_with(mission, world, &RunOptions::default())
 }
 
-pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
+/// The mission checked (without errors) and compiled for the world, and the world.
+pub fn compile(mission: &str, world: &str) -> (aviary_ir::Mission, aviary_world::World) {
     let mut sources = SourceMap::new();
     let checked = aviary_check::check_sources(
         &mut sources,
@@ -82,6 +83,11 @@ pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
     let mission =
         aviary_ir::compile(&checked.program.expect("program"), &world, &Descriptor::standard())
             .expect("mission");
+    (mission, world)
+}
+
+pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
+    let (mission, world) = compile(mission, world);
     let runtime = tokio::runtime::Builder::new_current_thread()
         .enable_time()
         .start_paused(true)

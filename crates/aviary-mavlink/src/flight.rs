@@ -10,7 +10,7 @@ use crate::craft::{failed, Craft, Paused};
 use crate::motion::{arm, fly, here, hover, land, orbit, rtl, take_off};
 use crate::vehicle::Activation;
 
-use aviary_api::flight::LOAD_TIME;
+use aviary_api::flight::{LOAD_MAX_ALTITUDE, LOAD_TIME};
 
 /// Runs one call to its end.
 pub async fn run(
@@ -186,8 +186,11 @@ async fn load(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> 
         return Err(failed(format!("{} already carries {held}: release it first", c.name)));
     }
     let z = c.fix().map_or(0.0, |f| f.pos[2]);
-    if c.state().airborne() && z >= 5.0 {
-        return Err(failed(format!("{} is at {z:.1} m: load while landed or below 5 m", c.name)));
+    if c.state().airborne() && z >= LOAD_MAX_ALTITUDE {
+        return Err(failed(format!(
+            "{} is at {z:.1} m: load while landed or below {LOAD_MAX_ALTITUDE} m",
+            c.name
+        )));
     }
     c.command(MavCmd::MAV_CMD_DO_GRIPPER, [1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0]).await?;
     hover(LOAD_TIME, paused).await?;

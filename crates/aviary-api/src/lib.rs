@@ -1,18 +1,19 @@
 //! The middle layer between missions and drones (the paper's API wrapper).
 //!
-//! The contract is typed: the middle-layer functions are the closed enum [`Function`], the
-//! built-in signals and exceptions [`BuiltinSignal`] and [`BuiltinException`]. The
-//! [`Descriptor`] the checker reads (functions with
-//! typed parameters, telemetry, built-ins) is derived from those enums.
+//! The contract is typed: the middle-layer functions are the closed enum [`Function`],
+//! the built-in signals and exceptions [`BuiltinSignal`] and [`BuiltinException`], and
+//! the trace's events [`trace::Event`]. The [`Descriptor`] the checker reads (functions
+//! with typed parameters, telemetry, built-ins) is derived from those enums.
 //!
 //! At run time a backend implements [`Backend`]: the engine starts calls, interrupts
 //! them, reads telemetry and receives drone events through it, and never learns which
 //! backend it drives.
 //!
 //! Invariant: this crate knows no engine, no backend and no syntax. Every name the
-//! contract gives (a function, a built-in) is a variant matched
-//! exhaustively where it is used, so adding one is a compile error wherever it is not
-//! handled; its text exists only where a mission is read or a trace is written.
+//! contract gives (a function, a built-in, a kind of event) is a variant, matched
+//! exhaustively where it is acted on, so adding one is a compile error wherever it is
+//! not handled yet; text exists only where a mission is read and where a trace line is
+//! written or read.
 
 mod builtin;
 pub mod flight;
@@ -24,6 +25,7 @@ mod names;
 mod runtime;
 pub mod show;
 pub mod sweep;
+pub mod trace;
 
 pub use builtin::{BuiltinException, BuiltinSignal};
 pub use function::{Function, Param, Signature};

@@ -6,10 +6,9 @@ use std::rc::Rc;
 
 use aviary_api::{CallEnd, CallId, DroneId, Ending, Function, Interrupt, Value};
 use aviary_ir::ApiCall;
-use serde_json::json;
 
 use crate::engine::{Ctx, Engine, Instance};
-use crate::trace::{Field, Kind};
+use aviary_api::trace::{CallStatus, Event, EventKind};
 
 /// A call made: what the rest of its statement needs.
 pub(crate) struct Begun {
@@ -64,12 +63,10 @@ impl<'m> Engine<'m> {
             a.args.iter().map(|e| env.eval(e)).collect::<Vec<_>>()
         };
         let function = a.function;
-        self.trace(Kind::ApiCall, || {
-            [
-                ("actor", Field::Str(self.name(drone))),
-                ("function", Field::Str(function.name())),
-                ("args", Field::Json(self.values(&args))),
-            ]
+        self.trace(EventKind::ApiCall, || Event::ApiCall {
+            actor: self.name(drone).into(),
+            function,
+            args: self.values(&args),
         });
         let pending = self.backend.call(drone, function, &args);
         Begun { call: Made { drone, function, args, id: pending.id }, end: pending.end }
@@ -140,15 +137,12 @@ impl Drop for CallGuard<'_, '_> {
         if !self.done.get() {
             self.engine.backend.interrupt(call.id, Interrupt::Abort);
             let engine = self.engine;
-            engine.trace(Kind::ApiDone, || {
-                let p = engine.backend.telemetry(call.drone).position;
-                [
-                    ("actor", Field::Str(engine.name(call.drone))),
-                    ("function", Field::Str(call.function.name())),
-                    ("args", Field::Json(engine.values(&call.args))),
-                    ("status", Field::Str("aborted")),
-                    ("position", Field::Json(json!(p))),
-                ]
+            engine.trace(EventKind::ApiDone, || Event::ApiDone {
+                actor: engine.name(call.drone).into(),
+                function: call.function,
+                args: engine.values(&call.args),
+                status: CallStatus::Aborted,
+                position: engine.backend.telemetry(call.drone).position,
             });
         }
         if let Some(root) = &self.root {

@@ -12,11 +12,10 @@
 use std::time::Duration;
 
 use aviary_api::{BuiltinException, CallEnd, DroneEvent, DroneId, FlightState, Function};
-use serde_json::json;
 use tokio::time::Instant;
 
 use crate::engine::Engine;
-use crate::trace::{Field, Kind};
+use aviary_api::trace::{Event, EventKind, Shown};
 
 /// How long a drone in the air may stay out of reach before it is left to its
 /// autopilot. Longer than any autopilot's own link-loss failsafe takes to act
@@ -110,12 +109,10 @@ impl<'m> Engine<'m> {
             } else {
                 Function::ReturnToLaunch
             };
-            self.trace(Kind::ApiCall, || {
-                [
-                    ("actor", Field::Str(name)),
-                    ("function", Field::Str(function.name())),
-                    ("args", Field::Json(json!([]))),
-                ]
+            self.trace(EventKind::ApiCall, || Event::ApiCall {
+                actor: name.into(),
+                function,
+                args: Vec::new(),
             });
             let pending = self.backend.call(d, function, &[]);
             let end = pending.end.wait().await.unwrap_or(CallEnd::Interrupted);
@@ -159,34 +156,27 @@ impl<'m> Engine<'m> {
             match self.next_event().await {
                 Some(DroneEvent::Fault { drone, failure }) => {
                     faults.seen.borrow_mut().push((drone, failure.exception));
-                    let args = json!([failure.reason]);
-                    self.trace(Kind::Exception, || {
-                        [
-                            ("name", Field::Str(failure.exception.name())),
-                            ("actor", Field::Str(self.name(drone))),
-                            ("args", Field::Json(args)),
-                            ("handled", Field::Bool(false)),
-                            ("handler", Field::Null),
-                            ("during", Field::Str("return home")),
-                        ]
+                    self.trace(EventKind::Exception, || Event::Exception {
+                        name: failure.exception.name().into(),
+                        actor: Some(self.name(drone).into()),
+                        args: vec![Shown::Text(failure.reason.as_str().into())],
+                        handled: false,
+                        handler: None,
+                        during: Some("return home".into()),
                     });
                 }
                 Some(DroneEvent::Signal { drone, signal }) => {
-                    self.trace(Kind::Signal, || {
-                        [
-                            ("name", Field::Str(signal.name())),
-                            ("actor", Field::Str(self.name(drone))),
-                            ("args", Field::Json(json!([]))),
-                        ]
+                    self.trace(EventKind::Signal, || Event::Signal {
+                        name: signal.name().into(),
+                        actor: Some(self.name(drone).into()),
+                        args: Vec::new(),
                     });
                 }
                 Some(DroneEvent::Detected { drone, kind, location }) => {
-                    self.trace(Kind::Detection, || {
-                        [
-                            ("actor", Field::Str(self.name(drone))),
-                            ("kind", Field::Str(&kind)),
-                            ("location", Field::Json(json!(location))),
-                        ]
+                    self.trace(EventKind::Detection, || Event::Detection {
+                        actor: self.name(drone).into(),
+                        kind: kind.as_str().into(),
+                        location,
                     });
                 }
                 None => std::future::pending().await,

@@ -22,7 +22,7 @@ use crate::activity::{frame_values, Resume};
 use crate::api::{remembers_scope, Begun};
 use crate::arbiter::{free, take, Needs};
 use crate::engine::{Actors, Ctx, Engine};
-use crate::trace::Kind;
+use aviary_api::trace::{EventKind, Status};
 
 /// Which capabilities may run as instant activities, by index.
 pub(crate) fn instant_capabilities(m: &Mission) -> Vec<bool> {
@@ -133,7 +133,9 @@ impl<'m> Engine<'m> {
             return Some(Stopped::Start(args));
         }
         let id = self.new_id();
-        self.trace(Kind::CapabilityStart, || self.capability_fields(call, &actors, &args));
+        self.trace(EventKind::CapabilityStart, || {
+            self.capability_event(call, &actors, &args, None)
+        });
         let mut frame = LocalFrame::new();
         // Pushed one by one: `collect` (`extend`) costs several times as much here.
         for v in frame_values(cap, &actors, &args) {
@@ -165,7 +167,7 @@ impl<'m> Engine<'m> {
                 &CallEnd::Done,
             );
         }
-        self.capability_end(call, &actors, &args, "ok");
+        self.capability_end(call, &actors, &args, Status::Ok);
         None
     }
 

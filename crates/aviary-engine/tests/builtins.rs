@@ -76,7 +76,7 @@ fn run(mission: &str, backend: &Scripted) -> (Status, Vec<Json>) {
         .build()
         .expect("runtime");
     let mut trace = Vec::new();
-    let mut sink = |e: Json| trace.push(e);
+    let mut sink = |r: &aviary_engine::Record| trace.push(harness::json(r));
     let outcome =
         runtime.block_on(aviary_engine::run(&mission, backend, &mut sink, &RunOptions::default()));
     (outcome.status, trace)

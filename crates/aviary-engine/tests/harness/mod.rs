@@ -6,7 +6,7 @@
 use aviary_api::Descriptor;
 use aviary_check::SourceProvider;
 use aviary_diagnostics::SourceMap;
-use aviary_engine::{Outcome, RunOptions};
+use aviary_engine::{Outcome, Record, RunOptions};
 use aviary_sim::{SimBackend, SimOptions};
 use serde_json::Value;
 
@@ -46,6 +46,11 @@ range = 20.0
 kind = "Body"
 at = [150, 150]
 "#;
+
+/// An event as the trace file has it, to look at by key.
+pub fn json(record: &Record) -> Value {
+    serde_json::to_value(record).expect("an event is JSON")
+}
 
 pub struct Run {
     pub outcome: Outcome,
@@ -96,7 +101,7 @@ pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
     runtime.block_on(async {
         let sim = SimBackend::start(&world, SimOptions::default());
         let mut trace = Vec::new();
-        let mut sink = |e: Value| trace.push(e);
+        let mut sink = |r: &Record| trace.push(json(r));
         let outcome = aviary_engine::run(&mission, &*sim, &mut sink, options).await;
         sim.shutdown().await;
         let releases = sim.releases().into_iter().map(|r| (r.drone, r.kind, r.position)).collect();

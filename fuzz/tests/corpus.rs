@@ -61,7 +61,10 @@ fn the_mavlink_seeds_reach_past_the_framing() {
     let flight = aviary_fuzz::heard_on_a_link(&read("in/link/flight_over_a_target.bin"));
     assert!(flight.fix.is_some() && flight.battery.is_some(), "{flight:?}");
     assert!(flight.events > 0, "{flight:?}");
-    assert!(flight.alarms.iter().any(|a| a.exception == "BatteryCritical"), "{flight:?}");
+    assert!(
+        flight.alarms.iter().any(|a| a.exception == aviary_api::BuiltinException::BatteryCritical),
+        "{flight:?}"
+    );
     let jumps = aviary_fuzz::heard_on_a_link(&read("in/link/implausible.bin"));
     assert!(!jumps.alarms.is_empty(), "{jumps:?}");
 

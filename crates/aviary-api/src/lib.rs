@@ -1,21 +1,27 @@
 //! The middle layer between missions and drones (the paper's API wrapper).
 //!
-//! A backend describes what it offers with a [`Descriptor`]: its functions with typed
-//! parameters and the drone resource each one uses, the telemetry it reports, and the
-//! built-in signals and exceptions it raises. The checker reads only the descriptor, so
-//! a backend that adds a function teaches the checker about it.
+//! The contract is typed: the middle-layer functions are the closed enum [`Function`],
+//! the built-in signals and exceptions [`BuiltinSignal`] and [`BuiltinException`], and
+//! the trace's events [`trace::Event`]. The [`Descriptor`] the checker reads (functions
+//! with typed parameters, telemetry, built-ins) is derived from those enums.
 //!
 //! At run time a backend implements [`Backend`]: the engine starts calls, interrupts
 //! them, reads telemetry and receives drone events through it, and never learns which
 //! backend it drives.
 //!
-//! Invariant: this crate knows no engine, no backend and no syntax.
+//! Invariant: this crate knows no engine, no backend and no syntax. Every name the
+//! contract gives (a function, a built-in, a kind of event) is a variant, matched
+//! exhaustively where it is acted on, so adding one is a compile error wherever it is
+//! not handled yet; text exists only where a mission is read and where a trace line is
+//! written or read.
 
 // A pure stage: no unsafe code, and no panic on any input (tests may unwrap).
 #![forbid(unsafe_code)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
+mod builtin;
 pub mod flight;
+mod function;
 pub mod geo;
 pub mod geometry;
 mod kind;
@@ -23,7 +29,10 @@ mod names;
 mod runtime;
 pub mod show;
 pub mod sweep;
+pub mod trace;
 
+pub use builtin::{BuiltinException, BuiltinSignal};
+pub use function::{Function, Param, Signature};
 pub use geometry::centroid;
 pub use kind::Kind;
 pub use names::Names;
@@ -49,158 +58,38 @@ impl Resource {
     }
 }
 
-#[derive(Clone, Debug, PartialEq)]
-pub struct Param {
-    pub name: &'static str,
-    pub kind: Kind,
-    pub optional: bool,
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct Function {
-    pub name: &'static str,
-    pub params: Vec<Param>,
-    /// The last parameter repeats (`FollowPath(points...)`).
-    pub variadic: bool,
-    pub resource: Option<Resource>,
-    pub summary: &'static str,
-}
-
-impl Function {
-    pub fn required(&self) -> usize {
-        self.params.iter().filter(|p| !p.optional).count()
-    }
-    /// `FlyToPosition(pos[, speed])`, for messages.
-    pub fn signature(&self) -> String {
-        let mut out = format!("{}(", self.name);
-        for (i, p) in self.params.iter().enumerate() {
-            let sep = if i == 0 { "" } else { ", " };
-            if p.optional {
-                out.push_str(&format!("[{sep}{}]", p.name));
-            } else {
-                out.push_str(&format!("{sep}{}", p.name));
-            }
-        }
-        if self.variadic {
-            out.push_str("...");
-        }
-        out.push(')');
-        out
-    }
-}
-
-/// A signal the middle layer raises on an actor, with the values it carries.
-#[derive(Clone, Debug, PartialEq)]
-pub struct BuiltinSignal {
-    pub name: &'static str,
-    pub values: Vec<(&'static str, Kind)>,
-}
-
+/// What a backend offers: the functions with their signatures, the telemetry with its
+/// kinds, and the built-in signals and exceptions. Derived from the contract's closed sets
+/// ([`Function`], [`BuiltinSignal`], [`BuiltinException`]), so the checker, the compiler
+/// and the backends read one list.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Descriptor {
-    pub functions: Vec<Function>,
+    pub functions: Vec<Signature>,
     pub telemetry: Vec<(&'static str, Kind)>,
     pub signals: Vec<BuiltinSignal>,
-    pub exceptions: Vec<&'static str>,
+    pub exceptions: Vec<BuiltinException>,
 }
 
 impl Descriptor {
-    pub fn function(&self, name: &str) -> Option<&Function> {
-        self.functions.iter().find(|f| f.name == name)
+    pub fn function(&self, name: &str) -> Option<&Signature> {
+        self.functions.iter().find(|f| f.name() == name)
     }
     pub fn telemetry(&self, field: &str) -> Option<Kind> {
         self.telemetry.iter().find(|(n, _)| *n == field).map(|&(_, k)| k)
     }
-    pub fn signal(&self, name: &str) -> Option<&BuiltinSignal> {
-        self.signals.iter().find(|s| s.name == name)
+    pub fn signal(&self, name: &str) -> Option<BuiltinSignal> {
+        self.signals.iter().copied().find(|s| s.name() == name)
     }
     pub fn is_exception(&self, name: &str) -> bool {
-        self.exceptions.contains(&name)
-    }
-    /// A backend's own functions join the standard set.
-    pub fn extend(&mut self, functions: impl IntoIterator<Item = Function>) {
-        for f in functions {
-            self.functions.retain(|g| g.name != f.name);
-            self.functions.push(f);
-        }
+        self.exceptions.iter().any(|e| e.name() == name)
     }
 
-    /// The functions of docs/LANGUAGE.md, section 19, which every backend offers.
+    /// The functions of docs/LANGUAGE.md, section 19, which every backend offers, with the
+    /// telemetry and the built-ins.
     pub fn standard() -> Descriptor {
         use Kind::*;
-        use Resource::*;
-        let p = |name, kind| Param { name, kind, optional: false };
-        let opt = |name, kind| Param { name, kind, optional: true };
-        let f = |name, params: Vec<Param>, resource, summary| Function {
-            name,
-            params,
-            variadic: false,
-            resource,
-            summary,
-        };
-        let mut functions = vec![
-            f("Arm", vec![], Some(Motion), "arm the motors"),
-            f("Disarm", vec![], Some(Motion), "disarm the motors (landed only)"),
-            f(
-                "TakeOff",
-                vec![p("alt", Length)],
-                Some(Motion),
-                "climb from the ground to an altitude",
-            ),
-            f("Land", vec![], Some(Motion), "land where the drone is"),
-            f("ReturnToLaunch", vec![], Some(Motion), "fly home and land"),
-            f(
-                "FlyToPosition",
-                vec![p("pos", Position), opt("speed", Speed)],
-                Some(Motion),
-                "fly to a position",
-            ),
-            f("DescendTo", vec![p("alt", Length)], Some(Motion), "descend to an altitude"),
-            f("AscendTo", vec![p("alt", Length)], Some(Motion), "climb to an altitude"),
-            f("Hover", vec![p("duration", Duration)], Some(Motion), "hold position for a time"),
-            f(
-                "Orbit",
-                vec![p("center", Position), p("radius", Length), opt("laps", Number)],
-                Some(Motion),
-                "circle a point",
-            ),
-            f(
-                "Sweep",
-                vec![p("area", Area), p("spacing", Length)],
-                Some(Motion),
-                "fly a lawnmower path over an area",
-            ),
-            f("StartStreaming", vec![], Some(Camera), "start the video stream"),
-            f("StopStreaming", vec![], Some(Camera), "stop the video stream"),
-            f(
-                "StartDetection",
-                vec![p("kind", Symbol)],
-                Some(Detection),
-                "start detecting a kind of target",
-            ),
-            f(
-                "StopDetection",
-                vec![p("kind", Symbol)],
-                Some(Detection),
-                "stop detecting a kind of target",
-            ),
-            f(
-                "LoadPayload",
-                vec![p("kind", Symbol)],
-                Some(Payload),
-                "load a payload (landed or below 5 m)",
-            ),
-            f("ReleasePayload", vec![], Some(Payload), "release the payload carried"),
-        ];
-        functions.push(Function {
-            name: "FollowPath",
-            params: vec![p("points", Position)],
-            variadic: true,
-            resource: Some(Motion),
-            summary: "fly through positions in order",
-        });
         Descriptor {
-            functions,
+            functions: Function::ALL.map(Function::signature).into(),
             telemetry: vec![
                 ("position", Position),
                 ("altitude", Length),
@@ -210,25 +99,8 @@ impl Descriptor {
                 ("state", Symbol),
                 ("link", Symbol),
             ],
-            signals: vec![
-                BuiltinSignal {
-                    name: "Detected",
-                    values: vec![("kind", Symbol), ("location", Position)],
-                },
-                BuiltinSignal { name: "BatteryLow", values: vec![] },
-                BuiltinSignal { name: "ConnectionRestored", values: vec![] },
-            ],
-            exceptions: vec![
-                "BatteryCritical",
-                "ConnectionLost",
-                "DroneLost",
-                "MotorFailure",
-                "PositionLost",
-                "GeofenceViolation",
-                "CommandFailed",
-                "RequirementNotMet",
-                "Timeout",
-            ],
+            signals: BuiltinSignal::ALL.into(),
+            exceptions: BuiltinException::ALL.into(),
         }
     }
 }
@@ -270,27 +142,5 @@ mod tests {
             Some("FlyToPosition(pos[, speed])")
         );
         assert_eq!(d.function("FlyToPosition").map(|f| f.required()), Some(1));
-    }
-
-    #[test]
-    fn a_backend_function_replaces_one_of_the_same_name() {
-        let mut d = Descriptor::standard();
-        let before = d.functions.len();
-        d.extend([Function {
-            name: "Winch",
-            params: vec![],
-            variadic: false,
-            resource: Some(Resource::Payload),
-            summary: "",
-        }]);
-        d.extend([Function {
-            name: "Land",
-            params: vec![],
-            variadic: false,
-            resource: Some(Resource::Motion),
-            summary: "soft",
-        }]);
-        assert_eq!(d.functions.len(), before + 1);
-        assert_eq!(d.function("Land").map(|f| f.summary), Some("soft"));
     }
 }

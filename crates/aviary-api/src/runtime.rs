@@ -1,6 +1,9 @@
 //! The run-time half of the middle layer: values, telemetry, calls and drone events.
 
+use serde::{Deserialize, Serialize};
 use tokio::sync::{mpsc, oneshot};
+
+use crate::{BuiltinException, BuiltinSignal, Function};
 
 /// A drone, by its index in the world file's order.
 pub type DroneId = usize;
@@ -32,8 +35,8 @@ pub enum Value {
     Actor(DroneId),
 }
 
-/// What a drone is doing, as telemetry's `state` reports it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// What a drone is doing, as telemetry's `state` reports it (and the trace writes it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum FlightState {
     Landed,
     TakingOff,
@@ -85,10 +88,10 @@ impl Telemetry {
     };
 }
 
-/// A built-in exception (docs/LANGUAGE.md, section 17), by the name a mission handles it with.
+/// A built-in exception (docs/LANGUAGE.md, section 17) and why it was raised.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Failure {
-    pub exception: &'static str,
+    pub exception: BuiltinException,
     /// Why, for people: the trace's `reason` and the summary.
     pub reason: String,
 }
@@ -147,7 +150,7 @@ pub enum DroneEvent {
     /// A target found while detection of its kind is on, once per target per activation.
     Detected { drone: DroneId, kind: String, location: [f64; 3] },
     /// A built-in signal of the drone (`BatteryLow`, `ConnectionRestored`).
-    Signal { drone: DroneId, name: &'static str },
+    Signal { drone: DroneId, signal: BuiltinSignal },
     /// A fault (`BatteryCritical`, `ConnectionLost`, ...). Raised once; the drone's calls
     /// in progress end `Interrupted`, so the exception is never raised twice.
     Fault { drone: DroneId, failure: Failure },
@@ -159,7 +162,7 @@ pub trait Backend {
     /// The functions, telemetry and built-ins this backend offers.
     fn descriptor(&self) -> crate::Descriptor;
     /// Starts `function` on `drone`. Arguments were checked against the descriptor.
-    fn call(&self, drone: DroneId, function: &str, args: &[Value]) -> PendingCall;
+    fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall;
     fn interrupt(&self, call: CallId, how: Interrupt);
     fn telemetry(&self, drone: DroneId) -> Telemetry;
     /// The stream of drone events; taken once, by the engine.

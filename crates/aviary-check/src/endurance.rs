@@ -242,11 +242,11 @@ impl Walker<'_> {
                     number(longest.endurance)
                 )
             };
-            let mut d = Diagnostic::new(Code::PastEndurance, w.file, w.span, format!("`{}` for {} s ({}) is longer than {who}", f.name, number(w.seconds), human(w.seconds)))
+            let mut d = Diagnostic::new(Code::PastEndurance, w.file, w.span, format!("`{}` for {} s ({}) is longer than {who}", f.name(), number(w.seconds), human(w.seconds)))
                 .label("longer than the battery lasts")
                 .with_help("give a duration the drone can fly (its `endurance` in the world file); in the air the battery runs out long before this ends, and on the ground the wait outlasts any mission");
             if (w.file, w.span) != (file, call.span) {
-                d = d.also(file, call.span, format!("{} is called here", f.name));
+                d = d.also(file, call.span, format!("{} is called here", f.name()));
             }
             self.out.push(d);
         }

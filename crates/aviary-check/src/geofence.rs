@@ -10,6 +10,7 @@ use std::collections::BTreeMap;
 
 use aviary_api::geometry::{circle_inside, contains, segment_inside};
 use aviary_api::show::number;
+use aviary_api::Function;
 use aviary_diagnostics::{Code, Diagnostic, FileId, Label, Span};
 use aviary_syntax::ast::*;
 use aviary_world::World;
@@ -177,18 +178,20 @@ impl Walker<'_> {
 
     fn api(&mut self, call: &ApiCall, values: &Values, site: Option<(FileId, Span)>, file: FileId) {
         let arg = |i: usize| call.args.get(i).and_then(|e| self.value(e, values));
-        match call.function.name.as_str() {
-            "FlyToPosition" => {
+        // A name the middle layer does not have is the walk's error, not a flight.
+        let Some(function) = Function::from_name(&call.function.name) else { return };
+        match function {
+            Function::FlyToPosition => {
                 if let Some(k) = arg(0) {
                     self.point(&k, call, site, file);
                 }
             }
-            "TakeOff" | "AscendTo" | "DescendTo" => {
+            Function::TakeOff | Function::AscendTo | Function::DescendTo => {
                 if let Some(Known::Number(alt)) = arg(0) {
                     self.altitude(alt, call, site, file);
                 }
             }
-            "Orbit" => {
+            Function::Orbit => {
                 if let (Some(center), Some(Known::Number(radius)), Some(fence)) =
                     (arg(0).and_then(|k| ground(&k)), arg(1), self.fence)
                 {
@@ -202,7 +205,7 @@ impl Walker<'_> {
                     }
                 }
             }
-            "Sweep" => {
+            Function::Sweep => {
                 if let (Some(Known::Area(area)), Some(fence)) = (arg(0), self.fence) {
                     // A corner outside, or else an edge that crosses the fence.
                     let corner = area.iter().find(|p| !contains(fence, **p));
@@ -221,14 +224,25 @@ impl Walker<'_> {
                     }
                 }
             }
-            "FollowPath" => {
+            Function::FollowPath => {
                 for e in &call.args {
                     if let Some(k) = self.value(e, values) {
                         self.point(&k, call, site, file);
                     }
                 }
             }
-            _ => {}
+            // Where these fly is not written in the call: the drone's place, or home.
+            Function::Arm
+            | Function::Disarm
+            | Function::Land
+            | Function::ReturnToLaunch
+            | Function::Hover
+            | Function::StartStreaming
+            | Function::StopStreaming
+            | Function::StartDetection
+            | Function::StopDetection
+            | Function::LoadPayload
+            | Function::ReleasePayload => {}
         }
     }
 

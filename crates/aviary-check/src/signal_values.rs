@@ -22,7 +22,7 @@ pub(crate) fn signal_values(
 ) -> BTreeMap<String, Vec<Option<Kind>>> {
     let mut out: BTreeMap<String, Vec<Option<Kind>>> = BTreeMap::new();
     for s in &api.signals {
-        out.insert(s.name.to_string(), s.values.iter().map(|(_, k)| Some(*k)).collect());
+        out.insert(s.name().to_string(), s.values().iter().map(|(_, k)| Some(*k)).collect());
     }
     let builtin = |name: &str| api.signal(name).is_some();
     let learn = |out: &mut BTreeMap<String, Vec<Option<Kind>>>,

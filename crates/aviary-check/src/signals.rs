@@ -70,7 +70,7 @@ pub(crate) fn check_signals(
         .raised
         .iter()
         .map(|(_, i)| i.name.as_str())
-        .chain(api.signals.iter().map(|s| s.name))
+        .chain(api.signals.iter().map(|s| s.name()))
         .collect();
     let raised_set: HashSet<&str> = raised.iter().copied().collect();
     for (file, h) in &uses.handlers {
@@ -104,7 +104,7 @@ pub(crate) fn check_signals(
         }
     }
     let exceptions: Vec<&str> =
-        api.exceptions.iter().copied().chain(uses.thrown.iter().copied()).collect();
+        api.exceptions.iter().map(|e| e.name()).chain(uses.thrown.iter().copied()).collect();
     let exception_set: HashSet<&str> = exceptions.iter().copied().collect();
     for (file, e) in &uses.exception_handlers {
         if !exception_set.contains(e.name.as_str()) && raised_set.contains(e.name.as_str()) {
@@ -125,7 +125,7 @@ pub(crate) fn check_signals(
             let help = did_you_mean(&e.name, exceptions.iter().copied()).unwrap_or_else(|| {
                 format!(
                     "the built-in exceptions are {}; or throw it with `THROW EXCEPTION {}`",
-                    api.exceptions.join(", "),
+                    api.exceptions.iter().map(|e| e.name()).collect::<Vec<_>>().join(", "),
                     e.name
                 )
             });

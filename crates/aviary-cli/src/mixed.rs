@@ -6,8 +6,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 use aviary_api::{
-    Backend, CallId, Descriptor, DroneEvent, DroneId, Ending, Interrupt, PendingCall, Telemetry,
-    Value,
+    Backend, CallId, Descriptor, DroneEvent, DroneId, Ending, Function, Interrupt, PendingCall,
+    Telemetry, Value,
 };
 use aviary_mavlink::MavlinkBackend;
 use aviary_sim::SimBackend;
@@ -74,7 +74,7 @@ impl Backend for Mixed {
         aviary_sim::descriptor()
     }
 
-    fn call(&self, drone: DroneId, function: &str, args: &[Value]) -> PendingCall {
+    fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall {
         let by_mavlink = self.mavlink.serves(drone);
         let inner = if by_mavlink {
             self.mavlink.call(drone, function, args)

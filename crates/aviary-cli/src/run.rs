@@ -4,6 +4,7 @@
 use std::io::Write;
 use std::path::PathBuf;
 
+use aviary_api::trace::{Event, Record};
 use aviary_api::Backend;
 use aviary_diagnostics::{render_text, SourceMap};
 use aviary_engine::{Control, Controller, Outcome, RunOptions, Status};
@@ -223,11 +224,11 @@ pub fn run(args: &RunArgs) -> u8 {
         };
         let watch = watch_backend(sim.take_driver(), controller.clone());
         let mut stats = Stats::default();
-        let mut sink = |event: serde_json::Value| {
-            stats.observe(&event, &progress, backend, mission.drones.len());
-            lock(&trace).write(&event);
+        let mut sink = |record: &Record| {
+            stats.observe(record, &progress, backend, mission.drones.len());
+            lock(&trace).write(record);
             if let Some(feed) = &feed {
-                feed.publish(&event);
+                feed.publish(record);
             }
         };
         let options = RunOptions { telemetry_hz, ..RunOptions::default() };
@@ -356,31 +357,27 @@ struct Stats {
 impl Stats {
     fn observe(
         &mut self,
-        event: &serde_json::Value,
+        record: &Record,
         progress: &ProgressBar,
         backend: &dyn Backend,
         drones: usize,
     ) {
-        let kind = event["event"].as_str().unwrap_or("");
-        match kind {
-            "capability_start" => self.running += 1,
-            "capability_end" => self.running -= 1,
-            "detection" => self.detections += 1,
-            "signal" => {
-                let name = event["name"].as_str().unwrap_or("").to_string();
-                match self.signals.iter_mut().find(|(n, _)| *n == name) {
-                    Some((_, count)) => *count += 1,
-                    None => self.signals.push((name, 1)),
-                }
+        match &record.event {
+            Event::CapabilityStart { .. } => self.running += 1,
+            Event::CapabilityEnd { .. } => self.running -= 1,
+            Event::Detection { .. } => self.detections += 1,
+            Event::Signal { name, .. } => match self.signals.iter_mut().find(|(n, _)| n == name) {
+                Some((_, count)) => *count += 1,
+                None => self.signals.push((name.to_string(), 1)),
+            },
+            Event::Exception { name, handled, .. } => {
+                self.exceptions.push((name.to_string(), *handled))
             }
-            "exception" => self.exceptions.push((
-                event["name"].as_str().unwrap_or("").to_string(),
-                event["handled"].as_bool().unwrap_or(false),
-            )),
             _ => {}
         }
-        let t = event["t"].as_f64().unwrap_or(0.0);
-        if t - self.last_shown >= 1.0 || kind == "mission_end" {
+        let t = if record.t.is_finite() { record.t } else { 0.0 };
+        let ended = matches!(record.event, Event::MissionEnd { .. });
+        if t - self.last_shown >= 1.0 || ended {
             self.last_shown = t;
             let flying = (0..drones).filter(|d| backend.telemetry(*d).state.airborne()).count();
             progress.set_message(format!(

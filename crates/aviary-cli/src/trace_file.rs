@@ -9,6 +9,8 @@
 use std::io::Write;
 use std::sync::{Arc, Mutex, MutexGuard};
 
+use aviary_api::trace::{Event, Record, Status};
+
 pub struct TraceFile {
     out: Box<dyn Write + Send>,
     /// Where it goes, for messages.
@@ -20,6 +22,8 @@ pub struct TraceFile {
     closed: bool,
     /// The first write error, once one happened.
     failed: Option<String>,
+    /// The line being written, kept between events so that writing one allocates nothing.
+    line: Vec<u8>,
 }
 
 pub type SharedTrace = Arc<Mutex<TraceFile>>;
@@ -38,6 +42,7 @@ impl TraceFile {
             last_t: 0.0,
             closed: false,
             failed: None,
+            line: Vec::new(),
         }))
     }
 
@@ -46,25 +51,29 @@ impl TraceFile {
         self.failed.as_deref()
     }
 
-    pub fn write(&mut self, event: &serde_json::Value) {
+    pub fn write(&mut self, record: &Record) {
         if self.closed || self.failed.is_some() {
             return;
         }
         // One write of the whole line: a cut never leaves half an event behind.
-        let line = format!("{event}\n");
-        if let Err(e) = self.out.write_all(line.as_bytes()).and_then(|()| self.out.flush()) {
+        self.line.clear();
+        let written = serde_json::to_writer(&mut self.line, record).map_err(std::io::Error::from);
+        self.line.push(b'\n');
+        let written =
+            written.and_then(|()| self.out.write_all(&self.line)).and_then(|()| self.out.flush());
+        if let Err(e) = written {
             eprintln!("\naviary: cannot write the trace {}: {e}; the mission goes on without it, and aviary will exit 3", self.name);
             self.failed = Some(e.to_string());
             return;
         }
-        if let Some(t) = event["t"].as_f64() {
-            self.last_t = t;
+        // A time that is not finite is written `null`: the last one stands.
+        if record.t.is_finite() {
+            self.last_t = record.t;
         }
-        if event["event"] == "mission_start" {
-            self.started = true;
-        }
-        if event["event"] == "mission_end" {
-            self.closed = true;
+        match record.event {
+            Event::MissionStart { .. } => self.started = true,
+            Event::MissionEnd { .. } => self.closed = true,
+            _ => {}
         }
     }
 
@@ -73,11 +82,11 @@ impl TraceFile {
     /// whenever it is cut.
     pub fn close_now(&mut self, reason: &str) {
         if !self.started {
-            let start =
-                serde_json::json!({ "t": 0.0, "event": "mission_start", "mission": self.mission });
-            self.write(&start);
+            let mission = self.mission.clone();
+            let start = Event::MissionStart { mission: mission.into() };
+            self.write(&Record { t: 0.0, event: start });
         }
-        let end = serde_json::json!({ "t": self.last_t, "event": "mission_end", "status": "aborted", "reason": reason });
-        self.write(&end);
+        let end = Event::MissionEnd { status: Status::Aborted, reason: Some(reason.into()) };
+        self.write(&Record { t: self.last_t, event: end });
     }
 }

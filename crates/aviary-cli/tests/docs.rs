@@ -495,7 +495,7 @@ fn documented_events() -> BTreeMap<String, (BTreeSet<String>, BTreeSet<String>)>
 fn the_trace_events_documented_are_the_engines_with_their_fields() {
     let doc = documented_events();
     let engine: BTreeSet<String> =
-        aviary_engine::Kind::ALL.iter().map(|k| k.as_str().to_string()).collect();
+        aviary_api::trace::EventKind::ALL.iter().map(|k| k.as_str().to_string()).collect();
     let documented: BTreeSet<String> = doc.keys().cloned().collect();
     assert_eq!(documented, engine, "docs/TRACE.md's events (left) and the engine's (right)");
 
@@ -514,7 +514,15 @@ fn the_trace_events_documented_are_the_engines_with_their_fields() {
         &dir,
     );
     assert_eq!(code, 0, "{out}{err}");
-    let events = json_lines(&std::fs::read_to_string(dir.join("trace.jsonl")).unwrap());
+    let text = std::fs::read_to_string(dir.join("trace.jsonl")).unwrap();
+    // A reader (a replay, a ground station) reads each line back as the typed event,
+    // which writes the line again byte for byte.
+    for line in text.lines() {
+        let record: aviary_api::trace::Record =
+            serde_json::from_str(line).unwrap_or_else(|e| panic!("{e}: {line}"));
+        assert_eq!(serde_json::to_string(&record).unwrap(), line);
+    }
+    let events = json_lines(&text);
     let mut seen = BTreeSet::new();
     for e in &events {
         let kind = e["event"].as_str().unwrap().to_string();

@@ -5,9 +5,11 @@ use std::cell::{Cell, RefCell};
 use std::pin::pin;
 use std::rc::Rc;
 
-use aviary_api::{DroneId, Value};
+use std::borrow::Cow;
+
+use aviary_api::trace::{Event, EventKind, Params, Shown, Status};
+use aviary_api::{BuiltinException, DroneId, Value};
 use aviary_ir::{BlockKind, Call, Capability};
-use serde_json::{Map, Value as Json};
 use smallvec::SmallVec;
 use tokio::sync::Notify;
 
@@ -16,16 +18,14 @@ use crate::arbiter::{acquire, try_acquire, Claims, Held, Needs};
 use crate::cancel::Token as CancellationToken;
 use crate::engine::{Actors, Ctx, Engine, Frame, Instance, Scope};
 use crate::jobs::Jobs;
-use crate::trace::{Field, Kind};
-use crate::value::to_json;
 
 /// Where an instance's PERFORM body starts: at its beginning, or (an instant activity
 /// that has to wait, `instant.rs`) at a statement of its sequence, that statement's
 /// call perhaps already made.
-pub(crate) enum Resume<'m> {
+pub(crate) enum Resume {
     Start,
     /// The call is boxed: the future of every instance has room for its `Resume`.
-    At(usize, Option<Box<Begun<'m>>>),
+    At(usize, Option<Box<Begun>>),
 }
 
 /// An instance that has started, for `perform`.
@@ -107,10 +107,12 @@ impl<'m> Engine<'m> {
             self.instances.borrow_mut().remove(&instance);
             return None;
         }
-        self.trace(Kind::CapabilityStart, || self.capability_fields(call, &instance.actors, &args));
+        self.trace(EventKind::CapabilityStart, || {
+            self.capability_event(call, &instance.actors, &args, None)
+        });
         let Some(held) = held else {
             self.instances.borrow_mut().remove(&instance);
-            self.capability_end(call, &instance.actors, &args, "aborted");
+            self.capability_end(call, &instance.actors, &args, Status::Aborted);
             return None;
         };
         let requirements_met = {
@@ -120,9 +122,9 @@ impl<'m> Engine<'m> {
         };
         if !requirements_met {
             self.instances.borrow_mut().remove(&instance);
-            self.capability_end(call, &instance.actors, &args, "failed");
+            self.capability_end(call, &instance.actors, &args, Status::Failed);
             drop(held);
-            let id = self.m.builtins.requirement_not_met;
+            let id = self.m.builtins.exception(BuiltinException::RequirementNotMet);
             let why = format!("a requirement of {} does not hold", cap.name);
             self.throw(id, vec![Value::Text(why)], actor, &ctx.scope);
             return None;
@@ -143,7 +145,7 @@ impl<'m> Engine<'m> {
         listed: bool,
         args: Vec<Value>,
         ctx: &Ctx<'m>,
-        resume: Resume<'m>,
+        resume: Resume,
     ) {
         let cap = &self.m.capabilities[call.capability];
         *instance.claims.borrow_mut() = claims.clone();
@@ -211,11 +213,11 @@ impl<'m> Engine<'m> {
         }
         drop(held);
         let status = if finished && !instance.failed.get() {
-            "ok"
+            Status::Ok
         } else if instance.failed.get() {
-            "failed"
+            Status::Failed
         } else {
-            "aborted"
+            Status::Aborted
         };
         self.capability_end(call, &instance.actors, &args, status);
     }
@@ -230,7 +232,7 @@ impl<'m> Engine<'m> {
             return false;
         }
         let cap = &self.m.capabilities[call.capability];
-        let id = self.m.builtins.command_failed;
+        let id = self.m.builtins.exception(BuiltinException::CommandFailed);
         let why = format!(
             "calling `{}` would nest capability calls {} deep, past the limit of {}: a capability that keeps calling itself",
             cap.name,
@@ -287,27 +289,30 @@ impl<'m> Engine<'m> {
             .collect()
     }
 
-    /// The fields of `capability_start` (built only when the trace wants them).
-    pub(crate) fn capability_fields(
-        &self,
+    /// `capability_start`, or with the status it ended with, `capability_end` (made only
+    /// when the trace wants them).
+    pub(crate) fn capability_event<'a>(
+        &'a self,
         call: &Call,
         actors: &[DroneId],
-        args: &[Value],
-    ) -> [(&'static str, Field<'m>); 4] {
+        args: &'a [Value],
+        end: Option<Status>,
+    ) -> Event<'a> {
         let cap = &self.m.capabilities[call.capability];
-        let tag = Field::name(call.tag.map(|t| self.m.tags[t].as_str()));
-        let shown_args: Map<String, Json> =
-            cap.params.iter().zip(args).map(|(p, v)| (p.clone(), to_json(self.m, v))).collect();
-        let who = match actors {
-            [one] => Field::Str(self.name(*one)),
-            all => Field::Text(all.iter().map(|d| self.name(*d)).collect::<Vec<_>>().join(" ")),
+        let tag = call.tag.map(|t| Cow::Borrowed(self.m.tags[t].as_str()));
+        let shown = cap.params.iter().zip(args);
+        let params = Params(
+            shown.map(|(p, v)| (Cow::Borrowed(p.as_str()), Shown::of(v, &self.m.drones))).collect(),
+        );
+        let actor = match actors {
+            [one] => Cow::Borrowed(self.name(*one)),
+            all => Cow::Owned(all.iter().map(|d| self.name(*d)).collect::<Vec<_>>().join(" ")),
         };
-        [
-            ("actor", who),
-            ("capability", Field::Str(&cap.name)),
-            ("tag", tag),
-            ("args", Field::Json(Json::Object(shown_args))),
-        ]
+        let capability = Cow::Borrowed(cap.name.as_str());
+        match end {
+            None => Event::CapabilityStart { actor, capability, tag, args: params },
+            Some(status) => Event::CapabilityEnd { actor, capability, tag, args: params, status },
+        }
     }
 
     pub(crate) fn capability_end(
@@ -315,11 +320,10 @@ impl<'m> Engine<'m> {
         call: &Call,
         actors: &[DroneId],
         args: &[Value],
-        status: &'static str,
+        status: Status,
     ) {
-        self.trace(Kind::CapabilityEnd, || {
-            let [actor, capability, tag, args] = self.capability_fields(call, actors, args);
-            [actor, capability, tag, args, ("status", Field::Str(status))]
+        self.trace(EventKind::CapabilityEnd, || {
+            self.capability_event(call, actors, args, Some(status))
         });
     }
 }

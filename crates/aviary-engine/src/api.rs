@@ -4,31 +4,30 @@
 use std::cell::Cell;
 use std::rc::Rc;
 
-use aviary_api::{CallEnd, CallId, DroneId, Ending, Interrupt, Value};
+use aviary_api::{CallEnd, CallId, DroneId, Ending, Function, Interrupt, Value};
 use aviary_ir::ApiCall;
-use serde_json::json;
 
 use crate::engine::{Ctx, Engine, Instance};
-use crate::trace::{Field, Kind};
+use aviary_api::trace::{CallStatus, Event, EventKind};
 
 /// A call made: what the rest of its statement needs.
-pub(crate) struct Begun<'m> {
-    pub call: Made<'m>,
+pub(crate) struct Begun {
+    pub call: Made,
     pub end: Ending,
 }
 
 /// Which call was made, with what.
-pub(crate) struct Made<'m> {
+pub(crate) struct Made {
     pub drone: DroneId,
-    pub function: &'m str,
+    pub function: Function,
     pub args: Vec<Value>,
     pub id: CallId,
 }
 
 /// Whether a call's ending is remembered with the scope that made it (detection: finds
 /// are raised in the activity that started it, docs/LANGUAGE.md, section 16).
-pub(crate) fn remembers_scope(function: &str) -> bool {
-    matches!(function, "StartDetection" | "StopDetection")
+pub(crate) fn remembers_scope(function: Function) -> bool {
+    matches!(function, Function::StartDetection | Function::StopDetection)
 }
 
 impl<'m> Engine<'m> {
@@ -57,19 +56,17 @@ impl<'m> Engine<'m> {
     }
 
     /// Evaluates the arguments, records `api_call` and makes the call.
-    pub(crate) fn api_begin(&self, a: &'m ApiCall, drone: DroneId, frame: &[Value]) -> Begun<'m> {
+    pub(crate) fn api_begin(&self, a: &'m ApiCall, drone: DroneId, frame: &[Value]) -> Begun {
         let args = {
             let received = self.received.borrow();
             let env = self.env(frame, &received);
             a.args.iter().map(|e| env.eval(e)).collect::<Vec<_>>()
         };
-        let function = self.m.functions[a.function].0.as_str();
-        self.trace(Kind::ApiCall, || {
-            [
-                ("actor", Field::Str(self.name(drone))),
-                ("function", Field::Str(function)),
-                ("args", Field::Json(self.values(&args))),
-            ]
+        let function = a.function;
+        self.trace(EventKind::ApiCall, || Event::ApiCall {
+            actor: self.name(drone).into(),
+            function,
+            args: self.values(&args),
         });
         let pending = self.backend.call(drone, function, &args);
         Begun { call: Made { drone, function, args, id: pending.id }, end: pending.end }
@@ -77,7 +74,7 @@ impl<'m> Engine<'m> {
 
     /// The rest of a call's statement: waits for its ending, records `api_done`, and
     /// raises what a failure or an interruption means.
-    pub(crate) async fn api_end(&self, begun: Begun<'m>, ctx: &Ctx<'m>) {
+    pub(crate) async fn api_end(&self, begun: Begun, ctx: &Ctx<'m>) {
         let Begun { call, end } = begun;
         let end = match end {
             // Over as it was made: nothing in flight to pause, resume or abort.
@@ -100,10 +97,7 @@ impl<'m> Engine<'m> {
         self.trace_done(drone, function, args, &end);
         match end {
             CallEnd::Done => self.after_call(function, drone, args, ctx),
-            CallEnd::Failed(f) => {
-                let (id, why) = self.exception_of(f);
-                self.throw(id, vec![Value::Text(why)], Some(drone), &ctx.scope);
-            }
+            CallEnd::Failed(f) => self.fail(f, drone, &ctx.scope),
             CallEnd::Interrupted => {
                 // A fault interrupted it: raise that first, while this activity still runs.
                 self.drain_events();
@@ -112,7 +106,7 @@ impl<'m> Engine<'m> {
         }
     }
 
-    fn after_call(&self, function: &str, drone: DroneId, args: &[Value], ctx: &Ctx<'m>) {
+    fn after_call(&self, function: Function, drone: DroneId, args: &[Value], ctx: &Ctx<'m>) {
         if !remembers_scope(function) {
             return;
         }
@@ -120,7 +114,7 @@ impl<'m> Engine<'m> {
             Some(Value::Symbol(k) | Value::Text(k)) => k.clone(),
             _ => return,
         };
-        if function == "StartDetection" {
+        if function == Function::StartDetection {
             self.detections.borrow_mut().insert((drone, kind), ctx.scope.clone());
         } else {
             self.detections.borrow_mut().remove(&(drone, kind));
@@ -132,7 +126,7 @@ impl<'m> Engine<'m> {
 /// the trace: every `api_call` has its `api_done`.
 struct CallGuard<'e, 'm> {
     engine: &'e Engine<'m>,
-    call: &'e Made<'m>,
+    call: &'e Made,
     root: Option<&'e Rc<Instance>>,
     done: Cell<bool>,
 }
@@ -143,15 +137,12 @@ impl Drop for CallGuard<'_, '_> {
         if !self.done.get() {
             self.engine.backend.interrupt(call.id, Interrupt::Abort);
             let engine = self.engine;
-            engine.trace(Kind::ApiDone, || {
-                let p = engine.backend.telemetry(call.drone).position;
-                [
-                    ("actor", Field::Str(engine.name(call.drone))),
-                    ("function", Field::Str(call.function)),
-                    ("args", Field::Json(engine.values(&call.args))),
-                    ("status", Field::Str("aborted")),
-                    ("position", Field::Json(json!(p))),
-                ]
+            engine.trace(EventKind::ApiDone, || Event::ApiDone {
+                actor: engine.name(call.drone).into(),
+                function: call.function,
+                args: engine.values(&call.args),
+                status: CallStatus::Aborted,
+                position: engine.backend.telemetry(call.drone).position,
             });
         }
         if let Some(root) = &self.root {

@@ -5,9 +5,11 @@ use std::cell::{Cell, RefCell};
 use std::collections::BTreeMap;
 use std::rc::Rc;
 
-use aviary_api::{Backend, DroneEvent, DroneId, Value};
+use std::borrow::Cow;
+
+use aviary_api::trace::{CallStatus, Event, EventKind, Record, Shown};
+use aviary_api::{Backend, DroneEvent, DroneId, Function, Value};
 use aviary_ir::{ActorFilter, ExceptionHandler, Handler, Mission};
-use serde_json::{json, Value as Json};
 use tokio::sync::{mpsc, Notify};
 
 use crate::cancel::Token as CancellationToken;
@@ -16,8 +18,7 @@ use crate::registry::Registry;
 use tokio::time::Instant;
 
 use crate::arbiter::{Arbiter, Claims};
-use crate::trace::{Event, Field, Kind};
-use crate::value::{to_json, Env};
+use crate::value::Env;
 use crate::{Outcome, RunOptions, Status, TraceSink};
 
 pub(crate) type Frame = Rc<[Value]>;
@@ -102,7 +103,7 @@ pub(crate) struct Engine<'m> {
     pub backend: &'m dyn Backend,
     sink: RefCell<&'m mut dyn TraceSink>,
     /// What the sink wants, by kind (asked once).
-    wanted: [bool; Kind::ALL.len()],
+    wanted: [bool; EventKind::ALL.len()],
     start: Instant,
     pub received: RefCell<Vec<bool>>,
     pub changed: Notify,
@@ -141,7 +142,7 @@ impl<'m> Engine<'m> {
         Engine {
             m,
             backend,
-            wanted: Kind::ALL.map(|k| sink.wants(k.as_str())),
+            wanted: EventKind::ALL.map(|k| sink.wants(k)),
             sink: RefCell::new(sink),
             start: Instant::now(),
             received: RefCell::new(vec![false; m.signals.len()]),
@@ -176,26 +177,23 @@ impl<'m> Engine<'m> {
         (Instant::now() - self.start).as_secs_f64()
     }
 
-    /// Records an event, if the sink wants its kind: `fields` is built only then.
-    pub fn trace<'a, const N: usize>(
-        &self,
-        kind: Kind,
-        fields: impl FnOnce() -> [(&'static str, Field<'a>); N],
-    ) {
+    /// Records an event of `kind`, if the sink wants that kind: `event` is made only then.
+    pub fn trace<'a>(&self, kind: EventKind, event: impl FnOnce() -> Event<'a>) {
         if !self.wanted[kind as usize] {
             return;
         }
-        let fields = fields();
-        let event = Event { t: self.now(), kind: kind.as_str(), fields: &fields };
-        self.sink.borrow_mut().record(&event);
+        let event = event();
+        debug_assert_eq!(event.kind(), kind, "an event of the kind asked for");
+        self.sink.borrow_mut().record(&Record { t: self.now(), event });
     }
 
     pub fn name(&self, d: DroneId) -> &'m str {
         self.m.drones.get(d).unwrap_or("?")
     }
 
-    pub fn values(&self, values: &[Value]) -> Json {
-        Json::Array(values.iter().map(|v| to_json(self.m, v)).collect())
+    /// Values as the trace shows them, their text borrowed.
+    pub fn values<'a>(&'a self, values: &'a [Value]) -> Vec<Shown<'a>> {
+        Shown::all(values, &self.m.drones)
     }
 
     pub fn env<'a>(&'a self, frame: &'a [Value], received: &'a [bool]) -> Env<'a> {
@@ -207,7 +205,9 @@ impl<'m> Engine<'m> {
         options: &RunOptions,
         controls: Option<mpsc::UnboundedReceiver<crate::ControlRequest>>,
     ) -> Outcome {
-        self.trace(Kind::MissionStart, || [("mission", Field::Str(&self.m.name))]);
+        self.trace(EventKind::MissionStart, || Event::MissionStart {
+            mission: self.m.name.as_str().into(),
+        });
         let root = Rc::new(Scope {
             parent: None,
             path: &self.m.name,
@@ -268,8 +268,9 @@ impl<'m> Engine<'m> {
         }
         let said: Vec<String> = reason.into_iter().chain(home.stranded).chain(home.notes).collect();
         reason = (!said.is_empty()).then(|| said.join("; "));
-        self.trace(Kind::MissionEnd, || {
-            [("status", Field::Str(status.as_str())), ("reason", Field::name(reason.as_deref()))]
+        self.trace(EventKind::MissionEnd, || Event::MissionEnd {
+            status,
+            reason: reason.as_deref().map(Cow::Borrowed),
         });
         Outcome { status, reason }
     }
@@ -290,23 +291,21 @@ impl<'m> Engine<'m> {
     pub fn trace_done(
         &self,
         d: DroneId,
-        function: &str,
+        function: Function,
         args: &[Value],
         end: &aviary_api::CallEnd,
     ) {
         let status = match end {
-            aviary_api::CallEnd::Done => "ok",
-            aviary_api::CallEnd::Failed(_) => "failed",
-            aviary_api::CallEnd::Interrupted => "interrupted",
+            aviary_api::CallEnd::Done => CallStatus::Ok,
+            aviary_api::CallEnd::Failed(_) => CallStatus::Failed,
+            aviary_api::CallEnd::Interrupted => CallStatus::Interrupted,
         };
-        self.trace(Kind::ApiDone, || {
-            [
-                ("actor", Field::Str(self.name(d))),
-                ("function", Field::Str(function)),
-                ("args", Field::Json(self.values(args))),
-                ("status", Field::Str(status)),
-                ("position", Field::Json(json!(self.backend.telemetry(d).position))),
-            ]
+        self.trace(EventKind::ApiDone, || Event::ApiDone {
+            actor: self.name(d).into(),
+            function,
+            args: self.values(args),
+            status,
+            position: self.backend.telemetry(d).position,
         });
     }
 
@@ -317,13 +316,11 @@ impl<'m> Engine<'m> {
         loop {
             for d in 0..self.m.drones.len() {
                 let t = self.backend.telemetry(d);
-                self.trace(Kind::Telemetry, || {
-                    [
-                        ("actor", Field::Str(self.name(d))),
-                        ("position", Field::Json(json!(t.position))),
-                        ("battery", Field::Json(json!(t.battery))),
-                        ("state", Field::Str(t.state.as_str())),
-                    ]
+                self.trace(EventKind::Telemetry, || Event::Telemetry {
+                    actor: self.name(d).into(),
+                    position: t.position,
+                    battery: t.battery,
+                    state: t.state,
                 });
             }
             next += period;
@@ -368,16 +365,14 @@ impl<'m> Engine<'m> {
     fn on_event(&self, event: DroneEvent) {
         match event {
             DroneEvent::Detected { drone, kind, location } => {
-                self.trace(Kind::Detection, || {
-                    [
-                        ("actor", Field::Str(self.name(drone))),
-                        ("kind", Field::Str(&kind)),
-                        ("location", Field::Json(json!(location))),
-                    ]
+                self.trace(EventKind::Detection, || Event::Detection {
+                    actor: self.name(drone).into(),
+                    kind: kind.as_str().into(),
+                    location,
                 });
                 let scope = self.detections.borrow().get(&(drone, kind.clone())).cloned();
                 if let Some(scope) = scope {
-                    let id = self.m.builtins.detected;
+                    let id = self.m.builtins.signal(aviary_api::BuiltinSignal::Detected);
                     // A find is a point on the ground: flying to it keeps the altitude.
                     let args = vec![
                         Value::Symbol(kind),
@@ -386,38 +381,21 @@ impl<'m> Engine<'m> {
                     self.raise(id, args, Some(drone), &scope);
                 }
             }
-            DroneEvent::Signal { drone, name } => {
-                if let Some(id) = self.signal_id(name) {
-                    let scope = self.actor_scope(drone);
-                    self.raise(id, Vec::new(), Some(drone), &scope);
-                }
+            DroneEvent::Signal { drone, signal } => {
+                let scope = self.actor_scope(drone);
+                self.raise(self.m.builtins.signal(signal), Vec::new(), Some(drone), &scope);
             }
             DroneEvent::Fault { drone, failure } => {
                 let scope = self.actor_scope(drone);
-                let (id, why) = self.exception_of(failure);
-                self.throw(id, vec![Value::Text(why)], Some(drone), &scope);
+                self.fail(failure, drone, &scope);
             }
         }
     }
 
-    /// The exception a backend's failure names, and its reason. The backend names it (the
-    /// contract's names are text); one the mission does not know is a backend's mistake,
-    /// raised as `CommandFailed` that says so, never as another exception.
-    pub(crate) fn exception_of(&self, failure: aviary_api::Failure) -> (usize, String) {
-        match self.m.exceptions.iter().position(|e| e == failure.exception) {
-            Some(id) => (id, failure.reason),
-            None => (
-                self.m.builtins.command_failed,
-                format!(
-                    "{} (the backend raised `{}`, an exception the mission does not know)",
-                    failure.reason, failure.exception
-                ),
-            ),
-        }
-    }
-
-    fn signal_id(&self, name: &str) -> Option<usize> {
-        self.m.signals.iter().position(|s| s == name)
+    /// Raises a backend's failure on `drone` as its built-in exception, with the reason.
+    pub(crate) fn fail(&self, failure: aviary_api::Failure, drone: DroneId, from: &Rc<Scope<'m>>) {
+        let id = self.m.builtins.exception(failure.exception);
+        self.throw(id, vec![Value::Text(failure.reason)], Some(drone), from);
     }
 
     /// Where an actor's built-in events are raised: in its innermost running capability
@@ -444,12 +422,10 @@ impl<'m> Engine<'m> {
     /// A signal from outside the mission (the operator): heard by every running handler
     /// that matches, at once (there is no signalling block to wait for).
     pub fn raise_from_outside(&self, signal: usize, args: Vec<Value>) {
-        self.trace(Kind::Signal, || {
-            [
-                ("name", Field::Str(&self.m.signals[signal])),
-                ("actor", Field::Null),
-                ("args", Field::Json(self.values(&args))),
-            ]
+        self.trace(EventKind::Signal, || Event::Signal {
+            name: self.m.signals[signal].as_str().into(),
+            actor: None,
+            args: self.values(&args),
         });
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {
             *r = true;
@@ -474,12 +450,10 @@ impl<'m> Engine<'m> {
         if self.stopped() {
             return;
         }
-        self.trace(Kind::Signal, || {
-            [
-                ("name", Field::Str(&self.m.signals[signal])),
-                ("actor", Field::name(actor.map(|a| self.name(a)))),
-                ("args", Field::Json(self.values(&args))),
-            ]
+        self.trace(EventKind::Signal, || Event::Signal {
+            name: self.m.signals[signal].as_str().into(),
+            actor: actor.map(|a| self.name(a).into()),
+            args: self.values(&args),
         });
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {
             *r = true;
@@ -535,22 +509,22 @@ impl<'m> Engine<'m> {
         if self.stopped() {
             return;
         }
-        let name = self.m.exceptions.get(exception).cloned().unwrap_or_default();
+        let name = self.m.exceptions.get(exception).map_or("", String::as_str);
         let found = from.chain().find_map(|scope| {
             let i = scope.exception_handlers.iter().position(|h| {
                 h.exception == exception && self.matches(&h.by, &scope.frame, actor)
             })?;
             Some((scope.clone(), i))
         });
-        self.trace(Kind::Exception, || {
-            let handler = found.as_ref().map(|(s, _)| format!("{}/ON EXCEPTION {name}", s.path));
-            [
-                ("name", Field::Str(&name)),
-                ("actor", Field::name(actor.map(|a| self.name(a)))),
-                ("args", Field::Json(self.values(&args))),
-                ("handled", Field::Bool(found.is_some())),
-                ("handler", handler.map_or(Field::Null, Field::Text)),
-            ]
+        self.trace(EventKind::Exception, || Event::Exception {
+            name: name.into(),
+            actor: actor.map(|a| self.name(a).into()),
+            args: self.values(&args),
+            handled: found.is_some(),
+            handler: found
+                .as_ref()
+                .map(|(s, _)| Cow::Owned(format!("{}/ON EXCEPTION {name}", s.path))),
+            during: None,
         });
         let Some((handler_scope, index)) = found else {
             for scope in from.chain() {

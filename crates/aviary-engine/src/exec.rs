@@ -18,7 +18,7 @@ use crate::arbiter::Claims;
 use crate::engine::{Actors, Ctx, Engine, Frame, Instance, Job, Scope};
 use crate::jobs::Jobs;
 use crate::join::{join_eager, join_in_order, join_woken, SMALL};
-use crate::trace::{Field, Kind};
+use aviary_api::trace::{Event, EventKind, Status};
 
 /// Conditions are looked at again at least this often (docs/LANGUAGE.md, section 7).
 const RECHECK: Duration = Duration::from_millis(100);
@@ -135,7 +135,9 @@ impl<'m> Engine<'m> {
         Box::pin(async move {
             let scope = self.new_scope(ctx, block, None);
             if block.traced {
-                self.trace(Kind::BlockStart, || [("block", Field::Str(&block.path))]);
+                self.trace(EventKind::BlockStart, || Event::BlockStart {
+                    block: block.path.as_str().into(),
+                });
             }
             let inner = Ctx { scope: scope.clone(), ..ctx.clone() };
             // Futures made in place and passed pinned: moving a large future into the
@@ -143,9 +145,10 @@ impl<'m> Engine<'m> {
             let items = pin!(self.items(block, &inner));
             self.drive(&scope, items).await;
             if block.traced {
-                let status = if scope.unwinding.get() { "aborted" } else { "ok" };
-                self.trace(Kind::BlockEnd, || {
-                    [("block", Field::Str(&block.path)), ("status", Field::Str(status))]
+                let status = if scope.unwinding.get() { Status::Aborted } else { Status::Ok };
+                self.trace(EventKind::BlockEnd, || Event::BlockEnd {
+                    block: block.path.as_str().into(),
+                    status,
                 });
             }
         })
@@ -418,22 +421,18 @@ impl<'m> Engine<'m> {
                     set(&mut frame, *slot, v);
                 }
                 let who = actor.map(|a| self.name(a));
-                let signal_name = &self.m.signals[signal];
-                self.trace(Kind::HandlerStart, || {
-                    [
-                        ("signal", Field::Str(signal_name)),
-                        ("handler", Field::Str(&handler.body.path)),
-                        ("actor", Field::name(who)),
-                    ]
+                let signal_name = self.m.signals[signal].as_str();
+                self.trace(EventKind::HandlerStart, || Event::HandlerStart {
+                    signal: signal_name.into(),
+                    handler: handler.body.path.as_str().into(),
+                    actor: who.map(Into::into),
                 });
                 let ctx = self.scope_ctx(&scope, Rc::from(frame));
                 self.block(&handler.body, &ctx).await;
-                self.trace(Kind::HandlerEnd, || {
-                    [
-                        ("signal", Field::Str(signal_name)),
-                        ("handler", Field::Str(&handler.body.path)),
-                        ("actor", Field::name(who)),
-                    ]
+                self.trace(EventKind::HandlerEnd, || Event::HandlerEnd {
+                    signal: signal_name.into(),
+                    handler: handler.body.path.as_str().into(),
+                    actor: who.map(Into::into),
                 });
             }
             Job::Exception { handler, args } => {
@@ -481,12 +480,10 @@ impl<'m> Engine<'m> {
         values: Vec<(usize, Value)>,
     ) {
         let cap = &self.m.capabilities[capability];
-        self.trace(Kind::Leash, || {
-            [
-                ("capability", Field::Str(&cap.name)),
-                ("tag", Field::Str(&self.m.tags[tag])),
-                ("action", Field::Str(action_name)),
-            ]
+        self.trace(EventKind::Leash, || Event::Leash {
+            capability: cap.name.as_str().into(),
+            tag: self.m.tags[tag].as_str().into(),
+            action: action_name.into(),
         });
         let targets: Vec<(Rc<Instance>, Rc<Scope<'m>>)> =
             self.instances.borrow().tagged(capability, tag).cloned().collect();

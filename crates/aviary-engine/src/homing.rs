@@ -11,12 +11,11 @@
 
 use std::time::Duration;
 
-use aviary_api::{CallEnd, DroneEvent, DroneId, FlightState};
-use serde_json::json;
+use aviary_api::{BuiltinException, CallEnd, DroneEvent, DroneId, FlightState, Function};
 use tokio::time::Instant;
 
 use crate::engine::Engine;
-use crate::trace::{Field, Kind};
+use aviary_api::trace::{Event, EventKind, Shown};
 
 /// How long a drone in the air may stay out of reach before it is left to its
 /// autopilot. Longer than any autopilot's own link-loss failsafe takes to act
@@ -42,18 +41,18 @@ pub(crate) struct Homecoming {
 /// The faults seen after the mission's handlers ended, in order.
 #[derive(Default)]
 struct Faults {
-    seen: std::cell::RefCell<Vec<(DroneId, &'static str)>>,
+    seen: std::cell::RefCell<Vec<(DroneId, BuiltinException)>>,
 }
 
 impl Faults {
-    fn last(&self, d: DroneId) -> Option<&'static str> {
+    fn last(&self, d: DroneId) -> Option<BuiltinException> {
         self.seen.borrow().iter().rev().find(|(x, _)| *x == d).map(|(_, e)| *e)
     }
 }
 
 /// Faults that leave a drone unable to fly home: it comes straight down instead.
-fn lands_where_it_is(exception: &str) -> bool {
-    matches!(exception, "PositionLost" | "MotorFailure")
+fn lands_where_it_is(exception: BuiltinException) -> bool {
+    matches!(exception, BuiltinException::PositionLost | BuiltinException::MotorFailure)
 }
 
 impl<'m> Engine<'m> {
@@ -106,16 +105,14 @@ impl<'m> Engine<'m> {
                 continue;
             }
             let function = if faults.last(d).is_some_and(lands_where_it_is) {
-                "Land"
+                Function::Land
             } else {
-                "ReturnToLaunch"
+                Function::ReturnToLaunch
             };
-            self.trace(Kind::ApiCall, || {
-                [
-                    ("actor", Field::Str(name)),
-                    ("function", Field::Str(function)),
-                    ("args", Field::Json(json!([]))),
-                ]
+            self.trace(EventKind::ApiCall, || Event::ApiCall {
+                actor: name.into(),
+                function,
+                args: Vec::new(),
             });
             let pending = self.backend.call(d, function, &[]);
             let end = pending.end.wait().await.unwrap_or(CallEnd::Interrupted);
@@ -159,34 +156,27 @@ impl<'m> Engine<'m> {
             match self.next_event().await {
                 Some(DroneEvent::Fault { drone, failure }) => {
                     faults.seen.borrow_mut().push((drone, failure.exception));
-                    let args = json!([failure.reason]);
-                    self.trace(Kind::Exception, || {
-                        [
-                            ("name", Field::Str(failure.exception)),
-                            ("actor", Field::Str(self.name(drone))),
-                            ("args", Field::Json(args)),
-                            ("handled", Field::Bool(false)),
-                            ("handler", Field::Null),
-                            ("during", Field::Str("return home")),
-                        ]
+                    self.trace(EventKind::Exception, || Event::Exception {
+                        name: failure.exception.name().into(),
+                        actor: Some(self.name(drone).into()),
+                        args: vec![Shown::Text(failure.reason.as_str().into())],
+                        handled: false,
+                        handler: None,
+                        during: Some("return home".into()),
                     });
                 }
-                Some(DroneEvent::Signal { drone, name }) => {
-                    self.trace(Kind::Signal, || {
-                        [
-                            ("name", Field::Str(name)),
-                            ("actor", Field::Str(self.name(drone))),
-                            ("args", Field::Json(json!([]))),
-                        ]
+                Some(DroneEvent::Signal { drone, signal }) => {
+                    self.trace(EventKind::Signal, || Event::Signal {
+                        name: signal.name().into(),
+                        actor: Some(self.name(drone).into()),
+                        args: Vec::new(),
                     });
                 }
                 Some(DroneEvent::Detected { drone, kind, location }) => {
-                    self.trace(Kind::Detection, || {
-                        [
-                            ("actor", Field::Str(self.name(drone))),
-                            ("kind", Field::Str(&kind)),
-                            ("location", Field::Json(json!(location))),
-                        ]
+                    self.trace(EventKind::Detection, || Event::Detection {
+                        actor: self.name(drone).into(),
+                        kind: kind.as_str().into(),
+                        location,
                     });
                 }
                 None => std::future::pending().await,

@@ -22,14 +22,14 @@ use crate::activity::{frame_values, Resume};
 use crate::api::{remembers_scope, Begun};
 use crate::arbiter::{free, take, Needs};
 use crate::engine::{Actors, Ctx, Engine};
-use crate::trace::Kind;
+use aviary_api::trace::{EventKind, Status};
 
 /// Which capabilities may run as instant activities, by index.
 pub(crate) fn instant_capabilities(m: &Mission) -> Vec<bool> {
-    m.capabilities.iter().map(|c| may_be_instant(m, c)).collect()
+    m.capabilities.iter().map(may_be_instant).collect()
 }
 
-fn may_be_instant(m: &Mission, cap: &Capability) -> bool {
+fn may_be_instant(cap: &Capability) -> bool {
     let body = &cap.perform;
     cap.actors == 1
         && cap.requirements.is_empty()
@@ -40,13 +40,13 @@ fn may_be_instant(m: &Mission, cap: &Capability) -> bool {
         && body.exception_handlers.is_empty()
         && !body.traced
         // A detection call remembers the activity's scope: that needs the scope.
-        && body.items.iter().all(|n| matches!(n, Node::Api(a) if !remembers_scope(&m.functions[a.function].0)))
+        && body.items.iter().all(|n| matches!(n, Node::Api(a) if !remembers_scope(a.function)))
 }
 
 /// An instant activity that has to wait, and where it stands. Made and taken apart at
 /// once, never kept: its size does not matter.
 #[allow(clippy::large_enum_variant)]
-enum Stopped<'m> {
+enum Stopped {
     /// Before anything of it happened.
     Start(Vec<Value>),
     /// Started, at statement `at` of its body.
@@ -56,7 +56,7 @@ enum Stopped<'m> {
         frame: LocalFrame,
         args: Vec<Value>,
         at: usize,
-        begun: Option<Begun<'m>>,
+        begun: Option<Begun>,
     },
 }
 
@@ -119,7 +119,7 @@ impl<'m> Engine<'m> {
         drone: DroneId,
         args: Vec<Value>,
         ctx: &Ctx<'m>,
-    ) -> Option<Stopped<'m>> {
+    ) -> Option<Stopped> {
         let cap = &self.m.capabilities[call.capability];
         let parent = ctx.instance.as_ref().map_or(&self.stop, |p| &p.token);
         if parent.is_cancelled() {
@@ -133,7 +133,9 @@ impl<'m> Engine<'m> {
             return Some(Stopped::Start(args));
         }
         let id = self.new_id();
-        self.trace(Kind::CapabilityStart, || self.capability_fields(call, &actors, &args));
+        self.trace(EventKind::CapabilityStart, || {
+            self.capability_event(call, &actors, &args, None)
+        });
         let mut frame = LocalFrame::new();
         // Pushed one by one: `collect` (`extend`) costs several times as much here.
         for v in frame_values(cap, &actors, &args) {
@@ -165,7 +167,7 @@ impl<'m> Engine<'m> {
                 &CallEnd::Done,
             );
         }
-        self.capability_end(call, &actors, &args, "ok");
+        self.capability_end(call, &actors, &args, Status::Ok);
         None
     }
 
@@ -176,7 +178,7 @@ impl<'m> Engine<'m> {
         &'a self,
         call: &'m Call,
         drone: DroneId,
-        stopped: Stopped<'m>,
+        stopped: Stopped,
         ctx: &'a Ctx<'m>,
     ) -> LocalBoxFuture<'a, ()> {
         match stopped {

@@ -21,35 +21,30 @@ mod instant;
 mod jobs;
 mod join;
 mod registry;
-mod trace;
 mod value;
 
 use aviary_api::Backend;
 
+pub use aviary_api::trace::{Event, EventKind, Record, Status};
 use aviary_ir::Mission;
 pub use control::{Control, ControlRequest, Controller};
-pub use trace::{Event, Field, Kind};
 
-/// Where trace events go, one JSON object per event, in order.
+/// Where trace events go, in order: the typed events of `aviary_api::trace`, which a
+/// sink writes as JSON (the trace file, the operator API) or reads field by field.
 pub trait TraceSink {
-    fn event(&mut self, event: serde_json::Value);
-    /// Whether this sink takes events of this kind (`"signal"`, `"api_call"`, ...). The
-    /// engine asks once per kind as the run starts and builds an event only when its
-    /// sink wants it, so a sink that keeps a few kinds spares the cost of the rest; what
-    /// the mission does is the same either way.
-    fn wants(&self, _event: &str) -> bool {
+    /// Whether this sink takes events of this kind. The engine asks once per kind as the
+    /// run starts and makes an event only when its sink wants it, so a sink that keeps a
+    /// few kinds spares the cost of the rest; what the mission does is the same either way.
+    fn wants(&self, _kind: EventKind) -> bool {
         true
     }
-    /// An event as the engine makes it, fields borrowed. By default its JSON object goes
-    /// to `event`; a sink that reads only a field or two can look at them here instead.
-    fn record(&mut self, event: &Event<'_>) {
-        self.event(event.to_json());
-    }
+    /// An event as the engine makes it, its text borrowed from the run.
+    fn record(&mut self, record: &Record<'_>);
 }
 
-impl<F: FnMut(serde_json::Value)> TraceSink for F {
-    fn event(&mut self, event: serde_json::Value) {
-        self(event)
+impl<F: FnMut(&Record<'_>)> TraceSink for F {
+    fn record(&mut self, record: &Record<'_>) {
+        self(record)
     }
 }
 
@@ -77,23 +72,6 @@ pub const MAX_CALL_DEPTH: usize = 10_000;
 impl Default for RunOptions {
     fn default() -> Self {
         RunOptions { telemetry_hz: None, instant_activities: true, max_call_depth: MAX_CALL_DEPTH }
-    }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Status {
-    Ok,
-    Failed,
-    Aborted,
-}
-
-impl Status {
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Status::Ok => "ok",
-            Status::Failed => "failed",
-            Status::Aborted => "aborted",
-        }
     }
 }
 

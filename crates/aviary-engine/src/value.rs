@@ -1,8 +1,7 @@
-//! Evaluating expressions at run time, and showing values in the trace.
+//! Evaluating expressions at run time.
 
 use aviary_api::{Backend, Point, Value};
 use aviary_ir::{ActorRef, Expr, Field, Mission};
-use serde_json::{json, Value as Json};
 
 /// What an expression needs from the run: the frame, telemetry, signals, the clock.
 pub(crate) struct Env<'a> {
@@ -111,20 +110,5 @@ fn number(v: &Value) -> f64 {
     match v {
         Value::Number(n) => *n,
         _ => f64::NAN,
-    }
-}
-
-/// A value as the trace shows it: SI numbers, `[x, y, z]` positions, names for drones.
-pub(crate) fn to_json(m: &Mission, v: &Value) -> Json {
-    match v {
-        Value::Number(n) => json!(n),
-        Value::Text(s) | Value::Symbol(s) => json!(s),
-        Value::Bool(b) => json!(b),
-        Value::Position(p) => match p.z {
-            Some(z) => json!([p.x, p.y, z]),
-            None => json!([p.x, p.y]),
-        },
-        Value::Area(poly) => json!(poly),
-        Value::Actor(d) => json!(m.drones.get(*d)),
     }
 }

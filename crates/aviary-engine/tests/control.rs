@@ -55,7 +55,7 @@ fn run_with_controls_and(
         let sim = SimBackend::start(&world, SimOptions::default());
         let (controller, rx) = Controller::new();
         let mut trace = Vec::new();
-        let mut sink = |e: Json| trace.push(e);
+        let mut sink = |r: &aviary_engine::Record| trace.push(harness::json(r));
         let operator = async {
             let start = tokio::time::Instant::now();
             let mut answers = Vec::new();

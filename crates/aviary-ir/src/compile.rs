@@ -2,7 +2,7 @@
 
 use std::collections::BTreeMap;
 
-use aviary_api::{Descriptor, Point, Value};
+use aviary_api::{BuiltinException, BuiltinSignal, Descriptor, Point, Value};
 use aviary_check::{bind_args, Program};
 use aviary_diagnostics::FileId;
 use aviary_syntax::ast;
@@ -28,12 +28,11 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
     c.scopes.clear();
     c.frame_size = 0;
     let body = c.body(&mission.body, &mission.name.name, BlockKind::Sequential, true);
-    // Interned (as the descriptor's built-ins are, first), so never missing: a backend's
-    // descriptor without them gets them added, not another name's id.
+    // Interned, so never missing: a descriptor without one gets it added, not another
+    // name's id.
     let builtins = Builtins {
-        detected: c.signals.id("Detected"),
-        command_failed: c.exceptions.id("CommandFailed"),
-        requirement_not_met: c.exceptions.id("RequirementNotMet"),
+        signals: BuiltinSignal::ALL.map(|s| c.signals.id(s.name())),
+        exceptions: BuiltinException::ALL.map(|e| c.exceptions.id(e.name())),
     };
     let signal_values = c
         .signals
@@ -51,7 +50,6 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
         signal_values,
         exceptions: c.exceptions.names,
         tags: c.tags.names,
-        functions: api.functions.iter().map(|f| (f.name.to_string(), f.resource)).collect(),
         attribute_names: c.attribute_names.clone(),
         attributes: attribute_table(world, &c.attribute_names),
         origin: world.site.origin.as_ref().map(|o| aviary_api::geo::Origin {
@@ -61,7 +59,7 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
         }),
         builtins,
     };
-    compute_claims(&mut out.capabilities, &out.functions);
+    compute_claims(&mut out.capabilities);
     Some(out)
 }
 
@@ -109,11 +107,11 @@ impl<'a> Compiler<'a> {
     fn new(program: &'a Program, world: &'a World, api: &'a Descriptor) -> Self {
         let mut signals = Interner::default();
         for s in &api.signals {
-            signals.id(s.name);
+            signals.id(s.name());
         }
         let mut exceptions = Interner::default();
         for e in &api.exceptions {
-            exceptions.id(e);
+            exceptions.id(e.name());
         }
         let mut attribute_names: Vec<String> = Vec::new();
         for d in &world.drones {
@@ -371,7 +369,7 @@ impl<'a> Compiler<'a> {
             ast::Stmt::Leash(l) => Node::Leash(self.leash(l)?),
             ast::Stmt::Api(a) => Node::Api(ApiCall {
                 actor: self.actor(&a.actor.name),
-                function: self.api.functions.iter().position(|f| f.name == a.function.name)?,
+                function: self.api.function(&a.function.name)?.function,
                 args: a.args.iter().map(|e| self.expr(e)).collect(),
                 origin: self.origin(a.span),
             }),
@@ -656,9 +654,9 @@ fn attribute_table(world: &World, names: &[String]) -> Vec<Column> {
 /// through every statement it makes on its actors, what the called capabilities claim.
 /// A worklist: when a capability's claims grow, only its callers are looked at again, so
 /// a chain of N capabilities costs N steps, not N rounds of N.
-fn compute_claims(caps: &mut [Capability], functions: &[(String, Option<aviary_api::Resource>)]) {
+fn compute_claims(caps: &mut [Capability]) {
     let mut claims: Vec<Vec<(usize, aviary_api::Resource)>> =
-        caps.iter().map(|c| direct_claims(c, functions)).collect();
+        caps.iter().map(direct_claims).collect();
     // Who calls each capability: (caller, the call), in caller order.
     let mut callers: Vec<Vec<(usize, &Call)>> = vec![Vec::new(); caps.len()];
     for (i, cap) in caps.iter().enumerate() {
@@ -707,19 +705,14 @@ fn compute_claims(caps: &mut [Capability], functions: &[(String, Option<aviary_a
     }
 }
 
-fn direct_claims(
-    cap: &Capability,
-    functions: &[(String, Option<aviary_api::Resource>)],
-) -> Vec<(usize, aviary_api::Resource)> {
+fn direct_claims(cap: &Capability) -> Vec<(usize, aviary_api::Resource)> {
     let mut out = Vec::new();
     for block in cap.bodies() {
         block.visit(&mut |n| {
             if let Node::Api(a) = n {
-                if let (ActorRef::Slot(s), Some((_, Some(r)))) =
-                    (&a.actor, functions.get(a.function))
-                {
+                if let ActorRef::Slot(s) = &a.actor {
                     if *s < cap.actors {
-                        out.push((*s, *r));
+                        out.push((*s, a.function.resource()));
                     }
                 }
             }

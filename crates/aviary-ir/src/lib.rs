@@ -1,7 +1,9 @@
 //! The compiled mission: what the engine runs.
 //!
-//! Everything a run needs is resolved here, once: capabilities, signals, exceptions,
-//! tags and middle-layer functions are indices; drones are `DroneId`s; numbers are SI;
+//! Everything a run needs is resolved here, once: capabilities, signals, exceptions and
+//! tags are indices; middle-layer functions are the contract's `Function`s, and every
+//! built-in signal and exception a backend raises has its id in [`Builtins`]; drones are
+//! `DroneId`s; numbers are SI;
 //! defaults are filled in; each handler sits on the block whose subtree it hears; each
 //! capability knows every resource its body can use. The engine looks nothing up by
 //! name. Spans survive, so a run-time problem can still point into the source.
@@ -16,7 +18,7 @@ mod compile;
 
 pub use compile::compile;
 
-use aviary_api::{DroneId, Kind, Resource, Value};
+use aviary_api::{BuiltinException, BuiltinSignal, DroneId, Function, Kind, Resource, Value};
 use aviary_diagnostics::{FileId, Span};
 
 /// Indices into the tables of [`Mission`].
@@ -24,7 +26,6 @@ pub type CapId = usize;
 pub type SignalId = usize;
 pub type ExceptionId = usize;
 pub type TagId = usize;
-pub type FunctionId = usize;
 /// A variable of the frame a node runs in.
 pub type Slot = usize;
 
@@ -52,26 +53,33 @@ pub struct Mission {
     pub exceptions: Vec<String>,
     /// `Capability-Tag` names, as written after the dash.
     pub tags: Vec<String>,
-    /// Middle-layer functions by index, with the resource each uses.
-    pub functions: Vec<(String, Option<Resource>)>,
     /// `attributes[a][d]`: attribute `a` of drone `d`, from the world file.
     pub attribute_names: Vec<String>,
     pub attributes: Vec<Column>,
     /// The world's geodetic origin, for `GEO(...)` evaluated at run time.
     pub origin: Option<aviary_api::geo::Origin>,
-    /// What the engine raises by itself, resolved here so that it looks up no name.
+    /// The ids of the built-in signals and exceptions, resolved here so that the engine
+    /// looks up no name when a backend or the engine itself raises one.
     pub builtins: Builtins,
 }
 
-/// The signal and exceptions the engine raises by itself (not the backend): their ids.
+/// Every built-in signal and exception's id in this mission, whether or not the mission
+/// names it: a backend may raise any of them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Builtins {
-    /// A find of a sensor that a `StartDetection` of the drone's activity asked for.
-    pub detected: SignalId,
-    /// A capability call nested too deep (one that keeps calling itself).
-    pub command_failed: ExceptionId,
-    /// A capability's REQUIREMENTS that do not hold when it is called.
-    pub requirement_not_met: ExceptionId,
+    /// By `BuiltinSignal as usize`.
+    pub signals: [SignalId; BuiltinSignal::ALL.len()],
+    /// By `BuiltinException as usize`.
+    pub exceptions: [ExceptionId; BuiltinException::ALL.len()],
+}
+
+impl Builtins {
+    pub fn signal(&self, s: BuiltinSignal) -> SignalId {
+        self.signals[s as usize]
+    }
+    pub fn exception(&self, e: BuiltinException) -> ExceptionId {
+        self.exceptions[e as usize]
+    }
 }
 
 impl Mission {
@@ -256,7 +264,7 @@ pub struct Leash {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ApiCall {
     pub actor: ActorRef,
-    pub function: FunctionId,
+    pub function: Function,
     pub args: Vec<Expr>,
     pub origin: Origin,
 }
@@ -413,11 +421,10 @@ mod column_tests {
             signal_values: vec![],
             exceptions: vec![],
             tags: vec![],
-            functions: vec![],
             attribute_names: vec![],
             attributes,
             origin: None,
-            builtins: Builtins { detected: 0, command_failed: 0, requirement_not_met: 0 },
+            builtins: Builtins { signals: [0; 3], exceptions: [0; 9] },
         }
     }
 

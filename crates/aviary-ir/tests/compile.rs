@@ -222,9 +222,12 @@ fn builtins_and_the_abort_section_are_resolved_when_compiling() {
         "CAPABILITY Watch BY d:\n    PERFORM:\n        d.Hover(100s)\n    PERFORM Look:\n        d.Hover(1s)\n    PERFORM ABORT:\n        SIGNAL Stopped\n\nMISSION M:\n    d1 Watch\n",
         "[drones.d1]\nhome = [0, 0]\n",
     );
-    assert_eq!(m.signals[m.builtins.detected], "Detected");
-    assert_eq!(m.exceptions[m.builtins.command_failed], "CommandFailed");
-    assert_eq!(m.exceptions[m.builtins.requirement_not_met], "RequirementNotMet");
+    for s in aviary_api::BuiltinSignal::ALL {
+        assert_eq!(m.signals[m.builtins.signal(s)], s.name());
+    }
+    for e in aviary_api::BuiltinException::ALL {
+        assert_eq!(m.exceptions[m.builtins.exception(e)], e.name());
+    }
     let watch = cap(&m, "Watch");
     assert_eq!(watch.abort_section.map(|k| watch.sections[k].0.as_str()), Some("ABORT"));
     let paper = paper();
@@ -232,4 +235,29 @@ fn builtins_and_the_abort_section_are_resolved_when_compiling() {
         paper.capabilities.iter().all(|c| c.abort_section.is_none()),
         "the paper's mission has no ABORT section"
     );
+}
+
+/// Every built-in a backend may raise has an id of its own, even when the descriptor the
+/// mission is compiled with does not list it: never another name's id.
+#[test]
+fn every_builtin_has_its_own_id_whatever_the_descriptor_lists() {
+    let mut sources = SourceMap::new();
+    let checked = aviary_check::check_sources(
+        &mut sources,
+        ("m.mission", b"MISSION M:\n    SIGNAL Go\n    THROW EXCEPTION Oops\n".as_slice()),
+        Some(("w.toml", b"[drones.d1]\nhome = [0, 0]\n".as_slice())),
+        &NoFiles,
+        &Descriptor::standard(),
+    );
+    let bare = Descriptor { signals: vec![], exceptions: vec![], ..Descriptor::standard() };
+    let m = compile(&checked.program.expect("program"), &checked.world.expect("world"), &bare)
+        .expect("a mission");
+    for s in aviary_api::BuiltinSignal::ALL {
+        assert_eq!(m.signals[m.builtins.signal(s)], s.name());
+    }
+    for e in aviary_api::BuiltinException::ALL {
+        assert_eq!(m.exceptions[m.builtins.exception(e)], e.name());
+    }
+    assert_eq!(m.signals[0], "Go", "the mission's own names come first here");
+    assert_eq!(m.exceptions[0], "Oops");
 }

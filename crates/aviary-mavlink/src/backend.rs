@@ -9,8 +9,8 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
 use aviary_api::{
-    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Ending, Failure, Interrupt,
-    PendingCall, Telemetry, Value,
+    Backend, BuiltinException, BuiltinSignal, CallEnd, CallId, Descriptor, DroneEvent, DroneId,
+    Ending, Failure, Function, Interrupt, PendingCall, Telemetry, Value,
 };
 use aviary_world::Sensor;
 use tokio::sync::{mpsc, oneshot, watch};
@@ -111,7 +111,7 @@ impl Inner {
     /// A fault: the event first, then every call of the drone ends `Interrupted` (so the
     /// engine raises one exception, once).
     fn fault(&self, drone: DroneId, failure: Failure) {
-        if failure.exception == "BatteryCritical" {
+        if failure.exception == BuiltinException::BatteryCritical {
             // The rule below and the autopilot's battery failsafe may both see it: one
             // fault, one exception.
             let mut flags = lock(&self.battery);
@@ -160,7 +160,8 @@ impl Inner {
         let (low, critical) = lock(&self.battery)[drone];
         if !low && is_low {
             lock(&self.battery)[drone].0 = true;
-            let _ = self.events.send(DroneEvent::Signal { drone, name: "BatteryLow" });
+            let _ =
+                self.events.send(DroneEvent::Signal { drone, signal: BuiltinSignal::BatteryLow });
         }
         if !critical && is_critical {
             let reason = format!(
@@ -168,7 +169,7 @@ impl Inner {
                 c.name,
                 battery * 100.0
             );
-            self.fault(drone, Failure { exception: "BatteryCritical", reason });
+            self.fault(drone, Failure { exception: BuiltinException::BatteryCritical, reason });
         }
     }
 }
@@ -199,8 +200,10 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
             if was_lost == fresh {
                 lock(&inner.lost)[drone] = !fresh;
                 if fresh {
-                    let _ =
-                        inner.events.send(DroneEvent::Signal { drone, name: "ConnectionRestored" });
+                    let _ = inner.events.send(DroneEvent::Signal {
+                        drone,
+                        signal: BuiltinSignal::ConnectionRestored,
+                    });
                 } else {
                     let reason = format!(
                         "{}: no HEARTBEAT from system {} for {:.1} s on {}",
@@ -209,7 +212,10 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
                         limit.as_secs_f64(),
                         c.link.address
                     );
-                    inner.fault(drone, Failure { exception: "ConnectionLost", reason });
+                    inner.fault(
+                        drone,
+                        Failure { exception: BuiltinException::ConnectionLost, reason },
+                    );
                 }
             }
         }
@@ -221,7 +227,7 @@ impl Backend for MavlinkBackend {
         Descriptor::standard()
     }
 
-    fn call(&self, drone: DroneId, function: &str, args: &[Value]) -> PendingCall {
+    fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall {
         let id = CallId(self.inner.next.fetch_add(1, Ordering::SeqCst));
         let (tx, rx) = oneshot::channel();
         let Some(Some(craft)) = self.inner.crafts.get(drone).cloned() else {
@@ -234,7 +240,7 @@ impl Backend for MavlinkBackend {
             // The drone stays lost to the mission until its link is back: what is asked
             // of it meanwhile raises the exception a handler of the loss already knows.
             let _ = tx.send(CallEnd::Failed(Failure {
-                exception: "ConnectionLost",
+                exception: BuiltinException::ConnectionLost,
                 reason: format!(
                     "{}: no link since its HEARTBEATs stopped; `{function}` was not sent",
                     craft.name
@@ -244,12 +250,11 @@ impl Backend for MavlinkBackend {
         }
         let (paused_tx, paused_rx) = watch::channel(false);
         let inner = Arc::clone(&self.inner);
-        let function = function.to_owned();
         let args = args.to_vec();
         // Hold the table while spawning, so that a call that ends at once finds its slot.
         let mut calls = lock(&self.inner.calls);
         let task = tokio::spawn(async move {
-            let end = match flight::run(&craft, &function, &args, paused_rx, &inner.sensors).await {
+            let end = match flight::run(&craft, function, &args, paused_rx, &inner.sensors).await {
                 Ok(()) => CallEnd::Done,
                 Err(failure) => CallEnd::Failed(failure),
             };

@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use aviary_api::{Failure, FlightState};
+use aviary_api::{BuiltinException, Failure, FlightState};
 use mavlink::dialects::ardupilotmega::{
     MavCmd, MavFrame, MavMessage, MavModeFlag, MavResult, PositionTargetTypemask, COMMAND_INT_DATA,
     COMMAND_LONG_DATA, SET_POSITION_TARGET_GLOBAL_INT_DATA,
@@ -55,11 +55,11 @@ pub struct Craft {
 }
 
 pub fn failed(reason: impl Into<String>) -> Failure {
-    Failure { exception: "CommandFailed", reason: reason.into() }
+    Failure { exception: BuiltinException::CommandFailed, reason: reason.into() }
 }
 
 pub fn timeout(reason: impl Into<String>) -> Failure {
-    Failure { exception: "Timeout", reason: reason.into() }
+    Failure { exception: BuiltinException::Timeout, reason: reason.into() }
 }
 
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {

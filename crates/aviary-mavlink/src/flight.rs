@@ -3,36 +3,36 @@
 //! with `Timeout` and never hangs the mission.
 
 use aviary_api::geometry::centroid;
-use aviary_api::{Failure, Value};
+use aviary_api::{Failure, Function, Value};
 use mavlink::dialects::ardupilotmega::MavCmd;
 
 use crate::craft::{failed, Craft, Paused};
 use crate::motion::{arm, fly, here, hover, land, orbit, rtl, take_off};
 use crate::vehicle::Activation;
 
-use aviary_api::flight::LOAD_TIME;
+use aviary_api::flight::{LOAD_MAX_ALTITUDE, LOAD_TIME};
 
 /// Runs one call to its end.
 pub async fn run(
     c: &Craft,
-    function: &str,
+    function: Function,
     args: &[Value],
     paused: Paused,
     sensors: &[aviary_world::Sensor],
 ) -> Result<(), Failure> {
     match function {
-        "Arm" => arm(c).await,
-        "Disarm" => {
+        Function::Arm => arm(c).await,
+        Function::Disarm => {
             if c.state().airborne() {
                 return Err(failed(format!("{} can only disarm on the ground", c.name)));
             }
             c.command(MavCmd::MAV_CMD_COMPONENT_ARM_DISARM, [0.0; 7]).await?;
             c.wait_for(c.tuning.ready_timeout, "disarming", |c| !c.v.seen().armed).await
         }
-        "TakeOff" => take_off(c, number(args, 0, "alt")?, paused).await,
-        "Land" => land(c).await,
-        "ReturnToLaunch" => rtl(c).await,
-        "FlyToPosition" => {
+        Function::TakeOff => take_off(c, number(args, 0, "alt")?, paused).await,
+        Function::Land => land(c).await,
+        Function::ReturnToLaunch => rtl(c).await,
+        Function::FlyToPosition => {
             let to = point(c, args.first(), "pos")?;
             let speed = match args.get(1) {
                 Some(Value::Number(s)) if *s > 0.0 => s.min(c.max_speed),
@@ -43,12 +43,12 @@ pub async fn run(
             };
             fly(c, &[to], speed, paused).await
         }
-        "DescendTo" | "AscendTo" => {
+        Function::DescendTo | Function::AscendTo => {
             let here = here(c)?;
             fly(c, &[[here[0], here[1], number(args, 0, "alt")?]], c.max_speed, paused).await
         }
-        "Hover" => hover(number(args, 0, "duration")?, paused).await,
-        "Orbit" => {
+        Function::Hover => hover(number(args, 0, "duration")?, paused).await,
+        Function::Orbit => {
             let center = point(c, args.first(), "center")?;
             let radius = number(args, 1, "radius")?;
             let laps = match args.get(2) {
@@ -69,7 +69,7 @@ pub async fn run(
             )
             .await
         }
-        "Sweep" => {
+        Function::Sweep => {
             let Some(Value::Area(area)) = args.first() else {
                 return Err(failed("`area` must be an area"));
             };
@@ -85,7 +85,7 @@ pub async fn run(
                 .collect();
             fly(c, &path, c.max_speed, paused).await
         }
-        "FollowPath" => {
+        Function::FollowPath => {
             here(c)?;
             let mut z = c.level();
             let mut path = Vec::new();
@@ -98,19 +98,20 @@ pub async fn run(
             }
             fly(c, &path, c.max_speed, paused).await
         }
-        "StartStreaming" | "StopStreaming" => {
+        Function::StartStreaming | Function::StopStreaming => {
             // Video is not carried over MAVLink: this records the state a mission reads.
             if !c.sensors.iter().any(|s| s == "camera") {
                 return Err(failed(format!("{} has no camera", c.name)));
             }
-            c.streaming.store(function == "StartStreaming", std::sync::atomic::Ordering::SeqCst);
+            c.streaming
+                .store(function == Function::StartStreaming, std::sync::atomic::Ordering::SeqCst);
             Ok(())
         }
-        "StartDetection" | "StopDetection" => {
-            detection(c, function == "StartDetection", args, sensors)
+        Function::StartDetection | Function::StopDetection => {
+            detection(c, function == Function::StartDetection, args, sensors)
         }
-        "LoadPayload" => load(c, args, paused).await,
-        "ReleasePayload" => {
+        Function::LoadPayload => load(c, args, paused).await,
+        Function::ReleasePayload => {
             if c.carrying.lock().unwrap_or_else(|p| p.into_inner()).is_none() {
                 return Err(failed(format!("{} carries nothing to release", c.name)));
             }
@@ -118,7 +119,6 @@ pub async fn run(
             *c.carrying.lock().unwrap_or_else(|p| p.into_inner()) = None;
             Ok(())
         }
-        other => Err(failed(format!("{} cannot do {other} over MAVLink", c.name))),
     }
 }
 
@@ -186,8 +186,11 @@ async fn load(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> 
         return Err(failed(format!("{} already carries {held}: release it first", c.name)));
     }
     let z = c.fix().map_or(0.0, |f| f.pos[2]);
-    if c.state().airborne() && z >= 5.0 {
-        return Err(failed(format!("{} is at {z:.1} m: load while landed or below 5 m", c.name)));
+    if c.state().airborne() && z >= LOAD_MAX_ALTITUDE {
+        return Err(failed(format!(
+            "{} is at {z:.1} m: load while landed or below {LOAD_MAX_ALTITUDE} m",
+            c.name
+        )));
     }
     c.command(MavCmd::MAV_CMD_DO_GRIPPER, [1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0]).await?;
     hover(LOAD_TIME, paused).await?;

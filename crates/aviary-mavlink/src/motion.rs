@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use aviary_api::geometry::{contains, dist};
 use aviary_api::show::fixed;
-use aviary_api::Failure;
+use aviary_api::{BuiltinException, Failure};
 use mavlink::dialects::ardupilotmega::MavCmd;
 use tokio::time::Instant;
 
@@ -42,7 +42,9 @@ pub(crate) async fn arm(c: &Craft) -> Result<(), Failure> {
             .await
         {
             Ok(()) => break,
-            Err(f) if f.exception == "CommandFailed" && Instant::now() < deadline => {
+            Err(f)
+                if f.exception == BuiltinException::CommandFailed && Instant::now() < deadline =>
+            {
                 tokio::time::sleep(c.tuning.arm_retry).await;
             }
             Err(f) => return Err(f),
@@ -204,7 +206,8 @@ pub(crate) async fn fly(
 /// The world's geofence and ceiling hold for MAVLink drones too: a path that leaves them
 /// is refused before anything is sent (`GeofenceViolation`).
 pub(crate) fn fenced(c: &Craft, path: &[[f64; 3]]) -> Result<(), Failure> {
-    let violation = |reason: String| Failure { exception: "GeofenceViolation", reason };
+    let violation =
+        |reason: String| Failure { exception: BuiltinException::GeofenceViolation, reason };
     for p in path {
         if let Some(max) = c.max_altitude.filter(|m| p[2] > m + 1e-9) {
             return Err(violation(format!(

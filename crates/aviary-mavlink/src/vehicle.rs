@@ -5,7 +5,7 @@ use std::collections::{BTreeMap, VecDeque};
 use std::sync::{Mutex, MutexGuard};
 
 use aviary_api::geometry::dist_to_segment;
-use aviary_api::{DroneEvent, DroneId, Failure};
+use aviary_api::{BuiltinException, DroneEvent, DroneId, Failure};
 use aviary_world::Target;
 use mavlink::dialects::ardupilotmega::{
     MavCmd, MavLandedState, MavMessage, MavModeFlag, MavParamType, MavResult, MavState,
@@ -181,8 +181,10 @@ impl Vehicle {
                         "{}: the autopilot reports {:?} ({why})",
                         self.name, hb.system_status
                     );
-                    let _ =
-                        self.alarms.send((self.drone, Failure { exception: "DroneLost", reason }));
+                    let _ = self.alarms.send((
+                        self.drone,
+                        Failure { exception: BuiltinException::DroneLost, reason },
+                    ));
                 }
                 let after = mode::classify(flavour, hb.custom_mode);
                 let changed = before.is_some_and(|b| b != after);
@@ -330,7 +332,9 @@ impl Vehicle {
             if jump >= 1000.0 { format!("{:.0} km", jump / 1000.0) } else { format!("{jump:.0} m") },
             dt
         );
-        let _ = self.alarms.send((self.drone, Failure { exception: "PositionLost", reason }));
+        let _ = self
+            .alarms
+            .send((self.drone, Failure { exception: BuiltinException::PositionLost, reason }));
     }
 
     /// Names a pending failsafe once the vehicle's state or words say what it was, or
@@ -341,16 +345,18 @@ impl Vehicle {
         let why: Vec<&str> =
             seen.texts.iter().filter(|(t, _)| *t >= since).map(|(_, s)| s.as_str()).collect();
         let state = if seen.battery_failing {
-            Some("BatteryCritical")
+            Some(BuiltinException::BatteryCritical)
         } else if seen.fence_unhealthy || seen.fence_breached {
-            Some("GeofenceViolation")
+            Some(BuiltinException::GeofenceViolation)
         } else if seen.no_gps {
-            Some("PositionLost")
+            Some(BuiltinException::PositionLost)
         } else {
             None
         };
         let failure = failsafe(&self.name, &mode, &why.join("; "), state);
-        if failure.exception == "CommandFailed" && now.duration_since(at) < FAILSAFE_WAIT {
+        if failure.exception == BuiltinException::CommandFailed
+            && now.duration_since(at) < FAILSAFE_WAIT
+        {
             return;
         }
         seen.failsafe = None;

@@ -26,8 +26,8 @@ pub use reply::BODY_LIMIT;
 use std::net::SocketAddr;
 use std::sync::{Arc, Mutex, MutexGuard};
 
+use aviary_api::trace::Record;
 use aviary_engine::Controller;
-use serde_json::Value;
 use tokio::sync::broadcast;
 
 use crate::state::MissionState;
@@ -69,9 +69,13 @@ pub struct Feed {
 }
 
 impl Feed {
-    pub fn publish(&self, event: &Value) {
-        self.shared.state().observe(event);
-        let _ = self.shared.events.send(Arc::from(event.to_string()));
+    /// Folds the event into the mission's state and sends it to every stream, as the
+    /// line the trace file has.
+    pub fn publish(&self, record: &Record) {
+        self.shared.state().observe(record);
+        if let Ok(line) = serde_json::to_string(record) {
+            let _ = self.shared.events.send(Arc::from(line));
+        }
     }
 }
 

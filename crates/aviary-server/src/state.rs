@@ -1,70 +1,103 @@
 //! What the operator sees: the mission's state, folded from its trace events.
 
+use aviary_api::trace::{Event, Params, Record};
 use serde_json::{json, Value};
 
 #[derive(Default)]
 pub struct MissionState {
     mission: Option<String>,
     t: f64,
-    /// `running`, then the outcome (`ok`, `failed`, `aborted`).
-    status: String,
+    /// `running`, then the outcome (`ok`, `failed`, `aborted`); empty before the start.
+    status: &'static str,
     reason: Option<String>,
     paused: bool,
     blocks: Vec<String>,
     /// Running activities, in the order they started.
-    activities: Vec<Value>,
+    activities: Vec<Activity>,
     /// Each drone's last telemetry, by name, in the order first seen.
     drones: Vec<(String, Value)>,
 }
 
+/// A running activity: who does what, since when, and whether it is paused.
+struct Activity {
+    capability: String,
+    tag: Option<String>,
+    actor: String,
+    args: Value,
+    since: f64,
+    paused: bool,
+}
+
 impl MissionState {
-    pub fn observe(&mut self, e: &Value) {
-        self.t = e["t"].as_f64().unwrap_or(self.t);
-        match e["event"].as_str().unwrap_or("") {
-            "mission_start" => {
-                self.mission = e["mission"].as_str().map(str::to_string);
-                self.status = "running".into();
+    pub fn observe(&mut self, record: &Record) {
+        // A time that is not finite is `null` in the trace: the last one stands.
+        if record.t.is_finite() {
+            self.t = record.t;
+        }
+        match &record.event {
+            Event::MissionStart { mission } => {
+                self.mission = Some(mission.to_string());
+                self.status = "running";
             }
-            "mission_end" => {
-                self.status = e["status"].as_str().unwrap_or("").to_string();
-                self.reason = e["reason"].as_str().map(str::to_string);
+            Event::MissionEnd { status, reason } => {
+                self.status = status.as_str();
+                self.reason = reason.as_deref().map(str::to_string);
             }
-            "block_start" => self.blocks.push(e["block"].as_str().unwrap_or("").to_string()),
-            "block_end" => {
-                if let Some(i) = self.blocks.iter().rposition(|b| *b == e["block"]) {
+            Event::BlockStart { block } => self.blocks.push(block.to_string()),
+            Event::BlockEnd { block, .. } => {
+                if let Some(i) = self.blocks.iter().rposition(|b| b == block) {
                     self.blocks.remove(i);
                 }
             }
-            "capability_start" => self.activities.push(json!({
-                "capability": e["capability"], "tag": e["tag"], "actor": e["actor"], "args": e["args"], "since": e["t"], "paused": false,
-            })),
-            "capability_end" => {
-                let same = |a: &Value| a["capability"] == e["capability"] && a["actor"] == e["actor"] && a["tag"] == e["tag"];
+            Event::CapabilityStart { actor, capability, tag, args } => {
+                self.activities.push(Activity {
+                    capability: capability.to_string(),
+                    tag: tag.as_deref().map(str::to_string),
+                    actor: actor.to_string(),
+                    args: shown(args),
+                    since: record.t,
+                    paused: false,
+                })
+            }
+            Event::CapabilityEnd { actor, capability, tag, .. } => {
+                let same = |a: &Activity| {
+                    a.capability == *capability
+                        && a.actor == *actor
+                        && a.tag.as_deref() == tag.as_deref()
+                };
                 if let Some(i) = self.activities.iter().position(same) {
                     self.activities.remove(i);
                 }
             }
-            "leash" => {
-                let paused = match e["action"].as_str() {
-                    Some("PAUSE") => Some(true),
-                    Some("RESUME") => Some(false),
+            Event::Leash { capability, tag, action } => {
+                let paused = match action.as_ref() {
+                    "PAUSE" => Some(true),
+                    "RESUME" => Some(false),
                     _ => None,
                 };
                 if let Some(paused) = paused {
-                    for a in self.activities.iter_mut().filter(|a| a["capability"] == e["capability"] && a["tag"] == e["tag"]) {
-                        a["paused"] = json!(paused);
+                    let tagged = |a: &&mut Activity| {
+                        a.capability == *capability && a.tag.as_deref() == Some(tag.as_ref())
+                    };
+                    for a in self.activities.iter_mut().filter(tagged) {
+                        a.paused = paused;
                     }
                 }
             }
-            "telemetry" => {
-                let name = e["actor"].as_str().unwrap_or("").to_string();
-                let t = json!({ "position": e["position"], "battery": e["battery"], "state": e["state"], "t": e["t"] });
-                match self.drones.iter_mut().find(|(n, _)| *n == name) {
+            Event::Telemetry { actor, position, battery, state } => {
+                let t = json!({ "position": position, "battery": battery, "state": state, "t": record.t });
+                match self.drones.iter_mut().find(|(n, _)| n == actor) {
                     Some((_, v)) => *v = t,
-                    None => self.drones.push((name, t)),
+                    None => self.drones.push((actor.to_string(), t)),
                 }
             }
-            _ => {}
+            Event::HandlerStart { .. }
+            | Event::HandlerEnd { .. }
+            | Event::ApiCall { .. }
+            | Event::ApiDone { .. }
+            | Event::Signal { .. }
+            | Event::Exception { .. }
+            | Event::Detection { .. } => {}
         }
     }
 
@@ -80,8 +113,15 @@ impl MissionState {
             "reason": self.reason,
             "paused": self.paused,
             "blocks": self.blocks,
-            "activities": self.activities,
+            "activities": self.activities.iter().map(|a| json!({
+                "capability": a.capability, "tag": a.tag, "actor": a.actor, "args": a.args, "since": a.since, "paused": a.paused,
+            })).collect::<Vec<_>>(),
             "drones": self.drones.iter().map(|(n, v)| { let mut d = v.clone(); d["name"] = json!(n); d }).collect::<Vec<_>>(),
         })
     }
+}
+
+/// An activity's arguments as the trace writes them.
+fn shown(args: &Params) -> Value {
+    serde_json::to_value(args).unwrap_or(Value::Null)
 }

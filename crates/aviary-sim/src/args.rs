@@ -1,16 +1,16 @@
 //! Reading a call's arguments, and the refusals a call can meet before it starts.
 
 use aviary_api::show::fixed;
-use aviary_api::{Failure, Point, Value};
+use aviary_api::{BuiltinException, Failure, Point, Value};
 
 use crate::geom::{self, circle_inside, contains, segment_inside};
 
 pub(crate) fn failed(reason: impl Into<String>) -> Failure {
-    Failure { exception: "CommandFailed", reason: reason.into() }
+    Failure { exception: BuiltinException::CommandFailed, reason: reason.into() }
 }
 
 pub(crate) fn fence_violation(reason: impl Into<String>) -> Failure {
-    Failure { exception: "GeofenceViolation", reason: reason.into() }
+    Failure { exception: BuiltinException::GeofenceViolation, reason: reason.into() }
 }
 
 fn arg<'a>(args: &'a [Value], i: usize, name: &str) -> Result<&'a Value, Failure> {

@@ -7,8 +7,8 @@ use std::sync::{Arc, Mutex, MutexGuard, Weak};
 use std::time::Duration;
 
 use aviary_api::{
-    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Ending, Interrupt, PendingCall,
-    Telemetry, Value,
+    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Ending, Function, Interrupt,
+    PendingCall, Telemetry, Value,
 };
 use aviary_world::World;
 use tokio::sync::{mpsc, oneshot};
@@ -184,7 +184,7 @@ impl Backend for SimBackend {
         crate::descriptor()
     }
 
-    fn call(&self, drone: DroneId, function: &str, args: &[Value]) -> PendingCall {
+    fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall {
         let mut state = lock(&self.state);
         let (id, end) = state.fleet.call(drone, function, args);
         let end = match end {

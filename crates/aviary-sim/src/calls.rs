@@ -1,6 +1,6 @@
 //! What each middle-layer function does when called (docs/LANGUAGE.md, section 19).
 
-use aviary_api::{show, CallId, DroneId, Failure, FlightState, Value};
+use aviary_api::{show, CallId, DroneId, Failure, FlightState, Function, Resource, Value};
 
 use crate::args::{failed, kind, number, opt_number, point, point_value, polygon, Limits};
 use crate::drone::{Loading, SimDrone};
@@ -13,21 +13,6 @@ use crate::sweep::lawnmower;
 use aviary_api::flight::{LOAD_MAX_ALTITUDE, LOAD_TIME};
 /// A landed drone this close to home (metres) is home.
 const AT_HOME: f64 = 0.5;
-
-const MOTION: &[&str] = &[
-    "Arm",
-    "Disarm",
-    "TakeOff",
-    "Land",
-    "ReturnToLaunch",
-    "FlyToPosition",
-    "DescendTo",
-    "AscendTo",
-    "Hover",
-    "Orbit",
-    "Sweep",
-    "FollowPath",
-];
 
 /// How a call that was not refused goes on.
 enum Start {
@@ -46,7 +31,7 @@ impl Fleet {
         &mut self,
         id: DroneId,
         call: CallId,
-        function: &str,
+        function: Function,
         args: &[Value],
     ) -> Result<bool, Failure> {
         let d =
@@ -60,7 +45,7 @@ impl Fleet {
         if let Some(why) = d.disabled() {
             return Err(failed(why.clone()));
         }
-        let motion = MOTION.contains(&function);
+        let motion = function.resource() == Resource::Motion;
         // A return the drone started on its own (after a link loss) gives way to a command.
         let own_return = d.motion.as_ref().is_some_and(|t| t.call.is_none());
         if motion && d.motion.is_some() && !own_return {
@@ -69,11 +54,7 @@ impl Fleet {
         if motion && d.gps_loss().is_some() {
             return Err(failed(format!("{} has no position fix", &self.names[id])));
         }
-        let start = if motion {
-            self.motion(id, function, args)?
-        } else {
-            self.other(id, call, function, args)?
-        };
+        let start = self.begin(id, call, function, args)?;
         match start {
             Start::Done => Ok(false),
             Start::Pending => Ok(true),
@@ -89,7 +70,14 @@ impl Fleet {
         }
     }
 
-    fn motion(&mut self, id: DroneId, function: &str, args: &[Value]) -> Result<Start, Failure> {
+    /// What the call does, once it may start.
+    fn begin(
+        &mut self,
+        id: DroneId,
+        call: CallId,
+        function: Function,
+        args: &[Value],
+    ) -> Result<Start, Failure> {
         let limits = self.limits();
         let d = &self.drones[id];
         let here = d.pos;
@@ -105,18 +93,18 @@ impl Fleet {
         };
         let fly = |to: [f64; 3], speed: f64| Leg::Move { to, speed, state: FlightState::Flying };
         let legs = match function {
-            "Arm" | "Disarm" => {
+            Function::Arm | Function::Disarm => {
                 if !landed {
                     return Err(failed(format!(
                         "{} can only {} on the ground",
                         &self.names[id],
-                        function.to_lowercase()
+                        function.name().to_lowercase()
                     )));
                 }
-                self.drones[id].armed = function == "Arm";
+                self.drones[id].armed = function == Function::Arm;
                 return Ok(Start::Done);
             }
-            "TakeOff" => {
+            Function::TakeOff => {
                 let alt = number(args, 0, "alt")?;
                 if alt <= 0.0 {
                     return Err(failed(format!(
@@ -136,14 +124,16 @@ impl Fleet {
                     vec![Leg::Move { to, speed: d.spec.max_speed, state: FlightState::TakingOff }]
                 }
             }
-            "Land" => {
+            Function::Land => {
                 if landed {
                     return Ok(Start::Done);
                 }
                 landing_legs(d, [here[0], here[1]])
             }
-            "ReturnToLaunch" => return_legs(d, &self.names[id], landed, limits.max_altitude)?,
-            "FlyToPosition" => {
+            Function::ReturnToLaunch => {
+                return_legs(d, &self.names[id], landed, limits.max_altitude)?
+            }
+            Function::FlyToPosition => {
                 in_air()?;
                 let p = point(args, 0, "pos")?;
                 let speed = match opt_number(args, 1, "speed")? {
@@ -166,7 +156,7 @@ impl Fleet {
                 limits.path(here, &[to])?;
                 vec![fly(to, speed)]
             }
-            "DescendTo" | "AscendTo" => {
+            Function::DescendTo | Function::AscendTo => {
                 in_air()?;
                 let alt = number(args, 0, "alt")?;
                 if alt < 0.0 {
@@ -178,7 +168,7 @@ impl Fleet {
                 limits.altitude(alt)?;
                 vec![fly([here[0], here[1], alt], d.spec.max_speed)]
             }
-            "Hover" => {
+            Function::Hover => {
                 let duration = number(args, 0, "duration")?;
                 if duration < 0.0 {
                     return Err(failed(format!(
@@ -188,7 +178,7 @@ impl Fleet {
                 }
                 vec![Leg::Hold { left: duration }]
             }
-            "Orbit" => {
+            Function::Orbit => {
                 in_air()?;
                 let c = point(args, 0, "center")?;
                 let radius = number(args, 1, "radius")?;
@@ -205,7 +195,7 @@ impl Fleet {
                 limits.circle([c.x, c.y], radius)?;
                 legs
             }
-            "Sweep" => {
+            Function::Sweep => {
                 in_air()?;
                 let area = polygon(args, 0, "area")?;
                 let spacing = number(args, 1, "spacing")?;
@@ -219,7 +209,7 @@ impl Fleet {
                 limits.path(here, &path)?;
                 path.into_iter().map(|to| fly(to, d.spec.max_speed)).collect()
             }
-            "FollowPath" => {
+            Function::FollowPath => {
                 in_air()?;
                 let mut z = level;
                 let mut path = Vec::new();
@@ -237,80 +227,80 @@ impl Fleet {
                 limits.path(here, &path)?;
                 path.into_iter().map(|to| fly(to, d.spec.max_speed)).collect()
             }
-            other => return Err(failed(format!("unknown function {other}"))),
+            Function::StartStreaming | Function::StopStreaming => {
+                return self.stream(id, function == Function::StartStreaming)
+            }
+            Function::StartDetection | Function::StopDetection => {
+                return self.detect(id, function == Function::StartDetection, args)
+            }
+            Function::LoadPayload => return self.load(id, call, args),
+            Function::ReleasePayload => return self.release(id),
         };
         Ok(if legs.is_empty() { Start::Done } else { Start::Moves(legs) })
     }
 
-    fn other(
-        &mut self,
-        id: DroneId,
-        call: CallId,
-        function: &str,
-        args: &[Value],
-    ) -> Result<Start, Failure> {
+    fn stream(&mut self, id: DroneId, on: bool) -> Result<Start, Failure> {
+        let d = &mut self.drones[id];
+        if !d.spec.sensors.iter().any(|s| s == "camera") {
+            return Err(failed(format!("{} has no camera", &self.names[id])));
+        }
+        d.streaming = on;
+        Ok(Start::Done)
+    }
+
+    fn detect(&mut self, id: DroneId, start: bool, args: &[Value]) -> Result<Start, Failure> {
+        let d = &mut self.drones[id];
+        let kind = kind(args, 0, "kind")?;
+        let Some((range, probability)) = detection_range(&self.sensors, &d.spec.sensors, &kind)
+        else {
+            return Err(failed(format!("{} has no sensor that detects {kind}", &self.names[id])));
+        };
+        let detections = &mut d.rare_mut().detections;
+        detections.retain(|a| a.kind != kind);
+        if start {
+            detections.push(Activation { kind, range, probability, found: Vec::new() });
+        }
+        Ok(Start::Done)
+    }
+
+    fn load(&mut self, id: DroneId, call: CallId, args: &[Value]) -> Result<Start, Failure> {
+        let d = &mut self.drones[id];
+        let kind = kind(args, 0, "kind")?;
+        if !d.spec.payload_kinds.contains(&kind) {
+            let can = if d.spec.payload_kinds.is_empty() {
+                "nothing".to_owned()
+            } else {
+                d.spec.payload_kinds.join(", ")
+            };
+            return Err(failed(format!(
+                "{} cannot carry {kind} (it can carry: {can})",
+                &self.names[id]
+            )));
+        }
+        if let Some(held) = d.carrying().or(d.loading().map(|l| &l.kind)) {
+            return Err(failed(format!(
+                "{} already carries {held}: release it first",
+                &self.names[id]
+            )));
+        }
+        if d.state != FlightState::Landed && d.pos[2] >= LOAD_MAX_ALTITUDE {
+            return Err(failed(format!(
+                "{} is at {} m: load while landed or below {LOAD_MAX_ALTITUDE} m",
+                &self.names[id],
+                show::fixed(d.pos[2], 1)
+            )));
+        }
+        d.rare_mut().loading = Some(Loading { call, kind, left: LOAD_TIME, paused: false });
+        Ok(Start::Pending)
+    }
+
+    fn release(&mut self, id: DroneId) -> Result<Start, Failure> {
         let time = self.time;
         let d = &mut self.drones[id];
-        match function {
-            "StartStreaming" | "StopStreaming" => {
-                if !d.spec.sensors.iter().any(|s| s == "camera") {
-                    return Err(failed(format!("{} has no camera", &self.names[id])));
-                }
-                d.streaming = function == "StartStreaming";
-            }
-            "StartDetection" | "StopDetection" => {
-                let kind = kind(args, 0, "kind")?;
-                let Some((range, probability)) =
-                    detection_range(&self.sensors, &d.spec.sensors, &kind)
-                else {
-                    return Err(failed(format!(
-                        "{} has no sensor that detects {kind}",
-                        &self.names[id]
-                    )));
-                };
-                let detections = &mut d.rare_mut().detections;
-                detections.retain(|a| a.kind != kind);
-                if function == "StartDetection" {
-                    detections.push(Activation { kind, range, probability, found: Vec::new() });
-                }
-            }
-            "LoadPayload" => {
-                let kind = kind(args, 0, "kind")?;
-                if !d.spec.payload_kinds.contains(&kind) {
-                    let can = if d.spec.payload_kinds.is_empty() {
-                        "nothing".to_owned()
-                    } else {
-                        d.spec.payload_kinds.join(", ")
-                    };
-                    return Err(failed(format!(
-                        "{} cannot carry {kind} (it can carry: {can})",
-                        &self.names[id]
-                    )));
-                }
-                if let Some(held) = d.carrying().or(d.loading().map(|l| &l.kind)) {
-                    return Err(failed(format!(
-                        "{} already carries {held}: release it first",
-                        &self.names[id]
-                    )));
-                }
-                if d.state != FlightState::Landed && d.pos[2] >= LOAD_MAX_ALTITUDE {
-                    return Err(failed(format!(
-                        "{} is at {} m: load while landed or below {LOAD_MAX_ALTITUDE} m",
-                        &self.names[id],
-                        show::fixed(d.pos[2], 1)
-                    )));
-                }
-                d.rare_mut().loading = Some(Loading { call, kind, left: LOAD_TIME, paused: false });
-                return Ok(Start::Pending);
-            }
-            "ReleasePayload" => {
-                let Some(kind) = d.rare.as_mut().and_then(|r| r.carrying.take()) else {
-                    return Err(failed(format!("{} carries nothing to release", &self.names[id])));
-                };
-                self.releases.push(Release { drone: id, kind, position: d.pos, time });
-            }
-            other => return Err(failed(format!("unknown function {other}"))),
-        }
+        let Some(kind) = d.rare.as_mut().and_then(|r| r.carrying.take()) else {
+            return Err(failed(format!("{} carries nothing to release", &self.names[id])));
+        };
+        self.releases.push(Release { drone: id, kind, position: d.pos, time });
         Ok(Start::Done)
     }
 }

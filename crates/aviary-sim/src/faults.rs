@@ -19,7 +19,7 @@
 //! Each of them ends the drone's calls in progress `Interrupted`. A fault on a lost drone
 //! does nothing.
 
-use aviary_api::{DroneEvent, FlightState};
+use aviary_api::{BuiltinException, BuiltinSignal, DroneEvent, FlightState};
 use aviary_world::FaultKind;
 
 use crate::calls::return_legs;
@@ -52,7 +52,7 @@ impl Fleet {
                     d.low_sent = true;
                     self.fault(
                         id,
-                        "BatteryCritical",
+                        BuiltinException::BatteryCritical,
                         format!("{name}: battery critical (simulated fault)"),
                         out,
                     );
@@ -61,7 +61,7 @@ impl Fleet {
                 FaultKind::MotorFailure => {
                     self.fault(
                         id,
-                        "MotorFailure",
+                        BuiltinException::MotorFailure,
                         format!("{name}: motor failure (simulated fault)"),
                         out,
                     );
@@ -78,7 +78,7 @@ impl Fleet {
                 FaultKind::LinkLoss => {
                     self.fault(
                         id,
-                        "ConnectionLost",
+                        BuiltinException::ConnectionLost,
                         format!("{name}: link lost (simulated fault)"),
                         out,
                     );
@@ -89,7 +89,7 @@ impl Fleet {
                 FaultKind::GpsLoss => {
                     self.fault(
                         id,
-                        "PositionLost",
+                        BuiltinException::PositionLost,
                         format!("{name}: GPS lost (simulated fault)"),
                         out,
                     );
@@ -108,7 +108,7 @@ impl Fleet {
                 if d.state != FlightState::Lost {
                     out.push(Report::Event(DroneEvent::Signal {
                         drone: id,
-                        name: "ConnectionRestored",
+                        signal: BuiltinSignal::ConnectionRestored,
                     }));
                 }
             }

@@ -7,7 +7,8 @@ use std::sync::Arc;
 
 use aviary_api::geometry::hypot;
 use aviary_api::{
-    CallEnd, CallId, DroneEvent, DroneId, Failure, FlightState, Interrupt, Telemetry, Value,
+    BuiltinException, BuiltinSignal, CallEnd, CallId, DroneEvent, DroneId, Failure, FlightState,
+    Function, Interrupt, Telemetry, Value,
 };
 use aviary_world::{FaultKind, Sensor, Target, World};
 
@@ -309,7 +310,7 @@ impl Fleet {
     pub fn call(
         &mut self,
         drone: DroneId,
-        function: &str,
+        function: Function,
         args: &[Value],
     ) -> (CallId, Option<CallEnd>) {
         let id = CallId(self.next_call);
@@ -541,7 +542,10 @@ impl Fleet {
         }
         let alarms = battery::drain(d, dt, airborne);
         if alarms.low {
-            out.push(Report::Event(DroneEvent::Signal { drone: id, name: "BatteryLow" }));
+            out.push(Report::Event(DroneEvent::Signal {
+                drone: id,
+                signal: BuiltinSignal::BatteryLow,
+            }));
         }
         if alarms.critical {
             let reason = format!(
@@ -549,7 +553,7 @@ impl Fleet {
                 &self.names[id],
                 d.battery * 100.0
             );
-            self.fault(id, "BatteryCritical", reason, out);
+            self.fault(id, BuiltinException::BatteryCritical, reason, out);
         }
         if alarms.empty {
             let reason = format!("{}: battery empty", &self.names[id]);
@@ -561,7 +565,7 @@ impl Fleet {
     pub(crate) fn fault(
         &mut self,
         id: DroneId,
-        exception: &'static str,
+        exception: BuiltinException,
         reason: String,
         out: &mut Vec<Report>,
     ) {
@@ -576,7 +580,7 @@ impl Fleet {
 
     /// The drone falls to the ground and is gone for good (`DroneLost`).
     pub(crate) fn lose(&mut self, id: DroneId, reason: String, out: &mut Vec<Report>) {
-        self.fault(id, "DroneLost", reason, out);
+        self.fault(id, BuiltinException::DroneLost, reason, out);
         let d = &mut self.drones[id];
         d.state = FlightState::Lost;
         d.avoid = None;

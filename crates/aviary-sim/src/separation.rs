@@ -23,7 +23,7 @@
 //! call that separation holds back for too long ends: see [`Fleet::held_back`].
 
 use aviary_api::geometry::hypot;
-use aviary_api::{CallEnd, DroneId, Failure, FlightState};
+use aviary_api::{BuiltinException, CallEnd, DroneId, Failure, FlightState};
 
 use crate::avoid::MARGIN;
 use crate::drone::SimDrone;
@@ -439,6 +439,9 @@ impl Fleet {
         d.humble = false;
         d.stalled = 0.0;
         d.settle();
-        Some(Report::Ended { call, end: CallEnd::Failed(Failure { exception: "Timeout", reason }) })
+        Some(Report::Ended {
+            call,
+            end: CallEnd::Failed(Failure { exception: BuiltinException::Timeout, reason }),
+        })
     }
 }

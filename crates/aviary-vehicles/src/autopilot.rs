@@ -3,7 +3,7 @@
 //! targets, and the telemetry messages. No IO and no clock: the server feeds it
 //! messages and simulated seconds, and sends what it returns.
 
-use aviary_api::{CallEnd, CallId, DroneEvent, FlightState, Value};
+use aviary_api::{BuiltinException, CallEnd, CallId, DroneEvent, FlightState, Function, Value};
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
     MavCmd, MavMessage, MavResult, MavSeverity, COMMAND_ACK_DATA, STATUSTEXT_DATA,
 };
@@ -192,7 +192,7 @@ impl Autopilot {
                     }
                 }
                 Report::Event(DroneEvent::Fault { drone, failure })
-                    if failure.exception == "BatteryCritical" =>
+                    if failure.exception == BuiltinException::BatteryCritical =>
                 {
                     // ArduCopter's battery failsafe: say so, then return to launch.
                     let system = self.copters[drone].system;
@@ -203,12 +203,12 @@ impl Autopilot {
                     ));
                     self.copters[drone].mode = COPTER_RTL;
                     self.copters[drone].failsafe = true;
-                    if let Err(why) = self.motion(drone, "ReturnToLaunch", &[]) {
+                    if let Err(why) = self.motion(drone, Function::ReturnToLaunch, &[]) {
                         out.push(text(system, MavSeverity::MAV_SEVERITY_CRITICAL, &why));
                     }
                 }
                 Report::Event(DroneEvent::Fault { drone, failure })
-                    if failure.exception == "DroneLost" =>
+                    if failure.exception == BuiltinException::DroneLost =>
                 {
                     // Down for good: HEARTBEAT says EMERGENCY from now on; say why first.
                     let system = self.copters[drone].system;
@@ -247,7 +247,7 @@ impl Autopilot {
     pub(crate) fn motion(
         &mut self,
         i: usize,
-        function: &str,
+        function: Function,
         args: &[Value],
     ) -> Result<(), String> {
         if let Some(call) = self.copters[i].call.take() {

@@ -2,7 +2,7 @@
 //! answered with the result ArduCopter would give, the reason it says first, and what a
 //! request asks for (AUTOPILOT_VERSION, HOME_POSITION, a telemetry message).
 
-use aviary_api::{CallEnd, FlightState, Value};
+use aviary_api::{CallEnd, FlightState, Function, Value};
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavCmd, MavResult, MavSeverity};
 use aviary_mavlink::mode::{COPTER_GUIDED, COPTER_LAND, COPTER_RTL};
 
@@ -74,7 +74,7 @@ impl Autopilot {
                 if self.copters[i].armed {
                     return Answer::of(MAV_RESULT_ACCEPTED);
                 }
-                let mut a = done(self.instant(i, "Arm", &[]));
+                let mut a = done(self.instant(i, Function::Arm, &[]));
                 self.copters[i].armed = a.result == MAV_RESULT_ACCEPTED;
                 // ArduCopter sets home where it arms, and says so on every link; the
                 // simulator's home does not move, so the same home is said again.
@@ -87,7 +87,7 @@ impl Autopilot {
                 if state.airborne() {
                     return refused("Disarm: vehicle is flying");
                 }
-                let a = done(self.instant(i, "Disarm", &[]));
+                let a = done(self.instant(i, Function::Disarm, &[]));
                 self.copters[i].armed &= a.result != MAV_RESULT_ACCEPTED;
                 a
             }
@@ -110,7 +110,7 @@ impl Autopilot {
                 if state != FlightState::Landed {
                     return refused("Takeoff: already flying");
                 }
-                done(self.motion(i, "TakeOff", &[Value::Number(f64::from(alt))]))
+                done(self.motion(i, Function::TakeOff, &[Value::Number(f64::from(alt))]))
             }
             MavCmd::MAV_CMD_NAV_LAND => simple(self.set_mode(i, COPTER_LAND)),
             MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH => simple(self.set_mode(i, COPTER_RTL)),
@@ -129,9 +129,9 @@ impl Autopilot {
             MavCmd::MAV_CMD_DO_GRIPPER => {
                 if p[1] >= 0.5 {
                     let kind = self.copters[i].payload.clone().unwrap_or_default();
-                    done(self.instant(i, "LoadPayload", &[Value::Symbol(kind)]))
+                    done(self.instant(i, Function::LoadPayload, &[Value::Symbol(kind)]))
                 } else {
-                    done(self.instant(i, "ReleasePayload", &[]))
+                    done(self.instant(i, Function::ReleasePayload, &[]))
                 }
             }
             MavCmd::MAV_CMD_GET_HOME_POSITION => match self.home_position(i) {
@@ -164,7 +164,7 @@ impl Autopilot {
     pub(crate) fn instant(
         &mut self,
         i: usize,
-        function: &str,
+        function: Function,
         args: &[Value],
     ) -> Result<(), String> {
         match self.fleet.call(i, function, args).1 {

@@ -1,7 +1,7 @@
 //! Modes and GUIDED targets: SET_MODE / DO_SET_MODE, SET_POSITION_TARGET_GLOBAL_INT and
 //! DO_REPOSITION, with their altitude frames converted as ArduCopter does.
 
-use aviary_api::{FlightState, Point, Value};
+use aviary_api::{FlightState, Function, Point, Value};
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavResult, MavSeverity};
 use aviary_mavlink::mode::{COPTER_BRAKE, COPTER_GUIDED, COPTER_LAND, COPTER_LOITER, COPTER_RTL};
 
@@ -58,7 +58,7 @@ impl Autopilot {
         let speed = self.copters[i].speed;
         self.motion(
             i,
-            "FlyToPosition",
+            Function::FlyToPosition,
             &[Value::Position(Point { x: to[0], y: to[1], z: Some(to[2]) }), Value::Number(speed)],
         )
     }
@@ -126,8 +126,8 @@ impl Autopilot {
                 }
                 Ok(())
             }
-            COPTER_RTL if airborne => self.motion(i, "ReturnToLaunch", &[]),
-            COPTER_LAND if airborne => self.motion(i, "Land", &[]),
+            COPTER_RTL if airborne => self.motion(i, Function::ReturnToLaunch, &[]),
+            COPTER_LAND if airborne => self.motion(i, Function::Land, &[]),
             COPTER_RTL | COPTER_LAND => Ok(()),
             other => {
                 return (

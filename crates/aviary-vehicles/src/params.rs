@@ -9,6 +9,7 @@
 //! answer; a read by name answers with index 65535 (ArduPilot echoes the -1 it was sent);
 //! a PARAM_VALUE for a change goes to every client, a read or a list only to the asker.
 
+use aviary_api::flight::return_height;
 use aviary_mavlink::mavlink::dialects::ardupilotmega::MavMessage;
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
     MavParamType, MavSeverity, PARAM_VALUE_DATA,
@@ -53,11 +54,12 @@ impl Autopilot {
             param("LAND_ALT_LOW", MAV_PARAM_TYPE_INT16, (c.descent.slow_below * 100.0).round()),
             param("LAND_SPEED", MAV_PARAM_TYPE_INT16, (c.descent.land_speed * 100.0).round()),
             param("MAV_SYSID", MAV_PARAM_TYPE_INT16, f64::from(c.system)),
-            // An RTL climbs to at least this (cm), or to the site's ceiling if lower.
+            // An RTL climbs to at least this (cm): the height one from the ground flies home
+            // at, the return altitude kept under the site's ceiling.
             param(
                 "RTL_ALT",
                 MAV_PARAM_TYPE_INT32,
-                (c.return_altitude.min(ceiling.unwrap_or(f64::INFINITY)) * 100.0).round(),
+                (return_height(0.0, c.return_altitude, ceiling) * 100.0).round(),
             ),
             // The wait above home before an RTL lands (ms).
             param("RTL_LOIT_TIME", MAV_PARAM_TYPE_INT32, (c.return_loiter * 1000.0).round()),

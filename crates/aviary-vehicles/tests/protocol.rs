@@ -4,7 +4,7 @@
 
 use std::time::Duration;
 
-use aviary_api::{Backend, CallEnd, DroneEvent, Value};
+use aviary_api::{Backend, BuiltinException, BuiltinSignal, CallEnd, DroneEvent, Function, Value};
 use aviary_mavlink::Tuning;
 use aviary_vehicles::{Behaviour, Listen, Options};
 use aviary_world::World;
@@ -32,7 +32,7 @@ fn quick() -> Tuning {
     }
 }
 
-async fn call(backend: &dyn Backend, function: &str, args: &[Value]) -> CallEnd {
+async fn call(backend: &dyn Backend, function: Function, args: &[Value]) -> CallEnd {
     let pending = backend.call(0, function, args);
     tokio::time::timeout(Duration::from_secs(30), pending.end.wait())
         .await
@@ -54,9 +54,9 @@ async fn arming_refused_by_pre_arm_checks_says_why() {
         aviary_mavlink::connect(&world(&scout(&format!("tcp:{}", vehicles.address), "")), quick())
             .await
             .unwrap();
-    match call(&backend, "Arm", &[]).await {
+    match call(&backend, Function::Arm, &[]).await {
         CallEnd::Failed(f) => {
-            assert_eq!(f.exception, "CommandFailed");
+            assert_eq!(f.exception, BuiltinException::CommandFailed);
             assert!(f.reason.contains("PreArm: GPS: waiting for 3D fix"), "{}", f.reason);
         }
         other => panic!("{other:?}"),
@@ -79,16 +79,16 @@ async fn a_battery_failsafe_rtl_raises_battery_critical() {
             .await
             .unwrap();
     let mut events = backend.events().unwrap();
-    let armed = call(&backend, "Arm", &[]).await;
+    let armed = call(&backend, Function::Arm, &[]).await;
     assert_eq!(armed, CallEnd::Done, "{:?}", events.try_recv());
-    let hover = backend.call(0, "Hover", &[Value::Number(60.0)]);
+    let hover = backend.call(0, Function::Hover, &[Value::Number(60.0)]);
     let event = tokio::time::timeout(Duration::from_secs(20), events.recv())
         .await
         .expect("an event")
         .expect("open");
     match event {
         DroneEvent::Fault { drone: 0, failure } => {
-            assert_eq!(failure.exception, "BatteryCritical");
+            assert_eq!(failure.exception, BuiltinException::BatteryCritical);
             assert!(
                 failure.reason.contains("switched to RTL by itself")
                     && failure.reason.contains("Battery 1 is critical"),
@@ -121,16 +121,16 @@ async fn take_off_and_land_over_udp() {
     )
     .await
     .unwrap();
-    assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
-    assert_eq!(call(&backend, "TakeOff", &[Value::Number(5.0)]).await, CallEnd::Done);
+    assert_eq!(call(&backend, Function::Arm, &[]).await, CallEnd::Done);
+    assert_eq!(call(&backend, Function::TakeOff, &[Value::Number(5.0)]).await, CallEnd::Done);
     let t = backend.telemetry(0);
     assert!(
         (t.position[2] - 5.0).abs() <= 0.5 && t.state == aviary_api::FlightState::Flying,
         "{t:?}"
     );
-    assert_eq!(call(&backend, "Land", &[]).await, CallEnd::Done);
+    assert_eq!(call(&backend, Function::Land, &[]).await, CallEnd::Done);
     assert_eq!(backend.telemetry(0).state, aviary_api::FlightState::Landed);
-    assert_eq!(call(&backend, "Disarm", &[]).await, CallEnd::Done);
+    assert_eq!(call(&backend, Function::Disarm, &[]).await, CallEnd::Done);
     vehicles.stop();
 }
 
@@ -148,7 +148,7 @@ async fn signed_links_take_only_the_right_key() {
     let address = format!("tcp:{}", vehicles.address);
     let right = world(&scout(&address, "signing_key = \"correct horse battery staple\"\n"));
     let backend = aviary_mavlink::connect(&right, quick()).await.expect("the right key connects");
-    assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
+    assert_eq!(call(&backend, Function::Arm, &[]).await, CallEnd::Done);
     let wrong = world(&scout(&address, "signing_key = \"wrong\"\n"));
     let err =
         aviary_mavlink::connect(&wrong, quick()).await.err().expect("a wrong key hears nothing");
@@ -169,10 +169,10 @@ async fn pause_holds_resume_goes_on_and_abort_stops() {
         aviary_mavlink::connect(&world(&scout(&format!("tcp:{}", vehicles.address), "")), quick())
             .await
             .unwrap();
-    assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
-    assert_eq!(call(&backend, "TakeOff", &[Value::Number(5.0)]).await, CallEnd::Done);
+    assert_eq!(call(&backend, Function::Arm, &[]).await, CallEnd::Done);
+    assert_eq!(call(&backend, Function::TakeOff, &[Value::Number(5.0)]).await, CallEnd::Done);
     let far = Value::Position(aviary_api::Point { x: 300.0, y: 0.0, z: None });
-    let flight = backend.call(0, "FlyToPosition", &[far]);
+    let flight = backend.call(0, Function::FlyToPosition, &[far]);
     tokio::time::sleep(Duration::from_secs(2)).await;
     backend.interrupt(flight.id, aviary_api::Interrupt::Pause);
     // Braking from 10 m/s and coming back to where it was paused takes a few seconds.
@@ -215,11 +215,11 @@ async fn a_vehicle_that_goes_and_comes_back_raises_lost_then_restored() {
         .expect("an event")
         .unwrap();
     assert!(
-        matches!(&lost, DroneEvent::Fault { failure, .. } if failure.exception == "ConnectionLost"),
+        matches!(&lost, DroneEvent::Fault { failure, .. } if failure.exception == BuiltinException::ConnectionLost),
         "{lost:?}"
     );
     assert!(!backend.telemetry(0).link);
-    match call(&backend, "Arm", &[]).await {
+    match call(&backend, Function::Arm, &[]).await {
         CallEnd::Failed(f) => assert!(f.reason.contains("no link"), "{}", f.reason),
         other => panic!("{other:?}"),
     }
@@ -229,9 +229,9 @@ async fn a_vehicle_that_goes_and_comes_back_raises_lost_then_restored() {
         .await
         .expect("an event")
         .unwrap();
-    assert_eq!(back, DroneEvent::Signal { drone: 0, name: "ConnectionRestored" });
+    assert_eq!(back, DroneEvent::Signal { drone: 0, signal: BuiltinSignal::ConnectionRestored });
     assert!(backend.telemetry(0).link);
-    assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
+    assert_eq!(call(&backend, Function::Arm, &[]).await, CallEnd::Done);
     second.stop();
 }
 
@@ -253,8 +253,8 @@ async fn the_battery_rule_signals_low_then_raises_critical_once() {
     .await
     .unwrap();
     let mut events = backend.events().unwrap();
-    assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
-    let _climb = backend.call(0, "TakeOff", &[Value::Number(10.0)]);
+    assert_eq!(call(&backend, Function::Arm, &[]).await, CallEnd::Done);
+    let _climb = backend.call(0, Function::TakeOff, &[Value::Number(10.0)]);
     let mut seen = Vec::new();
     let until = tokio::time::Instant::now() + Duration::from_secs(10);
     while let Ok(Some(e)) = tokio::time::timeout_at(until, events.recv()).await {
@@ -263,8 +263,8 @@ async fn the_battery_rule_signals_low_then_raises_critical_once() {
     let names: Vec<&str> = seen
         .iter()
         .map(|e| match e {
-            DroneEvent::Signal { name, .. } => *name,
-            DroneEvent::Fault { failure, .. } => failure.exception,
+            DroneEvent::Signal { signal, .. } => signal.name(),
+            DroneEvent::Fault { failure, .. } => failure.exception.name(),
             DroneEvent::Detected { .. } => "Detected",
         })
         .collect();
@@ -290,16 +290,16 @@ async fn a_crash_raises_drone_lost() {
             .await
             .unwrap();
     let mut events = backend.events().unwrap();
-    assert_eq!(call(&backend, "Arm", &[]).await, CallEnd::Done);
-    assert_eq!(call(&backend, "TakeOff", &[Value::Number(10.0)]).await, CallEnd::Done);
-    let hover = backend.call(0, "Hover", &[Value::Number(300.0)]);
+    assert_eq!(call(&backend, Function::Arm, &[]).await, CallEnd::Done);
+    assert_eq!(call(&backend, Function::TakeOff, &[Value::Number(10.0)]).await, CallEnd::Done);
+    let hover = backend.call(0, Function::Hover, &[Value::Number(300.0)]);
     match tokio::time::timeout(Duration::from_secs(15), events.recv())
         .await
         .expect("an event")
         .unwrap()
     {
         DroneEvent::Fault { drone: 0, failure } => {
-            assert_eq!(failure.exception, "DroneLost");
+            assert_eq!(failure.exception, BuiltinException::DroneLost);
             assert!(
                 failure.reason.contains("MAV_STATE_EMERGENCY") && failure.reason.contains("Crash"),
                 "{}",

@@ -21,7 +21,7 @@ mod raises;
 
 use std::collections::{BTreeMap, HashMap};
 
-use aviary_api::{DroneId, Resource};
+use aviary_api::{BuiltinSignal, DroneId, Resource};
 use aviary_diagnostics::{Code, Diagnostic};
 use aviary_ir::{BlockKind, Mission, SignalId};
 
@@ -318,7 +318,7 @@ impl Bucket<'_> {
             let signal = info.signal;
             // A drone's link comes back only after it was lost, and the loss aborted what
             // the drone was doing: its own restore handler does not race with that.
-            if self.mission.signals[signal] == "ConnectionRestored"
+            if signal == self.mission.builtins.signal(BuiltinSignal::ConnectionRestored)
                 && info.by.as_deref() == Some(&[self.drone])
             {
                 continue;

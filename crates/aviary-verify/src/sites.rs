@@ -6,7 +6,7 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use aviary_api::{DroneId, Resource};
+use aviary_api::{BuiltinSignal, DroneId, Function, Resource};
 use aviary_ir::{
     ActorFilter, ActorRef, Block, BlockKind, Call, CapId, Mission, Node, Origin, SignalId,
 };
@@ -62,11 +62,15 @@ pub struct Sites {
     pub raises: Vec<RaiseSite>,
 }
 
-/// The built-in signals the middle layer raises when it likes, not at a statement.
-const UNTIMED: &[&str] = &["BatteryLow", "ConnectionRestored"];
-
+/// Whether the middle layer raises this signal when it likes, not at a statement.
 pub fn untimed(mission: &Mission, signal: SignalId) -> bool {
-    mission.signals.get(signal).is_some_and(|s| UNTIMED.contains(&s.as_str()))
+    BuiltinSignal::ALL.into_iter().any(|s| match s {
+        BuiltinSignal::BatteryLow | BuiltinSignal::ConnectionRestored => {
+            mission.builtins.signal(s) == signal
+        }
+        // Raised where detection is on: `capability_raises` places it.
+        BuiltinSignal::Detected => false,
+    })
 }
 
 pub fn collect(mission: &Mission) -> Sites {
@@ -218,8 +222,7 @@ impl Walk<'_> {
 /// The signals each capability can raise while it runs, through the capabilities it
 /// calls: its own `SIGNAL`s, and `Detected` when it starts detection.
 fn capability_raises(mission: &Mission) -> Vec<BTreeSet<SignalId>> {
-    let detected = mission.signals.iter().position(|s| s == "Detected");
-    let start_detection = mission.functions.iter().position(|(name, _)| name == "StartDetection");
+    let detected = mission.builtins.signal(BuiltinSignal::Detected);
     let mut direct: Vec<BTreeSet<SignalId>> = Vec::new();
     let mut calls: Vec<BTreeSet<CapId>> = Vec::new();
     for cap in &mission.capabilities {
@@ -232,7 +235,9 @@ fn capability_raises(mission: &Mission) -> Vec<BTreeSet<SignalId>> {
                 Node::Call(c) => {
                     called.insert(c.capability);
                 }
-                Node::Api(a) if Some(a.function) == start_detection => raised.extend(detected),
+                Node::Api(a) if a.function == Function::StartDetection => {
+                    raised.insert(detected);
+                }
                 _ => {}
             });
         }

@@ -264,8 +264,11 @@ impl<'a> Checker<'a> {
                 if let Some(by) = &h.by {
                     self.by_filter(by);
                 }
-                let values =
-                    self.api.signal(&h.signal.name).map(|s| s.values.clone()).unwrap_or_default();
+                let values = self
+                    .api
+                    .signal(&h.signal.name)
+                    .map(|s| s.values().to_vec())
+                    .unwrap_or_default();
                 let scope = h
                     .bindings
                     .iter()
@@ -698,7 +701,7 @@ impl<'a> Checker<'a> {
             ));
         }
         let Some(f) = self.api.function(&call.function.name) else {
-            let names: Vec<&str> = self.api.functions.iter().map(|f| f.name).collect();
+            let names: Vec<&str> = self.api.functions.iter().map(|f| f.name()).collect();
             let help = did_you_mean(&call.function.name, names.iter().copied())
                 .or_else(|| {
                     same_start(&call.function.name, names.iter().copied())
@@ -722,7 +725,7 @@ impl<'a> Checker<'a> {
                 call.span,
                 format!(
                     "`{}` needs {}, and this call gives {}",
-                    f.name,
+                    f.name(),
                     count(f.required(), "argument"),
                     count_bare(n)
                 ),
@@ -731,11 +734,11 @@ impl<'a> Checker<'a> {
         } else if n > f.params.len() && !f.variadic {
             let extra = call.args[f.params.len()].span;
             let message = if f.params.is_empty() {
-                format!("`{}` takes no arguments", f.name)
+                format!("`{}` takes no arguments", f.name())
             } else {
                 format!(
                     "`{}` takes at most {}, and this call gives {n}",
-                    f.name,
+                    f.name(),
                     count(f.params.len(), "argument")
                 )
             };
@@ -744,8 +747,8 @@ impl<'a> Checker<'a> {
         }
         for (j, arg) in call.args.iter().enumerate() {
             let p = f.params.get(j).or(if f.variadic { f.params.last() } else { None });
-            let what = p.map_or(format!("`{}`'s argument", f.name), |p| {
-                format!("`{}`'s `{}`", f.name, p.name)
+            let what = p.map_or(format!("`{}`'s argument", f.name()), |p| {
+                format!("`{}`'s `{}`", f.name(), p.name)
             });
             self.value(arg, p.map(|p| p.kind), &what);
         }

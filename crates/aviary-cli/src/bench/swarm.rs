@@ -5,7 +5,7 @@
 
 use std::time::Instant;
 
-use serde_json::Value as Json;
+use aviary_api::trace::{Event, Record};
 
 use super::pipeline::{self, mib, peak_rss, Stages};
 
@@ -34,11 +34,11 @@ pub fn run(drones: usize, emit: bool, emit_world: bool) -> u8 {
         return 0;
     }
     let mut tally = Tally::default();
-    let mut sink = |e: Json| {
+    let mut sink = |r: &Record| {
         tally.events += 1;
-        match e["event"].as_str() {
-            Some("detection") => tally.detections += 1,
-            Some("handler_start") if e["signal"] == "Found" => tally.found_handled += 1,
+        match &r.event {
+            Event::Detection { .. } => tally.detections += 1,
+            Event::HandlerStart { signal, .. } if signal == "Found" => tally.found_handled += 1,
             _ => {}
         }
     };

@@ -4,13 +4,15 @@
 //! The sink checks from the trace that the work was done: N `Done` signals, each taken
 //! by the handler, whose indices sum to N(N-1)/2 (and, with `--full-trace`, N·K steps
 //! that ended ok). By default it asks the engine only for the events it checks
-//! (`TraceSink::wants`): building the other 40-odd JSON objects per actor that
-//! `aviary run --trace` writes would measure serde_json, not the language.
+//! (`TraceSink::wants`), and reads their fields where the engine made them: writing the
+//! other 40-odd lines per actor that `aviary run --trace` writes would measure
+//! serde_json, not the language. `--full-trace` takes every event and writes each line
+//! as `aviary run --trace` does (to memory).
 
 use std::time::Instant;
 
-use aviary_engine::{Event, Field, TraceSink};
-use serde_json::Value as Json;
+use aviary_api::trace::{Event, EventKind, Record, Shown, Status};
+use aviary_engine::TraceSink;
 
 use super::pipeline::{self, mib, peak_rss, Stages};
 
@@ -23,47 +25,32 @@ struct Tally {
     handled: u64,
     steps: u64,
     events: u64,
+    /// With `--full-trace`: the line each event is written to, as `aviary run --trace`
+    /// writes it.
+    line: Vec<u8>,
 }
 
 impl TraceSink for Tally {
-    fn wants(&self, event: &str) -> bool {
-        self.full || matches!(event, "signal" | "handler_start")
+    fn wants(&self, kind: EventKind) -> bool {
+        self.full || matches!(kind, EventKind::Signal | EventKind::HandlerStart)
     }
 
-    fn event(&mut self, event: Json) {
-        self.observe(&event);
-    }
-
-    /// Reads the fields it checks where the engine made them (no JSON object), except
-    /// with `--full-trace`, which builds every event's object as `aviary run --trace` does.
-    fn record(&mut self, event: &Event<'_>) {
-        if self.full {
-            return self.event(event.to_json());
-        }
+    fn record(&mut self, record: &Record<'_>) {
         self.events += 1;
-        let field = |key| event.get(key).and_then(Field::as_str);
-        match event.kind {
-            "signal" if field("name") == Some("Done") => {
+        if self.full {
+            self.line.clear();
+            if serde_json::to_writer(&mut self.line, record).is_ok() {
+                self.line.push(b'\n');
+            }
+        }
+        match &record.event {
+            Event::Signal { name, args, .. } if name == "Done" => {
                 self.done_signals += 1;
-                let index = event.get("args").and_then(Field::as_json).and_then(|a| a[0].as_f64());
+                let index = args.first().and_then(Shown::as_number);
                 self.index_sum += index.unwrap_or(f64::NAN) as u64;
             }
-            "handler_start" if field("signal") == Some("Done") => self.handled += 1,
-            _ => {}
-        }
-    }
-}
-
-impl Tally {
-    fn observe(&mut self, event: &Json) {
-        self.events += 1;
-        match event["event"].as_str() {
-            Some("signal") if event["name"] == "Done" => {
-                self.done_signals += 1;
-                self.index_sum += event["args"][0].as_f64().unwrap_or(f64::NAN) as u64;
-            }
-            Some("handler_start") if event["signal"] == "Done" => self.handled += 1,
-            Some("capability_end") if event["capability"] == "Step" && event["status"] == "ok" => {
+            Event::HandlerStart { signal, .. } if signal == "Done" => self.handled += 1,
+            Event::CapabilityEnd { capability, status: Status::Ok, .. } if capability == "Step" => {
                 self.steps += 1
             }
             _ => {}

@@ -6,7 +6,7 @@
 use aviary_api::Descriptor;
 use aviary_check::SourceProvider;
 use aviary_diagnostics::SourceMap;
-use aviary_engine::{Outcome, RunOptions};
+use aviary_engine::{Outcome, Record, RunOptions};
 use aviary_sim::{SimBackend, SimOptions};
 use serde_json::Value;
 
@@ -47,6 +47,11 @@ kind = "Body"
 at = [150, 150]
 "#;
 
+/// An event as the trace file has it, to look at by key.
+pub fn json(record: &Record) -> Value {
+    serde_json::to_value(record).expect("an event is JSON")
+}
+
 pub struct Run {
     pub outcome: Outcome,
     pub trace: Vec<Value>,
@@ -62,7 +67,8 @@ pub fn run_in(mission: &str, world: &str) -> Run {
     run_with(mission, world, &RunOptions::default())
 }
 
-pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
+/// The mission checked (without errors) and compiled for the world, and the world.
+pub fn compile(mission: &str, world: &str) -> (aviary_ir::Mission, aviary_world::World) {
     let mut sources = SourceMap::new();
     let checked = aviary_check::check_sources(
         &mut sources,
@@ -82,6 +88,11 @@ pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
     let mission =
         aviary_ir::compile(&checked.program.expect("program"), &world, &Descriptor::standard())
             .expect("mission");
+    (mission, world)
+}
+
+pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
+    let (mission, world) = compile(mission, world);
     let runtime = tokio::runtime::Builder::new_current_thread()
         .enable_time()
         .start_paused(true)
@@ -90,7 +101,7 @@ pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
     runtime.block_on(async {
         let sim = SimBackend::start(&world, SimOptions::default());
         let mut trace = Vec::new();
-        let mut sink = |e: Value| trace.push(e);
+        let mut sink = |r: &Record| trace.push(json(r));
         let outcome = aviary_engine::run(&mission, &*sim, &mut sink, options).await;
         sim.shutdown().await;
         let releases = sim.releases().into_iter().map(|r| (r.drone, r.kind, r.position)).collect();

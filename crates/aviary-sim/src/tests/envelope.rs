@@ -43,7 +43,7 @@ fn braking_only_shrinks_the_envelope_straight_on_an_arc_and_vertically() {
     let w = one_drone();
     // Straight, at full speed: stops exactly v²/2a further on.
     let mut fleet = airborne(&w, 20.0);
-    start(&mut fleet, 0, "FlyToPosition", &[pos(300.0, 0.0)]);
+    start(&mut fleet, 0, Function::FlyToPosition, &[pos(300.0, 0.0)]);
     run_for(&mut fleet, 6.0);
     let (x, v) = (fleet.drones[0].pos[0], fleet.drones[0].vel[0]);
     assert_eq!(v, 10.0);
@@ -52,15 +52,15 @@ fn braking_only_shrinks_the_envelope_straight_on_an_arc_and_vertically() {
     assert!(brake_to_a_stop(&fleet) > 60);
     // On an orbit.
     let mut fleet = airborne(&w, 20.0);
-    start(&mut fleet, 0, "Orbit", &[pos(40.0, 0.0), num(40.0)]);
+    start(&mut fleet, 0, Function::Orbit, &[pos(40.0, 0.0), num(40.0)]);
     run_for(&mut fleet, 15.0);
     assert!(fleet.drones[0].vel[0].hypot(fleet.drones[0].vel[1]) > 5.0);
     assert!(envelope(&fleet.drones[0]).pad > 0.0);
     brake_to_a_stop(&fleet);
     // Climbing.
     let mut fleet = Fleet::new(&w);
-    instant(&mut fleet, 0, "Arm", &[]);
-    start(&mut fleet, 0, "TakeOff", &[num(30.0)]);
+    instant(&mut fleet, 0, Function::Arm, &[]);
+    start(&mut fleet, 0, Function::TakeOff, &[num(30.0)]);
     run_for(&mut fleet, 3.0);
     assert_eq!(fleet.drones[0].vel[2], 3.0);
     let e = envelope(&fleet.drones[0]);

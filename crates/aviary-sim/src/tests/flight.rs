@@ -10,8 +10,8 @@ use crate::sweep::lawnmower;
 fn takeoff_climb_time_matches_the_trapezoid() {
     let w = one_drone();
     let mut fleet = Fleet::new(&w);
-    instant(&mut fleet, 0, "Arm", &[]);
-    let id = start(&mut fleet, 0, "TakeOff", &[num(20.0)]);
+    instant(&mut fleet, 0, Function::Arm, &[]);
+    let id = start(&mut fleet, 0, Function::TakeOff, &[num(20.0)]);
     assert_eq!(fleet.telemetry(0).unwrap().state, FlightState::TakingOff);
     let run = run_until(&mut fleet, 0, id, 60.0);
     // climb_rate 3 m/s, acceleration 3 m/s²: 1 s up to speed and 1 s to stop (3 m), 17 m at 3 m/s.
@@ -34,7 +34,7 @@ fn takeoff_climb_time_matches_the_trapezoid() {
 fn a_long_flight_keeps_speed_and_acceleration_bounds() {
     let w = one_drone();
     let mut fleet = airborne(&w, 20.0);
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(300.0, 400.0)]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(300.0, 400.0)]);
     let run = run_until(&mut fleet, 0, id, 200.0);
     // 500 m at 10 m/s, plus the time lost speeding up and braking at 3 m/s² (10/3 s).
     let expected = 500.0 / 10.0 + 10.0 / 3.0;
@@ -64,7 +64,7 @@ fn a_long_flight_keeps_speed_and_acceleration_bounds() {
     assert!((seconds - fleet.time()).abs() < 1e-9, "in the air since the take-off call");
     assert_eq!(fleet.odometry(7), (0.0, 0.0));
     // A slower speed asked is kept.
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(300.0, 300.0), num(4.0)]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(300.0, 300.0), num(4.0)]);
     let run = run_until(&mut fleet, 0, id, 200.0);
     assert!(run.samples.iter().all(|t| t.speed <= 4.0 + 1e-9));
     assert!((run.took - (100.0 / 4.0 + 4.0 / 3.0)).abs() < 0.3);
@@ -76,8 +76,8 @@ fn battery_drains_exactly_while_airborne_only() {
     let mut fleet = Fleet::new(&w);
     run_for(&mut fleet, 10.0);
     assert_eq!(fleet.telemetry(0).unwrap().battery, 0.8, "no drain on the ground");
-    instant(&mut fleet, 0, "Arm", &[]);
-    start(&mut fleet, 0, "TakeOff", &[num(30.0)]);
+    instant(&mut fleet, 0, Function::Arm, &[]);
+    start(&mut fleet, 0, Function::TakeOff, &[num(30.0)]);
     let steps = 2400; // 120 s
     for _ in 0..steps {
         fleet.step(DT);
@@ -92,15 +92,17 @@ fn battery_low_comes_before_critical_each_once_then_the_drone_is_lost() {
     let w = world("[drones.d]\nhome = [0, 0]\nendurance = 150\n");
     let mut fleet = airborne(&w, 20.0);
     // Low at about 40 s of flight, critical at about 64 s: before the 93 s it takes.
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(900.0, 0.0)]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(900.0, 0.0)]);
     let mut seen = Vec::new();
     let mut ended = None;
     for _ in 0..(400.0 / DT) as usize {
         for r in fleet.step(DT) {
             match r {
-                Report::Event(DroneEvent::Signal { name, .. }) => seen.push(name.to_owned()),
+                Report::Event(DroneEvent::Signal { signal, .. }) => {
+                    seen.push(signal.name().to_owned())
+                }
                 Report::Event(DroneEvent::Fault { failure, .. }) => {
-                    seen.push(failure.exception.to_owned())
+                    seen.push(failure.exception.name().to_owned())
                 }
                 Report::Ended { call, end } if call == id => ended = Some((end, fleet.time())),
                 _ => {}
@@ -113,16 +115,16 @@ fn battery_low_comes_before_critical_each_once_then_the_drone_is_lost() {
     let t = fleet.telemetry(0).unwrap();
     assert_eq!((t.state, t.battery, t.position[2]), (FlightState::Lost, 0.0, 0.0));
     assert!(t.position[0] > 500.0 && t.position[0] < 700.0, "{t:?}");
-    assert_eq!(refused(&mut fleet, 0, "Land", &[]).0, "CommandFailed");
+    assert_eq!(refused(&mut fleet, 0, Function::Land, &[]).0, BuiltinException::CommandFailed);
 }
 
 #[test]
 fn detection_fires_once_per_target_per_activation_and_only_in_range() {
     let w = one_drone();
     let mut fleet = airborne(&w, 20.0);
-    assert_eq!(instant(&mut fleet, 0, "StartDetection", &[sym("Body")]), CallEnd::Done);
+    assert_eq!(instant(&mut fleet, 0, Function::StartDetection, &[sym("Body")]), CallEnd::Done);
     // Passes (100, 10) at 10 m, and (100, 50) at 50 m (out of the 20 m range).
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(200.0, 0.0)]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(200.0, 0.0)]);
     let run = run_until(&mut fleet, 0, id, 100.0);
     let found = |events: &[DroneEvent]| -> Vec<[f64; 3]> {
         events
@@ -137,16 +139,16 @@ fn detection_fires_once_per_target_per_activation_and_only_in_range() {
     };
     assert_eq!(found(&run.events), [[100.0, 10.0, 0.0]]);
     // Flying back past it in the same activation finds nothing new.
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(50.0, 0.0)]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(50.0, 0.0)]);
     assert!(found(&run_until(&mut fleet, 0, id, 100.0).events).is_empty());
     // A new activation finds it again.
-    instant(&mut fleet, 0, "StartDetection", &[Value::Text("Body".into())]);
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(150.0, 0.0)]);
+    instant(&mut fleet, 0, Function::StartDetection, &[Value::Text("Body".into())]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(150.0, 0.0)]);
     assert_eq!(found(&run_until(&mut fleet, 0, id, 100.0).events), [[100.0, 10.0, 0.0]]);
     // Stopped: nothing.
-    instant(&mut fleet, 0, "StopDetection", &[sym("Body")]);
+    instant(&mut fleet, 0, Function::StopDetection, &[sym("Body")]);
     assert!(fleet.detecting(0).is_empty());
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(50.0, 0.0)]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(50.0, 0.0)]);
     assert!(found(&run_until(&mut fleet, 0, id, 100.0).events).is_empty());
 }
 
@@ -154,7 +156,7 @@ fn detection_fires_once_per_target_per_activation_and_only_in_range() {
 fn orbit_keeps_its_radius_and_speed() {
     let w = one_drone();
     let mut fleet = airborne(&w, 20.0);
-    let id = start(&mut fleet, 0, "Orbit", &[pos(100.0, 0.0), num(30.0), num(2.0)]);
+    let id = start(&mut fleet, 0, Function::Orbit, &[pos(100.0, 0.0), num(30.0), num(2.0)]);
     let run = run_until(&mut fleet, 0, id, 300.0);
     // The approach ends at (70, 0), the nearest point of the circle.
     let on_circle: Vec<_> = run
@@ -181,7 +183,7 @@ fn sweep_flies_the_lawnmower_path_and_covers_the_area() {
     let w = one_drone();
     let mut fleet = airborne(&w, 15.0);
     let l = crate::geom::L_SHAPE.to_vec();
-    let id = start(&mut fleet, 0, "Sweep", &[Value::Area(l.clone()), num(20.0)]);
+    let id = start(&mut fleet, 0, Function::Sweep, &[Value::Area(l.clone()), num(20.0)]);
     let run = run_until(&mut fleet, 0, id, 1000.0);
     let flown: Vec<[f64; 2]> = run.samples.iter().map(|t| [t.position[0], t.position[1]]).collect();
     let path = lawnmower(&l, 20.0);
@@ -204,7 +206,7 @@ fn sweep_flies_the_lawnmower_path_and_covers_the_area() {
 fn pause_holds_the_drone_and_resume_completes_the_move() {
     let w = one_drone();
     let mut fleet = airborne(&w, 20.0);
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(200.0, 0.0)]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(200.0, 0.0)]);
     run_for(&mut fleet, 5.0);
     assert_eq!(fleet.interrupt(id, Interrupt::Pause), None);
     let held = fleet.telemetry(0).unwrap();
@@ -226,7 +228,7 @@ fn pause_holds_the_drone_and_resume_completes_the_move() {
 fn abort_ends_the_call_interrupted_and_the_drone_hovers() {
     let w = one_drone();
     let mut fleet = airborne(&w, 20.0);
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(200.0, 0.0)]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(200.0, 0.0)]);
     run_for(&mut fleet, 5.0);
     assert_eq!(fleet.interrupt(id, Interrupt::Abort), Some(CallEnd::Interrupted));
     assert_eq!(fleet.interrupt(id, Interrupt::Abort), None, "once");
@@ -238,7 +240,7 @@ fn abort_ends_the_call_interrupted_and_the_drone_hovers() {
         (here.position, 0.0, FlightState::Flying)
     );
     // The drone takes a new move at once.
-    let id = start(&mut fleet, 0, "Land", &[]);
+    let id = start(&mut fleet, 0, Function::Land, &[]);
     assert_eq!(fleet.telemetry(0).unwrap().state, FlightState::Landing);
     assert_eq!(run_until(&mut fleet, 0, id, 100.0).end, CallEnd::Done);
     assert_eq!(fleet.telemetry(0).unwrap().state, FlightState::Landed);
@@ -266,25 +268,25 @@ at = [120, 60]
     let mut log = Vec::new();
     let mut reports = Vec::new();
     for d in 0..2 {
-        fleet.call(d, "Arm", &[]);
-        fleet.call(d, "TakeOff", &[num(12.5 + d as f64)]);
+        fleet.call(d, Function::Arm, &[]);
+        fleet.call(d, Function::TakeOff, &[num(12.5 + d as f64)]);
     }
     for i in 0..6000 {
         match i {
             300 => {
-                fleet.call(0, "StartDetection", &[sym("Body")]);
+                fleet.call(0, Function::StartDetection, &[sym("Body")]);
                 fleet.call(
                     0,
-                    "Sweep",
+                    Function::Sweep,
                     &[
                         Value::Area(vec![[50.0, 20.0], [200.0, 20.0], [200.0, 90.0], [50.0, 90.0]]),
                         num(15.0),
                     ],
                 );
-                fleet.call(1, "Orbit", &[pos(-40.0, 30.0), num(25.0), num(1.5)]);
+                fleet.call(1, Function::Orbit, &[pos(-40.0, 30.0), num(25.0), num(1.5)]);
             }
             4000 => {
-                fleet.call(1, "ReturnToLaunch", &[]);
+                fleet.call(1, Function::ReturnToLaunch, &[]);
             }
             _ => {}
         }

@@ -27,7 +27,7 @@ fn trapezoid(d: f64, v: f64, a: f64) -> f64 {
 fn a_landing_descends_at_its_rate_and_touches_down_at_the_landing_speed() {
     let w = arducopter();
     let mut fleet = airborne(&w, 25.0);
-    let id = start(&mut fleet, 0, "Land", &[]);
+    let id = start(&mut fleet, 0, Function::Land, &[]);
     let run = run_until(&mut fleet, 0, id, 120.0);
     assert_eq!(run.end, CallEnd::Done);
     let expected = trapezoid(15.0, 1.5, 2.5) + trapezoid(10.0, 0.5, 2.5);
@@ -45,7 +45,7 @@ fn a_landing_descends_at_its_rate_and_touches_down_at_the_landing_speed() {
 fn a_low_landing_is_slow_all_the_way() {
     let w = arducopter();
     let mut fleet = airborne(&w, 4.0);
-    let id = start(&mut fleet, 0, "Land", &[]);
+    let id = start(&mut fleet, 0, Function::Land, &[]);
     let run = run_until(&mut fleet, 0, id, 60.0);
     let expected = trapezoid(4.0, 0.5, 2.5);
     assert!((run.took - expected).abs() < 0.2, "took {} s, expected {expected} s", run.took);
@@ -55,9 +55,9 @@ fn a_low_landing_is_slow_all_the_way() {
 fn a_return_climbs_to_the_return_altitude_waits_above_home_and_lands() {
     let w = arducopter();
     let mut fleet = airborne(&w, 5.0);
-    let out = start(&mut fleet, 0, "FlyToPosition", &[pos(100.0, 0.0)]);
+    let out = start(&mut fleet, 0, Function::FlyToPosition, &[pos(100.0, 0.0)]);
     run_until(&mut fleet, 0, out, 120.0);
-    let id = start(&mut fleet, 0, "ReturnToLaunch", &[]);
+    let id = start(&mut fleet, 0, Function::ReturnToLaunch, &[]);
     let run = run_until(&mut fleet, 0, id, 200.0);
     assert_eq!(run.end, CallEnd::Done);
     let highest = run.samples.iter().map(|s| s.position[2]).fold(0.0, f64::max);

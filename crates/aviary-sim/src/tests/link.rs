@@ -28,8 +28,8 @@ fn names(reports: &[Report]) -> Vec<&'static str> {
     reports
         .iter()
         .filter_map(|r| match r {
-            Report::Event(DroneEvent::Signal { name, .. }) => Some(*name),
-            Report::Event(DroneEvent::Fault { failure, .. }) => Some(failure.exception),
+            Report::Event(DroneEvent::Signal { signal, .. }) => Some(signal.name()),
+            Report::Event(DroneEvent::Fault { failure, .. }) => Some(failure.exception.name()),
             _ => None,
         })
         .collect()
@@ -48,7 +48,7 @@ fn comes_at(fleet: &mut Fleet, name: &str, t: f64) -> bool {
 /// Takes off, flies east, and is cut off at 20 s: returns the fleet at that moment.
 fn cut_off(w: &World) -> Fleet {
     let mut fleet = airborne(w, 20.0);
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(400.0, 0.0)]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(400.0, 0.0)]);
     let reports = run_to(&mut fleet, 20.0);
     assert_eq!(names(&reports), ["ConnectionLost"]);
     assert!(reports.contains(&Report::Ended { call: id, end: CallEnd::Interrupted }));
@@ -68,7 +68,7 @@ fn link_loss_holds_then_returns_to_launch_after_the_timeout() {
         assert!(names(&fleet.step(DT)).is_empty());
         let t = fleet.telemetry(0).unwrap();
         assert_eq!((t.position, t.speed), (held, 0.0));
-        let (_, reason) = refused(&mut fleet, 0, "FlyToPosition", &[pos(0.0, 0.0)]);
+        let (_, reason) = refused(&mut fleet, 0, Function::FlyToPosition, &[pos(0.0, 0.0)]);
         assert!(reason.contains("no link"), "{reason}");
     }
     // Then flies home on its own and lands, still without a link.
@@ -82,7 +82,7 @@ fn link_loss_holds_then_returns_to_launch_after_the_timeout() {
     // The link comes back when the fault's duration ends.
     assert!(comes_at(&mut fleet, "ConnectionRestored", 80.0));
     assert!(fleet.telemetry(0).unwrap().link);
-    assert_eq!(instant(&mut fleet, 0, "Arm", &[]), CallEnd::Done);
+    assert_eq!(instant(&mut fleet, 0, Function::Arm, &[]), CallEnd::Done);
 }
 
 #[test]
@@ -96,7 +96,7 @@ fn a_short_loss_only_holds_and_the_default_timeout_is_ten_seconds() {
     let t = fleet.telemetry(0).unwrap();
     assert_eq!((t.position, t.speed, t.link), (held, 0.0, true));
     // Commands again: fly on, until the second loss at 40 s.
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(400.0, 0.0)]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(400.0, 0.0)]);
     let reports = run_to(&mut fleet, 40.0);
     assert_eq!(names(&reports), ["ConnectionLost"]);
     assert!(reports.contains(&Report::Ended { call: id, end: CallEnd::Interrupted }));
@@ -121,7 +121,7 @@ fn a_return_started_on_its_own_goes_on_after_the_link_is_back_until_commanded() 
     let t = alone.telemetry(0).unwrap();
     assert_eq!((t.position, t.state), ([0.0, 0.0, 0.0], FlightState::Landed));
     // A command replaces the return (the drone stops where it is, then obeys).
-    let id = start(&mut fleet, 0, "Hover", &[num(3.0)]);
+    let id = start(&mut fleet, 0, Function::Hover, &[num(3.0)]);
     let here = fleet.telemetry(0).unwrap().position;
     let run = run_until(&mut fleet, 0, id, 10.0);
     assert_eq!(run.end, CallEnd::Done);
@@ -148,25 +148,25 @@ fn battery_critical_two_km_out_leaves_enough_to_get_home() {
     let (w, diags) = aviary_world::parse_world(aviary_diagnostics::FileId(0), text);
     assert!(diags.is_empty(), "{diags:#?}");
     let mut fleet = airborne(&w.unwrap(), 20.0);
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(2000.0, 0.0)]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(2000.0, 0.0)]);
     let out = run_until(&mut fleet, 0, id, 300.0);
     assert_eq!(out.end, CallEnd::Done);
     // Waits out there until the battery says it is time to go home.
-    let id = start(&mut fleet, 0, "Hover", &[num(1000.0)]);
+    let id = start(&mut fleet, 0, Function::Hover, &[num(1000.0)]);
     let wait = run_until(&mut fleet, 0, id, 1000.0);
     assert_eq!(wait.end, CallEnd::Interrupted);
     let mut seen: Vec<&str> = Vec::new();
     for e in out.events.iter().chain(&wait.events) {
         match e {
-            DroneEvent::Signal { name, .. } => seen.push(name),
-            DroneEvent::Fault { failure, .. } => seen.push(failure.exception),
+            DroneEvent::Signal { signal, .. } => seen.push(signal.name()),
+            DroneEvent::Fault { failure, .. } => seen.push(failure.exception.name()),
             _ => {}
         }
     }
     assert_eq!(seen, ["BatteryLow", "BatteryCritical"]);
     let critical = fleet.telemetry(0).unwrap();
     assert_eq!(critical.position, [2000.0, 0.0, 20.0]);
-    let id = start(&mut fleet, 0, "ReturnToLaunch", &[]);
+    let id = start(&mut fleet, 0, Function::ReturnToLaunch, &[]);
     let home = run_until(&mut fleet, 0, id, 400.0);
     assert_eq!(home.end, CallEnd::Done);
     let t = fleet.telemetry(0).unwrap();

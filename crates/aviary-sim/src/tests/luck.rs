@@ -21,11 +21,11 @@ fn line_of_bodies(p: &str) -> World {
 /// The x of every body found flying the line with `seed`.
 fn found(world: &World, seed: u64) -> Vec<f64> {
     let mut fleet = Fleet::new(world).seeded(seed);
-    instant(&mut fleet, 0, "Arm", &[]);
-    let up = start(&mut fleet, 0, "TakeOff", &[num(10.0)]);
+    instant(&mut fleet, 0, Function::Arm, &[]);
+    let up = start(&mut fleet, 0, Function::TakeOff, &[num(10.0)]);
     run_until(&mut fleet, 0, up, 60.0);
-    assert_eq!(instant(&mut fleet, 0, "StartDetection", &[sym("Body")]), CallEnd::Done);
-    let go = start(&mut fleet, 0, "FlyToPosition", &[pos(700.0, 0.0)]);
+    assert_eq!(instant(&mut fleet, 0, Function::StartDetection, &[sym("Body")]), CallEnd::Done);
+    let go = start(&mut fleet, 0, Function::FlyToPosition, &[pos(700.0, 0.0)]);
     let run = run_until(&mut fleet, 0, go, 200.0);
     run.events
         .iter()
@@ -72,10 +72,10 @@ fn a_miss_holds_until_detection_starts_again() {
     let mut missed = 0;
     for seed in 0..20 {
         let mut fleet = Fleet::new(&w).seeded(seed);
-        instant(&mut fleet, 0, "Arm", &[]);
-        let up = start(&mut fleet, 0, "TakeOff", &[num(10.0)]);
+        instant(&mut fleet, 0, Function::Arm, &[]);
+        let up = start(&mut fleet, 0, Function::TakeOff, &[num(10.0)]);
         run_until(&mut fleet, 0, up, 60.0);
-        instant(&mut fleet, 0, "StartDetection", &[sym("Body")]);
+        instant(&mut fleet, 0, Function::StartDetection, &[sym("Body")]);
         let first = run_for(&mut fleet, 5.0);
         if !first.is_empty() {
             continue;
@@ -86,8 +86,8 @@ fn a_miss_holds_until_detection_starts_again() {
         // Each new start is a new chance: within 30 starts, found.
         let mut found = false;
         for _ in 0..30 {
-            instant(&mut fleet, 0, "StopDetection", &[sym("Body")]);
-            instant(&mut fleet, 0, "StartDetection", &[sym("Body")]);
+            instant(&mut fleet, 0, Function::StopDetection, &[sym("Body")]);
+            instant(&mut fleet, 0, Function::StartDetection, &[sym("Body")]);
             if !run_for(&mut fleet, 0.1).is_empty() {
                 found = true;
                 break;
@@ -107,8 +107,8 @@ fn crash_at(at: &str) -> World {
 /// When the drone is lost, to the tick.
 fn lost_at(world: &World, seed: u64) -> f64 {
     let mut fleet = Fleet::new(world).seeded(seed);
-    instant(&mut fleet, 0, "Arm", &[]);
-    start(&mut fleet, 0, "TakeOff", &[num(30.0)]);
+    instant(&mut fleet, 0, Function::Arm, &[]);
+    start(&mut fleet, 0, Function::TakeOff, &[num(30.0)]);
     for _ in 0..4000 {
         let reports = fleet.step(DT);
         if reports.iter().any(|r| matches!(r, Report::Event(DroneEvent::Fault { .. }))) {

@@ -11,6 +11,7 @@ mod separation;
 mod sky;
 mod start;
 
+pub(crate) use aviary_api::{BuiltinException, Function};
 use aviary_api::{CallEnd, CallId, DroneEvent, Point, Telemetry, Value};
 use aviary_diagnostics::FileId;
 use aviary_world::{parse_world, World};
@@ -74,14 +75,14 @@ pub(crate) fn sym(s: &str) -> Value {
 }
 
 /// A call that must start (not end at once).
-pub(crate) fn start(fleet: &mut Fleet, drone: usize, f: &str, args: &[Value]) -> CallId {
+pub(crate) fn start(fleet: &mut Fleet, drone: usize, f: Function, args: &[Value]) -> CallId {
     let (id, end) = fleet.call(drone, f, args);
     assert_eq!(end, None, "{f} ended at once");
     id
 }
 
 /// A call that must end at once, with this end.
-pub(crate) fn instant(fleet: &mut Fleet, drone: usize, f: &str, args: &[Value]) -> CallEnd {
+pub(crate) fn instant(fleet: &mut Fleet, drone: usize, f: Function, args: &[Value]) -> CallEnd {
     fleet.call(drone, f, args).1.unwrap_or_else(|| panic!("{f} did not end at once"))
 }
 
@@ -89,9 +90,9 @@ pub(crate) fn instant(fleet: &mut Fleet, drone: usize, f: &str, args: &[Value]) 
 pub(crate) fn refused(
     fleet: &mut Fleet,
     drone: usize,
-    f: &str,
+    f: Function,
     args: &[Value],
-) -> (&'static str, String) {
+) -> (BuiltinException, String) {
     match instant(fleet, drone, f, args) {
         CallEnd::Failed(failure) => (failure.exception, failure.reason),
         other => panic!("{f} was not refused: {other:?}"),
@@ -139,8 +140,8 @@ pub(crate) fn run_for(fleet: &mut Fleet, seconds: f64) -> Vec<Report> {
 /// Arms drone 0 and takes it off to `alt`.
 pub(crate) fn airborne(world: &World, alt: f64) -> Fleet {
     let mut fleet = Fleet::new(world);
-    assert_eq!(instant(&mut fleet, 0, "Arm", &[]), CallEnd::Done);
-    let id = start(&mut fleet, 0, "TakeOff", &[num(alt)]);
+    assert_eq!(instant(&mut fleet, 0, Function::Arm, &[]), CallEnd::Done);
+    let id = start(&mut fleet, 0, Function::TakeOff, &[num(alt)]);
     assert_eq!(run_until(&mut fleet, 0, id, 120.0).end, CallEnd::Done);
     fleet
 }

@@ -9,64 +9,73 @@ use crate::LOAD_TIME;
 fn takeoff_needs_arming_and_flights_need_the_air() {
     let w = one_drone();
     let mut fleet = Fleet::new(&w);
-    let (exception, reason) = refused(&mut fleet, 0, "TakeOff", &[num(10.0)]);
-    assert_eq!(exception, "CommandFailed");
+    let (exception, reason) = refused(&mut fleet, 0, Function::TakeOff, &[num(10.0)]);
+    assert_eq!(exception, BuiltinException::CommandFailed);
     assert!(reason.contains("not armed"), "{reason}");
-    let (_, reason) = refused(&mut fleet, 0, "FlyToPosition", &[pos(10.0, 0.0)]);
+    let (_, reason) = refused(&mut fleet, 0, Function::FlyToPosition, &[pos(10.0, 0.0)]);
     assert!(reason.contains("take off first"), "{reason}");
-    assert_eq!(refused(&mut fleet, 0, "TakeOff", &[sym("high")]).0, "CommandFailed");
-    assert_eq!(instant(&mut fleet, 0, "Land", &[]), CallEnd::Done, "landed already");
-    assert_eq!(instant(&mut fleet, 0, "ReturnToLaunch", &[]), CallEnd::Done, "at home already");
-    assert_eq!(instant(&mut fleet, 0, "Arm", &[]), CallEnd::Done);
-    assert_eq!(instant(&mut fleet, 0, "Disarm", &[]), CallEnd::Done);
-    instant(&mut fleet, 0, "Arm", &[]);
-    let id = start(&mut fleet, 0, "TakeOff", &[num(10.0)]);
-    let (_, reason) = refused(&mut fleet, 0, "Hover", &[num(1.0)]);
+    assert_eq!(
+        refused(&mut fleet, 0, Function::TakeOff, &[sym("high")]).0,
+        BuiltinException::CommandFailed
+    );
+    assert_eq!(instant(&mut fleet, 0, Function::Land, &[]), CallEnd::Done, "landed already");
+    assert_eq!(
+        instant(&mut fleet, 0, Function::ReturnToLaunch, &[]),
+        CallEnd::Done,
+        "at home already"
+    );
+    assert_eq!(instant(&mut fleet, 0, Function::Arm, &[]), CallEnd::Done);
+    assert_eq!(instant(&mut fleet, 0, Function::Disarm, &[]), CallEnd::Done);
+    instant(&mut fleet, 0, Function::Arm, &[]);
+    let id = start(&mut fleet, 0, Function::TakeOff, &[num(10.0)]);
+    let (_, reason) = refused(&mut fleet, 0, Function::Hover, &[num(1.0)]);
     assert!(reason.contains("busy"), "{reason}");
     run_until(&mut fleet, 0, id, 60.0);
-    assert_eq!(refused(&mut fleet, 0, "Arm", &[]).0, "CommandFailed");
-    assert_eq!(refused(&mut fleet, 0, "Disarm", &[]).0, "CommandFailed");
+    assert_eq!(refused(&mut fleet, 0, Function::Arm, &[]).0, BuiltinException::CommandFailed);
+    assert_eq!(refused(&mut fleet, 0, Function::Disarm, &[]).0, BuiltinException::CommandFailed);
     // In the air, TakeOff climbs or descends to the altitude.
-    let id = start(&mut fleet, 0, "TakeOff", &[num(4.0)]);
+    let id = start(&mut fleet, 0, Function::TakeOff, &[num(4.0)]);
     run_until(&mut fleet, 0, id, 60.0);
     assert_eq!(fleet.telemetry(0).unwrap().position[2], 4.0);
-    let id = start(&mut fleet, 0, "AscendTo", &[num(30.0)]);
+    let id = start(&mut fleet, 0, Function::AscendTo, &[num(30.0)]);
     run_until(&mut fleet, 0, id, 60.0);
-    let id = start(&mut fleet, 0, "DescendTo", &[num(12.0)]);
+    let id = start(&mut fleet, 0, Function::DescendTo, &[num(12.0)]);
     run_until(&mut fleet, 0, id, 60.0);
     assert_eq!(fleet.telemetry(0).unwrap().position, [0.0, 0.0, 12.0]);
-    assert_eq!(refused(&mut fleet, 999, "Hover", &[num(1.0)]).0, "CommandFailed");
-    assert_eq!(refused(&mut fleet, 0, "Somersault", &[]).0, "CommandFailed");
+    assert_eq!(
+        refused(&mut fleet, 999, Function::Hover, &[num(1.0)]).0,
+        BuiltinException::CommandFailed
+    );
 }
 
 #[test]
 fn hover_waits_and_return_to_launch_lands_at_home_disarmed() {
     let w = one_drone();
     let mut fleet = airborne(&w, 5.0);
-    let id = start(&mut fleet, 0, "Hover", &[num(10.0)]);
+    let id = start(&mut fleet, 0, Function::Hover, &[num(10.0)]);
     let run = run_until(&mut fleet, 0, id, 60.0);
     assert!((run.took - 10.0).abs() < DT + 1e-9, "{}", run.took);
     let id = start(
         &mut fleet,
         0,
-        "FollowPath",
+        Function::FollowPath,
         &[pos(50.0, 0.0), pos3(50.0, 50.0, 30.0), pos(0.0, 50.0)],
     );
     let run = run_until(&mut fleet, 0, id, 200.0);
     assert!(run.samples.iter().any(|t| t.position == [50.0, 0.0, 5.0]));
     assert_eq!(fleet.telemetry(0).unwrap().position, [0.0, 50.0, 30.0]);
-    let id = start(&mut fleet, 0, "ReturnToLaunch", &[]);
+    let id = start(&mut fleet, 0, Function::ReturnToLaunch, &[]);
     let run = run_until(&mut fleet, 0, id, 200.0);
     assert!(run.samples.iter().all(|t| t.position[2] <= 30.0));
     let t = fleet.telemetry(0).unwrap();
     assert_eq!((t.position, t.state), ([0.0, 0.0, 0.0], FlightState::Landed));
-    let (_, reason) = refused(&mut fleet, 0, "TakeOff", &[num(10.0)]);
+    let (_, reason) = refused(&mut fleet, 0, Function::TakeOff, &[num(10.0)]);
     assert!(reason.contains("not armed"), "landing disarms: {reason}");
     // From low down, the return climbs to 10 m first.
     let mut fleet = airborne(&w, 3.0);
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(40.0, 0.0)]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(40.0, 0.0)]);
     run_until(&mut fleet, 0, id, 60.0);
-    let id = start(&mut fleet, 0, "ReturnToLaunch", &[]);
+    let id = start(&mut fleet, 0, Function::ReturnToLaunch, &[]);
     let run = run_until(&mut fleet, 0, id, 200.0);
     let top = run.samples.iter().map(|t| t.position[2]).fold(0.0, f64::max);
     assert_eq!(top, 10.0);
@@ -76,24 +85,24 @@ fn hover_waits_and_return_to_launch_lands_at_home_disarmed() {
 fn payload_rules() {
     let w = one_drone();
     let mut fleet = Fleet::new(&w);
-    let (_, reason) = refused(&mut fleet, 0, "LoadPayload", &[sym("Radiation")]);
+    let (_, reason) = refused(&mut fleet, 0, Function::LoadPayload, &[sym("Radiation")]);
     assert!(reason.contains("cannot carry Radiation"), "{reason}");
-    let (_, reason) = refused(&mut fleet, 0, "ReleasePayload", &[]);
+    let (_, reason) = refused(&mut fleet, 0, Function::ReleasePayload, &[]);
     assert!(reason.contains("carries nothing"), "{reason}");
-    let id = start(&mut fleet, 0, "LoadPayload", &[sym("Body")]);
+    let id = start(&mut fleet, 0, Function::LoadPayload, &[sym("Body")]);
     let run = run_until(&mut fleet, 0, id, 10.0);
     assert_eq!(run.end, CallEnd::Done);
     assert!((run.took - LOAD_TIME).abs() < 1e-9);
     assert_eq!(fleet.carrying(0), Some("Body"));
-    let (_, reason) = refused(&mut fleet, 0, "LoadPayload", &[sym("Body")]);
+    let (_, reason) = refused(&mut fleet, 0, Function::LoadPayload, &[sym("Body")]);
     assert!(reason.contains("already carries Body"), "{reason}");
     // Release in flight, at the drone's position, and logged.
-    instant(&mut fleet, 0, "Arm", &[]);
-    let id = start(&mut fleet, 0, "TakeOff", &[num(20.0)]);
+    instant(&mut fleet, 0, Function::Arm, &[]);
+    let id = start(&mut fleet, 0, Function::TakeOff, &[num(20.0)]);
     run_until(&mut fleet, 0, id, 60.0);
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos3(30.0, 40.0, 3.0)]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos3(30.0, 40.0, 3.0)]);
     run_until(&mut fleet, 0, id, 60.0);
-    assert_eq!(instant(&mut fleet, 0, "ReleasePayload", &[]), CallEnd::Done);
+    assert_eq!(instant(&mut fleet, 0, Function::ReleasePayload, &[]), CallEnd::Done);
     let release = &fleet.releases()[0];
     assert_eq!(
         (release.drone, release.kind.as_str(), release.position),
@@ -101,16 +110,16 @@ fn payload_rules() {
     );
     assert_eq!(release.time, fleet.time());
     // Loading at 3 m is fine; at 20 m it is too high.
-    let id = start(&mut fleet, 0, "LoadPayload", &[sym("Body")]);
+    let id = start(&mut fleet, 0, Function::LoadPayload, &[sym("Body")]);
     run_until(&mut fleet, 0, id, 10.0);
-    instant(&mut fleet, 0, "ReleasePayload", &[]);
-    let id = start(&mut fleet, 0, "AscendTo", &[num(20.0)]);
+    instant(&mut fleet, 0, Function::ReleasePayload, &[]);
+    let id = start(&mut fleet, 0, Function::AscendTo, &[num(20.0)]);
     run_until(&mut fleet, 0, id, 60.0);
-    let (_, reason) = refused(&mut fleet, 0, "LoadPayload", &[sym("Body")]);
+    let (_, reason) = refused(&mut fleet, 0, Function::LoadPayload, &[sym("Body")]);
     assert!(reason.contains("below 5 m"), "{reason}");
     // An aborted load leaves the drone empty-handed.
     let mut fleet = Fleet::new(&w);
-    let id = start(&mut fleet, 0, "LoadPayload", &[sym("Body")]);
+    let id = start(&mut fleet, 0, Function::LoadPayload, &[sym("Body")]);
     fleet.step(DT);
     assert_eq!(fleet.interrupt(id, Interrupt::Abort), Some(CallEnd::Interrupted));
     assert_eq!(fleet.carrying(0), None);
@@ -121,24 +130,24 @@ fn geofence_and_ceiling_refuse_at_once_without_moving() {
     let w = one_drone();
     let mut fleet = airborne(&w, 20.0);
     let before = fleet.telemetry(0).unwrap();
-    let cases: Vec<(&str, Vec<Value>)> = vec![
-        ("FlyToPosition", vec![pos(1500.0, 0.0)]),
-        ("FlyToPosition", vec![pos3(10.0, 0.0, 150.0)]),
-        ("AscendTo", vec![num(121.0)]),
-        ("TakeOff", vec![num(200.0)]),
-        ("Orbit", vec![pos(900.0, 0.0), num(200.0)]),
+    let cases: Vec<(Function, Vec<Value>)> = vec![
+        (Function::FlyToPosition, vec![pos(1500.0, 0.0)]),
+        (Function::FlyToPosition, vec![pos3(10.0, 0.0, 150.0)]),
+        (Function::AscendTo, vec![num(121.0)]),
+        (Function::TakeOff, vec![num(200.0)]),
+        (Function::Orbit, vec![pos(900.0, 0.0), num(200.0)]),
         (
-            "Sweep",
+            Function::Sweep,
             vec![
                 Value::Area(vec![[900.0, 0.0], [1100.0, 0.0], [1100.0, 100.0], [900.0, 100.0]]),
                 num(20.0),
             ],
         ),
-        ("FollowPath", vec![pos(100.0, 0.0), pos(100.0, 1200.0)]),
+        (Function::FollowPath, vec![pos(100.0, 0.0), pos(100.0, 1200.0)]),
     ];
     for (f, args) in cases {
         let (exception, reason) = refused(&mut fleet, 0, f, &args);
-        assert_eq!(exception, "GeofenceViolation", "{f}: {reason}");
+        assert_eq!(exception, BuiltinException::GeofenceViolation, "{f}: {reason}");
     }
     run_for(&mut fleet, 2.0);
     let after = fleet.telemetry(0).unwrap();
@@ -154,9 +163,12 @@ fn geofence_and_ceiling_refuse_at_once_without_moving() {
         [-10.0, 100.0],
     ]);
     let mut fleet = airborne(&w, 20.0);
-    let id = start(&mut fleet, 0, "FlyToPosition", &[pos(90.0, 0.0)]);
+    let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(90.0, 0.0)]);
     run_until(&mut fleet, 0, id, 60.0);
-    assert_eq!(refused(&mut fleet, 0, "FlyToPosition", &[pos(0.0, 90.0)]).0, "GeofenceViolation");
+    assert_eq!(
+        refused(&mut fleet, 0, Function::FlyToPosition, &[pos(0.0, 90.0)]).0,
+        BuiltinException::GeofenceViolation
+    );
 }
 
 #[test]
@@ -165,13 +177,13 @@ fn camera_and_sensors_are_needed() {
         "[drones.plain]\nhome = [0, 0]\n[drones.cam]\nhome = [5, 0]\nsensors = [\"camera\"]\n",
     );
     let mut fleet = Fleet::new(&w);
-    let (_, reason) = refused(&mut fleet, 0, "StartStreaming", &[]);
+    let (_, reason) = refused(&mut fleet, 0, Function::StartStreaming, &[]);
     assert!(reason.contains("no camera"), "{reason}");
-    assert_eq!(instant(&mut fleet, 1, "StartStreaming", &[]), CallEnd::Done);
+    assert_eq!(instant(&mut fleet, 1, Function::StartStreaming, &[]), CallEnd::Done);
     assert!(fleet.streaming(1));
-    assert_eq!(instant(&mut fleet, 1, "StopStreaming", &[]), CallEnd::Done);
+    assert_eq!(instant(&mut fleet, 1, Function::StopStreaming, &[]), CallEnd::Done);
     assert!(!fleet.streaming(1));
-    let (_, reason) = refused(&mut fleet, 1, "StartDetection", &[sym("Body")]);
+    let (_, reason) = refused(&mut fleet, 1, Function::StartDetection, &[sym("Body")]);
     assert!(reason.contains("no sensor that detects Body"), "{reason}");
 }
 
@@ -203,8 +215,8 @@ kind = "motor_failure"
     let mut fleet = Fleet::new(&w);
     let mut calls = Vec::new();
     for d in 0..3 {
-        instant(&mut fleet, d, "Arm", &[]);
-        calls.push(start(&mut fleet, d, "TakeOff", &[num(30.0)]));
+        instant(&mut fleet, d, Function::Arm, &[]);
+        calls.push(start(&mut fleet, d, Function::TakeOff, &[num(30.0)]));
     }
     let reports = run_for(&mut fleet, 4.9);
     assert!(reports.iter().all(|r| !matches!(r, Report::Event(_))));
@@ -212,9 +224,11 @@ kind = "motor_failure"
     for r in run_for(&mut fleet, 30.0) {
         match r {
             Report::Event(DroneEvent::Fault { drone, failure }) => {
-                seen.push((drone, failure.exception))
+                seen.push((drone, failure.exception.name()))
             }
-            Report::Event(DroneEvent::Signal { drone, name }) => seen.push((drone, name)),
+            Report::Event(DroneEvent::Signal { drone, signal }) => {
+                seen.push((drone, signal.name()))
+            }
             Report::Ended { call, end } => assert_eq!(end, CallEnd::Interrupted, "{call:?}"),
             Report::Event(other) => panic!("{other:?}"),
         }
@@ -226,6 +240,6 @@ kind = "motor_failure"
     assert_eq!(fleet.telemetry(1).unwrap().state, FlightState::Lost);
     let c = fleet.telemetry(2).unwrap();
     assert_eq!((c.state, c.position[2]), (FlightState::Landed, 0.0), "emergency landing");
-    assert_eq!(refused(&mut fleet, 2, "Arm", &[]).0, "CommandFailed");
+    assert_eq!(refused(&mut fleet, 2, Function::Arm, &[]).0, BuiltinException::CommandFailed);
     assert!(fleet.telemetry(0).unwrap().link);
 }

@@ -24,10 +24,10 @@ fn go(world: &World, alt: f64, targets: &[[f64; 2]]) -> Flight {
         .iter()
         .map(|t| {
             vec![
-                call("Arm", &[]),
-                call("TakeOff", &[num(alt)]),
+                call(Function::Arm, &[]),
+                call(Function::TakeOff, &[num(alt)]),
                 Act::At(10.0),
-                call("FlyToPosition", &[pos(t[0], t[1])]),
+                call(Function::FlyToPosition, &[pos(t[0], t[1])]),
             ]
         })
         .collect();
@@ -141,7 +141,9 @@ fn different_speeds_head_on_crossing_and_overtaking() {
 #[test]
 fn take_off_side_by_side_at_exactly_the_separation() {
     let w = drones(&[("a", [0.0, 0.0], ""), ("b", [5.0, 0.0], ""), ("c", [0.0, 5.0], "")]);
-    let scripts = (0..3).map(|_| vec![call("Arm", &[]), call("TakeOff", &[num(20.0)])]).collect();
+    let scripts = (0..3)
+        .map(|_| vec![call(Function::Arm, &[]), call(Function::TakeOff, &[num(20.0)])])
+        .collect();
     let f = fly(&w, scripts, 60.0);
     assert_eq!(f.closest, 5.0);
     // Side by side climbs are not in each other's way: all three take the plain time.
@@ -153,9 +155,9 @@ fn take_off_side_by_side_at_exactly_the_separation() {
 /// The paper's world, with calls like the mission's: several drones take off from homes
 /// 5 m apart, fly out, two beacon drones cross near home, and all return together.
 fn paper_flight(world: &World) -> Flight {
-    let to = |x: f64, y: f64| call("FlyToPosition", &[pos(x, y)]);
-    let up = |alt: f64| vec![call("Arm", &[]), call("TakeOff", &[num(alt)])];
-    let back = [Act::At(70.0), call("ReturnToLaunch", &[])];
+    let to = |x: f64, y: f64| call(Function::FlyToPosition, &[pos(x, y)]);
+    let up = |alt: f64| vec![call(Function::Arm, &[]), call(Function::TakeOff, &[num(alt)])];
+    let back = [Act::At(70.0), call(Function::ReturnToLaunch, &[])];
     let with = |mut first: Vec<Act>, rest: &[Act]| {
         first.extend_from_slice(rest);
         first.extend_from_slice(&back);
@@ -172,8 +174,8 @@ fn paper_flight(world: &World) -> Flight {
         with(later(8.0, 10.0), &[to(200.0, 325.0)]),
         with(later(8.0, 10.0), &[to(-250.0, -25.0)]),
         with(up(10.0), &[to(0.0, -300.0)]),
-        with(later(20.0, 10.0), &[to(20.0, -20.0), call("DescendTo", &[num(3.0)])]),
-        with(later(20.0, 10.0), &[to(-20.0, -20.0), call("DescendTo", &[num(3.0)])]),
+        with(later(20.0, 10.0), &[to(20.0, -20.0), call(Function::DescendTo, &[num(3.0)])]),
+        with(later(20.0, 10.0), &[to(-20.0, -20.0), call(Function::DescendTo, &[num(3.0)])]),
     ];
     fly(world, scripts, 400.0)
 }
@@ -267,16 +269,21 @@ fn random_crowds_keep_separation_and_all_finish() {
                     ([rnd.metres(50.0), rnd.metres(50.0)], [rnd.metres(50.0), rnd.metres(50.0)]);
                 let mut s = vec![
                     Act::At((rnd.next() * 20.0).round()),
-                    call("Arm", &[]),
-                    call("TakeOff", &[num(alt)]),
-                    call("FlyToPosition", &[pos(a[0], a[1])]),
+                    call(Function::Arm, &[]),
+                    call(Function::TakeOff, &[num(alt)]),
+                    call(Function::FlyToPosition, &[pos(a[0], a[1])]),
                 ];
                 s.push(match (rnd.next() * 3.0) as usize {
-                    0 => call("Orbit", &[pos(b[0], b[1]), num(20.0 + rnd.metres(10.0) + 10.0)]),
-                    1 => call("FollowPath", &[pos(b[0], b[1]), pos3(a[0], b[1], alt + 5.0)]),
-                    _ => call("Hover", &[num(5.0)]),
+                    0 => call(
+                        Function::Orbit,
+                        &[pos(b[0], b[1]), num(20.0 + rnd.metres(10.0) + 10.0)],
+                    ),
+                    1 => {
+                        call(Function::FollowPath, &[pos(b[0], b[1]), pos3(a[0], b[1], alt + 5.0)])
+                    }
+                    _ => call(Function::Hover, &[num(5.0)]),
                 });
-                s.push(call("ReturnToLaunch", &[]));
+                s.push(call(Function::ReturnToLaunch, &[]));
                 s
             })
             .collect();
@@ -292,12 +299,12 @@ fn same_point(site: &str) -> (Fleet, Vec<(CallEnd, f64)>, Vec<Telemetry>) {
     let w = world(&format!("{site}\n[drones.a]\nhome = [0, 0]\n\n[drones.b]\nhome = [10, 0]\n"));
     let mut fleet = Fleet::new(&w);
     for d in 0..2 {
-        assert_eq!(instant(&mut fleet, d, "Arm", &[]), CallEnd::Done);
-        start(&mut fleet, d, "TakeOff", &[num(20.0)]);
+        assert_eq!(instant(&mut fleet, d, Function::Arm, &[]), CallEnd::Done);
+        start(&mut fleet, d, Function::TakeOff, &[num(20.0)]);
     }
     run_for(&mut fleet, 10.0);
     let calls: Vec<CallId> =
-        (0..2).map(|d| start(&mut fleet, d, "FlyToPosition", &[pos(0.0, 100.0)])).collect();
+        (0..2).map(|d| start(&mut fleet, d, Function::FlyToPosition, &[pos(0.0, 100.0)])).collect();
     let mut ends: Vec<Option<(CallEnd, f64)>> = vec![None, None];
     let mut log = Vec::new();
     while ends.iter().any(Option::is_none) && fleet.time() < 200.0 {
@@ -344,7 +351,7 @@ fn two_drones_sent_to_the_same_point_the_second_times_out_and_hovers() {
     // got nearer, its call ends with `Timeout`.
     let (end, at) = &ends[1];
     let CallEnd::Failed(failure) = end else { panic!("{end:?}") };
-    assert_eq!(failure.exception, "Timeout");
+    assert_eq!(failure.exception, BuiltinException::Timeout);
     assert_eq!(failure.reason, "b waited 30 s for a to make room");
     let waited = at - last_gain(&log, *at);
     assert!((29.99..31.0).contains(&waited), "{waited}");
@@ -358,7 +365,7 @@ fn two_drones_sent_to_the_same_point_the_second_times_out_and_hovers() {
     assert!(apart(&held) >= 5.0, "{held:?}");
     run_for(&mut fleet, 10.0);
     assert_eq!(fleet.telemetry(1).unwrap().position, held.position);
-    let id = start(&mut fleet, 1, "FlyToPosition", &[pos(10.0, 0.0)]);
+    let id = start(&mut fleet, 1, Function::FlyToPosition, &[pos(10.0, 0.0)]);
     assert_eq!(run_until(&mut fleet, 1, id, 60.0).end, CallEnd::Done);
 }
 
@@ -369,7 +376,7 @@ fn the_separation_timeout_is_the_sites() {
     let (end, at) = &ends[1];
     match end {
         CallEnd::Failed(f) => {
-            assert_eq!(f.exception, "Timeout");
+            assert_eq!(f.exception, BuiltinException::Timeout);
             assert_eq!(f.reason, "b waited 5 s for a to make room");
         }
         other => panic!("{other:?}"),

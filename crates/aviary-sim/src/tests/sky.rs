@@ -3,7 +3,7 @@
 
 use std::collections::VecDeque;
 
-use aviary_api::{CallEnd, CallId, Telemetry, Value};
+use aviary_api::{CallEnd, CallId, Function, Telemetry, Value};
 use aviary_world::World;
 
 use super::DT;
@@ -15,10 +15,10 @@ pub(crate) enum Act {
     /// Wait until this simulated time.
     At(f64),
     /// Call a function and wait until it is done (it must end `Done`).
-    Call(&'static str, Vec<Value>),
+    Call(Function, Vec<Value>),
 }
 
-pub(crate) fn call(f: &'static str, args: &[Value]) -> Act {
+pub(crate) fn call(f: Function, args: &[Value]) -> Act {
     Act::Call(f, args.to_vec())
 }
 
@@ -61,7 +61,7 @@ pub(crate) fn fly(world: &World, scripts: Vec<Vec<Act>>, limit: f64) -> Flight {
     let mut fleet = Fleet::new(world);
     let mut todo: Vec<VecDeque<Act>> = scripts.into_iter().map(VecDeque::from).collect();
     todo.resize(fleet.len(), VecDeque::new());
-    let mut waiting: Vec<Option<(CallId, &'static str)>> = vec![None; fleet.len()];
+    let mut waiting: Vec<Option<(CallId, Function)>> = vec![None; fleet.len()];
     let mut finished = vec![f64::NAN; fleet.len()];
     let mut log = Vec::new();
     let mut reports = Vec::new();

@@ -36,16 +36,16 @@ kind = "crash"
 fn fly(mut fleet: Fleet) -> Vec<String> {
     let mut seen = Vec::new();
     for d in 0..fleet.len() {
-        seen.push(format!("{:?}", fleet.call(d, "Arm", &[])));
-        seen.push(format!("{:?}", fleet.call(d, "TakeOff", &[num(10.0)])));
+        seen.push(format!("{:?}", fleet.call(d, Function::Arm, &[])));
+        seen.push(format!("{:?}", fleet.call(d, Function::TakeOff, &[num(10.0)])));
     }
     for step in 0..1200 {
         if step == 200 {
             for d in 0..fleet.len() {
-                seen.push(format!("{:?}", fleet.call(d, "StartDetection", &[sym("Body")])));
+                seen.push(format!("{:?}", fleet.call(d, Function::StartDetection, &[sym("Body")])));
                 seen.push(format!(
                     "{:?}",
-                    fleet.call(d, "FlyToPosition", &[pos(d as f64 * 30.0, 150.0)])
+                    fleet.call(d, Function::FlyToPosition, &[pos(d as f64 * 30.0, 150.0)])
                 ));
             }
         }

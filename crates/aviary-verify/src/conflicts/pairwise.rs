@@ -120,7 +120,8 @@ fn handler_and_item(
     let signal = info.signal;
     // A drone's link comes back only after it was lost, and the loss aborted what the
     // drone was doing: its own restore handler does not race with that.
-    if mission.signals[signal] == "ConnectionRestored" && info.by.as_deref() == Some(&[drone]) {
+    let restored = mission.builtins.signal(aviary_api::BuiltinSignal::ConnectionRestored);
+    if signal == restored && info.by.as_deref() == Some(&[drone]) {
         return None;
     }
     let prefix = &at[..at.len() - 1];

@@ -92,7 +92,7 @@ pub struct Estimator<'m> {
     /// Per capability, the actor slots whose motion it claims (asked at every call).
     motion: Vec<std::rc::Rc<[usize]>>,
     /// The built-in `Detected` signal, when the mission can hear it.
-    detected: Option<SignalId>,
+    detected: SignalId,
     /// Capability calls the walk may still follow ([`call_budget`]), and whether it ran out.
     budget: usize,
     cut_short: bool,
@@ -141,7 +141,7 @@ impl<'m> Estimator<'m> {
                         .into()
                 })
                 .collect(),
-            detected: mission.signals.iter().position(|s| s == "Detected"),
+            detected: mission.builtins.signal(aviary_api::BuiltinSignal::Detected),
             budget: call_budget(mission),
             cut_short: false,
             blank: Vec::new(),
@@ -545,8 +545,7 @@ impl<'m> Estimator<'m> {
     fn api(&mut self, a: &ApiCall, ctx: &Ctx, t: f64) -> (f64, Vec<Raise>) {
         let Some(d) = self.scope(ctx, t).actor(&a.actor) else { return (t, Vec::new()) };
         let args: Vec<Option<Value>> = a.args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
-        let name = self.mission.functions[a.function].0.as_str();
-        let (duration, raises) = super::flight::fly(self, d, name, &args, ctx.statement, t);
+        let (duration, raises) = super::flight::fly(self, d, a.function, &args, ctx.statement, t);
         let end = t + duration;
         let f = &self.s.drones[d];
         if f.battery_at(end) < super::RESERVE && self.s.reserve[d].is_none() {
@@ -565,7 +564,7 @@ impl<'m> Estimator<'m> {
         t: f64,
         duration: f64,
     ) -> Vec<Raise> {
-        let Some(detected) = self.detected else { return Vec::new() };
+        let detected = self.detected;
         let mut out = Vec::new();
         for (kind, range, found) in self.s.drones[d].detecting.iter_mut() {
             for (i, target) in self.world.targets.iter().enumerate() {

@@ -1,7 +1,7 @@
 //! Each middle-layer function's cost in the estimate (docs/LANGUAGE.md, section 19), as the simulator
 //! flies it.
 
-use aviary_api::{DroneId, Value};
+use aviary_api::{DroneId, Function, Value};
 use aviary_ir::Origin;
 
 use super::estimate::{number_arg, Estimator, Raise};
@@ -11,7 +11,7 @@ use aviary_api::flight::LOAD_TIME;
 pub fn fly(
     e: &mut Estimator,
     d: DroneId,
-    function: &str,
+    function: Function,
     args: &[Option<Value>],
     at: Option<Origin>,
     t: f64,
@@ -19,33 +19,33 @@ pub fn fly(
     let max_altitude = e.world.site.max_altitude;
     let mut raises = Vec::new();
     let duration = match function {
-        "TakeOff" => {
+        Function::TakeOff => {
             let alt = number_arg(args, 0).unwrap_or(10.0);
             let f = &mut e.s.drones[d];
             f.take_off(t);
             f.leg([f.pos[0], f.pos[1], alt])
         }
-        "Land" => {
+        Function::Land => {
             let f = &mut e.s.drones[d];
             let took = f.land_here();
             f.land(t + took);
             took
         }
-        "ReturnToLaunch" => {
+        Function::ReturnToLaunch => {
             let f = &mut e.s.drones[d];
             let took = f.return_home(max_altitude);
             f.land(t + took);
             took
         }
-        "DescendTo" | "AscendTo" => match number_arg(args, 0) {
+        Function::DescendTo | Function::AscendTo => match number_arg(args, 0) {
             Some(alt) => {
                 let f = &mut e.s.drones[d];
                 f.leg([f.pos[0], f.pos[1], alt])
             }
             None => 0.0,
         },
-        "Hover" => number_arg(args, 0).unwrap_or(0.0),
-        "FlyToPosition" => {
+        Function::Hover => number_arg(args, 0).unwrap_or(0.0),
+        Function::FlyToPosition => {
             let Some(to) = e.position_arg(args.first().unwrap_or(&None), d, at) else {
                 return (0.0, raises);
             };
@@ -53,7 +53,7 @@ pub fn fly(
             let speed = number_arg(args, 1).map_or(f.max_speed, |s| s.min(f.max_speed));
             leg(e, d, to, speed, t, &mut raises)
         }
-        "Orbit" => {
+        Function::Orbit => {
             let center = e.position_arg(args.first().unwrap_or(&None), d, at);
             let radius = number_arg(args, 1);
             match (center, radius) {
@@ -63,7 +63,7 @@ pub fn fly(
                 _ => 0.0,
             }
         }
-        "Sweep" => match (args.first(), number_arg(args, 1)) {
+        Function::Sweep => match (args.first(), number_arg(args, 1)) {
             (Some(Some(Value::Area(area))), Some(spacing)) => {
                 let z = e.s.drones[d].pos[2];
                 let mut took = 0.0;
@@ -75,7 +75,7 @@ pub fn fly(
             }
             _ => 0.0,
         },
-        "FollowPath" => {
+        Function::FollowPath => {
             let mut took = 0.0;
             for v in args {
                 if let Some(to) = e.position_arg(v, d, at) {
@@ -85,7 +85,7 @@ pub fn fly(
             }
             took
         }
-        "StartDetection" => {
+        Function::StartDetection => {
             if let Some(Some(Value::Symbol(kind))) = args.first() {
                 let f = &e.s.drones[d];
                 let range = e
@@ -103,15 +103,18 @@ pub fn fly(
             }
             0.0
         }
-        "StopDetection" => {
+        Function::StopDetection => {
             if let Some(Some(Value::Symbol(kind))) = args.first() {
                 e.s.drones[d].detecting.retain(|(k, _, _)| k != kind);
             }
             0.0
         }
-        "LoadPayload" => LOAD_TIME,
-        // Arm, Disarm, streaming, ReleasePayload and a backend's own functions: at once.
-        _ => 0.0,
+        Function::LoadPayload => LOAD_TIME,
+        Function::Arm
+        | Function::Disarm
+        | Function::StartStreaming
+        | Function::StopStreaming
+        | Function::ReleasePayload => 0.0,
     };
     (duration, raises)
 }

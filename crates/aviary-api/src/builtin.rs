@@ -1,0 +1,121 @@
+//! The built-in signals and exceptions (docs/LANGUAGE.md, sections 16 and 17): what the
+//! middle layer raises on a drone without being asked. Closed sets, as the functions are:
+//! a backend raises one of these variants, never a name, so the compiler resolves each
+//! one to the mission's id once and the engine looks nothing up at run time.
+
+use crate::Kind;
+
+/// A signal the middle layer raises on an actor.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum BuiltinSignal {
+    /// A find of a sensor whose detection the actor's activity started; it carries the
+    /// kind and where. A backend reports it as [`crate::DroneEvent::Detected`].
+    Detected,
+    BatteryLow,
+    ConnectionRestored,
+}
+
+impl BuiltinSignal {
+    pub const ALL: [BuiltinSignal; 3] =
+        [BuiltinSignal::Detected, BuiltinSignal::BatteryLow, BuiltinSignal::ConnectionRestored];
+
+    /// The name a mission hears it by.
+    pub fn name(self) -> &'static str {
+        match self {
+            BuiltinSignal::Detected => "Detected",
+            BuiltinSignal::BatteryLow => "BatteryLow",
+            BuiltinSignal::ConnectionRestored => "ConnectionRestored",
+        }
+    }
+
+    /// The values it carries, with their kinds (`ON Detected WITH kind, location`).
+    pub fn values(self) -> &'static [(&'static str, Kind)] {
+        match self {
+            BuiltinSignal::Detected => &[("kind", Kind::Symbol), ("location", Kind::Position)],
+            BuiltinSignal::BatteryLow | BuiltinSignal::ConnectionRestored => &[],
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<BuiltinSignal> {
+        BuiltinSignal::ALL.into_iter().find(|s| s.name() == name)
+    }
+}
+
+/// An exception the middle layer raises: a fault of the drone, or a call it refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum BuiltinException {
+    BatteryCritical,
+    ConnectionLost,
+    DroneLost,
+    MotorFailure,
+    PositionLost,
+    GeofenceViolation,
+    CommandFailed,
+    RequirementNotMet,
+    Timeout,
+}
+
+impl BuiltinException {
+    pub const ALL: [BuiltinException; 9] = [
+        BuiltinException::BatteryCritical,
+        BuiltinException::ConnectionLost,
+        BuiltinException::DroneLost,
+        BuiltinException::MotorFailure,
+        BuiltinException::PositionLost,
+        BuiltinException::GeofenceViolation,
+        BuiltinException::CommandFailed,
+        BuiltinException::RequirementNotMet,
+        BuiltinException::Timeout,
+    ];
+
+    /// The name a mission handles it by (`ON EXCEPTION BatteryCritical`).
+    pub fn name(self) -> &'static str {
+        match self {
+            BuiltinException::BatteryCritical => "BatteryCritical",
+            BuiltinException::ConnectionLost => "ConnectionLost",
+            BuiltinException::DroneLost => "DroneLost",
+            BuiltinException::MotorFailure => "MotorFailure",
+            BuiltinException::PositionLost => "PositionLost",
+            BuiltinException::GeofenceViolation => "GeofenceViolation",
+            BuiltinException::CommandFailed => "CommandFailed",
+            BuiltinException::RequirementNotMet => "RequirementNotMet",
+            BuiltinException::Timeout => "Timeout",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<BuiltinException> {
+        BuiltinException::ALL.into_iter().find(|e| e.name() == name)
+    }
+}
+
+impl std::fmt::Display for BuiltinSignal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::fmt::Display for BuiltinException {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_builtin_is_listed_once_and_spelt_as_its_variant() {
+        for (i, s) in BuiltinSignal::ALL.iter().enumerate() {
+            assert_eq!(*s as usize, i, "{s:?}");
+            assert_eq!(format!("{s:?}"), s.name());
+            assert_eq!(BuiltinSignal::from_name(s.name()), Some(*s));
+        }
+        for (i, e) in BuiltinException::ALL.iter().enumerate() {
+            assert_eq!(*e as usize, i, "{e:?}");
+            assert_eq!(format!("{e:?}"), e.name());
+            assert_eq!(BuiltinException::from_name(e.name()), Some(*e));
+        }
+        assert_eq!(BuiltinException::from_name("Nope"), None);
+    }
+}

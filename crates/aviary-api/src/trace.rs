@@ -1,0 +1,254 @@
+//! The trace's events (docs/TRACE.md), typed: the engine makes them, and every reader
+//! (the trace file, the operator API, a ground station, a replay) reads the same type.
+//! JSON exists only at the edges: a [`Record`] serialises to one line of the trace file,
+//! `{"t": …, "event": kind, fields…}`, byte for byte as docs/TRACE.md shows it, and
+//! deserialises back from one.
+//!
+//! One type serves both sides, a borrowed enum whose owned form is `Record<'static>`.
+//! Its text is `Cow<'a, str>` and its areas `Cow<'a, [..]>`: the engine borrows them from
+//! the compiled mission and the run (a drone's name, a block's path, a value's text), so
+//! making an event copies no string, and a sink that looks at a field or two matches on
+//! the event and reads it where it is, with no JSON map; what is read back from a file
+//! owns its text. What an event allocates is its list of values (`args`), and text made
+//! for it alone (the names of an activity's several drones, an exception handler's path);
+//! and an event is made only for a sink that wants its kind ([`EventKind`], asked once
+//! per kind when a run starts).
+
+mod shown;
+
+use std::borrow::Cow;
+
+use serde::{Deserialize, Serialize};
+
+use crate::{FlightState, Function};
+pub use shown::{Params, Shown};
+
+/// One line of the trace: when, and what happened.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Record<'a> {
+    /// Seconds of mission time since the start.
+    #[serde(deserialize_with = "shown::number")]
+    pub t: f64,
+    #[serde(flatten)]
+    pub event: Event<'a>,
+}
+
+/// Text an event borrows from the run, or owns once read back.
+pub type Text<'a> = Cow<'a, str>;
+
+/// What happened (docs/TRACE.md, "Every event"). The fields are in the order the trace
+/// writes them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "event", rename_all = "snake_case")]
+pub enum Event<'a> {
+    MissionStart {
+        mission: Text<'a>,
+    },
+    MissionEnd {
+        status: Status,
+        reason: Option<Text<'a>>,
+    },
+    BlockStart {
+        block: Text<'a>,
+    },
+    /// `status` is `ok`, or `aborted` when an exception stopped the block.
+    BlockEnd {
+        block: Text<'a>,
+        status: Status,
+    },
+    /// `actor`: the drone, or the names of several separated by spaces.
+    CapabilityStart {
+        actor: Text<'a>,
+        capability: Text<'a>,
+        tag: Option<Text<'a>>,
+        args: Params<'a>,
+    },
+    CapabilityEnd {
+        actor: Text<'a>,
+        capability: Text<'a>,
+        tag: Option<Text<'a>>,
+        args: Params<'a>,
+        status: Status,
+    },
+    HandlerStart {
+        signal: Text<'a>,
+        handler: Text<'a>,
+        actor: Option<Text<'a>>,
+    },
+    HandlerEnd {
+        signal: Text<'a>,
+        handler: Text<'a>,
+        actor: Option<Text<'a>>,
+    },
+    ApiCall {
+        actor: Text<'a>,
+        function: Function,
+        args: Vec<Shown<'a>>,
+    },
+    ApiDone {
+        actor: Text<'a>,
+        function: Function,
+        args: Vec<Shown<'a>>,
+        status: CallStatus,
+        #[serde(deserialize_with = "shown::coordinates")]
+        position: [f64; 3],
+    },
+    Signal {
+        name: Text<'a>,
+        actor: Option<Text<'a>>,
+        args: Vec<Shown<'a>>,
+    },
+    /// `args` of a built-in exception: the reason, in words. `during` is `return home` for
+    /// a fault after the mission's body has ended, which no handler can take.
+    Exception {
+        name: Text<'a>,
+        actor: Option<Text<'a>>,
+        args: Vec<Shown<'a>>,
+        handled: bool,
+        handler: Option<Text<'a>>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        during: Option<Text<'a>>,
+    },
+    /// `action`: `PAUSE`, `RESUME`, `ABORT` or a section's name.
+    Leash {
+        capability: Text<'a>,
+        tag: Text<'a>,
+        action: Text<'a>,
+    },
+    Detection {
+        actor: Text<'a>,
+        kind: Text<'a>,
+        #[serde(deserialize_with = "shown::coordinates")]
+        location: [f64; 3],
+    },
+    Telemetry {
+        actor: Text<'a>,
+        #[serde(deserialize_with = "shown::coordinates")]
+        position: [f64; 3],
+        #[serde(deserialize_with = "shown::number")]
+        battery: f64,
+        state: FlightState,
+    },
+}
+
+/// How a mission, a block or an activity ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    Ok,
+    /// An exception nobody handled, a fault, a drone that did not come down.
+    Failed,
+    /// Stopped: by a leash, an exception elsewhere, or the operator.
+    Aborted,
+}
+
+impl Status {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Failed => "failed",
+            Status::Aborted => "aborted",
+        }
+    }
+}
+
+/// How a middle-layer call ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CallStatus {
+    Ok,
+    /// Refused: an exception follows.
+    Failed,
+    /// Cut by a fault of the drone.
+    Interrupted,
+    /// Its activity was stopped.
+    Aborted,
+}
+
+/// The kinds of event, so that what a sink wants is asked once per kind when the run
+/// starts, not at every event.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum EventKind {
+    MissionStart,
+    MissionEnd,
+    BlockStart,
+    BlockEnd,
+    CapabilityStart,
+    CapabilityEnd,
+    HandlerStart,
+    HandlerEnd,
+    ApiCall,
+    ApiDone,
+    Signal,
+    Exception,
+    Leash,
+    Detection,
+    Telemetry,
+}
+
+impl EventKind {
+    /// Every kind; `ALL[k as usize] == k`.
+    pub const ALL: [EventKind; 15] = [
+        EventKind::MissionStart,
+        EventKind::MissionEnd,
+        EventKind::BlockStart,
+        EventKind::BlockEnd,
+        EventKind::CapabilityStart,
+        EventKind::CapabilityEnd,
+        EventKind::HandlerStart,
+        EventKind::HandlerEnd,
+        EventKind::ApiCall,
+        EventKind::ApiDone,
+        EventKind::Signal,
+        EventKind::Exception,
+        EventKind::Leash,
+        EventKind::Detection,
+        EventKind::Telemetry,
+    ];
+
+    /// The trace's `event`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            EventKind::MissionStart => "mission_start",
+            EventKind::MissionEnd => "mission_end",
+            EventKind::BlockStart => "block_start",
+            EventKind::BlockEnd => "block_end",
+            EventKind::CapabilityStart => "capability_start",
+            EventKind::CapabilityEnd => "capability_end",
+            EventKind::HandlerStart => "handler_start",
+            EventKind::HandlerEnd => "handler_end",
+            EventKind::ApiCall => "api_call",
+            EventKind::ApiDone => "api_done",
+            EventKind::Signal => "signal",
+            EventKind::Exception => "exception",
+            EventKind::Leash => "leash",
+            EventKind::Detection => "detection",
+            EventKind::Telemetry => "telemetry",
+        }
+    }
+}
+
+impl Event<'_> {
+    pub fn kind(&self) -> EventKind {
+        match self {
+            Event::MissionStart { .. } => EventKind::MissionStart,
+            Event::MissionEnd { .. } => EventKind::MissionEnd,
+            Event::BlockStart { .. } => EventKind::BlockStart,
+            Event::BlockEnd { .. } => EventKind::BlockEnd,
+            Event::CapabilityStart { .. } => EventKind::CapabilityStart,
+            Event::CapabilityEnd { .. } => EventKind::CapabilityEnd,
+            Event::HandlerStart { .. } => EventKind::HandlerStart,
+            Event::HandlerEnd { .. } => EventKind::HandlerEnd,
+            Event::ApiCall { .. } => EventKind::ApiCall,
+            Event::ApiDone { .. } => EventKind::ApiDone,
+            Event::Signal { .. } => EventKind::Signal,
+            Event::Exception { .. } => EventKind::Exception,
+            Event::Leash { .. } => EventKind::Leash,
+            Event::Detection { .. } => EventKind::Detection,
+            Event::Telemetry { .. } => EventKind::Telemetry,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,127 @@
+//! What a backend raises reaches the mission as the built-in it is: every built-in
+//! exception, whether a call is refused with it or a fault reports it, is raised under its
+//! own name and taken by the handler of that name, and every built-in signal starts its
+//! handler. The compiler resolved each built-in's id, so the engine looks no name up.
+
+mod harness;
+
+use std::sync::Mutex;
+use std::time::Duration;
+
+use aviary_api::{
+    Backend, BuiltinException, BuiltinSignal, CallEnd, CallId, Descriptor, DroneEvent, DroneId,
+    Ending, Failure, FlightState, Function, Interrupt, PendingCall, Telemetry, Value,
+};
+use aviary_engine::{RunOptions, Status};
+use serde_json::Value as Json;
+use tokio::sync::{mpsc, oneshot};
+
+/// A backend that answers every call as it is told, and reports the drone events it is
+/// given: a drone on the ground that never moves.
+struct Scripted {
+    /// A call is refused with this exception; without one it ends after a second.
+    refuse: Option<BuiltinException>,
+    events: Mutex<Option<mpsc::UnboundedReceiver<DroneEvent>>>,
+}
+
+impl Scripted {
+    fn new(refuse: Option<BuiltinException>, events: Vec<DroneEvent>) -> Scripted {
+        let (tx, rx) = mpsc::unbounded_channel();
+        for e in events {
+            tx.send(e).expect("the receiver is here");
+        }
+        Scripted { refuse, events: Mutex::new(Some(rx)) }
+    }
+}
+
+impl Backend for Scripted {
+    fn descriptor(&self) -> Descriptor {
+        Descriptor::standard()
+    }
+
+    fn call(&self, _: DroneId, _: Function, _: &[Value]) -> PendingCall {
+        let end = match self.refuse {
+            Some(exception) => Ending::Now(CallEnd::Failed(Failure {
+                exception,
+                reason: format!("refused with {exception}"),
+            })),
+            None => {
+                let (tx, rx) = oneshot::channel();
+                tokio::spawn(async move {
+                    tokio::time::sleep(Duration::from_secs(1)).await;
+                    let _ = tx.send(CallEnd::Done);
+                });
+                Ending::Later(rx)
+            }
+        };
+        PendingCall { id: CallId(0), end }
+    }
+
+    fn interrupt(&self, _: CallId, _: Interrupt) {}
+
+    fn telemetry(&self, _: DroneId) -> Telemetry {
+        Telemetry { state: FlightState::Landed, link: true, battery: 1.0, ..Telemetry::LOST }
+    }
+
+    fn events(&self) -> Option<mpsc::UnboundedReceiver<DroneEvent>> {
+        self.events.lock().unwrap_or_else(|p| p.into_inner()).take()
+    }
+}
+
+fn run(mission: &str, backend: &Scripted) -> (Status, Vec<Json>) {
+    let (mission, _) = harness::compile(mission, harness::WORLD);
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_time()
+        .start_paused(true)
+        .build()
+        .expect("runtime");
+    let mut trace = Vec::new();
+    let mut sink = |r: &aviary_engine::Record| trace.push(harness::json(r));
+    let outcome =
+        runtime.block_on(aviary_engine::run(&mission, backend, &mut sink, &RunOptions::default()));
+    (outcome.status, trace)
+}
+
+fn signalled(trace: &[Json], name: &str) -> bool {
+    trace.iter().any(|e| e["event"] == "signal" && e["name"] == name)
+}
+
+#[test]
+fn a_call_refused_with_any_builtin_exception_raises_that_exception() {
+    for exception in BuiltinException::ALL {
+        let mission = format!(
+            "MISSION M:\n    SEQUENTIAL Try:\n        a Hover WITH 1s\n        ON EXCEPTION {exception} BY a:\n            SIGNAL Caught\n"
+        );
+        let (status, trace) = run(&mission, &Scripted::new(Some(exception), vec![]));
+        assert_eq!(status, Status::Ok, "{exception}: {trace:#?}");
+        let raised: Vec<&Json> = trace.iter().filter(|e| e["event"] == "exception").collect();
+        assert_eq!(raised.len(), 1, "{exception}: {trace:#?}");
+        assert_eq!(raised[0]["name"], exception.name());
+        assert_eq!(raised[0]["handled"], true);
+        assert_eq!(raised[0]["args"], serde_json::json!([format!("refused with {exception}")]));
+        assert!(signalled(&trace, "Caught"), "{exception}: the handler ran");
+    }
+}
+
+#[test]
+fn faults_and_signals_a_backend_reports_start_their_handlers() {
+    let events = vec![
+        DroneEvent::Signal { drone: 0, signal: BuiltinSignal::BatteryLow },
+        DroneEvent::Signal { drone: 0, signal: BuiltinSignal::ConnectionRestored },
+        DroneEvent::Fault {
+            drone: 0,
+            failure: Failure { exception: BuiltinException::MotorFailure, reason: "motor".into() },
+        },
+    ];
+    let mission = "MISSION M:\n    PARALLEL Watch:\n        a Hover WITH 5s\n        ON BatteryLow BY a:\n            SIGNAL Low\n        ON ConnectionRestored BY a:\n            SIGNAL Back\n        ON EXCEPTION MotorFailure BY a:\n            SIGNAL Broken\n";
+    let (status, trace) = run(mission, &Scripted::new(None, events));
+    assert_eq!(status, Status::Ok, "{trace:#?}");
+    for name in ["BatteryLow", "ConnectionRestored", "Low", "Back", "Broken"] {
+        assert!(signalled(&trace, name), "{name}: {trace:#?}");
+    }
+    let e = trace.iter().find(|e| e["event"] == "exception").expect("an exception");
+    assert_eq!(
+        (&e["name"], &e["actor"], &e["handled"]),
+        (&"MotorFailure".into(), &"a".into(), &true.into())
+    );
+}

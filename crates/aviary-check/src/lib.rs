@@ -124,6 +124,47 @@ impl Program {
     }
 }
 
+/// From this size of mission text, the checker's passes run on two threads: below it, a
+/// thread costs more than it saves.
+const IN_PARALLEL_FROM: usize = 64 * 1024;
+
+/// What `a` and `b` give; with `parallel`, `b` runs on a second thread meanwhile. For
+/// passes that only read what they check, and write what they find to their own list.
+pub fn both<A: Send, B: Send>(
+    parallel: bool,
+    a: impl FnOnce() -> A + Send,
+    b: impl FnOnce() -> B + Send,
+) -> (A, B) {
+    if !parallel {
+        return (a(), b());
+    }
+    // Kept here rather than moved into the thread, so that `b` can still run here if no
+    // thread can be made.
+    let b = std::sync::Mutex::new(Some(b));
+    let take = || b.lock().ok().and_then(|mut b| b.take());
+    std::thread::scope(|s| {
+        let other =
+            std::thread::Builder::new().stack_size(STACK).spawn_scoped(s, || take().map(|b| b()));
+        let first = a();
+        let second = match other.map(|o| o.join()) {
+            Ok(Ok(Some(second))) => second,
+            Ok(Err(panicked)) => std::panic::resume_unwind(panicked),
+            // No thread could be made: `b` runs here.
+            _ => match take() {
+                Some(b) => b(),
+                None => unreachable!("`b` ran on the thread that failed to start"),
+            },
+        };
+        (first, second)
+    })
+}
+
+/// The stack the front end and the analyses need: they follow capability calls by
+/// recursion, and a mission may chain tens of thousands of capabilities. A thread that
+/// runs them (the command's, or the second of [`both`]) reserves this much; it is address
+/// space, used only as deep as a walk goes.
+pub const STACK: usize = 1 << 30;
+
 /// Checks the mission file `root` (already in `sources`): its program, and every problem.
 pub fn check(
     sources: &mut SourceMap,
@@ -140,15 +181,29 @@ pub fn check(
     (program.param_kinds, program.param_origins) = infer::parameter_kinds(&program, api);
     program.signal_values = signal_values::signal_values(&program, api);
     if syntax_ok {
-        walk::check_program(&program, world, api, root, &mut diagnostics);
-        signals::check_signals(&program, api, &mut diagnostics);
-        if let Some(world) = world {
-            geofence::check_geofence(&program, world, &mut diagnostics);
-            endurance::check_endurance(&program, world, api, &mut diagnostics);
-        }
-        chains::check_chains(&program, api, &mut diagnostics);
-        recursion::check_recursion(&program, &mut diagnostics);
+        let program = &program;
+        let names = || {
+            let mut out = Vec::new();
+            walk::check_program(program, world, api, root, &mut out);
+            signals::check_signals(program, api, &mut out);
+            out
+        };
+        let walks = || {
+            let mut out = Vec::new();
+            if let Some(world) = world {
+                geofence::check_geofence(program, world, &mut out);
+                endurance::check_endurance(program, world, api, &mut out);
+            }
+            chains::check_chains(program, api, &mut out);
+            recursion::check_recursion(program, &mut out);
+            out
+        };
+        let large = sources.text(root).len() >= IN_PARALLEL_FROM;
+        let (found, more) = both(large, names, walks);
+        diagnostics.extend(found);
+        diagnostics.extend(more);
     }
+    // Sorted, so the order in which the passes ran does not show.
     aviary_diagnostics::sort(&mut diagnostics);
     diagnostics.dedup();
     (program, diagnostics)

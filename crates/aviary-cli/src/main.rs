@@ -164,10 +164,9 @@ fn folder(s: &str) -> Result<PathBuf, String> {
     nonempty(s, "a folder")
 }
 
-/// The stack the command runs on. The checker, the plan and the engine follow capability
-/// calls by recursion, and a mission may chain thousands of capabilities; the main
-/// thread's 8 MiB would overflow. The size is reserved, not used, until needed.
-const STACK: usize = 1 << 30;
+/// The stack the command runs on: the front end's (the engine also follows capability
+/// calls by recursion); the main thread's 8 MiB would overflow on a long chain.
+const STACK: usize = aviary_check::STACK;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();

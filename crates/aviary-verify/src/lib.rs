@@ -27,11 +27,27 @@ pub struct Verification {
 
 /// Every pre-flight analysis of `mission` on `world`.
 pub fn verify(mission: &Mission, world: &World) -> Verification {
-    let mut diagnostics = Vec::new();
-    conflicts::check_conflicts(mission, &mut diagnostics);
-    let plan = plan::estimate(mission, world, &mut diagnostics);
+    let conflicts = || {
+        let mut out = Vec::new();
+        conflicts::check_conflicts(mission, &mut out);
+        out
+    };
+    let plan = || {
+        let mut out = Vec::new();
+        let plan = plan::estimate(mission, world, &mut out);
+        (plan, out)
+    };
+    let (mut diagnostics, (plan, more)) = aviary_check::both(large(mission), conflicts, plan);
+    diagnostics.extend(more);
+    // Sorted, so the order in which the analyses ran does not show.
     aviary_diagnostics::sort(&mut diagnostics);
     Verification { diagnostics, plan }
+}
+
+/// From this many statements at the mission's top level and capabilities, the two analyses
+/// run on two threads: below it, a thread costs more than it saves.
+fn large(mission: &Mission) -> bool {
+    mission.body.items.len() + mission.capabilities.len() >= 1000
 }
 
 /// Compiles and verifies what the checker accepted: `None` when it has errors, no world

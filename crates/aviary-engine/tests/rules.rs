@@ -1,10 +1,30 @@
-//! One trace-based test per rule of the language's semantics (docs/LANGUAGE.md), asserting order and timing, on the
-//! built-in simulator with a paused clock (so every time below is simulated seconds).
+//! One trace-based test per rule of the language's semantics (docs/LANGUAGE.md), asserting
+//! order and timing, on the built-in simulator with a paused clock (so every time below is
+//! simulated seconds). The missions are files, `tests/rules/*.mission`, and each one's
+//! whole trace is a snapshot (`tests/snapshots/rules__traces@*.snap`).
 
 mod harness;
 
 use aviary_engine::Status;
 use harness::run;
+
+/// The mission of a rule: `tests/rules/NAME.mission`.
+fn fixture(name: &str) -> String {
+    let path = format!("{}/tests/rules/{name}.mission", env!("CARGO_MANIFEST_DIR"));
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+/// Every rule's whole trace, one event a line: the order and the time of every event, so
+/// that a change in what a rule does shows, event by event, in review. The tests below
+/// say which of those facts are the rule.
+#[test]
+fn traces() {
+    insta::glob!("rules/*.mission", |path| {
+        let mission = std::fs::read_to_string(path).expect("read the fixture");
+        let r = run(&mission);
+        insta::assert_snapshot!(format!("outcome: {:?}\n{}", r.outcome.status, r.dump()));
+    });
+}
 
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() < 0.11
@@ -12,8 +32,7 @@ fn close(a: f64, b: f64) -> bool {
 
 #[test]
 fn sequential_runs_children_one_after_another() {
-    let r =
-        run("MISSION M:\n    SEQUENTIAL S:\n        a Hover WITH 5s\n        b Hover WITH 3s\n");
+    let r = run(&fixture("sequential_runs_children_one_after_another"));
     assert_eq!(r.outcome.status, Status::Ok);
     let a_end = r.ends("Hover", "a")[0]["t"].as_f64().unwrap();
     let b_start = r.t("capability_start", "actor", "b");
@@ -24,7 +43,7 @@ fn sequential_runs_children_one_after_another() {
 
 #[test]
 fn parallel_starts_all_at_once_and_ends_with_the_last() {
-    let r = run("MISSION M:\n    PARALLEL P:\n        a Hover WITH 5s\n        b Hover WITH 3s\n");
+    let r = run(&fixture("parallel_starts_all_at_once_and_ends_with_the_last"));
     assert_eq!(r.t("capability_start", "actor", "a"), 0.0);
     assert_eq!(r.t("capability_start", "actor", "b"), 0.0);
     assert!(close(r.t("block_end", "block", "P"), 5.0));
@@ -32,9 +51,7 @@ fn parallel_starts_all_at_once_and_ends_with_the_last() {
 
 #[test]
 fn on_fires_once_and_on_every_each_time() {
-    let r = run(
-        "MISSION M:\n    PARALLEL P:\n        SEQUENTIAL S:\n            SIGNAL Ping\n            a Hover WITH 1s\n            SIGNAL Ping\n            a Hover WITH 1s\n            SIGNAL Ping\n        ON Ping:\n            b Hover WITH 1s\n        ON EVERY Ping:\n            c Hover WITH 1s\n",
-    );
+    let r = run(&fixture("on_fires_once_and_on_every_each_time"));
     assert_eq!(r.find("signal", "name", "Ping").len(), 3);
     assert_eq!(r.find("capability_start", "actor", "b").len(), 1, "ON takes the first signal only");
     let c: Vec<f64> =
@@ -88,9 +105,7 @@ fn a_burst_of_signals_starts_its_handlers_one_after_another_in_signal_order() {
 
 #[test]
 fn sequential_on_waits_for_the_signalling_block_and_parallel_on_does_not() {
-    let r = run(
-        "MISSION M:\n    PARALLEL P:\n        SEQUENTIAL Signaller:\n            SIGNAL Go\n            a Hover WITH 4s\n        SEQUENTIAL ON Go:\n            b Hover WITH 1s\n        PARALLEL ON Go:\n            c Hover WITH 1s\n",
-    );
+    let r = run(&fixture("sequential_on_waits_for_the_signalling_block_and_parallel_on_does_not"));
     let signaller_end = r.t("block_end", "block", "Signaller");
     assert!(close(signaller_end, 4.0));
     assert_eq!(r.t("capability_start", "actor", "c"), 0.0, "PARALLEL ON starts at once");
@@ -104,9 +119,7 @@ fn sequential_on_waits_for_the_signalling_block_and_parallel_on_does_not() {
 
 #[test]
 fn a_handler_outside_the_signals_subtree_never_fires() {
-    let r = run(
-        "MISSION M:\n    PARALLEL:\n        SEQUENTIAL A:\n            SIGNAL Ping\n            a Hover WITH 1s\n        SEQUENTIAL B:\n            ON Ping:\n                b Hover WITH 1s\n            c Hover WITH 2s\n",
-    );
+    let r = run(&fixture("a_handler_outside_the_signals_subtree_never_fires"));
     assert_eq!(r.find("signal", "name", "Ping").len(), 1, "the signal is recorded");
     assert!(r.find("capability_start", "actor", "b").is_empty(), "but B does not hear it");
     assert!(r.find("handler_start", "signal", "Ping").is_empty());
@@ -114,7 +127,7 @@ fn a_handler_outside_the_signals_subtree_never_fires() {
 
 #[test]
 fn by_filters_on_the_signalling_actor() {
-    let r = run("MISSION M:\n    PARALLEL P:\n        PARALLEL FOR a AND b AS d:\n            SIGNAL Ping\n        ON EVERY Ping BY b:\n            c Hover WITH 1s\n");
+    let r = run(&fixture("by_filters_on_the_signalling_actor"));
     let pings = r.find("signal", "name", "Ping");
     assert_eq!(pings.len(), 2);
     assert_eq!(r.find("handler_start", "signal", "Ping").len(), 1);
@@ -124,9 +137,7 @@ fn by_filters_on_the_signalling_actor() {
 
 #[test]
 fn an_exception_aborts_the_throwing_actor_and_no_other() {
-    let r = run(
-        "CAPABILITY Boom BY d:\n    PERFORM:\n        d.Hover(1s)\n        THROW EXCEPTION Broken\n        d.Hover(10s)\n\nMISSION M:\n    PARALLEL P:\n        SEQUENTIAL A:\n            a Boom\n            a Hover WITH 5s\n        SEQUENTIAL B:\n            b Hover WITH 3s\n            b Hover WITH 3s\n        ON EXCEPTION Broken:\n            c Hover WITH 1s\n",
-    );
+    let r = run(&fixture("an_exception_aborts_the_throwing_actor_and_no_other"));
     assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
     let e = r.first("exception", "name", "Broken");
     assert_eq!(e["handled"], true);
@@ -142,9 +153,7 @@ fn an_exception_aborts_the_throwing_actor_and_no_other() {
 
 #[test]
 fn a_capability_handles_its_own_exceptions_first() {
-    let r = run(
-        "CAPABILITY Careful BY d:\n    PERFORM:\n        d.Hover(1s)\n        THROW EXCEPTION Broken\n        d.Hover(10s)\n    EXCEPTIONS:\n        ON EXCEPTION Broken:\n            d.Hover(2s)\n\nMISSION M:\n    SEQUENTIAL S:\n        a Careful\n        b Hover WITH 1s\n    ON EXCEPTION Broken:\n        c Hover WITH 1s\n",
-    );
+    let r = run(&fixture("a_capability_handles_its_own_exceptions_first"));
     assert_eq!(r.first("exception", "name", "Broken")["handler"], "Careful/ON EXCEPTION Broken");
     assert!(r.find("capability_start", "actor", "c").is_empty(), "the outer handler is not needed");
     let careful = r.ends("Careful", "a")[0];
@@ -158,7 +167,7 @@ fn a_capability_handles_its_own_exceptions_first() {
 
 #[test]
 fn two_motion_capabilities_on_one_drone_queue() {
-    let r = run("MISSION M:\n    PARALLEL:\n        a Hover WITH 3s\n        a Hover WITH 2s\n        b Hover WITH 1s\n");
+    let r = run(&fixture("two_motion_capabilities_on_one_drone_queue"));
     let starts: Vec<f64> =
         r.find("capability_start", "actor", "a").iter().map(|e| e["t"].as_f64().unwrap()).collect();
     let ends: Vec<f64> = r.ends("Hover", "a").iter().map(|e| e["t"].as_f64().unwrap()).collect();
@@ -170,9 +179,7 @@ fn two_motion_capabilities_on_one_drone_queue() {
 
 #[test]
 fn waitfor_startif_and_dowhile() {
-    let r = run(
-        "MISSION M:\n    PARALLEL:\n        SEQUENTIAL:\n            WAITFOR RECEIVED(Go)\n            a Hover WITH 1s\n        SEQUENTIAL:\n            b Hover WITH 2s\n            SIGNAL Go\n            STARTIF b.battery < 10%:\n                b Hover WITH 100s\n            DOWHILE ELAPSED < 5s:\n                c Hover WITH 1s\n",
-    );
+    let r = run(&fixture("waitfor_startif_and_dowhile"));
     assert!(close(r.t("capability_start", "actor", "a"), 2.0), "WAITFOR ends when Go is raised");
     assert_eq!(
         r.find("capability_start", "actor", "b").len(),
@@ -185,7 +192,7 @@ fn waitfor_startif_and_dowhile() {
 
 #[test]
 fn groups_and_for_instances() {
-    let r = run("MISSION M:\n    SEQUENTIAL FOR team AS d:\n        d Hover WITH 1s\n    team Hover WITH 2s\n");
+    let r = run(&fixture("groups_and_for_instances"));
     assert_eq!(r.t("capability_start", "actor", "a"), 0.0);
     assert!(
         close(r.t("capability_start", "actor", "b"), 1.0),
@@ -203,7 +210,7 @@ fn groups_and_for_instances() {
 
 #[test]
 fn an_unhandled_exception_fails_the_mission_and_sends_the_fleet_home() {
-    let r = run("MISSION M:\n    SEQUENTIAL:\n        a TakeOff WITH 20m\n        THROW EXCEPTION Broken\n        b TakeOff WITH 20m\n");
+    let r = run(&fixture("an_unhandled_exception_fails_the_mission_and_sends_the_fleet_home"));
     assert_eq!(r.outcome.status, Status::Failed);
     assert!(r.outcome.reason.as_deref().unwrap_or("").contains("Broken"), "{:?}", r.outcome.reason);
     assert_eq!(r.first("exception", "name", "Broken")["handled"], false);
@@ -219,9 +226,7 @@ fn an_unhandled_exception_fails_the_mission_and_sends_the_fleet_home() {
 
 #[test]
 fn leashes_pause_resume_and_abort_an_activity() {
-    let r = run(
-        "MISSION M:\n    PARALLEL:\n        a FlyTo-F1 WITH Far\n        SEQUENTIAL:\n            b Hover WITH 10s\n            FlyTo-F1 PAUSE\n            b Hover WITH 10s\n            FlyTo-F1 RESUME\n            b Hover WITH 5s\n            FlyTo-F1 ABORT\n            FlyTo-F1 ABORT\n",
-    );
+    let r = run(&fixture("leashes_pause_resume_and_abort_an_activity"));
     let actions: Vec<&str> = r
         .trace
         .iter()
@@ -250,7 +255,7 @@ fn the_same_mission_gives_the_same_trace() {
 
 #[test]
 fn a_failed_command_is_an_exception_of_its_actor() {
-    let r = run("MISSION M:\n    SEQUENTIAL:\n        b FlyCircle WITH center=North, radius=30m\n        c TakeOff\n");
+    let r = run(&fixture("a_failed_command_is_an_exception_of_its_actor"));
     let e = r.first("exception", "name", "CommandFailed");
     assert_eq!(e["actor"], "b");
     assert_eq!(e["args"][0], "b is on the ground: take off first");
@@ -265,9 +270,7 @@ fn a_failed_command_is_an_exception_of_its_actor() {
 
 #[test]
 fn several_actors_bind_in_order_and_one_actor_capabilities_run_once_each() {
-    let r = run(
-        "CAPABILITY Pair BY lead, wing:\n    PERFORM:\n        lead.Hover(2s)\n        wing.Hover(1s)\n\nMISSION M:\n    SEQUENTIAL:\n        a b Pair\n        a c Hover WITH 1s\n",
-    );
+    let r = run(&fixture("several_actors_bind_in_order_and_one_actor_capabilities_run_once_each"));
     let pair = r.first("capability_start", "capability", "Pair");
     assert_eq!(pair["actor"], "a b");
     let hovers: Vec<(String, f64)> = r

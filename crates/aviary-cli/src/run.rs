@@ -121,7 +121,7 @@ pub fn run(args: &RunArgs) -> u8 {
         None
     };
     let (Some(program), Some(world)) = (checked.program, checked.world) else { return 2 };
-    let Some(mission) = aviary_ir::compile(&program, &world, &api) else {
+    let Some(mission) = aviary_lower::compile(&program, &world, &api) else {
         eprintln!(
             "aviary: {} has no MISSION to run (it holds only capabilities)",
             args.file.display()

@@ -114,7 +114,7 @@ fn once(mission: &str, world: &str) -> Timed {
         (checked.has_errors(), &checked.program, &checked.world)
     {
         let start = Instant::now();
-        let compiled = aviary_ir::compile(program, w, &api);
+        let compiled = aviary_lower::compile(program, w, &api);
         compile = start.elapsed();
         if let Some(compiled) = compiled {
             let start = Instant::now();

@@ -191,7 +191,7 @@ mod tests {
             &api,
         );
         assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
-        aviary_ir::compile(
+        aviary_lower::compile(
             checked.program.as_ref().expect("program"),
             checked.world.as_ref().expect("world"),
             &api,
@@ -351,7 +351,7 @@ mod tests {
             &NoFiles,
             &api,
         );
-        let mission = aviary_ir::compile(
+        let mission = aviary_lower::compile(
             checked.program.as_ref().expect("program"),
             checked.world.as_ref().expect("world"),
             &api,

@@ -161,7 +161,7 @@ pub fn run(args: &RunArgs) -> u8 {
     // times) are drawn from the seed.
     let fleet = fleet.seeded(args.seed);
     let runtime = match if live {
-        crate::mixed::live_runtime()
+        aviary_backends::live_runtime()
     } else {
         tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build()
     } {
@@ -210,7 +210,7 @@ pub fn run(args: &RunArgs) -> u8 {
                 if let Some(sources) = &sources {
                     crate::figures::before_flight(&mission, world, mavlink.facts(), sources, args.quiet);
                 }
-                Some(crate::mixed::Mixed::new(sim.clone(), mavlink))
+                Some(aviary_backends::Mixed::new(sim.clone(), mavlink))
             }
             None => None,
         };

@@ -12,7 +12,6 @@
 mod chains;
 mod endurance;
 mod env;
-pub mod generate;
 mod geofence;
 mod infer;
 mod inputs;

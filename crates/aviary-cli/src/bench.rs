@@ -1,5 +1,5 @@
 //! `aviary bench parse`: generates a large mission and its world
-//! (`aviary_check::generate`), then times parsing alone and parse + check through the
+//! (`aviary_bench::generate`), then times parsing alone and parse + check through the
 //! same pipeline as `aviary check` (source map, world, `aviary_check::check`), and
 //! prints each run and the median throughput. MB here is 10^6 bytes.
 //! `aviary bench w` and `aviary bench swarm` (in `bench/`) run generated missions
@@ -113,14 +113,14 @@ fn parse(mb: f64, runs: usize) -> u8 {
     }
     let runs = runs.max(1);
     let started = Instant::now();
-    let (mission, world) = aviary_check::generate::large_mission((mb * MB) as usize);
+    let (mission, world) = aviary_bench::generate::large_mission((mb * MB) as usize);
     let size = mission.len();
     outln!(
         "generated a mission of {:.2} MB ({size} bytes, {} lines, {} capabilities) and a world of {} drones in {:.2} s",
         size as f64 / MB,
         mission.lines().count(),
         mission.matches("\nCAPABILITY ").count(),
-        aviary_check::generate::DRONES,
+        aviary_bench::generate::DRONES,
         started.elapsed().as_secs_f64()
     );
 

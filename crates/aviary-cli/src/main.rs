@@ -12,7 +12,6 @@ mod ctl;
 mod figures;
 mod files;
 mod fmt;
-mod mixed;
 mod run;
 mod serve;
 mod trace_file;

@@ -121,7 +121,7 @@ pub fn run(args: &RunArgs) -> u8 {
         None
     };
     let (Some(program), Some(world)) = (checked.program, checked.world) else { return 2 };
-    let Some(mission) = aviary_ir::compile(&program, &world, &api) else {
+    let Some(mission) = aviary_lower::compile(&program, &world, &api) else {
         eprintln!(
             "aviary: {} has no MISSION to run (it holds only capabilities)",
             args.file.display()
@@ -161,7 +161,7 @@ pub fn run(args: &RunArgs) -> u8 {
     // times) are drawn from the seed.
     let fleet = fleet.seeded(args.seed);
     let runtime = match if live {
-        crate::mixed::live_runtime()
+        aviary_backends::live_runtime()
     } else {
         tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build()
     } {
@@ -210,7 +210,7 @@ pub fn run(args: &RunArgs) -> u8 {
                 if let Some(sources) = &sources {
                     crate::figures::before_flight(&mission, world, mavlink.facts(), sources, args.quiet);
                 }
-                Some(crate::mixed::Mixed::new(sim.clone(), mavlink))
+                Some(aviary_backends::Mixed::new(sim.clone(), mavlink))
             }
             None => None,
         };

@@ -45,7 +45,7 @@ fn run_with_controls_and(
     assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
     let world = checked.world.unwrap();
     let compiled =
-        aviary_ir::compile(&checked.program.unwrap(), &world, &Descriptor::standard()).unwrap();
+        aviary_lower::compile(&checked.program.unwrap(), &world, &Descriptor::standard()).unwrap();
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_time()
         .start_paused(true)

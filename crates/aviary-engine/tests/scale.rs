@@ -5,7 +5,7 @@
 mod harness;
 
 use aviary_api::Descriptor;
-use aviary_check::generate::{swarm_mission, swarm_world, w_mission, w_world};
+use aviary_bench::generate::{swarm_mission, swarm_world, w_mission, w_world};
 use aviary_check::SourceProvider;
 use aviary_diagnostics::SourceMap;
 use aviary_engine::Status;

@@ -8,15 +8,14 @@
 //! capability knows every resource its body can use. The engine looks nothing up by
 //! name. Spans survive, so a run-time problem can still point into the source.
 //!
-//! Invariant: no IO; `compile` takes a checked program and never panics.
+//! The types only: the lowering from the checked syntax tree is `aviary-lower`'s, so the IR
+//! (and the engine) need neither the parser, the checker nor the world.
+//!
+//! Invariant: no IO; no panic.
 
 // A pure stage: no unsafe code, and no panic on any input (tests may unwrap).
 #![forbid(unsafe_code)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
-
-mod compile;
-
-pub use compile::compile;
 
 use aviary_api::{BuiltinException, BuiltinSignal, DroneId, Function, Kind, Resource, Value};
 use aviary_diagnostics::{FileId, Span};

@@ -79,7 +79,7 @@ pub async fn run(
             }
             here(c)?;
             let z = c.level();
-            let path: Vec<[f64; 3]> = aviary_sim::sweep::lawnmower(area, spacing)
+            let path: Vec<[f64; 3]> = aviary_api::sweep::lawnmower(area, spacing)
                 .into_iter()
                 .map(|p| [p[0], p[1], z])
                 .collect();

@@ -57,7 +57,7 @@ pub fn preflight(checked: &Checked, api: &Descriptor) -> Option<(Mission, Verifi
         return None;
     }
     let (program, world) = (checked.program.as_ref()?, checked.world.as_ref()?);
-    let mission = aviary_ir::compile(program, world, api)?;
+    let mission = aviary_lower::compile(program, world, api)?;
     let verification = verify(&mission, world);
     Some((mission, verification))
 }

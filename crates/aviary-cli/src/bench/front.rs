@@ -1,6 +1,6 @@
 //! `aviary bench front`: the whole of `aviary check` on a generated mission: the realistic
-//! mission of `aviary bench parse` (`aviary_check::generate::large_mission`), or a shape
-//! that once made the pre-flight analyses quadratic (`aviary_check::generate::front`):
+//! mission of `aviary bench parse` (`aviary_bench::generate::large_mission`), or a shape
+//! that once made the pre-flight analyses quadratic (`aviary_bench::generate::front`):
 //! N statements in one SEQUENTIAL block on one drone, or a chain of N capabilities.
 //! Times parse + check, compile, and the analyses (conflicts and the plan), and prints
 //! each run and the median throughput of the whole. MB is 10^6 bytes.
@@ -39,13 +39,13 @@ pub fn run(shape: Shape, n: usize, runs: usize, emit: bool, emit_world: bool) ->
     let runs = runs.max(1);
     let (mission, world, what) = match shape {
         Shape::Sequential => (
-            aviary_check::generate::sequential_mission(n),
-            aviary_check::generate::front_world(),
+            aviary_bench::generate::sequential_mission(n),
+            aviary_bench::generate::front_world(),
             "statements in one SEQUENTIAL block",
         ),
         Shape::Chain => (
-            aviary_check::generate::chain_mission(n),
-            aviary_check::generate::front_world(),
+            aviary_bench::generate::chain_mission(n),
+            aviary_bench::generate::front_world(),
             "capabilities in a chain",
         ),
         Shape::Realistic if n > 4000 => {
@@ -53,7 +53,7 @@ pub fn run(shape: Shape, n: usize, runs: usize, emit: bool, emit_world: bool) ->
             return 2;
         }
         Shape::Realistic => {
-            let (mission, world) = aviary_check::generate::large_mission(n * MB as usize);
+            let (mission, world) = aviary_bench::generate::large_mission(n * MB as usize);
             (mission, world, "MB of the realistic mission (waves of sectors)")
         }
     };
@@ -114,7 +114,7 @@ fn once(mission: &str, world: &str) -> Timed {
         (checked.has_errors(), &checked.program, &checked.world)
     {
         let start = Instant::now();
-        let compiled = aviary_ir::compile(program, w, &api);
+        let compiled = aviary_lower::compile(program, w, &api);
         compile = start.elapsed();
         if let Some(compiled) = compiled {
             let start = Instant::now();

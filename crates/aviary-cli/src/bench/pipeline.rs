@@ -71,7 +71,7 @@ pub fn run(
     drop(sources);
     crate::alloc::give_back();
     let texts_freed = freeing.elapsed();
-    let compiled = stages.time("compile", || aviary_ir::compile(&program, &world, &api));
+    let compiled = stages.time("compile", || aviary_lower::compile(&program, &world, &api));
     let Some(compiled) = compiled else { return Err("the mission has no MISSION".into()) };
     // The tree is not needed to fly either.
     let freeing = Instant::now();

@@ -1,5 +1,5 @@
 //! `aviary bench swarm --drones N`: N simulated drones, each sweeping its own cell with
-//! detection on, with handlers for the finds (`aviary_check::generate::swarm_mission`),
+//! detection on, with handlers for the finds (`aviary_bench::generate::swarm_mission`),
 //! through the whole pipeline at `--speed max`. Prints simulated seconds per wall second
 //! of the engine and simulator run.
 
@@ -23,12 +23,12 @@ pub fn run(drones: usize, emit: bool, emit_world: bool) -> u8 {
     }
     let started = Instant::now();
     let mut stages = Stages::default();
-    let mission = stages.time("generate", || aviary_check::generate::swarm_mission(drones));
+    let mission = stages.time("generate", || aviary_bench::generate::swarm_mission(drones));
     if emit {
         out!("{mission}");
         return 0;
     }
-    let world = stages.time("generate", || aviary_check::generate::swarm_world(drones));
+    let world = stages.time("generate", || aviary_bench::generate::swarm_world(drones));
     if emit_world {
         out!("{world}");
         return 0;

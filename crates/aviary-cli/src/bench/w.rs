@@ -1,6 +1,6 @@
 //! `aviary bench w --n N --k K`: the engine benchmark W(N, K) of
 //! docs/BENCHMARKS.md, written in the language
-//! (`aviary_check::generate::w_mission`) and run through the whole pipeline.
+//! (`aviary_bench::generate::w_mission`) and run through the whole pipeline.
 //! The sink checks from the trace that the work was done: N `Done` signals, each taken
 //! by the handler, whose indices sum to N(N-1)/2 (and, with `--full-trace`, N·K steps
 //! that ended ok). By default it asks the engine only for the events it checks
@@ -65,12 +65,12 @@ pub fn run(n: usize, k: usize, emit: bool, emit_world: bool, full_trace: bool) -
     }
     let started = Instant::now();
     let mut stages = Stages::default();
-    let mission = stages.time("generate", || aviary_check::generate::w_mission(k));
+    let mission = stages.time("generate", || aviary_bench::generate::w_mission(k));
     if emit {
         out!("{mission}");
         return 0;
     }
-    let world = stages.time("generate", || aviary_check::generate::w_world(n));
+    let world = stages.time("generate", || aviary_bench::generate::w_world(n));
     if emit_world {
         out!("{world}");
         return 0;

@@ -86,7 +86,7 @@ pub fn compile(mission: &str, world: &str) -> (aviary_ir::Mission, aviary_world:
     assert!(errors.is_empty(), "{errors:#?}");
     let world = checked.world.expect("world");
     let mission =
-        aviary_ir::compile(&checked.program.expect("program"), &world, &Descriptor::standard())
+        aviary_lower::compile(&checked.program.expect("program"), &world, &Descriptor::standard())
             .expect("mission");
     (mission, world)
 }

@@ -191,7 +191,7 @@ mod tests {
             &api,
         );
         assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
-        aviary_ir::compile(
+        aviary_lower::compile(
             checked.program.as_ref().expect("program"),
             checked.world.as_ref().expect("world"),
             &api,
@@ -228,7 +228,7 @@ mod tests {
 
     #[test]
     fn construct_by_construct_gives_what_pair_by_pair_gives_on_a_large_mission() {
-        let (text, world) = aviary_check::generate::large_mission(150_000);
+        let (text, world) = aviary_bench::generate::large_mission(150_000);
         let found = agree(&compiled(&text, &world));
         assert!(found.len() > 10, "only {} findings", found.len());
     }
@@ -237,7 +237,7 @@ mod tests {
     /// the first (the pairwise rule's choice); a SEQUENTIAL block of many: nothing.
     #[test]
     fn large_blocks_on_one_drone_give_one_finding_per_waiting_statement() {
-        let world = aviary_check::generate::front_world();
+        let world = aviary_bench::generate::front_world();
         let n = 400;
         let mut text = String::from("MISSION M:\n    PARALLEL All:\n");
         for _ in 0..n {
@@ -247,7 +247,7 @@ mod tests {
         assert_eq!(found.len(), n - 1);
         assert!(found.iter().all(|d| d.code == Code::CommandsMayCollide
             && d.secondary[0].span.start == found[0].secondary[0].span.start));
-        let many = aviary_check::generate::sequential_mission(100_000);
+        let many = aviary_bench::generate::sequential_mission(100_000);
         let mut none = Vec::new();
         super::super::check_conflicts(&compiled(&many, &world), &mut none);
         assert!(none.is_empty(), "{none:?}");
@@ -341,7 +341,7 @@ mod tests {
     /// on every pair of claimants in a large generated mission.
     #[test]
     fn may_run_in_parallel_is_symmetric() {
-        let (text, world) = aviary_check::generate::large_mission(150_000);
+        let (text, world) = aviary_bench::generate::large_mission(150_000);
         let mut sources = aviary_diagnostics::SourceMap::new();
         let api = aviary_api::Descriptor::standard();
         let checked = aviary_check::check_sources(
@@ -351,7 +351,7 @@ mod tests {
             &NoFiles,
             &api,
         );
-        let mission = aviary_ir::compile(
+        let mission = aviary_lower::compile(
             checked.program.as_ref().expect("program"),
             checked.world.as_ref().expect("world"),
             &api,

@@ -190,7 +190,7 @@ mod tests {
             &api,
         );
         assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
-        let mission = aviary_ir::compile(
+        let mission = aviary_lower::compile(
             checked.program.as_ref().expect("program"),
             checked.world.as_ref().expect("world"),
             &api,

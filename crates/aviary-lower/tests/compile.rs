@@ -5,6 +5,7 @@ use aviary_api::{Descriptor, Point, Resource, Value};
 use aviary_check::SourceProvider;
 use aviary_diagnostics::SourceMap;
 use aviary_ir::*;
+use aviary_lower::compile;
 
 struct NoFiles;
 impl SourceProvider for NoFiles {

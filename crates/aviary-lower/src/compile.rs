@@ -2,13 +2,13 @@
 
 use std::collections::BTreeMap;
 
-use aviary_api::{BuiltinException, BuiltinSignal, Descriptor, Point, Value};
+use aviary_api::{BuiltinException, BuiltinSignal, Descriptor, DroneId, Point, Value};
 use aviary_check::{bind_args, Program};
 use aviary_diagnostics::FileId;
 use aviary_syntax::ast;
 use aviary_world::{AttributeValue, World};
 
-use crate::*;
+use aviary_ir::*;
 
 /// Compiles the checked `program` for the fleet of `world`. `None` when the program
 /// holds no MISSION (a library of capabilities has nothing to run).

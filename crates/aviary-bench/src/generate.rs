@@ -38,7 +38,7 @@ pub fn large_mission(target_bytes: usize) -> (String, String) {
     let mut mission = String::with_capacity(target_bytes / 2 + 4096);
     let mut capabilities = String::with_capacity(target_bytes / 2 + 4096);
     mission.push_str(
-        "// A large generated mission (aviary_check::generate::large_mission): waves of four\n\
+        "// A large generated mission (aviary_bench::generate::large_mission): waves of four\n\
          // sectors in parallel; in each sector one team searches a zone while a second team\n\
          // watches, escorts, spots and marks every find with a beacon.\n\n\
          MISSION Regional_Search:\n\
@@ -291,7 +291,7 @@ CAPABILITY Watch_{n} BY drone WITH center, radius, laps:
 fn world() -> String {
     let mut w = String::new();
     w.push_str(
-        "# The world of aviary_check::generate::large_mission.\n\
+        "# The world of aviary_bench::generate::large_mission.\n\
          [site]\n\
          name = \"Generated region\"\n\
          origin = { lat = 46.6000, lon = 14.2600, alt = 440.0 }\n\
@@ -360,11 +360,11 @@ mod tests {
     use aviary_diagnostics::{FileId, SourceMap};
 
     use super::*;
-    use crate::SourceProvider;
+    use aviary_check::SourceProvider;
 
     struct NoFiles;
     impl SourceProvider for NoFiles {
-        fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), crate::LoadError> {
+        fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
             Err(format!("no files here ({path})").into())
         }
     }
@@ -381,8 +381,13 @@ mod tests {
         assert_eq!(world.drones.len(), DRONES);
         assert_eq!(world.groups.len(), GROUPS);
         let root = sources.add("generated.mission", mission);
-        let (program, diagnostics) =
-            crate::check(&mut sources, root, Some(&world), &NoFiles, &Descriptor::standard());
+        let (program, diagnostics) = aviary_check::check(
+            &mut sources,
+            root,
+            Some(&world),
+            &NoFiles,
+            &Descriptor::standard(),
+        );
         let shown: Vec<String> = diagnostics
             .iter()
             .take(10)

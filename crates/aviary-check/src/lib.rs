@@ -207,3 +207,31 @@ pub fn check(
     diagnostics.dedup();
     (program, diagnostics)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::both;
+
+    /// As deep as a walk of a long capability chain: far past a default thread's 2 MiB.
+    fn depth(n: u64) -> u64 {
+        if n == 0 {
+            return 0;
+        }
+        let frame = std::hint::black_box([n; 16]);
+        1 + depth(n - 1) + frame[0] - n
+    }
+
+    #[test]
+    fn both_gives_what_each_gives_on_one_thread_or_two() {
+        let one = both(false, || (1..=100u32).sum::<u32>(), || "b".repeat(3));
+        let two = both(true, || (1..=100u32).sum::<u32>(), || "b".repeat(3));
+        assert_eq!(one, (5050, "bbb".to_string()));
+        assert_eq!(one, two);
+    }
+
+    #[test]
+    fn the_second_thread_has_the_stack_a_deep_walk_needs() {
+        let (a, b) = both(true, || depth(10), || depth(200_000));
+        assert_eq!((a, b), (10, 200_000));
+    }
+}

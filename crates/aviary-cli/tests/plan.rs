@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{aviary, repo, scratch};
+use common::{aviary, repo, scratch, PAPER_DRONES};
 
 /// Per drone: (distance m, flight s), from the summary `aviary run` prints.
 fn simulated(mission: &str, world: &[&str]) -> Vec<(String, f64, f64)> {
@@ -204,15 +204,7 @@ fn the_text_plan_lists_every_drone_with_its_timeline() {
         aviary(&["check", "--plan", "examples/search_and_rescue.mission"], &repo());
     assert_eq!(code, 0);
     assert!(out.contains("plan: the mission takes about"), "{out}");
-    for drone in [
-        "video_drone1",
-        "video_drone2",
-        "flir_drone1",
-        "flir_drone2",
-        "sensor_drone",
-        "beacon_drone1",
-        "beacon_drone2",
-    ] {
+    for drone in PAPER_DRONES {
         assert!(
             out.lines().any(|l| l.starts_with(&format!("{drone}: ")) && l.contains("battery left")),
             "no line for {drone}:\n{out}"

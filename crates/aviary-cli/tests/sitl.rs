@@ -21,7 +21,7 @@ use std::process::{Child, Command};
 use std::time::{Duration, Instant};
 
 use common::sitl::{wait_until, Sitl};
-use common::{aviary, repo, scratch};
+use common::{aviary, repo, scratch, PAPER_DRONES};
 use serde_json::Value;
 
 /// Battery parameters for a copter that can fly the paper's mission: SITL's default
@@ -266,19 +266,7 @@ fn paper_mission(tag: &str, first_instance: u16, real: &[&str]) {
 mod fleet {
     #[test]
     fn paper_mission_on_seven_sitl_copters() {
-        super::paper_mission(
-            "sitl_paper",
-            0,
-            &[
-                "video_drone1",
-                "video_drone2",
-                "flir_drone1",
-                "flir_drone2",
-                "sensor_drone",
-                "beacon_drone1",
-                "beacon_drone2",
-            ],
-        );
+        super::paper_mission("sitl_paper", 0, &super::PAPER_DRONES);
     }
 
     #[test]
@@ -293,16 +281,6 @@ mod fleet {
 mod facts {
     use super::*;
 
-    const PAPER: [&str; 7] = [
-        "video_drone1",
-        "video_drone2",
-        "flir_drone1",
-        "flir_drone2",
-        "sensor_drone",
-        "beacon_drone1",
-        "beacon_drone2",
-    ];
-
     /// The paper's mission on seven copters with ArduPilot's default battery (3300 mAh),
     /// in a world whose drones draw SITL's 30 A: 6.6 minutes of flight for a mission whose
     /// longest drone flies about 8. The check warns before flight, naming the drones; with
@@ -310,7 +288,7 @@ mod facts {
     #[test]
     fn check_plan_warns_when_the_vehicles_batteries_cannot_finish_the_paper_mission() {
         let dir = scratch("sitl_facts");
-        let sitls: Vec<(&str, Sitl)> = PAPER
+        let sitls: Vec<(&str, Sitl)> = PAPER_DRONES
             .iter()
             .enumerate()
             .map(|(i, n)| (*n, Sitl::start(&dir, 30, i as u8 + 1, home_of(n), &[])))
@@ -324,7 +302,7 @@ mod facts {
         )
         .expect("world");
         let warned = |out: &str| -> Vec<&str> {
-            PAPER
+            PAPER_DRONES
                 .iter()
                 .copied()
                 .filter(|n| out.contains(&format!("{n}'s battery is estimated to fall under 20%")))
@@ -388,7 +366,7 @@ mod facts {
         let (code, out, err) = aviary(&["check", "--plan", "m.mission"], &dir);
         std::fs::write(dir.join("check-16500.txt"), &out).expect("keep the output");
         assert_eq!(code, 0, "{out}{err}");
-        for name in PAPER {
+        for name in PAPER_DRONES {
             assert!(
                 out.contains(&format!("{name}: battery 16500 mAh (the vehicle's BATT_CAPACITY)")),
                 "{out}"

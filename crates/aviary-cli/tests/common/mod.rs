@@ -6,6 +6,17 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// The drones of the paper's world (`examples/search_and_rescue.world.toml`), in its order.
+pub const PAPER_DRONES: [&str; 7] = [
+    "video_drone1",
+    "video_drone2",
+    "flir_drone1",
+    "flir_drone2",
+    "sensor_drone",
+    "beacon_drone1",
+    "beacon_drone2",
+];
+
 /// Runs `aviary ARGS` in `dir`: exit code, stdout, stderr.
 pub fn aviary(args: &[&str], dir: &Path) -> (i32, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_aviary"))

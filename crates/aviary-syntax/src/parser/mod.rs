@@ -28,23 +28,34 @@ pub(crate) struct Parser<'a> {
     diagnostics: &'a mut Vec<Diagnostic>,
 }
 
+impl<'a> Parser<'a> {
+    fn new(
+        file: FileId,
+        text: &'a str,
+        tokens: Vec<Token>,
+        diagnostics: &'a mut Vec<Diagnostic>,
+    ) -> Parser<'a> {
+        Parser {
+            file,
+            text,
+            tokens,
+            pos: 0,
+            depth: 0,
+            last_end: 0,
+            errors: 0,
+            gave_up: false,
+            diagnostics,
+        }
+    }
+}
+
 pub(crate) fn parse_tokens(
     file: FileId,
     text: &str,
     tokens: Vec<Token>,
     diagnostics: &mut Vec<Diagnostic>,
 ) -> SourceFile {
-    let mut parser = Parser {
-        file,
-        text,
-        tokens,
-        pos: 0,
-        depth: 0,
-        last_end: 0,
-        errors: 0,
-        gave_up: false,
-        diagnostics,
-    };
+    let mut parser = Parser::new(file, text, tokens, diagnostics);
     parser.file()
 }
 
@@ -57,17 +68,7 @@ pub(crate) fn parse_value_tokens(
     tokens: Vec<Token>,
     diagnostics: &mut Vec<Diagnostic>,
 ) -> crate::ast::Expr {
-    let mut parser = Parser {
-        file,
-        text,
-        tokens,
-        pos: 0,
-        depth: 0,
-        last_end: 0,
-        errors: 0,
-        gave_up: false,
-        diagnostics,
-    };
+    let mut parser = Parser::new(file, text, tokens, diagnostics);
     let value = parser.value();
     if !parser.at_line_end() {
         parser.expected("the end of the value", Some("write one value: a number with its unit (20m), (x, y), a name, or a string in quotes"));

@@ -82,7 +82,7 @@ fn check_one(
             figures = Some(crate::figures::ask(world));
         }
     }
-    let verified = aviary_verify::preflight(&checked, &api);
+    let verified = aviary_verify::preflight(&mut checked, &api);
     let mut diagnostics = checked.diagnostics;
     let mut plan = None;
     if let Some((_, v)) = verified {

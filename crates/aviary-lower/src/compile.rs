@@ -227,7 +227,8 @@ impl<'a> Compiler<'a> {
                 .map(|(i, p)| (p.name.clone(), cap.actors.len() + i, false)),
         );
         self.frame_size = scope.len();
-        self.scopes = vec![scope];
+        self.scopes.clear();
+        self.scopes.push(scope);
         let name = &cap.name.name;
         let mut out = Capability {
             name: name.clone(),
@@ -448,18 +449,13 @@ impl<'a> Compiler<'a> {
         let capability = *self.caps.get(&s.capability.name)?;
         let callee = self.program.capability(&s.capability.name)?;
         let binding = bind_args(&callee.params, &s.args);
-        let defaults = self.defaults.get(capability).cloned().unwrap_or_default();
-        let args = binding
-            .bound
-            .iter()
-            .enumerate()
-            .map(|(i, e)| match e {
+        let mut args = Vec::with_capacity(binding.bound.len());
+        for (i, e) in binding.bound.iter().enumerate() {
+            args.push(match e {
                 Some(e) => self.expr(e),
-                None => {
-                    defaults.get(i).cloned().flatten().unwrap_or(Expr::Const(Value::Bool(false)))
-                }
-            })
-            .collect();
+                None => self.default_of(capability, i),
+            });
+        }
         Some(Call {
             actors: s.actors.iter().map(|a| self.actor(&a.name)).collect(),
             capability,
@@ -467,6 +463,12 @@ impl<'a> Compiler<'a> {
             tag: s.tag.as_ref().map(|t| self.tags.id(&t.name)),
             origin: self.origin(s.span),
         })
+    }
+
+    /// The default of parameter `i` of a capability, for a call that leaves it out.
+    fn default_of(&self, capability: CapId, i: usize) -> Expr {
+        let default = self.defaults.get(capability).and_then(|d| d.get(i)).cloned().flatten();
+        default.unwrap_or(Expr::Const(Value::Bool(false)))
     }
 
     fn leash(&mut self, l: &ast::LeashCall) -> Option<Leash> {

@@ -29,7 +29,13 @@ keywords! {
 impl Keyword {
     /// The keyword this word would be if it were upper case.
     pub fn from_any_case(text: &str) -> Option<Keyword> {
-        Keyword::from_exact(&text.to_ascii_uppercase())
+        // Upper-cased on the stack: this runs for many words of a mission, and no keyword
+        // is longer than the buffer.
+        let mut upper = [0u8; 16];
+        let word = upper.get_mut(..text.len())?;
+        word.copy_from_slice(text.as_bytes());
+        word.make_ascii_uppercase();
+        Keyword::from_exact(std::str::from_utf8(word).ok()?)
     }
 }
 
@@ -96,5 +102,22 @@ impl TokenKind {
             TokenKind::Dedent => "the end of the block".into(),
             TokenKind::Eof => "the end of the file".into(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Keyword;
+
+    #[test]
+    fn every_keyword_is_found_in_any_case_and_longer_words_are_not_keywords() {
+        for &k in Keyword::ALL {
+            let lower = k.as_str().to_ascii_lowercase();
+            assert_eq!(Keyword::from_any_case(&lower), Some(k));
+            assert_eq!(Keyword::from_any_case(k.as_str()), Some(k));
+        }
+        assert_eq!(Keyword::from_any_case("sequentially"), None);
+        assert_eq!(Keyword::from_any_case("a_very_long_name_indeed_of_a_drone"), None);
+        assert_eq!(Keyword::from_any_case("ünicode"), None);
     }
 }

@@ -51,13 +51,19 @@ fn large(mission: &Mission) -> bool {
 }
 
 /// Compiles and verifies what the checker accepted: `None` when it has errors, no world
-/// or no MISSION.
-pub fn preflight(checked: &Checked, api: &Descriptor) -> Option<(Mission, Verification)> {
+/// or no MISSION. Takes the checked tree out of `checked` and drops it once compiled: the
+/// analyses read only the IR, and on a long mission the tree was a third of the peak
+/// memory, whose fresh pages are much of the time `aviary check` takes
+/// (docs/BENCHMARKS.md, "Pre-flight analyses at scale").
+pub fn preflight(checked: &mut Checked, api: &Descriptor) -> Option<(Mission, Verification)> {
     if checked.has_errors() {
         return None;
     }
-    let (program, world) = (checked.program.as_ref()?, checked.world.as_ref()?);
-    let mission = aviary_lower::compile(program, world, api)?;
+    let world = checked.world.as_ref()?;
+    let program = checked.program.take()?;
+    let mission = aviary_lower::compile(&program, world, api);
+    drop(program);
+    let mission = mission?;
     let verification = verify(&mission, world);
     Some((mission, verification))
 }

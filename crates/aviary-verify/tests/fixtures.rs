@@ -40,14 +40,14 @@ fn verify_fixture(name: &str) -> Outcome {
     let (mission, world) = (read(name), read(&world_name));
     let mut sources = SourceMap::new();
     let api = Descriptor::standard();
-    let checked = aviary_check::check_sources(
+    let mut checked = aviary_check::check_sources(
         &mut sources,
         (name, &mission),
         Some((&world_name, &world)),
         &NoFiles,
         &api,
     );
-    let verified = aviary_verify::preflight(&checked, &api);
+    let verified = aviary_verify::preflight(&mut checked, &api);
     let mut diagnostics: Vec<Diagnostic> = checked.diagnostics;
     let mut text = String::new();
     let plan = verified.map(|(_, v)| {

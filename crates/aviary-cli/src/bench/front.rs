@@ -110,11 +110,12 @@ fn once(mission: &str, world: &str) -> Timed {
     let mut errors = checked.diagnostics.iter().filter(|d| d.is_error()).count();
     let mut others = checked.diagnostics.len() - errors;
     let (mut compile, mut analyses) = (Duration::ZERO, Duration::ZERO);
-    if let (false, Some(program), Some(w)) =
-        (checked.has_errors(), &checked.program, &checked.world)
+    if let (false, Some(program), Some(w)) = (checked.has_errors(), checked.program, &checked.world)
     {
         let start = Instant::now();
-        let compiled = aviary_lower::compile(program, w, &api);
+        // As `aviary_verify::preflight` does: the tree is dropped before the analyses.
+        let compiled = aviary_lower::compile(&program, w, &api);
+        drop(program);
         compile = start.elapsed();
         if let Some(compiled) = compiled {
             let start = Instant::now();

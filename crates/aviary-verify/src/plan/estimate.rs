@@ -8,8 +8,8 @@
 
 use aviary_api::{DroneId, Resource, Value};
 use aviary_ir::{
-    ActorFilter, ActorRef, ApiCall, Block, BlockKind, Call, Expr, Handler, Mission, Node, Origin,
-    SignalId,
+    ActorFilter, ActorRef, ApiCall, Block, BlockKind, Call, Expr, For, Handler, Mission, Node,
+    Origin, SignalId,
 };
 use aviary_world::World;
 
@@ -257,7 +257,21 @@ impl<'m> Estimator<'m> {
         if b.handlers.is_empty() {
             return (end, raises);
         }
-        let items_end = end;
+        self.handlers(b, ctx, end, raises)
+    }
+
+    /// The block's handlers, fired by the raises of its items and by one another. Out of
+    /// `block`, which recurses once per nested block and capability call: its frame then
+    /// stays small, and a deep chain of calls touches less stack.
+    #[inline(never)]
+    fn handlers(
+        &mut self,
+        b: &Block,
+        ctx: &mut Ctx,
+        items_end: f64,
+        raises: Vec<Raise>,
+    ) -> (f64, Vec<Raise>) {
+        let mut end = items_end;
         let mut once = vec![false; b.handlers.len()];
         let (mut pending, mut heard) = (Pending::default(), Vec::new());
         for r in raises {
@@ -292,28 +306,18 @@ impl<'m> Estimator<'m> {
         (end, heard)
     }
 
+    /// Every arm but the plainest is a function of its own, kept out of line: `node` and
+    /// `block` recurse once per nested block and capability call, and the locals of every
+    /// arm would otherwise sit in each of their frames (a chain of 50,000 calls touched
+    /// 70 MB of stack).
     fn node(&mut self, node: &Node, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
         match node {
             Node::Block(b) => self.block(b, ctx, t),
             Node::Call(c) => self.call(c, ctx, t),
             Node::Api(a) => self.api(a, ctx, t),
-            Node::Signal { signal, args, .. } => {
-                let args = args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
-                self.s.raise(*signal, t);
-                (t, vec![Raise { t, signal: *signal, actor: ctx.actor, args }])
-            }
+            Node::Signal { signal, args, .. } => self.signal(*signal, args, ctx, t),
             Node::Leash(_) | Node::Throw { .. } => (t, Vec::new()),
-            Node::StartIf { condition, body } => {
-                match self.scope(ctx, t).condition(condition) {
-                    Some(false) => (t, Vec::new()),
-                    known => {
-                        if known.is_none() {
-                            self.note(ctx.statement, "a STARTIF whose condition is unknown before flight is counted as run".into());
-                        }
-                        self.block(body, ctx, t)
-                    }
-                }
-            }
+            Node::StartIf { condition, body } => self.start_if(condition, body, ctx, t),
             Node::WaitFor { condition, body } => {
                 let t = self.wait(condition, ctx, t);
                 match body {
@@ -322,31 +326,70 @@ impl<'m> Estimator<'m> {
                 }
             }
             Node::DoWhile { condition, body } => self.repeat(condition, body, ctx, t),
-            Node::For(f) => {
-                let mut end = t;
-                let mut raises = Vec::new();
-                for (actor, values) in &f.instances {
-                    let members = match actor {
-                        ActorRef::Group(g) => g.clone(),
-                        a => self.scope(ctx, t).actor(a).into_iter().collect(),
-                    };
-                    for d in members {
-                        // The values are read where the FOR stands, before its alias is set.
-                        let mut slots = vec![(f.alias, Some(Value::Actor(d)))];
-                        for (slot, v) in f.params.iter().zip(values) {
-                            slots.push((*slot, self.scope(ctx, t).eval(v)));
-                        }
-                        let start = if f.parallel { t } else { end };
-                        let (e, r) = self
-                            .with(ctx, slots, Some(d), |est, ctx| est.block(&f.body, ctx, start));
-                        end = end.max(e);
-                        raises.extend(r);
-                    }
-                }
-                (end, raises)
-            }
+            Node::For(f) => self.for_each(f, ctx, t),
             Node::If { branches, otherwise } => self.choose(branches, otherwise.as_ref(), ctx, t),
         }
+    }
+
+    #[inline(never)]
+    fn signal(
+        &mut self,
+        signal: SignalId,
+        args: &[Expr],
+        ctx: &mut Ctx,
+        t: f64,
+    ) -> (f64, Vec<Raise>) {
+        let args = args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
+        self.s.raise(signal, t);
+        (t, vec![Raise { t, signal, actor: ctx.actor, args }])
+    }
+
+    #[inline(never)]
+    fn start_if(
+        &mut self,
+        condition: &Expr,
+        body: &Block,
+        ctx: &mut Ctx,
+        t: f64,
+    ) -> (f64, Vec<Raise>) {
+        match self.scope(ctx, t).condition(condition) {
+            Some(false) => (t, Vec::new()),
+            known => {
+                if known.is_none() {
+                    self.note(
+                        ctx.statement,
+                        "a STARTIF whose condition is unknown before flight is counted as run"
+                            .into(),
+                    );
+                }
+                self.block(body, ctx, t)
+            }
+        }
+    }
+
+    #[inline(never)]
+    fn for_each(&mut self, f: &For, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
+        let mut end = t;
+        let mut raises = Vec::new();
+        for (actor, values) in &f.instances {
+            let members = match actor {
+                ActorRef::Group(g) => g.clone(),
+                a => self.scope(ctx, t).actor(a).into_iter().collect(),
+            };
+            for d in members {
+                // The values are read where the FOR stands, before its alias is set.
+                let mut slots = vec![(f.alias, Some(Value::Actor(d)))];
+                for (slot, v) in f.params.iter().zip(values) {
+                    slots.push((*slot, self.scope(ctx, t).eval(v)));
+                }
+                let start = if f.parallel { t } else { end };
+                let (e, r) =
+                    self.with(ctx, slots, Some(d), |est, ctx| est.block(&f.body, ctx, start));
+                end = end.max(e);
+                raises.extend(r);
+            }
+        }
+        (end, raises)
     }
 
     /// The first branch whose condition holds; when one cannot be decided, the longer of
@@ -434,25 +477,20 @@ impl<'m> Estimator<'m> {
         t
     }
 
+    #[inline(never)]
     fn call(&mut self, c: &Call, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
         let cap = &self.mission.capabilities[c.capability];
         // A capability that calls itself, directly or not, would never end here.
         if self.calling[c.capability] {
-            self.note(
-                Some(c.origin),
-                format!("`{}` calls itself; the estimate counts one round of it", cap.name),
-            );
+            self.note_calls_itself(c);
             return (t, Vec::new());
         }
         if self.budget == 0 {
-            if !self.cut_short {
-                self.cut_short = true;
-                self.note(Some(c.origin), "the capability calls fan out past what the estimate follows (64 per call written and a million more); from here on, calls are counted as taking no time".into());
-            }
+            self.note_cut_short(c);
             return (t, Vec::new());
         }
         self.budget -= 1;
-        let args: Vec<Option<Value>> = c.args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
+        let args = self.values(&c.args, ctx, t);
         // The common case, one drone for a one-actor capability, without the lists of
         // lists the general case builds.
         if let ([a @ (ActorRef::Drone(_) | ActorRef::Slot(_))], 1) =
@@ -461,6 +499,41 @@ impl<'m> Estimator<'m> {
             let Some(d) = self.scope(ctx, t).actor(a) else { return (t, Vec::new()) };
             return self.run_call(c, &[d], &args, ctx, t);
         }
+        self.call_on_sets(c, &args, ctx, t)
+    }
+
+    #[cold]
+    fn note_calls_itself(&mut self, c: &Call) {
+        let name = &self.mission.capabilities[c.capability].name;
+        let text = format!("`{name}` calls itself; the estimate counts one round of it");
+        self.note(Some(c.origin), text);
+    }
+
+    #[cold]
+    fn note_cut_short(&mut self, c: &Call) {
+        if !self.cut_short {
+            self.cut_short = true;
+            self.note(Some(c.origin), "the capability calls fan out past what the estimate follows (64 per call written and a million more); from here on, calls are counted as taking no time".into());
+        }
+    }
+
+    #[inline(never)]
+    fn values(&self, exprs: &[Expr], ctx: &Ctx, t: f64) -> Vec<Option<Value>> {
+        exprs.iter().map(|e| self.scope(ctx, t).eval(e)).collect()
+    }
+
+    /// A call on groups, or on several actors: one run per drone of a one-actor capability,
+    /// else one run on the first drone of each actor. Out of `call`, whose frame is on the
+    /// stack once per level of a chain of calls.
+    #[inline(never)]
+    fn call_on_sets(
+        &mut self,
+        c: &Call,
+        args: &[Option<Value>],
+        ctx: &mut Ctx,
+        t: f64,
+    ) -> (f64, Vec<Raise>) {
+        let cap = &self.mission.capabilities[c.capability];
         let sets: Vec<Vec<DroneId>> = c
             .actors
             .iter()
@@ -476,7 +549,7 @@ impl<'m> Estimator<'m> {
         };
         let (mut end, mut raises) = (t, Vec::new());
         for actors in runs {
-            let (e, r) = self.run_call(c, &actors, &args, ctx, t);
+            let (e, r) = self.run_call(c, &actors, args, ctx, t);
             end = end.max(e);
             raises.extend(r);
         }
@@ -521,20 +594,7 @@ impl<'m> Estimator<'m> {
             let (e, r) = self.block(&cap.perform, &mut cctx, start);
             self.calling[c.capability] = false;
             if top {
-                for &slot in motion.iter() {
-                    if let Some(&d) = actors.get(slot) {
-                        self.s.drones[d].free_at = self.s.drones[d].free_at.max(e);
-                    }
-                }
-                for &d in actors {
-                    self.s.activities[d].push(Activity {
-                        start,
-                        end: e,
-                        what: cap.name.clone(),
-                        at: None,
-                        origin: Some(c.origin),
-                    });
-                }
+                self.ran_at_top(c, actors, &motion, start, e);
             }
             end = end.max(e);
             raises.extend(r);
@@ -542,6 +602,28 @@ impl<'m> Estimator<'m> {
         (end, raises)
     }
 
+    /// A top-level call that ran from `start` to `end`: its drones are busy until then, and
+    /// it is one activity of each.
+    #[inline(never)]
+    fn ran_at_top(&mut self, c: &Call, actors: &[DroneId], motion: &[usize], start: f64, end: f64) {
+        for &slot in motion {
+            if let Some(&d) = actors.get(slot) {
+                self.s.drones[d].free_at = self.s.drones[d].free_at.max(end);
+            }
+        }
+        let what = &self.mission.capabilities[c.capability].name;
+        for &d in actors {
+            self.s.activities[d].push(Activity {
+                start,
+                end,
+                what: what.clone(),
+                at: None,
+                origin: Some(c.origin),
+            });
+        }
+    }
+
+    #[inline(never)]
     fn api(&mut self, a: &ApiCall, ctx: &Ctx, t: f64) -> (f64, Vec<Raise>) {
         let Some(d) = self.scope(ctx, t).actor(&a.actor) else { return (t, Vec::new()) };
         let args: Vec<Option<Value>> = a.args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();

@@ -159,11 +159,7 @@ impl<'m> Engine<'m> {
             root: RefCell::new(None),
             mission_scope: RefCell::new(None),
             next_id: Cell::new(0),
-            instant: if options.instant_activities {
-                crate::instant::instant_capabilities(m)
-            } else {
-                vec![false; m.capabilities.len()]
-            },
+            instant: crate::instant::instant_capabilities(m),
             max_call_depth: options.max_call_depth,
         }
     }

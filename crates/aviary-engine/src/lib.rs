@@ -52,10 +52,6 @@ impl<F: FnMut(&Record<'_>)> TraceSink for F {
 pub struct RunOptions {
     /// Telemetry events per second of mission time; `None` for none.
     pub telemetry_hz: Option<f64>,
-    /// Whether activities whose calls end at once run without the machinery of one that
-    /// waits (`instant.rs`). On by default; off, every activity takes the general path,
-    /// which gives the same trace: tests compare the two.
-    pub instant_activities: bool,
     /// How deep capability calls may nest (a capability that calls one that calls ...):
     /// a call that would go deeper raises `CommandFailed` where it stands instead of
     /// starting. Each level is a future inside its caller's, polled on the stack, so the
@@ -71,7 +67,7 @@ pub const MAX_CALL_DEPTH: usize = 10_000;
 
 impl Default for RunOptions {
     fn default() -> Self {
-        RunOptions { telemetry_hz: None, instant_activities: true, max_call_depth: MAX_CALL_DEPTH }
+        RunOptions { telemetry_hz: None, max_call_depth: MAX_CALL_DEPTH }
     }
 }
 
@@ -89,6 +85,28 @@ pub async fn run(
     options: &RunOptions,
 ) -> Outcome {
     engine::Engine::new(mission, backend, sink, options).run(options, None).await
+}
+
+/// The engine with every activity on the general path, for the tests that hold the instant
+/// path to it (`tests/instant.rs`): only in builds with the `testing` feature, which the
+/// engine's own tests turn on and no other crate does. An option of [`RunOptions`] would
+/// let a user's run take a path that is not the one users run.
+#[cfg(feature = "testing")]
+pub mod testing {
+    use super::*;
+
+    /// As [`run_controlled`](super::run_controlled), on the general path only.
+    pub async fn run_on_the_general_path(
+        mission: &Mission,
+        backend: &dyn Backend,
+        sink: &mut dyn TraceSink,
+        options: &RunOptions,
+        controls: Option<tokio::sync::mpsc::UnboundedReceiver<ControlRequest>>,
+    ) -> Outcome {
+        let mut engine = engine::Engine::new(mission, backend, sink, options);
+        engine.instant.fill(false);
+        engine.run(options, controls).await
+    }
 }
 
 /// As [`run`], and takes live controls (an operator, Ctrl-C) from `controls`.

@@ -2,19 +2,10 @@
 
 mod harness;
 
-use aviary_api::{Descriptor, Value};
-use aviary_check::SourceProvider;
-use aviary_diagnostics::SourceMap;
-use aviary_engine::{Control, Controller, Outcome, RunOptions, Status};
-use aviary_sim::{SimBackend, SimOptions};
+use aviary_api::Value;
+use aviary_engine::{Control, Outcome, RunOptions, Status};
+use harness::Path;
 use serde_json::Value as Json;
-
-struct NoFiles;
-impl SourceProvider for NoFiles {
-    fn load(&self, _: &str, p: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-        Err(p.to_string().into())
-    }
-}
 
 /// Runs `mission`, sending each control at its mission time; returns the outcome, the
 /// trace and the engine's answers.
@@ -22,54 +13,18 @@ fn run_with_controls(
     mission: &str,
     controls: Vec<(f64, Control)>,
 ) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
-    run_with_controls_and(
-        mission,
-        controls,
-        RunOptions { telemetry_hz: Some(10.0), ..RunOptions::default() },
-    )
+    run_with_controls_on(mission, controls, Path::AsUsersRun)
 }
 
-fn run_with_controls_and(
+fn run_with_controls_on(
     mission: &str,
     controls: Vec<(f64, Control)>,
-    options: RunOptions,
+    path: Path,
 ) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
-    let mut sources = SourceMap::new();
-    let checked = aviary_check::check_sources(
-        &mut sources,
-        ("m.mission", mission.as_bytes()),
-        Some(("w.toml", harness::WORLD.as_bytes())),
-        &NoFiles,
-        &Descriptor::standard(),
-    );
-    assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
-    let world = checked.world.unwrap();
-    let compiled =
-        aviary_lower::compile(&checked.program.unwrap(), &world, &Descriptor::standard()).unwrap();
-    let rt = tokio::runtime::Builder::new_current_thread()
-        .enable_time()
-        .start_paused(true)
-        .build()
-        .unwrap();
-    rt.block_on(async {
-        let sim = SimBackend::start(&world, SimOptions::default());
-        let (controller, rx) = Controller::new();
-        let mut trace = Vec::new();
-        let mut sink = |r: &aviary_engine::Record| trace.push(harness::json(r));
-        let operator = async {
-            let start = tokio::time::Instant::now();
-            let mut answers = Vec::new();
-            for (at, control) in controls {
-                tokio::time::sleep_until(start + std::time::Duration::from_secs_f64(at)).await;
-                answers.push(controller.ask(control).await);
-            }
-            answers
-        };
-        let mission_run = aviary_engine::run_controlled(&compiled, &*sim, &mut sink, &options, rx);
-        let (outcome, answers) = tokio::join!(mission_run, operator);
-        sim.shutdown().await;
-        (outcome, trace, answers)
-    })
+    let (compiled, world) = harness::compile(mission, harness::WORLD);
+    let options = RunOptions { telemetry_hz: Some(10.0), ..RunOptions::default() };
+    let (run, answers) = harness::run_compiled(&compiled, &world, &options, controls, path);
+    (run.outcome, run.trace, answers)
 }
 
 fn positions(trace: &[Json], actor: &str, from: f64, to: f64) -> Vec<Json> {
@@ -207,11 +162,7 @@ fn an_activity_started_while_the_mission_is_paused_starts_held_on_either_path() 
     let mission = "CAPABILITY Ping BY d:\n    PERFORM:\n        d.StartStreaming()\n        d.StopStreaming()\n\nMISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        SEQUENTIAL:\n            WAITFOR ELAPSED >= 18s\n            b Ping\n";
     let controls = || vec![(15.0, Control::Pause), (25.0, Control::Resume)];
     let (outcome, trace, _) = run_with_controls(mission, controls());
-    let general = run_with_controls_and(
-        mission,
-        controls(),
-        RunOptions { telemetry_hz: Some(10.0), instant_activities: false, ..RunOptions::default() },
-    );
+    let general = run_with_controls_on(mission, controls(), Path::GeneralOnly);
     assert_eq!((&outcome, &trace), (&general.0, &general.1), "the same trace both ways");
     let start = trace
         .iter()

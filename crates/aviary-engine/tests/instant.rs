@@ -5,15 +5,21 @@
 
 mod harness;
 
-use aviary_engine::{RunOptions, Status};
+use aviary_engine::{Control, RunOptions, Status};
+use harness::Path;
 
 fn both_ways(mission: &str, world: &str) -> harness::Run {
-    let instant = harness::run_with(mission, world, &RunOptions::default());
-    let general = harness::run_with(
-        mission,
-        world,
-        &RunOptions { instant_activities: false, ..RunOptions::default() },
-    );
+    both_ways_with(mission, world, Vec::new())
+}
+
+/// Runs the mission as users run it and with every activity on the general path, with
+/// the operator's controls at their times; panics where the traces part.
+fn both_ways_with(mission: &str, world: &str, controls: Vec<(f64, Control)>) -> harness::Run {
+    let (compiled, world) = harness::compile(mission, world);
+    let options = RunOptions::default();
+    let run = |path| harness::run_compiled(&compiled, &world, &options, controls.clone(), path);
+    let ((instant, a1), (general, a2)) = (run(Path::AsUsersRun), run(Path::GeneralOnly));
+    assert_eq!(a1, a2, "the engine answers the controls alike");
     assert_eq!(instant.outcome, general.outcome);
     let (a, b) = (instant.dump(), general.dump());
     if a != b {
@@ -164,4 +170,288 @@ fn a_capability_whose_calls_take_time_goes_on_where_it_stood() {
         r.ends("TakeOff", "b")[0]["t"].as_f64().unwrap()
             > r.ends("TakeOff", "a")[0]["t"].as_f64().unwrap()
     );
+}
+
+/// Generated missions: the law behind the cases above. Every activity whose capability
+/// may be instant (`Ping`, `Blink`, `Toggle`; the standard `Hover` and `TakeOff`) meets
+/// what can make it wait or stop: claims held by another activity (PARALLEL blocks, FOR,
+/// groups), calls that take time, a call that fails (`c` has no camera), signals and
+/// their handlers, exception handlers, leashes on its tag, the operator's pause, resume
+/// and abort, and drone faults at any time. Both paths must give the same trace, event
+/// for event.
+mod generated {
+    use super::*;
+    use proptest::prelude::*;
+
+    const CAPABILITIES: &str = "CAPABILITY Ping BY d:\n    PERFORM:\n        d.StartStreaming()\n        d.StopStreaming()\n\nCAPABILITY Blink BY d:\n    PERFORM:\n        d.StartStreaming()\n        d.Hover(1s)\n        d.StopStreaming()\n\nCAPABILITY Toggle BY d:\n    PERFORM:\n        d.StopStreaming()\n        d.StartStreaming()\n        d.StopStreaming()\n\n";
+
+    #[derive(Clone, Debug)]
+    enum Stmt {
+        /// `ACTOR CAPABILITY`, perhaps tagged (`Blink-T3`) for a leash.
+        Call {
+            actor: &'static str,
+            capability: &'static str,
+            tagged: bool,
+        },
+        Hover {
+            actor: &'static str,
+            seconds: u8,
+        },
+        TakeOff {
+            actor: &'static str,
+        },
+        Signal(u8),
+        WaitElapsed(u8),
+        /// A leash on the mission's `n`th tag (modulo how many there are).
+        Leash {
+            tag: usize,
+            action: &'static str,
+        },
+        For {
+            parallel: bool,
+            capability: &'static str,
+        },
+        Block {
+            parallel: bool,
+            items: Vec<Stmt>,
+            handlers: Vec<Handler>,
+        },
+    }
+
+    #[derive(Clone, Debug)]
+    enum Handler {
+        On { signal: u8, every: bool, body: Vec<Stmt> },
+        CommandFailed { body: Vec<Stmt> },
+    }
+
+    fn actor() -> impl Strategy<Value = &'static str> {
+        prop::sample::select(vec!["a", "b", "c", "team"])
+    }
+
+    fn leaf() -> impl Strategy<Value = Stmt> {
+        prop_oneof![
+            4 => (actor(), prop::sample::select(vec!["Ping", "Blink", "Toggle"]), any::<bool>())
+                .prop_map(|(actor, capability, tagged)| Stmt::Call { actor, capability, tagged }),
+            2 => (actor(), 1..4u8).prop_map(|(actor, seconds)| Stmt::Hover { actor, seconds }),
+            1 => actor().prop_map(|actor| Stmt::TakeOff { actor }),
+            1 => (0..2u8).prop_map(Stmt::Signal),
+            1 => (1..6u8).prop_map(Stmt::WaitElapsed),
+            1 => (0..4usize, prop::sample::select(vec!["PAUSE", "RESUME", "ABORT"]))
+                .prop_map(|(tag, action)| Stmt::Leash { tag, action }),
+            1 => (any::<bool>(), prop::sample::select(vec!["Ping", "Blink", "Toggle"]))
+                .prop_map(|(parallel, capability)| Stmt::For { parallel, capability }),
+        ]
+    }
+
+    fn stmt() -> impl Strategy<Value = Stmt> {
+        leaf().prop_recursive(3, 24, 4, |inner| {
+            let body = prop::collection::vec(inner.clone(), 1..3);
+            let handler = prop_oneof![
+                (0..2u8, any::<bool>(), body.clone())
+                    .prop_map(|(signal, every, body)| Handler::On { signal, every, body }),
+                body.clone().prop_map(|body| Handler::CommandFailed { body }),
+            ];
+            (
+                any::<bool>(),
+                prop::collection::vec(inner, 1..4),
+                prop::collection::vec(handler, 0..2),
+            )
+                .prop_map(|(parallel, items, handlers)| Stmt::Block {
+                    parallel,
+                    items,
+                    handlers,
+                })
+        })
+    }
+
+    struct Render {
+        text: String,
+        tags: usize,
+        in_handler: bool,
+        in_exception_handler: bool,
+    }
+
+    impl Render {
+        fn line(&mut self, depth: usize, line: &str) {
+            self.text.push_str(&"    ".repeat(depth));
+            self.text.push_str(line);
+            self.text.push('\n');
+        }
+
+        fn stmt(&mut self, s: &Stmt, depth: usize, leashes: &mut Vec<(usize, usize)>) {
+            match s {
+                // Under an exception handler, only calls that cannot fail: one that fails at
+                // once (`c` has no camera; a hover on the ground) would have the handler
+                // take its own exception again at the same instant for ever
+                // (docs/LANGUAGE.md, section 12), on either path.
+                Stmt::Call { actor: "c", capability, tagged } if self.in_exception_handler => {
+                    let s = Stmt::Call { actor: "a", capability, tagged: *tagged };
+                    self.stmt(&s, depth, leashes)
+                }
+                Stmt::Hover { .. } | Stmt::TakeOff { .. } if self.in_exception_handler => {
+                    self.line(depth, "b Ping")
+                }
+                Stmt::Call { actor, capability, tagged: true } => {
+                    self.tags += 1;
+                    self.line(depth, &format!("{actor} {capability}-T{}", self.tags));
+                }
+                Stmt::Call { actor, capability, tagged: false } => {
+                    self.line(depth, &format!("{actor} {capability}"))
+                }
+                Stmt::Hover { actor, seconds } => {
+                    self.line(depth, &format!("{actor} Hover WITH {seconds}s"))
+                }
+                Stmt::TakeOff { actor } => self.line(depth, &format!("{actor} TakeOff")),
+                // Not in a handler: two `ON EVERY` handlers raising each other's signal
+                // would never end, on either path.
+                Stmt::Signal(_) if self.in_handler => self.line(depth, "WAITFOR ELAPSED >= 1s"),
+                Stmt::Signal(n) => self.line(depth, &format!("SIGNAL S{n}")),
+                Stmt::WaitElapsed(n) => self.line(depth, &format!("WAITFOR ELAPSED >= {n}s")),
+                // A pause is always followed by its resume, some time later: an activity
+                // held for ever would hold the mission for ever, on either path.
+                Stmt::Leash { tag, action: "PAUSE" } => {
+                    self.line(depth, "SEQUENTIAL:");
+                    leashes.push((self.text.len(), *tag));
+                    self.line(depth + 1, "@LEASH PAUSE");
+                    self.line(depth + 1, &format!("WAITFOR ELAPSED >= {}s", tag + 2));
+                    leashes.push((self.text.len(), *tag));
+                    self.line(depth + 1, "@LEASH RESUME");
+                }
+                Stmt::Leash { tag, action } => {
+                    // Its tag is named once the whole mission is known (see `mission`).
+                    leashes.push((self.text.len(), *tag));
+                    self.line(depth, &format!("@LEASH {action}"));
+                }
+                Stmt::For { parallel, capability } => {
+                    let kind = if *parallel { "PARALLEL" } else { "SEQUENTIAL" };
+                    self.line(depth, &format!("{kind} FOR team AS d:"));
+                    self.line(depth + 1, &format!("d {capability}"));
+                }
+                Stmt::Block { parallel, items, handlers } => {
+                    self.line(depth, if *parallel { "PARALLEL:" } else { "SEQUENTIAL:" });
+                    for item in items {
+                        self.stmt(item, depth + 1, leashes);
+                    }
+                    for h in handlers {
+                        let body = match h {
+                            Handler::On { signal, every, body } => {
+                                let every = if *every { "EVERY " } else { "" };
+                                self.line(depth + 1, &format!("ON {every}S{signal}:"));
+                                body
+                            }
+                            Handler::CommandFailed { body } => {
+                                self.line(depth + 1, "ON EXCEPTION CommandFailed:");
+                                body
+                            }
+                        };
+                        let exception = matches!(h, Handler::CommandFailed { .. });
+                        let outer = (self.in_handler, self.in_exception_handler);
+                        self.in_handler = true;
+                        self.in_exception_handler |= exception;
+                        for item in body {
+                            self.stmt(item, depth + 2, leashes);
+                        }
+                        (self.in_handler, self.in_exception_handler) = outer;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The mission's text: the capabilities, then a MISSION of `items`. A leash names a
+    /// tag of the mission, or becomes a signal when there is none.
+    fn mission(items: &[Stmt]) -> String {
+        let mut r =
+            Render { text: String::new(), tags: 0, in_handler: false, in_exception_handler: false };
+        let mut leashes = Vec::new();
+        for item in items {
+            r.stmt(item, 1, &mut leashes);
+        }
+        let mut text = r.text;
+        for (at, tag) in leashes.into_iter().rev() {
+            let end = at + text[at..].find('\n').unwrap_or(0);
+            let line = &text[at..end];
+            let indent = line.len() - line.trim_start().len();
+            let action = line.trim_start().trim_start_matches("@LEASH ").to_string();
+            let replacement = if r.tags == 0 {
+                format!("{}SIGNAL S0", &line[..indent])
+            } else {
+                let capability = find_tagged(&text, tag % r.tags + 1);
+                format!("{}{capability}-T{} {action}", &line[..indent], tag % r.tags + 1)
+            };
+            text.replace_range(at..end, &replacement);
+        }
+        format!("{CAPABILITIES}MISSION M:\n{text}")
+    }
+
+    /// The capability that tag `Tn` is put on.
+    fn find_tagged(text: &str, n: usize) -> &str {
+        let tag = format!("-T{n}");
+        let at = text.find(&format!("{tag}\n")).expect("the tag is in the mission");
+        let start = text[..at].rfind(' ').map_or(0, |s| s + 1);
+        &text[start..at]
+    }
+
+    fn fault() -> impl Strategy<Value = String> {
+        let kind = prop::sample::select(vec![
+            "gps_loss",
+            "link_loss",
+            "battery_critical",
+            "crash",
+            "motor_failure",
+        ]);
+        (prop::sample::select(vec!["a", "b", "c"]), 1..30u8, kind).prop_map(|(drone, at, kind)| {
+            let duration = match kind {
+                "gps_loss" | "link_loss" => "duration = 5\n",
+                _ => "",
+            };
+            format!("[[faults]]\ndrone = \"{drone}\"\nat = {at}\nkind = \"{kind}\"\n{duration}")
+        })
+    }
+
+    fn control() -> impl Strategy<Value = (f64, Control)> {
+        let control = prop_oneof![
+            4 => Just(Control::Pause),
+            4 => Just(Control::Resume),
+            1 => Just(Control::Abort { reason: "the operator".into() }),
+        ];
+        (0..40u8, control).prop_map(|(at, c)| (f64::from(at) / 2.0, c))
+    }
+
+    #[derive(Debug)]
+    struct Case {
+        mission: String,
+        world: String,
+        controls: Vec<(f64, Control)>,
+    }
+
+    fn case() -> impl Strategy<Value = Case> {
+        (
+            prop::collection::vec(stmt(), 1..5),
+            prop::collection::vec(fault(), 0..2),
+            prop::collection::vec(control(), 0..3),
+        )
+            .prop_map(|(items, faults, mut controls)| {
+                controls.sort_by(|a, b| a.0.total_cmp(&b.0));
+                // The operator always resumes in the end: a mission held for ever would
+                // never end, on either path.
+                controls.push((25.0, Control::Resume));
+                Case {
+                    mission: mission(&items),
+                    world: format!("{}\n{}", harness::WORLD, faults.join("\n")),
+                    controls,
+                }
+            })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+        #[test]
+        fn generated_missions_run_the_same_both_ways(case in case()) {
+            // A mission the checker refuses says nothing about the paths.
+            prop_assume!(harness::try_compile(&case.mission, &case.world).is_ok());
+            both_ways_with(&case.mission, &case.world, case.controls.clone());
+        }
+    }
 }

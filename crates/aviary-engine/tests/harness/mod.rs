@@ -6,7 +6,7 @@
 use aviary_api::Descriptor;
 use aviary_check::SourceProvider;
 use aviary_diagnostics::SourceMap;
-use aviary_engine::{Outcome, Record, RunOptions};
+use aviary_engine::{Control, Controller, Outcome, Record, RunOptions};
 use aviary_sim::{SimBackend, SimOptions};
 use serde_json::Value;
 
@@ -69,6 +69,14 @@ pub fn run_in(mission: &str, world: &str) -> Run {
 
 /// The mission checked (without errors) and compiled for the world, and the world.
 pub fn compile(mission: &str, world: &str) -> (aviary_ir::Mission, aviary_world::World) {
+    try_compile(mission, world).unwrap_or_else(|errors| panic!("{errors:#?}"))
+}
+
+/// As [`compile`]; the checker's errors, if it finds any.
+pub fn try_compile(
+    mission: &str,
+    world: &str,
+) -> Result<(aviary_ir::Mission, aviary_world::World), Vec<String>> {
     let mut sources = SourceMap::new();
     let checked = aviary_check::check_sources(
         &mut sources,
@@ -83,29 +91,79 @@ pub fn compile(mission: &str, world: &str) -> (aviary_ir::Mission, aviary_world:
         .filter(|d| d.is_error())
         .map(|d| format!("{}: {}", d.code, d.message))
         .collect();
-    assert!(errors.is_empty(), "{errors:#?}");
+    if !errors.is_empty() {
+        return Err(errors);
+    }
     let world = checked.world.expect("world");
     let mission =
         aviary_lower::compile(&checked.program.expect("program"), &world, &Descriptor::standard())
             .expect("mission");
-    (mission, world)
+    Ok((mission, world))
 }
 
 pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
     let (mission, world) = compile(mission, world);
+    run_compiled(&mission, &world, options, Vec::new(), Path::AsUsersRun).0
+}
+
+/// Which way activities run: as users run them, or every one on the general path
+/// (`aviary_engine::testing`), to hold the instant path to the general one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Path {
+    AsUsersRun,
+    GeneralOnly,
+}
+
+/// Runs a compiled mission, sending each control at its mission time; the run and the
+/// engine's answers to the controls.
+pub fn run_compiled(
+    mission: &aviary_ir::Mission,
+    world: &aviary_world::World,
+    options: &RunOptions,
+    controls: Vec<(f64, Control)>,
+    path: Path,
+) -> (Run, Vec<Result<(), String>>) {
     let runtime = tokio::runtime::Builder::new_current_thread()
         .enable_time()
         .start_paused(true)
         .build()
         .expect("runtime");
     runtime.block_on(async {
-        let sim = SimBackend::start(&world, SimOptions::default());
+        let sim = SimBackend::start(world, SimOptions::default());
+        let (controller, rx) = Controller::new();
+        // Without controls, as a run without an operator: no channel at all.
+        let rx = (!controls.is_empty()).then_some(rx);
         let mut trace = Vec::new();
         let mut sink = |r: &Record| trace.push(json(r));
-        let outcome = aviary_engine::run(&mission, &*sim, &mut sink, options).await;
+        let operator = async {
+            let start = tokio::time::Instant::now();
+            let mut answers = Vec::new();
+            for (at, control) in controls {
+                tokio::time::sleep_until(start + std::time::Duration::from_secs_f64(at)).await;
+                answers.push(controller.ask(control).await);
+            }
+            answers
+        };
+        let run = async {
+            match (path, rx) {
+                (Path::AsUsersRun, None) => {
+                    aviary_engine::run(mission, &*sim, &mut sink, options).await
+                }
+                (Path::AsUsersRun, Some(rx)) => {
+                    aviary_engine::run_controlled(mission, &*sim, &mut sink, options, rx).await
+                }
+                (Path::GeneralOnly, rx) => {
+                    aviary_engine::testing::run_on_the_general_path(
+                        mission, &*sim, &mut sink, options, rx,
+                    )
+                    .await
+                }
+            }
+        };
+        let (outcome, answers) = tokio::join!(run, operator);
         sim.shutdown().await;
         let releases = sim.releases().into_iter().map(|r| (r.drone, r.kind, r.position)).collect();
-        Run { outcome, trace, releases }
+        (Run { outcome, trace, releases }, answers)
     })
 }
 

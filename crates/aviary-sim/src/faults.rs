@@ -22,7 +22,7 @@
 use aviary_api::{BuiltinException, BuiltinSignal, DroneEvent, FlightState};
 use aviary_world::FaultKind;
 
-use crate::calls::return_legs;
+use crate::legs::return_legs;
 use crate::drone::Outage;
 use crate::fleet::{Fleet, Report};
 use crate::motion::{Leg, MotionTask};

@@ -145,6 +145,7 @@ mod fleet;
 mod geom;
 mod grid;
 mod hot;
+mod legs;
 mod luck;
 mod motion;
 mod nearby;

@@ -152,6 +152,7 @@ mod nearby;
 mod profile;
 mod sensors;
 mod separation;
+mod step;
 pub mod sweep;
 #[cfg(test)]
 mod tests;

@@ -169,7 +169,7 @@ impl Fleet {
     /// where it lies. A `SimDrone` is no larger than a world's `Drone`, so collecting
     /// them reuses the world's allocation (`Vec`'s in-place collect), and what each world
     /// drone holds is freed as it goes: a large world and its fleet are never held whole
-    /// at once (100,000 drones: about 17 MB less at the simulator's start).
+    /// at once (docs/BENCHMARKS.md).
     pub fn from_world(mut world: World) -> Fleet {
         let fleet = Fleet::around(&world);
         let mut specs = Specs::default();

@@ -1,9 +1,14 @@
-//! Backends made of the simulator's and MAVLink's: `mixed.rs`, a fleet whose drones are
-//! each flown by one or the other, behind one `Backend` for the engine.
+//! Backends made of the simulator's and MAVLink's, and the run that chooses between them.
+//! `mixed.rs`: a fleet whose drones are each flown by one or the other, behind one
+//! `Backend` for the engine. `pipeline.rs`: [`fly`], a run's whole pipeline from the
+//! texts of a mission and its world to the end of its flight, which `aviary run` and the
+//! scale benchmarks share.
 //!
 //! The one crate that names both backends: the simulator and `aviary-mavlink` know nothing
-//! of each other, and the engine knows neither.
+//! of each other, and the engine knows neither. No IO of its own: texts in, an outcome out.
 
 mod mixed;
+pub mod pipeline;
 
 pub use mixed::{live_runtime, Mixed};
+pub use pipeline::fly;

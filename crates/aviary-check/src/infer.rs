@@ -41,25 +41,7 @@ pub(crate) fn parameter_kinds(
     let mut origins: Vec<Option<Vec<Option<KindOrigin>>>> = vec![None; names.len()];
     for (ci, c) in caps.iter().enumerate() {
         let Some(c) = c else { continue };
-        let mut k = vec![None; c.params.len()];
-        let mut o = vec![None; c.params.len()];
-        for section in &c.sections {
-            let Section::Defaults { entries, .. } = section else { continue };
-            for e in entries {
-                if let Some(i) = c.params.iter().position(|p| p.name == e.name.name) {
-                    k[i] = literal_kind(&e.value);
-                    o[i] = k[i].map(|kind| KindOrigin {
-                        span: e.value.span,
-                        why: format!(
-                            "`{}` is {} because of its default",
-                            e.name.name,
-                            kind.describe()
-                        ),
-                        from: None,
-                    });
-                }
-            }
-        }
+        let (k, o) = from_defaults(c);
         kinds[ci] = Some(k);
         origins[ci] = Some(o);
     }
@@ -78,73 +60,7 @@ pub(crate) fn parameter_kinds(
         let mut next_round: BTreeSet<usize> = BTreeSet::new();
         while let Some(ci) = round.pop_first() {
             let Some(c) = caps[ci] else { continue };
-            let mut learned: Vec<(usize, Kind, KindOrigin)> = Vec::new();
-            let param_index = |e: &Expr| match &e.kind {
-                ExprKind::Name(id) => c.params.iter().position(|p| p.name == id.name),
-                _ => None,
-            };
-            for body in capability_bodies(c) {
-                visit_stmts(body, &mut |stmt| match stmt {
-                    Stmt::Api(call) => {
-                        let Some(f) = api.function(&call.function.name) else { return };
-                        for (j, arg) in call.args.iter().enumerate() {
-                            let p =
-                                f.params.get(j).or(if f.variadic { f.params.last() } else { None });
-                            if let (Some(i), Some(p)) = (param_index(arg), p) {
-                                let why = format!(
-                                    "`{}` goes to the middle layer's {}: {}",
-                                    c.params[i].name,
-                                    f.signature(),
-                                    p.kind.describe()
-                                );
-                                learned.push((
-                                    i,
-                                    p.kind,
-                                    KindOrigin { span: arg.span, why, from: None },
-                                ));
-                            }
-                        }
-                    }
-                    Stmt::Statement(s) => {
-                        let Some(&callee_index) = index.get(s.capability.name.as_str()) else {
-                            return;
-                        };
-                        let (Some(callee), Some(callee_kinds)) =
-                            (caps[callee_index], &kinds[callee_index])
-                        else {
-                            return;
-                        };
-                        // Only a parameter passed on can learn anything here.
-                        if !s.args.iter().any(|a| param_index(&a.value).is_some()) {
-                            return;
-                        }
-                        let binding = bind_args(&callee.params, &s.args);
-                        for (k, arg) in binding.bound.iter().enumerate() {
-                            if let (Some(arg), Some(Some(kind))) = (arg, callee_kinds.get(k)) {
-                                if let Some(i) = param_index(arg) {
-                                    let why = format!(
-                                        "`{}` goes to `{}`'s `{}`: {}",
-                                        c.params[i].name,
-                                        callee.name.name,
-                                        callee.params[k].name,
-                                        kind.describe()
-                                    );
-                                    learned.push((
-                                        i,
-                                        *kind,
-                                        KindOrigin {
-                                            span: arg.span,
-                                            why,
-                                            from: Some((callee.name.name.clone(), k)),
-                                        },
-                                    ));
-                                }
-                            }
-                        }
-                    }
-                    _ => {}
-                });
-            }
+            let learned = Uses { api, caps: &caps, index: &index, kinds: &kinds }.of(c);
             let mut grew = false;
             if let (Some(k), Some(o)) = (kinds[ci].as_mut(), origins[ci].as_mut()) {
                 for (i, kind, origin) in learned {
@@ -172,6 +88,109 @@ pub(crate) fn parameter_kinds(
         round = next_round;
     }
     (by_name(&names, kinds), by_name(&names, origins))
+}
+
+/// The kinds a capability's parameters take from their defaults, and where.
+fn from_defaults(c: &Capability) -> (Vec<Option<Kind>>, Vec<Option<KindOrigin>>) {
+    let mut k = vec![None; c.params.len()];
+    let mut o = vec![None; c.params.len()];
+    for section in &c.sections {
+        let Section::Defaults { entries, .. } = section else { continue };
+        for e in entries {
+            if let Some(i) = c.params.iter().position(|p| p.name == e.name.name) {
+                k[i] = literal_kind(&e.value);
+                o[i] = k[i].map(|kind| KindOrigin {
+                    span: e.value.span,
+                    why: format!("`{}` is {} because of its default", e.name.name, kind.describe()),
+                    from: None,
+                });
+            }
+        }
+    }
+    (k, o)
+}
+
+/// A kind a parameter (by index) learns from a use, and where.
+type Learned = (usize, Kind, KindOrigin);
+
+/// What a visit of a capability learns from where its parameters go: to the middle
+/// layer's parameters, and to capabilities' parameters of the kinds known so far.
+struct Uses<'a> {
+    api: &'a Descriptor,
+    caps: &'a [Option<&'a Capability>],
+    index: &'a foldhash::HashMap<&'a str, usize>,
+    kinds: &'a [Option<Vec<Option<Kind>>>],
+}
+
+impl Uses<'_> {
+    fn of(&self, c: &Capability) -> Vec<Learned> {
+        let mut learned = Vec::new();
+        for body in capability_bodies(c) {
+            visit_stmts(body, &mut |stmt| match stmt {
+                Stmt::Api(call) => self.api_call(c, call, &mut learned),
+                Stmt::Statement(s) => self.capability_call(c, s, &mut learned),
+                _ => {}
+            });
+        }
+        learned
+    }
+
+    /// A parameter passed to a middle-layer function takes the kind of its parameter.
+    fn api_call(&self, c: &Capability, call: &ApiCall, learned: &mut Vec<Learned>) {
+        let Some(f) = self.api.function(&call.function.name) else { return };
+        for (j, arg) in call.args.iter().enumerate() {
+            let p = f.params.get(j).or(if f.variadic { f.params.last() } else { None });
+            if let (Some(i), Some(p)) = (param_index(c, arg), p) {
+                let why = format!(
+                    "`{}` goes to the middle layer's {}: {}",
+                    c.params[i].name,
+                    f.signature(),
+                    p.kind.describe()
+                );
+                learned.push((i, p.kind, KindOrigin { span: arg.span, why, from: None }));
+            }
+        }
+    }
+
+    /// A parameter passed to a capability takes the kind of its parameter, once known.
+    fn capability_call(&self, c: &Capability, s: &Statement, learned: &mut Vec<Learned>) {
+        let Some(&callee_index) = self.index.get(s.capability.name.as_str()) else {
+            return;
+        };
+        let (Some(callee), Some(callee_kinds)) =
+            (self.caps[callee_index], &self.kinds[callee_index])
+        else {
+            return;
+        };
+        // Only a parameter passed on can learn anything here.
+        if !s.args.iter().any(|a| param_index(c, &a.value).is_some()) {
+            return;
+        }
+        let binding = bind_args(&callee.params, &s.args);
+        for (k, arg) in binding.bound.iter().enumerate() {
+            if let (Some(arg), Some(Some(kind))) = (arg, callee_kinds.get(k)) {
+                if let Some(i) = param_index(c, arg) {
+                    let why = format!(
+                        "`{}` goes to `{}`'s `{}`: {}",
+                        c.params[i].name,
+                        callee.name.name,
+                        callee.params[k].name,
+                        kind.describe()
+                    );
+                    let from = Some((callee.name.name.clone(), k));
+                    learned.push((i, *kind, KindOrigin { span: arg.span, why, from }));
+                }
+            }
+        }
+    }
+}
+
+/// Which of the capability's parameters an argument is, when it is one by name.
+fn param_index(c: &Capability, e: &Expr) -> Option<usize> {
+    match &e.kind {
+        ExprKind::Name(id) => c.params.iter().position(|p| p.name == id.name),
+        _ => None,
+    }
 }
 
 /// Values by index as a map by name.

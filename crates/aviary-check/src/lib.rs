@@ -32,7 +32,7 @@ use aviary_world::World;
 
 pub use env::{bind_args, ArgBinding, BindProblem};
 pub use infer::KindOrigin;
-pub use inputs::{check_sources, normalize_path, Checked};
+pub use inputs::{check_against, check_sources, normalize_path, read_world, Checked, WorldRead};
 pub use load::{SourceProvider, STD_NAME, STD_SOURCE};
 pub use uses::LoadError;
 

@@ -25,45 +25,7 @@ pub(crate) fn check_signals(
     api: &Descriptor,
     diagnostics: &mut Vec<Diagnostic>,
 ) {
-    let mut uses = Uses::default();
-    for (file, tree) in &program.files {
-        for item in &tree.items {
-            let mut bodies = match item {
-                Item::Mission(m) => vec![&m.body],
-                Item::Capability(c) if program.is_active(*file, c) => capability_bodies(c),
-                _ => continue,
-            };
-            if let Item::Capability(c) = item {
-                for s in &c.sections {
-                    if let Section::Exceptions { handlers, .. } = s {
-                        uses.exception_handlers
-                            .extend(handlers.iter().map(|h| (*file, &h.exception)));
-                    }
-                    if let Section::Requirements { conditions, .. } = s {
-                        for c in conditions {
-                            collect_received(*file, c, &mut uses);
-                        }
-                    }
-                }
-            }
-            for body in bodies.drain(..) {
-                visit_stmts(body, &mut |stmt| {
-                    match stmt {
-                        Stmt::Signal(r) => uses.raised.push((*file, &r.name)),
-                        Stmt::Throw(r) => uses.thrown.push(&r.name.name),
-                        Stmt::Handler(h) => uses.handlers.push((*file, &h.signal)),
-                        Stmt::ExceptionHandler(h) => {
-                            uses.exception_handlers.push((*file, &h.exception))
-                        }
-                        _ => {}
-                    }
-                    for e in stmt_exprs(stmt) {
-                        collect_received(*file, e, &mut uses);
-                    }
-                });
-            }
-        }
-    }
+    let uses = Uses::of(program);
     // The lists keep their order for the "did you mean" help; the sets answer membership
     // in constant time, so a large mission is not checked in quadratic time.
     let raised: Vec<&str> = uses
@@ -73,6 +35,64 @@ pub(crate) fn check_signals(
         .chain(api.signals.iter().map(|s| s.name()))
         .collect();
     let raised_set: HashSet<&str> = raised.iter().copied().collect();
+    never_raised(&uses, &raised, &raised_set, diagnostics);
+    unknown_exceptions(&uses, api, &raised_set, diagnostics);
+    never_handled(&uses, diagnostics);
+}
+
+impl<'a> Uses<'a> {
+    /// Every use in the mission and the active capabilities, in file order.
+    fn of(program: &'a Program) -> Uses<'a> {
+        let mut uses = Uses::default();
+        for (file, tree) in &program.files {
+            for item in &tree.items {
+                let mut bodies = match item {
+                    Item::Mission(m) => vec![&m.body],
+                    Item::Capability(c) if program.is_active(*file, c) => capability_bodies(c),
+                    _ => continue,
+                };
+                if let Item::Capability(c) = item {
+                    for s in &c.sections {
+                        if let Section::Exceptions { handlers, .. } = s {
+                            uses.exception_handlers
+                                .extend(handlers.iter().map(|h| (*file, &h.exception)));
+                        }
+                        if let Section::Requirements { conditions, .. } = s {
+                            for c in conditions {
+                                collect_received(*file, c, &mut uses);
+                            }
+                        }
+                    }
+                }
+                for body in bodies.drain(..) {
+                    visit_stmts(body, &mut |stmt| {
+                        match stmt {
+                            Stmt::Signal(r) => uses.raised.push((*file, &r.name)),
+                            Stmt::Throw(r) => uses.thrown.push(&r.name.name),
+                            Stmt::Handler(h) => uses.handlers.push((*file, &h.signal)),
+                            Stmt::ExceptionHandler(h) => {
+                                uses.exception_handlers.push((*file, &h.exception))
+                            }
+                            _ => {}
+                        }
+                        for e in stmt_exprs(stmt) {
+                            collect_received(*file, e, &mut uses);
+                        }
+                    });
+                }
+            }
+        }
+        uses
+    }
+}
+
+/// Handlers and `RECEIVED` of signals nothing raises.
+fn never_raised(
+    uses: &Uses,
+    raised: &[&str],
+    raised_set: &HashSet<&str>,
+    diagnostics: &mut Vec<Diagnostic>,
+) {
     for (file, h) in &uses.handlers {
         if !raised_set.contains(h.name.as_str()) {
             let help = did_you_mean(&h.name, raised.iter().copied())
@@ -103,6 +123,15 @@ pub(crate) fn check_signals(
             );
         }
     }
+}
+
+/// Exception handlers of what is neither a built-in exception nor thrown (or is a signal).
+fn unknown_exceptions(
+    uses: &Uses,
+    api: &Descriptor,
+    raised_set: &HashSet<&str>,
+    diagnostics: &mut Vec<Diagnostic>,
+) {
     let exceptions: Vec<&str> =
         api.exceptions.iter().map(|e| e.name()).chain(uses.thrown.iter().copied()).collect();
     let exception_set: HashSet<&str> = exceptions.iter().copied().collect();
@@ -140,6 +169,10 @@ pub(crate) fn check_signals(
             );
         }
     }
+}
+
+/// Signals raised that no handler or `RECEIVED` hears.
+fn never_handled(uses: &Uses, diagnostics: &mut Vec<Diagnostic>) {
     let heard: HashSet<&str> =
         uses.handlers.iter().chain(&uses.received).map(|(_, h)| h.name.as_str()).collect();
     for (file, s) in &uses.raised {

@@ -1,32 +1,10 @@
-//! `aviary bench parse`: generates a large mission and its world
-//! (`aviary_bench::generate`), then times parsing alone and parse + check through the
-//! same pipeline as `aviary check` (source map, world, `aviary_check::check`), and
-//! prints each run and the median throughput. MB here is 10^6 bytes.
-//! `aviary bench w` and `aviary bench swarm` (in `bench/`) run generated missions
-//! through the whole pipeline.
+//! `aviary bench`: the arguments of the benchmarks, which `aviary_bench` runs and
+//! reports (docs/BENCHMARKS.md): `parse` (the front end), `front` (all of `aviary check`),
+//! `w` (the engine) and `swarm` (the simulator). Here only what the command line says and
+//! where the report goes.
 
-mod front;
-mod pipeline;
-mod swarm;
-mod w;
-
-use std::time::{Duration, Instant};
-
-use aviary_api::Descriptor;
-use aviary_check::SourceProvider;
-use aviary_diagnostics::{FileId, SourceMap};
-use clap::Subcommand;
-
-/// The generated mission USEs nothing, so nothing is served.
-pub(crate) struct NoFiles;
-
-impl SourceProvider for NoFiles {
-    fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-        Err(format!("the benchmark reads no files ({path})").into())
-    }
-}
-
-pub(crate) const MB: f64 = 1_000_000.0;
+use aviary_bench::{Emit, Error};
+use clap::{Subcommand, ValueEnum};
 
 #[derive(Subcommand)]
 pub enum BenchCommand {
@@ -65,7 +43,7 @@ pub enum BenchCommand {
         /// capabilities, each calling the next; `realistic`: the mission of `bench parse`, of
         /// N MB
         #[arg(long, value_enum, default_value = "sequential")]
-        shape: front::Shape,
+        shape: Shape,
         /// Statements, capabilities, or MB (realistic)
         #[arg(long, default_value_t = 100_000)]
         n: usize,
@@ -93,105 +71,51 @@ pub enum BenchCommand {
     },
 }
 
+/// The generated mission's shape (`aviary_bench::Shape`).
+#[derive(Clone, Copy, ValueEnum)]
+pub enum Shape {
+    /// N statements in one SEQUENTIAL block, all on one drone
+    Sequential,
+    /// N capabilities, each calling the next
+    Chain,
+    /// The realistic mission of `aviary bench parse`, of N MB
+    Realistic,
+}
+
 pub fn run(which: BenchCommand) -> u8 {
-    match which {
-        BenchCommand::Parse { mb, runs } => parse(mb, runs),
+    let out = &mut crate::out::Stdout;
+    let ran = match which {
+        BenchCommand::Parse { mb, runs } => aviary_bench::parse(mb, runs, out),
         BenchCommand::W { n, k, emit, emit_world, full_trace } => {
-            w::run(n, k, emit, emit_world, full_trace)
+            aviary_bench::w(n, k, Emit::of(emit, emit_world), full_trace, out)
         }
-        BenchCommand::Swarm { drones, emit, emit_world } => swarm::run(drones, emit, emit_world),
+        BenchCommand::Swarm { drones, emit, emit_world } => {
+            aviary_bench::swarm(drones, Emit::of(emit, emit_world), out)
+        }
         BenchCommand::Front { shape, n, runs, emit, emit_world } => {
-            front::run(shape, n, runs, emit, emit_world)
+            let shape = match shape {
+                Shape::Sequential => aviary_bench::Shape::Sequential,
+                Shape::Chain => aviary_bench::Shape::Chain,
+                Shape::Realistic => aviary_bench::Shape::Realistic,
+            };
+            aviary_bench::front(shape, n, runs, Emit::of(emit, emit_world), out)
         }
-    }
-}
-
-fn parse(mb: f64, runs: usize) -> u8 {
-    if !(mb.is_finite() && mb > 0.0) || mb > 4000.0 {
-        eprintln!("aviary: --mb must be a size in megabytes, above 0 and at most 4000");
-        return 2;
-    }
-    let runs = runs.max(1);
-    let started = Instant::now();
-    let (mission, world) = aviary_bench::generate::large_mission((mb * MB) as usize);
-    let size = mission.len();
-    outln!(
-        "generated a mission of {:.2} MB ({size} bytes, {} lines, {} capabilities) and a world of {} drones in {:.2} s",
-        size as f64 / MB,
-        mission.lines().count(),
-        mission.matches("\nCAPABILITY ").count(),
-        aviary_bench::generate::DRONES,
-        started.elapsed().as_secs_f64()
-    );
-
-    // One run outside the timings, to say what the checker thinks of the mission.
-    let (errors, others) = parse_and_check(&mission, &world);
-    if errors > 0 || others > 0 {
-        outln!("note: the check reports {errors} error(s) and {others} other diagnostic(s); the generator should give none");
-    }
-
-    let mut parse_times = Vec::with_capacity(runs);
-    let mut check_times = Vec::with_capacity(runs);
-    for run in 1..=runs {
-        // Parse alone: lexing, layout and parsing into the tree (dropping the tree is
-        // not timed here; it is in parse + check, as it is in `aviary check`).
-        let start = Instant::now();
-        let parsed = std::hint::black_box(aviary_syntax::parse(FileId(0), &mission));
-        let parse_time = start.elapsed();
-        drop(parsed);
-
-        let start = Instant::now();
-        std::hint::black_box(parse_and_check(&mission, &world));
-        let check_time = start.elapsed();
-
-        outln!(
-            "run {run}: parse {:.3} s ({:.1} MB/s); parse + check {:.3} s ({:.1} MB/s)",
-            parse_time.as_secs_f64(),
-            rate(size, parse_time),
-            check_time.as_secs_f64(),
-            rate(size, check_time)
-        );
-        parse_times.push(parse_time);
-        check_times.push(check_time);
-    }
-    let parse_median = median(&mut parse_times);
-    let check_median = median(&mut check_times);
-    outln!(
-        "median of {runs} run(s) over {:.2} MB: parse {:.1} MB/s ({:.3} s); parse + check {:.1} MB/s ({:.3} s)",
-        size as f64 / MB,
-        rate(size, parse_median),
-        parse_median.as_secs_f64(),
-        rate(size, check_median),
-        check_median.as_secs_f64()
-    );
-    0
-}
-
-/// What `aviary check` does with a mission and its world, minus reading and printing:
-/// the number of errors and of other diagnostics.
-fn parse_and_check(mission: &str, world_text: &str) -> (usize, usize) {
-    let mut sources = SourceMap::new();
-    let checked = aviary_check::check_sources(
-        &mut sources,
-        ("generated.mission", mission.as_bytes()),
-        Some(("generated.world.toml", world_text.as_bytes())),
-        &NoFiles,
-        &Descriptor::standard(),
-    );
-    let errors = checked.diagnostics.iter().filter(|d| d.is_error()).count();
-    (errors, checked.diagnostics.len() - errors)
-}
-
-pub(crate) fn rate(bytes: usize, time: Duration) -> f64 {
-    bytes as f64 / MB / time.as_secs_f64().max(1e-9)
-}
-
-pub(crate) fn median(times: &mut [Duration]) -> Duration {
-    times.sort_unstable();
-    let n = times.len();
-    if n % 2 == 1 {
-        times[n / 2]
-    } else {
-        (times[n / 2 - 1] + times[n / 2]) / 2
+    };
+    match ran {
+        Ok(()) => 0,
+        Err(Error::Usage(why)) => {
+            eprintln!("aviary: {why}");
+            2
+        }
+        Err(Error::Failed(why)) => {
+            eprintln!("aviary: {why}");
+            1
+        }
+        Err(Error::NotOk) => 1,
+        // `Stdout` says a failure itself, once, and then takes every write.
+        Err(Error::Write(e)) => {
+            eprintln!("aviary: cannot write to standard output: {e}");
+            2
+        }
     }
 }

@@ -5,7 +5,6 @@
 
 #[macro_use]
 mod out;
-mod alloc;
 mod bench;
 mod check;
 mod ctl;
@@ -17,8 +16,17 @@ mod serve;
 mod trace_file;
 mod vehicles;
 
+/// mimalloc, tuned before `main` (`aviary_alloc`; docs/BENCHMARKS.md).
 #[global_allocator]
-static ALLOCATOR: alloc::MiMalloc = alloc::MiMalloc;
+static ALLOCATOR: aviary_alloc::MiMalloc = aviary_alloc::MiMalloc;
+
+/// Before `main`, so before the first allocation: the first arena takes the options it
+/// finds then (`aviary_alloc::tune`). Declared here rather than in the library: a
+/// constructor in a library is linked only when something else of its object file is.
+#[ctor::ctor(unsafe)]
+fn tune_the_allocator() {
+    aviary_alloc::tune();
+}
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -185,7 +193,7 @@ fn main() -> ExitCode {
 
 fn command(cli: Cli) -> u8 {
     if matches!(cli.command, Command::Check { .. } | Command::Fmt { .. }) {
-        alloc::short_lived();
+        aviary_alloc::short_lived();
     }
     let code = match cli.command {
         Command::Check { files, world, format, plan, offline, use_root } => check::run(

@@ -9,11 +9,16 @@ use std::sync::atomic::{AtomicBool, Ordering};
 static FAILED: AtomicBool = AtomicBool::new(false);
 
 pub fn write(args: std::fmt::Arguments<'_>) {
+    put(|stdout| stdout.write_fmt(args));
+}
+
+/// Writes and flushes, unless standard output has failed before.
+fn put(what: impl FnOnce(&mut io::StdoutLock<'static>) -> io::Result<()>) {
     if FAILED.load(Ordering::Relaxed) {
         return;
     }
     let mut stdout = io::stdout().lock();
-    if let Err(e) = stdout.write_fmt(args).and_then(|()| stdout.flush()) {
+    if let Err(e) = what(&mut stdout).and_then(|()| stdout.flush()) {
         FAILED.store(true, Ordering::Relaxed);
         if e.kind() != io::ErrorKind::BrokenPipe {
             eprintln!("aviary: cannot write to standard output: {e}");
@@ -36,4 +41,25 @@ macro_rules! out {
 macro_rules! outln {
     () => { $crate::out::write(format_args!("\n")) };
     ($($arg:tt)*) => { $crate::out::write(format_args!("{}\n", format_args!($($arg)*))) };
+}
+
+/// Standard output as an `io::Write`, for reports written by a library (`aviary_bench`):
+/// each `write!` is one `out!`, so a reader that stops reading silences the rest, and the
+/// writes never fail.
+pub struct Stdout;
+
+impl Write for Stdout {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        put(|stdout| stdout.write_all(buf));
+        Ok(buf.len())
+    }
+
+    fn write_fmt(&mut self, args: std::fmt::Arguments<'_>) -> io::Result<()> {
+        write(args);
+        Ok(())
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        Ok(())
+    }
 }

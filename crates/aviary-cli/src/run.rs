@@ -1,14 +1,19 @@
 //! `aviary run`: check, compile and fly a mission on the drones its world binds (the
 //! built-in simulator), with a live progress line, a JSON Lines trace and a summary.
+//! The pipeline is `aviary_backends::fly`'s; here are the files, the terminal, the
+//! signals and the operator server, through the pipeline's hooks.
 
 use std::io::Write;
 use std::path::PathBuf;
 
 use aviary_api::trace::{Event, Record};
 use aviary_api::Backend;
+use aviary_backends::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
 use aviary_diagnostics::{render_text, SourceMap};
-use aviary_engine::{Control, Controller, Outcome, RunOptions, Status};
-use aviary_sim::{Fleet, SimBackend, SimOptions};
+use aviary_engine::{Control, Controller, RunOptions, Status};
+use aviary_ir::Mission;
+use aviary_mavlink::Facts;
+use aviary_world::World;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::files::{color_wanted, use_roots, world_beside, DiskProvider};
@@ -91,170 +96,71 @@ pub fn run(args: &RunArgs) -> u8 {
             return 2;
         }
     };
-    let mut sources = SourceMap::new();
     let name = args.file.display().to_string();
     let world_name = world_path.display().to_string();
-    let api = aviary_sim::descriptor();
-    let checked = aviary_check::check_sources(
-        &mut sources,
-        (&name, &bytes),
-        Some((&world_name, &world_bytes)),
-        &provider,
-        &api,
-    );
-    if checked.has_errors() {
-        for d in checked.diagnostics.iter().filter(|d| d.is_error()) {
-            eprint!("{}", render_text(&sources, d, color_wanted()));
-        }
-        eprintln!("aviary: {} has errors, so it was not run", args.file.display());
-        return 2;
-    }
-    // The source texts are needed only to show errors: they go before the mission is
-    // compiled (a large world's text is megabytes). With MAVLink drones the plan is made
-    // again with the vehicles' figures, and its warnings point into them.
-    let mavlink = checked.world.as_ref().is_some_and(|w| !aviary_mavlink::bindings(w).is_empty());
-    let sources = if mavlink {
-        Some(sources)
-    } else {
-        drop(sources);
-        crate::alloc::give_back();
-        None
+    let texts = Texts {
+        mission: Source { name: &name, bytes },
+        world: Source { name: &world_name, bytes: world_bytes },
+        files: &provider,
     };
-    let (Some(program), Some(world)) = (checked.program, checked.world) else { return 2 };
-    let Some(mission) = aviary_lower::compile(&program, &world, &api) else {
-        eprintln!(
-            "aviary: {} has no MISSION to run (it holds only capabilities)",
-            args.file.display()
-        );
-        return 2;
-    };
-    drop(program);
-    let out: Box<dyn Write + Send> = match &args.trace {
-        Some(path) => match std::fs::File::create(path) {
-            Ok(f) => Box::new(f),
-            Err(e) => {
-                eprintln!("aviary: cannot write the trace {}: {e}", path.display());
-                return 2;
-            }
+    let options = Options {
+        speed: args.speed,
+        seed: args.seed,
+        // The operator's view of the drones comes from telemetry events.
+        run: RunOptions {
+            telemetry_hz: args.telemetry_hz.or(args.serve.as_ref().map(|_| 2.0)),
+            ..RunOptions::default()
         },
-        None => Box::new(std::io::sink()),
     };
-    let trace = TraceFile::new(
-        out,
-        args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default(),
-        mission.name.clone(),
-    );
-    // Any MAVLink drone: the wall clock, and the simulated drones in real time with it.
-    let live = !aviary_mavlink::bindings(&world).is_empty();
-    if live && args.speed.is_some() {
-        eprintln!(
-            "aviary: {} has MAVLink drones, which fly in real time: leave out --speed",
-            world_path.display()
-        );
-        return 2;
+    let mut shown = Shown {
+        args,
+        trace: None,
+        server: None,
+        feed: None,
+        progress: None,
+        stats: Stats::default(),
+        drones: 0,
+        summary: String::new(),
+    };
+    let flown = aviary_backends::fly(texts, &options, &mut shown);
+    let Shown { trace, server, progress, summary, .. } = shown;
+    if let (Ok(flown), Some(trace)) = (&flown, &trace) {
+        if !flown.flew {
+            // Stopped while the vehicles connected: the trace is whole all the same.
+            lock(trace).close_now(flown.outcome.reason.as_deref().unwrap_or_default());
+        }
     }
-    // Simulated drones only: the fleet takes the world's drones where they lie. With
-    // MAVLink drones the world is kept to connect them.
-    let (fleet, world) =
-        if live { (Fleet::new(&world), Some(world)) } else { (Fleet::from_world(world), None) };
-    // The chances the world asks for (a sensor's `probability`, a fault's range of
-    // times) are drawn from the seed.
-    let fleet = fleet.seeded(args.seed);
-    let runtime = match if live {
-        aviary_backends::live_runtime()
-    } else {
-        tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build()
-    } {
-        Ok(r) => r,
-        Err(e) => {
-            eprintln!("aviary: cannot start the runtime: {e}");
+    if let Some(progress) = &progress {
+        progress.finish_and_clear();
+    }
+    let outcome = match flown {
+        Ok(flown) => flown.outcome,
+        Err(NotFlown::Errors { diagnostics, sources }) => {
+            for d in diagnostics.iter().filter(|d| d.is_error()) {
+                eprint!("{}", render_text(&sources, d, color_wanted()));
+            }
+            eprintln!("aviary: {} has errors, so it was not run", args.file.display());
             return 2;
         }
-    };
-    let (controller, controls) = Controller::new();
-    // The first stop signal, also seen before the engine runs (while vehicles connect).
-    let (stop_tx, stop_rx) = tokio::sync::watch::channel(None::<&'static str>);
-    on_stop_signals(controller.clone(), stop_tx, trace.clone());
-    let server = match args
-        .serve
-        .as_ref()
-        .map(|serve| crate::serve::start(serve, &mission, controller.clone()))
-        .transpose()
-    {
-        Ok(s) => s,
-        Err(why) => {
+        Err(NotFlown::NoMission) => {
+            eprintln!(
+                "aviary: {} has no MISSION to run (it holds only capabilities)",
+                args.file.display()
+            );
+            return 2;
+        }
+        Err(NotFlown::Speed) => {
+            eprintln!(
+                "aviary: {} has MAVLink drones, which fly in real time: leave out --speed",
+                world_path.display()
+            );
+            return 2;
+        }
+        Err(NotFlown::Failed(why)) => {
             eprintln!("aviary: {why}");
             return 2;
         }
     };
-    let feed = server.as_ref().map(|s| s.feed.clone());
-    // The operator's view of the drones comes from telemetry events.
-    let telemetry_hz = args.telemetry_hz.or(server.as_ref().map(|_| 2.0));
-    let progress = progress_bar(args.quiet);
-    let ran = runtime.block_on(async {
-        let sim = SimBackend::start_with(fleet, SimOptions { speed: args.speed, ..SimOptions::default() });
-        let mixed = match &world {
-            Some(world) => {
-                let mut stop = stop_rx.clone();
-                // A stop while the vehicles connect is answered at once: nothing has
-                // flown, so there is nothing to bring home.
-                let mavlink = tokio::select! {
-                    connected = aviary_mavlink::connect(world, aviary_mavlink::Tuning::default()) => connected?,
-                    by = stop.wait_for(Option::is_some) => {
-                        let by = by.ok().and_then(|b| *b).unwrap_or("a stop signal");
-                        let reason = format!("stopped by {by} while the vehicles connected; nothing flew");
-                        lock(&trace).close_now(&reason);
-                        return Ok((Outcome { status: Status::Aborted, reason: Some(reason) }, String::new()));
-                    }
-                };
-                if let Some(sources) = &sources {
-                    crate::figures::before_flight(&mission, world, mavlink.facts(), sources, args.quiet);
-                }
-                Some(aviary_backends::Mixed::new(sim.clone(), mavlink))
-            }
-            None => None,
-        };
-        // The backends keep what they need of the world: a large fleet's is not held
-        // through the flight.
-        drop(world);
-        drop(sources);
-        let backend: &dyn Backend = match &mixed {
-            Some(m) => m,
-            None => &*sim,
-        };
-        let watch = watch_backend(sim.take_driver(), controller.clone());
-        let mut stats = Stats::default();
-        let mut sink = |record: &Record| {
-            stats.observe(record, &progress, backend, mission.drones.len());
-            lock(&trace).write(record);
-            if let Some(feed) = &feed {
-                feed.publish(record);
-            }
-        };
-        let options = RunOptions { telemetry_hz, ..RunOptions::default() };
-        let outcome = tokio::select! {
-            biased;
-            outcome = aviary_engine::run_controlled(&mission, backend, &mut sink, &options, controls) => outcome,
-            _ = watch => unreachable!("the watch never ends"),
-        };
-        sim.stop();
-        // A MAVLink drone's distance and flight time come from the track it reported.
-        let odometry = |d: usize| match mixed.as_ref().filter(|m| m.mavlink.serves(d)) {
-            Some(m) => m.mavlink.odometry(d),
-            None => Some(sim.with_fleet(|f| f.odometry(d))),
-        };
-        let summary = summary(&mission, backend, &odometry, &stats);
-        Ok::<_, String>((outcome, summary))
-    });
-    let (outcome, summary) = match ran {
-        Ok(r) => r,
-        Err(why) => {
-            progress.finish_and_clear();
-            eprintln!("aviary: {why}");
-            return 2;
-        }
-    };
-    progress.finish_and_clear();
     if let Some(s) = &server {
         s.finish(std::time::Duration::from_secs(2));
     }
@@ -265,7 +171,7 @@ pub fn run(args: &RunArgs) -> u8 {
             None => outln!("mission {}", outcome.status.as_str()),
         }
     }
-    if let Some(why) = lock(&trace).failed() {
+    if let Some(why) = trace.as_ref().and_then(|t| lock(t).failed().map(str::to_owned)) {
         eprintln!(
             "aviary: the trace {} is not whole: {why}",
             args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default()
@@ -275,17 +181,95 @@ pub fn run(args: &RunArgs) -> u8 {
     u8::from(outcome.status != Status::Ok)
 }
 
+/// What a run shows as it goes, and where its trace goes: the hooks of the pipeline.
+struct Shown<'a> {
+    args: &'a RunArgs,
+    /// Opened once the mission compiled.
+    trace: Option<SharedTrace>,
+    server: Option<aviary_server::Server>,
+    feed: Option<aviary_server::Feed>,
+    /// Made once the run starts.
+    progress: Option<ProgressBar>,
+    stats: Stats,
+    drones: usize,
+    summary: String,
+}
+
+impl Hooks for Shown<'_> {
+    fn compiled(&mut self, mission: &Mission) -> Result<(), String> {
+        let out: Box<dyn Write + Send> = match &self.args.trace {
+            Some(path) => match std::fs::File::create(path) {
+                Ok(f) => Box::new(f),
+                Err(e) => return Err(format!("cannot write the trace {}: {e}", path.display())),
+            },
+            None => Box::new(std::io::sink()),
+        };
+        self.trace = Some(TraceFile::new(
+            out,
+            self.args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default(),
+            mission.name.clone(),
+        ));
+        Ok(())
+    }
+
+    fn starting(
+        &mut self,
+        mission: &Mission,
+        controller: &Controller,
+        stop: &Stop,
+    ) -> Result<(), String> {
+        if let Some(trace) = &self.trace {
+            on_stop_signals(controller.clone(), stop.clone(), trace.clone());
+        }
+        if let Some(serve) = &self.args.serve {
+            let server = crate::serve::start(serve, mission, controller.clone())?;
+            self.feed = Some(server.feed.clone());
+            self.server = Some(server);
+        }
+        self.progress = Some(progress_bar(self.args.quiet));
+        self.drones = mission.drones.len();
+        Ok(())
+    }
+
+    fn connected(
+        &mut self,
+        mission: &Mission,
+        world: &World,
+        facts: &[Facts],
+        sources: &SourceMap,
+    ) {
+        crate::figures::before_flight(mission, world, facts, sources, self.args.quiet);
+    }
+
+    fn record(&mut self, record: &Record<'_>, backend: &dyn Backend) {
+        if let Some(progress) = &self.progress {
+            self.stats.observe(record, progress, backend, self.drones);
+        }
+        if let Some(trace) = &self.trace {
+            lock(trace).write(record);
+        }
+        if let Some(feed) = &self.feed {
+            feed.publish(record);
+        }
+    }
+
+    fn landed(
+        &mut self,
+        mission: &Mission,
+        backend: &dyn Backend,
+        odometry: &dyn Fn(usize) -> Option<(f64, f64)>,
+    ) {
+        self.summary = summary(mission, backend, odometry, &self.stats);
+    }
+}
+
 /// The first Ctrl-C, SIGTERM or SIGHUP ends the mission gracefully: the fleet returns
 /// home and the trace is closed with `mission_end`. SIGTERM and SIGHUP count as a first
 /// Ctrl-C because they are how a session ends without a keyboard (a closed laptop lid,
 /// a logout, a service manager): with MAVLink drones, stopping at once would leave them
 /// without a ground station. A second signal of any of the three stops at once, still
 /// closing the trace.
-fn on_stop_signals(
-    controller: Controller,
-    stop: tokio::sync::watch::Sender<Option<&'static str>>,
-    trace: SharedTrace,
-) {
+fn on_stop_signals(controller: Controller, stop: Stop, trace: SharedTrace) {
     use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     let mut signals = match signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
         Ok(s) => s,
@@ -306,7 +290,7 @@ fn on_stop_signals(
             if presses == 1 {
                 eprintln!("\naviary: stopping ({by}); the fleet returns home (press Ctrl-C again to stop at once)");
                 controller.send(Control::Abort { reason: format!("interrupted by {by}") });
-                stop.send_replace(Some(by));
+                stop.by(by);
             } else {
                 lock(&trace).close_now(&format!("stopped at once by a second {by}"));
                 std::process::exit(130);
@@ -316,20 +300,6 @@ fn on_stop_signals(
     if let Err(e) = spawned {
         eprintln!("aviary: Ctrl-C, SIGTERM and SIGHUP will stop at once: {e}");
     }
-}
-
-/// A panic in the simulator's task ends the mission at once, `failed`, with the reason.
-async fn watch_backend(driver: Option<tokio::task::JoinHandle<()>>, controller: Controller) {
-    if let Some(handle) = driver {
-        if let Err(e) = handle.await {
-            if e.is_panic() {
-                controller.send(Control::BackendLost {
-                    reason: "the simulator stopped: its task panicked".into(),
-                });
-            }
-        }
-    }
-    std::future::pending::<()>().await
 }
 
 fn progress_bar(quiet: bool) -> ProgressBar {
@@ -390,7 +360,7 @@ impl Stats {
 }
 
 fn summary(
-    mission: &aviary_ir::Mission,
+    mission: &Mission,
     backend: &dyn Backend,
     odometry: &dyn Fn(usize) -> Option<(f64, f64)>,
     stats: &Stats,

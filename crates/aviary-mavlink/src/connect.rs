@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
 use aviary_api::flight::Descent;
+use aviary_api::DroneId;
 use aviary_world::{Drone, World};
 use mavlink::dialects::ardupilotmega::MavCmd;
 use tokio::sync::mpsc;
@@ -21,13 +22,7 @@ use crate::{battery, bindings, link, link_keys, signing_key, MavlinkBackend, Ori
 /// address, a vehicle that never sends HEARTBEAT, two drones on one system id.
 pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, String> {
     let bound = bindings(world);
-    // The world's frame must be pinned to the Earth: without an origin, local metres
-    // would be sent as if the site were at 0°N 0°E.
-    let Some(origin) =
-        world.site.origin.as_ref().map(|g| Origin { lat: g.lat, lon: g.lon, alt: g.alt })
-    else {
-        return Err("a world with MAVLink drones needs `origin = { lat, lon, alt }` in [site]: where the local frame sits on the Earth".into());
-    };
+    let origin = origin(world)?;
     let mut links = BTreeMap::new();
     for (address, key) in link_keys(world, &bound)? {
         let link = link::Link::open(&address, key.as_deref().map(signing_key)).await?;
@@ -50,45 +45,9 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
         link.add(Arc::clone(&v));
         vehicles.push((*i, link, v));
     }
-    for (_, link, v) in &vehicles {
-        let by = Instant::now() + tuning.connect_timeout;
-        while v.seen().heartbeat.is_none() {
-            if Instant::now() >= by {
-                return Err(format!(
-                    "no answer: waited {} s for a HEARTBEAT from system {} (drone `{}`) on {}; is the vehicle on, and is its system id right?",
-                    tuning.connect_timeout.as_secs(),
-                    v.system,
-                    v.name,
-                    link.address
-                ));
-            }
-            tokio::time::sleep(tuning.poll).await;
-        }
-    }
-    // The facts of all vehicles at once, within one wait.
-    let until = Instant::now() + tuning.facts_wait;
-    let mut reads = tokio::task::JoinSet::new();
-    for (i, link, v) in &vehicles {
-        let (i, link, v) = (*i, Arc::clone(link), Arc::clone(v));
-        reads.spawn(async move { facts::read(i, &link, &v, until).await });
-    }
-    let mut all: Vec<Facts> = Vec::new();
-    while let Some(done) = reads.join_next().await {
-        all.extend(done.ok());
-    }
-    all.sort_by_key(|f| f.drone);
-    let mut crafts: Vec<Option<Arc<Craft>>> = vec![None; world.drones.len()];
-    for (i, link, v) in vehicles {
-        let mut d = world.drones[i].clone();
-        let landing = match all.iter().find(|f| f.drone == i) {
-            Some(f) => {
-                f.apply(&mut d);
-                f.landing(&d)
-            }
-            None => d.descent(),
-        };
-        crafts[i] = Some(Arc::new(craft(&d, landing, link, v, world, tuning)));
-    }
+    hear_all(&vehicles, tuning).await?;
+    let all = read_facts(&vehicles, tuning).await;
+    let crafts = crafts(world, vehicles, &all, tuning);
     for c in crafts.iter().flatten() {
         request_streams(c, tuning.position_hz);
     }
@@ -110,6 +69,77 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
         alarms_rx,
         tuning.heartbeat_timeout,
     ))
+}
+
+/// A world drone's vehicle, on its link.
+type Bound = (DroneId, Arc<link::Link>, Arc<Vehicle>);
+
+/// Where the world's frame sits on the Earth. It must be pinned: without an origin, local
+/// metres would be sent as if the site were at 0°N 0°E.
+fn origin(world: &World) -> Result<Origin, String> {
+    let Some(g) = world.site.origin.as_ref() else {
+        return Err("a world with MAVLink drones needs `origin = { lat, lon, alt }` in [site]: where the local frame sits on the Earth".into());
+    };
+    Ok(Origin { lat: g.lat, lon: g.lon, alt: g.alt })
+}
+
+/// Waits for each vehicle's first HEARTBEAT, each within the connect timeout.
+async fn hear_all(vehicles: &[Bound], tuning: Tuning) -> Result<(), String> {
+    for (_, link, v) in vehicles {
+        let by = Instant::now() + tuning.connect_timeout;
+        while v.seen().heartbeat.is_none() {
+            if Instant::now() >= by {
+                return Err(format!(
+                    "no answer: waited {} s for a HEARTBEAT from system {} (drone `{}`) on {}; is the vehicle on, and is its system id right?",
+                    tuning.connect_timeout.as_secs(),
+                    v.system,
+                    v.name,
+                    link.address
+                ));
+            }
+            tokio::time::sleep(tuning.poll).await;
+        }
+    }
+    Ok(())
+}
+
+/// The facts of all vehicles at once, within one wait; by drone.
+async fn read_facts(vehicles: &[Bound], tuning: Tuning) -> Vec<Facts> {
+    let until = Instant::now() + tuning.facts_wait;
+    let mut reads = tokio::task::JoinSet::new();
+    for (i, link, v) in vehicles {
+        let (i, link, v) = (*i, Arc::clone(link), Arc::clone(v));
+        reads.spawn(async move { facts::read(i, &link, &v, until).await });
+    }
+    let mut all: Vec<Facts> = Vec::new();
+    while let Some(done) = reads.join_next().await {
+        all.extend(done.ok());
+    }
+    all.sort_by_key(|f| f.drone);
+    all
+}
+
+/// Every MAVLink drone as the backend flies it, by drone index: the world's drone with
+/// its vehicle's facts applied, when it has any.
+fn crafts(
+    world: &World,
+    vehicles: Vec<Bound>,
+    all: &[Facts],
+    tuning: Tuning,
+) -> Vec<Option<Arc<Craft>>> {
+    let mut crafts: Vec<Option<Arc<Craft>>> = vec![None; world.drones.len()];
+    for (i, link, v) in vehicles {
+        let mut d = world.drones[i].clone();
+        let landing = match all.iter().find(|f| f.drone == i) {
+            Some(f) => {
+                f.apply(&mut d);
+                f.landing(&d)
+            }
+            None => d.descent(),
+        };
+        crafts[i] = Some(Arc::new(craft(&d, landing, link, v, world, tuning)));
+    }
+    crafts
 }
 
 /// One drone as the backend flies it: `d` is the world's drone with its vehicle's facts

@@ -22,104 +22,122 @@ pub async fn run(
 ) -> Result<(), Failure> {
     match function {
         Function::Arm => arm(c).await,
-        Function::Disarm => {
-            if c.state().airborne() {
-                return Err(failed(format!("{} can only disarm on the ground", c.name)));
-            }
-            c.command(MavCmd::MAV_CMD_COMPONENT_ARM_DISARM, [0.0; 7]).await?;
-            c.wait_for(c.tuning.ready_timeout, "disarming", |c| !c.v.seen().armed).await
-        }
+        Function::Disarm => disarm(c).await,
         Function::TakeOff => take_off(c, number(args, 0, "alt")?, paused).await,
         Function::Land => land(c).await,
         Function::ReturnToLaunch => rtl(c).await,
-        Function::FlyToPosition => {
-            let to = point(c, args.first(), "pos")?;
-            let speed = match args.get(1) {
-                Some(Value::Number(s)) if *s > 0.0 => s.min(c.max_speed),
-                Some(other) => {
-                    return Err(failed(format!("`speed` must be above 0 m/s, not {other}")))
-                }
-                None => c.max_speed,
-            };
-            fly(c, &[to], speed, paused).await
-        }
+        Function::FlyToPosition => fly_to_position(c, args, paused).await,
         Function::DescendTo | Function::AscendTo => {
             let here = here(c)?;
             fly(c, &[[here[0], here[1], number(args, 0, "alt")?]], c.max_speed, paused).await
         }
         Function::Hover => hover(number(args, 0, "duration")?, paused).await,
-        Function::Orbit => {
-            let center = point(c, args.first(), "center")?;
-            let radius = number(args, 1, "radius")?;
-            let laps = match args.get(2) {
-                Some(_) => number(args, 2, "laps")?,
-                None => 1.0,
-            };
-            if radius <= 0.0 || laps <= 0.0 {
-                return Err(failed(format!(
-                    "an orbit needs a radius and laps above 0 (got {radius} m, {laps})"
-                )));
-            }
-            let here = here(c)?;
-            fly(
-                c,
-                &orbit(here, [center[0], center[1]], radius, laps, c.tuning.arrive_xy),
-                aviary_api::geometry::orbit_speed(c.max_speed, c.acceleration, radius),
-                paused,
-            )
-            .await
-        }
-        Function::Sweep => {
-            let Some(Value::Area(area)) = args.first() else {
-                return Err(failed("`area` must be an area"));
-            };
-            let spacing = number(args, 1, "spacing")?;
-            if spacing <= 0.0 {
-                return Err(failed(format!("sweep spacing must be above 0 m, not {spacing} m")));
-            }
-            here(c)?;
-            let z = c.level();
-            let path: Vec<[f64; 3]> = aviary_api::sweep::lawnmower(area, spacing)
-                .into_iter()
-                .map(|p| [p[0], p[1], z])
-                .collect();
-            fly(c, &path, c.max_speed, paused).await
-        }
-        Function::FollowPath => {
-            here(c)?;
-            let mut z = c.level();
-            let mut path = Vec::new();
-            for v in args {
-                let p = point(c, Some(v), "points")?;
-                if !p[2].is_nan() {
-                    z = p[2];
-                }
-                path.push([p[0], p[1], z]);
-            }
-            fly(c, &path, c.max_speed, paused).await
-        }
+        Function::Orbit => orbit_around(c, args, paused).await,
+        Function::Sweep => sweep(c, args, paused).await,
+        Function::FollowPath => follow_path(c, args, paused).await,
         Function::StartStreaming | Function::StopStreaming => {
-            // Video is not carried over MAVLink: this records the state a mission reads.
-            if !c.sensors.iter().any(|s| s == "camera") {
-                return Err(failed(format!("{} has no camera", c.name)));
-            }
-            c.streaming
-                .store(function == Function::StartStreaming, std::sync::atomic::Ordering::SeqCst);
-            Ok(())
+            streaming(c, function == Function::StartStreaming)
         }
         Function::StartDetection | Function::StopDetection => {
             detection(c, function == Function::StartDetection, args, sensors)
         }
         Function::LoadPayload => load(c, args, paused).await,
-        Function::ReleasePayload => {
-            if c.carrying.lock().unwrap_or_else(|p| p.into_inner()).is_none() {
-                return Err(failed(format!("{} carries nothing to release", c.name)));
-            }
-            c.command(MavCmd::MAV_CMD_DO_GRIPPER, [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]).await?;
-            *c.carrying.lock().unwrap_or_else(|p| p.into_inner()) = None;
-            Ok(())
-        }
+        Function::ReleasePayload => release(c).await,
     }
+}
+
+/// `Disarm`, on the ground only; done when the HEARTBEAT says so.
+async fn disarm(c: &Craft) -> Result<(), Failure> {
+    if c.state().airborne() {
+        return Err(failed(format!("{} can only disarm on the ground", c.name)));
+    }
+    c.command(MavCmd::MAV_CMD_COMPONENT_ARM_DISARM, [0.0; 7]).await?;
+    c.wait_for(c.tuning.ready_timeout, "disarming", |c| !c.v.seen().armed).await
+}
+
+/// `FlyToPosition`: at the speed asked for, at most the drone's.
+async fn fly_to_position(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
+    let to = point(c, args.first(), "pos")?;
+    let speed = match args.get(1) {
+        Some(Value::Number(s)) if *s > 0.0 => s.min(c.max_speed),
+        Some(other) => return Err(failed(format!("`speed` must be above 0 m/s, not {other}"))),
+        None => c.max_speed,
+    };
+    fly(c, &[to], speed, paused).await
+}
+
+/// `Orbit`: through the circle's points, at the speed its radius allows.
+async fn orbit_around(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
+    let center = point(c, args.first(), "center")?;
+    let radius = number(args, 1, "radius")?;
+    let laps = match args.get(2) {
+        Some(_) => number(args, 2, "laps")?,
+        None => 1.0,
+    };
+    if radius <= 0.0 || laps <= 0.0 {
+        return Err(failed(format!(
+            "an orbit needs a radius and laps above 0 (got {radius} m, {laps})"
+        )));
+    }
+    let here = here(c)?;
+    fly(
+        c,
+        &orbit(here, [center[0], center[1]], radius, laps, c.tuning.arrive_xy),
+        aviary_api::geometry::orbit_speed(c.max_speed, c.acceleration, radius),
+        paused,
+    )
+    .await
+}
+
+/// `Sweep`: the area's lawnmower path, at the altitude kept.
+async fn sweep(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
+    let Some(Value::Area(area)) = args.first() else {
+        return Err(failed("`area` must be an area"));
+    };
+    let spacing = number(args, 1, "spacing")?;
+    if spacing <= 0.0 {
+        return Err(failed(format!("sweep spacing must be above 0 m, not {spacing} m")));
+    }
+    here(c)?;
+    let z = c.level();
+    let path: Vec<[f64; 3]> =
+        aviary_api::sweep::lawnmower(area, spacing).into_iter().map(|p| [p[0], p[1], z]).collect();
+    fly(c, &path, c.max_speed, paused).await
+}
+
+/// `FollowPath`: through the points; one without an altitude keeps the one before.
+async fn follow_path(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
+    here(c)?;
+    let mut z = c.level();
+    let mut path = Vec::new();
+    for v in args {
+        let p = point(c, Some(v), "points")?;
+        if !p[2].is_nan() {
+            z = p[2];
+        }
+        path.push([p[0], p[1], z]);
+    }
+    fly(c, &path, c.max_speed, paused).await
+}
+
+/// `StartStreaming` and `StopStreaming`. Video is not carried over MAVLink: this records
+/// the state a mission reads.
+fn streaming(c: &Craft, on: bool) -> Result<(), Failure> {
+    if !c.sensors.iter().any(|s| s == "camera") {
+        return Err(failed(format!("{} has no camera", c.name)));
+    }
+    c.streaming.store(on, std::sync::atomic::Ordering::SeqCst);
+    Ok(())
+}
+
+/// `ReleasePayload`: opens the gripper (MAV_CMD_DO_GRIPPER release).
+async fn release(c: &Craft) -> Result<(), Failure> {
+    if c.carrying.lock().unwrap_or_else(|p| p.into_inner()).is_none() {
+        return Err(failed(format!("{} carries nothing to release", c.name)));
+    }
+    c.command(MavCmd::MAV_CMD_DO_GRIPPER, [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]).await?;
+    *c.carrying.lock().unwrap_or_else(|p| p.into_inner()) = None;
+    Ok(())
 }
 
 fn number(args: &[Value], i: usize, name: &str) -> Result<f64, Failure> {

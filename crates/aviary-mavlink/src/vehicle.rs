@@ -9,7 +9,7 @@ use aviary_api::{BuiltinException, DroneEvent, DroneId, Failure};
 use aviary_world::Target;
 use mavlink::dialects::ardupilotmega::{
     MavCmd, MavLandedState, MavMessage, MavModeFlag, MavParamType, MavResult, MavState,
-    MavSysStatusSensor, GLOBAL_POSITION_INT_DATA,
+    MavSysStatusSensor, GLOBAL_POSITION_INT_DATA, HEARTBEAT_DATA,
 };
 use tokio::sync::{mpsc, oneshot};
 use tokio::time::Instant;
@@ -86,6 +86,41 @@ pub struct Seen {
     acks: Vec<(MavCmd, oneshot::Sender<MavResult>)>,
 }
 
+impl Seen {
+    /// SYS_STATUS or BATTERY_STATUS: the charge left and the current drawn.
+    fn take_battery(&mut self, now: Instant, remaining: i8, centiamps: i16) {
+        self.battery_reported = true;
+        // -1 is "unknown", and no battery holds more than 100 %: the last
+        // believable charge stands.
+        if let Some(charge) = plausible::charge(remaining) {
+            self.battery = Some(charge);
+        }
+        let airborne = self.armed && self.fix.is_some_and(|f| f.pos[2] > AIRBORNE_ABOVE);
+        self.draw.record(now, battery::amps(centiamps), airborne);
+    }
+
+    /// COMMAND_ACK: the answer goes to the first one waiting for it.
+    fn answer(&mut self, command: MavCmd, result: MavResult) {
+        if let Some(i) = self.acks.iter().position(|(c, tx)| *c == command && !tx.is_closed()) {
+            let (_, tx) = self.acks.remove(i);
+            let _ = tx.send(result);
+        }
+        self.acks.retain(|(_, tx)| !tx.is_closed());
+    }
+}
+
+/// Whether a vehicle's state says it is going down, or gone.
+fn going_down(s: Option<MavState>) -> bool {
+    matches!(
+        s,
+        Some(
+            MavState::MAV_STATE_EMERGENCY
+                | MavState::MAV_STATE_FLIGHT_TERMINATION
+                | MavState::MAV_STATE_POWEROFF
+        )
+    )
+}
+
 /// A vehicle of a link, by its MAVLink system id.
 pub struct Vehicle {
     pub drone: DroneId,
@@ -156,49 +191,7 @@ impl Vehicle {
         let now = Instant::now();
         let mut seen = self.seen();
         match msg {
-            MavMessage::HEARTBEAT(hb) => {
-                let flavour = Flavour::of(hb.autopilot);
-                let before = seen.heartbeat.map(|_| mode::classify(flavour, seen.custom_mode));
-                seen.heartbeat = Some(now);
-                seen.flavour = Some(flavour);
-                seen.custom_mode = hb.custom_mode;
-                seen.armed = hb.base_mode.contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);
-                let was = seen.status.replace(hb.system_status);
-                let gone = |s: Option<MavState>| {
-                    matches!(
-                        s,
-                        Some(
-                            MavState::MAV_STATE_EMERGENCY
-                                | MavState::MAV_STATE_FLIGHT_TERMINATION
-                                | MavState::MAV_STATE_POWEROFF
-                        )
-                    )
-                };
-                if gone(Some(hb.system_status)) && !gone(was) {
-                    // The vehicle says it is going down (or gone): it is lost to the mission.
-                    let why = seen.texts.back().map_or("no reason given", |(_, s)| s.as_str());
-                    let reason = format!(
-                        "{}: the autopilot reports {:?} ({why})",
-                        self.name, hb.system_status
-                    );
-                    let _ = self.alarms.send((
-                        self.drone,
-                        Failure { exception: BuiltinException::DroneLost, reason },
-                    ));
-                }
-                let after = mode::classify(flavour, hb.custom_mode);
-                let changed = before.is_some_and(|b| b != after);
-                if changed
-                    && matches!(after, Mode::Rtl | Mode::Land)
-                    && seen.expected != Some(after)
-                {
-                    // The autopilot changed mode by itself: a failsafe. Its reason may
-                    // come just after the HEARTBEAT (ArduCopter queues its STATUSTEXT),
-                    // so it is named once the vehicle has said why, or after a moment.
-                    seen.expected = Some(after);
-                    seen.failsafe = Some((now, mode::name(flavour, hb.custom_mode)));
-                }
-            }
+            MavMessage::HEARTBEAT(hb) => self.take_heartbeat(&mut seen, now, hb),
             // ArduPilot sends 0°N 0°E until its EKF has an origin: that is no position.
             MavMessage::GLOBAL_POSITION_INT(p) if p.lat == 0 && p.lon == 0 => {}
             MavMessage::HOME_POSITION(h) if h.latitude != 0 || h.longitude != 0 => {
@@ -207,14 +200,7 @@ impl Vehicle {
             }
             MavMessage::GLOBAL_POSITION_INT(p) => self.take_position(&mut seen, now, p),
             MavMessage::SYS_STATUS(s) => {
-                seen.battery_reported = true;
-                // -1 is "unknown", and no battery holds more than 100 %: the last
-                // believable charge stands.
-                if let Some(charge) = plausible::charge(s.battery_remaining) {
-                    seen.battery = Some(charge);
-                }
-                let airborne = seen.armed && seen.fix.is_some_and(|f| f.pos[2] > AIRBORNE_ABOVE);
-                seen.draw.record(now, battery::amps(s.current_battery), airborne);
+                seen.take_battery(now, s.battery_remaining, s.current_battery);
                 // A sensor the vehicle has and uses but calls unhealthy (ArduPilot clears
                 // the battery's bit with its battery failsafe, the fence's on a breach).
                 let failing = |bit: MavSysStatusSensor| {
@@ -225,14 +211,7 @@ impl Vehicle {
                 seen.fence_unhealthy = failing(MavSysStatusSensor::MAV_SYS_STATUS_GEOFENCE);
             }
             MavMessage::BATTERY_STATUS(b) if b.id == 0 => {
-                seen.battery_reported = true;
-                // -1 is "unknown", and no battery holds more than 100 %: the last
-                // believable charge stands.
-                if let Some(charge) = plausible::charge(b.battery_remaining) {
-                    seen.battery = Some(charge);
-                }
-                let airborne = seen.armed && seen.fix.is_some_and(|f| f.pos[2] > AIRBORNE_ABOVE);
-                seen.draw.record(now, battery::amps(b.current_battery), airborne);
+                seen.take_battery(now, b.battery_remaining, b.current_battery);
             }
             MavMessage::PARAM_VALUE(p) => {
                 let name = p.param_id.to_str().unwrap_or("").trim_end_matches('\0');
@@ -253,17 +232,41 @@ impl Vehicle {
                 }
             }
             MavMessage::COMMAND_ACK(ack) if ack.result != MavResult::MAV_RESULT_IN_PROGRESS => {
-                if let Some(i) =
-                    seen.acks.iter().position(|(c, tx)| *c == ack.command && !tx.is_closed())
-                {
-                    let (_, tx) = seen.acks.remove(i);
-                    let _ = tx.send(ack.result);
-                }
-                seen.acks.retain(|(_, tx)| !tx.is_closed());
+                seen.answer(ack.command, ack.result);
             }
             _ => {}
         }
         self.name_failsafe(&mut seen, now);
+    }
+
+    /// HEARTBEAT: the autopilot, its mode, armed, its state; an alarm when the vehicle
+    /// says it is going down, and a failsafe noted when it changes mode by itself.
+    fn take_heartbeat(&self, seen: &mut Seen, now: Instant, hb: &HEARTBEAT_DATA) {
+        let flavour = Flavour::of(hb.autopilot);
+        let before = seen.heartbeat.map(|_| mode::classify(flavour, seen.custom_mode));
+        seen.heartbeat = Some(now);
+        seen.flavour = Some(flavour);
+        seen.custom_mode = hb.custom_mode;
+        seen.armed = hb.base_mode.contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);
+        let was = seen.status.replace(hb.system_status);
+        if going_down(Some(hb.system_status)) && !going_down(was) {
+            // The vehicle says it is going down (or gone): it is lost to the mission.
+            let why = seen.texts.back().map_or("no reason given", |(_, s)| s.as_str());
+            let reason =
+                format!("{}: the autopilot reports {:?} ({why})", self.name, hb.system_status);
+            let _ = self
+                .alarms
+                .send((self.drone, Failure { exception: BuiltinException::DroneLost, reason }));
+        }
+        let after = mode::classify(flavour, hb.custom_mode);
+        let changed = before.is_some_and(|b| b != after);
+        if changed && matches!(after, Mode::Rtl | Mode::Land) && seen.expected != Some(after) {
+            // The autopilot changed mode by itself: a failsafe. Its reason may
+            // come just after the HEARTBEAT (ArduCopter queues its STATUSTEXT),
+            // so it is named once the vehicle has said why, or after a moment.
+            seen.expected = Some(after);
+            seen.failsafe = Some((now, mode::name(flavour, hb.custom_mode)));
+        }
     }
 
     /// GLOBAL_POSITION_INT: the fix, the odometer and detection, unless the vehicle could

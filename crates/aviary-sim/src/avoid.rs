@@ -158,8 +158,9 @@ pub(crate) fn reach(fleet: &Fleet, d: &SimDrone) -> f64 {
 
 impl Fleet {
     /// The predicted track of drone `j` for the planning of drone `id`: for a drone before
-    /// `id`, which has moved in this step already, computed once per step. Drones after `id` (only a humble drone looks at them) have not moved yet: they are
-    /// predicted afresh, going their own way as if they did not yield.
+    /// `id`, which has moved in this step already, computed once per step. Drones after
+    /// `id` (only a humble drone looks at them) have not moved yet: they are predicted
+    /// afresh, going their own way as if they did not yield.
     fn track(&mut self, j: DroneId, id: DroneId) -> Track {
         let d = &self.drones[j];
         if j > id {
@@ -172,74 +173,131 @@ impl Fleet {
 
     /// Chooses how drone `id` gives way this tick (see the module doc); sets its `avoid`.
     pub(crate) fn plan(&mut self, id: DroneId, dt: f64, near: &[Envelope]) {
-        let sep = self.min_separation;
         let d = &self.drones[id];
         if !d.state.airborne() {
             self.drones[id].avoid = None;
             return;
         }
-        let speed = |d: &SimDrone| d.spec.max_speed + d.spec.climb_rate;
-        let range = |o: &SimDrone| sep + MARGIN + HORIZON * (speed(d) + speed(o)) + 1.0;
         // A drone held back for long gives way to everyone, not only to those before it,
         // until it no longer needs to give way.
         let humble = d.humble || d.stalled >= STALL;
-        // Every drone that could be in range, in index order, from the sky's grid.
-        let mut candidates = Vec::new();
-        self.sky.around(d.xy(), d.xy(), reach(self, d), &mut candidates);
-        let higher: Vec<DroneId> = (candidates.iter().copied())
-            .filter(|&j| j < id || (humble && j != id))
-            .filter(|&j| {
-                let o = &self.drones[j];
-                o.state.airborne() && norm(sub(o.pos, d.pos)) < range(o)
-            })
-            .collect();
+        let higher = self.to_give_way_to(id, humble);
         if higher.is_empty() && d.avoid.is_none() {
             self.drones[id].humble = false;
             return;
         }
         let theirs: Vec<Track> = higher.iter().map(|&j| self.track(j, id)).collect();
         let d = &self.drones[id];
-        // How far the drone's path would keep from theirs beyond what is needed (clear when
-        // not negative), and who comes within the margin. Going on as planned needs
-        // `min_separation`; a way to give way needs the margin too, or, when the drone is
-        // that close already, never to get any closer.
-        let score = |way: Option<Yield>, strict: bool| -> (f64, bool, Vec<usize>) {
-            let (mine, free) = predict_with(d, way, dt, near, sep);
-            let mut worst = f64::INFINITY;
-            let mut close = Vec::new();
-            for (k, t) in theirs.iter().enumerate() {
-                let c = closest(&mine, t);
-                let need =
-                    if strict { sep } else { (sep + MARGIN).min(first_gap(&mine, t)).max(sep) };
-                worst = worst.min(c - need);
-                if c < sep + MARGIN {
-                    close.push(k);
-                }
-            }
-            (worst, free, close)
-        };
+        let judge = Judge { d, theirs: &theirs, dt, near, sep: self.min_separation };
         let current = d.avoid;
         let back_to = current.filter(|y| y.alt.is_some()).map_or(d.pos[2], |y| y.back_to);
-        let nominal = match current.filter(|y| y.alt.is_some()) {
-            None => None,
-            Some(_) => {
-                let home = own_altitude(d, back_to);
-                (d.pos[2] != home || d.vel[2] != 0.0).then_some(Yield {
-                    scale: 1.0,
-                    alt: Some(home),
-                    back_to,
-                })
-            }
-        };
-        let (first, free, close) = score(nominal, current.is_none());
-        if first >= 0.0 {
+        let nominal = coming_back(d, current, back_to);
+        let first = judge.score(nominal, current.is_none());
+        if first.room >= 0.0 {
             self.drones[id].avoid = nominal;
             self.drones[id].humble = humble && nominal.is_some();
             return;
         }
-        // Who is in the way, how high they fly, and whether they are going anywhere.
+        let ways = self.ways_to_give_way(d, current, back_to, &theirs, &first.close);
+        let way = judge.choose(ways, (first.free, first.room, nominal));
+        self.drones[id].avoid = way;
+        self.drones[id].humble = humble && way.is_some();
+    }
+
+    /// The drones `id` gives way to: those in the air before it (every other one when it is
+    /// humble) that could come near it within the horizon, in index order.
+    fn to_give_way_to(&self, id: DroneId, humble: bool) -> Vec<DroneId> {
+        let sep = self.min_separation;
+        let d = &self.drones[id];
+        let speed = |d: &SimDrone| d.spec.max_speed + d.spec.climb_rate;
+        let range = |o: &SimDrone| sep + MARGIN + HORIZON * (speed(d) + speed(o)) + 1.0;
+        // Every drone that could be in range, in index order, from the sky's grid.
+        let mut candidates = Vec::new();
+        self.sky.around(d.xy(), d.xy(), reach(self, d), &mut candidates);
+        (candidates.iter().copied())
+            .filter(|&j| j < id || (humble && j != id))
+            .filter(|&j| {
+                let o = &self.drones[j];
+                o.state.airborne() && norm(sub(o.pos, d.pos)) < range(o)
+            })
+            .collect()
+    }
+
+    /// The ways for `d` to give way, in the order they are tried (the module doc's 2 to 8),
+    /// with `close` the drones (of `theirs`) in its way.
+    fn ways_to_give_way(
+        &self,
+        d: &SimDrone,
+        current: Option<Yield>,
+        back_to: f64,
+        theirs: &[Track],
+        close: &[usize],
+    ) -> Vec<Option<Yield>> {
+        let them = InTheWay::of(theirs, close);
+        let held = current.and_then(|y| y.alt);
+        let mut ways: Vec<Option<Yield>> = Vec::new();
+        if on_the_move(d) {
+            if held.is_some() {
+                ways.push(Some(Yield { scale: 1.0, alt: held, back_to }));
+            }
+            ways.push(Some(Yield { scale: 1.0, alt: Some(d.pos[2]), back_to }));
+            ways.push(Some(Yield { scale: 0.5, alt: held, back_to }));
+            if them.moving {
+                ways.push(Some(Yield { scale: 0.0, alt: held, back_to }));
+            }
+        }
+        let mut levels = if close.is_empty() { Vec::new() } else { self.passing_levels(&them) };
+        // Passing below already: below first.
+        if held.is_some_and(|h| h < own_altitude(d, back_to)) {
+            levels.reverse();
+        }
+        for &scale in &[1.0, 0.0] {
+            for &alt in &levels {
+                ways.push(Some(Yield { scale, alt: Some(alt), back_to }));
+            }
+        }
+        ways
+    }
+
+    /// The altitudes to pass the drones in the way at: above them, then below them, each
+    /// when the site's `max_altitude` (above) or [`FLOOR`] (below) leaves room.
+    fn passing_levels(&self, them: &InTheWay) -> Vec<f64> {
+        let sep = self.min_separation;
+        let ceiling = self.max_altitude.unwrap_or(f64::INFINITY);
+        let up = (them.top + sep + MARGIN).min(ceiling);
+        let down = (them.bottom - sep - MARGIN).max(FLOOR);
+        let mut levels = Vec::new();
+        if up >= them.top + sep {
+            levels.push(up);
+        }
+        if down <= them.bottom - sep {
+            levels.push(down);
+        }
+        levels
+    }
+}
+
+/// Going on as planned: when passing above or below, back to the drone's own altitude
+/// (`None` once it is there, at rest vertically).
+fn coming_back(d: &SimDrone, current: Option<Yield>, back_to: f64) -> Option<Yield> {
+    current.filter(|y| y.alt.is_some())?;
+    let home = own_altitude(d, back_to);
+    (d.pos[2] != home || d.vel[2] != 0.0).then_some(Yield { scale: 1.0, alt: Some(home), back_to })
+}
+
+/// The drones in the way, over the horizon: the highest and the lowest point they fly
+/// through, and whether every one of them is going somewhere (so that waiting helps).
+struct InTheWay {
+    top: f64,
+    bottom: f64,
+    moving: bool,
+}
+
+impl InTheWay {
+    /// Of the tracks `close` names among `theirs`.
+    fn of(theirs: &[Track], close: &[usize]) -> InTheWay {
         let (mut top, mut bottom, mut moving) = (f64::NEG_INFINITY, f64::INFINITY, true);
-        for &k in &close {
+        for &k in close {
             let t = &theirs[k];
             for p in t.iter().flatten() {
                 top = top.max(p[2]);
@@ -252,50 +310,67 @@ impl Fleet {
             };
             moving &= !still;
         }
-        let held = current.and_then(|y| y.alt);
-        let mut ways: Vec<Option<Yield>> = Vec::new();
-        if on_the_move(d) {
-            if held.is_some() {
-                ways.push(Some(Yield { scale: 1.0, alt: held, back_to }));
+        InTheWay { top, bottom, moving }
+    }
+}
+
+/// A drone's ways to fly this tick, judged against the tracks of the drones it gives way
+/// to.
+struct Judge<'a> {
+    d: &'a SimDrone,
+    theirs: &'a [Track],
+    dt: f64,
+    near: &'a [Envelope],
+    sep: f64,
+}
+
+/// How a way to fly does.
+struct Score {
+    /// How far its path keeps from theirs beyond what is needed: clear when not negative.
+    room: f64,
+    /// Whether the safety filter lets its first step through.
+    free: bool,
+    /// Which of theirs come within the margin.
+    close: Vec<usize>,
+}
+
+impl Judge<'_> {
+    /// Going on as planned (`strict`) needs `min_separation`; a way to give way needs the
+    /// margin too, or, when the drone is that close already, never to get any closer.
+    fn score(&self, way: Option<Yield>, strict: bool) -> Score {
+        let sep = self.sep;
+        let (mine, free) = predict_with(self.d, way, self.dt, self.near, sep);
+        let mut worst = f64::INFINITY;
+        let mut close = Vec::new();
+        for (k, t) in self.theirs.iter().enumerate() {
+            let c = closest(&mine, t);
+            let need = if strict { sep } else { (sep + MARGIN).min(first_gap(&mine, t)).max(sep) };
+            worst = worst.min(c - need);
+            if c < sep + MARGIN {
+                close.push(k);
             }
-            ways.push(Some(Yield { scale: 1.0, alt: Some(d.pos[2]), back_to }));
-            ways.push(Some(Yield { scale: 0.5, alt: held, back_to }));
-            if moving {
-                ways.push(Some(Yield { scale: 0.0, alt: held, back_to }));
-            }
         }
-        let ceiling = self.max_altitude.unwrap_or(f64::INFINITY);
-        let up = (top + sep + MARGIN).min(ceiling);
-        let down = (bottom - sep - MARGIN).max(FLOOR);
-        let mut levels = Vec::new();
-        if !close.is_empty() && up >= top + sep {
-            levels.push(up);
-        }
-        if !close.is_empty() && down <= bottom - sep {
-            levels.push(down);
-        }
-        if held.is_some_and(|h| h < own_altitude(d, back_to)) {
-            levels.reverse();
-        }
-        for &scale in &[1.0, 0.0] {
-            for &alt in &levels {
-                ways.push(Some(Yield { scale, alt: Some(alt), back_to }));
-            }
-        }
-        // The first way that is clear and can be flown now; else the one that keeps the most
-        // distance, among those that can be flown if any can.
-        let mut best = (free, first, nominal);
+        Score { room: worst, free, close }
+    }
+
+    /// The first way that is clear and can be flown now; else the one that keeps the most
+    /// distance, among those that can be flown if any can. `planned` is going on as
+    /// planned: whether it can be flown, its room, and the way.
+    fn choose(
+        &self,
+        ways: Vec<Option<Yield>>,
+        planned: (bool, f64, Option<Yield>),
+    ) -> Option<Yield> {
+        let mut best = planned;
         for way in ways {
-            let (s, free, _) = score(way, false);
-            if s >= 0.0 && free {
-                best = (free, s, way);
-                break;
+            let Score { room, free, .. } = self.score(way, false);
+            if room >= 0.0 && free {
+                return way;
             }
-            if (free, s) > (best.0, best.1) {
-                best = (free, s, way);
+            if (free, room) > (best.0, best.1) {
+                best = (free, room, way);
             }
         }
-        self.drones[id].avoid = best.2;
-        self.drones[id].humble = humble && best.2.is_some();
+        best.2
     }
 }

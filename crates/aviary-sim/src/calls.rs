@@ -2,17 +2,14 @@
 
 use aviary_api::{show, CallId, DroneId, Failure, FlightState, Function, Resource, Value};
 
-use crate::args::{failed, kind, number, opt_number, point, point_value, polygon, Limits};
-use crate::drone::{Loading, SimDrone};
+use crate::args::{failed, kind, Limits};
+use crate::drone::Loading;
 use crate::fleet::{Fleet, Release};
-use crate::geom::dist;
-use crate::motion::{orbit_legs, Leg, MotionTask};
+use crate::legs::{hover_legs, Mover};
+use crate::motion::{Leg, MotionTask};
 use crate::sensors::{detection_range, Activation};
-use crate::sweep::lawnmower;
 
 use aviary_api::flight::{LOAD_MAX_ALTITUDE, LOAD_TIME};
-/// A landed drone this close to home (metres) is home.
-const AT_HOME: f64 = 0.5;
 
 /// How a call that was not refused goes on.
 enum Start {
@@ -78,155 +75,18 @@ impl Fleet {
         function: Function,
         args: &[Value],
     ) -> Result<Start, Failure> {
-        let limits = self.limits();
-        let d = &self.drones[id];
-        let here = d.pos;
-        // The altitude a move without one keeps (not a detour around another drone).
-        let level = d.level();
-        let landed = d.state == FlightState::Landed;
-        let in_air = || {
-            if landed {
-                Err(failed(format!("{} is on the ground: take off first", &self.names[id])))
-            } else {
-                Ok(())
-            }
-        };
-        let fly = |to: [f64; 3], speed: f64| Leg::Move { to, speed, state: FlightState::Flying };
+        let m = Mover { d: &self.drones[id], name: &self.names[id], limits: self.limits() };
         let legs = match function {
-            Function::Arm | Function::Disarm => {
-                if !landed {
-                    return Err(failed(format!(
-                        "{} can only {} on the ground",
-                        &self.names[id],
-                        function.name().to_lowercase()
-                    )));
-                }
-                self.drones[id].armed = function == Function::Arm;
-                return Ok(Start::Done);
-            }
-            Function::TakeOff => {
-                let alt = number(args, 0, "alt")?;
-                if alt <= 0.0 {
-                    return Err(failed(format!(
-                        "take-off altitude must be above 0 m, not {alt} m"
-                    )));
-                }
-                limits.altitude(alt)?;
-                let to = [here[0], here[1], alt];
-                if !landed {
-                    vec![fly(to, d.spec.max_speed)]
-                } else if !d.armed {
-                    return Err(failed(format!(
-                        "{} is not armed: call Arm() before TakeOff",
-                        &self.names[id]
-                    )));
-                } else {
-                    vec![Leg::Move { to, speed: d.spec.max_speed, state: FlightState::TakingOff }]
-                }
-            }
-            Function::Land => {
-                if landed {
-                    return Ok(Start::Done);
-                }
-                landing_legs(d, [here[0], here[1]])
-            }
-            Function::ReturnToLaunch => {
-                return_legs(d, &self.names[id], landed, limits.max_altitude)?
-            }
-            Function::FlyToPosition => {
-                in_air()?;
-                let p = point(args, 0, "pos")?;
-                let speed = match opt_number(args, 1, "speed")? {
-                    Some(s) if s <= 0.0 => {
-                        return Err(failed(format!(
-                            "speed must be above 0 m/s, not {} m/s",
-                            show::number(s)
-                        )))
-                    }
-                    Some(s) => s.min(d.spec.max_speed),
-                    None => d.spec.max_speed,
-                };
-                let to = [p.x, p.y, p.z.unwrap_or(level)];
-                if to[2] < 0.0 {
-                    return Err(failed(format!(
-                        "altitude {} m is below the ground",
-                        show::number(to[2])
-                    )));
-                }
-                limits.path(here, &[to])?;
-                vec![fly(to, speed)]
-            }
-            Function::DescendTo | Function::AscendTo => {
-                in_air()?;
-                let alt = number(args, 0, "alt")?;
-                if alt < 0.0 {
-                    return Err(failed(format!(
-                        "altitude {} m is below the ground",
-                        show::number(alt)
-                    )));
-                }
-                limits.altitude(alt)?;
-                vec![fly([here[0], here[1], alt], d.spec.max_speed)]
-            }
-            Function::Hover => {
-                let duration = number(args, 0, "duration")?;
-                if duration < 0.0 {
-                    return Err(failed(format!(
-                        "a hover cannot last {} s",
-                        show::number(duration)
-                    )));
-                }
-                vec![Leg::Hold { left: duration }]
-            }
-            Function::Orbit => {
-                in_air()?;
-                let c = point(args, 0, "center")?;
-                let radius = number(args, 1, "radius")?;
-                let laps = opt_number(args, 2, "laps")?.unwrap_or(1.0);
-                if radius <= 0.0 || laps <= 0.0 {
-                    return Err(failed(format!(
-                        "an orbit needs a radius and laps above 0 (got {radius} m, {laps})"
-                    )));
-                }
-                let legs = orbit_legs(d, [c.x, c.y], radius, laps);
-                if let Some(Leg::Move { to, .. }) = legs.first() {
-                    limits.path(here, &[*to])?;
-                }
-                limits.circle([c.x, c.y], radius)?;
-                legs
-            }
-            Function::Sweep => {
-                in_air()?;
-                let area = polygon(args, 0, "area")?;
-                let spacing = number(args, 1, "spacing")?;
-                if spacing <= 0.0 {
-                    return Err(failed(format!(
-                        "sweep spacing must be above 0 m, not {spacing} m"
-                    )));
-                }
-                let path: Vec<[f64; 3]> =
-                    lawnmower(&area, spacing).into_iter().map(|p| [p[0], p[1], level]).collect();
-                limits.path(here, &path)?;
-                path.into_iter().map(|to| fly(to, d.spec.max_speed)).collect()
-            }
-            Function::FollowPath => {
-                in_air()?;
-                let mut z = level;
-                let mut path = Vec::new();
-                for (i, v) in args.iter().enumerate() {
-                    let p = point_value(v, &format!("points[{i}]"))?;
-                    z = p.z.unwrap_or(z);
-                    if z < 0.0 {
-                        return Err(failed(format!(
-                            "altitude {} m is below the ground",
-                            show::number(z)
-                        )));
-                    }
-                    path.push([p.x, p.y, z]);
-                }
-                limits.path(here, &path)?;
-                path.into_iter().map(|to| fly(to, d.spec.max_speed)).collect()
-            }
+            Function::Arm | Function::Disarm => return self.arm(id, function),
+            Function::TakeOff => m.take_off(args)?,
+            Function::Land => m.land(),
+            Function::ReturnToLaunch => m.return_home()?,
+            Function::FlyToPosition => m.fly_to(args)?,
+            Function::DescendTo | Function::AscendTo => m.to_altitude(args)?,
+            Function::Hover => hover_legs(args)?,
+            Function::Orbit => m.orbit(args)?,
+            Function::Sweep => m.sweep(args)?,
+            Function::FollowPath => m.follow_path(args)?,
             Function::StartStreaming | Function::StopStreaming => {
                 return self.stream(id, function == Function::StartStreaming)
             }
@@ -237,6 +97,19 @@ impl Fleet {
             Function::ReleasePayload => return self.release(id),
         };
         Ok(if legs.is_empty() { Start::Done } else { Start::Moves(legs) })
+    }
+
+    /// `Arm` and `Disarm`, on the ground only.
+    fn arm(&mut self, id: DroneId, function: Function) -> Result<Start, Failure> {
+        if self.drones[id].state != FlightState::Landed {
+            return Err(failed(format!(
+                "{} can only {} on the ground",
+                &self.names[id],
+                function.name().to_lowercase()
+            )));
+        }
+        self.drones[id].armed = function == Function::Arm;
+        Ok(Start::Done)
     }
 
     fn stream(&mut self, id: DroneId, on: bool) -> Result<Start, Failure> {
@@ -302,65 +175,5 @@ impl Fleet {
         };
         self.releases.push(Release { drone: id, kind, position: d.pos, time });
         Ok(Start::Done)
-    }
-}
-
-/// `ReturnToLaunch`: up to the return altitude, home, and down.
-pub(crate) fn return_legs(
-    d: &SimDrone,
-    name: &str,
-    landed: bool,
-    max_altitude: Option<f64>,
-) -> Result<Vec<Leg>, Failure> {
-    let home_dist = dist(d.xy(), d.home);
-    if landed {
-        if home_dist <= AT_HOME {
-            return Ok(Vec::new());
-        }
-        return Err(failed(format!("{name} is on the ground away from home: take off first")));
-    }
-    let z = d.pos[2];
-    let safe = aviary_api::flight::return_height(z, d.spec.return_altitude, max_altitude);
-    let mut legs = Vec::new();
-    if safe > z {
-        legs.push(Leg::Move {
-            to: [d.pos[0], d.pos[1], safe],
-            speed: d.spec.max_speed,
-            state: FlightState::Flying,
-        });
-    }
-    if home_dist > 0.0 {
-        legs.push(Leg::Move {
-            to: [d.home[0], d.home[1], safe],
-            speed: d.spec.max_speed,
-            state: FlightState::Flying,
-        });
-    }
-    if d.spec.return_loiter > 0.0 {
-        legs.push(Leg::Hold { left: d.spec.return_loiter });
-    }
-    legs.extend(landing_legs_from(d, d.home, safe));
-    Ok(legs)
-}
-
-/// A landing straight down from where the drone is.
-fn landing_legs(d: &SimDrone, here: [f64; 2]) -> Vec<Leg> {
-    landing_legs_from(d, here, d.pos[2])
-}
-
-/// Down to the ground at `at` from `height`: at the descent rate, and, when the drone
-/// lands slower than it descends, first to `slow_below` and from there at the landing
-/// speed (the motion's rule for a landing leg low enough), as an autopilot lands.
-fn landing_legs_from(d: &SimDrone, at: [f64; 2], height: f64) -> Vec<Leg> {
-    let down = |z: f64| Leg::Move {
-        to: [at[0], at[1], z],
-        speed: d.spec.max_speed,
-        state: FlightState::Landing,
-    };
-    let descent = d.spec.descent;
-    if descent.slows(height) && height > descent.slow_below {
-        vec![down(descent.slow_below), down(0.0)]
-    } else {
-        vec![down(0.0)]
     }
 }

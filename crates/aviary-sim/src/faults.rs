@@ -19,12 +19,12 @@
 //! Each of them ends the drone's calls in progress `Interrupted`. A fault on a lost drone
 //! does nothing.
 
-use aviary_api::{BuiltinException, BuiltinSignal, DroneEvent, FlightState};
+use aviary_api::{BuiltinException, BuiltinSignal, DroneEvent, DroneId, FlightState};
 use aviary_world::FaultKind;
 
-use crate::calls::return_legs;
 use crate::drone::Outage;
 use crate::fleet::{Fleet, Report};
+use crate::legs::return_legs;
 use crate::motion::{Leg, MotionTask};
 
 impl Fleet {
@@ -41,65 +41,84 @@ impl Fleet {
             if self.drones[id].state == FlightState::Lost {
                 continue;
             }
-            let name = self.names[id].to_owned();
-            match kind {
-                FaultKind::BatteryCritical => {
-                    let d = &mut self.drones[id];
-                    if d.critical_sent {
-                        continue;
-                    }
-                    d.critical_sent = true;
-                    d.low_sent = true;
-                    self.fault(
-                        id,
-                        BuiltinException::BatteryCritical,
-                        format!("{name}: battery critical (simulated fault)"),
-                        out,
-                    );
+            self.fire(id, kind, at, until, out);
+        }
+        self.end_outages(end, out);
+        self.return_without_link(end);
+        let drones = &self.drones;
+        self.outages.retain(|&id| {
+            drones[id].rare.as_ref().is_some_and(|r| r.link_loss.is_some() || r.gps_loss.is_some())
+        });
+    }
+
+    /// One fault on drone `id`, which is not lost; a link or GPS loss lasts from `at` to
+    /// `until`.
+    fn fire(&mut self, id: DroneId, kind: FaultKind, at: f64, until: f64, out: &mut Vec<Report>) {
+        let name = self.names[id].to_owned();
+        match kind {
+            FaultKind::BatteryCritical => {
+                let d = &mut self.drones[id];
+                if d.critical_sent {
+                    return;
                 }
-                FaultKind::Crash => self.lose(id, format!("{name} crashed (simulated fault)"), out),
-                FaultKind::MotorFailure => {
-                    self.fault(
-                        id,
-                        BuiltinException::MotorFailure,
-                        format!("{name}: motor failure (simulated fault)"),
-                        out,
-                    );
-                    let d = &mut self.drones[id];
-                    d.rare_mut().disabled = Some(format!("{name} had a motor failure"));
-                    if d.state.airborne() {
-                        let to = [d.pos[0], d.pos[1], 0.0];
-                        let leg =
-                            Leg::Move { to, speed: d.spec.max_speed, state: FlightState::Landing };
-                        d.motion = Some(Box::new(MotionTask::new(None, vec![leg])));
-                        d.begin_leg();
-                    }
-                }
-                FaultKind::LinkLoss => {
-                    self.fault(
-                        id,
-                        BuiltinException::ConnectionLost,
-                        format!("{name}: link lost (simulated fault)"),
-                        out,
-                    );
-                    self.drones[id].rare_mut().link_loss =
-                        Some(Outage { since: at, until, returned: false });
-                    self.outage(id);
-                }
-                FaultKind::GpsLoss => {
-                    self.fault(
-                        id,
-                        BuiltinException::PositionLost,
-                        format!("{name}: GPS lost (simulated fault)"),
-                        out,
-                    );
-                    self.drones[id].rare_mut().gps_loss =
-                        Some(Outage { since: at, until, returned: false });
-                    self.outage(id);
-                }
+                d.critical_sent = true;
+                d.low_sent = true;
+                self.fault(
+                    id,
+                    BuiltinException::BatteryCritical,
+                    format!("{name}: battery critical (simulated fault)"),
+                    out,
+                );
+            }
+            FaultKind::Crash => self.lose(id, format!("{name} crashed (simulated fault)"), out),
+            FaultKind::MotorFailure => self.motor_failure(id, &name, out),
+            FaultKind::LinkLoss => {
+                self.fault(
+                    id,
+                    BuiltinException::ConnectionLost,
+                    format!("{name}: link lost (simulated fault)"),
+                    out,
+                );
+                self.drones[id].rare_mut().link_loss =
+                    Some(Outage { since: at, until, returned: false });
+                self.outage(id);
+            }
+            FaultKind::GpsLoss => {
+                self.fault(
+                    id,
+                    BuiltinException::PositionLost,
+                    format!("{name}: GPS lost (simulated fault)"),
+                    out,
+                );
+                self.drones[id].rare_mut().gps_loss =
+                    Some(Outage { since: at, until, returned: false });
+                self.outage(id);
             }
         }
-        // Only drones with an outage have anything to end or to return for.
+    }
+
+    /// `MotorFailure`: the drone refuses every later command, and, in the air, lands
+    /// where it is.
+    fn motor_failure(&mut self, id: DroneId, name: &str, out: &mut Vec<Report>) {
+        self.fault(
+            id,
+            BuiltinException::MotorFailure,
+            format!("{name}: motor failure (simulated fault)"),
+            out,
+        );
+        let d = &mut self.drones[id];
+        d.rare_mut().disabled = Some(format!("{name} had a motor failure"));
+        if d.state.airborne() {
+            let to = [d.pos[0], d.pos[1], 0.0];
+            let leg = Leg::Move { to, speed: d.spec.max_speed, state: FlightState::Landing };
+            d.motion = Some(Box::new(MotionTask::new(None, vec![leg])));
+            d.begin_leg();
+        }
+    }
+
+    /// Ends the link and GPS losses over by `end`; a drone not lost has its link back
+    /// (`ConnectionRestored`). Only drones with an outage have anything to end.
+    fn end_outages(&mut self, end: f64, out: &mut Vec<Report>) {
         for &id in &self.outages {
             let d = &mut self.drones[id];
             let Some(rare) = d.rare.as_deref_mut() else { continue };
@@ -116,6 +135,11 @@ impl Fleet {
                 rare.gps_loss = None;
             }
         }
+    }
+
+    /// A drone whose link has been lost for `link_loss_rtl_after` by `end` returns to
+    /// launch on its own, once per outage: when it is in the air, idle and able to fly.
+    fn return_without_link(&mut self, end: f64) {
         let max_altitude = self.max_altitude;
         for &id in &self.outages {
             let d = &mut self.drones[id];
@@ -135,10 +159,6 @@ impl Fleet {
                 }
             }
         }
-        let drones = &self.drones;
-        self.outages.retain(|&id| {
-            drones[id].rare.as_ref().is_some_and(|r| r.link_loss.is_some() || r.gps_loss.is_some())
-        });
     }
 
     /// Notes that drone `id` has an outage (the list stays ascending, without repeats).

@@ -5,23 +5,16 @@
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::sync::Arc;
 
-use aviary_api::geometry::hypot;
-use aviary_api::{
-    BuiltinException, BuiltinSignal, CallEnd, CallId, DroneEvent, DroneId, Failure, FlightState,
-    Function, Interrupt, Telemetry, Value,
-};
+use aviary_api::{CallEnd, CallId, DroneEvent, DroneId, Function, Interrupt, Telemetry, Value};
 use aviary_world::{FaultKind, Sensor, Target, World};
 
 use crate::avoid::Track;
-use crate::battery;
 use crate::clearance::Clearance;
 use crate::drone::{SimDrone, Spec};
-use crate::geom::heading;
 use crate::grid::Grid;
 use crate::hot::Hot;
 use crate::luck::{Purpose, Stream};
 use crate::nearby::Nearby;
-use crate::sensors::scan;
 use aviary_api::Names;
 
 /// Something that happened during a [`Fleet::step`], in the order it happened.
@@ -111,12 +104,6 @@ pub struct Fleet {
 
 /// Metres on a side of a cell of [`Fleet::sky`]: about the planner's reach.
 const SKY_CELL: f64 = 400.0;
-/// Metres the drones of the sky may drift from where [`Fleet::clearance`] measured them
-/// before it measures again.
-const REMEASURE: f64 = 25.0;
-/// How many drones ahead [`Fleet::step`] warms the caches for the leg (twice as many for
-/// the task before it).
-const AHEAD: usize = 6;
 /// Metres on a side of a cell of [`Fleet::target_grid`], at least: about a sensor's range.
 const TARGET_CELL: f64 = 50.0;
 
@@ -182,7 +169,7 @@ impl Fleet {
     /// where it lies. A `SimDrone` is no larger than a world's `Drone`, so collecting
     /// them reuses the world's allocation (`Vec`'s in-place collect), and what each world
     /// drone holds is freed as it goes: a large world and its fleet are never held whole
-    /// at once (100,000 drones: about 17 MB less at the simulator's start).
+    /// at once (docs/BENCHMARKS.md).
     pub fn from_world(mut world: World) -> Fleet {
         let fleet = Fleet::around(&world);
         let mut specs = Specs::default();
@@ -384,212 +371,6 @@ impl Fleet {
     pub(crate) fn touch(&mut self, id: DroneId) {
         if let Some(h) = self.hot.get_mut(id) {
             h.known = false;
-        }
-    }
-
-    /// Advances every drone by `dt` simulated seconds.
-    // `!(drift <= REMEASURE)` on purpose: a NaN drift forces the rebuild.
-    #[allow(clippy::neg_cmp_op_on_partial_ord)]
-    pub fn step(&mut self, dt: f64) -> Vec<Report> {
-        let end = self.time + dt;
-        let mut out = Vec::new();
-        self.fire_faults(end, &mut out);
-        #[cfg(test)]
-        self.check_hot();
-        self.tracks.clear();
-        self.aloft.clear();
-        self.sky_fresh = false;
-        self.max_extent = 0.0;
-        let mut joined = false;
-        for (id, h) in self.hot.iter_mut().enumerate() {
-            // A known copy is where the drone was at its last `moved`, if a member.
-            let fresh = !h.known;
-            if fresh {
-                *h = Hot::of(&self.drones[id]);
-            }
-            self.in_sky[id] = h.up;
-            if !h.up {
-                self.clearance.leave(id);
-                continue;
-            }
-            self.aloft.push(id);
-            joined |=
-                !if fresh { self.clearance.moved(id, h.xy) } else { self.clearance.is_member(id) };
-            self.max_extent = self.max_extent.max(h.extent);
-        }
-        if joined || !(self.clearance.drift() <= REMEASURE) {
-            self.fresh_sky();
-            let cap = self.clearance_cap();
-            self.clearance.rebuild(&self.aloft, &self.sky, cap);
-        }
-        for id in 0..self.drones.len() {
-            // Overlap the cache misses of the drones to come (tasks, then their legs).
-            if let Some(d) = self.drones.get(id + 2 * AHEAD) {
-                d.warm();
-            }
-            if let Some(d) = self.drones.get(id + AHEAD) {
-                d.warm_leg();
-            }
-            if self.hot[id].idle {
-                continue;
-            }
-            self.step_drone(id, dt, &mut out);
-            let h = Hot::of(&self.drones[id]);
-            self.hot[id] = h;
-            // Keep the sky current for the drones after this one.
-            if self.in_sky[id] {
-                if self.sky_fresh {
-                    self.sky.put(id, h.xy);
-                }
-                self.clearance.moved(id, h.xy);
-                self.max_extent = self.max_extent.max(h.extent);
-            }
-        }
-        self.time = end;
-        for report in &out {
-            if let Report::Ended { call, .. } = report {
-                self.calls.remove(call);
-            }
-        }
-        out
-    }
-
-    /// Makes the sky hold every drone of `aloft` where it is now (once per step at most).
-    pub(crate) fn fresh_sky(&mut self) {
-        if self.sky_fresh {
-            return;
-        }
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for &id in &self.aloft {
-            let p = self.drones[id].xy();
-            (lo, hi) = ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])]);
-        }
-        self.sky.reframe(lo, hi, self.aloft.len());
-        for &id in &self.aloft {
-            self.sky.put(id, self.drones[id].xy());
-        }
-        self.sky_fresh = true;
-    }
-
-    /// How far [`Fleet::clearance`] measures: twice the planner's longest reach, plus the
-    /// drift allowed (farther gaps would tell nothing more).
-    fn clearance_cap(&self) -> f64 {
-        let reach = self.min_separation
-            + crate::avoid::MARGIN
-            + crate::avoid::HORIZON * 2.0 * self.fastest
-            + 1.0;
-        2.0 * reach + 2.0 * REMEASURE
-    }
-
-    fn step_drone(&mut self, id: DroneId, dt: f64, out: &mut Vec<Report>) {
-        if self.drones[id].state == FlightState::Lost {
-            return;
-        }
-        let airborne = self.drones[id].state.airborne();
-        let from = self.drones[id].xy();
-        let before = self.drones[id].pos;
-        let finished = self.move_drone(id, dt);
-        if finished.is_none() {
-            if let Some(report) = self.held_back(id, dt) {
-                out.push(report);
-            }
-        }
-        let d = &mut self.drones[id];
-        if let Some(task) = finished {
-            if let Some(call) = task.call {
-                out.push(Report::Ended { call, end: CallEnd::Done });
-            }
-        }
-        if hypot(d.vel[0], d.vel[1]) > 1e-9 {
-            d.heading = heading(d.vel[0], d.vel[1]);
-        }
-        if let Some(rare) = d.rare.as_deref_mut() {
-            if let Some(load) = rare.loading.as_mut().filter(|l| !l.paused) {
-                load.left -= dt;
-                if load.left <= 1e-9 {
-                    let call = load.call;
-                    rare.carrying = rare.loading.take().map(|l| l.kind);
-                    out.push(Report::Ended { call, end: CallEnd::Done });
-                }
-            }
-        }
-        let to = d.xy();
-        let moved = [d.pos[0] - before[0], d.pos[1] - before[1], d.pos[2] - before[2]];
-        d.odometer += (moved[0] * moved[0] + moved[1] * moved[1] + moved[2] * moved[2]).sqrt();
-        if airborne {
-            d.flight_time += dt;
-        }
-        // Only the targets near the way flown, in their order.
-        let nearby = match d.detections().iter().map(|a| a.range).reduce(f64::max) {
-            Some(range) => self.near_targets[id].get_or_insert_with(Box::default).around(
-                &self.target_grid,
-                from,
-                to,
-                range,
-            ),
-            None => &[],
-        };
-        if let Some(rare) = d.rare.as_deref_mut() {
-            let (luck, seed) = (&mut rare.luck, self.seed);
-            let mut draw = || {
-                luck.get_or_insert_with(|| Box::new(Stream::new(seed, Purpose::Detection, id)))
-                    .uniform()
-            };
-            let found = scan(id, &mut rare.detections, &self.targets, nearby, from, to, &mut draw);
-            if !found.is_empty() {
-                out.extend(found.into_iter().map(Report::Event));
-            }
-        }
-        let alarms = battery::drain(d, dt, airborne);
-        if alarms.low {
-            out.push(Report::Event(DroneEvent::Signal {
-                drone: id,
-                signal: BuiltinSignal::BatteryLow,
-            }));
-        }
-        if alarms.critical {
-            let reason = format!(
-                "{}: {:.0}% left, about what it needs to get home",
-                &self.names[id],
-                d.battery * 100.0
-            );
-            self.fault(id, BuiltinException::BatteryCritical, reason, out);
-        }
-        if alarms.empty {
-            let reason = format!("{}: battery empty", &self.names[id]);
-            self.lose(id, reason, out);
-        }
-    }
-
-    /// Raises a fault on a drone and ends its calls in progress (`Interrupted`).
-    pub(crate) fn fault(
-        &mut self,
-        id: DroneId,
-        exception: BuiltinException,
-        reason: String,
-        out: &mut Vec<Report>,
-    ) {
-        out.push(Report::Event(DroneEvent::Fault {
-            drone: id,
-            failure: Failure { exception, reason },
-        }));
-        for call in self.drones[id].cut_calls() {
-            out.push(Report::Ended { call, end: CallEnd::Interrupted });
-        }
-    }
-
-    /// The drone falls to the ground and is gone for good (`DroneLost`).
-    pub(crate) fn lose(&mut self, id: DroneId, reason: String, out: &mut Vec<Report>) {
-        self.fault(id, BuiltinException::DroneLost, reason, out);
-        let d = &mut self.drones[id];
-        d.state = FlightState::Lost;
-        d.avoid = None;
-        d.armed = false;
-        d.pos[2] = 0.0;
-        d.vel = [0.0; 3];
-        d.streaming = false;
-        if let Some(rare) = d.rare.as_deref_mut() {
-            rare.detections.clear();
         }
     }
 }

@@ -145,12 +145,14 @@ mod fleet;
 mod geom;
 mod grid;
 mod hot;
+mod legs;
 mod luck;
 mod motion;
 mod nearby;
 mod profile;
 mod sensors;
 mod separation;
+mod step;
 pub mod sweep;
 #[cfg(test)]
 mod tests;

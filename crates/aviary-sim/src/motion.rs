@@ -104,7 +104,7 @@ impl SimDrone {
     /// The legs of the task: speeds along the path scaled by `scale` (when yielding), and,
     /// when `owns_z`, the altitude left to [`SimDrone::steer_altitude`] and no leg ending.
     fn tick_task(&mut self, dt: f64, scale: Option<f64>, owns_z: bool) -> Option<MotionTask> {
-        let limit = |v: f64| scale.map_or(v, |s| v * s);
+        let tick = Tick { dt, scale, owns_z };
         let Some(task) = self.motion.as_mut() else {
             self.vel = [0.0; 3];
             return None;
@@ -113,68 +113,46 @@ impl SimDrone {
             self.vel = [0.0; 3];
             return None;
         }
+        let mut body = Body { pos: &mut self.pos, vel: &mut self.vel, spec: &self.spec };
         let done = match task.legs.front_mut() {
             None => true,
             Some(Leg::Hold { left }) => {
-                self.vel = [0.0; 3];
+                *body.vel = [0.0; 3];
                 *left -= dt;
                 *left <= 1e-9 && !owns_z
             }
-            Some(Leg::Move { to, speed, state }) => {
-                let (to, speed, landing) = (*to, *speed, *state == FlightState::Landing);
-                let here = [self.pos[0], self.pos[1]];
-                let d = geom::dist(here, [to[0], to[1]]);
-                let h = advance(d, task.ground_speed, limit(speed), self.spec.accel, dt);
-                task.ground_speed = h.speed;
-                if h.arrived {
-                    self.pos[0] = to[0];
-                    self.pos[1] = to[1];
-                    self.vel[0] = 0.0;
-                    self.vel[1] = 0.0;
-                } else {
-                    let (ux, uy) = ((to[0] - here[0]) / d, (to[1] - here[1]) / d);
-                    self.pos[0] += ux * h.moved;
-                    self.pos[1] += uy * h.moved;
-                    self.vel[0] = ux * h.speed;
-                    self.vel[1] = uy * h.speed;
-                }
-                if owns_z {
-                    task.climb_speed = 0.0;
-                    false
-                } else {
-                    let dz = to[2] - self.pos[2];
-                    let climb = limit(vertical_limit(&self.spec, self.pos[2], dz, to[2], landing));
-                    let v = advance(dz.abs(), task.climb_speed, climb, self.spec.accel, dt);
-                    task.climb_speed = v.speed;
-                    if v.arrived {
-                        self.pos[2] = to[2];
-                        self.vel[2] = 0.0;
-                    } else {
-                        self.pos[2] += dz.signum() * v.moved;
-                        self.vel[2] = dz.signum() * v.speed;
-                    }
-                    h.arrived && v.arrived
-                }
+            Some(&mut Leg::Move { to, speed, state }) => {
+                body.straight(task, to, speed, state == FlightState::Landing, tick)
             }
-            Some(Leg::Arc { center, radius, start, total, speed }) => {
-                let (center, radius, start, total, speed) =
-                    (*center, *radius, *start, *total, *speed);
+            Some(&mut Leg::Arc { center, radius, start, total, speed }) => {
                 let left = (total - task.arc_done) * radius;
-                let step =
-                    advance(left, task.arc_speed, limit(speed), arc_accel(self.spec.accel), dt);
+                let step = advance(
+                    left,
+                    task.arc_speed,
+                    tick.limit(speed),
+                    arc_accel(body.spec.accel),
+                    dt,
+                );
                 task.arc_speed = step.speed;
                 task.arc_done =
                     if step.arrived { total } else { task.arc_done + step.moved / radius };
                 let theta = start - task.arc_done;
-                self.pos[0] = center[0] + radius * theta.cos();
-                self.pos[1] = center[1] + radius * theta.sin();
-                self.vel = [theta.sin() * step.speed, -theta.cos() * step.speed, 0.0];
+                body.pos[0] = center[0] + radius * theta.cos();
+                body.pos[1] = center[1] + radius * theta.sin();
+                *body.vel = [theta.sin() * step.speed, -theta.cos() * step.speed, 0.0];
                 step.arrived && !owns_z
             }
         };
         if !done {
             return None;
         }
+        self.next_leg()
+    }
+
+    /// Ends the task's current leg, in the flight state it leads to, and begins the next
+    /// one; returns the task when that was its last leg.
+    fn next_leg(&mut self) -> Option<MotionTask> {
+        let task = self.motion.as_mut()?;
         let leg = task.legs.pop_front();
         task.rest();
         task.arc_done = 0.0;
@@ -194,6 +172,82 @@ impl SimDrone {
         }
         self.begin_leg();
         None
+    }
+}
+
+/// How one tick flies a task (see [`SimDrone::tick_task`]).
+#[derive(Clone, Copy)]
+struct Tick {
+    dt: f64,
+    scale: Option<f64>,
+    owns_z: bool,
+}
+
+impl Tick {
+    /// A speed limit of the path, scaled while yielding.
+    fn limit(self, v: f64) -> f64 {
+        self.scale.map_or(v, |s| v * s)
+    }
+}
+
+/// What a leg moves: the drone's position and velocity, within its make.
+struct Body<'a> {
+    pos: &'a mut [f64; 3],
+    vel: &'a mut [f64; 3],
+    spec: &'a Spec,
+}
+
+impl Body<'_> {
+    /// One tick of a straight leg to `to`: over the ground and, unless the yield owns the
+    /// altitude, vertically at the same time. Returns whether both have arrived.
+    fn straight(
+        &mut self,
+        task: &mut MotionTask,
+        to: [f64; 3],
+        speed: f64,
+        landing: bool,
+        tick: Tick,
+    ) -> bool {
+        let here = [self.pos[0], self.pos[1]];
+        let d = geom::dist(here, [to[0], to[1]]);
+        let h = advance(d, task.ground_speed, tick.limit(speed), self.spec.accel, tick.dt);
+        task.ground_speed = h.speed;
+        if h.arrived {
+            self.pos[0] = to[0];
+            self.pos[1] = to[1];
+            self.vel[0] = 0.0;
+            self.vel[1] = 0.0;
+        } else {
+            let (ux, uy) = ((to[0] - here[0]) / d, (to[1] - here[1]) / d);
+            self.pos[0] += ux * h.moved;
+            self.pos[1] += uy * h.moved;
+            self.vel[0] = ux * h.speed;
+            self.vel[1] = uy * h.speed;
+        }
+        if tick.owns_z {
+            task.climb_speed = 0.0;
+            return false;
+        }
+        // Both moves every tick: the climb must not wait for the ground track.
+        let climbed = self.vertical(task, to[2], landing, tick);
+        h.arrived && climbed
+    }
+
+    /// One tick of a straight leg's climb or descent to `to_z`; returns whether it has
+    /// arrived.
+    fn vertical(&mut self, task: &mut MotionTask, to_z: f64, landing: bool, tick: Tick) -> bool {
+        let dz = to_z - self.pos[2];
+        let climb = tick.limit(vertical_limit(self.spec, self.pos[2], dz, to_z, landing));
+        let v = advance(dz.abs(), task.climb_speed, climb, self.spec.accel, tick.dt);
+        task.climb_speed = v.speed;
+        if v.arrived {
+            self.pos[2] = to_z;
+            self.vel[2] = 0.0;
+        } else {
+            self.pos[2] += dz.signum() * v.moved;
+            self.vel[2] = dz.signum() * v.speed;
+        }
+        v.arrived
     }
 }
 

@@ -123,6 +123,18 @@ pub fn decode(bytes: &[u8]) -> (String, Option<usize>) {
     }
 }
 
+/// As [`decode`], taking the bytes: valid UTF-8 becomes the text without a copy (a large
+/// world's file is megabytes).
+pub fn decode_owned(bytes: Vec<u8>) -> (String, Option<usize>) {
+    match String::from_utf8(bytes) {
+        Ok(text) => (text, None),
+        Err(e) => {
+            let at = e.utf8_error().valid_up_to();
+            (String::from_utf8_lossy(e.as_bytes()).into_owned(), Some(at))
+        }
+    }
+}
+
 pub fn invalid_utf8(file: FileId, at: usize) -> Diagnostic {
     Diagnostic::new(
         Code::InvalidUtf8,

@@ -48,72 +48,15 @@ impl Autopilot {
         use MavResult::*;
         let system = self.copters[i].system;
         let p = c.p;
-        let simple =
-            |(result, why): (MavResult, Option<String>)| Answer::failed(system, result, why);
-        let refused = |why: &str| Answer::failed(system, MAV_RESULT_FAILED, Some(why.to_owned()));
-        let done = |r: Result<(), String>| match r {
-            Ok(()) => Answer::of(MAV_RESULT_ACCEPTED),
-            Err(why) => Answer::failed(system, MAV_RESULT_FAILED, Some(why)),
-        };
-        let state = self.state(i);
         match c.id {
-            MavCmd::MAV_CMD_DO_SET_MODE => simple(self.set_mode(i, p[1] as u32)),
-            MavCmd::MAV_CMD_COMPONENT_ARM_DISARM if p[0] >= 0.5 => {
-                if self.booting() {
-                    return simple((
-                        MAV_RESULT_TEMPORARILY_REJECTED,
-                        Some("Arm: still booting".into()),
-                    ));
-                }
-                if !self.ready() {
-                    return refused("PreArm: GPS: waiting for 3D fix");
-                }
-                if matches!(self.copters[i].mode, COPTER_RTL | COPTER_LAND) {
-                    return refused("Arm: Mode not armable");
-                }
-                if self.copters[i].armed {
-                    return Answer::of(MAV_RESULT_ACCEPTED);
-                }
-                let mut a = done(self.instant(i, Function::Arm, &[]));
-                self.copters[i].armed = a.result == MAV_RESULT_ACCEPTED;
-                // ArduCopter sets home where it arms, and says so on every link; the
-                // simulator's home does not move, so the same home is said again.
-                if let Some(home) = self.home_position(i).filter(|_| self.copters[i].armed) {
-                    a.after.push(Reply::all(Out { system, msg: home.into() }));
-                }
-                a
+            MavCmd::MAV_CMD_DO_SET_MODE => with_reason(system, self.set_mode(i, p[1] as u32)),
+            MavCmd::MAV_CMD_COMPONENT_ARM_DISARM if p[0] >= 0.5 => self.arm(i),
+            MavCmd::MAV_CMD_COMPONENT_ARM_DISARM => self.disarm(i),
+            MavCmd::MAV_CMD_NAV_TAKEOFF => self.take_off(i, c),
+            MavCmd::MAV_CMD_NAV_LAND => with_reason(system, self.set_mode(i, COPTER_LAND)),
+            MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH => {
+                with_reason(system, self.set_mode(i, COPTER_RTL))
             }
-            MavCmd::MAV_CMD_COMPONENT_ARM_DISARM => {
-                if state.airborne() {
-                    return refused("Disarm: vehicle is flying");
-                }
-                let a = done(self.instant(i, Function::Disarm, &[]));
-                self.copters[i].armed &= a.result != MAV_RESULT_ACCEPTED;
-                a
-            }
-            MavCmd::MAV_CMD_NAV_TAKEOFF => {
-                // COMMAND_INT carries the altitude in z, and only above home (as ArduCopter).
-                let alt = match c.int {
-                    None => p[6],
-                    Some((3 | 6, _, _, z)) => z,
-                    Some(_) => return Answer::of(MAV_RESULT_DENIED),
-                };
-                if !alt.is_finite() {
-                    return Answer::of(MAV_RESULT_DENIED);
-                }
-                if self.copters[i].mode != COPTER_GUIDED {
-                    return refused("Takeoff: not in GUIDED mode");
-                }
-                if !self.copters[i].armed {
-                    return refused("Takeoff: arm motors first");
-                }
-                if state != FlightState::Landed {
-                    return refused("Takeoff: already flying");
-                }
-                done(self.motion(i, Function::TakeOff, &[Value::Number(f64::from(alt))]))
-            }
-            MavCmd::MAV_CMD_NAV_LAND => simple(self.set_mode(i, COPTER_LAND)),
-            MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH => simple(self.set_mode(i, COPTER_RTL)),
             MavCmd::MAV_CMD_DO_CHANGE_SPEED if p[1] > 0.0 => {
                 let c = &mut self.copters[i];
                 c.speed = f64::from(p[1]).min(c.max_speed);
@@ -129,9 +72,9 @@ impl Autopilot {
             MavCmd::MAV_CMD_DO_GRIPPER => {
                 if p[1] >= 0.5 {
                     let kind = self.copters[i].payload.clone().unwrap_or_default();
-                    done(self.instant(i, Function::LoadPayload, &[Value::Symbol(kind)]))
+                    done(system, self.instant(i, Function::LoadPayload, &[Value::Symbol(kind)]))
                 } else {
-                    done(self.instant(i, Function::ReleasePayload, &[]))
+                    done(system, self.instant(i, Function::ReleasePayload, &[]))
                 }
             }
             MavCmd::MAV_CMD_GET_HOME_POSITION => match self.home_position(i) {
@@ -160,6 +103,73 @@ impl Autopilot {
         }
     }
 
+    /// MAV_CMD_COMPONENT_ARM_DISARM, arm: refused while booting, before the pre-arm
+    /// checks pass, and in RTL or LAND.
+    fn arm(&mut self, i: usize) -> Answer {
+        use MavResult::*;
+        let system = self.copters[i].system;
+        if self.booting() {
+            return with_reason(
+                system,
+                (MAV_RESULT_TEMPORARILY_REJECTED, Some("Arm: still booting".into())),
+            );
+        }
+        if !self.ready() {
+            return refused(system, "PreArm: GPS: waiting for 3D fix");
+        }
+        if matches!(self.copters[i].mode, COPTER_RTL | COPTER_LAND) {
+            return refused(system, "Arm: Mode not armable");
+        }
+        if self.copters[i].armed {
+            return Answer::of(MAV_RESULT_ACCEPTED);
+        }
+        let mut a = done(system, self.instant(i, Function::Arm, &[]));
+        self.copters[i].armed = a.result == MAV_RESULT_ACCEPTED;
+        // ArduCopter sets home where it arms, and says so on every link; the
+        // simulator's home does not move, so the same home is said again.
+        if let Some(home) = self.home_position(i).filter(|_| self.copters[i].armed) {
+            a.after.push(Reply::all(Out { system, msg: home.into() }));
+        }
+        a
+    }
+
+    /// MAV_CMD_COMPONENT_ARM_DISARM, disarm: on the ground only.
+    fn disarm(&mut self, i: usize) -> Answer {
+        let system = self.copters[i].system;
+        if self.state(i).airborne() {
+            return refused(system, "Disarm: vehicle is flying");
+        }
+        let a = done(system, self.instant(i, Function::Disarm, &[]));
+        self.copters[i].armed &= a.result != MavResult::MAV_RESULT_ACCEPTED;
+        a
+    }
+
+    /// MAV_CMD_NAV_TAKEOFF: in GUIDED, armed, from the ground.
+    fn take_off(&mut self, i: usize, c: &Command) -> Answer {
+        use MavResult::*;
+        let system = self.copters[i].system;
+        let state = self.state(i);
+        // COMMAND_INT carries the altitude in z, and only above home (as ArduCopter).
+        let alt = match c.int {
+            None => c.p[6],
+            Some((3 | 6, _, _, z)) => z,
+            Some(_) => return Answer::of(MAV_RESULT_DENIED),
+        };
+        if !alt.is_finite() {
+            return Answer::of(MAV_RESULT_DENIED);
+        }
+        if self.copters[i].mode != COPTER_GUIDED {
+            return refused(system, "Takeoff: not in GUIDED mode");
+        }
+        if !self.copters[i].armed {
+            return refused(system, "Takeoff: arm motors first");
+        }
+        if state != FlightState::Landed {
+            return refused(system, "Takeoff: already flying");
+        }
+        done(system, self.motion(i, Function::TakeOff, &[Value::Number(f64::from(alt))]))
+    }
+
     /// A call that does not move the drone (arming, the gripper): left to finish alone.
     pub(crate) fn instant(
         &mut self,
@@ -171,5 +181,23 @@ impl Autopilot {
             Some(CallEnd::Failed(f)) => Err(f.reason),
             _ => Ok(()),
         }
+    }
+}
+
+/// The result the autopilot gives, with its reason when it says one.
+fn with_reason(system: u8, (result, why): (MavResult, Option<String>)) -> Answer {
+    Answer::failed(system, result, why)
+}
+
+/// A refusal (`MAV_RESULT_FAILED`) with the autopilot's reason.
+fn refused(system: u8, why: &str) -> Answer {
+    Answer::failed(system, MavResult::MAV_RESULT_FAILED, Some(why.to_owned()))
+}
+
+/// Accepted when the simulator's call went through, else refused with its reason.
+fn done(system: u8, r: Result<(), String>) -> Answer {
+    match r {
+        Ok(()) => Answer::of(MavResult::MAV_RESULT_ACCEPTED),
+        Err(why) => Answer::failed(system, MavResult::MAV_RESULT_FAILED, Some(why)),
     }
 }

@@ -121,78 +121,14 @@ impl Facts {
         if self.unheard.is_some() {
             return lines;
         }
-        let name = &self.name;
         let mut missing = Vec::new();
         for (p, answer) in &self.answers {
-            let (key, unit) = p.figure.key();
-            let Some(value) = *answer else {
-                missing.push((p.name, key));
-                continue;
-            };
-            if !p.figure.usable(value) {
-                let raw = value / p.scale;
-                lines.push(format!(
-                    "{name}: the vehicle's {} is {} {}, no usable {}: the world's kept",
-                    p.name,
-                    num(raw),
-                    p.unit,
-                    what(p.figure)
-                ));
-                continue;
+            match *answer {
+                Some(value) => lines.extend(self.take_answer(p, value, d)),
+                None => missing.push((p.name, p.figure.key().0)),
             }
-            let slot = match p.figure {
-                Figure::Climb => &mut d.climb_rate,
-                Figure::Descent => &mut d.descent_rate,
-                Figure::Acceleration => &mut d.acceleration,
-                Figure::LandSpeed => &mut d.land_speed,
-                Figure::LandSpeedBelow => &mut d.land_speed_below,
-                Figure::ReturnAltitude => &mut d.return_altitude,
-                Figure::ReturnLoiter => &mut d.return_loiter,
-                Figure::LandSpeedHigh => {
-                    if value > 0.0 {
-                        lines.push(format!(
-                            "{name}: it lands from high at {} {unit} (the vehicle's {}); the world has one descent rate, so the plan lands at {} {unit} and the battery rule at {} {unit}",
-                            num(value), p.name, num(d.descent_rate), num(value)
-                        ));
-                    }
-                    continue;
-                }
-                Figure::Capacity => {
-                    match d.battery_capacity {
-                        Some(old) if same(old, value) => {}
-                        Some(old) => lines.push(format!("{name}: battery {} {unit} (the vehicle's {}), not the world's {} {unit}", num(value), p.name, num(old))),
-                        None => lines.push(format!("{name}: battery {} {unit} (the vehicle's {}); the world gave none", num(value), p.name)),
-                    }
-                    d.battery_capacity = Some(value);
-                    continue;
-                }
-            };
-            if !same(*slot, value) {
-                lines.push(format!(
-                    "{name}: {} {} {unit} (the vehicle's {}), not the world's {} {unit}",
-                    what(p.figure),
-                    num(value),
-                    p.name,
-                    num(*slot)
-                ));
-            }
-            *slot = value;
         }
-        match self.charge {
-            Some(c) if !same(c, d.battery) => {
-                lines.push(format!(
-                    "{name}: charge {}% (the vehicle's battery_remaining), not the world's {}%",
-                    num(c),
-                    num(d.battery)
-                ));
-                d.battery = c;
-            }
-            Some(_) => {}
-            None => lines.push(format!(
-                "{name}: the vehicle reports no charge: the world's {}% kept",
-                num(d.battery)
-            )),
-        }
+        lines.extend(self.take_charge(d));
         if self.answer(Figure::Capacity).is_some_and(|(_, c)| Figure::Capacity.usable(c)) {
             lines.extend(self.endurance(d));
         }
@@ -205,9 +141,92 @@ impl Facts {
             } else {
                 format!(": the world's {} kept", keys.join(", "))
             };
-            lines.push(format!("{name}: no answer for {}{kept}", names.join(", ")));
+            lines.push(format!("{}: no answer for {}{kept}", self.name, names.join(", ")));
         }
         lines
+    }
+
+    /// Sets the figure `p` is for to the vehicle's `value`, when the world can hold it; the
+    /// line that says how it differs from the world's, or why it is not used.
+    fn take_answer(&self, p: &Param, value: f64, d: &mut Drone) -> Option<String> {
+        let name = &self.name;
+        let (_, unit) = p.figure.key();
+        if !p.figure.usable(value) {
+            let raw = value / p.scale;
+            return Some(format!(
+                "{name}: the vehicle's {} is {} {}, no usable {}: the world's kept",
+                p.name,
+                num(raw),
+                p.unit,
+                what(p.figure)
+            ));
+        }
+        let slot = match p.figure {
+            Figure::Climb => &mut d.climb_rate,
+            Figure::Descent => &mut d.descent_rate,
+            Figure::Acceleration => &mut d.acceleration,
+            Figure::LandSpeed => &mut d.land_speed,
+            Figure::LandSpeedBelow => &mut d.land_speed_below,
+            Figure::ReturnAltitude => &mut d.return_altitude,
+            Figure::ReturnLoiter => &mut d.return_loiter,
+            Figure::LandSpeedHigh => {
+                return (value > 0.0).then(|| format!(
+                    "{name}: it lands from high at {} {unit} (the vehicle's {}); the world has one descent rate, so the plan lands at {} {unit} and the battery rule at {} {unit}",
+                    num(value), p.name, num(d.descent_rate), num(value)
+                ));
+            }
+            Figure::Capacity => {
+                let line = match d.battery_capacity {
+                    Some(old) if same(old, value) => None,
+                    Some(old) => Some(format!(
+                        "{name}: battery {} {unit} (the vehicle's {}), not the world's {} {unit}",
+                        num(value),
+                        p.name,
+                        num(old)
+                    )),
+                    None => Some(format!(
+                        "{name}: battery {} {unit} (the vehicle's {}); the world gave none",
+                        num(value),
+                        p.name
+                    )),
+                };
+                d.battery_capacity = Some(value);
+                return line;
+            }
+        };
+        let line = (!same(*slot, value)).then(|| {
+            format!(
+                "{name}: {} {} {unit} (the vehicle's {}), not the world's {} {unit}",
+                what(p.figure),
+                num(value),
+                p.name,
+                num(*slot)
+            )
+        });
+        *slot = value;
+        line
+    }
+
+    /// Sets the drone's charge to the vehicle's; the line that says how it differs, or
+    /// that the vehicle reports none.
+    fn take_charge(&self, d: &mut Drone) -> Option<String> {
+        let name = &self.name;
+        match self.charge {
+            Some(c) if !same(c, d.battery) => {
+                let line = format!(
+                    "{name}: charge {}% (the vehicle's battery_remaining), not the world's {}%",
+                    num(c),
+                    num(d.battery)
+                );
+                d.battery = c;
+                Some(line)
+            }
+            Some(_) => None,
+            None => Some(format!(
+                "{name}: the vehicle reports no charge: the world's {}% kept",
+                num(d.battery)
+            )),
+        }
     }
 
     /// The endurance from the vehicle's capacity and the world's draw (the vehicle has no

@@ -12,27 +12,7 @@ impl Parser<'_> {
         let start = self.span();
         let stmt = match self.peek() {
             TokenKind::Keyword(k @ (Keyword::Sequential | Keyword::Parallel)) => {
-                let kind = if k == Keyword::Sequential {
-                    BlockKind::Sequential
-                } else {
-                    BlockKind::Parallel
-                };
-                match self.peek_at(1) {
-                    TokenKind::Keyword(Keyword::For) => self.for_block(kind),
-                    TokenKind::Keyword(Keyword::On) => {
-                        self.bump();
-                        if self.peek_at(1) == TokenKind::Keyword(Keyword::Exception) {
-                            let span = start.to(self.span());
-                            let d = self
-                                .error(Code::Syntax, span, format!("`{} ON EXCEPTION` is not a form", k.as_str()))
-                                .with_help("an exception handler always starts at once: write `ON EXCEPTION Name:`");
-                            self.report(d);
-                            return self.exception_handler().map(Stmt::ExceptionHandler);
-                        }
-                        self.handler(Some(kind), start)
-                    }
-                    _ => self.block(kind),
-                }
+                return self.sequential_or_parallel(k, start);
             }
             TokenKind::Keyword(Keyword::On) => {
                 if self.peek_at(1) == TokenKind::Keyword(Keyword::Exception) {
@@ -64,36 +44,17 @@ impl Parser<'_> {
                 self.requirement(kind)
             }
             TokenKind::Keyword(Keyword::If) => self.if_chain(),
-            TokenKind::Keyword(Keyword::Else) => {
-                let d = self
-                    .error(Code::MisplacedItem, start, "ELSE without an IF before it")
-                    .with_help("ELSE must follow the body of an IF, at the IF's indentation");
-                self.report(d);
-                self.recover_line();
-                return None;
-            }
             TokenKind::Keyword(
-                k @ (Keyword::Requirements
+                k @ (Keyword::Else
+                | Keyword::Requirements
                 | Keyword::Defaults
                 | Keyword::Perform
-                | Keyword::Exceptions),
+                | Keyword::Exceptions
+                | Keyword::Mission
+                | Keyword::Capability
+                | Keyword::Use),
             ) => {
-                let d = self
-                    .error(Code::MisplacedItem, start, format!("{} is a capability section, and is not allowed here", k.as_str()))
-                    .with_help("sections stand directly under `CAPABILITY Name BY drone:`, indented by 4 spaces");
-                self.report(d);
-                self.recover_line();
-                return None;
-            }
-            TokenKind::Keyword(k @ (Keyword::Mission | Keyword::Capability | Keyword::Use)) => {
-                let d = self
-                    .error(Code::MisplacedItem, start, format!("{} inside a block", k.as_str()))
-                    .with_help(format!(
-                        "{} starts in the first column, outside every other definition",
-                        k.as_str()
-                    ));
-                self.report(d);
-                self.recover_line();
+                self.misplaced(k, start);
                 return None;
             }
             TokenKind::TaggedName => self.leash(),
@@ -119,6 +80,49 @@ impl Parser<'_> {
             }
         };
         Some(stmt)
+    }
+
+    /// SEQUENTIAL or PARALLEL: a block, a FOR block, or a handler whose body runs so.
+    fn sequential_or_parallel(&mut self, k: Keyword, start: Span) -> Option<Stmt> {
+        let kind =
+            if k == Keyword::Sequential { BlockKind::Sequential } else { BlockKind::Parallel };
+        Some(match self.peek_at(1) {
+            TokenKind::Keyword(Keyword::For) => self.for_block(kind),
+            TokenKind::Keyword(Keyword::On) => {
+                self.bump();
+                if self.peek_at(1) == TokenKind::Keyword(Keyword::Exception) {
+                    let span = start.to(self.span());
+                    let d = self
+                        .error(Code::Syntax, span, format!("`{} ON EXCEPTION` is not a form", k.as_str()))
+                        .with_help("an exception handler always starts at once: write `ON EXCEPTION Name:`");
+                    self.report(d);
+                    return self.exception_handler().map(Stmt::ExceptionHandler);
+                }
+                self.handler(Some(kind), start)
+            }
+            _ => self.block(kind),
+        })
+    }
+
+    /// A keyword that cannot start a statement here (ELSE without IF, a capability
+    /// section, a top-level item): reported, and its line skipped.
+    fn misplaced(&mut self, k: Keyword, start: Span) {
+        let d = match k {
+            Keyword::Else => self
+                .error(Code::MisplacedItem, start, "ELSE without an IF before it")
+                .with_help("ELSE must follow the body of an IF, at the IF's indentation"),
+            Keyword::Requirements | Keyword::Defaults | Keyword::Perform | Keyword::Exceptions => self
+                .error(Code::MisplacedItem, start, format!("{} is a capability section, and is not allowed here", k.as_str()))
+                .with_help("sections stand directly under `CAPABILITY Name BY drone:`, indented by 4 spaces"),
+            _ => self
+                .error(Code::MisplacedItem, start, format!("{} inside a block", k.as_str()))
+                .with_help(format!(
+                    "{} starts in the first column, outside every other definition",
+                    k.as_str()
+                )),
+        };
+        self.report(d);
+        self.recover_line();
     }
 
     /// The end of a one-line item: anything left on the line is an error.

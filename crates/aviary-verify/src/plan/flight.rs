@@ -45,14 +45,7 @@ pub fn fly(
             None => 0.0,
         },
         Function::Hover => number_arg(args, 0).unwrap_or(0.0),
-        Function::FlyToPosition => {
-            let Some(to) = e.position_arg(args.first().unwrap_or(&None), d, at) else {
-                return (0.0, raises);
-            };
-            let f = &e.s.drones[d];
-            let speed = number_arg(args, 1).map_or(f.max_speed, |s| s.min(f.max_speed));
-            leg(e, d, to, speed, t, &mut raises)
-        }
+        Function::FlyToPosition => fly_to_position(e, d, args, at, t, &mut raises),
         Function::Orbit => {
             let center = e.position_arg(args.first().unwrap_or(&None), d, at);
             let radius = number_arg(args, 1);
@@ -65,41 +58,14 @@ pub fn fly(
         }
         Function::Sweep => match (args.first(), number_arg(args, 1)) {
             (Some(Some(Value::Area(area))), Some(spacing)) => {
-                let z = e.s.drones[d].pos[2];
-                let mut took = 0.0;
-                for p in aviary_api::sweep::lawnmower(area, spacing) {
-                    let speed = e.s.drones[d].max_speed;
-                    took += leg(e, d, [p[0], p[1], z], speed, t + took, &mut raises);
-                }
-                took
+                sweep(e, d, area, spacing, t, &mut raises)
             }
             _ => 0.0,
         },
-        Function::FollowPath => {
-            let mut took = 0.0;
-            for v in args {
-                if let Some(to) = e.position_arg(v, d, at) {
-                    let speed = e.s.drones[d].max_speed;
-                    took += leg(e, d, to, speed, t + took, &mut raises);
-                }
-            }
-            took
-        }
+        Function::FollowPath => follow_path(e, d, args, at, t, &mut raises),
         Function::StartDetection => {
             if let Some(Some(Value::Symbol(kind))) = args.first() {
-                let f = &e.s.drones[d];
-                let range = e
-                    .world
-                    .sensors
-                    .iter()
-                    .filter(|s| f.sensors.contains(&s.kind) && s.detects.contains(kind))
-                    .map(|s| s.range)
-                    .reduce(f64::max);
-                let f = &mut e.s.drones[d];
-                f.detecting.retain(|(k, _, _)| k != kind);
-                if let Some(range) = range {
-                    f.detecting.push((kind.clone(), range, Vec::new()));
-                }
+                start_detection(e, d, kind);
             }
             0.0
         }
@@ -117,6 +83,78 @@ pub fn fly(
         | Function::ReleasePayload => 0.0,
     };
     (duration, raises)
+}
+
+/// `FlyToPosition`: one leg, at the speed asked for (at most the drone's).
+fn fly_to_position(
+    e: &mut Estimator,
+    d: DroneId,
+    args: &[Option<Value>],
+    at: Option<Origin>,
+    t: f64,
+    raises: &mut Vec<Raise>,
+) -> f64 {
+    let Some(to) = e.position_arg(args.first().unwrap_or(&None), d, at) else {
+        return 0.0;
+    };
+    let f = &e.s.drones[d];
+    let speed = number_arg(args, 1).map_or(f.max_speed, |s| s.min(f.max_speed));
+    leg(e, d, to, speed, t, raises)
+}
+
+/// `Sweep`: the area's lawnmower path at the altitude the drone is at.
+fn sweep(
+    e: &mut Estimator,
+    d: DroneId,
+    area: &[[f64; 2]],
+    spacing: f64,
+    t: f64,
+    raises: &mut Vec<Raise>,
+) -> f64 {
+    let z = e.s.drones[d].pos[2];
+    let mut took = 0.0;
+    for p in aviary_api::sweep::lawnmower(area, spacing) {
+        let speed = e.s.drones[d].max_speed;
+        took += leg(e, d, [p[0], p[1], z], speed, t + took, raises);
+    }
+    took
+}
+
+/// `FollowPath`: a leg to each point that is known before the flight.
+fn follow_path(
+    e: &mut Estimator,
+    d: DroneId,
+    args: &[Option<Value>],
+    at: Option<Origin>,
+    t: f64,
+    raises: &mut Vec<Raise>,
+) -> f64 {
+    let mut took = 0.0;
+    for v in args {
+        if let Some(to) = e.position_arg(v, d, at) {
+            let speed = e.s.drones[d].max_speed;
+            took += leg(e, d, to, speed, t + took, raises);
+        }
+    }
+    took
+}
+
+/// `StartDetection(kind)`: detecting `kind` at the longest range of the drone's sensors
+/// that detect it (an activation of the same kind is replaced).
+fn start_detection(e: &mut Estimator, d: DroneId, kind: &String) {
+    let f = &e.s.drones[d];
+    let range = e
+        .world
+        .sensors
+        .iter()
+        .filter(|s| f.sensors.contains(&s.kind) && s.detects.contains(kind))
+        .map(|s| s.range)
+        .reduce(f64::max);
+    let f = &mut e.s.drones[d];
+    f.detecting.retain(|(k, _, _)| k != kind);
+    if let Some(range) = range {
+        f.detecting.push((kind.clone(), range, Vec::new()));
+    }
 }
 
 /// A straight leg, scanning for targets on the way.

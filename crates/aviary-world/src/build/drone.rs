@@ -125,28 +125,7 @@ impl Drones {
         keys: &[Entry],
         index: usize,
     ) -> (Drone, Option<usize>) {
-        let mut d = Drone {
-            name: String::new(),
-            home: [0.0; 3],
-            group: None,
-            sensors: Box::default(),
-            payload: Box::default(),
-            max_speed: 10.0,
-            climb_rate: 3.0,
-            acceleration: 3.0,
-            battery: 100.0,
-            endurance: 1800.0,
-            descent_rate: f64::NAN,
-            land_speed: f64::NAN,
-            land_speed_below: 10.0,
-            return_altitude: 10.0,
-            return_loiter: 0.0,
-            battery_capacity: None,
-            flight_current: None,
-            backend: Backend::Sim,
-            attributes: Box::default(),
-            span: key_span,
-        };
+        let mut d = defaults(key_span);
         let mut group_index = None;
         let mut attributes = Vec::new();
         for k in keys {
@@ -161,41 +140,12 @@ impl Drones {
                         .map_or(d.home, |(p, _)| p)
                 }
                 "group" => {
-                    // Read in place: most drones name a group that exists already.
-                    let Value::Str(group) = &n.value else {
-                        cx.string(&what, n);
-                        continue;
-                    };
-                    if cx.identifier("group", group, n.span) {
-                        let (g, shared) = match self.group_index.get(group.as_str()) {
-                            Some((g, shared)) => (*g, shared.clone()),
-                            None => {
-                                let shared: Arc<str> = group.as_str().into();
-                                self.group_index
-                                    .insert(group.clone(), (self.groups.len(), shared.clone()));
-                                self.groups
-                                    .push(Group { name: group.clone(), members: Vec::new() });
-                                self.group_spans.push(n.span);
-                                (self.groups.len() - 1, shared)
-                            }
-                        };
+                    if let Some((g, shared)) = self.group(cx, &what, n) {
                         group_index = Some(g);
                         d.group = Some(shared);
                     }
                 }
-                "sensors" => {
-                    let mut sensors = Vec::new();
-                    for (kind, span) in cx.strings(&what, n).unwrap_or_default() {
-                        match owner {
-                            Owner::Drone(_) => self.sensors.push((index, sensors.len(), span)),
-                            Owner::Fleet(fleet) => {
-                                self.fleet_sensors.push((fleet.to_owned(), kind.clone(), span))
-                            }
-                        }
-                        sensors.push(kind);
-                    }
-                    d.sensors = sensors.into();
-                }
+                "sensors" => d.sensors = self.sensors(cx, &what, n, index),
                 "payload" => {
                     let mut payload = Vec::new();
                     for (kind, span) in cx.strings(&what, n).unwrap_or_default() {
@@ -232,20 +182,89 @@ impl Drones {
                 }
             }
         }
-        // Defaults that follow other keys of the same drone.
-        if d.descent_rate.is_nan() {
-            d.descent_rate = d.climb_rate;
-        }
-        if d.land_speed.is_nan() {
-            d.land_speed = d.descent_rate;
-        }
-        if let Some(endurance) = Drone::endurance_from_battery(d.battery_capacity, d.flight_current)
-        {
-            d.endurance = endurance;
-        }
+        follow_other_keys(&mut d);
         d.backend = backend(cx, owner, keys);
         d.attributes = attributes.into();
         (d, group_index)
+    }
+
+    /// `group = "NAME"`: the group's index and shared name; a group is made when it is
+    /// first named.
+    fn group(&mut self, cx: &mut Ctx, what: &KeyOf, n: &Node) -> Option<(usize, Arc<str>)> {
+        // Read in place: most drones name a group that exists already.
+        let Value::Str(group) = &n.value else {
+            cx.string(what, n);
+            return None;
+        };
+        if !cx.identifier("group", group, n.span) {
+            return None;
+        }
+        Some(match self.group_index.get(group.as_str()) {
+            Some((g, shared)) => (*g, shared.clone()),
+            None => {
+                let shared: Arc<str> = group.as_str().into();
+                self.group_index.insert(group.clone(), (self.groups.len(), shared.clone()));
+                self.groups.push(Group { name: group.clone(), members: Vec::new() });
+                self.group_spans.push(n.span);
+                (self.groups.len() - 1, shared)
+            }
+        })
+    }
+
+    /// `sensors = [...]`, each kept to be checked against `[sensors]` once that is read
+    /// (`index`: the drone's, or its fleet's first drone's, in `out`).
+    fn sensors(&mut self, cx: &mut Ctx, what: &KeyOf, n: &Node, index: usize) -> Box<[String]> {
+        let mut sensors = Vec::new();
+        for (kind, span) in cx.strings(what, n).unwrap_or_default() {
+            match what.1 {
+                Owner::Drone(_) => self.sensors.push((index, sensors.len(), span)),
+                Owner::Fleet(fleet) => {
+                    self.fleet_sensors.push((fleet.to_owned(), kind.clone(), span))
+                }
+            }
+            sensors.push(kind);
+        }
+        sensors.into()
+    }
+}
+
+/// A drone with the figures of a drone whose table gives none (its span: its table's).
+/// NaN: follows another key (see [`follow_other_keys`]).
+fn defaults(span: Span) -> Drone {
+    Drone {
+        name: String::new(),
+        home: [0.0; 3],
+        group: None,
+        sensors: Box::default(),
+        payload: Box::default(),
+        max_speed: 10.0,
+        climb_rate: 3.0,
+        acceleration: 3.0,
+        battery: 100.0,
+        endurance: 1800.0,
+        descent_rate: f64::NAN,
+        land_speed: f64::NAN,
+        land_speed_below: 10.0,
+        return_altitude: 10.0,
+        return_loiter: 0.0,
+        battery_capacity: None,
+        flight_current: None,
+        backend: Backend::Sim,
+        attributes: Box::default(),
+        span,
+    }
+}
+
+/// Defaults that follow other keys of the same drone.
+fn follow_other_keys(d: &mut Drone) {
+    if d.descent_rate.is_nan() {
+        d.descent_rate = d.climb_rate;
+    }
+    if d.land_speed.is_nan() {
+        d.land_speed = d.descent_rate;
+    }
+    if let Some(endurance) = Drone::endurance_from_battery(d.battery_capacity, d.flight_current) {
+        d.endurance = endurance;
     }
 }
 

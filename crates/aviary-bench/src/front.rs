@@ -1,18 +1,20 @@
 //! `aviary bench front`: the whole of `aviary check` on a generated mission: the realistic
-//! mission of `aviary bench parse` (`aviary_bench::generate::large_mission`), or a shape
-//! that once made the pre-flight analyses quadratic (`aviary_bench::generate::front`):
+//! mission of `aviary bench parse` ([`crate::generate::large_mission`]), or a shape
+//! that once made the pre-flight analyses quadratic (`generate/front.rs`):
 //! N statements in one SEQUENTIAL block on one drone, or a chain of N capabilities.
 //! Times parse + check, compile, and the analyses (conflicts and the plan), and prints
 //! each run and the median throughput of the whole. MB is 10^6 bytes.
 
+use std::io::Write;
 use std::time::{Duration, Instant};
 
 use aviary_diagnostics::SourceMap;
-use clap::ValueEnum;
 
-use super::{median, rate, NoFiles, MB};
+use crate::generate;
+use crate::{median, rate, Emit, Error, NoFiles, MB};
 
-#[derive(Clone, Copy, ValueEnum)]
+/// The generated mission's shape.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Shape {
     /// N statements in one SEQUENTIAL block, all on one drone
     Sequential,
@@ -31,43 +33,50 @@ struct Timed {
     others: usize,
 }
 
-pub fn run(shape: Shape, n: usize, runs: usize, emit: bool, emit_world: bool) -> u8 {
+/// All of `aviary check` on a generated mission of `shape` and size `n` (statements,
+/// capabilities, or MB for [`Shape::Realistic`]), `runs` times; or, with `emit`, the
+/// mission or its world instead.
+pub fn front(
+    shape: Shape,
+    n: usize,
+    runs: usize,
+    emit: Emit,
+    out: &mut dyn Write,
+) -> Result<(), Error> {
     if n == 0 || n > 50_000_000 {
-        eprintln!("aviary: --n must be from 1 to 50000000");
-        return 2;
+        return Err(Error::Usage("--n must be from 1 to 50000000".into()));
     }
     let runs = runs.max(1);
     let (mission, world, what) = match shape {
         Shape::Sequential => (
-            aviary_bench::generate::sequential_mission(n),
-            aviary_bench::generate::front_world(),
+            generate::sequential_mission(n),
+            generate::front_world(),
             "statements in one SEQUENTIAL block",
         ),
-        Shape::Chain => (
-            aviary_bench::generate::chain_mission(n),
-            aviary_bench::generate::front_world(),
-            "capabilities in a chain",
-        ),
+        Shape::Chain => {
+            (generate::chain_mission(n), generate::front_world(), "capabilities in a chain")
+        }
         Shape::Realistic if n > 4000 => {
-            eprintln!("aviary: --n is in MB for the realistic shape: at most 4000");
-            return 2;
+            return Err(Error::Usage("--n is in MB for the realistic shape: at most 4000".into()));
         }
         Shape::Realistic => {
-            let (mission, world) = aviary_bench::generate::large_mission(n * MB as usize);
+            let (mission, world) = generate::large_mission(n * MB as usize);
             (mission, world, "MB of the realistic mission (waves of sectors)")
         }
     };
-    if emit || emit_world {
-        out!("{}", if emit { &mission } else { &world });
-        return 0;
+    match emit {
+        Emit::Mission => return Ok(write!(out, "{mission}")?),
+        Emit::World => return Ok(write!(out, "{world}")?),
+        Emit::Nothing => {}
     }
     let size = mission.len();
-    outln!("generated a mission of {n} {what}: {:.2} MB ({size} bytes)", size as f64 / MB);
+    writeln!(out, "generated a mission of {n} {what}: {:.2} MB ({size} bytes)", size as f64 / MB)?;
     let mut totals = Vec::with_capacity(runs);
     for r in 1..=runs {
         let t = once(&mission, &world);
         let total = t.check + t.compile + t.analyses;
-        outln!(
+        writeln!(
+            out,
             "run {r}: parse + check {:.3} s, compile {:.3} s, analyses {:.3} s; all {:.3} s ({:.1} MB/s); {} error(s), {} other diagnostic(s)",
             t.check.as_secs_f64(),
             t.compile.as_secs_f64(),
@@ -76,21 +85,23 @@ pub fn run(shape: Shape, n: usize, runs: usize, emit: bool, emit_world: bool) ->
             rate(size, total),
             t.errors,
             t.others
-        );
+        )?;
         if t.errors > 0 {
-            eprintln!("aviary: the generated mission has errors; the generator is wrong");
-            return 1;
+            return Err(Error::Failed(
+                "the generated mission has errors; the generator is wrong".into(),
+            ));
         }
         totals.push(total);
     }
     let m = median(&mut totals);
-    outln!(
+    writeln!(
+        out,
         "median of {runs} run(s) over {:.2} MB: parse + check + analyses {:.1} MB/s ({:.3} s)",
         size as f64 / MB,
         rate(size, m),
         m.as_secs_f64()
-    );
-    0
+    )?;
+    Ok(())
 }
 
 /// What `aviary check` does with the mission, minus reading and printing: the front end,

@@ -1,6 +1,6 @@
 //! `aviary bench w --n N --k K`: the engine benchmark W(N, K) of
 //! docs/BENCHMARKS.md, written in the language
-//! (`aviary_bench::generate::w_mission`) and run through the whole pipeline.
+//! ([`crate::generate::w_mission`]) and run through the whole pipeline of `aviary run`.
 //! The sink checks from the trace that the work was done: N `Done` signals, each taken
 //! by the handler, whose indices sum to N(N-1)/2 (and, with `--full-trace`, N·K steps
 //! that ended ok). By default it asks the engine only for the events it checks
@@ -9,12 +9,14 @@
 //! serde_json, not the language. `--full-trace` takes every event and writes each line
 //! as `aviary run --trace` does (to memory).
 
+use std::io::Write;
 use std::time::Instant;
 
 use aviary_api::trace::{Event, EventKind, Record, Shown, Status};
 use aviary_engine::TraceSink;
 
-use super::pipeline::{self, mib, peak_rss, Stages};
+use crate::stages::{self, mib, peak_rss, Stages};
+use crate::{Emit, Error};
 
 /// Counts what W must have done, from the trace.
 #[derive(Default)]
@@ -58,32 +60,31 @@ impl TraceSink for Tally {
     }
 }
 
-pub fn run(n: usize, k: usize, emit: bool, emit_world: bool, full_trace: bool) -> u8 {
+/// W(`n`, `k`); with `full_trace`, every event built and written as a trace line; or,
+/// with `emit`, the mission or its world instead.
+pub fn w(
+    n: usize,
+    k: usize,
+    emit: Emit,
+    full_trace: bool,
+    out: &mut dyn Write,
+) -> Result<(), Error> {
     if n == 0 || k == 0 {
-        eprintln!("aviary: --n and --k must be at least 1");
-        return 2;
+        return Err(Error::Usage("--n and --k must be at least 1".into()));
     }
     let started = Instant::now();
     let mut stages = Stages::default();
-    let mission = stages.time("generate", || aviary_bench::generate::w_mission(k));
-    if emit {
-        out!("{mission}");
-        return 0;
+    let mission = stages.time("generate", || crate::generate::w_mission(k));
+    if emit == Emit::Mission {
+        return Ok(write!(out, "{mission}")?);
     }
-    let world = stages.time("generate", || aviary_bench::generate::w_world(n));
-    if emit_world {
-        out!("{world}");
-        return 0;
+    let world = stages.time("generate", || crate::generate::w_world(n));
+    if emit == Emit::World {
+        return Ok(write!(out, "{world}")?);
     }
     let mut tally = Tally { full: full_trace, ..Tally::default() };
-    let ran = pipeline::run(mission, world, &mut tally, &mut stages);
-    let ran = match ran {
-        Ok(r) => r,
-        Err(why) => {
-            eprintln!("aviary: the W mission did not run:\n{why}");
-            return 1;
-        }
-    };
+    let ran = stages::fly(mission, world, &mut tally, &mut stages)
+        .map_err(|why| Error::Failed(format!("the W mission did not run:\n{why}")))?;
     let wall = started.elapsed().as_secs_f64();
     let (n64, k64) = (n as u64, k as u64);
     let ok = ran.outcome.status == aviary_engine::Status::Ok
@@ -92,13 +93,18 @@ pub fn run(n: usize, k: usize, emit: bool, emit_world: bool, full_trace: bool) -
         && tally.index_sum == n64 * (n64 - 1) / 2
         && (!full_trace || tally.steps == n64 * k64);
     let steps = if full_trace { format!(" steps={}", tally.steps) } else { String::new() };
-    outln!(
+    writeln!(
+        out,
         "aviary W N={n} K={k} done={} handled={} sum={}{steps} ok={ok} elapsed={wall:.3}s peak={}",
         tally.done_signals,
         tally.handled,
         tally.index_sum,
         mib(peak_rss())
-    );
-    outln!("stages: {}; {} trace events", stages.show(), tally.events);
-    u8::from(!ok)
+    )?;
+    writeln!(out, "stages: {}; {} trace events", stages.show(), tally.events)?;
+    if ok {
+        Ok(())
+    } else {
+        Err(Error::NotOk)
+    }
 }

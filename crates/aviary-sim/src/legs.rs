@@ -1,0 +1,231 @@
+//! The legs a motion call flies, and the refusals it can meet before it starts: each
+//! function's arguments read, and its path held to the site's limits.
+
+use aviary_api::{show, Failure, FlightState, Value};
+
+use crate::args::{failed, number, opt_number, point, point_value, polygon, Limits};
+use crate::drone::SimDrone;
+use crate::geom::dist;
+use crate::motion::{orbit_legs, Leg};
+use crate::sweep::lawnmower;
+
+/// A landed drone this close to home (metres) is home.
+const AT_HOME: f64 = 0.5;
+
+/// The drone a motion call is for, as its legs are planned: its name for the refusals,
+/// and the limits its path must keep.
+pub(crate) struct Mover<'a> {
+    pub d: &'a SimDrone,
+    pub name: &'a str,
+    pub limits: Limits<'a>,
+}
+
+/// A straight leg flown in the air.
+fn fly(to: [f64; 3], speed: f64) -> Leg {
+    Leg::Move { to, speed, state: FlightState::Flying }
+}
+
+impl Mover<'_> {
+    fn landed(&self) -> bool {
+        self.d.state == FlightState::Landed
+    }
+
+    /// Refuses a call that needs the drone in the air.
+    fn in_air(&self) -> Result<(), Failure> {
+        if self.landed() {
+            Err(failed(format!("{} is on the ground: take off first", self.name)))
+        } else {
+            Ok(())
+        }
+    }
+
+    /// `TakeOff`: straight up from the ground, or to the altitude when in the air already.
+    pub fn take_off(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
+        let d = self.d;
+        let here = d.pos;
+        let alt = number(args, 0, "alt")?;
+        if alt <= 0.0 {
+            return Err(failed(format!("take-off altitude must be above 0 m, not {alt} m")));
+        }
+        self.limits.altitude(alt)?;
+        let to = [here[0], here[1], alt];
+        if !self.landed() {
+            Ok(vec![fly(to, d.spec.max_speed)])
+        } else if !d.armed {
+            Err(failed(format!("{} is not armed: call Arm() before TakeOff", self.name)))
+        } else {
+            Ok(vec![Leg::Move { to, speed: d.spec.max_speed, state: FlightState::TakingOff }])
+        }
+    }
+
+    /// `Land`: straight down; nothing on the ground.
+    pub fn land(&self) -> Vec<Leg> {
+        if self.landed() {
+            return Vec::new();
+        }
+        let here = self.d.pos;
+        landing_legs(self.d, [here[0], here[1]])
+    }
+
+    /// `ReturnToLaunch`.
+    pub fn return_home(&self) -> Result<Vec<Leg>, Failure> {
+        return_legs(self.d, self.name, self.landed(), self.limits.max_altitude)
+    }
+
+    /// `FlyToPosition`: one straight leg, at the altitude kept when the position has none.
+    pub fn fly_to(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
+        let d = self.d;
+        self.in_air()?;
+        let p = point(args, 0, "pos")?;
+        let speed = match opt_number(args, 1, "speed")? {
+            Some(s) if s <= 0.0 => {
+                return Err(failed(format!(
+                    "speed must be above 0 m/s, not {} m/s",
+                    show::number(s)
+                )))
+            }
+            Some(s) => s.min(d.spec.max_speed),
+            None => d.spec.max_speed,
+        };
+        let to = [p.x, p.y, p.z.unwrap_or(d.level())];
+        if to[2] < 0.0 {
+            return Err(failed(format!("altitude {} m is below the ground", show::number(to[2]))));
+        }
+        self.limits.path(d.pos, &[to])?;
+        Ok(vec![fly(to, speed)])
+    }
+
+    /// `DescendTo` and `AscendTo`: straight up or down.
+    pub fn to_altitude(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
+        let d = self.d;
+        self.in_air()?;
+        let alt = number(args, 0, "alt")?;
+        if alt < 0.0 {
+            return Err(failed(format!("altitude {} m is below the ground", show::number(alt))));
+        }
+        self.limits.altitude(alt)?;
+        Ok(vec![fly([d.pos[0], d.pos[1], alt], d.spec.max_speed)])
+    }
+
+    /// `Orbit`: to the circle, then round it.
+    pub fn orbit(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
+        self.in_air()?;
+        let c = point(args, 0, "center")?;
+        let radius = number(args, 1, "radius")?;
+        let laps = opt_number(args, 2, "laps")?.unwrap_or(1.0);
+        if radius <= 0.0 || laps <= 0.0 {
+            return Err(failed(format!(
+                "an orbit needs a radius and laps above 0 (got {radius} m, {laps})"
+            )));
+        }
+        let legs = orbit_legs(self.d, [c.x, c.y], radius, laps);
+        if let Some(Leg::Move { to, .. }) = legs.first() {
+            self.limits.path(self.d.pos, &[*to])?;
+        }
+        self.limits.circle([c.x, c.y], radius)?;
+        Ok(legs)
+    }
+
+    /// `Sweep`: the area's lawnmower path, at the altitude kept.
+    pub fn sweep(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
+        let d = self.d;
+        self.in_air()?;
+        let area = polygon(args, 0, "area")?;
+        let spacing = number(args, 1, "spacing")?;
+        if spacing <= 0.0 {
+            return Err(failed(format!("sweep spacing must be above 0 m, not {spacing} m")));
+        }
+        let level = d.level();
+        let path: Vec<[f64; 3]> =
+            lawnmower(&area, spacing).into_iter().map(|p| [p[0], p[1], level]).collect();
+        self.limits.path(d.pos, &path)?;
+        Ok(path.into_iter().map(|to| fly(to, d.spec.max_speed)).collect())
+    }
+
+    /// `FollowPath`: through the points; one without an altitude keeps the one before.
+    pub fn follow_path(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
+        let d = self.d;
+        self.in_air()?;
+        let mut z = d.level();
+        let mut path = Vec::new();
+        for (i, v) in args.iter().enumerate() {
+            let p = point_value(v, &format!("points[{i}]"))?;
+            z = p.z.unwrap_or(z);
+            if z < 0.0 {
+                return Err(failed(format!("altitude {} m is below the ground", show::number(z))));
+            }
+            path.push([p.x, p.y, z]);
+        }
+        self.limits.path(d.pos, &path)?;
+        Ok(path.into_iter().map(|to| fly(to, d.spec.max_speed)).collect())
+    }
+}
+
+/// `Hover`: a hold where the drone is, in the air or on the ground.
+pub(crate) fn hover_legs(args: &[Value]) -> Result<Vec<Leg>, Failure> {
+    let duration = number(args, 0, "duration")?;
+    if duration < 0.0 {
+        return Err(failed(format!("a hover cannot last {} s", show::number(duration))));
+    }
+    Ok(vec![Leg::Hold { left: duration }])
+}
+
+/// `ReturnToLaunch`: up to the return altitude, home, and down.
+pub(crate) fn return_legs(
+    d: &SimDrone,
+    name: &str,
+    landed: bool,
+    max_altitude: Option<f64>,
+) -> Result<Vec<Leg>, Failure> {
+    let home_dist = dist(d.xy(), d.home);
+    if landed {
+        if home_dist <= AT_HOME {
+            return Ok(Vec::new());
+        }
+        return Err(failed(format!("{name} is on the ground away from home: take off first")));
+    }
+    let z = d.pos[2];
+    let safe = aviary_api::flight::return_height(z, d.spec.return_altitude, max_altitude);
+    let mut legs = Vec::new();
+    if safe > z {
+        legs.push(Leg::Move {
+            to: [d.pos[0], d.pos[1], safe],
+            speed: d.spec.max_speed,
+            state: FlightState::Flying,
+        });
+    }
+    if home_dist > 0.0 {
+        legs.push(Leg::Move {
+            to: [d.home[0], d.home[1], safe],
+            speed: d.spec.max_speed,
+            state: FlightState::Flying,
+        });
+    }
+    if d.spec.return_loiter > 0.0 {
+        legs.push(Leg::Hold { left: d.spec.return_loiter });
+    }
+    legs.extend(landing_legs_from(d, d.home, safe));
+    Ok(legs)
+}
+
+/// A landing straight down from where the drone is.
+fn landing_legs(d: &SimDrone, here: [f64; 2]) -> Vec<Leg> {
+    landing_legs_from(d, here, d.pos[2])
+}
+
+/// Down to the ground at `at` from `height`: at the descent rate, and, when the drone
+/// lands slower than it descends, first to `slow_below` and from there at the landing
+/// speed (the motion's rule for a landing leg low enough), as an autopilot lands.
+fn landing_legs_from(d: &SimDrone, at: [f64; 2], height: f64) -> Vec<Leg> {
+    let down = |z: f64| Leg::Move {
+        to: [at[0], at[1], z],
+        speed: d.spec.max_speed,
+        state: FlightState::Landing,
+    };
+    let descent = d.spec.descent;
+    if descent.slows(height) && height > descent.slow_below {
+        vec![down(descent.slow_below), down(0.0)]
+    } else {
+        vec![down(0.0)]
+    }
+}

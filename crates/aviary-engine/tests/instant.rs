@@ -1,7 +1,8 @@
 //! Instant activities (src/instant.rs) against the general path: every mission gives the
-//! same trace, event for event, with `instant_activities` on and off. The missions are
-//! the examples and one for each way an instant activity has to wait and becomes a
-//! general one: its claims are busy, its root is paused, a call takes time, a call fails.
+//! same trace, event for event, as users run it and with every activity on the general
+//! path (`aviary_engine::testing`). The missions are the examples, one for each way an
+//! instant activity has to wait and becomes a general one (its claims are busy, its root
+//! is paused, a call takes time, a call fails), and generated ones (`mod generated`).
 
 mod harness;
 

@@ -46,7 +46,7 @@ pub fn mission(data: &[u8]) {
     }
     // The whole front end, as `aviary check` runs it (non-UTF-8 input included).
     let mut sources = SourceMap::new();
-    let checked = aviary_check::check_sources(
+    let mut checked = aviary_check::check_sources(
         &mut sources,
         ("fuzz.mission", data),
         Some(("world.toml", EXAMPLE_WORLD.as_bytes())),
@@ -59,7 +59,7 @@ pub fn mission(data: &[u8]) {
         let _ = render_json(&sources, d);
     }
     // A mission without errors is compiled and goes through the pre-flight analyses.
-    if let Some((_, verified)) = aviary_verify::preflight(&checked, &Descriptor::standard()) {
+    if let Some((_, verified)) = aviary_verify::preflight(&mut checked, &Descriptor::standard()) {
         for d in &verified.diagnostics {
             let _ = render_text(&sources, d, false);
         }

@@ -13,18 +13,10 @@ mod w;
 use std::time::{Duration, Instant};
 
 use aviary_api::Descriptor;
-use aviary_check::SourceProvider;
+// The generated missions USE nothing, so nothing is served.
+use aviary_check::NoFiles;
 use aviary_diagnostics::{FileId, SourceMap};
 use clap::Subcommand;
-
-/// The generated mission USEs nothing, so nothing is served.
-pub(crate) struct NoFiles;
-
-impl SourceProvider for NoFiles {
-    fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-        Err(format!("the benchmark reads no files ({path})").into())
-    }
-}
 
 pub(crate) const MB: f64 = 1_000_000.0;
 

@@ -7,10 +7,11 @@
 
 use std::time::{Duration, Instant};
 
+use aviary_check::NoFiles;
 use aviary_diagnostics::SourceMap;
 use clap::ValueEnum;
 
-use super::{median, rate, NoFiles, MB};
+use super::{median, rate, MB};
 
 #[derive(Clone, Copy, ValueEnum)]
 pub enum Shape {

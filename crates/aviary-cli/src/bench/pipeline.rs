@@ -4,11 +4,10 @@
 
 use std::time::{Duration, Instant};
 
+use aviary_check::NoFiles;
 use aviary_diagnostics::{render_text, SourceMap};
 use aviary_engine::{Outcome, RunOptions, TraceSink};
 use aviary_sim::{Fleet, SimBackend, SimOptions};
-
-use super::NoFiles;
 
 /// Wall time of each stage, in order, and the peak RSS once it had run.
 #[derive(Default)]

@@ -1,20 +1,10 @@
 //! Live control of a running mission, as the operator API and Ctrl-C use it.
 
-mod harness;
-
-use aviary_api::{Descriptor, Value};
-use aviary_check::SourceProvider;
-use aviary_diagnostics::SourceMap;
+use aviary_api::Value;
 use aviary_engine::{Control, Controller, Outcome, RunOptions, Status};
 use aviary_sim::{SimBackend, SimOptions};
+use aviary_test_support::harness;
 use serde_json::Value as Json;
-
-struct NoFiles;
-impl SourceProvider for NoFiles {
-    fn load(&self, _: &str, p: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-        Err(p.to_string().into())
-    }
-}
 
 /// Runs `mission`, sending each control at its mission time; returns the outcome, the
 /// trace and the engine's answers.
@@ -34,24 +24,8 @@ fn run_with_controls_and(
     controls: Vec<(f64, Control)>,
     options: RunOptions,
 ) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
-    let mut sources = SourceMap::new();
-    let checked = aviary_check::check_sources(
-        &mut sources,
-        ("m.mission", mission.as_bytes()),
-        Some(("w.toml", harness::WORLD.as_bytes())),
-        &NoFiles,
-        &Descriptor::standard(),
-    );
-    assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
-    let world = checked.world.unwrap();
-    let compiled =
-        aviary_lower::compile(&checked.program.unwrap(), &world, &Descriptor::standard()).unwrap();
-    let rt = tokio::runtime::Builder::new_current_thread()
-        .enable_time()
-        .start_paused(true)
-        .build()
-        .unwrap();
-    rt.block_on(async {
+    let (compiled, world) = harness::compile(mission, harness::WORLD);
+    harness::paused_runtime().block_on(async {
         let sim = SimBackend::start(&world, SimOptions::default());
         let (controller, rx) = Controller::new();
         let mut trace = Vec::new();

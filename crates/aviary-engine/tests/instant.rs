@@ -3,9 +3,8 @@
 //! the examples and one for each way an instant activity has to wait and becomes a
 //! general one: its claims are busy, its root is paused, a call takes time, a call fails.
 
-mod harness;
-
 use aviary_engine::{RunOptions, Status};
+use aviary_test_support::harness;
 
 fn both_ways(mission: &str, world: &str) -> harness::Run {
     let instant = harness::run_with(mission, world, &RunOptions::default());

@@ -1,21 +1,15 @@
-// Shared by several test binaries; each uses part of it.
-#![allow(dead_code)]
-
-//! Runs a mission text on the built-in simulator and returns its outcome and trace.
+//! Runs a mission text on the built-in simulator and returns its outcome and trace; and
+//! the steps before it (check, compile) for tests that stop there or run the compiled
+//! mission their own way.
 
 use aviary_api::Descriptor;
-use aviary_check::SourceProvider;
+use aviary_check::Checked;
 use aviary_diagnostics::SourceMap;
 use aviary_engine::{Outcome, Record, RunOptions};
 use aviary_sim::{SimBackend, SimOptions};
 use serde_json::Value;
 
-struct NoFiles;
-impl SourceProvider for NoFiles {
-    fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-        Err(format!("no file {path}").into())
-    }
-}
+use crate::NoFiles;
 
 /// A small world: drones a, b, c at the origin's corners, a place and an area.
 pub const WORLD: &str = r#"
@@ -67,8 +61,9 @@ pub fn run_in(mission: &str, world: &str) -> Run {
     run_with(mission, world, &RunOptions::default())
 }
 
-/// The mission checked (without errors) and compiled for the world, and the world.
-pub fn compile(mission: &str, world: &str) -> (aviary_ir::Mission, aviary_world::World) {
+/// The mission (`m.mission`) checked against the world (`w.toml`), as `aviary check`
+/// does it, with every diagnostic; and the texts, to render them.
+pub fn check(mission: &str, world: &str) -> (SourceMap, Checked) {
     let mut sources = SourceMap::new();
     let checked = aviary_check::check_sources(
         &mut sources,
@@ -77,6 +72,12 @@ pub fn compile(mission: &str, world: &str) -> (aviary_ir::Mission, aviary_world:
         &NoFiles,
         &Descriptor::standard(),
     );
+    (sources, checked)
+}
+
+/// The mission checked (without errors) and compiled for the world, and the world.
+pub fn compile(mission: &str, world: &str) -> (aviary_ir::Mission, aviary_world::World) {
+    let (_, checked) = check(mission, world);
     let errors: Vec<String> = checked
         .diagnostics
         .iter()
@@ -91,14 +92,19 @@ pub fn compile(mission: &str, world: &str) -> (aviary_ir::Mission, aviary_world:
     (mission, world)
 }
 
-pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
-    let (mission, world) = compile(mission, world);
-    let runtime = tokio::runtime::Builder::new_current_thread()
+/// The runtime a simulated run takes: one thread, its clock paused, so that simulated
+/// time passes as soon as every task waits and a run takes no real time.
+pub fn paused_runtime() -> tokio::runtime::Runtime {
+    tokio::runtime::Builder::new_current_thread()
         .enable_time()
         .start_paused(true)
         .build()
-        .expect("runtime");
-    runtime.block_on(async {
+        .expect("runtime")
+}
+
+pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
+    let (mission, world) = compile(mission, world);
+    paused_runtime().block_on(async {
         let sim = SimBackend::start(&world, SimOptions::default());
         let mut trace = Vec::new();
         let mut sink = |r: &Record| trace.push(json(r));

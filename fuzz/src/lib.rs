@@ -9,20 +9,12 @@ pub use mavlink::{answers_of_the_vehicles, heard_on_a_link, link, vehicles};
 pub use operator::operator;
 
 use aviary_api::Descriptor;
-use aviary_check::SourceProvider;
+// Fuzzed missions `USE` nothing that can be read.
+use aviary_check::NoFiles;
 use aviary_diagnostics::{render_json, render_text, FileId, SourceMap};
 
 /// The world every fuzzed mission is checked against.
 pub const EXAMPLE_WORLD: &str = include_str!("../../examples/search_and_rescue.world.toml");
-
-/// Fuzzed missions `USE` nothing that can be read.
-struct NoFiles;
-
-impl SourceProvider for NoFiles {
-    fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-        Err(format!("no files while fuzzing ({path})").into())
-    }
-}
 
 /// Parses the bytes as a mission. When they parse without errors: formats them, checks
 /// that the result parses without errors and that formatting it again changes nothing.

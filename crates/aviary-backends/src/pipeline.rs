@@ -333,14 +333,7 @@ async fn watch_backend(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    struct NoFiles;
-
-    impl SourceProvider for NoFiles {
-        fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-            Err(format!("no files here ({path})").into())
-        }
-    }
+    use aviary_check::NoFiles;
 
     /// What the hooks heard, in order.
     #[derive(Default)]

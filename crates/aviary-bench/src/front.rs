@@ -8,10 +8,11 @@
 use std::io::Write;
 use std::time::{Duration, Instant};
 
+use aviary_check::NoFiles;
 use aviary_diagnostics::SourceMap;
 
 use crate::generate;
-use crate::{median, rate, Emit, Error, NoFiles, MB};
+use crate::{median, rate, Emit, Error, MB};
 
 /// The generated mission's shape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

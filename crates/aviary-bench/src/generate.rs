@@ -360,14 +360,7 @@ mod tests {
     use aviary_diagnostics::{FileId, SourceMap};
 
     use super::*;
-    use aviary_check::SourceProvider;
-
-    struct NoFiles;
-    impl SourceProvider for NoFiles {
-        fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-            Err(format!("no files here ({path})").into())
-        }
-    }
+    use aviary_check::NoFiles;
 
     #[test]
     fn a_generated_mission_checks_clean() {

@@ -23,8 +23,6 @@ mod w;
 
 use std::time::Duration;
 
-use aviary_check::SourceProvider;
-
 pub use front::{front, Shape};
 pub use parse::parse;
 pub use swarm::swarm;
@@ -66,15 +64,6 @@ impl Emit {
             (false, true) => Emit::World,
             (false, false) => Emit::Nothing,
         }
-    }
-}
-
-/// The generated missions USE nothing, so nothing is served.
-pub(crate) struct NoFiles;
-
-impl SourceProvider for NoFiles {
-    fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-        Err(format!("the benchmark reads no files ({path})").into())
     }
 }
 

@@ -8,9 +8,10 @@ use std::io::Write;
 use std::time::Instant;
 
 use aviary_api::Descriptor;
+use aviary_check::NoFiles;
 use aviary_diagnostics::{FileId, SourceMap};
 
-use crate::{median, rate, Error, NoFiles, MB};
+use crate::{median, rate, Error, MB};
 
 /// Parses and checks a generated mission of about `mb` MB, `runs` times.
 pub fn parse(mb: f64, runs: usize, out: &mut dyn Write) -> Result<(), Error> {

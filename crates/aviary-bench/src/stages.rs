@@ -11,7 +11,7 @@ use aviary_backends::pipeline::{Flown, Hooks, NotFlown, Options, Source, Stage, 
 use aviary_diagnostics::{render_text, SourceMap};
 use aviary_engine::TraceSink;
 
-use crate::NoFiles;
+use aviary_check::NoFiles;
 
 /// Wall time of each stage, in order, and the peak RSS once it had run.
 #[derive(Default)]

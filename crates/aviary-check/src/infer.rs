@@ -224,12 +224,7 @@ mod tests {
     use aviary_api::{Descriptor, Kind};
     use aviary_diagnostics::SourceMap;
 
-    struct NoFiles;
-    impl crate::SourceProvider for NoFiles {
-        fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), crate::LoadError> {
-            Err(format!("no files here ({path})").into())
-        }
-    }
+    use crate::NoFiles;
 
     /// A parameter passed down a chain of capabilities to a middle-layer call gets its
     /// kind at every link, and a wrong argument at the top is reported with the chain.

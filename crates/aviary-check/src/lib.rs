@@ -3,7 +3,8 @@
 //! tags, API calls and signals. Every problem becomes a diagnostic with a stable code.
 //!
 //! Invariant: no IO. Files come through a [`SourceProvider`] that the caller supplies
-//! (the CLI reads the disk; tests use a map), as in typst's `World`.
+//! (the CLI reads the disk; a mission that stands alone is checked with [`NoFiles`]), as
+//! in typst's `World`.
 
 // A pure stage: no unsafe code, and no panic on any input (tests may unwrap).
 #![forbid(unsafe_code)]
@@ -33,7 +34,7 @@ use aviary_world::World;
 pub use env::{bind_args, ArgBinding, BindProblem};
 pub use infer::KindOrigin;
 pub use inputs::{check_against, check_sources, normalize_path, read_world, Checked, WorldRead};
-pub use load::{SourceProvider, STD_NAME, STD_SOURCE};
+pub use load::{NoFiles, SourceProvider, STD_NAME, STD_SOURCE};
 pub use uses::LoadError;
 
 /// Where a definition lives.

@@ -22,6 +22,18 @@ pub trait SourceProvider {
     fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), LoadError>;
 }
 
+/// The provider of a mission that stands alone, held in memory (tests, the benchmarks,
+/// fuzzing): it serves no file, so every `USE` is unreadable (E113). The one such
+/// provider; the CLI's `DiskProvider` is the one that reads the disk.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoFiles;
+
+impl SourceProvider for NoFiles {
+    fn load(&self, _from: &str, _path: &str) -> Result<(String, Vec<u8>), LoadError> {
+        Err(LoadError::Unreadable("no files are read here".into()))
+    }
+}
+
 pub(crate) fn load(
     sources: &mut SourceMap,
     root: FileId,
@@ -149,4 +161,35 @@ fn index_definitions(program: &mut Program, std_id: FileId, diagnostics: &mut Ve
         }
     }
     program.mission = mission.map(|(r, _)| r);
+}
+
+#[cfg(test)]
+mod tests {
+    use aviary_api::Descriptor;
+    use aviary_diagnostics::{Code, SourceMap};
+
+    use super::NoFiles;
+
+    #[test]
+    fn no_files_makes_every_use_unreadable() {
+        let mut sources = SourceMap::new();
+        let checked = crate::check_sources(
+            &mut sources,
+            ("m.mission", b"USE \"lib/beacons.mission\"\nMISSION M:\n    SIGNAL Go\n".as_slice()),
+            None,
+            &NoFiles,
+            &Descriptor::standard(),
+        );
+        let unreadable: Vec<(Code, &str)> = checked
+            .diagnostics
+            .iter()
+            .filter(|d| d.code == Code::UseNotFound)
+            .map(|d| (d.code, d.message.as_str()))
+            .collect();
+        assert_eq!(
+            unreadable,
+            [(Code::UseNotFound, "cannot read `lib/beacons.mission`: no files are read here")]
+        );
+        assert_eq!(checked.program.expect("a program").unreadable, ["lib/beacons.mission"]);
+    }
 }

@@ -128,14 +128,7 @@ mod tests {
     use aviary_diagnostics::SourceMap;
 
     use super::*;
-    use crate::SourceProvider;
-
-    struct NoFiles;
-    impl SourceProvider for NoFiles {
-        fn load(&self, _: &str, _: &str) -> Result<(String, Vec<u8>), crate::uses::LoadError> {
-            Err(crate::uses::LoadError::Unreadable("no files here".into()))
-        }
-    }
+    use crate::NoFiles;
 
     fn values(mission: &str) -> BTreeMap<String, Vec<Option<Kind>>> {
         let mut sources = SourceMap::default();

@@ -88,8 +88,8 @@ pub async fn run(
 }
 
 /// The engine with every activity on the general path, for the tests that hold the instant
-/// path to it (`tests/instant.rs`): only in builds with the `testing` feature, which the
-/// engine's own tests turn on and no other crate does. An option of [`RunOptions`] would
+/// path to it (`tests/instant.rs`): only in builds with the `testing` feature, which only
+/// the tests' support crate (a dev-dependency) turns on. An option of [`RunOptions`] would
 /// let a user's run take a path that is not the one users run.
 #[cfg(feature = "testing")]
 pub mod testing {

@@ -3,8 +3,6 @@
 //! own name and taken by the handler of that name, and every built-in signal starts its
 //! handler. The compiler resolved each built-in's id, so the engine looks no name up.
 
-mod harness;
-
 use std::sync::Mutex;
 use std::time::Duration;
 
@@ -13,6 +11,7 @@ use aviary_api::{
     Ending, Failure, FlightState, Function, Interrupt, PendingCall, Telemetry, Value,
 };
 use aviary_engine::{RunOptions, Status};
+use aviary_test_support::harness;
 use serde_json::Value as Json;
 use tokio::sync::{mpsc, oneshot};
 
@@ -70,11 +69,7 @@ impl Backend for Scripted {
 
 fn run(mission: &str, backend: &Scripted) -> (Status, Vec<Json>) {
     let (mission, _) = harness::compile(mission, harness::WORLD);
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_time()
-        .start_paused(true)
-        .build()
-        .expect("runtime");
+    let runtime = harness::paused_runtime();
     let mut trace = Vec::new();
     let mut sink = |r: &aviary_engine::Record| trace.push(harness::json(r));
     let outcome =

@@ -1,9 +1,8 @@
 //! Live control of a running mission, as the operator API and Ctrl-C use it.
 
-mod harness;
-
 use aviary_api::Value;
 use aviary_engine::{Control, Outcome, RunOptions, Status};
+use aviary_test_support::harness;
 use harness::Path;
 use serde_json::Value as Json;
 

@@ -2,9 +2,8 @@
 //! checker lets through (behind a condition) ends in a language exception, never in a
 //! stack overflow. The limit is small here so the test thread's stack holds it.
 
-mod harness;
-
 use aviary_engine::{RunOptions, Status};
+use aviary_test_support::harness;
 use harness::{run_with, WORLD};
 
 /// Calls itself for as long as the battery is above 1%, which it stays: no time passes.

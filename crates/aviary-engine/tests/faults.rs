@@ -1,9 +1,8 @@
 //! One end-to-end test per fault kind of the world file: the built-in exception it
 //! raises, the handler that takes it, and the other drones carrying on.
 
-mod harness;
-
 use aviary_engine::Status;
+use aviary_test_support::harness;
 
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() < 0.11

@@ -2,9 +2,8 @@
 //! activity stops its drone at once, gives its claims back at once, a queued activity
 //! that is aborted never starts, and nothing it started keeps running.
 
-mod harness;
-
 use aviary_engine::{RunOptions, Status};
+use aviary_test_support::harness;
 use harness::{run, run_with, WORLD};
 
 fn close(a: f64, b: f64) -> bool {

@@ -3,9 +3,8 @@
 //! home or straight down, until it is on the ground or lost. `a` flies 400 m out, the
 //! mission ends at about 48 s, and `a` is on its way back until about 95 s.
 
-mod harness;
-
 use aviary_engine::Status;
+use aviary_test_support::harness;
 use serde_json::Value;
 
 const OUT: &str = "MISSION M:\n    a FlyTo WITH Far\n";

@@ -4,9 +4,8 @@
 //! instant activity has to wait and becomes a general one (its claims are busy, its root
 //! is paused, a call takes time, a call fails), and generated ones (`mod generated`).
 
-mod harness;
-
 use aviary_engine::{Control, RunOptions, Status};
+use aviary_test_support::harness;
 use harness::Path;
 
 fn both_ways(mission: &str, world: &str) -> harness::Run {

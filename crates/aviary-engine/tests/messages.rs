@@ -2,9 +2,8 @@
 //! that the checker cannot judge (here, a signal's value passed on) and the middle layer
 //! refuses is shown as it would be written.
 
-mod harness;
-
 use aviary_engine::Status;
+use aviary_test_support::harness;
 
 /// `ON X WITH v` hands `v` to a capability whose parameter goes to `call`.
 fn refused(value: &str, call: &str) -> String {

@@ -1,8 +1,7 @@
 //! The paper's search-and-rescue mission, flown end to end on the simulator.
 
-mod harness;
-
 use aviary_engine::Status;
+use aviary_test_support::harness;
 
 fn paper() -> harness::Run {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/");

@@ -3,9 +3,8 @@
 //! simulated seconds). The missions are files, `tests/rules/*.mission`, and each one's
 //! whole trace is a snapshot (`tests/snapshots/rules__traces@*.snap`).
 
-mod harness;
-
 use aviary_engine::Status;
+use aviary_test_support::harness;
 use harness::run;
 
 /// The mission of a rule: `tests/rules/NAME.mission`.

@@ -2,31 +2,13 @@
 //! generated in the language, they check with no diagnostic at all and, flown small
 //! here, do all of it, as the trace shows.
 
-mod harness;
-
-use aviary_api::Descriptor;
 use aviary_bench::generate::{swarm_mission, swarm_world, w_mission, w_world};
-use aviary_check::SourceProvider;
-use aviary_diagnostics::SourceMap;
 use aviary_engine::Status;
-
-struct NoFiles;
-impl SourceProvider for NoFiles {
-    fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-        Err(format!("no files here ({path})").into())
-    }
-}
+use aviary_test_support::harness;
 
 /// Every diagnostic (errors, warnings and notes) of a mission in its world.
 fn diagnostics(mission: &str, world: &str) -> Vec<String> {
-    let mut sources = SourceMap::new();
-    let checked = aviary_check::check_sources(
-        &mut sources,
-        ("m.mission", mission.as_bytes()),
-        Some(("m.world.toml", world.as_bytes())),
-        &NoFiles,
-        &Descriptor::standard(),
-    );
+    let (_, checked) = harness::check(mission, world);
     checked.diagnostics.iter().map(|d| format!("{} {}", d.code, d.message)).collect()
 }
 

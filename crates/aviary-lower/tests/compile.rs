@@ -2,36 +2,12 @@
 //! handlers sit on the block they hear, defaults and units are resolved once.
 
 use aviary_api::{Descriptor, Point, Resource, Value};
-use aviary_check::SourceProvider;
-use aviary_diagnostics::SourceMap;
 use aviary_ir::*;
 use aviary_lower::compile;
-
-struct NoFiles;
-impl SourceProvider for NoFiles {
-    fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-        Err(format!("no file {path}").into())
-    }
-}
+use aviary_test_support::harness;
 
 fn compiled(mission: &str, world: &str) -> Mission {
-    let mut sources = SourceMap::new();
-    let checked = aviary_check::check_sources(
-        &mut sources,
-        ("m.mission", mission.as_bytes()),
-        Some(("w.toml", world.as_bytes())),
-        &NoFiles,
-        &Descriptor::standard(),
-    );
-    let errors: Vec<_> =
-        checked.diagnostics.iter().filter(|d| d.is_error()).map(|d| d.message.clone()).collect();
-    assert!(errors.is_empty(), "{errors:#?}");
-    compile(
-        &checked.program.expect("program"),
-        &checked.world.expect("world"),
-        &Descriptor::standard(),
-    )
-    .expect("a mission")
+    harness::compile(mission, world).0
 }
 
 fn paper() -> Mission {
@@ -242,13 +218,9 @@ fn builtins_and_the_abort_section_are_resolved_when_compiling() {
 /// mission is compiled with does not list it: never another name's id.
 #[test]
 fn every_builtin_has_its_own_id_whatever_the_descriptor_lists() {
-    let mut sources = SourceMap::new();
-    let checked = aviary_check::check_sources(
-        &mut sources,
-        ("m.mission", b"MISSION M:\n    SIGNAL Go\n    THROW EXCEPTION Oops\n".as_slice()),
-        Some(("w.toml", b"[drones.d1]\nhome = [0, 0]\n".as_slice())),
-        &NoFiles,
-        &Descriptor::standard(),
+    let (_, checked) = harness::check(
+        "MISSION M:\n    SIGNAL Go\n    THROW EXCEPTION Oops\n",
+        "[drones.d1]\nhome = [0, 0]\n",
     );
     let bare = Descriptor { signals: vec![], exceptions: vec![], ..Descriptor::standard() };
     let m = compile(&checked.program.expect("program"), &checked.world.expect("world"), &bare)

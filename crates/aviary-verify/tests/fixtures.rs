@@ -10,19 +10,11 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use aviary_api::Descriptor;
-use aviary_check::SourceProvider;
 use aviary_diagnostics::{render_text, Code, Diagnostic, SourceMap};
+use aviary_test_support::NoFiles;
 
 fn dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join("fixtures")
-}
-
-struct NoFiles;
-
-impl SourceProvider for NoFiles {
-    fn load(&self, _from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-        Err(format!("the fixtures USE no files ({path})").into())
-    }
 }
 
 struct Outcome {

@@ -167,36 +167,10 @@ fn later_in_source(x: &ClaimSite, y: &ClaimSite) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    struct NoFiles;
-
-    impl aviary_check::SourceProvider for NoFiles {
-        fn load(
-            &self,
-            _from: &str,
-            path: &str,
-        ) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-            Err(format!("no files here ({path})").into())
-        }
-    }
+    use aviary_test_support::harness;
 
     fn compiled(text: &str, world: &str) -> Mission {
-        let mut sources = aviary_diagnostics::SourceMap::new();
-        let api = aviary_api::Descriptor::standard();
-        let checked = aviary_check::check_sources(
-            &mut sources,
-            ("m.mission", text.as_bytes()),
-            Some(("m.world.toml", world.as_bytes())),
-            &NoFiles,
-            &api,
-        );
-        assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
-        aviary_lower::compile(
-            checked.program.as_ref().expect("program"),
-            checked.world.as_ref().expect("world"),
-            &api,
-        )
-        .expect("a mission")
+        harness::compile(text, world).0
     }
 
     /// Both ways of applying the rule, on one mission: the same diagnostics, in order.
@@ -342,15 +316,8 @@ mod tests {
     #[test]
     fn may_run_in_parallel_is_symmetric() {
         let (text, world) = aviary_bench::generate::large_mission(150_000);
-        let mut sources = aviary_diagnostics::SourceMap::new();
+        let (_, checked) = harness::check(&text, &world);
         let api = aviary_api::Descriptor::standard();
-        let checked = aviary_check::check_sources(
-            &mut sources,
-            ("gen.mission", text.as_bytes()),
-            Some(("gen.world.toml", world.as_bytes())),
-            &NoFiles,
-            &api,
-        );
         let mission = aviary_lower::compile(
             checked.program.as_ref().expect("program"),
             checked.world.as_ref().expect("world"),

@@ -166,37 +166,12 @@ impl State {
 
 #[cfg(test)]
 mod tests {
-    struct NoFiles;
-
-    impl aviary_check::SourceProvider for NoFiles {
-        fn load(
-            &self,
-            _from: &str,
-            path: &str,
-        ) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-            Err(format!("no files here ({path})").into())
-        }
-    }
+    use aviary_test_support::harness;
 
     fn plan(text: &str) -> crate::Plan {
         let world = "[drones.scout]\nhome = [0, 0]\nendurance = 100000\n";
-        let mut sources = aviary_diagnostics::SourceMap::new();
-        let api = aviary_api::Descriptor::standard();
-        let checked = aviary_check::check_sources(
-            &mut sources,
-            ("m.mission", text.as_bytes()),
-            Some(("w.toml", world.as_bytes())),
-            &NoFiles,
-            &api,
-        );
-        assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
-        let mission = aviary_lower::compile(
-            checked.program.as_ref().expect("program"),
-            checked.world.as_ref().expect("world"),
-            &api,
-        )
-        .expect("mission");
-        crate::verify(&mission, checked.world.as_ref().expect("world")).plan
+        let (mission, world) = harness::compile(text, world);
+        crate::verify(&mission, &world).plan
     }
 
     /// Many `IF`s the estimate cannot decide, in a row, each with a longer and a shorter

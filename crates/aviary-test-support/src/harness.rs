@@ -1,21 +1,15 @@
-// Shared by several test binaries; each uses part of it.
-#![allow(dead_code)]
-
-//! Runs a mission text on the built-in simulator and returns its outcome and trace.
+//! Runs a mission text on the built-in simulator and returns its outcome and trace; and
+//! the steps before it (check, compile) for tests that stop there or run the compiled
+//! mission their own way.
 
 use aviary_api::Descriptor;
-use aviary_check::SourceProvider;
+use aviary_check::Checked;
 use aviary_diagnostics::SourceMap;
 use aviary_engine::{Control, Controller, Outcome, Record, RunOptions};
 use aviary_sim::{SimBackend, SimOptions};
 use serde_json::Value;
 
-struct NoFiles;
-impl SourceProvider for NoFiles {
-    fn load(&self, _: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
-        Err(format!("no file {path}").into())
-    }
-}
+use crate::NoFiles;
 
 /// A small world: drones a, b, c at the origin's corners, a place and an area.
 pub const WORLD: &str = r#"
@@ -67,6 +61,20 @@ pub fn run_in(mission: &str, world: &str) -> Run {
     run_with(mission, world, &RunOptions::default())
 }
 
+/// The mission (`m.mission`) checked against the world (`w.toml`), as `aviary check`
+/// does it, with every diagnostic; and the texts, to render them.
+pub fn check(mission: &str, world: &str) -> (SourceMap, Checked) {
+    let mut sources = SourceMap::new();
+    let checked = aviary_check::check_sources(
+        &mut sources,
+        ("m.mission", mission.as_bytes()),
+        Some(("w.toml", world.as_bytes())),
+        &NoFiles,
+        &Descriptor::standard(),
+    );
+    (sources, checked)
+}
+
 /// The mission checked (without errors) and compiled for the world, and the world.
 pub fn compile(mission: &str, world: &str) -> (aviary_ir::Mission, aviary_world::World) {
     try_compile(mission, world).unwrap_or_else(|errors| panic!("{errors:#?}"))
@@ -77,14 +85,7 @@ pub fn try_compile(
     mission: &str,
     world: &str,
 ) -> Result<(aviary_ir::Mission, aviary_world::World), Vec<String>> {
-    let mut sources = SourceMap::new();
-    let checked = aviary_check::check_sources(
-        &mut sources,
-        ("m.mission", mission.as_bytes()),
-        Some(("w.toml", world.as_bytes())),
-        &NoFiles,
-        &Descriptor::standard(),
-    );
+    let (_, checked) = check(mission, world);
     let errors: Vec<String> = checked
         .diagnostics
         .iter()
@@ -99,6 +100,16 @@ pub fn try_compile(
         aviary_lower::compile(&checked.program.expect("program"), &world, &Descriptor::standard())
             .expect("mission");
     Ok((mission, world))
+}
+
+/// The runtime a simulated run takes: one thread, its clock paused, so that simulated
+/// time passes as soon as every task waits and a run takes no real time.
+pub fn paused_runtime() -> tokio::runtime::Runtime {
+    tokio::runtime::Builder::new_current_thread()
+        .enable_time()
+        .start_paused(true)
+        .build()
+        .expect("runtime")
 }
 
 pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
@@ -123,12 +134,7 @@ pub fn run_compiled(
     controls: Vec<(f64, Control)>,
     path: Path,
 ) -> (Run, Vec<Result<(), String>>) {
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_time()
-        .start_paused(true)
-        .build()
-        .expect("runtime");
-    runtime.block_on(async {
+    paused_runtime().block_on(async {
         let sim = SimBackend::start(world, SimOptions::default());
         let (controller, rx) = Controller::new();
         // Without controls, as a run without an operator: no channel at all.

@@ -81,9 +81,9 @@ pub trait Hooks {
     fn begin(&mut self, _stage: Stage) {}
     fn end(&mut self, _stage: Stage) {}
 
-    /// The mission compiled and nothing has started: the caller opens where its trace
-    /// goes. An `Err` ends the run here, with that reason ([`NotFlown::Failed`]).
-    fn compiled(&mut self, _mission: &Mission) -> Result<(), String> {
+    /// The mission compiled for its world and nothing has started: the caller opens where
+    /// its trace goes. An `Err` ends the run here, with that reason ([`NotFlown::Failed`]).
+    fn compiled(&mut self, _mission: &Mission, _world: &World) -> Result<(), String> {
         Ok(())
     }
 
@@ -218,7 +218,7 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
     hooks.begin(Stage::FreeTree);
     drop(program);
     hooks.end(Stage::FreeTree);
-    hooks.compiled(&mission).map_err(NotFlown::Failed)?;
+    hooks.compiled(&mission, &world).map_err(NotFlown::Failed)?;
     if live && options.speed.is_some() {
         return Err(NotFlown::Speed);
     }
@@ -349,7 +349,7 @@ mod tests {
         fn end(&mut self, stage: Stage) {
             self.said.push(format!("end {stage:?}"));
         }
-        fn compiled(&mut self, mission: &Mission) -> Result<(), String> {
+        fn compiled(&mut self, mission: &Mission, _world: &World) -> Result<(), String> {
             self.said.push(format!("compiled {}", mission.name));
             Ok(())
         }

@@ -11,6 +11,7 @@ mod ctl;
 mod figures;
 mod files;
 mod fmt;
+mod gcs;
 mod run;
 mod serve;
 mod trace_file;
@@ -106,6 +107,23 @@ enum Command {
         /// With --serve: also answer to this host name (the name a reverse proxy forwards,
         /// or this machine's name on the network); may be repeated
         #[arg(long, value_name = "NAME", requires = "serve")]
+        allow_host: Vec<String>,
+        /// A folder whose .mission files USE may read, besides the mission's own (repeatable)
+        #[arg(long, value_name = "DIR", value_parser = folder)]
+        use_root: Vec<PathBuf>,
+    },
+    /// Serve the ground station: a web page to open, check, fly, watch and steer the
+    /// missions of a folder (docs/GCS.md)
+    Gcs {
+        /// The folder of missions and worlds (default: the current one)
+        #[arg(default_value = ".", value_parser = folder)]
+        dir: PathBuf,
+        /// PORT (loopback) or HOST:PORT to listen on
+        #[arg(long, value_name = "[HOST:]PORT", default_value = "7878")]
+        listen: String,
+        /// Also answer to this host name (the name a reverse proxy forwards, or this
+        /// machine's name on the network); may be repeated
+        #[arg(long, value_name = "NAME")]
         allow_host: Vec<String>,
         /// A folder whose .mission files USE may read, besides the mission's own (repeatable)
         #[arg(long, value_name = "DIR", value_parser = folder)]
@@ -241,6 +259,15 @@ fn command(cli: Cli) -> u8 {
                 }
             }
         }
+        Command::Gcs { dir, listen, allow_host, use_root } => match run::parse_serve(&listen) {
+            Ok(address) => {
+                gcs::run(&dir, &serve::Serve { address, allowed_hosts: allow_host }, &use_root)
+            }
+            Err(why) => {
+                eprintln!("aviary: {}", why.replace("--serve", "--listen"));
+                2
+            }
+        },
         Command::Ctl { url, token, command } => ctl::run(&url, token.as_deref(), command),
         Command::Vehicles { world, listen, speed, signing_key } => {
             vehicles::run(&vehicles::VehiclesArgs {

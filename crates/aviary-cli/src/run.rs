@@ -117,6 +117,7 @@ pub fn run(args: &RunArgs) -> u8 {
         trace: None,
         server: None,
         feed: None,
+        map: serde_json::Value::Null,
         progress: None,
         stats: Stats::default(),
         drones: 0,
@@ -161,8 +162,8 @@ pub fn run(args: &RunArgs) -> u8 {
             return 2;
         }
     };
-    if let Some(s) = &server {
-        s.finish(std::time::Duration::from_secs(2));
+    if let Some((_, feed)) = &server {
+        feed.finish(std::time::Duration::from_secs(2));
     }
     if !args.quiet {
         out!("{summary}");
@@ -186,8 +187,11 @@ struct Shown<'a> {
     args: &'a RunArgs,
     /// Opened once the mission compiled.
     trace: Option<SharedTrace>,
-    server: Option<aviary_server::Server>,
+    /// The station serving this run, and where the run's events go.
+    server: Option<(aviary_station::Serving, aviary_server::Feed)>,
     feed: Option<aviary_server::Feed>,
+    /// The world as the station's map draws it, kept from `compiled` for `starting`.
+    map: serde_json::Value,
     /// Made once the run starts.
     progress: Option<ProgressBar>,
     stats: Stats,
@@ -196,7 +200,10 @@ struct Shown<'a> {
 }
 
 impl Hooks for Shown<'_> {
-    fn compiled(&mut self, mission: &Mission) -> Result<(), String> {
+    fn compiled(&mut self, mission: &Mission, world: &World) -> Result<(), String> {
+        if self.args.serve.is_some() {
+            self.map = aviary_station::checking::map_of(world);
+        }
         let out: Box<dyn Write + Send> = match &self.args.trace {
             Some(path) => match std::fs::File::create(path) {
                 Ok(f) => Box::new(f),
@@ -222,9 +229,10 @@ impl Hooks for Shown<'_> {
             on_stop_signals(controller.clone(), stop.clone(), trace.clone());
         }
         if let Some(serve) = &self.args.serve {
-            let server = crate::serve::start(serve, mission, controller.clone())?;
-            self.feed = Some(server.feed.clone());
-            self.server = Some(server);
+            let map = std::mem::take(&mut self.map);
+            let (serving, feed) = crate::serve::start(serve, mission, map, controller.clone())?;
+            self.feed = Some(feed.clone());
+            self.server = Some((serving, feed));
         }
         self.progress = Some(progress_bar(self.args.quiet));
         self.drones = mission.drones.len();

@@ -1,11 +1,12 @@
-//! `aviary run --serve`: starting the operator API for a compiled mission, with the
-//! kinds its arguments must have, and saying plainly how far it can be reached.
+//! `aviary run --serve` and `aviary gcs`: the ground station's page and the operator API,
+//! with the token printed once and a plain warning of how far the server can be reached.
 
 use std::net::SocketAddr;
 
 use aviary_engine::Controller;
 use aviary_ir::Mission;
-use aviary_server::{Kinds, Options, Server};
+use aviary_server::Feed;
+use aviary_station::{Mode, Options, Serving};
 
 /// Where and how to serve.
 pub struct Serve {
@@ -14,39 +15,33 @@ pub struct Serve {
     pub allowed_hosts: Vec<String>,
 }
 
-/// The kinds an operator's leash arguments and signal values must have.
-pub fn kinds(mission: &Mission) -> Kinds {
-    let mut kinds = Kinds::default();
-    for c in &mission.capabilities {
-        kinds.capability(
-            &c.name,
-            c.params.iter().cloned().zip(c.param_kinds.iter().copied()).collect(),
-        );
-    }
-    for (name, values) in mission.signals.iter().zip(&mission.signal_values) {
-        kinds.signal(name, values.clone());
-    }
-    kinds
-}
-
-/// Starts the server and prints where it is and its token (on standard error, which the
-/// operator reads; nothing else ever prints or logs the token).
-pub fn start(serve: &Serve, mission: &Mission, controller: Controller) -> Result<Server, String> {
-    let options = Options { kinds: kinds(mission), allowed_hosts: serve.allowed_hosts.clone() };
-    let server = aviary_server::start(serve.address, controller, options)?;
-    let shown = match server.address.ip().is_unspecified() {
-        // A wildcard address is no place to connect to; loopback reaches it from here.
-        true => SocketAddr::new(std::net::Ipv4Addr::LOCALHOST.into(), server.address.port()),
-        false => server.address,
-    };
-    eprintln!("aviary: operator API on http://{shown}  token {}", server.token);
-    if !server.address.ip().is_loopback() {
+/// The station in `mode`, announced on standard error (which the operator reads; nothing
+/// else ever prints or logs the token).
+pub fn station(serve: &Serve, mode: Mode, map: serde_json::Value) -> Result<Serving, String> {
+    let options = Options { address: serve.address, allowed_hosts: serve.allowed_hosts.clone() };
+    let serving = aviary_station::serve(&options, mode, map)?;
+    let url = serving.url();
+    eprintln!("aviary: ground station on {url}  token {}", serving.token);
+    eprintln!("aviary: operator API on {}  token {}", url.trim_end_matches('/'), serving.token);
+    if serving.beyond_loopback() {
         eprintln!(
-            "aviary: warning: the operator API listens on {} and can be reached from other machines. Every call, reads and the event \
+            "aviary: warning: the station listens on {} and can be reached from other machines. Every call, reads and the event \
              stream included, now needs the token, but plain HTTP carries it and the fleet's positions unencrypted: put it behind a \
              TLS reverse proxy (docs/OPERATOR_API.md) for use beyond this machine, or serve on loopback.",
-            server.address
+            serving.address
         );
     }
-    Ok(server)
+    Ok(serving)
+}
+
+/// `aviary run --serve`: the station for this one run, and where the run's events go.
+pub fn start(
+    serve: &Serve,
+    mission: &Mission,
+    map: serde_json::Value,
+    controller: Controller,
+) -> Result<(Serving, Feed), String> {
+    let serving = station(serve, Mode::Run, serde_json::Value::Null)?;
+    let feed = serving.serve_run(controller, mission, map);
+    Ok((serving, feed))
 }

@@ -26,6 +26,22 @@ pub struct Kinds {
 }
 
 impl Kinds {
+    /// What a compiled mission's leash arguments and signal values must be: the kinds the
+    /// checker inferred, which the mission keeps.
+    pub fn of(mission: &aviary_ir::Mission) -> Kinds {
+        let mut kinds = Kinds::default();
+        for c in &mission.capabilities {
+            kinds.capability(
+                &c.name,
+                c.params.iter().cloned().zip(c.param_kinds.iter().copied()).collect(),
+            );
+        }
+        for (name, values) in mission.signals.iter().zip(&mission.signal_values) {
+            kinds.signal(name, values.clone());
+        }
+        kinds
+    }
+
     /// A capability's parameters, in order, with each one's kind (`None`: any).
     pub fn capability(&mut self, name: &str, params: Vec<(String, Option<Kind>)>) {
         self.capabilities.insert(name.to_string(), params);

@@ -23,21 +23,48 @@ use axum::response::Response;
 use subtle::ConstantTimeEq;
 
 use crate::reply::error;
-use crate::Shared;
 
 /// The subprotocol prefix that carries the token on a browser's WebSocket: browsers
 /// cannot set `Authorization` on one.
 pub const TOKEN_PROTOCOL: &str = "aviary.bearer.";
 
-pub(crate) struct Access {
-    pub bound: SocketAddr,
+/// Who may call a server: its address, the names it answers to and its token. One gate
+/// guards every route a server has: the operator API of each run, and the ground
+/// station's own calls.
+pub struct Gate {
+    access: Access,
+    token: String,
+}
+
+impl Gate {
+    /// A server bound at `bound`, answering besides loopback and that address to
+    /// `allowed_hosts` (`--allow-host`), with its token.
+    pub fn new(bound: SocketAddr, token: String, allowed_hosts: &[String]) -> Gate {
+        let allowed =
+            allowed_hosts.iter().map(|h| h.trim_end_matches('.').to_ascii_lowercase()).collect();
+        Gate { access: Access { bound, allowed, scheme: "http" }, token }
+    }
+
+    /// Whether other machines can reach the server: then reading needs the token too.
+    pub fn beyond_loopback(&self) -> bool {
+        self.access.beyond_loopback()
+    }
+
+    /// In constant time: how much of a guess is right must not show in the time taken.
+    pub fn token_is(&self, given: &str) -> bool {
+        bool::from(given.as_bytes().ct_eq(self.token.as_bytes()))
+    }
+}
+
+struct Access {
+    bound: SocketAddr,
     /// `--allow-host` names, lower case: any port and scheme (a proxy's).
-    pub allowed: Vec<String>,
-    pub scheme: &'static str,
+    allowed: Vec<String>,
+    scheme: &'static str,
 }
 
 impl Access {
-    pub fn beyond_loopback(&self) -> bool {
+    fn beyond_loopback(&self) -> bool {
         !self.bound.ip().is_loopback()
     }
 
@@ -124,25 +151,17 @@ fn shown(text: &str) -> String {
 }
 
 /// Every request: Host and Origin.
-pub(crate) async fn same_origin(
-    State(shared): State<Arc<Shared>>,
-    request: Request,
-    next: Next,
-) -> Response {
-    match shared.access.check(request.headers(), request.uri()) {
+pub async fn same_origin(State(gate): State<Arc<Gate>>, request: Request, next: Next) -> Response {
+    match gate.access.check(request.headers(), request.uri()) {
         Ok(()) => next.run(request).await,
         Err(why) => error(StatusCode::FORBIDDEN, why),
     }
 }
 
 /// Control calls: the token, always.
-pub(crate) async fn token(
-    State(shared): State<Arc<Shared>>,
-    request: Request,
-    next: Next,
-) -> Response {
+pub async fn token(State(gate): State<Arc<Gate>>, request: Request, next: Next) -> Response {
     match given(request.headers()) {
-        Some(t) if shared.token_is(&t) => next.run(request).await,
+        Some(t) if gate.token_is(&t) => next.run(request).await,
         Some(_) => unauthorized("that is not this run's token"),
         None => unauthorized(
             "this call needs the token the run printed: send `Authorization: Bearer TOKEN`",
@@ -151,14 +170,10 @@ pub(crate) async fn token(
 }
 
 /// Reads: the token beyond loopback; on loopback none is needed, but a wrong one is refused.
-pub(crate) async fn read_token(
-    State(shared): State<Arc<Shared>>,
-    request: Request,
-    next: Next,
-) -> Response {
+pub async fn read_token(State(gate): State<Arc<Gate>>, request: Request, next: Next) -> Response {
     match given(request.headers()) {
-        Some(t) if !shared.token_is(&t) => unauthorized("that is not this run's token"),
-        None if shared.access.beyond_loopback() => {
+        Some(t) if !gate.token_is(&t) => unauthorized("that is not this run's token"),
+        None if gate.access.beyond_loopback() => {
             unauthorized("the server is reachable beyond this machine, so reading needs the token too: send `Authorization: Bearer TOKEN`")
         }
         _ => next.run(request).await,
@@ -189,13 +204,6 @@ fn given(headers: &HeaderMap) -> Option<String> {
         .filter_map(|v| v.to_str().ok())
         .flat_map(|v| v.split(','));
     protocols.map(str::trim).find_map(|p| p.strip_prefix(TOKEN_PROTOCOL)).map(str::to_string)
-}
-
-impl Shared {
-    /// In constant time: how much of a guess is right must not show in the time taken.
-    pub fn token_is(&self, given: &str) -> bool {
-        bool::from(given.as_bytes().ct_eq(self.token.as_bytes()))
-    }
 }
 
 #[cfg(test)]

@@ -20,7 +20,7 @@ mod routes;
 mod state;
 
 pub use args::{Kinds, MAX_MAGNITUDE};
-pub use guard::TOKEN_PROTOCOL;
+pub use guard::{read_token, same_origin, token, Gate, TOKEN_PROTOCOL};
 pub use reply::BODY_LIMIT;
 
 use std::net::SocketAddr;
@@ -35,15 +35,28 @@ use crate::state::MissionState;
 /// How many events a slow WebSocket client may fall behind before it misses some.
 const BACKLOG: usize = 4096;
 
+/// How many events (telemetry aside) a stream `?from=start` can replay: a page that opens
+/// mid-mission sees the blocks, activities and signals so far. Beyond, the oldest go.
+const HISTORY: usize = 100_000;
+
+/// The events so far, telemetry aside, as their lines.
+#[derive(Default)]
+pub(crate) struct History {
+    pub lines: std::collections::VecDeque<Arc<str>>,
+    /// How many of the oldest were let go.
+    pub dropped: u64,
+}
+
 pub(crate) struct Shared {
     /// Event streams still open.
     pub streams: std::sync::atomic::AtomicUsize,
-    pub token: String,
+    pub gate: Arc<Gate>,
     pub controller: Controller,
     pub state: Mutex<MissionState>,
     pub events: broadcast::Sender<Arc<str>>,
+    /// Appended and broadcast under one lock, so a new stream takes both at one instant.
+    pub history: Mutex<History>,
     pub kinds: Kinds,
-    pub access: guard::Access,
 }
 
 /// How to serve, beyond where.
@@ -60,6 +73,10 @@ impl Shared {
     pub fn state(&self) -> MutexGuard<'_, MissionState> {
         self.state.lock().unwrap_or_else(|p| p.into_inner())
     }
+
+    pub fn history(&self) -> MutexGuard<'_, History> {
+        self.history.lock().unwrap_or_else(|p| p.into_inner())
+    }
 }
 
 /// The engine's side: every trace event goes through here.
@@ -69,12 +86,32 @@ pub struct Feed {
 }
 
 impl Feed {
+    /// After `mission_end`: waits (at most `limit`) until every open event stream has
+    /// delivered it, so that no client misses how the mission ended.
+    pub fn finish(&self, limit: std::time::Duration) {
+        let start = std::time::Instant::now();
+        while self.shared.streams.load(std::sync::atomic::Ordering::SeqCst) > 0
+            && start.elapsed() < limit
+        {
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+    }
+
     /// Folds the event into the mission's state and sends it to every stream, as the
     /// line the trace file has.
     pub fn publish(&self, record: &Record) {
         self.shared.state().observe(record);
         if let Ok(line) = serde_json::to_string(record) {
-            let _ = self.shared.events.send(Arc::from(line));
+            let line: Arc<str> = Arc::from(line);
+            let mut history = self.shared.history();
+            if !matches!(record.event, aviary_api::trace::Event::Telemetry { .. }) {
+                history.lines.push_back(line.clone());
+                if history.lines.len() > HISTORY {
+                    history.lines.pop_front();
+                    history.dropped += 1;
+                }
+            }
+            let _ = self.shared.events.send(line);
         }
     }
 }
@@ -87,15 +124,9 @@ pub struct Server {
 }
 
 impl Server {
-    /// After `mission_end`: waits (at most `limit`) until every open event stream has
-    /// delivered it, so that no client misses how the mission ended.
+    /// As [`Feed::finish`].
     pub fn finish(&self, limit: std::time::Duration) {
-        let start = std::time::Instant::now();
-        while self.feed.shared.streams.load(std::sync::atomic::Ordering::SeqCst) > 0
-            && start.elapsed() < limit
-        {
-            std::thread::sleep(std::time::Duration::from_millis(10));
-        }
+        self.feed.finish(limit)
     }
 }
 
@@ -107,22 +138,27 @@ pub fn router(
     controller: Controller,
     options: Options,
 ) -> (axum::Router, Feed) {
+    let gate = Arc::new(Gate::new(bound, token, &options.allowed_hosts));
+    router_behind(gate, controller, options.kinds)
+}
+
+/// The routes of one run behind a gate that may guard more: a ground station's, which
+/// serves one run after another with the same token.
+pub fn router_behind(
+    gate: Arc<Gate>,
+    controller: Controller,
+    kinds: Kinds,
+) -> (axum::Router, Feed) {
     let (events, _) = broadcast::channel(BACKLOG);
-    let allowed = options
-        .allowed_hosts
-        .iter()
-        .map(|h| h.trim_end_matches('.').to_ascii_lowercase())
-        .collect();
-    let access = guard::Access { bound, allowed, scheme: "http" };
     let state = Mutex::new(MissionState::default());
     let shared = Arc::new(Shared {
         streams: Default::default(),
-        token,
+        gate,
         controller,
         state,
         events,
-        kinds: options.kinds,
-        access,
+        history: Default::default(),
+        kinds,
     });
     (routes::router(shared.clone()), Feed { shared })
 }
@@ -162,7 +198,8 @@ pub fn start(
     Ok(Server { address: bound, token, feed })
 }
 
-fn new_token() -> Result<String, String> {
+/// A new token: 16 random bytes, in hex.
+pub fn new_token() -> Result<String, String> {
     let mut bytes = [0u8; 16];
     getrandom::fill(&mut bytes).map_err(|e| format!("no randomness for the token: {e}"))?;
     Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())

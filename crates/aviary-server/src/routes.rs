@@ -22,20 +22,20 @@ pub(crate) fn router(shared: Arc<Shared>) -> Router {
     let reads = Router::new()
         .route("/api/state", get(state))
         .route("/api/events", get(events))
-        .route_layer(middleware::from_fn_with_state(shared.clone(), guard::read_token));
+        .route_layer(middleware::from_fn_with_state(shared.gate.clone(), guard::read_token));
     let controls = Router::new()
         .route("/api/leash", post(leash))
         .route("/api/signal", post(signal))
         .route("/api/pause", post(pause))
         .route("/api/resume", post(resume))
         .route("/api/abort", post(abort))
-        .route_layer(middleware::from_fn_with_state(shared.clone(), guard::token));
+        .route_layer(middleware::from_fn_with_state(shared.gate.clone(), guard::token));
     reads
         .merge(controls)
         .fallback(reply::not_found)
         .method_not_allowed_fallback(reply::method_not_allowed)
         .layer(DefaultBodyLimit::max(BODY_LIMIT))
-        .layer(middleware::from_fn_with_state(shared.clone(), guard::same_origin))
+        .layer(middleware::from_fn_with_state(shared.gate.clone(), guard::same_origin))
         .layer(middleware::map_response(reply::json_errors))
         .with_state(shared)
 }
@@ -53,8 +53,22 @@ async fn state(State(shared): State<Arc<Shared>>) -> Json<JsonValue> {
 
 async fn events(
     State(shared): State<Arc<Shared>>,
+    uri: axum::http::Uri,
     ws: Result<WebSocketUpgrade, WebSocketUpgradeRejection>,
 ) -> Response {
+    let from_start = match uri.query() {
+        None | Some("") => false,
+        Some("from=start") => true,
+        Some(other) => {
+            let other: String = other.chars().filter(|c| !c.is_control()).take(80).collect();
+            return error(
+                StatusCode::BAD_REQUEST,
+                format!(
+                    "`?{other}` is no option of the event stream: the one option is `?from=start`"
+                ),
+            );
+        }
+    };
     let ws = match ws {
         Ok(ws) => ws,
         Err(rejection) => {
@@ -64,7 +78,13 @@ async fn events(
             )
         }
     };
-    let rx = shared.events.subscribe();
+    // The history and the subscription at one instant, so that no event is missed or
+    // sent twice between them.
+    let (past, rx) = {
+        let history = shared.history();
+        let past = from_start.then(|| (history.lines.iter().cloned().collect(), history.dropped));
+        (past, shared.events.subscribe())
+    };
     // Counted from the handshake on, so that a stream opened just before the mission
     // ends still gets `mission_end` (`Server::finish` waits for it).
     shared.streams.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
@@ -75,13 +95,36 @@ async fn events(
             failed.streams.fetch_sub(1, std::sync::atomic::Ordering::SeqCst);
         })
         .on_upgrade(move |socket| async move {
-            stream(socket, rx).await;
+            stream(socket, past, rx).await;
             shared.streams.fetch_sub(1, std::sync::atomic::Ordering::SeqCst);
         })
 }
 
-/// Every event from now on, one JSON text message each, until the mission ends.
-async fn stream(mut socket: WebSocket, mut rx: tokio::sync::broadcast::Receiver<Arc<str>>) {
+/// Every event from now on, one JSON text message each, until the mission ends; first,
+/// with `?from=start`, every event since the start but telemetry.
+async fn stream(
+    mut socket: WebSocket,
+    past: Option<(Vec<Arc<str>>, u64)>,
+    mut rx: tokio::sync::broadcast::Receiver<Arc<str>>,
+) {
+    if let Some((lines, dropped)) = past {
+        if dropped > 0 {
+            let note = json!({ "history_dropped": dropped }).to_string();
+            if socket.send(Message::Text(note.into())).await.is_err() {
+                return;
+            }
+        }
+        for event in lines {
+            let end = event.contains("\"event\":\"mission_end\"");
+            if socket.send(Message::Text(event.to_string().into())).await.is_err() {
+                return;
+            }
+            if end {
+                let _ = socket.send(Message::Close(None)).await;
+                return;
+            }
+        }
+    }
     loop {
         match rx.recv().await {
             Ok(event) => {

@@ -1,0 +1,100 @@
+//! Checking a mission as the page edits it: every diagnostic with its line, code and
+//! help (as `aviary check --format json` gives them), the energy and time plan (as
+//! `aviary check --plan`), the mission's block tree and the world's map. The same
+//! front end and pre-flight analyses as `aviary check`; the texts are the page's, which
+//! may not be saved yet, and the files they `USE` come from the disk.
+
+use aviary_check::SourceProvider;
+use aviary_diagnostics::{render_json, Diagnostic, SourceMap};
+use serde_json::{json, Value};
+
+use crate::tree;
+
+/// A text as the page sends it: the file it is (for `USE` and for messages) and what the
+/// editor holds.
+#[derive(Debug, Clone, serde::Deserialize)]
+pub struct Text {
+    pub path: String,
+    pub text: String,
+}
+
+/// What the page shows of a check.
+pub struct Report {
+    /// Whether the mission may fly: no error, a world, and a MISSION.
+    pub flyable: bool,
+    pub json: Value,
+}
+
+/// Checks `mission` against `world`, reading what it `USE`s through `files`.
+pub fn check(mission: &Text, world: &Text, files: &dyn SourceProvider) -> Report {
+    let api = aviary_sim::descriptor();
+    let mut sources = SourceMap::new();
+    let mut checked = aviary_check::check_sources(
+        &mut sources,
+        (&mission.path, mission.text.as_bytes()),
+        Some((&world.path, world.text.as_bytes())),
+        files,
+        &api,
+    );
+    let map = checked.world.as_ref().map(map_of);
+    let verified = aviary_verify::preflight(&mut checked, &api);
+    let mut diagnostics = checked.diagnostics;
+    let mut plan = Value::Null;
+    let mut tree = Value::Null;
+    let flyable = verified.is_some();
+    if let Some((compiled, v)) = verified {
+        diagnostics.extend(v.diagnostics);
+        aviary_diagnostics::sort(&mut diagnostics);
+        let mut v_plan = v.plan;
+        v_plan.locate(|o| {
+            let at = sources.line_col(o.file, o.span.start);
+            format!("{}:{}:{}", sources.name(o.file), at.line, at.column)
+        });
+        plan = serde_json::to_value(&v_plan).unwrap_or(Value::Null);
+        tree = tree::of(&compiled, Some(&sources));
+    }
+    let errors = diagnostics.iter().filter(|d| d.is_error()).count();
+    let shown: Vec<Value> = diagnostics.iter().map(|d| rendered(&sources, d)).collect();
+    Report {
+        flyable,
+        json: json!({
+            "flyable": flyable,
+            "errors": errors,
+            "diagnostics": shown,
+            "plan": plan,
+            "tree": tree,
+            "map": map,
+        }),
+    }
+}
+
+/// A diagnostic as `aviary check --format json` gives it, with the text rendering too.
+fn rendered(sources: &SourceMap, d: &Diagnostic) -> Value {
+    let mut value = render_json(sources, d);
+    value["text"] = aviary_diagnostics::render_text(sources, d, false).into();
+    value
+}
+
+/// What the map shows of a world: the site, places, areas, homes and targets, in the
+/// local frame (metres east and north of the origin).
+pub fn map_of(world: &aviary_world::World) -> Value {
+    let drones: Vec<Value> = world
+        .drones
+        .iter()
+        .map(|d| {
+            json!({
+                "name": d.name,
+                "home": d.home,
+                "group": d.group.as_deref(),
+                "sensors": d.sensors,
+            })
+        })
+        .collect();
+    json!({
+        "site": world.site,
+        "places": world.places,
+        "areas": world.areas,
+        "drones": drones,
+        "targets": world.targets,
+    })
+}

@@ -1,0 +1,136 @@
+//! A flight started from the page: the mission and world texts the page holds, flown
+//! through the same pipeline as `aviary run` (`aviary_backends::fly`) on a thread of its
+//! own, its events fed to the operator API of that run, which the station serves while it
+//! flies and after it has ended, until the next flight.
+
+use std::sync::Arc;
+
+use aviary_api::trace::Record;
+use aviary_api::Backend;
+use aviary_backends::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
+use aviary_check::SourceProvider;
+use aviary_engine::{Controller, RunOptions};
+use aviary_ir::Mission;
+use aviary_server::{Feed, Kinds};
+use aviary_world::World;
+
+use crate::checking::{map_of, Text};
+use crate::{Run, Station};
+
+/// The telemetry rate of a flight from the page: smooth enough to watch and to replay.
+pub const TELEMETRY_HZ: f64 = 4.0;
+
+/// What the page asks to fly.
+#[derive(Debug, serde::Deserialize)]
+pub struct Request {
+    pub mission: Text,
+    pub world: Text,
+    /// Times real time; `None` as fast as the machine goes.
+    pub speed: Option<f64>,
+    #[serde(default)]
+    pub seed: u64,
+}
+
+/// Flies `request` on a new thread. The run's routes are installed as the mission
+/// starts; `Err` is why it could not start (the page shows it).
+pub fn start(
+    station: Arc<Station>,
+    request: Request,
+    tree: serde_json::Value,
+    files: Box<dyn SourceProvider + Send>,
+) -> Result<(), String> {
+    if let Some(speed) = request.speed {
+        if !(speed.is_finite() && speed > 0.0 && speed <= 1000.0) {
+            return Err(format!("{speed} is not a speed: give a number of times real time, from just above 0 to 1000, or none for as fast as possible"));
+        }
+    }
+    if station.flying.swap(true, std::sync::atomic::Ordering::SeqCst) {
+        return Err("a mission is flying: wait for its end, or abort it, before the next".into());
+    }
+    let (ready, started) = std::sync::mpsc::channel::<Result<(), String>>();
+    let landed = station.clone();
+    let flying = station.clone();
+    let spawned = std::thread::Builder::new()
+        .name("aviary-flight".into())
+        .stack_size(aviary_check::STACK)
+        .spawn(move || {
+            let options = Options {
+                speed: request.speed,
+                seed: request.seed,
+                run: RunOptions { telemetry_hz: Some(TELEMETRY_HZ), ..RunOptions::default() },
+            };
+            let texts = Texts {
+                mission: Source {
+                    name: &request.mission.path,
+                    bytes: request.mission.text.into_bytes(),
+                },
+                world: Source { name: &request.world.path, bytes: request.world.text.into_bytes() },
+                files: &*files,
+            };
+            let mut hooks = Flight { station: flying, tree, feed: None, ready: Some(ready) };
+            let flown = aviary_backends::fly(texts, &options, &mut hooks);
+            landed.flying.store(false, std::sync::atomic::Ordering::SeqCst);
+            let why = match flown {
+                Ok(_) => return,
+                Err(NotFlown::Errors { .. }) => "the mission has errors: check it".to_string(),
+                Err(NotFlown::NoMission) => "the file holds no MISSION to fly".into(),
+                Err(NotFlown::Speed) => {
+                    "the world has MAVLink drones, which fly in real time: fly without a speed"
+                        .into()
+                }
+                Err(NotFlown::Failed(why)) => why,
+            };
+            if let Some(ready) = hooks.ready.take() {
+                let _ = ready.send(Err(why));
+            }
+        });
+    if let Err(e) = spawned {
+        station.flying.store(false, std::sync::atomic::Ordering::SeqCst);
+        return Err(format!("cannot start the flight: {e}"));
+    }
+    // The answer comes once the mission starts, or with why it did not.
+    started.recv().unwrap_or_else(|_| Err("the flight stopped before it started".into()))
+}
+
+struct Flight {
+    station: Arc<Station>,
+    tree: serde_json::Value,
+    feed: Option<Feed>,
+    ready: Option<std::sync::mpsc::Sender<Result<(), String>>>,
+}
+
+impl Hooks for Flight {
+    fn compiled(&mut self, _mission: &Mission, world: &World) -> Result<(), String> {
+        self.station.set_map(map_of(world));
+        Ok(())
+    }
+
+    fn starting(
+        &mut self,
+        mission: &Mission,
+        controller: &Controller,
+        _stop: &Stop,
+    ) -> Result<(), String> {
+        let (router, feed) = aviary_server::router_behind(
+            self.station.gate.clone(),
+            controller.clone(),
+            Kinds::of(mission),
+        );
+        self.station.install(Run {
+            router,
+            mission: mission.name.clone(),
+            tree: std::mem::take(&mut self.tree),
+        });
+        self.feed = Some(feed);
+        if let Some(ready) = self.ready.take() {
+            let _ = ready.send(Ok(()));
+        }
+        Ok(())
+    }
+
+    fn record(&mut self, record: &Record<'_>, _backend: &dyn Backend) {
+        if let Some(feed) = &self.feed {
+            feed.publish(record);
+        }
+    }
+}

@@ -1,0 +1,185 @@
+//! The ground station: one web page, served over HTTP beside the operator API, where an
+//! operator loads a mission and its world, checks them, flies them and watches and steers
+//! the flight on a map, a fleet grid, the block tree and a log (`docs/GCS.md`).
+//!
+//! Two ways to serve it ([`Mode`]): `aviary gcs DIR` (the missions and worlds of a
+//! folder, each flown from the page) and `aviary run --serve` (one run, started from the
+//! command line). The page and the code it loads
+//! are embedded in the binary (`assets.rs`); the operator API of the flight in progress
+//! is `aviary_server`'s, reached through the same address, behind the same [`Gate`]:
+//! one token for the station's lifetime.
+//!
+//! Invariants: every request passes the gate (Host, Origin; the token for anything that
+//! changes something, and for reading beyond loopback); the page names files only inside
+//! the station's folder (`dir.rs`); no page loads anything from another site.
+
+mod assets;
+pub mod checking;
+mod dir;
+mod flight;
+mod routes;
+pub mod tree;
+
+use std::net::SocketAddr;
+use std::path::Path;
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use aviary_check::SourceProvider;
+use aviary_engine::Controller;
+use aviary_server::{Feed, Gate, Kinds};
+use serde_json::Value;
+
+pub use dir::{Folder, Listing};
+
+/// How the station finds the files a mission `USE`s: the command line's provider, made
+/// for a mission file (its folder, and the `--use-root`s).
+pub type FilesFor =
+    Box<dyn Fn(&Path) -> Result<Box<dyn SourceProvider + Send>, String> + Send + Sync>;
+
+/// What the station serves.
+pub enum Mode {
+    /// `aviary gcs DIR`: the folder's missions and worlds, flown from the page.
+    Folder { folder: Folder, files: FilesFor },
+    /// `aviary run --serve`: the one run the command line flies.
+    Run,
+}
+
+impl Mode {
+    fn name(&self) -> &'static str {
+        match self {
+            Mode::Folder { .. } => "station",
+            Mode::Run => "run",
+        }
+    }
+}
+
+/// The flight whose operator API the station serves now.
+pub(crate) struct Run {
+    pub router: axum::Router,
+    pub mission: String,
+    pub tree: Value,
+}
+
+pub(crate) struct Station {
+    pub mode: Mode,
+    pub gate: Arc<Gate>,
+    run: Mutex<Option<Run>>,
+    /// A flight from the page is under way: the next waits for its end.
+    pub flying: std::sync::atomic::AtomicBool,
+    /// The world of the flight or trace shown, as the map draws it.
+    map: Mutex<Value>,
+}
+
+impl Station {
+    fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+        m.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    pub fn install(&self, run: Run) {
+        *Self::lock(&self.run) = Some(run);
+    }
+
+    pub fn set_map(&self, map: Value) {
+        *Self::lock(&self.map) = map;
+    }
+
+    pub fn map(&self) -> Value {
+        Self::lock(&self.map).clone()
+    }
+
+    /// The routes of the flight in progress (or the last one), and what the page shows of it.
+    pub fn run(&self) -> Option<(axum::Router, Value)> {
+        Self::lock(&self.run).as_ref().map(|r| {
+            (r.router.clone(), serde_json::json!({ "mission": r.mission, "tree": r.tree }))
+        })
+    }
+}
+
+/// Where and for whom to serve.
+#[derive(Clone, Debug)]
+pub struct Options {
+    pub address: SocketAddr,
+    /// `--allow-host`: names to answer to besides loopback and the bound address.
+    pub allowed_hosts: Vec<String>,
+}
+
+/// A station being served.
+pub struct Serving {
+    pub address: SocketAddr,
+    pub token: String,
+    station: Arc<Station>,
+}
+
+impl Serving {
+    /// The address to open in a browser: loopback for a wildcard bind.
+    pub fn url(&self) -> String {
+        let shown = match self.address.ip().is_unspecified() {
+            true => SocketAddr::new(std::net::Ipv4Addr::LOCALHOST.into(), self.address.port()),
+            false => self.address,
+        };
+        format!("http://{shown}/")
+    }
+
+    /// Whether other machines can reach it.
+    pub fn beyond_loopback(&self) -> bool {
+        self.station.gate.beyond_loopback()
+    }
+
+    /// For `aviary run --serve`: the operator API of the run, and where its events go.
+    /// `tree` and `map` are what the page shows of the mission and its world.
+    pub fn serve_run(
+        &self,
+        controller: Controller,
+        mission: &aviary_ir::Mission,
+        map: Value,
+    ) -> Feed {
+        let (router, feed) =
+            aviary_server::router_behind(self.station.gate.clone(), controller, Kinds::of(mission));
+        self.station.set_map(map);
+        self.station.install(Run {
+            router,
+            mission: mission.name.clone(),
+            tree: tree::of(mission, None),
+        });
+        feed
+    }
+}
+
+/// Binds `options.address` and serves the station in `mode`, on a thread of its own.
+pub fn serve(options: &Options, mode: Mode, map: Value) -> Result<Serving, String> {
+    let listener = std::net::TcpListener::bind(options.address)
+        .map_err(|e| format!("cannot listen on {}: {e}", options.address))?;
+    listener.set_nonblocking(true).map_err(|e| e.to_string())?;
+    let bound = listener.local_addr().map_err(|e| e.to_string())?;
+    let token = aviary_server::new_token()?;
+    let gate = Arc::new(Gate::new(bound, token.clone(), &options.allowed_hosts));
+    let station = Arc::new(Station {
+        mode,
+        gate,
+        run: Mutex::new(None),
+        flying: Default::default(),
+        map: Mutex::new(map),
+    });
+    let app = routes::router(station.clone());
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(1)
+        .enable_all()
+        .build()
+        .map_err(|e| e.to_string())?;
+    std::thread::Builder::new()
+        .name("aviary-station".into())
+        .spawn(move || {
+            runtime.block_on(async move {
+                match tokio::net::TcpListener::from_std(listener) {
+                    Ok(listener) => {
+                        if let Err(e) = axum::serve(listener, app).await {
+                            eprintln!("aviary: the station stopped: {e}");
+                        }
+                    }
+                    Err(e) => eprintln!("aviary: the station cannot start: {e}"),
+                }
+            })
+        })
+        .map_err(|e| e.to_string())?;
+    Ok(Serving { address: bound, token, station })
+}

@@ -1,0 +1,225 @@
+//! The station's routes: the page (`/`, `/assets/...`), its own calls under
+//! `/api/station/`, and every other `/api/` call handed to the operator API of the
+//! flight in progress. Every request passes the gate first (Host and Origin); reads pass
+//! `read_token`, changes `token`.
+
+use std::sync::Arc;
+
+use axum::body::Body;
+use axum::extract::{DefaultBodyLimit, Path, Query, Request, State};
+use axum::http::{header, StatusCode};
+use axum::middleware;
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::{Json, Router};
+use serde_json::{json, Value};
+use tower::ServiceExt;
+
+use crate::checking::{self, Text};
+use crate::{assets, dir, flight, Mode, Station};
+
+/// The largest body a station call takes: a mission and a world of the largest size
+/// the station opens, with room for JSON's escapes.
+const BODY_LIMIT: usize = 3 * dir::MAX_FILE_BYTES as usize;
+
+pub(crate) fn router(station: Arc<Station>) -> Router {
+    let gate = station.gate.clone();
+    let reads = Router::new()
+        .route("/api/station", get(about))
+        .route("/api/station/files", get(files))
+        .route("/api/station/file", get(open))
+        .route("/api/station/check", post(check))
+        .route_layer(middleware::from_fn_with_state(gate.clone(), aviary_server::read_token));
+    let changes = Router::new()
+        .route("/api/station/save", post(save))
+        .route("/api/station/fly", post(fly))
+        .route_layer(middleware::from_fn_with_state(gate.clone(), aviary_server::token));
+    Router::new()
+        .route("/", get(|| async { page("index.html") }))
+        .route("/assets/{*path}", get(|Path(path): Path<String>| async move { page(&path) }))
+        .merge(reads)
+        .merge(changes)
+        .layer(DefaultBodyLimit::max(BODY_LIMIT))
+        .fallback(operator)
+        .layer(middleware::from_fn_with_state(gate, aviary_server::same_origin))
+        .with_state(station)
+}
+
+fn error(status: StatusCode, message: impl Into<String>) -> Response {
+    (status, Json(json!({ "error": message.into() }))).into_response()
+}
+
+/// Why a call is refused, and its status: what the helpers below return, made a response
+/// only at the end.
+struct Refusal(StatusCode, String);
+
+impl IntoResponse for Refusal {
+    fn into_response(self) -> Response {
+        error(self.0, self.1)
+    }
+}
+
+fn page(path: &str) -> Response {
+    match assets::find(path) {
+        Some(a) => (
+            [
+                (header::CONTENT_TYPE, a.mime),
+                // The page's own files only: no script, style or image from anywhere else,
+                // and no page of another site may frame it.
+                (
+                    header::CONTENT_SECURITY_POLICY,
+                    "default-src 'self'; img-src 'self' data:; style-src 'self' 'unsafe-inline'; connect-src 'self'; frame-ancestors 'none'",
+                ),
+                (header::X_CONTENT_TYPE_OPTIONS, "nosniff"),
+            ],
+            a.bytes,
+        )
+            .into_response(),
+        None => error(StatusCode::NOT_FOUND, format!("the page has no file {path}")),
+    }
+}
+
+/// Any other call: the operator API of the flight in progress, if there is one.
+async fn operator(State(station): State<Arc<Station>>, request: Request<Body>) -> Response {
+    if !request.uri().path().starts_with("/api/") {
+        return error(StatusCode::NOT_FOUND, "no such page: the station is at /");
+    }
+    match station.run() {
+        Some((router, _)) => match router.oneshot(request).await {
+            Ok(response) => response,
+            Err(never) => match never {},
+        },
+        None => error(
+            StatusCode::NOT_FOUND,
+            "no mission has flown yet: open a mission and its world, check them and fly",
+        ),
+    }
+}
+
+async fn about(State(station): State<Arc<Station>>) -> Json<Value> {
+    let run = station.run().map(|(_, shown)| shown);
+    Json(json!({
+        "mode": station.mode.name(),
+        "reading_needs_token": station.gate.beyond_loopback(),
+        "run": run,
+        "map": station.map(),
+    }))
+}
+
+fn folder(station: &Station) -> Result<(&dir::Folder, &crate::FilesFor), Refusal> {
+    match &station.mode {
+        Mode::Folder { folder, files } => Ok((folder, files)),
+        _ => Err(Refusal(
+            StatusCode::NOT_FOUND,
+            "this station serves one run, not a folder: start it with `aviary gcs DIR`".into(),
+        )),
+    }
+}
+
+async fn files(State(station): State<Arc<Station>>) -> Response {
+    match folder(&station) {
+        Ok((folder, _)) => Json(folder.list()).into_response(),
+        Err(refusal) => refusal.into_response(),
+    }
+}
+
+#[derive(serde::Deserialize)]
+struct Named {
+    path: String,
+}
+
+async fn open(State(station): State<Arc<Station>>, Query(named): Query<Named>) -> Response {
+    let (folder, _) = match folder(&station) {
+        Ok(f) => f,
+        Err(refusal) => return refusal.into_response(),
+    };
+    match folder.read(&named.path) {
+        Ok(text) => Json(json!({ "path": named.path, "text": text })).into_response(),
+        Err(why) => error(StatusCode::NOT_FOUND, why),
+    }
+}
+
+async fn save(State(station): State<Arc<Station>>, body: Json<Text>) -> Response {
+    let (folder, _) = match folder(&station) {
+        Ok(f) => f,
+        Err(refusal) => return refusal.into_response(),
+    };
+    match folder.save(&body.path, &body.text) {
+        Ok(()) => Json(json!({ "ok": true })).into_response(),
+        Err(why) => error(StatusCode::CONFLICT, why),
+    }
+}
+
+#[derive(serde::Deserialize)]
+struct Pair {
+    mission: Text,
+    world: Text,
+}
+
+/// The checks of `pair`, with the files it `USE`s read from the station's folder.
+fn checked(station: &Station, pair: &Pair) -> Result<checking::Report, Refusal> {
+    let (folder, files_for) = folder(station)?;
+    let mission =
+        folder.resolve(&pair.mission.path).map_err(|w| Refusal(StatusCode::BAD_REQUEST, w))?;
+    folder.resolve(&pair.world.path).map_err(|w| Refusal(StatusCode::BAD_REQUEST, w))?;
+    let files = files_for(&mission).map_err(|w| Refusal(StatusCode::CONFLICT, w))?;
+    Ok(checking::check(&pair.mission, &pair.world, &*files))
+}
+
+async fn check(State(station): State<Arc<Station>>, Json(pair): Json<Pair>) -> Response {
+    // The checker recurses: it runs where its stack is (`aviary_check::STACK`).
+    let work = move || match checked(&station, &pair) {
+        Ok(report) => Json(report.json).into_response(),
+        Err(refusal) => refusal.into_response(),
+    };
+    on_a_deep_stack(work).await
+}
+
+async fn fly(
+    State(station): State<Arc<Station>>,
+    Json(request): Json<flight::Request>,
+) -> Response {
+    let work = move || {
+        let pair = Pair { mission: request.mission.clone(), world: request.world.clone() };
+        let report = match checked(&station, &pair) {
+            Ok(r) => r,
+            Err(refusal) => return refusal.into_response(),
+        };
+        if !report.flyable {
+            let mut body =
+                json!({ "error": "the mission cannot fly: fix the errors the check shows" });
+            body["check"] = report.json;
+            return (StatusCode::CONFLICT, Json(body)).into_response();
+        }
+        let (folder, files_for) = match folder(&station) {
+            Ok(f) => f,
+            Err(refusal) => return refusal.into_response(),
+        };
+        let files = match folder.resolve(&request.mission.path).and_then(|m| files_for(&m)) {
+            Ok(f) => f,
+            Err(why) => return error(StatusCode::CONFLICT, why),
+        };
+        let tree = report.json["tree"].clone();
+        match flight::start(station.clone(), request, tree, files) {
+            Ok(()) => Json(json!({ "ok": true })).into_response(),
+            Err(why) => error(StatusCode::CONFLICT, why),
+        }
+    };
+    on_a_deep_stack(work).await
+}
+
+/// Runs `work` on a thread with the checker's stack, and waits for it without holding
+/// the server's thread.
+async fn on_a_deep_stack(work: impl FnOnce() -> Response + Send + 'static) -> Response {
+    let (tx, rx) = tokio::sync::oneshot::channel();
+    let spawned = std::thread::Builder::new()
+        .name("aviary-station-check".into())
+        .stack_size(aviary_check::STACK)
+        .spawn(move || {
+            let _ = tx.send(work());
+        });
+    if let Err(e) = spawned {
+        return error(StatusCode::SERVICE_UNAVAILABLE, format!("cannot check now: {e}"));
+    }
+    rx.await.unwrap_or_else(|_| error(StatusCode::INTERNAL_SERVER_ERROR, "the check stopped"))
+}

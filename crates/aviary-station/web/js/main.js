@@ -1,0 +1,321 @@
+// The station's page: loads what the station serves (a folder of missions, or one run),
+// and wires the map, the fleet grid, the tree, the log and the controls to the model
+// that the live event stream keeps.
+
+import * as api from "./api.js";
+import { newModel, observe, drone } from "./model.js";
+import { StationMap } from "./map.js";
+import { FleetGrid } from "./fleet.js";
+import { TreeView } from "./tree.js";
+import { Log } from "./log.js";
+import { Editor } from "./editor.js";
+
+const $ = (id) => document.getElementById(id);
+
+const page = {
+  model: newModel(),
+  map: new StationMap($("map")),
+  tree: new TreeView($("tree")),
+  log: new Log($("log"), $("timeline")),
+  fleet: null,
+  editor: null,
+  socket: null,
+  about: null,
+};
+page.fleet = new FleetGrid($("fleet"), (name, action) => droneAction(name, action));
+window.aviary = page; // for the browser tests and for a curious operator
+
+function confirmDanger(text) {
+  const dialog = $("confirm-dialog");
+  $("confirm-text").textContent = text;
+  return new Promise((resolve) => {
+    dialog.onclose = () => resolve(dialog.returnValue === "ok");
+    dialog.showModal();
+  });
+}
+
+/// A refusal or an error, as an alarm the operator acknowledges.
+function refused(what, result) {
+  const why = (result.body && result.body.error) || `status ${result.status}`;
+  page.model.alarms.push({ id: `refused|${Date.now()}`, kind: "refused", text: `${what}: ${why}`, severe: false, acknowledged: false });
+  showAlarms();
+}
+
+async function control(path, body, what) {
+  const result = await api.call("POST", path, body);
+  if (!result.ok) refused(what, result);
+  return result;
+}
+
+async function droneAction(name, action) {
+  if ((action === "land" || action === "home") &&
+      !(await confirmDanger(action === "land" ? `Land ${name} where it is? Its activities are aborted.` : `Send ${name} home? Its activities are aborted; the mission goes on with the rest.`)))
+    return;
+  await control("/api/drone", { drone: name, action }, `${action} ${name}`);
+}
+
+function showAlarms() {
+  const box = $("alarms");
+  box.textContent = "";
+  for (const a of page.model.alarms) {
+    if (a.acknowledged) continue;
+    const div = document.createElement("div");
+    div.className = "alarm" + (a.severe ? "" : " warn");
+    div.dataset.kind = a.kind;
+    const text = document.createElement("span");
+    text.textContent = `${a.t !== undefined ? "t = " + a.t.toFixed(1) + " s  " : ""}${a.text}`;
+    const ack = document.createElement("button");
+    ack.textContent = "Acknowledge";
+    ack.onclick = () => { a.acknowledged = true; showAlarms(); };
+    div.append(text, ack);
+    box.appendChild(div);
+  }
+  page.shownAlarms = page.model.alarms.length;
+}
+
+function render() {
+  const m = page.model;
+  $("mission-name").textContent = m.mission || (page.about && page.about.run && page.about.run.mission) || "no mission";
+  const status = m.paused && m.status === "running" ? "paused" : m.status;
+  $("status").textContent = status;
+  $("status").dataset.status = status;
+  $("clock").textContent = `t = ${m.t.toFixed(1)} s`;
+  page.fleet.update(m);
+  page.tree.update(m);
+  page.log.flush(m);
+  page.map.changed();
+  if (page.shownAlarms !== m.alarms.length) showAlarms();
+  const live = m.status === "running";
+  for (const id of ["pause", "resume", "abort"]) $(id).disabled = !live;
+}
+
+let renderQueued = false;
+function queueRender() {
+  if (renderQueued) return;
+  renderQueued = true;
+  // The grid, tree and log at most 5 times a second; the map every frame it changed.
+  setTimeout(() => { renderQueued = false; render(); }, 200);
+  page.map.changed();
+}
+
+/// Watches the run the station serves now: its tree, the state so far, then its events.
+async function watch() {
+  const about = (await api.call("GET", "/api/station")).body;
+  page.about = about;
+  if (!about || !about.run) return;
+  page.model = newModel();
+  page.map.follow(page.model);
+  page.fleet.clear();
+  page.log.clear();
+  page.map.setWorld(about.map);
+  page.tree.show(about.run.tree);
+  fillLists(about.run.tree);
+  for (const d of (about.map && about.map.drones) || []) drone(page.model, d.name).pos = d.home;
+  const state = await api.call("GET", "/api/state");
+  if (state.ok) {
+    const s = state.body;
+    const m = page.model;
+    m.mission = s.mission; m.t = s.t || 0; m.status = s.status || "running"; m.paused = !!s.paused;
+    for (const b of s.running_blocks || s.blocks || []) m.blocks.set(typeof b === "string" ? b : b.block, "running");
+    for (const d of s.drones || []) {
+      const x = drone(m, d.name);
+      if (d.position) { x.pos = d.position; x.trail.push([d.position[0], d.position[1]]); }
+      if (d.battery !== undefined) x.battery = d.battery;
+      if (d.state) x.state = d.state;
+    }
+  }
+  if (page.socket) page.socket.close();
+  page.socket = api.events((e) => {
+    if (observe(page.model, e)) page.log.add(e);
+    queueRender();
+  }, () => queueRender());
+  render();
+}
+
+function fillLists(tree) {
+  const tags = new Set(), signals = new Set();
+  const walk = (n) => {
+    if (!n) return;
+    if (n.kind === "activity" && n.tag) tags.add(`${n.capability}-${n.tag}`);
+    if (n.kind === "handler" && n.signal) signals.add(n.signal);
+    (n.children || []).forEach(walk);
+  };
+  walk(tree);
+  $("tags").innerHTML = "";
+  for (const t of tags) $("tags").appendChild(new Option(t));
+  $("signals").innerHTML = "";
+  for (const s of signals) $("signals").appendChild(new Option(s));
+}
+
+/// `radius=200m, rounds=2` as the operator API's values: a number with its unit, a
+/// position, TRUE/FALSE, or a name.
+function value(text) {
+  const t = text.trim();
+  const unit = t.match(/^(-?\d+(?:\.\d+)?)\s*(m|km|s|min|h|m\/s|km\/h|deg|%)?$/);
+  if (unit) return unit[2] ? { number: Number(unit[1]), unit: unit[2] } : { number: Number(unit[1]) };
+  const pos = t.match(/^\(?\s*(-?[\d.]+)\s*,\s*(-?[\d.]+)\s*(?:,\s*(-?[\d.]+)\s*m?)?\)?$/);
+  if (pos) return pos.slice(1).filter((v) => v !== undefined).map(Number);
+  if (t === "TRUE" || t === "FALSE") return t === "TRUE";
+  return t.replace(/^"(.*)"$/, "$1");
+}
+
+function splitTag(text) {
+  const i = text.lastIndexOf("-");
+  return i > 0 ? [text.slice(0, i), text.slice(i + 1)] : [text, ""];
+}
+
+function wireControls() {
+  $("pause").onclick = () => control("/api/pause", {}, "pause");
+  $("resume").onclick = () => control("/api/resume", {}, "resume");
+  $("abort").onclick = async () => {
+    if (await confirmDanger("Abort the mission? Every drone returns home.")) control("/api/abort", {}, "abort");
+  };
+  $("token").onclick = () => api.askToken();
+  $("leash-form").onsubmit = (ev) => {
+    ev.preventDefault();
+    const activity = $("leash-tag").value.trim();
+    const action = $("leash-action").value.trim();
+    const args = {};
+    for (const part of $("leash-args").value.split(",")) {
+      const [k, v] = part.split("=");
+      if (k && v !== undefined) args[k.trim()] = value(v);
+    }
+    const body = { activity, action };
+    if (Object.keys(args).length) body.args = args;
+    control("/api/leash", body, `leash ${activity} ${action}`);
+  };
+  $("signal-form").onsubmit = (ev) => {
+    ev.preventDefault();
+    const raw = $("signal-args").value.trim();
+    const args = raw ? raw.split(/,(?![^(]*\))/).map(value) : [];
+    control("/api/signal", { name: $("signal-name").value.trim(), args }, `signal ${$("signal-name").value}`);
+  };
+  window.addEventListener("keydown", (e) => {
+    if (e.key === " " && e.target === document.body) {
+      e.preventDefault();
+      control(page.model.paused ? "/api/resume" : "/api/pause", {}, "pause");
+    }
+  });
+}
+
+// The folder's missions: open, edit, check, save, fly.
+async function station() {
+  $("files").hidden = false;
+  const editor = (page.editor = new Editor());
+  const listing = (await api.call("GET", "/api/station/files")).body || { missions: [], worlds: [] };
+  const missions = $("mission-file"), worlds = $("world-file");
+  for (const m of listing.missions) missions.appendChild(new Option(m));
+  for (const w of listing.worlds) worlds.appendChild(new Option(w));
+  const open = async (which, path) => {
+    if (!path) return;
+    const file = await api.call("GET", `/api/station/file?path=${encodeURIComponent(path)}`);
+    if (file.ok) editor.load(which, path, file.body.text);
+    else refused(`open ${path}`, file);
+  };
+  missions.onchange = async () => {
+    const stem = missions.value.replace(/\.mission$/, "");
+    const beside = listing.worlds.find((w) => w === `${stem}.world.toml`);
+    if (beside) worlds.value = beside;
+    await open("mission", missions.value);
+    await open("world", worlds.value);
+    check();
+  };
+  worlds.onchange = () => open("world", worlds.value).then(check);
+  $("edit-mission").onclick = () => { editor.show("mission"); tabs("mission"); };
+  $("edit-world").onclick = () => { editor.show("world"); tabs("world"); };
+  const tabs = (which) => {
+    $("edit-mission").classList.toggle("active", which === "mission");
+    $("edit-world").classList.toggle("active", which === "world");
+  };
+  const pair = () => ({ mission: { path: editor.files.mission.path, text: editor.files.mission.text },
+                        world: { path: editor.files.world.path, text: editor.files.world.text } });
+  const check = async () => {
+    const result = await api.call("POST", "/api/station/check", pair());
+    if (!result.ok) return refused("check", result);
+    showCheck(result.body);
+  };
+  $("check").onclick = check;
+  $("save").onclick = async () => {
+    for (const which of ["mission", "world"]) {
+      const f = editor.files[which];
+      if (!f.dirty) continue;
+      const r = await control("/api/station/save", { path: f.path, text: f.text }, `save ${f.path}`);
+      if (r.ok) f.dirty = false;
+    }
+  };
+  $("fly").onclick = async () => {
+    const speed = $("speed").value.trim();
+    const body = { ...pair(), speed: speed ? Number(speed) : null };
+    const result = await api.call("POST", "/api/station/fly", body);
+    if (!result.ok) {
+      if (result.body && result.body.check) showCheck(result.body.check);
+      return refused("fly", result);
+    }
+    await watch();
+  };
+  if (listing.missions.length) {
+    const preferred = listing.missions.find((m) => /search_and_rescue|paper/.test(m)) || listing.missions[0];
+    missions.value = preferred;
+    await missions.onchange();
+  }
+}
+
+function showCheck(report) {
+  page.checked = report;
+  page.editor.mark(report.diagnostics);
+  const summary = $("check-summary");
+  const warnings = report.diagnostics.length - report.errors;
+  summary.textContent = report.errors
+    ? `${report.errors} error${report.errors > 1 ? "s" : ""}: the mission cannot fly`
+    : `no errors${warnings ? `, ${warnings} warning${warnings > 1 ? "s" : ""}` : ""}: ready to fly`;
+  summary.className = "summary " + (report.errors ? "bad" : "good");
+  $("fly").disabled = !report.flyable;
+  showPlan(report.plan);
+  if (report.map && !(page.about && page.about.run)) page.map.setWorld(report.map);
+  if (report.tree && !(page.about && page.about.run)) page.tree.show(report.tree);
+}
+
+function showPlan(plan) {
+  const box = $("plan");
+  box.textContent = "";
+  if (!plan || !plan.drones) { box.textContent = "no plan: fix the errors first"; return; }
+  const end = Math.max(plan.mission_time || 1, 1);
+  const head = document.createElement("div");
+  head.textContent = `mission about ${Math.round(end)} s`;
+  box.appendChild(head);
+  for (const d of plan.drones) {
+    const lane = document.createElement("div");
+    lane.className = "lane";
+    const who = document.createElement("span");
+    who.className = "who"; who.textContent = d.drone;
+    const bar = document.createElement("div");
+    bar.className = "bar";
+    for (const a of d.activities || []) {
+      const act = document.createElement("div");
+      act.className = "act";
+      act.style.left = `${(100 * a.start) / end}%`;
+      act.style.width = `${(100 * Math.max(a.end - a.start, 0)) / end}%`;
+      act.title = `${a.what} ${a.start.toFixed(0)}–${a.end.toFixed(0)} s (${a.at || ""})`;
+      bar.appendChild(act);
+    }
+    const left = document.createElement("span");
+    left.className = "left";
+    left.textContent = `${Math.round((d.battery_left || 0) * 100)} %`;
+    left.title = "battery left at the end";
+    lane.append(who, bar, left);
+    box.appendChild(lane);
+  }
+}
+
+async function start() {
+  wireControls();
+  const about = (await api.call("GET", "/api/station")).body;
+  page.about = about;
+  if (!about) return;
+  if (about.mode !== "station") $("files") && document.querySelector("main").classList.add("no-files");
+  if (about.mode === "station") await station();
+  if (about.run) await watch();
+  render();
+}
+
+start();

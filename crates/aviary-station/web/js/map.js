@@ -1,0 +1,149 @@
+// The map: the world in its local frame (metres east and north of the origin; Leaflet's
+// CRS.Simple, one unit a metre), with the geofence, areas, places, homes, targets and
+// finds as Leaflet layers, and the drones on a canvas of their own over it, redrawn once
+// a frame at most: a thousand moving markers as DOM elements would not keep 30 frames a
+// second.
+
+/* global L */
+
+const toLatLng = (p) => L.latLng(p[1], p[0]);
+
+export function batteryColor(b) {
+  if (b === null || b === undefined) return "#8792a6";
+  if (b < 0.15) return "#c2352b";
+  if (b < 0.35) return "#e08a00";
+  return "#1f8a4c";
+}
+
+export class StationMap {
+  constructor(element) {
+    this.map = L.map(element, {
+      crs: L.CRS.Simple, minZoom: -8, maxZoom: 6, zoomSnap: 0.25, attributionControl: false,
+      preferCanvas: true,
+    });
+    this.map.setView([0, 0], 0);
+    this.world = L.layerGroup().addTo(this.map);
+    this.findLayer = L.layerGroup().addTo(this.map);
+    this.findCount = 0;
+    this.canvas = document.createElement("canvas");
+    this.canvas.className = "drone-canvas";
+    Object.assign(this.canvas.style, { position: "absolute", inset: "0", zIndex: 450, pointerEvents: "none" });
+    element.appendChild(this.canvas);
+    this.model = null;
+    this.dirty = true;
+    this.frames = 0;
+    this.map.on("move zoom resize", () => { this.dirty = true; });
+    const loop = () => {
+      if (this.dirty) this.draw();
+      this.frames++;
+      requestAnimationFrame(loop);
+    };
+    requestAnimationFrame(loop);
+  }
+
+  /// Draws the world: everything but the drones and what they find.
+  setWorld(world) {
+    this.world.clearLayers();
+    if (!world) return;
+    const bounds = L.latLngBounds([]);
+    const site = world.site || {};
+    if (site.geofence) {
+      const fence = L.polygon(site.geofence.map(toLatLng), { color: "#c2352b", weight: 2, dashArray: "6 4", fill: false });
+      fence.bindTooltip("geofence").addTo(this.world);
+      bounds.extend(fence.getBounds());
+    }
+    for (const a of world.areas || []) {
+      const p = L.polygon(a.polygon.map(toLatLng), { color: "#1c64d1", weight: 1, fillOpacity: 0.08 });
+      p.bindTooltip(a.name, { permanent: true, direction: "center", className: "place-label" }).addTo(this.world);
+      bounds.extend(p.getBounds());
+    }
+    for (const p of world.places || []) {
+      const m = L.circleMarker(toLatLng(p.at), { radius: 4, color: "#3b4456", weight: 1, fillOpacity: 0.8 });
+      m.bindTooltip(p.name, { permanent: true, direction: "right", className: "place-label" }).addTo(this.world);
+      bounds.extend(m.getLatLng());
+    }
+    for (const d of world.drones || []) {
+      const h = L.rectangle([[d.home[1] - 1.5, d.home[0] - 1.5], [d.home[1] + 1.5, d.home[0] + 1.5]], { color: "#6b7385", weight: 1, fillOpacity: 0.3 });
+      h.bindTooltip(`home of ${d.name}`).addTo(this.world);
+      bounds.extend(L.latLng(d.home[1], d.home[0]));
+    }
+    for (const t of world.targets || []) {
+      const m = L.circleMarker(toLatLng(t.at), { radius: 3, color: "#7b4bc4", weight: 1, fillOpacity: 0.6 });
+      m.bindTooltip(`target: ${t.kind}`).addTo(this.world);
+    }
+    if (bounds.isValid()) this.map.fitBounds(bounds.pad(0.15));
+    this.dirty = true;
+  }
+
+  /// Follows `model`'s drones from now on.
+  follow(model) {
+    this.model = model;
+    this.findCount = 0;
+    this.findLayer.clearLayers();
+    this.dirty = true;
+  }
+
+  changed() {
+    this.dirty = true;
+  }
+
+  draw() {
+    this.dirty = false;
+    const size = this.map.getSize();
+    const ratio = window.devicePixelRatio || 1;
+    if (this.canvas.width !== size.x * ratio || this.canvas.height !== size.y * ratio) {
+      this.canvas.width = size.x * ratio; this.canvas.height = size.y * ratio;
+      this.canvas.style.width = size.x + "px"; this.canvas.style.height = size.y + "px";
+    }
+    const ctx = this.canvas.getContext("2d");
+    ctx.setTransform(ratio, 0, 0, ratio, 0, 0);
+    ctx.clearRect(0, 0, size.x, size.y);
+    const model = this.model;
+    if (!model) return;
+    while (this.findCount < model.finds.length) {
+      const f = model.finds[this.findCount++];
+      L.circleMarker(toLatLng(f.at), { radius: 7, color: "#c2352b", weight: 2, fill: false })
+        .bindTooltip(`${f.kind} found by ${f.actor} at t = ${f.t.toFixed(1)} s`).addTo(this.findLayer);
+    }
+    const point = (p) => this.map.latLngToContainerPoint(toLatLng(p));
+    const many = model.drones.size > 200;
+    // Trails first, under every drone.
+    ctx.lineWidth = 1.5;
+    for (const d of model.drones.values()) {
+      if (d.trail.length < 2) continue;
+      ctx.strokeStyle = "rgba(28,100,209,0.35)";
+      ctx.beginPath();
+      const step = many ? Math.ceil(d.trail.length / 20) : 1;
+      let first = true;
+      for (let i = 0; i < d.trail.length; i += step) {
+        const q = point(d.trail[i]);
+        if (first) { ctx.moveTo(q.x, q.y); first = false; } else ctx.lineTo(q.x, q.y);
+      }
+      const last = point(d.trail[d.trail.length - 1]);
+      ctx.lineTo(last.x, last.y);
+      ctx.stroke();
+    }
+    ctx.font = "11px system-ui, sans-serif";
+    for (const d of model.drones.values()) {
+      if (!d.pos) continue;
+      const q = point(d.pos);
+      if (q.x < -20 || q.y < -20 || q.x > size.x + 20 || q.y > size.y + 20) continue;
+      ctx.save();
+      ctx.translate(q.x, q.y);
+      ctx.rotate(d.heading);
+      ctx.beginPath();
+      ctx.moveTo(0, -8); ctx.lineTo(5.5, 6); ctx.lineTo(0, 3); ctx.lineTo(-5.5, 6); ctx.closePath();
+      ctx.fillStyle = batteryColor(d.battery);
+      ctx.globalAlpha = d.state === "Landed" || d.state === "Lost" ? 0.55 : 1;
+      ctx.fill();
+      ctx.lineWidth = d.held ? 3 : 1;
+      ctx.strokeStyle = d.held ? "#7b4bc4" : d.link === "lost" ? "#c2352b" : "#16202e";
+      ctx.stroke();
+      ctx.restore();
+      if (!many) {
+        ctx.fillStyle = "#16202e";
+        ctx.fillText(d.name, q.x + 9, q.y + 4);
+      }
+    }
+  }
+}

@@ -1,0 +1,192 @@
+// What the page knows of the mission, folded from trace events: the same events a
+// trace file holds, so a live run and a replay build the same state.
+
+export function newModel() {
+  return {
+    t: 0,
+    mission: null,
+    status: "idle",
+    reason: null,
+    paused: false,
+    drones: new Map(),     // name -> drone
+    blocks: new Map(),     // block name -> status
+    handlers: new Map(),   // handler name -> {running, done}
+    activities: new Map(), // "capability|tag|actor" -> {running, done, aborted, failed, paused}
+    finds: [],
+    marks: [],             // timeline: {t, kind, text}
+    log: [],
+    alarms: [],
+    version: 0,
+  };
+}
+
+export function drone(model, name) {
+  let d = model.drones.get(name);
+  if (!d) {
+    d = { name, pos: null, battery: null, state: "unknown", speed: 0, heading: 0, trail: [],
+          activity: "", link: "ok", held: false, withdrawn: false, lastT: null, alarms: new Set() };
+    model.drones.set(name, d);
+  }
+  return d;
+}
+
+const TRAIL = 240;
+
+function key(capability, tag, actor) {
+  return `${capability}|${tag || ""}|${actor}`;
+}
+
+function bump(map, k, field, by) {
+  let v = map.get(k);
+  if (!v) { v = { running: 0, done: 0, aborted: 0, failed: 0, paused: 0 }; map.set(k, v); }
+  v[field] = Math.max(0, v[field] + by);
+  return v;
+}
+
+function alarm(model, kind, who, text, severe = true) {
+  const id = `${kind}|${who || ""}`;
+  if (model.alarms.some((a) => a.id === id && !a.acknowledged)) return;
+  model.alarms.push({ id, kind, who, text, t: model.t, severe, acknowledged: false });
+}
+
+/// Folds one event into the model; returns whether it is worth a line in the log.
+export function observe(model, e) {
+  model.version++;
+  if (typeof e.t === "number") model.t = Math.max(model.t, e.t);
+  switch (e.event) {
+    case "mission_start":
+      model.mission = e.mission; model.status = "running"; break;
+    case "mission_end":
+      model.status = e.status; model.reason = e.reason || null;
+      model.marks.push({ t: e.t, kind: "end", text: `mission ${e.status}` });
+      if (e.status === "failed") alarm(model, "failed", null, `mission failed: ${e.reason || ""}`);
+      break;
+    case "block_start": model.blocks.set(e.block, "running"); break;
+    case "block_end": model.blocks.set(e.block, e.status === "ok" ? "done" : e.status); break;
+    case "handler_start": bump(model.handlers, e.handler, "running", 1); break;
+    case "handler_end": {
+      const v = bump(model.handlers, e.handler, "running", -1); v.done++; break;
+    }
+    case "capability_start": {
+      for (const a of e.actor.split(" ")) {
+        bump(model.activities, key(e.capability, e.tag, a), "running", 1);
+        const d = drone(model, a);
+        d.activity = e.tag ? `${e.capability}-${e.tag}` : e.capability;
+      }
+      break;
+    }
+    case "capability_end": {
+      for (const a of e.actor.split(" ")) {
+        const v = bump(model.activities, key(e.capability, e.tag, a), "running", -1);
+        v[e.status === "ok" ? "done" : e.status === "failed" ? "failed" : "aborted"]++;
+        const d = drone(model, a);
+        if (d.activity === (e.tag ? `${e.capability}-${e.tag}` : e.capability)) d.activity = "";
+      }
+      break;
+    }
+    case "leash": {
+      model.marks.push({ t: e.t, kind: "operator", text: `${e.capability}-${e.tag} ${e.action}` });
+      for (const [k, v] of model.activities) {
+        if (k.startsWith(`${e.capability}|${e.tag}|`)) {
+          if (e.action === "PAUSE") v.paused = v.running;
+          if (e.action === "RESUME") v.paused = 0;
+        }
+      }
+      return true;
+    }
+    case "signal":
+      model.marks.push({ t: e.t, kind: "signal", text: e.name });
+      if (e.name === "BatteryLow" && e.actor) alarm(model, "battery", e.actor, `${e.actor}: battery low`, false);
+      if (e.name === "ConnectionRestored" && e.actor) drone(model, e.actor).link = "ok";
+      break;
+    case "exception": {
+      model.marks.push({ t: e.t, kind: "exception", text: e.name });
+      if (e.actor) {
+        if (e.name === "ConnectionLost") drone(model, e.actor).link = "lost";
+      }
+      const what = `${e.name}${e.actor ? " on " + e.actor : ""}`;
+      if (!e.handled) alarm(model, "unhandled", e.actor, `unhandled exception ${what}`);
+      else if (["ConnectionLost", "BatteryCritical", "MotorFailure", "PositionLost", "DroneLost", "GeofenceViolation"].includes(e.name))
+        alarm(model, e.name, e.actor, `${what}: ${(e.args || []).join(" ")}`);
+      else if (e.name === "Timeout" && /separation/i.test((e.args || []).join(" ")))
+        alarm(model, "separation", e.actor, `${what}: ${(e.args || []).join(" ")}`, false);
+      break;
+    }
+    case "operator":
+      model.marks.push({ t: e.t, kind: "operator", text: `${e.action}${e.drone ? " " + e.drone : ""}` });
+      if (e.drone) {
+        const d = drone(model, e.drone);
+        if (e.action === "hold") d.held = true;
+        if (e.action === "resume") d.held = false;
+        if (e.action === "return_home" || e.action === "land") { d.held = false; d.withdrawn = true; }
+      } else if (e.action === "pause") model.paused = true;
+      else if (e.action === "resume") model.paused = false;
+      return true;
+    case "detection":
+      model.finds.push({ t: e.t, actor: e.actor, kind: e.kind, at: e.location });
+      model.marks.push({ t: e.t, kind: "find", text: `${e.kind} by ${e.actor}` });
+      break;
+    case "telemetry": {
+      const d = drone(model, e.actor);
+      const [x, y, z] = e.position;
+      if (d.pos && d.lastT !== null && e.t > d.lastT) {
+        const dx = x - d.pos[0], dy = y - d.pos[1], dz = z - d.pos[2];
+        const dt = e.t - d.lastT;
+        d.speed = Math.hypot(dx, dy, dz) / dt;
+        if (Math.hypot(dx, dy) > 0.05) d.heading = Math.atan2(dx, dy);
+      }
+      d.pos = [x, y, z]; d.battery = e.battery; d.state = e.state; d.lastT = e.t;
+      d.trail.push([x, y]);
+      if (d.trail.length > TRAIL) d.trail.splice(0, d.trail.length - TRAIL);
+      if (e.battery < 0.2) alarm(model, "battery", e.actor, `${e.actor}: battery ${(e.battery * 100).toFixed(0)} %`, e.battery < 0.1);
+      return false;
+    }
+    case "api_done":
+      if (e.status !== "ok" && e.status !== "aborted" && e.actor) {
+        const d = drone(model, e.actor);
+        d.pos = d.pos || e.position;
+      }
+      return false;
+    case "api_call":
+      return false;
+  }
+  return true;
+}
+
+/// The status of an activity node: its drones' instances, summed.
+export function activityStatus(model, capability, tag, actors) {
+  let sum = { running: 0, done: 0, aborted: 0, failed: 0, paused: 0 };
+  const add = (v) => { if (v) for (const k in sum) sum[k] += v[k]; };
+  if (actors && actors.length) {
+    for (const a of actors) for (const name of [].concat(a || [])) add(model.activities.get(key(capability, tag, name)));
+  } else {
+    const prefix = `${capability}|${tag || ""}|`;
+    for (const [k, v] of model.activities) if (k.startsWith(prefix)) add(v);
+  }
+  if (sum.paused && sum.running) return "paused";
+  if (sum.running) return "running";
+  if (sum.failed) return "failed";
+  if (sum.aborted && !sum.done) return "aborted";
+  if (sum.done) return "done";
+  return "waiting";
+}
+
+/// A line of the log for an event.
+export function describe(e) {
+  switch (e.event) {
+    case "mission_start": return `mission ${e.mission} starts`;
+    case "mission_end": return `mission ${e.status}${e.reason ? ": " + e.reason : ""}`;
+    case "block_start": return `block ${e.block} starts`;
+    case "block_end": return `block ${e.block} ${e.status}`;
+    case "capability_start": return `${e.actor} ${e.capability}${e.tag ? "-" + e.tag : ""} starts`;
+    case "capability_end": return `${e.actor} ${e.capability}${e.tag ? "-" + e.tag : ""} ${e.status}`;
+    case "handler_start": return `handler ${e.handler} starts${e.actor ? " (" + e.actor + ")" : ""}`;
+    case "handler_end": return `handler ${e.handler} ends`;
+    case "signal": return `signal ${e.name}${e.actor ? " from " + e.actor : ""}${e.args && e.args.length ? " " + JSON.stringify(e.args) : ""}`;
+    case "exception": return `exception ${e.name}${e.actor ? " on " + e.actor : ""}${e.handled ? " handled" : " UNHANDLED"} ${(e.args || []).join(" ")}`;
+    case "leash": return `leash ${e.capability}-${e.tag} ${e.action}`;
+    case "operator": return `operator: ${e.action}${e.drone ? " " + e.drone : ""}`;
+    case "detection": return `${e.actor} found ${e.kind} at (${e.location.map((v) => v.toFixed(0)).join(", ")})`;
+    default: return `${e.event}`;
+  }
+}

@@ -1,0 +1,128 @@
+// The ground station as an operator uses it: `aviary gcs` on a copy of the examples, the
+// page in headless Chromium.
+
+import { test, before, after } from "node:test";
+import assert from "node:assert/strict";
+import { readFileSync } from "node:fs";
+import { join } from "node:path";
+import { browser, examples, open, shot, start } from "./harness.mjs";
+
+let station, chromium, dir;
+
+before(async () => {
+  dir = examples();
+  station = await start(["gcs", dir, "--listen", "0"]);
+  chromium = await browser();
+});
+
+after(async () => {
+  await chromium?.close();
+  station?.process.kill("SIGTERM");
+});
+
+test("the paper's mission flies from the page: 7 drones move on the map and the tree ends done", async () => {
+  const page = await open(chromium, station);
+  await page.waitForSelector("#mission-file option", { state: "attached" });
+  assert.equal(await page.inputValue("#mission-file"), "search_and_rescue.mission");
+  await page.waitForSelector("#check-summary.good");
+  await shot(page, "checked");
+  await page.fill("#speed", "40");
+  await page.click("#fly");
+  await page.waitForFunction(() => window.aviary.model.status === "running");
+  // Seven drones on the map, each moving away from its home.
+  await page.waitForFunction(() => window.aviary.model.drones.size === 7);
+  const homes = await page.evaluate(() => Object.fromEntries([...window.aviary.model.drones].map(([n, d]) => [n, d.pos])));
+  await page.waitForFunction(() => [...window.aviary.model.drones.values()].filter((d) => d.trail.length > 5).length >= 3);
+  await page.waitForFunction(() => document.querySelector('#tree .node[data-status="running"]') !== null);
+  // Well into the mission (the search has started), and the page drawn since.
+  await page.waitForFunction(() => window.aviary.model.t > 120);
+  await page.waitForTimeout(400);
+  const shown = await page.evaluate(() => ({
+    clock: document.getElementById("clock").textContent,
+    activities: [...document.querySelectorAll("#fleet tbody tr td:nth-child(7)")].map((td) => td.textContent),
+  }));
+  assert.match(shown.clock, /^t = (1[2-9]\d|[2-9]\d\d)\.\d s$/, "the clock goes with the mission");
+  assert.ok(shown.activities.filter((a) => a !== "–").length >= 3, `running activities in the grid: ${shown.activities}`);
+  await shot(page, "flying");
+  // As the operator sees it: the badge, not the model behind it.
+  await page.waitForFunction(() => !["running", "paused"].includes(document.getElementById("status").textContent), null, { timeout: 240000 });
+  const end = await page.evaluate(() => ({
+    status: window.aviary.model.status,
+    badge: document.getElementById("status").textContent,
+    moved: [...window.aviary.model.drones.values()].filter((d) => d.trail.length > 2).length,
+    done: document.querySelectorAll('#tree .node[data-status="done"]').length,
+    running: document.querySelectorAll('#tree .node[data-status="running"]').length,
+  }));
+  assert.equal(end.status, "ok");
+  assert.equal(end.badge, "ok");
+  assert.equal(end.moved, 7, "every drone moved");
+  assert.ok(end.done > 10, `blocks and activities done in the tree: ${end.done}`);
+  assert.equal(end.running, 0, "nothing is left running");
+  await page.waitForTimeout(300);
+  await shot(page, "done");
+  assert.deepEqual(page.foreign, [], "the page loaded nothing from elsewhere");
+  assert.ok(homes, "positions were known");
+});
+
+test("an edited mission with an error shows the diagnostic on its line and cannot fly", async () => {
+  const page = await open(chromium, station);
+  await page.waitForSelector("#check-summary.good");
+  const text = await page.inputValue("#text");
+  const lines = text.split("\n");
+  const at = lines.findIndex((l) => l.includes("FlyTo WITH"));
+  lines[at] = lines[at].replace(/FlyTo WITH \w+/, "FlyTo WITH Nowhere");
+  await page.fill("#text", lines.join("\n"));
+  await page.click("#check");
+  await page.waitForSelector("#diagnostics li.error");
+  const d = await page.evaluate(() => {
+    const li = document.querySelector("#diagnostics li.error");
+    return { code: li.dataset.code, line: Number(li.dataset.line), text: li.textContent,
+      gutter: document.querySelector(`#gutter span.err[data-line="${li.dataset.line}"]`) !== null,
+      fly: document.getElementById("fly").disabled };
+  });
+  assert.equal(d.code, "E103");
+  assert.equal(d.line, at + 1, "the diagnostic is on the edited line");
+  assert.match(d.text, /unknown place `Nowhere`/);
+  assert.ok(d.gutter, "the gutter marks the line");
+  assert.ok(d.fly, "Fly is disabled");
+  await shot(page, "diagnostic");
+  // Asked to fly all the same (as a script could), the station refuses.
+  const refused = await page.evaluate(async ({ token, text }) => {
+    const r = await fetch("/api/station/fly", { method: "POST", headers: { "Content-Type": "application/json", Authorization: "Bearer " + token },
+      body: JSON.stringify({ mission: { path: "search_and_rescue.mission", text }, world: { path: "search_and_rescue.world.toml", text: "" }, speed: 10 }) });
+    return { status: r.status, body: await r.json() };
+  }, { token: station.token, text: lines.join("\n") });
+  assert.equal(refused.status, 409);
+  assert.match(refused.body.error, /cannot fly/);
+  // Nothing was saved: the file on disk is as it was.
+  assert.equal(readFileSync(join(dir, "search_and_rescue.mission"), "utf8"), text);
+});
+
+test("control needs the token and other sites are refused", async () => {
+  const fly = await fetch(station.url + "/api/station/fly", { method: "POST", headers: { "Content-Type": "application/json" }, body: "{}" });
+  assert.equal(fly.status, 401);
+  const save = await fetch(station.url + "/api/station/save", { method: "POST", headers: { "Content-Type": "application/json", Authorization: "Bearer nope" }, body: "{}" });
+  assert.equal(save.status, 401);
+  const cross = await fetch(station.url + "/api/station/files", { headers: { Origin: "http://evil.example" } });
+  assert.equal(cross.status, 403);
+  // From a page of another site, in the browser: the request is refused and unreadable.
+  const page = await open(chromium, station, { token: false });
+  const other = await page.context().newPage();
+  await other.route("http://evil.example/", (r) => r.fulfill({ body: "<html><body>evil</body></html>", contentType: "text/html" }));
+  await other.goto("http://evil.example/");
+  const seen = await other.evaluate(async (url) => {
+    try {
+      const r = await fetch(url + "/api/station/files");
+      return `read ${r.status}`;
+    } catch (e) {
+      return "refused";
+    }
+  }, station.url);
+  assert.equal(seen, "refused");
+  const socket = await other.evaluate((url) => new Promise((resolve) => {
+    const ws = new WebSocket(url.replace("http", "ws") + "/api/events", ["aviary"]);
+    ws.onopen = () => resolve("open");
+    ws.onerror = () => resolve("refused");
+  }), station.url);
+  assert.equal(socket, "refused");
+});

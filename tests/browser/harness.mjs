@@ -13,11 +13,26 @@ export const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), "../..");
 export const AVIARY = process.env.AVIARY_BIN || join(ROOT, "target/debug/aviary");
 export const SHOTS = join(ROOT, "docs/gcs");
 
-/// A copy of the examples, so that a test may edit and save without touching the repository.
+/// A copy of the examples and of the tests' own missions (`fixtures/`), so that a test may
+/// edit and save without touching the repository.
 export function examples() {
   const dir = mkdtempSync(join(tmpdir(), "aviary-gcs-"));
   cpSync(join(ROOT, "examples"), dir, { recursive: true });
+  cpSync(join(ROOT, "tests/browser/fixtures"), join(dir, "drills"), { recursive: true });
   return dir;
+}
+
+/// Opens `mission` (and the world beside it) in the page, and waits for its check.
+export async function choose(page, mission) {
+  await page.waitForSelector("#mission-file option", { state: "attached" });
+  await page.selectOption("#mission-file", mission);
+  await page.waitForFunction((m) => window.aviary.checked && window.aviary.editor.files.mission.path === m &&
+    document.getElementById("check-summary").classList.contains("good"), mission);
+}
+
+/// A drone's position as the page has it.
+export function position(page, name) {
+  return page.evaluate((n) => window.aviary.model.drones.get(n)?.pos, name);
 }
 
 /// Starts `aviary ARGS...` and waits for the line that says where the station is and its

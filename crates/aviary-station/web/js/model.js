@@ -141,12 +141,16 @@ export function observe(model, e) {
       if (e.battery < 0.2) alarm(model, "battery", e.actor, `${e.actor}: battery ${(e.battery * 100).toFixed(0)} %`, e.battery < 0.1);
       return false;
     }
-    case "api_done":
-      if (e.status !== "ok" && e.status !== "aborted" && e.actor) {
-        const d = drone(model, e.actor);
-        d.pos = d.pos || e.position;
+    case "api_done": {
+      // Where the call left the drone: the last word on a landing, which may come
+      // between two telemetry samples (the fleet's return at the end, an abort).
+      const d = drone(model, e.actor);
+      if (e.position) d.pos = e.position;
+      if (e.status === "ok" && (e.function === "Land" || e.function === "ReturnToLaunch")) {
+        d.state = "Landed"; d.speed = 0;
       }
       return false;
+    }
     case "api_call":
       return false;
   }

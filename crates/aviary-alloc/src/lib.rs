@@ -1,9 +1,9 @@
 //! The process's allocator: mimalloc rather than glibc's malloc. The engine makes and
-//! frees many small objects per step and the world reader many small strings; with glibc
-//! W(100k, 10) took 1.7 times as long (docs/BENCHMARKS.md). The `mimalloc` crate's
-//! allocator asks for the alignment on every call (`mi_malloc_aligned`), a slower path
-//! that showed in the profile; mimalloc aligns every block to 16 bytes anyway, so only
-//! larger alignments take it here.
+//! frees many small objects per step and the world reader many small strings, which
+//! mimalloc serves much faster (docs/BENCHMARKS.md has the figures). The `mimalloc`
+//! crate's allocator asks for the alignment on every call (`mi_malloc_aligned`), a slower
+//! path; mimalloc aligns every block to 16 bytes anyway, so only larger alignments take it
+//! here.
 //!
 //! A library, so that what a run does with memory is said where the run is: the binary
 //! declares [`MiMalloc`] its `#[global_allocator]` and calls [`tune`] before `main`; the
@@ -25,8 +25,8 @@ pub struct MiMalloc;
 /// Gives freed memory back to the system soon, rather than after mimalloc's default
 /// second, and commits arena memory as it is used, rather than up front. Peak memory
 /// then follows what is alive: a short run such as W(100k, 10) frees the world it read
-/// before its engine peaks, and that memory used to stay resident for the whole run
-/// (98 MiB against 65 MiB now, for about 5% more time: docs/BENCHMARKS.md).
+/// before its engine peaks, and with mimalloc's defaults that memory would stay resident
+/// for the whole run. The price is a little time (docs/BENCHMARKS.md has the trade).
 /// `MIMALLOC_PURGE_DELAY` and `MIMALLOC_ARENA_EAGER_COMMIT` in the environment still win.
 ///
 /// Call it before `main` (the binary's `ctor`): the first arena is made at the first
@@ -48,8 +48,8 @@ pub fn tune() {
 
 /// For a command that ends within a second or so (`check`, `fmt`): memory freed is kept
 /// for reuse rather than given back after the purge delay. Given back, it is faulted in
-/// again page by page when the next stage allocates (a tenth of `aviary check`'s time on
-/// a long mission); the process ends soon, and gives it all back then.
+/// again page by page when the next stage allocates, a cost that shows on a long mission;
+/// the process ends soon, and gives it all back then.
 /// `MIMALLOC_PURGE_DELAY` in the environment still wins.
 pub fn short_lived() {
     if !in_environment(c"MIMALLOC_PURGE_DELAY") {

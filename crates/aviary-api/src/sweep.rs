@@ -8,6 +8,9 @@
 //! at the pass itself; that is what makes the `spacing / 2` guarantee hold everywhere.
 //! A pass that the polygon splits in several pieces (a U shape) flies them in order; the
 //! passes alternate direction.
+//!
+//! Part of the contract rather than of a backend, so that the simulator and the MAVLink
+//! backend fly the same path and the plan costs the path they fly.
 
 /// The path, as `[x, y]` points in flying order. Empty for fewer than 3 corners or a
 /// spacing that is not positive.

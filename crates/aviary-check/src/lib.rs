@@ -64,8 +64,8 @@ pub struct Program {
     pub unreadable: Vec<String>,
     /// The capability each name means, after user definitions override the library. By
     /// hash: every pass looks names up, and a mission may have tens of thousands of
-    /// capabilities (string comparisons down a tree were a tenth of checking a long
-    /// chain); [`Program::capability_names`] gives them in order.
+    /// capabilities, where a tree would compare strings all the way down;
+    /// [`Program::capability_names`] gives them in order.
     index: foldhash::HashMap<Box<str>, DefRef>,
 }
 

@@ -1,5 +1,9 @@
 //! Middle-layer calls: made, waited for (held while the activity is paused, interrupted
 //! when it is dropped), traced, and what their ending raises.
+//!
+//! A call is split in two, [`Engine::api_begin`] (evaluate, trace `api_call`, call) and
+//! [`Engine::api_end`] (wait, `CallGuard`, `api_done`, what a failure or interruption
+//! raises), so that an instant activity can hand a call it made to the general path.
 
 use std::cell::Cell;
 use std::rc::Rc;

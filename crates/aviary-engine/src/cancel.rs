@@ -2,7 +2,8 @@
 //! `cancelled()` wakes whoever waits. `tokio_util`'s `CancellationToken` is made for
 //! threads: each child, check and drop takes its parent's mutex, and every top-level
 //! activity is a child of the mission's one `stop` token, so each step of every actor
-//! took the same lock several times. Here it is cells and `Rc`s.
+//! would take the same lock several times. The engine is one thread: here it is cells and
+//! `Rc`s.
 
 use std::cell::{Cell, RefCell};
 use std::future::{poll_fn, Future};

@@ -236,8 +236,8 @@ impl<'m> Engine<'m> {
         };
         // Unconstrained by tokio's cooperative budget: the budget makes a task yield
         // after 128 channel operations, and each yield re-polls the mission's tree of
-        // futures from its root. With N actors in parallel that turned every step into
-        // a walk over many of them (W(100k, 10) was quadratic). Nothing here needs it:
+        // futures from its root. With N actors in parallel that would turn every step
+        // into a walk over many of them, and a run quadratic in N. Nothing here needs it:
         // the mission is one task, every wait is on time or a notification, and the
         // simulator's driver runs whenever the mission waits.
         let body = tokio::task::unconstrained(body);

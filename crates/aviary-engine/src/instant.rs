@@ -10,6 +10,15 @@
 //! its root is paused, a call must wait, fails or is interrupted), it becomes a general
 //! instance where it stands: with the id, claims and frame it has, at the statement it
 //! reached, that statement's call perhaps made ([`Resume::At`]).
+//!
+//! A specialisation of the general path, not a second definition of it: each step here
+//! is a call of the general path's own functions (`needs`, `capability_event`,
+//! `api_begin`, `trace_done`, `capability_end`), in the general path's order. What holds
+//! it there is `tests/instant.rs`: the examples and generated missions (claims held by
+//! others, calls that take time or fail, signals, handlers, leashes, the operator's pause,
+//! resume and abort, drone faults) run both ways must give the same trace, event for
+//! event. The general path alone is reachable only through `aviary_engine::testing`,
+//! behind a feature that only the tests' support crate turns on.
 
 use futures_util::future::LocalBoxFuture;
 

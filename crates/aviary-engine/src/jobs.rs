@@ -1,7 +1,8 @@
 //! A scope's queue of work to start (handler instances, leash sections): a plain
 //! single-threaded queue and the waker of the scope's `drive`. Every block, capability
 //! instance and handler has a scope, so a channel each (an allocation of a block of
-//! slots, and atomics) was the largest cost of starting one; most scopes never get a job.
+//! slots, and atomics) would be the largest cost of starting one; most scopes never get
+//! a job.
 
 use std::cell::{Cell, RefCell};
 use std::collections::VecDeque;

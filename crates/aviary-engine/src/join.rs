@@ -1,6 +1,6 @@
 //! Joining futures: the branches of a `PARALLEL` block, the instances of a `PARALLEL FOR`
 //! and of a statement on a group. Which branch is polled when decides the order of
-//! events at one instant, so the order is defined here, by the engine, and no longer by
+//! events at one instant, so the order is defined here, by the engine, not by
 //! `futures_util::future::join_all`, which switches its polling at a size private to
 //! futures-util.
 //!
@@ -18,9 +18,9 @@ use std::task::Poll;
 
 use futures_util::stream::{FuturesOrdered, FuturesUnordered, StreamExt};
 
-/// At most this many futures are joined in index order. The engine's own figure: it is the
-/// size up to which `join_all`, which the engine used before, polled in index order, so
-/// every trace stayed byte for byte what it was.
+/// At most this many futures are joined in index order. The engine's own figure, which
+/// decides traces: it is the size up to which `join_all` polls in index order, so the
+/// traces of missions are those they had when the engine joined with `join_all`.
 pub(crate) const SMALL: usize = 30;
 
 /// Runs every future to its end: at every wake, each pending one is polled, in order.

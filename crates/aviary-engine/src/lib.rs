@@ -1,7 +1,8 @@
 //! The executor: runs a compiled mission on a fleet through the middle layer.
 //!
 //! Every block, capability instance and handler instance is its own future, polled
-//! concurrently (`FuturesUnordered`) on one thread: lightweight tasks that borrow the IR.
+//! concurrently (`FuturesUnordered`) on one thread: lightweight tasks that borrow the IR
+//! (tokio tasks would need `'static` copies of it).
 //! Cancellation is dropping: resource claims and calls in flight are released by drop
 //! guards, so an abort can never leave a claim held or a drone commanded. Time is tokio's:
 //! with a paused clock a simulated run takes no real time, and on one thread the same

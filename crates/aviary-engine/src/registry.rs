@@ -2,8 +2,8 @@
 //! (drone events and exceptions go to one drone's activities) and by (capability, tag)
 //! (leashes). With ten thousand drones in the air, a per-event scan over every running
 //! activity would make each event cost the fleet's size. Each list is in the order the
-//! instances started (ids grow), as the single list it replaces was. An instance of
-//! several actors is listed under each.
+//! instances started (ids grow), the order a single list of them all would have. An
+//! instance of several actors is listed under each.
 //!
 //! By actor it is a slot per drone, with room for one activity inline: starting and
 //! ending the activity of a drone allocates nothing and hashes nothing.

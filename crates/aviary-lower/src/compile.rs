@@ -64,7 +64,7 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
 }
 
 /// Names (signals, exceptions, tags) to indices, in order of first use. Looked up by
-/// hash: a scan of the names so far made a mission of N signals cost N².
+/// hash: a scan of the names so far would make a mission of N signals cost N².
 #[derive(Default)]
 struct Interner {
     names: Vec<String>,
@@ -733,8 +733,9 @@ fn visit_calls<'b>(block: &'b Block, out: &mut Vec<&'b Call>) {
 
 /// The world's drones, groups, places and areas by name (the first of a name wins, as a
 /// scan in file order would find it).
-/// Hashed with foldhash (seeded per process): SipHash was most of building the drones'
-/// table of a large world.
+/// Hashed with foldhash (seeded per process): a quick hash for keys no attacker chooses,
+/// since the names come from the operator's own world file, and a large world has one a
+/// drone.
 struct WorldIndex<'w> {
     drones: foldhash::HashMap<&'w str, DroneId>,
     groups: foldhash::HashMap<&'w str, &'w aviary_world::Group>,

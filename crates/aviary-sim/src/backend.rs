@@ -1,5 +1,11 @@
 //! [`SimBackend`]: the physics core behind the engine's [`Backend`] trait, driven by one
 //! tokio task that steps it every `tick` seconds of tokio time.
+//!
+//! Tokio time is simulated time: the runtime runs on tokio's paused clock (its
+//! `test-util` feature, kept in production builds on purpose), the one clock the engine's
+//! timers and the simulator share, deterministic and free: with every task waiting, it
+//! moves to the next tick at once. With [`SimOptions::speed`] the driver also waits for
+//! the wall clock, off the engine's thread (see [`drive`]).
 
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -1,7 +1,7 @@
 //! A lower bound, kept from tick to tick, of how far each drone in the air is from every
 //! other one (Chebyshev distance over the ground). With it, "is anybody within reach" of
 //! an isolated drone costs a few subtractions instead of a query of the sky's grid; when
-//! the bound cannot tell, the grid answers exactly, as before.
+//! the bound cannot tell, the grid answers exactly.
 //!
 //! At a rebuild, each member's gap to its nearest other member is measured (up to a cap)
 //! and every member's position is kept as its base. Since then, no member has moved

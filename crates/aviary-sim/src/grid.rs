@@ -3,16 +3,16 @@
 //! step) and the world's targets (fixed). A query returns a superset of what is within
 //! the distance asked, in ascending index order, so callers apply the same exact test
 //! in the same order as a scan over everything would: results do not change, only the
-//! cost, which no longer grows with the size of the fleet.
+//! cost, which does not grow with the size of the fleet.
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
 type Cell = (i64, i64);
 
-/// A cell's hash: SipHash (the default, made to resist chosen keys) was most of the cost
-/// of a query, and cells are no one's choice. The multiply-and-rotate of Firefox's and
-/// rustc's "FxHash".
+/// A cell's hash: the multiply-and-rotate of Firefox's and rustc's "FxHash". A query hashes
+/// every cell it looks at, and cells are coordinates no one chooses, so the default
+/// SipHash's resistance to chosen keys would buy nothing for its cost.
 #[derive(Default)]
 struct CellHasher(u64);
 

@@ -19,8 +19,8 @@ pub(crate) struct Activation {
     /// The chance of finding a target that comes within range.
     pub probability: f64,
     /// The world targets (their indices, ascending) found, or missed, in this activation:
-    /// few, where a flag per target cost every drone as much memory as the world has
-    /// targets.
+    /// few, where a flag per target would cost every drone as much memory as the world
+    /// has targets.
     pub found: Vec<usize>,
 }
 

@@ -14,6 +14,13 @@
 //! are compared, each statement with the first (in statement order) it may wait for.
 //! So N statements in one SEQUENTIAL block cost N, not N² pairs, and a PARALLEL block of
 //! N costs N log N. Each statement gets the report the pairwise rule gives first.
+//!
+//! At each construct: a sweep in source order for parallel branches and for handlers
+//! (`Bucket::later_waits`), a running minimum for `PARALLEL FOR` instances, and for
+//! a block's handlers one scan of its statements per signal, with `raises.rs` telling in
+//! O(depth) whether a statement ends before every raise. The tests hold this to the
+//! pairwise rule, diagnostic for diagnostic, on every fixture, a large generated mission
+//! and 300 random block structures (`pairwise.rs`).
 
 #[cfg(test)]
 mod pairwise;

@@ -52,9 +52,9 @@ fn large(mission: &Mission) -> bool {
 
 /// Compiles and verifies what the checker accepted: `None` when it has errors, no world
 /// or no MISSION. Takes the checked tree out of `checked` and drops it once compiled: the
-/// analyses read only the IR, and on a long mission the tree was a third of the peak
-/// memory, whose fresh pages are much of the time `aviary check` takes
-/// (docs/BENCHMARKS.md, "Pre-flight analyses at scale").
+/// analyses read only the IR, and on a long mission the tree is a large part of the peak
+/// memory, whose fresh pages are much of the time `aviary check` takes; the analyses
+/// reuse what it frees (docs/BENCHMARKS.md, "Pre-flight analyses at scale").
 pub fn preflight(checked: &mut Checked, api: &Descriptor) -> Option<(Mission, Verification)> {
     if checked.has_errors() {
         return None;

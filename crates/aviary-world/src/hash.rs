@@ -1,6 +1,7 @@
-//! A quick hasher for the reader's sets of names (one lookup per drone): SipHash was 4%
-//! of reading a large fleet. The names come from the file being read, so resistance to
-//! chosen collisions buys nothing here (a colliding file only reads slower).
+//! A quick hasher for the reader's sets of names, which a large world looks up once per
+//! drone. The names come from the operator's own world file, so the default SipHash's
+//! resistance to chosen collisions buys nothing here (a file that collides on purpose
+//! only reads slower).
 
 use std::collections::{HashMap, HashSet};
 use std::hash::{BuildHasherDefault, Hasher};

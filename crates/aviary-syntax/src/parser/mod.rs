@@ -1,6 +1,9 @@
 //! Recursive descent over the layout tokens. It never fails: every problem becomes a
 //! diagnostic, the parser skips to the end of the line (and past an indented body it
 //! cannot use), and goes on. Depth is bounded, so no input can overflow the stack.
+//!
+//! Written by hand, as rust-analyzer's, typst's and gleam's parsers are: error recovery
+//! and exact spans matter more here than a grammar generator's brevity.
 
 mod expr;
 mod items;
@@ -307,8 +310,8 @@ impl<'a> Parser<'a> {
         }
         self.depth -= 1;
         // Most bodies hold one to three statements, and a vector grows to four at its first
-        // push: the slack was a third of the tree's memory, and the tree lives until the
-        // mission is compiled.
+        // push: the slack would be a large part of the tree's memory, and the tree lives
+        // until the mission is compiled.
         items.shrink_to_fit();
         items
     }

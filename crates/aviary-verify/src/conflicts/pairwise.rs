@@ -1,4 +1,4 @@
-//! The conflict rule pair by pair, as it was first written: for any two statements that
+//! The conflict rule pair by pair, its plainest statement: for any two statements that
 //! claim one resource of one drone, whether they may run at once and which one waits.
 //! Quadratic, so only the tests run it: they hold `check_conflicts` to it.
 

@@ -69,7 +69,7 @@ pub use super::state::State;
 /// Where the walk is. One `Ctx` serves a whole walk of the mission body: a FOR instance
 /// or a handler sets its slots in place and puts back what they held ([`Estimator::with`]),
 /// because the mission's frame has a slot for every alias and binding of the mission, and
-/// a copy per instance or per firing made a long mission's walk quadratic.
+/// a copy per instance or per firing would make a long mission's walk quadratic.
 struct Ctx {
     frame: Frame,
     /// The signalling actor: of the capability or FOR instance.
@@ -278,7 +278,7 @@ impl<'m> Estimator<'m> {
             pending.push(r);
         }
         // The block's handlers by signal, each list in handler order: a raise looks only
-        // at its own (a block of N handlers for N signals was N² here).
+        // at its own (matched against them all, N handlers for N signals would cost N²).
         let mut by_signal: std::collections::HashMap<SignalId, Vec<usize>> =
             std::collections::HashMap::new();
         for (hi, h) in b.handlers.iter().enumerate() {

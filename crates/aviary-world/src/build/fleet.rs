@@ -2,6 +2,12 @@
 //! table and differ in their names (a pattern with the drone's number in it), their homes
 //! (a grid or a ring) and their number, which each holds as its `index` attribute. A fleet
 //! may also give each drone an area of its own, placed about its home.
+//!
+//! Fleets are how large worlds are written: 100,000 drones are a few lines. A fleet's own
+//! keys ([`FLEET_KEYS`]) are read here, its `count` checked against [`MAX_DRONES`] before
+//! anything is made; every other key is read once, by the same code as a drone's table
+//! (`Drones::read_keys`), into a template that each drone copies with its name, home and
+//! `index`. So a problem with a fleet's key is reported once, at the key, not per drone.
 
 use std::fmt::Write;
 use std::ops::Range;

@@ -631,3 +631,23 @@ fn nothing_in_the_repository_points_outside_it() {
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
+
+/// The code map names every crate of the workspace, and nothing that is not one.
+#[test]
+fn the_architecture_maps_every_crate() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let map = std::fs::read_to_string(root.join("docs/ARCHITECTURE.md")).expect("ARCHITECTURE.md");
+    let mapped: BTreeSet<String> = map
+        .lines()
+        .filter_map(|l| l.strip_prefix("### `crates/"))
+        .filter_map(|l| l.strip_suffix('`'))
+        .map(str::to_string)
+        .collect();
+    let crates: BTreeSet<String> = std::fs::read_dir(root.join("crates"))
+        .expect("crates/")
+        .map(|e| e.expect("an entry").path())
+        .filter(|p| p.join("Cargo.toml").is_file())
+        .map(|p| p.file_name().unwrap_or_default().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(mapped, crates, "docs/ARCHITECTURE.md's code map and crates/ differ");
+}

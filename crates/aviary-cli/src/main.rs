@@ -12,6 +12,7 @@ mod figures;
 mod files;
 mod fmt;
 mod gcs;
+mod replay;
 mod run;
 mod serve;
 mod trace_file;
@@ -129,6 +130,22 @@ enum Command {
         #[arg(long, value_name = "DIR", value_parser = folder)]
         use_root: Vec<PathBuf>,
     },
+    /// Play a recorded trace back in the ground station: map, fleet grid, log and a
+    /// scrubber over the mission's time (docs/GCS.md)
+    Replay {
+        /// The trace, as `aviary run --trace` writes it
+        #[arg(value_parser = recorded_trace)]
+        trace: PathBuf,
+        /// The world file the mission flew in, for the map's areas, places and homes
+        #[arg(long, value_parser = world_file)]
+        world: Option<PathBuf>,
+        /// PORT (loopback) or HOST:PORT to listen on
+        #[arg(long, value_name = "[HOST:]PORT", default_value = "7878")]
+        listen: String,
+        /// Also answer to this host name; may be repeated
+        #[arg(long, value_name = "NAME")]
+        allow_host: Vec<String>,
+    },
     /// Talk to a running mission's operator API (see `aviary run --serve`)
     Ctl {
         /// The API's address, as the run printed it
@@ -183,6 +200,10 @@ fn world_file(s: &str) -> Result<PathBuf, String> {
 
 fn trace_file(s: &str) -> Result<PathBuf, String> {
     nonempty(s, "the file to write the trace to")
+}
+
+fn recorded_trace(s: &str) -> Result<PathBuf, String> {
+    nonempty(s, "a trace (JSON Lines, as `aviary run --trace` writes it)")
 }
 
 fn folder(s: &str) -> Result<PathBuf, String> {
@@ -263,6 +284,17 @@ fn command(cli: Cli) -> u8 {
             Ok(address) => {
                 gcs::run(&dir, &serve::Serve { address, allowed_hosts: allow_host }, &use_root)
             }
+            Err(why) => {
+                eprintln!("aviary: {}", why.replace("--serve", "--listen"));
+                2
+            }
+        },
+        Command::Replay { trace, world, listen, allow_host } => match run::parse_serve(&listen) {
+            Ok(address) => replay::run(
+                &trace,
+                world.as_deref(),
+                &serve::Serve { address, allowed_hosts: allow_host },
+            ),
             Err(why) => {
                 eprintln!("aviary: {}", why.replace("--serve", "--listen"));
                 2

@@ -33,6 +33,7 @@ pub const ASSETS: &[Asset] = &[
     asset!("js/tree.js", "text/javascript; charset=utf-8"),
     asset!("js/log.js", "text/javascript; charset=utf-8"),
     asset!("js/editor.js", "text/javascript; charset=utf-8"),
+    asset!("js/replay.js", "text/javascript; charset=utf-8"),
     asset!("vendor/leaflet-1.9.4/leaflet.js", "text/javascript; charset=utf-8"),
     asset!("vendor/leaflet-1.9.4/leaflet.css", "text/css; charset=utf-8"),
     asset!("vendor/leaflet-1.9.4/LICENSE", "text/plain; charset=utf-8"),

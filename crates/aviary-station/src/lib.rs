@@ -2,9 +2,9 @@
 //! operator loads a mission and its world, checks them, flies them and watches and steers
 //! the flight on a map, a fleet grid, the block tree and a log (`docs/GCS.md`).
 //!
-//! Two ways to serve it ([`Mode`]): `aviary gcs DIR` (the missions and worlds of a
-//! folder, each flown from the page) and `aviary run --serve` (one run, started from the
-//! command line). The page and the code it loads
+//! Three ways to serve it ([`Mode`]): `aviary gcs DIR` (the missions and worlds of a
+//! folder, each flown from the page), `aviary run --serve` (one run, started from the
+//! command line) and `aviary replay TRACE` (a recorded trace, played back on the page). The page and the code it loads
 //! are embedded in the binary (`assets.rs`); the operator API of the flight in progress
 //! is `aviary_server`'s, reached through the same address, behind the same [`Gate`]:
 //! one token for the station's lifetime.
@@ -17,6 +17,7 @@ mod assets;
 pub mod checking;
 mod dir;
 mod flight;
+pub mod replay;
 mod routes;
 pub mod tree;
 
@@ -42,6 +43,9 @@ pub enum Mode {
     Folder { folder: Folder, files: FilesFor },
     /// `aviary run --serve`: the one run the command line flies.
     Run,
+    /// `aviary replay`: a recorded trace, each line an event (read and checked by the
+    /// caller, `replay::read`).
+    Replay { name: String, trace: String },
 }
 
 impl Mode {
@@ -49,6 +53,7 @@ impl Mode {
         match self {
             Mode::Folder { .. } => "station",
             Mode::Run => "run",
+            Mode::Replay { .. } => "replay",
         }
     }
 }

@@ -29,6 +29,7 @@ pub(crate) fn router(station: Arc<Station>) -> Router {
         .route("/api/station/files", get(files))
         .route("/api/station/file", get(open))
         .route("/api/station/check", post(check))
+        .route("/api/station/trace", get(trace))
         .route_layer(middleware::from_fn_with_state(gate.clone(), aviary_server::read_token));
     let changes = Router::new()
         .route("/api/station/save", post(save))
@@ -206,6 +207,24 @@ async fn fly(
         }
     };
     on_a_deep_stack(work).await
+}
+
+/// The recorded trace a replay plays, as its file has it: JSON Lines.
+async fn trace(State(station): State<Arc<Station>>) -> Response {
+    match &station.mode {
+        Mode::Replay { name, trace } => (
+            [
+                (header::CONTENT_TYPE, "application/x-ndjson".to_string()),
+                (header::HeaderName::from_static("x-aviary-trace"), name.clone()),
+            ],
+            trace.clone(),
+        )
+            .into_response(),
+        _ => error(
+            StatusCode::NOT_FOUND,
+            "this station replays no trace: start it with `aviary replay TRACE.jsonl`",
+        ),
+    }
 }
 
 /// Runs `work` on a thread with the checker's stack, and waits for it without holding

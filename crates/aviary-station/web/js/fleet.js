@@ -8,7 +8,7 @@ export class FleetGrid {
   constructor(table, act) {
     this.body = table.tBodies[0];
     this.rows = new Map();
-    this.act = act; // (drone, action) => void
+    this.act = act; // (drone, action) => void; none in a replay, which steers nothing
   }
 
   clear() {
@@ -25,7 +25,7 @@ export class FleetGrid {
     for (let i = 0; i < 7; i++) cells.push(tr.insertCell());
     cells[0].textContent = d.name;
     const actions = tr.insertCell();
-    for (const [action, label, title] of [
+    for (const [action, label, title] of !this.act ? [] : [
       ["hold", "Hold", "pause all its activities"],
       ["resume", "Resume", "go on after a hold"],
       ["home", "Home", "abort its activities and send it home; the mission goes on"],

@@ -9,6 +9,7 @@ import { FleetGrid } from "./fleet.js";
 import { TreeView } from "./tree.js";
 import { Log } from "./log.js";
 import { Editor } from "./editor.js";
+import { Replay, treeOf } from "./replay.js";
 
 const $ = (id) => document.getElementById(id);
 
@@ -85,7 +86,7 @@ function render() {
   page.log.flush(m);
   page.map.changed();
   if (page.shownAlarms !== m.alarms.length) showAlarms();
-  const live = m.status === "running";
+  const live = m.status === "running" && !page.replay;
   for (const id of ["pause", "resume", "abort"]) $(id).disabled = !live;
 }
 
@@ -191,7 +192,7 @@ function wireControls() {
     control("/api/signal", { name: $("signal-name").value.trim(), args }, `signal ${$("signal-name").value}`);
   };
   window.addEventListener("keydown", (e) => {
-    if (e.key === " " && e.target === document.body) {
+    if (e.key === " " && e.target === document.body && page.about && page.about.mode !== "replay") {
       e.preventDefault();
       control(page.model.paused ? "/api/resume" : "/api/pause", {}, "pause");
     }
@@ -307,6 +308,55 @@ function showPlan(plan) {
   }
 }
 
+// A recorded trace, played back: the controls steer nothing, the scrubber picks the time.
+async function replay() {
+  for (const id of ["pause", "resume", "abort"]) $(id).hidden = true;
+  for (const id of ["leash-form", "signal-form"]) $(id).hidden = true;
+  document.querySelector("#side h2:nth-of-type(2)").hidden = true;
+  page.fleet.act = null;
+  $("replay").hidden = false;
+  const headers = api.token() ? { Authorization: "Bearer " + api.token() } : {};
+  let response = await fetch("/api/station/trace", { headers });
+  if (response.status === 401 && (await api.askToken())) {
+    response = await fetch("/api/station/trace", { headers: { Authorization: "Bearer " + api.token() } });
+  }
+  if (!response.ok) return refused("replay", { status: response.status, body: await response.json().catch(() => null) });
+  const name = response.headers.get("x-aviary-trace") || "trace";
+  const events = (await response.text()).split("\n").filter((l) => l.trim()).map((l) => JSON.parse(l));
+  const world = page.about.map;
+  page.map.setWorld(world);
+  page.tree.show(treeOf(events));
+  const homes = new Map(((world && world.drones) || []).map((d) => [d.name, d.home]));
+  const r = new Replay(events, homes, (model, logged) => {
+    page.model = model;
+    for (const e of logged) page.log.add(e);
+    queueRender();
+  }, (model) => {
+    page.model = model;
+    page.map.follow(model);
+    page.fleet.clear();
+    page.log.clear();
+  });
+  page.replay = r;
+  const scrub = $("scrub");
+  scrub.max = String(r.end);
+  const shown = () => {
+    scrub.value = String(r.t);
+    $("replay-time").textContent = `${r.t.toFixed(1)} / ${r.end.toFixed(1)} s`;
+    $("play").textContent = r.playing ? "Pause" : "Play";
+  };
+  r.onchange = shown;
+  scrub.oninput = () => { r.seek(Number(scrub.value)); shown(); };
+  $("replay-speed").onchange = () => { r.speed = Number($("replay-speed").value); };
+  $("play").onclick = () => { if (r.playing) r.pause(); else r.play(); shown(); };
+  window.addEventListener("keydown", (e) => {
+    if (e.key === " " && e.target === document.body) { e.preventDefault(); $("play").click(); }
+  });
+  $("mission-name").textContent = name;
+  r.seek(0);
+  shown();
+}
+
 async function start() {
   wireControls();
   const about = (await api.call("GET", "/api/station")).body;
@@ -314,6 +364,7 @@ async function start() {
   if (!about) return;
   if (about.mode !== "station") $("files") && document.querySelector("main").classList.add("no-files");
   if (about.mode === "station") await station();
+  if (about.mode === "replay") return replay();
   if (about.run) await watch();
   render();
 }

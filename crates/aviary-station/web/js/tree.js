@@ -33,7 +33,7 @@ export class TreeView {
     let status = () => "waiting";
     switch (n.kind) {
       case "block":
-        kind.textContent = n.parallel ? "PARALLEL" : "SEQUENTIAL";
+        kind.textContent = n.parallel === true ? "PARALLEL" : n.parallel === false ? "SEQUENTIAL" : "BLOCK";
         label.textContent = n.traced ? last(n.name) : "";
         if (n.traced) status = (m) => m.blocks.get(n.name) || "waiting";
         if (!n.traced && n.children && n.children.length) {

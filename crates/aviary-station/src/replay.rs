@@ -1,0 +1,51 @@
+//! A recorded trace for `aviary replay`: read whole and checked line by line before the
+//! station serves it, so that the page gets only events it can play. A line that is not
+//! an event is reported with its place (`path:line:col`), the line and a caret, and the
+//! replay does not start.
+
+use aviary_api::trace::Record;
+
+/// The trace's text when every line is an event, or why not.
+pub fn read(name: &str, bytes: Vec<u8>) -> Result<String, String> {
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        format!("{name}: byte {at} is not UTF-8: a trace is JSON Lines, as `aviary run --trace` writes it")
+    })?;
+    let mut events = 0usize;
+    for (index, line) in text.lines().enumerate() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        if let Err(e) = serde_json::from_str::<Record>(line) {
+            let column = e.column().max(1);
+            let shown: String = line.chars().take(160).collect();
+            let caret = " ".repeat(column.saturating_sub(1).min(160));
+            return Err(format!(
+                "{name}:{}:{column}: this line is not a trace event: {e}\n  | {shown}\n  | {caret}^\n  = help: a trace is what `aviary run --trace FILE` writes, one event a line (docs/TRACE.md)",
+                index + 1
+            ));
+        }
+        events += 1;
+    }
+    if events == 0 {
+        return Err(format!("{name}: the trace holds no event"));
+    }
+    Ok(text)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_trace_reads_and_a_bad_line_is_shown_with_its_place() {
+        let good = "{\"t\":0.0,\"event\":\"mission_start\",\"mission\":\"M\"}\n";
+        assert_eq!(read("t.jsonl", good.as_bytes().to_vec()).unwrap(), good);
+        let bad = format!("{good}{{\"t\":1.0,\"event\":\"nonsense\"}}\n");
+        let why = read("t.jsonl", bad.into_bytes()).unwrap_err();
+        assert!(why.starts_with("t.jsonl:2:"), "{why}");
+        assert!(why.contains('^'), "{why}");
+        assert!(read("t.jsonl", vec![0xff, 0xfe]).unwrap_err().contains("UTF-8"));
+        assert!(read("t.jsonl", b"\n\n".to_vec()).unwrap_err().contains("no event"));
+    }
+}

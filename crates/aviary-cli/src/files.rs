@@ -132,3 +132,24 @@ pub fn color_wanted() -> bool {
     use std::io::IsTerminal;
     std::env::var_os("NO_COLOR").is_none() && std::io::stdout().is_terminal()
 }
+
+/// A world file read and checked on its own (`aviary replay`, `aviary report`): the world,
+/// or what to print of why not (its errors rendered, each at its place).
+pub fn world_alone(path: &Path) -> Result<aviary_world::World, String> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| format!("aviary: cannot read the world file {}: {e}\n", path.display()))?;
+    let mut sources = aviary_diagnostics::SourceMap::new();
+    let read = aviary_check::read_world(
+        &mut sources,
+        &path.display().to_string(),
+        std::borrow::Cow::Owned(bytes),
+    );
+    read.world.ok_or_else(|| {
+        let mut shown = String::new();
+        for d in read.diagnostics.iter().filter(|d| d.is_error()) {
+            shown.push_str(&aviary_diagnostics::render_text(&sources, d, color_wanted()));
+        }
+        shown.push_str(&format!("aviary: the world file {} has errors\n", path.display()));
+        shown
+    })
+}

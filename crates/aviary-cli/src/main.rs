@@ -13,6 +13,7 @@ mod files;
 mod fmt;
 mod gcs;
 mod replay;
+mod report;
 mod run;
 mod serve;
 mod trace_file;
@@ -146,6 +147,19 @@ enum Command {
         #[arg(long, value_name = "NAME")]
         allow_host: Vec<String>,
     },
+    /// Write one self-contained HTML report of a recorded trace: the summary, a map of
+    /// every track, per-drone plots and the timeline (docs/GCS.md)
+    Report {
+        /// The trace, as `aviary run --trace` writes it
+        #[arg(value_parser = recorded_trace)]
+        trace: PathBuf,
+        /// The world file the mission flew in, for the map's areas, places and homes
+        #[arg(long, value_parser = world_file)]
+        world: Option<PathBuf>,
+        /// Where to write the report
+        #[arg(short, long, value_name = "OUT.html", value_parser = report_file)]
+        output: PathBuf,
+    },
     /// Talk to a running mission's operator API (see `aviary run --serve`)
     Ctl {
         /// The API's address, as the run printed it
@@ -204,6 +218,10 @@ fn trace_file(s: &str) -> Result<PathBuf, String> {
 
 fn recorded_trace(s: &str) -> Result<PathBuf, String> {
     nonempty(s, "a trace (JSON Lines, as `aviary run --trace` writes it)")
+}
+
+fn report_file(s: &str) -> Result<PathBuf, String> {
+    nonempty(s, "the report to write (OUT.html)")
 }
 
 fn folder(s: &str) -> Result<PathBuf, String> {
@@ -300,6 +318,7 @@ fn command(cli: Cli) -> u8 {
                 2
             }
         },
+        Command::Report { trace, world, output } => report::run(&trace, world.as_deref(), &output),
         Command::Ctl { url, token, command } => ctl::run(&url, token.as_deref(), command),
         Command::Vehicles { world, listen, speed, signing_key } => {
             vehicles::run(&vehicles::VehiclesArgs {

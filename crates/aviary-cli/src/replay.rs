@@ -4,10 +4,8 @@
 
 use std::path::Path;
 
-use aviary_diagnostics::{render_text, SourceMap};
 use aviary_station::Mode;
 
-use crate::files::color_wanted;
 use crate::serve::Serve;
 
 pub fn run(trace: &Path, world: Option<&Path>, serve: &Serve) -> u8 {
@@ -26,32 +24,11 @@ pub fn run(trace: &Path, world: Option<&Path>, serve: &Serve) -> u8 {
             return 2;
         }
     };
-    let map = match world {
-        None => serde_json::Value::Null,
-        Some(path) => {
-            let bytes = match std::fs::read(path) {
-                Ok(b) => b,
-                Err(e) => {
-                    eprintln!("aviary: cannot read the world file {}: {e}", path.display());
-                    return 2;
-                }
-            };
-            let mut sources = SourceMap::new();
-            let read = aviary_check::read_world(
-                &mut sources,
-                &path.display().to_string(),
-                std::borrow::Cow::Owned(bytes),
-            );
-            match read.world {
-                Some(w) => aviary_station::checking::map_of(&w),
-                None => {
-                    for d in read.diagnostics.iter().filter(|d| d.is_error()) {
-                        eprint!("{}", render_text(&sources, d, color_wanted()));
-                    }
-                    eprintln!("aviary: the world file {} has errors", path.display());
-                    return 2;
-                }
-            }
+    let map = match world.map(crate::files::world_alone).transpose() {
+        Ok(w) => w.as_ref().map(aviary_station::checking::map_of).unwrap_or_default(),
+        Err(shown) => {
+            eprint!("{shown}");
+            return 2;
         }
     };
     match crate::serve::station(serve, Mode::Replay { name: name.clone(), trace: text }, map) {

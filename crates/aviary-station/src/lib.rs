@@ -18,6 +18,7 @@ pub mod checking;
 mod dir;
 mod flight;
 pub mod replay;
+pub mod report;
 mod routes;
 pub mod tree;
 

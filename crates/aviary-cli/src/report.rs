@@ -1,0 +1,46 @@
+//! `aviary report TRACE [--world W] -o OUT.html`: one self-contained HTML file for the
+//! record after a mission (`aviary_station::report`).
+
+use std::path::Path;
+
+pub fn run(trace: &Path, world: Option<&Path>, out: &Path) -> u8 {
+    let name = trace.display().to_string();
+    let bytes = match std::fs::read(trace) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("aviary: cannot read {name}: {e}");
+            return 2;
+        }
+    };
+    let text = match aviary_station::replay::read(&name, bytes) {
+        Ok(t) => t,
+        Err(why) => {
+            eprintln!("aviary: {why}");
+            return 2;
+        }
+    };
+    let world = match world.map(crate::files::world_alone).transpose() {
+        Ok(w) => w,
+        Err(shown) => {
+            eprint!("{shown}");
+            return 2;
+        }
+    };
+    let html = match aviary_station::report::render(&name, &text, world.as_ref()) {
+        Ok(h) => h,
+        Err(why) => {
+            eprintln!("aviary: {why}");
+            return 2;
+        }
+    };
+    // Written beside and renamed over: a report is whole or not there.
+    let temporary = out.with_extension("html.writing");
+    if let Err(e) = std::fs::write(&temporary, html).and_then(|()| std::fs::rename(&temporary, out))
+    {
+        let _ = std::fs::remove_file(&temporary);
+        eprintln!("aviary: cannot write {}: {e}", out.display());
+        return 2;
+    }
+    eprintln!("aviary: wrote {}", out.display());
+    0
+}

@@ -44,10 +44,11 @@ export function start(args) {
     const timer = setTimeout(() => reject(new Error(`aviary did not start: ${output}`)), 60000);
     const seen = (chunk) => {
       output += chunk.toString();
-      const m = output.match(/ground station on (http:\/\/\S+?)\/?\s+token ([0-9a-f]+)/);
-      if (m) {
+      const token = output.match(/operator API on \S+\s+token ([0-9a-f]+)/);
+      const page = output.match(/ground station on (http:\/\/\S+?)\/?\s/);
+      if (token && page) {
         clearTimeout(timer);
-        resolveStart({ url: m[1], token: m[2], process: child, output: () => output });
+        resolveStart({ url: page[1], token: token[1], process: child, output: () => output });
       }
     };
     child.stderr.on("data", seen);

@@ -21,16 +21,19 @@ pub fn station(serve: &Serve, mode: Mode, map: serde_json::Value) -> Result<Serv
     let options = Options { address: serve.address, allowed_hosts: serve.allowed_hosts.clone() };
     let serving = aviary_station::serve(&options, mode, map)?;
     let url = serving.url();
-    eprintln!("aviary: ground station on {url}  token {}", serving.token);
+    // The operator API's line first, then the warning, as they always were: scripts read
+    // the first line, and the operator sees the warning before anything else.
     eprintln!("aviary: operator API on {}  token {}", url.trim_end_matches('/'), serving.token);
     if serving.beyond_loopback() {
         eprintln!(
-            "aviary: warning: the station listens on {} and can be reached from other machines. Every call, reads and the event \
-             stream included, now needs the token, but plain HTTP carries it and the fleet's positions unencrypted: put it behind a \
-             TLS reverse proxy (docs/OPERATOR_API.md) for use beyond this machine, or serve on loopback.",
+            "aviary: warning: the operator API listens on {} (the ground station with it) and can be reached from other machines. \
+             Every call, reads and the event stream included, now needs the token, but plain HTTP carries it and the fleet's \
+             positions unencrypted: put it behind a TLS reverse proxy (docs/OPERATOR_API.md) for use beyond this machine, or \
+             serve on loopback.",
             serving.address
         );
     }
+    eprintln!("aviary: ground station on {url}  (the same token)");
     Ok(serving)
 }
 

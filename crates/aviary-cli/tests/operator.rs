@@ -5,6 +5,8 @@
 
 #[path = "operator/args.rs"]
 mod args;
+#[path = "operator/batches.rs"]
+mod batches;
 mod common;
 #[path = "operator/guard.rs"]
 mod guard;

@@ -18,6 +18,7 @@ mod guard;
 mod reply;
 mod routes;
 mod state;
+mod stream;
 
 pub use args::{Kinds, MAX_MAGNITUDE};
 pub use guard::{read_token, same_origin, token, Gate, TOKEN_PROTOCOL};
@@ -39,10 +40,20 @@ const BACKLOG: usize = 4096;
 /// mid-mission sees the blocks, activities and signals so far. Beyond, the oldest go.
 const HISTORY: usize = 100_000;
 
+/// An event as streams send it: its trace line, and what a stream needs to know of it
+/// without reading the line again.
+pub(crate) struct Line {
+    pub text: Box<str>,
+    /// The drone, for a telemetry sample.
+    pub telemetry_of: Option<Box<str>>,
+    /// `mission_end`: the last.
+    pub end: bool,
+}
+
 /// The events so far, telemetry aside, as their lines.
 #[derive(Default)]
 pub(crate) struct History {
-    pub lines: std::collections::VecDeque<Arc<str>>,
+    pub lines: std::collections::VecDeque<Arc<Line>>,
     /// How many of the oldest were let go.
     pub dropped: u64,
 }
@@ -53,7 +64,7 @@ pub(crate) struct Shared {
     pub gate: Arc<Gate>,
     pub controller: Controller,
     pub state: Mutex<MissionState>,
-    pub events: broadcast::Sender<Arc<str>>,
+    pub events: broadcast::Sender<Arc<Line>>,
     /// Appended and broadcast under one lock, so a new stream takes both at one instant.
     pub history: Mutex<History>,
     pub kinds: Kinds,
@@ -101,10 +112,16 @@ impl Feed {
     /// line the trace file has.
     pub fn publish(&self, record: &Record) {
         self.shared.state().observe(record);
-        if let Ok(line) = serde_json::to_string(record) {
-            let line: Arc<str> = Arc::from(line);
+        if let Ok(text) = serde_json::to_string(record) {
+            use aviary_api::trace::Event;
+            let telemetry_of = match &record.event {
+                Event::Telemetry { actor, .. } => Some(Box::from(&**actor)),
+                _ => None,
+            };
+            let end = matches!(record.event, Event::MissionEnd { .. });
+            let line = Arc::new(Line { text: text.into_boxed_str(), telemetry_of, end });
             let mut history = self.shared.history();
-            if !matches!(record.event, aviary_api::trace::Event::Telemetry { .. }) {
+            if line.telemetry_of.is_none() {
                 history.lines.push_back(line.clone());
                 if history.lines.len() > HISTORY {
                     history.lines.pop_front();

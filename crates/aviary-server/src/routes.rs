@@ -6,17 +6,16 @@ use std::sync::Arc;
 
 use aviary_engine::Control;
 use axum::extract::ws::rejection::WebSocketUpgradeRejection;
-use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
+use axum::extract::ws::WebSocketUpgrade;
 use axum::extract::{DefaultBodyLimit, State};
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::{middleware, Json, Router};
 use serde_json::{json, Value as JsonValue};
-use tokio::sync::broadcast::error::RecvError;
 
 use crate::reply::{error, Object, BODY_LIMIT};
-use crate::{guard, reply, Shared};
+use crate::{guard, reply, stream, Shared};
 
 pub(crate) fn router(shared: Arc<Shared>) -> Router {
     let reads = Router::new()
@@ -56,18 +55,9 @@ async fn events(
     uri: axum::http::Uri,
     ws: Result<WebSocketUpgrade, WebSocketUpgradeRejection>,
 ) -> Response {
-    let from_start = match uri.query() {
-        None | Some("") => false,
-        Some("from=start") => true,
-        Some(other) => {
-            let other: String = other.chars().filter(|c| !c.is_control()).take(80).collect();
-            return error(
-                StatusCode::BAD_REQUEST,
-                format!(
-                    "`?{other}` is no option of the event stream: the one option is `?from=start`"
-                ),
-            );
-        }
+    let (from_start, every) = match options(uri.query().unwrap_or("")) {
+        Ok(o) => o,
+        Err(why) => return error(StatusCode::BAD_REQUEST, why),
     };
     let ws = match ws {
         Ok(ws) => ws,
@@ -95,54 +85,40 @@ async fn events(
             failed.streams.fetch_sub(1, std::sync::atomic::Ordering::SeqCst);
         })
         .on_upgrade(move |socket| async move {
-            stream(socket, past, rx).await;
+            match every {
+                Some(every) => stream::batched(socket, past, rx, every).await,
+                None => stream::each(socket, past, rx).await,
+            }
             shared.streams.fetch_sub(1, std::sync::atomic::Ordering::SeqCst);
         })
 }
 
-/// Every event from now on, one JSON text message each, until the mission ends; first,
-/// with `?from=start`, every event since the start but telemetry.
-async fn stream(
-    mut socket: WebSocket,
-    past: Option<(Vec<Arc<str>>, u64)>,
-    mut rx: tokio::sync::broadcast::Receiver<Arc<str>>,
-) {
-    if let Some((lines, dropped)) = past {
-        if dropped > 0 {
-            let note = json!({ "history_dropped": dropped }).to_string();
-            if socket.send(Message::Text(note.into())).await.is_err() {
-                return;
-            }
-        }
-        for event in lines {
-            let end = event.contains("\"event\":\"mission_end\"");
-            if socket.send(Message::Text(event.to_string().into())).await.is_err() {
-                return;
-            }
-            if end {
-                let _ = socket.send(Message::Close(None)).await;
-                return;
+/// The stream's options: `from=start` (the history first) and `every=MS` (batches, every
+/// 20 to 1000 ms).
+fn options(query: &str) -> Result<(bool, Option<std::time::Duration>), String> {
+    let shown = |t: &str| -> String { t.chars().filter(|c| !c.is_control()).take(80).collect() };
+    let (mut from_start, mut every) = (false, None);
+    for pair in query.split('&').filter(|p| !p.is_empty()) {
+        match pair.split_once('=') {
+            Some(("from", "start")) => from_start = true,
+            Some(("every", ms)) => match ms.parse::<u64>() {
+                Ok(ms @ 20..=1000) => every = Some(std::time::Duration::from_millis(ms)),
+                _ => {
+                    return Err(format!(
+                        "`every={}` is not a window: give milliseconds from 20 to 1000",
+                        shown(ms)
+                    ))
+                }
+            },
+            _ => {
+                return Err(format!(
+                    "`{}` is no option of the event stream: the options are `from=start` and `every=MS`",
+                    shown(pair)
+                ))
             }
         }
     }
-    loop {
-        match rx.recv().await {
-            Ok(event) => {
-                let end = event.contains("\"event\":\"mission_end\"");
-                if socket.send(Message::Text(event.to_string().into())).await.is_err() || end {
-                    break;
-                }
-            }
-            Err(RecvError::Lagged(missed)) => {
-                let note = json!({ "lagged": missed }).to_string();
-                if socket.send(Message::Text(note.into())).await.is_err() {
-                    break;
-                }
-            }
-            Err(RecvError::Closed) => break,
-        }
-    }
-    let _ = socket.send(Message::Close(None)).await;
+    Ok((from_start, every))
 }
 
 /// `{"activity": "FlyCircle-C1", "action": "PAUSE", "args": {"radius": 40}}`, or with
@@ -231,4 +207,21 @@ async fn resume(State(shared): State<Arc<Shared>>) -> Response {
 
 async fn abort(State(shared): State<Arc<Shared>>) -> Response {
     control(&shared, Control::Abort { reason: "aborted by the operator".into() }).await
+}
+
+#[cfg(test)]
+mod tests {
+    use super::options;
+    use std::time::Duration;
+
+    #[test]
+    fn the_streams_options_are_read_or_refused_with_the_reason() {
+        assert_eq!(options(""), Ok((false, None)));
+        assert_eq!(options("from=start"), Ok((true, None)));
+        assert_eq!(options("every=100&from=start"), Ok((true, Some(Duration::from_millis(100)))));
+        for bad in ["every=5", "every=2000", "every=x", "from=now", "since=0", "every"] {
+            let why = options(bad).unwrap_err();
+            assert!(why.contains('`'), "{bad}: {why}");
+        }
+    }
 }

@@ -17,7 +17,8 @@ use aviary_world::World;
 use crate::checking::{map_of, Text};
 use crate::{Run, Station};
 
-/// The telemetry rate of a flight from the page: smooth enough to watch and to replay.
+/// The telemetry rate of a flight from the page, unless it asks for another: smooth
+/// enough to watch and to replay.
 pub const TELEMETRY_HZ: f64 = 4.0;
 
 /// What the page asks to fly.
@@ -29,6 +30,8 @@ pub struct Request {
     pub speed: Option<f64>,
     #[serde(default)]
     pub seed: u64,
+    /// Telemetry samples per drone per second of mission time, 1 to 20 (default 4).
+    pub telemetry_hz: Option<f64>,
 }
 
 /// Flies `request` on a new thread. The run's routes are installed as the mission
@@ -44,6 +47,12 @@ pub fn start(
             return Err(format!("{speed} is not a speed: give a number of times real time, from just above 0 to 1000, or none for as fast as possible"));
         }
     }
+    let telemetry_hz = request.telemetry_hz.unwrap_or(TELEMETRY_HZ);
+    if !(1.0..=20.0).contains(&telemetry_hz) {
+        return Err(format!(
+            "{telemetry_hz} is not a telemetry rate: give 1 to 20 samples a second"
+        ));
+    }
     if station.flying.swap(true, std::sync::atomic::Ordering::SeqCst) {
         return Err("a mission is flying: wait for its end, or abort it, before the next".into());
     }
@@ -57,7 +66,7 @@ pub fn start(
             let options = Options {
                 speed: request.speed,
                 seed: request.seed,
-                run: RunOptions { telemetry_hz: Some(TELEMETRY_HZ), ..RunOptions::default() },
+                run: RunOptions { telemetry_hz: Some(telemetry_hz), ..RunOptions::default() },
             };
             let texts = Texts {
                 mission: Source {

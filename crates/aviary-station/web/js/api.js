@@ -59,16 +59,25 @@ export async function call(method, path, body, retried = false) {
 /// The event stream from the mission's start (telemetry from now on): every trace event,
 /// as the trace file has it. `onEvent` gets
 /// each; `onClose` when the stream ends.
-export function events(onEvent, onClose) {
+export function events(onEvent, onClose, onNote) {
   const scheme = location.protocol === "https:" ? "wss:" : "ws:";
   const protocols = ["aviary"];
   if (token()) protocols.push("aviary.bearer." + token());
-  const socket = new WebSocket(`${scheme}//${location.host}/api/events?from=start`, protocols);
+  // Batches every 100 ms: the window's events and each drone's latest telemetry, so a
+  // large fleet does not send more than the page can draw.
+  const socket = new WebSocket(`${scheme}//${location.host}/api/events?from=start&every=100`, protocols);
   socket.onmessage = (m) => {
+    let data;
     try {
-      onEvent(JSON.parse(m.data));
+      data = JSON.parse(m.data);
     } catch (e) {
       console.warn("an event that is not JSON", e);
+      return;
+    }
+    for (const e of Array.isArray(data) ? data : [data]) {
+      // Notes (`dropped`, `history_dropped`, `lagged`) are not events.
+      if (e && typeof e.event === "string") onEvent(e);
+      else if (e && onNote) onNote(e);
     }
   };
   socket.onclose = () => onClose && onClose();

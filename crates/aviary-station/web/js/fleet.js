@@ -50,7 +50,18 @@ export class FleetGrid {
   }
 
   update(model) {
-    for (const d of model.drones.values()) {
+    // Rows are made for every drone, but with many only those in view are rewritten:
+    // a thousand rows a few times a second would take the frames the map needs.
+    let drones = [...model.drones.values()];
+    for (const d of drones) this.row(d);
+    if (drones.length > 60) {
+      const box = this.body.closest(".panel") || this.body.parentElement;
+      const height = this.body.rows[0]?.offsetHeight || 20;
+      const first = Math.max(0, Math.floor((box.scrollTop - 40) / height) - 2);
+      const count = Math.ceil(box.clientHeight / height) + 4;
+      drones = drones.slice(first, first + count);
+    }
+    for (const d of drones) {
       const r = this.row(d);
       r.tr.classList.toggle("held", d.held);
       r.tr.classList.toggle("withdrawn", d.withdrawn);

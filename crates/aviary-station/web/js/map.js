@@ -113,7 +113,7 @@ export class StationMap {
       if (d.trail.length < 2) continue;
       ctx.strokeStyle = "rgba(28,100,209,0.35)";
       ctx.beginPath();
-      const step = many ? Math.ceil(d.trail.length / 20) : 1;
+      const step = many ? Math.ceil(d.trail.length / 8) : 1;
       let first = true;
       for (let i = 0; i < d.trail.length; i += step) {
         const q = point(d.trail[i]);

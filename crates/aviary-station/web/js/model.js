@@ -137,7 +137,9 @@ export function observe(model, e) {
       }
       d.pos = [x, y, z]; d.battery = e.battery; d.state = e.state; d.lastT = e.t;
       d.trail.push([x, y]);
-      if (d.trail.length > TRAIL) d.trail.splice(0, d.trail.length - TRAIL);
+      // Trimmed now and then, not at every sample: a shift per sample is the most a
+      // thousand drones' telemetry would cost.
+      if (d.trail.length > TRAIL * 1.5) d.trail.splice(0, d.trail.length - TRAIL);
       if (e.battery < 0.2) alarm(model, "battery", e.actor, `${e.actor}: battery ${(e.battery * 100).toFixed(0)} %`, e.battery < 0.1);
       return false;
     }

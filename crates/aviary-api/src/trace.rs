@@ -129,6 +129,45 @@ pub enum Event<'a> {
         battery: f64,
         state: FlightState,
     },
+    /// The operator steered the mission (a leash or a signal of the operator is written
+    /// as a `leash` or a `signal`). `drone`: the drone it applies to, or `null` for the
+    /// whole mission.
+    Operator {
+        action: OperatorAction,
+        drone: Option<Text<'a>>,
+    },
+}
+
+/// What the operator did (`operator` events).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OperatorAction {
+    /// Held every activity where it is (the whole mission).
+    Pause,
+    /// Undid a `pause` (without a drone) or a `hold` (of its drone).
+    Resume,
+    /// Ended the mission: the fleet returns home.
+    Abort,
+    /// Held one drone's activities where they are.
+    Hold,
+    /// Aborted one drone's activities and sent it home, out of the mission.
+    ReturnHome,
+    /// Aborted one drone's activities and landed it where it is, out of the mission.
+    Land,
+}
+
+impl OperatorAction {
+    /// The trace's `action`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            OperatorAction::Pause => "pause",
+            OperatorAction::Resume => "resume",
+            OperatorAction::Abort => "abort",
+            OperatorAction::Hold => "hold",
+            OperatorAction::ReturnHome => "return_home",
+            OperatorAction::Land => "land",
+        }
+    }
 }
 
 /// How a mission, a block or an activity ended.
@@ -184,11 +223,12 @@ pub enum EventKind {
     Leash,
     Detection,
     Telemetry,
+    Operator,
 }
 
 impl EventKind {
     /// Every kind; `ALL[k as usize] == k`.
-    pub const ALL: [EventKind; 15] = [
+    pub const ALL: [EventKind; 16] = [
         EventKind::MissionStart,
         EventKind::MissionEnd,
         EventKind::BlockStart,
@@ -204,6 +244,7 @@ impl EventKind {
         EventKind::Leash,
         EventKind::Detection,
         EventKind::Telemetry,
+        EventKind::Operator,
     ];
 
     /// The trace's `event`.
@@ -224,6 +265,7 @@ impl EventKind {
             EventKind::Leash => "leash",
             EventKind::Detection => "detection",
             EventKind::Telemetry => "telemetry",
+            EventKind::Operator => "operator",
         }
     }
 }
@@ -246,6 +288,7 @@ impl Event<'_> {
             Event::Leash { .. } => EventKind::Leash,
             Event::Detection { .. } => EventKind::Detection,
             Event::Telemetry { .. } => EventKind::Telemetry,
+            Event::Operator { .. } => EventKind::Operator,
         }
     }
 }

@@ -2,7 +2,7 @@
 //! starts (docs/OPERATOR_API.md).
 
 use aviary_syntax::ast::{Expr, ExprKind};
-use clap::Subcommand;
+use clap::{Subcommand, ValueEnum};
 use serde_json::{json, Value};
 
 #[derive(Subcommand)]
@@ -16,12 +16,41 @@ pub enum CtlCommand {
     Leash { activity: String, action: String, args: Vec<String> },
     /// Raise a signal the mission hears: `signal Go`, `signal Found (120, 40) Body`
     Signal { name: String, values: Vec<String> },
+    /// Steer one drone: `drone scout1 hold` (its activities wait where they are), `resume`,
+    /// `home` or `land` (its activities are aborted and it leaves the mission, flying home
+    /// or landing where it is)
+    Drone { name: String, action: DroneCtl },
     /// Hold every drone where it is
     Pause,
     /// Go on after `pause`
     Resume,
     /// End the mission; the fleet returns home
     Abort,
+}
+
+/// What `aviary ctl drone NAME ACTION` tells a drone.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum DroneCtl {
+    /// Hold its activities where they are
+    Hold,
+    /// Let them go on after `hold`
+    Resume,
+    /// Abort its activities and send it home, out of the mission
+    Home,
+    /// Abort its activities and land it where it is, out of the mission
+    Land,
+}
+
+impl DroneCtl {
+    /// As the operator API takes it.
+    fn as_str(self) -> &'static str {
+        match self {
+            DroneCtl::Hold => "hold",
+            DroneCtl::Resume => "resume",
+            DroneCtl::Home => "home",
+            DroneCtl::Land => "land",
+        }
+    }
 }
 
 pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
@@ -57,6 +86,9 @@ pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
                 }
             }
             post(base, "signal", token, json!({ "name": name, "args": args }))
+        }
+        CtlCommand::Drone { name, action } => {
+            post(base, "drone", token, json!({ "drone": name, "action": action.as_str() }))
         }
         CtlCommand::Pause => post(base, "pause", token, json!({})),
         CtlCommand::Resume => post(base, "resume", token, json!({})),

@@ -1,13 +1,16 @@
 //! The operator API through the real server and `aviary ctl`: a leash round trip (pause
 //! holds the drone, resume goes on, abort ends the activity `aborted`), the state, the
 //! event stream, and refusal without the token. `operator/` holds the checks of who
-//! may call (`guard.rs`) and of what an operator may send (`args.rs`).
+//! may call (`guard.rs`), of what an operator may send (`args.rs`), and of steering one
+//! drone (`drone.rs`).
 
 #[path = "operator/args.rs"]
 mod args;
 #[path = "operator/batches.rs"]
 mod batches;
 mod common;
+#[path = "operator/drone.rs"]
+mod drone;
 #[path = "operator/guard.rs"]
 mod guard;
 #[path = "operator/serve.rs"]

@@ -79,6 +79,15 @@ impl<'m> Engine<'m> {
         ctx: &Ctx<'m>,
     ) -> Option<Started> {
         let cap = &self.m.capabilities[call.capability];
+        if self.any_withdrawn(&actors) {
+            // A drone of it is out of the mission (the operator took it, `steer.rs`): it
+            // ends at once, without flying, and its block goes on.
+            self.trace(EventKind::CapabilityStart, || {
+                self.capability_event(call, &actors, &args, None)
+            });
+            self.capability_end(call, &actors, &args, Status::Aborted);
+            return None;
+        }
         if self.too_deep(call, &actors, ctx) {
             return None;
         }
@@ -204,7 +213,9 @@ impl<'m> Engine<'m> {
         let drive = pin!(self.drive(&scope, body));
         let finished = instance.token.run(drive).await.is_some();
         self.instances.borrow_mut().remove(&instance);
-        if !finished && instance.by_leash.get() {
+        // Not for a drone the operator took out of the mission (`steer.rs`): the way down
+        // is the operator's, not the section's.
+        if !finished && instance.by_leash.get() && !self.any_withdrawn(&instance.actors) {
             // `PERFORM ABORT:` says what aborting this activity also does.
             if let Some((_, section)) = cap.abort_section.map(|k| &cap.sections[k]) {
                 let after = Ctx { instance: None, ..inner.clone() };
@@ -257,6 +268,11 @@ impl<'m> Engine<'m> {
         ctx: &Ctx<'m>,
     ) -> Rc<Instance> {
         let cap = &self.m.capabilities[call.capability];
+        // A drone of it the operator holds holds the activity its statement started.
+        let held = actors.iter().any(|d| self.steering.held(*d));
+        if let (true, Some(parent)) = (held, &ctx.instance) {
+            self.hold_root(parent.root());
+        }
         Rc::new(Instance {
             id,
             capability: call.capability,
@@ -273,6 +289,7 @@ impl<'m> Engine<'m> {
             failed: Cell::new(false),
             // An activity started while the operator holds the mission starts held.
             paused: Cell::new(ctx.instance.is_none() && self.mission_paused.get()),
+            held: Cell::new(ctx.instance.is_none() && held),
             resumed: Notify::new(),
             calls: RefCell::new(SmallVec::new()),
             depth: ctx.instance.as_ref().map_or(0, |p| p.depth + 1),

@@ -40,7 +40,7 @@ impl<'m> Engine<'m> {
         if let Some(root) = ctx.instance.as_ref().map(|i| i.root()) {
             loop {
                 let resumed = root.resumed.notified();
-                if !root.paused.get() {
+                if !root.waits() {
                     break;
                 }
                 resumed.await;
@@ -88,7 +88,7 @@ impl<'m> Engine<'m> {
                 let guard = CallGuard { engine: self, call: &call, root, done: Cell::new(false) };
                 if let Some(root) = root {
                     root.calls.borrow_mut().push(call.id);
-                    if root.paused.get() {
+                    if root.waits() {
                         self.backend.interrupt(call.id, Interrupt::Pause);
                     }
                 }

@@ -1,6 +1,10 @@
 //! Live control from outside the mission: an operator's leashes and signals, pausing
-//! and aborting the whole mission (issue: operator API), and a backend that died.
+//! and aborting the whole mission (issue: operator API), steering one drone (`steer.rs`),
+//! and a backend that died. What the operator does to the mission or a drone is written
+//! to the trace as an `operator` event; leashes and signals are written as the mission's
+//! own are.
 
+use aviary_api::trace::{Event, EventKind, OperatorAction};
 use aviary_api::{Interrupt, Value};
 use aviary_ir::LeashAction;
 use tokio::sync::{mpsc, oneshot};
@@ -25,6 +29,11 @@ pub enum Control {
     /// Holds every drone's activity where it is, until `Resume`.
     Pause,
     Resume,
+    /// Steers one drone, by name (`steer.rs`).
+    Drone {
+        drone: String,
+        action: DroneAction,
+    },
     /// Ends the mission: the fleet returns home, and the mission ends `aborted`.
     Abort {
         reason: String,
@@ -33,6 +42,33 @@ pub enum Control {
     BackendLost {
         reason: String,
     },
+}
+
+/// What the operator does to one drone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DroneAction {
+    /// Pauses every activity of the drone, as a `PAUSE` leash would, and those that start
+    /// while it is held; a group activity with it is held whole.
+    Hold,
+    /// Undoes `Hold` (not a pause of the whole mission: each holds on its own).
+    Resume,
+    /// Aborts every activity of the drone, as an `ABORT` leash would, and sends it home,
+    /// out of the mission for the rest of the run.
+    ReturnHome,
+    /// As `ReturnHome`, but lands it where it is.
+    Land,
+}
+
+impl DroneAction {
+    /// As the trace writes it.
+    pub fn traced(self) -> OperatorAction {
+        match self {
+            DroneAction::Hold => OperatorAction::Hold,
+            DroneAction::Resume => OperatorAction::Resume,
+            DroneAction::ReturnHome => OperatorAction::ReturnHome,
+            DroneAction::Land => OperatorAction::Land,
+        }
+    }
 }
 
 /// A control and where to send its answer (`Err` says why it was refused).
@@ -75,6 +111,14 @@ impl<'m> Engine<'m> {
             let _ = answer.send(self.apply(control));
         }
         std::future::pending::<()>().await;
+    }
+
+    /// The `operator` event: what the operator did, to a drone or (`None`) the mission.
+    pub(crate) fn operator(&self, action: OperatorAction, drone: Option<aviary_api::DroneId>) {
+        self.trace(EventKind::Operator, || Event::Operator {
+            action,
+            drone: drone.map(|d| self.name(d).into()),
+        });
     }
 
     fn apply(&self, control: Control) -> Result<(), String> {
@@ -129,22 +173,31 @@ impl<'m> Engine<'m> {
             }
             Control::Pause | Control::Resume => {
                 let pause = control == Control::Pause;
+                self.operator(
+                    if pause { OperatorAction::Pause } else { OperatorAction::Resume },
+                    None,
+                );
                 self.mission_paused.set(pause);
                 for (instance, _) in
                     self.instances.borrow().all().iter().filter(|(i, _)| i.root.is_none())
                 {
                     instance.paused.set(pause);
-                    for call in instance.calls.borrow().iter() {
-                        self.backend.interrupt(
-                            *call,
-                            if pause { Interrupt::Pause } else { Interrupt::Resume },
-                        );
+                    // A drone the operator holds stays held: its calls are left paused.
+                    if !instance.held.get() {
+                        for call in instance.calls.borrow().iter() {
+                            self.backend.interrupt(
+                                *call,
+                                if pause { Interrupt::Pause } else { Interrupt::Resume },
+                            );
+                        }
                     }
                     instance.resumed.notify_waiters();
                 }
                 Ok(())
             }
+            Control::Drone { drone, action } => self.steer(&drone, action),
             Control::Abort { reason } => {
+                self.operator(OperatorAction::Abort, None);
                 self.end_with(crate::Status::Aborted, reason, true);
                 Ok(())
             }

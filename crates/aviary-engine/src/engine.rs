@@ -74,7 +74,11 @@ pub(crate) struct Instance {
     pub perform: Option<CancellationToken>,
     pub by_leash: Cell<bool>,
     pub failed: Cell<bool>,
+    /// Paused by a leash or with the whole mission (kept on the root).
     pub paused: Cell<bool>,
+    /// Held because the operator holds a drone of it (kept on the root, `steer.rs`). On
+    /// its own beside `paused`: either holds the activity, and resuming one leaves the other.
+    pub held: Cell<bool>,
     pub resumed: Notify,
     pub calls: RefCell<smallvec::SmallVec<[aviary_api::CallId; 2]>>,
     pub depth: usize,
@@ -85,6 +89,11 @@ pub(crate) struct Instance {
 impl Instance {
     pub fn root(self: &Rc<Self>) -> &Rc<Instance> {
         self.root.as_ref().unwrap_or(self)
+    }
+
+    /// Whether this root's calls wait: paused (a leash, the mission) or held (a drone).
+    pub fn waits(&self) -> bool {
+        self.paused.get() || self.held.get()
     }
 }
 
@@ -117,6 +126,14 @@ pub(crate) struct Engine<'m> {
     backend_alive: Cell<bool>,
     /// The operator paused the whole mission.
     pub mission_paused: Cell<bool>,
+    /// What the operator did to single drones (`steer.rs`).
+    pub steering: crate::steer::Steering,
+    /// Faults of drones on their way down, outside the mission: after its end, or once the
+    /// operator took them out of it (`homing.rs`).
+    pub down_faults: crate::homing::Faults,
+    /// Set once the mission's body, handlers and controls are over and only the way
+    /// down is left.
+    pub over: Cell<bool>,
     /// Running scopes that declare handlers, in the order they started (for signals from
     /// outside the mission, which every running block hears).
     pub listeners: RefCell<Vec<std::rc::Weak<Scope<'m>>>>,
@@ -153,6 +170,9 @@ impl<'m> Engine<'m> {
             ending: RefCell::new(None),
             backend_alive: Cell::new(true),
             mission_paused: Cell::new(false),
+            steering: Default::default(),
+            down_faults: Default::default(),
+            over: Cell::new(false),
             listeners: RefCell::new(Vec::new()),
             stop: CancellationToken::new(),
             events: RefCell::new(backend.events()),
@@ -241,6 +261,9 @@ impl<'m> Engine<'m> {
         // the mission is one task, every wait is on time or a notification, and the
         // simulator's driver runs whenever the mission waits.
         let body = tokio::task::unconstrained(body);
+        // Drones the operator took out of the mission, brought down beside it and after
+        // its end (last: what the mission does at an instant comes first).
+        let mut withdrawals = Box::pin(self.withdrawals());
         tokio::select! {
             biased;
             _ = self.stop.cancelled() => {}
@@ -248,11 +271,19 @@ impl<'m> Engine<'m> {
             _ = self.pump() => {}
             _ = controls => {}
             _ = self.telemetry(options.telemetry_hz) => {}
+            _ = withdrawals.as_mut() => {}
         }
+        self.over.set(true);
         let ending = self.ending.borrow().clone();
         // Drones still flying go home: at the end of the mission, or as the failsafe.
-        let home =
-            if self.backend_alive.get() { self.all_home().await } else { Default::default() };
+        let home = if self.backend_alive.get() {
+            self.all_home(withdrawals.as_mut()).await
+        } else {
+            Default::default()
+        };
+        // Nobody can be commanded any more: a drone on its way down is left to it, its
+        // call written as ended before the mission's end.
+        drop(withdrawals);
         let (mut status, mut reason) = match ending {
             Some((status, reason)) => (status, Some(reason)),
             None => (Status::Ok, None),
@@ -359,6 +390,12 @@ impl<'m> Engine<'m> {
     }
 
     fn on_event(&self, event: DroneEvent) {
+        // A drone the operator took out of the mission is on its way down: the mission
+        // no longer hears from it (`steer.rs`).
+        if self.steering.withdrawn(crate::homing::drone_of(&event)).is_some() {
+            self.on_the_way_down(event);
+            return;
+        }
         match event {
             DroneEvent::Detected { drone, kind, location } => {
                 self.trace(EventKind::Detection, || Event::Detection {

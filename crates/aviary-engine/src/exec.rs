@@ -495,14 +495,20 @@ impl<'m> Engine<'m> {
                 }
                 LeashAction::Pause => {
                     instance.paused.set(true);
-                    for call in instance.calls.borrow().iter() {
-                        self.backend.interrupt(*call, Interrupt::Pause);
+                    // Those of a drone the operator holds are paused already.
+                    if !instance.held.get() {
+                        for call in instance.calls.borrow().iter() {
+                            self.backend.interrupt(*call, Interrupt::Pause);
+                        }
                     }
                 }
                 LeashAction::Resume => {
                     instance.paused.set(false);
-                    for call in instance.calls.borrow().iter() {
-                        self.backend.interrupt(*call, Interrupt::Resume);
+                    // A drone the operator holds stays held.
+                    if !instance.held.get() {
+                        for call in instance.calls.borrow().iter() {
+                            self.backend.interrupt(*call, Interrupt::Resume);
+                        }
                     }
                     instance.resumed.notify_waiters();
                 }

@@ -1,5 +1,7 @@
 //! After the mission's body, and as the failsafe after an unhandled exception or an
-//! abort: every drone still in the air is brought down, and watched until it is.
+//! abort: every drone still in the air is brought down, and watched until it is. A drone
+//! the operator takes out of the mission (`steer.rs`) is brought down the same way,
+//! at once, beside the rest of the mission: home, or where it is.
 //!
 //! A fault that hits a drone on its way home is still an exception: it is recorded
 //! (unhandled: the mission's handlers have ended) and the drone is sent again, home or,
@@ -9,13 +11,20 @@
 //! cannot be reached for [`LINK_WAIT`] or keeps refusing for [`REFUSED_FOR`]: then it is
 //! left to its autopilot's own failsafe, and the outcome says so.
 
+use std::cell::Cell;
+use std::future::{poll_fn, Future};
+use std::pin::Pin;
+use std::rc::Rc;
+use std::task::Poll;
 use std::time::Duration;
 
 use aviary_api::{BuiltinException, CallEnd, DroneEvent, DroneId, FlightState, Function};
+use futures_util::stream::{FuturesUnordered, StreamExt};
 use tokio::time::Instant;
 
-use crate::engine::Engine;
-use aviary_api::trace::{Event, EventKind, Shown};
+use crate::engine::{Engine, Instance};
+use crate::steer::Down;
+use aviary_api::trace::{CallStatus, Event, EventKind, Shown};
 
 /// How long a drone in the air may stay out of reach before it is left to its
 /// autopilot. Longer than any autopilot's own link-loss failsafe takes to act
@@ -28,6 +37,9 @@ const REFUSED_FOR: Duration = Duration::from_secs(300);
 const RETRY: Duration = Duration::from_secs(2);
 /// How often an unreachable drone's link is looked at.
 const LINK_POLL: Duration = Duration::from_millis(500);
+/// How many polls of the run a drone the operator took out waits for its aborted
+/// activities to end before it is sent down (one is enough, a few when they nest).
+const ABORTED_POLLS: usize = 16;
 
 /// What the way down did to the fleet.
 #[derive(Default)]
@@ -38,9 +50,10 @@ pub(crate) struct Homecoming {
     pub notes: Vec<String>,
 }
 
-/// The faults seen after the mission's handlers ended, in order.
+/// The faults of drones on their way down, outside the mission, in order: seen after
+/// the mission's handlers ended, or of a drone the operator took out of it.
 #[derive(Default)]
-struct Faults {
+pub(crate) struct Faults {
     seen: std::cell::RefCell<Vec<(DroneId, BuiltinException)>>,
 }
 
@@ -56,26 +69,37 @@ fn lands_where_it_is(exception: BuiltinException) -> bool {
 }
 
 impl<'m> Engine<'m> {
-    /// Brings every drone in the air down, recording what happens to them on the way.
-    /// Returns what the outcome must say: the drones that did not come down safely
-    /// (which fail the mission), and the faults of those that did.
-    pub(crate) async fn all_home(&self) -> Homecoming {
+    /// Brings every drone in the air down, recording what happens to them on the way,
+    /// and lets `withdrawals` (what `Engine::withdrawals` made) finish bringing down those
+    /// the operator took out of the mission. Returns what the outcome must say: the drones
+    /// that did not come down safely (which fail the mission), and the faults of those
+    /// that did.
+    pub(crate) async fn all_home(
+        &self,
+        withdrawals: Pin<&mut impl Future<Output = ()>>,
+    ) -> Homecoming {
+        // A drone the operator took out is brought down by its own withdrawal, which
+        // goes on here, whether it is still on its way or was left to its autopilot.
         let flying: Vec<DroneId> = (0..self.m.drones.len())
-            .filter(|&d| self.backend.telemetry(d).state.airborne())
+            .filter(|&d| {
+                self.steering.withdrawn(d).is_none() && self.backend.telemetry(d).state.airborne()
+            })
             .collect();
-        if flying.is_empty() {
+        if flying.is_empty() && !self.steering.any_withdrawn() {
             return Homecoming::default();
         }
-        let faults = Faults::default();
-        let homes =
-            futures_util::future::join_all(flying.into_iter().map(|d| self.bring_down(d, &faults)));
-        let stranded: Vec<(DroneId, String)> = tokio::select! {
+        let homes = futures_util::future::join_all(flying.into_iter().map(|d| self.bring_down(d)));
+        let mut stranded: Vec<(DroneId, String)> = tokio::select! {
             biased;
-            stranded = homes => stranded.into_iter().flatten().collect(),
-            _ = self.watch_after_end(&faults) => unreachable!("drone events never end"),
+            (stranded, ()) = futures_util::future::join(homes, withdrawals) => {
+                stranded.into_iter().flatten().collect()
+            }
+            _ = self.watch_after_end() => unreachable!("drone events never end"),
         };
+        stranded.extend(self.steering.stranded.take());
+        stranded.sort_by_key(|(d, _)| *d);
         let mut notes = Vec::new();
-        for (d, exception) in faults.seen.borrow().iter() {
+        for (d, exception) in self.down_faults.seen.borrow().iter() {
             if !stranded.iter().any(|(s, _)| s == d) {
                 notes.push(format!(
                     "{exception} on {} on its way down, which it survived",
@@ -87,7 +111,7 @@ impl<'m> Engine<'m> {
     }
 
     /// One drone: sent home (or down) until it is on the ground or lost.
-    async fn bring_down(&self, d: DroneId, faults: &Faults) -> Option<(DroneId, String)> {
+    async fn bring_down(&self, d: DroneId) -> Option<(DroneId, String)> {
         let name = self.name(d);
         let mut refused_since: Option<Instant> = None;
         loop {
@@ -104,18 +128,26 @@ impl<'m> Engine<'m> {
                 }
                 continue;
             }
-            let function = if faults.last(d).is_some_and(lands_where_it_is) {
-                Function::Land
-            } else {
-                Function::ReturnToLaunch
-            };
+            let function = self.way_down(d);
             self.trace(EventKind::ApiCall, || Event::ApiCall {
                 actor: name.into(),
                 function,
                 args: Vec::new(),
             });
             let pending = self.backend.call(d, function, &[]);
-            let end = pending.end.wait().await.unwrap_or(CallEnd::Interrupted);
+            let end = {
+                let guard = DownGuard { engine: self, drone: d, function, done: Cell::new(false) };
+                self.steering.calls.borrow_mut().push((d, pending.id));
+                let end = pending.end.wait().await.unwrap_or(CallEnd::Interrupted);
+                guard.done.set(true);
+                self.steering.calls.borrow_mut().retain(|(x, _)| *x != d);
+                end
+            };
+            if self.steering.take_cut(d) && end == CallEnd::Interrupted {
+                // The operator landed a drone on its way home: the return was cut for it.
+                self.trace_cut(d, function);
+                continue;
+            }
             self.trace_done(d, function, &[], &end);
             if end == CallEnd::Done {
                 refused_since = None;
@@ -135,6 +167,114 @@ impl<'m> Engine<'m> {
         }
     }
 
+    /// How `d` comes down now: landed where it is when the operator said so or its fault
+    /// requires it, else home.
+    fn way_down(&self, d: DroneId) -> Function {
+        if self.steering.withdrawn(d) == Some(Down::Land)
+            || self.down_faults.last(d).is_some_and(lands_where_it_is)
+        {
+            Function::Land
+        } else {
+            Function::ReturnToLaunch
+        }
+    }
+
+    /// `api_done` of a call on the way down that will not end as it was: `aborted`.
+    fn trace_cut(&self, d: DroneId, function: Function) {
+        self.trace(EventKind::ApiDone, || Event::ApiDone {
+            actor: self.name(d).into(),
+            function,
+            args: Vec::new(),
+            status: CallStatus::Aborted,
+            position: self.backend.telemetry(d).position,
+        });
+    }
+
+    /// Brings down, beside the mission, each drone the operator takes out of it, as
+    /// `steer.rs` queues them. Ends once the mission is over (`over`) and every one of them
+    /// is down or left to its autopilot; until then it never ends.
+    pub(crate) async fn withdrawals(&self) {
+        let mut running = FuturesUnordered::new();
+        poll_fn(|cx| loop {
+            for (d, aborted) in self.steering.queued.take() {
+                running.push(self.withdraw(d, aborted));
+            }
+            while let Poll::Ready(Some(())) = running.poll_next_unpin(cx) {}
+            // A drone queued by what just ran is taken at once.
+            if !self.steering.queued.borrow().is_empty() {
+                continue;
+            }
+            self.steering.waker.replace(Some(cx.waker().clone()));
+            return if running.is_empty() && self.over.get() {
+                Poll::Ready(())
+            } else {
+                Poll::Pending
+            };
+        })
+        .await
+    }
+
+    /// One drone the operator took out: once the activities aborted for it have ended
+    /// (their calls cut, their ends written), it is brought down as at the end.
+    async fn withdraw(&self, d: DroneId, aborted: Vec<Rc<Instance>>) {
+        // Each ends at its next poll, which comes first in the run's order; after the
+        // mission's end, with its body dropped, none ever will, and none is in the way.
+        // Their calls were cut as they were aborted, so the wait is only for the trace's
+        // order, and it is bounded: an activity dropped inside another (a `PERFORM
+        // ABORT:` section's) never leaves the registry, and time stands still while this
+        // waits.
+        let mut polls = 0;
+        while !self.over.get()
+            && polls < ABORTED_POLLS
+            && aborted.iter().any(|r| self.registered(r))
+        {
+            polls += 1;
+            yield_once().await;
+        }
+        if let Some(stranded) = self.bring_down(d).await {
+            self.steering.stranded.borrow_mut().push(stranded);
+        }
+    }
+
+    /// Whether a root activity still runs (is in the registry).
+    fn registered(&self, root: &Rc<Instance>) -> bool {
+        let instances = self.instances.borrow();
+        root.actors.iter().any(|d| instances.of_actor(*d).any(|(i, _)| Rc::ptr_eq(i, root)))
+    }
+
+    /// A drone event of a drone on its way down, outside the mission: a fault is still an
+    /// exception of its drone, recorded, unhandled, and remembered (it may decide how the
+    /// drone comes down); the rest is recorded as it comes.
+    pub(crate) fn on_the_way_down(&self, event: DroneEvent) {
+        match event {
+            DroneEvent::Fault { drone, failure } => {
+                self.down_faults.seen.borrow_mut().push((drone, failure.exception));
+                self.trace(EventKind::Exception, || Event::Exception {
+                    name: failure.exception.name().into(),
+                    actor: Some(self.name(drone).into()),
+                    args: vec![Shown::Text(failure.reason.as_str().into())],
+                    handled: false,
+                    handler: None,
+                    during: Some("return home".into()),
+                });
+            }
+            DroneEvent::Signal { drone, signal } => {
+                self.trace(EventKind::Signal, || Event::Signal {
+                    name: signal.name().into(),
+                    actor: Some(self.name(drone).into()),
+                    args: Vec::new(),
+                });
+            }
+            DroneEvent::Detected { drone, kind, location } => {
+                self.trace(EventKind::Detection, || Event::Detection {
+                    actor: self.name(drone).into(),
+                    kind: kind.as_str().into(),
+                    location,
+                });
+            }
+        }
+    }
+
     /// Waits until the drone can be reached again (or is no longer in the air); false
     /// after [`LINK_WAIT`].
     async fn link_back(&self, d: DroneId) -> bool {
@@ -149,38 +289,54 @@ impl<'m> Engine<'m> {
         false
     }
 
-    /// Drone events after the mission's handlers have ended: a fault is still an
-    /// exception of its drone (recorded, unhandled), the rest is recorded as it comes.
-    async fn watch_after_end(&self, faults: &Faults) {
+    /// Drone events after the mission's handlers have ended, each as on the way down.
+    async fn watch_after_end(&self) {
         loop {
             match self.next_event().await {
-                Some(DroneEvent::Fault { drone, failure }) => {
-                    faults.seen.borrow_mut().push((drone, failure.exception));
-                    self.trace(EventKind::Exception, || Event::Exception {
-                        name: failure.exception.name().into(),
-                        actor: Some(self.name(drone).into()),
-                        args: vec![Shown::Text(failure.reason.as_str().into())],
-                        handled: false,
-                        handler: None,
-                        during: Some("return home".into()),
-                    });
-                }
-                Some(DroneEvent::Signal { drone, signal }) => {
-                    self.trace(EventKind::Signal, || Event::Signal {
-                        name: signal.name().into(),
-                        actor: Some(self.name(drone).into()),
-                        args: Vec::new(),
-                    });
-                }
-                Some(DroneEvent::Detected { drone, kind, location }) => {
-                    self.trace(EventKind::Detection, || Event::Detection {
-                        actor: self.name(drone).into(),
-                        kind: kind.as_str().into(),
-                        location,
-                    });
-                }
+                Some(event) => self.on_the_way_down(event),
                 None => std::future::pending().await,
             }
+        }
+    }
+}
+
+/// The drone a drone event is of.
+pub(crate) fn drone_of(event: &DroneEvent) -> DroneId {
+    match event {
+        DroneEvent::Detected { drone, .. }
+        | DroneEvent::Signal { drone, .. }
+        | DroneEvent::Fault { drone, .. } => *drone,
+    }
+}
+
+/// Lets every other branch of the run be polled once before going on.
+async fn yield_once() {
+    let mut yielded = false;
+    poll_fn(|cx| {
+        if yielded {
+            return Poll::Ready(());
+        }
+        yielded = true;
+        cx.waker().wake_by_ref();
+        Poll::Pending
+    })
+    .await
+}
+
+/// Writes `api_done` (`aborted`) for a call on the way down whose wait is dropped before
+/// it ended (the backend was lost): every `api_call` has its `api_done`.
+struct DownGuard<'e, 'm> {
+    engine: &'e Engine<'m>,
+    drone: DroneId,
+    function: Function,
+    done: Cell<bool>,
+}
+
+impl Drop for DownGuard<'_, '_> {
+    fn drop(&mut self) {
+        if !self.done.get() {
+            self.engine.steering.calls.borrow_mut().retain(|(x, _)| *x != self.drone);
+            self.engine.trace_cut(self.drone, self.function);
         }
     }
 }

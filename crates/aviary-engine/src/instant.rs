@@ -131,7 +131,8 @@ impl<'m> Engine<'m> {
     ) -> Option<Stopped> {
         let cap = &self.m.capabilities[call.capability];
         let parent = ctx.instance.as_ref().map_or(&self.stop, |p| &p.token);
-        if parent.is_cancelled() {
+        // A drone out of the mission: the general path ends it at once (`steer.rs`).
+        if parent.is_cancelled() || self.steering.withdrawn(drone).is_some() {
             return Some(Stopped::Start(args));
         }
         let actors = [drone];
@@ -157,11 +158,13 @@ impl<'m> Engine<'m> {
             }
             let Some(to) = self.api_drone(a, &frame) else { continue };
             // The activity's root: the caller's, or this one, which starts held while the
-            // operator holds the mission.
-            let paused = ctx
-                .instance
-                .as_ref()
-                .map_or_else(|| self.mission_paused.get(), |p| p.root().paused.get());
+            // operator holds the mission. Either is held while the operator holds its
+            // drone (the general path's `new_instance` holds the caller's then).
+            let paused = self.steering.held(drone)
+                || ctx
+                    .instance
+                    .as_ref()
+                    .map_or_else(|| self.mission_paused.get(), |p| p.root().waits());
             if paused {
                 return Some(Stopped::At { id, needs, frame, args, at, begun: None });
             }

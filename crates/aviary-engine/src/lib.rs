@@ -22,13 +22,14 @@ mod instant;
 mod jobs;
 mod join;
 mod registry;
+mod steer;
 mod value;
 
 use aviary_api::Backend;
 
-pub use aviary_api::trace::{Event, EventKind, Record, Status};
+pub use aviary_api::trace::{Event, EventKind, OperatorAction, Record, Status};
 use aviary_ir::Mission;
-pub use control::{Control, ControlRequest, Controller};
+pub use control::{Control, ControlRequest, Controller, DroneAction};
 
 /// Where trace events go, in order: the typed events of `aviary_api::trace`, which a
 /// sink writes as JSON (the trace file, the operator API) or reads field by field.

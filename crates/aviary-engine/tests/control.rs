@@ -152,6 +152,16 @@ fn pausing_the_mission_holds_every_drone_and_resuming_goes_on() {
             "{drone} holds while the mission is paused"
         );
     }
+    let operator: Vec<(f64, &str, &Json)> = trace
+        .iter()
+        .filter(|e| e["event"] == "operator")
+        .map(|e| (e["t"].as_f64().unwrap(), e["action"].as_str().unwrap(), &e["drone"]))
+        .collect();
+    assert_eq!(
+        operator,
+        [(15.0, "pause", &Json::Null), (25.0, "resume", &Json::Null)],
+        "each written when the operator did it, for the whole mission"
+    );
 }
 
 #[test]
@@ -184,6 +194,15 @@ fn aborting_the_mission_sends_the_fleet_home() {
     );
     assert_eq!(outcome.status, Status::Aborted);
     assert_eq!(outcome.reason.as_deref(), Some("aborted by the operator"));
+    let said = trace.iter().position(|e| e["event"] == "operator").unwrap();
+    assert_eq!(
+        (trace[said]["t"].as_f64(), trace[said]["action"].as_str(), &trace[said]["drone"]),
+        (Some(12.0), Some("abort"), &Json::Null)
+    );
+    assert!(
+        trace[said + 1..].iter().all(|e| e["event"] != "capability_start"),
+        "written before what it does"
+    );
     let home: Vec<&str> = trace
         .iter()
         .filter(|e| e["event"] == "api_done" && e["function"] == "ReturnToLaunch")

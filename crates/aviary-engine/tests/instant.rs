@@ -4,7 +4,7 @@
 //! instant activity has to wait and becomes a general one (its claims are busy, its root
 //! is paused, a call takes time, a call fails), and generated ones (`mod generated`).
 
-use aviary_engine::{Control, RunOptions, Status};
+use aviary_engine::{Control, DroneAction, RunOptions, Status};
 use aviary_test_support::harness;
 use harness::Path;
 
@@ -177,7 +177,8 @@ fn a_capability_whose_calls_take_time_goes_on_where_it_stood() {
 /// what can make it wait or stop: claims held by another activity (PARALLEL blocks, FOR,
 /// groups), calls that take time, a call that fails (`c` has no camera), signals and
 /// their handlers, exception handlers, leashes on its tag, the operator's pause, resume
-/// and abort, and drone faults at any time. Both paths must give the same trace, event
+/// and abort of the mission and hold, resume, return home and land of a drone, and drone
+/// faults at any time. Both paths must give the same trace, event
 /// for event.
 mod generated {
     use super::*;
@@ -278,7 +279,7 @@ mod generated {
             self.text.push('\n');
         }
 
-        fn stmt(&mut self, s: &Stmt, depth: usize, leashes: &mut Vec<(usize, usize)>) {
+        fn stmt(&mut self, s: &Stmt, depth: usize, leashes: &mut Vec<(usize, usize, bool)>) {
             match s {
                 // Under an exception handler, only calls that cannot fail: one that fails at
                 // once (`c` has no camera; a hover on the ground) would have the handler
@@ -311,15 +312,15 @@ mod generated {
                 // held for ever would hold the mission for ever, on either path.
                 Stmt::Leash { tag, action: "PAUSE" } => {
                     self.line(depth, "SEQUENTIAL:");
-                    leashes.push((self.text.len(), *tag));
+                    leashes.push((self.text.len(), *tag, self.in_handler));
                     self.line(depth + 1, "@LEASH PAUSE");
                     self.line(depth + 1, &format!("WAITFOR ELAPSED >= {}s", tag + 2));
-                    leashes.push((self.text.len(), *tag));
+                    leashes.push((self.text.len(), *tag, self.in_handler));
                     self.line(depth + 1, "@LEASH RESUME");
                 }
                 Stmt::Leash { tag, action } => {
                     // Its tag is named once the whole mission is known (see `mission`).
-                    leashes.push((self.text.len(), *tag));
+                    leashes.push((self.text.len(), *tag, self.in_handler));
                     self.line(depth, &format!("@LEASH {action}"));
                 }
                 Stmt::For { parallel, capability } => {
@@ -359,7 +360,8 @@ mod generated {
     }
 
     /// The mission's text: the capabilities, then a MISSION of `items`. A leash names a
-    /// tag of the mission, or becomes a signal when there is none.
+    /// tag of the mission, or becomes a signal when there is none (a wait in a handler,
+    /// for the reason `Stmt::Signal` is one there).
     fn mission(items: &[Stmt]) -> String {
         let mut r =
             Render { text: String::new(), tags: 0, in_handler: false, in_exception_handler: false };
@@ -368,12 +370,14 @@ mod generated {
             r.stmt(item, 1, &mut leashes);
         }
         let mut text = r.text;
-        for (at, tag) in leashes.into_iter().rev() {
+        for (at, tag, in_handler) in leashes.into_iter().rev() {
             let end = at + text[at..].find('\n').unwrap_or(0);
             let line = &text[at..end];
             let indent = line.len() - line.trim_start().len();
             let action = line.trim_start().trim_start_matches("@LEASH ").to_string();
-            let replacement = if r.tags == 0 {
+            let replacement = if r.tags == 0 && in_handler {
+                format!("{}WAITFOR ELAPSED >= 1s", &line[..indent])
+            } else if r.tags == 0 {
                 format!("{}SIGNAL S0", &line[..indent])
             } else {
                 let capability = find_tagged(&text, tag % r.tags + 1);
@@ -410,10 +414,18 @@ mod generated {
     }
 
     fn control() -> impl Strategy<Value = (f64, Control)> {
+        let drone = |action| {
+            prop::sample::select(vec!["a", "b", "c"])
+                .prop_map(move |d| Control::Drone { drone: d.into(), action })
+        };
         let control = prop_oneof![
             4 => Just(Control::Pause),
             4 => Just(Control::Resume),
             1 => Just(Control::Abort { reason: "the operator".into() }),
+            3 => drone(DroneAction::Hold),
+            3 => drone(DroneAction::Resume),
+            1 => drone(DroneAction::ReturnHome),
+            1 => drone(DroneAction::Land),
         ];
         (0..40u8, control).prop_map(|(at, c)| (f64::from(at) / 2.0, c))
     }
@@ -433,9 +445,14 @@ mod generated {
         )
             .prop_map(|(items, faults, mut controls)| {
                 controls.sort_by(|a, b| a.0.total_cmp(&b.0));
-                // The operator always resumes in the end: a mission held for ever would
+                // The operator always resumes in the end, the mission and each drone (a
+                // drone not held refuses, alike both ways): a mission held for ever would
                 // never end, on either path.
                 controls.push((25.0, Control::Resume));
+                for d in ["a", "b", "c"] {
+                    let action = DroneAction::Resume;
+                    controls.push((25.0, Control::Drone { drone: d.into(), action }));
+                }
                 Case {
                     mission: mission(&items),
                     world: format!("{}\n{}", harness::WORLD, faults.join("\n")),

@@ -1,10 +1,10 @@
 //! The routes: `GET /api/state`, `GET /api/events` (WebSocket), and the control calls
-//! `POST /api/leash`, `/api/signal`, `/api/pause`, `/api/resume`, `/api/abort`.
+//! `POST /api/leash`, `/api/signal`, `/api/drone`, `/api/pause`, `/api/resume`, `/api/abort`.
 //! Who may call is decided before any of them runs (`guard.rs`).
 
 use std::sync::Arc;
 
-use aviary_engine::Control;
+use aviary_engine::{Control, DroneAction};
 use axum::extract::ws::rejection::WebSocketUpgradeRejection;
 use axum::extract::ws::WebSocketUpgrade;
 use axum::extract::{DefaultBodyLimit, State};
@@ -25,6 +25,7 @@ pub(crate) fn router(shared: Arc<Shared>) -> Router {
     let controls = Router::new()
         .route("/api/leash", post(leash))
         .route("/api/signal", post(signal))
+        .route("/api/drone", post(drone))
         .route("/api/pause", post(pause))
         .route("/api/resume", post(resume))
         .route("/api/abort", post(abort))
@@ -189,20 +190,41 @@ async fn signal(State(shared): State<Arc<Shared>>, Object(body): Object) -> Resp
     }
 }
 
+/// `{"drone": "scout1", "action": "hold"}`: `hold`, `resume`, `home` (or `return_home`,
+/// as the trace writes it) or `land`. Which drones there are is the engine's to say (409,
+/// with the name meant): the server knows the fleet only from the trace.
+async fn drone(State(shared): State<Arc<Shared>>, Object(body): Object) -> Response {
+    const ACTIONS: &str = "\"action\": \"hold\", \"resume\", \"home\" or \"land\"";
+    let Some(name) = body.get("drone").and_then(JsonValue::as_str) else {
+        return error(
+            StatusCode::BAD_REQUEST,
+            "name the drone: {\"drone\": \"scout1\", \"action\": \"hold\"}",
+        );
+    };
+    let action = match body.get("action").and_then(JsonValue::as_str) {
+        Some("hold") => DroneAction::Hold,
+        Some("resume") => DroneAction::Resume,
+        Some("home" | "return_home") => DroneAction::ReturnHome,
+        Some("land") => DroneAction::Land,
+        Some(other) => {
+            return error(
+                StatusCode::BAD_REQUEST,
+                format!("`{other}` is not something a drone is told: {ACTIONS}"),
+            )
+        }
+        None => return error(StatusCode::BAD_REQUEST, format!("say what to do: {ACTIONS}")),
+    };
+    control(&shared, Control::Drone { drone: name.to_string(), action }).await
+}
+
+// The state's `paused` follows the trace's `operator` events (`state.rs`), which the
+// engine writes before it answers.
 async fn pause(State(shared): State<Arc<Shared>>) -> Response {
-    let response = control(&shared, Control::Pause).await;
-    if response.status().is_success() {
-        shared.state().set_paused(true);
-    }
-    response
+    control(&shared, Control::Pause).await
 }
 
 async fn resume(State(shared): State<Arc<Shared>>) -> Response {
-    let response = control(&shared, Control::Resume).await;
-    if response.status().is_success() {
-        shared.state().set_paused(false);
-    }
-    response
+    control(&shared, Control::Resume).await
 }
 
 async fn abort(State(shared): State<Arc<Shared>>) -> Response {

@@ -1,6 +1,6 @@
 //! What the operator sees: the mission's state, folded from its trace events.
 
-use aviary_api::trace::{Event, Params, Record};
+use aviary_api::trace::{Event, OperatorAction, Params, Record};
 use serde_json::{json, Value};
 
 #[derive(Default)]
@@ -10,12 +10,22 @@ pub struct MissionState {
     /// `running`, then the outcome (`ok`, `failed`, `aborted`); empty before the start.
     status: &'static str,
     reason: Option<String>,
+    /// The operator paused the whole mission (`operator` events).
     paused: bool,
     blocks: Vec<String>,
     /// Running activities, in the order they started.
     activities: Vec<Activity>,
     /// Each drone's last telemetry, by name, in the order first seen.
     drones: Vec<(String, Value)>,
+    /// What the operator did to single drones, by name, in the order first steered.
+    steered: Vec<(String, Steered)>,
+}
+
+/// A drone the operator steered: held, or taken out of the mission (`home`, `land`).
+#[derive(Clone, Copy, Default)]
+struct Steered {
+    held: bool,
+    withdrawn: Option<&'static str>,
 }
 
 /// A running activity: who does what, since when, and whether it is paused.
@@ -91,6 +101,32 @@ impl MissionState {
                     None => self.drones.push((actor.to_string(), t)),
                 }
             }
+            Event::Operator { action, drone: None } => match action {
+                OperatorAction::Pause => self.paused = true,
+                OperatorAction::Resume => self.paused = false,
+                _ => {}
+            },
+            Event::Operator { action, drone: Some(drone) } => {
+                let i = match self.steered.iter().position(|(n, _)| n == drone) {
+                    Some(i) => i,
+                    None => {
+                        self.steered.push((drone.to_string(), Steered::default()));
+                        self.steered.len() - 1
+                    }
+                };
+                let steered = &mut self.steered[i].1;
+                match action {
+                    OperatorAction::Hold => steered.held = true,
+                    OperatorAction::Resume => steered.held = false,
+                    OperatorAction::ReturnHome => {
+                        *steered = Steered { held: false, withdrawn: Some("home") }
+                    }
+                    OperatorAction::Land => {
+                        *steered = Steered { held: false, withdrawn: Some("land") }
+                    }
+                    OperatorAction::Pause | OperatorAction::Abort => {}
+                }
+            }
             Event::HandlerStart { .. }
             | Event::HandlerEnd { .. }
             | Event::ApiCall { .. }
@@ -99,10 +135,6 @@ impl MissionState {
             | Event::Exception { .. }
             | Event::Detection { .. } => {}
         }
-    }
-
-    pub fn set_paused(&mut self, paused: bool) {
-        self.paused = paused;
     }
 
     pub fn to_json(&self) -> Value {
@@ -116,12 +148,88 @@ impl MissionState {
             "activities": self.activities.iter().map(|a| json!({
                 "capability": a.capability, "tag": a.tag, "actor": a.actor, "args": a.args, "since": a.since, "paused": a.paused,
             })).collect::<Vec<_>>(),
-            "drones": self.drones.iter().map(|(n, v)| { let mut d = v.clone(); d["name"] = json!(n); d }).collect::<Vec<_>>(),
+            "drones": self.drones_json(),
         })
+    }
+
+    /// Each drone: its last telemetry and whether the operator holds it or took it out
+    /// of the mission (`withdrawn`: `home`, `land` or `null`); a drone steered before its
+    /// first telemetry is listed with the latter only.
+    fn drones_json(&self) -> Vec<Value> {
+        let steered = |name: &str| {
+            self.steered.iter().find(|(n, _)| n == name).map(|(_, s)| *s).unwrap_or_default()
+        };
+        let mut out: Vec<Value> = Vec::with_capacity(self.drones.len());
+        for (name, telemetry) in &self.drones {
+            let mut d = telemetry.clone();
+            let s = steered(name);
+            d["name"] = json!(name);
+            d["held"] = json!(s.held);
+            d["withdrawn"] = json!(s.withdrawn);
+            out.push(d);
+        }
+        for (name, s) in &self.steered {
+            if !self.drones.iter().any(|(n, _)| n == name) {
+                out.push(json!({ "name": name, "held": s.held, "withdrawn": s.withdrawn }));
+            }
+        }
+        out
     }
 }
 
 /// An activity's arguments as the trace writes them.
 fn shown(args: &Params) -> Value {
     serde_json::to_value(args).unwrap_or(Value::Null)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn observe(state: &mut MissionState, t: f64, line: &str) {
+        let mut record: Record = serde_json::from_str(line).expect("a trace line");
+        record.t = t;
+        state.observe(&record);
+    }
+
+    #[test]
+    fn the_operators_steering_shows_per_drone_and_for_the_mission() {
+        let mut state = MissionState::default();
+        observe(&mut state, 0.0, r#"{"t":0,"event":"mission_start","mission":"M"}"#);
+        let telemetry = |d: &str| {
+            format!(
+                r#"{{"t":0,"event":"telemetry","actor":"{d}","position":[0.0,0.0,5.0],"battery":0.9,"state":"Flying"}}"#
+            )
+        };
+        observe(&mut state, 1.0, &telemetry("a"));
+        observe(&mut state, 1.0, &telemetry("b"));
+        observe(&mut state, 2.0, r#"{"t":0,"event":"operator","action":"hold","drone":"a"}"#);
+        observe(&mut state, 2.0, r#"{"t":0,"event":"operator","action":"pause","drone":null}"#);
+        observe(&mut state, 3.0, r#"{"t":0,"event":"operator","action":"land","drone":"c"}"#);
+        let json = state.to_json();
+        assert_eq!(json["paused"], true);
+        let drone = |name: &str| {
+            json["drones"].as_array().unwrap().iter().find(|d| d["name"] == name).unwrap().clone()
+        };
+        assert_eq!(
+            (drone("a")["held"].clone(), drone("a")["withdrawn"].clone()),
+            (json!(true), Value::Null)
+        );
+        assert_eq!(
+            (drone("b")["held"].clone(), drone("b")["state"].clone()),
+            (json!(false), json!("Flying"))
+        );
+        assert_eq!(drone("c"), json!({ "name": "c", "held": false, "withdrawn": "land" }));
+
+        observe(&mut state, 4.0, r#"{"t":0,"event":"operator","action":"resume","drone":null}"#);
+        observe(
+            &mut state,
+            4.0,
+            r#"{"t":0,"event":"operator","action":"return_home","drone":"a"}"#,
+        );
+        let json = state.to_json();
+        assert_eq!(json["paused"], false, "the mission's resume");
+        let a = json["drones"].as_array().unwrap().iter().find(|d| d["name"] == "a").unwrap();
+        assert_eq!((a["held"].clone(), a["withdrawn"].clone()), (json!(false), json!("home")));
+    }
 }

@@ -7,7 +7,8 @@ use crate::{Names, Point, Value};
 
 /// Lines of real traces (the docs/TRACE.md tour, as `aviary run` wrote it before the
 /// events were typed) and hand-written lines for the rarer shapes: several actors, a
-/// fault on the way home, numbers that are not finite, escapes, every status.
+/// fault on the way home, numbers that are not finite, escapes, every status, every
+/// action of the operator.
 const EXAMPLES: &str = include_str!("examples.jsonl");
 
 #[test]
@@ -27,6 +28,23 @@ fn every_example_line_reads_back_and_is_written_byte_for_byte() {
 }
 
 #[test]
+fn every_operator_action_has_an_example_written_as_its_name() {
+    use OperatorAction::*;
+    let mut seen = Vec::new();
+    for line in EXAMPLES.lines() {
+        if let Event::Operator { action, .. } = serde_json::from_str::<Record>(line).unwrap().event
+        {
+            let json: serde_json::Value = serde_json::from_str(line).unwrap();
+            assert_eq!(json["action"], action.as_str(), "{line}");
+            seen.push(action);
+        }
+    }
+    for action in [Pause, Resume, Abort, Hold, ReturnHome, Land] {
+        assert!(seen.contains(&action), "no example of {action:?}");
+    }
+}
+
+#[test]
 fn what_is_not_a_trace_line_is_an_error() {
     for line in [
         "",
@@ -39,6 +57,8 @@ fn what_is_not_a_trace_line_is_an_error() {
         r#"{"t":1.0,"event":"signal","name":"S","actor":null,"args":[[1.0,[2.0,3.0]]]}"#,
         r#"{"t":1.0,"event":"signal","name":"S","actor":null,"args":[[1.0,2.0,3.0,4.0]]}"#,
         r#"{"t":1.0,"event":"mission_end","status":"fine","reason":null}"#,
+        r#"{"t":1.0,"event":"operator","action":"jump","drone":null}"#,
+        r#"{"t":1.0,"event":"operator","action":"hold","drone":7}"#,
     ] {
         assert!(serde_json::from_str::<Record>(line).is_err(), "{line}");
     }
@@ -127,6 +147,11 @@ fn state() -> impl Strategy<Value = FlightState> {
     proptest::sample::select(vec![Landed, TakingOff, Flying, Landing, Lost])
 }
 
+fn operator_action() -> impl Strategy<Value = OperatorAction> {
+    use OperatorAction::*;
+    proptest::sample::select(vec![Pause, Resume, Abort, Hold, ReturnHome, Land])
+}
+
 fn point() -> impl Strategy<Value = [f64; 3]> {
     [number(), number(), number()]
 }
@@ -205,6 +230,8 @@ fn event() -> impl Strategy<Value = Event<'static>> {
         (text(), point(), number(), state()).prop_map(|(actor, position, battery, state)| {
             Event::Telemetry { actor, position, battery, state }
         }),
+        (operator_action(), opt(text()))
+            .prop_map(|(action, drone)| Event::Operator { action, drone }),
     ]
 }
 

@@ -108,7 +108,8 @@ export function observe(model, e) {
       if (!e.handled) alarm(model, "unhandled", e.actor, `unhandled exception ${what}`);
       else if (["ConnectionLost", "BatteryCritical", "MotorFailure", "PositionLost", "DroneLost", "GeofenceViolation"].includes(e.name))
         alarm(model, e.name, e.actor, `${what}: ${(e.args || []).join(" ")}`);
-      else if (e.name === "Timeout" && /separation/i.test((e.args || []).join(" ")))
+      // The simulator's separation layer: "scout waited 30 s for carrier to make room".
+      else if (e.name === "Timeout" && /make room|separation/i.test((e.args || []).join(" ")))
         alarm(model, "separation", e.actor, `${what}: ${(e.args || []).join(" ")}`, false);
       break;
     }
@@ -163,13 +164,17 @@ export function observe(model, e) {
 export function activityStatus(model, capability, tag, actors) {
   let sum = { running: 0, done: 0, aborted: 0, failed: 0, paused: 0 };
   const add = (v) => { if (v) for (const k in sum) sum[k] += v[k]; };
+  let held = false;
   if (actors && actors.length) {
-    for (const a of actors) for (const name of [].concat(a || [])) add(model.activities.get(key(capability, tag, name)));
+    for (const a of actors) for (const name of [].concat(a || [])) {
+      add(model.activities.get(key(capability, tag, name)));
+      held = held || !!model.drones.get(name)?.held;
+    }
   } else {
     const prefix = `${capability}|${tag || ""}|`;
     for (const [k, v] of model.activities) if (k.startsWith(prefix)) add(v);
   }
-  if (sum.paused && sum.running) return "paused";
+  if ((sum.paused || held || model.paused) && sum.running) return "paused";
   if (sum.running) return "running";
   if (sum.failed) return "failed";
   if (sum.aborted && !sum.done) return "aborted";

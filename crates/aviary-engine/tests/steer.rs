@@ -1,0 +1,434 @@
+//! The operator steers one drone (`Control::Drone`, src/steer.rs): hold and resume its
+//! activities, send it home or land it out of the mission; each an `operator` event in
+//! the trace, at its time and before what it does; refusals say why.
+
+use aviary_engine::{Control, DroneAction, Outcome, RunOptions, Status};
+use aviary_test_support::harness;
+use harness::Path;
+use serde_json::Value as Json;
+
+/// The harness's world, with more far places, so that drones flying far do not meet at
+/// the end.
+fn world() -> String {
+    harness::WORLD.replace(
+        "Far = [0, 400]\n",
+        "Far = [0, 400]\nFarEast = [200, 400]\nFarWest = [-200, 400]\n",
+    )
+}
+
+fn run(
+    mission: &str,
+    controls: Vec<(f64, Control)>,
+) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
+    run_on(mission, &world(), controls, Path::AsUsersRun)
+}
+
+fn run_on(
+    mission: &str,
+    world: &str,
+    controls: Vec<(f64, Control)>,
+    path: Path,
+) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
+    let (compiled, world) = harness::compile(mission, world);
+    let options = RunOptions { telemetry_hz: Some(10.0), ..RunOptions::default() };
+    let (run, answers) = harness::run_compiled(&compiled, &world, &options, controls, path);
+    (run.outcome, run.trace, answers)
+}
+
+fn drone(name: &str, action: DroneAction) -> Control {
+    Control::Drone { drone: name.into(), action }
+}
+
+use DroneAction::{Hold, Land, Resume, ReturnHome};
+
+fn t(e: &Json) -> f64 {
+    e["t"].as_f64().unwrap()
+}
+
+/// Telemetry positions of `actor` strictly between two times.
+fn positions(trace: &[Json], actor: &str, from: f64, to: f64) -> Vec<Json> {
+    trace
+        .iter()
+        .filter(|e| e["event"] == "telemetry" && e["actor"] == actor && t(e) > from && t(e) < to)
+        .map(|e| e["position"].clone())
+        .collect()
+}
+
+fn still(trace: &[Json], actor: &str, from: f64, to: f64) -> bool {
+    let held = positions(trace, actor, from, to);
+    held.len() > 10 && held.iter().all(|p| *p == held[0])
+}
+
+fn moving(trace: &[Json], actor: &str, from: f64, to: f64) -> bool {
+    let seen = positions(trace, actor, from, to);
+    seen.len() > 10 && seen.windows(2).all(|w| w[0] != w[1])
+}
+
+/// The index of the first event for which `is` holds.
+fn index(trace: &[Json], is: impl Fn(&Json) -> bool) -> usize {
+    trace.iter().position(is).unwrap_or_else(|| {
+        panic!(
+            "no such event in:\n{}",
+            trace.iter().map(Json::to_string).collect::<Vec<_>>().join("\n")
+        )
+    })
+}
+
+/// `(t, action, drone)` of every `operator` event, in order.
+fn operator_events(trace: &[Json]) -> Vec<(f64, String, Json)> {
+    trace
+        .iter()
+        .filter(|e| e["event"] == "operator")
+        .map(|e| (t(e), e["action"].as_str().unwrap().to_string(), e["drone"].clone()))
+        .collect()
+}
+
+fn ends<'a>(trace: &'a [Json], capability: &str, actor: &str) -> Vec<&'a Json> {
+    trace
+        .iter()
+        .filter(|e| {
+            e["event"] == "capability_end" && e["capability"] == capability && e["actor"] == actor
+        })
+        .collect()
+}
+
+const TWO_FLY: &str =
+    "MISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        b FlyTo WITH FarEast\n";
+
+#[test]
+fn a_held_drone_stays_put_while_the_others_fly_on_and_goes_on_when_resumed() {
+    let (outcome, trace, answers) =
+        run(TWO_FLY, vec![(10.0, drone("a", Hold)), (20.0, drone("a", Resume))]);
+    assert_eq!(answers, [Ok(()), Ok(())]);
+    assert_eq!(outcome.status, Status::Ok, "{:?}", outcome.reason);
+    assert!(still(&trace, "a", 10.05, 19.95), "a holds where it is");
+    assert!(moving(&trace, "b", 10.05, 19.95), "b flies on");
+    assert!(moving(&trace, "a", 20.05, 25.0), "a goes on after the resume");
+    assert_eq!(
+        operator_events(&trace),
+        [(10.0, "hold".into(), Json::from("a")), (20.0, "resume".into(), Json::from("a"))]
+    );
+    let (fly_a, fly_b) = (ends(&trace, "FlyTo", "a"), ends(&trace, "FlyTo", "b"));
+    assert_eq!(
+        (fly_a[0]["status"].as_str(), fly_b[0]["status"].as_str()),
+        (Some("ok"), Some("ok"))
+    );
+    // Ten seconds held, and a stop and a start: a arrives that much later than unheld.
+    let (alone, unheld, _) = run(TWO_FLY, vec![]);
+    assert_eq!(alone.status, Status::Ok);
+    let late = t(fly_a[0]) - t(ends(&unheld, "FlyTo", "a")[0]);
+    assert!((10.0..13.0).contains(&late), "a arrives {late} s later than unheld");
+}
+
+#[test]
+fn an_activity_that_starts_while_its_drone_is_held_starts_held_on_either_path() {
+    // Ping's calls end at once (an instant activity, src/instant.rs); it starts at 18 s,
+    // while b is held, and makes its first call only when b is resumed.
+    let mission = "CAPABILITY Ping BY d:\n    PERFORM:\n        d.StartStreaming()\n        d.StopStreaming()\n\nMISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        SEQUENTIAL:\n            WAITFOR ELAPSED >= 18s\n            b Ping\n";
+    let controls = || vec![(15.0, drone("b", Hold)), (25.0, drone("b", Resume))];
+    let users = run_on(mission, &world(), controls(), Path::AsUsersRun);
+    let general = run_on(mission, &world(), controls(), Path::GeneralOnly);
+    assert_eq!((&users.0, &users.1), (&general.0, &general.1), "the same trace both ways");
+    let (outcome, trace, _) = users;
+    assert_eq!(outcome.status, Status::Ok);
+    let start =
+        &trace[index(&trace, |e| e["event"] == "capability_start" && e["capability"] == "Ping")];
+    assert!((t(start) - 18.0).abs() < 0.11, "{start}");
+    let call =
+        &trace[index(&trace, |e| e["event"] == "api_call" && e["function"] == "StartStreaming")];
+    assert_eq!(t(call), 25.0, "held until the resume");
+    assert!(moving(&trace, "a", 15.05, 24.95), "a is not held");
+}
+
+#[test]
+fn a_hold_and_a_pause_of_the_mission_are_apart() {
+    let (outcome, trace, answers) = run(
+        TWO_FLY,
+        vec![
+            (10.0, Control::Pause),
+            (12.0, drone("a", Hold)),
+            (15.0, Control::Resume),
+            (20.0, drone("a", Resume)),
+        ],
+    );
+    assert_eq!(answers, [Ok(()), Ok(()), Ok(()), Ok(())]);
+    assert_eq!(outcome.status, Status::Ok);
+    assert!(still(&trace, "b", 10.05, 14.95) && still(&trace, "a", 10.05, 19.95));
+    assert!(moving(&trace, "b", 15.05, 19.95), "resuming the mission lets b go on, not a");
+    assert!(moving(&trace, "a", 20.05, 25.0), "resuming a lets it go on");
+    let actions: Vec<(String, Json)> =
+        operator_events(&trace).into_iter().map(|(_, a, d)| (a, d)).collect();
+    assert_eq!(
+        actions,
+        [
+            ("pause".into(), Json::Null),
+            ("hold".into(), Json::from("a")),
+            ("resume".into(), Json::Null),
+            ("resume".into(), Json::from("a")),
+        ]
+    );
+}
+
+#[test]
+fn holding_one_drone_of_a_group_activity_holds_the_activity() {
+    let mission = "CAPABILITY Pair BY x, y:\n    PERFORM:\n        PARALLEL:\n            x FlyTo WITH Far\n            y FlyTo WITH FarEast\n\nMISSION M:\n    PARALLEL:\n        a b Pair\n        c FlyTo WITH FarWest\n";
+    let (outcome, trace, answers) =
+        run(mission, vec![(10.0, drone("b", Hold)), (20.0, drone("b", Resume))]);
+    assert_eq!(answers, [Ok(()), Ok(())]);
+    assert_eq!(outcome.status, Status::Ok);
+    assert!(
+        still(&trace, "a", 10.05, 19.95) && still(&trace, "b", 10.05, 19.95),
+        "the pair is held whole"
+    );
+    assert!(moving(&trace, "c", 10.05, 19.95));
+    assert_eq!(ends(&trace, "Pair", "a b")[0]["status"], "ok");
+}
+
+#[test]
+fn sending_a_drone_home_aborts_its_activities_and_the_mission_goes_on_with_the_rest() {
+    let mission = "MISSION M:\n    PARALLEL:\n        SEQUENTIAL:\n            a FlyTo-F1 WITH Far\n            a Hover WITH 5s\n        b FlyTo WITH FarEast\n";
+    let (outcome, trace, answers) = run(mission, vec![(10.0, drone("a", ReturnHome))]);
+    for e in trace.iter().filter(|e| e["event"] != "telemetry") {
+        println!("{e}");
+    }
+    assert_eq!(answers, [Ok(())]);
+    assert_eq!(outcome.status, Status::Ok, "{:?}", outcome.reason);
+    assert_eq!(operator_events(&trace), [(10.0, "return_home".into(), Json::from("a"))]);
+    let said = index(&trace, |e| e["event"] == "operator");
+    let fly_end = index(&trace, |e| {
+        e["event"] == "capability_end" && e["capability"] == "FlyTo" && e["actor"] == "a"
+    });
+    let cut = index(&trace, |e| {
+        e["event"] == "api_done" && e["actor"] == "a" && e["function"] == "FlyToPosition"
+    });
+    let hover = index(&trace, |e| e["event"] == "capability_end" && e["capability"] == "Hover");
+    let home = index(&trace, |e| {
+        e["event"] == "api_call" && e["actor"] == "a" && e["function"] == "ReturnToLaunch"
+    });
+    assert_eq!(trace[fly_end]["status"], "aborted");
+    assert_eq!(trace[cut]["status"], "aborted");
+    assert_eq!(trace[hover]["status"], "aborted", "a later activity of a ends at once");
+    assert!(said < fly_end && fly_end < cut && cut < hover && hover < home, "in this order");
+    assert!([fly_end, cut, hover, home].iter().all(|i| t(&trace[*i]) == 10.0), "all at once");
+    assert!(
+        !trace
+            .iter()
+            .any(|e| e["event"] == "api_call" && e["actor"] == "a" && e["function"] == "Hover"),
+        "the later activity did not fly"
+    );
+    let back = &trace[index(&trace, |e| {
+        e["event"] == "api_done" && e["actor"] == "a" && e["function"] == "ReturnToLaunch"
+    })];
+    assert_eq!(
+        (back["status"].as_str(), back["position"].clone()),
+        (Some("ok"), Json::from(vec![0.0, 0.0, 0.0]))
+    );
+    let fly_b = ends(&trace, "FlyTo", "b");
+    assert_eq!(fly_b[0]["status"], "ok");
+    assert!(t(fly_b[0]) > t(back), "b carries on after a is home");
+    // Out of the mission: it is not sent home again at the end.
+    let returns = trace
+        .iter()
+        .filter(|e| {
+            e["event"] == "api_call" && e["actor"] == "a" && e["function"] == "ReturnToLaunch"
+        })
+        .count();
+    assert_eq!(returns, 1);
+}
+
+#[test]
+fn landing_a_drone_brings_it_down_where_it_is() {
+    let (outcome, trace, answers) = run(TWO_FLY, vec![(15.0, drone("a", Land))]);
+    assert_eq!(answers, [Ok(())]);
+    assert_eq!(outcome.status, Status::Ok, "{:?}", outcome.reason);
+    let at = positions(&trace, "a", 14.9, 15.05)[0].clone();
+    let landed = &trace[index(&trace, |e| {
+        e["event"] == "api_done" && e["actor"] == "a" && e["function"] == "Land"
+    })];
+    assert_eq!(landed["status"], "ok");
+    let p = &landed["position"];
+    assert!(at[2].as_f64().unwrap() > 5.0, "a was in the air: {at}");
+    assert_eq!(
+        (p[0].clone(), p[1].clone(), p[2].as_f64()),
+        (at[0].clone(), at[1].clone(), Some(0.0))
+    );
+    assert_eq!(ends(&trace, "FlyTo", "a")[0]["status"], "aborted");
+    assert_eq!(ends(&trace, "FlyTo", "b")[0]["status"], "ok");
+    assert!(!trace.iter().any(|e| e["actor"] == "a" && e["function"] == "ReturnToLaunch"));
+}
+
+#[test]
+fn a_drone_on_its_way_home_can_still_be_landed() {
+    let (outcome, trace, answers) =
+        run(TWO_FLY, vec![(10.0, drone("a", ReturnHome)), (14.0, drone("a", Land))]);
+    assert_eq!(answers, [Ok(()), Ok(())]);
+    assert_eq!(outcome.status, Status::Ok, "{:?}", outcome.reason);
+    let cut = &trace[index(&trace, |e| {
+        e["event"] == "api_done" && e["actor"] == "a" && e["function"] == "ReturnToLaunch"
+    })];
+    assert_eq!((cut["status"].as_str(), t(cut)), (Some("aborted"), 14.0));
+    let land =
+        index(&trace, |e| e["event"] == "api_call" && e["actor"] == "a" && e["function"] == "Land");
+    assert_eq!(t(&trace[land]), 14.0);
+    let landed = &trace[index(&trace, |e| {
+        e["event"] == "api_done" && e["actor"] == "a" && e["function"] == "Land"
+    })];
+    assert_eq!(landed["status"], "ok");
+    assert_ne!(landed["position"], Json::from(vec![0.0, 0.0, 0.0]), "down where it was, not home");
+}
+
+#[test]
+fn a_withdrawn_drones_fault_is_its_way_downs_and_no_handler_takes_it() {
+    let world =
+        format!("{}\n[[faults]]\ndrone = \"a\"\nat = 12\nkind = \"battery_critical\"\n", world());
+    let mission = "MISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        b FlyTo WITH FarEast\n        ON EXCEPTION BatteryCritical BY a:\n            c Hover WITH 1s\n";
+    let (outcome, trace, _) =
+        run_on(mission, &world, vec![(10.0, drone("a", ReturnHome))], Path::AsUsersRun);
+    let fault = &trace[index(&trace, |e| e["event"] == "exception")];
+    assert_eq!(
+        (fault["handled"].as_bool(), fault["during"].as_str(), t(fault)),
+        (Some(false), Some("return home"), 12.0)
+    );
+    assert!(
+        !trace.iter().any(|e| e["actor"] == "c" && e["event"] == "capability_start"),
+        "no handler ran"
+    );
+    assert_eq!(outcome.status, Status::Ok, "the mission goes on and ends ok");
+    assert!(
+        outcome
+            .reason
+            .as_deref()
+            .is_some_and(|r| r.contains("BatteryCritical on a on its way down")),
+        "{:?}",
+        outcome.reason
+    );
+}
+
+#[test]
+fn the_operator_is_told_why_a_drone_control_is_refused() {
+    let three = format!("{TWO_FLY}        c FlyTo WITH North\n");
+    let (outcome, _, answers) = run(
+        &three,
+        vec![
+            (1.0, drone("d", Hold)),
+            (1.0, drone("tower", Hold)),
+            (1.0, drone("a", Resume)),
+            (2.0, drone("a", Hold)),
+            (2.0, drone("a", Hold)),
+            (3.0, Control::Pause),
+            (3.0, drone("b", Resume)),
+            (4.0, Control::Resume),
+            (5.0, drone("a", Land)),
+            (5.0, drone("a", Resume)),
+            (5.0, drone("a", ReturnHome)),
+            (5.0, drone("a", Land)),
+            (6.0, drone("b", ReturnHome)),
+            (6.0, drone("b", Hold)),
+            (600.0, drone("b", Land)),
+        ],
+    );
+    assert_eq!(outcome.status, Status::Ok);
+    let refused = |i: usize| answers[i].clone().expect_err("refused");
+    assert_eq!(refused(0), "no drone is called `d`: did you mean `a`?");
+    assert_eq!(refused(1), "no drone is called `tower`: the fleet is a, b, c");
+    assert_eq!(refused(2), "a is not held: there is nothing of it to resume");
+    assert_eq!(answers[3], Ok(()));
+    assert_eq!(refused(4), "a is already held: resume it to let its activities go on");
+    assert_eq!(
+        refused(6),
+        "b is not held: there is nothing of it to resume; the whole mission is paused: resume the mission instead"
+    );
+    assert_eq!(answers[8], Ok(()), "a held drone can be landed");
+    for i in [9, 10, 11] {
+        assert_eq!(
+            refused(i),
+            "a is landing or has landed, out of the mission (the operator landed it): it takes no more orders"
+        );
+    }
+    assert_eq!(answers[12], Ok(()));
+    assert_eq!(
+        refused(13),
+        "b is on its way home, out of the mission (the operator sent it): it takes no more orders but land"
+    );
+    assert_eq!(refused(14), "the mission has ended", "after the end");
+}
+
+#[test]
+fn a_hold_reaches_an_activity_inside_another() {
+    // At 2 s, a is taking off: the standard FlyTo calls TakeOff, an activity inside it.
+    let (outcome, trace, answers) =
+        run(TWO_FLY, vec![(2.0, drone("a", Hold)), (8.0, drone("a", Resume))]);
+    assert_eq!(answers, [Ok(()), Ok(())]);
+    assert_eq!(outcome.status, Status::Ok);
+    assert!(still(&trace, "a", 2.05, 7.95), "a holds its climb");
+    let climbed = |actor: &str, at: f64| {
+        positions(&trace, actor, at - 0.05, at + 0.05)[0][2].as_f64().unwrap()
+    };
+    assert!(climbed("b", 4.0) > climbed("a", 4.0) + 3.0, "b climbs on");
+    let takeoff = ends(&trace, "TakeOff", "a");
+    assert_eq!(takeoff[0]["status"], "ok");
+    assert!(t(takeoff[0]) > 8.0, "it ends after the resume: {}", takeoff[0]);
+}
+
+#[test]
+fn a_statement_that_names_a_drone_out_of_the_mission_ends_at_once_for_that_drone() {
+    // `team Hover` is one activity per drone of the group; `a b Pair` is one of both.
+    let mission = "CAPABILITY Pair BY x, y:\n    PERFORM:\n        x Hover WITH 2s\n        y Hover WITH 2s\n\nMISSION M:\n    c FlyTo WITH North\n    PARALLEL:\n        team TakeOff\n        c Hover WITH 20s\n    team Hover WITH 3s\n    a b Pair\n";
+    let (outcome, trace, answers) = run(mission, vec![(1.0, drone("b", Land))]);
+    assert_eq!(answers, [Ok(())]);
+    assert_eq!(outcome.status, Status::Ok, "{:?}", outcome.reason);
+    let status = |capability: &str, actor: &str| {
+        ends(&trace, capability, actor)
+            .iter()
+            .map(|e| e["status"].as_str().unwrap())
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(status("TakeOff", "b"), ["aborted"]);
+    assert_eq!(status("Hover", "b"), ["aborted"]);
+    assert_eq!(status("Pair", "a b"), ["aborted"]);
+    assert_eq!(status("TakeOff", "a"), ["ok"]);
+    assert_eq!(status("Hover", "a"), ["ok"], "a's own instance of `team Hover` flies");
+    for capability in ["TakeOff", "Hover", "Pair"] {
+        let start = index(&trace, |e| {
+            e["event"] == "capability_start"
+                && e["capability"] == capability
+                && e["actor"].as_str().unwrap().contains('b')
+        });
+        let end = index(&trace, |e| {
+            e["event"] == "capability_end"
+                && e["capability"] == capability
+                && e["actor"].as_str().unwrap().contains('b')
+        });
+        assert_eq!((end, t(&trace[end])), (start + 1, t(&trace[start])), "{capability}: at once");
+    }
+    assert!(
+        !trace.iter().any(|e| e["event"] == "api_call" && e["actor"] == "b"),
+        "b, on the ground, never flew"
+    );
+}
+
+#[test]
+fn a_drone_taken_out_while_an_abort_section_runs_for_it_still_goes_home_at_once() {
+    // At 8 s a leash aborts Patrol inside Outer; its `PERFORM ABORT:` section starts
+    // Wait on a, an activity of its own (a statement of the section). At 10 s the
+    // operator sends a home: Outer and Wait are aborted, and Wait, inside Outer, is
+    // dropped with it, never to end: the way down does not wait for it.
+    let mission = "CAPABILITY Wait BY d:\n    PERFORM:\n        WAITFOR ELAPSED >= 30s\n\nCAPABILITY Patrol BY drone:\n    PERFORM:\n        drone FlyTo WITH Far\n    PERFORM ABORT:\n        drone Wait\n\nCAPABILITY Outer BY drone:\n    PERFORM:\n        drone Patrol-P1\n\nMISSION M:\n    PARALLEL:\n        a Outer\n        SEQUENTIAL:\n            WAITFOR ELAPSED >= 8s\n            Patrol-P1 ABORT\n        b FlyTo WITH FarEast\n";
+    let (outcome, trace, answers) = run(mission, vec![(10.0, drone("a", ReturnHome))]);
+    assert_eq!(answers, [Ok(())]);
+    assert_eq!(outcome.status, Status::Ok, "{:?}", outcome.reason);
+    let wait =
+        &trace[index(&trace, |e| e["event"] == "capability_start" && e["capability"] == "Wait")];
+    assert_eq!(t(wait), 8.0, "the section runs");
+    let outer =
+        &trace[index(&trace, |e| e["event"] == "capability_end" && e["capability"] == "Outer")];
+    assert_eq!((outer["status"].as_str(), t(outer)), (Some("aborted"), 10.0));
+    let home = &trace[index(&trace, |e| {
+        e["event"] == "api_call" && e["actor"] == "a" && e["function"] == "ReturnToLaunch"
+    })];
+    assert_eq!(t(home), 10.0, "sent home at once");
+    let back = &trace[index(&trace, |e| {
+        e["event"] == "api_done" && e["actor"] == "a" && e["function"] == "ReturnToLaunch"
+    })];
+    assert_eq!(back["status"], "ok");
+}

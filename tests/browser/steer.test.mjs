@@ -52,6 +52,47 @@ test("PAUSE on a tagged activity holds its drone; RESUME lets it go on", async (
   assert.equal(circle.done, 1, "the circle ends ok");
 });
 
+test("hold one drone, then send it home, from the fleet grid: the others carry on", async () => {
+  const page = await open(chromium, station);
+  await choose(page, "drills/patrol.mission");
+  await page.fill("#speed", "10");
+  await page.click("#fly");
+  await page.waitForFunction(() => window.aviary.model.activities.get("FlyCircle|C1|scout")?.running === 1, null, { timeout: 60000 });
+  const row = (drone) => `#fleet tr[data-drone="${drone}"]`;
+  await page.click(`${row("scout")} button[data-action="hold"]`);
+  await page.waitForFunction(() => window.aviary.model.drones.get("scout").held);
+  await page.waitForTimeout(300);
+  const held = await travel(page, "scout", 1500);
+  const carrier = await travel(page, "carrier", 1000);
+  assert.ok(held < 0.5, `scout holds (moved ${held.toFixed(2)} m)`);
+  assert.ok(carrier > 20, `the carrier carries on (moved ${carrier.toFixed(1)} m)`);
+  await page.waitForFunction(() => document.querySelector('#fleet tr[data-drone="scout"]').classList.contains("held"));
+  await shot(page, "drone-held");
+  await page.click(`${row("scout")} button[data-action="resume"]`);
+  assert.ok((await travel(page, "scout", 1000)) > 20, "scout goes on after resume");
+  await page.click(`${row("scout")} button[data-action="home"]`);
+  await page.waitForSelector("#confirm-dialog[open]");
+  await page.click('#confirm-dialog button[value="ok"]');
+  await page.waitForFunction(() => window.aviary.model.drones.get("scout").withdrawn);
+  await page.waitForFunction(() => document.getElementById("status").textContent !== "running", null, { timeout: 120000 });
+  const end = await page.evaluate(() => ({
+    status: window.aviary.model.status,
+    log: [...document.querySelectorAll("#log li")].map((li) => li.textContent),
+    scout: window.aviary.model.drones.get("scout"),
+    circle: window.aviary.model.activities.get("FlyCircle|C1|scout"),
+    carrier: window.aviary.model.activities.get("ReturnHome||carrier"),
+  }));
+  assert.equal(end.status, "ok", "the mission goes on with the rest and ends ok");
+  for (const action of ["hold scout", "resume scout", "return_home scout"]) {
+    assert.ok(end.log.some((l) => l.includes(`operator: ${action}`)), `the trace has the operator's ${action}: ${end.log.slice(-20)}`);
+  }
+  assert.equal(end.circle.aborted, 1, "sending scout home aborted its circle");
+  assert.equal(end.carrier.done, 1, "the carrier flew its whole round");
+  assert.equal(end.scout.state, "Landed");
+  assert.ok(moved(end.scout.pos, [0, 0, 0]) < 3, `scout is home: ${end.scout.pos}`);
+  await shot(page, "drone-home");
+});
+
 test("a fault raises its alarm; aborting brings the fleet home", async () => {
   const page = await open(chromium, station);
   await choose(page, "faults/motor_failure.mission");

@@ -20,7 +20,6 @@ mod load;
 mod recursion;
 mod signal_values;
 mod signals;
-mod suggest;
 pub mod uses;
 mod walk;
 

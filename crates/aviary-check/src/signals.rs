@@ -8,8 +8,8 @@ use aviary_diagnostics::{Code, Diagnostic, FileId};
 use aviary_syntax::ast::*;
 
 use crate::env::{capability_bodies, stmt_exprs, visit_exprs, visit_stmts};
-use crate::suggest::did_you_mean;
 use crate::Program;
+use aviary_diagnostics::suggest::did_you_mean;
 
 #[derive(Default)]
 struct Uses<'a> {

@@ -9,6 +9,7 @@
 mod code;
 mod render;
 mod source;
+pub mod suggest;
 
 pub use code::Code;
 pub use render::{render_json, render_text, summary_line};

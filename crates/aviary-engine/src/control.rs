@@ -6,6 +6,7 @@
 
 use aviary_api::trace::{Event, EventKind, OperatorAction};
 use aviary_api::{Interrupt, Value};
+use aviary_diagnostics::suggest::{closest, did_you_mean};
 use aviary_ir::LeashAction;
 use tokio::sync::{mpsc, oneshot};
 
@@ -127,23 +128,31 @@ impl<'m> Engine<'m> {
         }
         match control {
             Control::Leash { capability, tag, action, args } => {
-                let cap = self
-                    .m
-                    .capabilities
-                    .iter()
-                    .position(|c| c.name == capability)
-                    .ok_or_else(|| format!("no capability is called {capability}"))?;
+                let caps = &self.m.capabilities;
+                let cap = caps.iter().position(|c| c.name == capability).ok_or_else(|| {
+                    let mean = did_you_mean(&capability, caps.iter().map(|c| c.name.as_str()));
+                    format!("no capability is called {capability}{}", spaced(mean))
+                })?;
                 let action_kind = match action.as_str() {
                     "ABORT" => LeashAction::Abort,
                     "PAUSE" => LeashAction::Pause,
                     "RESUME" => LeashAction::Resume,
-                    name => LeashAction::Section(
-                        self.m.capabilities[cap]
-                            .sections
-                            .iter()
-                            .position(|(n, _)| n == name)
-                            .ok_or_else(|| format!("{capability} has no section PERFORM {name}"))?,
-                    ),
+                    name => {
+                        let sections = &self.m.capabilities[cap].sections;
+                        let section =
+                            sections.iter().position(|(n, _)| n == name).ok_or_else(|| {
+                                let known = ["ABORT", "PAUSE", "RESUME"].into_iter();
+                                let mean = did_you_mean(
+                                    name,
+                                    known.chain(sections.iter().map(|(n, _)| n.as_str())),
+                                );
+                                format!(
+                                    "{capability} has no section PERFORM {name}{}",
+                                    spaced(mean)
+                                )
+                            })?;
+                        LeashAction::Section(section)
+                    }
                 };
                 let params = &self.m.capabilities[cap].params;
                 let mut values = Vec::new();
@@ -156,7 +165,12 @@ impl<'m> Engine<'m> {
                 }
                 // A tag no statement defines can never match: refuse it, as the checker would.
                 let tag_id = self.m.tags.iter().position(|t| *t == tag).ok_or_else(|| {
-                    format!("no statement starts an activity tagged {capability}-{tag}")
+                    let mean = closest(&tag, self.m.tags.iter().map(String::as_str))
+                        .map(|t| format!("did you mean `{capability}-{t}`?"));
+                    format!(
+                        "no statement starts an activity tagged {capability}-{tag}{}",
+                        spaced(mean)
+                    )
                 })?;
                 self.leash_by_id(cap, tag_id, action_kind, &action, values);
                 Ok(())
@@ -207,4 +221,9 @@ impl<'m> Engine<'m> {
             }
         }
     }
+}
+
+/// `: did you mean ...?` after a refusal, or nothing.
+fn spaced(mean: Option<String>) -> String {
+    mean.map(|m| format!(": {m}")).unwrap_or_default()
 }

@@ -25,6 +25,7 @@ use std::rc::Rc;
 use std::task::Waker;
 
 use aviary_api::{CallId, DroneId, Interrupt};
+use aviary_diagnostics::suggest::closest;
 
 use crate::control::DroneAction;
 use crate::engine::{Engine, Instance};
@@ -261,31 +262,5 @@ impl<'m> Engine<'m> {
     /// them out of the mission.
     pub(crate) fn any_withdrawn(&self, actors: &[DroneId]) -> bool {
         actors.iter().any(|d| self.steering.withdrawn(*d).is_some())
-    }
-}
-
-/// The candidate closest to `name`, if one is close enough to be a likely typo (as the
-/// checker's suggestions: `aviary_check`'s `suggest.rs`).
-fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
-    let lower = name.to_ascii_lowercase();
-    let limit = (name.chars().count() / 3).max(1);
-    candidates
-        .into_iter()
-        .map(|c| (strsim::damerau_levenshtein(&lower, &c.to_ascii_lowercase()), c))
-        .filter(|&(d, _)| d <= limit)
-        .min_by_key(|&(d, c)| (d, c.len(), c))
-        .map(|(_, c)| c)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::closest;
-
-    #[test]
-    fn a_close_name_is_suggested_and_a_far_one_is_not() {
-        let fleet = ["scout1", "scout2", "carrier"];
-        assert_eq!(closest("scuot1", fleet), Some("scout1"));
-        assert_eq!(closest("Carrier", fleet), Some("carrier"));
-        assert_eq!(closest("tower", fleet), None);
     }
 }

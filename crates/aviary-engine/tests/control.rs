@@ -112,12 +112,38 @@ fn operator_controls_that_cannot_apply_are_refused_with_a_reason() {
                 },
             ),
             (1.0, Control::Signal { name: "Nobody".into(), args: vec![] }),
+            (
+                1.0,
+                Control::Leash {
+                    capability: "FlyT0".into(),
+                    tag: "F1".into(),
+                    action: "PAUSE".into(),
+                    args: vec![],
+                },
+            ),
+            (
+                1.0,
+                Control::Leash {
+                    capability: "FlyTo".into(),
+                    tag: "F1".into(),
+                    action: "PAUES".into(),
+                    args: vec![],
+                },
+            ),
         ],
     );
-    assert_eq!(answers[0], Err("no statement starts an activity tagged FlyTo-F9".to_string()));
+    assert_eq!(
+        answers[0],
+        Err("no statement starts an activity tagged FlyTo-F9: did you mean `FlyTo-F1`?".to_string())
+    );
     assert_eq!(answers[1], Err("no capability is called Fly".to_string()));
     assert_eq!(answers[2], Err("FlyTo has no section PERFORM Widen".to_string()));
     assert_eq!(answers[3], Err("the mission neither raises nor hears Nobody".to_string()));
+    assert_eq!(answers[4], Err("no capability is called FlyT0: did you mean `FlyTo`?".to_string()));
+    assert_eq!(
+        answers[5],
+        Err("FlyTo has no section PERFORM PAUES: did you mean `PAUSE`?".to_string())
+    );
 }
 
 #[test]

@@ -6,7 +6,7 @@ use aviary_syntax::ast::*;
 
 use super::{count, quoted, Checker};
 use crate::env::*;
-use crate::suggest::did_you_mean;
+use aviary_diagnostics::suggest::did_you_mean;
 
 impl<'a> Checker<'a> {
     pub(super) fn statement(&mut self, s: &'a Statement) {

@@ -8,7 +8,7 @@ use aviary_world::AttributeValue;
 
 use super::{shown, Checker};
 use crate::env::*;
-use crate::suggest::did_you_mean;
+use aviary_diagnostics::suggest::did_you_mean;
 
 impl<'a> Checker<'a> {
     pub(super) fn condition(&mut self, e: &'a Expr) {

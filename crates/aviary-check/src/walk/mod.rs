@@ -8,8 +8,8 @@ use aviary_syntax::ast::*;
 use aviary_world::World;
 
 use crate::env::*;
-use crate::suggest::did_you_mean;
 use crate::Program;
+use aviary_diagnostics::suggest::did_you_mean;
 
 mod calls;
 mod kinds;

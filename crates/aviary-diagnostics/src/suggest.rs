@@ -1,10 +1,8 @@
-//! "Did you mean" suggestions.
+//! "Did you mean" suggestions: one rule for every message that offers a name, the
+//! checker's and the engine's refusals of an operator's control alike.
 
 /// The candidate closest to `name`, if one is close enough to be a likely typo.
-pub(crate) fn closest<'a>(
-    name: &str,
-    candidates: impl IntoIterator<Item = &'a str>,
-) -> Option<&'a str> {
+pub fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
     let lower = name.to_ascii_lowercase();
     let limit = (name.chars().count() / 3).max(1);
     candidates
@@ -17,7 +15,7 @@ pub(crate) fn closest<'a>(
 }
 
 /// `did you mean `X`?`, or `None`.
-pub(crate) fn did_you_mean<'a>(
+pub fn did_you_mean<'a>(
     name: &str,
     candidates: impl IntoIterator<Item = &'a str>,
 ) -> Option<String> {
@@ -35,5 +33,9 @@ mod tests {
         assert_eq!(closest("BuildingZ", ["BuildingA", "BuildingB"]), Some("BuildingA"));
         assert_eq!(closest("Xyz", ["Home", "Base"]), None);
         assert_eq!(closest("takeoff", ["TakeOff", "Land"]), Some("TakeOff"));
+        let fleet = ["scout1", "scout2", "carrier"];
+        assert_eq!(closest("scuot1", fleet), Some("scout1"));
+        assert_eq!(closest("Carrier", fleet), Some("carrier"));
+        assert_eq!(closest("tower", fleet), None);
     }
 }

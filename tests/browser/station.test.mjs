@@ -60,6 +60,13 @@ test("the paper's mission flies from the page: 7 drones move on the map and the 
   assert.equal(end.running, 0, "nothing is left running");
   await page.waitForTimeout(300);
   await shot(page, "done");
+  // The flight's trace is in the folder, whole, with telemetry to replay it.
+  const shownTrace = (await page.textContent("#trace-file")).replace(/^trace /, "");
+  assert.match(shownTrace, /^traces\/search_and_rescue-\d{4}-\d\d-\d\dT\d\d-\d\d-\d\dZ(-\d+)?\.jsonl$/);
+  const lines = readFileSync(join(dir, shownTrace), "utf8").trim().split("\n").map((l) => JSON.parse(l));
+  assert.equal(lines[0].event, "mission_start");
+  assert.deepEqual([lines.at(-1).event, lines.at(-1).status], ["mission_end", "ok"]);
+  assert.ok(lines.filter((e) => e.event === "telemetry").length > 7 * 400, "4 samples a second per drone");
   assert.deepEqual(page.foreign, [], "the page loaded nothing from elsewhere");
   assert.ok(homes, "positions were known");
 });

@@ -9,6 +9,7 @@
 
 mod mixed;
 pub mod pipeline;
+pub mod trace_file;
 
 pub use mixed::{live_runtime, Mixed};
 pub use pipeline::fly;

@@ -16,7 +16,6 @@ mod replay;
 mod report;
 mod run;
 mod serve;
-mod trace_file;
 mod vehicles;
 
 /// mimalloc, tuned before `main` (`aviary_alloc`; docs/BENCHMARKS.md).

@@ -17,7 +17,7 @@ use aviary_world::World;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::files::{color_wanted, use_roots, world_beside, DiskProvider};
-use crate::trace_file::{lock, SharedTrace, TraceFile};
+use aviary_backends::trace_file::{lock, SharedTrace, TraceFile};
 
 pub struct RunArgs {
     pub file: PathBuf,
@@ -128,7 +128,11 @@ pub fn run(args: &RunArgs) -> u8 {
     if let (Ok(flown), Some(trace)) = (&flown, &trace) {
         if !flown.flew {
             // Stopped while the vehicles connected: the trace is whole all the same.
-            lock(trace).close_now(flown.outcome.reason.as_deref().unwrap_or_default());
+            if let Some(why) =
+                lock(trace).close_now(flown.outcome.reason.as_deref().unwrap_or_default())
+            {
+                eprintln!("aviary: {why}");
+            }
         }
     }
     if let Some(progress) = &progress {
@@ -254,7 +258,11 @@ impl Hooks for Shown<'_> {
             self.stats.observe(record, progress, backend, self.drones);
         }
         if let Some(trace) = &self.trace {
-            lock(trace).write(record);
+            if let Some(why) = lock(trace).write(record) {
+                eprintln!(
+                    "\naviary: {why}; the mission goes on without it, and aviary will exit 3"
+                );
+            }
         }
         if let Some(feed) = &self.feed {
             feed.publish(record);
@@ -300,7 +308,11 @@ fn on_stop_signals(controller: Controller, stop: Stop, trace: SharedTrace) {
                 controller.send(Control::Abort { reason: format!("interrupted by {by}") });
                 stop.by(by);
             } else {
-                lock(&trace).close_now(&format!("stopped at once by a second {by}"));
+                if let Some(why) =
+                    lock(&trace).close_now(&format!("stopped at once by a second {by}"))
+                {
+                    eprintln!("aviary: {why}");
+                }
                 std::process::exit(130);
             }
         }

@@ -8,6 +8,7 @@ use std::sync::Arc;
 use aviary_api::trace::Record;
 use aviary_api::Backend;
 use aviary_backends::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
+use aviary_backends::trace_file::{lock, SharedTrace, TraceFile};
 use aviary_check::SourceProvider;
 use aviary_engine::{Controller, RunOptions};
 use aviary_ir::Mission;
@@ -41,6 +42,7 @@ pub fn start(
     request: Request,
     tree: serde_json::Value,
     files: Box<dyn SourceProvider + Send>,
+    trace: Trace,
 ) -> Result<(), String> {
     if let Some(speed) = request.speed {
         if !(speed.is_finite() && speed > 0.0 && speed <= 1000.0) {
@@ -76,7 +78,8 @@ pub fn start(
                 world: Source { name: &request.world.path, bytes: request.world.text.into_bytes() },
                 files: &*files,
             };
-            let mut hooks = Flight { station: flying, tree, feed: None, ready: Some(ready) };
+            let mut hooks =
+                Flight { station: flying, tree, feed: None, ready: Some(ready), trace, file: None };
             let flown = aviary_backends::fly(texts, &options, &mut hooks);
             landed.flying.store(false, std::sync::atomic::Ordering::SeqCst);
             let why = match flown {
@@ -101,16 +104,33 @@ pub fn start(
     started.recv().unwrap_or_else(|_| Err("the flight stopped before it started".into()))
 }
 
+/// Where a flight's trace goes: a file of the station's folder, and its name as the page
+/// shows it.
+pub struct Trace {
+    pub path: std::path::PathBuf,
+    pub shown: String,
+}
+
 struct Flight {
     station: Arc<Station>,
     tree: serde_json::Value,
     feed: Option<Feed>,
     ready: Option<std::sync::mpsc::Sender<Result<(), String>>>,
+    trace: Trace,
+    file: Option<SharedTrace>,
 }
 
 impl Hooks for Flight {
-    fn compiled(&mut self, _mission: &Mission, world: &World) -> Result<(), String> {
+    fn compiled(&mut self, mission: &Mission, world: &World) -> Result<(), String> {
         self.station.set_map(map_of(world));
+        if let Some(folder) = self.trace.path.parent() {
+            std::fs::create_dir_all(folder)
+                .map_err(|e| format!("cannot make {}: {e}", folder.display()))?;
+        }
+        let out = std::fs::File::create(&self.trace.path)
+            .map_err(|e| format!("cannot write the trace {}: {e}", self.trace.shown))?;
+        self.file =
+            Some(TraceFile::new(Box::new(out), self.trace.shown.clone(), mission.name.clone()));
         Ok(())
     }
 
@@ -129,6 +149,7 @@ impl Hooks for Flight {
             router,
             mission: mission.name.clone(),
             tree: std::mem::take(&mut self.tree),
+            trace: Some(self.trace.shown.clone()),
         });
         self.feed = Some(feed);
         if let Some(ready) = self.ready.take() {
@@ -138,6 +159,11 @@ impl Hooks for Flight {
     }
 
     fn record(&mut self, record: &Record<'_>, _backend: &dyn Backend) {
+        if let Some(file) = &self.file {
+            if let Some(why) = lock(file).write(record) {
+                eprintln!("aviary: {why}; the flight goes on without it");
+            }
+        }
         if let Some(feed) = &self.feed {
             feed.publish(record);
         }

@@ -64,6 +64,8 @@ pub(crate) struct Run {
     pub router: axum::Router,
     pub mission: String,
     pub tree: Value,
+    /// Where its trace is written, for a flight from the page.
+    pub trace: Option<String>,
 }
 
 pub(crate) struct Station {
@@ -96,7 +98,9 @@ impl Station {
     /// The routes of the flight in progress (or the last one), and what the page shows of it.
     pub fn run(&self) -> Option<(axum::Router, Value)> {
         Self::lock(&self.run).as_ref().map(|r| {
-            (r.router.clone(), serde_json::json!({ "mission": r.mission, "tree": r.tree }))
+            let shown =
+                serde_json::json!({ "mission": r.mission, "tree": r.tree, "trace": r.trace });
+            (r.router.clone(), shown)
         })
     }
 }
@@ -146,6 +150,7 @@ impl Serving {
             router,
             mission: mission.name.clone(),
             tree: tree::of(mission, None),
+            trace: None,
         });
         feed
     }

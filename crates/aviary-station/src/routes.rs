@@ -201,7 +201,8 @@ async fn fly(
             Err(why) => return error(StatusCode::CONFLICT, why),
         };
         let tree = report.json["tree"].clone();
-        match flight::start(station.clone(), request, tree, files) {
+        let trace = trace_for(folder, &request.mission.path);
+        match flight::start(station.clone(), request, tree, files, trace) {
             Ok(()) => Json(json!({ "ok": true })).into_response(),
             Err(why) => error(StatusCode::CONFLICT, why),
         }
@@ -225,6 +226,24 @@ async fn trace(State(station): State<Arc<Station>>) -> Response {
             "this station replays no trace: start it with `aviary replay TRACE.jsonl`",
         ),
     }
+}
+
+/// A new trace file for a flight of `mission`: `traces/NAME-TIME.jsonl` in the folder,
+/// the time in UTC.
+fn trace_for(folder: &dir::Folder, mission: &str) -> flight::Trace {
+    let stem = std::path::Path::new(mission)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "mission".into());
+    let now = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string();
+    let stamp: String = now.chars().map(|c| if c == ':' { '-' } else { c }).collect();
+    let mut shown = format!("traces/{stem}-{stamp}.jsonl");
+    let mut n = 1;
+    while folder.root().join(&shown).exists() {
+        n += 1;
+        shown = format!("traces/{stem}-{stamp}-{n}.jsonl");
+    }
+    flight::Trace { path: folder.root().join(&shown), shown }
 }
 
 /// Runs `work` on a thread with the checker's stack, and waits for it without holding

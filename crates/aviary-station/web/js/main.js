@@ -111,6 +111,7 @@ async function watch() {
   page.map.setWorld(about.map);
   page.tree.show(about.run.tree);
   fillLists(about.run.tree);
+  $("trace-file").textContent = about.run.trace ? `trace ${about.run.trace}` : "";
   for (const d of (about.map && about.map.drones) || []) drone(page.model, d.name).pos = d.home;
   const state = await api.call("GET", "/api/state");
   if (state.ok) {

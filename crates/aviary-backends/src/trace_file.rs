@@ -1,10 +1,12 @@
 //! The trace file: one JSON object per line, each written whole and flushed at once, so a
 //! run cut short (a kill, a crash, a second Ctrl-C) keeps every event before the cut.
 //!
-//! A write that fails (a full disk, `/dev/full`, a closed pipe) is said on stderr at
-//! once, and nothing more is written: a line written after a failed one could follow half
-//! an event. The mission flies on (stopping a fleet in the air because a disk filled up
-//! would be the worse failure), and `aviary run` exits 3 at its end.
+//! A write that fails (a full disk, `/dev/full`, a closed pipe) is answered with the
+//! reason once, for the caller to say at once, and nothing more is written: a line written
+//! after a failed one could follow half an event. The mission flies on (stopping a fleet
+//! in the air because a disk filled up would be the worse failure); `aviary run` exits 3
+//! at its end, and the ground station says so on the page. Used by `aviary run --trace`
+//! and by the station's flights.
 
 use std::io::Write;
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -51,9 +53,11 @@ impl TraceFile {
         self.failed.as_deref()
     }
 
-    pub fn write(&mut self, record: &Record) {
+    /// Writes the event; `Some(why)` when this write failed (once: nothing is written
+    /// after).
+    pub fn write(&mut self, record: &Record) -> Option<String> {
         if self.closed || self.failed.is_some() {
-            return;
+            return None;
         }
         // One write of the whole line: a cut never leaves half an event behind.
         self.line.clear();
@@ -62,9 +66,8 @@ impl TraceFile {
         let written =
             written.and_then(|()| self.out.write_all(&self.line)).and_then(|()| self.out.flush());
         if let Err(e) = written {
-            eprintln!("\naviary: cannot write the trace {}: {e}; the mission goes on without it, and aviary will exit 3", self.name);
             self.failed = Some(e.to_string());
-            return;
+            return Some(format!("cannot write the trace {}: {e}", self.name));
         }
         // A time that is not finite is written `null`: the last one stands.
         if record.t.is_finite() {
@@ -75,18 +78,21 @@ impl TraceFile {
             Event::MissionEnd { .. } => self.closed = true,
             _ => {}
         }
+        None
     }
 
     /// Ends the trace now, from outside the engine (a second Ctrl-C, or a stop before
     /// the mission started): a trace is whole, from `mission_start` to `mission_end`,
     /// whenever it is cut.
-    pub fn close_now(&mut self, reason: &str) {
+    pub fn close_now(&mut self, reason: &str) -> Option<String> {
         if !self.started {
             let mission = self.mission.clone();
             let start = Event::MissionStart { mission: mission.into() };
-            self.write(&Record { t: 0.0, event: start });
+            if let Some(why) = self.write(&Record { t: 0.0, event: start }) {
+                return Some(why);
+            }
         }
         let end = Event::MissionEnd { status: Status::Aborted, reason: Some(reason.into()) };
-        self.write(&Record { t: self.last_t, event: end });
+        self.write(&Record { t: self.last_t, event: end })
     }
 }

@@ -4,9 +4,11 @@
 
 mod mavlink;
 mod operator;
+mod station;
 
 pub use mavlink::{answers_of_the_vehicles, heard_on_a_link, link, vehicles};
 pub use operator::operator;
+pub use station::station;
 
 use aviary_api::Descriptor;
 // Fuzzed missions `USE` nothing that can be read.

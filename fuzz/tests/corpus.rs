@@ -86,3 +86,9 @@ fn the_mavlink_seeds_reach_past_the_framing() {
     });
     assert!(armed && climbed, "drone 1 did not arm and climb: {} answers", answers.len());
 }
+
+#[test]
+fn seeds_and_regressions_of_fuzz_station() {
+    assert!(each_file("in/station", aviary_fuzz::station) > 0);
+    each_file("regressions/station", aviary_fuzz::station);
+}

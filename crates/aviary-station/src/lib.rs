@@ -156,6 +156,34 @@ impl Serving {
     }
 }
 
+/// The routes of a station in `mode` bound at `bound`, without a socket: what [`serve`]
+/// serves, and what the `fuzz_station` target drives request by request.
+pub fn router(
+    mode: Mode,
+    bound: SocketAddr,
+    token: String,
+    allowed_hosts: &[String],
+    map: Value,
+) -> axum::Router {
+    routes::router(station(mode, bound, token, allowed_hosts, map))
+}
+
+fn station(
+    mode: Mode,
+    bound: SocketAddr,
+    token: String,
+    allowed_hosts: &[String],
+    map: Value,
+) -> Arc<Station> {
+    Arc::new(Station {
+        mode,
+        gate: Arc::new(Gate::new(bound, token, allowed_hosts)),
+        run: Mutex::new(None),
+        flying: Default::default(),
+        map: Mutex::new(map),
+    })
+}
+
 /// Binds `options.address` and serves the station in `mode`, on a thread of its own.
 pub fn serve(options: &Options, mode: Mode, map: Value) -> Result<Serving, String> {
     let listener = std::net::TcpListener::bind(options.address)
@@ -163,14 +191,7 @@ pub fn serve(options: &Options, mode: Mode, map: Value) -> Result<Serving, Strin
     listener.set_nonblocking(true).map_err(|e| e.to_string())?;
     let bound = listener.local_addr().map_err(|e| e.to_string())?;
     let token = aviary_server::new_token()?;
-    let gate = Arc::new(Gate::new(bound, token.clone(), &options.allowed_hosts));
-    let station = Arc::new(Station {
-        mode,
-        gate,
-        run: Mutex::new(None),
-        flying: Default::default(),
-        map: Mutex::new(map),
-    });
+    let station = station(mode, bound, token.clone(), &options.allowed_hosts, map);
     let app = routes::router(station.clone());
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(1)

@@ -2,6 +2,7 @@
 //! these functions; a test runs the seed corpus through them without AFL. Every
 //! function panics when a property does not hold, which AFL records as a crash.
 
+mod call;
 mod mavlink;
 mod operator;
 mod station;

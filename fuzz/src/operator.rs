@@ -8,16 +8,14 @@
 //! header lines `Name: value` up to an empty line, then the body.
 
 use std::cell::Cell;
-use std::net::SocketAddr;
 
 use aviary_api::{Kind, Value};
 use aviary_engine::{Control, Controller};
 use aviary_server::{Kinds, Options, MAX_MAGNITUDE};
-use axum::body::Body;
-use axum::http::{HeaderName, HeaderValue, Request};
 use tower::ServiceExt;
 
-const TOKEN: &str = "00112233445566778899aabbccddeeff";
+use crate::call::{call, Call, TOKEN};
+
 /// Byte 0 modulo their number picks one; a route added goes last, so that every seed
 /// keeps its route.
 const ROUTES: [(&str, &str); 8] = [
@@ -55,38 +53,9 @@ fn kinds() -> Kinds {
 }
 
 pub fn operator(data: &[u8]) {
-    let (route, flags, rest) = match data {
-        [r, f, rest @ ..] => (ROUTES[*r as usize % ROUTES.len()], *f, rest),
-        _ => (ROUTES[0], 0, data),
+    let Some(Call { request, bound, carries_token, .. }) = call(data, &ROUTES, false) else {
+        return;
     };
-    let (head, body) = match rest.windows(2).position(|w| w == b"\n\n") {
-        Some(i) => (&rest[..i], &rest[i + 2..]),
-        None => (&[][..], rest),
-    };
-    let bound: SocketAddr =
-        if flags & 2 != 0 { "0.0.0.0:7878" } else { "127.0.0.1:7878" }.parse().unwrap();
-    let mut request =
-        Request::builder().method(route.0).uri(route.1).body(Body::from(body.to_vec())).unwrap();
-    let headers = request.headers_mut();
-    headers.insert("host", HeaderValue::from_static("127.0.0.1:7878"));
-    if flags & 1 != 0 {
-        headers.insert("authorization", HeaderValue::from_str(&format!("Bearer {TOKEN}")).unwrap());
-    }
-    if flags & 4 != 0 {
-        headers.insert("content-type", HeaderValue::from_static("application/json"));
-    }
-    for line in head.split(|b| *b == b'\n') {
-        let Some(colon) = line.iter().position(|b| *b == b':') else { continue };
-        if let (Ok(name), Ok(value)) = (
-            HeaderName::from_bytes(&line[..colon]),
-            HeaderValue::from_bytes(line[colon + 1..].trim_ascii()),
-        ) {
-            headers.append(name, value);
-        }
-    }
-    let carries_token =
-        headers.values().any(|v| v.as_bytes().windows(TOKEN.len()).any(|w| w == TOKEN.as_bytes()));
-
     let (controller, mut rx) = Controller::new();
     let (app, _feed) = aviary_server::router(
         bound,

@@ -10,17 +10,15 @@
 //! up to an empty line, then the body. Flying is left out: each call would start a flight;
 //! its body is read as the check's is, and the flight's own limits are unit-tested.
 
-use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use aviary_check::{NoFiles, SourceProvider};
 use aviary_station::{FilesFor, Folder, Mode};
-use axum::body::Body;
-use axum::http::{HeaderName, HeaderValue, Request};
 use tower::ServiceExt;
 
-const TOKEN: &str = "00112233445566778899aabbccddeeff";
+use crate::call::{call, Call, TOKEN};
+
 /// Byte 0 modulo their number picks one; a route added goes last.
 const ROUTES: [(&str, &str); 7] = [
     ("GET", "/api/station"),
@@ -59,45 +57,10 @@ fn beside(parent: &Path) -> Vec<String> {
 }
 
 pub fn station(data: &[u8]) {
-    let (route, flags, rest) = match data {
-        [r, f, rest @ ..] => (ROUTES[*r as usize % ROUTES.len()], *f, rest),
-        _ => (ROUTES[0], 0, data),
+    // A path that is no URI a client could send never reaches the router.
+    let Some(Call { route, request, bound, carries_token }) = call(data, &ROUTES, true) else {
+        return;
     };
-    let (line, rest) = match rest.iter().position(|b| *b == b'\n') {
-        Some(i) => (&rest[..i], &rest[i + 1..]),
-        None => (rest, &[][..]),
-    };
-    let (head, body) = match rest.windows(2).position(|w| w == b"\n\n") {
-        Some(i) => (&rest[..i], &rest[i + 2..]),
-        None => (&[][..], rest),
-    };
-    let uri = format!("{}{}", route.1, String::from_utf8_lossy(line));
-    let Ok(mut request) =
-        Request::builder().method(route.0).uri(uri).body(Body::from(body.to_vec()))
-    else {
-        return; // not a URI a client could send
-    };
-    let headers = request.headers_mut();
-    headers.insert("host", HeaderValue::from_static("127.0.0.1:7878"));
-    if flags & 1 != 0 {
-        headers.insert("authorization", HeaderValue::from_str(&format!("Bearer {TOKEN}")).unwrap());
-    }
-    if flags & 4 != 0 {
-        headers.insert("content-type", HeaderValue::from_static("application/json"));
-    }
-    for line in head.split(|b| *b == b'\n') {
-        let Some(colon) = line.iter().position(|b| *b == b':') else { continue };
-        if let (Ok(name), Ok(value)) = (
-            HeaderName::from_bytes(&line[..colon]),
-            HeaderValue::from_bytes(line[colon + 1..].trim_ascii()),
-        ) {
-            headers.append(name, value);
-        }
-    }
-    let carries_token =
-        headers.values().any(|v| v.as_bytes().windows(TOKEN.len()).any(|w| w == TOKEN.as_bytes()));
-    let bound: SocketAddr =
-        if flags & 2 != 0 { "0.0.0.0:7878" } else { "127.0.0.1:7878" }.parse().unwrap();
     let (parent, dir) = folder();
     let before = beside(parent);
     let files: FilesFor =

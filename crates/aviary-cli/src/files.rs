@@ -153,3 +153,13 @@ pub fn world_alone(path: &Path) -> Result<aviary_world::World, String> {
         shown
     })
 }
+
+/// A recorded trace read and checked line by line (`aviary replay`, `aviary report`): its
+/// name as messages show it and its text, or what to print of why not.
+pub fn recorded_trace(path: &Path) -> Result<(String, String), String> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| format!("aviary: cannot read {name}: {e}\n"))?;
+    let text =
+        aviary_station::replay::read(&name, bytes).map_err(|why| format!("aviary: {why}\n"))?;
+    Ok((name, text))
+}

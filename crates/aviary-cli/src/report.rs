@@ -4,18 +4,10 @@
 use std::path::Path;
 
 pub fn run(trace: &Path, world: Option<&Path>, out: &Path) -> u8 {
-    let name = trace.display().to_string();
-    let bytes = match std::fs::read(trace) {
-        Ok(b) => b,
-        Err(e) => {
-            eprintln!("aviary: cannot read {name}: {e}");
-            return 2;
-        }
-    };
-    let text = match aviary_station::replay::read(&name, bytes) {
-        Ok(t) => t,
-        Err(why) => {
-            eprintln!("aviary: {why}");
+    let (name, text) = match crate::files::recorded_trace(trace) {
+        Ok(read) => read,
+        Err(shown) => {
+            eprint!("{shown}");
             return 2;
         }
     };

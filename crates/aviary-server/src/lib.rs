@@ -133,21 +133,7 @@ impl Feed {
     }
 }
 
-/// A running server.
-pub struct Server {
-    pub address: SocketAddr,
-    pub token: String,
-    pub feed: Feed,
-}
-
-impl Server {
-    /// As [`Feed::finish`].
-    pub fn finish(&self, limit: std::time::Duration) {
-        self.feed.finish(limit)
-    }
-}
-
-/// The routes of a server bound at `bound`, without a socket: what [`start`] serves, and
+/// The routes of a server bound at `bound`, without a socket: what a server serves (`serve`), and
 /// what a fuzz target or a test drives request by request.
 pub fn router(
     bound: SocketAddr,
@@ -180,39 +166,40 @@ pub fn router_behind(
     (routes::router(shared.clone()), Feed { shared })
 }
 
-/// Binds `address` and serves in the background. The token is new for each run.
-pub fn start(
+/// Binds `address` and serves the routes `make` gives for the bound address, on a
+/// thread and a real-time runtime of their own, until the process ends; the address
+/// bound (a port 0 is a free port). `what` names the server in messages.
+pub fn serve(
     address: SocketAddr,
-    controller: Controller,
-    options: Options,
-) -> Result<Server, String> {
+    what: &'static str,
+    make: impl FnOnce(SocketAddr) -> axum::Router,
+) -> Result<SocketAddr, String> {
     let listener = std::net::TcpListener::bind(address)
         .map_err(|e| format!("cannot listen on {address}: {e}"))?;
     listener.set_nonblocking(true).map_err(|e| e.to_string())?;
     let bound = listener.local_addr().map_err(|e| e.to_string())?;
-    let token = new_token()?;
-    let (app, feed) = router(bound, token.clone(), controller, options);
+    let app = make(bound);
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(1)
         .enable_all()
         .build()
         .map_err(|e| e.to_string())?;
     std::thread::Builder::new()
-        .name("aviary-server".into())
+        .name(format!("aviary {what}"))
         .spawn(move || {
             runtime.block_on(async move {
                 match tokio::net::TcpListener::from_std(listener) {
                     Ok(listener) => {
                         if let Err(e) = axum::serve(listener, app).await {
-                            eprintln!("aviary: the operator API stopped: {e}");
+                            eprintln!("aviary: the {what} stopped: {e}");
                         }
                     }
-                    Err(e) => eprintln!("aviary: the operator API cannot start: {e}"),
+                    Err(e) => eprintln!("aviary: the {what} cannot start: {e}"),
                 }
             })
         })
         .map_err(|e| e.to_string())?;
-    Ok(Server { address: bound, token, feed })
+    Ok(bound)
 }
 
 /// A new token: 16 random bytes, in hex.

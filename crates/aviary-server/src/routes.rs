@@ -77,7 +77,7 @@ async fn events(
         (past, shared.events.subscribe())
     };
     // Counted from the handshake on, so that a stream opened just before the mission
-    // ends still gets `mission_end` (`Server::finish` waits for it).
+    // ends still gets `mission_end` (`Feed::finish` waits for it).
     shared.streams.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
     let failed = shared.clone();
     // A browser that offered `aviary` (beside its token) must get it back, or it drops the socket.

@@ -186,32 +186,13 @@ fn station(
 
 /// Binds `options.address` and serves the station in `mode`, on a thread of its own.
 pub fn serve(options: &Options, mode: Mode, map: Value) -> Result<Serving, String> {
-    let listener = std::net::TcpListener::bind(options.address)
-        .map_err(|e| format!("cannot listen on {}: {e}", options.address))?;
-    listener.set_nonblocking(true).map_err(|e| e.to_string())?;
-    let bound = listener.local_addr().map_err(|e| e.to_string())?;
     let token = aviary_server::new_token()?;
-    let station = station(mode, bound, token.clone(), &options.allowed_hosts, map);
-    let app = routes::router(station.clone());
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(1)
-        .enable_all()
-        .build()
-        .map_err(|e| e.to_string())?;
-    std::thread::Builder::new()
-        .name("aviary-station".into())
-        .spawn(move || {
-            runtime.block_on(async move {
-                match tokio::net::TcpListener::from_std(listener) {
-                    Ok(listener) => {
-                        if let Err(e) = axum::serve(listener, app).await {
-                            eprintln!("aviary: the station stopped: {e}");
-                        }
-                    }
-                    Err(e) => eprintln!("aviary: the station cannot start: {e}"),
-                }
-            })
-        })
-        .map_err(|e| e.to_string())?;
-    Ok(Serving { address: bound, token, station })
+    let mut made = None;
+    let address = aviary_server::serve(options.address, "ground station", |bound| {
+        let s = station(mode, bound, token.clone(), &options.allowed_hosts, map);
+        made = Some(s.clone());
+        routes::router(s)
+    })?;
+    let station = made.ok_or("the station was not made")?;
+    Ok(Serving { address, token, station })
 }

@@ -163,6 +163,7 @@ impl<'m> Engine<'m> {
                         handled: false,
                         handler: None,
                         during: Some("return home".into()),
+                        skipped: None,
                     });
                 }
                 Some(DroneEvent::Signal { drone, signal }) => {

@@ -442,8 +442,14 @@ mod generated {
             })
     }
 
+    /// 64 cases (a second in a debug build); `PROPTEST_CASES=1000` for a longer hunt.
+    fn config() -> ProptestConfig {
+        let cases = std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(64);
+        ProptestConfig { cases, ..ProptestConfig::default() }
+    }
+
     proptest! {
-        #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+        #![proptest_config(config())]
 
         #[test]
         fn generated_missions_run_the_same_both_ways(case in case()) {

@@ -99,7 +99,9 @@ pub enum Event<'a> {
         args: Vec<Shown<'a>>,
     },
     /// `args` of a built-in exception: the reason, in words. `during` is `return home` for
-    /// a fault after the mission's body has ended, which no handler can take.
+    /// a fault after the mission's body has ended, which no handler can take. `skipped`:
+    /// a handler that would have taken it and did not, and why (it was re-entered too
+    /// often at one instant, docs/LANGUAGE.md section 12).
     Exception {
         name: Text<'a>,
         actor: Option<Text<'a>>,
@@ -108,6 +110,8 @@ pub enum Event<'a> {
         handler: Option<Text<'a>>,
         #[serde(default, skip_serializing_if = "Option::is_none")]
         during: Option<Text<'a>>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        skipped: Option<Text<'a>>,
     },
     /// `action`: `PAUSE`, `RESUME`, `ABORT` or a section's name.
     Leash {

@@ -1,5 +1,6 @@
 //! Signals and exceptions across the whole program: handlers that can never fire,
-//! waits that can never end, and signals nobody listens to.
+//! waits that can never end, signals nobody listens to, and exception handlers that take
+//! their own exception again at once.
 
 use std::collections::HashSet;
 
@@ -38,6 +39,7 @@ pub(crate) fn check_signals(
     never_raised(&uses, &raised, &raised_set, diagnostics);
     unknown_exceptions(&uses, api, &raised_set, diagnostics);
     never_handled(&uses, diagnostics);
+    rethrows(program, diagnostics);
 }
 
 impl<'a> Uses<'a> {
@@ -196,4 +198,75 @@ fn collect_received<'a>(file: FileId, e: &'a Expr, uses: &mut Uses<'a>) {
             uses.received.push((file, id));
         }
     });
+}
+
+/// An `ON EXCEPTION X` (with no `BY`) whose body throws `X` before anything else that it
+/// runs: the throw is taken by that handler again at once, round after round, until the
+/// run passes the handler over (docs/LANGUAGE.md, section 12). Someone who wrote it most
+/// likely meant to hand the exception to the blocks around, which a throw does not do.
+fn rethrows(program: &Program, diagnostics: &mut Vec<Diagnostic>) {
+    for (file, tree) in &program.files {
+        for item in &tree.items {
+            let bodies = match item {
+                Item::Mission(m) => vec![&m.body],
+                Item::Capability(c) if program.is_active(*file, c) => capability_bodies(c),
+                _ => continue,
+            };
+            let mut check = |h: &ExceptionHandler| {
+                if let Some(throw) = rethrow(h) {
+                    let name = &h.exception.name;
+                    diagnostics.push(
+                        Diagnostic::new(
+                            Code::HandlerRethrows,
+                            *file,
+                            throw.span,
+                            format!("this handler of `{name}` throws `{name}` at once and takes it again itself, round after round at one instant, until the run passes it over"),
+                        )
+                        .with_help("a THROW in a handler is taken by the nearest handler, this one; to hand the exception to the blocks around, throw another exception and handle that there"),
+                    );
+                }
+            };
+            if let Item::Capability(c) = item {
+                for s in &c.sections {
+                    if let Section::Exceptions { handlers, .. } = s {
+                        handlers.iter().for_each(&mut check);
+                    }
+                }
+            }
+            for body in bodies {
+                visit_stmts(body, &mut |stmt| {
+                    if let Stmt::ExceptionHandler(h) = stmt {
+                        check(h);
+                    }
+                });
+            }
+        }
+    }
+}
+
+/// The `THROW` of its own exception that `h` starts with, if it does: only signals
+/// (which take no time) before it, no `BY` (a thrower it filters out would go outward),
+/// and no handler of that exception in its own body (which would take it first).
+fn rethrow(h: &ExceptionHandler) -> Option<&Raise> {
+    let name = &h.exception.name;
+    if h.by.is_some() {
+        return None;
+    }
+    let handled_inside = h
+        .body
+        .items
+        .iter()
+        .any(|s| matches!(s, Stmt::ExceptionHandler(inner) if inner.exception.name == *name));
+    if handled_inside {
+        return None;
+    }
+    let first = h
+        .body
+        .items
+        .iter()
+        .find(|s| !matches!(s, Stmt::Signal(_) | Stmt::Handler(_) | Stmt::ExceptionHandler(_)));
+    match first {
+        Some(Stmt::Throw(r)) if r.name.name == *name => Some(r),
+        _ => None,
+    }
 }

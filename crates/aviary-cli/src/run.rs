@@ -339,7 +339,9 @@ fn progress_bar(quiet: bool) -> ProgressBar {
 struct Stats {
     running: i64,
     signals: Vec<(String, usize)>,
-    exceptions: Vec<(String, bool)>,
+    /// Name, handled, how many times: a handler re-entered at one instant until it was
+    /// cut off takes its exception a hundred times over.
+    exceptions: Vec<(String, bool, usize)>,
     detections: usize,
     last_shown: f64,
 }
@@ -361,7 +363,10 @@ impl Stats {
                 None => self.signals.push((name.to_string(), 1)),
             },
             Event::Exception { name, handled, .. } => {
-                self.exceptions.push((name.to_string(), *handled))
+                match self.exceptions.iter_mut().find(|(n, h, _)| n == name && h == handled) {
+                    Some((_, _, count)) => *count += 1,
+                    None => self.exceptions.push((name.to_string(), *handled, 1)),
+                }
             }
             _ => {}
         }
@@ -428,7 +433,14 @@ fn summary(
     let exceptions: Vec<String> = stats
         .exceptions
         .iter()
-        .map(|(n, h)| format!("{n} ({})", if *h { "handled" } else { "unhandled" }))
+        .map(|(n, h, c)| {
+            let handled = if *h { "handled" } else { "unhandled" };
+            if *c == 1 {
+                format!("{n} ({handled})")
+            } else {
+                format!("{n} ({handled}) ×{c}")
+            }
+        })
         .collect();
     out.push_str(&format!(
         "exceptions: {}\n",

@@ -284,3 +284,60 @@ fn a_trace_that_cannot_be_written_is_said_at_once_and_exits_3_after_a_whole_flig
     assert!(out.contains("mission ok"), "{out}");
     assert!(out.lines().filter(|l| l.ends_with("Landed")).count() == 7, "every drone down:\n{out}");
 }
+
+/// A handler whose work fails at once takes its own exception again at the same instant:
+/// the run passes it over after 100 re-entries instead of looping for ever (which once
+/// filled a disk with its trace, and took no SIGTERM), fails, and brings the fleet home.
+#[test]
+fn a_handler_that_fails_at_once_ends_the_run_instead_of_looping() {
+    let dir = scratch("reentered");
+    std::fs::write(
+        dir.join("m.world.toml"),
+        "[places]\nFar = [0, 300]\n[drones.a]\nhome = [0, 0]\n[drones.c]\nhome = [10, 0]\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("m.mission"),
+        "MISSION M:\n    a TakeOff WITH 20m\n    SEQUENTIAL Stream:\n        c StartStreaming\n        ON EXCEPTION CommandFailed BY c:\n            c StartStreaming\n    a FlyTo WITH Far\n",
+    )
+    .unwrap();
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(["run", "m.mission", "--trace", "t.jsonl"])
+        .current_dir(&dir)
+        .env("NO_COLOR", "1")
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .expect("run aviary");
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("wait for aviary") {
+            break status;
+        }
+        if std::time::Instant::now() > deadline {
+            child.kill().expect("kill aviary");
+            panic!("the run did not end within 60 s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let mut out = String::new();
+    std::io::Read::read_to_string(&mut child.stdout.take().unwrap(), &mut out).unwrap();
+    assert_eq!(status.code(), Some(1), "{out}");
+    assert!(
+        out.contains("mission failed: unhandled exception CommandFailed on c: c has no camera; its handler Stream/ON EXCEPTION CommandFailed, line 5, re-entered 100 times at t = 7.7 s without time passing, so it did not take it again"),
+        "{out}"
+    );
+    assert!(
+        out.contains("exceptions: CommandFailed (handled) ×101, CommandFailed (unhandled)"),
+        "{out}"
+    );
+    let trace = std::fs::read_to_string(dir.join("t.jsonl")).unwrap();
+    assert!(trace.lines().count() < 1000, "{} lines", trace.lines().count());
+    assert!(!trace.contains("\"FlyToPosition\""), "nothing new starts");
+    assert!(
+        trace.lines().any(|l| l.contains("\"function\":\"ReturnToLaunch\"")
+            && l.contains("\"actor\":\"a\"")
+            && l.contains("\"status\":\"ok\"")),
+        "a is brought home"
+    );
+    assert!(trace.lines().last().unwrap().contains("\"event\":\"mission_end\""));
+}

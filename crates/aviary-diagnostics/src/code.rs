@@ -87,6 +87,7 @@ codes! {
     CommandsMayCollide = "W203", Warning, "one drone commanded from two places that may run at once";
     LowReserve = "W204", Warning, "a drone's estimated battery reserve falls under 20%";
     PastEndurance = "W205", Warning, "a duration (such as Hover's) longer than the drone's endurance";
+    HandlerRethrows = "W206", Warning, "an ON EXCEPTION that throws the exception it handles before doing anything else";
     // Notes.
     SignalNeverHandled = "N301", Note, "a signal raised but never handled";
     NoWorld = "N302", Note, "no world file, so actors, places and areas were not checked";

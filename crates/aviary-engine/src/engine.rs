@@ -3,6 +3,8 @@
 
 use std::cell::{Cell, RefCell};
 use std::collections::BTreeMap;
+use std::future::Future;
+use std::pin::pin;
 use std::rc::Rc;
 
 use std::borrow::Cow;
@@ -28,8 +30,67 @@ pub(crate) type Actors = smallvec::SmallVec<[DroneId; 2]>;
 /// Work a scope starts on request, while it runs.
 pub(crate) enum Job<'m> {
     Signal { handler: &'m Handler, args: Vec<Value>, actor: Option<DroneId>, signal: usize },
-    Exception { handler: &'m ExceptionHandler, args: Vec<Value> },
+    Exception { handler: &'m ExceptionHandler, args: Vec<Value>, entry: Rc<Entry<'m>> },
     Section { block: &'m aviary_ir::Block, frame: Frame },
+}
+
+/// An exception handler's instance, for the bound on re-entering a handler at one instant
+/// ([`crate::RunOptions::max_handler_reentries`]): kept by its body's scope while the body
+/// runs (`Engine::entered`), so that an exception from inside the body knows what led to it.
+pub(crate) struct Entry<'m> {
+    handler: &'m ExceptionHandler,
+    /// When it was entered: the clock, and the runtime's poll of the mission.
+    at: Instant,
+    poll: u64,
+    /// The instance whose body led to the exception this one handles, if that one was
+    /// entered at this same instant; so on back, all at this instant.
+    cause: Option<Rc<Entry<'m>>>,
+    /// The re-entries of the instances one exception led to at this instant, shared by
+    /// all of them: a body that fails twice at once (a statement on a group) starts two
+    /// instances, and their count must not grow as a tree does.
+    counts: Rc<Counts<'m>>,
+}
+
+/// How many times each handler has been re-entered among the instances one exception led
+/// to at one instant.
+#[derive(Default)]
+struct Counts<'m>(RefCell<Vec<(&'m ExceptionHandler, usize)>>);
+
+impl<'m> Counts<'m> {
+    fn of(&self, handler: &ExceptionHandler) -> usize {
+        let counts = self.0.borrow();
+        counts.iter().find(|(h, _)| std::ptr::eq(*h, handler)).map_or(0, |(_, n)| *n)
+    }
+
+    fn add(&self, handler: &'m ExceptionHandler) {
+        let mut counts = self.0.borrow_mut();
+        match counts.iter_mut().find(|(h, _)| std::ptr::eq(*h, handler)) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((handler, 1)),
+        }
+    }
+}
+
+impl Entry<'_> {
+    /// Whether an instance of `handler` led to this one (or is this one): another instance
+    /// of it started now is a re-entry.
+    fn led_from(&self, handler: &ExceptionHandler) -> bool {
+        std::iter::successors(Some(self), |e| e.cause.as_deref())
+            .any(|e| std::ptr::eq(e.handler, handler))
+    }
+}
+
+/// While an exception handler's body runs, its scope is known by the instance's
+/// [`Entry`]; the guard forgets it when the body ends or is dropped.
+pub(crate) struct Entered<'e, 'm> {
+    engine: &'e Engine<'m>,
+    key: usize,
+}
+
+impl Drop for Entered<'_, '_> {
+    fn drop(&mut self) {
+        self.engine.entered.borrow_mut().remove(&self.key);
+    }
 }
 
 /// A running body: what it hears, where its handlers start, whether it is unwinding.
@@ -147,6 +208,14 @@ pub(crate) struct Engine<'m> {
     pub instant: Vec<bool>,
     /// [`crate::RunOptions::max_call_depth`].
     pub max_call_depth: usize,
+    /// [`crate::RunOptions::max_handler_reentries`].
+    max_handler_reentries: usize,
+    /// The exception handler instances running, by their body's scope (its address).
+    entered: RefCell<BTreeMap<usize, Rc<Entry<'m>>>>,
+    /// How many times the runtime has polled the mission. Within one poll the engine has
+    /// not waited for anything: with the wall clock (MAVLink drones), whose every reading
+    /// differs, that is what "at one instant" is.
+    polls: Cell<u64>,
 }
 
 impl<'m> Engine<'m> {
@@ -181,6 +250,9 @@ impl<'m> Engine<'m> {
             next_id: Cell::new(0),
             instant: crate::instant::instant_capabilities(m),
             max_call_depth: options.max_call_depth,
+            max_handler_reentries: options.max_handler_reentries,
+            entered: RefCell::new(BTreeMap::new()),
+            polls: Cell::new(0),
         }
     }
 
@@ -264,14 +336,24 @@ impl<'m> Engine<'m> {
         // Drones the operator took out of the mission, brought down beside it and after
         // its end (last: what the mission does at an instant comes first).
         let mut withdrawals = Box::pin(self.withdrawals());
-        tokio::select! {
-            biased;
-            _ = self.stop.cancelled() => {}
-            _ = body => {}
-            _ = self.pump() => {}
-            _ = controls => {}
-            _ = self.telemetry(options.telemetry_hz) => {}
-            _ = withdrawals.as_mut() => {}
+        {
+            let mut all = pin!(async {
+                tokio::select! {
+                    biased;
+                    _ = self.stop.cancelled() => {}
+                    _ = body => {}
+                    _ = self.pump() => {}
+                    _ = controls => {}
+                    _ = self.telemetry(options.telemetry_hz) => {}
+                    _ = withdrawals.as_mut() => {}
+                }
+            });
+            // Each poll counted (`polls`): between two, the engine has waited.
+            std::future::poll_fn(|cx| {
+                self.polls.set(self.polls.get().wrapping_add(1));
+                all.as_mut().poll(cx)
+            })
+            .await;
         }
         self.over.set(true);
         let ending = self.ending.borrow().clone();
@@ -543,11 +625,33 @@ impl<'m> Engine<'m> {
             return;
         }
         let name = self.m.exceptions.get(exception).map_or("", String::as_str);
+        let cause = self.cause(from);
+        // A handler re-entered too often at this instant is passed over, as if it were not
+        // there: the exception goes on outward. The first one passed over is reported.
+        let mut skipped = None;
         let found = from.chain().find_map(|scope| {
-            let i = scope.exception_handlers.iter().position(|h| {
+            let handlers: &'m [ExceptionHandler] = scope.exception_handlers;
+            let i = handlers.iter().position(|h| {
                 h.exception == exception && self.matches(&h.by, &scope.frame, actor)
             })?;
-            Some((scope.clone(), i))
+            let reentry = cause.as_ref().filter(|c| c.led_from(&handlers[i]));
+            let reentries = reentry.map_or(0, |c| c.counts.of(&handlers[i]));
+            if reentry.is_some() && reentries >= self.max_handler_reentries {
+                skipped.get_or_insert_with(|| {
+                    let line = match handlers[i].line {
+                        0 => String::new(),
+                        line => format!(", line {line},"),
+                    };
+                    // Whole milliseconds: the clock's own digits say nothing more.
+                    let t = (self.now() * 1000.0).round() / 1000.0;
+                    format!(
+                        "{}/ON EXCEPTION {name}{line} re-entered {} times at t = {t} s without time passing",
+                        scope.path, reentries
+                    )
+                });
+                return None;
+            }
+            Some((scope.clone(), i, reentry.is_some()))
         });
         self.trace(EventKind::Exception, || Event::Exception {
             name: name.into(),
@@ -556,10 +660,11 @@ impl<'m> Engine<'m> {
             handled: found.is_some(),
             handler: found
                 .as_ref()
-                .map(|(s, _)| Cow::Owned(format!("{}/ON EXCEPTION {name}", s.path))),
+                .map(|(s, _, _)| Cow::Owned(format!("{}/ON EXCEPTION {name}", s.path))),
             during: None,
+            skipped: skipped.as_deref().map(Cow::Borrowed),
         });
-        let Some((handler_scope, index)) = found else {
+        let Some((handler_scope, index, reentry)) = found else {
             for scope in from.chain() {
                 scope.unwinding.set(true);
                 if let Some(i) = &scope.instance {
@@ -567,10 +672,13 @@ impl<'m> Engine<'m> {
                 }
             }
             let who = actor.map_or(String::from("the mission"), |a| self.name(a).to_string());
-            let reason = match args.first() {
+            let mut reason = match args.first() {
                 Some(Value::Text(why)) => format!("unhandled exception {name} on {who}: {why}"),
                 _ => format!("unhandled exception {name} on {who}"),
             };
+            if let Some(skipped) = skipped {
+                reason = format!("{reason}; its handler {skipped}, so it did not take it again");
+            }
             self.end_with(Status::Failed, reason, true);
             return;
         };
@@ -593,6 +701,34 @@ impl<'m> Engine<'m> {
         }
         handler_scope.catching.set(handler_scope.catching.get() + 1);
         let handlers: &'m [ExceptionHandler] = handler_scope.exception_handlers;
-        handler_scope.jobs.send(Job::Exception { handler: &handlers[index], args });
+        let handler = &handlers[index];
+        let counts = cause.as_ref().map_or_else(Rc::default, |c| c.counts.clone());
+        if reentry {
+            counts.add(handler);
+        }
+        let entry =
+            Rc::new(Entry { handler, at: Instant::now(), poll: self.polls.get(), cause, counts });
+        handler_scope.jobs.send(Job::Exception { handler, args, entry });
+    }
+
+    /// The innermost exception handler instance whose body `from` is in, if it was
+    /// entered at this instant: no time has passed since, or the engine has not waited
+    /// since (with the wall clock, time passes between any two readings).
+    fn cause(&self, from: &Rc<Scope<'m>>) -> Option<Rc<Entry<'m>>> {
+        let entered = self.entered.borrow();
+        if entered.is_empty() {
+            return None;
+        }
+        let innermost = from.chain().find_map(|s| entered.get(&(Rc::as_ptr(s) as usize)))?;
+        (innermost.at == Instant::now() || innermost.poll == self.polls.get())
+            .then(|| innermost.clone())
+    }
+
+    /// Knows `body`, the scope of an exception handler's body, by `entry` while the
+    /// guard lives.
+    pub fn enter<'e>(&'e self, body: &Rc<Scope<'m>>, entry: Rc<Entry<'m>>) -> Entered<'e, 'm> {
+        let key = Rc::as_ptr(body) as usize;
+        self.entered.borrow_mut().insert(key, entry);
+        Entered { engine: self, key }
     }
 }

@@ -132,26 +132,36 @@ impl<'m> Engine<'m> {
         block: &'m Block,
         ctx: &'a Ctx<'m>,
     ) -> LocalBoxFuture<'a, ()> {
-        Box::pin(async move {
-            let scope = self.new_scope(ctx, block, None);
-            if block.traced {
-                self.trace(EventKind::BlockStart, || Event::BlockStart {
-                    block: block.path.as_str().into(),
-                });
-            }
-            let inner = Ctx { scope: scope.clone(), ..ctx.clone() };
-            // Futures made in place and passed pinned: moving a large future into the
-            // next one's state is a copy of all of it, at every step.
-            let items = pin!(self.items(block, &inner));
-            self.drive(&scope, items).await;
-            if block.traced {
-                let status = if scope.unwinding.get() { Status::Aborted } else { Status::Ok };
-                self.trace(EventKind::BlockEnd, || Event::BlockEnd {
-                    block: block.path.as_str().into(),
-                    status,
-                });
-            }
-        })
+        Box::pin(self.block_with(block, ctx, |_| ()))
+    }
+
+    /// A block in a scope of its own. `on_scope` is told the scope first, and what it
+    /// gives back is kept while the block runs.
+    async fn block_with<T>(
+        &self,
+        block: &'m Block,
+        ctx: &Ctx<'m>,
+        on_scope: impl FnOnce(&Rc<Scope<'m>>) -> T,
+    ) {
+        let scope = self.new_scope(ctx, block, None);
+        let _kept = on_scope(&scope);
+        if block.traced {
+            self.trace(EventKind::BlockStart, || Event::BlockStart {
+                block: block.path.as_str().into(),
+            });
+        }
+        let inner = Ctx { scope: scope.clone(), ..ctx.clone() };
+        // Futures made in place and passed pinned: moving a large future into the
+        // next one's state is a copy of all of it, at every step.
+        let items = pin!(self.items(block, &inner));
+        self.drive(&scope, items).await;
+        if block.traced {
+            let status = if scope.unwinding.get() { Status::Aborted } else { Status::Ok };
+            self.trace(EventKind::BlockEnd, || Event::BlockEnd {
+                block: block.path.as_str().into(),
+                status,
+            });
+        }
     }
 
     pub(crate) async fn items(&self, block: &'m Block, ctx: &Ctx<'m>) {
@@ -435,13 +445,15 @@ impl<'m> Engine<'m> {
                     actor: who.map(Into::into),
                 });
             }
-            Job::Exception { handler, args } => {
+            Job::Exception { handler, args, entry } => {
                 let mut frame = scope.frame.to_vec();
                 for (slot, v) in handler.bindings.iter().zip(args) {
                     set(&mut frame, *slot, v);
                 }
                 let ctx = self.scope_ctx(&scope, Rc::from(frame));
-                self.block(&handler.body, &ctx).await;
+                // Boxed, as `block` is: the job's future stays small while it waits.
+                Box::pin(self.block_with(&handler.body, &ctx, |body| self.enter(body, entry)))
+                    .await;
                 scope.catching.set(scope.catching.get().saturating_sub(1));
                 scope.caught.notify_waiters();
             }

@@ -256,6 +256,7 @@ impl<'m> Engine<'m> {
                     handled: false,
                     handler: None,
                     during: Some("return home".into()),
+                    skipped: None,
                 });
             }
             DroneEvent::Signal { drone, signal } => {

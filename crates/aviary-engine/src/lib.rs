@@ -61,15 +61,33 @@ pub struct RunOptions {
     /// build and 6 KB in release (`aviary` runs on a 1 GiB stack). A recursion the
     /// checker allows (one behind a condition) ends here, never in a stack overflow.
     pub max_call_depth: usize,
+    /// How many times an exception handler may be re-entered at one instant: started
+    /// again by an exception that one of its own instances led to at that instant (its
+    /// body threw at once, or a handler that its body's exception started did), counted
+    /// over everything the first exception led to then. Past the limit that handler does
+    /// not take the exception: it goes on outward as if the handler were not there, and
+    /// the trace says which handler was passed over and why (docs/LANGUAGE.md, section
+    /// 12). Without it, a handler whose body fails at once would run for ever at one
+    /// instant, and the engine's thread, never waiting, would not even hear Ctrl-C.
+    pub max_handler_reentries: usize,
 }
 
 /// The default [`RunOptions::max_call_depth`]: twice the 5,000-deep chain the CLI's tests
 /// run, and 300 MB of stack in a debug build.
 pub const MAX_CALL_DEPTH: usize = 10_000;
 
+/// The default [`RunOptions::max_handler_reentries`]. Between two rounds at one instant
+/// no drone has moved and no time has passed, so a handler re-entered this often is
+/// going round in a loop; the trace of one passed over here stays under a megabyte.
+pub const MAX_HANDLER_REENTRIES: usize = 100;
+
 impl Default for RunOptions {
     fn default() -> Self {
-        RunOptions { telemetry_hz: None, max_call_depth: MAX_CALL_DEPTH }
+        RunOptions {
+            telemetry_hz: None,
+            max_call_depth: MAX_CALL_DEPTH,
+            max_handler_reentries: MAX_HANDLER_REENTRIES,
+        }
     }
 }
 

@@ -1,11 +1,16 @@
 //! One trace-based test per rule of the language's semantics (docs/LANGUAGE.md), asserting
 //! order and timing, on the built-in simulator with a paused clock (so every time below is
 //! simulated seconds). The missions are files, `tests/rules/*.mission`, and each one's
-//! whole trace is a snapshot (`tests/snapshots/rules__traces@*.snap`).
+//! whole trace is a snapshot (`tests/snapshots/rules__traces@*.snap`), taken with a
+//! handler re-entered at most [`SNAPSHOT_REENTRIES`] times at one instant.
 
-use aviary_engine::Status;
+use aviary_engine::{RunOptions, Status, MAX_HANDLER_REENTRIES};
 use aviary_test_support::harness;
 use harness::run;
+
+/// `RunOptions::max_handler_reentries` in the snapshots: a handler cut off by the bound
+/// shows whole in a few lines. No other rule comes near it.
+const SNAPSHOT_REENTRIES: usize = 3;
 
 /// The mission of a rule: `tests/rules/NAME.mission`.
 fn fixture(name: &str) -> String {
@@ -20,7 +25,9 @@ fn fixture(name: &str) -> String {
 fn traces() {
     insta::glob!("rules/*.mission", |path| {
         let mission = std::fs::read_to_string(path).expect("read the fixture");
-        let r = run(&mission);
+        let options =
+            RunOptions { max_handler_reentries: SNAPSHOT_REENTRIES, ..RunOptions::default() };
+        let r = harness::run_with(&mission, harness::WORLD, &options);
         insta::assert_snapshot!(format!("outcome: {:?}\n{}", r.outcome.status, r.dump()));
     });
 }
@@ -368,4 +375,28 @@ fn parallel_branches_woken_at_one_instant_go_on_in_written_order() {
             .filter(|e| e["event"] == "signal")
             .all(|e| close(e["t"].as_f64().unwrap_or(0.0), 1.0)));
     }
+}
+
+#[test]
+fn a_handler_re_entered_at_one_instant_is_passed_over() {
+    // `c` has no camera: `c Ping` fails as it starts, in the handler's body as in the
+    // block's, and the handler takes its own exception again at the same instant.
+    let r = run(&fixture("a_handler_re_entered_at_one_instant_is_passed_over"));
+    assert_eq!(r.outcome.status, Status::Failed, "the run ends, failed");
+    let exceptions = r.find("exception", "name", "CommandFailed");
+    let handled = exceptions.iter().filter(|e| e["handled"] == true).count();
+    assert_eq!(handled, 1 + MAX_HANDLER_REENTRIES, "entered once, then re-entered to the limit");
+    let last = exceptions.last().unwrap();
+    assert_eq!(last["handled"], false, "past the limit nothing else takes it");
+    let why = "S/ON EXCEPTION CommandFailed, line 9, re-entered 100 times at t = 0 s without time passing";
+    assert_eq!(last["skipped"], why);
+    assert!(exceptions[..handled].iter().all(|e| e.get("skipped").is_none()));
+    let reason = r.outcome.reason.as_deref().unwrap_or("");
+    assert_eq!(
+        reason,
+        format!("unhandled exception CommandFailed on c: c has no camera; its handler {why}, so it did not take it again")
+    );
+    assert!(r.find("capability_start", "actor", "a").is_empty(), "nothing new starts");
+    assert!(r.trace.iter().all(|e| e["t"] == 0.0), "all of it at the one instant");
+    assert_eq!(r.trace.last().unwrap()["event"], "mission_end");
 }

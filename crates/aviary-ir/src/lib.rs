@@ -302,6 +302,9 @@ pub struct ExceptionHandler {
     pub by: Option<ActorFilter>,
     pub bindings: Vec<Slot>,
     pub body: Block,
+    /// The line of its `ON EXCEPTION` in the file that declares it (from 1; 0 unknown),
+    /// for a run-time report that names the handler.
+    pub line: u32,
 }
 
 /// Telemetry a condition may read.

@@ -344,11 +344,18 @@ impl<'a> Compiler<'a> {
         let by = self.filter(&h.by);
         let path = format!("{parent}/ON EXCEPTION {}", h.exception.name);
         let names = h.bindings.iter().map(|b| (b.name.clone(), false));
+        let line = self
+            .program
+            .files
+            .iter()
+            .find(|(f, _)| *f == self.file)
+            .map_or(0, |(_, tree)| tree.line_of(h.span.start));
         self.bound_scope(names, |c, bindings| ExceptionHandler {
             exception,
             by,
             bindings,
             body: c.body(&h.body, &path, BlockKind::Sequential, false),
+            line,
         })
     }
 

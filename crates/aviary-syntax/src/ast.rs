@@ -26,6 +26,17 @@ pub struct Comment {
 pub struct SourceFile {
     pub items: Vec<Item>,
     pub comments: Vec<Comment>,
+    /// Where each physical line starts, as a byte offset: what turns a span into a line
+    /// once the text is gone (a run-time report names the line of a handler).
+    pub line_offsets: Vec<u32>,
+}
+
+impl SourceFile {
+    /// The line (from 1) that the byte at `offset` is on; 0 for a tree made without its
+    /// text.
+    pub fn line_of(&self, offset: u32) -> u32 {
+        self.line_offsets.partition_point(|&start| start <= offset) as u32
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -55,6 +55,8 @@ pub fn parse(file: FileId, text: &str) -> Parse {
     let layout = layout::layout(file, &lexed, text.len(), &mut diagnostics);
     let mut tree = parser::parse_tokens(file, text, layout.tokens, &mut diagnostics);
     tree.comments = lexed.comments;
+    tree.line_offsets =
+        std::iter::once(0).chain(text.match_indices('\n').map(|(at, _)| at as u32 + 1)).collect();
     if tree.items.is_empty() && !diagnostics.iter().any(|d| d.is_error()) {
         diagnostics.push(
             Diagnostic::new(Code::EmptyFile, file, Span::point(0), "this file has no MISSION and no CAPABILITY")

@@ -19,6 +19,18 @@ fn fixtures() {
     });
 }
 
+/// A tree names the line of any offset once the text is gone: what a run-time report
+/// uses to point at a handler.
+#[test]
+fn a_tree_tells_the_line_of_an_offset() {
+    let text = "MISSION M:\r\n    a Hover\n\n    b Hover\n";
+    let tree = aviary_syntax::parse(FileId(0), text).tree;
+    let line = |s: &str| tree.line_of(text.find(s).unwrap() as u32);
+    assert_eq!((line("MISSION"), line("M:"), line("a Hover"), line("b Hover")), (1, 1, 2, 4));
+    assert_eq!(tree.line_of(text.len() as u32), 5, "past the last line break");
+    assert_eq!(aviary_syntax::ast::SourceFile::default().line_of(7), 0, "made without text");
+}
+
 /// The pretty `Debug` text with each `Span {\n start: A,\n end: B,\n }` as `A..B`.
 fn compact_spans(debug: &str) -> String {
     let mut out = String::with_capacity(debug.len());

@@ -7,8 +7,8 @@ use crate::{Names, Point, Value};
 
 /// Lines of real traces (the docs/TRACE.md tour, as `aviary run` wrote it before the
 /// events were typed) and hand-written lines for the rarer shapes: several actors, a
-/// fault on the way home, numbers that are not finite, escapes, every status, every
-/// action of the operator.
+/// fault on the way home, a handler passed over, numbers that are not finite, escapes,
+/// every status, every action of the operator.
 const EXAMPLES: &str = include_str!("examples.jsonl");
 
 #[test]
@@ -207,16 +207,10 @@ fn event() -> impl Strategy<Value = Event<'static>> {
             actor,
             args
         }),
-        (text(), opt(text()), values(), any::<bool>(), opt(text()), opt(text())).prop_map(
-            |(name, actor, args, handled, handler, during)| Event::Exception {
-                name,
-                actor,
-                args,
-                handled,
-                handler,
-                during
-            }
-        ),
+        (text(), opt(text()), values(), any::<bool>(), opt(text()), opt(text()), opt(text()))
+            .prop_map(|(name, actor, args, handled, handler, during, skipped)| {
+                Event::Exception { name, actor, args, handled, handler, during, skipped }
+            }),
         (text(), text(), text()).prop_map(|(capability, tag, action)| Event::Leash {
             capability,
             tag,

@@ -194,7 +194,7 @@ export function describe(e) {
     case "handler_start": return `handler ${e.handler} starts${e.actor ? " (" + e.actor + ")" : ""}`;
     case "handler_end": return `handler ${e.handler} ends`;
     case "signal": return `signal ${e.name}${e.actor ? " from " + e.actor : ""}${e.args && e.args.length ? " " + JSON.stringify(e.args) : ""}`;
-    case "exception": return `exception ${e.name}${e.actor ? " on " + e.actor : ""}${e.handled ? " handled" : " UNHANDLED"} ${(e.args || []).join(" ")}`;
+    case "exception": return `exception ${e.name}${e.actor ? " on " + e.actor : ""}${e.handled ? " handled" : " UNHANDLED"} ${(e.args || []).join(" ")}${e.skipped ? ` (passed over: ${e.skipped})` : ""}`;
     case "leash": return `leash ${e.capability}-${e.tag} ${e.action}`;
     case "operator": return `operator: ${e.action}${e.drone ? " " + e.drone : ""}`;
     case "detection": return `${e.actor} found ${e.kind} at (${e.location.map((v) => v.toFixed(0)).join(", ")})`;

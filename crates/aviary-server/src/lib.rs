@@ -22,7 +22,7 @@ mod stream;
 
 pub use args::{Kinds, MAX_MAGNITUDE};
 pub use guard::{read_token, same_origin, token, Gate, TOKEN_PROTOCOL};
-pub use reply::BODY_LIMIT;
+pub use reply::{json_errors, BODY_LIMIT};
 
 use std::net::SocketAddr;
 use std::sync::{Arc, Mutex, MutexGuard};

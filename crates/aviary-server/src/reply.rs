@@ -60,7 +60,7 @@ fn kind_of(v: &Value) -> &'static str {
 
 /// The last word on every answer: an error that is not JSON yet (axum's 404, 405, a
 /// failed WebSocket handshake) becomes `{"error": its text}`, keeping status and headers.
-pub(crate) async fn json_errors(response: Response) -> Response {
+pub async fn json_errors(response: Response) -> Response {
     let status = response.status();
     let is_json = response
         .headers()

@@ -43,6 +43,8 @@ pub(crate) fn router(station: Arc<Station>) -> Router {
         .layer(DefaultBodyLimit::max(BODY_LIMIT))
         .fallback(operator)
         .layer(middleware::from_fn_with_state(gate, aviary_server::same_origin))
+        // Every error in JSON, an extractor's rejection too (axum's are plain text).
+        .layer(middleware::map_response(aviary_server::json_errors))
         .with_state(station)
 }
 

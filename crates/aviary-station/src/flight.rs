@@ -92,8 +92,13 @@ pub fn start(
                 }
                 Err(NotFlown::Failed(why)) => why,
             };
-            if let Some(ready) = hooks.ready.take() {
-                let _ = ready.send(Err(why));
+            match hooks.ready.take() {
+                Some(ready) => {
+                    let _ = ready.send(Err(why));
+                }
+                // Started, then ended before the engine ran (the MAVLink vehicles did not
+                // connect): the page hears no `mission_end`, so the operator is told here.
+                None => eprintln!("aviary: the flight from the page ended before it flew: {why}"),
             }
         });
     if let Err(e) = spawned {

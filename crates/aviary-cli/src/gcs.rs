@@ -1,6 +1,7 @@
 //! `aviary gcs [DIR]`: the ground station for the missions and worlds of a folder, served
 //! until Ctrl-C. The files a mission `USE`s are read as `aviary run` reads them.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use aviary_station::{FilesFor, Folder, Mode};
@@ -30,7 +31,11 @@ pub fn run(dir: &Path, serve: &Serve, use_root: &[PathBuf]) -> u8 {
     let shown = folder.root().display().to_string();
     match crate::serve::station(serve, Mode::Folder { folder, files }, serde_json::Value::Null) {
         Ok(_serving) => {
-            eprintln!("aviary: serving the missions of {shown}; Ctrl-C stops");
+            // Not `eprintln!`: a script that closed standard error must not stop the station.
+            let _ = writeln!(
+                std::io::stderr(),
+                "aviary: serving the missions of {shown}; Ctrl-C stops"
+            );
             // The station serves on its own thread until the process ends.
             loop {
                 std::thread::park();

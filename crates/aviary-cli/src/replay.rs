@@ -2,6 +2,7 @@
 //! on the page (play, pause, speed, a scrubber over the mission's time), with the world's
 //! map when the world is given.
 
+use std::io::Write;
 use std::path::Path;
 
 use aviary_station::Mode;
@@ -25,7 +26,8 @@ pub fn run(trace: &Path, world: Option<&Path>, serve: &Serve) -> u8 {
     };
     match crate::serve::station(serve, Mode::Replay { name: name.clone(), trace: text }, map) {
         Ok(_serving) => {
-            eprintln!("aviary: replaying {name}; Ctrl-C stops");
+            // Not `eprintln!`: a script that closed standard error must not stop the replay.
+            let _ = writeln!(std::io::stderr(), "aviary: replaying {name}; Ctrl-C stops");
             loop {
                 std::thread::park();
             }

@@ -20,12 +20,29 @@ pub struct Serve {
 pub fn station(serve: &Serve, mode: Mode, map: serde_json::Value) -> Result<Serving, String> {
     let options = Options { address: serve.address, allowed_hosts: serve.allowed_hosts.clone() };
     let serving = aviary_station::serve(&options, mode, map)?;
+    announce(&serving);
+    Ok(serving)
+}
+
+/// Where the station is and its token: said once the station answers every call it
+/// will, since a client may call as soon as it reads the first line.
+fn announce(serving: &Serving) {
     let url = serving.url();
     // The operator API's line first, then the warning, as they always were: scripts read
-    // the first line, and the operator sees the warning before anything else.
-    eprintln!("aviary: operator API on {}  token {}", url.trim_end_matches('/'), serving.token);
+    // the first line, and the operator sees the warning before anything else. A script
+    // that closes standard error after the first line must not stop the run: a write that
+    // fails is let go (`eprintln!` would panic).
+    use std::io::Write;
+    let mut err = std::io::stderr();
+    let _ = writeln!(
+        err,
+        "aviary: operator API on {}  token {}",
+        url.trim_end_matches('/'),
+        serving.token
+    );
     if serving.beyond_loopback() {
-        eprintln!(
+        let _ = writeln!(
+            err,
             "aviary: warning: the operator API listens on {} (the ground station with it) and can be reached from other machines. \
              Every call, reads and the event stream included, now needs the token, but plain HTTP carries it and the fleet's \
              positions unencrypted: put it behind a TLS reverse proxy (docs/OPERATOR_API.md) for use beyond this machine, or \
@@ -33,8 +50,7 @@ pub fn station(serve: &Serve, mode: Mode, map: serde_json::Value) -> Result<Serv
             serving.address
         );
     }
-    eprintln!("aviary: ground station on {url}  (the same token)");
-    Ok(serving)
+    let _ = writeln!(err, "aviary: ground station on {url}  (the same token)");
 }
 
 /// `aviary run --serve`: the station for this one run, and where the run's events go.
@@ -44,7 +60,9 @@ pub fn start(
     map: serde_json::Value,
     controller: Controller,
 ) -> Result<(Serving, Feed), String> {
-    let serving = station(serve, Mode::Run, serde_json::Value::Null)?;
+    let options = Options { address: serve.address, allowed_hosts: serve.allowed_hosts.clone() };
+    let serving = aviary_station::serve(&options, Mode::Run, serde_json::Value::Null)?;
     let feed = serving.serve_run(controller, mission, map);
+    announce(&serving);
     Ok((serving, feed))
 }

@@ -104,10 +104,7 @@ fn check_one(
         );
         return failed.max(1);
     };
-    plan.locate(|o| {
-        let at = sources.line_col(o.file, o.span.start);
-        format!("{}:{}:{}", sources.name(o.file), at.line, at.column)
-    });
+    plan.locate_in(&sources);
     match format {
         Format::Text => {
             print(&sources, &diagnostics, format, path);

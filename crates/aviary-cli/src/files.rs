@@ -154,12 +154,10 @@ pub fn world_alone(path: &Path) -> Result<aviary_world::World, String> {
     })
 }
 
-/// A recorded trace read and checked line by line (`aviary replay`, `aviary report`): its
-/// name as messages show it and its text, or what to print of why not.
-pub fn recorded_trace(path: &Path) -> Result<(String, String), String> {
+/// A recorded trace's bytes (`aviary replay`, `aviary report`): its name as messages show
+/// it and the bytes, or what to print of why not.
+pub fn recorded_trace(path: &Path) -> Result<(String, Vec<u8>), String> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| format!("aviary: cannot read {name}: {e}\n"))?;
-    let text =
-        aviary_station::replay::read(&name, bytes).map_err(|why| format!("aviary: {why}\n"))?;
-    Ok((name, text))
+    Ok((name, bytes))
 }

@@ -10,10 +10,17 @@ use aviary_station::Mode;
 use crate::serve::Serve;
 
 pub fn run(trace: &Path, world: Option<&Path>, serve: &Serve) -> u8 {
-    let (name, text) = match crate::files::recorded_trace(trace) {
+    let (name, bytes) = match crate::files::recorded_trace(trace) {
         Ok(read) => read,
         Err(shown) => {
             eprint!("{shown}");
+            return 2;
+        }
+    };
+    let text = match aviary_station::replay::read(&name, bytes) {
+        Ok(t) => t,
+        Err(why) => {
+            eprintln!("aviary: {why}");
             return 2;
         }
     };

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 pub fn run(trace: &Path, world: Option<&Path>, out: &Path) -> u8 {
-    let (name, text) = match crate::files::recorded_trace(trace) {
+    let (name, bytes) = match crate::files::recorded_trace(trace) {
         Ok(read) => read,
         Err(shown) => {
             eprint!("{shown}");
@@ -18,7 +18,7 @@ pub fn run(trace: &Path, world: Option<&Path>, out: &Path) -> u8 {
             return 2;
         }
     };
-    let html = match aviary_station::report::render(&name, &text, world.as_ref()) {
+    let html = match aviary_station::report::render(&name, bytes, world.as_ref()) {
         Ok(h) => h,
         Err(why) => {
             eprintln!("aviary: {why}");

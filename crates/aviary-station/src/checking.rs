@@ -46,10 +46,7 @@ pub fn check(mission: &Text, world: &Text, files: &dyn SourceProvider) -> Report
         diagnostics.extend(v.diagnostics);
         aviary_diagnostics::sort(&mut diagnostics);
         let mut v_plan = v.plan;
-        v_plan.locate(|o| {
-            let at = sources.line_col(o.file, o.span.start);
-            format!("{}:{}:{}", sources.name(o.file), at.line, at.column)
-        });
+        v_plan.locate_in(&sources);
         plan = serde_json::to_value(&v_plan).unwrap_or(Value::Null);
         tree = tree::of(&compiled, Some(&sources));
     }

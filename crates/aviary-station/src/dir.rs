@@ -92,7 +92,7 @@ impl Folder {
             Ok(p) => p,
             Err(_) => parent.join(full.file_name().unwrap_or_default()),
         };
-        if !target.starts_with(&self.root) {
+        if !aviary_check::uses::within_roots(&target, std::slice::from_ref(&self.root)) {
             return Err(format!(
                 "`{}` leads outside the station's folder {}",
                 shown(relative),

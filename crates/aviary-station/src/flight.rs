@@ -12,11 +12,11 @@ use aviary_backends::trace_file::{lock, SharedTrace, TraceFile};
 use aviary_check::SourceProvider;
 use aviary_engine::{Controller, RunOptions};
 use aviary_ir::Mission;
-use aviary_server::{Feed, Kinds};
+use aviary_server::Feed;
 use aviary_world::World;
 
 use crate::checking::{map_of, Text};
-use crate::{Run, Station};
+use crate::Station;
 
 /// The telemetry rate of a flight from the page, unless it asks for another: smooth
 /// enough to watch and to replay.
@@ -145,18 +145,9 @@ impl Hooks for Flight {
         controller: &Controller,
         _stop: &Stop,
     ) -> Result<(), String> {
-        let (router, feed) = aviary_server::router_behind(
-            self.station.gate.clone(),
-            controller.clone(),
-            Kinds::of(mission),
-        );
-        self.station.install(Run {
-            router,
-            mission: mission.name.clone(),
-            tree: std::mem::take(&mut self.tree),
-            trace: Some(self.trace.shown.clone()),
-        });
-        self.feed = Some(feed);
+        let tree = std::mem::take(&mut self.tree);
+        let trace = Some(self.trace.shown.clone());
+        self.feed = Some(self.station.start_run(controller.clone(), mission, tree, trace));
         if let Some(ready) = self.ready.take() {
             let _ = ready.send(Ok(()));
         }

@@ -83,8 +83,20 @@ impl Station {
         m.lock().unwrap_or_else(|p| p.into_inner())
     }
 
-    pub fn install(&self, run: Run) {
-        *Self::lock(&self.run) = Some(run);
+    /// Serves the operator API of a run of `mission` from now on (the last one's goes);
+    /// its events go to the feed returned. `tree` is what the page shows of the mission,
+    /// `trace` where its trace is written, if the station writes it.
+    pub fn start_run(
+        &self,
+        controller: Controller,
+        mission: &aviary_ir::Mission,
+        tree: Value,
+        trace: Option<String>,
+    ) -> Feed {
+        let (router, feed) =
+            aviary_server::router_behind(self.gate.clone(), controller, Kinds::of(mission));
+        *Self::lock(&self.run) = Some(Run { router, mission: mission.name.clone(), tree, trace });
+        feed
     }
 
     pub fn set_map(&self, map: Value) {
@@ -143,16 +155,8 @@ impl Serving {
         mission: &aviary_ir::Mission,
         map: Value,
     ) -> Feed {
-        let (router, feed) =
-            aviary_server::router_behind(self.station.gate.clone(), controller, Kinds::of(mission));
         self.station.set_map(map);
-        self.station.install(Run {
-            router,
-            mission: mission.name.clone(),
-            tree: tree::of(mission, None),
-            trace: None,
-        });
-        feed
+        self.station.start_run(controller, mission, tree::of(mission, None), None)
     }
 }
 

@@ -7,30 +7,45 @@ use aviary_api::trace::Record;
 
 /// The trace's text when every line is an event, or why not.
 pub fn read(name: &str, bytes: Vec<u8>) -> Result<String, String> {
-    let text = String::from_utf8(bytes).map_err(|e| {
+    let text = text(name, bytes)?;
+    records(name, &text, |_| {})?;
+    Ok(text)
+}
+
+/// The bytes of a trace as text, or why they are none.
+pub fn text(name: &str, bytes: Vec<u8>) -> Result<String, String> {
+    String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         format!("{name}: byte {at} is not UTF-8: a trace is JSON Lines, as `aviary run --trace` writes it")
-    })?;
+    })
+}
+
+/// Reads each line of `text` as an event and hands it to `each`; the number of events,
+/// or why a line is none (its place, the line and a caret) or there is none at all.
+pub fn records(name: &str, text: &str, mut each: impl FnMut(Record)) -> Result<usize, String> {
     let mut events = 0usize;
     for (index, line) in text.lines().enumerate() {
         if line.trim().is_empty() {
             continue;
         }
-        if let Err(e) = serde_json::from_str::<Record>(line) {
-            let column = e.column().max(1);
-            let shown: String = line.chars().take(160).collect();
-            let caret = " ".repeat(column.saturating_sub(1).min(160));
-            return Err(format!(
-                "{name}:{}:{column}: this line is not a trace event: {e}\n  | {shown}\n  | {caret}^\n  = help: a trace is what `aviary run --trace FILE` writes, one event a line (docs/TRACE.md)",
-                index + 1
-            ));
+        match serde_json::from_str::<Record>(line) {
+            Ok(record) => each(record),
+            Err(e) => {
+                let column = e.column().max(1);
+                let shown: String = line.chars().take(160).collect();
+                let caret = " ".repeat(column.saturating_sub(1).min(160));
+                return Err(format!(
+                    "{name}:{}:{column}: this line is not a trace event: {e}\n  | {shown}\n  | {caret}^\n  = help: a trace is what `aviary run --trace FILE` writes, one event a line (docs/TRACE.md)",
+                    index + 1
+                ));
+            }
         }
         events += 1;
     }
     if events == 0 {
         return Err(format!("{name}: the trace holds no event"));
     }
-    Ok(text)
+    Ok(events)
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use aviary_api::trace::{CallStatus, Event, Record};
+use aviary_api::trace::{CallStatus, Event};
 use aviary_api::Function;
 use plotters::prelude::*;
 
@@ -39,11 +39,9 @@ fn escape(text: &str) -> String {
     text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
-fn read(trace: &str) -> Result<Mission, String> {
+fn read(name: &str, trace: &str) -> Result<Mission, String> {
     let mut m = Mission::default();
-    for (index, line) in trace.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
-        let record: Record =
-            serde_json::from_str(line).map_err(|e| format!("line {}: {e}", index + 1))?;
+    crate::replay::records(name, trace, |record| {
         let t = record.t;
         m.end = m.end.max(t);
         match record.event {
@@ -102,9 +100,9 @@ fn read(trace: &str) -> Result<Mission, String> {
             }
             _ => {}
         }
-    }
+    })?;
     if m.name.is_empty() {
-        return Err("the trace has no mission_start: is it a whole trace?".into());
+        return Err(format!("{name}: the trace has no mission_start: is it a whole trace?"));
     }
     Ok(m)
 }
@@ -282,13 +280,14 @@ fn plot(
     Ok(svg)
 }
 
-/// The report of `trace` (JSON Lines, checked by `replay::read`), named `name`.
+/// The report of the trace `bytes` (JSON Lines, each line read once), named `name`.
 pub fn render(
     name: &str,
-    trace: &str,
+    bytes: Vec<u8>,
     world: Option<&aviary_world::World>,
 ) -> Result<String, String> {
-    let m = read(trace).map_err(|e| format!("{name}: {e}"))?;
+    let trace = crate::replay::text(name, bytes)?;
+    let m = read(name, &trace)?;
     let mut html = String::new();
     let title = format!("Mission {} — {}", escape(&m.name), escape(&m.status));
     let _ = write!(

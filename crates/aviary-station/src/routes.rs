@@ -15,6 +15,8 @@ use axum::{Json, Router};
 use serde_json::{json, Value};
 use tower::ServiceExt;
 
+use aviary_check::SourceProvider;
+
 use crate::checking::{self, Text};
 use crate::{assets, dir, flight, Mode, Station};
 
@@ -160,19 +162,23 @@ struct Pair {
 }
 
 /// The checks of `pair`, with the files it `USE`s read from the station's folder.
-fn checked(station: &Station, pair: &Pair) -> Result<checking::Report, Refusal> {
+/// And the provider it read them with, for a flight to read them again.
+fn checked(
+    station: &Station,
+    mission: &Text,
+    world: &Text,
+) -> Result<(checking::Report, Box<dyn SourceProvider + Send>), Refusal> {
     let (folder, files_for) = folder(station)?;
-    let mission =
-        folder.resolve(&pair.mission.path).map_err(|w| Refusal(StatusCode::BAD_REQUEST, w))?;
-    folder.resolve(&pair.world.path).map_err(|w| Refusal(StatusCode::BAD_REQUEST, w))?;
-    let files = files_for(&mission).map_err(|w| Refusal(StatusCode::CONFLICT, w))?;
-    Ok(checking::check(&pair.mission, &pair.world, &*files))
+    let path = folder.resolve(&mission.path).map_err(|w| Refusal(StatusCode::BAD_REQUEST, w))?;
+    folder.resolve(&world.path).map_err(|w| Refusal(StatusCode::BAD_REQUEST, w))?;
+    let files = files_for(&path).map_err(|w| Refusal(StatusCode::CONFLICT, w))?;
+    Ok((checking::check(mission, world, &*files), files))
 }
 
 async fn check(State(station): State<Arc<Station>>, Json(pair): Json<Pair>) -> Response {
     // The checker recurses: it runs where its stack is (`aviary_check::STACK`).
-    let work = move || match checked(&station, &pair) {
-        Ok(report) => Json(report.json).into_response(),
+    let work = move || match checked(&station, &pair.mission, &pair.world) {
+        Ok((report, _)) => Json(report.json).into_response(),
         Err(refusal) => refusal.into_response(),
     };
     on_a_deep_stack(work).await
@@ -183,9 +189,8 @@ async fn fly(
     Json(request): Json<flight::Request>,
 ) -> Response {
     let work = move || {
-        let pair = Pair { mission: request.mission.clone(), world: request.world.clone() };
-        let report = match checked(&station, &pair) {
-            Ok(r) => r,
+        let (report, files) = match checked(&station, &request.mission, &request.world) {
+            Ok(checked) => checked,
             Err(refusal) => return refusal.into_response(),
         };
         if !report.flyable {
@@ -194,13 +199,9 @@ async fn fly(
             body["check"] = report.json;
             return (StatusCode::CONFLICT, Json(body)).into_response();
         }
-        let (folder, files_for) = match folder(&station) {
+        let (folder, _) = match folder(&station) {
             Ok(f) => f,
             Err(refusal) => return refusal.into_response(),
-        };
-        let files = match folder.resolve(&request.mission.path).and_then(|m| files_for(&m)) {
-            Ok(f) => f,
-            Err(why) => return error(StatusCode::CONFLICT, why),
         };
         let tree = report.json["tree"].clone();
         let trace = trace_for(folder, &request.mission.path);

@@ -52,10 +52,7 @@ fn verify_fixture(name: &str) -> Outcome {
     }
     match plan {
         Some(mut plan) => {
-            plan.locate(|o| {
-                let at = sources.line_col(o.file, o.span.start);
-                format!("{}:{}:{}", sources.name(o.file), at.line, at.column)
-            });
+            plan.locate_in(&sources);
             text.push_str(&plan.render_text());
         }
         None => text.push_str("no plan: the mission did not check\n"),

@@ -11,7 +11,7 @@ mod model;
 mod state;
 
 use aviary_api::show::fixed;
-use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
+use aviary_diagnostics::{Code, Diagnostic, FileId, SourceMap, Span};
 use aviary_ir::{Block, Handler, Mission, Node, Origin};
 use aviary_world::World;
 use serde::Serialize;
@@ -195,6 +195,14 @@ impl Plan {
                 place(Origin { file: FileId(file), span: Span::point(start as usize) })
             });
         }
+    }
+
+    /// Fills each `at` with `path:line:col` in `sources`, as diagnostics name places.
+    pub fn locate_in(&mut self, sources: &SourceMap) {
+        self.locate(|o| {
+            let at = sources.line_col(o.file, o.span.start);
+            format!("{}:{}:{}", sources.name(o.file), at.line, at.column)
+        });
     }
 
     /// The plan as a table per drone, for people.

@@ -40,6 +40,15 @@ impl Origin {
         (lat, lon)
     }
 
+    /// Degrees of latitude and of longitude per metre north and east: the projection is
+    /// linear, `to_geodetic(x, y)` = (lat + y · these.0, lon + x · these.1) but for rounding,
+    /// so a map that places local points on the Earth needs only these and the origin.
+    pub fn degrees_per_metre(&self) -> (f64, f64) {
+        let north = (1.0 / EARTH_RADIUS).to_degrees();
+        let east = (1.0 / (EARTH_RADIUS * self.lat.to_radians().cos())).to_degrees();
+        (north, east)
+    }
+
     /// Local `[x, y]` → MAVLink's degrees × 10⁷.
     pub fn to_e7(&self, x: f64, y: f64) -> (i32, i32) {
         let (lat, lon) = self.to_geodetic(x, y);

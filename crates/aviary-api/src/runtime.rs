@@ -154,6 +154,22 @@ pub enum DroneEvent {
     /// A fault (`BatteryCritical`, `ConnectionLost`, ...). Raised once; the drone's calls
     /// in progress end `Interrupted`, so the exception is never raised twice.
     Fault { drone: DroneId, failure: Failure },
+    /// The drone's autopilot acted on its own (a failsafe: holding after a lost link,
+    /// returning home, landing), after the fault that made it, if any. Recorded, never
+    /// raised: the fault is the exception.
+    Autopilot { drone: DroneId, action: crate::trace::AutopilotAction, reason: String },
+}
+
+impl DroneEvent {
+    /// The drone the event is of.
+    pub fn drone(&self) -> DroneId {
+        match self {
+            DroneEvent::Detected { drone, .. }
+            | DroneEvent::Signal { drone, .. }
+            | DroneEvent::Fault { drone, .. }
+            | DroneEvent::Autopilot { drone, .. } => *drone,
+        }
+    }
 }
 
 /// A fleet of drones as the engine sees it. Implemented by the built-in simulator and by

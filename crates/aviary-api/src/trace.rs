@@ -140,6 +140,36 @@ pub enum Event<'a> {
         action: OperatorAction,
         drone: Option<Text<'a>>,
     },
+    /// The drone's autopilot acted on its own, without a call of the mission (a
+    /// failsafe): it held where it was, flew home or landed. `reason` says why, in words.
+    Autopilot {
+        actor: Text<'a>,
+        action: AutopilotAction,
+        reason: Text<'a>,
+    },
+}
+
+/// What a drone's autopilot did on its own (`autopilot` events).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AutopilotAction {
+    /// Stopped and held where it was (a lost link or position).
+    Hold,
+    /// Flew home and landed (a failsafe return to launch).
+    ReturnHome,
+    /// Landed where it was (a motor failure, a failsafe landing).
+    Land,
+}
+
+impl AutopilotAction {
+    /// The trace's `action`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            AutopilotAction::Hold => "hold",
+            AutopilotAction::ReturnHome => "return_home",
+            AutopilotAction::Land => "land",
+        }
+    }
 }
 
 /// What the operator did (`operator` events).
@@ -228,11 +258,12 @@ pub enum EventKind {
     Detection,
     Telemetry,
     Operator,
+    Autopilot,
 }
 
 impl EventKind {
     /// Every kind; `ALL[k as usize] == k`.
-    pub const ALL: [EventKind; 16] = [
+    pub const ALL: [EventKind; 17] = [
         EventKind::MissionStart,
         EventKind::MissionEnd,
         EventKind::BlockStart,
@@ -249,6 +280,7 @@ impl EventKind {
         EventKind::Detection,
         EventKind::Telemetry,
         EventKind::Operator,
+        EventKind::Autopilot,
     ];
 
     /// The trace's `event`.
@@ -270,6 +302,7 @@ impl EventKind {
             EventKind::Detection => "detection",
             EventKind::Telemetry => "telemetry",
             EventKind::Operator => "operator",
+            EventKind::Autopilot => "autopilot",
         }
     }
 }
@@ -293,6 +326,7 @@ impl Event<'_> {
             Event::Detection { .. } => EventKind::Detection,
             Event::Telemetry { .. } => EventKind::Telemetry,
             Event::Operator { .. } => EventKind::Operator,
+            Event::Autopilot { .. } => EventKind::Autopilot,
         }
     }
 }

@@ -23,14 +23,6 @@ pub struct Mixed {
     events: Mutex<Option<mpsc::UnboundedReceiver<DroneEvent>>>,
 }
 
-fn drone_of(event: &DroneEvent) -> DroneId {
-    match event {
-        DroneEvent::Detected { drone, .. }
-        | DroneEvent::Signal { drone, .. }
-        | DroneEvent::Fault { drone, .. } => *drone,
-    }
-}
-
 impl Mixed {
     /// Call inside the tokio runtime (it starts the task that merges the event streams).
     pub fn new(sim: Arc<SimBackend>, mavlink: MavlinkBackend) -> Mixed {
@@ -44,7 +36,7 @@ impl Mixed {
                 while let Some(e) = from_sim.recv().await {
                     // The simulator also models the MAVLink drones (idle at home): drop
                     // what it says of them.
-                    if !served.get(drone_of(&e)).copied().unwrap_or(false) && tx.send(e).is_err() {
+                    if !served.get(e.drone()).copied().unwrap_or(false) && tx.send(e).is_err() {
                         return;
                     }
                 }

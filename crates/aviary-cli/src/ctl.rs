@@ -7,8 +7,12 @@ use serde_json::{json, Value};
 
 #[derive(Subcommand)]
 pub enum CtlCommand {
-    /// Print the mission's state: blocks, activities with tags, drones
-    State,
+    /// Print the mission's state: blocks, activities with their leashes, drones
+    State {
+        /// Print the operator API's JSON document instead of the table
+        #[arg(long)]
+        json: bool,
+    },
     /// Print every event as it happens, one JSON object per line
     Events,
     /// A leash on a running activity: `leash FlyCircle-C1 PAUSE`, `leash FlyCircle-C1 Widen radius=200m`
@@ -56,7 +60,22 @@ impl DroneCtl {
 pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
     let base = url.trim_end_matches('/');
     let result = match command {
-        CtlCommand::State => get(&format!("{base}/api/state"), token),
+        CtlCommand::State { json } => {
+            let got = get(&format!("{base}/api/state"), token);
+            match (&got, json) {
+                (Ok((200, body)), false) => match serde_json::from_str::<Value>(body) {
+                    Ok(state) => {
+                        out!("{}", crate::ctl_table::state_table(&state));
+                        return 0;
+                    }
+                    Err(e) => {
+                        eprintln!("aviary: the state from {base} is not JSON ({e})");
+                        return 2;
+                    }
+                },
+                _ => got,
+            }
+        }
         CtlCommand::Events => return events(base, token),
         CtlCommand::Leash { activity, action, args } => {
             let mut named = serde_json::Map::new();

@@ -8,6 +8,7 @@ mod out;
 mod bench;
 mod check;
 mod ctl;
+mod ctl_table;
 mod figures;
 mod files;
 mod fmt;

@@ -339,9 +339,14 @@ fn progress_bar(quiet: bool) -> ProgressBar {
 struct Stats {
     running: i64,
     signals: Vec<(String, usize)>,
-    /// Name, handled, how many times: a handler re-entered at one instant until it was
-    /// cut off takes its exception a hundred times over.
-    exceptions: Vec<(String, bool, usize)>,
+    /// Each exception by name, drone and whether it was handled, with how many times: a
+    /// handler re-entered at one instant until it was cut off takes its exception a
+    /// hundred times over.
+    exceptions: Vec<(Raised, usize)>,
+    /// What the operator did, and each drone's autopilot on its own, as the summary says
+    /// it, in the order it happened.
+    operator: Vec<String>,
+    autopilot: Vec<String>,
     detections: usize,
     last_shown: f64,
 }
@@ -354,22 +359,7 @@ impl Stats {
         backend: &dyn Backend,
         drones: usize,
     ) {
-        match &record.event {
-            Event::CapabilityStart { .. } => self.running += 1,
-            Event::CapabilityEnd { .. } => self.running -= 1,
-            Event::Detection { .. } => self.detections += 1,
-            Event::Signal { name, .. } => match self.signals.iter_mut().find(|(n, _)| n == name) {
-                Some((_, count)) => *count += 1,
-                None => self.signals.push((name.to_string(), 1)),
-            },
-            Event::Exception { name, handled, .. } => {
-                match self.exceptions.iter_mut().find(|(n, h, _)| n == name && h == handled) {
-                    Some((_, _, count)) => *count += 1,
-                    None => self.exceptions.push((name.to_string(), *handled, 1)),
-                }
-            }
-            _ => {}
-        }
+        self.count(record);
         let t = if record.t.is_finite() { record.t } else { 0.0 };
         let ended = matches!(record.event, Event::MissionEnd { .. });
         if t - self.last_shown >= 1.0 || ended {
@@ -380,6 +370,38 @@ impl Stats {
                 self.running
             ));
             progress.tick();
+        }
+    }
+
+    /// What the summary counts of one event.
+    fn count(&mut self, record: &Record) {
+        match &record.event {
+            Event::CapabilityStart { .. } => self.running += 1,
+            Event::CapabilityEnd { .. } => self.running -= 1,
+            Event::Detection { .. } => self.detections += 1,
+            Event::Signal { name, .. } => match self.signals.iter_mut().find(|(n, _)| n == name) {
+                Some((_, count)) => *count += 1,
+                None => self.signals.push((name.to_string(), 1)),
+            },
+            Event::Exception { name, actor, handled, .. } => {
+                let raised = Raised {
+                    name: name.to_string(),
+                    actor: actor.as_deref().map(str::to_owned),
+                    handled: *handled,
+                };
+                match self.exceptions.iter_mut().find(|(r, _)| *r == raised) {
+                    Some((_, count)) => *count += 1,
+                    None => self.exceptions.push((raised, 1)),
+                }
+            }
+            Event::Operator { action, drone } => self.operator.push(match drone {
+                Some(d) => format!("{} {d} at {:.1} s", action.as_str(), record.t),
+                None => format!("{} at {:.1} s", action.as_str(), record.t),
+            }),
+            Event::Autopilot { reason, .. } => {
+                self.autopilot.push(format!("{reason} (at {:.1} s)", record.t));
+            }
+            _ => {}
         }
     }
 }
@@ -430,21 +452,78 @@ fn summary(
         if signals.is_empty() { "none".to_string() } else { signals.join(", ") }
     ));
     out.push_str(&format!("detections: {}\n", stats.detections));
+    out.push_str(&what_happened(stats));
+    out
+}
+
+/// The summary's lines of what happened to whom: exceptions, the operator's actions and
+/// what autopilots did on their own.
+fn what_happened(stats: &Stats) -> String {
+    let mut out = String::new();
     let exceptions: Vec<String> = stats
         .exceptions
         .iter()
-        .map(|(n, h, c)| {
-            let handled = if *h { "handled" } else { "unhandled" };
-            if *c == 1 {
-                format!("{n} ({handled})")
-            } else {
-                format!("{n} ({handled}) ×{c}")
-            }
+        .map(|(r, c)| {
+            let handled = if r.handled { "handled" } else { "unhandled" };
+            let on = r.actor.as_deref().map(|a| format!(" on {a}")).unwrap_or_default();
+            let times = if *c == 1 { String::new() } else { format!(" ×{c}") };
+            format!("{}{on} ({handled}){times}", r.name)
         })
         .collect();
-    out.push_str(&format!(
-        "exceptions: {}\n",
-        if exceptions.is_empty() { "none".to_string() } else { exceptions.join(", ") }
-    ));
+    let listed = |items: &[String], separator: &str| {
+        if items.is_empty() {
+            "none".to_string()
+        } else {
+            items.join(separator)
+        }
+    };
+    out.push_str(&format!("exceptions: {}\n", listed(&exceptions, ", ")));
+    out.push_str(&format!("operator actions: {}\n", listed(&stats.operator, ", ")));
+    if !stats.autopilot.is_empty() {
+        out.push_str(&format!("autopilot, on its own: {}\n", listed(&stats.autopilot, "; ")));
+    }
     out
+}
+
+/// An exception as the summary counts it: by name, drone (none for a `THROW` at mission
+/// level) and whether a handler took it.
+#[derive(PartialEq)]
+struct Raised {
+    name: String,
+    actor: Option<String>,
+    handled: bool,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{what_happened, Stats};
+
+    #[test]
+    fn the_summary_names_each_exceptions_drone_and_lists_what_the_operator_and_autopilots_did() {
+        let mut stats = Stats::default();
+        for line in [
+            r#"{"t":3.0,"event":"operator","action":"hold","drone":"a"}"#,
+            r#"{"t":4.25,"event":"operator","action":"resume","drone":"a"}"#,
+            r#"{"t":5.0,"event":"exception","name":"ConnectionLost","actor":"b","args":["b: link lost"],"handled":true,"handler":"M/ON EXCEPTION ConnectionLost"}"#,
+            r#"{"t":5.0,"event":"autopilot","actor":"b","action":"hold","reason":"b: link lost: holds where it is"}"#,
+            r#"{"t":6.0,"event":"exception","name":"CommandFailed","actor":"a","args":["no"],"handled":true,"handler":"H"}"#,
+            r#"{"t":6.0,"event":"exception","name":"CommandFailed","actor":"a","args":["no"],"handled":true,"handler":"H"}"#,
+            r#"{"t":7.0,"event":"exception","name":"Late","actor":null,"args":[],"handled":false,"handler":null}"#,
+            r#"{"t":8.0,"event":"operator","action":"abort","drone":null}"#,
+        ] {
+            stats.count(&serde_json::from_str(line).expect("a trace line"));
+        }
+        assert_eq!(
+            what_happened(&stats),
+            "exceptions: ConnectionLost on b (handled), CommandFailed on a (handled) ×2, \
+             Late (unhandled)\n\
+             operator actions: hold a at 3.0 s, resume a at 4.2 s, abort at 8.0 s\n\
+             autopilot, on its own: b: link lost: holds where it is (at 5.0 s)\n"
+        );
+        assert_eq!(
+            what_happened(&Stats::default()),
+            "exceptions: none\noperator actions: none\n",
+            "no autopilot line when no autopilot acted"
+        );
+    }
 }

@@ -523,12 +523,19 @@ fn the_trace_events_documented_are_the_engines_with_their_fields() {
         assert_eq!(serde_json::to_string(&record).unwrap(), line);
     }
     let mut events = json_lines(&text);
-    // Only an operator writes `operator`: it is checked as the engine's own type writes it.
-    use aviary_api::trace::{Event, OperatorAction, Record};
+    // Only an operator writes `operator`, and only a failsafe `autopilot`: they are checked
+    // as the engine's own type writes them.
+    use aviary_api::trace::{AutopilotAction, Event, OperatorAction, Record};
     for (action, drone) in [(OperatorAction::Pause, None), (OperatorAction::Hold, Some("scout1"))] {
         let event = Event::Operator { action, drone: drone.map(Into::into) };
         events.push(serde_json::to_value(Record { t: 1.0, event }).unwrap());
     }
+    let event = Event::Autopilot {
+        actor: "scout1".into(),
+        action: AutopilotAction::Hold,
+        reason: "scout1: link lost: holds where it is".into(),
+    };
+    events.push(serde_json::to_value(Record { t: 1.0, event }).unwrap());
     let mut seen = BTreeSet::new();
     for e in &events {
         let kind = e["event"].as_str().unwrap().to_string();

@@ -84,7 +84,10 @@ fn a_leash_round_trip_through_the_server() {
     let (code, out, err) = ctl(&url, Some(&token), &["leash", "FlyTo-F1", "PAUSE"], &dir);
     assert_eq!(code, 0, "{out}{err}");
     std::thread::sleep(Duration::from_millis(300));
-    let (_, state, _) = ctl(&url, None, &["state"], &dir);
+    let (_, table, _) = ctl(&url, None, &["state"], &dir);
+    assert!(table.contains("  FlyTo-F1 ") && table.contains(" paused"), "{table}");
+    assert!(table.starts_with("mission "), "{table}");
+    let (_, state, _) = ctl(&url, None, &["state", "--json"], &dir);
     let state: serde_json::Value = serde_json::from_str(&state).expect("state is JSON");
     let fly = state["activities"]
         .as_array()
@@ -167,7 +170,10 @@ fn control_calls_without_the_token_are_refused() {
     let (code, _, err) = ctl(&url, Some(&token), &["leash", "FlyTo-F9", "ABORT"], &dir);
     assert_eq!(code, 1, "a leash on a tag no statement starts is refused");
     assert!(
-        err.contains("refused (409): no statement starts an activity tagged FlyTo-F9"),
+        err.contains(
+            "refused (409): no statement starts an activity tagged FlyTo-F9 (running now: \
+             FlyTo-F1): did you mean `FlyTo-F1`?"
+        ),
         "{err}"
     );
     assert_eq!(ctl(&url, Some(&token), &["abort"], &dir).0, 0);

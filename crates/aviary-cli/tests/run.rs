@@ -327,7 +327,9 @@ fn a_handler_that_fails_at_once_ends_the_run_instead_of_looping() {
         "{out}"
     );
     assert!(
-        out.contains("exceptions: CommandFailed (handled) ×101, CommandFailed (unhandled)"),
+        out.contains(
+            "exceptions: CommandFailed on c (handled) ×101, CommandFailed on c (unhandled)"
+        ),
         "{out}"
     );
     let trace = std::fs::read_to_string(dir.join("t.jsonl")).unwrap();
@@ -340,4 +342,57 @@ fn a_handler_that_fails_at_once_ends_the_run_instead_of_looping() {
         "a is brought home"
     );
     assert!(trace.lines().last().unwrap().contains("\"event\":\"mission_end\""));
+}
+
+/// What a drone's autopilot does on its own is in the trace, after the fault behind it, and
+/// in the summary, with the drone of every exception.
+#[test]
+fn a_drone_acting_on_its_own_is_in_the_trace_and_the_summary() {
+    let dir = scratch("autopilot_run");
+    let drill = repo().join("examples/faults");
+    std::fs::copy(drill.join("link_loss.mission"), dir.join("drill.mission")).unwrap();
+    // The link-loss drill with an outage longer than `link_loss_rtl_after` (10 s): the
+    // scout holds where it is, then flies home on its own.
+    let world = std::fs::read_to_string(drill.join("link_loss.world.toml")).unwrap();
+    assert!(world.contains("duration = 5.0"));
+    std::fs::write(
+        dir.join("drill.world.toml"),
+        world.replace("duration = 5.0", "duration = 30.0"),
+    )
+    .unwrap();
+    let (code, out, err) = aviary(&["run", "drill.mission", "--trace", "t.jsonl"], &dir);
+    assert_eq!(code, 0, "{out}{err}");
+    let trace: Vec<serde_json::Value> = std::fs::read_to_string(dir.join("t.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let autopilot: Vec<(f64, &str, &str)> = trace
+        .iter()
+        .filter(|e| e["event"] == "autopilot")
+        .map(|e| {
+            (e["t"].as_f64().unwrap(), e["actor"].as_str().unwrap(), e["action"].as_str().unwrap())
+        })
+        .collect();
+    assert_eq!(autopilot.len(), 2, "{autopilot:?}");
+    assert_eq!((autopilot[0].0, autopilot[0].1, autopilot[0].2), (20.0, "scout", "hold"));
+    assert_eq!((autopilot[1].1, autopilot[1].2), ("scout", "return_home"));
+    assert!(
+        (autopilot[1].0 - 30.0).abs() <= 0.05 + 1e-9,
+        "10 s after the link went: {autopilot:?}"
+    );
+    // The fault's exception comes first, then what the autopilot does about it.
+    let lost = trace.iter().position(|e| e["event"] == "exception").unwrap();
+    let held = trace.iter().position(|e| e["event"] == "autopilot").unwrap();
+    assert_eq!(trace[lost]["name"], "ConnectionLost");
+    assert!(lost < held);
+    assert!(out.contains("exceptions: ConnectionLost on scout (handled)\n"), "{out}");
+    assert!(out.contains("operator actions: none\n"), "{out}");
+    assert!(
+        out.contains(
+            "autopilot, on its own: scout: link lost: holds where it is (at 20.0 s); \
+             scout: no link for 10 s: returns to launch on its own (at 30."
+        ),
+        "{out}"
+    );
 }

@@ -131,7 +131,11 @@ impl<'m> Engine<'m> {
                 let caps = &self.m.capabilities;
                 let cap = caps.iter().position(|c| c.name == capability).ok_or_else(|| {
                     let mean = did_you_mean(&capability, caps.iter().map(|c| c.name.as_str()));
-                    format!("no capability is called {capability}{}", spaced(mean))
+                    format!(
+                        "no capability is called {capability} ({}){}",
+                        self.running_leashes(),
+                        spaced(mean)
+                    )
                 })?;
                 let action_kind = match action.as_str() {
                     "ABORT" => LeashAction::Abort,
@@ -168,7 +172,8 @@ impl<'m> Engine<'m> {
                     let mean = closest(&tag, self.m.tags.iter().map(String::as_str))
                         .map(|t| format!("did you mean `{capability}-{t}`?"));
                     format!(
-                        "no statement starts an activity tagged {capability}-{tag}{}",
+                        "no statement starts an activity tagged {capability}-{tag} ({}){}",
+                        self.running_leashes(),
                         spaced(mean)
                     )
                 })?;
@@ -219,6 +224,25 @@ impl<'m> Engine<'m> {
                 self.end_with(crate::Status::Failed, reason, false);
                 Ok(())
             }
+        }
+    }
+}
+
+impl Engine<'_> {
+    /// The tagged activities running now, as a leash names them, for a refused leash:
+    /// what the operator can pull instead.
+    fn running_leashes(&self) -> String {
+        let running: Vec<String> = self
+            .instances
+            .borrow()
+            .tags()
+            .into_iter()
+            .map(|(c, t)| format!("{}-{}", self.m.capabilities[c].name, self.m.tags[t]))
+            .collect();
+        if running.is_empty() {
+            "no tagged activity is running now".to_owned()
+        } else {
+            format!("running now: {}", running.join(", "))
         }
     }
 }

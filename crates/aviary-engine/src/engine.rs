@@ -9,7 +9,7 @@ use std::rc::Rc;
 
 use std::borrow::Cow;
 
-use aviary_api::trace::{CallStatus, Event, EventKind, Record, Shown};
+use aviary_api::trace::{AutopilotAction, CallStatus, Event, EventKind, Record, Shown};
 use aviary_api::{Backend, DroneEvent, DroneId, Function, Value};
 use aviary_ir::{ActorFilter, ExceptionHandler, Handler, Mission};
 use tokio::sync::{mpsc, Notify};
@@ -474,7 +474,7 @@ impl<'m> Engine<'m> {
     fn on_event(&self, event: DroneEvent) {
         // A drone the operator took out of the mission is on its way down: the mission
         // no longer hears from it (`steer.rs`).
-        if self.steering.withdrawn(crate::homing::drone_of(&event)).is_some() {
+        if self.steering.withdrawn(event.drone()).is_some() {
             self.on_the_way_down(event);
             return;
         }
@@ -504,7 +504,20 @@ impl<'m> Engine<'m> {
                 let scope = self.actor_scope(drone);
                 self.fail(failure, drone, &scope);
             }
+            DroneEvent::Autopilot { drone, action, reason } => {
+                self.autopilot(drone, action, &reason)
+            }
         }
+    }
+
+    /// What a drone's autopilot did on its own: recorded, for the operator and the
+    /// record; the mission hears the fault behind it, not this.
+    pub(crate) fn autopilot(&self, drone: DroneId, action: AutopilotAction, reason: &str) {
+        self.trace(EventKind::Autopilot, || Event::Autopilot {
+            actor: self.name(drone).into(),
+            action,
+            reason: reason.into(),
+        });
     }
 
     /// Raises a backend's failure on `drone` as its built-in exception, with the reason.

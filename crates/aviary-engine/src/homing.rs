@@ -273,6 +273,9 @@ impl<'m> Engine<'m> {
                     location,
                 });
             }
+            DroneEvent::Autopilot { drone, action, reason } => {
+                self.autopilot(drone, action, &reason)
+            }
         }
     }
 
@@ -298,15 +301,6 @@ impl<'m> Engine<'m> {
                 None => std::future::pending().await,
             }
         }
-    }
-}
-
-/// The drone a drone event is of.
-pub(crate) fn drone_of(event: &DroneEvent) -> DroneId {
-    match event {
-        DroneEvent::Detected { drone, .. }
-        | DroneEvent::Signal { drone, .. }
-        | DroneEvent::Fault { drone, .. } => *drone,
     }
 }
 

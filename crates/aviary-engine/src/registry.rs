@@ -102,6 +102,13 @@ impl<'m> Registry<'m> {
         self.by_actor.get(drone).into_iter().flatten()
     }
 
+    /// Each (capability, tag) that a running instance has, once, in that order.
+    pub fn tags(&self) -> Vec<(usize, usize)> {
+        let mut tags: Vec<(usize, usize)> = self.by_tag.keys().map(|&(c, t, _)| (c, t)).collect();
+        tags.dedup();
+        tags
+    }
+
     /// The instances of `capability` tagged `tag`, in the order they started.
     pub fn tagged(&self, capability: usize, tag: usize) -> impl Iterator<Item = &Entry<'m>> {
         self.by_tag.range((capability, tag, 0)..=(capability, tag, u64::MAX)).map(|(_, e)| e)

@@ -134,12 +134,16 @@ fn operator_controls_that_cannot_apply_are_refused_with_a_reason() {
     );
     assert_eq!(
         answers[0],
-        Err("no statement starts an activity tagged FlyTo-F9: did you mean `FlyTo-F1`?".to_string())
+        Err("no statement starts an activity tagged FlyTo-F9 (running now: FlyTo-F1): did you mean `FlyTo-F1`?".to_string())
     );
-    assert_eq!(answers[1], Err("no capability is called Fly".to_string()));
+    assert_eq!(answers[1], Err("no capability is called Fly (running now: FlyTo-F1)".to_string()));
     assert_eq!(answers[2], Err("FlyTo has no section PERFORM Widen".to_string()));
     assert_eq!(answers[3], Err("the mission neither raises nor hears Nobody".to_string()));
-    assert_eq!(answers[4], Err("no capability is called FlyT0: did you mean `FlyTo`?".to_string()));
+    assert_eq!(
+        answers[4],
+        Err("no capability is called FlyT0 (running now: FlyTo-F1): did you mean `FlyTo`?"
+            .to_string())
+    );
     assert_eq!(
         answers[5],
         Err("FlyTo has no section PERFORM PAUES: did you mean `PAUSE`?".to_string())

@@ -5,6 +5,7 @@ use std::collections::{BTreeMap, VecDeque};
 use std::sync::{Mutex, MutexGuard};
 
 use aviary_api::geometry::dist_to_segment;
+use aviary_api::trace::AutopilotAction;
 use aviary_api::{BuiltinException, DroneEvent, DroneId, Failure};
 use aviary_world::Target;
 use mavlink::dialects::ardupilotmega::{
@@ -62,8 +63,9 @@ pub struct Seen {
     pub texts: VecDeque<(Instant, String)>,
     /// The mode this backend last asked for; another RTL or LAND is the autopilot's own.
     pub expected: Option<Mode>,
-    /// A failsafe mode change not yet named: when it was seen, and the mode.
-    failsafe: Option<(Instant, String)>,
+    /// A failsafe mode change not yet named: when it was seen, the mode's name and what
+    /// it does.
+    failsafe: Option<(Instant, String, Mode)>,
     /// What the vehicle reports of itself, for naming a failsafe: the battery's charge
     /// state is LOW or worse, its fence is breached, its GPS has no 3D fix.
     battery_failing: bool,
@@ -265,7 +267,7 @@ impl Vehicle {
             // come just after the HEARTBEAT (ArduCopter queues its STATUSTEXT),
             // so it is named once the vehicle has said why, or after a moment.
             seen.expected = Some(after);
-            seen.failsafe = Some((now, mode::name(flavour, hb.custom_mode)));
+            seen.failsafe = Some((now, mode::name(flavour, hb.custom_mode), after));
         }
     }
 
@@ -343,7 +345,7 @@ impl Vehicle {
     /// Names a pending failsafe once the vehicle's state or words say what it was, or
     /// after [`FAILSAFE_WAIT`] with what is known then.
     fn name_failsafe(&self, seen: &mut Seen, now: Instant) {
-        let Some((at, mode)) = seen.failsafe.clone() else { return };
+        let Some((at, mode, does)) = seen.failsafe.clone() else { return };
         let since = at - std::time::Duration::from_secs(3);
         let why: Vec<&str> =
             seen.texts.iter().filter(|(t, _)| *t >= since).map(|(_, s)| s.as_str()).collect();
@@ -363,6 +365,12 @@ impl Vehicle {
             return;
         }
         seen.failsafe = None;
+        // What the autopilot does is recorded as it is said (`autopilot`), before the fault
+        // it stands for reaches the engine through the backend.
+        let action =
+            if does == Mode::Land { AutopilotAction::Land } else { AutopilotAction::ReturnHome };
+        let reason = failure.reason.clone();
+        let _ = self.events.send(DroneEvent::Autopilot { drone: self.drone, action, reason });
         let _ = self.alarms.send((self.drone, failure));
     }
 

@@ -128,6 +128,7 @@ impl MissionState {
                 }
             }
             Event::HandlerStart { .. }
+            | Event::Autopilot { .. }
             | Event::HandlerEnd { .. }
             | Event::ApiCall { .. }
             | Event::ApiDone { .. }

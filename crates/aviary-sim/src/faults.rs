@@ -19,6 +19,7 @@
 //! Each of them ends the drone's calls in progress `Interrupted`. A fault on a lost drone
 //! does nothing.
 
+use aviary_api::trace::AutopilotAction;
 use aviary_api::{BuiltinException, BuiltinSignal, DroneEvent, DroneId, FlightState};
 use aviary_world::FaultKind;
 
@@ -44,7 +45,7 @@ impl Fleet {
             self.fire(id, kind, at, until, out);
         }
         self.end_outages(end, out);
-        self.return_without_link(end);
+        self.return_without_link(end, out);
         let drones = &self.drones;
         self.outages.retain(|&id| {
             drones[id].rare.as_ref().is_some_and(|r| r.link_loss.is_some() || r.gps_loss.is_some())
@@ -82,6 +83,7 @@ impl Fleet {
                 self.drones[id].rare_mut().link_loss =
                     Some(Outage { since: at, until, returned: false });
                 self.outage(id);
+                self.on_its_own(id, AutopilotAction::Hold, "link lost: holds where it is", out);
             }
             FaultKind::GpsLoss => {
                 self.fault(
@@ -93,6 +95,7 @@ impl Fleet {
                 self.drones[id].rare_mut().gps_loss =
                     Some(Outage { since: at, until, returned: false });
                 self.outage(id);
+                self.on_its_own(id, AutopilotAction::Hold, "GPS lost: holds where it is", out);
             }
         }
     }
@@ -106,6 +109,7 @@ impl Fleet {
             format!("{name}: motor failure (simulated fault)"),
             out,
         );
+        self.on_its_own(id, AutopilotAction::Land, "motor failure: lands where it is", out);
         let d = &mut self.drones[id];
         d.rare_mut().disabled = Some(format!("{name} had a motor failure"));
         if d.state.airborne() {
@@ -113,6 +117,15 @@ impl Fleet {
             let leg = Leg::Move { to, speed: d.spec.max_speed, state: FlightState::Landing };
             d.motion = Some(Box::new(MotionTask::new(None, vec![leg])));
             d.begin_leg();
+        }
+    }
+
+    /// Tells the engine what the autopilot of drone `id` does on its own after a fault,
+    /// when the drone is in the air (on the ground it just stays there).
+    fn on_its_own(&self, id: DroneId, action: AutopilotAction, why: &str, out: &mut Vec<Report>) {
+        if self.drones[id].state.airborne() {
+            let reason = format!("{}: {why}", &self.names[id]);
+            out.push(Report::Event(DroneEvent::Autopilot { drone: id, action, reason }));
         }
     }
 
@@ -139,7 +152,7 @@ impl Fleet {
 
     /// A drone whose link has been lost for `link_loss_rtl_after` by `end` returns to
     /// launch on its own, once per outage: when it is in the air, idle and able to fly.
-    fn return_without_link(&mut self, end: f64) {
+    fn return_without_link(&mut self, end: f64, out: &mut Vec<Report>) {
         let max_altitude = self.max_altitude;
         for &id in &self.outages {
             let d = &mut self.drones[id];
@@ -156,6 +169,16 @@ impl Fleet {
                 if let Ok(legs) = return_legs(d, &self.names[id], false, max_altitude) {
                     d.motion = Some(Box::new(MotionTask::new(None, legs)));
                     d.begin_leg();
+                    let reason = format!(
+                        "{}: no link for {} s: returns to launch on its own",
+                        &self.names[id],
+                        aviary_api::show::number(self.link_loss_rtl_after)
+                    );
+                    out.push(Report::Event(DroneEvent::Autopilot {
+                        drone: id,
+                        action: AutopilotAction::ReturnHome,
+                        reason,
+                    }));
                 }
             }
         }

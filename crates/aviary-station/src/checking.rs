@@ -89,6 +89,7 @@ pub fn map_of(world: &aviary_world::World) -> Value {
         .collect();
     json!({
         "site": world.site,
+        "base": crate::tiles::base_map(world),
         "places": world.places,
         "areas": world.areas,
         "drones": drones,

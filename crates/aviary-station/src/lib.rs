@@ -20,6 +20,7 @@ mod flight;
 pub mod replay;
 pub mod report;
 mod routes;
+mod tiles;
 pub mod tree;
 
 use std::net::SocketAddr;

@@ -85,6 +85,13 @@ fn read(name: &str, trace: &str) -> Result<Mission, String> {
             Event::Leash { capability, tag, action } => {
                 m.marks.push((t, format!("{capability}-{tag} {action}"), "operator"));
             }
+            Event::Operator { action, drone } => {
+                let of = drone.map(|d| format!(" {d}")).unwrap_or_default();
+                m.marks.push((t, format!("operator: {}{of}", action.as_str()), "operator"));
+            }
+            Event::Autopilot { reason, .. } => {
+                m.marks.push((t, format!("autopilot: {reason}"), "exception"));
+            }
             Event::ApiDone { actor, position, function, status, .. } => {
                 // Where a call left a drone: the only positions of a trace without telemetry,
                 // and the end of a landing, which may fall between two samples.

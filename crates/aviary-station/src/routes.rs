@@ -18,7 +18,7 @@ use tower::ServiceExt;
 use aviary_check::SourceProvider;
 
 use crate::checking::{self, Text};
-use crate::{assets, dir, flight, Mode, Station};
+use crate::{assets, dir, flight, tiles, Mode, Station};
 
 /// The largest body a station call takes: a mission and a world of the largest size
 /// the station opens, with room for JSON's escapes.
@@ -38,7 +38,7 @@ pub(crate) fn router(station: Arc<Station>) -> Router {
         .route("/api/station/fly", post(fly))
         .route_layer(middleware::from_fn_with_state(gate.clone(), aviary_server::token));
     Router::new()
-        .route("/", get(|| async { page("index.html") }))
+        .route("/", get(index))
         .route("/assets/{*path}", get(|Path(path): Path<String>| async move { page(&path) }))
         .merge(reads)
         .merge(changes)
@@ -64,22 +64,38 @@ impl IntoResponse for Refusal {
     }
 }
 
+/// The page, allowed images from the tile servers of the worlds it may show (and from
+/// nowhere else).
+async fn index(State(station): State<Arc<Station>>) -> Response {
+    let policy =
+        tokio::task::spawn_blocking(move || tiles::policy(&tiles::image_sources(&station)))
+            .await
+            .unwrap_or_else(|_| tiles::policy(&[]));
+    served("index.html", &policy)
+}
+
 fn page(path: &str) -> Response {
+    served(path, &tiles::policy(&[]))
+}
+
+/// One of the page's files. The page's own files only: no script, style or image from
+/// anywhere else (but a world's tiles), and no page of another site may frame it.
+fn served(path: &str, policy: &str) -> Response {
     match assets::find(path) {
-        Some(a) => (
-            [
-                (header::CONTENT_TYPE, a.mime),
-                // The page's own files only: no script, style or image from anywhere else,
-                // and no page of another site may frame it.
-                (
-                    header::CONTENT_SECURITY_POLICY,
-                    "default-src 'self'; img-src 'self' data:; style-src 'self' 'unsafe-inline'; connect-src 'self'; frame-ancestors 'none'",
-                ),
-                (header::X_CONTENT_TYPE_OPTIONS, "nosniff"),
-            ],
-            a.bytes,
-        )
-            .into_response(),
+        Some(a) => {
+            let mut response = (
+                [(header::CONTENT_TYPE, a.mime), (header::X_CONTENT_TYPE_OPTIONS, "nosniff")],
+                a.bytes,
+            )
+                .into_response();
+            // A tile source is only a scheme and a host (`tiles::source`), so the policy is
+            // always a header's text; were it not, the page would load no image but its own.
+            let value = header::HeaderValue::from_str(policy)
+                .or_else(|_| header::HeaderValue::from_str(&tiles::policy(&[])))
+                .unwrap_or(header::HeaderValue::from_static("default-src 'self'"));
+            response.headers_mut().insert(header::CONTENT_SECURITY_POLICY, value);
+            response
+        }
         None => error(StatusCode::NOT_FOUND, format!("the page has no file {path}")),
     }
 }

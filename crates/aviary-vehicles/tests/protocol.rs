@@ -4,6 +4,7 @@
 
 use std::time::Duration;
 
+use aviary_api::trace::AutopilotAction;
 use aviary_api::{Backend, BuiltinException, BuiltinSignal, CallEnd, DroneEvent, Function, Value};
 use aviary_mavlink::Tuning;
 use aviary_vehicles::{Behaviour, Listen, Options};
@@ -262,14 +263,24 @@ async fn the_battery_rule_signals_low_then_raises_critical_once() {
     }
     let names: Vec<&str> = seen
         .iter()
-        .map(|e| match e {
-            DroneEvent::Signal { signal, .. } => signal.name(),
-            DroneEvent::Fault { failure, .. } => failure.exception.name(),
-            DroneEvent::Detected { .. } => "Detected",
+        .filter_map(|e| match e {
+            DroneEvent::Signal { signal, .. } => Some(signal.name()),
+            DroneEvent::Fault { failure, .. } => Some(failure.exception.name()),
+            DroneEvent::Detected { .. } => Some("Detected"),
+            DroneEvent::Autopilot { .. } => None,
         })
         .collect();
-    // The vehicle's own battery failsafe (RTL) comes too: still one exception.
+    // The vehicle's own battery failsafe (RTL) comes too: still one exception, and the
+    // autopilot's return is recorded as what it did on its own.
     assert_eq!(names, ["BatteryLow", "BatteryCritical"], "{seen:?}");
+    let on_its_own: Vec<AutopilotAction> = seen
+        .iter()
+        .filter_map(|e| match e {
+            DroneEvent::Autopilot { action, .. } => Some(*action),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(on_its_own, [AutopilotAction::ReturnHome], "{seen:?}");
     vehicles.stop();
 }
 

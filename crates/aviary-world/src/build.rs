@@ -25,6 +25,8 @@ const SITE_KEYS: &[&str] = &[
     "min_separation",
     "link_loss_rtl_after",
     "separation_timeout",
+    "tiles",
+    "tiles_attribution",
 ];
 const ORIGIN_KEYS: &[&str] = &["lat", "lon", "alt"];
 
@@ -202,10 +204,44 @@ fn site(cx: &mut Ctx, node: &Node) -> Site {
                     site.separation_timeout = v;
                 }
             }
+            "tiles" => site.tiles = tiles(cx, n),
+            "tiles_attribution" => {
+                site.tiles_attribution = cx.string(&"`tiles_attribution` in [site]", n)
+            }
             _ => {}
         }
     }
+    if site.origin.is_none() {
+        if let Some(e) = entries.iter().find(|e| e.key == "tiles") {
+            cx.error(
+                e.key_span,
+                "a base map (`tiles`) needs the site's `origin`, to place the local frame on it",
+                "add `origin = { lat = ..., lon = ..., alt = ... }` to [site], or leave `tiles` out",
+            );
+        }
+    }
     site
+}
+
+/// `tiles`: an XYZ tile server's address, with `{z}`, `{x}` and `{y}` where the zoom and
+/// the tile's column and row go (Leaflet's form; `{s}` for a server's subdomains too).
+fn tiles(cx: &mut Ctx, node: &Node) -> Option<String> {
+    let url = cx.string(&"`tiles` in [site]", node)?;
+    let help = "write the tile server's address with {z}, {x} and {y}, e.g. \
+                `tiles = \"https://tile.openstreetmap.org/{z}/{x}/{y}.png\"`";
+    if !(url.starts_with("https://") || url.starts_with("http://")) {
+        cx.error(
+            node.span,
+            format!("`tiles` must be an http:// or https:// address, found `{url}`"),
+            help,
+        );
+        return None;
+    }
+    if let Some(missing) = ["{z}", "{x}", "{y}"].into_iter().find(|p| !url.contains(p)) {
+        cx.error(node.span, format!("`tiles` has no `{missing}` in `{url}`"), help);
+        return None;
+    }
+    Some(url)
 }
 
 fn origin(cx: &mut Ctx, e: &Entry) -> Option<Geo> {

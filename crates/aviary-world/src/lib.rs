@@ -67,6 +67,11 @@ pub struct Site {
     /// Seconds a simulated drone's motion call may be held back by separation (no
     /// progress towards its target) before it ends with `Timeout`; default 30.
     pub separation_timeout: f64,
+    /// A base map for the ground station and the report: an XYZ tile server's URL
+    /// (`https://tile.example.org/{z}/{x}/{y}.png`); only with an `origin`.
+    pub tiles: Option<String>,
+    /// What the tiles' licence asks to be shown with them.
+    pub tiles_attribution: Option<String>,
 }
 
 impl Default for Site {
@@ -79,6 +84,8 @@ impl Default for Site {
             min_separation: 5.0,
             link_loss_rtl_after: 10.0,
             separation_timeout: 30.0,
+            tiles: None,
+            tiles_attribution: None,
         }
     }
 }

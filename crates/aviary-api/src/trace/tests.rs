@@ -152,6 +152,11 @@ fn operator_action() -> impl Strategy<Value = OperatorAction> {
     proptest::sample::select(vec![Pause, Resume, Abort, Hold, ReturnHome, Land])
 }
 
+fn autopilot_action() -> impl Strategy<Value = AutopilotAction> {
+    use AutopilotAction::*;
+    proptest::sample::select(vec![Hold, ReturnHome, Land])
+}
+
 fn point() -> impl Strategy<Value = [f64; 3]> {
     [number(), number(), number()]
 }
@@ -226,6 +231,11 @@ fn event() -> impl Strategy<Value = Event<'static>> {
         }),
         (operator_action(), opt(text()))
             .prop_map(|(action, drone)| Event::Operator { action, drone }),
+        (text(), autopilot_action(), text()).prop_map(|(actor, action, reason)| Event::Autopilot {
+            actor,
+            action,
+            reason
+        }),
     ]
 }
 

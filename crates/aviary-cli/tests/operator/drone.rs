@@ -88,7 +88,7 @@ fn a_drone_is_held_resumed_and_sent_home_through_aviary_ctl() {
     let (code, out, err) = ctl(&["a", "hold"]);
     assert_eq!(code, 0, "{out}{err}");
     assert!(out.contains("\"ok\":true"), "{out}");
-    let (_, state, _) = aviary(&["ctl", "--url", &url, "state"], &dir);
+    let (_, state, _) = aviary(&["ctl", "--url", &url, "state", "--json"], &dir);
     let state: serde_json::Value = serde_json::from_str(&state).expect("state is JSON");
     let a = state["drones"].as_array().unwrap().iter().find(|d| d["name"] == "a");
     assert_eq!(a.map(|a| a["held"].clone()), Some(serde_json::json!(true)), "{state}");

@@ -2,11 +2,11 @@
 // CRS.Simple, one unit a metre), with the geofence, areas, places, homes, targets and
 // finds as Leaflet layers, and the drones on a canvas of their own over it, redrawn once
 // a frame at most: a thousand moving markers as DOM elements would not keep 30 frames a
-// second.
+// second. A world with `tiles` and an `origin` is drawn over its base map instead
+// (Leaflet's Web Mercator), each local point placed by the station's figures of the one
+// projection (`base`: degrees per metre about the origin).
 
 /* global L */
-
-const toLatLng = (p) => L.latLng(p[1], p[0]);
 
 export function batteryColor(b) {
   if (b === null || b === undefined) return "#8792a6";
@@ -15,24 +15,18 @@ export function batteryColor(b) {
   return "#1f8a4c";
 }
 
+const sameBase = (a, b) => JSON.stringify(a || null) === JSON.stringify(b || null);
+
 export class StationMap {
   constructor(element) {
-    this.map = L.map(element, {
-      crs: L.CRS.Simple, minZoom: -8, maxZoom: 6, zoomSnap: 0.25, attributionControl: false,
-      preferCanvas: true,
-    });
-    this.map.setView([0, 0], 0);
-    this.world = L.layerGroup().addTo(this.map);
-    this.findLayer = L.layerGroup().addTo(this.map);
-    this.findCount = 0;
+    this.element = element;
     this.canvas = document.createElement("canvas");
     this.canvas.className = "drone-canvas";
     Object.assign(this.canvas.style, { position: "absolute", inset: "0", zIndex: 450, pointerEvents: "none" });
-    element.appendChild(this.canvas);
     this.model = null;
     this.dirty = true;
     this.frames = 0;
-    this.map.on("move zoom resize", () => { this.dirty = true; });
+    this.build(null);
     const loop = () => {
       if (this.dirty) this.draw();
       this.frames++;
@@ -41,34 +35,70 @@ export class StationMap {
     requestAnimationFrame(loop);
   }
 
+  /// A Leaflet map in the local frame (`base` null) or over a world's tiles; a map's
+  /// frame cannot change, so another frame is another map.
+  build(base) {
+    if (this.map) this.map.remove();
+    this.base = base;
+    const options = { zoomSnap: 0.25, preferCanvas: true, attributionControl: Boolean(base) };
+    if (base) Object.assign(options, { minZoom: 3, maxZoom: 21 });
+    else Object.assign(options, { crs: L.CRS.Simple, minZoom: -8, maxZoom: 6 });
+    this.map = L.map(this.element, options);
+    if (base) {
+      this.tiles = L.tileLayer(base.url, { attribution: base.attribution || "", maxNativeZoom: 19, maxZoom: 21 });
+      this.tiles.addTo(this.map);
+      if (this.map.attributionControl) this.map.attributionControl.setPrefix(false);
+      this.map.setView(this.toLatLng([0, 0]), 16);
+    } else {
+      this.tiles = null;
+      this.map.setView([0, 0], 0);
+    }
+    this.world = L.layerGroup().addTo(this.map);
+    this.findLayer = L.layerGroup().addTo(this.map);
+    this.findCount = 0;
+    this.element.appendChild(this.canvas);
+    this.map.on("move zoom resize", () => { this.dirty = true; });
+    this.dirty = true;
+  }
+
+  /// A local point `[x, y]` (metres east, north) where the map draws it.
+  toLatLng(p) {
+    const b = this.base;
+    return b ? L.latLng(b.lat + p[1] * b.lat_per_m, b.lon + p[0] * b.lon_per_m) : L.latLng(p[1], p[0]);
+  }
+
   /// Draws the world: everything but the drones and what they find.
   setWorld(world) {
+    const base = (world && world.base) || null;
+    if (!sameBase(base, this.base)) this.build(base);
     this.world.clearLayers();
     if (!world) return;
+    const at = (p) => this.toLatLng(p);
     const bounds = L.latLngBounds([]);
     const site = world.site || {};
     if (site.geofence) {
-      const fence = L.polygon(site.geofence.map(toLatLng), { color: "#c2352b", weight: 2, dashArray: "6 4", fill: false });
+      const fence = L.polygon(site.geofence.map(at), { color: "#c2352b", weight: 2, dashArray: "6 4", fill: false });
       fence.bindTooltip("geofence").addTo(this.world);
       bounds.extend(fence.getBounds());
     }
     for (const a of world.areas || []) {
-      const p = L.polygon(a.polygon.map(toLatLng), { color: "#1c64d1", weight: 1, fillOpacity: 0.08 });
+      const p = L.polygon(a.polygon.map(at), { color: "#1c64d1", weight: 1, fillOpacity: 0.08 });
       p.bindTooltip(a.name, { permanent: true, direction: "center", className: "place-label" }).addTo(this.world);
       bounds.extend(p.getBounds());
     }
     for (const p of world.places || []) {
-      const m = L.circleMarker(toLatLng(p.at), { radius: 4, color: "#3b4456", weight: 1, fillOpacity: 0.8 });
+      const m = L.circleMarker(at(p.at), { radius: 4, color: "#3b4456", weight: 1, fillOpacity: 0.8 });
       m.bindTooltip(p.name, { permanent: true, direction: "right", className: "place-label" }).addTo(this.world);
       bounds.extend(m.getLatLng());
     }
     for (const d of world.drones || []) {
-      const h = L.rectangle([[d.home[1] - 1.5, d.home[0] - 1.5], [d.home[1] + 1.5, d.home[0] + 1.5]], { color: "#6b7385", weight: 1, fillOpacity: 0.3 });
+      const [x, y] = d.home;
+      const h = L.rectangle([at([x - 1.5, y - 1.5]), at([x + 1.5, y + 1.5])], { color: "#6b7385", weight: 1, fillOpacity: 0.3 });
       h.bindTooltip(`home of ${d.name}`).addTo(this.world);
-      bounds.extend(L.latLng(d.home[1], d.home[0]));
+      bounds.extend(at(d.home));
     }
     for (const t of world.targets || []) {
-      const m = L.circleMarker(toLatLng(t.at), { radius: 3, color: "#7b4bc4", weight: 1, fillOpacity: 0.6 });
+      const m = L.circleMarker(at(t.at), { radius: 3, color: "#7b4bc4", weight: 1, fillOpacity: 0.6 });
       m.bindTooltip(`target: ${t.kind}`).addTo(this.world);
     }
     if (bounds.isValid()) this.map.fitBounds(bounds.pad(0.15));
@@ -102,10 +132,10 @@ export class StationMap {
     if (!model) return;
     while (this.findCount < model.finds.length) {
       const f = model.finds[this.findCount++];
-      L.circleMarker(toLatLng(f.at), { radius: 7, color: "#c2352b", weight: 2, fill: false })
+      L.circleMarker(this.toLatLng(f.at), { radius: 7, color: "#c2352b", weight: 2, fill: false })
         .bindTooltip(`${f.kind} found by ${f.actor} at t = ${f.t.toFixed(1)} s`).addTo(this.findLayer);
     }
-    const point = (p) => this.map.latLngToContainerPoint(toLatLng(p));
+    const point = (p) => this.map.latLngToContainerPoint(this.toLatLng(p));
     const many = model.drones.size > 200;
     // Trails first, under every drone.
     ctx.lineWidth = 1.5;

@@ -123,6 +123,11 @@ export function observe(model, e) {
       } else if (e.action === "pause") model.paused = true;
       else if (e.action === "resume") model.paused = false;
       return true;
+    case "autopilot":
+      // A drone acting on its own (a failsafe): the operator must see it at once.
+      model.marks.push({ t: e.t, kind: "exception", text: `${e.actor}: ${e.action}` });
+      alarm(model, "autopilot", e.actor, `${e.actor}, on its own: ${e.action.replace("_", " ")} (${e.reason})`, e.action !== "hold");
+      break;
     case "detection":
       model.finds.push({ t: e.t, actor: e.actor, kind: e.kind, at: e.location });
       model.marks.push({ t: e.t, kind: "find", text: `${e.kind} by ${e.actor}` });
@@ -197,6 +202,7 @@ export function describe(e) {
     case "exception": return `exception ${e.name}${e.actor ? " on " + e.actor : ""}${e.handled ? " handled" : " UNHANDLED"} ${(e.args || []).join(" ")}${e.skipped ? ` (passed over: ${e.skipped})` : ""}`;
     case "leash": return `leash ${e.capability}-${e.tag} ${e.action}`;
     case "operator": return `operator: ${e.action}${e.drone ? " " + e.drone : ""}`;
+    case "autopilot": return `autopilot of ${e.actor}, on its own: ${e.action.replace("_", " ")} (${e.reason})`;
     case "detection": return `${e.actor} found ${e.kind} at (${e.location.map((v) => v.toFixed(0)).join(", ")})`;
     default: return `${e.event}`;
   }

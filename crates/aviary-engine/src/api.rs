@@ -12,6 +12,7 @@ use aviary_api::{CallEnd, CallId, DroneId, Ending, Function, Interrupt, Value};
 use aviary_ir::ApiCall;
 
 use crate::engine::{Ctx, Engine, Instance};
+use crate::place::Level;
 use aviary_api::trace::{CallStatus, Event, EventKind};
 
 /// A call made: what the rest of its statement needs.
@@ -80,12 +81,19 @@ impl<'m> Engine<'m> {
     /// raises what a failure or an interruption means.
     pub(crate) async fn api_end(&self, begun: Begun, ctx: &Ctx<'m>) {
         let Begun { call, end } = begun;
+        // While the call is in flight, its drone's own events are raised here, where the
+        // call was made (`place.rs`); kept until what its ending raises has been raised.
+        let mut _placed = None;
         let end = match end {
             // Over as it was made: nothing in flight to pause, resume or abort.
             Ending::Now(end) => end,
             Ending::Later(answer) => {
                 let root = ctx.instance.as_ref().map(|i| i.root());
                 let guard = CallGuard { engine: self, call: &call, root, done: Cell::new(false) };
+                if let Some(instance) = &ctx.instance {
+                    _placed =
+                        Some(self.place(&[call.drone], instance.depth, Level::Call, &ctx.scope));
+                }
                 if let Some(root) = root {
                     root.calls.borrow_mut().push(call.id);
                     if root.waits() {

@@ -180,6 +180,8 @@ pub(crate) struct Engine<'m> {
     pub arbiter: Rc<RefCell<Arbiter>>,
     pub instances: RefCell<Registry<'m>>,
     pub detections: RefCell<BTreeMap<(DroneId, String), Rc<Scope<'m>>>>,
+    /// Where each drone's work is, for its own events (`place.rs`).
+    pub places: crate::place::Places<'m>,
     /// How the mission ends early, if it does: failed (an unhandled exception, a lost
     /// backend) or aborted (the operator), and why.
     ending: RefCell<Option<(Status, String)>>,
@@ -236,6 +238,7 @@ impl<'m> Engine<'m> {
             arbiter: Rc::new(RefCell::new(Arbiter::default())),
             instances: RefCell::new(Registry::default()),
             detections: RefCell::new(BTreeMap::new()),
+            places: Default::default(),
             ending: RefCell::new(None),
             backend_alive: Cell::new(true),
             mission_paused: Cell::new(false),
@@ -511,17 +514,6 @@ impl<'m> Engine<'m> {
     pub(crate) fn fail(&self, failure: aviary_api::Failure, drone: DroneId, from: &Rc<Scope<'m>>) {
         let id = self.m.builtins.exception(failure.exception);
         self.throw(id, vec![Value::Text(failure.reason)], Some(drone), from);
-    }
-
-    /// Where an actor's built-in events are raised: in its innermost running capability
-    /// instance, or at mission level when it is idle.
-    fn actor_scope(&self, drone: DroneId) -> Rc<Scope<'m>> {
-        let instances = self.instances.borrow();
-        let innermost = instances.of_actor(drone).max_by_key(|(i, _)| (i.depth, i.id));
-        match innermost {
-            Some((_, scope)) => scope.clone(),
-            None => self.mission_scope.borrow().clone().unwrap_or_else(|| self.root_scope()),
-        }
     }
 
     fn matches(&self, by: &Option<ActorFilter>, frame: &[Value], actor: Option<DroneId>) -> bool {

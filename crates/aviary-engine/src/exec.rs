@@ -137,7 +137,7 @@ impl<'m> Engine<'m> {
 
     /// A block in a scope of its own. `on_scope` is told the scope first, and what it
     /// gives back is kept while the block runs.
-    async fn block_with<T>(
+    pub(crate) async fn block_with<T>(
         &self,
         block: &'m Block,
         ctx: &Ctx<'m>,

@@ -21,6 +21,7 @@ mod homing;
 mod instant;
 mod jobs;
 mod join;
+mod place;
 mod registry;
 mod steer;
 mod value;

@@ -18,6 +18,23 @@ fn fixture(name: &str) -> String {
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
 }
 
+/// The world a rule flies in: `tests/rules/NAME.world.toml` beside its mission when the
+/// rule needs one of its own (a drone's battery, a fault), else the harness's.
+fn world_of(mission: &std::path::Path) -> String {
+    let own = mission.with_extension("world.toml");
+    match std::fs::read_to_string(&own) {
+        Ok(world) => world,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => harness::WORLD.to_string(),
+        Err(e) => panic!("{}: {e}", own.display()),
+    }
+}
+
+/// A rule's mission flown in its world, as the snapshots fly it.
+fn run_rule(name: &str) -> harness::Run {
+    let path = format!("{}/tests/rules/{name}.mission", env!("CARGO_MANIFEST_DIR"));
+    harness::run_in(&fixture(name), &world_of(std::path::Path::new(&path)))
+}
+
 /// Every rule's whole trace, one event a line: the order and the time of every event, so
 /// that a change in what a rule does shows, event by event, in review. The tests below
 /// say which of those facts are the rule.
@@ -27,7 +44,7 @@ fn traces() {
         let mission = std::fs::read_to_string(path).expect("read the fixture");
         let options =
             RunOptions { max_handler_reentries: SNAPSHOT_REENTRIES, ..RunOptions::default() };
-        let r = harness::run_with(&mission, harness::WORLD, &options);
+        let r = harness::run_with(&mission, &world_of(path), &options);
         insta::assert_snapshot!(format!("outcome: {:?}\n{}", r.outcome.status, r.dump()));
     });
 }
@@ -399,4 +416,60 @@ fn a_handler_re_entered_at_one_instant_is_passed_over() {
     assert!(r.find("capability_start", "actor", "a").is_empty(), "nothing new starts");
     assert!(r.trace.iter().all(|e| e["t"] == 0.0), "all of it at the one instant");
     assert_eq!(r.trace.last().unwrap()["event"], "mission_end");
+}
+
+/// The index in the trace of the first event matching all of `fields`.
+fn at(r: &harness::Run, event: &str, fields: &[(&str, &str)]) -> usize {
+    r.trace
+        .iter()
+        .position(|e| e["event"] == event && fields.iter().all(|(k, v)| e[*k] == *v))
+        .unwrap_or_else(|| panic!("no {event} with {fields:?}:\n{}", r.dump()))
+}
+
+#[test]
+fn a_drones_signals_are_heard_where_its_work_is() {
+    let r = run_rule("a_drones_signals_are_heard_where_its_work_is");
+    assert_eq!(r.outcome.status, Status::Ok);
+    let low = at(&r, "signal", &[("name", "BatteryLow"), ("actor", "a")]);
+    let inner = at(&r, "handler_start", &[("handler", "Patrol/ON BatteryLow")]);
+    let outer = at(&r, "handler_start", &[("handler", "P/ON BatteryLow")]);
+    let t = r.trace[low]["t"].as_f64().unwrap();
+    // While the PERFORM itself flies its Orbit: the call is in flight then.
+    let orbit = r.first("api_call", "function", "Orbit")["t"].as_f64().unwrap();
+    let orbit_done = r.first("api_done", "function", "Orbit");
+    assert!(orbit < t && t <= orbit_done["t"].as_f64().unwrap(), "{t}");
+    assert_eq!(orbit_done["status"], "aborted", "the outer handler's leash stopped it");
+    assert!(low < inner && inner < outer, "the PERFORM's handler first, then outward");
+    for i in [inner, outer] {
+        assert_eq!(r.trace[i]["t"].as_f64().unwrap(), t, "at the signal's instant");
+    }
+    assert!(r.find("signal", "name", "Tired").len() == 1);
+    assert!(r.find("signal", "name", "Never").is_empty(), "b's block does not hold a's work");
+}
+
+#[test]
+fn a_drones_signal_while_its_perform_waits_is_heard_there() {
+    let r = run_rule("a_drones_signal_while_its_perform_waits_is_heard_there");
+    assert_eq!(r.outcome.status, Status::Ok);
+    let t = r.t("signal", "name", "BatteryLow");
+    let took_off = r.trace.iter().find(|e| e["event"] == "api_done" && e["function"] == "TakeOff");
+    let took_off = took_off.expect("took off")["t"].as_f64().unwrap();
+    assert!(took_off < t, "no call in flight: the PERFORM waits");
+    assert_eq!(r.t("handler_start", "handler", "Stay/ON BatteryLow"), t);
+    assert_eq!(r.t("api_call", "function", "ReturnToLaunch"), t, "the wait ends at once");
+}
+
+#[test]
+fn connection_restored_is_heard_in_the_perform_that_caught_the_loss() {
+    let r = run_rule("connection_restored_is_heard_in_the_perform_that_caught_the_loss");
+    assert_eq!(r.outcome.status, Status::Ok);
+    let lost = r.first("exception", "name", "ConnectionLost");
+    assert_eq!(lost["handler"], "Watch/ON EXCEPTION ConnectionLost");
+    assert!(close(lost["t"].as_f64().unwrap(), 30.0));
+    let back = r.t("signal", "name", "ConnectionRestored");
+    assert!(close(back, 35.0), "{back}");
+    assert_eq!(r.t("handler_start", "handler", "Watch/ON ConnectionRestored"), back);
+    let watch = r.ends("Watch", "a")[0];
+    assert_eq!(watch["status"], "ok");
+    assert_eq!(watch["t"].as_f64().unwrap(), back, "the caught loss's wait ends then");
 }

@@ -173,6 +173,7 @@ impl<'m> Engine<'m> {
             catching: Cell::new(0),
             caught: Notify::new(),
             instance: Some(instance.clone()),
+            section: Cell::new(ctx.scope.section.get()),
         });
         if listed {
             self.instances.borrow_mut().set_scope(&instance, scope.clone());
@@ -300,6 +301,9 @@ impl<'m> Engine<'m> {
             held: Cell::new(ctx.instance.is_none() && held),
             resumed: Notify::new(),
             calls: RefCell::new(SmallVec::new()),
+            sections: Cell::new(0),
+            section_calls: RefCell::new(SmallVec::new()),
+            turn: tokio::sync::Semaphore::const_new(1),
             depth: ctx.instance.as_ref().map_or(0, |p| p.depth + 1),
             claims: RefCell::new(ctx.claims.clone()),
         })

@@ -39,9 +39,11 @@ impl<'m> Engine<'m> {
     pub(crate) async fn api(&self, a: &'m ApiCall, ctx: &Ctx<'m>) {
         let Some(drone) = self.api_drone(a, &ctx.frame) else { return };
         if let Some(root) = ctx.instance.as_ref().map(|i| i.root()) {
+            // Paused or held; in the body, also while a leash section runs (`section.rs`).
+            let in_section = ctx.scope.section.get();
             loop {
                 let resumed = root.resumed.notified();
-                if !root.waits() {
+                if !root.holds(in_section) {
                     break;
                 }
                 resumed.await;
@@ -89,14 +91,21 @@ impl<'m> Engine<'m> {
             Ending::Now(end) => end,
             Ending::Later(answer) => {
                 let root = ctx.instance.as_ref().map(|i| i.root());
-                let guard = CallGuard { engine: self, call: &call, root, done: Cell::new(false) };
+                let in_section = ctx.scope.section.get();
+                let guard = CallGuard {
+                    engine: self,
+                    call: &call,
+                    root,
+                    in_section,
+                    done: Cell::new(false),
+                };
                 if let Some(instance) = &ctx.instance {
                     _placed =
                         Some(self.place(&[call.drone], instance.depth, Level::Call, &ctx.scope));
                 }
                 if let Some(root) = root {
-                    root.calls.borrow_mut().push(call.id);
-                    if root.waits() {
+                    root.calls_of(in_section).borrow_mut().push(call.id);
+                    if root.holds(in_section) {
                         self.backend.interrupt(call.id, Interrupt::Pause);
                     }
                 }
@@ -140,6 +149,8 @@ struct CallGuard<'e, 'm> {
     engine: &'e Engine<'m>,
     call: &'e Made,
     root: Option<&'e Rc<Instance>>,
+    /// Made in a leash section: listed with the root's `section_calls`.
+    in_section: bool,
     done: Cell<bool>,
 }
 
@@ -158,7 +169,7 @@ impl Drop for CallGuard<'_, '_> {
             });
         }
         if let Some(root) = &self.root {
-            root.calls.borrow_mut().retain(|c| *c != call.id);
+            root.calls_of(self.in_section).borrow_mut().retain(|c| *c != call.id);
         }
     }
 }

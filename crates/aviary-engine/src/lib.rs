@@ -23,6 +23,7 @@ mod jobs;
 mod join;
 mod place;
 mod registry;
+mod section;
 mod steer;
 mod value;
 

@@ -473,3 +473,98 @@ fn connection_restored_is_heard_in_the_perform_that_caught_the_loss() {
     assert_eq!(watch["status"], "ok");
     assert_eq!(watch["t"].as_f64().unwrap(), back, "the caught loss's wait ends then");
 }
+
+/// A rule's run with telemetry every 0.1 s, to follow where the drone is.
+fn run_rule_watched(mission: &str) -> harness::Run {
+    let options = RunOptions { telemetry_hz: Some(10.0), ..RunOptions::default() };
+    harness::run_with(mission, harness::WORLD, &options)
+}
+
+fn apart(p: [f64; 3], q: [f64; 3]) -> f64 {
+    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+}
+
+/// The times of the calls of `function` by `a`: (made, done, status).
+fn calls_of(r: &harness::Run, function: &str) -> Vec<(f64, f64, String)> {
+    let made = r.trace.iter().filter(|e| e["event"] == "api_call" && e["function"] == function);
+    let done = r.trace.iter().filter(|e| e["event"] == "api_done" && e["function"] == function);
+    made.zip(done)
+        .map(|(m, d)| {
+            let t = |e: &serde_json::Value| e["t"].as_f64().unwrap();
+            (t(m), t(d), d["status"].as_str().unwrap().to_string())
+        })
+        .collect()
+}
+
+#[test]
+fn a_leash_section_holds_the_body_while_it_runs() {
+    let mission = fixture("a_leash_section_holds_the_body_while_it_runs");
+    let r = run_rule_watched(&mission);
+    assert_eq!(r.outcome.status, Status::Ok);
+    assert!(r.find("exception", "name", "CommandFailed").is_empty(), "the section may fly");
+    let leash = r.t("leash", "action", "Check");
+    let fly = calls_of(&r, "FlyToPosition");
+    let hover = calls_of(&r, "Hover");
+    assert_eq!(fly.len(), 1);
+    assert_eq!((fly[0].0, fly[0].2.as_str()), (leash, "ok"), "the section flies at once");
+    let section_end = hover[0].1;
+    let orbit = &calls_of(&r, "Orbit")[0];
+    assert_eq!(orbit.2, "ok");
+    assert!(orbit.0 < leash && orbit.1 > section_end, "the body's orbit spans the section");
+
+    // Held where the leash came: the drone leaves the circle for the spot and is back at
+    // that point after the section, then goes on along the circle to the orbit's end.
+    let track = r.positions("a");
+    let at = |t: f64| track.iter().find(|(s, _)| *s >= t - 1e-9).expect("a point").1;
+    let held = at(leash);
+    let on_circle = |p: [f64; 3]| ((p[0]).hypot(p[1] - 100.0) - 50.0).abs() < 0.5;
+    assert!(track.iter().any(|(t, p)| *t > leash && *t < section_end && p[0].hypot(p[1]) < 0.01));
+    let back = track
+        .iter()
+        .find(|(t, p)| *t >= section_end && apart(*p, held) < 0.5)
+        .expect("back where the body was held")
+        .0;
+    assert!(
+        track.iter().filter(|(t, _)| *t > back + 0.5 && *t < orbit.1).all(|(_, p)| on_circle(*p)),
+        "then along the circle again"
+    );
+
+    // The orbit took longer by the time away from it (the section and the way back), and
+    // a few seconds more to stop and to speed up again on the arc: none of it was flown
+    // twice, none skipped.
+    let alone = run_rule_watched(&mission.replace("            Patrol-P1 Check\n", ""));
+    let orbit_alone = &calls_of(&alone, "Orbit")[0];
+    let longer = (orbit.1 - orbit.0) - (orbit_alone.1 - orbit_alone.0);
+    let away = back - leash;
+    assert!(away <= longer && longer < away + 4.0, "{longer} s longer, {away} s away");
+}
+
+#[test]
+fn a_pause_during_a_section_holds_it_too_and_a_second_section_waits_its_turn() {
+    let name = "a_pause_during_a_section_holds_it_too_and_a_second_section_waits_its_turn";
+    let r = run_rule_watched(&fixture(name));
+    assert_eq!(r.outcome.status, Status::Ok);
+    let leashes: Vec<f64> = r
+        .trace
+        .iter()
+        .filter(|e| e["event"] == "leash")
+        .map(|e| e["t"].as_f64().unwrap())
+        .collect();
+    let [first, pause, second, resume] = leashes[..] else { panic!("{leashes:?}") };
+    let fly = calls_of(&r, "FlyToPosition");
+    let hover = calls_of(&r, "Hover");
+    assert_eq!((fly.len(), hover.len()), (2, 2));
+    assert_eq!(fly[0].0, first);
+    // The pause holds the first section's flight: not a metre between PAUSE and RESUME.
+    let track = r.positions("a");
+    let still: Vec<[f64; 3]> =
+        track.iter().filter(|(t, _)| *t >= pause + 0.1 && *t <= resume).map(|(_, p)| *p).collect();
+    assert!(still.len() > 50 && still.iter().all(|p| apart(*p, still[0]) < 1e-9), "{still:?}");
+    assert!(fly[0].1 > resume, "it goes on after the RESUME");
+    // The second section waits for the first, asked though it was while the first ran.
+    assert!(second < fly[0].1);
+    assert_eq!(fly[1].0, hover[0].1, "its turn comes as the first one ends");
+    // The body waits for both.
+    let orbit = &calls_of(&r, "Orbit")[0];
+    assert!(orbit.1 > hover[1].1 && orbit.2 == "ok");
+}

@@ -568,3 +568,18 @@ fn a_pause_during_a_section_holds_it_too_and_a_second_section_waits_its_turn() {
     let orbit = &calls_of(&r, "Orbit")[0];
     assert!(orbit.1 > hover[1].1 && orbit.2 == "ok");
 }
+
+#[test]
+fn an_area_where_a_position_is_expected_is_its_centroid() {
+    let r = run(&fixture("an_area_where_a_position_is_expected_is_its_centroid"));
+    assert_eq!(r.outcome.status, Status::Ok);
+    let done = |f: &str| r.first("api_done", "function", f).clone();
+    let fly = done("FlyToPosition");
+    assert_eq!(fly["args"][0].as_array().map(Vec::len), Some(4), "the area itself is passed");
+    assert_eq!(fly["position"], serde_json::json!([150.0, 150.0, 20.0]), "to its centroid");
+    assert_eq!(done("Sweep")["status"], "ok");
+    // The circle is flown around the centroid: it ends on it, 20 m out.
+    let p = &done("Orbit")["position"];
+    let (x, y) = (p[0].as_f64().unwrap(), p[1].as_f64().unwrap());
+    assert!(((x - 150.0).hypot(y - 150.0) - 20.0).abs() < 1e-6, "{p}");
+}

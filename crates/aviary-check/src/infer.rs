@@ -1,7 +1,10 @@
 //! Parameter kinds, inferred from use: a parameter takes the kind of its default, or of
 //! the API or capability parameter it is passed to, through nested calls, to a fixpoint.
 //! The first use that fixes a kind wins; a conflicting use is then reported at its call,
-//! with the chain of uses that fixed the kind (`KindOrigin`).
+//! with the chain of uses that fixed the kind (`KindOrigin`). One exception: a parameter
+//! used both as a position and as an area is an area, whichever use comes first, since an
+//! area stands for its centroid where a position is expected (docs/LANGUAGE.md, section
+//! 13). `merge` says which kind two uses give.
 
 use std::collections::BTreeSet;
 
@@ -54,7 +57,8 @@ pub(crate) fn parameter_kinds(
     // the result is the full scan's; a chain of N capabilities costs N visits, not N².
     let callers = callers(&caps, &index);
     let mut round: BTreeSet<usize> = (0..names.len()).collect();
-    let total: usize = kinds.iter().flatten().map(Vec::len).sum();
+    // Each parameter's kind is fixed once and may be widened once (position to area).
+    let total: usize = 2 * kinds.iter().flatten().map(Vec::len).sum::<usize>();
     for _ in 0..=total {
         let mut changed = false;
         let mut next_round: BTreeSet<usize> = BTreeSet::new();
@@ -64,8 +68,9 @@ pub(crate) fn parameter_kinds(
             let mut grew = false;
             if let (Some(k), Some(o)) = (kinds[ci].as_mut(), origins[ci].as_mut()) {
                 for (i, kind, origin) in learned {
-                    if k[i].is_none() {
-                        k[i] = Some(kind);
+                    let merged = merge(k[i], kind);
+                    if merged != k[i] {
+                        k[i] = merged;
                         o[i] = Some(origin);
                         grew = true;
                     }
@@ -88,6 +93,17 @@ pub(crate) fn parameter_kinds(
         round = next_round;
     }
     (by_name(&names, kinds), by_name(&names, origins))
+}
+
+/// The kind of a parameter known as `known` that a use as `used` gives: the first kind
+/// fixed stays, but a position used as an area too becomes an area (every area is a
+/// position as well, its centroid; not every position an area).
+fn merge(known: Option<Kind>, used: Kind) -> Option<Kind> {
+    match known {
+        None => Some(used),
+        Some(Kind::Position) if used == Kind::Area => Some(Kind::Area),
+        known => known,
+    }
 }
 
 /// The kinds a capability's parameters take from their defaults, and where.
@@ -225,6 +241,32 @@ mod tests {
     use aviary_diagnostics::SourceMap;
 
     use crate::NoFiles;
+
+    /// A parameter used as a position and as an area is an area, in either order, and so
+    /// is one that passes it on to such a parameter: nothing is reported.
+    #[test]
+    fn a_position_also_used_as_an_area_is_an_area() {
+        let text = "MISSION M:\n    scout Outer WITH Field\n\n\
+            CAPABILITY Outer BY d WITH z:\n    PERFORM:\n        d FlyTo WITH z\n        d Both WITH z\n\n\
+            CAPABILITY Both BY d WITH z:\n    PERFORM:\n        d.FlyToPosition(z)\n        d.Sweep(z, 20m)\n\n\
+            CAPABILITY Swapped BY d WITH z:\n    PERFORM:\n        d.Sweep(z, 20m)\n        d.FlyToPosition(z)\n";
+        let world = "[areas]\nField = [[0, 0], [100, 0], [100, 100], [0, 100]]\n\
+            [drones.scout]\nhome = [0, 0]\n";
+        let mut sources = SourceMap::new();
+        let checked = crate::check_sources(
+            &mut sources,
+            ("m.mission", text.as_bytes()),
+            Some(("w.toml", world.as_bytes())),
+            &NoFiles,
+            &Descriptor::standard(),
+        );
+        let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).collect();
+        assert!(errors.is_empty(), "{errors:?}");
+        let program = checked.program.expect("program");
+        for cap in ["Outer", "Both", "Swapped"] {
+            assert_eq!(program.param_kinds[cap], vec![Some(Kind::Area)], "{cap}");
+        }
+    }
 
     /// A parameter passed down a chain of capabilities to a middle-layer call gets its
     /// kind at every link, and a wrong argument at the top is reported with the chain.

@@ -20,6 +20,7 @@ mod load;
 mod recursion;
 mod signal_values;
 mod signals;
+mod unheard;
 pub mod uses;
 mod walk;
 
@@ -195,6 +196,7 @@ pub fn check(
             }
             chains::check_chains(program, api, &mut out);
             recursion::check_recursion(program, &mut out);
+            unheard::check_unheard(program, world, api, &mut out);
             out
         };
         let large = sources.text(root).len() >= IN_PARALLEL_FROM;

@@ -1,4 +1,5 @@
-//! The traces of the examples, byte for byte: the paper's mission and each fault drill,
+//! The traces of the examples, byte for byte: the paper's mission, the newcomers'
+//! scenarios (the bridge inspection as it flies with no operator) and each fault drill,
 //! run as a user runs them (`aviary run FILE --trace OUT`), against a snapshot. A change
 //! that should not change behaviour must leave every one of them as it is; one that does
 //! shows, event by event, in review.
@@ -10,7 +11,13 @@ use common::{aviary, repo, scratch};
 #[test]
 fn every_example_writes_the_trace_it_always_wrote() {
     let dir = scratch("example_traces");
-    let mut missions = vec!["examples/search_and_rescue.mission".to_string()];
+    let mut missions: Vec<String> = [
+        "examples/search_and_rescue.mission",
+        "examples/wildfire_perimeter.mission",
+        "examples/bridge_inspection.mission",
+    ]
+    .map(String::from)
+    .to_vec();
     let mut drills: Vec<String> = std::fs::read_dir(repo().join("examples/faults"))
         .expect("examples/faults")
         .map(|e| e.expect("entry").path())

@@ -88,6 +88,7 @@ codes! {
     LowReserve = "W204", Warning, "a drone's estimated battery reserve falls under 20%";
     PastEndurance = "W205", Warning, "a duration (such as Hover's) longer than the drone's endurance";
     HandlerRethrows = "W206", Warning, "an ON EXCEPTION that throws the exception it handles before doing anything else";
+    SignalNeverHeard = "W207", Warning, "a handler of a drone's built-in signal that can never hear it: the drone never works inside its block";
     // Notes.
     SignalNeverHandled = "N301", Note, "a signal raised but never handled";
     NoWorld = "N302", Note, "no world file, so actors, places and areas were not checked";

@@ -18,6 +18,7 @@ use crate::arbiter::{acquire, try_acquire, Claims, Held, Needs};
 use crate::cancel::Token as CancellationToken;
 use crate::engine::{Actors, Ctx, Engine, Frame, Instance, Scope};
 use crate::jobs::Jobs;
+use crate::place::Level;
 
 /// Where an instance's PERFORM body starts: at its beginning, or (an instant activity
 /// that has to wait, `instant.rs`) at a statement of its sequence, that statement's
@@ -172,6 +173,7 @@ impl<'m> Engine<'m> {
             catching: Cell::new(0),
             caught: Notify::new(),
             instance: Some(instance.clone()),
+            section: Cell::new(ctx.scope.section.get()),
         });
         if listed {
             self.instances.borrow_mut().set_scope(&instance, scope.clone());
@@ -187,11 +189,18 @@ impl<'m> Engine<'m> {
         let own_scope = !cap.perform.handlers.is_empty()
             || !cap.perform.exception_handlers.is_empty()
             || cap.perform.traced;
+        // A body in a scope of its own is where its drones' own events are raised between
+        // two calls (`place.rs`); one run in the instance's scope needs no place.
+        let body_block = || {
+            Box::pin(self.block_with(&cap.perform, &inner, |body| {
+                self.place(&instance.actors, instance.depth, Level::Body, body)
+            }))
+        };
         let body = pin!(async {
             match resume {
                 Resume::Start => match &instance.perform {
-                    Some(perform) => _ = perform.run(self.block(&cap.perform, &inner)).await,
-                    None if own_scope => self.block(&cap.perform, &inner).await,
+                    Some(perform) => _ = perform.run(body_block()).await,
+                    None if own_scope => body_block().await,
                     None => self.items(&cap.perform, &inner).await,
                 },
                 // Only for a sequence run in the instance's scope (`instant.rs`).
@@ -292,6 +301,9 @@ impl<'m> Engine<'m> {
             held: Cell::new(ctx.instance.is_none() && held),
             resumed: Notify::new(),
             calls: RefCell::new(SmallVec::new()),
+            sections: Cell::new(0),
+            section_calls: RefCell::new(SmallVec::new()),
+            turn: tokio::sync::Semaphore::const_new(1),
             depth: ctx.instance.as_ref().map_or(0, |p| p.depth + 1),
             claims: RefCell::new(ctx.claims.clone()),
         })

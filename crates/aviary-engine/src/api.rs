@@ -12,6 +12,7 @@ use aviary_api::{CallEnd, CallId, DroneId, Ending, Function, Interrupt, Value};
 use aviary_ir::ApiCall;
 
 use crate::engine::{Ctx, Engine, Instance};
+use crate::place::Level;
 use aviary_api::trace::{CallStatus, Event, EventKind};
 
 /// A call made: what the rest of its statement needs.
@@ -38,9 +39,11 @@ impl<'m> Engine<'m> {
     pub(crate) async fn api(&self, a: &'m ApiCall, ctx: &Ctx<'m>) {
         let Some(drone) = self.api_drone(a, &ctx.frame) else { return };
         if let Some(root) = ctx.instance.as_ref().map(|i| i.root()) {
+            // Paused or held; in the body, also while a leash section runs (`section.rs`).
+            let in_section = ctx.scope.section.get();
             loop {
                 let resumed = root.resumed.notified();
-                if !root.waits() {
+                if !root.holds(in_section) {
                     break;
                 }
                 resumed.await;
@@ -80,15 +83,29 @@ impl<'m> Engine<'m> {
     /// raises what a failure or an interruption means.
     pub(crate) async fn api_end(&self, begun: Begun, ctx: &Ctx<'m>) {
         let Begun { call, end } = begun;
+        // While the call is in flight, its drone's own events are raised here, where the
+        // call was made (`place.rs`); kept until what its ending raises has been raised.
+        let mut _placed = None;
         let end = match end {
             // Over as it was made: nothing in flight to pause, resume or abort.
             Ending::Now(end) => end,
             Ending::Later(answer) => {
                 let root = ctx.instance.as_ref().map(|i| i.root());
-                let guard = CallGuard { engine: self, call: &call, root, done: Cell::new(false) };
+                let in_section = ctx.scope.section.get();
+                let guard = CallGuard {
+                    engine: self,
+                    call: &call,
+                    root,
+                    in_section,
+                    done: Cell::new(false),
+                };
+                if let Some(instance) = &ctx.instance {
+                    _placed =
+                        Some(self.place(&[call.drone], instance.depth, Level::Call, &ctx.scope));
+                }
                 if let Some(root) = root {
-                    root.calls.borrow_mut().push(call.id);
-                    if root.waits() {
+                    root.calls_of(in_section).borrow_mut().push(call.id);
+                    if root.holds(in_section) {
                         self.backend.interrupt(call.id, Interrupt::Pause);
                     }
                 }
@@ -132,6 +149,8 @@ struct CallGuard<'e, 'm> {
     engine: &'e Engine<'m>,
     call: &'e Made,
     root: Option<&'e Rc<Instance>>,
+    /// Made in a leash section: listed with the root's `section_calls`.
+    in_section: bool,
     done: Cell<bool>,
 }
 
@@ -150,7 +169,7 @@ impl Drop for CallGuard<'_, '_> {
             });
         }
         if let Some(root) = &self.root {
-            root.calls.borrow_mut().retain(|c| *c != call.id);
+            root.calls_of(self.in_section).borrow_mut().retain(|c| *c != call.id);
         }
     }
 }

@@ -5,7 +5,7 @@
 //! own are.
 
 use aviary_api::trace::{Event, EventKind, OperatorAction};
-use aviary_api::{Interrupt, Value};
+use aviary_api::Value;
 use aviary_diagnostics::suggest::{closest, did_you_mean};
 use aviary_ir::LeashAction;
 use tokio::sync::{mpsc, oneshot};
@@ -200,17 +200,10 @@ impl<'m> Engine<'m> {
                 for (instance, _) in
                     self.instances.borrow().all().iter().filter(|(i, _)| i.root.is_none())
                 {
+                    // A drone the operator holds stays held, a body a section holds too.
+                    let before = instance.holding();
                     instance.paused.set(pause);
-                    // A drone the operator holds stays held: its calls are left paused.
-                    if !instance.held.get() {
-                        for call in instance.calls.borrow().iter() {
-                            self.backend.interrupt(
-                                *call,
-                                if pause { Interrupt::Pause } else { Interrupt::Resume },
-                            );
-                        }
-                    }
-                    instance.resumed.notify_waiters();
+                    self.rehold(instance, before);
                 }
                 Ok(())
             }

@@ -113,6 +113,10 @@ pub(crate) struct Scope<'m> {
     pub caught: Notify,
     /// The capability instance this scope is the top of, if any.
     pub instance: Option<Rc<Instance>>,
+    /// Inside a leash section (`PERFORM Name:`) running on an activity: its calls are not
+    /// held while the sections hold the activity's body (`section.rs`). Set on the
+    /// section's block, and taken over by every scope made inside one.
+    pub section: Cell<bool>,
 }
 
 impl<'m> Scope<'m> {
@@ -121,6 +125,9 @@ impl<'m> Scope<'m> {
         std::iter::successors(Some(self), |s| s.parent.as_ref())
     }
 }
+
+/// Calls in flight: nearly always one or none, kept inline.
+pub(crate) type Calls = smallvec::SmallVec<[aviary_api::CallId; 2]>;
 
 /// A running capability instance (an activity).
 pub(crate) struct Instance {
@@ -141,7 +148,16 @@ pub(crate) struct Instance {
     /// its own beside `paused`: either holds the activity, and resuming one leaves the other.
     pub held: Cell<bool>,
     pub resumed: Notify,
-    pub calls: RefCell<smallvec::SmallVec<[aviary_api::CallId; 2]>>,
+    /// The calls in flight of the activity's body and of the activities inside it (kept
+    /// on the root), but not its leash sections'.
+    pub calls: RefCell<Calls>,
+    /// The leash sections asked of this activity (kept on the root) and not yet ended,
+    /// running or waiting their turn: while there is one, the body is held (`section.rs`).
+    pub sections: Cell<usize>,
+    /// The calls in flight of its leash sections (kept on the root).
+    pub section_calls: RefCell<Calls>,
+    /// One leash section at a time, in the order they were asked (kept on the root).
+    pub turn: tokio::sync::Semaphore,
     pub depth: usize,
     /// What this activity and its ancestors hold: handlers inside it share the claim.
     pub claims: RefCell<Claims>,
@@ -156,6 +172,35 @@ impl Instance {
     pub fn waits(&self) -> bool {
         self.paused.get() || self.held.get()
     }
+
+    /// Whether this root's calls made in its body (`in_section` false) or in its leash
+    /// sections wait: a section is held only by a pause or a hold, the body also while a
+    /// section runs.
+    pub fn holds(&self, in_section: bool) -> bool {
+        self.waits() || (!in_section && self.sections.get() > 0)
+    }
+
+    /// What holds this root now, body and sections: before a change, for
+    /// [`Engine::rehold`].
+    pub fn holding(&self) -> Holds {
+        Holds { body: self.holds(false), sections: self.holds(true) }
+    }
+
+    /// The calls in flight of this root's body (`in_section` false) or of its sections.
+    pub fn calls_of(&self, in_section: bool) -> &RefCell<Calls> {
+        if in_section {
+            &self.section_calls
+        } else {
+            &self.calls
+        }
+    }
+}
+
+/// Whether a root's body and its leash sections are held (`Instance::holding`).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Holds {
+    pub body: bool,
+    pub sections: bool,
 }
 
 /// What an execution knows about where it is.
@@ -180,6 +225,8 @@ pub(crate) struct Engine<'m> {
     pub arbiter: Rc<RefCell<Arbiter>>,
     pub instances: RefCell<Registry<'m>>,
     pub detections: RefCell<BTreeMap<(DroneId, String), Rc<Scope<'m>>>>,
+    /// Where each drone's work is, for its own events (`place.rs`).
+    pub places: crate::place::Places<'m>,
     /// How the mission ends early, if it does: failed (an unhandled exception, a lost
     /// backend) or aborted (the operator), and why.
     ending: RefCell<Option<(Status, String)>>,
@@ -236,6 +283,7 @@ impl<'m> Engine<'m> {
             arbiter: Rc::new(RefCell::new(Arbiter::default())),
             instances: RefCell::new(Registry::default()),
             detections: RefCell::new(BTreeMap::new()),
+            places: Default::default(),
             ending: RefCell::new(None),
             backend_alive: Cell::new(true),
             mission_paused: Cell::new(false),
@@ -310,6 +358,7 @@ impl<'m> Engine<'m> {
             catching: Cell::new(0),
             caught: Notify::new(),
             instance: None,
+            section: Cell::new(false),
         });
         *self.root.borrow_mut() = Some(root.clone());
         let ctx = Ctx {
@@ -524,17 +573,6 @@ impl<'m> Engine<'m> {
     pub(crate) fn fail(&self, failure: aviary_api::Failure, drone: DroneId, from: &Rc<Scope<'m>>) {
         let id = self.m.builtins.exception(failure.exception);
         self.throw(id, vec![Value::Text(failure.reason)], Some(drone), from);
-    }
-
-    /// Where an actor's built-in events are raised: in its innermost running capability
-    /// instance, or at mission level when it is idle.
-    fn actor_scope(&self, drone: DroneId) -> Rc<Scope<'m>> {
-        let instances = self.instances.borrow();
-        let innermost = instances.of_actor(drone).max_by_key(|(i, _)| (i.depth, i.id));
-        match innermost {
-            Some((_, scope)) => scope.clone(),
-            None => self.mission_scope.borrow().clone().unwrap_or_else(|| self.root_scope()),
-        }
     }
 
     fn matches(&self, by: &Option<ActorFilter>, frame: &[Value], actor: Option<DroneId>) -> bool {

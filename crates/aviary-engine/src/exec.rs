@@ -8,7 +8,7 @@ use std::rc::Rc;
 use std::task::Poll;
 use std::time::Duration;
 
-use aviary_api::{DroneId, Interrupt, Value};
+use aviary_api::{DroneId, Value};
 use aviary_ir::{ActorRef, Block, BlockKind, Call, Expr, For, Leash, LeashAction, Node};
 use futures_util::future::{Either, LocalBoxFuture};
 use futures_util::stream::{FuturesUnordered, StreamExt};
@@ -117,6 +117,7 @@ impl<'m> Engine<'m> {
             catching: Cell::new(0),
             caught: Notify::new(),
             instance,
+            section: Cell::new(ctx.scope.section.get()),
         });
         if !block.handlers.is_empty() {
             self.listeners.borrow_mut().push(Rc::downgrade(&scope));
@@ -137,7 +138,7 @@ impl<'m> Engine<'m> {
 
     /// A block in a scope of its own. `on_scope` is told the scope first, and what it
     /// gives back is kept while the block runs.
-    async fn block_with<T>(
+    pub(crate) async fn block_with<T>(
         &self,
         block: &'m Block,
         ctx: &Ctx<'m>,
@@ -459,7 +460,7 @@ impl<'m> Engine<'m> {
             }
             Job::Section { block, frame } => {
                 let ctx = self.scope_ctx(&scope, frame);
-                self.block(block, &ctx).await;
+                Box::pin(self.section(block, &ctx)).await;
             }
         }
     }
@@ -505,24 +506,11 @@ impl<'m> Engine<'m> {
                     instance.by_leash.set(true);
                     instance.token.cancel();
                 }
-                LeashAction::Pause => {
-                    instance.paused.set(true);
-                    // Those of a drone the operator holds are paused already.
-                    if !instance.held.get() {
-                        for call in instance.calls.borrow().iter() {
-                            self.backend.interrupt(*call, Interrupt::Pause);
-                        }
-                    }
-                }
-                LeashAction::Resume => {
-                    instance.paused.set(false);
-                    // A drone the operator holds stays held.
-                    if !instance.held.get() {
-                        for call in instance.calls.borrow().iter() {
-                            self.backend.interrupt(*call, Interrupt::Resume);
-                        }
-                    }
-                    instance.resumed.notify_waiters();
+                // What else holds it (a drone the operator holds, a section) stays.
+                LeashAction::Pause | LeashAction::Resume => {
+                    let before = instance.holding();
+                    instance.paused.set(action == LeashAction::Pause);
+                    self.rehold(&instance, before);
                 }
                 LeashAction::Section(i) => {
                     let mut frame = scope.frame.to_vec();

@@ -161,10 +161,10 @@ impl<'m> Engine<'m> {
             // operator holds the mission. Either is held while the operator holds its
             // drone (the general path's `new_instance` holds the caller's then).
             let paused = self.steering.held(drone)
-                || ctx
-                    .instance
-                    .as_ref()
-                    .map_or_else(|| self.mission_paused.get(), |p| p.root().waits());
+                || ctx.instance.as_ref().map_or_else(
+                    || self.mission_paused.get(),
+                    |p| p.root().holds(ctx.scope.section.get()),
+                );
             if paused {
                 return Some(Stopped::At { id, needs, frame, args, at, begun: None });
             }

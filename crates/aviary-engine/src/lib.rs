@@ -21,7 +21,9 @@ mod homing;
 mod instant;
 mod jobs;
 mod join;
+mod place;
 mod registry;
+mod section;
 mod steer;
 mod value;
 

@@ -196,12 +196,9 @@ impl<'m> Engine<'m> {
     /// Holds a root activity for a drone the operator holds: its calls in flight are
     /// paused (unless they already are) and its next ones wait.
     pub(crate) fn hold_root(&self, root: &Rc<Instance>) {
-        if root.held.replace(true) || root.paused.get() {
-            return;
-        }
-        for call in root.calls.borrow().iter() {
-            self.backend.interrupt(*call, Interrupt::Pause);
-        }
+        let before = root.holding();
+        root.held.set(true);
+        self.rehold(root, before);
     }
 
     /// After a drone is no longer held: every held root activity that no held drone
@@ -222,15 +219,12 @@ impl<'m> Engine<'m> {
                 held.iter()
                     .any(|d| instances.of_actor(*d).any(|(i, _)| Rc::ptr_eq(i.root(), &root)))
             };
-            if still || !root.held.replace(false) {
+            if still || !root.held.get() {
                 continue;
             }
-            if !root.paused.get() {
-                for call in root.calls.borrow().iter() {
-                    self.backend.interrupt(*call, Interrupt::Resume);
-                }
-            }
-            root.resumed.notify_waiters();
+            let before = root.holding();
+            root.held.set(false);
+            self.rehold(&root, before);
         }
     }
 
@@ -247,7 +241,9 @@ impl<'m> Engine<'m> {
         }
         for root in &roots {
             root.token.cancel();
-            for call in root.calls.borrow().iter() {
+            let calls = root.calls.borrow();
+            let sections = root.section_calls.borrow();
+            for call in calls.iter().chain(sections.iter()) {
                 self.backend.interrupt(*call, Interrupt::Abort);
             }
         }

@@ -18,6 +18,23 @@ fn fixture(name: &str) -> String {
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
 }
 
+/// The world a rule flies in: `tests/rules/NAME.world.toml` beside its mission when the
+/// rule needs one of its own (a drone's battery, a fault), else the harness's.
+fn world_of(mission: &std::path::Path) -> String {
+    let own = mission.with_extension("world.toml");
+    match std::fs::read_to_string(&own) {
+        Ok(world) => world,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => harness::WORLD.to_string(),
+        Err(e) => panic!("{}: {e}", own.display()),
+    }
+}
+
+/// A rule's mission flown in its world, as the snapshots fly it.
+fn run_rule(name: &str) -> harness::Run {
+    let path = format!("{}/tests/rules/{name}.mission", env!("CARGO_MANIFEST_DIR"));
+    harness::run_in(&fixture(name), &world_of(std::path::Path::new(&path)))
+}
+
 /// Every rule's whole trace, one event a line: the order and the time of every event, so
 /// that a change in what a rule does shows, event by event, in review. The tests below
 /// say which of those facts are the rule.
@@ -27,7 +44,7 @@ fn traces() {
         let mission = std::fs::read_to_string(path).expect("read the fixture");
         let options =
             RunOptions { max_handler_reentries: SNAPSHOT_REENTRIES, ..RunOptions::default() };
-        let r = harness::run_with(&mission, harness::WORLD, &options);
+        let r = harness::run_with(&mission, &world_of(path), &options);
         insta::assert_snapshot!(format!("outcome: {:?}\n{}", r.outcome.status, r.dump()));
     });
 }
@@ -399,4 +416,170 @@ fn a_handler_re_entered_at_one_instant_is_passed_over() {
     assert!(r.find("capability_start", "actor", "a").is_empty(), "nothing new starts");
     assert!(r.trace.iter().all(|e| e["t"] == 0.0), "all of it at the one instant");
     assert_eq!(r.trace.last().unwrap()["event"], "mission_end");
+}
+
+/// The index in the trace of the first event matching all of `fields`.
+fn at(r: &harness::Run, event: &str, fields: &[(&str, &str)]) -> usize {
+    r.trace
+        .iter()
+        .position(|e| e["event"] == event && fields.iter().all(|(k, v)| e[*k] == *v))
+        .unwrap_or_else(|| panic!("no {event} with {fields:?}:\n{}", r.dump()))
+}
+
+#[test]
+fn a_drones_signals_are_heard_where_its_work_is() {
+    let r = run_rule("a_drones_signals_are_heard_where_its_work_is");
+    assert_eq!(r.outcome.status, Status::Ok);
+    let low = at(&r, "signal", &[("name", "BatteryLow"), ("actor", "a")]);
+    let inner = at(&r, "handler_start", &[("handler", "Patrol/ON BatteryLow")]);
+    let outer = at(&r, "handler_start", &[("handler", "P/ON BatteryLow")]);
+    let t = r.trace[low]["t"].as_f64().unwrap();
+    // While the PERFORM itself flies its Orbit: the call is in flight then.
+    let orbit = r.first("api_call", "function", "Orbit")["t"].as_f64().unwrap();
+    let orbit_done = r.first("api_done", "function", "Orbit");
+    assert!(orbit < t && t <= orbit_done["t"].as_f64().unwrap(), "{t}");
+    assert_eq!(orbit_done["status"], "aborted", "the outer handler's leash stopped it");
+    assert!(low < inner && inner < outer, "the PERFORM's handler first, then outward");
+    for i in [inner, outer] {
+        assert_eq!(r.trace[i]["t"].as_f64().unwrap(), t, "at the signal's instant");
+    }
+    assert!(r.find("signal", "name", "Tired").len() == 1);
+    assert!(r.find("signal", "name", "Never").is_empty(), "b's block does not hold a's work");
+}
+
+#[test]
+fn a_drones_signal_while_its_perform_waits_is_heard_there() {
+    let r = run_rule("a_drones_signal_while_its_perform_waits_is_heard_there");
+    assert_eq!(r.outcome.status, Status::Ok);
+    let t = r.t("signal", "name", "BatteryLow");
+    let took_off = r.trace.iter().find(|e| e["event"] == "api_done" && e["function"] == "TakeOff");
+    let took_off = took_off.expect("took off")["t"].as_f64().unwrap();
+    assert!(took_off < t, "no call in flight: the PERFORM waits");
+    assert_eq!(r.t("handler_start", "handler", "Stay/ON BatteryLow"), t);
+    assert_eq!(r.t("api_call", "function", "ReturnToLaunch"), t, "the wait ends at once");
+}
+
+#[test]
+fn connection_restored_is_heard_in_the_perform_that_caught_the_loss() {
+    let r = run_rule("connection_restored_is_heard_in_the_perform_that_caught_the_loss");
+    assert_eq!(r.outcome.status, Status::Ok);
+    let lost = r.first("exception", "name", "ConnectionLost");
+    assert_eq!(lost["handler"], "Watch/ON EXCEPTION ConnectionLost");
+    assert!(close(lost["t"].as_f64().unwrap(), 30.0));
+    let back = r.t("signal", "name", "ConnectionRestored");
+    assert!(close(back, 35.0), "{back}");
+    assert_eq!(r.t("handler_start", "handler", "Watch/ON ConnectionRestored"), back);
+    let watch = r.ends("Watch", "a")[0];
+    assert_eq!(watch["status"], "ok");
+    assert_eq!(watch["t"].as_f64().unwrap(), back, "the caught loss's wait ends then");
+}
+
+/// A rule's run with telemetry every 0.1 s, to follow where the drone is.
+fn run_rule_watched(mission: &str) -> harness::Run {
+    let options = RunOptions { telemetry_hz: Some(10.0), ..RunOptions::default() };
+    harness::run_with(mission, harness::WORLD, &options)
+}
+
+fn apart(p: [f64; 3], q: [f64; 3]) -> f64 {
+    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+}
+
+/// The times of the calls of `function` by `a`: (made, done, status).
+fn calls_of(r: &harness::Run, function: &str) -> Vec<(f64, f64, String)> {
+    let made = r.trace.iter().filter(|e| e["event"] == "api_call" && e["function"] == function);
+    let done = r.trace.iter().filter(|e| e["event"] == "api_done" && e["function"] == function);
+    made.zip(done)
+        .map(|(m, d)| {
+            let t = |e: &serde_json::Value| e["t"].as_f64().unwrap();
+            (t(m), t(d), d["status"].as_str().unwrap().to_string())
+        })
+        .collect()
+}
+
+#[test]
+fn a_leash_section_holds_the_body_while_it_runs() {
+    let mission = fixture("a_leash_section_holds_the_body_while_it_runs");
+    let r = run_rule_watched(&mission);
+    assert_eq!(r.outcome.status, Status::Ok);
+    assert!(r.find("exception", "name", "CommandFailed").is_empty(), "the section may fly");
+    let leash = r.t("leash", "action", "Check");
+    let fly = calls_of(&r, "FlyToPosition");
+    let hover = calls_of(&r, "Hover");
+    assert_eq!(fly.len(), 1);
+    assert_eq!((fly[0].0, fly[0].2.as_str()), (leash, "ok"), "the section flies at once");
+    let section_end = hover[0].1;
+    let orbit = &calls_of(&r, "Orbit")[0];
+    assert_eq!(orbit.2, "ok");
+    assert!(orbit.0 < leash && orbit.1 > section_end, "the body's orbit spans the section");
+
+    // Held where the leash came: the drone leaves the circle for the spot and is back at
+    // that point after the section, then goes on along the circle to the orbit's end.
+    let track = r.positions("a");
+    let at = |t: f64| track.iter().find(|(s, _)| *s >= t - 1e-9).expect("a point").1;
+    let held = at(leash);
+    let on_circle = |p: [f64; 3]| ((p[0]).hypot(p[1] - 100.0) - 50.0).abs() < 0.5;
+    assert!(track.iter().any(|(t, p)| *t > leash && *t < section_end && p[0].hypot(p[1]) < 0.01));
+    let back = track
+        .iter()
+        .find(|(t, p)| *t >= section_end && apart(*p, held) < 0.5)
+        .expect("back where the body was held")
+        .0;
+    assert!(
+        track.iter().filter(|(t, _)| *t > back + 0.5 && *t < orbit.1).all(|(_, p)| on_circle(*p)),
+        "then along the circle again"
+    );
+
+    // The orbit took longer by the time away from it (the section and the way back), and
+    // a few seconds more to stop and to speed up again on the arc: none of it was flown
+    // twice, none skipped.
+    let alone = run_rule_watched(&mission.replace("            Patrol-P1 Check\n", ""));
+    let orbit_alone = &calls_of(&alone, "Orbit")[0];
+    let longer = (orbit.1 - orbit.0) - (orbit_alone.1 - orbit_alone.0);
+    let away = back - leash;
+    assert!(away <= longer && longer < away + 4.0, "{longer} s longer, {away} s away");
+}
+
+#[test]
+fn a_pause_during_a_section_holds_it_too_and_a_second_section_waits_its_turn() {
+    let name = "a_pause_during_a_section_holds_it_too_and_a_second_section_waits_its_turn";
+    let r = run_rule_watched(&fixture(name));
+    assert_eq!(r.outcome.status, Status::Ok);
+    let leashes: Vec<f64> = r
+        .trace
+        .iter()
+        .filter(|e| e["event"] == "leash")
+        .map(|e| e["t"].as_f64().unwrap())
+        .collect();
+    let [first, pause, second, resume] = leashes[..] else { panic!("{leashes:?}") };
+    let fly = calls_of(&r, "FlyToPosition");
+    let hover = calls_of(&r, "Hover");
+    assert_eq!((fly.len(), hover.len()), (2, 2));
+    assert_eq!(fly[0].0, first);
+    // The pause holds the first section's flight: not a metre between PAUSE and RESUME.
+    let track = r.positions("a");
+    let still: Vec<[f64; 3]> =
+        track.iter().filter(|(t, _)| *t >= pause + 0.1 && *t <= resume).map(|(_, p)| *p).collect();
+    assert!(still.len() > 50 && still.iter().all(|p| apart(*p, still[0]) < 1e-9), "{still:?}");
+    assert!(fly[0].1 > resume, "it goes on after the RESUME");
+    // The second section waits for the first, asked though it was while the first ran.
+    assert!(second < fly[0].1);
+    assert_eq!(fly[1].0, hover[0].1, "its turn comes as the first one ends");
+    // The body waits for both.
+    let orbit = &calls_of(&r, "Orbit")[0];
+    assert!(orbit.1 > hover[1].1 && orbit.2 == "ok");
+}
+
+#[test]
+fn an_area_where_a_position_is_expected_is_its_centroid() {
+    let r = run(&fixture("an_area_where_a_position_is_expected_is_its_centroid"));
+    assert_eq!(r.outcome.status, Status::Ok);
+    let done = |f: &str| r.first("api_done", "function", f).clone();
+    let fly = done("FlyToPosition");
+    assert_eq!(fly["args"][0].as_array().map(Vec::len), Some(4), "the area itself is passed");
+    assert_eq!(fly["position"], serde_json::json!([150.0, 150.0, 20.0]), "to its centroid");
+    assert_eq!(done("Sweep")["status"], "ok");
+    // The circle is flown around the centroid: it ends on it, 20 m out.
+    let p = &done("Orbit")["position"];
+    let (x, y) = (p[0].as_f64().unwrap(), p[1].as_f64().unwrap());
+    assert!(((x - 150.0).hypot(y - 150.0) - 20.0).abs() < 1e-6, "{p}");
 }

@@ -45,14 +45,26 @@ impl Fleet {
         let motion = function.resource() == Resource::Motion;
         // A return the drone started on its own (after a link loss) gives way to a command.
         let own_return = d.motion.as_ref().is_some_and(|t| t.call.is_none());
-        if motion && d.motion.is_some() && !own_return {
+        // A motion call the engine paused (its activity's body, held while a leash section
+        // flies the drone) gives way to a newer one: it is set aside, and comes back when
+        // that one ends (`SimDrone::bring_back`).
+        let aside = motion && d.paused_call();
+        if motion && d.motion.is_some() && !own_return && !aside {
             return Err(failed(format!("{} is busy with another motion call", &self.names[id])));
         }
         if motion && d.gps_loss().is_some() {
             return Err(failed(format!("{} has no position fix", &self.names[id])));
         }
-        let start = self.begin(id, call, function, args)?;
-        match start {
+        let d = &mut self.drones[id];
+        if aside {
+            d.set_aside();
+        }
+        let start = self.begin(id, call, function, args);
+        if aside && !matches!(start, Ok(Start::Moves(_))) {
+            // Refused, or nothing to fly: the paused call is back at once, as it was.
+            self.drones[id].bring_back();
+        }
+        match start? {
             Start::Done => Ok(false),
             Start::Pending => Ok(true),
             Start::Moves(legs) => {

@@ -99,6 +99,18 @@ pub(crate) struct Rare {
     pub disabled: Option<String>,
     /// The drone's stream for its sensors' chances, made at its first draw.
     pub luck: Option<Box<crate::luck::Stream>>,
+    /// Paused motion calls set aside for a newer motion call, the last one on top
+    /// ([`SimDrone::set_aside`]).
+    pub aside: Vec<Aside>,
+}
+
+/// A paused motion call set aside while another motion call flies the drone (a leash
+/// section runs while the activity's body is held): where the drone was when it was set
+/// aside, to fly back there before it goes on.
+#[derive(Clone, Debug)]
+pub(crate) struct Aside {
+    pub task: Box<MotionTask>,
+    pub at: [f64; 3],
 }
 
 /// Every drone's state; its name is the fleet's ([`aviary_api::Names`]).
@@ -245,17 +257,60 @@ impl SimDrone {
     }
 
     /// Ends every call in progress (motion and loading), for a fault; returns their ids in
-    /// a fixed order (motion first).
+    /// a fixed order (motion first, then those set aside, the latest first).
     pub fn cut_calls(&mut self) -> Vec<CallId> {
         let mut ended = Vec::new();
         if let Some(task) = self.motion.take() {
             ended.extend(task.call);
+        }
+        if let Some(rare) = self.rare.as_mut() {
+            ended.extend(rare.aside.drain(..).rev().filter_map(|a| a.task.call));
         }
         if let Some(load) = self.rare.as_mut().and_then(|r| r.loading.take()) {
             ended.push(load.call);
         }
         self.settle();
         ended
+    }
+
+    /// Whether the motion in progress is a call the engine paused: a newer motion call
+    /// may then set it aside instead of being refused.
+    pub fn paused_call(&self) -> bool {
+        self.motion.as_ref().is_some_and(|t| t.paused && t.call.is_some())
+    }
+
+    /// Sets the paused motion call aside, where the drone is, for a newer one. An arc
+    /// begun is cut where the drone stands, so that it goes on from there, not from its
+    /// start, when the call is brought back.
+    pub fn set_aside(&mut self) {
+        let Some(mut task) = self.motion.take() else { return };
+        if let Some(Leg::Arc { start, total, .. }) = task.legs.front_mut() {
+            *start -= task.arc_done;
+            *total -= task.arc_done;
+        }
+        task.arc_done = 0.0;
+        task.rest();
+        let at = self.pos;
+        self.rare_mut().aside.push(Aside { task, at });
+    }
+
+    /// Once no motion is in progress, brings back the last call set aside: it first flies
+    /// back to where it was set aside (at the drone's top speed), then goes on, paused
+    /// until the engine resumes it.
+    pub fn bring_back(&mut self) {
+        if self.motion.is_some() {
+            return;
+        }
+        let Some(Aside { mut task, at }) = self.rare.as_mut().and_then(|r| r.aside.pop()) else {
+            return;
+        };
+        let off = [self.pos[0] - at[0], self.pos[1] - at[1], self.pos[2] - at[2]];
+        if hypot(hypot(off[0], off[1]), off[2]) > 1e-6 {
+            let back = Leg::Move { to: at, speed: self.spec.max_speed, state: FlightState::Flying };
+            task.legs.push_front(back);
+        }
+        self.motion = Some(task);
+        self.begin_leg();
     }
 }
 

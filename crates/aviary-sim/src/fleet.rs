@@ -334,6 +334,7 @@ impl Fleet {
                     Interrupt::Abort => {
                         d.motion = None;
                         d.settle();
+                        d.bring_back();
                         return Some(CallEnd::Interrupted);
                     }
                     Interrupt::Pause => {
@@ -349,6 +350,20 @@ impl Fleet {
                     }
                 }
                 return None;
+            }
+            // A paused call set aside for a newer one: it waits there, paused or not.
+            if let Some(rare) = d.rare.as_deref_mut() {
+                if let Some(at) = rare.aside.iter().position(|a| a.task.call == Some(call)) {
+                    match how {
+                        Interrupt::Abort => {
+                            rare.aside.remove(at);
+                            return Some(CallEnd::Interrupted);
+                        }
+                        Interrupt::Pause => rare.aside[at].task.paused = true,
+                        Interrupt::Resume => rare.aside[at].task.paused = false,
+                    }
+                    return None;
+                }
             }
             let rare = d.rare.as_deref_mut();
             if let Some(rare) = rare.filter(|r| r.loading.as_ref().is_some_and(|l| l.call == call))

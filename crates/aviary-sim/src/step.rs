@@ -135,6 +135,8 @@ impl Fleet {
                 out.push(Report::Ended { call, end: CallEnd::Done });
             }
         }
+        // A call set aside for the one that just ended (or gave up) is back.
+        d.bring_back();
         if hypot(d.vel[0], d.vel[1]) > 1e-9 {
             d.heading = heading(d.vel[0], d.vel[1]);
         }

@@ -72,14 +72,19 @@ impl<'a> Checker<'a> {
             }
         }
         let origin = self.parameter_origin(e);
+        let help = self.what_to_write(e, expected, actual);
         let file = self.file;
         let d = self.report(
             Code::WrongKind,
             e.span,
-            format!("{what} is {}, but this is {}", expected.describe(), actual.describe()),
+            format!(
+                "{what} is {}, but this is {}",
+                expected.describe(),
+                shown_as(actual, expected)
+            ),
         );
         d.primary.message = format!("expected {}", expected.describe());
-        d.help = Some(format!("write {}, such as `{}`", expected.describe(), expected.example()));
+        d.help = Some(help);
         if let Some((name, cap, default)) = origin {
             // A parameter has one kind: say where this one comes from.
             match default {
@@ -93,13 +98,51 @@ impl<'a> Checker<'a> {
                 }
                 None => {
                     d.help = Some(format!(
-                        "`{name}` is a parameter of `{cap}`, and it is {} where it is first used; a parameter has one kind",
-                        actual.describe()
+                        "`{name}` is a parameter of `{cap}`, and it is {} where it is first used; a parameter has one kind: pass `{name}` on only where {} is expected, or give `{cap}` a second parameter for {}",
+                        actual.describe(),
+                        actual.describe(),
+                        expected.describe()
                     ))
                 }
             }
         }
         Some(actual)
+    }
+
+    /// What to write where `expected` is wanted and `e` is `actual`: the kind, with an
+    /// example from the world where there is one (a place, an area), and why a point is
+    /// no area.
+    fn what_to_write(&self, e: &Expr, expected: Kind, actual: Kind) -> String {
+        let world_example = |areas: bool| {
+            self.world.and_then(|w| {
+                if areas {
+                    w.areas.first().map(|a| a.name.clone())
+                } else {
+                    w.places.first().map(|p| p.name.clone())
+                }
+            })
+        };
+        match (expected, actual) {
+            (Kind::Area, Kind::Position) => {
+                let what = match &e.kind {
+                    ExprKind::Name(id) => format!("`{}` is a place, a single point", id.name),
+                    _ => "a position is a single point".to_string(),
+                };
+                match world_example(true) {
+                    Some(area) => format!("{what}, with no area to cover: name an area of the world file's [areas], such as `{area}`, or add one there (an area stands for its centre where a position is expected, so one area serves both)"),
+                    None => format!("{what}, with no area to cover: add the area to the world file's [areas] and name it here"),
+                }
+            }
+            (Kind::Area, _) => match world_example(true) {
+                Some(area) => format!("write the name of an area of the world file's [areas], such as `{area}`"),
+                None => "write the name of an area of the world file's [areas]".to_string(),
+            },
+            (Kind::Position, _) => match world_example(false) {
+                Some(place) => format!("write a position: a place of the world file such as `{place}`, an area (its centre), or coordinates such as `(100, 50)`"),
+                None => "write a position: a place or an area of the world file, or coordinates such as `(100, 50)`".to_string(),
+            },
+            _ => format!("write {}, such as `{}`", expected.describe(), expected.example()),
+        }
     }
 
     /// For a name that is a parameter of the capability being checked: its name, the
@@ -253,5 +296,15 @@ impl<'a> Checker<'a> {
                 None
             }
         }
+    }
+}
+
+/// How to call a value of kind `actual` where `expected` was wanted: a position where an
+/// area is wanted is a single point (an area is a position too, so "a position (a place,
+/// an area, ...)" would say nothing).
+fn shown_as(actual: Kind, expected: Kind) -> &'static str {
+    match (expected, actual) {
+        (Kind::Area, Kind::Position) => "a single point (a place or coordinates)",
+        _ => actual.describe(),
     }
 }

@@ -224,6 +224,68 @@ fn pause_holds_the_drone_and_resume_completes_the_move() {
     assert_eq!(fleet.telemetry(0).unwrap().position, [200.0, 0.0, 20.0]);
 }
 
+/// A motion call while another is paused (a leash section while its activity's body is
+/// held) sets the paused one aside; when the newer one ends, the paused one is back, still
+/// paused, and once resumed it flies back to where it was held and goes on from there.
+#[test]
+fn a_paused_motion_call_gives_way_to_a_newer_one_and_comes_back_after_it() {
+    let w = one_drone();
+    let mut fleet = airborne(&w, 20.0);
+    let orbit = start(&mut fleet, 0, Function::Orbit, &[pos(0.0, 100.0), num(50.0), num(1.0)]);
+    run_for(&mut fleet, 20.0);
+    fleet.interrupt(orbit, Interrupt::Pause);
+    let held = fleet.telemetry(0).unwrap().position;
+    let section = start(&mut fleet, 0, Function::FlyToPosition, &[pos(0.0, 0.0)]);
+    let run = run_until(&mut fleet, 0, section, 100.0);
+    assert_eq!(run.end, CallEnd::Done, "not refused as busy");
+    assert_eq!(fleet.telemetry(0).unwrap().position, [0.0, 0.0, 20.0]);
+    for r in run_for(&mut fleet, 5.0) {
+        assert!(!matches!(r, Report::Ended { call, .. } if call == orbit), "still paused");
+    }
+    assert_eq!(fleet.telemetry(0).unwrap().position, [0.0, 0.0, 20.0], "held: not flying");
+    fleet.interrupt(orbit, Interrupt::Resume);
+    let run = run_until(&mut fleet, 0, orbit, 300.0);
+    assert_eq!(run.end, CallEnd::Done);
+    let back = run.samples.iter().position(|t| {
+        let p = t.position;
+        (p[0] - held[0]).hypot(p[1] - held[1]) < 1e-6
+    });
+    let back = back.expect("it flies back to where it was held");
+    // From there along the circle, the rest of its lap only: it ends where the lap began.
+    let on_circle = |p: [f64; 3]| (p[0].hypot(p[1] - 100.0) - 50.0).abs() < 1e-6;
+    assert!(run.samples[back..].iter().all(|t| on_circle(t.position)));
+    let end = fleet.telemetry(0).unwrap().position;
+    assert!(end[0].abs() < 1e-6 && (end[1] - 50.0).abs() < 1e-6, "{end:?}");
+}
+
+/// A newer call that is refused leaves the paused one where it was; an abort of a call set
+/// aside ends it, and a fault ends every call, those set aside too.
+#[test]
+fn a_call_set_aside_is_kept_on_a_refusal_and_ended_by_an_abort_or_a_fault() {
+    let w = one_drone();
+    let mut fleet = airborne(&w, 20.0);
+    let first = start(&mut fleet, 0, Function::FlyToPosition, &[pos(200.0, 0.0)]);
+    run_for(&mut fleet, 3.0);
+    fleet.interrupt(first, Interrupt::Pause);
+    let (_, refused) = fleet.call(0, Function::FlyToPosition, &[pos(5000.0, 0.0)]);
+    assert!(matches!(refused, Some(CallEnd::Failed(_))), "outside the geofence: {refused:?}");
+    let (busy, end) = fleet.call(0, Function::Hover, &[num(60.0)]);
+    assert_eq!(end, None, "the paused call was back, and gives way again");
+    assert_eq!(fleet.interrupt(first, Interrupt::Abort), Some(CallEnd::Interrupted));
+    fleet.interrupt(busy, Interrupt::Pause);
+    let (last, _) = fleet.call(0, Function::Hover, &[num(60.0)]);
+    let mut reports = Vec::new();
+    fleet.fault(0, aviary_api::BuiltinException::MotorFailure, "test".into(), &mut reports);
+    let ended: Vec<CallId> = reports
+        .iter()
+        .filter_map(|r| match r {
+            Report::Ended { call, end: CallEnd::Interrupted } => Some(*call),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(ended, vec![last, busy]);
+}
+
 #[test]
 fn abort_ends_the_call_interrupted_and_the_drone_hovers() {
     let w = one_drone();

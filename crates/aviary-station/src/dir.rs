@@ -19,6 +19,8 @@ const MAX_DEPTH: usize = 4;
 pub struct Listing {
     pub missions: Vec<String>,
     pub worlds: Vec<String>,
+    /// The recorded traces (`.jsonl`), such as the station's own flights in `traces/`.
+    pub traces: Vec<String>,
 }
 
 pub struct Folder {
@@ -44,6 +46,7 @@ impl Folder {
         self.walk(&self.root, 0, &mut listing);
         listing.missions.sort();
         listing.worlds.sort();
+        listing.traces.sort();
         listing
     }
 
@@ -60,6 +63,7 @@ impl Folder {
                 match FileKind::of(&shown) {
                     Some(FileKind::Mission) => listing.missions.push(shown),
                     Some(FileKind::World) => listing.worlds.push(shown),
+                    Some(FileKind::Trace) => listing.traces.push(shown),
                     None => {}
                 }
             }
@@ -70,7 +74,7 @@ impl Folder {
     pub fn resolve(&self, relative: &str) -> Result<PathBuf, String> {
         if FileKind::of(relative).is_none() {
             return Err(format!(
-                "`{}` is not a mission (.mission) or a world (.toml): the station opens only those",
+                "`{}` is not a mission (.mission), a world (.toml) or a trace (.jsonl): the station opens only those",
                 shown(relative)
             ));
         }
@@ -121,6 +125,12 @@ impl Folder {
         if text.len() as u64 > MAX_FILE_BYTES {
             return Err("the text is larger than the station saves (16 MiB)".into());
         }
+        if FileKind::of(relative) == Some(FileKind::Trace) {
+            return Err(format!(
+                "`{}` is a trace, the record of a flight: the station never rewrites one",
+                shown(relative)
+            ));
+        }
         let path = self.resolve(relative)?;
         if path.is_dir() {
             return Err(format!("`{}` is a folder", shown(relative)));
@@ -140,6 +150,8 @@ impl Folder {
 pub enum FileKind {
     Mission,
     World,
+    /// A recorded trace: read (replayed, reported), never saved.
+    Trace,
 }
 
 impl FileKind {
@@ -148,6 +160,8 @@ impl FileKind {
             Some(FileKind::Mission)
         } else if path.ends_with(".toml") {
             Some(FileKind::World)
+        } else if path.ends_with(".jsonl") {
+            Some(FileKind::Trace)
         } else {
             None
         }
@@ -171,6 +185,8 @@ mod tests {
         std::fs::write(dir.join("a.world.toml"), "").unwrap();
         std::fs::write(dir.join("drills/b.mission"), "").unwrap();
         std::fs::write(dir.join("notes.txt"), "").unwrap();
+        std::fs::create_dir_all(dir.join("traces")).unwrap();
+        std::fs::write(dir.join("traces/a-1.jsonl"), "{}\n").unwrap();
         let folder = Folder::new(&dir).unwrap();
         (dir, folder)
     }
@@ -181,6 +197,11 @@ mod tests {
         let listing = folder.list();
         assert_eq!(listing.missions, ["a.mission", "drills/b.mission"]);
         assert_eq!(listing.worlds, ["a.world.toml"]);
+        assert_eq!(listing.traces, ["traces/a-1.jsonl"]);
+        assert_eq!(folder.read("traces/a-1.jsonl").unwrap(), "{}\n");
+        let why = folder.save("traces/a-1.jsonl", "").unwrap_err();
+        assert!(why.contains("never rewrites"), "{why}");
+        assert_eq!(folder.read("traces/a-1.jsonl").unwrap(), "{}\n", "a trace is kept as it was");
         assert_eq!(folder.read("a.mission").unwrap(), "MISSION A:\n");
         folder.save("drills/b.mission", "MISSION B:\n").unwrap();
         assert_eq!(folder.read("drills/b.mission").unwrap(), "MISSION B:\n");

@@ -32,6 +32,8 @@ pub(crate) fn router(station: Arc<Station>) -> Router {
         .route("/api/station/file", get(open))
         .route("/api/station/check", post(check))
         .route("/api/station/trace", get(trace))
+        .route("/api/station/report", get(report))
+        .route("/api/station/world", get(world_map))
         .route_layer(middleware::from_fn_with_state(gate.clone(), aviary_server::read_token));
     let changes = Router::new()
         .route("/api/station/save", post(save))
@@ -229,21 +231,129 @@ async fn fly(
     on_a_deep_stack(work).await
 }
 
-/// The recorded trace a replay plays, as its file has it: JSON Lines.
-async fn trace(State(station): State<Arc<Station>>) -> Response {
-    match &station.mode {
-        Mode::Replay { name, trace } => (
-            [
-                (header::CONTENT_TYPE, "application/x-ndjson".to_string()),
-                (header::HeaderName::from_static("x-aviary-trace"), name.clone()),
-            ],
-            trace.clone(),
-        )
-            .into_response(),
-        _ => error(
-            StatusCode::NOT_FOUND,
-            "this station replays no trace: start it with `aviary replay TRACE.jsonl`",
-        ),
+#[derive(serde::Deserialize)]
+struct Recorded {
+    /// A trace of the station's folder (`traces/NAME-TIME.jsonl`); none in a replay.
+    path: Option<String>,
+    /// The world to draw it on, in the folder (a report's map).
+    world: Option<String>,
+}
+
+/// The recorded trace a replay plays, as its file has it: JSON Lines. `aviary replay`
+/// serves its one trace; `aviary gcs` any trace of its folder, checked line by line
+/// first, as `aviary replay` checks its own.
+async fn trace(State(station): State<Arc<Station>>, Query(asked): Query<Recorded>) -> Response {
+    let (name, text) = match (&station.mode, asked.path) {
+        (Mode::Replay { name, trace }, _) => (name.clone(), trace.clone()),
+        (Mode::Folder { folder, .. }, Some(path)) => match recorded(folder, &path) {
+            Ok(text) => (path, text),
+            Err(refusal) => return refusal.into_response(),
+        },
+        (Mode::Folder { .. }, None) => {
+            return error(StatusCode::BAD_REQUEST, "name the trace: ?path=traces/NAME.jsonl")
+        }
+        (Mode::Run, _) => {
+            return error(
+                StatusCode::NOT_FOUND,
+                "this station replays no trace: start it with `aviary replay TRACE.jsonl`",
+            )
+        }
+    };
+    (
+        [
+            (header::CONTENT_TYPE, "application/x-ndjson".to_string()),
+            (header::HeaderName::from_static("x-aviary-trace"), name),
+        ],
+        text,
+    )
+        .into_response()
+}
+
+/// A trace of the folder, read and checked to be events.
+fn recorded(folder: &dir::Folder, path: &str) -> Result<String, Refusal> {
+    if dir::FileKind::of(path) != Some(dir::FileKind::Trace) {
+        return Err(Refusal(
+            StatusCode::BAD_REQUEST,
+            format!("`{path}` is not a trace (.jsonl): name one of the folder's traces"),
+        ));
+    }
+    let text = folder.read(path).map_err(|why| Refusal(StatusCode::NOT_FOUND, why))?;
+    crate::replay::read(path, text.into_bytes()).map_err(|why| Refusal(StatusCode::CONFLICT, why))
+}
+
+/// The report of a trace of the folder (`aviary report`'s HTML), on the world named, as a
+/// file to save: `GET /api/station/report?path=traces/X.jsonl&world=W.toml`.
+async fn report(State(station): State<Arc<Station>>, Query(asked): Query<Recorded>) -> Response {
+    let work = move || {
+        let (folder, _) = match folder(&station) {
+            Ok(f) => f,
+            Err(refusal) => return refusal.into_response(),
+        };
+        let Some(path) = asked.path else {
+            return error(StatusCode::BAD_REQUEST, "name the trace: ?path=traces/NAME.jsonl");
+        };
+        let text = match recorded(folder, &path) {
+            Ok(text) => text,
+            Err(refusal) => return refusal.into_response(),
+        };
+        let world = match asked.world.map(|w| world_of(folder, &w)).transpose() {
+            Ok(world) => world,
+            Err(refusal) => return refusal.into_response(),
+        };
+        match crate::report::render(&path, text.into_bytes(), world.as_ref()) {
+            Ok(html) => {
+                let stem = std::path::Path::new(&path)
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().replace('"', ""))
+                    .unwrap_or_else(|| "report".into());
+                (
+                    [
+                        (header::CONTENT_TYPE, "text/html; charset=utf-8".to_string()),
+                        (
+                            header::CONTENT_DISPOSITION,
+                            format!("attachment; filename=\"{stem}.html\""),
+                        ),
+                        // The report is a document of its own, with no script.
+                        (
+                            header::CONTENT_SECURITY_POLICY,
+                            "default-src 'none'; style-src 'unsafe-inline'; img-src data:".into(),
+                        ),
+                    ],
+                    html,
+                )
+                    .into_response()
+            }
+            Err(why) => error(StatusCode::CONFLICT, why),
+        }
+    };
+    on_a_deep_stack(work).await
+}
+
+/// What the map shows of a world of the folder: `GET /api/station/world?path=W.toml`
+/// (for a replay of one of the folder's traces on its world).
+async fn world_map(State(station): State<Arc<Station>>, Query(named): Query<Named>) -> Response {
+    let (folder, _) = match folder(&station) {
+        Ok(f) => f,
+        Err(refusal) => return refusal.into_response(),
+    };
+    match world_of(folder, &named.path) {
+        Ok(world) => Json(checking::map_of(&world)).into_response(),
+        Err(refusal) => refusal.into_response(),
+    }
+}
+
+/// A world of the folder, read; refused with its first error.
+fn world_of(folder: &dir::Folder, path: &str) -> Result<aviary_world::World, Refusal> {
+    if dir::FileKind::of(path) != Some(dir::FileKind::World) {
+        return Err(Refusal(StatusCode::BAD_REQUEST, format!("`{path}` is not a world (.toml)")));
+    }
+    let text = folder.read(path).map_err(|why| Refusal(StatusCode::NOT_FOUND, why))?;
+    match aviary_world::parse_world(aviary_diagnostics::FileId(0), &text) {
+        (Some(world), _) => Ok(world),
+        (None, diagnostics) => {
+            let first = diagnostics.first().map(|d| d.message.clone()).unwrap_or_default();
+            Err(Refusal(StatusCode::CONFLICT, format!("{path} has errors: {first}")))
+        }
     }
 }
 

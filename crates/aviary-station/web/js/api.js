@@ -28,6 +28,15 @@ export function askToken() {
   });
 }
 
+/// A GET whose answer is not JSON (a trace, a report): the response itself, with the
+/// token when one is known; on 401 asks for it once and tries again.
+export async function raw(path) {
+  const get = () => fetch(path, { headers: token() ? { Authorization: "Bearer " + token() } : {} });
+  let response = await get();
+  if (response.status === 401 && (await askToken())) response = await get();
+  return response;
+}
+
 /// A JSON call. Resolves to `{ok, status, body}`; on 401 asks for the token once and
 /// tries again.
 export async function call(method, path, body, retried = false) {

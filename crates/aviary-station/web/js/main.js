@@ -129,6 +129,7 @@ async function watch() {
   if (page.socket) page.socket.close();
   page.socket = api.events((e) => {
     if (observe(page.model, e)) page.log.add(e);
+    if (e.event === "mission_end" && page.onFlightEnd) page.onFlightEnd(about.run.trace);
     queueRender();
   }, () => queueRender());
   render();
@@ -255,11 +256,45 @@ async function station() {
     }
     await watch();
   };
+  records(listing.traces || [], () => worlds.value);
   if (listing.missions.length) {
     const preferred = listing.missions.find((m) => /search_and_rescue|paper/.test(m)) || listing.missions[0];
     missions.value = preferred;
     await missions.onchange();
   }
+}
+
+/// The folder's recorded flights (`traces/`): replayed in this page, or their report
+/// saved, on the world chosen above (`world()`).
+function records(traces, world) {
+  const list = $("trace-list");
+  const fill = (paths, chosen) => {
+    list.textContent = "";
+    for (const t of paths) list.appendChild(new Option(t));
+    list.value = chosen || paths[paths.length - 1] || "";
+    $("replay-trace").disabled = $("report-trace").disabled = !list.value;
+  };
+  fill(traces);
+  // A flight that ended adds its trace: the list is read again, the new one chosen.
+  page.onFlightEnd = async (trace) => {
+    const listing = (await api.call("GET", "/api/station/files")).body;
+    if (listing) fill(listing.traces || [], trace);
+  };
+  $("replay-trace").onclick = () => {
+    const q = new URLSearchParams({ replay: list.value, world: world() });
+    location.href = `/?${q}`;
+  };
+  $("report-trace").onclick = async () => {
+    const q = new URLSearchParams({ path: list.value, world: world() });
+    const response = await api.raw(`/api/station/report?${q}`);
+    if (!response.ok) return refused(`report of ${list.value}`, { status: response.status, body: await response.json().catch(() => null) });
+    const link = document.createElement("a");
+    link.href = URL.createObjectURL(await response.blob());
+    link.download = list.value.replace(/^.*\//, "").replace(/\.jsonl$/, "") + ".html";
+    document.body.appendChild(link);
+    link.click();
+    link.remove();
+  };
 }
 
 function showCheck(report) {
@@ -310,21 +345,25 @@ function showPlan(plan) {
 }
 
 // A recorded trace, played back: the controls steer nothing, the scrubber picks the time.
-async function replay() {
+// `aviary replay` serves one trace; in `aviary gcs` the page replays one of the folder's
+// (`recorded`: its path, and the world to draw it on).
+async function replay(recorded) {
   for (const id of ["pause", "resume", "abort"]) $(id).hidden = true;
   for (const id of ["leash-form", "signal-form"]) $(id).hidden = true;
   document.querySelector("#side h2:nth-of-type(2)").hidden = true;
   page.fleet.act = null;
   $("replay").hidden = false;
-  const headers = api.token() ? { Authorization: "Bearer " + api.token() } : {};
-  let response = await fetch("/api/station/trace", { headers });
-  if (response.status === 401 && (await api.askToken())) {
-    response = await fetch("/api/station/trace", { headers: { Authorization: "Bearer " + api.token() } });
-  }
+  const query = recorded ? `?path=${encodeURIComponent(recorded.path)}` : "";
+  const response = await api.raw(`/api/station/trace${query}`);
   if (!response.ok) return refused("replay", { status: response.status, body: await response.json().catch(() => null) });
   const name = response.headers.get("x-aviary-trace") || "trace";
   const events = (await response.text()).split("\n").filter((l) => l.trim()).map((l) => JSON.parse(l));
-  const world = page.about.map;
+  let world = page.about.map;
+  if (recorded) {
+    $("leave-replay").hidden = false;
+    const shown = recorded.world ? await api.call("GET", `/api/station/world?path=${encodeURIComponent(recorded.world)}`) : null;
+    world = shown && shown.ok ? shown.body : null;
+  }
   page.map.setWorld(world);
   page.tree.show(treeOf(events));
   const homes = new Map(((world && world.drones) || []).map((d) => [d.name, d.home]));
@@ -364,6 +403,11 @@ async function start() {
   page.about = about;
   if (!about) return;
   if (about.mode !== "station") $("files") && document.querySelector("main").classList.add("no-files");
+  const asked = new URLSearchParams(location.search);
+  if (about.mode === "station" && asked.get("replay")) {
+    document.querySelector("main").classList.add("no-files");
+    return replay({ path: asked.get("replay"), world: asked.get("world") });
+  }
   if (about.mode === "station") await station();
   if (about.mode === "replay") return replay();
   if (about.run) await watch();

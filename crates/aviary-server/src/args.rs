@@ -298,3 +298,33 @@ fn example(kind: Kind) -> String {
     let si = if kind == Kind::Ratio { "a fraction such as 0.25" } else { "a number in SI units" };
     format!("write {si}, or {{\"number\": 20, \"unit\": \"{unit}\"}}")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Kinds;
+
+    #[test]
+    fn only_a_declared_signal_may_be_raised_and_a_refusal_lists_them() {
+        let mut kinds = Kinds::default();
+        kinds.signal("Hold_Position", vec![]);
+        kinds.signal("Found", vec![None]);
+        assert_eq!(
+            kinds.may_raise("Hold_Position"),
+            Err("the mission declares no signal an operator may raise, so not Hold_Position: it would need `OPERATOR SIGNAL Hold_Position` in its MISSION body".into())
+        );
+        kinds.operator_signal("Hold_Position");
+        kinds.operator_signal("Carry_On");
+        kinds.operator_signal("Hold_Position");
+        assert_eq!(kinds.operator_signals(), ["Hold_Position", "Carry_On"], "each once, in order");
+        assert_eq!(kinds.may_raise("Hold_Position"), Ok(()));
+        assert_eq!(
+            kinds.may_raise("Hold_Postion"),
+            Err("the mission does not declare Hold_Postion as an operator signal: did you mean `Hold_Position`? It declares Hold_Position, Carry_On".into())
+        );
+        assert_eq!(
+            kinds.may_raise("Found"),
+            Err("the mission does not declare Found as an operator signal: it declares Hold_Position, Carry_On".into()),
+            "heard by the mission, raised by it, and still not the operator's"
+        );
+    }
+}

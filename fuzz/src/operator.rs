@@ -49,6 +49,9 @@ fn kinds() -> Kinds {
     k.signal("Go", vec![Some(Kind::Position), Some(Kind::Duration), Some(Kind::Ratio)]);
     k.signal("Any", vec![None, None]);
     k.signal("Bare", vec![]);
+    // `Bare` is heard by the mission but not declared: the operator may not raise it.
+    k.operator_signal("Go");
+    k.operator_signal("Any");
     k
 }
 
@@ -102,8 +105,12 @@ pub fn operator(data: &[u8]) {
 }
 
 /// What reaches the engine is what a mission could have written, or a drone's name (any
-/// text: the engine looks it up and refuses a name the fleet does not have).
+/// text: the engine looks it up and refuses a name the fleet does not have); a signal
+/// only if the mission declares it for the operator.
 fn checked(control: &Control) {
+    if let Control::Signal { name, .. } = control {
+        assert!(["Go", "Any"].contains(&name.as_str()), "{name} reached the engine undeclared");
+    }
     let values: Vec<&Value> = match control {
         Control::Leash { args, .. } => args.iter().map(|(_, v)| v).collect(),
         Control::Signal { args, .. } => args.iter().collect(),

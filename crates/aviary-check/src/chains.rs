@@ -8,7 +8,7 @@ use aviary_api::Descriptor;
 use aviary_diagnostics::{Code, Diagnostic, FileId};
 use aviary_syntax::ast::*;
 
-use crate::env::{capability_bodies, visit_stmts};
+use crate::env::{capability_bodies, operator_signals, visit_stmts};
 use crate::Program;
 
 /// The names of the signals `SIGNAL`ed anywhere in the capabilities that run.
@@ -130,6 +130,9 @@ pub(crate) fn check_chains(program: &Program, api: &Descriptor, diagnostics: &mu
     let (Some(mission), Some(at)) = (program.mission(), program.mission) else { return };
     let file: FileId = at.file;
     let in_capabilities = raised_in_capabilities(program);
+    // The operator may raise these at any time, so a wait for one can always end.
+    let operator: HashSet<&str> =
+        operator_signals(program).into_iter().map(|i| i.name.as_str()).collect();
     let mut found = Walk::default();
     walk(&mission.body, false, false, false, &mut Vec::new(), &mut found);
 
@@ -139,7 +142,7 @@ pub(crate) fn check_chains(program: &Program, api: &Descriptor, diagnostics: &mu
     }
     for (wait, id) in &found.waits {
         let name = id.name.as_str();
-        if api.signal(name).is_some() || in_capabilities.contains(name) {
+        if api.signal(name).is_some() || in_capabilities.contains(name) || operator.contains(name) {
             continue;
         }
         let Some(raisers) = raisers.get(name) else { continue };
@@ -160,10 +163,23 @@ pub(crate) fn check_chains(program: &Program, api: &Descriptor, diagnostics: &mu
     for (signal, by) in &found.filtered {
         let name = signal.name.as_str();
         if api.signal(name).is_some()
-            || !raisers.contains_key(name)
+            || !(raisers.contains_key(name) || operator.contains(name))
             || in_capabilities.contains(name)
             || in_for.contains(name)
         {
+            continue;
+        }
+        if !raisers.contains_key(name) {
+            // Only the operator raises it, and the operator is no drone.
+            diagnostics.push(
+                Diagnostic::new(
+                    Code::HandlerNeverFires,
+                    file,
+                    by.span,
+                    format!("`{name}` is raised only by the operator, who is no drone, so `BY {}` never matches", by.name),
+                )
+                .with_help(format!("remove `BY {}`: every `{name}` the operator raises is heard without it", by.name)),
+            );
             continue;
         }
         diagnostics.push(

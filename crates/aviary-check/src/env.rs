@@ -60,6 +60,19 @@ pub(crate) fn visit_exprs<'a>(expr: &'a Expr, f: &mut dyn FnMut(&'a Expr)) {
     }
 }
 
+/// The signals the MISSION declares with `OPERATOR SIGNAL` (directly in its body, the
+/// only place they count), in the order written.
+pub(crate) fn operator_signals(program: &crate::Program) -> Vec<&Ident> {
+    let Some(mission) = program.mission() else { return Vec::new() };
+    mission
+        .body
+        .items
+        .iter()
+        .filter_map(|s| if let Stmt::OperatorSignals(o) = s { Some(&o.names) } else { None })
+        .flatten()
+        .collect()
+}
+
 /// The expressions a statement holds directly (not those of nested bodies).
 pub(crate) fn stmt_exprs(stmt: &Stmt) -> Vec<&Expr> {
     fn args(args: &[Arg]) -> Vec<&Expr> {

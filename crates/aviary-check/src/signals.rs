@@ -8,7 +8,7 @@ use aviary_api::Descriptor;
 use aviary_diagnostics::{Code, Diagnostic, FileId};
 use aviary_syntax::ast::*;
 
-use crate::env::{capability_bodies, stmt_exprs, visit_exprs, visit_stmts};
+use crate::env::{capability_bodies, operator_signals, stmt_exprs, visit_exprs, visit_stmts};
 use crate::Program;
 use aviary_diagnostics::suggest::did_you_mean;
 
@@ -27,6 +27,9 @@ pub(crate) fn check_signals(
     diagnostics: &mut Vec<Diagnostic>,
 ) {
     let uses = Uses::of(program);
+    // A built-in one is refused where it is declared (E130), and said no more.
+    let declared: Vec<&Ident> =
+        operator_signals(program).into_iter().filter(|i| api.signal(&i.name).is_none()).collect();
     // The lists keep their order for the "did you mean" help; the sets answer membership
     // in constant time, so a large mission is not checked in quadratic time.
     let raised: Vec<&str> = uses
@@ -34,11 +37,12 @@ pub(crate) fn check_signals(
         .iter()
         .map(|(_, i)| i.name.as_str())
         .chain(api.signals.iter().map(|s| s.name()))
+        .chain(declared.iter().map(|i| i.name.as_str()))
         .collect();
     let raised_set: HashSet<&str> = raised.iter().copied().collect();
     never_raised(&uses, &raised, &raised_set, diagnostics);
     unknown_exceptions(&uses, api, &raised_set, diagnostics);
-    never_handled(&uses, diagnostics);
+    never_handled(&uses, &declared, program, diagnostics);
     rethrows(program, diagnostics);
 }
 
@@ -97,8 +101,9 @@ fn never_raised(
 ) {
     for (file, h) in &uses.handlers {
         if !raised_set.contains(h.name.as_str()) {
-            let help = did_you_mean(&h.name, raised.iter().copied())
-                .unwrap_or_else(|| format!("raise it somewhere with `SIGNAL {}`", h.name));
+            let help = did_you_mean(&h.name, raised.iter().copied()).unwrap_or_else(|| {
+                format!("raise it somewhere with `SIGNAL {}`; if the operator raises it, declare it in the MISSION body: `OPERATOR SIGNAL {}`", h.name, h.name)
+            });
             diagnostics.push(
                 Diagnostic::new(
                     Code::HandlerNeverFires,
@@ -112,8 +117,9 @@ fn never_raised(
     }
     for (file, r) in &uses.received {
         if !raised_set.contains(r.name.as_str()) {
-            let help = did_you_mean(&r.name, raised.iter().copied())
-                .unwrap_or_else(|| format!("raise it somewhere with `SIGNAL {}`", r.name));
+            let help = did_you_mean(&r.name, raised.iter().copied()).unwrap_or_else(|| {
+                format!("raise it somewhere with `SIGNAL {}`; if the operator raises it, declare it in the MISSION body: `OPERATOR SIGNAL {}`", r.name, r.name)
+            });
             diagnostics.push(
                 Diagnostic::new(
                     Code::SignalNeverRaised,
@@ -173,10 +179,30 @@ fn unknown_exceptions(
     }
 }
 
-/// Signals raised that no handler or `RECEIVED` hears.
-fn never_handled(uses: &Uses, diagnostics: &mut Vec<Diagnostic>) {
+/// Signals raised (or declared for the operator) that no handler or `RECEIVED` hears.
+fn never_handled(
+    uses: &Uses,
+    declared: &[&Ident],
+    program: &Program,
+    diagnostics: &mut Vec<Diagnostic>,
+) {
     let heard: HashSet<&str> =
         uses.handlers.iter().chain(&uses.received).map(|(_, h)| h.name.as_str()).collect();
+    let file = program.mission.map(|r| r.file).unwrap_or_default();
+    let mut said = HashSet::new();
+    for s in declared {
+        if !heard.contains(s.name.as_str()) && said.insert(s.name.as_str()) {
+            diagnostics.push(
+                Diagnostic::new(
+                    Code::SignalNeverHandled,
+                    file,
+                    s.span,
+                    format!("nothing in the mission hears `{}`; when the operator raises it, it is only recorded in the trace", s.name),
+                )
+                .with_help(format!("handle it with `ON {}:` where it should be heard, or leave it out of OPERATOR SIGNAL", s.name)),
+            );
+        }
+    }
     for (file, s) in &uses.raised {
         if !heard.contains(s.name.as_str()) {
             diagnostics.push(

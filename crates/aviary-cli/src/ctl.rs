@@ -18,7 +18,8 @@ pub enum CtlCommand {
     /// A leash on a running activity: `leash FlyCircle-C1 PAUSE`, `leash FlyCircle-C1 Widen radius=200m`
     /// (values as the language writes them: 200m, 2min, (100, 50), Body, "text")
     Leash { activity: String, action: String, args: Vec<String> },
-    /// Raise a signal the mission hears: `signal Go`, `signal Found (120, 40) Body`
+    /// Raise a signal the mission declares with OPERATOR SIGNAL: `signal Go`, `signal Found
+    /// (120, 40) Body` (the state lists them as `operator_signals`)
     Signal { name: String, values: Vec<String> },
     /// Steer one drone: `drone scout1 hold` (its activities wait where they are), `resume`,
     /// `home` or `land` (its activities are aborted and it leaves the mission, flying home

@@ -81,6 +81,8 @@ codes! {
     AboveCeiling = "E125", Error, "an altitude above the site's max_altitude";
     UnboundedRecursion = "E126", Error, "a capability that calls itself, directly or through others, with nothing to stop it";
     UseRefused = "E127", Error, "a USE of a file that is not a .mission file under the mission's folder (or a --use-root), or not a regular file of at most 16 MiB";
+    OneAtATimeNotEvery = "E129", Error, "`ONE AT A TIME` on a handler that is not an `ON EVERY`";
+    OperatorSignalBuiltin = "E130", Error, "an OPERATOR SIGNAL that names a built-in signal, which only a drone raises";
     // Warnings.
     HandlerNeverFires = "W201", Warning, "a handler for a signal that nothing raises";
     UnknownException = "W202", Warning, "an ON EXCEPTION for a name neither built in nor thrown";
@@ -89,10 +91,11 @@ codes! {
     PastEndurance = "W205", Warning, "a duration (such as Hover's) longer than the drone's endurance";
     HandlerRethrows = "W206", Warning, "an ON EXCEPTION that throws the exception it handles before doing anything else";
     SignalNeverHeard = "W207", Warning, "a handler of a drone's built-in signal that can never hear it: the drone never works inside its block";
+    OperatorSignalTwice = "W208", Warning, "a signal declared twice with OPERATOR SIGNAL";
     // Notes.
     SignalNeverHandled = "N301", Note, "a signal raised but never handled";
     NoWorld = "N302", Note, "no world file, so actors, places and areas were not checked";
-    CommandsQueue = "N303", Note, "a handler that may wait for its drone, held by the flow that raised its signal or by an earlier firing";
+    CommandsQueue = "N303", Note, "a handler that may wait for its drone, held by the flow that raised its signal or by another firing of itself";
 }
 
 impl Code {

@@ -170,6 +170,7 @@ impl<'m> Engine<'m> {
             jobs: Jobs::default(),
             unwinding: Cell::new(false),
             deferred: RefCell::new(Vec::new()),
+            serial: RefCell::new(Vec::new()),
             catching: Cell::new(0),
             caught: Notify::new(),
             instance: Some(instance.clone()),

@@ -22,7 +22,8 @@ pub enum Control {
         action: String,
         args: Vec<(String, Value)>,
     },
-    /// Raises a signal at mission level (no actor), as the mission's own `SIGNAL` would.
+    /// Raises a signal at mission level (no actor), as the mission's own `SIGNAL` would:
+    /// one the mission declares with `OPERATOR SIGNAL`, and no other.
     Signal {
         name: String,
         args: Vec<Value>,
@@ -181,12 +182,20 @@ impl<'m> Engine<'m> {
                 Ok(())
             }
             Control::Signal { name, args } => {
-                let id = self
-                    .m
-                    .signals
-                    .iter()
-                    .position(|s| *s == name)
-                    .ok_or_else(|| format!("the mission neither raises nor hears {name}"))?;
+                // Only among the signals the mission declares with OPERATOR SIGNAL (by
+                // their ids, resolved when it was compiled).
+                let ops = &self.m.operator_signals;
+                let id = ops.iter().copied().find(|&s| self.m.signals[s] == name).ok_or_else(|| {
+                    let declared: Vec<&str> = ops.iter().map(|&s| self.m.signals[s].as_str()).collect();
+                    let mean = did_you_mean(&name, declared.iter().copied());
+                    match declared.is_empty() {
+                        true => format!("the mission declares no signal an operator may raise, so not {name}"),
+                        false => match mean {
+                            Some(mean) => format!("the mission does not declare {name} as an operator signal: {mean} It declares {}", declared.join(", ")),
+                            None => format!("the mission does not declare {name} as an operator signal: it declares {}", declared.join(", ")),
+                        },
+                    }
+                })?;
                 self.raise_from_outside(id, args);
                 Ok(())
             }

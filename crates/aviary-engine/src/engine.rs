@@ -108,6 +108,10 @@ pub(crate) struct Scope<'m> {
     pub unwinding: Cell<bool>,
     /// `SEQUENTIAL ON` handlers to start, in their own scope, when this block has finished.
     pub deferred: RefCell<Vec<(Rc<Scope<'m>>, Job<'m>)>>,
+    /// The `ONE AT A TIME` handlers of this scope with a firing running, by index, each
+    /// with the firings that came meanwhile, in order. Empty (no allocation) in nearly
+    /// every scope.
+    pub serial: RefCell<Vec<(usize, std::collections::VecDeque<Job<'m>>)>>,
     /// Exception handlers running here; a sequence waits for them before going on.
     pub catching: Cell<usize>,
     pub caught: Notify,
@@ -120,6 +124,49 @@ pub(crate) struct Scope<'m> {
 }
 
 impl<'m> Scope<'m> {
+    /// Starts a firing of one of this scope's handlers; a firing of a `ONE AT A TIME`
+    /// handler that has one running waits behind it instead (docs/LANGUAGE.md, section 11).
+    pub fn fire(&self, job: Job<'m>) {
+        if let Job::Signal { handler, .. } = &job {
+            if let Some(i) = self.serial_index(handler) {
+                let mut serial = self.serial.borrow_mut();
+                match serial.iter_mut().find(|(h, _)| *h == i) {
+                    Some((_, waiting)) => {
+                        waiting.push_back(job);
+                        return;
+                    }
+                    None => serial.push((i, std::collections::VecDeque::new())),
+                }
+            }
+        }
+        self.jobs.send(job);
+    }
+
+    /// A firing of `handler` has ended: for a `ONE AT A TIME` handler, the next one that
+    /// waits starts now.
+    pub fn firing_ended(&self, handler: &Handler) {
+        let Some(i) = self.serial_index(handler) else { return };
+        let next = {
+            let mut serial = self.serial.borrow_mut();
+            let Some(k) = serial.iter().position(|(h, _)| *h == i) else { return };
+            let next = serial[k].1.pop_front();
+            if next.is_none() {
+                serial.swap_remove(k);
+            }
+            next
+        };
+        if let Some(job) = next {
+            self.jobs.send(job);
+        }
+    }
+
+    fn serial_index(&self, handler: &Handler) -> Option<usize> {
+        if !handler.one_at_a_time {
+            return None;
+        }
+        self.handlers.iter().position(|h| std::ptr::eq(h, handler))
+    }
+
     /// This scope and those around it, innermost first.
     pub fn chain(self: &Rc<Self>) -> impl Iterator<Item = &Rc<Scope<'m>>> {
         std::iter::successors(Some(self), |s| s.parent.as_ref())
@@ -355,6 +402,7 @@ impl<'m> Engine<'m> {
             jobs: Jobs::default(),
             unwinding: Cell::new(false),
             deferred: RefCell::new(Vec::new()),
+            serial: RefCell::new(Vec::new()),
             catching: Cell::new(0),
             caught: Notify::new(),
             instance: None,
@@ -656,9 +704,7 @@ impl<'m> Engine<'m> {
             let job = Job::Signal { handler: h, args: args.to_vec(), actor, signal };
             match (signalling_block, h.sequential) {
                 (Some(block), true) => block.deferred.borrow_mut().push((scope.clone(), job)),
-                _ => {
-                    scope.jobs.send(job);
-                }
+                _ => scope.fire(job),
             }
         }
     }

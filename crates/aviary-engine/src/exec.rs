@@ -36,7 +36,7 @@ impl<'m> Engine<'m> {
         if scope.handlers.is_empty() && scope.exception_handlers.is_empty() && !takes_sections {
             items.await;
             for (target, job) in scope.deferred.take() {
-                target.jobs.send(job);
+                target.fire(job);
             }
             return;
         }
@@ -68,7 +68,7 @@ impl<'m> Engine<'m> {
                 items_done = true;
                 // `SEQUENTIAL ON` handlers that waited for this block start now.
                 for (target, job) in scope.deferred.take() {
-                    target.jobs.send(job);
+                    target.fire(job);
                 }
                 continue;
             }
@@ -114,6 +114,7 @@ impl<'m> Engine<'m> {
             jobs: Jobs::default(),
             unwinding: Cell::new(false),
             deferred: RefCell::new(Vec::new()),
+            serial: RefCell::new(Vec::new()),
             catching: Cell::new(0),
             caught: Notify::new(),
             instance,
@@ -445,6 +446,7 @@ impl<'m> Engine<'m> {
                     handler: handler.body.path.as_str().into(),
                     actor: who.map(Into::into),
                 });
+                scope.firing_ended(handler);
             }
             Job::Exception { handler, args, entry } => {
                 let mut frame = scope.frame.to_vec();

@@ -138,7 +138,10 @@ fn operator_controls_that_cannot_apply_are_refused_with_a_reason() {
     );
     assert_eq!(answers[1], Err("no capability is called Fly (running now: FlyTo-F1)".to_string()));
     assert_eq!(answers[2], Err("FlyTo has no section PERFORM Widen".to_string()));
-    assert_eq!(answers[3], Err("the mission neither raises nor hears Nobody".to_string()));
+    assert_eq!(
+        answers[3],
+        Err("the mission declares no signal an operator may raise, so not Nobody".to_string())
+    );
     assert_eq!(
         answers[4],
         Err("no capability is called FlyT0 (running now: FlyTo-F1): did you mean `FlyTo`?"
@@ -153,10 +156,24 @@ fn operator_controls_that_cannot_apply_are_refused_with_a_reason() {
 #[test]
 fn an_operator_signal_is_heard_by_the_mission() {
     let (outcome, trace, answers) = run_with_controls(
-        "MISSION M:\n    PARALLEL:\n        a Hover WITH 10s\n        ON Go WITH what:\n            b Hover WITH 1s\n",
-        vec![(7.0, Control::Signal { name: "Go".into(), args: vec![Value::Text("now".into())] })],
+        "MISSION M:\n    OPERATOR SIGNAL Go, Stop\n    PARALLEL:\n        a Hover WITH 10s\n        ON Go WITH what:\n            b Hover WITH 1s\n        ON Halt:\n            b Hover WITH 1s\n        ON Stop:\n            SIGNAL Halt\n",
+        vec![
+            (7.0, Control::Signal { name: "Go".into(), args: vec![Value::Text("now".into())] }),
+            // Heard by the mission, but not declared: the operator may not raise it.
+            (7.0, Control::Signal { name: "Halt".into(), args: vec![] }),
+            (7.0, Control::Signal { name: "Sotp".into(), args: vec![] }),
+        ],
     );
-    assert_eq!(answers, [Ok(())]);
+    assert_eq!(
+        answers,
+        [
+            Ok(()),
+            Err("the mission does not declare Halt as an operator signal: it declares Go, Stop"
+                .to_string()),
+            Err("the mission does not declare Sotp as an operator signal: did you mean `Stop`? It declares Go, Stop".to_string()),
+        ]
+    );
+    assert_eq!(trace.iter().filter(|e| e["event"] == "signal").count(), 1, "only Go was raised");
     assert_eq!(outcome.status, Status::Ok);
     let signal = trace.iter().find(|e| e["event"] == "signal").unwrap();
     assert_eq!(

@@ -172,11 +172,36 @@ fn a_capability_whose_calls_take_time_goes_on_where_it_stood() {
     );
 }
 
+/// `ONE AT A TIME` firings whose activities end at once (`Ping`) or take time (`Hover`):
+/// a firing that ends within an instant hands the drone on to the next at that instant,
+/// on either path.
+#[test]
+fn one_at_a_time_firings_of_instant_activities_run_in_turn() {
+    let r = both_ways(
+        &format!("{PING}MISSION M:\n    PARALLEL P:\n        SEQUENTIAL:\n            SIGNAL Go WITH 1s\n            SIGNAL Go WITH 0s\n            SIGNAL Go WITH 2s\n        ON EVERY Go WITH how_long ONE AT A TIME:\n            a Ping\n            STARTIF how_long > 0s:\n                a Hover WITH how_long\n            a Ping\n"),
+        harness::WORLD,
+    );
+    let starts: Vec<f64> = r
+        .trace
+        .iter()
+        .filter(|e| e["event"] == "handler_start")
+        .map(|e| e["t"].as_f64().unwrap())
+        .collect();
+    assert_eq!(starts, [0.0, 1.0, 1.0], "{}", r.dump());
+    let pings: Vec<f64> = r
+        .trace
+        .iter()
+        .filter(|e| e["event"] == "capability_start" && e["capability"] == "Ping")
+        .map(|e| e["t"].as_f64().unwrap())
+        .collect();
+    assert_eq!(pings, [0.0, 1.0, 1.0, 1.0, 1.0, 3.0], "each firing whole, in turn");
+}
+
 /// Generated missions: the law behind the cases above. Every activity whose capability
 /// may be instant (`Ping`, `Blink`, `Toggle`; the standard `Hover` and `TakeOff`) meets
 /// what can make it wait or stop: claims held by another activity (PARALLEL blocks, FOR,
 /// groups), calls that take time, a call that fails (`c` has no camera), signals and
-/// their handlers, exception handlers (one whose body fails at once takes its own
+/// their handlers (`ON`, `ON EVERY`, `ON EVERY ... ONE AT A TIME`), exception handlers (one whose body fails at once takes its own
 /// exception again until it is passed over, docs/LANGUAGE.md section 12), leashes on its
 /// tag, the operator's pause, resume and abort of the mission and hold, resume, return
 /// home and land of a drone, and drone faults at any time. Both paths must give the same
@@ -222,8 +247,16 @@ mod generated {
 
     #[derive(Clone, Debug)]
     enum Handler {
-        On { signal: u8, every: bool, body: Vec<Stmt> },
-        CommandFailed { body: Vec<Stmt> },
+        /// `ON S`, `ON EVERY S`, or `ON EVERY S ONE AT A TIME` (`one`, with `every`).
+        On {
+            signal: u8,
+            every: bool,
+            one: bool,
+            body: Vec<Stmt>,
+        },
+        CommandFailed {
+            body: Vec<Stmt>,
+        },
     }
 
     fn actor() -> impl Strategy<Value = &'static str> {
@@ -249,8 +282,9 @@ mod generated {
         leaf().prop_recursive(3, 24, 4, |inner| {
             let body = prop::collection::vec(inner.clone(), 1..3);
             let handler = prop_oneof![
-                (0..2u8, any::<bool>(), body.clone())
-                    .prop_map(|(signal, every, body)| Handler::On { signal, every, body }),
+                (0..2u8, any::<bool>(), any::<bool>(), body.clone()).prop_map(
+                    |(signal, every, one, body)| Handler::On { signal, every, one, body }
+                ),
                 body.clone().prop_map(|body| Handler::CommandFailed { body }),
             ];
             (
@@ -324,9 +358,13 @@ mod generated {
                     }
                     for h in handlers {
                         let body = match h {
-                            Handler::On { signal, every, body } => {
-                                let every = if *every { "EVERY " } else { "" };
-                                self.line(depth + 1, &format!("ON {every}S{signal}:"));
+                            Handler::On { signal, every, one, body } => {
+                                let (every, one) = match (*every, *one) {
+                                    (true, true) => ("EVERY ", " ONE AT A TIME"),
+                                    (true, false) => ("EVERY ", ""),
+                                    _ => ("", ""),
+                                };
+                                self.line(depth + 1, &format!("ON {every}S{signal}{one}:"));
                                 body
                             }
                             Handler::CommandFailed { body } => {

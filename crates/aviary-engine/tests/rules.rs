@@ -583,3 +583,133 @@ fn an_area_where_a_position_is_expected_is_its_centroid() {
     let (x, y) = (p[0].as_f64().unwrap(), p[1].as_f64().unwrap());
     assert!(((x - 150.0).hypot(y - 150.0) - 20.0).abs() < 1e-6, "{p}");
 }
+
+/// The firings of handler `path`, paired in trace order: (start index, end index, start
+/// time, end time). Right for firings that do not overlap, which is what the caller then
+/// asserts.
+fn firings(r: &harness::Run, path: &str) -> Vec<(usize, usize, f64, f64)> {
+    let at = |event: &str| -> Vec<(usize, f64)> {
+        r.trace
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| e["event"] == event && e["handler"] == path)
+            .map(|(i, e)| (i, e["t"].as_f64().unwrap()))
+            .collect()
+    };
+    let (starts, ends) = (at("handler_start"), at("handler_end"));
+    assert_eq!(starts.len(), ends.len(), "every firing ends:\n{}", r.dump());
+    starts.iter().zip(&ends).map(|(&(si, st), &(ei, et))| (si, ei, st, et)).collect()
+}
+
+/// Each firing's events lie between its start and its end, and the next firing starts
+/// after the one before has ended (in trace order, at the same instant).
+fn one_after_another(r: &harness::Run, path: &str) -> Vec<(usize, usize, f64, f64)> {
+    let f = firings(r, path);
+    for w in f.windows(2) {
+        let ((_, end, _, t_end), (start, _, t_start, _)) = (w[0], w[1]);
+        assert!(start > end, "a firing starts only after the one before ended:\n{}", r.dump());
+        assert!(close(t_start, t_end), "and at once: {t_start} after {t_end}");
+    }
+    f
+}
+
+#[test]
+fn on_every_firings_interleave_on_one_drone() {
+    // What ONE AT A TIME is for: without it, two firings take turns on drone a statement
+    // by statement, and the second firing's TakeOff comes while a is in the air.
+    let r = run(&fixture("on_every_firings_interleave_on_one_drone"));
+    assert_eq!(r.outcome.status, Status::Failed);
+    let takeoffs: Vec<usize> = r
+        .trace
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e["event"] == "capability_start" && e["capability"] == "TakeOff")
+        .map(|(i, _)| i)
+        .collect();
+    assert_eq!(takeoffs.len(), 2, "{}", r.dump());
+    let first_takeoff_end = r.index("capability_end", "capability", "TakeOff");
+    assert!(takeoffs[1] > first_takeoff_end, "the second waits for the first");
+    assert!(
+        r.find("capability_start", "capability", "FlyTo").is_empty(),
+        "and gets a before the first firing's FlyTo:\n{}",
+        r.dump()
+    );
+    let e = r.first("exception", "name", "CommandFailed");
+    assert_eq!(e["actor"], "a");
+}
+
+#[test]
+fn one_at_a_time_runs_firings_one_after_another() {
+    let r = run(&fixture("one_at_a_time_runs_firings_one_after_another"));
+    assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
+    let f = one_after_another(&r, "P/ON Go");
+    assert_eq!(f.len(), 3, "no firing is dropped");
+    assert_eq!(f[0].2, 0.0, "the first starts at once");
+    // Inside each firing: its three statements, in order, and nothing of another firing.
+    let targets = ["[0.0,100.0]", "[0.0,400.0]", "[50.0,50.0]"];
+    for (&(start, end, _, _), target) in f.iter().zip(targets) {
+        let caps: Vec<String> = r.trace[start..end]
+            .iter()
+            .filter(|e| e["event"] == "capability_start")
+            .map(|e| format!("{} {}", e["capability"].as_str().unwrap(), e["args"]))
+            .collect();
+        assert_eq!(caps.len(), 3, "{caps:?}");
+        assert!(caps[0].starts_with("TakeOff"), "{caps:?}");
+        assert_eq!(caps[1], format!("FlyTo {{\"target\":{target}}}"), "in signal order");
+        assert!(caps[2].starts_with("ReturnHome"), "{caps:?}");
+    }
+    // Never two activities of the drone at once: each capability ends before the next starts.
+    let mut running = 0;
+    for e in &r.trace {
+        match e["event"].as_str() {
+            Some("capability_start") if e["actor"] == "a" => running += 1,
+            Some("capability_end") if e["actor"] == "a" => running -= 1,
+            _ => {}
+        }
+        assert!(running <= 2, "TakeOff and FlyTo may nest their own calls, no more");
+    }
+    assert!(r.find("exception", "actor", "a").is_empty(), "{}", r.dump());
+}
+
+#[test]
+fn one_at_a_time_firings_that_come_later_wait_in_order() {
+    let r = run(&fixture("one_at_a_time_firings_that_come_later_wait_in_order"));
+    assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
+    let signals: Vec<f64> =
+        r.find("signal", "name", "Go").iter().map(|e| e["t"].as_f64().unwrap()).collect();
+    assert!(close(signals[0], 0.0) && close(signals[1], 1.0) && close(signals[2], 2.0));
+    // 3 s + 3 s, then 2 s + 2 s, then 1 s + 1 s: each waits for the one before.
+    let f = one_after_another(&r, "P/ON Go");
+    let times: Vec<(f64, f64)> = f.iter().map(|&(_, _, s, e)| (s, e)).collect();
+    let expected = [(0.0, 6.0), (6.0, 10.0), (10.0, 12.0)];
+    for (got, want) in times.iter().zip(expected) {
+        assert!(close(got.0, want.0) && close(got.1, want.1), "{times:?}");
+    }
+    let hovers: Vec<f64> = r
+        .trace
+        .iter()
+        .filter(|e| e["event"] == "capability_start" && e["actor"] == "a")
+        .map(|e| e["args"]["duration"].as_f64().unwrap())
+        .collect();
+    assert_eq!(hovers, [3.0, 2.0, 1.0], "in the order of the signals");
+}
+
+#[test]
+fn sequential_on_every_one_at_a_time_starts_after_the_block_then_in_turn() {
+    let r = run(&fixture("sequential_on_every_one_at_a_time_starts_after_the_block_then_in_turn"));
+    assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
+    assert!(close(r.t("block_end", "block", "Raise"), 2.0));
+    let f = one_after_another(&r, "P/ON Go");
+    let times: Vec<(f64, f64)> = f.iter().map(|&(_, _, s, e)| (s, e)).collect();
+    let expected = [(2.0, 8.0), (8.0, 12.0), (12.0, 14.0)];
+    for (got, want) in times.iter().zip(expected) {
+        assert!(close(got.0, want.0) && close(got.1, want.1), "{times:?}");
+    }
+    let hovers: Vec<f64> = r
+        .trace
+        .iter()
+        .filter(|e| e["event"] == "capability_start" && e["actor"] == "b")
+        .map(|e| e["args"]["duration"].as_f64().unwrap())
+        .collect();
+    assert_eq!(hovers, [3.0, 2.0, 1.0], "in the order of the signals");
+}

@@ -49,6 +49,9 @@ pub struct Mission {
     /// knows it. The engine does not need them; the operator API checks a signal raised
     /// from outside against them.
     pub signal_values: Vec<Vec<Option<Kind>>>,
+    /// The signals the mission declares with `OPERATOR SIGNAL`, each once, in the order
+    /// written: the only ones an operator may raise while it runs.
+    pub operator_signals: Vec<SignalId>,
     pub exceptions: Vec<String>,
     /// `Capability-Tag` names, as written after the dash.
     pub tags: Vec<String>,
@@ -291,6 +294,10 @@ pub struct Handler {
     pub every: bool,
     /// `SEQUENTIAL ON`: starts when the signalling block has finished.
     pub sequential: bool,
+    /// `ONE AT A TIME` (only with `every`): a firing starts when the previous firing of
+    /// this handler, in the same running block, has finished; firings that come
+    /// meanwhile wait in the order of their signals.
+    pub one_at_a_time: bool,
     pub by: Option<ActorFilter>,
     pub bindings: Vec<Slot>,
     pub body: Block,
@@ -421,6 +428,7 @@ mod column_tests {
             drones: aviary_api::Names::new(["a", "b", "c"].into_iter()),
             signals: vec![],
             signal_values: vec![],
+            operator_signals: vec![],
             exceptions: vec![],
             tags: vec![],
             attribute_names: vec![],

@@ -28,6 +28,18 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
     c.scopes.clear();
     c.frame_size = 0;
     let body = c.body(&mission.body, &mission.name.name, BlockKind::Sequential, true);
+    // Declared only directly in the MISSION body (the checker refuses it elsewhere).
+    let mut operator_signals = Vec::new();
+    for stmt in &mission.body.items {
+        if let ast::Stmt::OperatorSignals(o) = stmt {
+            for name in &o.names {
+                let id = c.signals.id(&name.name);
+                if !operator_signals.contains(&id) {
+                    operator_signals.push(id);
+                }
+            }
+        }
+    }
     // Interned, so never missing: a descriptor without one gets it added, not another
     // name's id.
     let builtins = Builtins {
@@ -48,6 +60,7 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
         drones: aviary_api::Names::new(world.drones.iter().map(|d| d.name.as_str())),
         signals: c.signals.names,
         signal_values,
+        operator_signals,
         exceptions: c.exceptions.names,
         tags: c.tags.names,
         attribute_names: c.attribute_names.clone(),
@@ -333,6 +346,7 @@ impl<'a> Compiler<'a> {
             signal,
             every: h.every,
             sequential: h.mode == Some(ast::BlockKind::Sequential),
+            one_at_a_time: h.every && h.one_at_a_time.is_some(),
             by,
             bindings,
             body: c.body(&h.body, &path, BlockKind::Sequential, false),
@@ -442,9 +456,10 @@ impl<'a> Compiler<'a> {
                     .map(|b| self.body(b, &format!("{parent}/ELSE"), BlockKind::Sequential, false));
                 Node::If { branches, otherwise }
             }
-            ast::Stmt::Handler(_) | ast::Stmt::ExceptionHandler(_) | ast::Stmt::Error(_) => {
-                return None
-            }
+            ast::Stmt::Handler(_)
+            | ast::Stmt::ExceptionHandler(_)
+            | ast::Stmt::OperatorSignals(_)
+            | ast::Stmt::Error(_) => return None,
         })
     }
 

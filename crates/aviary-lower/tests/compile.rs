@@ -234,3 +234,20 @@ fn every_builtin_has_its_own_id_whatever_the_descriptor_lists() {
     assert_eq!(m.signals[0], "Go", "the mission's own names come first here");
     assert_eq!(m.exceptions[0], "Oops");
 }
+
+#[test]
+fn operator_signals_become_ids_once_each_and_one_at_a_time_is_kept() {
+    let m = compiled(
+        "MISSION M:\n    OPERATOR SIGNAL Go, Stop\n    OPERATOR SIGNAL Never_Heard\n    PARALLEL P:\n        SIGNAL Go\n        ON EVERY Go ONE AT A TIME:\n            a Hover WITH 1s\n        ON EVERY Stop:\n            a Hover WITH 1s\n        ON Go:\n            a Hover WITH 1s\n",
+        harness::WORLD,
+    );
+    let names: Vec<&str> = m.operator_signals.iter().map(|&s| m.signals[s].as_str()).collect();
+    assert_eq!(names, ["Go", "Stop", "Never_Heard"], "in the order written, each a signal");
+    assert!(m.body.items.len() == 1, "the declarations are no nodes: {:?}", m.body.items);
+    let p = block(&m.body.items[0]);
+    let flags: Vec<(bool, bool)> = p.handlers.iter().map(|h| (h.every, h.one_at_a_time)).collect();
+    assert_eq!(flags, [(true, true), (true, false), (false, false)]);
+    assert!(compiled("MISSION M:\n    a Hover WITH 1s\n", harness::WORLD)
+        .operator_signals
+        .is_empty());
+}

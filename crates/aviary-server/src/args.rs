@@ -23,6 +23,9 @@ pub const MAX_MAGNITUDE: f64 = 1e9;
 pub struct Kinds {
     capabilities: HashMap<String, Vec<(String, Option<Kind>)>>,
     signals: HashMap<String, Vec<Option<Kind>>>,
+    /// The signals the mission declares with `OPERATOR SIGNAL`, in the order written: the
+    /// only ones an operator may raise.
+    operator: Vec<String>,
 }
 
 impl Kinds {
@@ -39,6 +42,11 @@ impl Kinds {
         for (name, values) in mission.signals.iter().zip(&mission.signal_values) {
             kinds.signal(name, values.clone());
         }
+        for &id in &mission.operator_signals {
+            if let Some(name) = mission.signals.get(id) {
+                kinds.operator_signal(name);
+            }
+        }
         kinds
     }
 
@@ -49,6 +57,40 @@ impl Kinds {
     /// The values a signal carries, in order, with each one's kind (`None`: any).
     pub fn signal(&mut self, name: &str, values: Vec<Option<Kind>>) {
         self.signals.insert(name.to_string(), values);
+    }
+
+    /// Lets the operator raise `name` (`OPERATOR SIGNAL name` in the mission).
+    pub fn operator_signal(&mut self, name: &str) {
+        if !self.operator.iter().any(|n| n == name) {
+            self.operator.push(name.to_string());
+        }
+    }
+
+    /// The signals an operator may raise, in the order the mission declares them.
+    pub fn operator_signals(&self) -> &[String] {
+        &self.operator
+    }
+
+    /// Whether the operator may raise `name`; if not, why, with the signals the mission
+    /// declares and the one meant when one is close.
+    pub(crate) fn may_raise(&self, name: &str) -> Result<(), String> {
+        if self.operator.iter().any(|n| n == name) {
+            return Ok(());
+        }
+        let declared = self.operator.iter().map(String::as_str);
+        let mean = aviary_diagnostics::suggest::did_you_mean(name, declared.clone());
+        let list = declared.collect::<Vec<_>>().join(", ");
+        Err(match (self.operator.is_empty(), mean) {
+            (true, _) => format!(
+                "the mission declares no signal an operator may raise, so not {name}: it would need `OPERATOR SIGNAL {name}` in its MISSION body"
+            ),
+            (false, Some(mean)) => format!(
+                "the mission does not declare {name} as an operator signal: {mean} It declares {list}"
+            ),
+            (false, None) => format!(
+                "the mission does not declare {name} as an operator signal: it declares {list}"
+            ),
+        })
     }
 
     /// A leash's arguments as the engine takes them. A capability the mission does not
@@ -255,4 +297,34 @@ fn example(kind: Kind) -> String {
     };
     let si = if kind == Kind::Ratio { "a fraction such as 0.25" } else { "a number in SI units" };
     format!("write {si}, or {{\"number\": 20, \"unit\": \"{unit}\"}}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Kinds;
+
+    #[test]
+    fn only_a_declared_signal_may_be_raised_and_a_refusal_lists_them() {
+        let mut kinds = Kinds::default();
+        kinds.signal("Hold_Position", vec![]);
+        kinds.signal("Found", vec![None]);
+        assert_eq!(
+            kinds.may_raise("Hold_Position"),
+            Err("the mission declares no signal an operator may raise, so not Hold_Position: it would need `OPERATOR SIGNAL Hold_Position` in its MISSION body".into())
+        );
+        kinds.operator_signal("Hold_Position");
+        kinds.operator_signal("Carry_On");
+        kinds.operator_signal("Hold_Position");
+        assert_eq!(kinds.operator_signals(), ["Hold_Position", "Carry_On"], "each once, in order");
+        assert_eq!(kinds.may_raise("Hold_Position"), Ok(()));
+        assert_eq!(
+            kinds.may_raise("Hold_Postion"),
+            Err("the mission does not declare Hold_Postion as an operator signal: did you mean `Hold_Position`? It declares Hold_Position, Carry_On".into())
+        );
+        assert_eq!(
+            kinds.may_raise("Found"),
+            Err("the mission does not declare Found as an operator signal: it declares Hold_Position, Carry_On".into()),
+            "heard by the mission, raised by it, and still not the operator's"
+        );
+    }
 }

@@ -47,8 +47,12 @@ async fn control(shared: &Shared, control: Control) -> Response {
     }
 }
 
+/// The state folded from the trace, and the signals the operator may raise (which the
+/// trace does not say: they are the mission's).
 async fn state(State(shared): State<Arc<Shared>>) -> Json<JsonValue> {
-    Json(shared.state().to_json())
+    let mut state = shared.state().to_json();
+    state["operator_signals"] = json!(shared.kinds.operator_signals());
+    Json(state)
 }
 
 async fn events(
@@ -184,6 +188,11 @@ async fn signal(State(shared): State<Arc<Shared>>, Object(body): Object) -> Resp
             )
         }
     };
+    // Only a signal the mission declares with OPERATOR SIGNAL: refused as the engine
+    // would refuse it (409), with what the mission declares.
+    if let Err(why) = shared.kinds.may_raise(name) {
+        return error(StatusCode::CONFLICT, why);
+    }
     match shared.kinds.signal_args(name, &args) {
         Ok(args) => control(&shared, Control::Signal { name: name.to_string(), args }).await,
         Err(why) => error(StatusCode::BAD_REQUEST, why),

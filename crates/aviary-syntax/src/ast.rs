@@ -141,6 +141,9 @@ pub enum Stmt {
     Handler(Handler),
     ExceptionHandler(ExceptionHandler),
     If(IfChain),
+    /// `OPERATOR SIGNAL A, B`: the signals an operator may raise while the mission runs.
+    /// Allowed only directly in the MISSION body (the checker says so elsewhere).
+    OperatorSignals(OperatorSignals),
     /// A line that could not be read. It was reported; later stages skip it.
     Error(Span),
 }
@@ -163,6 +166,7 @@ impl Stmt {
             | Stmt::Api(_)
             | Stmt::Signal(_)
             | Stmt::Throw(_)
+            | Stmt::OperatorSignals(_)
             | Stmt::Error(_) => {}
         }
     }
@@ -264,7 +268,17 @@ pub struct Handler {
     pub signal: Ident,
     pub by: Option<Ident>,
     pub bindings: Vec<Ident>,
+    /// `ONE AT A TIME` at the end of the header (only with `ON EVERY`): each firing starts
+    /// when the previous firing of this handler has finished. The span of the phrase.
+    pub one_at_a_time: Option<Span>,
     pub body: Body,
+    pub span: Span,
+}
+
+/// `OPERATOR SIGNAL Name, Name`: `OPERATOR` is a word only at the start of such a line.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OperatorSignals {
+    pub names: Vec<Ident>,
     pub span: Span,
 }
 

@@ -1,12 +1,20 @@
-//! Conflicting commands: two mission-level statements that may run at once and claim the
-//! same resource of the same drone. The second to start waits (docs/LANGUAGE.md, section 6).
+//! Conflicting commands: two statements that may run at once and claim the same resource
+//! of the same drone. The second to start waits (docs/LANGUAGE.md, section 6).
 //!
 //! May-run-in-parallel comes from the block structure: two statements are compared at
 //! the construct where their paths part. Parallel branches, parallel `FOR` instances and
 //! two handlers may overlap (W203). A handler may overlap the statements of the block it
 //! listens on, unless they end before any raise of its signal; when every raise comes
 //! earlier in the same sequential flow, the overlap is the handler queueing behind the
-//! flow that started it, and firings of one `ON EVERY` queue behind each other (N303).
+//! flow that started it (N303). An `ON EXCEPTION` may overlap what its block runs beside
+//! the chain the exception aborts (W203; `sites::goes_on_beside_exceptions`), unless it
+//! hears only the drone's own exceptions, which stop the drone's work.
+//!
+//! Two firings of one `ON EVERY` (without `ONE AT A TIME`) run at once, each statement
+//! holding the drone only while it runs: two statements under it on one drone may
+//! interleave (W203, whatever stands between them inside), and a statement alone there
+//! queues behind itself in the other firings (N303). Under `ONE AT A TIME` the firings
+//! never overlap, and the body is compared as one firing.
 //!
 //! The rule is stated pair by pair (`pairwise.rs`, which the tests hold this to), but
 //! applied construct by construct: the statements that claim one resource of one drone
@@ -30,7 +38,7 @@ use std::collections::{BTreeMap, HashMap};
 
 use aviary_api::{BuiltinSignal, DroneId, Resource};
 use aviary_diagnostics::{Code, Diagnostic};
-use aviary_ir::{BlockKind, Mission, SignalId};
+use aviary_ir::{BlockKind, ExceptionId, Mission, SignalId};
 
 use crate::sites::{self, ClaimSite, Construct, Key, Sites};
 use raises::{Order, Raises};
@@ -44,8 +52,12 @@ enum Overlap {
     HandlerAndFlow(SignalId),
     /// A handler against the flow after every raise of its signal.
     AfterSignal(SignalId),
-    /// Firings of one `ON EVERY`.
+    /// Firings of one `ON EVERY`: a statement alone on the drone there, against itself.
     Firings(SignalId),
+    /// Two statements under one `ON EVERY` whose firings may interleave.
+    Interleave(SignalId),
+    /// An `ON EXCEPTION` (the waiting side) against what its block runs meanwhile.
+    Exception(ExceptionId),
 }
 
 impl Overlap {
@@ -143,26 +155,37 @@ impl Bucket<'_> {
 
     fn solve(&self) -> Best {
         let mut best = Best::new();
-        // Each firing of an `ON EVERY` runs the statement again: it waits for itself.
+        // Under an `ON EVERY` whose firings overlap: a statement alone there waits for
+        // itself in another firing; several interleave, each pair.
+        let mut firings: BTreeMap<sites::Step, (SignalId, Vec<usize>)> = BTreeMap::new();
         for pos in 0..self.members.len() {
-            if let Some(signal) = self.path(pos).iter().find_map(|&(id, key)| self.every(id, key)) {
-                offer(&mut best, pos, pos, Overlap::Firings(signal));
+            if let Some((step, signal)) = sites::overlapping_firings(self.sites, self.path(pos)) {
+                firings.entry(step).or_insert((signal, Vec::new())).1.push(pos);
             }
         }
-        self.split(&(0..self.members.len()).collect::<Vec<_>>(), 0, false, &mut best);
+        for (signal, group) in firings.values() {
+            match group.as_slice() {
+                [pos] => offer(&mut best, *pos, *pos, Overlap::Firings(*signal)),
+                _ => {
+                    let each: Vec<&[usize]> = group.chunks(1).collect();
+                    self.later_waits(&each, Overlap::Interleave(*signal), &mut best);
+                }
+            }
+        }
+        self.split(&(0..self.members.len()).collect::<Vec<_>>(), 0, &mut best);
         best
     }
 
-    /// The signal of the `ON EVERY` handler a step enters, if it enters one.
-    fn every(&self, id: usize, key: Key) -> Option<SignalId> {
-        let Key::Handler(h) = key else { return None };
-        self.sites.handlers.get(&(id, h)).filter(|info| info.every).map(|info| info.signal)
+    /// Whether a step enters an `ON EVERY` whose firings may overlap: all below it is
+    /// compared in `solve`.
+    fn overlapping(&self, id: usize, key: Key) -> bool {
+        let Key::Handler(h) = key else { return false };
+        self.sites.handlers.get(&(id, h)).is_some_and(|i| i.every && !i.one_at_a_time)
     }
 
-    /// `group` shares the path down to `depth`; `every`: that path enters an `ON EVERY`
-    /// handler, whose firings then order what is inside (only parallel constructs still
-    /// make it overlap).
-    fn split(&self, group: &[usize], depth: usize, every: bool, best: &mut Best) {
+    /// `group` shares the path down to `depth`, which enters no `ON EVERY` whose firings
+    /// overlap.
+    fn split(&self, group: &[usize], depth: usize, best: &mut Best) {
         let step = |pos: usize| self.path(pos).get(depth).copied();
         // Sites are in the order of a depth-first walk that visits a construct's children
         // in key order, so a group's steps come sorted, each child's statements together.
@@ -176,10 +199,12 @@ impl Bucket<'_> {
                 group.last().and_then(|&p| step(p)).is_some_and(|(last, _)| last == id);
             let plain =
                 matches!(self.sites.constructs[id], Construct::Block(BlockKind::Sequential))
-                    && group.iter().all(|&p| !matches!(step(p), Some((_, Key::Handler(_)))));
+                    && group.iter().all(|&p| {
+                        !matches!(step(p), Some((_, Key::Handler(_) | Key::Exception(_))))
+                    });
             if one_construct && plain {
                 for child in group.chunk_by(|&a, &b| step(a) == step(b)).filter(|g| g.len() > 1) {
-                    self.split(child, depth + 1, every, best);
+                    self.split(child, depth + 1, best);
                 }
                 return;
             }
@@ -201,38 +226,15 @@ impl Bucket<'_> {
         }
         for same in children.chunk_by(|a, b| a.0 .0 == b.0 .0) {
             let id = same[0].0 .0;
-            let parallel = matches!(
-                self.sites.constructs[id],
-                Construct::Block(BlockKind::Parallel) | Construct::For { parallel: true }
-            );
             match self.sites.constructs[id] {
                 // A SEQUENTIAL block without handlers orders all it holds: nothing here.
                 Construct::Block(kind)
                     if kind == BlockKind::Parallel
-                        || same.iter().any(|(s, _)| matches!(s.1, Key::Handler(_))) =>
+                        || same
+                            .iter()
+                            .any(|(s, _)| matches!(s.1, Key::Handler(_) | Key::Exception(_))) =>
                 {
-                    let items: Vec<&[usize]> = same
-                        .iter()
-                        .filter(|(s, _)| matches!(s.1, Key::Item(_)))
-                        .map(|(_, g)| *g)
-                        .collect();
-                    let handlers: Vec<(usize, &[usize])> = same
-                        .iter()
-                        .filter_map(
-                            |(s, g)| if let Key::Handler(h) = s.1 { Some((h, *g)) } else { None },
-                        )
-                        .collect();
-                    if kind == BlockKind::Parallel {
-                        self.later_waits(&items, Overlap::Branches, best);
-                    }
-                    if !every || parallel {
-                        self.later_waits(
-                            &handlers.iter().map(|(_, g)| *g).collect::<Vec<_>>(),
-                            Overlap::Handlers,
-                            best,
-                        );
-                        self.handlers_and_items(id, depth, &handlers, &items, best);
-                    }
+                    self.block(id, kind, depth, same, best);
                 }
                 Construct::For { parallel: true } => {
                     // A later instance waits for any earlier one.
@@ -252,9 +254,71 @@ impl Bucket<'_> {
                 _ => {}
             }
             // One statement alone below a step pairs with nobody there (with itself only
-            // through `ON EVERY`, which `solve` has done).
+            // through `ON EVERY`, which `solve` has done, as all below such a handler).
             for ((sid, key), g) in same.iter().filter(|(_, g)| g.len() > 1) {
-                self.split(g, depth + 1, every || self.every(*sid, *key).is_some(), best);
+                if !self.overlapping(*sid, *key) {
+                    self.split(g, depth + 1, best);
+                }
+            }
+        }
+    }
+
+    /// The children of block `id` that hold statements of the bucket: its items (branches
+    /// of a PARALLEL block), its handlers and its exception handlers.
+    fn block(
+        &self,
+        id: usize,
+        kind: BlockKind,
+        depth: usize,
+        same: &[((usize, Key), &[usize])],
+        best: &mut Best,
+    ) {
+        let items: Vec<&[usize]> =
+            same.iter().filter(|(s, _)| matches!(s.1, Key::Item(_))).map(|(_, g)| *g).collect();
+        let handlers: Vec<(usize, &[usize])> = same
+            .iter()
+            .filter_map(|(s, g)| if let Key::Handler(h) = s.1 { Some((h, *g)) } else { None })
+            .collect();
+        // An exception handler that hears only this drone stops its work: left out.
+        let exceptions: Vec<(usize, &[usize])> = same
+            .iter()
+            .filter_map(|(s, g)| if let Key::Exception(e) = s.1 { Some((e, *g)) } else { None })
+            .filter(|(e, _)| !sites::stops_the_drone(self.sites, id, *e, self.drone))
+            .collect();
+        if kind == BlockKind::Parallel {
+            self.later_waits(&items, Overlap::Branches, best);
+        }
+        let all_handlers: Vec<&[usize]> =
+            handlers.iter().chain(&exceptions).map(|(_, g)| *g).collect();
+        self.later_waits(&all_handlers, Overlap::Handlers, best);
+        self.handlers_and_items(id, depth, &handlers, &items, best);
+        self.exceptions_and_items(id, depth, &exceptions, &items, best);
+    }
+
+    /// An exception handler of block `id` against the block's own statements: the
+    /// handler's statement waits for the first that may run meanwhile.
+    fn exceptions_and_items(
+        &self,
+        id: usize,
+        depth: usize,
+        exceptions: &[(usize, &[usize])],
+        items: &[&[usize]],
+        best: &mut Best,
+    ) {
+        if exceptions.is_empty() {
+            return;
+        }
+        let all = sites::goes_on_beside_exceptions(self.sites, id);
+        let first = items
+            .iter()
+            .flat_map(|g| g.iter().copied())
+            .filter(|&x| all || sites::beside_the_chain(self.sites, &self.path(x)[depth + 1..]))
+            .min();
+        let Some(x) = first else { return };
+        for &(e, g) in exceptions {
+            let Some(info) = self.sites.exceptions.get(&(id, e)) else { continue };
+            for &w in g {
+                offer(best, w, x, Overlap::Exception(info.exception));
             }
         }
     }
@@ -386,8 +450,13 @@ fn report(
     let (code, message, help) = match why {
         Overlap::Firings(s) => (
             Code::CommandsQueue,
-            format!("each `{}` firing runs `{name} {}`; a later firing waits until the earlier one ends", signal(s), cap(waiting)),
-            format!("the handler's firings take {name}'s {res} one at a time, in the order of their signals"),
+            format!("each `{}` firing runs `{name} {}`; a firing that reaches it while another firing's runs waits until that one ends", signal(s), cap(waiting)),
+            format!("the firings take {name}'s {res} one at a time, first come, first served; to run each firing whole before the next starts, write `ONE AT A TIME` at the end of the handler's header"),
+        ),
+        Overlap::Interleave(s) => (
+            Code::CommandsMayCollide,
+            format!("{name} is commanded from two places that may run at once (two `{}` firings may interleave: another firing's `{name} {}` may take {name} between this firing's statements); the second to start waits", signal(s), cap(other)),
+            format!("write `ONE AT A TIME` at the end of the handler's header (`ON EVERY {} ... ONE AT A TIME:`) so that each firing runs whole before the next starts, or give the firings different drones", signal(s)),
         ),
         Overlap::AfterSignal(s) => (
             Code::CommandsQueue,
@@ -400,6 +469,7 @@ fn report(
                 Overlap::Instances => "two instances of this PARALLEL FOR both give it".to_string(),
                 Overlap::Handlers => "both handlers may run at once".to_string(),
                 Overlap::HandlerAndFlow(s) => format!("`{}` may be raised while the other statement runs", signal(s)),
+                Overlap::Exception(e) => format!("`{}` may be handled while the other statement runs", mission.exceptions.get(*e).map_or("", String::as_str)),
                 _ => String::new(),
             };
             (

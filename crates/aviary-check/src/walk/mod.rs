@@ -57,6 +57,7 @@ pub(crate) fn check_program(
         tag_set,
         aliases,
         world_names,
+        top_level: HashSet::new(),
     };
     for (file, tree) in &program.files {
         checker.file = *file;
@@ -76,6 +77,7 @@ pub(crate) fn check_program(
                         checker.diagnostics.push(d);
                     }
                     checker.capability = None;
+                    checker.operator_signals(&m.body);
                     checker.body(&m.body);
                 }
                 // Overridden library capabilities are never run, so never checked here.
@@ -106,6 +108,9 @@ struct Checker<'a> {
     aliases: HashSet<&'a str>,
     /// What each name of the world means (see [`world_names`]).
     world_names: foldhash::HashMap<&'a str, Meaning>,
+    /// Where the `OPERATOR SIGNAL` lines directly in the MISSION body start: those are
+    /// in their place; any other is misplaced.
+    top_level: HashSet<(u32, u32)>,
 }
 
 /// The world's names: a drone before a group of the same name, then places, then
@@ -291,7 +296,59 @@ impl<'a> Checker<'a> {
                     self.body(b);
                 }
             }
-            Stmt::Error(_) => {}
+            // Those directly in the MISSION body are checked by `operator_signals`.
+            Stmt::OperatorSignals(o) if !self.top_level.contains(&(self.file.0, o.span.start)) => {
+                let d = self.report(
+                    Code::MisplacedItem,
+                    o.span,
+                    "OPERATOR SIGNAL declares the signals of the whole mission, and is allowed only directly in the MISSION body",
+                );
+                d.help = Some(format!(
+                    "move `OPERATOR SIGNAL {}` to the MISSION body, indented by 4 spaces under `MISSION Name:`",
+                    o.names.iter().map(|n| n.name.as_str()).collect::<Vec<_>>().join(", ")
+                ));
+            }
+            Stmt::OperatorSignals(_) | Stmt::Error(_) => {}
+        }
+    }
+
+    /// The `OPERATOR SIGNAL` lines of the MISSION body: a built-in signal cannot be one
+    /// (E130), and a name declared twice is said (W208).
+    fn operator_signals(&mut self, body: &'a Body) {
+        let mut seen: Vec<&Ident> = Vec::new();
+        for stmt in &body.items {
+            let Stmt::OperatorSignals(o) = stmt else { continue };
+            self.top_level.insert((self.file.0, o.span.start));
+            for name in &o.names {
+                if self.api.signal(&name.name).is_some() {
+                    let d = self.report(
+                        Code::OperatorSignalBuiltin,
+                        name.span,
+                        format!("`{}` is a built-in signal, which only a drone raises", name.name),
+                    );
+                    d.help = Some(format!(
+                        "handle it with `ON {} BY drone:`; for the operator, declare a signal of your own, such as `OPERATOR SIGNAL Operator_{}`",
+                        name.name, name.name
+                    ));
+                    continue;
+                }
+                if let Some(first) = seen.iter().find(|s| s.name == name.name) {
+                    let (file, first) = (self.file, first.span);
+                    let d = self.report(
+                        Code::OperatorSignalTwice,
+                        name.span,
+                        format!("`{}` is declared as an operator signal twice", name.name),
+                    );
+                    d.secondary.push(aviary_diagnostics::Label {
+                        file,
+                        span: first,
+                        message: "first declared here".into(),
+                    });
+                    d.help = Some(format!("remove this `{}`: once is enough", name.name));
+                    continue;
+                }
+                seen.push(name);
+            }
         }
     }
 

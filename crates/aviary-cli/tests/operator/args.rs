@@ -6,8 +6,8 @@ use super::serve::{bearer, http, serve, Run};
 use crate::common::{aviary, scratch};
 
 /// `Watch`'s `radius` is a length (its default); `Go` carries a position and a duration
-/// (what its handler passes them to). Nothing here moves a drone, so that a good call
-/// leaves the mission running.
+/// (what its handler passes them to), and is the one signal the operator may raise.
+/// Nothing here moves a drone, so that a good call leaves the mission running.
 const MISSION: &str = "CAPABILITY Watch BY drone WITH radius:
     DEFAULTS:
         radius: 50m
@@ -24,6 +24,7 @@ CAPABILITY Note BY drone WITH where, how_long:
         SIGNAL Noted WITH where, how_long
 
 MISSION M:
+    OPERATOR SIGNAL Go
     PARALLEL:
         a Watch-W1
         ON EVERY Go WITH where, how_long:
@@ -109,6 +110,23 @@ fn leash_arguments_and_signal_values_are_checked_against_the_mission_kinds() {
     let (status, why) = go(&run, "[[1, 2], -5]");
     assert_eq!((status, why.contains("cannot be negative")), (400, true), "{why}");
 
+    // Only a signal the mission declares: `Widened` is the mission's own, `Og` a slip.
+    let body = "{\"name\": \"Widened\", \"args\": [5]}";
+    let a = http(
+        &run,
+        "POST",
+        "/api/signal",
+        &[("Authorization", &bearer(&run)), ("Content-Type", "application/json")],
+        body,
+    );
+    assert_eq!(
+        (a.status, a.error().as_str()),
+        (409, "the mission does not declare Widened as an operator signal: it declares Go")
+    );
+    let a = http(&run, "GET", "/api/state", &[], "");
+    let state: serde_json::Value = serde_json::from_str(&a.body).unwrap();
+    assert_eq!(state["operator_signals"], serde_json::json!(["Go"]), "{}", a.body);
+
     // `aviary ctl` reads values as the language does, and keeps their units.
     let ctl = |args: &[&str]| {
         let mut all = vec!["ctl", "--url", &run.url, "--token", &run.token];
@@ -129,6 +147,12 @@ fn leash_arguments_and_signal_values_are_checked_against_the_mission_kinds() {
     );
     let (code, _, err) = ctl(&["signal", "Go", "10 parsecs"]);
     assert_eq!(code, 2, "{err}");
+    let (code, _, err) = ctl(&["signal", "Og", "(1, 2)", "2s"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("refused (409): the mission does not declare Og as an operator signal: did you mean `Go`? It declares Go"),
+        "{err}"
+    );
 
     assert_eq!(ctl(&["leash", "Watch-W1", "Widen", "radius=0.2km"]).0, 0);
     assert_eq!(ctl(&["signal", "Go", "(100, -50)", "2min"]).0, 0);

@@ -114,6 +114,7 @@ async function watch() {
   $("trace-file").textContent = about.run.trace ? `trace ${about.run.trace}` : "";
   for (const d of (about.map && about.map.drones) || []) drone(page.model, d.name).pos = d.home;
   const state = await api.call("GET", "/api/state");
+  fillSignals((state.ok && state.body.operator_signals) || []);
   if (state.ok) {
     const s = state.body;
     const m = page.model;
@@ -136,18 +137,23 @@ async function watch() {
 }
 
 function fillLists(tree) {
-  const tags = new Set(), signals = new Set();
+  const tags = new Set();
   const walk = (n) => {
     if (!n) return;
     if (n.kind === "activity" && n.tag) tags.add(`${n.capability}-${n.tag}`);
-    if (n.kind === "handler" && n.signal) signals.add(n.signal);
     (n.children || []).forEach(walk);
   };
   walk(tree);
   $("tags").innerHTML = "";
   for (const t of tags) $("tags").appendChild(new Option(t));
+}
+
+/// The signals the operator may raise: those the mission declares (OPERATOR SIGNAL), as
+/// the state lists them; the API refuses any other.
+function fillSignals(names) {
   $("signals").innerHTML = "";
-  for (const s of signals) $("signals").appendChild(new Option(s));
+  for (const s of names) $("signals").appendChild(new Option(s));
+  $("signal-name").placeholder = names.length ? names.join(", ") : "the mission declares no operator signal";
 }
 
 /// `radius=200m, rounds=2` as the operator API's values: a number with its unit, a

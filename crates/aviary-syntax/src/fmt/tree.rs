@@ -224,12 +224,16 @@ impl Printer<'_> {
                     text.push_str("EVERY ");
                 }
                 text.push_str(&h.signal.name);
-                handler_tail(&mut text, &h.by, &h.bindings);
+                handler_tail(&mut text, &h.by, &h.bindings, h.one_at_a_time.is_some());
                 self.line(depth, &text, Last::Header, start, h.body.header_end as usize);
                 self.body(&h.body, depth + 1, span.start);
             }
             Stmt::ExceptionHandler(h) => self.exception_handler(h, depth),
             Stmt::If(chain) => self.if_chain(chain, depth),
+            Stmt::OperatorSignals(o) => {
+                let text = format!("OPERATOR SIGNAL {}", names(&o.names));
+                self.line(depth, &text, Last::Code, start, end);
+            }
             // Only in trees with errors, which are never formatted: the text as written.
             Stmt::Error(span) => {
                 let text = verbatim(self.source, span.start as usize, span.end as usize);
@@ -240,7 +244,7 @@ impl Printer<'_> {
 
     fn exception_handler(&mut self, h: &ExceptionHandler, depth: usize) {
         let mut text = format!("ON EXCEPTION {}", h.exception.name);
-        handler_tail(&mut text, &h.by, &h.bindings);
+        handler_tail(&mut text, &h.by, &h.bindings, false);
         self.line(depth, &text, Last::Header, h.span.start as usize, h.body.header_end as usize);
         self.body(&h.body, depth + 1, h.span.start);
     }
@@ -318,7 +322,7 @@ impl Printer<'_> {
     }
 }
 
-fn handler_tail(text: &mut String, by: &Option<Ident>, bindings: &[Ident]) {
+fn handler_tail(text: &mut String, by: &Option<Ident>, bindings: &[Ident], one_at_a_time: bool) {
     if let Some(by) = by {
         text.push_str(" BY ");
         text.push_str(&by.name);
@@ -326,6 +330,9 @@ fn handler_tail(text: &mut String, by: &Option<Ident>, bindings: &[Ident]) {
     if !bindings.is_empty() {
         text.push_str(" WITH ");
         text.push_str(&names(bindings));
+    }
+    if one_at_a_time {
+        text.push_str(" ONE AT A TIME");
     }
     text.push(':');
 }
@@ -355,6 +362,7 @@ pub(super) fn stmt_span(stmt: &Stmt) -> aviary_diagnostics::Span {
         Stmt::Handler(h) => h.span,
         Stmt::ExceptionHandler(h) => h.span,
         Stmt::If(i) => i.span,
+        Stmt::OperatorSignals(o) => o.span,
         Stmt::Error(span) => *span,
     }
 }

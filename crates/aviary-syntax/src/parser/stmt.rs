@@ -59,6 +59,14 @@ impl Parser<'_> {
             }
             TokenKind::TaggedName => self.leash(),
             TokenKind::Ident if self.peek_at(1) == TokenKind::Dot => self.api_call(),
+            // `OPERATOR` is a word only before `SIGNAL` at the start of a line: a drone or
+            // capability called `OPERATOR` stays what it was.
+            TokenKind::Ident
+                if self.text_of(start).eq_ignore_ascii_case("OPERATOR")
+                    && self.peek_at(1) == TokenKind::Keyword(Keyword::Signal) =>
+            {
+                self.operator_signals()
+            }
             TokenKind::Ident => self.statement(),
             TokenKind::Unknown => {
                 self.recover_line();
@@ -594,6 +602,95 @@ impl Parser<'_> {
         (by, bindings)
     }
 
+    /// `ONE AT A TIME` before a handler header's `:`, if it is there: its span. The four
+    /// words are words of the language only here, so a drone called `ONE` stays one.
+    fn one_at_a_time(&mut self) -> Option<Span> {
+        const WORDS: [&str; 4] = ["ONE", "AT", "A", "TIME"];
+        if !(self.at(TokenKind::Ident) && self.text_of(self.span()).eq_ignore_ascii_case("ONE")) {
+            return None;
+        }
+        let start = self.span();
+        let fits = |p: &Self, i: usize, exact: bool| {
+            p.peek_at(i) == TokenKind::Ident && {
+                let word = p.text_of(p.span_at(i));
+                if exact {
+                    word == WORDS[i]
+                } else {
+                    word.eq_ignore_ascii_case(WORDS[i])
+                }
+            }
+        };
+        if !(0..WORDS.len()).all(|i| fits(self, i, false)) {
+            // `ONE AT TIME`, `ONE BY ONE`: the phrase misspelt. Up to the `:` is skipped,
+            // so the body is still read.
+            let mut end = start;
+            while !matches!(self.peek(), TokenKind::Colon | TokenKind::Newline | TokenKind::Eof) {
+                end = self.bump().span;
+            }
+            let d = self
+                .error(Code::Syntax, start.to(end), "expected `ONE AT A TIME` before the `:`")
+                .with_help("write `ONE AT A TIME:` at the end of an `ON EVERY` header to run its firings one after another");
+            self.report(d);
+            return Some(start.to(end));
+        }
+        let exact = (0..WORDS.len()).all(|i| fits(self, i, true));
+        let mut end = start;
+        for _ in WORDS {
+            end = self.bump().span;
+        }
+        let span = start.to(end);
+        if !exact {
+            let d = self
+                .error(
+                    Code::KeywordCase,
+                    span,
+                    "the words of the language are written in upper case: `ONE AT A TIME`",
+                )
+                .with_help("write `ONE AT A TIME`");
+            self.report(d);
+        }
+        Some(span)
+    }
+
+    /// `OPERATOR SIGNAL Name, Name`.
+    fn operator_signals(&mut self) -> Stmt {
+        let start = self.bump().span; // OPERATOR
+        if self.text_of(start) != "OPERATOR" {
+            let d = self
+                .error(
+                    Code::KeywordCase,
+                    start,
+                    "the words of the language are written in upper case: `OPERATOR`",
+                )
+                .with_help("write `OPERATOR SIGNAL Name`");
+            self.report(d);
+        }
+        self.bump(); // SIGNAL
+        if !self.at(TokenKind::Ident) {
+            self.expected(
+                "the name of a signal the operator may raise",
+                Some("write `OPERATOR SIGNAL Pause_Inspection` (several names separated by `,`)"),
+            );
+            self.recover_line();
+            return Stmt::Error(Span::new(start.start as usize, self.last_end as usize));
+        }
+        let names = self.name_list("a signal's name after `,`");
+        if self.at_keyword(Keyword::With) {
+            let span = self.span();
+            let d = self
+                .error(Code::Syntax, span, "an operator signal is declared by its name only")
+                .with_help("the values the operator sends are those its handlers bind: `ON Go WITH where:`");
+            self.report(d);
+            self.skip_line();
+        } else {
+            self.end_line("the OPERATOR SIGNAL line");
+        }
+        Stmt::OperatorSignals(OperatorSignals {
+            names,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        })
+    }
+
     fn handler(&mut self, mode: Option<BlockKind>, start: Span) -> Stmt {
         self.bump(); // ON
         let every = self.eat_keyword(Keyword::Every).is_some();
@@ -603,6 +700,14 @@ impl Parser<'_> {
             return Stmt::Error(Span::new(start.start as usize, self.last_end as usize));
         };
         let (by, bindings) = self.handler_tail();
+        let mut one_at_a_time = self.one_at_a_time();
+        if let (Some(span), false) = (one_at_a_time, every) {
+            let d = self
+                .error(Code::OneAtATimeNotEvery, span, "`ONE AT A TIME` orders the firings of an `ON EVERY`, and a plain `ON` fires once")
+                .with_help(format!("write `ON EVERY {}` to handle every signal one firing after another, or leave `ONE AT A TIME` out", signal.name));
+            self.report(d);
+            one_at_a_time = None;
+        }
         let body = if self.header_colon(start, "a handler's header") {
             self.body("the handler")
         } else {
@@ -614,6 +719,7 @@ impl Parser<'_> {
             signal,
             by,
             bindings,
+            one_at_a_time,
             body,
             span: Span::new(start.start as usize, self.last_end as usize),
         })
@@ -631,6 +737,12 @@ impl Parser<'_> {
             return None;
         };
         let (by, bindings) = self.handler_tail();
+        if let Some(span) = self.one_at_a_time() {
+            let d = self
+                .error(Code::OneAtATimeNotEvery, span, "`ONE AT A TIME` orders the firings of an `ON EVERY`; an exception handler starts at once")
+                .with_help("leave `ONE AT A TIME` out: an `ON EXCEPTION` takes the place of the work the exception aborted, so there is nothing to wait for");
+            self.report(d);
+        }
         let body = if self.header_colon(start, "an exception handler's header") {
             self.body("the handler")
         } else {

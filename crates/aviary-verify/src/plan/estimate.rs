@@ -273,6 +273,8 @@ impl<'m> Estimator<'m> {
     ) -> (f64, Vec<Raise>) {
         let mut end = items_end;
         let mut once = vec![false; b.handlers.len()];
+        // When the last firing of each `ONE AT A TIME` handler ends: the next starts then.
+        let mut serial_end = vec![f64::NEG_INFINITY; b.handlers.len()];
         let (mut pending, mut heard) = (Pending::default(), Vec::new());
         for r in raises {
             pending.push(r);
@@ -293,9 +295,13 @@ impl<'m> Estimator<'m> {
                 once[hi] = true;
                 self.s.fired.push(h as *const Handler as usize);
                 let bindings = h.bindings.iter().copied().zip(r.args.iter().cloned());
-                let start = if h.sequential { items_end.max(r.t) } else { r.t };
+                let mut start = if h.sequential { items_end.max(r.t) } else { r.t };
+                if h.one_at_a_time {
+                    start = start.max(serial_end[hi]);
+                }
                 let (e, more) =
                     self.with(ctx, bindings, ctx.actor, |est, ctx| est.block(&h.body, ctx, start));
+                serial_end[hi] = e;
                 end = end.max(e);
                 for r in more {
                     pending.push(r);

@@ -143,9 +143,11 @@ pub fn follow_points(args: &[Value]) -> Result<Vec<Point>, String> {
                 out.push(Point::flat(c[0], c[1]));
             }
             Value::Remainder(left) => out.extend(left.path()),
-            other => return Err(format!(
+            other => {
+                return Err(format!(
                 "`points[{i}]` must be a position, or what a Sweep or FollowPath left, not {other}"
-            )),
+            ))
+            }
         }
     }
     Ok(out)

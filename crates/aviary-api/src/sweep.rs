@@ -71,12 +71,12 @@ pub fn path(lanes: &[Lane]) -> Vec<[f64; 2]> {
 }
 
 /// What a point of [`path`] is: the start of lane `i`, or (`true`) its end.
-pub(crate) type Role = (usize, bool);
+pub type Role = (usize, bool);
 
 /// [`path`]'s points, each with what it is. A lane's start that equals the point before
 /// it (a lane of no length after another's end) is that point; a lane's end that equals
 /// its start is its start.
-pub(crate) fn points(lanes: &[Lane]) -> Vec<([f64; 2], Role)> {
+pub fn points(lanes: &[Lane]) -> Vec<([f64; 2], Role)> {
     let mut out: Vec<([f64; 2], Role)> = Vec::new();
     for (i, lane) in lanes.iter().enumerate() {
         for (k, &p) in lane.iter().enumerate() {

@@ -634,6 +634,7 @@ fn telemetry_field(name: &str) -> Option<Field> {
         "battery" => Field::Battery,
         "state" => Field::State,
         "link" => Field::Link,
+        "remaining" => Field::Remaining,
         _ => return None,
     })
 }

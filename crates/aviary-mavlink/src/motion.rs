@@ -142,7 +142,9 @@ pub(crate) fn pass_radius(speed: f64, accel: f64, arrive_xy: f64) -> f64 {
 
 /// Flies through `path` (local metres): the last point is reached by position within the
 /// tolerances, the ones before it are passed within [`pass_radius`]. PAUSE holds where the
-/// drone is, RESUME sends the target again.
+/// drone is, RESUME sends the target again. The point flown to is noted on the craft by
+/// its index in `path` (`Craft::flying_to`): for a `Sweep` or `FollowPath`, `path` is the
+/// contract's path point for point, which is what a remainder is computed from.
 pub(crate) async fn fly(
     c: &Craft,
     path: &[[f64; 3]],
@@ -164,6 +166,7 @@ pub(crate) async fn fly(
         let far = dist([from[0], from[1]], [to[0], to[1]]).hypot(to[2] - from[2]);
         let mut left = Duration::from_secs_f64(far / speed.max(0.5) * 3.0 + 30.0);
         c.set_level(Some(to[2]));
+        c.set_flying_to(Some(i));
         c.target(to).await?;
         let mut resend = Instant::now() + c.tuning.resend;
         loop {

@@ -99,6 +99,9 @@ pub(crate) struct Rare {
     pub disabled: Option<String>,
     /// The drone's stream for its sensors' chances, made at its first draw.
     pub luck: Option<Box<crate::luck::Stream>>,
+    /// Where its last `Sweep` or `FollowPath` stopped, when it ended early
+    /// (`Backend::stopped`); forgotten when its next motion call starts.
+    pub stopped: Option<aviary_api::Progress>,
 }
 
 /// Every drone's state; its name is the fleet's ([`aviary_api::Names`]).
@@ -244,10 +247,22 @@ impl SimDrone {
         }
     }
 
+    /// Notes where the motion task in progress stops, when it is a path call about to end
+    /// early: the point of its path it is flying to, and where the drone is.
+    pub fn note_stop(&mut self) {
+        let Some((n, left)) = self.motion.as_ref().and_then(|t| Some((t.path?, t.legs.len())))
+        else {
+            return;
+        };
+        let at = self.pos;
+        self.rare_mut().stopped = Some(aviary_api::Progress { next: n.saturating_sub(left), at });
+    }
+
     /// Ends every call in progress (motion and loading), for a fault; returns their ids in
     /// a fixed order (motion first).
     pub fn cut_calls(&mut self) -> Vec<CallId> {
         let mut ended = Vec::new();
+        self.note_stop();
         if let Some(task) = self.motion.take() {
             ended.extend(task.call);
         }

@@ -7,7 +7,7 @@ use aviary_api::{Failure, Function, Value};
 use mavlink::dialects::ardupilotmega::MavCmd;
 
 use crate::craft::{failed, Craft, Paused};
-use crate::motion::{arm, fly, here, hover, land, orbit, rtl, take_off};
+use crate::motion::{arm, fly, fly_passing, here, hover, land, orbit, rtl, take_off, Corners};
 use crate::vehicle::Activation;
 
 use aviary_api::flight::{LOAD_MAX_ALTITUDE, LOAD_TIME};
@@ -109,7 +109,7 @@ async fn sweep(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure>
     let z = c.level();
     let path: Vec<[f64; 3]> =
         aviary_api::sweep::path(&lanes).into_iter().map(|p| [p[0], p[1], z]).collect();
-    fly(c, &path, c.max_speed, paused).await
+    fly_passing(c, &path, c.max_speed, paused, Corners::Reach).await
 }
 
 /// `FollowPath`: through the points (a remainder's in its place); one without an altitude

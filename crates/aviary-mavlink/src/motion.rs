@@ -149,13 +149,38 @@ pub(crate) async fn fly(
     c: &Craft,
     path: &[[f64; 3]],
     speed: f64,
+    paused: Paused,
+) -> Result<(), Failure> {
+    fly_passing(c, path, speed, paused, Corners::Cut).await
+}
+
+/// How a path's points before its last are passed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Corners {
+    /// Within [`pass_radius`], at speed.
+    Cut,
+    /// Reached, within the arrival tolerance: a sweep's lanes are flown to their ends,
+    /// as the simulator flies them, or the turn would cut across the next lane (the pass
+    /// radius is often longer than the spacing).
+    Reach,
+}
+
+/// [`fly`], with the corners passed as `corners` says.
+pub(crate) async fn fly_passing(
+    c: &Craft,
+    path: &[[f64; 3]],
+    speed: f64,
     mut paused: Paused,
+    corners: Corners,
 ) -> Result<(), Failure> {
     in_air(c)?;
     fenced(c, path)?;
     c.set_mode(Mode::Guided).await?;
     c.speed(speed).await?;
-    let pass = pass_radius(speed, c.acceleration, c.tuning.arrive_xy);
+    let pass = match corners {
+        Corners::Cut => pass_radius(speed, c.acceleration, c.tuning.arrive_xy),
+        Corners::Reach => c.tuning.arrive_xy,
+    };
     for (i, &to) in path.iter().enumerate() {
         let last = i + 1 == path.len();
         let from = here(c)?;

@@ -16,9 +16,12 @@ use aviary_api::{CallEnd, DroneId, Function, Remainder, Value};
 
 use crate::engine::Engine;
 
+/// A `Sweep` or `FollowPath` in progress, with its arguments.
+type PathCall = (Function, Vec<Value>);
+
 pub(crate) struct Coverage {
-    /// Per drone: its `Sweep` or `FollowPath` in progress, with its arguments.
-    flying: RefCell<Vec<Option<(Function, Vec<Value>)>>>,
+    /// Per drone: its path call in progress.
+    flying: RefCell<Vec<Option<PathCall>>>,
     /// Per drone: what its last one left; `None` for nothing.
     left: RefCell<Vec<Option<Arc<Remainder>>>>,
     nothing: Arc<Remainder>,

@@ -30,7 +30,7 @@ fn an_aborted_sweep_stops_on_its_lane_and_leaves_the_rest_from_there() {
     let left = coverage::left(Function::Sweep, &field(), fleet.stopped(0)).unwrap();
     let Remainder::Lanes { lanes: left_lanes, .. } = &left else { panic!("{left:?}") };
     // It was on a lane: what is left of it starts where the drone is.
-    assert_eq!(sweep::points(&lanes)[next].1 .1, true, "on a lane, not a turn");
+    assert!(sweep::points(&lanes)[next].1 .1, "on a lane, not a turn");
     let begun = left_lanes[0];
     assert!((begun[0][0] - here[0]).abs() < 1e-9 && (begun[0][1] - here[1]).abs() < 1e-9);
     assert_eq!(left_lanes[1..], lanes[lanes.len() - left_lanes.len() + 1..]);

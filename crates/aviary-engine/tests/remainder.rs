@@ -158,3 +158,27 @@ fn what_a_finished_sweep_leaves_is_nothing_and_sweeping_it_ends_at_once() {
     let b_done = done(&r, "b", "Sweep")[0];
     assert_eq!((b_done["status"].as_str(), &b_done["t"]), (Some("ok"), &call["t"]));
 }
+
+#[test]
+fn a_drone_the_operator_sends_home_leaves_the_rest_of_its_sweep() {
+    use aviary_engine::{Control, DroneAction};
+    let mission = format!(
+        "{SPRAY}\nMISSION Handover:\n    PARALLEL Fields:\n        SEQUENTIAL First:\n            a TakeOff WITH 20m\n            a Spray WITH Field\n            a ReturnHome\n        SEQUENTIAL Second:\n            WAITFOR ELAPSED >= 60s\n            b TakeOff WITH 20m\n            b Spray WITH a.remaining\n            b ReturnHome\n"
+    );
+    let (compiled, world) = harness::compile(&mission, harness::WORLD);
+    let options = RunOptions { telemetry_hz: Some(20.0), ..RunOptions::default() };
+    let home = Control::Drone { drone: "a".into(), action: DroneAction::ReturnHome };
+    let (r, answers) = harness::run_compiled(
+        &compiled,
+        &world,
+        &options,
+        vec![(50.0, home)],
+        harness::Path::AsUsersRun,
+    );
+    assert_eq!(answers, vec![Ok(())]);
+    assert_eq!(r.outcome.status, Status::Ok, "{:?}", r.outcome.reason);
+    let cut = done(&r, "a", "Sweep")[0];
+    assert_eq!((cut["status"].as_str(), cut["t"].as_f64()), (Some("aborted"), Some(50.0)));
+    assert!(cut["left"].as_f64().unwrap() > 0.0);
+    handed_over(&r);
+}

@@ -182,3 +182,13 @@ fn a_drone_the_operator_sends_home_leaves_the_rest_of_its_sweep() {
     assert!(cut["left"].as_f64().unwrap() > 0.0);
     handed_over(&r);
 }
+
+#[test]
+fn in_a_for_the_alias_of_an_exception_handler_names_the_drone_whose_sweep_was_cut() {
+    let mission = format!(
+        "{SPRAY}\nMISSION Handover:\n    PARALLEL FOR a WITH Field AS d WITH field:\n        SEQUENTIAL Work:\n            d TakeOff WITH 20m\n            d Spray WITH field\n            d ReturnHome\n        ON EXCEPTION ConnectionLost BY d:\n            b TakeOff WITH 20m\n            b Spray WITH d.remaining\n            b ReturnHome\n"
+    );
+    let r = run(&mission, &with_fault("at = 50.0\nkind = \"link_loss\"\nduration = 600.0"));
+    assert_eq!(r.outcome.status, Status::Ok, "{:?}", r.outcome.reason);
+    handed_over(&r);
+}

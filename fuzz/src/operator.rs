@@ -123,7 +123,9 @@ fn checked(control: &Control) {
             Value::Position(p) => {
                 assert!(fine(p.x) && fine(p.y) && p.z.is_none_or(fine), "{p:?} reached the engine")
             }
-            Value::Area(_) | Value::Actor(_) => panic!("{v:?} reached the engine from outside"),
+            Value::Area(_) | Value::Actor(_) | Value::Remainder(_) => {
+                panic!("{v:?} reached the engine from outside")
+            }
             Value::Text(_) | Value::Symbol(_) | Value::Bool(_) => {}
         }
     }

@@ -131,9 +131,10 @@ impl Function {
                 vec![p("center", Position), p("radius", Length), opt("laps", Number)],
                 "circle a point",
             ),
-            Function::Sweep => {
-                (vec![p("area", Area), p("spacing", Length)], "fly a lawnmower path over an area")
-            }
+            Function::Sweep => (
+                vec![p("area", Area), p("spacing", Length)],
+                "fly a lawnmower path over an area (or what a Sweep left)",
+            ),
             Function::StartStreaming => (vec![], "start the video stream"),
             Function::StopStreaming => (vec![], "stop the video stream"),
             Function::StartDetection => {
@@ -177,6 +178,14 @@ pub struct Signature {
 impl Signature {
     pub fn name(&self) -> &'static str {
         self.function.name()
+    }
+    /// Whether a value of kind `value` may be given for `param`: a value its kind
+    /// accepts, or, for `FollowPath`'s points, what a Sweep or FollowPath left (its points
+    /// are flown in its place; a parameter of a capability passed on to `FollowPath` is
+    /// still a position).
+    pub fn accepts(&self, param: &Param, value: Kind) -> bool {
+        param.kind.accepts(value)
+            || (self.function == Function::FollowPath && value == Kind::Remainder)
     }
     pub fn required(&self) -> usize {
         self.params.iter().filter(|p| !p.optional).count()

@@ -17,6 +17,9 @@ pub enum Kind {
     /// A name that only equals itself (`Body`, `Landed`).
     Symbol,
     Actor,
+    /// What a `Sweep` or `FollowPath` left (`drone.remaining`): taken by `Sweep` in place
+    /// of an area and by `FollowPath` in place of its points, and nowhere else.
+    Remainder,
 }
 
 impl Kind {
@@ -35,6 +38,7 @@ impl Kind {
             Kind::Area => "an area",
             Kind::Symbol => "a symbol",
             Kind::Actor => "a drone or group",
+            Kind::Remainder => "what a Sweep or FollowPath left (`drone.remaining`)",
         }
     }
 
@@ -44,6 +48,7 @@ impl Kind {
             || matches!(
                 (self, value),
                 (Kind::Position, Kind::Area)
+                    | (Kind::Area, Kind::Remainder)
                     | (Kind::Symbol, Kind::Text)
                     | (Kind::Text, Kind::Symbol)
             )
@@ -64,6 +69,7 @@ impl Kind {
             Kind::Area => "an area from the world file",
             Kind::Symbol => "Body",
             Kind::Actor => "a drone's name",
+            Kind::Remainder => "drone.remaining",
         }
     }
 }

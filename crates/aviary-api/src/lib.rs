@@ -20,6 +20,7 @@
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
 mod builtin;
+pub mod coverage;
 pub mod flight;
 mod function;
 pub mod geo;
@@ -32,6 +33,7 @@ pub mod sweep;
 pub mod trace;
 
 pub use builtin::{BuiltinException, BuiltinSignal};
+pub use coverage::{Progress, Remainder};
 pub use function::{Function, Param, Signature};
 pub use geometry::centroid;
 pub use kind::Kind;
@@ -98,6 +100,9 @@ impl Descriptor {
                 ("battery", Ratio),
                 ("state", Symbol),
                 ("link", Symbol),
+                // Not read from the backend's telemetry: the engine keeps what each drone's
+                // last Sweep or FollowPath left (docs/LANGUAGE.md, section 18).
+                ("remaining", Remainder),
             ],
             signals: BuiltinSignal::ALL.into(),
             exceptions: BuiltinException::ALL.into(),
@@ -134,7 +139,9 @@ mod tests {
         ] {
             assert!(d.function(name).is_some(), "{name} missing");
         }
-        for field in ["position", "altitude", "speed", "heading", "battery", "state", "link"] {
+        for field in
+            ["position", "altitude", "speed", "heading", "battery", "state", "link", "remaining"]
+        {
             assert!(d.telemetry(field).is_some(), "{field} missing");
         }
         assert_eq!(

@@ -33,6 +33,9 @@ pub enum Value {
     Position(Point),
     Area(Vec<[f64; 2]>),
     Actor(DroneId),
+    /// What a drone's last `Sweep` or `FollowPath` left (`drone.remaining`); shared, since
+    /// a mission passes it on as it is.
+    Remainder(std::sync::Arc<crate::Remainder>),
 }
 
 /// What a drone is doing, as telemetry's `state` reports it (and the trace writes it).
@@ -181,6 +184,14 @@ pub trait Backend {
     fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall;
     fn interrupt(&self, call: CallId, how: Interrupt);
     fn telemetry(&self, drone: DroneId) -> Telemetry;
+    /// Where drone `drone`'s last `Sweep` or `FollowPath` stopped, once it ended other
+    /// than done (a fault, an abort, a failure on the way): the point of its path it was
+    /// flying to and where the drone was ([`crate::Progress`]; the path is the contract's,
+    /// [`crate::coverage`]). `None` when that call was refused before the drone moved, or
+    /// the drone's last motion call was no such call: a motion call forgets what the one
+    /// before it left. The engine asks as soon as it learns the call ended, and computes
+    /// what is left with [`crate::coverage::left`].
+    fn stopped(&self, drone: DroneId) -> Option<crate::Progress>;
     /// The stream of drone events; taken once, by the engine.
     fn events(&self) -> Option<mpsc::UnboundedReceiver<DroneEvent>>;
 }

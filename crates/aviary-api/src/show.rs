@@ -99,6 +99,12 @@ impl fmt::Display for Value {
             Value::Area(corners) if corners.len() == 1 => f.write_str("an area of 1 corner"),
             Value::Area(corners) => write!(f, "an area of {} corners", corners.len()),
             Value::Actor(d) => write!(f, "drone #{d}"),
+            Value::Remainder(left) => match (left.lane_count(), left.length()) {
+                (Some(0), _) => f.write_str("nothing left"),
+                (Some(1), m) => write!(f, "1 lane left ({} m)", fixed(m, 1)),
+                (Some(n), m) => write!(f, "{n} lanes left ({} m)", fixed(m, 1)),
+                (None, m) => write!(f, "a path left ({} m)", fixed(m, 1)),
+            },
         }
     }
 }

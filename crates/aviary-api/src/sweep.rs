@@ -12,9 +12,18 @@
 //! Part of the contract rather than of a backend, so that the simulator and the MAVLink
 //! backend fly the same path and the plan costs the path they fly.
 
+/// A lane: a piece of one pass, from where the drone enters it to where it leaves it.
+pub type Lane = [[f64; 2]; 2];
+
 /// The path, as `[x, y]` points in flying order. Empty for fewer than 3 corners or a
 /// spacing that is not positive.
 pub fn lawnmower(polygon: &[[f64; 2]], spacing: f64) -> Vec<[f64; 2]> {
+    path(&lanes(polygon, spacing))
+}
+
+/// The lanes of the path, in flying order: each pass's pieces, the passes alternating
+/// direction. Empty for fewer than 3 corners or a spacing that is not positive.
+pub fn lanes(polygon: &[[f64; 2]], spacing: f64) -> Vec<Lane> {
     if polygon.len() < 3 || spacing.is_nan() || spacing <= 0.0 {
         return Vec::new();
     }
@@ -34,7 +43,7 @@ pub fn lawnmower(polygon: &[[f64; 2]], spacing: f64) -> Vec<[f64; 2]> {
     let passes = ((extent / spacing) - 1e-9).ceil().max(1.0) as usize;
     let first = w_min + (extent - (passes - 1) as f64 * spacing) / 2.0;
 
-    let mut path: Vec<[f64; 2]> = Vec::new();
+    let mut lanes: Vec<Lane> = Vec::new();
     let mut forward = true;
     for i in 0..passes {
         let w = first + i as f64 * spacing;
@@ -48,16 +57,35 @@ pub fn lawnmower(polygon: &[[f64; 2]], spacing: f64) -> Vec<[f64; 2]> {
         }
         for (a, b) in pieces {
             let (s, e) = if forward { (a, b) } else { (b, a) };
-            for u in [s, e] {
-                let p = to_uw([u, w]);
-                if path.last() != Some(&p) {
-                    path.push(p);
-                }
-            }
+            lanes.push([to_uw([s, w]), to_uw([e, w])]);
         }
         forward = !forward;
     }
-    path
+    lanes
+}
+
+/// The points a drone flies through to fly `lanes` in order: each lane's start and end,
+/// a point equal to the one before it given once.
+pub fn path(lanes: &[Lane]) -> Vec<[f64; 2]> {
+    points(lanes).into_iter().map(|(p, _)| p).collect()
+}
+
+/// What a point of [`path`] is: the start of lane `i`, or (`true`) its end.
+pub type Role = (usize, bool);
+
+/// [`path`]'s points, each with what it is. A lane's start that equals the point before
+/// it (a lane of no length after another's end) is that point; a lane's end that equals
+/// its start is its start.
+pub fn points(lanes: &[Lane]) -> Vec<([f64; 2], Role)> {
+    let mut out: Vec<([f64; 2], Role)> = Vec::new();
+    for (i, lane) in lanes.iter().enumerate() {
+        for (k, &p) in lane.iter().enumerate() {
+            if out.last().map(|(q, _)| *q) != Some(p) {
+                out.push((p, (i, k == 1)));
+            }
+        }
+    }
+    out
 }
 
 /// The intervals of `u` that the polygon (in (u, w) coordinates) covers for some `w` in

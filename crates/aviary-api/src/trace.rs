@@ -85,6 +85,8 @@ pub enum Event<'a> {
         function: Function,
         args: Vec<Shown<'a>>,
     },
+    /// `left`: for a `Sweep` or `FollowPath` that ended other than `ok`, the metres of
+    /// its path it left unflown (the length of its drone's `remaining`).
     ApiDone {
         actor: Text<'a>,
         function: Function,
@@ -92,6 +94,8 @@ pub enum Event<'a> {
         status: CallStatus,
         #[serde(deserialize_with = "shown::coordinates")]
         position: [f64; 3],
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        left: Option<f64>,
     },
     Signal {
         name: Text<'a>,

@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex};
 
 use aviary_api::{
     Backend, CallId, Descriptor, DroneEvent, DroneId, Ending, Function, Interrupt, PendingCall,
-    Telemetry, Value,
+    Progress, Telemetry, Value,
 };
 use aviary_mavlink::MavlinkBackend;
 use aviary_sim::SimBackend;
@@ -110,6 +110,14 @@ impl Backend for Mixed {
             self.mavlink.telemetry(drone)
         } else {
             self.sim.telemetry(drone)
+        }
+    }
+
+    fn stopped(&self, drone: DroneId) -> Option<Progress> {
+        if self.mavlink.serves(drone) {
+            self.mavlink.stopped(drone)
+        } else {
+            self.sim.stopped(drone)
         }
     }
 

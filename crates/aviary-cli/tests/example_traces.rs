@@ -1,8 +1,9 @@
-//! The traces of the examples, byte for byte: the paper's mission, the newcomers'
-//! scenarios (the bridge inspection as it flies with no operator) and each fault drill,
-//! run as a user runs them (`aviary run FILE --trace OUT`), against a snapshot. A change
-//! that should not change behaviour must leave every one of them as it is; one that does
-//! shows, event by event, in review.
+//! The traces of the examples, byte for byte: every mission in `examples/` (the paper's
+//! mission and the newcomers' scenarios, the bridge inspection as it flies with no
+//! operator) and each fault drill in `examples/faults/`, run as a user runs them
+//! (`aviary run FILE --trace OUT`), against a snapshot. A change that should not change
+//! behaviour must leave every one of them as it is; one that does shows, event by event,
+//! in review.
 
 mod common;
 
@@ -11,20 +12,19 @@ use common::{aviary, repo, scratch};
 #[test]
 fn every_example_writes_the_trace_it_always_wrote() {
     let dir = scratch("example_traces");
-    let mut missions: Vec<String> = [
-        "examples/search_and_rescue.mission",
-        "examples/wildfire_perimeter.mission",
-        "examples/bridge_inspection.mission",
-    ]
-    .map(String::from)
-    .to_vec();
-    let mut drills: Vec<String> = std::fs::read_dir(repo().join("examples/faults"))
-        .expect("examples/faults")
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "mission"))
-        .map(|p| format!("examples/faults/{}", p.file_name().unwrap_or_default().to_string_lossy()))
-        .collect();
-    drills.sort();
+    // Every mission of `examples/` and of `examples/faults/`, as the folders hold them.
+    let missions_in = |folder: &str| -> Vec<String> {
+        let mut found: Vec<String> = std::fs::read_dir(repo().join(folder))
+            .expect(folder)
+            .map(|e| e.expect("entry").path())
+            .filter(|p| p.extension().is_some_and(|x| x == "mission"))
+            .map(|p| format!("{folder}/{}", p.file_name().unwrap_or_default().to_string_lossy()))
+            .collect();
+        found.sort();
+        found
+    };
+    let mut missions = missions_in("examples");
+    let drills = missions_in("examples/faults");
     missions.extend(drills);
     for mission in missions {
         let name = std::path::Path::new(&mission)

@@ -422,3 +422,128 @@ fn check_plan_hears_aviary_vehicles_and_says_where_the_figures_come_from() {
     assert!(doc["plan"]["drones"].as_array().is_some_and(|d| d.len() == 2), "{doc}");
     assert!(took < Duration::from_secs(8), "check --plan took {took:?}");
 }
+
+const FIELD_WORLD: &str = "\
+[site]
+name = \"Loopback farm\"
+origin = { lat = 46.6167, lon = 14.2650, alt = 440.0 }
+geofence = [[-100, -100], [100, -100], [100, 100], [-100, 100]]
+
+[places]
+Mid = [0, 50]
+
+[areas]
+Field = [[-60, 20], [60, 20], [60, 80], [-60, 80]]
+
+[drones.scout]
+home = [0, 0]
+
+[drones.buddy]
+home = [10, 0]
+";
+
+/// The scout's sweep is aborted on its second lane (`Mid`); the buddy sweeps what it
+/// left. Three lanes of 120 m, 20 m apart: along y = 30 (east), 50 (west), 70 (east).
+const HANDOVER: &str = "\
+CAPABILITY Spray BY drone WITH field:
+    PERFORM:
+        drone.Sweep(field, 20m)
+
+MISSION Handover:
+    SEQUENTIAL Fields:
+        PARALLEL Work:
+            SEQUENTIAL First:
+                scout TakeOff WITH 10m
+                scout Spray-S1 WITH Field
+                scout ReturnHome
+            SEQUENTIAL Control:
+                WAITFOR distance(scout, Mid) < 10m
+                Spray-S1 ABORT
+        buddy TakeOff WITH 15m
+        buddy Spray WITH scout.remaining
+        buddy ReturnHome
+";
+
+/// Over MAVLink the backend knows which point of the sweep a vehicle was flying to when
+/// its sweep was aborted, and where the vehicle said it was: the remainder starts there,
+/// and the other vehicle flies just that. Nothing is missed; what is flown twice is at
+/// most the metres the first vehicle took to stop after the abort.
+#[test]
+fn the_remainder_of_a_sweep_aborted_over_mavlink_is_flown_by_another_vehicle() {
+    let dir = scratch("mavlink_remainder");
+    std::fs::write(dir.join("vehicles.world.toml"), FIELD_WORLD).expect("world");
+    let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
+    std::fs::write(dir.join("m.mission"), HANDOVER).expect("mission");
+    std::fs::write(dir.join("m.world.toml"), bind(FIELD_WORLD, vehicles.port, &[])).expect("world");
+    let code = run_within(
+        &dir,
+        &["run", "m.mission", "--quiet", "--telemetry-hz", "10", "--trace", "t.jsonl"],
+        Duration::from_secs(180),
+    );
+    let trace = events(&dir.join("t.jsonl"));
+    assert_eq!(code, 0, "{:?}", trace.last());
+    let sweep = |actor: &str, event: &str| -> Value {
+        trace
+            .iter()
+            .find(|e| e["event"] == event && e["actor"] == actor && e["function"] == "Sweep")
+            .cloned()
+            .unwrap_or_else(|| panic!("no {event} of {actor}'s Sweep: {trace:?}"))
+    };
+    let cut = sweep("scout", "api_done");
+    assert_eq!(cut["status"], "aborted");
+    assert!(cut["left"].as_f64().unwrap() > 0.0, "{cut}");
+    let stop = [cut["position"][0].as_f64().unwrap(), cut["position"][1].as_f64().unwrap()];
+    assert!((stop[1] - 50.0).abs() < 2.0 && stop[0].abs() < 12.0, "stopped near Mid: {stop:?}");
+
+    // What is left: the rest of the second lane from where the scout stopped, and the third.
+    let left = sweep("buddy", "api_call")["args"][0].clone();
+    let lanes = left["lanes"].as_array().unwrap_or_else(|| panic!("lanes: {left}"));
+    assert_eq!(lanes.len(), 2, "{left}");
+    let from = [lanes[0][0][0].as_f64().unwrap(), lanes[0][0][1].as_f64().unwrap()];
+    assert_eq!(from[1], 50.0, "on the lane");
+    assert!((from[0] - stop[0]).abs() < 1.5, "where the scout stopped: {from:?} {stop:?}");
+    assert_eq!(lanes[0][1], serde_json::json!([-60.0, 50.0]));
+    assert_eq!(lanes[1], serde_json::json!([[-60.0, 70.0], [60.0, 70.0]]));
+    let done = sweep("buddy", "api_done");
+    assert_eq!(done["status"], "ok");
+
+    // From the telemetry: the middle of every lane (away from the corners a vehicle cuts)
+    // is flown; the second lane by the scout east of where it stopped and by the buddy
+    // west of it.
+    let tracks: Vec<(String, Vec<[f64; 3]>)> = ["scout", "buddy"]
+        .iter()
+        .map(|d| {
+            let track = trace
+                .iter()
+                .filter(|e| e["event"] == "telemetry" && e["actor"] == *d)
+                .map(|e| {
+                    let p = &e["position"];
+                    [p[0].as_f64().unwrap(), p[1].as_f64().unwrap(), p[2].as_f64().unwrap()]
+                })
+                .collect();
+            (d.to_string(), track)
+        })
+        .collect();
+    let field = [[-60.0, 20.0], [60.0, 20.0], [60.0, 80.0], [-60.0, 80.0]];
+    let all = aviary_api::sweep::lanes(&field, 20.0);
+    let passes = aviary_test_support::lanes::passes(&all, &tracks);
+    let step = aviary_test_support::lanes::STEP;
+    let margin = aviary_test_support::lanes::MARGIN;
+    for (k, lane) in passes.iter().enumerate() {
+        for (i, who) in lane.iter().enumerate() {
+            let along = margin + i as f64 * step;
+            if !(25.0..=95.0).contains(&along) {
+                continue;
+            }
+            assert!(!who.is_empty(), "lane {k}, {along} m in: not flown");
+            let x = all[k][0][0] + (all[k][1][0] - all[k][0][0]) * along / 120.0;
+            if who.len() > 1 {
+                // Only just past where the scout stopped: its braking.
+                assert!(
+                    k == 1 && x <= stop[0] && x > stop[0] - 15.0,
+                    "lane {k} at x = {x}: {who:?}"
+                );
+            }
+        }
+    }
+}

@@ -83,6 +83,7 @@ codes! {
     UseRefused = "E127", Error, "a USE of a file that is not a .mission file under the mission's folder (or a --use-root), or not a regular file of at most 16 MiB";
     OneAtATimeNotEvery = "E129", Error, "`ONE AT A TIME` on a handler that is not an `ON EVERY`";
     OperatorSignalBuiltin = "E130", Error, "an OPERATOR SIGNAL that names a built-in signal, which only a drone raises";
+    GroupRemainder = "E131", Error, "`group.remaining`: a remainder is one drone's, not a group's";
     // Warnings.
     HandlerNeverFires = "W201", Warning, "a handler for a signal that nothing raises";
     UnknownException = "W202", Warning, "an ON EXCEPTION for a name neither built in nor thrown";

@@ -76,6 +76,7 @@ impl<'m> Engine<'m> {
             args: self.values(&args),
         });
         let pending = self.backend.call(drone, function, &args);
+        self.path_begun(drone, function, &args);
         Begun { call: Made { drone, function, args, id: pending.id }, end: pending.end }
     }
 
@@ -160,12 +161,15 @@ impl Drop for CallGuard<'_, '_> {
         if !self.done.get() {
             self.engine.backend.interrupt(call.id, Interrupt::Abort);
             let engine = self.engine;
+            // Ended early: any way but done.
+            let left = engine.path_ended(call.drone, call.function, &CallEnd::Interrupted);
             engine.trace(EventKind::ApiDone, || Event::ApiDone {
                 actor: engine.name(call.drone).into(),
                 function: call.function,
                 args: engine.values(&call.args),
                 status: CallStatus::Aborted,
                 position: engine.backend.telemetry(call.drone).position,
+                left,
             });
         }
         if let Some(root) = &self.root {

@@ -306,6 +306,8 @@ pub(crate) struct Engine<'m> {
     max_handler_reentries: usize,
     /// The exception handler instances running, by their body's scope (its address).
     entered: RefCell<BTreeMap<usize, Rc<Entry<'m>>>>,
+    /// What each drone's last `Sweep` or `FollowPath` left (`coverage.rs`).
+    pub coverage: crate::coverage::Coverage,
     /// How many times the runtime has polled the mission. Within one poll the engine has
     /// not waited for anything: with the wall clock (MAVLink drones), whose every reading
     /// differs, that is what "at one instant" is.
@@ -348,6 +350,7 @@ impl<'m> Engine<'m> {
             max_handler_reentries: options.max_handler_reentries,
             entered: RefCell::new(BTreeMap::new()),
             polls: Cell::new(0),
+            coverage: crate::coverage::Coverage::new(m.drones.len()),
         }
     }
 
@@ -380,7 +383,14 @@ impl<'m> Engine<'m> {
     }
 
     pub fn env<'a>(&'a self, frame: &'a [Value], received: &'a [bool]) -> Env<'a> {
-        Env { mission: self.m, backend: self.backend, frame, received, start: self.start }
+        Env {
+            mission: self.m,
+            backend: self.backend,
+            coverage: &self.coverage,
+            frame,
+            received,
+            start: self.start,
+        }
     }
 
     pub async fn run(
@@ -506,12 +516,14 @@ impl<'m> Engine<'m> {
             aviary_api::CallEnd::Failed(_) => CallStatus::Failed,
             aviary_api::CallEnd::Interrupted => CallStatus::Interrupted,
         };
+        let left = self.path_ended(d, function, end);
         self.trace(EventKind::ApiDone, || Event::ApiDone {
             actor: self.name(d).into(),
             function,
             args: self.values(args),
             status,
             position: self.backend.telemetry(d).position,
+            left,
         });
     }
 
@@ -598,6 +610,8 @@ impl<'m> Engine<'m> {
                 self.raise(self.m.builtins.signal(signal), Vec::new(), Some(drone), &scope);
             }
             DroneEvent::Fault { drone, failure } => {
+                // What a path call in progress left, before a handler can read it.
+                self.path_stopped(drone);
                 let scope = self.actor_scope(drone);
                 self.fail(failure, drone, &scope);
             }

@@ -187,6 +187,7 @@ impl<'m> Engine<'m> {
             args: Vec::new(),
             status: CallStatus::Aborted,
             position: self.backend.telemetry(d).position,
+            left: None,
         });
     }
 

@@ -15,6 +15,7 @@ mod api;
 mod arbiter;
 mod cancel;
 mod control;
+mod coverage;
 mod engine;
 mod exec;
 mod homing;

@@ -7,6 +7,7 @@ use aviary_ir::{ActorRef, Expr, Field, Mission};
 pub(crate) struct Env<'a> {
     pub mission: &'a Mission,
     pub backend: &'a dyn Backend,
+    pub coverage: &'a crate::coverage::Coverage,
     pub frame: &'a [Value],
     pub received: &'a [bool],
     /// When the mission started: `ELAPSED` is read from the clock only when evaluated
@@ -32,6 +33,7 @@ impl Env<'_> {
             Expr::Slot(s) => self.frame.get(*s).cloned().unwrap_or(Value::Bool(false)),
             Expr::Actor(r) => self.actor(r).map_or(Value::Bool(false), Value::Actor),
             Expr::Telemetry(r, field) => match self.actor(r) {
+                Some(d) if *field == Field::Remaining => self.coverage.remaining(d),
                 Some(d) => telemetry(self.backend, d, *field),
                 None => Value::Bool(false),
             },
@@ -99,6 +101,8 @@ fn telemetry(backend: &dyn Backend, d: usize, field: Field) -> Value {
         Field::Battery => Value::Number(t.battery),
         Field::State => Value::Symbol(t.state.as_str().to_string()),
         Field::Link => Value::Symbol(if t.link { "Connected" } else { "Lost" }.to_string()),
+        // The engine's, not the backend's: read in `Env::eval`.
+        Field::Remaining => Value::Bool(false),
     }
 }
 

@@ -58,6 +58,10 @@ impl Backend for Scripted {
 
     fn interrupt(&self, _: CallId, _: Interrupt) {}
 
+    fn stopped(&self, _: DroneId) -> Option<aviary_api::Progress> {
+        None
+    }
+
     fn telemetry(&self, _: DroneId) -> Telemetry {
         Telemetry { state: FlightState::Landed, link: true, battery: 1.0, ..Telemetry::LOST }
     }

@@ -324,6 +324,8 @@ pub enum Field {
     Battery,
     State,
     Link,
+    /// What the drone's last `Sweep` or `FollowPath` left: the engine's, not telemetry.
+    Remaining,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

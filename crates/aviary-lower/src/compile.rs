@@ -649,6 +649,7 @@ fn telemetry_field(name: &str) -> Option<Field> {
         "battery" => Field::Battery,
         "state" => Field::State,
         "link" => Field::Link,
+        "remaining" => Field::Remaining,
         _ => return None,
     })
 }

@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use aviary_api::{
     Backend, BuiltinException, BuiltinSignal, CallEnd, CallId, Descriptor, DroneEvent, DroneId,
-    Ending, Failure, Function, Interrupt, PendingCall, Telemetry, Value,
+    Ending, Failure, Function, Interrupt, PendingCall, Progress, Telemetry, Value,
 };
 use aviary_world::Sensor;
 use tokio::sync::{mpsc, oneshot, watch};
@@ -22,6 +22,7 @@ use crate::flight;
 
 struct Slot {
     drone: DroneId,
+    function: Function,
     task: AbortHandle,
     paused: watch::Sender<bool>,
     end: oneshot::Sender<CallEnd>,
@@ -37,6 +38,8 @@ pub(crate) struct Inner {
     lost: Mutex<Vec<bool>>,
     /// Per drone: `BatteryLow` signalled, `BatteryCritical` raised (each once).
     battery: Mutex<Vec<(bool, bool)>>,
+    /// Per drone: where its last `Sweep` or `FollowPath` stopped (`Backend::stopped`).
+    stops: Mutex<Vec<Option<Progress>>>,
 }
 
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
@@ -69,6 +72,7 @@ impl MavlinkBackend {
             taken: Mutex::new(Some(events.1)),
             lost: Mutex::new(vec![false; n]),
             battery: Mutex::new(vec![(false, false); n]),
+            stops: Mutex::new(vec![None; n]),
         });
         tokio::spawn(alarms_task(Arc::downgrade(&inner), alarms));
         tokio::spawn(watchdog(Arc::downgrade(&inner), heartbeat_timeout));
@@ -104,12 +108,29 @@ impl MavlinkBackend {
 impl Inner {
     fn finish(&self, call: CallId, end: CallEnd) {
         if let Some(slot) = lock(&self.calls).remove(&call) {
+            if end != CallEnd::Done {
+                self.note_stop(&slot);
+            }
             let _ = slot.end.send(end);
         }
     }
 
+    /// Notes where a path call that ends early stops: the point of its path the drone was
+    /// flying to, and where the vehicle last said it was. Nothing when it had not begun
+    /// to fly (refused before a target was sent).
+    fn note_stop(&self, slot: &Slot) {
+        if !matches!(slot.function, Function::Sweep | Function::FollowPath) {
+            return;
+        }
+        let Some(Some(c)) = self.crafts.get(slot.drone) else { return };
+        let (Some(next), Some(fix)) = (c.flying_to(), c.fix()) else { return };
+        if let Some(stop) = lock(&self.stops).get_mut(slot.drone) {
+            *stop = Some(Progress { next, at: fix.pos });
+        }
+    }
+
     /// A fault: the event first, then every call of the drone ends `Interrupted` (so the
-    /// engine raises one exception, once).
+    /// engine raises one exception, once); where a path call stopped is noted before both.
     fn fault(&self, drone: DroneId, failure: Failure) {
         if failure.exception == BuiltinException::BatteryCritical {
             // The rule below and the autopilot's battery failsafe may both see it: one
@@ -120,15 +141,20 @@ impl Inner {
             }
             flags[drone].1 = true;
         }
-        let _ = self.events.send(DroneEvent::Fault { drone, failure });
         let cut: Vec<Slot> = {
             let mut calls = lock(&self.calls);
             let ids: Vec<CallId> =
                 calls.iter().filter(|(_, s)| s.drone == drone).map(|(id, _)| *id).collect();
             ids.into_iter().filter_map(|id| calls.remove(&id)).collect()
         };
-        for slot in cut {
+        // Where a path call stopped is known before the engine hears of the fault: a
+        // handler of it may read what is left at once.
+        for slot in &cut {
             slot.task.abort();
+            self.note_stop(slot);
+        }
+        let _ = self.events.send(DroneEvent::Fault { drone, failure });
+        for slot in cut {
             let _ = slot.end.send(CallEnd::Interrupted);
         }
         if let Some(Some(c)) = self.crafts.get(drone) {
@@ -236,6 +262,12 @@ impl Backend for MavlinkBackend {
             ))));
             return PendingCall { id, end: Ending::Later(rx) };
         };
+        if function.resource() == aviary_api::Resource::Motion {
+            // A motion call forgets where the last path call stopped, before anything can
+            // refuse it: a refused call has not moved.
+            craft.set_flying_to(None);
+            lock(&self.inner.stops)[drone] = None;
+        }
         if lock(&self.inner.lost)[drone] {
             // The drone stays lost to the mission until its link is back: what is asked
             // of it meanwhile raises the exception a handler of the loss already knows.
@@ -260,7 +292,10 @@ impl Backend for MavlinkBackend {
             };
             inner.finish(id, end);
         });
-        calls.insert(id, Slot { drone, task: task.abort_handle(), paused: paused_tx, end: tx });
+        calls.insert(
+            id,
+            Slot { drone, function, task: task.abort_handle(), paused: paused_tx, end: tx },
+        );
         PendingCall { id, end: Ending::Later(rx) }
     }
 
@@ -271,6 +306,7 @@ impl Backend for MavlinkBackend {
                     return;
                 };
                 slot.task.abort();
+                self.inner.note_stop(&slot);
                 if let Some(Some(c)) = self.inner.crafts.get(slot.drone).cloned() {
                     c.set_doing(Doing::Other);
                     // The drone stops where it is and hovers (the task that flew it is gone).
@@ -303,6 +339,10 @@ impl Backend for MavlinkBackend {
             state,
             link: !lock(&self.inner.lost)[drone],
         }
+    }
+
+    fn stopped(&self, drone: DroneId) -> Option<Progress> {
+        lock(&self.inner.stops).get(drone).copied().flatten()
     }
 
     fn events(&self) -> Option<mpsc::UnboundedReceiver<DroneEvent>> {

@@ -176,6 +176,7 @@ fn craft(
         doing: Mutex::new(Doing::Other),
         speed: Mutex::new(None),
         level: Mutex::new(None),
+        flying_to: Mutex::new(None),
         tuning,
     }
 }

@@ -51,6 +51,11 @@ pub struct Craft {
     /// The altitude last commanded: a flight without one keeps it (as the simulator's
     /// drones do), not the height reported on the way up to it.
     pub level: Mutex<Option<f64>>,
+    /// The point of the path being flown that the drone is flying to (its index in the
+    /// path `motion::fly` was given), for where a `Sweep` or `FollowPath` stops
+    /// (`Backend::stopped`). Set before the point's target is sent; cleared when a motion
+    /// call starts.
+    pub flying_to: Mutex<Option<usize>>,
     pub tuning: Tuning,
 }
 
@@ -78,6 +83,14 @@ impl Craft {
 
     pub fn set_level(&self, z: Option<f64>) {
         *lock(&self.level) = z;
+    }
+
+    pub fn flying_to(&self) -> Option<usize> {
+        *lock(&self.flying_to)
+    }
+
+    pub fn set_flying_to(&self, point: Option<usize>) {
+        *lock(&self.flying_to) = point;
     }
 
     pub fn set_doing(&self, doing: Doing) {

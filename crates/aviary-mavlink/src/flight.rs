@@ -7,7 +7,7 @@ use aviary_api::{Failure, Function, Value};
 use mavlink::dialects::ardupilotmega::MavCmd;
 
 use crate::craft::{failed, Craft, Paused};
-use crate::motion::{arm, fly, here, hover, land, orbit, rtl, take_off};
+use crate::motion::{arm, fly, fly_passing, here, hover, land, orbit, rtl, take_off, Corners};
 use crate::vehicle::Activation;
 
 use aviary_api::flight::{LOAD_MAX_ALTITUDE, LOAD_TIME};
@@ -89,33 +89,42 @@ async fn orbit_around(c: &Craft, args: &[Value], paused: Paused) -> Result<(), F
     .await
 }
 
-/// `Sweep`: the area's lawnmower path, at the altitude kept.
+/// `Sweep`: the area's lawnmower path, or the lanes a remainder left (the contract's,
+/// `aviary_api::coverage`), at the altitude kept.
 async fn sweep(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
-    let Some(Value::Area(area)) = args.first() else {
-        return Err(failed("`area` must be an area"));
+    let area = match args.first() {
+        Some(area @ (Value::Area(_) | Value::Remainder(_))) => area,
+        _ => return Err(failed("`area` must be an area, or what a Sweep left")),
     };
     let spacing = number(args, 1, "spacing")?;
     if spacing <= 0.0 {
         return Err(failed(format!("sweep spacing must be above 0 m, not {spacing} m")));
     }
+    let lanes = aviary_api::coverage::sweep_lanes(area, spacing).map_err(failed)?;
+    if lanes.is_empty() {
+        // Nothing left to sweep: done at once, as in the simulator.
+        return Ok(());
+    }
     here(c)?;
     let z = c.level();
     let path: Vec<[f64; 3]> =
-        aviary_api::sweep::lawnmower(area, spacing).into_iter().map(|p| [p[0], p[1], z]).collect();
-    fly(c, &path, c.max_speed, paused).await
+        aviary_api::sweep::path(&lanes).into_iter().map(|p| [p[0], p[1], z]).collect();
+    fly_passing(c, &path, c.max_speed, paused, Corners::Reach).await
 }
 
-/// `FollowPath`: through the points; one without an altitude keeps the one before.
+/// `FollowPath`: through the points (a remainder's in its place); one without an altitude
+/// keeps the one before.
 async fn follow_path(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
+    let points = aviary_api::coverage::follow_points(args).map_err(failed)?;
+    if points.is_empty() {
+        return Ok(());
+    }
     here(c)?;
     let mut z = c.level();
     let mut path = Vec::new();
-    for v in args {
-        let p = point(c, Some(v), "points")?;
-        if !p[2].is_nan() {
-            z = p[2];
-        }
-        path.push([p[0], p[1], z]);
+    for p in points {
+        z = p.z.unwrap_or(z);
+        path.push([p.x, p.y, z]);
     }
     fly(c, &path, c.max_speed, paused).await
 }
@@ -147,16 +156,16 @@ fn number(args: &[Value], i: usize, name: &str) -> Result<f64, Failure> {
     }
 }
 
-/// A position argument in local metres; z is NaN when it has none (keep the altitude).
+/// A position argument in local metres; without a height, the altitude kept.
 fn point(c: &Craft, v: Option<&Value>, name: &str) -> Result<[f64; 3], Failure> {
     let here_z = c.level();
     match v {
         Some(Value::Position(p)) if p.x.is_finite() && p.y.is_finite() => {
-            Ok([p.x, p.y, p.z.unwrap_or(if name == "points" { f64::NAN } else { here_z })])
+            Ok([p.x, p.y, p.z.unwrap_or(here_z)])
         }
         Some(Value::Area(a)) if !a.is_empty() => {
             let m = centroid(a);
-            Ok([m[0], m[1], if name == "points" { f64::NAN } else { here_z }])
+            Ok([m[0], m[1], here_z])
         }
         other => Err(failed(format!("`{name}` must be a position, not {}", given(other)))),
     }

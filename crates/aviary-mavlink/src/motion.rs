@@ -142,18 +142,45 @@ pub(crate) fn pass_radius(speed: f64, accel: f64, arrive_xy: f64) -> f64 {
 
 /// Flies through `path` (local metres): the last point is reached by position within the
 /// tolerances, the ones before it are passed within [`pass_radius`]. PAUSE holds where the
-/// drone is, RESUME sends the target again.
+/// drone is, RESUME sends the target again. The point flown to is noted on the craft by
+/// its index in `path` (`Craft::flying_to`): for a `Sweep` or `FollowPath`, `path` is the
+/// contract's path point for point, which is what a remainder is computed from.
 pub(crate) async fn fly(
     c: &Craft,
     path: &[[f64; 3]],
     speed: f64,
+    paused: Paused,
+) -> Result<(), Failure> {
+    fly_passing(c, path, speed, paused, Corners::Cut).await
+}
+
+/// How a path's points before its last are passed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Corners {
+    /// Within [`pass_radius`], at speed.
+    Cut,
+    /// Reached, within the arrival tolerance: a sweep's lanes are flown to their ends,
+    /// as the simulator flies them, or the turn would cut across the next lane (the pass
+    /// radius is often longer than the spacing).
+    Reach,
+}
+
+/// [`fly`], with the corners passed as `corners` says.
+pub(crate) async fn fly_passing(
+    c: &Craft,
+    path: &[[f64; 3]],
+    speed: f64,
     mut paused: Paused,
+    corners: Corners,
 ) -> Result<(), Failure> {
     in_air(c)?;
     fenced(c, path)?;
     c.set_mode(Mode::Guided).await?;
     c.speed(speed).await?;
-    let pass = pass_radius(speed, c.acceleration, c.tuning.arrive_xy);
+    let pass = match corners {
+        Corners::Cut => pass_radius(speed, c.acceleration, c.tuning.arrive_xy),
+        Corners::Reach => c.tuning.arrive_xy,
+    };
     for (i, &to) in path.iter().enumerate() {
         let last = i + 1 == path.len();
         let from = here(c)?;
@@ -164,6 +191,7 @@ pub(crate) async fn fly(
         let far = dist([from[0], from[1]], [to[0], to[1]]).hypot(to[2] - from[2]);
         let mut left = Duration::from_secs_f64(far / speed.max(0.5) * 3.0 + 30.0);
         c.set_level(Some(to[2]));
+        c.set_flying_to(Some(i));
         c.target(to).await?;
         let mut resend = Instant::now() + c.tuning.resend;
         loop {

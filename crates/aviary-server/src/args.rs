@@ -264,7 +264,7 @@ pub(crate) fn value(v: &JsonValue, kind: Option<Kind>, what: &str) -> Result<Val
         (Some(Kind::Symbol) | None, Given::Word(s)) => Ok(Value::Symbol(s)),
         (Some(Kind::Text), Given::Word(s)) => Ok(Value::Text(s)),
         (Some(Kind::Bool) | None, Given::Bool(b)) => Ok(Value::Bool(b)),
-        (Some(k @ (Kind::Area | Kind::Actor)), _) => {
+        (Some(k @ (Kind::Area | Kind::Actor | Kind::Remainder)), _) => {
             Err(format!("{what} is {}, which the operator API cannot send", k.describe()))
         }
         (Some(k), _) => Err(format!("{what} is {}, and {v} is not: {}", k.describe(), example(k))),
@@ -293,7 +293,7 @@ fn example(kind: Kind) -> String {
         Kind::Position => return "write [x, y] or [x, y, z] in metres".into(),
         Kind::Symbol | Kind::Text => return "write a string such as \"Body\"".into(),
         Kind::Bool => return "write true or false".into(),
-        Kind::Area | Kind::Actor => return String::new(),
+        Kind::Area | Kind::Actor | Kind::Remainder => return String::new(),
     };
     let si = if kind == Kind::Ratio { "a fraction such as 0.25" } else { "a number in SI units" };
     format!("write {si}, or {{\"number\": 20, \"unit\": \"{unit}\"}}")

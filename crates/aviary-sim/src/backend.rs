@@ -215,6 +215,10 @@ impl Backend for SimBackend {
         lock(&self.state).fleet.telemetry(drone).unwrap_or(Telemetry::LOST)
     }
 
+    fn stopped(&self, drone: DroneId) -> Option<aviary_api::Progress> {
+        lock(&self.state).fleet.stopped(drone)
+    }
+
     fn events(&self) -> Option<mpsc::UnboundedReceiver<DroneEvent>> {
         lock(&self.events).take()
     }

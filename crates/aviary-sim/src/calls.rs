@@ -31,6 +31,14 @@ impl Fleet {
         function: Function,
         args: &[Value],
     ) -> Result<bool, Failure> {
+        let motion = function.resource() == Resource::Motion;
+        if motion {
+            // A motion call forgets where the last path call stopped (`Backend::stopped`),
+            // before anything can refuse it: a refused call has not moved.
+            if let Some(rare) = self.drones.get_mut(id).and_then(|d| d.rare.as_deref_mut()) {
+                rare.stopped = None;
+            }
+        }
         let d =
             self.drones.get(id).ok_or_else(|| failed(format!("there is no drone number {id}")))?;
         if d.state == FlightState::Lost {
@@ -42,7 +50,6 @@ impl Fleet {
         if let Some(why) = d.disabled() {
             return Err(failed(why.clone()));
         }
-        let motion = function.resource() == Resource::Motion;
         // A return the drone started on its own (after a link loss) gives way to a command.
         let own_return = d.motion.as_ref().is_some_and(|t| t.call.is_none());
         // A motion call the engine paused (its activity's body, held while a leash section
@@ -72,7 +79,11 @@ impl Fleet {
                 if d.motion.take().is_some() {
                     d.settle();
                 }
-                d.motion = Some(Box::new(MotionTask::new(Some(call), legs)));
+                let path = matches!(function, Function::Sweep | Function::FollowPath)
+                    .then_some(legs.len());
+                let mut task = MotionTask::new(Some(call), legs);
+                task.path = path;
+                d.motion = Some(Box::new(task));
                 d.begin_leg();
                 Ok(true)
             }

@@ -102,6 +102,9 @@ pub(crate) struct Rare {
     /// Paused motion calls set aside for a newer motion call, the last one on top
     /// ([`SimDrone::set_aside`]).
     pub aside: Vec<Aside>,
+    /// Where its last `Sweep` or `FollowPath` stopped, when it ended early
+    /// (`Backend::stopped`); forgotten when its next motion call starts.
+    pub stopped: Option<aviary_api::Progress>,
 }
 
 /// A paused motion call set aside while another motion call flies the drone (a leash
@@ -256,10 +259,22 @@ impl SimDrone {
         }
     }
 
+    /// Notes where the motion task in progress stops, when it is a path call about to end
+    /// early: the point of its path it is flying to, and where the drone is.
+    pub fn note_stop(&mut self) {
+        let Some((n, left)) = self.motion.as_ref().and_then(|t| Some((t.path?, t.legs.len())))
+        else {
+            return;
+        };
+        let at = self.pos;
+        self.rare_mut().stopped = Some(aviary_api::Progress { next: n.saturating_sub(left), at });
+    }
+
     /// Ends every call in progress (motion and loading), for a fault; returns their ids in
     /// a fixed order (motion first, then those set aside, the latest first).
     pub fn cut_calls(&mut self) -> Vec<CallId> {
         let mut ended = Vec::new();
+        self.note_stop();
         if let Some(task) = self.motion.take() {
             ended.extend(task.call);
         }

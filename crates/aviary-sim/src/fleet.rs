@@ -274,6 +274,11 @@ impl Fleet {
     }
 
     /// What the drone carries.
+    /// Where `drone`'s last `Sweep` or `FollowPath` stopped, when it ended early.
+    pub fn stopped(&self, drone: DroneId) -> Option<aviary_api::Progress> {
+        self.drones.get(drone)?.rare.as_ref()?.stopped
+    }
+
     pub fn carrying(&self, drone: DroneId) -> Option<&str> {
         self.drones.get(drone)?.carrying().map(String::as_str)
     }
@@ -332,6 +337,7 @@ impl Fleet {
             if d.motion.as_ref().is_some_and(|t| t.call == Some(call)) {
                 match how {
                     Interrupt::Abort => {
+                        d.note_stop();
                         d.motion = None;
                         d.settle();
                         d.bring_back();

@@ -3,11 +3,11 @@
 
 use aviary_api::{show, Failure, FlightState, Value};
 
-use crate::args::{failed, number, opt_number, point, point_value, polygon, Limits};
+use crate::args::{failed, number, opt_number, point, polygon, Limits};
 use crate::drone::SimDrone;
 use crate::geom::dist;
 use crate::motion::{orbit_legs, Leg};
-use crate::sweep::lawnmower;
+use aviary_api::{coverage, sweep};
 
 /// A landed drone this close to home (metres) is home.
 const AT_HOME: f64 = 0.5;
@@ -126,30 +126,43 @@ impl Mover<'_> {
         Ok(legs)
     }
 
-    /// `Sweep`: the area's lawnmower path, at the altitude kept.
+    /// `Sweep`: the area's lawnmower path, or the lanes a remainder left, at the altitude
+    /// kept; one leg per point of the contract's path (`aviary_api::coverage`), which is
+    /// what [`crate::motion::MotionTask::path`] counts on.
     pub fn sweep(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
         let d = self.d;
         self.in_air()?;
-        let area = polygon(args, 0, "area")?;
-        let spacing = number(args, 1, "spacing")?;
-        if spacing <= 0.0 {
-            return Err(failed(format!("sweep spacing must be above 0 m, not {spacing} m")));
-        }
+        let lanes = match args.first() {
+            Some(Value::Remainder(_)) => {
+                let spacing = number(args, 1, "spacing")?;
+                coverage::sweep_lanes(&args[0], spacing).map_err(failed)?
+            }
+            _ => {
+                let area = polygon(args, 0, "area")?;
+                let spacing = number(args, 1, "spacing")?;
+                if spacing <= 0.0 {
+                    return Err(failed(format!(
+                        "sweep spacing must be above 0 m, not {spacing} m"
+                    )));
+                }
+                sweep::lanes(&area, spacing)
+            }
+        };
         let level = d.level();
         let path: Vec<[f64; 3]> =
-            lawnmower(&area, spacing).into_iter().map(|p| [p[0], p[1], level]).collect();
+            sweep::path(&lanes).into_iter().map(|p| [p[0], p[1], level]).collect();
         self.limits.path(d.pos, &path)?;
         Ok(path.into_iter().map(|to| fly(to, d.spec.max_speed)).collect())
     }
 
-    /// `FollowPath`: through the points; one without an altitude keeps the one before.
+    /// `FollowPath`: through the points (a remainder's in its place); one without an
+    /// altitude keeps the one before. One leg per point, as for `Sweep`.
     pub fn follow_path(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
         let d = self.d;
         self.in_air()?;
         let mut z = d.level();
         let mut path = Vec::new();
-        for (i, v) in args.iter().enumerate() {
-            let p = point_value(v, &format!("points[{i}]"))?;
+        for p in coverage::follow_points(args).map_err(failed)? {
             z = p.z.unwrap_or(z);
             if z < 0.0 {
                 return Err(failed(format!("altitude {} m is below the ground", show::number(z))));

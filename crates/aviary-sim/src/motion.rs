@@ -42,6 +42,10 @@ pub(crate) struct MotionTask {
     /// the nearest it has got (see [`crate::fleet::Fleet::held_back`]).
     pub held: f64,
     pub best: Progress,
+    /// For a `Sweep` or `FollowPath`: how many points its path has, one leg each, so that
+    /// the legs left say which point the drone is flying to when it stops
+    /// ([`SimDrone::note_stop`]).
+    pub path: Option<usize>,
 }
 
 /// How far a task is from its end: (legs left, phase, amount left on the current leg),
@@ -62,6 +66,7 @@ impl MotionTask {
             arc_done: 0.0,
             held: 0.0,
             best: (usize::MAX, u8::MAX, f64::INFINITY),
+            path: None,
         }
     }
 

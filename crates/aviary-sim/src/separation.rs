@@ -434,6 +434,7 @@ impl Fleet {
             .map_or_else(|| "the drones near it".to_owned(), |(_, j)| self.names[j].to_owned());
         let reason = format!("{} waited {limit} s for {blocker} to make room", &self.names[id]);
         let d = &mut self.drones[id];
+        d.note_stop();
         d.motion = None;
         d.avoid = None;
         d.humble = false;

@@ -83,10 +83,21 @@ async fn a_battery_failsafe_rtl_raises_battery_critical() {
     let armed = call(&backend, Function::Arm, &[]).await;
     assert_eq!(armed, CallEnd::Done, "{:?}", events.try_recv());
     let hover = backend.call(0, Function::Hover, &[Value::Number(60.0)]);
-    let event = tokio::time::timeout(Duration::from_secs(20), events.recv())
-        .await
-        .expect("an event")
-        .expect("open");
+    async fn next(events: &mut tokio::sync::mpsc::UnboundedReceiver<DroneEvent>) -> DroneEvent {
+        tokio::time::timeout(Duration::from_secs(20), events.recv())
+            .await
+            .expect("an event")
+            .expect("open")
+    }
+    // What the autopilot did is said as it is seen, then the fault it stands for.
+    match next(&mut events).await {
+        DroneEvent::Autopilot { drone: 0, action, reason } => {
+            assert_eq!(action, AutopilotAction::ReturnHome);
+            assert!(reason.contains("switched to RTL by itself"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let event = next(&mut events).await;
     match event {
         DroneEvent::Fault { drone: 0, failure } => {
             assert_eq!(failure.exception, BuiltinException::BatteryCritical);

@@ -7,11 +7,12 @@ use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::ser::{SerializeMap, SerializeSeq, Serializer};
 use serde::{Deserialize, Serialize};
 
-use crate::{Names, Point, Value};
+use crate::{Names, Point, Remainder, Value};
 
 /// A value as the trace shows it (docs/TRACE.md): SI numbers; text for strings, symbols
 /// and drones (by name); booleans; a position as `[x, y]` or `[x, y, z]`; an area as its
-/// corners `[[x, y], …]`. A number that is not finite is written `null`, as is a drone
+/// corners `[[x, y], …]`; what a Sweep or FollowPath left as an object, `{"lanes": …,
+/// "spacing": …}` or `{"points": …}` ([`crate::Remainder`]). A number that is not finite is written `null`, as is a drone
 /// the fleet does not have; `null` reads back as [`Shown::Null`], and `null` inside a
 /// position or an area as NaN.
 #[derive(Clone, Debug, PartialEq)]
@@ -21,6 +22,7 @@ pub enum Shown<'a> {
     Bool(bool),
     Position(Point),
     Area(Cow<'a, [[f64; 2]]>),
+    Remainder(Cow<'a, Remainder>),
     Null,
 }
 
@@ -34,6 +36,7 @@ impl<'a> Shown<'a> {
             Value::Position(p) => Shown::Position(*p),
             Value::Area(corners) => Shown::Area(Cow::Borrowed(corners)),
             Value::Actor(d) => drones.get(*d).map_or(Shown::Null, |n| Shown::Text(n.into())),
+            Value::Remainder(left) => Shown::Remainder(Cow::Borrowed(left)),
         }
     }
 
@@ -74,6 +77,7 @@ impl Serialize for Shown<'_> {
                 seq.end()
             }
             Shown::Area(corners) => corners.serialize(s),
+            Shown::Remainder(left) => left.serialize(s),
             Shown::Null => s.serialize_unit(),
         }
     }
@@ -91,7 +95,12 @@ impl<'de> Visitor<'de> for ShownVisitor {
     type Value = Shown<'static>;
 
     fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        f.write_str("a number, a string, a boolean, a position, an area or null")
+        f.write_str("a number, a string, a boolean, a position, an area, a remainder or null")
+    }
+    /// An object is what a Sweep or FollowPath left.
+    fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
+        let left = Remainder::deserialize(de::value::MapAccessDeserializer::new(map))?;
+        Ok(Shown::Remainder(Cow::Owned(left)))
     }
     fn visit_bool<E>(self, b: bool) -> Result<Self::Value, E> {
         Ok(Shown::Bool(b))

@@ -113,6 +113,14 @@ fn shown() -> impl Strategy<Value = Shown<'static>> {
             .prop_map(|(x, y, z)| Shown::Position(Point { x, y, z })),
         proptest::collection::vec([number(), number()], 0..4)
             .prop_map(|c| Shown::Area(Cow::Owned(c))),
+        (proptest::collection::vec([[number(), number()], [number(), number()]], 0..3), number())
+            .prop_map(|(lanes, spacing)| Shown::Remainder(Cow::Owned(crate::Remainder::lanes(
+                lanes, spacing
+            )))),
+        proptest::collection::vec((number(), number(), proptest::option::of(number())), 0..3)
+            .prop_map(|p| Shown::Remainder(Cow::Owned(crate::Remainder::points(
+                p.into_iter().map(|(x, y, z)| Point { x, y, z }).collect()
+            )))),
         Just(Shown::Null),
     ]
 }
@@ -198,15 +206,15 @@ fn event() -> impl Strategy<Value = Event<'static>> {
             function,
             args
         }),
-        (text(), function(), values(), call_status(), point()).prop_map(
-            |(actor, function, args, status, position)| Event::ApiDone {
+        (text(), function(), values(), call_status(), point(), proptest::option::of(number()))
+            .prop_map(|(actor, function, args, status, position, left)| Event::ApiDone {
                 actor,
                 function,
                 args,
                 status,
-                position
-            }
-        ),
+                position,
+                left
+            }),
         (text(), opt(text()), values()).prop_map(|(name, actor, args)| Event::Signal {
             name,
             actor,

@@ -339,7 +339,13 @@ impl<'a> Checker<'a> {
             let what = p.map_or(format!("`{}`'s argument", f.name()), |p| {
                 format!("`{}`'s `{}`", f.name(), p.name)
             });
-            self.value(arg, p.map(|p| p.kind), &what);
+            let actual = self.kind_of(arg);
+            if let (Some(p), Some(k)) = (p, actual) {
+                if f.accepts(p, k) {
+                    continue;
+                }
+            }
+            self.fits(arg, actual, p.map(|p| p.kind), &what);
         }
     }
 

@@ -10,6 +10,9 @@ use super::{shown, Checker};
 use crate::env::*;
 use aviary_diagnostics::suggest::did_you_mean;
 
+/// Where a remainder goes, for help lines.
+const REMAINDER_FLOWN: &str = "give a remainder to `Sweep` in place of an area (`drone.Sweep(lost.remaining, 20m)`, or a capability that sweeps its parameter), or to `FollowPath` in place of its points";
+
 impl<'a> Checker<'a> {
     pub(super) fn condition(&mut self, e: &'a Expr) {
         let k = self.value(e, None, "a condition");
@@ -34,8 +37,23 @@ impl<'a> Checker<'a> {
         what: &str,
     ) -> Option<Kind> {
         let actual = self.kind_of(e);
+        self.fits(e, actual, expected, what)
+    }
+
+    /// Whether `e`, of kind `actual`, fits where `expected` is: reports what is wrong.
+    pub(super) fn fits(
+        &mut self,
+        e: &'a Expr,
+        actual: Option<Kind>,
+        expected: Option<Kind>,
+        what: &str,
+    ) -> Option<Kind> {
         let (Some(expected), Some(actual)) = (expected, actual) else { return actual };
         if expected.accepts(actual) {
+            return Some(actual);
+        }
+        if actual == Kind::Remainder {
+            self.remainder_misplaced(e, expected, what);
             return Some(actual);
         }
         if let ExprKind::Name(id) = &e.kind {
@@ -145,6 +163,48 @@ impl<'a> Checker<'a> {
         }
     }
 
+    /// `group.remaining`: each drone of a group leaves its own remainder.
+    fn group_remainder(&mut self, a: &'a Ident, field: &'a Ident) {
+        let first = self.world.and_then(|w| {
+            w.drones
+                .iter()
+                .find(|d| d.group.as_deref() == Some(a.name.as_str()))
+                .map(|d| d.name.clone())
+        });
+        let d = self.report(
+            Code::GroupRemainder,
+            a.span.to(field.span),
+            format!("`{}` is a group, and each of its drones leaves its own remainder", a.name),
+        );
+        d.help = Some(match first {
+            Some(one) => format!("name one drone (`{one}.{}`), or a FOR alias over the group (`PARALLEL FOR {} AS d:` then `d.{}`)", field.name, a.name, field.name),
+            None => format!("name one drone, or a FOR alias over the group (`PARALLEL FOR {} AS d:` then `d.{}`)", a.name, field.name),
+        });
+    }
+
+    /// What a Sweep or FollowPath left, where something else is expected.
+    fn remainder_misplaced(&mut self, e: &'a Expr, expected: Kind, what: &str) {
+        let d = self.report(
+            Code::WrongKind,
+            e.span,
+            format!(
+                "{what} is {}, but this is {}",
+                expected.describe(),
+                Kind::Remainder.describe()
+            ),
+        );
+        d.primary.message = format!("expected {}", expected.describe());
+        let flown = REMAINDER_FLOWN;
+        d.help = Some(match expected {
+            Kind::Position => {
+                format!("{flown}; for where a drone is, name the drone or read `drone.position`")
+            }
+            _ => format!(
+                "{flown}; to compare how far a drone got, read its telemetry (`drone.position`)"
+            ),
+        });
+    }
+
     /// For a name that is a parameter of the capability being checked: its name, the
     /// capability's name, and its default, if it has one.
     pub(super) fn parameter_origin(&self, e: &Expr) -> Option<(String, String, Option<&'a Expr>)> {
@@ -239,6 +299,15 @@ impl<'a> Checker<'a> {
             ExprKind::Binary(l, op, r) => {
                 let lk = self.kind_of(l);
                 match lk {
+                    Some(Kind::Remainder) => {
+                        let d = self.report(
+                            Code::WrongKind,
+                            l.span,
+                            format!("{} cannot be compared", Kind::Remainder.describe()),
+                        );
+                        d.help = Some(format!("{REMAINDER_FLOWN}: it ends at once when nothing is left; to know how far a drone got, read its `position`"));
+                        self.kind_of(r);
+                    }
                     // A symbol on the left (`x = Hoem` reads fine either way): check the right against it.
                     Some(k) => {
                         let what = shown(l).map_or_else(
@@ -263,6 +332,9 @@ impl<'a> Checker<'a> {
     pub(super) fn path(&mut self, a: &'a Ident, field: &'a Ident) -> Option<Kind> {
         self.actor(a);
         if let Some(k) = self.api.telemetry(&field.name) {
+            if k == Kind::Remainder && matches!(self.lookup(&a.name), Meaning::Group) {
+                self.group_remainder(a, field);
+            }
             return Some(k);
         }
         let world = self.world?;

@@ -6,6 +6,7 @@ mod flight;
 mod landing;
 mod link;
 mod luck;
+mod remainder;
 mod rules;
 mod separation;
 mod sky;

@@ -229,13 +229,24 @@ kind = "motor_failure"
             Report::Event(DroneEvent::Signal { drone, signal }) => {
                 seen.push((drone, signal.name()))
             }
+            Report::Event(DroneEvent::Autopilot { drone, action, .. }) => {
+                seen.push((drone, action.as_str()))
+            }
             Report::Ended { call, end } => assert_eq!(end, CallEnd::Interrupted, "{call:?}"),
             Report::Event(other) => panic!("{other:?}"),
         }
     }
+    // Each fault once, and after it what the drone does on its own (a crash, nothing).
     assert_eq!(
         seen,
-        [(0, "ConnectionLost"), (1, "DroneLost"), (2, "MotorFailure"), (0, "ConnectionRestored")]
+        [
+            (0, "ConnectionLost"),
+            (0, "hold"),
+            (1, "DroneLost"),
+            (2, "MotorFailure"),
+            (2, "land"),
+            (0, "ConnectionRestored")
+        ]
     );
     assert_eq!(fleet.telemetry(1).unwrap().state, FlightState::Lost);
     let c = fleet.telemetry(2).unwrap();

@@ -104,7 +104,8 @@ impl Scope<'_> {
             ),
             // Between activities the estimate has the drone at rest.
             Field::Speed => Value::Number(0.0),
-            Field::Heading | Field::Link => return None,
+            // What a Sweep will leave is known only in flight.
+            Field::Heading | Field::Link | Field::Remaining => return None,
         })
     }
 }

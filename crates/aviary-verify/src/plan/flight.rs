@@ -57,8 +57,15 @@ pub fn fly(
             }
         }
         Function::Sweep => match (args.first(), number_arg(args, 1)) {
-            (Some(Some(Value::Area(area))), Some(spacing)) => {
-                sweep(e, d, area, spacing, t, &mut raises)
+            (Some(Some(area @ (Value::Area(_) | Value::Remainder(_)))), Some(spacing)) => {
+                match aviary_api::coverage::sweep_lanes(area, spacing) {
+                    Ok(lanes) => sweep(e, d, &aviary_api::sweep::path(&lanes), t, &mut raises),
+                    Err(_) => 0.0,
+                }
+            }
+            (Some(None), _) => {
+                e.note(at, "an area known only in flight (a signal's value, or what a Sweep left: `drone.remaining`) is not counted: the plan assumes every Sweep finishes and leaves nothing".into());
+                0.0
             }
             _ => 0.0,
         },
@@ -102,18 +109,12 @@ fn fly_to_position(
     leg(e, d, to, speed, t, raises)
 }
 
-/// `Sweep`: the area's lawnmower path at the altitude the drone is at.
-fn sweep(
-    e: &mut Estimator,
-    d: DroneId,
-    area: &[[f64; 2]],
-    spacing: f64,
-    t: f64,
-    raises: &mut Vec<Raise>,
-) -> f64 {
+/// `Sweep`: its path (an area's lawnmower path, or a remainder's lanes) at the altitude
+/// the drone is at.
+fn sweep(e: &mut Estimator, d: DroneId, path: &[[f64; 2]], t: f64, raises: &mut Vec<Raise>) -> f64 {
     let z = e.s.drones[d].pos[2];
     let mut took = 0.0;
-    for p in aviary_api::sweep::lawnmower(area, spacing) {
+    for &p in path {
         let speed = e.s.drones[d].max_speed;
         took += leg(e, d, [p[0], p[1], z], speed, t + took, raises);
     }

@@ -74,6 +74,8 @@ impl Zone {
 #[derive(Debug)]
 pub struct Airspace {
     fence: Option<Outline>,
+    /// The zones' names, for messages.
+    names: Vec<String>,
     zones: Vec<Zone>,
     /// The `up_to` heights, ascending, each once: flights between two of them meet the
     /// same zones.
@@ -86,7 +88,9 @@ impl Airspace {
     /// The airspace of a world: its geofence and its `[no_fly]` zones, in file order.
     pub fn of(world: &World) -> Airspace {
         let zones = world.no_fly.iter().map(|z| (z.polygon.as_slice(), z.up_to));
-        Airspace::new(world.site.geofence.as_deref(), zones, MARGIN)
+        let mut space = Airspace::new(world.site.geofence.as_deref(), zones, MARGIN);
+        space.names = world.no_fly.iter().map(|z| z.name.clone()).collect();
+        space
     }
 
     /// An airspace of `zones` (corners, `up_to`), grown by `margin`, inside `fence`.
@@ -107,7 +111,18 @@ impl Airspace {
         levels.sort_by(f64::total_cmp);
         levels.dedup();
         let graphs = (0..=levels.len()).map(|_| OnceLock::new()).collect();
-        Airspace { fence: fence.map(|f| Outline::new(f.to_vec())), zones, levels, graphs }
+        let names = (1..=zones.len()).map(|i| format!("zone {i}")).collect();
+        Airspace { fence: fence.map(|f| Outline::new(f.to_vec())), names, zones, levels, graphs }
+    }
+
+    /// Zone `zone`'s name (the `NAME` of `[no_fly.NAME]`).
+    pub fn name(&self, zone: usize) -> &str {
+        self.names.get(zone).map_or("", String::as_str)
+    }
+
+    /// Zone `zone`'s `up_to`: `None` when it holds at every height.
+    pub fn up_to(&self, zone: usize) -> Option<f64> {
+        self.zones.get(zone).and_then(|z| z.up_to)
     }
 
     /// Whether there are no zones: every transit is then the straight line.
@@ -169,7 +184,7 @@ impl Airspace {
     /// which is not routed around. Touching a zone's line is not entering it.
     pub fn path_enters(&self, from: [f64; 2], path: &[[f64; 2]], low: f64) -> Option<usize> {
         let mut prev = from;
-        for &p in path {
+        for &p in std::iter::once(&from).chain(path) {
             let hit = (0..self.zones.len()).find(|&i| {
                 let z = &self.zones[i];
                 z.holds_at(low) && (z.outline.holds(p) || z.outline.crossed_by(prev, p))
@@ -196,6 +211,17 @@ impl Airspace {
             let far = c.iter().map(|p| dist(*p, center)).fold(0.0, f64::max);
             zone.holds_at(z) && near < radius - shape::ON_LINE && radius < far - shape::ON_LINE
         })
+    }
+
+    /// The zone that a sweep enters at height `z`, if any: its `area` overlaps the zone,
+    /// or its `lanes` (the lawnmower path, which reaches a little past a slanted side)
+    /// cross it. A sweep is the mission's own path: it is not routed around.
+    pub fn sweep_enters(&self, area: &[[f64; 2]], lanes: &[[f64; 2]], z: f64) -> Option<usize> {
+        let lanes_enter = || match lanes.split_first() {
+            Some((first, rest)) => self.path_enters(*first, rest, z),
+            None => None,
+        };
+        self.area_overlaps(area, z).or_else(lanes_enter)
     }
 
     /// The zone that an area overlaps (their insides meet) at height `z`, if any.

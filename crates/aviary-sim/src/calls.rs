@@ -20,7 +20,11 @@ enum Start {
 
 impl Fleet {
     fn limits(&self) -> Limits<'_> {
-        Limits { fence: self.fence.as_deref(), max_altitude: self.max_altitude }
+        Limits {
+            fence: self.fence.as_deref(),
+            max_altitude: self.max_altitude,
+            airspace: &self.airspace,
+        }
     }
 
     /// Starts a call; `Ok(true)` when it is in progress, `Ok(false)` when already done.
@@ -79,7 +83,7 @@ impl Fleet {
         let legs = match function {
             Function::Arm | Function::Disarm => return self.arm(id, function),
             Function::TakeOff => m.take_off(args)?,
-            Function::Land => m.land(),
+            Function::Land => m.land()?,
             Function::ReturnToLaunch => m.return_home()?,
             Function::FlyToPosition => m.fly_to(args)?,
             Function::DescendTo | Function::AscendTo => m.to_altitude(args)?,

@@ -6,6 +6,7 @@ mod flight;
 mod landing;
 mod link;
 mod luck;
+mod no_fly;
 mod rules;
 mod separation;
 mod sky;

@@ -31,6 +31,7 @@ mod shape;
 use std::sync::OnceLock;
 
 use aviary_api::geometry::{contains, dist};
+use aviary_api::show::fixed;
 use aviary_world::World;
 
 use shape::{grow, Outline};
@@ -238,6 +239,73 @@ impl Airspace {
         })
     }
 
+    /// A zone as a refusal names it: "the no-fly zone `Fire` (up to 40.0 m)".
+    pub fn describe(&self, zone: usize) -> String {
+        let name = self.name(zone);
+        match self.up_to(zone) {
+            Some(top) => format!("the no-fly zone `{name}` (up to {} m)", fixed(top, 1)),
+            None => format!("the no-fly zone `{name}`"),
+        }
+    }
+
+    /// Why a transit from `from` to `to` (local metres, z the height) was `blocked`, as a
+    /// backend's refusal says it (`GeofenceViolation`): the simulator and the MAVLink
+    /// backend say the same.
+    pub fn refusal(&self, blocked: Blocked, from: [f64; 3], to: [f64; 3]) -> String {
+        let (a, b) = ([from[0], from[1]], [to[0], to[1]]);
+        match blocked {
+            Blocked::Inside { zone, start: true } => {
+                format!("{} is inside {}", at(a), self.describe(zone))
+            }
+            Blocked::Inside { zone, start: false } if self.zone_at(b, to[2]).is_none() => format!(
+                "{} at {} m is above {}, but the way there from {} m would pass through it: climb above it first",
+                at(b),
+                fixed(to[2], 1),
+                self.describe(zone),
+                fixed(from[2], 1)
+            ),
+            Blocked::Inside { zone, start: false } => {
+                format!("{} is inside {}", at(b), self.describe(zone))
+            }
+            Blocked::NoWay { zone } => format!(
+                "there is no way from {} to {} around {} inside the geofence",
+                at(a),
+                at(b),
+                self.describe(zone)
+            ),
+        }
+    }
+
+    /// A move straight up or down at `p` (z its height now) to height `z`: the refusal
+    /// when it would come down into a zone.
+    pub fn vertical_refusal(&self, p: [f64; 3], z: f64) -> Option<String> {
+        let xy = [p[0], p[1]];
+        let zone = self.zone_at(xy, z.min(p[2]))?;
+        Some(format!(
+            "coming down to {} m at {} enters {}",
+            fixed(z, 1),
+            at(xy),
+            self.describe(zone)
+        ))
+    }
+
+    /// An orbit's circle: the refusal when it enters a zone at height `z`.
+    pub fn circle_refusal(&self, center: [f64; 2], radius: f64, z: f64) -> Option<String> {
+        let zone = self.circle_enters(center, radius, z)?;
+        Some(format!(
+            "a circle of {} m around {} enters {}",
+            fixed(radius, 1),
+            at(center),
+            self.describe(zone)
+        ))
+    }
+
+    /// A sweep: the refusal when its area or lanes enter a zone at height `z`.
+    pub fn sweep_refusal(&self, area: &[[f64; 2]], lanes: &[[f64; 2]], z: f64) -> Option<String> {
+        let zone = self.sweep_enters(area, lanes, z)?;
+        Some(format!("the area swept enters {}", self.describe(zone)))
+    }
+
     /// The band of heights `z` lies in: how many `up_to` levels are below it.
     fn band(&self, z: f64) -> usize {
         self.levels.partition_point(|&level| level < z)
@@ -253,6 +321,11 @@ impl Airspace {
     fn in_zone(&self, i: usize, p: [f64; 2]) -> bool {
         contains(&self.zones[i].outline.corners, p)
     }
+}
+
+/// A point as a refusal shows it: `(12.0, -3.5)`.
+fn at(p: [f64; 2]) -> String {
+    format!("({}, {})", fixed(p[0], 1), fixed(p[1], 1))
 }
 
 /// The way without its needless points: one the search turned at twice, and one on the

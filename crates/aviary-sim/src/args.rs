@@ -3,7 +3,7 @@
 use aviary_api::show::fixed;
 use aviary_api::{BuiltinException, Failure, Point, Value};
 
-use aviary_route::{Airspace, Blocked};
+use aviary_route::Airspace;
 
 use crate::geom::{self, circle_inside, contains, segment_inside};
 
@@ -86,11 +86,6 @@ pub(crate) struct Limits<'a> {
     pub airspace: &'a Airspace,
 }
 
-/// A point as a refusal shows it.
-fn at(p: [f64; 2]) -> String {
-    format!("({}, {})", fixed(p[0], 1), fixed(p[1], 1))
-}
-
 impl Limits<'_> {
     pub fn altitude(&self, z: f64) -> Result<(), Failure> {
         match self.max_altitude {
@@ -139,70 +134,24 @@ impl Limits<'_> {
         Ok(())
     }
 
-    /// A zone's name and, when it holds only near the ground, how high.
-    fn zone(&self, zone: usize) -> String {
-        let name = self.airspace.name(zone);
-        match self.airspace.up_to(zone) {
-            Some(top) => format!("the no-fly zone `{name}` (up to {} m)", fixed(top, 1)),
-            None => format!("the no-fly zone `{name}`"),
-        }
-    }
-
     /// The way over the ground from `from` to `to` (aviary-route) around the no-fly zones
     /// that hold at the lower of their heights: the points after `from`, `to` last.
     pub fn route(&self, from: [f64; 3], to: [f64; 3]) -> Result<Vec<[f64; 2]>, Failure> {
         let (a, b) = ([from[0], from[1]], [to[0], to[1]]);
-        self.airspace.route(a, b, from[2].min(to[2])).map_err(|blocked| match blocked {
-            Blocked::Inside { zone, start: true } => {
-                fence_violation(format!("{} is inside {}", at(a), self.zone(zone)))
-            }
-            Blocked::Inside { zone, start: false } if self.airspace.zone_at(b, to[2]).is_none() => {
-                fence_violation(format!(
-                    "{} at {} m is above {}, but the way there from {} m would pass through it: climb above it first",
-                    at(b),
-                    fixed(to[2], 1),
-                    self.zone(zone),
-                    fixed(from[2], 1)
-                ))
-            }
-            Blocked::Inside { zone, start: false } => {
-                fence_violation(format!("{} is inside {}", at(b), self.zone(zone)))
-            }
-            Blocked::NoWay { zone } => fence_violation(format!(
-                "there is no way from {} to {} around {} inside the geofence",
-                at(a),
-                at(b),
-                self.zone(zone)
-            )),
-        })
+        (self.airspace.route(a, b, from[2].min(to[2])))
+            .map_err(|blocked| fence_violation(self.airspace.refusal(blocked, from, to)))
     }
 
     /// A move straight up or down at `p` to height `z`: refused when it would enter a
     /// zone (coming down into one whose `up_to` is below the drone).
     pub fn vertical(&self, p: [f64; 3], z: f64) -> Result<(), Failure> {
-        let xy = [p[0], p[1]];
-        match self.airspace.zone_at(xy, z.min(p[2])) {
-            Some(zone) => Err(fence_violation(format!(
-                "coming down to {} m at {} enters {}",
-                fixed(z, 1),
-                at(xy),
-                self.zone(zone)
-            ))),
-            None => Ok(()),
-        }
+        self.airspace.vertical_refusal(p, z).map_or(Ok(()), |why| Err(fence_violation(why)))
     }
 
     /// The circle an orbit flies, clear of the zones at height `z`.
     pub fn orbit_clear(&self, center: [f64; 2], radius: f64, z: f64) -> Result<(), Failure> {
-        match self.airspace.circle_enters(center, radius, z) {
-            Some(zone) => Err(fence_violation(format!(
-                "a circle of {} m around {} enters {}",
-                fixed(radius, 1),
-                at(center),
-                self.zone(zone)
-            ))),
-            None => Ok(()),
-        }
+        (self.airspace.circle_refusal(center, radius, z))
+            .map_or(Ok(()), |why| Err(fence_violation(why)))
     }
 
     /// A sweep's area and lanes, clear of the zones at height `z`.
@@ -212,12 +161,8 @@ impl Limits<'_> {
         lanes: &[[f64; 2]],
         z: f64,
     ) -> Result<(), Failure> {
-        match self.airspace.sweep_enters(area, lanes, z) {
-            Some(zone) => {
-                Err(fence_violation(format!("the area swept enters {}", self.zone(zone))))
-            }
-            None => Ok(()),
-        }
+        (self.airspace.sweep_refusal(area, lanes, z))
+            .map_or(Ok(()), |why| Err(fence_violation(why)))
     }
 
     pub fn circle(&self, center: [f64; 2], radius: f64) -> Result<(), Failure> {

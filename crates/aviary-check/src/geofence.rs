@@ -100,12 +100,6 @@ impl Walker<'_> {
                 if let Some(v) = values.get(&id.name) {
                     return Some(v.clone());
                 }
-                if let Some(i) = self.world.drones.iter().position(|d| d.name == id.name) {
-                    return Some(Known::Drones(vec![i]));
-                }
-                if let Some(g) = self.world.group(&id.name) {
-                    return Some(Known::Drones(g.members.clone()));
-                }
                 if let Some(p) = self.world.place(&id.name) {
                     return Some(Known::Point([p.at[0], p.at[1]], p.has_z.then_some(p.at[2])));
                 }

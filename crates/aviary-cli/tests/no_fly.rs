@@ -59,4 +59,25 @@ fn the_wildfire_example_flies_around_the_fire_and_over_the_corridor_never_into_a
     let over = samples.iter().filter(|(d, p)| d == "scout2" && (250.0..=350.0).contains(&p[1]));
     assert!(over.clone().count() > 0 && over.clone().all(|(_, p)| p[2] > 60.0));
     assert_eq!(events.last().unwrap()["status"], "ok");
+
+    // The report's map draws the zones, named, the one up to a height with it.
+    let html = dir.join("report.html");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(["report", "--world", "examples/fire_front.world.toml", "--output"])
+        .arg(&html)
+        .arg(&trace)
+        .current_dir(repo())
+        .status()
+        .expect("run aviary report");
+    assert!(status.success());
+    let html = std::fs::read_to_string(html).unwrap();
+    assert!(html.contains("no-fly: Fire_Front\n"), "the fire is not named on the map");
+    assert!(html.contains("no-fly: Heli_Corridor (up to 60 m)"), "the corridor is not named");
+}
+
+#[test]
+fn explain_e128_names_the_no_fly_zones() {
+    let (code, out, _) = common::aviary(&["explain", "E128"], &repo());
+    assert_eq!(code, 0);
+    assert!(out.contains("E128 (error): a flight into a no-fly zone"), "{out}");
 }

@@ -18,7 +18,10 @@
 //! - A route never passes through the inside of a zone that holds at its height, nor
 //!   through the grown zone, except where an end of it lies in that zone's margin (a place
 //!   closer to the zone than the margin): the pieces from and to such an end keep out of
-//!   the zone itself. A route leaves the geofence only if it starts outside it.
+//!   the zone itself. Only a zone makes a detour, and a detour stays inside the
+//!   geofence (when it starts inside): a straight line that no zone is in the way of is
+//!   returned as it is, even where it leaves the fence, for the backends to refuse as in
+//!   a world without zones.
 //! - Pure and deterministic: no IO, no randomness, no panic; the same airspace and query
 //!   give the same route.
 
@@ -159,10 +162,15 @@ impl Airspace {
             return Err(Blocked::Inside { zone, start: false });
         }
         let fenced = self.fence.as_ref().is_some_and(|f| contains(&f.corners, from));
-        let ends = graph::Ends::new(self, &held, from, to, fenced);
-        if ends.clear(from, to) {
+        // Only a zone makes a detour: a straight line that no zone is in the way of is
+        // the transit, whatever the fence says (the backends refuse what leaves it, as
+        // in a world without zones), and so is one to a point outside the fence.
+        let ends = graph::Ends::new(self, &held, from, to, false);
+        let outside = fenced && self.fence.as_ref().is_some_and(|f| !contains(&f.corners, to));
+        if outside || ends.clear(from, to) {
             return Ok(vec![to]);
         }
+        let ends = graph::Ends::new(self, &held, from, to, fenced);
         let graph = self.graphs[band].get_or_init(|| graph::Graph::new(self, &held));
         match graph.search(&ends) {
             Some(way) => Ok(taut(from, way)),

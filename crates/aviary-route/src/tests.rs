@@ -103,8 +103,8 @@ fn an_end_inside_a_zone_and_a_zone_that_closes_the_fence_are_blocked() {
 
 #[test]
 fn a_route_keeps_to_a_concave_fence_and_bends_at_its_corner() {
-    // An L-shaped fence; the zone blocks the straight line across the L's corner, so the
-    // way goes along the inner corner of the fence.
+    // An L-shaped fence; a zone (in the L's notch, outside the fence) blocks the
+    // straight line across the L's corner, so the way goes by the fence's inner corner.
     let fence = vec![
         [0.0, 0.0],
         [400.0, 0.0],
@@ -113,7 +113,7 @@ fn a_route_keeps_to_a_concave_fence_and_bends_at_its_corner() {
         [100.0, 400.0],
         [0.0, 400.0],
     ];
-    let zone = square(30.0, 30.0, 40.0);
+    let zone = square(150.0, 150.0, 50.0);
     let space = Airspace::new(Some(&fence), [(zone.as_slice(), None)], MARGIN);
     let (from, to) = ([50.0, 300.0], [300.0, 50.0]);
     let way = space.route(from, to, 5.0).unwrap();
@@ -236,4 +236,23 @@ fn sweeps_and_orbits_that_enter_a_zone_are_found_and_an_orbit_around_one_is_not(
     assert_eq!(space.area_overlaps(&around, 20.0), Some(0));
     assert_eq!(space.path_enters([-10.0, 50.0], &[[110.0, 50.0]], 20.0), Some(0));
     assert_eq!(space.path_enters([-10.0, 50.0], &[[-10.0, 150.0]], 20.0), None);
+}
+
+#[test]
+fn only_a_zone_makes_a_detour_not_the_fence() {
+    // An L-shaped fence whose inner corner the straight line cuts, and a zone far away:
+    // the line is the transit (the backends refuse it as leaving the fence), as in a
+    // world without zones; and so is a line to a point outside the fence.
+    let fence = vec![
+        [0.0, 0.0],
+        [400.0, 0.0],
+        [400.0, 100.0],
+        [100.0, 100.0],
+        [100.0, 400.0],
+        [0.0, 400.0],
+    ];
+    let zone = square(20.0, 20.0, 20.0);
+    let space = Airspace::new(Some(&fence), [(zone.as_slice(), None)], MARGIN);
+    assert_eq!(space.route([50.0, 300.0], [300.0, 50.0], 5.0), Ok(vec![[300.0, 50.0]]));
+    assert_eq!(space.route([50.0, 300.0], [900.0, 50.0], 5.0), Ok(vec![[900.0, 50.0]]));
 }

@@ -1,6 +1,7 @@
-//! Geofence and ceiling before flight (docs/LANGUAGE.md, section 22): every place, area, orbit and
-//! sweep the mission flies to, where it is known before the run, lies inside the world's
-//! geofence, and every altitude stays under `max_altitude`.
+//! Geofence, ceiling and no-fly zones before flight (docs/LANGUAGE.md, section 22): every
+//! place, area, orbit and sweep the mission flies to, where it is known before the run,
+//! lies inside the world's geofence, every altitude stays under `max_altitude`, and no
+//! flight goes into a no-fly zone or where there is no way around them (`no_fly.rs`).
 //!
 //! Values are followed from each mission statement into the capabilities it calls (by
 //! their parameters and defaults), down to the middle-layer calls that fly. A problem is
@@ -22,17 +23,19 @@ use crate::Program;
 const MAX_CALLS: usize = 16;
 
 #[derive(Clone, Debug)]
-enum Known {
+pub(crate) enum Known {
     Point([f64; 2], Option<f64>),
     Area(Vec<[f64; 2]>),
     Number(f64),
+    /// An actor: the world's drones it stands for (indices), for where they start from.
+    Drones(Vec<usize>),
 }
 
-type Values = BTreeMap<String, Known>;
+pub(crate) type Values = BTreeMap<String, Known>;
 
 pub(crate) fn check_geofence(program: &Program, world: &World, diagnostics: &mut Vec<Diagnostic>) {
     let (fence, ceiling) = (world.site.geofence.as_deref(), world.site.max_altitude);
-    if fence.is_none() && ceiling.is_none() {
+    if fence.is_none() && ceiling.is_none() && world.no_fly.is_empty() {
         return;
     }
     let (Some(mission), Some(file)) = (program.mission(), program.mission.map(|r| r.file)) else {
@@ -43,17 +46,20 @@ pub(crate) fn check_geofence(program: &Program, world: &World, diagnostics: &mut
         world,
         fence,
         ceiling,
+        zones: crate::no_fly::Zones::of(world),
         diagnostics,
         budget: follow_budget(&mission.body),
     };
     walker.body(&mission.body, &Values::new(), None, file, 0);
 }
 
-struct Walker<'a> {
+pub(crate) struct Walker<'a> {
     program: &'a Program,
-    world: &'a World,
+    pub(crate) world: &'a World,
     fence: Option<&'a [[f64; 2]]>,
     ceiling: Option<f64>,
+    /// The no-fly zones, when the world has any.
+    pub(crate) zones: Option<crate::no_fly::Zones>,
     diagnostics: &'a mut Vec<Diagnostic>,
     /// Calls into capabilities the walk may still follow ([`follow_budget`]).
     budget: usize,
@@ -123,6 +129,9 @@ impl Walker<'_> {
                     for inst in &f.instances {
                         let mut inner = values.clone();
                         inner.remove(&f.alias.name);
+                        if let Some(Known::Drones(d)) = self.actor(&inst.actor.name, values) {
+                            inner.insert(f.alias.name.clone(), Known::Drones(d));
+                        }
                         for (p, v) in f.params.iter().zip(&inst.values) {
                             match self.value(v, values) {
                                 Some(k) => inner.insert(p.name.clone(), k),
@@ -162,6 +171,7 @@ impl Walker<'_> {
         self.budget -= 1;
         let binding = bind_args(&callee.params, &s.args);
         let mut inner = Values::new();
+        self.bind_actors(callee, s, values, &mut inner);
         for (i, p) in callee.params.iter().enumerate() {
             let known = match binding.bound[i] {
                 Some(e) => self.value(e, values),
@@ -177,13 +187,15 @@ impl Walker<'_> {
     }
 
     fn api(&mut self, call: &ApiCall, values: &Values, site: Option<(FileId, Span)>, file: FileId) {
-        let arg = |i: usize| call.args.get(i).and_then(|e| self.value(e, values));
+        let known: Vec<Option<Known>> = call.args.iter().map(|e| self.value(e, values)).collect();
+        let arg = |i: usize| known.get(i).cloned().flatten();
         // A name the middle layer does not have is the walk's error, not a flight.
         let Some(function) = Function::from_name(&call.function.name) else { return };
         match function {
             Function::FlyToPosition => {
                 if let Some(k) = arg(0) {
                     self.point(&k, call, site, file);
+                    self.zone_point(&k, None, call, values, site, file);
                 }
             }
             Function::TakeOff | Function::AscendTo | Function::DescendTo => {
@@ -192,6 +204,11 @@ impl Walker<'_> {
                 }
             }
             Function::Orbit => {
+                if let (Some(center), Some(Known::Number(radius))) =
+                    (arg(0).and_then(|k| ground(&k)), arg(1))
+                {
+                    self.zone_circle(center, radius, call, site, file);
+                }
                 if let (Some(center), Some(Known::Number(radius)), Some(fence)) =
                     (arg(0).and_then(|k| ground(&k)), arg(1), self.fence)
                 {
@@ -206,6 +223,13 @@ impl Walker<'_> {
                 }
             }
             Function::Sweep => {
+                if let Some(Known::Area(area)) = arg(0) {
+                    let spacing = match arg(1) {
+                        Some(Known::Number(s)) => Some(s),
+                        _ => None,
+                    };
+                    self.zone_sweep(&area, spacing, call, values, site, file);
+                }
                 if let (Some(Known::Area(area)), Some(fence)) = (arg(0), self.fence) {
                     // A corner outside, or else an edge that crosses the fence.
                     let corner = area.iter().find(|p| !contains(fence, **p));
@@ -225,9 +249,18 @@ impl Walker<'_> {
                 }
             }
             Function::FollowPath => {
+                // A point without a height keeps the one before (unknown before the first).
+                let mut z = None;
                 for e in &call.args {
-                    if let Some(k) = self.value(e, values) {
-                        self.point(&k, call, site, file);
+                    match self.value(e, values) {
+                        Some(k) => {
+                            self.point(&k, call, site, file);
+                            self.zone_point(&k, z, call, values, site, file);
+                            if let Known::Point(_, Some(h)) = k {
+                                z = Some(h);
+                            }
+                        }
+                        None => z = None,
                     }
                 }
             }
@@ -289,13 +322,27 @@ impl Walker<'_> {
         site: Option<(FileId, Span)>,
         file: FileId,
     ) {
-        let (at_file, at) = site.unwrap_or((file, call.span));
         let help = match code {
             Code::AboveCeiling => "fly lower, or raise `max_altitude` in the world file's [site]",
             _ => {
                 "choose a place inside the geofence, or widen `geofence` in the world file's [site]"
             }
         };
+        self.report_with(code, message, help.to_owned(), call, site, file);
+    }
+
+    /// A finding at the mission statement (`site`), with the call that flies as a second
+    /// place.
+    pub(crate) fn report_with(
+        &mut self,
+        code: Code,
+        message: String,
+        help: String,
+        call: &ApiCall,
+        site: Option<(FileId, Span)>,
+        file: FileId,
+    ) {
+        let (at_file, at) = site.unwrap_or((file, call.span));
         let mut d = Diagnostic::new(code, at_file, at, message).with_help(help);
         if site.is_some() {
             d.secondary.push(Label {
@@ -319,15 +366,15 @@ pub(crate) fn default_of<'c>(callee: &'c Capability, name: &str) -> Option<&'c E
     })
 }
 
-fn ground(k: &Known) -> Option<[f64; 2]> {
+pub(crate) fn ground(k: &Known) -> Option<[f64; 2]> {
     match k {
         Known::Point(p, _) => Some(*p),
         Known::Area(a) => Some(aviary_api::centroid(a)),
-        Known::Number(_) => None,
+        Known::Number(_) | Known::Drones(_) => None,
     }
 }
 
-fn shown(p: [f64; 2]) -> String {
+pub(crate) fn shown(p: [f64; 2]) -> String {
     format!("({}, {})", number(p[0]), number(p[1]))
 }
 

@@ -17,6 +17,7 @@ mod geofence;
 mod infer;
 mod inputs;
 mod load;
+mod no_fly;
 mod recursion;
 mod signal_values;
 mod signals;

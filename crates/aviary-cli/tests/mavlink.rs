@@ -547,3 +547,75 @@ fn the_remainder_of_a_sweep_aborted_over_mavlink_is_flown_by_another_vehicle() {
         }
     }
 }
+
+/// A fire front between the drone's home and where it flies. The vehicles (like a real
+/// autopilot) know nothing of it: the detour is the MAVLink backend's.
+const FIRE_WORLD: &str = "\
+[site]
+name = \"Loopback field\"
+origin = { lat = 46.6167, lon = 14.2650, alt = 440.0 }
+geofence = [[-400, -400], [400, -400], [400, 400], [-400, 400]]
+
+[no_fly.Fire_Front]
+polygon = [[60, -40], [140, -40], [140, 40], [60, 40]]
+
+[drones.scout]
+home = [0, 0]
+";
+
+const ACROSS_THE_FIRE: &str = "\
+MISSION Across:
+    scout TakeOff WITH 15m
+    scout FlyTo WITH (200, 0)
+    scout ReturnHome
+";
+
+#[test]
+fn a_flight_across_a_no_fly_zone_is_sent_as_waypoints_around_it() {
+    let dir = scratch("mavlink_no_fly");
+    std::fs::write(dir.join("vehicles.world.toml"), FIRE_WORLD).expect("world");
+    let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "4");
+    std::fs::write(dir.join("m.mission"), ACROSS_THE_FIRE).expect("mission");
+    std::fs::write(dir.join("m.world.toml"), bind(FIRE_WORLD, vehicles.port, &["scout"]))
+        .expect("world");
+    let code = run_within(
+        &dir,
+        &["run", "m.mission", "--quiet", "--trace", "t.jsonl", "--telemetry-hz", "20"],
+        Duration::from_secs(180),
+    );
+    let trace = events(&dir.join("t.jsonl"));
+    assert_eq!(code, 0, "{:?}", trace.last());
+    let zone = [[60.0, -40.0], [140.0, -40.0], [140.0, 40.0], [60.0, 40.0]];
+    let samples: Vec<[f64; 3]> = trace
+        .iter()
+        .filter(|e| e["event"] == "telemetry" && e["actor"] == "scout")
+        .map(|e| {
+            let p = &e["position"];
+            [p[0].as_f64().unwrap(), p[1].as_f64().unwrap(), p[2].as_f64().unwrap()]
+        })
+        .collect();
+    assert!(samples.len() > 100, "{} samples", samples.len());
+    // Never in the zone, and never into its margin by more than the arrival tolerance and
+    // the vehicle's overshoot: a corner passed within the pass radius (up to 25 m) instead
+    // of reached would cut deep into it.
+    for p in &samples {
+        let xy = [p[0], p[1]];
+        let near = aviary_api::geometry::dist_to_boundary(&zone, xy);
+        assert!(!aviary_api::geometry::contains(&zone, xy), "{p:?} is inside the zone");
+        assert!(
+            p[2] < 0.5 || near >= aviary_route::MARGIN - 3.0,
+            "{p:?} is {near} m from the zone"
+        );
+    }
+    // It went around (off the straight line by the zone's half-width and the margin),
+    // got there, and came home.
+    let widest = samples.iter().map(|p| p[1].abs()).fold(0.0, f64::max);
+    assert!(widest >= 40.0 + aviary_route::MARGIN - 2.0, "{widest}");
+    assert!(samples.iter().any(|p| (p[0] - 200.0).abs() < 2.0 && p[1].abs() < 2.0));
+    let done: Vec<&str> = trace
+        .iter()
+        .filter(|e| e["event"] == "api_done" && e["actor"] == "scout")
+        .filter_map(|e| e["function"].as_str())
+        .collect();
+    assert_eq!(done, ["Arm", "TakeOff", "FlyToPosition", "ReturnToLaunch"], "{trace:?}");
+}

@@ -81,6 +81,7 @@ codes! {
     AboveCeiling = "E125", Error, "an altitude above the site's max_altitude";
     UnboundedRecursion = "E126", Error, "a capability that calls itself, directly or through others, with nothing to stop it";
     UseRefused = "E127", Error, "a USE of a file that is not a .mission file under the mission's folder (or a --use-root), or not a regular file of at most 16 MiB";
+    IntoNoFlyZone = "E128", Error, "a flight into a no-fly zone, or one with no way around the zones inside the geofence";
     OneAtATimeNotEvery = "E129", Error, "`ONE AT A TIME` on a handler that is not an `ON EVERY`";
     OperatorSignalBuiltin = "E130", Error, "an OPERATOR SIGNAL that names a built-in signal, which only a drone raises";
     GroupRemainder = "E131", Error, "`group.remaining`: a remainder is one drone's, not a group's";

@@ -128,6 +128,7 @@ fn crafts(
     tuning: Tuning,
 ) -> Vec<Option<Arc<Craft>>> {
     let mut crafts: Vec<Option<Arc<Craft>>> = vec![None; world.drones.len()];
+    let airspace = Arc::new(aviary_route::Airspace::of(world));
     for (i, link, v) in vehicles {
         let mut d = world.drones[i].clone();
         let landing = match all.iter().find(|f| f.drone == i) {
@@ -137,7 +138,8 @@ fn crafts(
             }
             None => d.descent(),
         };
-        crafts[i] = Some(Arc::new(craft(&d, landing, link, v, world, tuning)));
+        let craft = craft(&d, landing, (link, v), world, Arc::clone(&airspace), tuning);
+        crafts[i] = Some(Arc::new(craft));
     }
     crafts
 }
@@ -147,9 +149,9 @@ fn crafts(
 fn craft(
     d: &Drone,
     landing: Descent,
-    link: Arc<link::Link>,
-    v: Arc<Vehicle>,
+    (link, v): (Arc<link::Link>, Arc<Vehicle>),
     world: &World,
+    airspace: Arc<aviary_route::Airspace>,
     tuning: Tuning,
 ) -> Craft {
     Craft {
@@ -171,6 +173,8 @@ fn craft(
         payload: d.payload.to_vec(),
         fence: world.site.geofence.clone(),
         max_altitude: world.site.max_altitude,
+        airspace,
+        return_altitude: d.return_altitude,
         streaming: false.into(),
         carrying: Mutex::new(None),
         doing: Mutex::new(Doing::Other),

@@ -43,6 +43,11 @@ pub struct Craft {
     pub payload: Vec<String>,
     pub fence: Option<Vec<[f64; 2]>>,
     pub max_altitude: Option<f64>,
+    /// The geofence and the no-fly zones (one for every drone): transits go their route.
+    pub airspace: Arc<aviary_route::Airspace>,
+    /// `ReturnToLaunch` flies a detour home at least this high (the vehicle's RTL_ALT
+    /// when it answered).
+    pub return_altitude: f64,
     pub streaming: AtomicBool,
     pub carrying: Mutex<Option<String>>,
     pub doing: Mutex<Doing>,

@@ -7,7 +7,9 @@ use aviary_api::{Failure, Function, Value};
 use mavlink::dialects::ardupilotmega::MavCmd;
 
 use crate::craft::{failed, Craft, Paused};
-use crate::motion::{arm, fly, fly_passing, here, hover, land, orbit, rtl, take_off, Corners};
+use crate::motion::{
+    arm, fly, fly_through, here, hover, land, orbit, routed, rtl, take_off, vertical, Pass,
+};
 use crate::vehicle::Activation;
 
 use aviary_api::flight::{LOAD_MAX_ALTITUDE, LOAD_TIME};
@@ -25,11 +27,13 @@ pub async fn run(
         Function::Disarm => disarm(c).await,
         Function::TakeOff => take_off(c, number(args, 0, "alt")?, paused).await,
         Function::Land => land(c).await,
-        Function::ReturnToLaunch => rtl(c).await,
+        Function::ReturnToLaunch => rtl(c, paused).await,
         Function::FlyToPosition => fly_to_position(c, args, paused).await,
         Function::DescendTo | Function::AscendTo => {
             let here = here(c)?;
-            fly(c, &[[here[0], here[1], number(args, 0, "alt")?]], c.max_speed, paused).await
+            let alt = number(args, 0, "alt")?;
+            vertical(c, here, alt)?;
+            fly(c, &[[here[0], here[1], alt]], c.max_speed, paused).await
         }
         Function::Hover => hover(number(args, 0, "duration")?, paused).await,
         Function::Orbit => orbit_around(c, args, paused).await,
@@ -55,7 +59,8 @@ async fn disarm(c: &Craft) -> Result<(), Failure> {
     c.wait_for(c.tuning.ready_timeout, "disarming", |c| !c.v.seen().armed).await
 }
 
-/// `FlyToPosition`: at the speed asked for, at most the drone's.
+/// `FlyToPosition`: at the speed asked for, at most the drone's, around the no-fly zones
+/// (the detour's corners sent one after the other, each reached before the next).
 async fn fly_to_position(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
     let to = point(c, args.first(), "pos")?;
     let speed = match args.get(1) {
@@ -63,10 +68,12 @@ async fn fly_to_position(c: &Craft, args: &[Value], paused: Paused) -> Result<()
         Some(other) => return Err(failed(format!("`speed` must be above 0 m/s, not {other}"))),
         None => c.max_speed,
     };
-    fly(c, &[to], speed, paused).await
+    let way = routed(c, here(c)?, &[to])?;
+    fly_through(c, &way, speed, paused).await
 }
 
-/// `Orbit`: through the circle's points, at the speed its radius allows.
+/// `Orbit`: to the circle around the no-fly zones, then through its points, at the speed
+/// its radius allows; a circle that enters a zone is refused.
 async fn orbit_around(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
     let center = point(c, args.first(), "center")?;
     let radius = number(args, 1, "radius")?;
@@ -80,17 +87,20 @@ async fn orbit_around(c: &Craft, args: &[Value], paused: Paused) -> Result<(), F
         )));
     }
     let here = here(c)?;
-    fly(
-        c,
-        &orbit(here, [center[0], center[1]], radius, laps, c.tuning.arrive_xy),
-        aviary_api::geometry::orbit_speed(c.max_speed, c.acceleration, radius),
-        paused,
-    )
-    .await
+    let center = [center[0], center[1]];
+    if let Some(reason) = c.airspace.circle_refusal(center, radius, c.level()) {
+        return Err(Failure { exception: aviary_api::BuiltinException::GeofenceViolation, reason });
+    }
+    let circle = orbit(here, center, radius, laps, c.tuning.arrive_xy);
+    let mut way = routed(c, here, &circle[..1])?;
+    way.extend(circle[1..].iter().map(|&p| (p, Pass::Cut)));
+    let speed = aviary_api::geometry::orbit_speed(c.max_speed, c.acceleration, radius);
+    fly_through(c, &way, speed, paused).await
 }
 
-/// `Sweep`: the area's lawnmower path, or the lanes a remainder left (the contract's,
-/// `aviary_api::coverage`), at the altitude kept.
+/// `Sweep`: to the area's lawnmower path, or to the lanes a remainder left (the
+/// contract's, `aviary_api::coverage`), around the no-fly zones; then along it, each lane
+/// flown to its end, at the altitude kept. A sweep that enters a zone is refused.
 async fn sweep(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
     let area = match args.first() {
         Some(area @ (Value::Area(_) | Value::Remainder(_))) => area,
@@ -105,28 +115,44 @@ async fn sweep(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure>
         // Nothing left to sweep: done at once, as in the simulator.
         return Ok(());
     }
-    here(c)?;
+    let here = here(c)?;
     let z = c.level();
-    let path: Vec<[f64; 3]> =
-        aviary_api::sweep::path(&lanes).into_iter().map(|p| [p[0], p[1], z]).collect();
-    fly_passing(c, &path, c.max_speed, paused, Corners::Reach).await
+    let flat = aviary_api::sweep::path(&lanes);
+    // A remainder has no area: its lanes alone must keep out of the zones.
+    let outline: &[[f64; 2]] = match area {
+        Value::Area(a) => a,
+        _ => &[],
+    };
+    if let Some(reason) = c.airspace.sweep_refusal(outline, &flat, z) {
+        return Err(Failure { exception: aviary_api::BuiltinException::GeofenceViolation, reason });
+    }
+    let path: Vec<[f64; 3]> = flat.into_iter().map(|p| [p[0], p[1], z]).collect();
+    // Each lane is flown to its end, as the simulator flies it: the pass radius is often
+    // longer than the spacing, and a turn cut short would cross the next lane.
+    let mut way = routed(c, here, &path[..1])?;
+    for w in way.iter_mut().filter(|w| w.1 == Pass::Cut) {
+        w.1 = Pass::Reach;
+    }
+    way.extend(path.iter().skip(1).map(|&p| (p, Pass::Reach)));
+    fly_through(c, &way, c.max_speed, paused).await
 }
 
-/// `FollowPath`: through the points (a remainder's in its place); one without an altitude
-/// keeps the one before.
+/// `FollowPath`: through the points (a remainder's in its place), each a transit around
+/// the no-fly zones from the one before; one without an altitude keeps the one before.
 async fn follow_path(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
     let points = aviary_api::coverage::follow_points(args).map_err(failed)?;
     if points.is_empty() {
         return Ok(());
     }
-    here(c)?;
+    let here = here(c)?;
     let mut z = c.level();
     let mut path = Vec::new();
     for p in points {
         z = p.z.unwrap_or(z);
         path.push([p.x, p.y, z]);
     }
-    fly(c, &path, c.max_speed, paused).await
+    let way = routed(c, here, &path)?;
+    fly_through(c, &way, c.max_speed, paused).await
 }
 
 /// `StartStreaming` and `StopStreaming`. Video is not carried over MAVLink: this records

@@ -59,6 +59,7 @@ pub(crate) async fn take_off(c: &Craft, alt: f64, paused: Paused) -> Result<(), 
     }
     if c.state().airborne() {
         let here = here(c)?;
+        vertical(c, here, alt)?;
         return fly(c, &[[here[0], here[1], alt]], c.max_speed, paused).await;
     }
     if !c.v.seen().armed {
@@ -95,6 +96,9 @@ pub(crate) async fn land(c: &Craft) -> Result<(), Failure> {
     if !c.state().airborne() {
         return Ok(());
     }
+    if let Ok(here) = here(c) {
+        vertical(c, here, 0.0)?;
+    }
     c.v.seen().expected = Some(Mode::Land);
     c.set_level(None);
     c.set_doing(Doing::Landing);
@@ -110,7 +114,24 @@ pub(crate) async fn land(c: &Craft) -> Result<(), Failure> {
     result
 }
 
-pub(crate) async fn rtl(c: &Craft) -> Result<(), Failure> {
+/// The way home of `ReturnToLaunch` around the no-fly zones: when the straight line home
+/// is clear, nothing (the autopilot's RTL flies it); else up to the return height and
+/// through the detour's corners in GUIDED, each reached before the next, to the last one,
+/// from which the line home is clear and the autopilot's RTL takes over.
+async fn detour_home(c: &Craft, here: [f64; 3], paused: Paused) -> Result<(), Failure> {
+    let safe = aviary_api::flight::return_height(here[2], c.return_altitude, c.max_altitude);
+    let home = [c.home[0], c.home[1], safe];
+    let mut way = routed(c, [here[0], here[1], safe], &[home])?;
+    way.pop();
+    if way.is_empty() {
+        return Ok(());
+    }
+    let up = ([here[0], here[1], safe], Pass::Reach);
+    let path: Vec<Waypoint> = std::iter::once(up).chain(way).collect();
+    fly_through(c, &path, c.max_speed, paused).await
+}
+
+pub(crate) async fn rtl(c: &Craft, paused: Paused) -> Result<(), Failure> {
     let Some(here) = c.fix().map(|f| f.pos) else {
         return Err(failed(format!("{} has reported no position yet", c.name)));
     };
@@ -121,6 +142,9 @@ pub(crate) async fn rtl(c: &Craft) -> Result<(), Failure> {
         }
         return Err(failed(format!("{} is on the ground away from home: take off first", c.name)));
     }
+    detour_home(c, here, paused).await?;
+    let here = c.fix().map_or(here, |f| f.pos);
+    let away = dist([here[0], here[1]], c.home);
     c.v.seen().expected = Some(Mode::Rtl);
     c.set_level(None);
     c.command(MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH, [0.0; 7]).await?;
@@ -140,49 +164,99 @@ pub(crate) fn pass_radius(speed: f64, accel: f64, arrive_xy: f64) -> f64 {
     (1.5 * speed * speed / (2.0 * accel.max(0.1))).clamp(arrive_xy, 25.0)
 }
 
-/// Flies through `path` (local metres): the last point is reached by position within the
-/// tolerances, the ones before it are passed within [`pass_radius`]. PAUSE holds where the
-/// drone is, RESUME sends the target again. The point flown to is noted on the craft by
-/// its index in `path` (`Craft::flying_to`): for a `Sweep` or `FollowPath`, `path` is the
-/// contract's path point for point, which is what a remainder is computed from.
+/// How a point of a flight is flown.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Pass {
+    /// A point of the call's own path, passed within [`pass_radius`], at speed.
+    Cut,
+    /// A point of the call's own path, reached within the arrival tolerances before the
+    /// next is sent: a sweep's lanes are flown to their ends, as the simulator flies them,
+    /// or the turn would cut across the next lane (the pass radius is often longer than
+    /// the spacing).
+    Reach,
+    /// A detour's corner around a no-fly zone: reached too (a drone that cut it would cut
+    /// into the zone's margin), and no point of the call's path.
+    Corner,
+}
+
+/// A point of a flight (local metres; a NaN height keeps the altitude), and how it is
+/// flown.
+pub(crate) type Waypoint = ([f64; 3], Pass);
+
+/// The waypoints of transits from `from` through `points`: each the planner's way around
+/// the no-fly zones (aviary-route), its corners reached, at the height of the point it
+/// leads to, and the point itself passed (`Pass::Cut`). Refused with `GeofenceViolation`,
+/// as the simulator refuses it, when there is no way.
+pub(crate) fn routed(
+    c: &Craft,
+    from: [f64; 3],
+    points: &[[f64; 3]],
+) -> Result<Vec<Waypoint>, Failure> {
+    let mut out = Vec::new();
+    let mut prev = from;
+    for &p in points {
+        let to = [p[0], p[1], if p[2].is_nan() { c.level() } else { p[2] }];
+        let low = if prev[2].is_nan() { to[2] } else { prev[2].min(to[2]) };
+        let way =
+            c.airspace.route([prev[0], prev[1]], [to[0], to[1]], low).map_err(|b| Failure {
+                exception: BuiltinException::GeofenceViolation,
+                reason: c.airspace.refusal(b, prev, to),
+            })?;
+        let corners = way.len().saturating_sub(1);
+        out.extend(way.into_iter().take(corners).map(|q| ([q[0], q[1], to[2]], Pass::Corner)));
+        out.push((p, Pass::Cut));
+        prev = to;
+    }
+    Ok(out)
+}
+
+/// A move straight up or down at `here` to height `z`: refused (`GeofenceViolation`) when
+/// it would come down into a no-fly zone.
+pub(crate) fn vertical(c: &Craft, here: [f64; 3], z: f64) -> Result<(), Failure> {
+    match c.airspace.vertical_refusal(here, z) {
+        Some(reason) => Err(Failure { exception: BuiltinException::GeofenceViolation, reason }),
+        None => Ok(()),
+    }
+}
+
+/// Flies through `path` (local metres), every point before the last passed within
+/// [`pass_radius`] (see [`fly_through`]).
 pub(crate) async fn fly(
     c: &Craft,
     path: &[[f64; 3]],
     speed: f64,
     paused: Paused,
 ) -> Result<(), Failure> {
-    fly_passing(c, path, speed, paused, Corners::Cut).await
+    let path: Vec<Waypoint> = path.iter().map(|&p| (p, Pass::Cut)).collect();
+    fly_through(c, &path, speed, paused).await
 }
 
-/// How a path's points before its last are passed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Corners {
-    /// Within [`pass_radius`], at speed.
-    Cut,
-    /// Reached, within the arrival tolerance: a sweep's lanes are flown to their ends,
-    /// as the simulator flies them, or the turn would cut across the next lane (the pass
-    /// radius is often longer than the spacing).
-    Reach,
-}
-
-/// [`fly`], with the corners passed as `corners` says.
-pub(crate) async fn fly_passing(
+/// Flies through `path`: the last point, and every point to be reached, is reached by
+/// position within the tolerances before the next is sent; the others are passed within
+/// [`pass_radius`]. PAUSE holds where the drone is, RESUME sends the target again. The
+/// point of the call's own path flown to is noted on the craft by its index among them
+/// (`Craft::flying_to`; a detour's corners lead to the point after them): for a `Sweep`
+/// or `FollowPath` those points are the contract's path point for point, which is what a
+/// remainder is computed from.
+pub(crate) async fn fly_through(
     c: &Craft,
-    path: &[[f64; 3]],
+    path: &[Waypoint],
     speed: f64,
     mut paused: Paused,
-    corners: Corners,
 ) -> Result<(), Failure> {
     in_air(c)?;
-    fenced(c, path)?;
+    let points: Vec<[f64; 3]> = path.iter().map(|(p, _)| *p).collect();
+    fenced(c, &points)?;
     c.set_mode(Mode::Guided).await?;
     c.speed(speed).await?;
-    let pass = match corners {
-        Corners::Cut => pass_radius(speed, c.acceleration, c.tuning.arrive_xy),
-        Corners::Reach => c.tuning.arrive_xy,
-    };
-    for (i, &to) in path.iter().enumerate() {
-        let last = i + 1 == path.len();
+    let pass = pass_radius(speed, c.acceleration, c.tuning.arrive_xy);
+    let mut on_path = 0;
+    for (i, &(to, how)) in path.iter().enumerate() {
+        let last = i + 1 == path.len() || how != Pass::Cut;
+        let flying_to = on_path;
+        if how != Pass::Corner {
+            on_path += 1;
+        }
         let from = here(c)?;
         let to = [to[0], to[1], if to[2].is_nan() { c.level() } else { to[2] }];
         if to[2] < 0.0 {
@@ -191,7 +265,7 @@ pub(crate) async fn fly_passing(
         let far = dist([from[0], from[1]], [to[0], to[1]]).hypot(to[2] - from[2]);
         let mut left = Duration::from_secs_f64(far / speed.max(0.5) * 3.0 + 30.0);
         c.set_level(Some(to[2]));
-        c.set_flying_to(Some(i));
+        c.set_flying_to(Some(flying_to));
         c.target(to).await?;
         let mut resend = Instant::now() + c.tuning.resend;
         loop {

@@ -3,6 +3,8 @@
 use aviary_api::show::fixed;
 use aviary_api::{BuiltinException, Failure, Point, Value};
 
+use aviary_route::Airspace;
+
 use crate::geom::{self, circle_inside, contains, segment_inside};
 
 pub(crate) fn failed(reason: impl Into<String>) -> Failure {
@@ -80,6 +82,8 @@ pub(crate) fn kind(args: &[Value], i: usize, name: &str) -> Result<String, Failu
 pub(crate) struct Limits<'a> {
     pub fence: Option<&'a [[f64; 2]]>,
     pub max_altitude: Option<f64>,
+    /// The no-fly zones (and the fence again), for the routes of transits.
+    pub airspace: &'a Airspace,
 }
 
 impl Limits<'_> {
@@ -128,6 +132,37 @@ impl Limits<'_> {
             check = true;
         }
         Ok(())
+    }
+
+    /// The way over the ground from `from` to `to` (aviary-route) around the no-fly zones
+    /// that hold at the lower of their heights: the points after `from`, `to` last.
+    pub fn route(&self, from: [f64; 3], to: [f64; 3]) -> Result<Vec<[f64; 2]>, Failure> {
+        let (a, b) = ([from[0], from[1]], [to[0], to[1]]);
+        (self.airspace.route(a, b, from[2].min(to[2])))
+            .map_err(|blocked| fence_violation(self.airspace.refusal(blocked, from, to)))
+    }
+
+    /// A move straight up or down at `p` to height `z`: refused when it would enter a
+    /// zone (coming down into one whose `up_to` is below the drone).
+    pub fn vertical(&self, p: [f64; 3], z: f64) -> Result<(), Failure> {
+        self.airspace.vertical_refusal(p, z).map_or(Ok(()), |why| Err(fence_violation(why)))
+    }
+
+    /// The circle an orbit flies, clear of the zones at height `z`.
+    pub fn orbit_clear(&self, center: [f64; 2], radius: f64, z: f64) -> Result<(), Failure> {
+        (self.airspace.circle_refusal(center, radius, z))
+            .map_or(Ok(()), |why| Err(fence_violation(why)))
+    }
+
+    /// A sweep's area and lanes, clear of the zones at height `z`.
+    pub fn sweep_clear(
+        &self,
+        area: &[[f64; 2]],
+        lanes: &[[f64; 2]],
+        z: f64,
+    ) -> Result<(), Failure> {
+        (self.airspace.sweep_refusal(area, lanes, z))
+            .map_or(Ok(()), |why| Err(fence_violation(why)))
     }
 
     pub fn circle(&self, center: [f64; 2], radius: f64) -> Result<(), Failure> {

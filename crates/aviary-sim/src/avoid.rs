@@ -22,7 +22,9 @@
 //! starts when going on as planned would come closer than `min_separation`, and ends
 //! when coming back keeps the margin. Passing altitudes are `min_separation +`
 //! [`MARGIN`] above the highest (below the lowest) point of the drones in the way over the
-//! horizon, within the site's `max_altitude` and [`FLOOR`].
+//! horizon, within the site's `max_altitude` and [`FLOOR`] (and, in a world with no-fly
+//! zones that hold up to a height, [`MARGIN`] above the highest of them: a drone passing
+//! over such a zone must not pass below another one into it).
 //!
 //! A yield never changes the ground track, only the speed along it and the altitude
 //! (within the climb rate and the acceleration). A leg does not end while the drone is off
@@ -260,12 +262,16 @@ impl Fleet {
     }
 
     /// The altitudes to pass the drones in the way at: above them, then below them, each
-    /// when the site's `max_altitude` (above) or [`FLOOR`] (below) leaves room.
+    /// when the site's `max_altitude` (above) or [`FLOOR`] (below; higher over height-limited
+    /// no-fly zones) leaves room.
     fn passing_levels(&self, them: &InTheWay) -> Vec<f64> {
         let sep = self.min_separation;
         let ceiling = self.max_altitude.unwrap_or(f64::INFINITY);
         let up = (them.top + sep + MARGIN).min(ceiling);
-        let down = (them.bottom - sep - MARGIN).max(FLOOR);
+        // Never down into a no-fly zone that holds only up to a height: the ground track
+        // may be over one (a route flies over a zone its height is above).
+        let floor = self.airspace.highest_up_to().map_or(FLOOR, |top| FLOOR.max(top + MARGIN));
+        let down = (them.bottom - sep - MARGIN).max(floor);
         let mut levels = Vec::new();
         if up >= them.top + sep {
             levels.push(up);

@@ -6,7 +6,7 @@ use crate::args::{failed, kind, Limits};
 use crate::drone::Loading;
 use crate::fleet::{Fleet, Release};
 use crate::legs::{hover_legs, Mover};
-use crate::motion::{Leg, MotionTask};
+use crate::motion::{Leg, MotionTask, PathTrack};
 use crate::sensors::{detection_range, Activation};
 
 use aviary_api::flight::{LOAD_MAX_ALTITUDE, LOAD_TIME};
@@ -14,13 +14,18 @@ use aviary_api::flight::{LOAD_MAX_ALTITUDE, LOAD_TIME};
 /// How a call that was not refused goes on.
 enum Start {
     Done,
-    Moves(Vec<Leg>),
+    /// The legs to fly, and for a `Sweep` or `FollowPath` the points of its path.
+    Moves(Vec<Leg>, Option<Vec<[f64; 3]>>),
     Pending,
 }
 
 impl Fleet {
     fn limits(&self) -> Limits<'_> {
-        Limits { fence: self.fence.as_deref(), max_altitude: self.max_altitude }
+        Limits {
+            fence: self.fence.as_deref(),
+            max_altitude: self.max_altitude,
+            airspace: &self.airspace,
+        }
     }
 
     /// Starts a call; `Ok(true)` when it is in progress, `Ok(false)` when already done.
@@ -67,22 +72,20 @@ impl Fleet {
             d.set_aside();
         }
         let start = self.begin(id, call, function, args);
-        if aside && !matches!(start, Ok(Start::Moves(_))) {
+        if aside && !matches!(start, Ok(Start::Moves(..))) {
             // Refused, or nothing to fly: the paused call is back at once, as it was.
             self.drones[id].bring_back();
         }
         match start? {
             Start::Done => Ok(false),
             Start::Pending => Ok(true),
-            Start::Moves(legs) => {
+            Start::Moves(legs, path) => {
                 let d = &mut self.drones[id];
                 if d.motion.take().is_some() {
                     d.settle();
                 }
-                let path = matches!(function, Function::Sweep | Function::FollowPath)
-                    .then_some(legs.len());
                 let mut task = MotionTask::new(Some(call), legs);
-                task.path = path;
+                task.path = path.map(PathTrack::new);
                 d.motion = Some(Box::new(task));
                 d.begin_leg();
                 Ok(true)
@@ -99,17 +102,24 @@ impl Fleet {
         args: &[Value],
     ) -> Result<Start, Failure> {
         let m = Mover { d: &self.drones[id], name: &self.names[id], limits: self.limits() };
+        let mut path = None;
         let legs = match function {
             Function::Arm | Function::Disarm => return self.arm(id, function),
             Function::TakeOff => m.take_off(args)?,
-            Function::Land => m.land(),
+            Function::Land => m.land()?,
             Function::ReturnToLaunch => m.return_home()?,
             Function::FlyToPosition => m.fly_to(args)?,
             Function::DescendTo | Function::AscendTo => m.to_altitude(args)?,
             Function::Hover => hover_legs(args)?,
             Function::Orbit => m.orbit(args)?,
-            Function::Sweep => m.sweep(args)?,
-            Function::FollowPath => m.follow_path(args)?,
+            Function::Sweep | Function::FollowPath => {
+                let (legs, points) = match function {
+                    Function::Sweep => m.sweep(args)?,
+                    _ => m.follow_path(args)?,
+                };
+                path = Some(points);
+                legs
+            }
             Function::StartStreaming | Function::StopStreaming => {
                 return self.stream(id, function == Function::StartStreaming)
             }
@@ -119,7 +129,7 @@ impl Fleet {
             Function::LoadPayload => return self.load(id, call, args),
             Function::ReleasePayload => return self.release(id),
         };
-        Ok(if legs.is_empty() { Start::Done } else { Start::Moves(legs) })
+        Ok(if legs.is_empty() { Start::Done } else { Start::Moves(legs, path) })
     }
 
     /// `Arm` and `Disarm`, on the ground only.

@@ -262,12 +262,11 @@ impl SimDrone {
     /// Notes where the motion task in progress stops, when it is a path call about to end
     /// early: the point of its path it is flying to, and where the drone is.
     pub fn note_stop(&mut self) {
-        let Some((n, left)) = self.motion.as_ref().and_then(|t| Some((t.path?, t.legs.len())))
-        else {
+        let Some(next) = self.motion.as_ref().and_then(|t| Some(t.path.as_ref()?.next())) else {
             return;
         };
         let at = self.pos;
-        self.rare_mut().stopped = Some(aviary_api::Progress { next: n.saturating_sub(left), at });
+        self.rare_mut().stopped = Some(aviary_api::Progress { next, at });
     }
 
     /// Ends every call in progress (motion and loading), for a fault; returns their ids in

@@ -23,6 +23,7 @@ use aviary_api::trace::AutopilotAction;
 use aviary_api::{BuiltinException, BuiltinSignal, DroneEvent, DroneId, FlightState};
 use aviary_world::FaultKind;
 
+use crate::args::Limits;
 use crate::drone::Outage;
 use crate::fleet::{Fleet, Report};
 use crate::legs::return_legs;
@@ -153,7 +154,11 @@ impl Fleet {
     /// A drone whose link has been lost for `link_loss_rtl_after` by `end` returns to
     /// launch on its own, once per outage: when it is in the air, idle and able to fly.
     fn return_without_link(&mut self, end: f64, out: &mut Vec<Report>) {
-        let max_altitude = self.max_altitude;
+        let limits = Limits {
+            fence: self.fence.as_deref(),
+            max_altitude: self.max_altitude,
+            airspace: &self.airspace,
+        };
         for &id in &self.outages {
             let d = &mut self.drones[id];
             let Some(outage) = d.rare.as_mut().and_then(|r| r.link_loss.as_mut()) else {
@@ -166,7 +171,7 @@ impl Fleet {
             self.hot[id].known = false;
             let on_its_own = d.state.airborne() && d.motion.is_none() && d.disabled().is_none();
             if on_its_own {
-                if let Ok(legs) = return_legs(d, &self.names[id], false, max_altitude) {
+                if let Ok(legs) = return_legs(d, &self.names[id], false, &limits) {
                     d.motion = Some(Box::new(MotionTask::new(None, legs)));
                     d.begin_leg();
                     let reason = format!(

@@ -16,6 +16,7 @@ use crate::hot::Hot;
 use crate::luck::{Purpose, Stream};
 use crate::nearby::Nearby;
 use aviary_api::Names;
+use aviary_route::Airspace;
 
 /// Something that happened during a [`Fleet::step`], in the order it happened.
 #[derive(Clone, Debug, PartialEq)]
@@ -54,6 +55,9 @@ pub struct Fleet {
     pub(crate) names: Names,
     pub(crate) fence: Option<Vec<[f64; 2]>>,
     pub(crate) max_altitude: Option<f64>,
+    /// The geofence and the no-fly zones, for the routes of transits (shared: the
+    /// planner's graphs are made once, whoever asks first).
+    pub(crate) airspace: Arc<Airspace>,
     /// `[site] min_separation`: metres kept between drones in the air (0: none).
     pub(crate) min_separation: f64,
     /// `[site] link_loss_rtl_after`: seconds without link before a drone returns on its own.
@@ -217,6 +221,7 @@ impl Fleet {
             names: Names::new(world.drones.iter().map(|d| d.name.as_str())),
             fence: world.site.geofence.clone(),
             max_altitude: world.site.max_altitude,
+            airspace: Arc::new(Airspace::of(world)),
             min_separation: world.site.min_separation,
             link_loss_rtl_after: world.site.link_loss_rtl_after,
             separation_timeout: world.site.separation_timeout,

@@ -48,6 +48,7 @@ impl Mover<'_> {
             return Err(failed(format!("take-off altitude must be above 0 m, not {alt} m")));
         }
         self.limits.altitude(alt)?;
+        self.limits.vertical(here, alt)?;
         let to = [here[0], here[1], alt];
         if !self.landed() {
             Ok(vec![fly(to, d.spec.max_speed)])
@@ -58,21 +59,41 @@ impl Mover<'_> {
         }
     }
 
-    /// `Land`: straight down; nothing on the ground.
-    pub fn land(&self) -> Vec<Leg> {
+    /// `Land`: straight down; nothing on the ground. Refused over a no-fly zone (every
+    /// zone holds at the ground).
+    pub fn land(&self) -> Result<Vec<Leg>, Failure> {
         if self.landed() {
-            return Vec::new();
+            return Ok(Vec::new());
         }
         let here = self.d.pos;
-        landing_legs(self.d, [here[0], here[1]])
+        self.limits.vertical(here, 0.0)?;
+        Ok(landing_legs(self.d, [here[0], here[1]]))
+    }
+
+    /// The legs of a transit from where the drone is to `to`, at up to `speed`: around the
+    /// no-fly zones ([`Limits::route`]), each point at `to`'s height; one straight leg
+    /// when nothing is in the way.
+    fn transit(&self, from: [f64; 3], to: [f64; 3], speed: f64) -> Result<Vec<Leg>, Failure> {
+        let way = self.limits.route(from, to)?;
+        Ok(way.into_iter().map(|p| fly([p[0], p[1], to[2]], speed)).collect())
+    }
+
+    /// The points of a list of legs, for the limits' checks.
+    fn points(legs: &[Leg]) -> Vec<[f64; 3]> {
+        legs.iter()
+            .filter_map(|leg| match leg {
+                Leg::Move { to, .. } => Some(*to),
+                _ => None,
+            })
+            .collect()
     }
 
     /// `ReturnToLaunch`.
     pub fn return_home(&self) -> Result<Vec<Leg>, Failure> {
-        return_legs(self.d, self.name, self.landed(), self.limits.max_altitude)
+        return_legs(self.d, self.name, self.landed(), &self.limits)
     }
 
-    /// `FlyToPosition`: one straight leg, at the altitude kept when the position has none.
+    /// `FlyToPosition`: a transit, at the altitude kept when the position has none.
     pub fn fly_to(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
         let d = self.d;
         self.in_air()?;
@@ -91,8 +112,9 @@ impl Mover<'_> {
         if to[2] < 0.0 {
             return Err(failed(format!("altitude {} m is below the ground", show::number(to[2]))));
         }
-        self.limits.path(d.pos, &[to])?;
-        Ok(vec![fly(to, speed)])
+        let legs = self.transit(d.pos, to, speed)?;
+        self.limits.path(d.pos, &Self::points(&legs))?;
+        Ok(legs)
     }
 
     /// `DescendTo` and `AscendTo`: straight up or down.
@@ -104,10 +126,12 @@ impl Mover<'_> {
             return Err(failed(format!("altitude {} m is below the ground", show::number(alt))));
         }
         self.limits.altitude(alt)?;
+        self.limits.vertical(d.pos, alt)?;
         Ok(vec![fly([d.pos[0], d.pos[1], alt], d.spec.max_speed)])
     }
 
-    /// `Orbit`: to the circle, then round it.
+    /// `Orbit`: to the circle (a transit), then round it (its own path, which must keep
+    /// out of the zones).
     pub fn orbit(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
         self.in_air()?;
         let c = point(args, 0, "center")?;
@@ -118,24 +142,29 @@ impl Mover<'_> {
                 "an orbit needs a radius and laps above 0 (got {radius} m, {laps})"
             )));
         }
-        let legs = orbit_legs(self.d, [c.x, c.y], radius, laps);
-        if let Some(Leg::Move { to, .. }) = legs.first() {
-            self.limits.path(self.d.pos, &[*to])?;
+        // The circle first: a circle through a zone is said as such, not as a way there.
+        self.limits.orbit_clear([c.x, c.y], radius, self.d.level())?;
+        let mut legs = orbit_legs(self.d, [c.x, c.y], radius, laps);
+        if let Some(Leg::Move { to, speed, .. }) = legs.first().cloned() {
+            let way = self.transit(self.d.pos, to, speed)?;
+            self.limits.path(self.d.pos, &Self::points(&way))?;
+            legs.splice(0..1, way);
         }
         self.limits.circle([c.x, c.y], radius)?;
         Ok(legs)
     }
 
-    /// `Sweep`: the area's lawnmower path, or the lanes a remainder left, at the altitude
-    /// kept; one leg per point of the contract's path (`aviary_api::coverage`), which is
-    /// what [`crate::motion::MotionTask::path`] counts on.
-    pub fn sweep(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
+    /// `Sweep`: to the area's lawnmower path, or to the lanes a remainder left (a transit
+    /// around the no-fly zones), then along it (the contract's path, `aviary_api::coverage`,
+    /// which must keep out of the zones), at the altitude kept. With the legs, the path's
+    /// points, which [`crate::motion::PathTrack`] follows for where a cut sweep stopped.
+    pub fn sweep(&self, args: &[Value]) -> Result<(Vec<Leg>, Vec<[f64; 3]>), Failure> {
         let d = self.d;
         self.in_air()?;
-        let lanes = match args.first() {
+        let (area, lanes) = match args.first() {
             Some(Value::Remainder(_)) => {
                 let spacing = number(args, 1, "spacing")?;
-                coverage::sweep_lanes(&args[0], spacing).map_err(failed)?
+                (Vec::new(), coverage::sweep_lanes(&args[0], spacing).map_err(failed)?)
             }
             _ => {
                 let area = polygon(args, 0, "area")?;
@@ -145,19 +174,28 @@ impl Mover<'_> {
                         "sweep spacing must be above 0 m, not {spacing} m"
                     )));
                 }
-                sweep::lanes(&area, spacing)
+                let lanes = sweep::lanes(&area, spacing);
+                (area, lanes)
             }
         };
         let level = d.level();
-        let path: Vec<[f64; 3]> =
-            sweep::path(&lanes).into_iter().map(|p| [p[0], p[1], level]).collect();
-        self.limits.path(d.pos, &path)?;
-        Ok(path.into_iter().map(|to| fly(to, d.spec.max_speed)).collect())
+        let flat = sweep::path(&lanes);
+        // A remainder has no area: its lanes alone must keep out of the zones.
+        self.limits.sweep_clear(&area, &flat, level)?;
+        let path: Vec<[f64; 3]> = flat.into_iter().map(|p| [p[0], p[1], level]).collect();
+        let mut legs = Vec::new();
+        if let Some((&first, rest)) = path.split_first() {
+            legs = self.transit(d.pos, first, d.spec.max_speed)?;
+            legs.extend(rest.iter().map(|&to| fly(to, d.spec.max_speed)));
+        }
+        self.limits.path(d.pos, &Self::points(&legs))?;
+        Ok((legs, path))
     }
 
-    /// `FollowPath`: through the points (a remainder's in its place); one without an
-    /// altitude keeps the one before. One leg per point, as for `Sweep`.
-    pub fn follow_path(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
+    /// `FollowPath`: through the points (a remainder's in its place), each a transit from
+    /// the one before (around the zones); one without an altitude keeps the one before.
+    /// With the legs, the points, as for `Sweep`.
+    pub fn follow_path(&self, args: &[Value]) -> Result<(Vec<Leg>, Vec<[f64; 3]>), Failure> {
         let d = self.d;
         self.in_air()?;
         let mut z = d.level();
@@ -169,8 +207,14 @@ impl Mover<'_> {
             }
             path.push([p.x, p.y, z]);
         }
-        self.limits.path(d.pos, &path)?;
-        Ok(path.into_iter().map(|to| fly(to, d.spec.max_speed)).collect())
+        let mut legs = Vec::new();
+        let mut from = d.pos;
+        for &to in &path {
+            legs.extend(self.transit(from, to, d.spec.max_speed)?);
+            from = to;
+        }
+        self.limits.path(d.pos, &Self::points(&legs))?;
+        Ok((legs, path))
     }
 }
 
@@ -183,13 +227,14 @@ pub(crate) fn hover_legs(args: &[Value]) -> Result<Vec<Leg>, Failure> {
     Ok(vec![Leg::Hold { left: duration }])
 }
 
-/// `ReturnToLaunch`: up to the return altitude, home, and down.
+/// `ReturnToLaunch`: up to the return altitude, home (around the no-fly zones), and down.
 pub(crate) fn return_legs(
     d: &SimDrone,
     name: &str,
     landed: bool,
-    max_altitude: Option<f64>,
+    limits: &Limits,
 ) -> Result<Vec<Leg>, Failure> {
+    let max_altitude = limits.max_altitude;
     let home_dist = dist(d.xy(), d.home);
     if landed {
         if home_dist <= AT_HOME {
@@ -208,11 +253,12 @@ pub(crate) fn return_legs(
         });
     }
     if home_dist > 0.0 {
-        legs.push(Leg::Move {
-            to: [d.home[0], d.home[1], safe],
+        let way = limits.route([d.pos[0], d.pos[1], safe], [d.home[0], d.home[1], safe])?;
+        legs.extend(way.into_iter().map(|p| Leg::Move {
+            to: [p[0], p[1], safe],
             speed: d.spec.max_speed,
             state: FlightState::Flying,
-        });
+        }));
     }
     if d.spec.return_loiter > 0.0 {
         legs.push(Leg::Hold { left: d.spec.return_loiter });

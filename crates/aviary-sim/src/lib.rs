@@ -61,6 +61,17 @@
 //! progress is refused (`CommandFailed`); the engine serialises calls per resource, so
 //! that does not happen.
 //!
+//! # No-fly zones
+//! A transit (`FlyToPosition`, the way to an orbit's circle or a sweep's first lane, each
+//! leg of `FollowPath`, the way home of `ReturnToLaunch` and of the return after a link
+//! loss) is the route of `aviary_route` (the one planner, shared with the checker, the plan
+//! and the MAVLink backend): its legs go around the zones that hold at the lower of the
+//! transit's two heights, at the planner's margin, and it is the one straight leg of
+//! before when no zone is in the way. What a function flies by itself (an orbit's circle,
+//! a sweep's lanes) must keep out of the zones, and a move straight down (`DescendTo`,
+//! `Land`) must not come down into one: else the call is refused with
+//! `GeofenceViolation`, as is a transit with no way around.
+//!
 //! # Separation
 //! No two drones *in the air* (taking off, flying or landing, and above the ground; a
 //! landed or lost drone does not count) are ever closer than `[site] min_separation`

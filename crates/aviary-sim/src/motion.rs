@@ -42,10 +42,38 @@ pub(crate) struct MotionTask {
     /// the nearest it has got (see [`crate::fleet::Fleet::held_back`]).
     pub held: f64,
     pub best: Progress,
-    /// For a `Sweep` or `FollowPath`: how many points its path has, one leg each, so that
-    /// the legs left say which point the drone is flying to when it stops
+    /// For a `Sweep` or `FollowPath`: its path's points and how many the drone has
+    /// reached, so that where it stops says which point it was flying to
     /// ([`SimDrone::note_stop`]).
-    pub path: Option<usize>,
+    pub path: Option<PathTrack>,
+}
+
+/// The points of a `Sweep`'s or `FollowPath`'s path (the contract's, `aviary_api::coverage`)
+/// as the drone reaches them. A leg counts when it ends at the next point: the other legs
+/// of the task (a detour's corners around a no-fly zone, the way back to where a leash
+/// section took the drone from) lead towards a point without being one.
+#[derive(Clone, Debug)]
+pub(crate) struct PathTrack {
+    points: Vec<[f64; 3]>,
+    reached: usize,
+}
+
+impl PathTrack {
+    pub fn new(points: Vec<[f64; 3]>) -> PathTrack {
+        PathTrack { points, reached: 0 }
+    }
+
+    /// The index of the point the drone flies to next (the number reached).
+    pub fn next(&self) -> usize {
+        self.reached
+    }
+
+    /// A leg ended at `at`.
+    fn arrived(&mut self, at: [f64; 3]) {
+        if self.points.get(self.reached) == Some(&at) {
+            self.reached += 1;
+        }
+    }
 }
 
 /// How far a task is from its end: (legs left, phase, amount left on the current leg),
@@ -159,6 +187,9 @@ impl SimDrone {
     fn next_leg(&mut self) -> Option<MotionTask> {
         let task = self.motion.as_mut()?;
         let leg = task.legs.pop_front();
+        if let (Some(Leg::Move { to, .. }), Some(track)) = (&leg, task.path.as_mut()) {
+            track.arrived(*to);
+        }
         task.rest();
         task.arc_done = 0.0;
         self.vel = [0.0; 3];

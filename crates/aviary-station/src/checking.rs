@@ -72,8 +72,9 @@ fn rendered(sources: &SourceMap, d: &Diagnostic) -> Value {
     value
 }
 
-/// What the map shows of a world: the site, places, areas, homes and targets, in the
-/// local frame (metres east and north of the origin).
+/// What the map shows of a world: the site, places, areas, no-fly zones (`no_fly`: name,
+/// polygon, `up_to`), homes and targets, in the local frame (metres east and north of the
+/// origin).
 pub fn map_of(world: &aviary_world::World) -> Value {
     let drones: Vec<Value> = world
         .drones
@@ -92,6 +93,7 @@ pub fn map_of(world: &aviary_world::World) -> Value {
         "base": crate::tiles::base_map(world),
         "places": world.places,
         "areas": world.areas,
+        "no_fly": world.no_fly,
         "drones": drones,
         "targets": world.targets,
     })

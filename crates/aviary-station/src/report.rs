@@ -131,6 +131,40 @@ fn colour(i: usize) -> RGBColor {
 
 type Drawn = Result<(), Box<dyn std::error::Error>>;
 
+/// The world's no-fly zones: red, filled half-transparent, each named at its centre (with
+/// its height, when it holds only up to one).
+fn no_fly_zones<DB: DrawingBackend>(
+    chart: &mut ChartContext<
+        '_,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    w: &aviary_world::World,
+) -> Drawn
+where
+    DB::ErrorType: 'static,
+{
+    let red = RGBColor(194, 53, 43);
+    for z in &w.no_fly {
+        let polygon: Vec<(f64, f64)> = z.polygon.iter().map(|p| (p[0], p[1])).collect();
+        chart.draw_series(std::iter::once(Polygon::new(polygon.clone(), red.mix(0.3))))?;
+        let mut closed = polygon;
+        closed.push(closed[0]);
+        chart.draw_series(std::iter::once(PathElement::new(closed, red.stroke_width(2))))?;
+        let c = aviary_api::centroid(&z.polygon);
+        let name = match z.up_to {
+            Some(top) => format!("no-fly: {} (up to {} m)", z.name, aviary_api::show::number(top)),
+            None => format!("no-fly: {}", z.name),
+        };
+        chart.draw_series(std::iter::once(Text::new(
+            escape(&name),
+            (c[0], c[1]),
+            ("sans-serif", 12).into_font().color(&red),
+        )))?;
+    }
+    Ok(())
+}
+
 /// The map: the world's geofence, areas, places and homes when known, every drone's
 /// track, the finds (circles) and where exceptions were raised (crosses).
 fn map(m: &Mission, world: Option<&aviary_world::World>) -> Result<String, String> {
@@ -141,6 +175,7 @@ fn map(m: &Mission, world: Option<&aviary_world::World>) -> Result<String, Strin
     if let Some(w) = world {
         points.extend(w.site.geofence.iter().flatten().copied());
         points.extend(w.areas.iter().flat_map(|a| a.polygon.iter().copied()));
+        points.extend(w.no_fly.iter().flat_map(|z| z.polygon.iter().copied()));
         points.extend(w.places.iter().map(|p| [p.at[0], p.at[1]]));
     }
     points.extend(m.finds.iter().map(|f| [f.3[0], f.3[1]]));
@@ -193,6 +228,7 @@ fn map(m: &Mission, world: Option<&aviary_world::World>) -> Result<String, Strin
                     ("sans-serif", 12).into_font().color(&RGBColor(28, 100, 209)),
                 )))?;
             }
+            no_fly_zones(&mut chart, w)?;
             if let Some(fence) = &w.site.geofence {
                 let mut closed: Vec<(f64, f64)> = fence.iter().map(|p| (p[0], p[1])).collect();
                 closed.push(closed[0]);
@@ -345,7 +381,7 @@ pub fn render(
 
     // The map.
     let _ = write!(html, "<h2>Map</h2><div class=\"map\">{}</div>", map(&m, world)?);
-    let _ = write!(html, "<p class=\"note\">Tracks per drone; red circles: finds ({}); red crosses: exceptions; grey squares: homes; red outline: the geofence.</p>", m.finds.len());
+    let _ = write!(html, "<p class=\"note\">Tracks per drone; red circles: finds ({}); red crosses: exceptions; grey squares: homes; red outline: the geofence; red, filled: no-fly zones.</p>", m.finds.len());
 
     // The timeline.
     let end = m.end.max(1.0);

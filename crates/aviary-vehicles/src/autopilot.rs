@@ -144,6 +144,17 @@ impl Autopilot {
             lon: g.lon,
             alt: g.alt,
         });
+        // An autopilot knows its geofence, not Aviary's no-fly zones: a real ArduCopter
+        // flies a GUIDED target and its own RTL straight, so the detour must be the
+        // backend's (aviary-mavlink sends it as waypoints), and the test of it means
+        // something only if these vehicles do not go around by themselves.
+        let unzoned;
+        let world = if world.no_fly.is_empty() {
+            world
+        } else {
+            unzoned = World { no_fly: Vec::new(), ..world.clone() };
+            &unzoned
+        };
         Autopilot {
             fleet: Fleet::new(world),
             origin,

@@ -21,7 +21,9 @@
 //! Underneath is the same [`aviary_sim::Fleet`] as `aviary run`, stepped in whole 0.05 s
 //! ticks at `speed` times real time.
 //!
-//! Not simulated: missions (MISSION_ITEM), fences and rally points as missions, MAVLink
+//! Not simulated: the world's no-fly zones (an autopilot does not know them: the vehicles
+//! fly a GUIDED target and RTL straight, and the detour is the ground station's),
+//! missions (MISSION_ITEM), fences and rally points as missions, MAVLink
 //! FTP (refused at once), RC input, manual modes (STABILIZE is accepted and does
 //! nothing), more than one component per vehicle. A world `link_loss` fault silences the
 //! drone (no messages either way) for its duration; a `battery_critical` fault is

@@ -1,5 +1,6 @@
 //! From the spanned tree to a [`World`]: the top level, `[site]`, `[places]`, `[areas]`,
-//! and the checks across tables (one name, one meaning).
+//! and the checks across tables (one name, one meaning); `[no_fly.NAME]` is
+//! `build/no_fly.rs`.
 
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 
@@ -10,13 +11,14 @@ use crate::{Area, Geo, Place, Site, World};
 
 mod drone;
 mod fleet;
+mod no_fly;
 mod sim;
 
 use drone::Drones;
 use fleet::FleetInfo;
 
 const TABLES: &[&str] =
-    &["site", "places", "areas", "drones", "fleets", "sensors", "targets", "faults"];
+    &["site", "places", "areas", "no_fly", "drones", "fleets", "sensors", "targets", "faults"];
 const SITE_KEYS: &[&str] = &[
     "name",
     "origin",
@@ -129,6 +131,9 @@ fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Dia
     if let Some(e) = table("areas") {
         world.areas = areas(cx, &e.node);
     }
+    if let Some(e) = table("no_fly") {
+        world.no_fly = no_fly::zones(cx, &e.node);
+    }
     let sensor_kinds = keys_of(table("sensors"));
     if let Some(e) = table("sensors") {
         world.sensors = sim::sensors(cx, &e.node);
@@ -153,6 +158,7 @@ fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Dia
     world.drones = std::mem::take(&mut drones.out);
     one_name_per_drone(cx, &world.drones, &drones.fleets);
     homes_in_fence(cx, &world, &drones.fleets);
+    no_fly::homes_outside_zones(cx, &world, &drones.fleets);
     unique_names(cx, &world, &group_spans);
     (world, std::mem::take(&mut cx.diags))
 }
@@ -404,7 +410,7 @@ fn one_name_per_drone(cx: &mut Ctx, drones: &[crate::Drone], fleets: &[FleetInfo
 
 /// Where each drone's `home` value is written, by drone name (the file parses: its world
 /// was built).
-fn home_spans(text: &str) -> std::collections::HashMap<String, Span> {
+pub(super) fn home_spans(text: &str) -> std::collections::HashMap<String, Span> {
     let mut out = std::collections::HashMap::new();
     let Ok(root) = Node::parse_serde(text) else { return out };
     let Value::Table(top) = &root.value else { return out };

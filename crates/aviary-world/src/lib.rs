@@ -41,6 +41,8 @@ pub struct World {
     pub places: Vec<Place>,
     /// In file order.
     pub areas: Vec<Area>,
+    /// `[no_fly.NAME]`, in file order: where no drone may fly (docs/WORLD.md).
+    pub no_fly: Vec<NoFly>,
     /// In file order: a group expands to its members in this order.
     pub drones: Vec<Drone>,
     /// From the drones' `group` keys, in order of first appearance.
@@ -137,6 +139,27 @@ impl Area {
     /// Whether a ground point lies inside the polygon.
     pub fn contains(&self, p: [f64; 2]) -> bool {
         contains(&self.polygon, p)
+    }
+}
+
+/// One `[no_fly.NAME]`: a polygon no drone may enter, from the ground up to `up_to`
+/// (at every height without it). Missions do not name zones; the name is for people.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NoFly {
+    pub name: String,
+    pub polygon: Vec<[f64; 2]>,
+    /// Metres above the ground; `None`: the zone holds at every height.
+    pub up_to: Option<f64>,
+    /// The name's key.
+    #[serde(skip)]
+    pub span: Span,
+}
+
+impl NoFly {
+    /// Whether the zone holds at height `z` (metres above the ground): a flight at
+    /// `up_to` or lower is in it, one above it is not.
+    pub fn holds_at(&self, z: f64) -> bool {
+        self.up_to.is_none_or(|top| z <= top)
     }
 }
 
@@ -353,6 +376,7 @@ impl Default for World {
             site: Site::default(),
             places: Vec::new(),
             areas: Vec::new(),
+            no_fly: Vec::new(),
             drones: Vec::new(),
             groups: Vec::new(),
             sensors: Vec::new(),

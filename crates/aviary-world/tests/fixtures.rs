@@ -1,7 +1,7 @@
 //! World files as `aviary check` shows them: every `*.world.toml` under `tests/fixtures/`
 //! is read, and what a user sees is compared with a snapshot (`tests/snapshots/`): each
 //! diagnostic rendered (`path:line:col`, the line, a caret, the help), or for a world
-//! without problems a summary of its drones, groups and areas.
+//! without problems a summary of its drones, groups, areas and no-fly zones.
 
 use std::fmt::Write;
 use std::path::Path;
@@ -41,6 +41,9 @@ fn shown(path: &Path) -> String {
     }
     for a in w.areas.iter().take(3) {
         let _ = writeln!(out, "area {}: {:?}", a.name, a.polygon);
+    }
+    for z in &w.no_fly {
+        let _ = writeln!(out, "no-fly zone {} up to {:?}: {:?}", z.name, z.up_to, z.polygon);
     }
     out
 }

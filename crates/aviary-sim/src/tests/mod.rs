@@ -6,6 +6,7 @@ mod flight;
 mod landing;
 mod link;
 mod luck;
+mod no_fly;
 mod remainder;
 mod rules;
 mod separation;

@@ -1,5 +1,5 @@
 // The map: the world in its local frame (metres east and north of the origin; Leaflet's
-// CRS.Simple, one unit a metre), with the geofence, areas, places, homes, targets and
+// CRS.Simple, one unit a metre), with the geofence, areas, no-fly zones, places, homes, targets and
 // finds as Leaflet layers, and the drones on a canvas of their own over it, redrawn once
 // a frame at most: a thousand moving markers as DOM elements would not keep 30 frames a
 // second. A world with `tiles` and an `origin` is drawn over its base map instead
@@ -84,6 +84,13 @@ export class StationMap {
     for (const a of world.areas || []) {
       const p = L.polygon(a.polygon.map(at), { color: "#1c64d1", weight: 1, fillOpacity: 0.08 });
       p.bindTooltip(a.name, { permanent: true, direction: "center", className: "place-label" }).addTo(this.world);
+      bounds.extend(p.getBounds());
+    }
+    // No-fly zones: red, filled half-transparent, named (with their height, if any).
+    for (const z of world.no_fly || []) {
+      const p = L.polygon(z.polygon.map(at), { color: "#c2352b", weight: 2, fillColor: "#c2352b", fillOpacity: 0.3 });
+      const label = z.up_to == null ? `no-fly: ${z.name}` : `no-fly: ${z.name} (up to ${z.up_to} m)`;
+      p.bindTooltip(label, { permanent: true, direction: "center", className: "place-label" }).addTo(this.world);
       bounds.extend(p.getBounds());
     }
     for (const p of world.places || []) {

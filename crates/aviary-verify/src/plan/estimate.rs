@@ -81,6 +81,8 @@ struct Ctx {
 pub struct Estimator<'m> {
     pub mission: &'m Mission,
     pub world: &'m World,
+    /// The world's geofence and no-fly zones: transits are costed along their routes.
+    pub airspace: aviary_route::Airspace,
     /// First raise times from the previous pass, for `WAITFOR RECEIVED` ahead of its signal.
     pub known: Vec<Option<f64>>,
     /// Whether the walk read `known`: a walk that did not would be the same again.
@@ -126,6 +128,7 @@ impl<'m> Estimator<'m> {
         Estimator {
             mission,
             world,
+            airspace: aviary_route::Airspace::of(world),
             known,
             read_known: false,
             calling: vec![false; mission.capabilities.len()],
@@ -159,7 +162,7 @@ impl<'m> Estimator<'m> {
             if self.s.drones[d].airborne {
                 let f = &mut self.s.drones[d];
                 let start = end.max(f.free_at);
-                let done = start + f.return_home(self.world.site.max_altitude);
+                let done = start + f.return_home(&self.airspace, self.world.site.max_altitude);
                 f.land(done);
                 self.s.activities[d].push(Activity {
                     start,
@@ -187,7 +190,7 @@ impl<'m> Estimator<'m> {
         for (d, then) in mark.drones().iter().enumerate() {
             let f = &mut self.s.drones[d];
             if f.airborne {
-                let took = f.return_home(self.world.site.max_altitude);
+                let took = f.return_home(&self.airspace, self.world.site.max_altitude);
                 f.land(end.max(f.free_at) + took);
             }
             let now = &self.s.drones[d];

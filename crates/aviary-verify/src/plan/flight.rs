@@ -33,7 +33,7 @@ pub fn fly(
         }
         Function::ReturnToLaunch => {
             let f = &mut e.s.drones[d];
-            let took = f.return_home(max_altitude);
+            let took = f.return_home(&e.airspace, max_altitude);
             f.land(t + took);
             took
         }
@@ -51,7 +51,8 @@ pub fn fly(
             let radius = number_arg(args, 1);
             match (center, radius) {
                 (Some(c), Some(r)) => {
-                    e.s.drones[d].orbit([c[0], c[1]], r, number_arg(args, 2).unwrap_or(1.0))
+                    let laps = number_arg(args, 2).unwrap_or(1.0);
+                    e.s.drones[d].orbit(&e.airspace, [c[0], c[1]], r, laps)
                 }
                 _ => 0.0,
             }
@@ -106,22 +107,27 @@ fn fly_to_position(
     };
     let f = &e.s.drones[d];
     let speed = number_arg(args, 1).map_or(f.max_speed, |s| s.min(f.max_speed));
-    leg(e, d, to, speed, t, raises)
+    transit(e, d, to, speed, t, raises)
 }
 
-/// `Sweep`: its path (an area's lawnmower path, or a remainder's lanes) at the altitude
-/// the drone is at.
+/// `Sweep`: to its path (an area's lawnmower path, or a remainder's lanes; a transit),
+/// then along it, at the altitude the drone is at.
 fn sweep(e: &mut Estimator, d: DroneId, path: &[[f64; 2]], t: f64, raises: &mut Vec<Raise>) -> f64 {
     let z = e.s.drones[d].pos[2];
     let mut took = 0.0;
-    for &p in path {
+    for (i, p) in path.iter().enumerate() {
         let speed = e.s.drones[d].max_speed;
-        took += leg(e, d, [p[0], p[1], z], speed, t + took, raises);
+        let to = [p[0], p[1], z];
+        took += if i == 0 {
+            transit(e, d, to, speed, t + took, raises)
+        } else {
+            leg(e, d, to, speed, t + took, raises)
+        };
     }
     took
 }
 
-/// `FollowPath`: a leg to each point that is known before the flight.
+/// `FollowPath`: a transit to each point that is known before the flight.
 fn follow_path(
     e: &mut Estimator,
     d: DroneId,
@@ -134,7 +140,7 @@ fn follow_path(
     for v in args {
         if let Some(to) = e.position_arg(v, d, at) {
             let speed = e.s.drones[d].max_speed;
-            took += leg(e, d, to, speed, t + took, raises);
+            took += transit(e, d, to, speed, t + took, raises);
         }
     }
     took
@@ -156,6 +162,23 @@ fn start_detection(e: &mut Estimator, d: DroneId, kind: &String) {
     if let Some(range) = range {
         f.detecting.push((kind.clone(), range, Vec::new()));
     }
+}
+
+/// A transit: the legs of the planner's way around the no-fly zones (one straight leg
+/// when nothing is in the way), scanning for targets on the way.
+fn transit(
+    e: &mut Estimator,
+    d: DroneId,
+    to: [f64; 3],
+    speed: f64,
+    t: f64,
+    raises: &mut Vec<Raise>,
+) -> f64 {
+    let mut took = 0.0;
+    for p in e.s.drones[d].way(&e.airspace, to) {
+        took += leg(e, d, p, speed, t + took, raises);
+    }
+    took
 }
 
 /// A straight leg, scanning for targets on the way.

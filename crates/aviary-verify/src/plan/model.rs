@@ -5,6 +5,7 @@
 
 use aviary_api::flight::Descent;
 use aviary_api::geometry::dist_to_segment;
+use aviary_route::Airspace;
 use aviary_world::Drone;
 
 /// A drone as the estimate follows it.
@@ -106,28 +107,45 @@ impl Flyer {
         upper + trapezoid(low, descent.land_speed, self.accel)
     }
 
-    /// `Orbit`: to the nearest point of the circle, then `laps` turns.
-    pub fn orbit(&mut self, center: [f64; 2], radius: f64, laps: f64) -> f64 {
+    /// The points a transit from here to `to` flies through, as the simulator flies it:
+    /// the planner's way around the no-fly zones, each point at `to`'s height (`[to]` when
+    /// nothing is in the way, or when there is no way: the flight is refused then, and
+    /// the checker said so).
+    pub fn way(&self, space: &Airspace, to: [f64; 3]) -> Vec<[f64; 3]> {
+        let from = [self.pos[0], self.pos[1]];
+        match space.route(from, [to[0], to[1]], self.pos[2].min(to[2])) {
+            Ok(way) => way.into_iter().map(|p| [p[0], p[1], to[2]]).collect(),
+            Err(_) => vec![to],
+        }
+    }
+
+    /// A transit to `to` at up to `speed`: its legs around the zones; the duration.
+    pub fn transit(&mut self, space: &Airspace, to: [f64; 3], speed: f64) -> f64 {
+        self.way(space, to).into_iter().map(|p| self.leg_at(p, speed)).sum()
+    }
+
+    /// `Orbit`: to the nearest point of the circle (a transit), then `laps` turns.
+    pub fn orbit(&mut self, space: &Airspace, center: [f64; 2], radius: f64, laps: f64) -> f64 {
         let (dx, dy) = (self.pos[0] - center[0], self.pos[1] - center[1]);
         let angle = if dx == 0.0 && dy == 0.0 { 0.0 } else { dy.atan2(dx) };
         let entry =
             [center[0] + radius * angle.cos(), center[1] + radius * angle.sin(), self.pos[2]];
-        let to_circle = self.leg(entry);
+        let to_circle = self.transit(space, entry, self.max_speed);
         let arc = laps * std::f64::consts::TAU * radius;
         let speed = aviary_api::geometry::orbit_speed(self.max_speed, self.accel, radius);
         self.distance += arc;
         to_circle + trapezoid(arc, speed, self.accel * 0.75f64.sqrt())
     }
 
-    /// `ReturnToLaunch`: up to a safe altitude, home, down.
-    pub fn return_home(&mut self, max_altitude: Option<f64>) -> f64 {
+    /// `ReturnToLaunch`: up to a safe altitude, home (around the zones), down.
+    pub fn return_home(&mut self, space: &Airspace, max_altitude: Option<f64>) -> f64 {
         if !self.airborne {
             return 0.0;
         }
         let safe =
             aviary_api::flight::return_height(self.pos[2], self.return_altitude, max_altitude);
         let up = self.leg([self.pos[0], self.pos[1], safe]);
-        let across = self.leg([self.home[0], self.home[1], safe]);
+        let across = self.transit(space, [self.home[0], self.home[1], safe], self.max_speed);
         up + across + self.return_loiter + self.land_here()
     }
 }

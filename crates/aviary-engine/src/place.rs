@@ -15,9 +15,9 @@
 //! `THROW` of that work; `Detected` is raised where `StartDetection` was called
 //! (`api.rs`), which is the same place for a detection switched on by the work itself.
 //!
-//! Before this rule the events were raised in the innermost activity's own scope, above
-//! its PERFORM body's handlers: an `ON BatteryLow BY drone:` written in a PERFORM heard
-//! nothing while that PERFORM flew a middle-layer call.
+//! The activity's own scope is not enough: it lies above its PERFORM body's handlers, so
+//! an `ON BatteryLow BY drone:` written in a PERFORM would hear nothing while that
+//! PERFORM flies a middle-layer call.
 //!
 //! The places are kept per drone, a few each (an activity's body, and a call or two in
 //! flight), added and removed by guards: no event scans anything but its own drone's.

@@ -74,20 +74,7 @@ fn the_lost_sprayers_field_is_sprayed_once_lane_by_lane() {
     assert_eq!(done[2]["status"], "ok");
 
     // Lane by lane, from every sprayer's track.
-    let tracks: Vec<(String, Vec<[f64; 3]>)> = ["sprayer1", "sprayer2", "sprayer3"]
-        .iter()
-        .map(|d| {
-            let track = events
-                .iter()
-                .filter(|e| e["event"] == "telemetry" && e["actor"] == *d)
-                .map(|e| {
-                    let p = &e["position"];
-                    [p[0].as_f64().unwrap(), p[1].as_f64().unwrap(), p[2].as_f64().unwrap()]
-                })
-                .collect();
-            (d.to_string(), track)
-        })
-        .collect();
+    let tracks = lanes::tracks(&events, &["sprayer1", "sprayer2", "sprayer3"]);
     let east = sweep::lanes(&field, 10.0);
     let owners = lanes::each_lane_once(&east, &tracks);
     let shared = owners.iter().position(|o| o.len() == 2).expect("the lane it was on");

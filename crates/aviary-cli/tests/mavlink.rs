@@ -510,20 +510,7 @@ fn the_remainder_of_a_sweep_aborted_over_mavlink_is_flown_by_another_vehicle() {
     // From the telemetry: the middle of every lane (away from the corners a vehicle cuts)
     // is flown; the second lane by the scout east of where it stopped and by the buddy
     // west of it.
-    let tracks: Vec<(String, Vec<[f64; 3]>)> = ["scout", "buddy"]
-        .iter()
-        .map(|d| {
-            let track = trace
-                .iter()
-                .filter(|e| e["event"] == "telemetry" && e["actor"] == *d)
-                .map(|e| {
-                    let p = &e["position"];
-                    [p[0].as_f64().unwrap(), p[1].as_f64().unwrap(), p[2].as_f64().unwrap()]
-                })
-                .collect();
-            (d.to_string(), track)
-        })
-        .collect();
+    let tracks = aviary_test_support::lanes::tracks(&trace, &["scout", "buddy"]);
     let field = [[-60.0, 20.0], [60.0, 20.0], [60.0, 80.0], [-60.0, 80.0]];
     let all = aviary_api::sweep::lanes(&field, 20.0);
     let passes = aviary_test_support::lanes::passes(&all, &tracks);
@@ -586,13 +573,9 @@ fn a_flight_across_a_no_fly_zone_is_sent_as_waypoints_around_it() {
     let trace = events(&dir.join("t.jsonl"));
     assert_eq!(code, 0, "{:?}", trace.last());
     let zone = [[60.0, -40.0], [140.0, -40.0], [140.0, 40.0], [60.0, 40.0]];
-    let samples: Vec<[f64; 3]> = trace
-        .iter()
-        .filter(|e| e["event"] == "telemetry" && e["actor"] == "scout")
-        .map(|e| {
-            let p = &e["position"];
-            [p[0].as_f64().unwrap(), p[1].as_f64().unwrap(), p[2].as_f64().unwrap()]
-        })
+    let samples: Vec<[f64; 3]> = aviary_test_support::harness::positions_in(&trace, "scout")
+        .into_iter()
+        .map(|(_, p)| p)
         .collect();
     assert!(samples.len() > 100, "{} samples", samples.len());
     // Never in the zone, and never into its margin by more than the arrival tolerance and

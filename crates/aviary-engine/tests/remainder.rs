@@ -23,10 +23,7 @@ fn with_fault(fault: &str) -> String {
 }
 
 fn tracks(r: &harness::Run, drones: &[&str]) -> Vec<(String, Vec<[f64; 3]>)> {
-    drones
-        .iter()
-        .map(|d| (d.to_string(), r.positions(d).into_iter().map(|(_, p)| p).collect()))
-        .collect()
+    lanes::tracks(&r.trace, drones)
 }
 
 /// The `api_done` of `actor`'s `function` calls, in order.

@@ -208,19 +208,23 @@ impl Run {
     }
     /// Telemetry positions of a drone, by time.
     pub fn positions(&self, actor: &str) -> Vec<(f64, [f64; 3])> {
-        self.trace
-            .iter()
-            .filter(|e| e["event"] == "telemetry" && e["actor"] == actor)
-            .map(|e| {
-                let p = &e["position"];
-                (
-                    e["t"].as_f64().unwrap(),
-                    [p[0].as_f64().unwrap(), p[1].as_f64().unwrap(), p[2].as_f64().unwrap()],
-                )
-            })
-            .collect()
+        positions_in(&self.trace, actor)
     }
     pub fn dump(&self) -> String {
         self.trace.iter().map(|e| e.to_string()).collect::<Vec<_>>().join("\n")
     }
+}
+
+/// Telemetry positions of a drone in a trace (its lines as JSON), by time: a run of the
+/// harness's, or a trace file `aviary run` wrote.
+pub fn positions_in(trace: &[Value], actor: &str) -> Vec<(f64, [f64; 3])> {
+    trace
+        .iter()
+        .filter(|e| e["event"] == "telemetry" && e["actor"] == actor)
+        .map(|e| {
+            let p = &e["position"];
+            let n = |v: &Value| v.as_f64().expect("a number");
+            (n(&e["t"]), [n(&p[0]), n(&p[1]), n(&p[2])])
+        })
+        .collect()
 }

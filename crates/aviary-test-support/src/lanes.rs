@@ -12,6 +12,18 @@
 
 use aviary_api::sweep::Lane;
 
+/// Each drone's track in a trace (its lines as JSON): its telemetry positions, for
+/// [`passes`] and [`each_lane_once`].
+pub fn tracks(trace: &[serde_json::Value], drones: &[&str]) -> Vec<(String, Vec<[f64; 3]>)> {
+    drones
+        .iter()
+        .map(|d| {
+            let track = crate::harness::positions_in(trace, d).into_iter().map(|(_, p)| p);
+            (d.to_string(), track.collect())
+        })
+        .collect()
+}
+
 /// Metres between two points looked at along a lane.
 pub const STEP: f64 = 0.5;
 /// Metres left out at each end of a lane.

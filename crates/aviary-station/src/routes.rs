@@ -302,10 +302,15 @@ async fn report(State(station): State<Arc<Station>>, Query(asked): Query<Recorde
         };
         match crate::report::render(&path, text.into_bytes(), world.as_ref()) {
             Ok(html) => {
-                let stem = std::path::Path::new(&path)
+                // A name a header can carry whatever the trace is called.
+                let stem: String = std::path::Path::new(&path)
                     .file_stem()
-                    .map(|s| s.to_string_lossy().replace('"', ""))
-                    .unwrap_or_else(|| "report".into());
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_default()
+                    .chars()
+                    .filter(|c| c.is_ascii_alphanumeric() || "-_.".contains(*c))
+                    .collect();
+                let stem = if stem.is_empty() { "report".to_string() } else { stem };
                 (
                     [
                         (header::CONTENT_TYPE, "text/html; charset=utf-8".to_string()),

@@ -184,18 +184,7 @@ impl<'m> Engine<'m> {
             Control::Signal { name, args } => {
                 // Only among the signals the mission declares with OPERATOR SIGNAL (by
                 // their ids, resolved when it was compiled).
-                let ops = &self.m.operator_signals;
-                let id = ops.iter().copied().find(|&s| self.m.signals[s] == name).ok_or_else(|| {
-                    let declared: Vec<&str> = ops.iter().map(|&s| self.m.signals[s].as_str()).collect();
-                    let mean = did_you_mean(&name, declared.iter().copied());
-                    match declared.is_empty() {
-                        true => format!("the mission declares no signal an operator may raise, so not {name}"),
-                        false => match mean {
-                            Some(mean) => format!("the mission does not declare {name} as an operator signal: {mean} It declares {}", declared.join(", ")),
-                            None => format!("the mission does not declare {name} as an operator signal: it declares {}", declared.join(", ")),
-                        },
-                    }
-                })?;
+                let id = self.m.operator_signal(&name)?;
                 self.raise_from_outside(id, args);
                 Ok(())
             }

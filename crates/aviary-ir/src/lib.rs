@@ -84,7 +84,36 @@ impl Builtins {
     }
 }
 
+/// Why an operator may not raise `name`, when the mission declares `declared` (in the
+/// order written) as its operator signals.
+pub fn undeclared_signal(name: &str, declared: &[&str]) -> String {
+    if declared.is_empty() {
+        return format!("the mission declares no signal an operator may raise, so not {name}");
+    }
+    let list = declared.join(", ");
+    match aviary_diagnostics::suggest::did_you_mean(name, declared.iter().copied()) {
+        Some(mean) => format!(
+            "the mission does not declare {name} as an operator signal: {mean} It declares {list}"
+        ),
+        None => {
+            format!("the mission does not declare {name} as an operator signal: it declares {list}")
+        }
+    }
+}
+
 impl Mission {
+    /// The operator signal called `name`, or why an operator may not raise it: the
+    /// mission does not declare it with `OPERATOR SIGNAL` (with the ones it declares, and
+    /// the one meant when one is close). The engine and the operator API refuse with it.
+    pub fn operator_signal(&self, name: &str) -> Result<SignalId, String> {
+        let ops = &self.operator_signals;
+        if let Some(&id) = ops.iter().find(|&&s| self.signals[s] == name) {
+            return Ok(id);
+        }
+        let declared: Vec<&str> = ops.iter().map(|&s| self.signals[s].as_str()).collect();
+        Err(undeclared_signal(name, &declared))
+    }
+
     /// Attribute `a` of drone `d`, if the world gives the drone one.
     pub fn attribute(&self, a: usize, d: DroneId) -> Option<Value> {
         match self.attributes.get(a)? {

@@ -77,19 +77,11 @@ impl Kinds {
         if self.operator.iter().any(|n| n == name) {
             return Ok(());
         }
-        let declared = self.operator.iter().map(String::as_str);
-        let mean = aviary_diagnostics::suggest::did_you_mean(name, declared.clone());
-        let list = declared.collect::<Vec<_>>().join(", ");
-        Err(match (self.operator.is_empty(), mean) {
-            (true, _) => format!(
-                "the mission declares no signal an operator may raise, so not {name}: it would need `OPERATOR SIGNAL {name}` in its MISSION body"
-            ),
-            (false, Some(mean)) => format!(
-                "the mission does not declare {name} as an operator signal: {mean} It declares {list}"
-            ),
-            (false, None) => format!(
-                "the mission does not declare {name} as an operator signal: it declares {list}"
-            ),
+        let declared: Vec<&str> = self.operator.iter().map(String::as_str).collect();
+        let why = aviary_ir::undeclared_signal(name, &declared);
+        Err(match declared.is_empty() {
+            true => format!("{why}: it would need `OPERATOR SIGNAL {name}` in its MISSION body"),
+            false => why,
         })
     }
 

@@ -174,16 +174,11 @@ impl Fleet {
                 if let Ok(legs) = return_legs(d, &self.names[id], false, &limits) {
                     d.motion = Some(Box::new(MotionTask::new(None, legs)));
                     d.begin_leg();
-                    let reason = format!(
-                        "{}: no link for {} s: returns to launch on its own",
-                        &self.names[id],
+                    let why = format!(
+                        "no link for {} s: returns to launch on its own",
                         aviary_api::show::number(self.link_loss_rtl_after)
                     );
-                    out.push(Report::Event(DroneEvent::Autopilot {
-                        drone: id,
-                        action: AutopilotAction::ReturnHome,
-                        reason,
-                    }));
+                    self.on_its_own(id, AutopilotAction::ReturnHome, &why, out);
                 }
             }
         }

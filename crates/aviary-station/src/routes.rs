@@ -245,10 +245,16 @@ struct Recorded {
 async fn trace(State(station): State<Arc<Station>>, Query(asked): Query<Recorded>) -> Response {
     let (name, text) = match (&station.mode, asked.path) {
         (Mode::Replay { name, trace }, _) => (name.clone(), trace.clone()),
-        (Mode::Folder { folder, .. }, Some(path)) => match recorded(folder, &path) {
-            Ok(text) => (path, text),
-            Err(refusal) => return refusal.into_response(),
-        },
+        (Mode::Folder { folder, .. }, Some(path)) => {
+            let checked = trace_text(folder, &path).and_then(|text| {
+                crate::replay::read(&path, text.into_bytes())
+                    .map_err(|why| Refusal(StatusCode::CONFLICT, why))
+            });
+            match checked {
+                Ok(text) => (path, text),
+                Err(refusal) => return refusal.into_response(),
+            }
+        }
         (Mode::Folder { .. }, None) => {
             return error(StatusCode::BAD_REQUEST, "name the trace: ?path=traces/NAME.jsonl")
         }
@@ -269,16 +275,16 @@ async fn trace(State(station): State<Arc<Station>>, Query(asked): Query<Recorded
         .into_response()
 }
 
-/// A trace of the folder, read and checked to be events.
-fn recorded(folder: &dir::Folder, path: &str) -> Result<String, Refusal> {
+/// A trace of the folder, as its file holds it. Its lines are read as events by the one
+/// who uses them (a replay checks them all first; a report reads each once).
+fn trace_text(folder: &dir::Folder, path: &str) -> Result<String, Refusal> {
     if dir::FileKind::of(path) != Some(dir::FileKind::Trace) {
         return Err(Refusal(
             StatusCode::BAD_REQUEST,
             format!("`{path}` is not a trace (.jsonl): name one of the folder's traces"),
         ));
     }
-    let text = folder.read(path).map_err(|why| Refusal(StatusCode::NOT_FOUND, why))?;
-    crate::replay::read(path, text.into_bytes()).map_err(|why| Refusal(StatusCode::CONFLICT, why))
+    folder.read(path).map_err(|why| Refusal(StatusCode::NOT_FOUND, why))
 }
 
 /// The report of a trace of the folder (`aviary report`'s HTML), on the world named, as a
@@ -292,7 +298,7 @@ async fn report(State(station): State<Arc<Station>>, Query(asked): Query<Recorde
         let Some(path) = asked.path else {
             return error(StatusCode::BAD_REQUEST, "name the trace: ?path=traces/NAME.jsonl");
         };
-        let text = match recorded(folder, &path) {
+        let text = match trace_text(folder, &path) {
             Ok(text) => text,
             Err(refusal) => return refusal.into_response(),
         };

@@ -1,5 +1,7 @@
-//! Aviary against a real autopilot: ArduCopter SITL (`AVIARY_SITL`, or `../shared/sitl/arducopter`), each
-//! vehicle a process of its own, flown by `aviary run` over MAVLink on TCP.
+//! Aviary against a real autopilot: ArduCopter SITL, each vehicle a process of its own,
+//! flown by `aviary run` over MAVLink on TCP. The tests run where `AVIARY_SITL` names the
+//! binary (build.rs turns on `cfg(arducopter_sitl)`); elsewhere each is ignored with the
+//! line that says how to run it.
 //!
 //! - `fleet::`: the paper's mission on seven SITL copters, and on two SITL copters with
 //!   five simulated drones. These are the long ones (10 minutes of real flight); their
@@ -265,11 +267,19 @@ fn paper_mission(tag: &str, first_instance: u16, real: &[&str]) {
 
 mod fleet {
     #[test]
+    #[cfg_attr(
+        not(arducopter_sitl),
+        ignore = "ArduCopter SITL not named: set AVIARY_SITL=/path/to/arducopter to fly it (docs/REAL_DRONES.md)"
+    )]
     fn paper_mission_on_seven_sitl_copters() {
         super::paper_mission("sitl_paper", 0, &super::PAPER_DRONES);
     }
 
     #[test]
+    #[cfg_attr(
+        not(arducopter_sitl),
+        ignore = "ArduCopter SITL not named: set AVIARY_SITL=/path/to/arducopter to fly it (docs/REAL_DRONES.md)"
+    )]
     fn paper_mission_on_two_sitl_copters_and_five_simulated() {
         super::paper_mission("sitl_mixed", 10, &["flir_drone2", "beacon_drone2"]);
     }
@@ -286,6 +296,10 @@ mod facts {
     /// longest drone flies about 8. The check warns before flight, naming the drones; with
     /// BATT_CAPACITY 16500 set on the same running vehicles it does not.
     #[test]
+    #[cfg_attr(
+        not(arducopter_sitl),
+        ignore = "ArduCopter SITL not named: set AVIARY_SITL=/path/to/arducopter to fly it (docs/REAL_DRONES.md)"
+    )]
     fn check_plan_warns_when_the_vehicles_batteries_cannot_finish_the_paper_mission() {
         let dir = scratch("sitl_facts");
         let sitls: Vec<(&str, Sitl)> = PAPER_DRONES
@@ -380,6 +394,10 @@ mod facts {
     /// anyway (the choice: handlers and the autopilot's failsafe may cover it). The run is
     /// stopped once the take-off is under way.
     #[test]
+    #[cfg_attr(
+        not(arducopter_sitl),
+        ignore = "ArduCopter SITL not named: set AVIARY_SITL=/path/to/arducopter to fly it (docs/REAL_DRONES.md)"
+    )]
     fn run_warns_before_flight_that_the_battery_runs_out_and_flies() {
         let dir = scratch("sitl_facts_run");
         let sitl = Sitl::start(&dir, 30, 1, [0.0, 0.0], &[]);
@@ -435,6 +453,10 @@ mod facts {
     /// BatteryCritical under ~45 %. On the world's figures alone (30 minutes, no capacity)
     /// both would wait until ~13 % and ~11 %.
     #[test]
+    #[cfg_attr(
+        not(arducopter_sitl),
+        ignore = "ArduCopter SITL not named: set AVIARY_SITL=/path/to/arducopter to fly it (docs/REAL_DRONES.md)"
+    )]
     fn the_battery_rule_uses_the_draw_the_vehicle_measures() {
         let dir = scratch("sitl_facts_draw");
         let sitl = Sitl::start(&dir, 30, 1, [0.0, 0.0], &[("BATT_CAPACITY", 600.0)]);
@@ -508,6 +530,10 @@ mod single {
     }
 
     #[test]
+    #[cfg_attr(
+        not(arducopter_sitl),
+        ignore = "ArduCopter SITL not named: set AVIARY_SITL=/path/to/arducopter to fly it (docs/REAL_DRONES.md)"
+    )]
     fn takes_off_flies_orbits_and_lands_where_sitl_says() {
         let mission = "MISSION Sitl:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d FlyTo WITH North\n        d FlyCircle WITH North, 20m, 1\n        d Land\n";
         let (dir, sitl, mut run) = one("sitl_one", &[], "[places]\nNorth = [0, 40]\n", mission);
@@ -560,6 +586,10 @@ mod single {
     }
 
     #[test]
+    #[cfg_attr(
+        not(arducopter_sitl),
+        ignore = "ArduCopter SITL not named: set AVIARY_SITL=/path/to/arducopter to fly it (docs/REAL_DRONES.md)"
+    )]
     fn a_drained_battery_raises_battery_critical() {
         // ArduCopter's own battery failsafe: under 10.5 V for 2 s, RTL.
         let params = [("BATT_LOW_VOLT", 10.5), ("BATT_FS_LOW_ACT", 2.0), ("BATT_LOW_TIMER", 2.0)];
@@ -576,6 +606,10 @@ mod single {
     }
 
     #[test]
+    #[cfg_attr(
+        not(arducopter_sitl),
+        ignore = "ArduCopter SITL not named: set AVIARY_SITL=/path/to/arducopter to fly it (docs/REAL_DRONES.md)"
+    )]
     fn the_vehicles_own_fence_raises_geofence_violation() {
         // ArduCopter holds a GUIDED target outside its fence instead of flying there, so
         // the breach is made as on a real site: the drone is 80 m out when the ground
@@ -599,6 +633,10 @@ mod single {
     }
 
     #[test]
+    #[cfg_attr(
+        not(arducopter_sitl),
+        ignore = "ArduCopter SITL not named: set AVIARY_SITL=/path/to/arducopter to fly it (docs/REAL_DRONES.md)"
+    )]
     fn gps_loss_raises_position_lost() {
         let mission = "MISSION Drill:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d Hover WITH 120s\n    ON EXCEPTION PositionLost BY d:\n        SIGNAL Caught\n";
         let (dir, sitl, mut run) = one("sitl_gps", &[], "", mission);
@@ -612,6 +650,10 @@ mod single {
     }
 
     #[test]
+    #[cfg_attr(
+        not(arducopter_sitl),
+        ignore = "ArduCopter SITL not named: set AVIARY_SITL=/path/to/arducopter to fly it (docs/REAL_DRONES.md)"
+    )]
     fn a_stopped_vehicle_is_lost_and_a_restarted_one_restored() {
         // Lost: later statements on the drone raise ConnectionLost, which a handler
         // catches; restarted: ConnectionRestored is heard.
@@ -651,6 +693,10 @@ mod single {
     }
 
     #[test]
+    #[cfg_attr(
+        not(arducopter_sitl),
+        ignore = "ArduCopter SITL not named: set AVIARY_SITL=/path/to/arducopter to fly it (docs/REAL_DRONES.md)"
+    )]
     fn a_refused_command_fails_with_the_autopilots_reason() {
         // A minimum arming voltage above the battery's: ArduCopter refuses to arm, and
         // says why.
@@ -670,6 +716,10 @@ mod single {
     }
 
     #[test]
+    #[cfg_attr(
+        not(arducopter_sitl),
+        ignore = "ArduCopter SITL not named: set AVIARY_SITL=/path/to/arducopter to fly it (docs/REAL_DRONES.md)"
+    )]
     fn a_vehicle_away_from_its_world_home_is_refused_before_flight() {
         let dir = scratch("sitl_home");
         // SITL stands 40 m east of where the world puts it.

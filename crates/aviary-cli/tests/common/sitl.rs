@@ -4,10 +4,10 @@
 //! test's "ground station") changes parameters mid-flight and records what the vehicle
 //! reports, independently of `aviary run`.
 //!
-//! The binary is `AVIARY_SITL`, or `../shared/sitl/arducopter` beside the repository
-//! (where CI keeps one), with ArduPilot's `copter.parm` beside it. The gripper's
-//! parameters are ours (`tests/sitl/gripper.parm`). A missing binary fails the test with
-//! what to do; it is never skipped.
+//! The binary is `AVIARY_SITL`, with ArduPilot's `copter.parm` beside it or in the
+//! ArduPilot tree it was built in. The gripper's parameters are ours
+//! (`tests/sitl/gripper.parm`). The tests that use it are ignored where `AVIARY_SITL` is
+//! not set (build.rs); set to a path that is not a binary, they fail and say so.
 
 use std::io::Write;
 use std::net::TcpListener;
@@ -31,21 +31,28 @@ pub struct Files {
 }
 
 pub fn files() -> Files {
-    let dir = match std::env::var_os("AVIARY_SITL") {
-        Some(bin) => PathBuf::from(bin).parent().map(Path::to_path_buf).unwrap_or_default(),
-        None => super::repo().join("../shared/sitl"),
-    };
-    let binary =
-        std::env::var_os("AVIARY_SITL").map_or_else(|| dir.join("arducopter"), PathBuf::from);
+    let binary = PathBuf::from(std::env::var_os("AVIARY_SITL").unwrap_or_default());
     assert!(
         binary.is_file(),
-        "ArduCopter SITL not found at {}: the SITL tests need it. Build it from ArduPilot's source and set AVIARY_SITL to the binary, with ArduPilot's Tools/autotest/default_params/copter.parm beside it (docs/REAL_DRONES.md says how), or put both in ../shared/sitl beside the repository",
+        "ArduCopter SITL not found at `{}`: AVIARY_SITL must name the binary that ArduPilot's `./waf copter` builds (build/sitl/bin/arducopter; docs/REAL_DRONES.md)",
         binary.display()
     );
-    let copter_parm = dir.join("copter.parm");
-    assert!(copter_parm.is_file(), "{} not found beside the SITL binary: ArduPilot's Tools/autotest/default_params/copter.parm", copter_parm.display());
+    let copter_parm = copter_parm(&binary).unwrap_or_else(|| {
+        panic!(
+            "ArduPilot's copter.parm not found for {}: put Tools/autotest/default_params/copter.parm of the ArduPilot tree beside the binary",
+            binary.display()
+        )
+    });
     let gripper_parm = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/sitl/gripper.parm");
     Files { binary, copter_parm, gripper_parm }
+}
+
+/// ArduPilot's default parameters for the copter: beside the binary, or in the tree it
+/// was built in (`build/sitl/bin/arducopter` is three folders below the tree's top).
+fn copter_parm(binary: &Path) -> Option<PathBuf> {
+    let beside = binary.with_file_name("copter.parm");
+    let tree = binary.ancestors().nth(4)?.join("Tools/autotest/default_params/copter.parm");
+    [beside, tree].into_iter().find(|p| p.is_file())
 }
 
 /// Instance numbers this test binary hands out; each test binary has its own range

@@ -139,14 +139,13 @@ impl Craft {
         .await
     }
 
-    /// COMMAND_INT (positions as degrees × 10⁷ in a relative-altitude frame), with ACK.
+    /// COMMAND_INT (positions as degrees × 10⁷, the altitude in `frame`), with ACK.
     pub async fn command_int(
         &self,
         command: MavCmd,
+        frame: MavFrame,
         p: [f32; 4],
-        lat: i32,
-        lon: i32,
-        z: f32,
+        (lat, lon, z): (i32, i32, f32),
     ) -> Result<(), Failure> {
         self.command_with(command, |_| {
             MavMessage::COMMAND_INT(COMMAND_INT_DATA {
@@ -160,7 +159,7 @@ impl Craft {
                 command,
                 target_system: self.v.system,
                 target_component: 1,
-                frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+                frame,
                 current: 0,
                 autocontinue: 0,
             })
@@ -289,13 +288,21 @@ impl Craft {
         let (lat, lon) = self.v.origin().to_e7(to[0], to[1]);
         match self.v.flavour() {
             Flavour::Px4 => {
-                // -1: keep the default speed; bit 0 of param2: switch to the reposition mode.
+                // PX4's navigator reads DO_REPOSITION's altitude above mean sea level,
+                // whatever frame it comes in: a height above home sent as such (12 m,
+                // relative frame) brought a PX4 SITL copter down to land. So it is sent
+                // above sea level, from the vehicle's own home, in the frame that says so.
+                let Some(home) = self.fix().map(|f| f.home_amsl) else {
+                    return Err(failed(format!("{} has reported no position yet", self.name)));
+                };
+                // param1: the ground speed last set (-1: PX4's cruise speed); bit 0 of
+                // param2: switch to HOLD, where a reposition is flown.
+                let speed = lock(&self.speed).map_or(-1.0, |s| s as f32);
                 self.command_int(
                     MavCmd::MAV_CMD_DO_REPOSITION,
-                    [-1.0, 1.0, 0.0, f32::NAN],
-                    lat,
-                    lon,
-                    to[2] as f32,
+                    MavFrame::MAV_FRAME_GLOBAL,
+                    [speed, 1.0, 0.0, f32::NAN],
+                    (lat, lon, (home + to[2]) as f32),
                 )
                 .await
             }

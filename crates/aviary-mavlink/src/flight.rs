@@ -7,6 +7,7 @@ use aviary_api::{Failure, Function, Value};
 use mavlink::dialects::ardupilotmega::MavCmd;
 
 use crate::craft::{failed, Craft, Paused};
+use crate::mode::Flavour;
 use crate::motion::{
     arm, fly, fly_through, here, hover, land, orbit, routed, rtl, take_off, vertical, Pass,
 };
@@ -93,8 +94,13 @@ async fn orbit_around(c: &Craft, args: &[Value], paused: Paused) -> Result<(), F
     }
     let circle = orbit(here, center, radius, laps, c.tuning.arrive_xy);
     let mut way = routed(c, here, &circle[..1])?;
-    way.extend(circle[1..].iter().map(|&p| (p, Pass::Cut)));
     let speed = aviary_api::geometry::orbit_speed(c.max_speed, c.acceleration, radius);
+    if c.v.flavour() == Flavour::Px4 {
+        // To the circle, then PX4's own ORBIT mode around it.
+        fly_through(c, &way, c.max_speed, paused.clone()).await?;
+        return crate::px4::orbit(c, center, radius, circle[0][2], laps, speed, paused).await;
+    }
+    way.extend(circle[1..].iter().map(|&p| (p, Pass::Cut)));
     fly_through(c, &way, speed, paused).await
 }
 

@@ -31,6 +31,7 @@ pub mod link;
 pub mod mode;
 mod motion;
 mod plausible;
+mod px4;
 mod vehicle;
 
 use std::collections::BTreeMap;

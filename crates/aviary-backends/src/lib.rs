@@ -11,5 +11,5 @@ mod mixed;
 pub mod pipeline;
 pub mod trace_file;
 
-pub use mixed::{live_runtime, Mixed};
+pub use mixed::{live_runtime, simulated_runtime, Mixed};
 pub use pipeline::fly;

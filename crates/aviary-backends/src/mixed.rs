@@ -126,8 +126,15 @@ impl Backend for Mixed {
     }
 }
 
-/// The runtime of a run with MAVLink drones: one thread as in a simulated run (the engine
-/// relies on it), but the wall clock and sockets.
+/// The runtime of a run with MAVLink drones: one thread on tokio's paused clock, as a
+/// simulated run (the engine relies on both), with sockets. The simulator's driver holds
+/// the clock to the run's `aviary_sim::Pace`: without it, an idle runtime would jump to
+/// its next timer.
 pub fn live_runtime() -> std::io::Result<tokio::runtime::Runtime> {
-    tokio::runtime::Builder::new_current_thread().enable_all().build()
+    tokio::runtime::Builder::new_current_thread().enable_all().start_paused(true).build()
+}
+
+/// The runtime of a simulated run: one thread, tokio's paused clock, no sockets.
+pub fn simulated_runtime() -> std::io::Result<tokio::runtime::Runtime> {
+    tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build()
 }

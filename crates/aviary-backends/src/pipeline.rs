@@ -23,7 +23,7 @@ use aviary_sim::{Fleet, SimBackend, SimOptions};
 use aviary_world::World;
 use tokio::sync::watch;
 
-use crate::{live_runtime, Mixed};
+use crate::{live_runtime, simulated_runtime, Mixed};
 
 /// One file, as read: its name (as diagnostics show it) and its bytes, handed over (valid
 /// UTF-8 becomes the text without a copy: a large world's file is megabytes).
@@ -51,6 +51,20 @@ pub struct Options {
     pub seed: u64,
     /// The engine's options (telemetry events, ...).
     pub run: RunOptions,
+    /// What the time of a run with MAVLink drones follows.
+    pub clock: LiveClock,
+}
+
+/// The clock of a run with MAVLink drones: its `Hover`, `WAITFOR ELAPSED`, `ON EVERY`,
+/// trace times, link timeouts and simulated drones all keep it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LiveClock {
+    /// The vehicles' own (`aviary_mavlink::clock`): a SITL that runs faster than real
+    /// time has a mission that does too. Real vehicles keep real time, and so does this.
+    #[default]
+    Vehicles,
+    /// The wall clock, whatever the vehicles' say.
+    Wall,
 }
 
 /// The stages of [`fly`], in order, each announced as it begins and ends
@@ -222,12 +236,12 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
     if live && options.speed.is_some() {
         return Err(NotFlown::Speed);
     }
-    let runtime = if live {
-        live_runtime()
-    } else {
-        tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build()
-    }
-    .map_err(|e| NotFlown::Failed(format!("cannot start the runtime: {e}")))?;
+    // Every run is on tokio's paused clock, which the simulator's driver lets move: as
+    // fast as it goes, at `speed`, or, with MAVLink drones, at the pace of the wall clock
+    // and then of the vehicles' (`aviary_sim::Pace`).
+    let runtime = if live { live_runtime() } else { simulated_runtime() }
+        .map_err(|e| NotFlown::Failed(format!("cannot start the runtime: {e}")))?;
+    let pace = live.then(|| Arc::new(aviary_sim::Pace::default()));
     let (controller, controls) = Controller::new();
     // The first stop, also seen before the engine runs (while vehicles connect).
     let (stop, stopped) = watch::channel(None::<&'static str>);
@@ -242,8 +256,10 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
         // The chances the world asks for (a sensor's `probability`, a fault's range of
         // times) are drawn from the seed.
         let fleet = fleet.seeded(options.seed);
-        let sim =
-            SimBackend::start_with(fleet, SimOptions { speed: options.speed, ..SimOptions::default() });
+        let sim = SimBackend::start_with(
+            fleet,
+            SimOptions { speed: options.speed, pace: pace.clone(), ..SimOptions::default() },
+        );
         hooks.end(Stage::SimStart);
         let mixed = match &world {
             Some(world) => {
@@ -263,6 +279,10 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
                 };
                 if let Some(sources) = &sources {
                     hooks.connected(&mission, world, mavlink.facts(), sources);
+                }
+                if let (Some(pace), LiveClock::Vehicles) = (&pace, options.clock) {
+                    let mut clocks = mavlink.clocks();
+                    pace.follow(Box::new(move || clocks.moved()));
                 }
                 Some(Mixed::new(sim.clone(), mavlink))
             }

@@ -43,6 +43,13 @@ struct Cli {
     command: Command,
 }
 
+/// `aviary run --clock`.
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Debug)]
+pub enum Clock {
+    Vehicles,
+    Wall,
+}
+
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
 pub enum Format {
     Text,
@@ -113,6 +120,10 @@ enum Command {
         /// A folder whose .mission files USE may read, besides the mission's own (repeatable)
         #[arg(long, value_name = "DIR", value_parser = folder)]
         use_root: Vec<PathBuf>,
+        /// With MAVLink drones: the clock the mission keeps, the vehicles' own (a SITL
+        /// faster than real time makes the mission faster too) or the wall's
+        #[arg(long, value_enum, default_value_t = Clock::Vehicles)]
+        clock: Clock,
     },
     /// Serve the ground station: a web page to open, check, fly, watch and steer the
     /// missions of a folder (docs/GCS.md)
@@ -272,6 +283,7 @@ fn command(cli: Cli) -> u8 {
             serve,
             allow_host,
             use_root,
+            clock,
         } => {
             // Served to an operator, a mission runs in real time unless told otherwise.
             let speed =
@@ -290,6 +302,10 @@ fn command(cli: Cli) -> u8 {
                         quiet,
                         serve,
                         use_root,
+                        clock: match clock {
+                            Clock::Vehicles => aviary_backends::pipeline::LiveClock::Vehicles,
+                            Clock::Wall => aviary_backends::pipeline::LiveClock::Wall,
+                        },
                     })
                 }
                 (Err(why), _) | (_, Err(why)) => {

@@ -33,6 +33,8 @@ pub struct RunArgs {
     pub serve: Option<crate::serve::Serve>,
     /// Folders whose .mission files USE may read, besides the mission's own.
     pub use_root: Vec<PathBuf>,
+    /// What a run with MAVLink drones keeps time by.
+    pub clock: aviary_backends::pipeline::LiveClock,
 }
 
 /// `7878` is loopback port 7878; `HOST:PORT` binds exactly that.
@@ -111,6 +113,7 @@ pub fn run(args: &RunArgs) -> u8 {
             telemetry_hz: args.telemetry_hz.or(args.serve.as_ref().map(|_| 2.0)),
             ..RunOptions::default()
         },
+        clock: args.clock,
     };
     let mut shown = Shown {
         args,

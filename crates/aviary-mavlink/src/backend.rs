@@ -54,6 +54,13 @@ pub struct MavlinkBackend {
 }
 
 impl MavlinkBackend {
+    /// The clocks of the vehicles this backend flies, as one (`clock`): what a live
+    /// run's time follows.
+    pub fn clocks(&self) -> crate::clock::Clocks {
+        let vehicles = self.inner.crafts.iter().flatten().map(|c| Arc::clone(&c.v)).collect();
+        crate::clock::Clocks::new(vehicles)
+    }
+
     pub(crate) fn new(
         crafts: Vec<Option<Arc<Craft>>>,
         facts: Vec<Facts>,

@@ -21,6 +21,7 @@
 
 mod backend;
 pub mod battery;
+pub mod clock;
 mod connect;
 mod craft;
 pub mod facts;

@@ -43,6 +43,8 @@ pub struct Activation {
 #[derive(Default)]
 pub struct Seen {
     pub heartbeat: Option<Instant>,
+    /// Its own clock, for the run's pace (`clock`).
+    pub clock: Option<crate::clock::Heard>,
     pub flavour: Option<Flavour>,
     pub custom_mode: u32,
     pub armed: bool,
@@ -200,7 +202,14 @@ impl Vehicle {
                 let xy = self.origin.from_e7(h.latitude, h.longitude);
                 seen.home = Some([xy[0], xy[1], f64::from(h.altitude) / 1000.0 - self.origin.alt]);
             }
-            MavMessage::GLOBAL_POSITION_INT(p) => self.take_position(&mut seen, now, p),
+            MavMessage::GLOBAL_POSITION_INT(p) => {
+                seen.clock = Some(crate::clock::Heard::take(
+                    seen.clock,
+                    p.time_boot_ms,
+                    std::time::Instant::now(),
+                ));
+                self.take_position(&mut seen, now, p);
+            }
             MavMessage::SYS_STATUS(s) => {
                 seen.take_battery(now, s.battery_remaining, s.current_battery);
                 // A sensor the vehicle has and uses but calls unhealthy (ArduPilot clears

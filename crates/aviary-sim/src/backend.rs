@@ -22,9 +22,10 @@ use tokio::task::JoinHandle;
 use tokio::time::MissedTickBehavior;
 
 use crate::fleet::{Fleet, Release, Report};
+use crate::pace::Pace;
 
 /// How the simulator runs.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone)]
 pub struct SimOptions {
     /// Simulated seconds per physics step (default 0.05). Tokio's timer counts whole
     /// milliseconds, so keep it a multiple of 0.001.
@@ -34,11 +35,15 @@ pub struct SimOptions {
     /// simulated time never runs ahead of `x` × wall time. Run the runtime with a paused
     /// clock in both cases, so that tokio time is simulated time.
     pub speed: Option<f64>,
+    /// A live run's reference (with MAVLink drones): simulated time never runs ahead of
+    /// it (the wall clock, or the vehicles' clocks once it follows them). Instead of
+    /// `speed`.
+    pub pace: Option<Arc<Pace>>,
 }
 
 impl Default for SimOptions {
     fn default() -> SimOptions {
-        SimOptions { tick: 0.05, speed: None }
+        SimOptions { tick: 0.05, speed: None, pace: None }
     }
 }
 
@@ -170,7 +175,19 @@ async fn drive(backend: Weak<SimBackend>, options: SimOptions) {
         sim.tick(options.tick);
         drop(sim);
         ticks += 1;
-        if let Some(speed) = options.speed.filter(|s| s.is_finite() && *s > 0.0) {
+        if let Some(pace) = &options.pace {
+            // Until the reference has reached this tick's time, in waits of a few
+            // milliseconds, each a blocking task that holds the paused clock still.
+            let due = ticks as f64 * options.tick;
+            while pace.now() < due {
+                let running =
+                    backend.upgrade().is_some_and(|sim| !sim.stopped.load(Ordering::SeqCst));
+                if !running {
+                    return;
+                }
+                let _ = tokio::task::spawn_blocking(|| std::thread::sleep(PACE_POLL)).await;
+            }
+        } else if let Some(speed) = options.speed.filter(|s| s.is_finite() && *s > 0.0) {
             let due = Duration::from_secs_f64(ticks as f64 * options.tick / speed);
             let elapsed = wall.elapsed();
             if due > elapsed {
@@ -184,6 +201,9 @@ async fn drive(backend: Weak<SimBackend>, options: SimOptions) {
         }
     }
 }
+
+/// How often a paced driver looks at its reference while it waits.
+const PACE_POLL: Duration = Duration::from_millis(2);
 
 impl Backend for SimBackend {
     fn descriptor(&self) -> Descriptor {

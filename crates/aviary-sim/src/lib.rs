@@ -160,6 +160,7 @@ mod legs;
 mod luck;
 mod motion;
 mod nearby;
+mod pace;
 mod profile;
 mod sensors;
 mod separation;
@@ -169,6 +170,7 @@ pub mod sweep;
 mod tests;
 
 pub use backend::{SimBackend, SimOptions};
+pub use pace::{Pace, Source as PaceSource};
 
 /// What the simulator offers: the standard middle layer (docs/LANGUAGE.md, section 19). The checker
 /// reads this before a run, so a function the simulator added would be known to it.

@@ -69,6 +69,7 @@ pub fn start(
                 speed: request.speed,
                 seed: request.seed,
                 run: RunOptions { telemetry_hz: Some(telemetry_hz), ..RunOptions::default() },
+                ..Options::default()
             };
             let texts = Texts {
                 mission: Source {

@@ -44,7 +44,7 @@ fn is_heartbeat(o: &Out) -> bool {
 }
 
 /// Per (system, message id): the rate a client asked for (Hz; 0 is off) and when the
-/// next one is due (seconds of wall time since the server started).
+/// next one is due (seconds of the vehicles' time since the server started).
 #[derive(Default)]
 pub struct Schedule {
     rates: HashMap<(u8, u32), f64>,

@@ -48,7 +48,9 @@ pub(crate) fn lock(ap: &Shared) -> MutexGuard<'_, Autopilot> {
 
 /// Steps the simulation in real time × `speed` (whole physics ticks, so the simulator
 /// behaves as in `aviary run`), tells every client what happened, and queues each client
-/// the streams that are due for it, at the rates it asked for, of wall time.
+/// the streams that are due for it, at the rates it asked for, of the vehicles' own time:
+/// as a SITL run faster than real time (ArduPilot's `--speedup`, PX4's speed factor)
+/// sends its heartbeat once a second of its own clock, so more often by the wall's.
 pub(crate) async fn pace(ap: Shared, clients: Arc<Registry>, tick: f64, speed: f64) {
     let mut every = tokio::time::interval(Duration::from_millis(10));
     every.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
@@ -63,13 +65,14 @@ pub(crate) async fn pace(ap: Shared, clients: Arc<Registry>, tick: f64, speed: f
             events.extend(ap.step(tick));
             ticks += 1;
         }
-        tell(&ap, &clients.all(), events, wall);
+        tell(&ap, &clients.all(), events, ticks as f64 * tick);
     }
 }
 
 /// Tells each client what happened (`events`) and queues it the streams due for it at
-/// `wall` seconds, at the rates it asked for. A vehicle whose radio is down says nothing.
-pub(crate) fn tell(ap: &Autopilot, clients: &[Arc<Client>], mut events: Vec<Out>, wall: f64) {
+/// `time` seconds of the vehicles' clock, at the rates it asked for. A vehicle whose
+/// radio is down says nothing.
+pub(crate) fn tell(ap: &Autopilot, clients: &[Arc<Client>], mut events: Vec<Out>, time: f64) {
     let up: Vec<usize> = (0..ap.copters.len()).filter(|i| ap.link(*i)).collect();
     events.retain(|e: &Out| up.iter().any(|i| ap.copters[*i].system == e.system));
     for c in clients {
@@ -80,7 +83,7 @@ pub(crate) fn tell(ap: &Autopilot, clients: &[Arc<Client>], mut events: Vec<Out>
         for &i in &up {
             let system = ap.copters[i].system;
             for (id, hz) in STREAMS {
-                if !schedule.due(system, id, hz, wall) {
+                if !schedule.due(system, id, hz, time) {
                     continue;
                 }
                 if let Some(msg) = ap.message(i, id) {

@@ -55,6 +55,15 @@ fn copter_parm(binary: &Path) -> Option<PathBuf> {
     [beside, tree].into_iter().find(|p| p.is_file())
 }
 
+/// SITL's `--speedup`: `AVIARY_SITL_SPEEDUP`, else 1 (real time). The mission keeps the
+/// vehicles' clock, so a faster SITL makes the tests faster and flies the same.
+pub fn speedup() -> String {
+    std::env::var("AVIARY_SITL_SPEEDUP")
+        .ok()
+        .filter(|s| s.parse::<f64>().is_ok_and(|x| x > 0.0))
+        .unwrap_or_else(|| "1".into())
+}
+
 /// Instance numbers this test binary hands out; each test binary has its own range
 /// (`first`), and a number whose ports are taken by somebody else is passed over.
 static NEXT: AtomicU16 = AtomicU16::new(0);
@@ -111,7 +120,7 @@ impl Sitl {
             "--model".into(),
             "quad".into(),
             "--speedup".into(),
-            "1".into(),
+            speedup(),
             "--home".into(),
             format!("{lat:.8},{lon:.8},{},0", ORIGIN.alt),
             "-I".into(),

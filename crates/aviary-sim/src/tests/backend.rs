@@ -168,7 +168,8 @@ async fn the_backend_is_deterministic() {
 
 #[tokio::test(flavor = "current_thread", start_paused = true)]
 async fn speed_paces_against_the_wall_clock() {
-    let sim = SimBackend::start(&one_drone(), SimOptions { tick: 0.05, speed: Some(50.0) });
+    let sim =
+        SimBackend::start(&one_drone(), SimOptions { speed: Some(50.0), ..SimOptions::default() });
     let wall = std::time::Instant::now();
     done(sim.call(0, Function::Hover, &[num(2.0)])).await;
     // 2 s of simulated time at 50x: at least 40 ms of wall time.
@@ -177,11 +178,42 @@ async fn speed_paces_against_the_wall_clock() {
 }
 
 #[tokio::test(flavor = "current_thread", start_paused = true)]
+async fn a_pace_holds_simulated_time_to_its_source() {
+    // A source that moves 1 s per look for five looks, then stands still (a vehicle
+    // whose clock stopped, heard all the same): the simulated clock gets no further
+    // than those 5 s (and one tick), however long the wall waits.
+    let pace = std::sync::Arc::new(crate::Pace::default());
+    let mut looks = 0;
+    pace.follow(Box::new(move || {
+        looks += 1;
+        Some(if looks <= 5 { 1.0 } else { 0.0 })
+    }));
+    let sim = SimBackend::start(
+        &one_drone(),
+        SimOptions { pace: Some(std::sync::Arc::clone(&pace)), ..SimOptions::default() },
+    );
+    let hover = sim.call(0, Function::Hover, &[num(60.0)]);
+    // 300 ms of wall time, told from another thread (a wait of this task's own would
+    // hold the paused clock still).
+    let (tx, rx) = tokio::sync::oneshot::channel();
+    std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_millis(300));
+        let _ = tx.send(());
+    });
+    rx.await.expect("the wall's 300 ms");
+    let t = sim.time();
+    assert!((5.0..=5.05 + 1e-9).contains(&t), "simulated {t} s");
+    drop(hover);
+    sim.shutdown().await;
+}
+
+#[tokio::test(flavor = "current_thread", start_paused = true)]
 async fn pacing_leaves_the_thread_free_and_the_clock_still() {
     // At a tenth of real time each 0.05 s tick waits 0.5 s of wall time. A message sent
     // from another thread 20 ms into that wait is taken at once by a task on the same
     // thread, not when the wait is over; and the simulated clock has not moved meanwhile.
-    let sim = SimBackend::start(&one_drone(), SimOptions { tick: 0.05, speed: Some(0.1) });
+    let sim =
+        SimBackend::start(&one_drone(), SimOptions { speed: Some(0.1), ..SimOptions::default() });
     let hover = sim.call(0, Function::Hover, &[num(10.0)]);
     tokio::time::sleep(Duration::from_millis(60)).await;
     let (tx, mut rx) = tokio::sync::mpsc::unbounded_channel();

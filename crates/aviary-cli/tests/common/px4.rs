@@ -1,0 +1,164 @@
+//! PX4 SITL for tests, with PX4's built-in SIH simulator (no Gazebo): each vehicle a
+//! process of its own, with its own instance number (so its own UDP ports and system id
+//! N + 1) and working directory, stopped when dropped (also when the test panics).
+//!
+//! The binary is `AVIARY_PX4` (the `bin/px4` of a `px4_sitl_default` build, its ROMFS
+//! `etc` beside `bin`). The tests that use it are ignored where `AVIARY_PX4` is not set
+//! (build.rs). `AVIARY_PX4_SPEED` sets `PX4_SIM_SPEED_FACTOR` (1 when not set): the
+//! mission keeps the vehicles' clock, so a faster PX4 flies the same mission sooner.
+
+use std::net::UdpSocket;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::atomic::{AtomicU16, Ordering};
+use std::time::{Duration, Instant};
+
+use aviary_mavlink::Origin;
+
+/// The world origin the PX4 tests use (the example worlds' site).
+pub const ORIGIN: Origin = Origin { lat: 46.6167, lon: 14.2650, alt: 440.0 };
+
+pub fn binary() -> PathBuf {
+    let binary = PathBuf::from(std::env::var_os("AVIARY_PX4").unwrap_or_default());
+    assert!(
+        binary.is_file(),
+        "PX4 SITL not found at `{}`: AVIARY_PX4 must name the bin/px4 of PX4's `make px4_sitl_default` build (docs/REAL_DRONES.md)",
+        binary.display()
+    );
+    binary
+}
+
+/// `PX4_SIM_SPEED_FACTOR`: `AVIARY_PX4_SPEED`, else 1.
+pub fn speed() -> String {
+    std::env::var("AVIARY_PX4_SPEED")
+        .ok()
+        .filter(|s| s.parse::<f64>().is_ok_and(|x| x > 0.0))
+        .unwrap_or_else(|| "1".into())
+}
+
+/// Instance numbers this test binary hands out (PX4 keeps a lock file per number in the
+/// system's temporary folder, so instances that run at once need distinct numbers); a
+/// number whose ports are taken by somebody else is passed over.
+static NEXT: AtomicU16 = AtomicU16::new(0);
+
+fn instance(first: u16) -> u16 {
+    loop {
+        let n = first + NEXT.fetch_add(1, Ordering::SeqCst);
+        assert!(n < first + 100, "no free PX4 instance number from {first}");
+        // Its GCS port, its API port, and the API port it sends to.
+        if [18570, 14580, 14540].iter().all(|p| UdpSocket::bind(("127.0.0.1", p + n)).is_ok()) {
+            return n;
+        }
+    }
+}
+
+/// One PX4 SITL copter.
+pub struct Px4 {
+    child: Option<Child>,
+    pub instance: u16,
+    pub system: u8,
+    pub dir: PathBuf,
+    home: [f64; 2],
+}
+
+impl Px4 {
+    /// Starts a copter at `home` (local metres about [`ORIGIN`]) and waits until it says
+    /// its start-up script has run.
+    pub fn start(scratch: &Path, first: u16, home: [f64; 2]) -> Px4 {
+        let instance = instance(first);
+        let dir = scratch.join(format!("px4_{instance}"));
+        std::fs::create_dir_all(&dir).expect("PX4 dir");
+        let system = u8::try_from(instance + 1).expect("a system id");
+        let mut px4 = Px4 { child: None, instance, system, dir, home };
+        px4.launch();
+        px4
+    }
+
+    fn launch(&mut self) {
+        let binary = binary();
+        let etc = binary.parent().and_then(Path::parent).map(|b| b.join("etc")).unwrap_or_default();
+        let (lat, lon) = ORIGIN.to_geodetic(self.home[0], self.home[1]);
+        let log = std::fs::File::create(self.dir.join("px4.log")).expect("px4.log");
+        let child = Command::new(&binary)
+            .args(["-i", &self.instance.to_string(), "-d", "-w"])
+            .arg(&self.dir)
+            .args(["-s", "etc/init.d-posix/rcS"])
+            .arg(&etc)
+            .env("PX4_SYS_AUTOSTART", "10040")
+            .env("PX4_SIMULATOR", "sihsim")
+            .env("PX4_SIM_MODEL", "sihsim_quadx")
+            .env("PX4_HOME_LAT", format!("{lat:.8}"))
+            .env("PX4_HOME_LON", format!("{lon:.8}"))
+            .env("PX4_HOME_ALT", format!("{}", ORIGIN.alt))
+            .env("PX4_SIM_SPEED_FACTOR", speed())
+            .current_dir(&self.dir)
+            .stdin(Stdio::null())
+            .stdout(log.try_clone().expect("log"))
+            .stderr(log)
+            .spawn()
+            .unwrap_or_else(|e| panic!("cannot start {}: {e}", binary.display()));
+        self.child = Some(child);
+        let deadline = Instant::now() + Duration::from_secs(60);
+        loop {
+            let log = std::fs::read_to_string(self.dir.join("px4.log")).unwrap_or_default();
+            if log.contains("Startup script returned successfully") {
+                return;
+            }
+            if let Some(Some(status)) = self.child.as_mut().map(|c| c.try_wait().ok().flatten()) {
+                panic!(
+                    "PX4 instance {} exited ({status}) before it started:\n{log}",
+                    self.instance
+                );
+            }
+            assert!(
+                Instant::now() < deadline,
+                "PX4 instance {} did not start within 60 s:\n{log}",
+                self.instance
+            );
+            std::thread::sleep(Duration::from_millis(200));
+        }
+    }
+
+    /// Where `aviary run` listens for it: PX4 sends its API link to UDP 14540 + instance.
+    pub fn address(&self) -> String {
+        format!("udp:127.0.0.1:{}", 14540 + self.instance)
+    }
+
+    /// Stops the process, as a vehicle that loses power (its parameters stay).
+    pub fn kill(&mut self) {
+        if let Some(mut c) = self.child.take() {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+    }
+
+    /// Starts it again in the same folder (the parameters it saved there hold).
+    pub fn restart(&mut self) {
+        self.kill();
+        self.launch();
+    }
+
+    /// The flight logs (ULog) it wrote.
+    pub fn logs(&self) -> Vec<PathBuf> {
+        let mut found = Vec::new();
+        let mut dirs = vec![self.dir.join("log")];
+        while let Some(d) = dirs.pop() {
+            for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
+                let p = e.path();
+                if p.is_dir() {
+                    dirs.push(p);
+                } else if p.extension().is_some_and(|x| x == "ulg") {
+                    found.push(p);
+                }
+            }
+        }
+        found.sort();
+        found
+    }
+}
+
+impl Drop for Px4 {
+    fn drop(&mut self) {
+        self.kill();
+    }
+}

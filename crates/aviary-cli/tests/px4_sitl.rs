@@ -64,7 +64,7 @@ fn done<'a>(events: &'a [Value], function: &str) -> (usize, &'a Value) {
 )]
 fn the_hop_mission_takes_off_flies_orbits_and_lands() {
     let dir = scratch("px4_hop");
-    let px4 = Px4::start(&dir, 10, [0.0, 0.0]);
+    let px4 = Px4::start(&dir, [0.0, 0.0]);
     std::fs::write(
         dir.join("m.world.toml"),
         world(&[("copter", [0.0, 0.0], &px4)], "[places]\nFar = [30, 30]\n"),
@@ -105,4 +105,95 @@ fn the_hop_mission_takes_off_flies_orbits_and_lands() {
     let (_, down) = done(&flown, "Land");
     assert!(pos(&down["position"])[2] < 0.5, "{down}");
     assert!(out.contains("mission ok"), "{out}");
+}
+
+fn home_of(name: &str) -> [f64; 2] {
+    match name {
+        "video_drone1" => [0.0, 0.0],
+        "video_drone2" => [5.0, 0.0],
+        "flir_drone1" => [0.0, 5.0],
+        "flir_drone2" => [5.0, 5.0],
+        "sensor_drone" => [10.0, 0.0],
+        "beacon_drone1" => [-10.0, -10.0],
+        "beacon_drone2" => [10.0, -10.0],
+        other => panic!("no drone {other} in the example"),
+    }
+}
+
+/// The signals (with their counts) and finds of a trace, which must not depend on
+/// whether the drones are PX4 or simulated.
+fn outcome(events: &[Value]) -> (Vec<String>, Vec<(String, i64, i64)>) {
+    let named = |kind: &'static str| events.iter().filter(move |e| e["event"] == kind);
+    let mut signals: Vec<String> =
+        named("signal").map(|e| e["name"].as_str().unwrap_or("").to_owned()).collect();
+    signals.sort();
+    let mut finds: Vec<(String, i64, i64)> = named("detection")
+        .map(|e| {
+            let p = pos(&e["location"]);
+            (e["kind"].as_str().unwrap_or("").to_owned(), p[0].round() as i64, p[1].round() as i64)
+        })
+        .collect();
+    finds.sort();
+    (signals, finds)
+}
+
+/// The paper's mission on seven PX4 copters (the beacon carriers with PX4's payload
+/// deliverer as their gripper): it ends ok with the signals and finds of the simulated
+/// run of the same files, and every beacon is dropped within 5 m of its find.
+#[test]
+#[cfg_attr(
+    not(px4_sitl),
+    ignore = "PX4 SITL not named: set AVIARY_PX4=/path/to/build/px4_sitl_default/bin/px4 to fly it (docs/REAL_DRONES.md)"
+)]
+fn the_paper_mission_on_seven_px4_copters() {
+    let dir = scratch("px4_paper");
+    let copters: Vec<(&str, Px4)> = common::PAPER_DRONES
+        .iter()
+        .map(|name| {
+            let px4 = Px4::start(&dir, home_of(name));
+            (*name, if name.starts_with("beacon") { px4.with_gripper() } else { px4 })
+        })
+        .collect();
+    std::fs::copy(common::repo().join("examples/search_and_rescue.mission"), dir.join("m.mission"))
+        .expect("mission");
+    let world = common::example_world_with(|name| {
+        let (_, px4) = copters.iter().find(|(n, _)| *n == name).expect("a PX4 copter");
+        format!("mavlink = \"{}\"\nsystem_id = {}\n", px4.address(), px4.system)
+    });
+    std::fs::write(dir.join("m.world.toml"), world).expect("world");
+    let (code, out, err) =
+        aviary(&["run", "m.mission", "--trace", "t.jsonl", "--telemetry-hz", "1"], &dir);
+    assert_eq!(code, 0, "{out}{err}\nsee {}", dir.display());
+    let flown = events(&dir.join("t.jsonl"));
+
+    let (code, _, err) = aviary(
+        &[
+            "run",
+            "examples/search_and_rescue.mission",
+            "--trace",
+            &dir.join("sim.jsonl").to_string_lossy(),
+        ],
+        &common::repo(),
+    );
+    assert_eq!(code, 0, "the simulated run: {err}");
+    let simulated = events(&dir.join("sim.jsonl"));
+    assert_eq!(outcome(&flown), outcome(&simulated), "the same signals and finds");
+    let finds: Vec<[f64; 3]> =
+        flown.iter().filter(|e| e["event"] == "detection").map(|e| pos(&e["location"])).collect();
+    let drops: Vec<&Value> = flown
+        .iter()
+        .filter(|e| e["event"] == "api_done" && e["function"] == "ReleasePayload")
+        .collect();
+    assert_eq!(drops.len(), finds.len(), "a beacon for every find");
+    for drop in drops {
+        let at = pos(&drop["position"]);
+        let near =
+            finds.iter().map(|f| (f[0] - at[0]).hypot(f[1] - at[1])).fold(f64::INFINITY, f64::min);
+        assert!(
+            near <= 5.0,
+            "{} dropped its beacon {near:.1} m from the nearest find",
+            drop["actor"]
+        );
+    }
+    println!("{out}");
 }

@@ -64,6 +64,9 @@ pub struct Craft {
     pub tuning: Tuning,
 }
 
+/// How long a command the vehicle says is in progress is waited for, all told.
+const IN_PROGRESS_LIMIT: Duration = Duration::from_secs(30);
+
 pub fn failed(reason: impl Into<String>) -> Failure {
     Failure { exception: BuiltinException::CommandFailed, reason: reason.into() }
 }
@@ -174,11 +177,25 @@ impl Craft {
     ) -> Result<(), Failure> {
         let started = Instant::now();
         for attempt in 0..self.tuning.command_tries {
-            let ack = self.v.expect_ack(command);
+            let mut ack = self.v.expect_ack(command);
             self.link.send(&msg(attempt)).await;
-            match tokio::time::timeout(self.tuning.ack_timeout, ack).await {
-                Ok(Ok(MavResult::MAV_RESULT_ACCEPTED)) => return Ok(()),
-                Ok(Ok(result)) => {
+            let result = loop {
+                match tokio::time::timeout(self.tuning.ack_timeout, &mut ack).await {
+                    Ok(Ok(result)) => break Some(result),
+                    // Said to be in progress (PX4's gripper): its final answer is waited for,
+                    // not asked again, which PX4 would refuse as a second of the same.
+                    Err(_)
+                        if self.v.in_progress(command, started)
+                            && started.elapsed() < IN_PROGRESS_LIMIT =>
+                    {
+                        continue
+                    }
+                    _ => break None,
+                }
+            };
+            match result {
+                Some(MavResult::MAV_RESULT_ACCEPTED) => return Ok(()),
+                Some(result) => {
                     // The reason usually comes just before the ACK; give a late one a moment.
                     tokio::time::sleep(Duration::from_millis(50)).await;
                     let why =
@@ -188,7 +205,7 @@ impl Craft {
                         self.name
                     )));
                 }
-                _ => continue,
+                None => continue,
             }
         }
         Err(timeout(format!(

@@ -10,7 +10,8 @@
 //! - [`facts::ask`] reads the facts alone, for `aviary check --plan`.
 //! - [`MavlinkBackend`] runs each call as MAVLink exchanges (`flight`): COMMAND_LONG or
 //!   COMMAND_INT with ACK, retries and timeouts, refusals as `CommandFailed` with the
-//!   autopilot's STATUSTEXT; GUIDED (ArduPilot) or HOLD with DO_REPOSITION (PX4); arrival
+//!   autopilot's STATUSTEXT; GUIDED (ArduPilot) or HOLD with DO_REPOSITION and ORBIT
+//!   (PX4, `px4.rs`); arrival
 //!   by position within [`Tuning::arrive_xy`] and [`Tuning::arrive_z`].
 //! - Positions are converted about the world's `origin` (`geo`); heights are relative
 //!   to home.

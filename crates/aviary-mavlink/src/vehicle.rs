@@ -88,6 +88,8 @@ pub struct Seen {
     doubted_since: Option<(Instant, u32)>,
     doubt_raised: bool,
     acks: Vec<(MavCmd, oneshot::Sender<MavResult>)>,
+    /// The last command the vehicle said was in progress (COMMAND_ACK IN_PROGRESS), and when.
+    in_progress: Option<(MavCmd, Instant)>,
 }
 
 impl Seen {
@@ -176,6 +178,12 @@ impl Vehicle {
     }
 
     /// Waits for the COMMAND_ACK of `command`; register before sending.
+    /// Whether the vehicle has said, since `since`, that `command` is in progress (PX4's
+    /// gripper does, until it has opened or closed).
+    pub fn in_progress(&self, command: MavCmd, since: Instant) -> bool {
+        self.seen().in_progress.is_some_and(|(c, at)| c == command && at >= since)
+    }
+
     pub fn expect_ack(&self, command: MavCmd) -> oneshot::Receiver<MavResult> {
         let (tx, rx) = oneshot::channel();
         self.seen().acks.push((command, tx));
@@ -242,7 +250,10 @@ impl Vehicle {
                     seen.texts.pop_front();
                 }
             }
-            MavMessage::COMMAND_ACK(ack) if ack.result != MavResult::MAV_RESULT_IN_PROGRESS => {
+            MavMessage::COMMAND_ACK(ack) if ack.result == MavResult::MAV_RESULT_IN_PROGRESS => {
+                seen.in_progress = Some((ack.command, now));
+            }
+            MavMessage::COMMAND_ACK(ack) => {
                 seen.answer(ack.command, ack.result);
             }
             _ => {}

@@ -36,15 +36,16 @@ pub fn speed() -> String {
         .unwrap_or_else(|| "1".into())
 }
 
-/// Instance numbers this test binary hands out (PX4 keeps a lock file per number in the
+/// Instance numbers (0 to 9) this test binary hands out (PX4 keeps a lock file per number in the
 /// system's temporary folder, so instances that run at once need distinct numbers); a
 /// number whose ports are taken by somebody else is passed over.
 static NEXT: AtomicU16 = AtomicU16::new(0);
 
-fn instance(first: u16) -> u16 {
+fn instance() -> u16 {
     loop {
-        let n = first + NEXT.fetch_add(1, Ordering::SeqCst);
-        assert!(n < first + 100, "no free PX4 instance number from {first}");
+        let n = NEXT.fetch_add(1, Ordering::SeqCst);
+        // From instance 10 on, PX4 sends every API link to the same port, 14549.
+        assert!(n <= 9, "no free PX4 instance number from 0 to 9 (one API port each)");
         // Its GCS port, its API port, and the API port it sends to.
         if [18570, 14580, 14540].iter().all(|p| UdpSocket::bind(("127.0.0.1", p + n)).is_ok()) {
             return n;
@@ -64,8 +65,8 @@ pub struct Px4 {
 impl Px4 {
     /// Starts a copter at `home` (local metres about [`ORIGIN`]) and waits until it says
     /// its start-up script has run.
-    pub fn start(scratch: &Path, first: u16, home: [f64; 2]) -> Px4 {
-        let instance = instance(first);
+    pub fn start(scratch: &Path, home: [f64; 2]) -> Px4 {
+        let instance = instance();
         let dir = scratch.join(format!("px4_{instance}"));
         std::fs::create_dir_all(&dir).expect("PX4 dir");
         let system = u8::try_from(instance + 1).expect("a system id");
@@ -136,6 +137,26 @@ impl Px4 {
     pub fn restart(&mut self) {
         self.kill();
         self.launch();
+    }
+
+    /// A ground station on its GCS port (UDP 18570 + instance), which PX4 answers once
+    /// it hears from it.
+    pub fn gcs(&self) -> super::sitl::Gcs {
+        let address = format!("udpout:127.0.0.1:{}", 18570 + self.instance);
+        super::sitl::Gcs::connect_to(&address, self.system, Duration::from_secs(10))
+    }
+
+    /// With its gripper (PX4's payload deliverer, started at boot when PD_GRIPPER_EN is
+    /// 1): the parameter set and saved, and the vehicle started again.
+    pub fn with_gripper(mut self) -> Px4 {
+        {
+            let gcs = self.gcs();
+            gcs.set_param_px4_int("PD_GRIPPER_EN", 1);
+        }
+        // PX4 saves a changed parameter in its folder at once; a moment for the write.
+        std::thread::sleep(Duration::from_millis(500));
+        self.restart();
+        self
     }
 
     /// The flight logs (ULog) it wrote.

@@ -218,15 +218,17 @@ pub struct Gcs {
 
 impl Gcs {
     pub fn connect(port: u16, system: u8, within: Duration) -> Gcs {
+        Gcs::connect_to(&format!("tcpout:127.0.0.1:{port}"), system, within)
+    }
+
+    /// A ground station on `address` (as the `mavlink` crate names it) for `system`.
+    pub fn connect_to(address: &str, system: u8, within: Duration) -> Gcs {
         let deadline = Instant::now() + within;
         let conn = loop {
-            match mavlink::connect::<mav::MavMessage>(&format!("tcpout:127.0.0.1:{port}")) {
+            match mavlink::connect::<mav::MavMessage>(address) {
                 Ok(c) => break c,
                 Err(e) => {
-                    assert!(
-                        Instant::now() < deadline,
-                        "no ground station link on port {port}: {e}"
-                    );
+                    assert!(Instant::now() < deadline, "no ground station link on {address}: {e}");
                     std::thread::sleep(Duration::from_millis(250));
                 }
             }
@@ -306,6 +308,19 @@ impl Gcs {
 
     /// Sets a parameter and waits for the vehicle to echo it.
     pub fn set_param(&self, name: &str, value: f32) {
+        self.set_param_as(name, value, mav::MavParamType::MAV_PARAM_TYPE_REAL32);
+    }
+
+    /// Sets an integer parameter as PX4 takes it: its bytes in the float's place.
+    pub fn set_param_px4_int(&self, name: &str, value: i32) {
+        self.set_param_as(
+            name,
+            f32::from_bits(value as u32),
+            mav::MavParamType::MAV_PARAM_TYPE_INT32,
+        );
+    }
+
+    fn set_param_as(&self, name: &str, value: f32, kind: mav::MavParamType) {
         let deadline = Instant::now() + Duration::from_secs(10);
         loop {
             self.send(mav::MavMessage::PARAM_SET(mav::PARAM_SET_DATA {
@@ -313,17 +328,12 @@ impl Gcs {
                 target_system: self.system,
                 target_component: 1,
                 param_id: name.into(),
-                param_type: mav::MavParamType::MAV_PARAM_TYPE_REAL32,
+                param_type: kind,
             }));
             std::thread::sleep(Duration::from_millis(300));
-            if self
-                .seen
-                .lock()
-                .unwrap()
-                .params
-                .iter()
-                .any(|(n, v)| n == name && (*v - value).abs() < 1e-3)
-            {
+            if self.seen.lock().unwrap().params.iter().any(|(n, v)| {
+                n == name && (v.to_bits() == value.to_bits() || (*v - value).abs() < 1e-3)
+            }) {
                 return;
             }
             assert!(Instant::now() < deadline, "the vehicle did not confirm {name} = {value}");

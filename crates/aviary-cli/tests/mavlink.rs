@@ -517,8 +517,8 @@ fn the_remainder_of_a_sweep_aborted_over_mavlink_is_flown_by_another_vehicle() {
     let step = aviary_test_support::lanes::STEP;
     let margin = aviary_test_support::lanes::MARGIN;
     // The handover is a corner too: the buddy reaches the point where the scout stopped
-    // within the arrival tolerance (1 m) and turns onto the lane there, so the metre or
-    // two around it is flown by both within a metre of the lane, but not along it, which
+    // within the arrival tolerance (1 m) and turns onto the lane there, so the metres
+    // around it is flown by both within a metre of the lane, but not along it, which
     // is what `passes` counts. That both come to it is asserted on its own.
     let arrive = aviary_mavlink::Tuning::default().arrive_xy;
     let came = |track: &[[f64; 3]]| {
@@ -532,7 +532,10 @@ fn the_remainder_of_a_sweep_aborted_over_mavlink_is_flown_by_another_vehicle() {
                 continue;
             }
             let x = all[k][0][0] + (all[k][1][0] - all[k][0][0]) * along / 120.0;
-            if k == 1 && (x - from[0]).abs() <= 2.0 * arrive {
+            // The turn there settles over a few metres: positions that keep the vehicles'
+            // clock (10 Hz of its own time) are close enough together that the
+            // centimetres it still drifts sideways turn a piece by more than `ALONG`.
+            if k == 1 && (x - from[0]).abs() <= 3.0 * arrive {
                 continue;
             }
             assert!(!who.is_empty(), "lane {k}, {along} m in: not flown");

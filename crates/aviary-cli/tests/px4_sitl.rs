@@ -107,36 +107,6 @@ fn the_hop_mission_takes_off_flies_orbits_and_lands() {
     assert!(out.contains("mission ok"), "{out}");
 }
 
-fn home_of(name: &str) -> [f64; 2] {
-    match name {
-        "video_drone1" => [0.0, 0.0],
-        "video_drone2" => [5.0, 0.0],
-        "flir_drone1" => [0.0, 5.0],
-        "flir_drone2" => [5.0, 5.0],
-        "sensor_drone" => [10.0, 0.0],
-        "beacon_drone1" => [-10.0, -10.0],
-        "beacon_drone2" => [10.0, -10.0],
-        other => panic!("no drone {other} in the example"),
-    }
-}
-
-/// The signals (with their counts) and finds of a trace, which must not depend on
-/// whether the drones are PX4 or simulated.
-fn outcome(events: &[Value]) -> (Vec<String>, Vec<(String, i64, i64)>) {
-    let named = |kind: &'static str| events.iter().filter(move |e| e["event"] == kind);
-    let mut signals: Vec<String> =
-        named("signal").map(|e| e["name"].as_str().unwrap_or("").to_owned()).collect();
-    signals.sort();
-    let mut finds: Vec<(String, i64, i64)> = named("detection")
-        .map(|e| {
-            let p = pos(&e["location"]);
-            (e["kind"].as_str().unwrap_or("").to_owned(), p[0].round() as i64, p[1].round() as i64)
-        })
-        .collect();
-    finds.sort();
-    (signals, finds)
-}
-
 /// The paper's mission on seven PX4 copters (the beacon carriers with PX4's payload
 /// deliverer as their gripper): it ends ok with the signals and finds of the simulated
 /// run of the same files, and every beacon is dropped within 5 m of its find.
@@ -150,7 +120,7 @@ fn the_paper_mission_on_seven_px4_copters() {
     let copters: Vec<(&str, Px4)> = common::PAPER_DRONES
         .iter()
         .map(|name| {
-            let px4 = Px4::start(&dir, home_of(name));
+            let px4 = Px4::start(&dir, common::paper_home(name));
             (*name, if name.starts_with("beacon") { px4.with_gripper() } else { px4 })
         })
         .collect();
@@ -177,7 +147,11 @@ fn the_paper_mission_on_seven_px4_copters() {
     );
     assert_eq!(code, 0, "the simulated run: {err}");
     let simulated = events(&dir.join("sim.jsonl"));
-    assert_eq!(outcome(&flown), outcome(&simulated), "the same signals and finds");
+    assert_eq!(
+        common::paper_outcome(&flown),
+        common::paper_outcome(&simulated),
+        "the same signals and finds"
+    );
     let finds: Vec<[f64; 3]> =
         flown.iter().filter(|e| e["event"] == "detection").map(|e| pos(&e["location"])).collect();
     let drops: Vec<&Value> = flown

@@ -123,35 +123,6 @@ fn example_world_with(sitls: &[(&str, &Sitl)], extra: &str) -> String {
     })
 }
 
-fn home_of(name: &str) -> [f64; 2] {
-    match name {
-        "video_drone1" => [0.0, 0.0],
-        "video_drone2" => [5.0, 0.0],
-        "flir_drone1" => [0.0, 5.0],
-        "flir_drone2" => [5.0, 5.0],
-        "sensor_drone" => [10.0, 0.0],
-        "beacon_drone1" => [-10.0, -10.0],
-        "beacon_drone2" => [10.0, -10.0],
-        other => panic!("no drone {other} in the example"),
-    }
-}
-
-/// The signals (with their counts) and finds of a trace, which must not depend on
-/// whether the drones are real or simulated.
-fn outcome(events: &[Value]) -> (Vec<String>, Vec<(String, i64, i64)>) {
-    let mut signals: Vec<String> =
-        named(events, "signal").map(|e| e["name"].as_str().unwrap_or("").to_owned()).collect();
-    signals.sort();
-    let mut finds: Vec<(String, i64, i64)> = named(events, "detection")
-        .map(|e| {
-            let p = pos(&e["location"]);
-            (e["kind"].as_str().unwrap_or("").to_owned(), p[0].round() as i64, p[1].round() as i64)
-        })
-        .collect();
-    finds.sort();
-    (signals, finds)
-}
-
 /// The paper's mission with the drones in `real` on SITL and the rest simulated: it ends
 /// ok with the signals and finds of the simulated run, every beacon is dropped within
 /// 5 m of its target, and each SITL drone's flight time is within 15% of what the plan
@@ -162,7 +133,16 @@ fn paper_mission(tag: &str, first_instance: u16, real: &[&str]) {
         .iter()
         .enumerate()
         .map(|(i, name)| {
-            (*name, Sitl::start(&dir, first_instance, i as u8 + 1, home_of(name), BIG_BATTERY))
+            (
+                *name,
+                Sitl::start(
+                    &dir,
+                    first_instance,
+                    i as u8 + 1,
+                    common::paper_home(name),
+                    BIG_BATTERY,
+                ),
+            )
         })
         .collect();
     let refs: Vec<(&str, &Sitl)> = sitls.iter().map(|(n, s)| (*n, s)).collect();
@@ -217,8 +197,8 @@ fn paper_mission(tag: &str, first_instance: u16, real: &[&str]) {
     assert_eq!(code, 0, "the mission on SITL ended badly:\n{out}\nsee {}", dir.display());
     let flown = events(&dir.join("t.jsonl"));
     assert_eq!(
-        outcome(&flown),
-        outcome(&simulated),
+        common::paper_outcome(&flown),
+        common::paper_outcome(&simulated),
         "the same signals and finds as the simulated run"
     );
     let finds: Vec<[f64; 3]> = named(&flown, "detection").map(|e| pos(&e["location"])).collect();
@@ -305,7 +285,7 @@ mod facts {
         let sitls: Vec<(&str, Sitl)> = PAPER_DRONES
             .iter()
             .enumerate()
-            .map(|(i, n)| (*n, Sitl::start(&dir, 30, i as u8 + 1, home_of(n), &[])))
+            .map(|(i, n)| (*n, Sitl::start(&dir, 30, i as u8 + 1, common::paper_home(n), &[])))
             .collect();
         let refs: Vec<(&str, &Sitl)> = sitls.iter().map(|(n, s)| (*n, s)).collect();
         std::fs::copy(repo().join("examples/search_and_rescue.mission"), dir.join("m.mission"))

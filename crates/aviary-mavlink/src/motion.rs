@@ -276,12 +276,7 @@ pub(crate) async fn fly_through(
                 break;
             }
             if *paused.borrow() {
-                c.hold().await;
-                while *paused.borrow() {
-                    if paused.changed().await.is_err() {
-                        return Err(failed("the call was dropped"));
-                    }
-                }
+                held(c, &mut paused).await?;
                 c.target(to).await?;
             }
             if Instant::now() >= resend {
@@ -300,6 +295,17 @@ pub(crate) async fn fly_through(
             }
             tokio::time::sleep(c.tuning.poll).await;
             left = left.saturating_sub(c.tuning.poll);
+        }
+    }
+    Ok(())
+}
+
+/// A PAUSE: holds where the drone is until RESUME.
+pub(crate) async fn held(c: &Craft, paused: &mut Paused) -> Result<(), Failure> {
+    c.hold().await;
+    while *paused.borrow() {
+        if paused.changed().await.is_err() {
+            return Err(failed("the call was dropped"));
         }
     }
     Ok(())

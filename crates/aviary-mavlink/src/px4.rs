@@ -43,12 +43,7 @@ pub(crate) async fn orbit(
             break;
         }
         if *paused.borrow() {
-            c.hold().await;
-            while *paused.borrow() {
-                if paused.changed().await.is_err() {
-                    return Err(failed("the call was dropped"));
-                }
-            }
+            crate::motion::held(c, &mut paused).await?;
             turned = Turned { from: here(c)?, ..turned };
             circle(c, center, radius, z, speed).await?;
         }

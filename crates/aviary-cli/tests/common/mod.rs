@@ -78,3 +78,35 @@ pub fn summary_rows(out: &str) -> Vec<(String, f64, f64)> {
         })
         .collect()
 }
+
+/// Where each drone of the paper's world stands (its `home`), for the vehicles that
+/// stand in for it.
+pub fn paper_home(name: &str) -> [f64; 2] {
+    match name {
+        "video_drone1" => [0.0, 0.0],
+        "video_drone2" => [5.0, 0.0],
+        "flir_drone1" => [0.0, 5.0],
+        "flir_drone2" => [5.0, 5.0],
+        "sensor_drone" => [10.0, 0.0],
+        "beacon_drone1" => [-10.0, -10.0],
+        "beacon_drone2" => [10.0, -10.0],
+        other => panic!("no drone {other} in the example"),
+    }
+}
+
+/// The signals (with their counts) and finds of a trace, which must not depend on
+/// whether the drones are real or simulated.
+pub fn paper_outcome(events: &[serde_json::Value]) -> (Vec<String>, Vec<(String, i64, i64)>) {
+    let named = |kind: &'static str| events.iter().filter(move |e| e["event"] == kind);
+    let mut signals: Vec<String> =
+        named("signal").map(|e| e["name"].as_str().unwrap_or("").to_owned()).collect();
+    signals.sort();
+    let mut finds: Vec<(String, i64, i64)> = named("detection")
+        .map(|e| {
+            let at = |i: usize| e["location"][i].as_f64().unwrap_or(0.0).round() as i64;
+            (e["kind"].as_str().unwrap_or("").to_owned(), at(0), at(1))
+        })
+        .collect();
+    finds.sort();
+    (signals, finds)
+}

@@ -36,6 +36,7 @@ mod commands;
 mod dispatch;
 mod guided;
 mod params;
+mod px4;
 mod reports;
 mod server;
 mod telemetry;
@@ -50,6 +51,8 @@ use tokio::net::{TcpListener, UdpSocket};
 use tokio::task::JoinHandle;
 
 pub use autopilot::Behaviour;
+/// Which autopilot the vehicles answer as (`Behaviour::autopilot`).
+pub use aviary_mavlink::mode::Flavour;
 pub use server::{parse_listen, Listen};
 pub use udp::{MAX_PEERS, PEER_EXPIRY};
 

@@ -223,6 +223,10 @@ impl Autopilot {
         if self.ready() {
             health |= fixed;
         }
+        if self.px4_flavour() && !self.px4_can_arm(i) {
+            // PX4's pre-arm bit is its canArm in the mode it is in.
+            health.remove(S::MAV_SYS_STATUS_PREARM_CHECK);
+        }
         if !self.copters[i].failsafe {
             health |= S::MAV_SYS_STATUS_SENSOR_BATTERY;
         }

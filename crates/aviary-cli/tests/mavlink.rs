@@ -26,6 +26,11 @@ struct Vehicles {
 
 impl Vehicles {
     fn start(world: &Path, speed: &str) -> Vehicles {
+        Vehicles::start_as(world, speed, "ardupilot")
+    }
+
+    /// `aviary vehicles --autopilot AUTOPILOT`.
+    fn start_as(world: &Path, speed: &str, autopilot: &str) -> Vehicles {
         let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
             .args([
                 "vehicles",
@@ -35,6 +40,8 @@ impl Vehicles {
                 "tcp:127.0.0.1:0",
                 "--speed",
                 speed,
+                "--autopilot",
+                autopilot,
             ])
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
@@ -421,6 +428,54 @@ fn check_plan_hears_aviary_vehicles_and_says_where_the_figures_come_from() {
     }
     assert!(doc["plan"]["drones"].as_array().is_some_and(|d| d.len() == 2), "{doc}");
     assert!(took < Duration::from_secs(8), "check --plan took {took:?}");
+}
+
+/// Against `aviary vehicles --autopilot px4`, whose drones climb, descend, land and return
+/// otherwise than the mission's world says: check --plan hears PX4 vehicles, reads their
+/// figures under PX4's names (aviary_mavlink's PX4 table, integers bytewise), names each
+/// parameter that differs, and plans with them.
+#[test]
+fn check_plan_reads_the_figures_of_px4_vehicles_under_px4s_names() {
+    let dir = scratch("mavlink_check_px4");
+    let figures = "climb_rate = 2.5\ndescent_rate = 1.5\nacceleration = 2.0\nland_speed = 0.6\nland_speed_below = 8.0\nreturn_altitude = 25.0\nreturn_loiter = 4.0\n";
+    let theirs = SMALL_WORLD.replace("home = [0, 0]\n", &format!("home = [0, 0]\n{figures}"));
+    std::fs::write(dir.join("vehicles.world.toml"), &theirs).expect("world");
+    let vehicles = Vehicles::start_as(&dir.join("vehicles.world.toml"), "1", "px4");
+    std::fs::write(dir.join("m.world.toml"), bind(SMALL_WORLD, vehicles.port, &["scout"]))
+        .expect("world");
+    std::fs::write(dir.join("m.mission"), SMALL_MISSION).expect("mission");
+    let (code, out, err) = aviary(&["check", "--plan", "--format", "json", "m.mission"], &dir);
+    assert_eq!(code, 0, "{out}{err}");
+    let doc: Value = serde_json::from_str(&out).expect("one JSON document");
+    let scout = &doc["vehicles"][0];
+    let source = scout["source"].as_str().expect("source");
+    assert!(
+        source.starts_with("scout: figures from the vehicle on"),
+        "every parameter answered: {source}"
+    );
+    let differences: Vec<&str> = scout["differences"]
+        .as_array()
+        .expect("differences")
+        .iter()
+        .filter_map(Value::as_str)
+        .collect();
+    for (name, figure) in [
+        ("MPC_Z_V_AUTO_UP", "climb 2.5 m/s"),
+        ("MPC_Z_V_AUTO_DN", "descent 1.5 m/s"),
+        ("MPC_ACC_HOR", "acceleration 2 m/s²"),
+        ("MPC_LAND_SPEED", "landing speed 0.6 m/s"),
+        ("RTL_RETURN_ALT", "return altitude 25 m"),
+        ("RTL_LAND_DELAY", "wait above home 4 s"),
+    ] {
+        assert!(
+            differences
+                .iter()
+                .any(|d| d.contains(figure) && d.contains(&format!("the vehicle's {name}"))),
+            "no {name} ({figure}) in {differences:?}"
+        );
+    }
+    // BAT1_CAPACITY is -1 (the world gives none): no usable capacity, the world's kept.
+    assert!(differences.iter().any(|d| d.contains("BAT1_CAPACITY")), "{differences:?}");
 }
 
 const FIELD_WORLD: &str = "\

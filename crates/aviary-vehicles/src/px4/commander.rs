@@ -441,6 +441,13 @@ impl Autopilot {
         let here = self.here(i);
         let p = self.px4(i);
         let z = alt.map_or(here[2], |a| a - self.origin.alt);
+        // A latitude or longitude off the Earth (a COMMAND_LONG's float can be anything)
+        // is no place: the vehicle holds where it is.
+        let on_earth = |lat: f64, lon: f64| lat.abs() <= 90.0 && lon.abs() <= 180.0;
+        let (lat, lon) = match (lat, lon) {
+            (Some(a), Some(o)) if !on_earth(a, o) => (None, None),
+            other => other,
+        };
         let to = match (lat, lon) {
             (Some(lat), Some(lon)) => {
                 let [x, y] = self.origin.to_local(lat, lon);
@@ -512,7 +519,7 @@ impl Autopilot {
                 Some((_, x, y, _)) => Some((f64::from(x) / 1e7, f64::from(y) / 1e7)),
                 None => finite(p[4]).zip(finite(p[5])),
             };
-            if let Some((lat, lon)) = center {
+            if let Some((lat, lon)) = center.filter(|(a, o)| a.abs() <= 90.0 && o.abs() <= 180.0) {
                 orbit.center = self.origin.to_local(lat, lon);
             }
             let alt = match c.int {

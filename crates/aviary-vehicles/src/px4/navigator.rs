@@ -320,7 +320,12 @@ impl Autopilot {
         let seq = m.current;
         let mut out = self.say(i, INFO, "Executing Mission\t");
         let here = self.here(i);
-        let next = self.px4(i).mission.items[usize::from(seq)..]
+        let next = self
+            .px4(i)
+            .mission
+            .items
+            .get(usize::from(seq)..)
+            .unwrap_or_default()
             .iter()
             .find(|it| has_position(it.command as u32))
             .and_then(|it| self.px4_item_place(it));

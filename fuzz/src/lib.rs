@@ -7,7 +7,9 @@ mod mavlink;
 mod operator;
 mod station;
 
-pub use mavlink::{answers_of_the_vehicles, heard_on_a_link, link, vehicles};
+pub use mavlink::{
+    answers_of_px4_vehicles, answers_of_the_vehicles, heard_on_a_link, link, vehicles,
+};
 pub use operator::operator;
 pub use station::station;
 

@@ -50,23 +50,34 @@ pub fn heard_on_a_link(data: &[u8]) -> aviary_mavlink::hear::Heard {
 /// What the example world's `aviary vehicles` answers to `data` from a ground station
 /// (booted and ready to arm at once, so commands take effect), over 10 s of flight.
 pub fn answers_of_the_vehicles(data: &[u8]) -> Vec<Vec<u8>> {
+    answers_as(data, aviary_vehicles::Flavour::ArduPilot)
+}
+
+/// The same of `aviary vehicles --autopilot px4`.
+pub fn answers_of_px4_vehicles(data: &[u8]) -> Vec<Vec<u8>> {
+    answers_as(data, aviary_vehicles::Flavour::Px4)
+}
+
+fn answers_as(data: &[u8], autopilot: aviary_vehicles::Flavour) -> Vec<Vec<u8>> {
     let world = example_world();
     let runtime =
         tokio::runtime::Builder::new_current_thread().enable_all().build().expect("a runtime");
     runtime.block_on(aviary_vehicles::answer(
         world,
-        aviary_vehicles::Behaviour { boot_time: 0.0, prearm_time: 0.0 },
+        aviary_vehicles::Behaviour { boot_time: 0.0, prearm_time: 0.0, autopilot },
         data,
         10.0,
     ))
 }
 
 /// The bytes as a ground station's to the example world's `aviary vehicles` (booted and
-/// ready to arm at once), then 10 s of flight. Every answer is a whole MAVLink 2 frame
-/// from one of the world's vehicles.
+/// ready to arm at once), then 10 s of flight, as ArduCopter and as PX4. Every answer is
+/// a whole MAVLink 2 frame from one of the world's vehicles.
 pub fn vehicles(data: &[u8]) {
     let systems: Vec<u32> = (1..=example_world().drones.len() as u32).collect();
-    for frame in answers_of_the_vehicles(data) {
+    let mut answers = answers_of_the_vehicles(data);
+    answers.extend(answers_of_px4_vehicles(data));
+    for frame in answers {
         let mut reader = MavlinkReader::new(frame.as_slice());
         let raw = reader
             .read_any_raw_message::<MavMessage>()

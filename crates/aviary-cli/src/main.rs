@@ -182,7 +182,7 @@ enum Command {
         #[command(subcommand)]
         command: ctl::CtlCommand,
     },
-    /// Serve the world's drones as simulated MAVLink vehicles (ArduCopter-like) until Ctrl-C
+    /// Serve the world's drones as simulated MAVLink vehicles (ArduCopter-like, or PX4) until Ctrl-C
     Vehicles {
         /// The world file whose drones to serve
         #[arg(long, value_parser = world_file)]
@@ -196,6 +196,9 @@ enum Command {
         /// MAVLink 2 signing: a passphrase (hashed with SHA-256) or 64 hex digits
         #[arg(long)]
         signing_key: Option<String>,
+        /// The autopilot the vehicles answer as: ArduCopter's words, modes and parameters, or PX4's
+        #[arg(long, value_enum, default_value = "ardupilot")]
+        autopilot: vehicles::Autopilot,
     },
     /// Explain a diagnostic code, such as E107
     Explain { code: String },
@@ -336,12 +339,13 @@ fn command(cli: Cli) -> u8 {
         },
         Command::Report { trace, world, output } => report::run(&trace, world.as_deref(), &output),
         Command::Ctl { url, token, command } => ctl::run(&url, token.as_deref(), command),
-        Command::Vehicles { world, listen, speed, signing_key } => {
+        Command::Vehicles { world, listen, speed, signing_key, autopilot } => {
             vehicles::run(&vehicles::VehiclesArgs {
                 world: &world,
                 listen: &listen,
                 speed,
                 signing_key: signing_key.as_deref(),
+                autopilot,
             })
         }
         Command::Explain { code } => explain(&code),

@@ -1,5 +1,5 @@
-//! `aviary vehicles`: serves the drones of a world as ArduCopter-like MAVLink vehicles
-//! (the `aviary-vehicles` crate) until Ctrl-C.
+//! `aviary vehicles`: serves the drones of a world as ArduCopter-like or PX4 MAVLink
+//! vehicles (the `aviary-vehicles` crate) until Ctrl-C.
 
 use std::path::Path;
 
@@ -7,11 +7,21 @@ use aviary_diagnostics::{render_text, SourceMap};
 
 use crate::files::color_wanted;
 
+/// `--autopilot`: whose behaviour the vehicles have.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Autopilot {
+    /// ArduCopter's (the default)
+    Ardupilot,
+    /// PX4's
+    Px4,
+}
+
 pub struct VehiclesArgs<'a> {
     pub world: &'a Path,
     pub listen: &'a str,
     pub speed: f64,
     pub signing_key: Option<&'a str>,
+    pub autopilot: Autopilot,
 }
 
 pub fn run(args: &VehiclesArgs) -> u8 {
@@ -54,10 +64,17 @@ pub fn run(args: &VehiclesArgs) -> u8 {
                 return 2;
             }
         };
+    let autopilot = match args.autopilot {
+        Autopilot::Ardupilot => aviary_vehicles::Flavour::ArduPilot,
+        Autopilot::Px4 => aviary_vehicles::Flavour::Px4,
+    };
     let options = aviary_vehicles::Options {
         speed: args.speed,
         signing_key: args.signing_key.map(aviary_mavlink::signing_key),
-        ..aviary_vehicles::Options::default()
+        behaviour: aviary_vehicles::Behaviour {
+            autopilot,
+            ..aviary_vehicles::Behaviour::default()
+        },
     };
     runtime.block_on(async {
         let server = match aviary_vehicles::serve(&world, listen, options).await {

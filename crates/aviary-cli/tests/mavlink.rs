@@ -26,6 +26,11 @@ struct Vehicles {
 
 impl Vehicles {
     fn start(world: &Path, speed: &str) -> Vehicles {
+        Vehicles::start_as(world, speed, "ardupilot")
+    }
+
+    /// `aviary vehicles --autopilot AUTOPILOT`.
+    fn start_as(world: &Path, speed: &str, autopilot: &str) -> Vehicles {
         let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
             .args([
                 "vehicles",
@@ -35,6 +40,8 @@ impl Vehicles {
                 "tcp:127.0.0.1:0",
                 "--speed",
                 speed,
+                "--autopilot",
+                autopilot,
             ])
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
@@ -423,6 +430,54 @@ fn check_plan_hears_aviary_vehicles_and_says_where_the_figures_come_from() {
     assert!(took < Duration::from_secs(8), "check --plan took {took:?}");
 }
 
+/// Against `aviary vehicles --autopilot px4`, whose drones climb, descend, land and return
+/// otherwise than the mission's world says: check --plan hears PX4 vehicles, reads their
+/// figures under PX4's names (aviary_mavlink's PX4 table, integers bytewise), names each
+/// parameter that differs, and plans with them.
+#[test]
+fn check_plan_reads_the_figures_of_px4_vehicles_under_px4s_names() {
+    let dir = scratch("mavlink_check_px4");
+    let figures = "climb_rate = 2.5\ndescent_rate = 1.5\nacceleration = 2.0\nland_speed = 0.6\nland_speed_below = 8.0\nreturn_altitude = 25.0\nreturn_loiter = 4.0\n";
+    let theirs = SMALL_WORLD.replace("home = [0, 0]\n", &format!("home = [0, 0]\n{figures}"));
+    std::fs::write(dir.join("vehicles.world.toml"), &theirs).expect("world");
+    let vehicles = Vehicles::start_as(&dir.join("vehicles.world.toml"), "1", "px4");
+    std::fs::write(dir.join("m.world.toml"), bind(SMALL_WORLD, vehicles.port, &["scout"]))
+        .expect("world");
+    std::fs::write(dir.join("m.mission"), SMALL_MISSION).expect("mission");
+    let (code, out, err) = aviary(&["check", "--plan", "--format", "json", "m.mission"], &dir);
+    assert_eq!(code, 0, "{out}{err}");
+    let doc: Value = serde_json::from_str(&out).expect("one JSON document");
+    let scout = &doc["vehicles"][0];
+    let source = scout["source"].as_str().expect("source");
+    assert!(
+        source.starts_with("scout: figures from the vehicle on"),
+        "every parameter answered: {source}"
+    );
+    let differences: Vec<&str> = scout["differences"]
+        .as_array()
+        .expect("differences")
+        .iter()
+        .filter_map(Value::as_str)
+        .collect();
+    for (name, figure) in [
+        ("MPC_Z_V_AUTO_UP", "climb 2.5 m/s"),
+        ("MPC_Z_V_AUTO_DN", "descent 1.5 m/s"),
+        ("MPC_ACC_HOR", "acceleration 2 m/s²"),
+        ("MPC_LAND_SPEED", "landing speed 0.6 m/s"),
+        ("RTL_RETURN_ALT", "return altitude 25 m"),
+        ("RTL_LAND_DELAY", "wait above home 4 s"),
+    ] {
+        assert!(
+            differences
+                .iter()
+                .any(|d| d.contains(figure) && d.contains(&format!("the vehicle's {name}"))),
+            "no {name} ({figure}) in {differences:?}"
+        );
+    }
+    // BAT1_CAPACITY is -1 (the world gives none): no usable capacity, the world's kept.
+    assert!(differences.iter().any(|d| d.contains("BAT1_CAPACITY")), "{differences:?}");
+}
+
 const FIELD_WORLD: &str = "\
 [site]
 name = \"Loopback farm\"
@@ -616,4 +671,41 @@ fn a_flight_across_a_no_fly_zone_is_sent_as_waypoints_around_it() {
         .filter_map(|e| e["function"].as_str())
         .collect();
     assert_eq!(done, ["Arm", "TakeOff", "FlyToPosition", "ReturnToLaunch"], "{trace:?}");
+}
+
+/// The hop mission that first failed on PX4 SITL (PX4 read FlyTo's height above home as
+/// one above sea level and came down to land), flown by `aviary run` on `aviary vehicles
+/// --autopilot px4`, which reads DO_REPOSITION's and DO_ORBIT's altitude as PX4 does: the
+/// drone stays up, reaches the place, circles it in ORBIT and lands.
+#[test]
+fn the_hop_mission_flies_on_px4_vehicles_with_heights_above_sea_level() {
+    let dir = scratch("mavlink_px4_hop");
+    let world = "[site]\nname = \"Hop\"\norigin = { lat = 46.6167, lon = 14.2650, alt = 440 }\nmax_altitude = 60\n\n[places]\nFar = [30, 30]\n\n[drones.copter]\nhome = [0, 0]\n";
+    std::fs::write(dir.join("vehicles.world.toml"), world).expect("world");
+    let vehicles = Vehicles::start_as(&dir.join("vehicles.world.toml"), "5", "px4");
+    std::fs::write(dir.join("m.world.toml"), bind(world, vehicles.port, &[])).expect("world");
+    std::fs::write(
+        dir.join("m.mission"),
+        "MISSION Hop:\n    SEQUENTIAL Fly:\n        copter TakeOff WITH 12m\n        copter FlyTo WITH Far\n        copter FlyCircle WITH Far, 15m, 1\n        copter Land\n",
+    )
+    .expect("mission");
+    let code = run_within(
+        &dir,
+        &["run", "m.mission", "--quiet", "--trace", "t.jsonl"],
+        Duration::from_secs(120),
+    );
+    let trace = events(&dir.join("t.jsonl"));
+    assert_eq!(code, 0, "{:?}", trace.last());
+    let done = |function: &str| {
+        trace
+            .iter()
+            .find(|e| e["event"] == "api_done" && e["function"] == function)
+            .map(|e| flatten(&e["position"]))
+            .unwrap_or_else(|| panic!("no {function} done: {trace:?}"))
+    };
+    let there = done("FlyToPosition");
+    assert!((there[0] - 30.0).hypot(there[1] - 30.0) < 1.5 && (there[2] - 12.0).abs() < 1.0);
+    let around = done("Orbit");
+    assert!(((around[0] - 30.0).hypot(around[1] - 30.0) - 15.0).abs() < 3.0, "{around:?}");
+    assert!(done("Land")[2] < 0.3);
 }

@@ -1,8 +1,9 @@
 //! Flight modes of the two autopilot families, as HEARTBEAT's `custom_mode` carries them.
 //!
 //! ArduCopter numbers its modes (GUIDED 4, RTL 6, LAND 9, ...). PX4 packs a main mode in
-//! bits 16–23 and an AUTO sub-mode in bits 24–31. Aviary flies ArduPilot in GUIDED and
-//! PX4 in HOLD (AUTO.LOITER) with DO_REPOSITION, so it only needs these few.
+//! bits 16–23 and a sub mode in bits 24–31 ([`px4`], the one encoding of PX4's modes, which
+//! `aviary vehicles --autopilot px4` serves too). Aviary flies ArduPilot in GUIDED and PX4
+//! in HOLD (AUTO.LOITER) with DO_REPOSITION, so it only needs these few.
 
 use mavlink::dialects::ardupilotmega::MavAutopilot;
 
@@ -41,11 +42,51 @@ pub const COPTER_BRAKE: u32 = 17;
 pub const COPTER_SMART_RTL: u32 = 21;
 pub const COPTER_AUTO_RTL: u32 = 27;
 
-const PX4_AUTO: u32 = 4;
-const PX4_OFFBOARD: u32 = 6;
-const PX4_LOITER: u32 = 3;
-const PX4_RTL: u32 = 5;
-const PX4_LAND: u32 = 6;
+/// PX4's modes as HEARTBEAT's `custom_mode` carries them and MAV_CMD_DO_SET_MODE takes
+/// them (param2 the main mode, param3 the sub mode), as PX4 defines them in
+/// src/modules/commander/px4_custom_mode.h: the main mode in bits 16–23, the sub mode (of
+/// AUTO, or of POSCTL) in bits 24–31.
+pub mod px4 {
+    pub const MANUAL: u8 = 1;
+    pub const ALTCTL: u8 = 2;
+    pub const POSCTL: u8 = 3;
+    pub const AUTO: u8 = 4;
+    pub const ACRO: u8 = 5;
+    pub const OFFBOARD: u8 = 6;
+    pub const STABILIZED: u8 = 7;
+    pub const RATTITUDE_LEGACY: u8 = 8;
+    pub const SIMPLE: u8 = 9;
+    pub const TERMINATION: u8 = 10;
+
+    /// AUTO's sub modes.
+    pub const AUTO_READY: u8 = 1;
+    pub const AUTO_TAKEOFF: u8 = 2;
+    pub const AUTO_LOITER: u8 = 3;
+    pub const AUTO_MISSION: u8 = 4;
+    pub const AUTO_RTL: u8 = 5;
+    pub const AUTO_LAND: u8 = 6;
+    pub const AUTO_FOLLOW_TARGET: u8 = 8;
+    pub const AUTO_PRECLAND: u8 = 9;
+    pub const AUTO_VTOL_TAKEOFF: u8 = 10;
+    /// The first of the eight external modes (ROS 2 modes), 11 to 18.
+    pub const AUTO_EXTERNAL1: u8 = 11;
+    pub const AUTO_EXTERNAL8: u8 = 18;
+
+    /// POSCTL's sub modes.
+    pub const POSCTL_POSCTL: u8 = 0;
+    pub const POSCTL_ORBIT: u8 = 1;
+    pub const POSCTL_SLOW: u8 = 2;
+
+    /// `custom_mode` of a main and a sub mode.
+    pub const fn encode(main: u8, sub: u8) -> u32 {
+        ((main as u32) << 16) | ((sub as u32) << 24)
+    }
+
+    /// The main and the sub mode of a `custom_mode`.
+    pub const fn decode(custom_mode: u32) -> (u8, u8) {
+        (((custom_mode >> 16) & 0xff) as u8, (custom_mode >> 24) as u8)
+    }
+}
 
 /// The meaning of a HEARTBEAT's `custom_mode`.
 pub fn classify(flavour: Flavour, custom_mode: u32) -> Mode {
@@ -56,16 +97,12 @@ pub fn classify(flavour: Flavour, custom_mode: u32) -> Mode {
             COPTER_LAND => Mode::Land,
             _ => Mode::Other,
         },
-        Flavour::Px4 => {
-            let main = (custom_mode >> 16) & 0xff;
-            let sub = (custom_mode >> 24) & 0xff;
-            match (main, sub) {
-                (PX4_OFFBOARD, _) | (PX4_AUTO, PX4_LOITER) => Mode::Guided,
-                (PX4_AUTO, PX4_RTL) => Mode::Rtl,
-                (PX4_AUTO, PX4_LAND) => Mode::Land,
-                _ => Mode::Other,
-            }
-        }
+        Flavour::Px4 => match px4::decode(custom_mode) {
+            (px4::OFFBOARD, _) | (px4::AUTO, px4::AUTO_LOITER) => Mode::Guided,
+            (px4::AUTO, px4::AUTO_RTL) => Mode::Rtl,
+            (px4::AUTO, px4::AUTO_LAND) => Mode::Land,
+            _ => Mode::Other,
+        },
     }
 }
 
@@ -75,9 +112,9 @@ pub fn set_mode_params(flavour: Flavour, mode: Mode) -> Option<(f32, f32)> {
         (Flavour::ArduPilot, Mode::Guided) => (COPTER_GUIDED, 0),
         (Flavour::ArduPilot, Mode::Land) => (COPTER_LAND, 0),
         (Flavour::ArduPilot, Mode::Rtl) => (COPTER_RTL, 0),
-        (Flavour::Px4, Mode::Guided) => (PX4_AUTO, PX4_LOITER),
-        (Flavour::Px4, Mode::Land) => (PX4_AUTO, PX4_LAND),
-        (Flavour::Px4, Mode::Rtl) => (PX4_AUTO, PX4_RTL),
+        (Flavour::Px4, Mode::Guided) => (px4::AUTO.into(), px4::AUTO_LOITER.into()),
+        (Flavour::Px4, Mode::Land) => (px4::AUTO.into(), px4::AUTO_LAND.into()),
+        (Flavour::Px4, Mode::Rtl) => (px4::AUTO.into(), px4::AUTO_RTL.into()),
         (_, Mode::Other) => return None,
     };
     Some((main as f32, sub as f32))
@@ -112,8 +149,21 @@ mod tests {
     fn px4_modes_round_trip_through_set_mode() {
         for mode in [Mode::Guided, Mode::Land, Mode::Rtl] {
             let (main, sub) = set_mode_params(Flavour::Px4, mode).unwrap();
-            let custom = ((main as u32) << 16) | ((sub as u32) << 24);
+            let custom = px4::encode(main as u8, sub as u8);
             assert_eq!(classify(Flavour::Px4, custom), mode);
+        }
+    }
+
+    #[test]
+    fn px4_modes_encode_as_px4_custom_mode_h_packs_them() {
+        // AUTO.LOITER, AUTO.TAKEOFF and POSCTL.ORBIT as PX4 SITL's HEARTBEAT carries them.
+        assert_eq!(px4::encode(px4::AUTO, px4::AUTO_LOITER), 0x0304_0000);
+        assert_eq!(px4::encode(px4::AUTO, px4::AUTO_TAKEOFF), 0x0204_0000);
+        assert_eq!(px4::encode(px4::POSCTL, px4::POSCTL_ORBIT), 0x0103_0000);
+        for main in 0..=u8::MAX {
+            for sub in [0, 1, 7, 255] {
+                assert_eq!(px4::decode(px4::encode(main, sub)), (main, sub));
+            }
         }
     }
 

@@ -1,31 +1,33 @@
-//! ArduCopter-like autopilots over the simulator's [`Fleet`]: modes, arming with pre-arm
-//! checks, the command protocol with ACKs and STATUSTEXT reasons, GUIDED position
-//! targets, and the telemetry messages. No IO and no clock: the server feeds it
-//! messages and simulated seconds, and sends what it returns.
+//! The autopilots over the simulator's [`Fleet`], ArduCopter-like or PX4 (`crate::px4`):
+//! modes, arming with pre-arm checks, the command protocol with ACKs and STATUSTEXT
+//! reasons, GUIDED position targets, and the telemetry messages. No IO and no clock: the
+//! server feeds it messages and simulated seconds, and sends what it returns.
 
 use aviary_api::{BuiltinException, CallEnd, CallId, DroneEvent, FlightState, Function, Value};
-use aviary_mavlink::mavlink::dialects::ardupilotmega::{
-    MavCmd, MavMessage, MavResult, MavSeverity, COMMAND_ACK_DATA, STATUSTEXT_DATA,
-};
-use aviary_mavlink::mode::COPTER_RTL;
+use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavMessage, MavSeverity, STATUSTEXT_DATA};
+use aviary_mavlink::mode::{Flavour, COPTER_RTL};
 use aviary_mavlink::Origin;
 use aviary_sim::{Fleet, Report};
 use aviary_world::World;
 
+use crate::px4::Px4;
 use crate::wire::Wire;
 
 /// How the simulated autopilots behave.
 #[derive(Clone, Copy, Debug)]
 pub struct Behaviour {
-    /// Simulated seconds in MAV_STATE_BOOT, when mode changes are refused.
+    /// Simulated seconds in MAV_STATE_BOOT, when mode changes are refused (ArduCopter;
+    /// PX4 shows UNINIT until the pre-arm checks pass, and takes modes at once).
     pub boot_time: f64,
     /// Simulated seconds from power-on until the pre-arm checks pass (GPS and EKF).
     pub prearm_time: f64,
+    /// Which autopilot the vehicles answer as: ArduCopter (the default) or PX4.
+    pub autopilot: Flavour,
 }
 
 impl Default for Behaviour {
     fn default() -> Behaviour {
-        Behaviour { boot_time: 1.0, prearm_time: 3.0 }
+        Behaviour { boot_time: 1.0, prearm_time: 3.0, autopilot: Flavour::ArduPilot }
     }
 }
 
@@ -58,6 +60,8 @@ pub struct Copter {
     pub(crate) home: [f64; 2],
     pub(crate) payload: Option<String>,
     was_airborne: bool,
+    /// PX4's state (`--autopilot px4`; unused for ArduCopter).
+    pub(crate) px4: Px4,
 }
 
 /// A message for the ground stations, from one vehicle.
@@ -98,6 +102,8 @@ pub struct Autopilot {
     pub(crate) behaviour: Behaviour,
     /// The site's geofence and altitude limit, which the simulator enforces.
     pub(crate) fence: (bool, Option<f64>),
+    /// PX4's STATUSTEXT id, one more for every message.
+    pub(crate) text_id: std::cell::Cell<u16>,
 }
 
 pub(crate) const STABILIZE: u32 = 0;
@@ -116,9 +122,14 @@ impl Autopilot {
                     aviary_world::Backend::Sim => None,
                 }
                 .unwrap_or_else(|| u8::try_from(i + 1).unwrap_or(u8::MAX));
+                let px4 = Px4::new(d.max_speed, !d.payload.is_empty());
+                let mode = match behaviour.autopilot {
+                    Flavour::ArduPilot => STABILIZE,
+                    Flavour::Px4 => px4.nav.custom_mode(),
+                };
                 Copter {
                     system,
-                    mode: STABILIZE,
+                    mode,
                     armed: false,
                     failsafe: false,
                     call: None,
@@ -136,6 +147,7 @@ impl Autopilot {
                     home: [d.home[0], d.home[1]],
                     payload: d.payload.first().cloned(),
                     was_airborne: false,
+                    px4,
                 }
             })
             .collect();
@@ -161,7 +173,12 @@ impl Autopilot {
             copters,
             behaviour,
             fence: (world.site.geofence.is_some(), world.site.max_altitude),
+            text_id: std::cell::Cell::new(0),
         }
+    }
+
+    pub fn px4_flavour(&self) -> bool {
+        self.behaviour.autopilot == Flavour::Px4
     }
 
     pub fn booting(&self) -> bool {
@@ -195,12 +212,22 @@ impl Autopilot {
                     };
                     self.copters[i].call = None;
                     if let CallEnd::Failed(f) = end {
-                        out.push(text(
-                            self.copters[i].system,
-                            MavSeverity::MAV_SEVERITY_WARNING,
-                            &f.reason,
-                        ));
+                        if self.px4_flavour() {
+                            out.extend(self.px4_failed(i, &f));
+                        } else {
+                            out.push(text(
+                                self.copters[i].system,
+                                MavSeverity::MAV_SEVERITY_WARNING,
+                                &f.reason,
+                            ));
+                        }
                     }
+                }
+                Report::Event(DroneEvent::Fault { drone, failure })
+                    if failure.exception == BuiltinException::BatteryCritical
+                        && self.px4_flavour() =>
+                {
+                    out.extend(self.px4_battery_failsafe(drone));
                 }
                 Report::Event(DroneEvent::Fault { drone, failure })
                     if failure.exception == BuiltinException::BatteryCritical =>
@@ -223,17 +250,22 @@ impl Autopilot {
                 {
                     // Down for good: HEARTBEAT says EMERGENCY from now on; say why first.
                     let system = self.copters[drone].system;
-                    out.push(text(
-                        system,
-                        MavSeverity::MAV_SEVERITY_EMERGENCY,
-                        &format!("Crash: {}", failure.reason),
-                    ));
+                    let why = format!("Crash: {}", failure.reason);
+                    if self.px4_flavour() {
+                        out.extend(self.px4_text(
+                            system,
+                            MavSeverity::MAV_SEVERITY_EMERGENCY,
+                            &why,
+                        ));
+                    } else {
+                        out.push(text(system, MavSeverity::MAV_SEVERITY_EMERGENCY, &why));
+                    }
                 }
                 Report::Event(_) => {}
             }
         }
         if self.ready() {
-            // The GPS has its fix: home is set, and said, as ArduCopter does.
+            // The GPS has its fix: home is set, and said, as ArduCopter and PX4 do.
             for i in 0..self.copters.len() {
                 if !self.copters[i].home_set {
                     self.copters[i].home_set = true;
@@ -242,6 +274,10 @@ impl Autopilot {
                     }
                 }
             }
+        }
+        if self.px4_flavour() {
+            out.extend(self.px4_step());
+            return out;
         }
         for (i, c) in self.copters.iter_mut().enumerate() {
             let state = self.fleet.telemetry(i).map_or(FlightState::Lost, |t| t.state);
@@ -283,21 +319,6 @@ pub fn text(system: u8, severity: MavSeverity, s: &str) -> Out {
             severity,
             text: s.into(),
             ..STATUSTEXT_DATA::default()
-        })
-        .into(),
-    }
-}
-
-/// A COMMAND_ACK addressed, as ArduPilot's, to the system and component that asked.
-pub fn ack(system: u8, command: MavCmd, result: MavResult, to: (u8, u8)) -> Out {
-    Out {
-        system,
-        msg: MavMessage::COMMAND_ACK(COMMAND_ACK_DATA {
-            command,
-            result,
-            target_system: to.0,
-            target_component: to.1,
-            ..COMMAND_ACK_DATA::default()
         })
         .into(),
     }

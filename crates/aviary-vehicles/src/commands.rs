@@ -14,11 +14,20 @@ pub struct Answer {
     pub result: MavResult,
     pub before: Vec<Reply>,
     pub after: Vec<Reply>,
+    /// COMMAND_ACK's `progress` (PX4 sends 255 with IN_PROGRESS, "unknown").
+    pub progress: u8,
+    /// No COMMAND_ACK at all (a command PX4 leaves unanswered).
+    pub silent: bool,
 }
 
 impl Answer {
     pub fn of(result: MavResult) -> Answer {
-        Answer { result, before: Vec::new(), after: Vec::new() }
+        Answer { result, before: Vec::new(), after: Vec::new(), progress: 0, silent: false }
+    }
+
+    /// No COMMAND_ACK, only what comes with it.
+    pub fn none() -> Answer {
+        Answer { silent: true, ..Answer::of(MavResult::MAV_RESULT_ACCEPTED) }
     }
 
     /// A refusal with the autopilot's reason, a STATUSTEXT every ground station sees (as
@@ -79,22 +88,19 @@ impl Autopilot {
             }
             MavCmd::MAV_CMD_GET_HOME_POSITION => match self.home_position(i) {
                 Some(home) => Answer {
-                    result: MAV_RESULT_ACCEPTED,
                     before: vec![Reply::asker(system, home)],
-                    after: Vec::new(),
+                    ..Answer::of(MAV_RESULT_ACCEPTED)
                 },
                 None => Answer::of(MAV_RESULT_FAILED),
             },
             MavCmd::MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES if p[0] >= 0.5 => Answer {
-                result: MAV_RESULT_ACCEPTED,
-                before: Vec::new(),
                 after: vec![Reply::asker(system, self.autopilot_version(i))],
+                ..Answer::of(MAV_RESULT_ACCEPTED)
             },
             MavCmd::MAV_CMD_REQUEST_MESSAGE => match self.message(i, p[0] as u32) {
                 Some(msg) => Answer {
-                    result: MAV_RESULT_ACCEPTED,
-                    before: Vec::new(),
                     after: vec![Reply::asker(system, msg)],
+                    ..Answer::of(MAV_RESULT_ACCEPTED)
                 },
                 // ArduPilot's answer for a message it cannot send.
                 None => Answer::of(MAV_RESULT_FAILED),

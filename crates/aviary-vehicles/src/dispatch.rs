@@ -1,15 +1,18 @@
 //! One message from a ground station: which vehicles it is for, and what they answer.
 //! SET_MODE and REQUEST_DATA_STREAM are deprecated, but pymavlink's `set_mode`, MAVProxy
-//! and older ground stations still send them, and ArduPilot still takes them.
+//! and older ground stations still send them, and ArduPilot still takes them. PX4 takes
+//! SET_MODE, ignores REQUEST_DATA_STREAM, and speaks the mission protocol (`px4`).
 
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
-    MavCmd, MavMessage, MavResult, FILE_TRANSFER_PROTOCOL_DATA,
+    MavCmd, MavMessage, MavResult, COMMAND_ACK_DATA, FILE_TRANSFER_PROTOCOL_DATA,
 };
+use aviary_mavlink::mode::px4;
 
-use crate::autopilot::{ack, Autopilot, Reply, To};
+use crate::autopilot::{Autopilot, Out, Reply, To};
 use crate::client::Client;
 use crate::commands::{Answer, Command};
-use crate::telemetry::{stream_group, STREAMS};
+use crate::px4::{for_me, Incoming};
+use crate::telemetry::stream_group;
 use crate::wire::{known_command, Unparsed, Wire};
 
 /// The fastest stream rate a client may ask for, Hz.
@@ -30,9 +33,49 @@ fn targets(ap: &Autopilot, system: u8, component: Option<u8>) -> Vec<usize> {
 
 fn answered(system: u8, command: MavCmd, a: Answer, from: (u8, u8)) -> Vec<Reply> {
     let mut out = a.before;
-    out.push(Reply { to: To::Asker, out: ack(system, command, a.result, from) });
+    if !a.silent {
+        let msg = MavMessage::COMMAND_ACK(COMMAND_ACK_DATA {
+            command,
+            result: a.result,
+            progress: a.progress,
+            result_param2: 0,
+            target_system: from.0,
+            target_component: from.1,
+        });
+        out.push(Reply { to: To::Asker, out: Out { system, msg: msg.into() } });
+    }
     out.extend(a.after);
     out
+}
+
+/// Whether PX4 takes a command for `system` (mavlink_receiver.cpp, evaluate_target_ok):
+/// addressed to it exactly, to the autopilot or any component; the two old requests for
+/// its version and capabilities also broadcast.
+fn px4_target(ap: &Autopilot, i: usize, command: MavCmd, target: (u8, u8)) -> bool {
+    let me = ap.copters[i].system;
+    #[allow(deprecated)]
+    let broadcast = matches!(
+        command,
+        MavCmd::MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES | MavCmd::MAV_CMD_REQUEST_PROTOCOL_VERSION
+    );
+    if broadcast {
+        target.0 == 0 || target.0 == me
+    } else {
+        target.0 == me && matches!(target.1, 0 | 1)
+    }
+}
+
+/// A COMMAND_INT with x and y NaN's bits (a NaN sent as an int), or a COMMAND_LONG whose
+/// param5 and param6 are INT32_MAX (COMMAND_INT's "not given" sent in a COMMAND_LONG):
+/// PX4 DENIES both at once.
+fn px4_malformed(c: &Command) -> bool {
+    match c.int {
+        Some((_, x, y, _)) => x == 0x7ff8_0000 && y == 0x7ff8_0000,
+        None => {
+            let near = |v: f32| (v - i32::MAX as f32).abs() <= 128.0;
+            near(c.p[4]) && near(c.p[5])
+        }
+    }
 }
 
 /// The replies to `msg`, which came from system and component `from` on `client`'s link.
@@ -43,6 +86,9 @@ pub fn dispatch(
     from: (u8, u8),
     msg: &MavMessage,
 ) -> Vec<Reply> {
+    if ap.px4_flavour() {
+        return dispatch_px4(ap, client, from, msg);
+    }
     let (system, component, command) = match msg {
         MavMessage::COMMAND_LONG(c) => (
             c.target_system,
@@ -78,8 +124,8 @@ pub fn dispatch(
         let me = ap.copters[i].system;
         match (msg, &command) {
             (_, Some(c)) if c.id == MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL => {
-                let result = set_interval(client, me, c.p[0], c.p[1]);
-                out.push(Reply { to: To::Asker, out: ack(me, c.id, result, from) });
+                let result = set_interval(ap, client, me, c.p[0], c.p[1]);
+                out.extend(answered(me, c.id, Answer::of(result), from));
             }
             (_, Some(c)) => out.extend(answered(me, c.id, ap.command(i, c), from)),
             (MavMessage::SET_MODE(m), _) => {
@@ -119,6 +165,116 @@ pub fn dispatch(
     out
 }
 
+/// The replies of PX4 vehicles to `msg` from `from` on `client`'s link.
+#[allow(deprecated)]
+fn dispatch_px4(
+    ap: &mut Autopilot,
+    client: &Client,
+    from: (u8, u8),
+    msg: &MavMessage,
+) -> Vec<Reply> {
+    let command = match msg {
+        MavMessage::COMMAND_LONG(c) => Some((
+            (c.target_system, c.target_component),
+            Command {
+                id: c.command,
+                p: [c.param1, c.param2, c.param3, c.param4, c.param5, c.param6, c.param7],
+                int: None,
+            },
+        )),
+        MavMessage::COMMAND_INT(c) => Some((
+            (c.target_system, c.target_component),
+            Command {
+                id: c.command,
+                p: [c.param1, c.param2, c.param3, c.param4, 0.0, 0.0, 0.0],
+                int: Some((c.frame as u32, c.x, c.y, c.z)),
+            },
+        )),
+        _ => None,
+    };
+    let mut out = Vec::new();
+    let up: Vec<usize> = (0..ap.copters.len()).filter(|i| ap.link(*i)).collect();
+    for i in up {
+        let me = ap.copters[i].system;
+        if let Some((target, c)) = &command {
+            if !px4_target(ap, i, c.id, *target) {
+                continue;
+            }
+            let a = if px4_malformed(c) {
+                Answer::of(MavResult::MAV_RESULT_DENIED)
+            } else if c.id == MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL {
+                Answer::of(set_interval(ap, client, me, c.p[0], c.p[1]))
+            } else {
+                ap.px4_command(i, c, from)
+            };
+            out.extend(answered(me, c.id, a, from));
+            continue;
+        }
+        let mine = |target: (u8, u8)| target.0 == me && matches!(target.1, 0 | 1);
+        let mission = |target: (u8, u8)| for_me(me, target);
+        match msg {
+            // PX4 turns SET_MODE into DO_SET_MODE for the commander, which takes a
+            // broadcast (target system 0) too.
+            MavMessage::SET_MODE(m) if m.target_system == 0 || m.target_system == me => {
+                let (main, sub) = px4::decode(m.custom_mode);
+                let a = ap.px4_set_mode(i, m.base_mode.bits(), main, sub, from);
+                out.extend(answered(me, MavCmd::MAV_CMD_DO_SET_MODE, a, from));
+            }
+            MavMessage::PARAM_REQUEST_LIST(r) if mine((r.target_system, r.target_component)) => {
+                out.extend(ap.px4_param_list(i));
+            }
+            MavMessage::PARAM_REQUEST_READ(r) if mine((r.target_system, r.target_component)) => {
+                let name = r.param_id.to_str().unwrap_or("");
+                out.extend(ap.px4_param_read(i, name, r.param_index));
+            }
+            MavMessage::PARAM_SET(r) if mine((r.target_system, r.target_component)) => {
+                let name = r.param_id.to_str().unwrap_or("");
+                out.extend(ap.px4_param_set(i, name, r.param_value, r.param_type));
+            }
+            MavMessage::FILE_TRANSFER_PROTOCOL(f) if f.target_system == me => {
+                out.push(Reply::asker(me, ftp_refusal(&f.payload, from)));
+            }
+            MavMessage::MISSION_COUNT(m) if mission((m.target_system, m.target_component)) => {
+                out.extend(ap.px4_mission_count(i, from, m.count, m.mission_type));
+            }
+            MavMessage::MISSION_ITEM_INT(m) if mission((m.target_system, m.target_component)) => {
+                out.extend(ap.px4_mission_item(i, from, Incoming::of_int(m)));
+            }
+            MavMessage::MISSION_ITEM(m) if mission((m.target_system, m.target_component)) => {
+                out.extend(ap.px4_mission_item(i, from, Incoming::of_float(m)));
+            }
+            MavMessage::MISSION_REQUEST_LIST(m)
+                if mission((m.target_system, m.target_component)) =>
+            {
+                out.extend(ap.px4_mission_list(i, from, m.mission_type));
+            }
+            MavMessage::MISSION_REQUEST_INT(m)
+                if mission((m.target_system, m.target_component)) =>
+            {
+                out.extend(ap.px4_mission_request(i, from, m.seq, m.mission_type, true));
+            }
+            MavMessage::MISSION_REQUEST(m) if mission((m.target_system, m.target_component)) => {
+                out.extend(ap.px4_mission_request(i, from, m.seq, m.mission_type, false));
+            }
+            MavMessage::MISSION_ACK(m) if mission((m.target_system, m.target_component)) => {
+                out.extend(ap.px4_mission_ack(i, from, m.mavtype, m.mission_type));
+            }
+            MavMessage::MISSION_CLEAR_ALL(m) if mission((m.target_system, m.target_component)) => {
+                out.extend(ap.px4_mission_clear(i, from, m.mission_type));
+            }
+            MavMessage::MISSION_SET_CURRENT(m)
+                if mission((m.target_system, m.target_component)) =>
+            {
+                out.extend(ap.px4_mission_set_current(i, m.seq));
+            }
+            // SET_POSITION_TARGET_GLOBAL_INT is for Offboard, which is not simulated; PX4
+            // has no REQUEST_DATA_STREAM.
+            _ => {}
+        }
+    }
+    out
+}
+
 /// The vehicle has no files (AUTOPILOT_VERSION does not claim MAVLink FTP): every FTP
 /// request is answered, as the FTP protocol asks of a server without an operation, by a
 /// NAK with ERR_UnknownCommand, so that a ground station that tries FTP first (MAVProxy,
@@ -145,10 +301,21 @@ fn ftp_refusal(request: &[u8; 251], from: (u8, u8)) -> MavMessage {
 /// MAV_CMD_SET_MESSAGE_INTERVAL for this client's link (as ArduPilot's, per link): an
 /// interval in µs, 0 for the default rate, -1 for none. DENIED for a message the vehicle
 /// does not send.
-fn set_interval(client: &Client, system: u8, id: f32, interval_us: f32) -> MavResult {
+fn set_interval(
+    ap: &Autopilot,
+    client: &Client,
+    system: u8,
+    id: f32,
+    interval_us: f32,
+) -> MavResult {
     let id = id as u32;
-    if !STREAMS.iter().any(|(s, _)| *s == id) || !interval_us.is_finite() {
-        return MavResult::MAV_RESULT_DENIED;
+    if !ap.streams().iter().any(|(s, _)| *s == id) || !interval_us.is_finite() {
+        // PX4 answers FAILED for a message it cannot configure.
+        return if ap.px4_flavour() {
+            MavResult::MAV_RESULT_FAILED
+        } else {
+            MavResult::MAV_RESULT_DENIED
+        };
     }
     let hz = if interval_us < 0.0 {
         Some(0.0)

@@ -2,7 +2,9 @@
 //!
 //! Every drone of a world becomes its own MAVLink system (its `system_id`, or its place
 //! in the world: 1, 2, ...), component 1, with the behaviour of an ArduCopter-like
-//! autopilot, checked against ArduCopter SITL (docs/REAL_DRONES.md lists it all):
+//! autopilot, checked against ArduCopter SITL, or of PX4 ([`Behaviour::autopilot`],
+//! `aviary vehicles --autopilot px4`: `px4`, after PX4's source) (docs/REAL_DRONES.md
+//! lists it all). ArduCopter's:
 //! - `autopilot`, `guided`, `commands`: modes, arming with pre-arm checks, the command
 //!   protocol (COMMAND_ACK addressed to the asker, the reason first as STATUSTEXT,
 //!   UNSUPPORTED for anything else, `wire` for command numbers the dialect has no name
@@ -21,11 +23,18 @@
 //! Underneath is the same [`aviary_sim::Fleet`] as `aviary run`, stepped in whole 0.05 s
 //! ticks at `speed` times real time.
 //!
-//! Not simulated: the world's no-fly zones (an autopilot does not know them: the vehicles
-//! fly a GUIDED target and RTL straight, and the detour is the ground station's),
-//! missions (MISSION_ITEM), fences and rally points as missions, MAVLink
-//! FTP (refused at once), RC input, manual modes (STABILIZE is accepted and does
-//! nothing), more than one component per vehicle. A world `link_loss` fault silences the
+//! PX4's (`px4`): its modes in `custom_mode` (main and sub mode), arming and auto-disarm,
+//! NAV_TAKEOFF handing over to Hold, DO_REPOSITION as COMMAND_INT and COMMAND_LONG with
+//! its altitude above sea level whatever the frame, DO_ORBIT, missions (the protocol and
+//! the flight), its parameters bytewise, its words chunked as its STATUSTEXT stream sends
+//! them.
+//!
+//! Not simulated (ArduCopter; PX4's list is in `px4` and docs/REAL_DRONES.md): the
+//! world's no-fly zones (an autopilot does not know them: the vehicles fly a GUIDED
+//! target and RTL straight, and the detour is the ground station's), missions
+//! (MISSION_ITEM), fences and rally points as missions, MAVLink FTP (refused at once), RC
+//! input, manual modes (STABILIZE is accepted and does nothing), more than one component
+//! per vehicle. A world `link_loss` fault silences the
 //! drone (no messages either way) for its duration; a `battery_critical` fault is
 //! ArduCopter's battery failsafe (STATUSTEXT, then RTL); a `crash` says "Crash: ..." and
 //! turns the state to EMERGENCY.
@@ -36,6 +45,7 @@ mod commands;
 mod dispatch;
 mod guided;
 mod params;
+mod px4;
 mod reports;
 mod server;
 mod telemetry;
@@ -50,6 +60,8 @@ use tokio::net::{TcpListener, UdpSocket};
 use tokio::task::JoinHandle;
 
 pub use autopilot::Behaviour;
+/// Which autopilot the vehicles answer as (`Behaviour::autopilot`).
+pub use aviary_mavlink::mode::Flavour;
 pub use server::{parse_listen, Listen};
 pub use udp::{MAX_PEERS, PEER_EXPIRY};
 

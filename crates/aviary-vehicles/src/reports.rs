@@ -89,9 +89,10 @@ impl Autopilot {
     }
 
     /// AUTOPILOT_VERSION: the capabilities of what is served (MAVLink 2, COMMAND_INT,
-    /// SET_POSITION_TARGET_GLOBAL_INT, parameters as floats as ArduPilot encodes them) and
-    /// none of what is not (missions, fences and rally points as missions, FTP, terrain,
-    /// attitude and local targets); the version is Aviary's own, the uid the system id.
+    /// SET_POSITION_TARGET_GLOBAL_INT, parameters as floats as ArduPilot encodes them; for
+    /// PX4 missions and parameters bytewise, no position targets) and none of what is not
+    /// (fences and rally points as missions, FTP, terrain, attitude and local targets);
+    /// the version is Aviary's own, the uid the system id.
     #[allow(deprecated)] // PARAM_FLOAT: what ArduPilot still sets for its float encoding.
     pub fn autopilot_version(&self, i: usize) -> MavMessage {
         use MavProtocolCapability as C;
@@ -105,11 +106,23 @@ impl Autopilot {
         };
         // major.minor.patch and FIRMWARE_VERSION_TYPE_DEV (0), MAVLink's packing.
         let version = v(0) << 24 | v(1) << 16 | v(2) << 8;
-        MavMessage::AUTOPILOT_VERSION(AUTOPILOT_VERSION_DATA {
-            capabilities: C::MAV_PROTOCOL_CAPABILITY_MAVLINK2
+        // PX4's (mavlink_main.cpp) but FTP, the fence and rally missions and the
+        // attitude and local targets, which are not served.
+        let capabilities = if self.px4_flavour() {
+            C::MAV_PROTOCOL_CAPABILITY_MAVLINK2
+                | C::MAV_PROTOCOL_CAPABILITY_COMMAND_INT
+                | C::MAV_PROTOCOL_CAPABILITY_MISSION_FLOAT
+                | C::MAV_PROTOCOL_CAPABILITY_MISSION_INT
+                | C::MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT
+                | C::MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_BYTEWISE
+        } else {
+            C::MAV_PROTOCOL_CAPABILITY_MAVLINK2
                 | C::MAV_PROTOCOL_CAPABILITY_COMMAND_INT
                 | C::MAV_PROTOCOL_CAPABILITY_SET_POSITION_TARGET_GLOBAL_INT
-                | C::MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT,
+                | C::MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT
+        };
+        MavMessage::AUTOPILOT_VERSION(AUTOPILOT_VERSION_DATA {
+            capabilities,
             uid: u64::from(self.copters[i].system),
             flight_sw_version: version,
             ..AUTOPILOT_VERSION_DATA::default()

@@ -17,7 +17,6 @@ use tokio::time::Instant;
 use crate::autopilot::{Autopilot, Out, Reply, To};
 use crate::client::{Client, Registry, Sequences};
 use crate::dispatch::{dispatch, dispatch_unparsed};
-use crate::telemetry::STREAMS;
 use crate::wire::{unparsed_command, Wire};
 
 /// Where to listen: `tcp:HOST:PORT` or `udp:HOST:PORT` (port 0: any free one).
@@ -82,7 +81,7 @@ pub(crate) fn tell(ap: &Autopilot, clients: &[Arc<Client>], mut events: Vec<Out>
         let mut schedule = c.schedule.lock().unwrap_or_else(|p| p.into_inner());
         for &i in &up {
             let system = ap.copters[i].system;
-            for (id, hz) in STREAMS {
+            for &(id, hz) in ap.streams() {
                 if !schedule.due(system, id, hz, time) {
                     continue;
                 }

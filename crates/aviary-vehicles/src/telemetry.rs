@@ -17,7 +17,7 @@ use crate::autopilot::Autopilot;
 /// (message id, default rate in Hz) of every stream. ArduPilot streams nothing but
 /// HEARTBEAT until a ground station asks; these defaults let a client that asks for
 /// nothing (pymavlink, `aviary run` before its SET_MESSAGE_INTERVAL) see the vehicle.
-pub const STREAMS: [(u32, f64); 8] = [
+pub const STREAMS: &[(u32, f64)] = &[
     (0, 1.0),   // HEARTBEAT
     (1, 1.0),   // SYS_STATUS
     (24, 1.0),  // GPS_RAW_INT
@@ -25,6 +25,19 @@ pub const STREAMS: [(u32, f64); 8] = [
     (147, 1.0), // BATTERY_STATUS
     (193, 1.0), // EKF_STATUS_REPORT
     (242, 0.0), // HOME_POSITION: sent when home is set, on request, or at an asked rate
+    (245, 1.0), // EXTENDED_SYS_STATE
+];
+
+/// PX4's streams on a link to a ground station, at its rates (mavlink_main.cpp's normal
+/// mode; MISSION_CURRENT from the mission manager at 1 Hz). PX4 has no EKF_STATUS_REPORT.
+pub const PX4_STREAMS: &[(u32, f64)] = &[
+    (0, 1.0),   // HEARTBEAT
+    (1, 1.0),   // SYS_STATUS
+    (24, 5.0),  // GPS_RAW_INT
+    (33, 5.0),  // GLOBAL_POSITION_INT
+    (42, 1.0),  // MISSION_CURRENT
+    (147, 0.5), // BATTERY_STATUS
+    (242, 0.5), // HOME_POSITION, once home is set
     (245, 1.0), // EXTENDED_SYS_STATE
 ];
 
@@ -41,9 +54,29 @@ pub fn stream_group(group: u8) -> &'static [u32] {
 }
 
 impl Autopilot {
+    /// The streams of the autopilot served.
+    pub fn streams(&self) -> &'static [(u32, f64)] {
+        if self.px4_flavour() {
+            PX4_STREAMS
+        } else {
+            STREAMS
+        }
+    }
+
     /// Any message the vehicle can send, by id: a stream, HOME_POSITION once home is set,
     /// AUTOPILOT_VERSION (for MAV_CMD_REQUEST_MESSAGE).
     pub fn message(&self, i: usize, id: u32) -> Option<MavMessage> {
+        if self.px4_flavour() {
+            return match id {
+                42 => Some(self.px4_mission_current(i)),
+                193 => None,
+                _ => self.any_message(i, id),
+            };
+        }
+        self.any_message(i, id)
+    }
+
+    fn any_message(&self, i: usize, id: u32) -> Option<MavMessage> {
         match id {
             0 => Some(self.heartbeat(i)),
             1 => self.sys_status(i),
@@ -59,6 +92,9 @@ impl Autopilot {
     }
 
     pub fn heartbeat(&self, i: usize) -> MavMessage {
+        if self.px4_flavour() {
+            return self.px4_heartbeat(i);
+        }
         let c = &self.copters[i];
         let state = self.fleet.telemetry(i).map_or(FlightState::Lost, |t| t.state);
         let mut base = MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
@@ -87,6 +123,49 @@ impl Autopilot {
             custom_mode: c.mode,
             mavtype: MavType::MAV_TYPE_QUADROTOR,
             autopilot: MavAutopilot::MAV_AUTOPILOT_ARDUPILOTMEGA,
+            base_mode: base,
+            system_status: status,
+            mavlink_version: 3,
+        })
+    }
+
+    /// PX4's HEARTBEAT (streams/HEARTBEAT.hpp): MAV_AUTOPILOT_PX4, the mode in
+    /// `custom_mode`, the base mode of its controls (AUTO, GUIDED and STABILIZE in the auto
+    /// modes, MANUAL_INPUT in the manual ones), and the state: ACTIVE armed (CRITICAL in
+    /// a failsafe), STANDBY when it could arm, else UNINIT.
+    fn px4_heartbeat(&self, i: usize) -> MavMessage {
+        let c = &self.copters[i];
+        let nav = c.px4.nav;
+        let state = self.fleet.telemetry(i).map_or(FlightState::Lost, |t| t.state);
+        let mut base = MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED;
+        if c.armed {
+            base |= MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED;
+        }
+        if nav.manual() {
+            base |= MavModeFlag::MAV_MODE_FLAG_MANUAL_INPUT_ENABLED;
+        }
+        if nav != crate::px4::Nav::Acro {
+            base |= MavModeFlag::MAV_MODE_FLAG_STABILIZE_ENABLED;
+        }
+        if nav.auto() {
+            base |=
+                MavModeFlag::MAV_MODE_FLAG_AUTO_ENABLED | MavModeFlag::MAV_MODE_FLAG_GUIDED_ENABLED;
+        }
+        let status = if state == FlightState::Lost {
+            MavState::MAV_STATE_EMERGENCY
+        } else if c.armed && c.failsafe {
+            MavState::MAV_STATE_CRITICAL
+        } else if c.armed {
+            MavState::MAV_STATE_ACTIVE
+        } else if self.px4_can_arm(i) {
+            MavState::MAV_STATE_STANDBY
+        } else {
+            MavState::MAV_STATE_UNINIT
+        };
+        MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+            custom_mode: nav.custom_mode(),
+            mavtype: MavType::MAV_TYPE_QUADROTOR,
+            autopilot: MavAutopilot::MAV_AUTOPILOT_PX4,
             base_mode: base,
             system_status: status,
             mavlink_version: 3,
@@ -143,6 +222,10 @@ impl Autopilot {
         let mut health = always | S::MAV_SYS_STATUS_GEOFENCE;
         if self.ready() {
             health |= fixed;
+        }
+        if self.px4_flavour() && !self.px4_can_arm(i) {
+            // PX4's pre-arm bit is its canArm in the mode it is in.
+            health.remove(S::MAV_SYS_STATUS_PREARM_CHECK);
         }
         if !self.copters[i].failsafe {
             health |= S::MAV_SYS_STATUS_SENSOR_BATTERY;

@@ -168,7 +168,8 @@ async fn an_unknown_frame_is_denied_with_arducopters_words() {
 async fn a_reposition_in_the_take_offs_own_tick_leaves_the_take_off_flying() {
     use aviary_mavlink::mavlink::dialects::ardupilotmega::MavModeFlag;
     use aviary_mavlink::mavlink::{self, MavHeader};
-    let behaviour = aviary_vehicles::Behaviour { boot_time: 0.0, prearm_time: 0.0 };
+    let behaviour =
+        aviary_vehicles::Behaviour { boot_time: 0.0, prearm_time: 0.0, ..Default::default() };
     let long = |command, p| common::command_long(1, command, p);
     let (lat, lon) = ORIGIN_GEO.to_e7(0.0, 30.0);
     let asked = [

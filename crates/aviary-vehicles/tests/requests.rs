@@ -137,7 +137,7 @@ async fn autopilot_version_is_sent_on_request_to_the_asker() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn home_gps_and_health_turn_ready_at_the_pre_arm_time() {
     // Ready after 8 simulated seconds, 4 s of wall time.
-    let behaviour = Behaviour { boot_time: 1.0, prearm_time: 8.0 };
+    let behaviour = Behaviour { boot_time: 1.0, prearm_time: 8.0, ..Behaviour::default() };
     let fence = "geofence = [[-100, -100], [100, -100], [100, 100], [-100, 100]]";
     let vehicles = serve(&fleet(2, fence), 2.0, behaviour).await;
     let mut gcs = Gcs::connect(vehicles.address).await;

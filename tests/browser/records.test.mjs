@@ -47,7 +47,8 @@ test("a flight's record replays in the page and its report is saved from it", as
 
   // Replay: the same page plays the record back on its world, and leads back.
   await page.click("#replay-trace");
-  await page.waitForFunction(() => window.aviary.replay && window.aviary.replay.end > 0);
+  // The page loads anew for the replay: until it has, there is no `window.aviary`.
+  await page.waitForFunction(() => window.aviary && window.aviary.replay && window.aviary.replay.end > 0);
   const end = await page.evaluate(() => window.aviary.replay.end);
   assert.equal(end, events.at(-1).t, "the scrubber spans the whole flight");
   const t = Math.round(end / 2);

@@ -189,6 +189,9 @@ impl<'m> Engine<'m> {
             if ctx.scope.unwinding.get() {
                 break;
             }
+            // Long runs of statements that end at once (W's steps) never let the engine
+            // wait: a stop from outside is looked for before each.
+            self.heed_interrupt();
             self.statement(node, ctx).await;
             self.caught(ctx).await;
         }

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use aviary_api::trace::Record;
 use aviary_api::Backend;
 use aviary_backends::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
-use aviary_backends::trace_file::{lock, SharedTrace, TraceFile};
+use aviary_backends::trace_file::{lock, Cut, SharedTrace, TraceFile, DEFAULT_MAX_BYTES};
 use aviary_check::SourceProvider;
 use aviary_engine::{Controller, RunOptions};
 use aviary_ir::Mission;
@@ -78,8 +78,15 @@ pub fn start(
                 world: Source { name: &request.world.path, bytes: request.world.text.into_bytes() },
                 files: &*files,
             };
-            let mut hooks =
-                Flight { station: flying, tree, feed: None, ready: Some(ready), trace, file: None };
+            let mut hooks = Flight {
+                station: flying,
+                tree,
+                feed: None,
+                ready: Some(ready),
+                trace,
+                file: None,
+                controller: None,
+            };
             let flown = aviary_backends::fly(texts, &options, &mut hooks);
             landed.flying.store(false, std::sync::atomic::Ordering::SeqCst);
             let why = match flown {
@@ -123,6 +130,8 @@ struct Flight {
     ready: Option<std::sync::mpsc::Sender<Result<(), String>>>,
     trace: Trace,
     file: Option<SharedTrace>,
+    /// The flight's, once it starts: a trace at its size limit stops it.
+    controller: Option<Controller>,
 }
 
 impl Hooks for Flight {
@@ -134,8 +143,12 @@ impl Hooks for Flight {
         }
         let out = std::fs::File::create(&self.trace.path)
             .map_err(|e| format!("cannot write the trace {}: {e}", self.trace.shown))?;
-        self.file =
-            Some(TraceFile::new(Box::new(out), self.trace.shown.clone(), mission.name.clone()));
+        self.file = Some(TraceFile::new(
+            Box::new(out),
+            self.trace.shown.clone(),
+            mission.name.clone(),
+            DEFAULT_MAX_BYTES,
+        ));
         Ok(())
     }
 
@@ -145,6 +158,7 @@ impl Hooks for Flight {
         controller: &Controller,
         _stop: &Stop,
     ) -> Result<(), String> {
+        self.controller = Some(controller.clone());
         let tree = std::mem::take(&mut self.tree);
         let trace = Some(self.trace.shown.clone());
         self.feed = Some(self.station.start_run(controller.clone(), mission, tree, trace));
@@ -156,8 +170,18 @@ impl Hooks for Flight {
 
     fn record(&mut self, record: &Record<'_>, _backend: &dyn Backend) {
         if let Some(file) = &self.file {
-            if let Some(why) = lock(file).write(record) {
-                eprintln!("aviary: {why}; the flight goes on without it");
+            let cut = lock(file).write(record);
+            match cut {
+                Some(Cut::Failed(why)) => eprintln!("aviary: {why}; the flight goes on without it"),
+                // As `aviary run`'s: a flight that makes events without end stops, and its
+                // fleet comes home.
+                Some(full @ Cut::Full { .. }) => {
+                    eprintln!("aviary: {full}; the flight stops and its fleet returns home");
+                    if let Some(controller) = &self.controller {
+                        controller.interrupt(full.to_string());
+                    }
+                }
+                None => {}
             }
         }
         if let Some(feed) = &self.feed {

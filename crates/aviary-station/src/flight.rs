@@ -16,7 +16,7 @@ use aviary_server::Feed;
 use aviary_world::World;
 
 use crate::checking::{map_of, Text};
-use crate::Station;
+use crate::{Mode, Station};
 
 /// The telemetry rate of a flight from the page, unless it asks for another: smooth
 /// enough to watch and to replay.
@@ -116,10 +116,9 @@ pub fn start(
     started.recv().unwrap_or_else(|_| Err("the flight stopped before it started".into()))
 }
 
-/// Where a flight's trace goes: a file of the station's folder, and its name as the page
-/// shows it.
+/// Where a flight's trace goes: a new file of the station's folder, by its name there
+/// (as the page shows it).
 pub struct Trace {
-    pub path: std::path::PathBuf,
     pub shown: String,
 }
 
@@ -137,12 +136,13 @@ struct Flight {
 impl Hooks for Flight {
     fn compiled(&mut self, mission: &Mission, world: &World) -> Result<(), String> {
         self.station.set_map(map_of(world));
-        if let Some(folder) = self.trace.path.parent() {
-            std::fs::create_dir_all(folder)
-                .map_err(|e| format!("cannot make {}: {e}", folder.display()))?;
-        }
-        let out = std::fs::File::create(&self.trace.path)
-            .map_err(|e| format!("cannot write the trace {}: {e}", self.trace.shown))?;
+        // Made as every file of the folder is reached: checked by `Folder::place`.
+        let Mode::Folder { folder, .. } = &self.station.mode else {
+            return Err("a flight from the page needs the station's folder".into());
+        };
+        let out = folder
+            .record(&self.trace.shown)
+            .map_err(|why| format!("cannot write the trace: {why}"))?;
         self.file = Some(TraceFile::new(
             Box::new(out),
             self.trace.shown.clone(),

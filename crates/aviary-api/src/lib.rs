@@ -40,6 +40,14 @@ pub use kind::Kind;
 pub use names::Names;
 pub use runtime::*;
 
+/// How many times a handler may be started again at one instant by what its own runs led
+/// to (docs/LANGUAGE.md, sections 11 and 12): a rule of the language, so the engine
+/// (`RunOptions::max_handler_reentries`, its default), the plan's estimate and the
+/// checker's messages (W206, W209) share it. Between two rounds at one instant no drone
+/// has moved and no time has passed, so a handler started again this often is going
+/// round in a loop; the trace of one cut off here stays under a megabyte.
+pub const MAX_HANDLER_REENTRIES: usize = 100;
+
 /// A part of a drone that one activity at a time may command (docs/LANGUAGE.md, section 6).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Resource {

@@ -19,6 +19,7 @@ mod inputs;
 mod load;
 mod no_fly;
 mod recursion;
+mod signal_cycles;
 mod signal_values;
 mod signals;
 mod unheard;
@@ -187,6 +188,7 @@ pub fn check(
             let mut out = Vec::new();
             walk::check_program(program, world, api, root, &mut out);
             signals::check_signals(program, api, &mut out);
+            signal_cycles::check_signal_cycles(program, &mut out);
             out
         };
         let walks = || {

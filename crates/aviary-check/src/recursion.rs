@@ -76,7 +76,7 @@ fn visit<'a>(body: &'a Body, f: &mut dyn FnMut(&'a Statement)) {
 /// The components of the call graph that hold a cycle (two or more capabilities, or
 /// one that calls itself), each in index order; Tarjan's algorithm without recursion,
 /// since a chain of thousands of capabilities is a fine mission.
-fn strongly_connected(edges: &[Vec<Edge>]) -> Vec<Vec<usize>> {
+pub(crate) fn strongly_connected<T>(edges: &[Vec<(usize, T)>]) -> Vec<Vec<usize>> {
     const NONE: usize = usize::MAX;
     let n = edges.len();
     let (mut order, mut low, mut on_stack) = (vec![NONE; n], vec![0; n], vec![false; n]);
@@ -133,16 +133,17 @@ fn strongly_connected(edges: &[Vec<Edge>]) -> Vec<Vec<usize>> {
     out
 }
 
-/// The shortest cycle through the component's first capability, as the calls that make
-/// it, in order.
-fn shortest_cycle<'a>(
-    edges: &[Vec<Edge<'a>>],
+/// The shortest cycle through the component's first node (capability), as the edges
+/// (calls) that make it, in order, each with the node it leaves. Also the checker's
+/// cycles of signals (`signal_cycles.rs`).
+pub(crate) fn shortest_cycle<T: Copy>(
+    edges: &[Vec<(usize, T)>],
     component: &[usize],
-) -> Option<Vec<(usize, Edge<'a>)>> {
+) -> Option<Vec<(usize, (usize, T))>> {
     let start = *component.first()?;
     let inside = |v: usize| component.binary_search(&v).is_ok();
     // How each capability was first reached: (caller, the call).
-    let mut reached: HashMap<usize, (usize, Edge)> = HashMap::new();
+    let mut reached: HashMap<usize, (usize, (usize, T))> = HashMap::new();
     let mut queue = VecDeque::from([start]);
     while let Some(v) = queue.pop_front() {
         for &edge in &edges[v] {
@@ -155,7 +156,7 @@ fn shortest_cycle<'a>(
                 let mut cycle = vec![(v, edge)];
                 let mut at = v;
                 while at != start {
-                    let (caller, e) = reached[&at];
+                    let &(caller, e) = reached.get(&at)?;
                     cycle.push((caller, e));
                     at = caller;
                 }

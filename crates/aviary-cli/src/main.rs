@@ -103,6 +103,10 @@ enum Command {
         /// Write every event to this JSON Lines file
         #[arg(long, value_parser = trace_file)]
         trace: Option<PathBuf>,
+        /// The most the trace may hold (such as 64MiB or 2GiB): reached, the mission
+        /// stops, the fleet returns home, the trace is closed, and aviary exits 3
+        #[arg(long, value_name = "SIZE", default_value = "1GiB", value_parser = run::parse_size)]
+        max_trace_size: u64,
         /// Telemetry events per second of mission time (default: none)
         #[arg(long)]
         telemetry_hz: Option<f64>,
@@ -281,6 +285,7 @@ fn command(cli: Cli) -> u8 {
             speed,
             seed,
             trace,
+            max_trace_size,
             telemetry_hz,
             quiet,
             serve,
@@ -301,6 +306,7 @@ fn command(cli: Cli) -> u8 {
                         speed,
                         seed,
                         trace,
+                        max_trace_bytes: max_trace_size,
                         telemetry_hz,
                         quiet,
                         serve,

@@ -10,14 +10,14 @@ use aviary_api::trace::{Event, Record};
 use aviary_api::Backend;
 use aviary_backends::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
 use aviary_diagnostics::{render_text, SourceMap};
-use aviary_engine::{Control, Controller, RunOptions, Status};
+use aviary_engine::{Controller, RunOptions, Status};
 use aviary_ir::Mission;
 use aviary_mavlink::Facts;
 use aviary_world::World;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::files::{color_wanted, use_roots, world_beside, DiskProvider};
-use aviary_backends::trace_file::{lock, SharedTrace, TraceFile};
+use aviary_backends::trace_file::{lock, show_size, Cut, SharedTrace, TraceFile};
 
 pub struct RunArgs {
     pub file: PathBuf,
@@ -27,6 +27,8 @@ pub struct RunArgs {
     /// The simulator's seed: every chance the world asks for is drawn from it.
     pub seed: u64,
     pub trace: Option<PathBuf>,
+    /// `--max-trace-size`: the most the trace may hold, in bytes.
+    pub max_trace_bytes: u64,
     pub telemetry_hz: Option<f64>,
     pub quiet: bool,
     /// Where to serve the operator API.
@@ -45,6 +47,40 @@ pub fn parse_serve(text: &str) -> Result<std::net::SocketAddr, String> {
     text.parse().map_err(|_| {
         format!("`{text}` is not a port or HOST:PORT for --serve: write 7878 or 127.0.0.1:7878")
     })
+}
+
+/// A size for `--max-trace-size`: a whole number of bytes, or with a unit: `KiB`, `MiB`,
+/// `GiB`, `TiB` (powers of 1024; `K`, `M`, `G`, `T` alone too) or `KB`, `MB`, `GB`, `TB`
+/// (powers of 1000), in any case. At least 4 KiB, the room the trace's first and last
+/// events need.
+pub fn parse_size(text: &str) -> Result<u64, String> {
+    let wrong = || {
+        format!("`{text}` is not a size for --max-trace-size: write a number of bytes, or one with a unit such as 64KiB, 500MB or 1GiB")
+    };
+    let digits = text.trim().find(|c: char| !c.is_ascii_digit()).unwrap_or(text.trim().len());
+    let (number, unit) = text.trim().split_at(digits);
+    let number: u64 = number.parse().map_err(|_| wrong())?;
+    let scale: u64 = match unit.trim().to_ascii_lowercase().as_str() {
+        "" | "b" => 1,
+        "k" | "kib" => 1 << 10,
+        "m" | "mib" => 1 << 20,
+        "g" | "gib" => 1 << 30,
+        "t" | "tib" => 1 << 40,
+        "kb" => 1_000,
+        "mb" => 1_000_000,
+        "gb" => 1_000_000_000,
+        "tb" => 1_000_000_000_000,
+        _ => return Err(wrong()),
+    };
+    let bytes = number.checked_mul(scale).ok_or_else(wrong)?;
+    let least = aviary_backends::trace_file::MIN_MAX_BYTES;
+    if bytes < least {
+        return Err(format!(
+            "`{text}` is too small for --max-trace-size: a trace needs at least {}",
+            show_size(least)
+        ));
+    }
+    Ok(bytes)
 }
 
 /// `max` or a positive number of times real time.
@@ -118,6 +154,7 @@ pub fn run(args: &RunArgs) -> u8 {
     let mut shown = Shown {
         args,
         trace: None,
+        controller: None,
         server: None,
         feed: None,
         map: serde_json::Value::Null,
@@ -194,6 +231,8 @@ struct Shown<'a> {
     args: &'a RunArgs,
     /// Opened once the mission compiled.
     trace: Option<SharedTrace>,
+    /// The run's, once it starts: a trace at its size limit stops the run.
+    controller: Option<Controller>,
     /// The station serving this run, and where the run's events go.
     server: Option<(aviary_station::Serving, aviary_server::Feed)>,
     feed: Option<aviary_server::Feed>,
@@ -218,10 +257,16 @@ impl Hooks for Shown<'_> {
             },
             None => Box::new(std::io::sink()),
         };
+        // Without a file nothing is written, so nothing can fill a disk.
+        let limit = match &self.args.trace {
+            Some(_) => self.args.max_trace_bytes,
+            None => u64::MAX,
+        };
         self.trace = Some(TraceFile::new(
             out,
             self.args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default(),
             mission.name.clone(),
+            limit,
         ));
         Ok(())
     }
@@ -235,6 +280,7 @@ impl Hooks for Shown<'_> {
         if let Some(trace) = &self.trace {
             on_stop_signals(controller.clone(), stop.clone(), trace.clone());
         }
+        self.controller = Some(controller.clone());
         if let Some(serve) = &self.args.serve {
             let map = std::mem::take(&mut self.map);
             let (serving, feed) = crate::serve::start(serve, mission, map, controller.clone())?;
@@ -261,10 +307,20 @@ impl Hooks for Shown<'_> {
             self.stats.observe(record, progress, backend, self.drones);
         }
         if let Some(trace) = &self.trace {
-            if let Some(why) = lock(trace).write(record) {
-                eprintln!(
+            let cut = lock(trace).write(record);
+            match cut {
+                Some(Cut::Failed(why)) => eprintln!(
                     "\naviary: {why}; the mission goes on without it, and aviary will exit 3"
-                );
+                ),
+                // A mission that makes events without end would fill the disk: it stops,
+                // and its fleet comes home.
+                Some(full @ Cut::Full { .. }) => {
+                    eprintln!("\naviary: {full} (--max-trace-size); the mission stops, the fleet returns home, and aviary will exit 3");
+                    if let Some(controller) = &self.controller {
+                        controller.interrupt(format!("{full} (--max-trace-size)"));
+                    }
+                }
+                None => {}
             }
         }
         if let Some(feed) = &self.feed {
@@ -282,12 +338,21 @@ impl Hooks for Shown<'_> {
     }
 }
 
+/// How long the engine has to take a first stop before the process ends at once.
+const GRACE: std::time::Duration = std::time::Duration::from_secs(5);
+
 /// The first Ctrl-C, SIGTERM or SIGHUP ends the mission gracefully: the fleet returns
 /// home and the trace is closed with `mission_end`. SIGTERM and SIGHUP count as a first
 /// Ctrl-C because they are how a session ends without a keyboard (a closed laptop lid,
 /// a logout, a service manager): with MAVLink drones, stopping at once would leave them
 /// without a ground station. A second signal of any of the three stops at once, still
 /// closing the trace.
+///
+/// The stop is an interrupt the engine hears even when it never waits (it looks at it
+/// between the steps it takes at one instant). Should it still not take it within
+/// [`GRACE`] (busy somewhere it does not look), the process stops at once as on a
+/// second signal: a stop must never hang. Once the engine has taken it, the way home
+/// may take as long as it takes.
 fn on_stop_signals(controller: Controller, stop: Stop, trace: SharedTrace) {
     use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     let mut signals = match signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
@@ -308,8 +373,9 @@ fn on_stop_signals(controller: Controller, stop: Stop, trace: SharedTrace) {
             presses += 1;
             if presses == 1 {
                 eprintln!("\naviary: stopping ({by}); the fleet returns home (press Ctrl-C again to stop at once)");
-                controller.send(Control::Abort { reason: format!("interrupted by {by}") });
+                controller.interrupt(format!("interrupted by {by}"));
                 stop.by(by);
+                unless_heard(controller.clone(), trace.clone(), by);
             } else {
                 if let Some(why) =
                     lock(&trace).close_now(&format!("stopped at once by a second {by}"))
@@ -323,6 +389,26 @@ fn on_stop_signals(controller: Controller, stop: Stop, trace: SharedTrace) {
     if let Err(e) = spawned {
         eprintln!("aviary: Ctrl-C, SIGTERM and SIGHUP will stop at once: {e}");
     }
+}
+
+/// Ends the process at once, the trace closed, if the engine has not taken the stop
+/// within [`GRACE`].
+fn unless_heard(controller: Controller, trace: SharedTrace, by: &'static str) {
+    let _ = std::thread::Builder::new().name("stop-grace".into()).spawn(move || {
+        std::thread::sleep(GRACE);
+        if controller.heard() {
+            return;
+        }
+        let reason = format!(
+            "stopped at once: the mission did not take the {by} within {} s",
+            GRACE.as_secs()
+        );
+        eprintln!("aviary: {reason}");
+        if let Some(why) = lock(&trace).close_now(&reason) {
+            eprintln!("aviary: {why}");
+        }
+        std::process::exit(130);
+    });
 }
 
 fn progress_bar(quiet: bool) -> ProgressBar {

@@ -7,6 +7,8 @@
 //! - Every key that `docs/WORLD.md`'s tables name is one the world reader reads, and every
 //!   key the reader reads is in those tables.
 //! - The events `docs/TRACE.md` lists are the engine's, each with the fields it writes.
+//! - Every flag of `aviary run` is in the README's "What works today", and the trace's
+//!   size limit is documented with the default the binary has.
 //! - Nothing in the docs, the README, the standard library, the examples or the crates'
 //!   sources points outside the repository.
 //!
@@ -666,4 +668,35 @@ fn the_architecture_maps_every_crate() {
         .map(|p| p.file_name().unwrap_or_default().to_string_lossy().into_owned())
         .collect();
     assert_eq!(mapped, crates, "docs/ARCHITECTURE.md's code map and crates/ differ");
+}
+
+/// The long flags a command's `--help` lists (but `--help` itself).
+fn flags_of(command: &str) -> BTreeSet<String> {
+    let (code, help, err) = aviary(&[command, "--help"], &repo());
+    assert_eq!(code, 0, "{err}");
+    help.split(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
+        .filter(|w| w.starts_with("--") && w.len() > 2 && *w != "--help")
+        .map(str::to_owned)
+        .collect()
+}
+
+#[test]
+fn every_flag_of_aviary_run_is_documented_with_its_default() {
+    let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
+    let works = readme
+        .split("## What works today")
+        .nth(1)
+        .and_then(|rest| rest.split("\n## ").next())
+        .expect("README has a \"What works today\" section");
+    let missing: Vec<String> =
+        flags_of("run").into_iter().filter(|f| !works.contains(f.as_str())).collect();
+    assert!(missing.is_empty(), "README's \"What works today\" does not name {missing:?}");
+    // The trace's size limit: its default as the binary has it, as the docs say it.
+    let (_, help, _) = aviary(&["run", "--help"], &repo());
+    assert!(help.contains("[default: 1GiB]"), "{help}");
+    for doc in ["README.md", "docs/GUIDE.md", "docs/TRACE.md", "docs/SECURITY.md"] {
+        let text = std::fs::read_to_string(repo().join(doc)).unwrap();
+        let said = text.lines().any(|l| l.contains("1 GiB"));
+        assert!(text.contains("--max-trace-size") && said, "{doc} documents --max-trace-size and its default, 1 GiB");
+    }
 }

@@ -94,6 +94,7 @@ codes! {
     HandlerRethrows = "W206", Warning, "an ON EXCEPTION that throws the exception it handles before doing anything else";
     SignalNeverHeard = "W207", Warning, "a handler of a drone's built-in signal that can never hear it: the drone never works inside its block";
     OperatorSignalTwice = "W208", Warning, "a signal declared twice with OPERATOR SIGNAL";
+    SignalCycle = "W209", Warning, "ON EVERY handlers that raise one another's signals at once, in a cycle that takes no time";
     // Notes.
     SignalNeverHandled = "N301", Note, "a signal raised but never handled";
     NoWorld = "N302", Note, "no world file, so actors, places and areas were not checked";

@@ -4,6 +4,9 @@
 //! to the trace as an `operator` event; leashes and signals are written as the mission's
 //! own are.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+
 use aviary_api::trace::{Event, EventKind, OperatorAction};
 use aviary_api::Value;
 use aviary_diagnostics::suggest::{closest, did_you_mean};
@@ -80,13 +83,76 @@ pub type ControlRequest = (Control, oneshot::Sender<Result<(), String>>);
 #[derive(Clone)]
 pub struct Controller {
     tx: mpsc::UnboundedSender<ControlRequest>,
+    interrupt: Arc<Interrupt>,
+}
+
+/// The engine's side of a [`Controller`], for [`crate::run_controlled`].
+pub struct Controls {
+    rx: mpsc::UnboundedReceiver<ControlRequest>,
+    interrupt: Arc<Interrupt>,
+}
+
+/// A stop asked from outside the mission that the engine hears even when it never waits
+/// (it reads controls only when it waits): a flag it looks at between the steps it takes
+/// at one instant (every handler it starts, every signal and exception), so a mission
+/// busy at one instant for as long as it likes is stopped all the same, the fleet sent
+/// home. `heard` says the engine has stopped, for whatever reason (or has no more
+/// mission to run: only the way home is left, and that waits): a caller that sees it
+/// unset long after asking knows the engine is stuck where it does not look, and may end
+/// the process.
+#[derive(Default)]
+pub(crate) struct Interrupt {
+    asked: AtomicBool,
+    reason: Mutex<Option<String>>,
+    heard: AtomicBool,
+}
+
+impl Interrupt {
+    pub fn asked(&self) -> bool {
+        self.asked.load(Ordering::Acquire)
+    }
+
+    pub fn reason(&self) -> String {
+        let reason = self.reason.lock().unwrap_or_else(|p| p.into_inner());
+        reason.clone().unwrap_or_else(|| "interrupted".into())
+    }
+
+    pub fn heard(&self) {
+        self.heard.store(true, Ordering::Release);
+    }
+}
+
+impl Controls {
+    pub(crate) fn into_parts(self) -> (mpsc::UnboundedReceiver<ControlRequest>, Arc<Interrupt>) {
+        (self.rx, self.interrupt)
+    }
 }
 
 impl Controller {
-    /// A controller and the receiver to pass to [`crate::run_controlled`].
-    pub fn new() -> (Controller, mpsc::UnboundedReceiver<ControlRequest>) {
+    /// A controller and the engine's side of it, to pass to [`crate::run_controlled`].
+    pub fn new() -> (Controller, Controls) {
         let (tx, rx) = mpsc::unbounded_channel();
-        (Controller { tx }, rx)
+        let interrupt = Arc::new(Interrupt::default());
+        (Controller { tx, interrupt: interrupt.clone() }, Controls { rx, interrupt })
+    }
+
+    /// Ends the mission as [`Control::Abort`] does, with `reason`, and is heard even by an
+    /// engine that never waits ([`Interrupt`]): for Ctrl-C, SIGTERM, SIGHUP, and a trace
+    /// that reached its size limit. The first reason given stands.
+    pub fn interrupt(&self, reason: String) {
+        {
+            let mut held = self.interrupt.reason.lock().unwrap_or_else(|p| p.into_inner());
+            held.get_or_insert_with(|| reason.clone());
+        }
+        self.interrupt.asked.store(true, Ordering::Release);
+        // Wakes an engine that waits: it applies the abort at once.
+        self.send(Control::Abort { reason });
+    }
+
+    /// Whether the engine has stopped the mission (an interrupt, an abort, a failure, its
+    /// end) and has only the way home left, or has no more to do.
+    pub fn heard(&self) -> bool {
+        self.interrupt.heard.load(Ordering::Acquire) || self.tx.is_closed()
     }
     /// Sends without waiting for the answer (for signal handlers).
     pub fn send(&self, control: Control) {
@@ -108,6 +174,23 @@ impl Default for Controller {
 }
 
 impl<'m> Engine<'m> {
+    /// A stop asked from outside ([`Controller::interrupt`]), looked at between the steps
+    /// the engine takes at one instant: heard even when the mission never waits.
+    #[inline]
+    pub(crate) fn heed_interrupt(&self) {
+        if let Some(interrupt) = self.interrupt.get() {
+            if interrupt.asked() && !self.stopped() {
+                self.interrupted(interrupt);
+            }
+        }
+    }
+
+    #[cold]
+    fn interrupted(&self, interrupt: &Interrupt) {
+        self.operator(OperatorAction::Abort, None);
+        self.end_with(crate::Status::Aborted, interrupt.reason(), true);
+    }
+
     pub(crate) async fn controls(&self, mut rx: mpsc::UnboundedReceiver<ControlRequest>) {
         while let Some((control, answer)) = rx.recv().await {
             let _ = answer.send(self.apply(control));

@@ -29,54 +29,86 @@ pub(crate) type Actors = smallvec::SmallVec<[DroneId; 2]>;
 
 /// Work a scope starts on request, while it runs.
 pub(crate) enum Job<'m> {
-    Signal { handler: &'m Handler, args: Vec<Value>, actor: Option<DroneId>, signal: usize },
-    Exception { handler: &'m ExceptionHandler, args: Vec<Value>, entry: Rc<Entry<'m>> },
-    Section { block: &'m aviary_ir::Block, frame: Frame },
+    Signal {
+        handler: &'m Handler,
+        args: Vec<Value>,
+        actor: Option<DroneId>,
+        signal: usize,
+        entry: Rc<Entry>,
+    },
+    Exception {
+        handler: &'m ExceptionHandler,
+        args: Vec<Value>,
+        entry: Rc<Entry>,
+    },
+    Section {
+        block: &'m aviary_ir::Block,
+        frame: Frame,
+    },
 }
 
-/// An exception handler's instance, for the bound on re-entering a handler at one instant
-/// ([`crate::RunOptions::max_handler_reentries`]): kept by its body's scope while the body
-/// runs (`Engine::entered`), so that an exception from inside the body knows what led to it.
-pub(crate) struct Entry<'m> {
-    handler: &'m ExceptionHandler,
-    /// When it was entered: the clock, and the runtime's poll of the mission.
-    at: Instant,
-    poll: u64,
-    /// The instance whose body led to the exception this one handles, if that one was
-    /// entered at this same instant; so on back, all at this instant.
-    cause: Option<Rc<Entry<'m>>>,
-    /// The re-entries of the instances one exception led to at this instant, shared by
-    /// all of them: a body that fails twice at once (a statement on a group) starts two
-    /// instances, and their count must not grow as a tree does.
-    counts: Rc<Counts<'m>>,
-}
+/// A handler of either kind, known by its address in the mission: what the bound on
+/// re-entering handlers at one instant counts.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Taker(usize);
 
-/// How many times each handler has been re-entered among the instances one exception led
-/// to at one instant.
-#[derive(Default)]
-struct Counts<'m>(RefCell<Vec<(&'m ExceptionHandler, usize)>>);
-
-impl<'m> Counts<'m> {
-    fn of(&self, handler: &ExceptionHandler) -> usize {
-        let counts = self.0.borrow();
-        counts.iter().find(|(h, _)| std::ptr::eq(*h, handler)).map_or(0, |(_, n)| *n)
+impl Taker {
+    pub fn signal(h: &Handler) -> Taker {
+        Taker(h as *const Handler as usize)
     }
 
-    fn add(&self, handler: &'m ExceptionHandler) {
+    pub fn exception(h: &ExceptionHandler) -> Taker {
+        Taker(h as *const ExceptionHandler as usize)
+    }
+}
+
+/// A handler's instance (an exception handler's, or a firing of a signal's handler), for
+/// the bound on re-entering a handler at one instant
+/// ([`crate::RunOptions::max_handler_reentries`]): made when the exception is thrown or
+/// the signal raised, and kept by its body's scope while the body runs
+/// (`Engine::entered`), so that what the body throws or raises knows what led to it. The
+/// two kinds share one chain: a signal's handler that throws, and an exception's handler
+/// that raises the signal again, are one cycle.
+pub(crate) struct Entry {
+    handler: Taker,
+    /// When it was made: the clock, and the runtime's poll of the mission. A firing that
+    /// waited its turn (`ONE AT A TIME`) while time passed starts a new count.
+    at: Instant,
+    poll: u64,
+    /// The instance whose body led to this one, if that one was made at this same
+    /// instant; so on back, all at this instant.
+    cause: Option<Rc<Entry>>,
+    /// The re-entries of the instances one exception or signal led to at this instant,
+    /// shared by all of them: a body that fails twice at once (a statement on a group),
+    /// or raises twice, starts two instances, and their count must not grow as a tree does.
+    counts: Rc<Counts>,
+}
+
+/// How many times each handler has been re-entered among the instances one exception or
+/// signal led to at one instant.
+#[derive(Default)]
+pub(crate) struct Counts(RefCell<Vec<(Taker, usize)>>);
+
+impl Counts {
+    fn of(&self, handler: Taker) -> usize {
+        let counts = self.0.borrow();
+        counts.iter().find(|(h, _)| *h == handler).map_or(0, |(_, n)| *n)
+    }
+
+    fn add(&self, handler: Taker) {
         let mut counts = self.0.borrow_mut();
-        match counts.iter_mut().find(|(h, _)| std::ptr::eq(*h, handler)) {
+        match counts.iter_mut().find(|(h, _)| *h == handler) {
             Some((_, n)) => *n += 1,
             None => counts.push((handler, 1)),
         }
     }
 }
 
-impl Entry<'_> {
+impl Entry {
     /// Whether an instance of `handler` led to this one (or is this one): another instance
     /// of it started now is a re-entry.
-    fn led_from(&self, handler: &ExceptionHandler) -> bool {
-        std::iter::successors(Some(self), |e| e.cause.as_deref())
-            .any(|e| std::ptr::eq(e.handler, handler))
+    fn led_from(&self, handler: Taker) -> bool {
+        std::iter::successors(Some(self), |e| e.cause.as_deref()).any(|e| e.handler == handler)
     }
 }
 
@@ -305,13 +337,15 @@ pub(crate) struct Engine<'m> {
     /// [`crate::RunOptions::max_handler_reentries`].
     max_handler_reentries: usize,
     /// The exception handler instances running, by their body's scope (its address).
-    entered: RefCell<BTreeMap<usize, Rc<Entry<'m>>>>,
+    entered: RefCell<BTreeMap<usize, Rc<Entry>>>,
     /// What each drone's last `Sweep` or `FollowPath` left (`coverage.rs`).
     pub coverage: crate::coverage::Coverage,
     /// How many times the runtime has polled the mission. Within one poll the engine has
     /// not waited for anything: with the wall clock (MAVLink drones), whose every reading
     /// differs, that is what "at one instant" is.
     polls: Cell<u64>,
+    /// A stop asked from outside, looked at between steps (`control.rs`).
+    pub(crate) interrupt: std::cell::OnceCell<std::sync::Arc<crate::control::Interrupt>>,
 }
 
 impl<'m> Engine<'m> {
@@ -350,6 +384,7 @@ impl<'m> Engine<'m> {
             max_handler_reentries: options.max_handler_reentries,
             entered: RefCell::new(BTreeMap::new()),
             polls: Cell::new(0),
+            interrupt: std::cell::OnceCell::new(),
             coverage: crate::coverage::Coverage::new(m.drones.len()),
         }
     }
@@ -393,11 +428,12 @@ impl<'m> Engine<'m> {
         }
     }
 
-    pub async fn run(
-        &self,
-        options: &RunOptions,
-        controls: Option<mpsc::UnboundedReceiver<crate::ControlRequest>>,
-    ) -> Outcome {
+    pub async fn run(&self, options: &RunOptions, controls: Option<crate::Controls>) -> Outcome {
+        let controls = controls.map(|c| {
+            let (rx, interrupt) = c.into_parts();
+            let _ = self.interrupt.set(interrupt);
+            rx
+        });
         self.trace(EventKind::MissionStart, || Event::MissionStart {
             mission: self.m.name.as_str().into(),
         });
@@ -463,6 +499,10 @@ impl<'m> Engine<'m> {
             .await;
         }
         self.over.set(true);
+        // No more mission: only the way home is left, and it waits.
+        if let Some(interrupt) = self.interrupt.get() {
+            interrupt.heard();
+        }
         let ending = self.ending.borrow().clone();
         // Drones still flying go home: at the end of the mission, or as the failsafe.
         let home = if self.backend_alive.get() {
@@ -494,6 +534,9 @@ impl<'m> Engine<'m> {
     /// Ends the mission early; the first reason given is the one reported.
     pub fn end_with(&self, status: Status, reason: String, backend_alive: bool) {
         self.ending.borrow_mut().get_or_insert((status, reason));
+        if let Some(interrupt) = self.interrupt.get() {
+            interrupt.heard();
+        }
         if !backend_alive {
             self.backend_alive.set(false);
         }
@@ -663,7 +706,10 @@ impl<'m> Engine<'m> {
         let scopes: Vec<Rc<Scope<'m>>> =
             self.listeners.borrow().iter().filter_map(|w| w.upgrade()).collect();
         for scope in scopes {
-            self.deliver(&scope, signal, &args, None, None);
+            if self.stopped() {
+                break;
+            }
+            self.deliver(&scope, signal, &args, None, None, &None);
         }
     }
 
@@ -675,6 +721,7 @@ impl<'m> Engine<'m> {
         actor: Option<DroneId>,
         from: &Rc<Scope<'m>>,
     ) {
+        self.heed_interrupt();
         if self.stopped() {
             return;
         }
@@ -688,13 +735,30 @@ impl<'m> Engine<'m> {
         }
         self.changed.notify_waiters();
         let signalling_block = from.chain().find(|s| s.mission_block);
+        let cause = self.cause(from);
         for scope in from.chain() {
-            self.deliver(scope, signal, &args, actor, signalling_block);
+            // A cycle of signals cut off by the bound ends the mission: no one hears more.
+            if self.stopped() {
+                break;
+            }
+            self.deliver(scope, signal, &args, actor, signalling_block, &cause);
+        }
+        if self.stopped() {
+            // The raiser's chain ends aborted, as an unhandled exception's does.
+            for scope in from.chain() {
+                scope.unwinding.set(true);
+                if let Some(i) = &scope.instance {
+                    i.failed.set(true);
+                }
+            }
         }
     }
 
     /// Starts (or, for `SEQUENTIAL ON`, defers to the signalling block's end) each handler
-    /// of `scope` that hears this signal.
+    /// of `scope` that hears this signal. `cause` is the handler instance whose body
+    /// raised it, if that one was made at this instant: a handler that it (or what led to
+    /// it) is an instance of, started again too often at this instant, is a cycle of
+    /// signals that takes no time, and ends the mission.
     fn deliver(
         &self,
         scope: &Rc<Scope<'m>>,
@@ -702,6 +766,7 @@ impl<'m> Engine<'m> {
         args: &[Value],
         actor: Option<DroneId>,
         signalling_block: Option<&Rc<Scope<'m>>>,
+        cause: &Option<Rc<Entry>>,
     ) {
         let handlers: &'m [Handler] = scope.handlers;
         for (i, h) in handlers.iter().enumerate() {
@@ -715,7 +780,14 @@ impl<'m> Engine<'m> {
                 }
                 fired[i] = true;
             }
-            let job = Job::Signal { handler: h, args: args.to_vec(), actor, signal };
+            let taker = Taker::signal(h);
+            let reentries = self.reentries(taker, cause);
+            if let Some(n) = reentries.filter(|n| *n >= self.max_handler_reentries) {
+                self.cycle_of_signals(h, n);
+                return;
+            }
+            let entry = self.new_entry(taker, cause.clone(), reentries.is_some());
+            let job = Job::Signal { handler: h, args: args.to_vec(), actor, signal, entry };
             match (signalling_block, h.sequential) {
                 (Some(block), true) => block.deferred.borrow_mut().push((scope.clone(), job)),
                 _ => scope.fire(job),
@@ -732,6 +804,7 @@ impl<'m> Engine<'m> {
         actor: Option<DroneId>,
         from: &Rc<Scope<'m>>,
     ) {
+        self.heed_interrupt();
         if self.stopped() {
             return;
         }
@@ -745,8 +818,8 @@ impl<'m> Engine<'m> {
             let i = handlers.iter().position(|h| {
                 h.exception == exception && self.matches(&h.by, &scope.frame, actor)
             })?;
-            let reentry = cause.as_ref().filter(|c| c.led_from(&handlers[i]));
-            let reentries = reentry.map_or(0, |c| c.counts.of(&handlers[i]));
+            let reentry = self.reentries(Taker::exception(&handlers[i]), &cause);
+            let reentries = reentry.unwrap_or(0);
             if reentry.is_some() && reentries >= self.max_handler_reentries {
                 skipped.get_or_insert_with(|| {
                     let line = match handlers[i].line {
@@ -813,19 +886,48 @@ impl<'m> Engine<'m> {
         handler_scope.catching.set(handler_scope.catching.get() + 1);
         let handlers: &'m [ExceptionHandler] = handler_scope.exception_handlers;
         let handler = &handlers[index];
+        let entry = self.new_entry(Taker::exception(handler), cause, reentry);
+        handler_scope.jobs.send(Job::Exception { handler, args, entry });
+    }
+
+    /// How many times `handler` has been re-entered among the instances that led to
+    /// `cause`, if one of them is an instance of it (a new one is then a re-entry).
+    fn reentries(&self, handler: Taker, cause: &Option<Rc<Entry>>) -> Option<usize> {
+        cause.as_ref().filter(|c| c.led_from(handler)).map(|c| c.counts.of(handler))
+    }
+
+    /// A new instance of `handler`, made now, led to by `cause`; counted if a re-entry.
+    fn new_entry(&self, handler: Taker, cause: Option<Rc<Entry>>, reentry: bool) -> Rc<Entry> {
         let counts = cause.as_ref().map_or_else(Rc::default, |c| c.counts.clone());
         if reentry {
             counts.add(handler);
         }
-        let entry =
-            Rc::new(Entry { handler, at: Instant::now(), poll: self.polls.get(), cause, counts });
-        handler_scope.jobs.send(Job::Exception { handler, args, entry });
+        Rc::new(Entry { handler, at: Instant::now(), poll: self.polls.get(), cause, counts })
     }
 
-    /// The innermost exception handler instance whose body `from` is in, if it was
-    /// entered at this instant: no time has passed since, or the engine has not waited
-    /// since (with the wall clock, time passes between any two readings).
-    fn cause(&self, from: &Rc<Scope<'m>>) -> Option<Rc<Entry<'m>>> {
+    /// A signal's handler started again `n` times at this instant by what its own firings
+    /// raised: the signals go round for ever without time passing. The mission fails, and
+    /// the fleet goes home.
+    #[cold]
+    fn cycle_of_signals(&self, h: &Handler, n: usize) {
+        let line = match h.line {
+            0 => String::new(),
+            line => format!(", line {line}"),
+        };
+        // Whole milliseconds: the clock's own digits say nothing more.
+        let t = (self.now() * 1000.0).round() / 1000.0;
+        let reason = format!(
+            "a cycle of signals at one instant: {}{line}, started again {n} times at t = {t} s by what its own firings raised, without time passing",
+            h.body.path
+        );
+        self.end_with(Status::Failed, reason, true);
+    }
+
+    /// The innermost handler instance (of an exception, or a signal's firing) whose body
+    /// `from` is in, if it was made at this instant: no time has passed since, or the
+    /// engine has not waited since (with the wall clock, time passes between any two
+    /// readings).
+    fn cause(&self, from: &Rc<Scope<'m>>) -> Option<Rc<Entry>> {
         let entered = self.entered.borrow();
         if entered.is_empty() {
             return None;
@@ -835,9 +937,8 @@ impl<'m> Engine<'m> {
             .then(|| innermost.clone())
     }
 
-    /// Knows `body`, the scope of an exception handler's body, by `entry` while the
-    /// guard lives.
-    pub fn enter<'e>(&'e self, body: &Rc<Scope<'m>>, entry: Rc<Entry<'m>>) -> Entered<'e, 'm> {
+    /// Knows `body`, the scope of a handler's body, by `entry` while the guard lives.
+    pub fn enter<'e>(&'e self, body: &Rc<Scope<'m>>, entry: Rc<Entry>) -> Entered<'e, 'm> {
         let key = Rc::as_ptr(body) as usize;
         self.entered.borrow_mut().insert(key, entry);
         Entered { engine: self, key }

@@ -51,6 +51,9 @@ impl<'m> Engine<'m> {
         let mut running: Option<FuturesUnordered<_>> = None;
         let mut items_done = false;
         std::future::poll_fn(|cx| loop {
+            // A stop from outside is heard here too: a scope that starts handler after
+            // handler at one instant never lets the engine wait.
+            self.heed_interrupt();
             // Jobs first, then the items, then the handlers running, as a biased select.
             let took_jobs = !unstarted.get();
             if took_jobs {
@@ -186,6 +189,9 @@ impl<'m> Engine<'m> {
             if ctx.scope.unwinding.get() {
                 break;
             }
+            // Long runs of statements that end at once (W's steps) never let the engine
+            // wait: a stop from outside is looked for before each.
+            self.heed_interrupt();
             self.statement(node, ctx).await;
             self.caught(ctx).await;
         }
@@ -427,7 +433,14 @@ impl<'m> Engine<'m> {
 
     async fn job(&self, job: Job<'m>, scope: Rc<Scope<'m>>) {
         match job {
-            Job::Signal { handler, args, actor, signal } => {
+            Job::Signal { handler, args, actor, signal, entry } => {
+                self.heed_interrupt();
+                // Nothing new starts once the mission has failed: a firing that waited
+                // its turn (`ONE AT A TIME`) is dropped, and lets the next go (dropped too).
+                if self.stopped() {
+                    scope.firing_ended(handler);
+                    return;
+                }
                 let mut frame = scope.frame.to_vec();
                 for (slot, v) in handler.bindings.iter().zip(args) {
                     set(&mut frame, *slot, v);
@@ -440,7 +453,9 @@ impl<'m> Engine<'m> {
                     actor: who.map(Into::into),
                 });
                 let ctx = self.scope_ctx(&scope, Rc::from(frame));
-                self.block(&handler.body, &ctx).await;
+                // Boxed, as `block` is: the job's future stays small while it waits.
+                Box::pin(self.block_with(&handler.body, &ctx, |body| self.enter(body, entry)))
+                    .await;
                 self.trace(EventKind::HandlerEnd, || Event::HandlerEnd {
                     signal: signal_name.into(),
                     handler: handler.body.path.as_str().into(),

@@ -76,6 +76,7 @@ impl<'m> Engine<'m> {
     /// A statement calling a capability that may be instant, unless the mission has
     /// stopped: what `instant_call` leaves, awaited.
     pub(crate) async fn instant_statement(&self, call: &'m Call, ctx: &Ctx<'m>) {
+        self.heed_interrupt();
         let rest = if self.stopped() { None } else { self.instant_call(call, ctx) };
         if let Some(rest) = rest {
             rest.await;

@@ -32,7 +32,7 @@ use aviary_api::Backend;
 
 pub use aviary_api::trace::{Event, EventKind, OperatorAction, Record, Status};
 use aviary_ir::Mission;
-pub use control::{Control, ControlRequest, Controller, DroneAction};
+pub use control::{Control, ControlRequest, Controller, Controls, DroneAction};
 
 /// Where trace events go, in order: the typed events of `aviary_api::trace`, which a
 /// sink writes as JSON (the trace file, the operator API) or reads field by field.
@@ -64,14 +64,17 @@ pub struct RunOptions {
     /// build and 6 KB in release (`aviary` runs on a 1 GiB stack). A recursion the
     /// checker allows (one behind a condition) ends here, never in a stack overflow.
     pub max_call_depth: usize,
-    /// How many times an exception handler may be re-entered at one instant: started
-    /// again by an exception that one of its own instances led to at that instant (its
-    /// body threw at once, or a handler that its body's exception started did), counted
-    /// over everything the first exception led to then. Past the limit that handler does
-    /// not take the exception: it goes on outward as if the handler were not there, and
-    /// the trace says which handler was passed over and why (docs/LANGUAGE.md, section
-    /// 12). Without it, a handler whose body fails at once would run for ever at one
-    /// instant, and the engine's thread, never waiting, would not even hear Ctrl-C.
+    /// How many times a handler may be re-entered at one instant: started again by an
+    /// exception or a signal that one of its own instances led to at that instant (its
+    /// body threw or raised at once, or a handler that its body started did), counted
+    /// over everything the first exception or signal led to then. Past the limit an
+    /// exception handler does not take the exception: it goes on outward as if the
+    /// handler were not there, and the trace says which handler was passed over and why
+    /// (docs/LANGUAGE.md, section 12). A signal's handler is not started again: the
+    /// signals go round in a cycle at one instant, and the mission fails with the reason,
+    /// its fleet sent home (section 11). Without it, such a handler would run for ever at
+    /// one instant, the trace growing without end, and the engine's thread, never
+    /// waiting, would not even read its controls.
     pub max_handler_reentries: usize,
 }
 
@@ -79,10 +82,9 @@ pub struct RunOptions {
 /// run, and 300 MB of stack in a debug build.
 pub const MAX_CALL_DEPTH: usize = 10_000;
 
-/// The default [`RunOptions::max_handler_reentries`]. Between two rounds at one instant
-/// no drone has moved and no time has passed, so a handler re-entered this often is
-/// going round in a loop; the trace of one passed over here stays under a megabyte.
-pub const MAX_HANDLER_REENTRIES: usize = 100;
+/// The default [`RunOptions::max_handler_reentries`]: the language's
+/// ([`aviary_api::MAX_HANDLER_REENTRIES`]).
+pub const MAX_HANDLER_REENTRIES: usize = aviary_api::MAX_HANDLER_REENTRIES;
 
 impl Default for RunOptions {
     fn default() -> Self {
@@ -124,7 +126,7 @@ pub mod testing {
         backend: &dyn Backend,
         sink: &mut dyn TraceSink,
         options: &RunOptions,
-        controls: Option<tokio::sync::mpsc::UnboundedReceiver<ControlRequest>>,
+        controls: Option<Controls>,
     ) -> Outcome {
         let mut engine = engine::Engine::new(mission, backend, sink, options);
         engine.instant.fill(false);
@@ -138,7 +140,7 @@ pub async fn run_controlled(
     backend: &dyn Backend,
     sink: &mut dyn TraceSink,
     options: &RunOptions,
-    controls: tokio::sync::mpsc::UnboundedReceiver<ControlRequest>,
+    controls: Controls,
 ) -> Outcome {
     engine::Engine::new(mission, backend, sink, options).run(options, Some(controls)).await
 }

@@ -330,6 +330,9 @@ pub struct Handler {
     pub by: Option<ActorFilter>,
     pub bindings: Vec<Slot>,
     pub body: Block,
+    /// The line of its `ON` in the file that declares it (from 1; 0 unknown), for a
+    /// run-time report that names the handler (a cycle of signals at one instant).
+    pub line: u32,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -342,6 +342,7 @@ impl<'a> Compiler<'a> {
         let by = self.filter(&h.by);
         let path = format!("{parent}/ON {}", h.signal.name);
         let names = h.bindings.iter().map(|b| (b.name.clone(), false));
+        let line = self.line_of(h.span.start);
         self.bound_scope(names, |c, bindings| Handler {
             signal,
             every: h.every,
@@ -350,7 +351,17 @@ impl<'a> Compiler<'a> {
             by,
             bindings,
             body: c.body(&h.body, &path, BlockKind::Sequential, false),
+            line,
         })
+    }
+
+    /// The line (from 1) of a byte of the file being compiled; 0 if unknown.
+    fn line_of(&self, at: u32) -> u32 {
+        self.program
+            .files
+            .iter()
+            .find(|(f, _)| *f == self.file)
+            .map_or(0, |(_, tree)| tree.line_of(at))
     }
 
     fn exception_handler(&mut self, h: &ast::ExceptionHandler, parent: &str) -> ExceptionHandler {
@@ -358,12 +369,7 @@ impl<'a> Compiler<'a> {
         let by = self.filter(&h.by);
         let path = format!("{parent}/ON EXCEPTION {}", h.exception.name);
         let names = h.bindings.iter().map(|b| (b.name.clone(), false));
-        let line = self
-            .program
-            .files
-            .iter()
-            .find(|(f, _)| *f == self.file)
-            .map_or(0, |(_, tree)| tree.line_of(h.span.start));
+        let line = self.line_of(h.span.start);
         self.bound_scope(names, |c, bindings| ExceptionHandler {
             exception,
             by,

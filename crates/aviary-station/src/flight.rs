@@ -8,7 +8,7 @@ use std::sync::Arc;
 use aviary_api::trace::Record;
 use aviary_api::Backend;
 use aviary_backends::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
-use aviary_backends::trace_file::{lock, SharedTrace, TraceFile};
+use aviary_backends::trace_file::{lock, Cut, SharedTrace, TraceFile, DEFAULT_MAX_BYTES};
 use aviary_check::SourceProvider;
 use aviary_engine::{Controller, RunOptions};
 use aviary_ir::Mission;
@@ -16,7 +16,7 @@ use aviary_server::Feed;
 use aviary_world::World;
 
 use crate::checking::{map_of, Text};
-use crate::Station;
+use crate::{Mode, Station};
 
 /// The telemetry rate of a flight from the page, unless it asks for another: smooth
 /// enough to watch and to replay.
@@ -79,8 +79,15 @@ pub fn start(
                 world: Source { name: &request.world.path, bytes: request.world.text.into_bytes() },
                 files: &*files,
             };
-            let mut hooks =
-                Flight { station: flying, tree, feed: None, ready: Some(ready), trace, file: None };
+            let mut hooks = Flight {
+                station: flying,
+                tree,
+                feed: None,
+                ready: Some(ready),
+                trace,
+                file: None,
+                controller: None,
+            };
             let flown = aviary_backends::fly(texts, &options, &mut hooks);
             landed.flying.store(false, std::sync::atomic::Ordering::SeqCst);
             let why = match flown {
@@ -110,10 +117,9 @@ pub fn start(
     started.recv().unwrap_or_else(|_| Err("the flight stopped before it started".into()))
 }
 
-/// Where a flight's trace goes: a file of the station's folder, and its name as the page
-/// shows it.
+/// Where a flight's trace goes: a new file of the station's folder, by its name there
+/// (as the page shows it).
 pub struct Trace {
-    pub path: std::path::PathBuf,
     pub shown: String,
 }
 
@@ -124,19 +130,26 @@ struct Flight {
     ready: Option<std::sync::mpsc::Sender<Result<(), String>>>,
     trace: Trace,
     file: Option<SharedTrace>,
+    /// The flight's, once it starts: a trace at its size limit stops it.
+    controller: Option<Controller>,
 }
 
 impl Hooks for Flight {
     fn compiled(&mut self, mission: &Mission, world: &World) -> Result<(), String> {
         self.station.set_map(map_of(world));
-        if let Some(folder) = self.trace.path.parent() {
-            std::fs::create_dir_all(folder)
-                .map_err(|e| format!("cannot make {}: {e}", folder.display()))?;
-        }
-        let out = std::fs::File::create(&self.trace.path)
-            .map_err(|e| format!("cannot write the trace {}: {e}", self.trace.shown))?;
-        self.file =
-            Some(TraceFile::new(Box::new(out), self.trace.shown.clone(), mission.name.clone()));
+        // Made as every file of the folder is reached: checked by `Folder::place`.
+        let Mode::Folder { folder, .. } = &self.station.mode else {
+            return Err("a flight from the page needs the station's folder".into());
+        };
+        let out = folder
+            .record(&self.trace.shown)
+            .map_err(|why| format!("cannot write the trace: {why}"))?;
+        self.file = Some(TraceFile::new(
+            Box::new(out),
+            self.trace.shown.clone(),
+            mission.name.clone(),
+            DEFAULT_MAX_BYTES,
+        ));
         Ok(())
     }
 
@@ -146,6 +159,7 @@ impl Hooks for Flight {
         controller: &Controller,
         _stop: &Stop,
     ) -> Result<(), String> {
+        self.controller = Some(controller.clone());
         let tree = std::mem::take(&mut self.tree);
         let trace = Some(self.trace.shown.clone());
         self.feed = Some(self.station.start_run(controller.clone(), mission, tree, trace));
@@ -157,8 +171,18 @@ impl Hooks for Flight {
 
     fn record(&mut self, record: &Record<'_>, _backend: &dyn Backend) {
         if let Some(file) = &self.file {
-            if let Some(why) = lock(file).write(record) {
-                eprintln!("aviary: {why}; the flight goes on without it");
+            let cut = lock(file).write(record);
+            match cut {
+                Some(Cut::Failed(why)) => eprintln!("aviary: {why}; the flight goes on without it"),
+                // As `aviary run`'s: a flight that makes events without end stops, and its
+                // fleet comes home.
+                Some(full @ Cut::Full { .. }) => {
+                    eprintln!("aviary: {full}; the flight stops and its fleet returns home");
+                    if let Some(controller) = &self.controller {
+                        controller.interrupt(full.to_string());
+                    }
+                }
+                None => {}
             }
         }
         if let Some(feed) = &self.feed {

@@ -32,7 +32,7 @@ use aviary_engine::Controller;
 use aviary_server::{Feed, Gate, Kinds};
 use serde_json::Value;
 
-pub use dir::{Folder, Listing};
+pub use dir::{refused_name, Access, Folder, Listing};
 
 /// How the station finds the files a mission `USE`s: the command line's provider, made
 /// for a mission file (its folder, and the `--use-root`s).

@@ -187,8 +187,12 @@ fn checked(
     world: &Text,
 ) -> Result<(checking::Report, Box<dyn SourceProvider + Send>), Refusal> {
     let (folder, files_for) = folder(station)?;
-    let path = folder.resolve(&mission.path).map_err(|w| Refusal(StatusCode::BAD_REQUEST, w))?;
-    folder.resolve(&world.path).map_err(|w| Refusal(StatusCode::BAD_REQUEST, w))?;
+    // Where the page would save them: the mission's folder is where its `USE`s are read.
+    let place = |path: &str| {
+        folder.place(path, dir::Access::Save).map_err(|w| Refusal(StatusCode::BAD_REQUEST, w))
+    };
+    let path = place(&mission.path)?;
+    place(&world.path)?;
     let files = files_for(&path).map_err(|w| Refusal(StatusCode::CONFLICT, w))?;
     Ok((checking::check(mission, world, &*files), files))
 }
@@ -369,7 +373,7 @@ fn world_of(folder: &dir::Folder, path: &str) -> Result<aviary_world::World, Ref
 }
 
 /// A new trace file for a flight of `mission`: `traces/NAME-TIME.jsonl` in the folder,
-/// the time in UTC.
+/// the time in UTC. Only its name: the flight makes it (`Folder::record`).
 fn trace_for(folder: &dir::Folder, mission: &str) -> flight::Trace {
     let stem = std::path::Path::new(mission)
         .file_stem()
@@ -379,11 +383,12 @@ fn trace_for(folder: &dir::Folder, mission: &str) -> flight::Trace {
     let stamp: String = now.chars().map(|c| if c == ':' { '-' } else { c }).collect();
     let mut shown = format!("traces/{stem}-{stamp}.jsonl");
     let mut n = 1;
-    while folder.root().join(&shown).exists() {
+    // A link counts as a file there, whether or not it leads anywhere.
+    while folder.root().join(&shown).symlink_metadata().is_ok() {
         n += 1;
         shown = format!("traces/{stem}-{stamp}-{n}.jsonl");
     }
-    flight::Trace { path: folder.root().join(&shown), shown }
+    flight::Trace { shown }
 }
 
 /// Runs `work` on a thread with the checker's stack, and waits for it without holding

@@ -12,6 +12,8 @@ use aviary_ir::{
     Origin, SignalId,
 };
 use aviary_world::World;
+use std::cell::RefCell;
+use std::rc::Rc;
 
 use super::eval::{number, Frame, Scope};
 use super::model::{first_within, Flyer};
@@ -23,6 +25,42 @@ pub struct Raise {
     pub signal: SignalId,
     pub actor: Option<DroneId>,
     pub args: Vec<Option<Value>>,
+    /// The handler's firing whose body raised it, if any.
+    pub from: Option<Rc<Fired>>,
+}
+
+/// A firing of a handler in the walk, for the bound the run puts on a cycle of signals
+/// at one instant ([`aviary_api::MAX_HANDLER_REENTRIES`]; docs/LANGUAGE.md, section 11):
+/// the run fails the mission there, and the walk, which would otherwise follow the cycle
+/// for ever, stops following it there too. As the engine's `Entry`, made when it fired.
+#[derive(Debug)]
+pub struct Fired {
+    handler: *const Handler,
+    t: f64,
+    /// The firing whose body raised this one's signal, if that one fired at this time.
+    cause: Option<Rc<Fired>>,
+    /// Re-entries per handler among the firings one signal led to at this time.
+    counts: Rc<RefCell<Vec<(*const Handler, usize)>>>,
+}
+
+impl Fired {
+    fn led_from(&self, handler: *const Handler) -> bool {
+        std::iter::successors(Some(self), |f| f.cause.as_deref())
+            .any(|f| std::ptr::eq(f.handler, handler))
+    }
+
+    fn count(&self, handler: *const Handler) -> usize {
+        let counts = self.counts.borrow();
+        counts.iter().find(|(h, _)| std::ptr::eq(*h, handler)).map_or(0, |(_, n)| *n)
+    }
+
+    fn add(&self, handler: *const Handler) {
+        let mut counts = self.counts.borrow_mut();
+        match counts.iter_mut().find(|(h, _)| std::ptr::eq(*h, handler)) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((handler, 1)),
+        }
+    }
 }
 
 /// Raises waiting for a block's handlers, taken earliest first and, at one time, in the
@@ -76,6 +114,8 @@ struct Ctx {
     actor: Option<DroneId>,
     /// The mission-level statement running, while inside a capability.
     statement: Option<Origin>,
+    /// The handler's firing being walked, if any: what its body raises comes from it.
+    firing: Option<Rc<Fired>>,
 }
 
 pub struct Estimator<'m> {
@@ -98,6 +138,8 @@ pub struct Estimator<'m> {
     /// Capability calls the walk may still follow ([`call_budget`]), and whether it ran out.
     budget: usize,
     cut_short: bool,
+    /// Whether the walk met a cycle of signals at one instant ([`Fired`]).
+    cycled: bool,
     /// A mission frame with every slot empty, lent to each walk of [`Estimator::bound`]
     /// and given back as empty as it was lent.
     blank: Frame,
@@ -147,6 +189,7 @@ impl<'m> Estimator<'m> {
             detected: mission.builtins.signal(aviary_api::BuiltinSignal::Detected),
             budget: call_budget(mission),
             cut_short: false,
+            cycled: false,
             blank: Vec::new(),
             s: State::new(drones, mission.signals.len()),
         }
@@ -154,8 +197,12 @@ impl<'m> Estimator<'m> {
 
     /// Walks the mission body, then sends home what is still in the air; the end time.
     pub fn run(&mut self) -> f64 {
-        let mut ctx =
-            Ctx { frame: vec![None; self.mission.frame_size], actor: None, statement: None };
+        let mut ctx = Ctx {
+            frame: vec![None; self.mission.frame_size],
+            actor: None,
+            statement: None,
+            firing: None,
+        };
         let (end, _) = self.block(&self.mission.body, &mut ctx, 0.0);
         let mut last = end;
         for d in 0..self.s.drones.len() {
@@ -183,7 +230,7 @@ impl<'m> Estimator<'m> {
         let mark = self.s.mark();
         let mut blank = std::mem::take(&mut self.blank);
         blank.resize(self.mission.frame_size, None);
-        let mut ctx = Ctx { frame: blank, actor: None, statement: None };
+        let mut ctx = Ctx { frame: blank, actor: None, statement: None, firing: None };
         let (end, _) = self.block(&h.body, &mut ctx, t);
         self.blank = ctx.frame;
         let mut out = Vec::new();
@@ -295,6 +342,17 @@ impl<'m> Estimator<'m> {
                 if (!h.every && once[hi]) || !matches(h, &ctx.frame, r.actor) {
                     continue;
                 }
+                // A firing raised at once by a firing of the same handler (or by one it led
+                // to), at the same time: the run allows so many, then fails the mission.
+                let cause = r.from.as_ref().filter(|f| f.t == r.t).cloned();
+                let again = cause.as_ref().filter(|c| c.led_from(h));
+                if let Some(c) = again {
+                    if c.count(h) >= aviary_api::MAX_HANDLER_REENTRIES {
+                        self.note_cycle(h);
+                        continue;
+                    }
+                    c.add(h);
+                }
                 once[hi] = true;
                 self.s.fired.push(h as *const Handler as usize);
                 let bindings = h.bindings.iter().copied().zip(r.args.iter().cloned());
@@ -302,8 +360,14 @@ impl<'m> Estimator<'m> {
                 if h.one_at_a_time {
                     start = start.max(serial_end[hi]);
                 }
+                // A firing that starts later than its signal starts a count of its own.
+                let cause = cause.filter(|_| start == r.t);
+                let counts = cause.as_ref().map_or_else(Rc::default, |c| c.counts.clone());
+                let fired = Rc::new(Fired { handler: h, t: start, cause, counts });
+                let outer = ctx.firing.replace(fired);
                 let (e, more) =
                     self.with(ctx, bindings, ctx.actor, |est, ctx| est.block(&h.body, ctx, start));
+                ctx.firing = outer;
                 serial_end[hi] = e;
                 end = end.max(e);
                 for r in more {
@@ -350,7 +414,7 @@ impl<'m> Estimator<'m> {
     ) -> (f64, Vec<Raise>) {
         let args = args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
         self.s.raise(signal, t);
-        (t, vec![Raise { t, signal, actor: ctx.actor, args }])
+        (t, vec![Raise { t, signal, actor: ctx.actor, args, from: ctx.firing.clone() }])
     }
 
     #[inline(never)]
@@ -519,6 +583,19 @@ impl<'m> Estimator<'m> {
     }
 
     #[cold]
+    fn note_cycle(&mut self, h: &Handler) {
+        if !self.cycled {
+            self.cycled = true;
+            let text = format!(
+                "signals go round in a cycle at one instant ({} is started again {} times without time passing): the run fails the mission there, and the estimate follows the signals no further",
+                h.body.path,
+                aviary_api::MAX_HANDLER_REENTRIES
+            );
+            self.note(None, text);
+        }
+    }
+
+    #[cold]
     fn note_cut_short(&mut self, c: &Call) {
         if !self.cut_short {
             self.cut_short = true;
@@ -598,6 +675,7 @@ impl<'m> Estimator<'m> {
                 frame,
                 actor: actors.first().copied(),
                 statement: Some(ctx.statement.unwrap_or(c.origin)),
+                firing: ctx.firing.clone(),
             };
             self.calling[c.capability] = true;
             let (e, r) = self.block(&cap.perform, &mut cctx, start);
@@ -674,6 +752,7 @@ impl<'m> Estimator<'m> {
                             Some(Value::Symbol(kind.clone())),
                             Some(Value::Position(location)),
                         ],
+                        from: None,
                     });
                 }
             }

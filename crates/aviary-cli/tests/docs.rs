@@ -697,6 +697,9 @@ fn every_flag_of_aviary_run_is_documented_with_its_default() {
     for doc in ["README.md", "docs/GUIDE.md", "docs/TRACE.md", "docs/SECURITY.md"] {
         let text = std::fs::read_to_string(repo().join(doc)).unwrap();
         let said = text.lines().any(|l| l.contains("1 GiB"));
-        assert!(text.contains("--max-trace-size") && said, "{doc} documents --max-trace-size and its default, 1 GiB");
+        assert!(
+            text.contains("--max-trace-size") && said,
+            "{doc} documents --max-trace-size and its default, 1 GiB"
+        );
     }
 }

@@ -35,6 +35,7 @@ mod motion;
 mod plausible;
 mod px4;
 mod vehicle;
+mod words;
 
 use std::collections::BTreeMap;
 use std::time::Duration;

@@ -1,7 +1,7 @@
 //! What the backend knows of one vehicle: the last of each message it sent, the answers
 //! commands wait for, and detection (a geometric sensor over the reported track).
 
-use std::collections::{BTreeMap, VecDeque};
+use std::collections::BTreeMap;
 use std::sync::{Mutex, MutexGuard};
 
 use aviary_api::geometry::dist_to_segment;
@@ -19,6 +19,7 @@ use crate::battery::{self, Draw};
 use crate::failsafe::{failsafe, FAILSAFE_WAIT};
 use crate::mode::{self, Flavour, Mode};
 use crate::plausible;
+use crate::words::Words;
 use aviary_api::geo::Origin;
 
 /// The last fix a vehicle reported, in the local frame.
@@ -62,7 +63,7 @@ pub struct Seen {
     pub params: BTreeMap<String, (f32, MavParamType)>,
     pub landed: Option<MavLandedState>,
     /// Recent STATUSTEXTs (the autopilot's reasons), newest last.
-    pub texts: VecDeque<(Instant, String)>,
+    pub words: Words,
     /// The mode this backend last asked for; another RTL or LAND is the autopilot's own.
     pub expected: Option<Mode>,
     /// A failsafe mode change not yet named: when it was seen, the mode's name and what
@@ -139,7 +140,6 @@ pub struct Vehicle {
     alarms: mpsc::UnboundedSender<(DroneId, Failure)>,
 }
 
-const TEXTS_KEPT: usize = 16;
 /// Armed and this high (m): in the air, for the flight time and the measured draw.
 const AIRBORNE_ABOVE: f64 = 0.3;
 
@@ -192,9 +192,7 @@ impl Vehicle {
 
     /// STATUSTEXTs received since `since`, joined: the autopilot's reason for a refusal.
     pub fn texts_since(&self, since: Instant) -> Option<String> {
-        let seen = self.seen();
-        let texts: Vec<&str> =
-            seen.texts.iter().filter(|(t, _)| *t >= since).map(|(_, s)| s.as_str()).collect();
+        let texts = self.seen().words.since(since);
         (!texts.is_empty()).then(|| texts.join("; "))
     }
 
@@ -244,11 +242,7 @@ impl Vehicle {
                 seen.no_gps = (g.fix_type as u8) < 3;
             }
             MavMessage::STATUSTEXT(t) => {
-                let text = t.text.to_str().unwrap_or("").trim_end_matches('\0').to_owned();
-                seen.texts.push_back((now, text));
-                while seen.texts.len() > TEXTS_KEPT {
-                    seen.texts.pop_front();
-                }
+                seen.words.take(now, t.id, t.chunk_seq, &t.text[..]);
             }
             MavMessage::COMMAND_ACK(ack) if ack.result == MavResult::MAV_RESULT_IN_PROGRESS => {
                 seen.in_progress = Some((ack.command, now));
@@ -273,7 +267,7 @@ impl Vehicle {
         let was = seen.status.replace(hb.system_status);
         if going_down(Some(hb.system_status)) && !going_down(was) {
             // The vehicle says it is going down (or gone): it is lost to the mission.
-            let why = seen.texts.back().map_or("no reason given", |(_, s)| s.as_str());
+            let why = seen.words.last().unwrap_or_else(|| "no reason given".to_owned());
             let reason =
                 format!("{}: the autopilot reports {:?} ({why})", self.name, hb.system_status);
             let _ = self
@@ -367,8 +361,7 @@ impl Vehicle {
     fn name_failsafe(&self, seen: &mut Seen, now: Instant) {
         let Some((at, mode, does)) = seen.failsafe.clone() else { return };
         let since = at - std::time::Duration::from_secs(3);
-        let why: Vec<&str> =
-            seen.texts.iter().filter(|(t, _)| *t >= since).map(|(_, s)| s.as_str()).collect();
+        let why = seen.words.since(since);
         let state = if seen.battery_failing {
             Some(BuiltinException::BatteryCritical)
         } else if seen.fence_unhealthy || seen.fence_breached {

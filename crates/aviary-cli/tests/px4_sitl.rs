@@ -7,25 +7,10 @@
 
 mod common;
 
-use std::path::Path;
-
+use common::background::{events, pos};
 use common::px4::{Px4, ORIGIN};
 use common::{aviary, scratch};
 use serde_json::Value;
-
-fn events(path: &Path) -> Vec<Value> {
-    std::fs::read_to_string(path)
-        .unwrap_or_default()
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("a whole JSON event"))
-        .collect()
-}
-
-fn pos(v: &Value) -> [f64; 3] {
-    let a = v.as_array().expect("a position");
-    let n = |i: usize| a.get(i).and_then(Value::as_f64).unwrap_or(0.0);
-    [n(0), n(1), n(2)]
-}
 
 /// A world of PX4 copters, each `(name, vehicle)` at its home.
 fn world(copters: &[(&str, [f64; 2], &Px4)], extra: &str) -> String {
@@ -170,4 +155,175 @@ fn the_paper_mission_on_seven_px4_copters() {
         );
     }
     println!("{out}");
+}
+
+/// One PX4 copter: each of PX4's failsafes reaching the mission as the language's
+/// exception, a target PX4 refuses in words, and a vehicle that stops and comes back.
+mod single {
+    use std::path::PathBuf;
+    use std::time::{Duration, Instant};
+
+    use super::*;
+    use aviary_mavlink::mavlink::dialects::ardupilotmega as mav;
+    use common::background::{airborne, exception, finish, named, start_run, Run};
+    use common::sitl::{wait_until, Gcs};
+
+    /// A copter `d` at home (0, 0), set up by the test's ground station (`before`), and
+    /// `aviary run` flying `mission` on it.
+    fn one(
+        tag: &str,
+        world_extra: &str,
+        mission: &str,
+        before: impl FnOnce(&Gcs),
+    ) -> (PathBuf, Px4, Gcs, Run) {
+        let dir = scratch(tag);
+        let px4 = Px4::start(&dir, [0.0, 0.0]);
+        let gcs = px4.gcs();
+        before(&gcs);
+        std::fs::write(dir.join("m.world.toml"), world(&[("d", [0.0, 0.0], &px4)], world_extra))
+            .expect("world");
+        std::fs::write(dir.join("m.mission"), mission).expect("mission");
+        let run = start_run(&dir, "m.mission");
+        (dir, px4, gcs, run)
+    }
+
+    /// The exception `name`, raised on `d` and handled, with PX4's own action before it.
+    fn caught<'a>(flown: &'a [Value], name: &str, out: &str) -> &'a Value {
+        let e = exception(flown, name).unwrap_or_else(|| panic!("no {name}:\n{out}"));
+        assert_eq!((e["actor"].as_str(), e["handled"].as_bool()), (Some("d"), Some(true)), "{e}");
+        assert!(named(flown, "signal").any(|s| s["name"] == "Caught"), "the handler ran:\n{out}");
+        e
+    }
+
+    /// Up, and a hover for as long as a failsafe needs, with a handler of `exception`.
+    fn hover(exception: &str) -> String {
+        format!("MISSION Drill:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d Hover WITH 120s\n    ON EXCEPTION {exception} BY d:\n        SIGNAL Caught\n")
+    }
+
+    #[test]
+    #[cfg_attr(
+        not(px4_sitl),
+        ignore = "PX4 SITL not named: set AVIARY_PX4=/path/to/build/px4_sitl_default/bin/px4 to fly it (docs/REAL_DRONES.md)"
+    )]
+    fn an_emptied_battery_raises_battery_critical() {
+        // PX4's failure injection empties its simulated battery. Its charge, as PX4
+        // reports it, falls below what the way home needs: the backend's battery rule
+        // raises BatteryCritical (PX4's own failsafe, COM_LOW_BAT_ACT 3, acts on the same
+        // battery a moment later, unless the mission has already sent the drone home).
+        let (dir, _px4, gcs, mut run) = one("px4_battery", "", &hover("BatteryCritical"), |gcs| {
+            gcs.set_param_px4_int("SYS_FAILURE_EN", 1);
+            gcs.set_param_px4_int("COM_LOW_BAT_ACT", 3);
+        });
+        airborne(&dir, Duration::from_secs(150));
+        let answer = gcs.command(
+            mav::MavCmd::MAV_CMD_INJECT_FAILURE,
+            [100.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0], // the battery, off
+        );
+        assert_eq!(answer, mav::MavResult::MAV_RESULT_ACCEPTED);
+        let (code, out) = finish(&mut run, &dir, Duration::from_secs(300));
+        let flown = events(&dir.join("t.jsonl"));
+        let e = caught(&flown, "BatteryCritical", &out);
+        assert!(e["args"].to_string().contains("% left"), "from the charge PX4 reports: {e}");
+        assert_eq!(code, 0, "{out}");
+    }
+
+    #[test]
+    #[cfg_attr(
+        not(px4_sitl),
+        ignore = "PX4 SITL not named: set AVIARY_PX4=/path/to/build/px4_sitl_default/bin/px4 to fly it (docs/REAL_DRONES.md)"
+    )]
+    fn the_vehicles_own_fence_raises_geofence_violation() {
+        // PX4 refuses a reposition outside its fence, so the breach is made as on a real
+        // site: the drone is 80 m out when the ground station sets PX4's fence, 50 m
+        // from home with Return, which the world knows nothing of.
+        let mission = "MISSION Drill:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d FlyTo WITH Far\n        d Hover WITH 120s\n    ON EXCEPTION GeofenceViolation BY d:\n        SIGNAL Caught\n";
+        let (dir, _px4, gcs, mut run) =
+            one("px4_fence", "[places]\nFar = [0, 80]\n", mission, |_| {});
+        wait_until(Duration::from_secs(200), "the flight out", || {
+            events(&dir.join("t.jsonl"))
+                .iter()
+                .any(|e| e["event"] == "api_done" && e["function"] == "FlyToPosition")
+        });
+        gcs.set_param_px4_int("GF_ACTION", 3);
+        gcs.set_param("GF_MAX_HOR_DIST", 50.0);
+        let (_, out) = finish(&mut run, &dir, Duration::from_secs(300));
+        let flown = events(&dir.join("t.jsonl"));
+        caught(&flown, "GeofenceViolation", &out);
+    }
+
+    #[test]
+    #[cfg_attr(
+        not(px4_sitl),
+        ignore = "PX4 SITL not named: set AVIARY_PX4=/path/to/build/px4_sitl_default/bin/px4 to fly it (docs/REAL_DRONES.md)"
+    )]
+    fn a_target_outside_px4s_fence_fails_with_px4s_words() {
+        // PX4 acknowledges the reposition, then its navigator refuses it in words alone
+        // (with a fence that has an action: one that only warns lets it fly).
+        let mission = "MISSION Drill:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d FlyTo WITH Far\n    ON EXCEPTION CommandFailed BY d:\n        SIGNAL Caught\n";
+        let (dir, _px4, _gcs, mut run) =
+            one("px4_refused", "[places]\nFar = [0, 80]\n", mission, |gcs| {
+                gcs.set_param_px4_int("GF_ACTION", 3);
+                gcs.set_param("GF_MAX_HOR_DIST", 50.0);
+            });
+        let started = Instant::now();
+        let (code, out) = finish(&mut run, &dir, Duration::from_secs(300));
+        let flown = events(&dir.join("t.jsonl"));
+        let e = caught(&flown, "CommandFailed", &out);
+        let said = e["args"].to_string();
+        assert!(said.contains("Reposition is outside geofence"), "PX4's own words in {said}");
+        assert_eq!(code, 0, "{out}");
+        // Refused at once, not after the flight's time ran out.
+        let (_, up) = done(&flown, "TakeOff");
+        let refused = e["t"].as_f64().unwrap() - up["t"].as_f64().unwrap();
+        assert!(
+            refused < 10.0,
+            "refused {refused:.1} s after the take-off ({:?} in all)",
+            started.elapsed()
+        );
+    }
+
+    #[test]
+    #[cfg_attr(
+        not(px4_sitl),
+        ignore = "PX4 SITL not named: set AVIARY_PX4=/path/to/build/px4_sitl_default/bin/px4 to fly it (docs/REAL_DRONES.md)"
+    )]
+    fn gps_loss_raises_position_lost() {
+        // PX4's SIH takes no GPS failure injection (only its Gazebo bridge does): its
+        // simulated GPS loses its fix when it sees fewer than 4 satellites.
+        let (dir, _px4, gcs, mut run) = one("px4_gps", "", &hover("PositionLost"), |_| {});
+        airborne(&dir, Duration::from_secs(150));
+        gcs.set_param_px4_int("SIM_GPS_USED", 0);
+        let (_, out) = finish(&mut run, &dir, Duration::from_secs(300));
+        let flown = events(&dir.join("t.jsonl"));
+        let e =
+            exception(&flown, "PositionLost").unwrap_or_else(|| panic!("no PositionLost:\n{out}"));
+        assert_eq!(e["actor"].as_str(), Some("d"));
+    }
+
+    #[test]
+    #[cfg_attr(
+        not(px4_sitl),
+        ignore = "PX4 SITL not named: set AVIARY_PX4=/path/to/build/px4_sitl_default/bin/px4 to fly it (docs/REAL_DRONES.md)"
+    )]
+    fn a_stopped_vehicle_is_lost_and_a_restarted_one_restored() {
+        let mission = "MISSION Drill:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d Hover WITH 200s\n    ON EXCEPTION ConnectionLost BY d:\n        SIGNAL Offline\n        WAITFOR RECEIVED(Back)\n    ON ConnectionRestored BY d:\n        SIGNAL Back\n";
+        let (dir, mut px4, _gcs, mut run) = one("px4_link", "", mission, |_| {});
+        airborne(&dir, Duration::from_secs(150));
+        px4.kill();
+        let lost_at = Instant::now();
+        wait_until(Duration::from_secs(30), "ConnectionLost", || {
+            exception(&events(&dir.join("t.jsonl")), "ConnectionLost").is_some()
+        });
+        let noticed = lost_at.elapsed();
+        assert!(noticed < Duration::from_secs(10), "the lost link was noticed after {noticed:?}");
+        px4.restart();
+        let (code, out) = finish(&mut run, &dir, Duration::from_secs(200));
+        let flown = events(&dir.join("t.jsonl"));
+        let signals: Vec<&str> =
+            named(&flown, "signal").filter_map(|s| s["name"].as_str()).collect();
+        for s in ["Offline", "ConnectionRestored", "Back"] {
+            assert!(signals.contains(&s), "{s} in {signals:?}:\n{out}");
+        }
+        assert_eq!(code, 0, "{out}");
+    }
 }

@@ -19,9 +19,9 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command};
 use std::time::{Duration, Instant};
 
+use common::background::{events, exception, finish, named, pos, start_run, Run};
 use common::sitl::{wait_until, Sitl};
 use common::{aviary, repo, scratch, PAPER_DRONES};
 use serde_json::Value;
@@ -29,67 +29,6 @@ use serde_json::Value;
 /// Battery parameters for a copter that can fly the paper's mission: SITL's default
 /// (3300 mAh, some 6.5 minutes) is not enough for the longest drone's ~10 minutes.
 const BIG_BATTERY: &[(&str, f64)] = &[("BATT_CAPACITY", 16500.0), ("SIM_BATT_CAP_AH", 16.5)];
-
-/// `aviary run` started in `dir`, killed if the test ends first.
-struct Run(Child);
-
-impl Drop for Run {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn start_run(dir: &Path, mission: &str) -> Run {
-    let child = Command::new(env!("CARGO_BIN_EXE_aviary"))
-        .args(["run", mission, "--trace", "t.jsonl", "--telemetry-hz", "2"])
-        .current_dir(dir)
-        .env("NO_COLOR", "1")
-        .stdout(std::fs::File::create(dir.join("stdout.txt")).expect("stdout"))
-        .stderr(std::fs::File::create(dir.join("stderr.txt")).expect("stderr"))
-        .spawn()
-        .expect("aviary run");
-    Run(child)
-}
-
-/// Waits for the run to end: its exit code and the output it printed.
-fn finish(run: &mut Run, dir: &Path, limit: Duration) -> (i32, String) {
-    let start = Instant::now();
-    let status = loop {
-        if let Some(s) = run.0.try_wait().expect("wait") {
-            break s;
-        }
-        assert!(
-            start.elapsed() < limit,
-            "aviary run took more than {} s; see {}",
-            limit.as_secs(),
-            dir.display()
-        );
-        std::thread::sleep(Duration::from_millis(250));
-    };
-    let out = std::fs::read_to_string(dir.join("stdout.txt")).unwrap_or_default()
-        + &std::fs::read_to_string(dir.join("stderr.txt")).unwrap_or_default();
-    (status.code().unwrap_or(-1), out)
-}
-
-fn events(path: &Path) -> Vec<Value> {
-    std::fs::read_to_string(path)
-        .unwrap_or_default()
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("a whole JSON event"))
-        .collect()
-}
-
-fn named<'a>(events: &'a [Value], event: &str) -> impl Iterator<Item = &'a Value> {
-    let event = event.to_owned();
-    events.iter().filter(move |e| e["event"] == event.as_str())
-}
-
-fn pos(v: &Value) -> [f64; 3] {
-    let a = v.as_array().expect("a position");
-    let n = |i: usize| a.get(i).and_then(Value::as_f64).unwrap_or(0.0);
-    [n(0), n(1), n(2)]
-}
 
 fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
@@ -496,17 +435,9 @@ mod single {
         (dir, sitl, run)
     }
 
-    fn exception<'a>(events: &'a [Value], name: &str) -> Option<&'a Value> {
-        named(events, "exception").find(|e| e["name"] == name)
-    }
-
     /// Waits until the trace shows the drone in the air (after GPS lock and take-off).
     fn airborne(dir: &Path) {
-        wait_until(Duration::from_secs(150), "the take-off", || {
-            events(&dir.join("t.jsonl"))
-                .iter()
-                .any(|e| e["event"] == "api_done" && e["function"] == "TakeOff")
-        });
+        common::background::airborne(dir, Duration::from_secs(150));
     }
 
     #[test]

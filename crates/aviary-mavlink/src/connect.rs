@@ -181,6 +181,7 @@ fn craft(
         speed: Mutex::new(None),
         level: Mutex::new(None),
         flying_to: Mutex::new(None),
+        targeted: Mutex::new(None),
         tuning,
     }
 }

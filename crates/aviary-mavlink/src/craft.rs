@@ -61,6 +61,9 @@ pub struct Craft {
     /// (`Backend::stopped`). Set before the point's target is sent; cleared when a motion
     /// call starts.
     pub flying_to: Mutex<Option<usize>>,
+    /// When the last target (PX4's DO_REPOSITION or DO_ORBIT) was sent, for
+    /// [`Craft::refused`].
+    pub targeted: Mutex<Option<Instant>>,
     pub tuning: Tuning,
 }
 
@@ -315,6 +318,7 @@ impl Craft {
                 // param1: the ground speed last set (-1: PX4's cruise speed); bit 0 of
                 // param2: switch to HOLD, where a reposition is flown.
                 let speed = lock(&self.speed).map_or(-1.0, |s| s as f32);
+                self.set_targeted();
                 self.command_int(
                     MavCmd::MAV_CMD_DO_REPOSITION,
                     MavFrame::MAV_FRAME_GLOBAL,
@@ -355,6 +359,23 @@ impl Craft {
                 self.link.send(&msg).await;
                 Ok(())
             }
+        }
+    }
+
+    /// Notes that a target is about to be sent, for [`Craft::refused`].
+    pub fn set_targeted(&self) {
+        *lock(&self.targeted) = Some(Instant::now());
+    }
+
+    /// Fails the call when the autopilot refused its last target in words only. PX4
+    /// acknowledges DO_REPOSITION and DO_ORBIT (its commander) before its navigator looks
+    /// at them, and the navigator refuses one in words alone (`crate::px4::refuses`):
+    /// without this the drone would wait where it is until the call's time ran out.
+    pub fn refused(&self) -> Result<(), Failure> {
+        let Some(sent) = *lock(&self.targeted) else { return Ok(()) };
+        match self.v.words_since(sent).into_iter().find(|w| crate::px4::refuses(w)) {
+            Some(words) => Err(failed(format!("{} refused where it was sent: {words}", self.name))),
+            None => Ok(()),
         }
     }
 

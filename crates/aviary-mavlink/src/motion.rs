@@ -275,6 +275,7 @@ pub(crate) async fn fly_through(
             if arrived || (!last && off.hypot(fix[2] - to[2]) <= pass) {
                 break;
             }
+            c.refused()?;
             if *paused.borrow() {
                 held(c, &mut paused).await?;
                 c.target(to).await?;

@@ -42,6 +42,7 @@ pub(crate) async fn orbit(
         if turned.to(here(c)?) >= goal {
             break;
         }
+        c.refused()?;
         if *paused.borrow() {
             crate::motion::held(c, &mut paused).await?;
             turned = Turned { from: here(c)?, ..turned };
@@ -78,6 +79,7 @@ async fn circle(
         return Err(failed(format!("{} has reported no position yet", c.name)));
     };
     let (lat, lon) = c.v.origin().to_e7(center[0], center[1]);
+    c.set_targeted();
     c.command_int(
         MavCmd::MAV_CMD_DO_ORBIT,
         MavFrame::MAV_FRAME_GLOBAL,
@@ -85,6 +87,13 @@ async fn circle(
         (lat, lon, (home + z) as f32),
     )
     .await
+}
+
+/// Whether PX4's words refuse a target it has acknowledged: its navigator's "Reposition
+/// is outside geofence", "Orbit is outside geofence", "Altitude change is outside
+/// geofence" (`navigator_main.cpp`), said instead of flying there.
+pub(crate) fn refuses(words: &str) -> bool {
+    words.to_ascii_lowercase().contains("is outside geofence")
 }
 
 /// The angle (radians) a drone has turned clockwise about a center, from the positions it
@@ -122,6 +131,22 @@ mod tests {
 
     fn at(center: [f64; 2], r: f64, a: f64) -> [f64; 3] {
         [center[0] + r * a.cos(), center[1] + r * a.sin(), 10.0]
+    }
+
+    #[test]
+    fn the_navigators_refusals_are_told_from_other_words() {
+        for said in [
+            "Reposition is outside geofence",
+            "Orbit is outside geofence",
+            "Altitude change is outside geofence",
+        ] {
+            assert!(super::refuses(said), "{said}");
+        }
+        for said in
+            ["Geofence violation: exceeding maximum distance to Home", "Takeoff detected", ""]
+        {
+            assert!(!super::refuses(said), "{said}");
+        }
     }
 
     #[test]

@@ -192,8 +192,13 @@ impl Vehicle {
 
     /// STATUSTEXTs received since `since`, joined: the autopilot's reason for a refusal.
     pub fn texts_since(&self, since: Instant) -> Option<String> {
-        let texts = self.seen().words.since(since);
+        let texts = self.words_since(since);
         (!texts.is_empty()).then(|| texts.join("; "))
+    }
+
+    /// The texts received since `since`, oldest first.
+    pub fn words_since(&self, since: Instant) -> Vec<String> {
+        self.seen().words.since(since)
     }
 
     /// Takes in one message from this vehicle's autopilot.
@@ -360,8 +365,14 @@ impl Vehicle {
     /// after [`FAILSAFE_WAIT`] with what is known then.
     fn name_failsafe(&self, seen: &mut Seen, now: Instant) {
         let Some((at, mode, does)) = seen.failsafe.clone() else { return };
-        let since = at - std::time::Duration::from_secs(3);
-        let why = seen.words.since(since);
+        // The reason is said before the mode changes: by ArduPilot at once, by PX4 when its
+        // failsafe starts, which then holds for COM_FAIL_ACT_T (5 s by default, on the
+        // vehicle's clock, which is the mission's) before it acts.
+        let look_back = match seen.flavour {
+            Some(Flavour::Px4) => std::time::Duration::from_secs(10),
+            _ => std::time::Duration::from_secs(3),
+        };
+        let why = seen.words.since(at.checked_sub(look_back).unwrap_or(at));
         let state = if seen.battery_failing {
             Some(BuiltinException::BatteryCritical)
         } else if seen.fence_unhealthy || seen.fence_breached {

@@ -43,6 +43,7 @@ pub fn scratch(name: &str) -> PathBuf {
     std::fs::create_dir_all(&dir).expect("scratch dir");
     dir
 }
+pub mod background;
 pub mod px4;
 pub mod sitl;
 

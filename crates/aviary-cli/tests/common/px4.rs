@@ -7,10 +7,11 @@
 //! (build.rs). `AVIARY_PX4_SPEED` sets `PX4_SIM_SPEED_FACTOR` (1 when not set): the
 //! mission keeps the vehicles' clock, so a faster PX4 flies the same mission sooner.
 
+use std::collections::BTreeSet;
 use std::net::UdpSocket;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
-use std::sync::atomic::{AtomicU16, Ordering};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use aviary_mavlink::Origin;
@@ -36,20 +37,33 @@ pub fn speed() -> String {
         .unwrap_or_else(|| "1".into())
 }
 
-/// Instance numbers (0 to 9) this test binary hands out (PX4 keeps a lock file per number in the
-/// system's temporary folder, so instances that run at once need distinct numbers); a
-/// number whose ports are taken by somebody else is passed over.
-static NEXT: AtomicU16 = AtomicU16::new(0);
+/// The instance numbers (0 to 9) in use by this test binary's copters. PX4 keeps a lock
+/// file per number in the system's temporary folder, so copters that fly at once need
+/// distinct numbers; a copter's number is free again once it is dropped.
+static IN_USE: Mutex<BTreeSet<u16>> = Mutex::new(BTreeSet::new());
 
+/// A free instance number, waited for while other tests' copters hold them all; a number
+/// whose ports are taken by somebody else is passed over.
 fn instance() -> u16 {
+    let deadline = Instant::now() + Duration::from_secs(1800);
     loop {
-        let n = NEXT.fetch_add(1, Ordering::SeqCst);
-        // From instance 10 on, PX4 sends every API link to the same port, 14549.
-        assert!(n <= 9, "no free PX4 instance number from 0 to 9 (one API port each)");
-        // Its GCS port, its API port, and the API port it sends to.
-        if [18570, 14580, 14540].iter().all(|p| UdpSocket::bind(("127.0.0.1", p + n)).is_ok()) {
-            return n;
+        {
+            let mut in_use = IN_USE.lock().unwrap_or_else(|e| e.into_inner());
+            // From instance 10 on, PX4 sends every API link to the same port, 14549.
+            let free = (0..=9u16).find(|n| {
+                !in_use.contains(n)
+                    // Its GCS port, its API port, and the API port it sends to.
+                    && [18570, 14580, 14540]
+                        .iter()
+                        .all(|p| UdpSocket::bind(("127.0.0.1", p + n)).is_ok())
+            });
+            if let Some(n) = free {
+                in_use.insert(n);
+                return n;
+            }
         }
+        assert!(Instant::now() < deadline, "no PX4 instance number from 0 to 9 came free");
+        std::thread::sleep(Duration::from_millis(500));
     }
 }
 
@@ -181,5 +195,6 @@ impl Px4 {
 impl Drop for Px4 {
     fn drop(&mut self) {
         self.kill();
+        IN_USE.lock().unwrap_or_else(|e| e.into_inner()).remove(&self.instance);
     }
 }

@@ -208,6 +208,8 @@ pub struct Seen {
     pub track: Vec<(f64, [f64; 3])>,
     pub texts: Vec<String>,
     pub params: Vec<(String, f32)>,
+    /// The vehicle's answers to commands, in order.
+    pub acks: Vec<(mav::MavCmd, mav::MavResult)>,
 }
 
 pub struct Gcs {
@@ -270,6 +272,7 @@ impl Gcs {
                     mav::MavMessage::STATUSTEXT(t) => seen
                         .texts
                         .push(t.text.to_str().unwrap_or("").trim_end_matches('\0').to_owned()),
+                    mav::MavMessage::COMMAND_ACK(a) => seen.acks.push((a.command, a.result)),
                     mav::MavMessage::PARAM_VALUE(v) => seen.params.push((
                         v.param_id.to_str().unwrap_or("").trim_end_matches('\0').to_owned(),
                         v.param_value,
@@ -304,6 +307,35 @@ impl Gcs {
     fn send(&self, msg: mav::MavMessage) {
         let header = mavlink::MavHeader { system_id: 250, component_id: 190, sequence: 0 };
         let _ = self.conn.send(&header, &msg);
+    }
+
+    /// Sends a command (COMMAND_LONG), again until the vehicle answers it: its answer.
+    pub fn command(&self, command: mav::MavCmd, p: [f32; 7]) -> mav::MavResult {
+        let deadline = Instant::now() + Duration::from_secs(10);
+        let answered = |seen: &Seen| seen.acks.iter().filter(|a| a.0 == command).count();
+        let before = answered(&self.seen.lock().unwrap());
+        loop {
+            self.send(mav::MavMessage::COMMAND_LONG(mav::COMMAND_LONG_DATA {
+                command,
+                param1: p[0],
+                param2: p[1],
+                param3: p[2],
+                param4: p[3],
+                param5: p[4],
+                param6: p[5],
+                param7: p[6],
+                target_system: self.system,
+                target_component: 1,
+                confirmation: 0,
+            }));
+            std::thread::sleep(Duration::from_millis(500));
+            let seen = self.seen.lock().unwrap();
+            if answered(&seen) > before {
+                return seen.acks.iter().rev().find(|a| a.0 == command).map(|a| a.1).unwrap();
+            }
+            drop(seen);
+            assert!(Instant::now() < deadline, "the vehicle did not answer {command:?}");
+        }
     }
 
     /// Sets a parameter and waits for the vehicle to echo it.

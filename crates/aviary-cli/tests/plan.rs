@@ -70,6 +70,19 @@ fn the_plan_agrees_with_a_simulated_run_of_drones_with_arducopters_figures() {
     );
 }
 
+#[test]
+fn the_plan_agrees_with_a_simulated_run_of_drones_with_px4s_figures() {
+    // A take-off at half the climb rate and a slower way home (MPC_TKO_SPEED,
+    // MPC_XY_CRUISE), a high return: the plan follows each as the simulator flies it.
+    let dir = scratch("plan_px4");
+    let world = dir.join("px4.world.toml");
+    std::fs::write(&world, common::example_world_with(|_| common::PX4.to_owned())).expect("world");
+    agrees_within_15_percent(
+        "examples/search_and_rescue.mission",
+        &["--world", &world.to_string_lossy()],
+    );
+}
+
 const FIXTURES: &str = "crates/aviary-verify/tests/fixtures";
 
 #[test]

@@ -9,6 +9,7 @@ mod common;
 
 use common::background::{events, pos};
 use common::px4::{Px4, ORIGIN};
+use common::sitl::{Sitl, BIG_BATTERY};
 use common::{aviary, scratch};
 use serde_json::Value;
 
@@ -90,48 +91,95 @@ fn the_hop_mission_takes_off_flies_orbits_and_lands() {
     let (_, down) = done(&flown, "Land");
     assert!(pos(&down["position"])[2] < 0.5, "{down}");
     assert!(out.contains("mission ok"), "{out}");
+    // PX4's own flight log (ULog, from arming to disarming): every position of the trace
+    // lies within 2.5 m of one PX4 logged.
+    let log = px4.logs().pop().expect("PX4 wrote a flight log");
+    let logged = common::logs::logged_positions(&log, ORIGIN);
+    let flown: Vec<[f64; 3]> =
+        flown.iter().filter(|e| e["event"] == "telemetry").map(|e| pos(&e["position"])).collect();
+    let (off, at) = common::logs::farthest_from_log(&flown, &logged);
+    assert!(off < 2.5, "the trace's {at:?} is {off:.1} m from anything in {}", log.display());
 }
 
 /// The paper's mission on seven PX4 copters (the beacon carriers with PX4's payload
-/// deliverer as their gripper): it ends ok with the signals and finds of the simulated
-/// run of the same files, and every beacon is dropped within 5 m of its find.
+/// deliverer as their gripper).
 #[test]
 #[cfg_attr(
     not(px4_sitl),
     ignore = "PX4 SITL not named: set AVIARY_PX4=/path/to/build/px4_sitl_default/bin/px4 to fly it (docs/REAL_DRONES.md)"
 )]
 fn the_paper_mission_on_seven_px4_copters() {
-    let dir = scratch("px4_paper");
-    let copters: Vec<(&str, Px4)> = common::PAPER_DRONES
+    paper_mission("px4_paper", &common::PAPER_DRONES, &[]);
+}
+
+/// The paper's mission on a mixed fleet: two PX4 copters, two ArduCopter copters and
+/// three simulated drones, in one run.
+#[test]
+#[cfg_attr(
+    not(all(px4_sitl, arducopter_sitl)),
+    ignore = "PX4 SITL and ArduCopter SITL not both named: set AVIARY_PX4 and AVIARY_SITL to fly it (docs/REAL_DRONES.md)"
+)]
+fn the_paper_mission_on_px4_arducopter_and_simulated_drones() {
+    paper_mission(
+        "px4_mixed",
+        &["video_drone1", "beacon_drone1"],
+        &["flir_drone1", "beacon_drone2"],
+    );
+}
+
+/// The paper's mission with the drones `px4` names on PX4 SITL, those `arducopter` names
+/// on ArduCopter SITL and the rest simulated: it ends ok with the signals and finds of
+/// the simulated run, every beacon is dropped within 5 m of its find, and each real
+/// drone's flight time is within 15% of what the simulator and the plan give for a drone
+/// with its autopilot's figures.
+fn paper_mission(tag: &str, px4: &[&str], arducopter: &[&str]) {
+    let dir = scratch(tag);
+    let px4s: Vec<(&str, Px4)> = px4
         .iter()
         .map(|name| {
-            let px4 = Px4::start(&dir, common::paper_home(name));
-            (*name, if name.starts_with("beacon") { px4.with_gripper() } else { px4 })
+            let v = Px4::start(&dir, common::paper_home(name));
+            (*name, if name.starts_with("beacon") { v.with_gripper() } else { v })
+        })
+        .collect();
+    // ArduCopter's system ids stay clear of PX4's (its instance number + 1, 1 to 10).
+    let sitls: Vec<(&str, Sitl)> = arducopter
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            let system = 20 + i as u8;
+            (*name, Sitl::start(&dir, 40, system, common::paper_home(name), BIG_BATTERY))
         })
         .collect();
     std::fs::copy(common::repo().join("examples/search_and_rescue.mission"), dir.join("m.mission"))
         .expect("mission");
     let world = common::example_world_with(|name| {
-        let (_, px4) = copters.iter().find(|(n, _)| *n == name).expect("a PX4 copter");
-        format!("mavlink = \"{}\"\nsystem_id = {}\n", px4.address(), px4.system)
+        let link = |address: String, system: u8| {
+            format!("mavlink = \"{address}\"\nsystem_id = {system}\n")
+        };
+        if let Some((_, v)) = px4s.iter().find(|(n, _)| *n == name) {
+            link(v.address(), v.system)
+        } else if let Some((_, v)) = sitls.iter().find(|(n, _)| *n == name) {
+            link(v.address(), v.system)
+        } else {
+            String::new()
+        }
     });
     std::fs::write(dir.join("m.world.toml"), world).expect("world");
+    // The same drones in the simulator, each real one with its autopilot's figures.
+    let (sim_out, simulated, plan) = common::simulated_and_planned(&dir, |name| {
+        if px4.contains(&name) {
+            common::PX4.to_owned()
+        } else if arducopter.contains(&name) {
+            common::ARDUCOPTER.to_owned()
+        } else {
+            String::new()
+        }
+    });
+
     let (code, out, err) =
         aviary(&["run", "m.mission", "--trace", "t.jsonl", "--telemetry-hz", "1"], &dir);
     assert_eq!(code, 0, "{out}{err}\nsee {}", dir.display());
     let flown = events(&dir.join("t.jsonl"));
-
-    let (code, _, err) = aviary(
-        &[
-            "run",
-            "examples/search_and_rescue.mission",
-            "--trace",
-            &dir.join("sim.jsonl").to_string_lossy(),
-        ],
-        &common::repo(),
-    );
-    assert_eq!(code, 0, "the simulated run: {err}");
-    let simulated = events(&dir.join("sim.jsonl"));
     assert_eq!(
         common::paper_outcome(&flown),
         common::paper_outcome(&simulated),
@@ -154,7 +202,10 @@ fn the_paper_mission_on_seven_px4_copters() {
             drop["actor"]
         );
     }
-    println!("{out}");
+    let real: Vec<&str> = px4.iter().chain(arducopter).copied().collect();
+    println!("{out}\nthe simulator, with the autopilots' figures:\n{sim_out}");
+    let off = common::flight_times_apart(&out, &sim_out, &plan, &real, 0.15);
+    assert!(off.is_empty(), "flight times more than 15% apart:\n{}", off.join("\n"));
 }
 
 /// One PX4 copter: each of PX4's failsafes reaching the mission as the language's

@@ -22,13 +22,9 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use common::background::{events, exception, finish, named, pos, start_run, Run};
-use common::sitl::{wait_until, Sitl};
+use common::sitl::{wait_until, Sitl, BIG_BATTERY};
 use common::{aviary, repo, scratch, PAPER_DRONES};
 use serde_json::Value;
-
-/// Battery parameters for a copter that can fly the paper's mission: SITL's default
-/// (3300 mAh, some 6.5 minutes) is not enough for the longest drone's ~10 minutes.
-const BIG_BATTERY: &[(&str, f64)] = &[("BATT_CAPACITY", 16500.0), ("SIM_BATT_CAP_AH", 16.5)];
 
 fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
@@ -89,47 +85,13 @@ fn paper_mission(tag: &str, first_instance: u16, real: &[&str]) {
         .expect("mission");
     std::fs::write(dir.join("m.world.toml"), example_world(&refs)).expect("world");
     // The same drones in the simulator: those on SITL with ArduCopter's figures.
-    let sim_world = dir.join("sim.world.toml");
-    std::fs::write(
-        &sim_world,
-        common::example_world_with(|name| {
-            if real.contains(&name) {
-                common::ARDUCOPTER.to_owned()
-            } else {
-                String::new()
-            }
-        }),
-    )
-    .expect("world");
-    let sim_world = sim_world.to_string_lossy().into_owned();
-
-    let (code, sim_out, err) = aviary(
-        &[
-            "run",
-            "examples/search_and_rescue.mission",
-            "--world",
-            &sim_world,
-            "--trace",
-            &dir.join("sim.jsonl").to_string_lossy(),
-        ],
-        &repo(),
-    );
-    assert_eq!(code, 0, "the simulated run: {err}");
-    let simulated = events(&dir.join("sim.jsonl"));
-    let (code, plan, err) = aviary(
-        &[
-            "check",
-            "--plan",
-            "--format",
-            "json",
-            "examples/search_and_rescue.mission",
-            "--world",
-            &sim_world,
-        ],
-        &repo(),
-    );
-    assert_eq!(code, 0, "the plan: {err}");
-    let plan: Value = serde_json::from_str(&plan).expect("the plan's JSON");
+    let (sim_out, simulated, plan) = common::simulated_and_planned(&dir, |name| {
+        if real.contains(&name) {
+            common::ARDUCOPTER.to_owned()
+        } else {
+            String::new()
+        }
+    });
 
     let mut run = start_run(&dir, "m.mission");
     let (code, out) = finish(&mut run, &dir, Duration::from_secs(1500));
@@ -158,29 +120,7 @@ fn paper_mission(tag: &str, first_instance: u16, real: &[&str]) {
 
     // Flight times: SITL's (from the track it reported) against the simulator's and the
     // plan's for the same drone.
-    let sitl = common::summary_rows(&out);
-    let sim = common::summary_rows(&sim_out);
-    let flight = |rows: &[(String, f64, f64)], name: &str| {
-        rows.iter().find(|r| r.0 == name).map(|r| r.2).expect("a summary row")
-    };
-    let planned = |name: &str| {
-        plan["plan"]["drones"]
-            .as_array()
-            .expect("drones")
-            .iter()
-            .find(|d| d["drone"] == name)
-            .and_then(|d| d["flight_time"].as_f64())
-            .expect("a planned flight time")
-    };
-    let mut off = Vec::new();
-    for name in real {
-        let real_time = flight(&sitl, name);
-        for (what, t) in [("the simulator", flight(&sim, name)), ("the plan", planned(name))] {
-            if (t - real_time).abs() > 0.15 * real_time {
-                off.push(format!("{name}: {real_time:.0} s on SITL, {t:.0} s in {what}"));
-            }
-        }
-    }
+    let off = common::flight_times_apart(&out, &sim_out, &plan, real, 0.15);
     assert!(off.is_empty(), "flight times more than 15% apart:\n{}", off.join("\n"));
 }
 
@@ -494,6 +434,12 @@ mod single {
         let done = named(&flown, "api_done").find(|e| e["function"] == "Orbit").expect("orbit end");
         let took = done["t"].as_f64().unwrap() - orbit["t"].as_f64().unwrap();
         assert!(took < 60.0, "the orbit took {took:.0} s");
+        // ArduPilot's own flight log (DataFlash, POS): every position of the trace lies
+        // within 2.5 m of one it logged.
+        let log = common::logs::files_ending(&sitl.dir, ".BIN").pop().expect("a DataFlash log");
+        let logged = common::logs::logged_positions(&log, common::sitl::ORIGIN);
+        let (off, at) = common::logs::farthest_from_log(&points, &logged);
+        assert!(off < 2.5, "the trace's {at:?} is {off:.1} m from anything in {}", log.display());
     }
 
     #[test]

@@ -22,8 +22,8 @@ pub const SETTLED: Duration = Duration::from_secs(10);
 /// What the rule needs of one drone: the world's figures with the vehicle's applied.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Figures {
-    /// m/s over the ground on the way home.
-    pub max_speed: f64,
+    /// m/s over the ground on the way home (the world's `return_speed`).
+    pub return_speed: f64,
     /// How it comes down at home (ArduCopter: LAND_SPEED_HIGH or WPNAV_SPEED_DN, then
     /// LAND_SPEED under LAND_ALT_LOW).
     pub descent: Descent,
@@ -41,7 +41,8 @@ impl Figures {
     /// The share of a full battery (0..1) that flying home from `ground` metres away at
     /// `height` takes, with `measured` the average current in flight (A), if known.
     pub fn need(&self, ground: f64, height: f64, measured: Option<f64>) -> f64 {
-        let time = time_home(ground, self.max_speed, height.max(0.0), self.loiter, &self.descent);
+        let time =
+            time_home(ground, self.return_speed, height.max(0.0), self.loiter, &self.descent);
         match (self.capacity, measured.or(self.flight_current)) {
             // mAh × 3.6 = ampere-seconds.
             (Some(mah), Some(amps)) if mah > 0.0 && amps > 0.0 => time * amps / (mah * 3.6),
@@ -114,7 +115,7 @@ mod tests {
     /// 10 m, 5 s above home, 3300 mAh.
     fn sitl() -> Figures {
         Figures {
-            max_speed: 10.0,
+            return_speed: 10.0,
             descent: Descent { rate: 1.5, land_speed: 0.5, slow_below: 10.0 },
             loiter: 5.0,
             endurance: 1800.0,

@@ -161,7 +161,7 @@ fn craft(
         max_speed: d.max_speed,
         acceleration: d.acceleration,
         battery: battery::Figures {
-            max_speed: d.max_speed,
+            return_speed: d.return_speed,
             descent: landing,
             loiter: d.return_loiter,
             endurance: d.endurance,

@@ -152,10 +152,7 @@ fn on_the_move(d: &SimDrone) -> bool {
 /// How far from drone `d` another drone can be and still matter to its planning: at
 /// least `range` below for every drone of the fleet.
 pub(crate) fn reach(fleet: &Fleet, d: &SimDrone) -> f64 {
-    fleet.min_separation
-        + MARGIN
-        + HORIZON * (d.spec.max_speed + d.spec.climb_rate + fleet.fastest)
-        + 1.0
+    fleet.min_separation + MARGIN + HORIZON * (d.spec.fastest + fleet.fastest) + 1.0
 }
 
 impl Fleet {
@@ -211,7 +208,7 @@ impl Fleet {
     fn to_give_way_to(&self, id: DroneId, humble: bool) -> Vec<DroneId> {
         let sep = self.min_separation;
         let d = &self.drones[id];
-        let speed = |d: &SimDrone| d.spec.max_speed + d.spec.climb_rate;
+        let speed = |d: &SimDrone| d.spec.fastest;
         let range = |o: &SimDrone| sep + MARGIN + HORIZON * (speed(d) + speed(o)) + 1.0;
         // Every drone that could be in range, in index order, from the sky's grid.
         let mut candidates = Vec::new();

@@ -1,6 +1,6 @@
 //! Battery: drains only in the air, `dt / endurance` of a full battery per `dt` seconds.
 //!
-//! The energy needed to get home is the time to fly there at `max_speed`, wait above home
+//! The energy needed to get home is the time to fly there at `return_speed`, wait above home
 //! and land (`aviary_api::flight::time_home`), as a fraction of the endurance. `BatteryLow` is raised (once)
 //! when what is left falls under twice that plus 10 %; `BatteryCritical` (once) under
 //! that plus 10 %; at zero the drone falls and is lost.
@@ -24,7 +24,7 @@ pub(crate) fn energy_home(d: &SimDrone) -> f64 {
 /// At least [`energy_home`] (or NaN), bit for bit: `|dx| + |dy|`, widened far beyond the
 /// rounding of both, bounds the distance, and rounding keeps the order of the rest.
 pub(crate) fn energy_home_bound(d: &SimDrone) -> f64 {
-    if !(d.spec.max_speed > 0.0
+    if !(d.spec.return_speed > 0.0
         && d.spec.descent.rate > 0.0
         && d.spec.descent.land_speed > 0.0
         && d.spec.endurance > 0.0)
@@ -38,7 +38,7 @@ pub(crate) fn energy_home_bound(d: &SimDrone) -> f64 {
 fn time_home(ground: f64, d: &SimDrone) -> f64 {
     aviary_api::flight::time_home(
         ground,
-        d.spec.max_speed,
+        d.spec.return_speed,
         d.pos[2],
         d.spec.return_loiter,
         &d.spec.descent,
@@ -91,7 +91,7 @@ mod tests {
         ) {
             let world = crate::tests::one_drone();
             let mut spec = crate::drone::Spec::of(&world.drones[0]);
-            (spec.max_speed, spec.climb_rate, spec.endurance) = (speed, climb, endurance);
+            (spec.return_speed, spec.climb_rate, spec.endurance) = (speed, climb, endurance);
             let mut d = SimDrone::new(&world.drones[0], std::sync::Arc::new(spec));
             d.home = [hx, hy];
             // On an axis of home, too, where the distance is one side alone.

@@ -44,6 +44,10 @@ pub(crate) struct Spec {
     pub descent: aviary_api::flight::Descent,
     pub return_altitude: f64,
     pub return_loiter: f64,
+    pub takeoff_speed: f64,
+    pub return_speed: f64,
+    /// `Drone::fastest`: what separation and avoidance plan with.
+    pub fastest: f64,
     pub sensors: Box<[String]>,
     pub payload_kinds: Box<[String]>,
 }
@@ -58,6 +62,9 @@ impl Spec {
             descent: d.descent(),
             return_altitude: d.return_altitude,
             return_loiter: d.return_loiter,
+            takeoff_speed: d.takeoff_speed,
+            return_speed: d.return_speed,
+            fastest: d.fastest(),
             sensors: d.sensors.clone(),
             payload_kinds: d.payload.clone(),
         }
@@ -76,6 +83,8 @@ impl Hash for Spec {
             self.endurance,
             self.return_altitude,
             self.return_loiter,
+            self.takeoff_speed,
+            self.return_speed,
         ];
         let descent = [self.descent.rate, self.descent.land_speed, self.descent.slow_below];
         for x in figures.into_iter().chain(descent) {

@@ -240,7 +240,7 @@ impl Fleet {
             max_extent: 0.0,
             hot: vec![Hot::UNKNOWN; world.drones.len()],
             outages: Vec::new(),
-            fastest: world.drones.iter().map(|d| d.max_speed + d.climb_rate).fold(0.0, f64::max),
+            fastest: world.drones.iter().map(|d| d.fastest()).fold(0.0, f64::max),
             target_grid: target_grid(&world.targets),
             near_targets: vec![None; world.drones.len()],
             calls: HashMap::new(),

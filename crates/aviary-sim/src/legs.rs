@@ -256,7 +256,7 @@ pub(crate) fn return_legs(
         let way = limits.route([d.pos[0], d.pos[1], safe], [d.home[0], d.home[1], safe])?;
         legs.extend(way.into_iter().map(|p| Leg::Move {
             to: [p[0], p[1], safe],
-            speed: d.spec.max_speed,
+            speed: d.spec.return_speed,
             state: FlightState::Flying,
         }));
     }

@@ -155,7 +155,7 @@ impl SimDrone {
                 *left <= 1e-9 && !owns_z
             }
             Some(&mut Leg::Move { to, speed, state }) => {
-                body.straight(task, to, speed, state == FlightState::Landing, tick)
+                body.straight(task, to, speed, state, tick)
             }
             Some(&mut Leg::Arc { center, radius, start, total, speed }) => {
                 let left = (total - task.arc_done) * radius;
@@ -241,7 +241,7 @@ impl Body<'_> {
         task: &mut MotionTask,
         to: [f64; 3],
         speed: f64,
-        landing: bool,
+        state: FlightState,
         tick: Tick,
     ) -> bool {
         let here = [self.pos[0], self.pos[1]];
@@ -265,15 +265,21 @@ impl Body<'_> {
             return false;
         }
         // Both moves every tick: the climb must not wait for the ground track.
-        let climbed = self.vertical(task, to[2], landing, tick);
+        let climbed = self.vertical(task, to[2], state, tick);
         h.arrived && climbed
     }
 
     /// One tick of a straight leg's climb or descent to `to_z`; returns whether it has
     /// arrived.
-    fn vertical(&mut self, task: &mut MotionTask, to_z: f64, landing: bool, tick: Tick) -> bool {
+    fn vertical(
+        &mut self,
+        task: &mut MotionTask,
+        to_z: f64,
+        state: FlightState,
+        tick: Tick,
+    ) -> bool {
         let dz = to_z - self.pos[2];
-        let climb = tick.limit(vertical_limit(self.spec, self.pos[2], dz, to_z, landing));
+        let climb = tick.limit(vertical_limit(self.spec, self.pos[2], dz, to_z, state));
         let v = advance(dz.abs(), task.climb_speed, climb, self.spec.accel, tick.dt);
         task.climb_speed = v.speed;
         if v.arrived {
@@ -305,11 +311,15 @@ pub(crate) fn orbit_legs(d: &SimDrone, center: [f64; 2], radius: f64, laps: f64)
 }
 
 /// The vertical speed limit of a leg `dz` away from its end at `to_z`, for a drone at
-/// height `z`: the climb rate up, the descent rate down, and the landing speed for the
-/// last part of a landing (from `slow_below` to the ground).
-fn vertical_limit(spec: &Spec, z: f64, dz: f64, to_z: f64, landing: bool) -> f64 {
+/// height `z` in `state`: the take-off speed up from the ground, the climb rate up
+/// otherwise, the descent rate down, and the landing speed for the last part of a landing
+/// (from `slow_below` to the ground).
+fn vertical_limit(spec: &Spec, z: f64, dz: f64, to_z: f64, state: FlightState) -> f64 {
     let descent = spec.descent;
-    if dz >= 0.0 {
+    let landing = state == FlightState::Landing;
+    if dz >= 0.0 && state == FlightState::TakingOff {
+        spec.takeoff_speed
+    } else if dz >= 0.0 {
         spec.climb_rate
     } else if landing && to_z <= 0.0 && z <= descent.slow_below + 1e-9 && descent.slows(z) {
         descent.land_speed

@@ -45,6 +45,8 @@ pub struct Copter {
     pub(crate) wpnav_speed: f64,
     pub(crate) max_speed: f64,
     pub(crate) climb_rate: f64,
+    /// The world's `takeoff_speed` (PX4's MPC_TKO_SPEED).
+    pub(crate) takeoff_speed: f64,
     /// How it comes down, and how it returns: the world's figures, which its simulated
     /// drone flies and its parameters report.
     pub(crate) descent: aviary_api::flight::Descent,
@@ -122,7 +124,7 @@ impl Autopilot {
                     aviary_world::Backend::Sim => None,
                 }
                 .unwrap_or_else(|| u8::try_from(i + 1).unwrap_or(u8::MAX));
-                let px4 = Px4::new(d.max_speed, !d.payload.is_empty());
+                let px4 = Px4::new(d.return_speed, !d.payload.is_empty());
                 let mode = match behaviour.autopilot {
                     Flavour::ArduPilot => STABILIZE,
                     Flavour::Px4 => px4.nav.custom_mode(),
@@ -137,6 +139,7 @@ impl Autopilot {
                     wpnav_speed: d.max_speed,
                     max_speed: d.max_speed,
                     climb_rate: d.climb_rate,
+                    takeoff_speed: d.takeoff_speed,
                     descent: d.descent(),
                     return_altitude: d.return_altitude,
                     return_loiter: d.return_loiter,

@@ -197,6 +197,12 @@ pub struct Drone {
     /// s, default 0: `ReturnToLaunch` waits this long above home before it lands
     /// (ArduCopter's RTL_LOIT_TIME).
     pub return_loiter: f64,
+    /// m/s up, default `climb_rate`: how fast `TakeOff` climbs from the ground (PX4's
+    /// MPC_TKO_SPEED, 1.5 m/s, is half its climb rate).
+    pub takeoff_speed: f64,
+    /// m/s, default `max_speed`: `ReturnToLaunch`'s speed over the ground on its way home
+    /// (the autopilot's own, PX4's MPC_XY_CRUISE).
+    pub return_speed: f64,
     /// mAh, if known (a MAVLink vehicle reports its own: BATT_CAPACITY).
     pub battery_capacity: Option<f64>,
     /// A drawn in flight on average, if known.
@@ -219,6 +225,12 @@ impl Drone {
             }
             _ => None,
         }
+    }
+
+    /// The most it can move in a second, over the ground plus up or down, whatever it
+    /// does: what the simulator's separation and avoidance plan with.
+    pub fn fastest(&self) -> f64 {
+        self.max_speed.max(self.return_speed) + self.climb_rate.max(self.takeoff_speed)
     }
 
     /// How the drone comes down.

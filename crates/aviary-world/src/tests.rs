@@ -415,6 +415,8 @@ fn speeds_and_endurance_must_be_positive() {
         "endurance",
         "descent_rate",
         "land_speed",
+        "takeoff_speed",
+        "return_speed",
         "battery_capacity",
         "flight_current",
     ] {
@@ -451,6 +453,35 @@ fn descent_and_landing_follow_the_climb_unless_given() {
         (1.5, 0.5, 15.0, 5.0)
     );
     assert!(d.attributes.is_empty(), "figures are not attributes");
+}
+
+#[test]
+fn the_take_off_and_the_way_home_follow_the_climb_and_the_speed_unless_given() {
+    let w = ok(&format!(
+        "{HOME}climb_rate = 2
+max_speed = 12
+"
+    ));
+    let d = &w.drones[0];
+    assert_eq!((d.takeoff_speed, d.return_speed), (2.0, 12.0));
+    assert_eq!(d.fastest(), 14.0);
+    // PX4's figures: half the climb rate up from the ground, its cruise speed home.
+    let w = ok(&format!(
+        "{HOME}climb_rate = 3
+takeoff_speed = 1.5
+return_speed = 5
+"
+    ));
+    let d = &w.drones[0];
+    assert_eq!((d.takeoff_speed, d.return_speed), (1.5, 5.0));
+    assert!(d.attributes.is_empty(), "figures are not attributes");
+    // A way home faster than the mission may fly still bounds what the drone can do.
+    let w = ok(&format!(
+        "{HOME}max_speed = 8
+return_speed = 11
+"
+    ));
+    assert_eq!(w.drones[0].fastest(), 14.0);
 }
 
 #[test]

@@ -44,6 +44,7 @@ pub fn scratch(name: &str) -> PathBuf {
     dir
 }
 pub mod background;
+pub mod logs;
 pub mod px4;
 pub mod sitl;
 
@@ -51,6 +52,86 @@ pub mod sitl;
 /// WPNAV_SPEED_UP 250 cm/s, WPNAV_SPEED_DN 150 cm/s, WPNAV_ACCEL 250 cm/s², LAND_SPEED
 /// 50 cm/s under LAND_ALT_LOW 1000 cm, RTL_ALT 1500 cm, RTL_LOIT_TIME 5000 ms.
 pub const ARDUCOPTER: &str = "climb_rate = 2.5\ndescent_rate = 1.5\nacceleration = 2.5\nland_speed = 0.5\nland_speed_below = 10\nreturn_altitude = 15\nreturn_loiter = 5\n";
+
+/// PX4's own figures (its default parameters, as PX4 SITL gave them) as a drone's world
+/// keys: MPC_Z_V_AUTO_UP 3 m/s, MPC_TKO_SPEED 1.5 m/s, MPC_Z_V_AUTO_DN 1.5 m/s,
+/// MPC_ACC_HOR 3 m/s², MPC_LAND_SPEED 0.7 m/s under MPC_LAND_ALT1 10 m, RTL_RETURN_ALT
+/// 30 m, RTL_LAND_DELAY 0 s, MPC_XY_CRUISE 5 m/s.
+pub const PX4: &str = "climb_rate = 3\ntakeoff_speed = 1.5\ndescent_rate = 1.5\nacceleration = 3\nland_speed = 0.7\nland_speed_below = 10\nreturn_altitude = 30\nreturn_loiter = 0\nreturn_speed = 5\n";
+
+/// The paper's mission flown in the simulator and planned (`aviary check --plan`), in
+/// its world with `keys(name)` added to each drone (the figures of the vehicles that fly
+/// it for real): the run's output, its events, and the plan.
+pub fn simulated_and_planned(
+    dir: &Path,
+    keys: impl Fn(&str) -> String,
+) -> (String, Vec<serde_json::Value>, serde_json::Value) {
+    let world = dir.join("sim.world.toml");
+    std::fs::write(&world, example_world_with(keys)).expect("world");
+    let world = world.to_string_lossy().into_owned();
+    let trace = dir.join("sim.jsonl");
+    let (code, out, err) = aviary(
+        &[
+            "run",
+            "examples/search_and_rescue.mission",
+            "--world",
+            &world,
+            "--trace",
+            &trace.to_string_lossy(),
+        ],
+        &repo(),
+    );
+    assert_eq!(code, 0, "the simulated run: {err}");
+    let (code, plan, err) = aviary(
+        &[
+            "check",
+            "--plan",
+            "--format",
+            "json",
+            "examples/search_and_rescue.mission",
+            "--world",
+            &world,
+        ],
+        &repo(),
+    );
+    assert_eq!(code, 0, "the plan: {err}");
+    let plan = serde_json::from_str(&plan).expect("the plan's JSON");
+    (out, background::events(&trace), plan)
+}
+
+/// Each of the `real` drones' flight time (from `aviary run`'s summary, `out`) against
+/// the simulator's (`sim_out`) and the plan's: those more than `share` apart, in words.
+pub fn flight_times_apart(
+    out: &str,
+    sim_out: &str,
+    plan: &serde_json::Value,
+    real: &[&str],
+    share: f64,
+) -> Vec<String> {
+    let (flown, sim) = (summary_rows(out), summary_rows(sim_out));
+    let flight = |rows: &[(String, f64, f64)], name: &str| {
+        rows.iter().find(|r| r.0 == name).map(|r| r.2).expect("a summary row")
+    };
+    let planned = |name: &str| {
+        plan["plan"]["drones"]
+            .as_array()
+            .expect("drones")
+            .iter()
+            .find(|d| d["drone"] == name)
+            .and_then(|d| d["flight_time"].as_f64())
+            .expect("a planned flight time")
+    };
+    let mut apart = Vec::new();
+    for name in real {
+        let real_time = flight(&flown, name);
+        for (what, t) in [("the simulator", flight(&sim, name)), ("the plan", planned(name))] {
+            if (t - real_time).abs() > share * real_time {
+                apart.push(format!("{name}: {real_time:.0} s flown, {t:.0} s in {what}"));
+            }
+        }
+    }
+    apart
+}
 
 /// The paper's example world with `keys(name)` added to each drone's table.
 pub fn example_world_with(keys: impl Fn(&str) -> String) -> String {

@@ -175,20 +175,7 @@ impl Px4 {
 
     /// The flight logs (ULog) it wrote.
     pub fn logs(&self) -> Vec<PathBuf> {
-        let mut found = Vec::new();
-        let mut dirs = vec![self.dir.join("log")];
-        while let Some(d) = dirs.pop() {
-            for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
-                let p = e.path();
-                if p.is_dir() {
-                    dirs.push(p);
-                } else if p.extension().is_some_and(|x| x == "ulg") {
-                    found.push(p);
-                }
-            }
-        }
-        found.sort();
-        found
+        super::logs::files_ending(&self.dir.join("log"), ".ulg")
     }
 }
 

@@ -23,6 +23,10 @@ use aviary_mavlink::Origin;
 /// The world origin the SITL tests use (the example worlds' site).
 pub const ORIGIN: Origin = Origin { lat: 46.6167, lon: 14.2650, alt: 440.0 };
 
+/// Battery parameters for a copter that can fly the paper's mission: SITL's default
+/// (3300 mAh, some 6.5 minutes) is not enough for the longest drone's ~10 minutes.
+pub const BIG_BATTERY: &[(&str, f64)] = &[("BATT_CAPACITY", 16500.0), ("SIM_BATT_CAP_AH", 16.5)];
+
 /// The SITL binary and its parameter files.
 pub struct Files {
     pub binary: PathBuf,

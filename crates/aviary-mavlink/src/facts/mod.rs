@@ -169,6 +169,8 @@ impl Facts {
             Figure::LandSpeedBelow => &mut d.land_speed_below,
             Figure::ReturnAltitude => &mut d.return_altitude,
             Figure::ReturnLoiter => &mut d.return_loiter,
+            Figure::TakeoffSpeed => &mut d.takeoff_speed,
+            Figure::ReturnSpeed => &mut d.return_speed,
             Figure::LandSpeedHigh => {
                 return (value > 0.0).then(|| format!(
                     "{name}: it lands from high at {} {unit} (the vehicle's {}); the world has one descent rate, so the plan lands at {} {unit} and the battery rule at {} {unit}",
@@ -277,6 +279,8 @@ fn what(figure: Figure) -> &'static str {
         Figure::LandSpeedHigh => "landing speed from high",
         Figure::ReturnAltitude => "return altitude",
         Figure::ReturnLoiter => "wait above home",
+        Figure::TakeoffSpeed => "take-off speed",
+        Figure::ReturnSpeed => "speed home",
         Figure::Capacity => "battery capacity",
     }
 }

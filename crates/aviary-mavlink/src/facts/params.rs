@@ -17,6 +17,10 @@ pub enum Figure {
     LandSpeedHigh,
     ReturnAltitude,
     ReturnLoiter,
+    /// `TakeOff`'s climb from the ground (PX4's MPC_TKO_SPEED).
+    TakeoffSpeed,
+    /// `ReturnToLaunch`'s speed over the ground (PX4's MPC_XY_CRUISE).
+    ReturnSpeed,
     Capacity,
 }
 
@@ -32,6 +36,8 @@ impl Figure {
             Figure::LandSpeedHigh => ("landing from high", "m/s"),
             Figure::ReturnAltitude => ("return_altitude", "m"),
             Figure::ReturnLoiter => ("return_loiter", "s"),
+            Figure::TakeoffSpeed => ("takeoff_speed", "m/s"),
+            Figure::ReturnSpeed => ("return_speed", "m/s"),
             Figure::Capacity => ("battery_capacity", "mAh"),
         }
     }
@@ -46,6 +52,8 @@ impl Figure {
                 | Figure::Descent
                 | Figure::Acceleration
                 | Figure::LandSpeed
+                | Figure::TakeoffSpeed
+                | Figure::ReturnSpeed
                 | Figure::Capacity => value > 0.0,
                 Figure::LandSpeedBelow
                 | Figure::ReturnAltitude
@@ -85,14 +93,17 @@ pub const ARDUPILOT: &[Param] = &[
     p("BATT_CAPACITY", Figure::Capacity, 1.0, "mAh"),
 ];
 
-/// PX4 (not tested here: there is no PX4 SITL in the test runs). Aviary flies PX4 in HOLD
+/// PX4 (read from PX4 SITL, and from `aviary vehicles --autopilot px4`). Aviary flies PX4 in HOLD
 /// with DO_REPOSITION, an auto mode, whose vertical limits are MPC_Z_V_AUTO_UP/DN (the
 /// MPC_Z_VEL_MAX_* are the manual modes'). PX4 lands at MPC_LAND_SPEED below
 /// MPC_LAND_ALT2 after slowing from MPC_LAND_ALT1; the slow part is taken from ALT1, the
 /// longer landing, so that the battery rule errs towards home. RTL_LAND_DELAY is -1 for
-/// "hover, never land", which is no usable wait and keeps the world's.
+/// "hover, never land", which is no usable wait and keeps the world's. PX4 takes off at
+/// MPC_TKO_SPEED (half its climb rate by default) and returns at MPC_XY_CRUISE.
 pub const PX4: &[Param] = &[
     p("MPC_Z_V_AUTO_UP", Figure::Climb, 1.0, "m/s"),
+    p("MPC_TKO_SPEED", Figure::TakeoffSpeed, 1.0, "m/s"),
+    p("MPC_XY_CRUISE", Figure::ReturnSpeed, 1.0, "m/s"),
     p("MPC_Z_V_AUTO_DN", Figure::Descent, 1.0, "m/s"),
     p("MPC_ACC_HOR", Figure::Acceleration, 1.0, "m/s²"),
     p("MPC_LAND_SPEED", Figure::LandSpeed, 1.0, "m/s"),

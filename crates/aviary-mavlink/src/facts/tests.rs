@@ -189,6 +189,8 @@ fn px4_s_parameters_are_in_si_units_and_minus_one_means_unset() {
     let answers = [
         ("MPC_Z_V_AUTO_UP", 3.0, MAV_PARAM_TYPE_REAL32),
         ("MPC_Z_V_AUTO_DN", 1.0, MAV_PARAM_TYPE_REAL32),
+        ("MPC_TKO_SPEED", 1.5, MAV_PARAM_TYPE_REAL32),
+        ("MPC_XY_CRUISE", 5.0, MAV_PARAM_TYPE_REAL32),
         ("MPC_LAND_SPEED", 0.7, MAV_PARAM_TYPE_REAL32),
         ("MPC_LAND_ALT1", 10.0, MAV_PARAM_TYPE_REAL32),
         ("RTL_RETURN_ALT", 60.0, MAV_PARAM_TYPE_REAL32),
@@ -199,6 +201,12 @@ fn px4_s_parameters_are_in_si_units_and_minus_one_means_unset() {
     let lines = facts(Flavour::Px4, &answers, Some(100.0)).apply(&mut d);
     assert_eq!((d.descent_rate, d.return_altitude), (1.0, 60.0));
     assert!((d.land_speed - 0.7).abs() < 1e-6);
+    // Up from the ground at MPC_TKO_SPEED, home at MPC_XY_CRUISE.
+    assert_eq!((d.takeoff_speed, d.return_speed), (1.5, 5.0));
+    assert!(
+        lines.iter().any(|l| l.contains("take-off speed 1.5 m/s (the vehicle's MPC_TKO_SPEED)")),
+        "{lines:?}"
+    );
     assert_eq!((d.return_loiter, d.battery_capacity), (0.0, None), "-1 is no usable figure");
     assert!(lines.iter().any(|l| l.contains("RTL_LAND_DELAY is -1 s")), "{lines:?}");
     assert!(lines.iter().any(|l| l.contains("no answer for MPC_ACC_HOR")), "{lines:?}");

@@ -79,3 +79,44 @@ fn a_return_climbs_to_the_return_altitude_waits_above_home_and_lands() {
         + trapezoid(10.0, 0.5, 2.5);
     assert!((run.took - expected).abs() < 0.5, "took {} s, expected {expected} s", run.took);
 }
+
+/// PX4's figures: it takes off at MPC_TKO_SPEED (half its climb rate) and returns at
+/// MPC_XY_CRUISE, slower than the mission flies.
+fn px4() -> World {
+    world(
+        "[drones.d]\nhome = [0, 0]\nmax_speed = 10\nclimb_rate = 3\ntakeoff_speed = 1.5\ndescent_rate = 1.5\nacceleration = 3\nland_speed = 0.7\nland_speed_below = 10\nreturn_altitude = 30\nreturn_speed = 5\n",
+    )
+}
+
+#[test]
+fn a_take_off_climbs_at_the_take_off_speed_and_later_climbs_at_the_climb_rate() {
+    let w = px4();
+    let mut fleet = Fleet::new(&w);
+    assert_eq!(instant(&mut fleet, 0, Function::Arm, &[]), CallEnd::Done);
+    let up = start(&mut fleet, 0, Function::TakeOff, &[num(12.0)]);
+    let run = run_until(&mut fleet, 0, up, 60.0);
+    assert_eq!(run.end, CallEnd::Done);
+    let expected = trapezoid(12.0, 1.5, 3.0);
+    assert!((run.took - expected).abs() < 0.2, "took {} s, expected {expected} s", run.took);
+    // In the air, a higher take-off is a climb like any other.
+    let higher = start(&mut fleet, 0, Function::TakeOff, &[num(24.0)]);
+    let run = run_until(&mut fleet, 0, higher, 60.0);
+    let expected = trapezoid(12.0, 3.0, 3.0);
+    assert!((run.took - expected).abs() < 0.2, "took {} s, expected {expected} s", run.took);
+}
+
+#[test]
+fn a_return_flies_home_at_the_return_speed() {
+    let w = px4();
+    let mut fleet = airborne(&w, 30.0);
+    let out = start(&mut fleet, 0, Function::FlyToPosition, &[pos(200.0, 0.0)]);
+    run_until(&mut fleet, 0, out, 120.0);
+    let id = start(&mut fleet, 0, Function::ReturnToLaunch, &[]);
+    let run = run_until(&mut fleet, 0, id, 300.0);
+    assert_eq!(run.end, CallEnd::Done);
+    let fastest = run.samples.iter().map(|s| s.speed).fold(0.0, f64::max);
+    assert!((fastest - 5.0).abs() < 1e-6, "flew home at up to {fastest} m/s");
+    let expected =
+        trapezoid(200.0, 5.0, 3.0) + trapezoid(20.0, 1.5, 3.0) + trapezoid(10.0, 0.7, 3.0);
+    assert!((run.took - expected).abs() < 0.5, "took {} s, expected {expected} s", run.took);
+}

@@ -185,7 +185,8 @@ pub(crate) struct Px4 {
 }
 
 impl Px4 {
-    pub fn new(max_speed: f64, has_gripper: bool) -> Px4 {
+    /// `xy_cruise`: MPC_XY_CRUISE, the world's `return_speed` (PX4 returns at it).
+    pub fn new(xy_cruise: f64, has_gripper: bool) -> Px4 {
         Px4 {
             // PX4 boots in Hold (UserModeIntention.hpp).
             nav: Nav::Loiter,
@@ -195,7 +196,7 @@ impl Px4 {
             landed_at: None,
             was_airborne: false,
             cruise: None,
-            xy_cruise: max_speed,
+            xy_cruise,
             takeoff_alt: 2.5,
             nav_acc_rad: 2.0,
             takeoff_request: None,

@@ -67,7 +67,7 @@ impl Autopilot {
             real("MPC_LAND_ALT1", c.descent.slow_below),
             real("MPC_LAND_ALT2", c.descent.slow_below),
             real("MPC_LAND_SPEED", c.descent.land_speed),
-            real("MPC_TKO_SPEED", c.climb_rate),
+            real("MPC_TKO_SPEED", c.takeoff_speed),
             writable(real("MPC_XY_CRUISE", p.xy_cruise)),
             real("MPC_XY_VEL_MAX", c.max_speed),
             real("MPC_Z_VEL_MAX_DN", c.descent.rate),

@@ -22,8 +22,13 @@ pub fn fly(
         Function::TakeOff => {
             let alt = number_arg(args, 0).unwrap_or(10.0);
             let f = &mut e.s.drones[d];
+            let from_the_ground = !f.airborne;
             f.take_off(t);
-            f.leg([f.pos[0], f.pos[1], alt])
+            if from_the_ground {
+                f.lift_off(alt)
+            } else {
+                f.leg([f.pos[0], f.pos[1], alt])
+            }
         }
         Function::Land => {
             let f = &mut e.s.drones[d];

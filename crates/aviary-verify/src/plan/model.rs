@@ -18,6 +18,10 @@ pub struct Flyer {
     pub descent: Descent,
     pub return_altitude: f64,
     pub return_loiter: f64,
+    /// `TakeOff`'s climb from the ground.
+    pub takeoff_speed: f64,
+    /// `ReturnToLaunch`'s speed over the ground.
+    pub return_speed: f64,
     pub accel: f64,
     pub endurance: f64,
     pub battery_start: f64,
@@ -44,6 +48,8 @@ impl Flyer {
             descent: d.descent(),
             return_altitude: d.return_altitude,
             return_loiter: d.return_loiter,
+            takeoff_speed: d.takeoff_speed,
+            return_speed: d.return_speed,
             accel: d.acceleration,
             endurance: d.endurance,
             battery_start: d.battery / 100.0,
@@ -89,6 +95,15 @@ impl Flyer {
         let vertical = if to[2] >= self.pos[2] { self.climb_rate } else { self.descent.rate };
         self.pos = to;
         trapezoid(h, speed, self.accel).max(trapezoid(v, vertical, self.accel))
+    }
+
+    /// `TakeOff` from the ground: straight up to `alt` at the take-off speed (as the
+    /// simulator flies it); the duration.
+    pub fn lift_off(&mut self, alt: f64) -> f64 {
+        let v = (alt - self.pos[2]).abs();
+        self.distance += v;
+        self.pos[2] = alt;
+        trapezoid(v, self.takeoff_speed, self.accel)
     }
 
     /// `Land`, and the end of `ReturnToLaunch`: straight down, the last `slow_below`
@@ -145,7 +160,7 @@ impl Flyer {
         let safe =
             aviary_api::flight::return_height(self.pos[2], self.return_altitude, max_altitude);
         let up = self.leg([self.pos[0], self.pos[1], safe]);
-        let across = self.transit(space, [self.home[0], self.home[1], safe], self.max_speed);
+        let across = self.transit(space, [self.home[0], self.home[1], safe], self.return_speed);
         up + across + self.return_loiter + self.land_here()
     }
 }

@@ -170,6 +170,10 @@ impl Drones {
                 "return_loiter" => {
                     d.return_loiter = cx.non_negative(&what, n).unwrap_or(d.return_loiter)
                 }
+                "takeoff_speed" => {
+                    d.takeoff_speed = cx.positive(&what, n).unwrap_or(d.takeoff_speed)
+                }
+                "return_speed" => d.return_speed = cx.positive(&what, n).unwrap_or(d.return_speed),
                 "battery_capacity" => {
                     d.battery_capacity = cx.positive(&what, n).or(d.battery_capacity)
                 }
@@ -247,6 +251,8 @@ fn defaults(span: Span) -> Drone {
         land_speed_below: 10.0,
         return_altitude: 10.0,
         return_loiter: 0.0,
+        takeoff_speed: f64::NAN,
+        return_speed: f64::NAN,
         battery_capacity: None,
         flight_current: None,
         backend: Backend::Sim,
@@ -262,6 +268,12 @@ fn follow_other_keys(d: &mut Drone) {
     }
     if d.land_speed.is_nan() {
         d.land_speed = d.descent_rate;
+    }
+    if d.takeoff_speed.is_nan() {
+        d.takeoff_speed = d.climb_rate;
+    }
+    if d.return_speed.is_nan() {
+        d.return_speed = d.max_speed;
     }
     if let Some(endurance) = Drone::endurance_from_battery(d.battery_capacity, d.flight_current) {
         d.endurance = endurance;

@@ -709,3 +709,46 @@ fn the_hop_mission_flies_on_px4_vehicles_with_heights_above_sea_level() {
     assert!(((around[0] - 30.0).hypot(around[1] - 30.0) - 15.0).abs() < 3.0, "{around:?}");
     assert!(done("Land")[2] < 0.3);
 }
+
+/// What PX4 SITL taught, held without it: PX4 acknowledges a DO_REPOSITION outside its
+/// geofence, then its navigator refuses it in words alone ("Reposition is outside
+/// geofence") and the drone stays. `aviary vehicles --autopilot px4` refuses as PX4 does
+/// (its world has a fence that the mission's world lacks, as a vehicle's own fence is
+/// unknown to the world); the call fails at once with PX4's words, not when its time
+/// runs out.
+#[test]
+fn a_target_px4_refuses_in_words_fails_the_call_with_them_at_once() {
+    let dir = scratch("mavlink_px4_refused");
+    let site = "[site]\nname = \"Fence\"\norigin = { lat = 46.6167, lon = 14.2650, alt = 440 }\nmax_altitude = 60\n";
+    let rest = "\n[places]\nFar = [0, 80]\n\n[drones.copter]\nhome = [0, 0]\n";
+    let fenced = format!("{site}geofence = [[-50, -50], [50, -50], [50, 50], [-50, 50]]\n{rest}");
+    std::fs::write(dir.join("vehicles.world.toml"), fenced).expect("world");
+    let vehicles = Vehicles::start_as(&dir.join("vehicles.world.toml"), "5", "px4");
+    std::fs::write(dir.join("m.world.toml"), bind(&format!("{site}{rest}"), vehicles.port, &[]))
+        .expect("world");
+    std::fs::write(
+        dir.join("m.mission"),
+        "MISSION Out:\n    SEQUENTIAL Fly:\n        copter TakeOff WITH 10m\n        copter FlyTo WITH Far\n    ON EXCEPTION CommandFailed BY copter:\n        SIGNAL Refused\n",
+    )
+    .expect("mission");
+    let code = run_within(
+        &dir,
+        &["run", "m.mission", "--quiet", "--trace", "t.jsonl"],
+        Duration::from_secs(120),
+    );
+    let trace = events(&dir.join("t.jsonl"));
+    assert_eq!(code, 0, "{:?}", trace.last());
+    let refused = trace
+        .iter()
+        .find(|e| e["event"] == "exception" && e["name"] == "CommandFailed")
+        .unwrap_or_else(|| panic!("no CommandFailed: {trace:?}"));
+    let said = refused["args"].to_string();
+    assert!(said.contains("Reposition is outside geofence"), "PX4's words in {said}");
+    let sent = trace
+        .iter()
+        .find(|e| e["event"] == "api_call" && e["function"] == "FlyToPosition")
+        .expect("the flight out");
+    let took = refused["t"].as_f64().unwrap() - sent["t"].as_f64().unwrap();
+    assert!(took < 5.0, "refused {took:.1} s after it was sent");
+    assert!(trace.iter().any(|e| e["event"] == "signal" && e["name"] == "Refused"));
+}

@@ -228,7 +228,15 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
         for (drone, craft) in inner.crafts.iter().enumerate() {
             let Some(c) = craft else { continue };
             inner.battery_rule(drone, c);
-            let fresh = c.v.seen().heartbeat.is_some_and(|t| now.duration_since(t) < limit);
+            // Lost only when silent by both clocks. The mission's follows the vehicles'
+            // (`clock`): on a machine too busy for its SITLs one vehicle may lag a second
+            // of the wall's while the others set the pace, which is many seconds of theirs,
+            // and it has not gone. At real time the two clocks agree.
+            let fresh = {
+                let seen = c.v.seen();
+                seen.heartbeat.is_some_and(|t| now.duration_since(t) < limit)
+                    || seen.heartbeat_wall.is_some_and(|t| t.elapsed() < limit)
+            };
             let was_lost = lock(&inner.lost)[drone];
             if was_lost == fresh {
                 lock(&inner.lost)[drone] = !fresh;

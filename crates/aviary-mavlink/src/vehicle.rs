@@ -43,7 +43,9 @@ pub struct Activation {
 
 #[derive(Default)]
 pub struct Seen {
+    /// The last HEARTBEAT, by the mission's clock and by the wall's.
     pub heartbeat: Option<Instant>,
+    pub heartbeat_wall: Option<std::time::Instant>,
     /// Its own clock, for the run's pace (`clock`).
     pub clock: Option<crate::clock::Heard>,
     pub flavour: Option<Flavour>,
@@ -266,6 +268,7 @@ impl Vehicle {
         let flavour = Flavour::of(hb.autopilot);
         let before = seen.heartbeat.map(|_| mode::classify(flavour, seen.custom_mode));
         seen.heartbeat = Some(now);
+        seen.heartbeat_wall = Some(std::time::Instant::now());
         seen.flavour = Some(flavour);
         seen.custom_mode = hb.custom_mode;
         seen.armed = hb.base_mode.contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);

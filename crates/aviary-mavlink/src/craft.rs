@@ -182,8 +182,10 @@ impl Craft {
         for attempt in 0..self.tuning.command_tries {
             let mut ack = self.v.expect_ack(command);
             self.link.send(&msg(attempt)).await;
+            let sent = std::time::Instant::now();
+            let mut wait = self.tuning.ack_timeout;
             let result = loop {
-                match tokio::time::timeout(self.tuning.ack_timeout, &mut ack).await {
+                match tokio::time::timeout(wait, &mut ack).await {
                     Ok(Ok(result)) => break Some(result),
                     // Said to be in progress (PX4's gripper): its final answer is waited for,
                     // not asked again, which PX4 would refuse as a second of the same.
@@ -192,6 +194,13 @@ impl Craft {
                             && started.elapsed() < IN_PROGRESS_LIMIT =>
                     {
                         continue
+                    }
+                    // Unanswered only when the time is up by the wall's clock too: the
+                    // mission's follows the vehicles', and one that lags the others on a
+                    // busy machine has had less of it (as for the link's timeout).
+                    Err(_) if sent.elapsed() < self.tuning.ack_timeout => {
+                        wait = self.tuning.poll;
+                        continue;
                     }
                     _ => break None,
                 }

@@ -100,6 +100,22 @@ impl Program {
             })
         })
     }
+    /// The bodies of `item` that the checks walk: a mission's, or an active capability's
+    /// PERFORM sections and exception handlers (`env::capability_bodies`); `None` for any
+    /// other item, or a capability its name does not mean.
+    pub fn walked_bodies<'a>(
+        &self,
+        file: FileId,
+        item: &'a aviary_syntax::ast::Item,
+    ) -> Option<Vec<&'a aviary_syntax::ast::Body>> {
+        match item {
+            aviary_syntax::ast::Item::Mission(m) => Some(vec![&m.body]),
+            aviary_syntax::ast::Item::Capability(c) if self.is_active(file, c) => {
+                Some(env::capability_bodies(c))
+            }
+            _ => None,
+        }
+    }
     /// Whether this definition is the one its name means (not overridden, not a duplicate).
     pub fn is_active(&self, file: FileId, c: &Capability) -> bool {
         self.index.get(c.name.name.as_str()).map(|r| r.file) == Some(file)

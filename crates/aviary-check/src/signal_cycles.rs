@@ -17,7 +17,6 @@ use aviary_api::MAX_HANDLER_REENTRIES;
 use aviary_diagnostics::{Code, Diagnostic, FileId};
 use aviary_syntax::ast::*;
 
-use crate::env::capability_bodies;
 use crate::recursion::{shortest_cycle, strongly_connected};
 use crate::Program;
 
@@ -37,11 +36,7 @@ pub(crate) fn check_signal_cycles(program: &Program, diagnostics: &mut Vec<Diagn
     let mut nodes = Vec::new();
     for (file, tree) in &program.files {
         for item in &tree.items {
-            let bodies = match item {
-                Item::Mission(m) => vec![&m.body],
-                Item::Capability(c) if program.is_active(*file, c) => capability_bodies(c),
-                _ => continue,
-            };
+            let Some(bodies) = program.walked_bodies(*file, item) else { continue };
             for body in bodies {
                 collect(*file, body, &mut Vec::new(), &mut nodes);
             }

@@ -13,7 +13,7 @@ use std::collections::BTreeMap;
 use aviary_api::{Descriptor, Kind};
 use aviary_syntax::ast::*;
 
-use crate::env::{bind_args, capability_bodies, literal_kind, visit_stmts};
+use crate::env::{bind_args, literal_kind, visit_stmts};
 use crate::Program;
 
 pub(crate) fn signal_values(
@@ -39,12 +39,10 @@ pub(crate) fn signal_values(
     };
     for (file, tree) in &program.files {
         for item in &tree.items {
-            let (bodies, capability) = match item {
-                Item::Mission(m) => (vec![&m.body], None),
-                Item::Capability(c) if program.is_active(*file, c) => {
-                    (capability_bodies(c), Some(c))
-                }
-                _ => continue,
+            let Some(bodies) = program.walked_bodies(*file, item) else { continue };
+            let capability = match item {
+                Item::Capability(c) => Some(c),
+                _ => None,
             };
             // A parameter of the capability being read, with the kind inference gave it.
             let param_kind = |e: &Expr| -> Option<Kind> {

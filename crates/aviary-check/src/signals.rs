@@ -8,7 +8,7 @@ use aviary_api::Descriptor;
 use aviary_diagnostics::{Code, Diagnostic, FileId};
 use aviary_syntax::ast::*;
 
-use crate::env::{capability_bodies, operator_signals, stmt_exprs, visit_exprs, visit_stmts};
+use crate::env::{operator_signals, stmt_exprs, visit_exprs, visit_stmts};
 use crate::Program;
 use aviary_diagnostics::suggest::did_you_mean;
 
@@ -52,11 +52,7 @@ impl<'a> Uses<'a> {
         let mut uses = Uses::default();
         for (file, tree) in &program.files {
             for item in &tree.items {
-                let mut bodies = match item {
-                    Item::Mission(m) => vec![&m.body],
-                    Item::Capability(c) if program.is_active(*file, c) => capability_bodies(c),
-                    _ => continue,
-                };
+                let Some(mut bodies) = program.walked_bodies(*file, item) else { continue };
                 if let Item::Capability(c) = item {
                     for s in &c.sections {
                         if let Section::Exceptions { handlers, .. } = s {
@@ -233,11 +229,7 @@ fn collect_received<'a>(file: FileId, e: &'a Expr, uses: &mut Uses<'a>) {
 fn rethrows(program: &Program, diagnostics: &mut Vec<Diagnostic>) {
     for (file, tree) in &program.files {
         for item in &tree.items {
-            let bodies = match item {
-                Item::Mission(m) => vec![&m.body],
-                Item::Capability(c) if program.is_active(*file, c) => capability_bodies(c),
-                _ => continue,
-            };
+            let Some(bodies) = program.walked_bodies(*file, item) else { continue };
             let mut check = |h: &ExceptionHandler| {
                 if let Some(throw) = rethrow(h) {
                     let name = &h.exception.name;

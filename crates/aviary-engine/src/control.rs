@@ -123,6 +123,12 @@ impl Interrupt {
 }
 
 impl Controls {
+    /// The next request, for a stand-in that answers requests itself instead of an
+    /// engine (the operator API's fuzz target drives the router so, without a mission).
+    pub async fn recv(&mut self) -> Option<ControlRequest> {
+        self.rx.recv().await
+    }
+
     pub(crate) fn into_parts(self) -> (mpsc::UnboundedReceiver<ControlRequest>, Arc<Interrupt>) {
         (self.rx, self.interrupt)
     }

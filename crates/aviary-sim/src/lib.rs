@@ -25,7 +25,8 @@
 //!   a home's z is ignored) at the start.
 //! - A move is a chain of legs flown from rest to rest: straight lines over the ground at
 //!   up to the speed asked (at most `max_speed`) with, at the same time, a vertical move at
-//!   up to `climb_rate` (up) or `descent_rate` (down), and a landing's last
+//!   up to `climb_rate` (up; `takeoff_speed` from the ground) or `descent_rate` (down),
+//!   and a landing's last
 //!   `land_speed_below` metres at `land_speed`; each axis follows a trapezoidal speed profile (accelerate and
 //!   brake at most `acceleration`). A path (`Sweep`, `FollowPath`, `ReturnToLaunch`) stops
 //!   at each corner. Orbits fly clockwise at up to `max_speed`, slow enough that the
@@ -43,7 +44,8 @@
 //! # Functions
 //! `Arm`/`Disarm` (landed only), `TakeOff(alt)` (armed; or, in the air, a climb or
 //! descent to `alt`), `Land` (lands and disarms), `ReturnToLaunch` (climbs to at least
-//! `return_altitude`, or the site's `max_altitude` if lower, flies home, waits
+//! `return_altitude`, or the site's `max_altitude` if lower, flies home at
+//! `return_speed`, waits
 //! `return_loiter` above home and lands; done at once when
 //! landed at home), `FlyToPosition(pos[, speed])` (a position without z keeps the
 //! altitude), `DescendTo(alt)`/`AscendTo(alt)` (either direction), `Hover(duration)`

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::scratch;
+use common::{scratch, wait_at_most};
 
 fn folder() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join("endless")
@@ -31,22 +31,6 @@ fn spawn(args: &[&str], dir: &Path, out: &Path) -> Child {
         .stdin(Stdio::null())
         .spawn()
         .expect("run aviary")
-}
-
-/// Waits for `child` at most `limit`; killed and a failure past it.
-fn wait_at_most(child: &mut Child, limit: Duration, what: &str) -> i32 {
-    let start = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().expect("wait") {
-            return status.code().unwrap_or(-1);
-        }
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("{what} did not end within {limit:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
 }
 
 /// `aviary ARGS` in `dir`, waited for at most `limit`: exit code, stdout, stderr.

@@ -90,18 +90,7 @@ fn run_within(dir: &Path, args: &[&str], limit: Duration) -> i32 {
         .stderr(Stdio::null())
         .spawn()
         .expect("spawn aviary run");
-    let start = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().expect("wait") {
-            return status.code().unwrap_or(-1);
-        }
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("aviary run took longer than {limit:?}");
-        }
-        std::thread::sleep(Duration::from_millis(100));
-    }
+    common::wait_at_most(&mut child, limit, "aviary run")
 }
 
 fn events(path: &Path) -> Vec<Value> {

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 use std::process::{Child, Command};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use serde_json::Value;
 
@@ -33,22 +33,10 @@ pub fn start_run(dir: &Path, mission: &str) -> Run {
 
 /// Waits for the run to end: its exit code and the output it printed.
 pub fn finish(run: &mut Run, dir: &Path, limit: Duration) -> (i32, String) {
-    let start = Instant::now();
-    let status = loop {
-        if let Some(s) = run.0.try_wait().expect("wait") {
-            break s;
-        }
-        assert!(
-            start.elapsed() < limit,
-            "aviary run took more than {} s; see {}",
-            limit.as_secs(),
-            dir.display()
-        );
-        std::thread::sleep(Duration::from_millis(250));
-    };
+    let code = super::wait_at_most(&mut run.0, limit, &format!("aviary run in {}", dir.display()));
     let out = std::fs::read_to_string(dir.join("stdout.txt")).unwrap_or_default()
         + &std::fs::read_to_string(dir.join("stderr.txt")).unwrap_or_default();
-    (status.code().unwrap_or(-1), out)
+    (code, out)
 }
 
 /// The events of a trace, as far as it is written.

@@ -514,9 +514,20 @@ MISSION Handover:
 /// most the metres the first vehicle took to stop after the abort.
 #[test]
 fn the_remainder_of_a_sweep_aborted_over_mavlink_is_flown_by_another_vehicle() {
-    let dir = scratch("mavlink_remainder");
+    remainder_handover("ardupilot");
+}
+
+/// The same on PX4, whose sweeps are uploaded and flown as missions: the point flown to
+/// comes from MISSION_CURRENT.
+#[test]
+fn the_remainder_of_a_sweep_flown_as_a_px4_mission_is_flown_by_another_vehicle() {
+    remainder_handover("px4");
+}
+
+fn remainder_handover(autopilot: &str) {
+    let dir = scratch(&format!("mavlink_remainder_{autopilot}"));
     std::fs::write(dir.join("vehicles.world.toml"), FIELD_WORLD).expect("world");
-    let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
+    let vehicles = Vehicles::start_as(&dir.join("vehicles.world.toml"), "5", autopilot);
     std::fs::write(dir.join("m.mission"), HANDOVER).expect("mission");
     std::fs::write(dir.join("m.world.toml"), bind(FIELD_WORLD, vehicles.port, &[])).expect("world");
     let code = run_within(
@@ -740,4 +751,60 @@ fn a_target_px4_refuses_in_words_fails_the_call_with_them_at_once() {
     let took = refused["t"].as_f64().unwrap() - sent["t"].as_f64().unwrap();
     assert!(took < 5.0, "refused {took:.1} s after it was sent");
     assert!(trace.iter().any(|e| e["event"] == "signal" && e["name"] == "Refused"));
+}
+
+/// A PX4 path paused half way and resumed: the vehicle holds where it was (PX4's HOLD),
+/// then flies the mission on from the point it was flying to, to its end.
+#[test]
+fn a_px4_path_paused_holds_and_resumed_flies_on_to_its_end() {
+    let dir = scratch("mavlink_px4_pause");
+    let world = "[site]\nname = \"Pause\"\norigin = { lat = 46.6167, lon = 14.2650, alt = 440 }\nmax_altitude = 60\n\n[places]\nMid = [30, 60]\n\n[drones.copter]\nhome = [0, 0]\n";
+    std::fs::write(dir.join("vehicles.world.toml"), world).expect("world");
+    let vehicles = Vehicles::start_as(&dir.join("vehicles.world.toml"), "5", "px4");
+    std::fs::write(dir.join("m.world.toml"), bind(world, vehicles.port, &[])).expect("world");
+    std::fs::write(
+        dir.join("m.mission"),
+        "CAPABILITY Trace BY drone:\n    PERFORM:\n        drone.FollowPath((0, 60), (60, 60), (60, 0))\n\nMISSION Held:\n    PARALLEL Work:\n        SEQUENTIAL Fly:\n            copter TakeOff WITH 10m\n            copter Trace-T\n            copter Land\n        SEQUENTIAL Control:\n            WAITFOR distance(copter, Mid) < 5m\n            Trace-T PAUSE\n            WAITFOR ELAPSED > 60s\n            Trace-T RESUME\n",
+    )
+    .expect("mission");
+    let code = run_within(
+        &dir,
+        &["run", "m.mission", "--quiet", "--trace", "t.jsonl", "--telemetry-hz", "4"],
+        Duration::from_secs(180),
+    );
+    let trace = events(&dir.join("t.jsonl"));
+    assert_eq!(code, 0, "{:?}", trace.last());
+    let leash = |action: &str| {
+        trace
+            .iter()
+            .find(|e| e["event"] == "leash" && e["action"] == action)
+            .and_then(|e| e["t"].as_f64())
+            .unwrap_or_else(|| panic!("no {action}: {trace:?}"))
+    };
+    let (paused, resumed) = (leash("PAUSE"), leash("RESUME"));
+    let track: Vec<(f64, [f64; 3])> = aviary_test_support::harness::positions_in(&trace, "copter");
+    // Held: from 5 s after the PAUSE (braking) to the RESUME, within 2 m of one place.
+    let held: Vec<[f64; 3]> =
+        track.iter().filter(|(t, _)| *t > paused + 5.0 && *t < resumed).map(|(_, p)| *p).collect();
+    assert!(held.len() > 40, "{held:?}");
+    let spread =
+        held.iter().map(|p| (p[0] - held[0][0]).hypot(p[1] - held[0][1])).fold(0.0, f64::max);
+    assert!(spread < 2.0, "moved {spread:.1} m while held");
+    assert!((held[0][1] - 60.0).abs() < 3.0, "held on the path's second leg: {:?}", held[0]);
+    // Then on, through (60, 60) to (60, 0), where the path ends.
+    let after: Vec<[f64; 3]> =
+        track.iter().filter(|(t, _)| *t > resumed).map(|(_, p)| *p).collect();
+    for point in [[60.0, 60.0], [60.0, 0.0]] {
+        let near = after
+            .iter()
+            .map(|p| (p[0] - point[0]).hypot(p[1] - point[1]))
+            .fold(f64::INFINITY, f64::min);
+        assert!(near < 1.5, "{point:?}: {near:.1} m away");
+    }
+    let done = trace
+        .iter()
+        .find(|e| e["event"] == "api_done" && e["function"] == "FollowPath")
+        .expect("the path's end");
+    assert_eq!(done["status"], "ok", "{done}");
+    assert!(done["t"].as_f64().unwrap() > resumed);
 }

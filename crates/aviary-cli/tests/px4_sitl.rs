@@ -101,6 +101,81 @@ fn the_hop_mission_takes_off_flies_orbits_and_lands() {
     assert!(off < 2.5, "the trace's {at:?} is {off:.1} m from anything in {}", log.display());
 }
 
+/// A path and a sweep, which PX4 flies as missions: through the path's bends at speed
+/// (its HOLD, given the points one by one, stopped at each), every lane of the sweep to
+/// its end, and the trace where PX4's own log says the copter was.
+#[test]
+#[cfg_attr(
+    not(px4_sitl),
+    ignore = "PX4 SITL not named: set AVIARY_PX4=/path/to/build/px4_sitl_default/bin/px4 to fly it (docs/REAL_DRONES.md)"
+)]
+fn a_path_and_a_sweep_are_flown_through_as_px4_missions() {
+    let dir = scratch("px4_paths");
+    let px4 = Px4::start(&dir, [0.0, 0.0]);
+    std::fs::write(
+        dir.join("m.world.toml"),
+        world(
+            &[("copter", [0.0, 0.0], &px4)],
+            "[areas]\nPlot = [[0, 100], [60, 100], [60, 140], [0, 140]]\n",
+        ),
+    )
+    .expect("world");
+    std::fs::write(
+        dir.join("m.mission"),
+        "CAPABILITY Trace BY drone:\n    PERFORM:\n        drone.FollowPath((60, 0), (100, 40), (100, 100))\n\nCAPABILITY Cover BY drone WITH plot:\n    PERFORM:\n        drone.Sweep(plot, 20m)\n\nMISSION Paths:\n    SEQUENTIAL Fly:\n        copter TakeOff WITH 10m\n        copter Trace\n        copter Cover WITH Plot\n        copter Land\n",
+    )
+    .expect("mission");
+    let (code, out, err) =
+        aviary(&["run", "m.mission", "--trace", "t.jsonl", "--telemetry-hz", "4"], &dir);
+    assert_eq!(code, 0, "{out}{err}\nsee {}", dir.display());
+    let flown = events(&dir.join("t.jsonl"));
+    let samples = |from: usize, to: usize| -> Vec<(f64, [f64; 3])> {
+        flown[from..to]
+            .iter()
+            .filter(|e| e["event"] == "telemetry")
+            .map(|e| (e["t"].as_f64().expect("t"), pos(&e["position"])))
+            .collect()
+    };
+    let (path_end, _) = done(&flown, "FollowPath");
+    let (sweep_end, _) = done(&flown, "Sweep");
+    let path = samples(done(&flown, "TakeOff").0, path_end);
+    // Through the bends at (60, 0) and (100, 40), close to each (point by point, the
+    // drone turned up to its pass radius, 25 m, before them), and never stopped: from
+    // 20 m out of the start to 20 m before the end, at least 0.5 m/s over any second
+    // (PX4 slows to about 1 m/s where the path turns by 45°).
+    let far = |p: &[f64; 3], q: [f64; 2]| (p[0] - q[0]).hypot(p[1] - q[1]);
+    for bend in [[60.0, 0.0], [100.0, 40.0]] {
+        let near = path.iter().map(|(_, p)| far(p, bend)).fold(f64::INFINITY, f64::min);
+        assert!(near < 3.0, "passed {bend:?} {near:.1} m away");
+    }
+    let middle: Vec<&(f64, [f64; 3])> = path
+        .iter()
+        .skip_while(|(_, p)| far(p, [0.0, 0.0]) < 20.0)
+        .take_while(|(_, p)| far(p, [100.0, 100.0]) > 20.0)
+        .collect();
+    assert!(middle.len() > 20, "{middle:?}");
+    let slowest = middle
+        .windows(5)
+        .map(|w| far(&w[4].1, [w[0].1[0], w[0].1[1]]) / (w[4].0 - w[0].0))
+        .fold(f64::INFINITY, f64::min);
+    assert!(slowest > 0.5, "slowed to {slowest:.2} m/s on the path");
+    // Every lane of the sweep flown to both its ends.
+    let sweep = samples(path_end, sweep_end);
+    for lane in
+        aviary_api::sweep::lanes(&[[0.0, 100.0], [60.0, 100.0], [60.0, 140.0], [0.0, 140.0]], 20.0)
+    {
+        for end in lane {
+            let near = sweep.iter().map(|(_, p)| far(p, end)).fold(f64::INFINITY, f64::min);
+            assert!(near < 2.5, "the lane's end {end:?}: {near:.1} m away");
+        }
+    }
+    let log = px4.logs().pop().expect("PX4 wrote a flight log");
+    let logged = common::logs::logged_positions(&log, ORIGIN);
+    let all: Vec<[f64; 3]> = samples(0, flown.len()).into_iter().map(|(_, p)| p).collect();
+    let (off, at) = common::logs::farthest_from_log(&all, &logged);
+    assert!(off < 2.5, "the trace's {at:?} is {off:.1} m from anything in {}", log.display());
+}
+
 /// The paper's mission on seven PX4 copters (the beacon carriers with PX4's payload
 /// deliverer as their gripper).
 #[test]

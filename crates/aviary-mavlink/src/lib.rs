@@ -30,6 +30,7 @@ mod failsafe;
 mod flight;
 pub mod hear;
 pub mod link;
+mod mission;
 pub mod mode;
 mod motion;
 mod plausible;

@@ -3,7 +3,8 @@
 //! ArduCopter numbers its modes (GUIDED 4, RTL 6, LAND 9, ...). PX4 packs a main mode in
 //! bits 16–23 and a sub mode in bits 24–31 ([`px4`], the one encoding of PX4's modes, which
 //! `aviary vehicles --autopilot px4` serves too). Aviary flies ArduPilot in GUIDED and PX4
-//! in HOLD (AUTO.LOITER) with DO_REPOSITION, so it only needs these few.
+//! in HOLD (AUTO.LOITER) with DO_REPOSITION, and a PX4 path as a mission (AUTO.MISSION),
+//! so it only needs these few.
 
 use mavlink::dialects::ardupilotmega::MavAutopilot;
 
@@ -31,6 +32,8 @@ pub enum Mode {
     Guided,
     Land,
     Rtl,
+    /// Flies the uploaded mission (PX4's AUTO.MISSION): paths on PX4.
+    Mission,
     Other,
 }
 
@@ -101,6 +104,7 @@ pub fn classify(flavour: Flavour, custom_mode: u32) -> Mode {
             (px4::OFFBOARD, _) | (px4::AUTO, px4::AUTO_LOITER) => Mode::Guided,
             (px4::AUTO, px4::AUTO_RTL) => Mode::Rtl,
             (px4::AUTO, px4::AUTO_LAND) => Mode::Land,
+            (px4::AUTO, px4::AUTO_MISSION) => Mode::Mission,
             _ => Mode::Other,
         },
     }
@@ -115,7 +119,9 @@ pub fn set_mode_params(flavour: Flavour, mode: Mode) -> Option<(f32, f32)> {
         (Flavour::Px4, Mode::Guided) => (px4::AUTO.into(), px4::AUTO_LOITER.into()),
         (Flavour::Px4, Mode::Land) => (px4::AUTO.into(), px4::AUTO_LAND.into()),
         (Flavour::Px4, Mode::Rtl) => (px4::AUTO.into(), px4::AUTO_RTL.into()),
-        (_, Mode::Other) => return None,
+        (Flavour::Px4, Mode::Mission) => (px4::AUTO.into(), px4::AUTO_MISSION.into()),
+        // ArduPilot's paths are flown in GUIDED, point by point.
+        (Flavour::ArduPilot, Mode::Mission) | (_, Mode::Other) => return None,
     };
     Some((main as f32, sub as f32))
 }
@@ -137,6 +143,7 @@ pub fn name(flavour: Flavour, custom_mode: u32) -> String {
         (Flavour::Px4, Mode::Guided) => "HOLD".into(),
         (Flavour::Px4, Mode::Rtl) => "RTL".into(),
         (Flavour::Px4, Mode::Land) => "LAND".into(),
+        (Flavour::Px4, Mode::Mission) => "MISSION".into(),
         (Flavour::Px4, Mode::Other) => format!("mode {custom_mode:#x}"),
     }
 }
@@ -147,7 +154,7 @@ mod tests {
 
     #[test]
     fn px4_modes_round_trip_through_set_mode() {
-        for mode in [Mode::Guided, Mode::Land, Mode::Rtl] {
+        for mode in [Mode::Guided, Mode::Land, Mode::Rtl, Mode::Mission] {
             let (main, sub) = set_mode_params(Flavour::Px4, mode).unwrap();
             let custom = px4::encode(main as u8, sub as u8);
             assert_eq!(classify(Flavour::Px4, custom), mode);

@@ -233,7 +233,8 @@ pub(crate) async fn fly(
 
 /// Flies through `path`: the last point, and every point to be reached, is reached by
 /// position within the tolerances before the next is sent; the others are passed within
-/// [`pass_radius`]. PAUSE holds where the drone is, RESUME sends the target again. The
+/// [`pass_radius`]. On PX4, a path of more than one point is uploaded and flown as a
+/// mission instead (`crate::mission`), with the same tolerances. PAUSE holds where the drone is, RESUME sends the target again. The
 /// point of the call's own path flown to is noted on the craft by its index among them
 /// (`Craft::flying_to`; a detour's corners lead to the point after them): for a `Sweep`
 /// or `FollowPath` those points are the contract's path point for point, which is what a
@@ -247,6 +248,10 @@ pub(crate) async fn fly_through(
     in_air(c)?;
     let points: Vec<[f64; 3]> = path.iter().map(|(p, _)| *p).collect();
     fenced(c, &points)?;
+    if c.v.flavour() == crate::mode::Flavour::Px4 && path.len() > 1 {
+        // PX4's HOLD stops at every target: a path is its mission (`crate::mission`).
+        return crate::mission::fly(c, path, speed, paused).await;
+    }
     c.set_mode(Mode::Guided).await?;
     c.speed(speed).await?;
     let pass = pass_radius(speed, c.acceleration, c.tuning.arrive_xy);

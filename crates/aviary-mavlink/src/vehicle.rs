@@ -9,8 +9,9 @@ use aviary_api::trace::AutopilotAction;
 use aviary_api::{BuiltinException, DroneEvent, DroneId, Failure};
 use aviary_world::Target;
 use mavlink::dialects::ardupilotmega::{
-    MavCmd, MavLandedState, MavMessage, MavModeFlag, MavParamType, MavResult, MavState,
-    MavSysStatusSensor, GLOBAL_POSITION_INT_DATA, HEARTBEAT_DATA,
+    MavCmd, MavLandedState, MavMessage, MavMissionResult, MavMissionType, MavModeFlag,
+    MavParamType, MavResult, MavState, MavSysStatusSensor, GLOBAL_POSITION_INT_DATA,
+    HEARTBEAT_DATA,
 };
 use tokio::sync::{mpsc, oneshot};
 use tokio::time::Instant;
@@ -93,6 +94,21 @@ pub struct Seen {
     acks: Vec<(MavCmd, oneshot::Sender<MavResult>)>,
     /// The last command the vehicle said was in progress (COMMAND_ACK IN_PROGRESS), and when.
     in_progress: Option<(MavCmd, Instant)>,
+    /// Where an upload in progress hears the vehicle's requests and its answer.
+    pub upload: Option<mpsc::UnboundedSender<Upload>>,
+    /// The mission item the vehicle flies to (MISSION_CURRENT) and the last one it reached
+    /// (MISSION_ITEM_REACHED), until the next upload clears them.
+    pub mission_current: Option<u16>,
+    pub mission_reached: Option<u16>,
+}
+
+/// What a vehicle says during a mission upload.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Upload {
+    /// MISSION_REQUEST_INT or MISSION_REQUEST: send item `seq`.
+    Request(u16),
+    /// MISSION_ACK: the upload's end.
+    Ack(MavMissionResult),
 }
 
 impl Seen {
@@ -106,6 +122,13 @@ impl Seen {
         }
         let airborne = self.armed && self.fix.is_some_and(|f| f.pos[2] > AIRBORNE_ABOVE);
         self.draw.record(now, battery::amps(centiamps), airborne);
+    }
+
+    /// A mission message to the upload in progress, if one is.
+    fn tell_upload(&mut self, what: Upload) {
+        if let Some(tx) = &self.upload {
+            let _ = tx.send(what);
+        }
     }
 
     /// COMMAND_ACK: the answer goes to the first one waiting for it.
@@ -141,6 +164,8 @@ pub struct Vehicle {
     events: mpsc::UnboundedSender<DroneEvent>,
     alarms: mpsc::UnboundedSender<(DroneId, Failure)>,
 }
+
+const MISSION: MavMissionType = MavMissionType::MAV_MISSION_TYPE_MISSION;
 
 /// Armed and this high (m): in the air, for the flight time and the measured draw.
 const AIRBORNE_ABOVE: f64 = 0.3;
@@ -251,6 +276,18 @@ impl Vehicle {
             MavMessage::STATUSTEXT(t) => {
                 seen.words.take(now, t.id, t.chunk_seq, &t.text[..]);
             }
+            MavMessage::MISSION_REQUEST_INT(r) if r.mission_type == MISSION => {
+                seen.tell_upload(Upload::Request(r.seq));
+            }
+            #[allow(deprecated)] // PX4 asks with it until it hears MISSION_ITEM_INT.
+            MavMessage::MISSION_REQUEST(r) if r.mission_type == MISSION => {
+                seen.tell_upload(Upload::Request(r.seq));
+            }
+            MavMessage::MISSION_ACK(a) if a.mission_type == MISSION => {
+                seen.tell_upload(Upload::Ack(a.mavtype));
+            }
+            MavMessage::MISSION_CURRENT(m) => seen.mission_current = Some(m.seq),
+            MavMessage::MISSION_ITEM_REACHED(m) => seen.mission_reached = Some(m.seq),
             MavMessage::COMMAND_ACK(ack) if ack.result == MavResult::MAV_RESULT_IN_PROGRESS => {
                 seen.in_progress = Some((ack.command, now));
             }

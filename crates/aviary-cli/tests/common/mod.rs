@@ -76,9 +76,9 @@ pub const ARDUCOPTER: &str = "climb_rate = 2.5\ndescent_rate = 1.5\nacceleration
 
 /// PX4's own figures (its default parameters, as PX4 SITL gave them) as a drone's world
 /// keys: MPC_Z_V_AUTO_UP 3 m/s, MPC_TKO_SPEED 1.5 m/s, MPC_Z_V_AUTO_DN 1.5 m/s,
-/// MPC_ACC_HOR 3 m/s², MPC_LAND_SPEED 0.7 m/s under MPC_LAND_ALT1 10 m, RTL_RETURN_ALT
-/// 30 m, RTL_LAND_DELAY 0 s, MPC_XY_CRUISE 5 m/s.
-pub const PX4: &str = "climb_rate = 3\ntakeoff_speed = 1.5\ndescent_rate = 1.5\nacceleration = 3\nland_speed = 0.7\nland_speed_below = 10\nreturn_altitude = 30\nreturn_loiter = 0\nreturn_speed = 5\n";
+/// MPC_ACC_HOR 3 m/s² (of which its paths average half: 1.5), MPC_LAND_SPEED 0.7 m/s
+/// under MPC_LAND_ALT1 10 m, RTL_RETURN_ALT 30 m, RTL_LAND_DELAY 0 s, MPC_XY_CRUISE 5 m/s.
+pub const PX4: &str = "climb_rate = 3\ntakeoff_speed = 1.5\ndescent_rate = 1.5\nacceleration = 1.5\nland_speed = 0.7\nland_speed_below = 10\nreturn_altitude = 30\nreturn_loiter = 0\nreturn_speed = 5\n";
 
 /// The paper's mission flown in the simulator and planned (`aviary check --plan`), in
 /// its world with `keys(name)` added to each drone (the figures of the vehicles that fly

@@ -21,7 +21,7 @@ use mavlink::dialects::ardupilotmega::MavParamType;
 
 use crate::mode::Flavour;
 
-pub use params::{decode, table, wanted, Figure, Param, ARDUPILOT, PX4};
+pub use params::{decode, table, wanted, Figure, Param, ARDUPILOT, PX4, PX4_ACCELERATION_SHARE};
 pub use read::ask;
 pub(crate) use read::read;
 
@@ -198,9 +198,10 @@ impl Facts {
         };
         let line = (!same(*slot, value)).then(|| {
             format!(
-                "{name}: {} {} {unit} (the vehicle's {}), not the world's {} {unit}",
+                "{name}: {} {} {unit} ({} {}), not the world's {} {unit}",
                 what(p.figure),
                 num(value),
+                p.of,
                 p.name,
                 num(*slot)
             )

@@ -61,7 +61,8 @@ impl Autopilot {
             int("MAV_SYS_ID", i32::from(c.system)),
             real("MC_ORBIT_RAD_MAX", 1000.0),
             writable(real("MIS_TAKEOFF_ALT", p.takeoff_alt)),
-            real("MPC_ACC_HOR", c.acceleration),
+            // The limit, of which PX4's paths average a share: the world's figure.
+            real("MPC_ACC_HOR", c.acceleration / aviary_mavlink::facts::PX4_ACCELERATION_SHARE),
             // A landing slows to MPC_LAND_SPEED below MPC_LAND_ALT1 and is at it from
             // MPC_LAND_ALT2; the simulator slows at once, at the world's land_speed_below.
             real("MPC_LAND_ALT1", c.descent.slow_below),

@@ -13,7 +13,6 @@
 use std::time::Duration;
 
 use aviary_api::geometry::dist;
-use aviary_api::show::fixed;
 use aviary_api::Failure;
 use mavlink::dialects::ardupilotmega::{
     MavCmd, MavFrame, MavMessage, MavMissionResult, MavMissionType, MISSION_COUNT_DATA,
@@ -24,7 +23,7 @@ use tokio::time::Instant;
 
 use crate::craft::{failed, timeout, Craft, Paused};
 use crate::mode::{self, Mode};
-use crate::motion::{held, here, Pass, Waypoint};
+use crate::motion::{held, here, late, Pass, Waypoint};
 use crate::vehicle::Upload;
 use aviary_api::geo::Origin;
 
@@ -163,13 +162,7 @@ pub(crate) async fn fly(
             )));
         }
         if left.is_zero() {
-            return Err(timeout(format!(
-                "{} did not fly its path to ({}, {}, {}) in time",
-                c.name,
-                fixed(end[0], 1),
-                fixed(end[1], 1),
-                fixed(end[2], 1)
-            )));
+            return Err(late(c, "fly its path to", end));
         }
         tokio::time::sleep(c.tuning.poll).await;
         left = left.saturating_sub(c.tuning.poll);

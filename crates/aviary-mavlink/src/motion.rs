@@ -291,19 +291,24 @@ pub(crate) async fn fly_through(
                 resend = Instant::now() + c.tuning.resend;
             }
             if left.is_zero() {
-                return Err(timeout(format!(
-                    "{} did not reach ({}, {}, {}) in time",
-                    c.name,
-                    fixed(to[0], 1),
-                    fixed(to[1], 1),
-                    fixed(to[2], 1)
-                )));
+                return Err(late(c, "reach", to));
             }
             tokio::time::sleep(c.tuning.poll).await;
             left = left.saturating_sub(c.tuning.poll);
         }
     }
     Ok(())
+}
+
+/// `Timeout`: the drone did not `what` (reach, fly its path to) `to` in its time.
+pub(crate) fn late(c: &Craft, what: &str, to: [f64; 3]) -> Failure {
+    timeout(format!(
+        "{} did not {what} ({}, {}, {}) in time",
+        c.name,
+        fixed(to[0], 1),
+        fixed(to[1], 1),
+        fixed(to[2], 1)
+    ))
 }
 
 /// A PAUSE: holds where the drone is until RESUME.

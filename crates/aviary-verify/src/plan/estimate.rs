@@ -125,8 +125,9 @@ pub struct Estimator<'m> {
     pub airspace: aviary_route::Airspace,
     /// First raise times from the previous pass, for `WAITFOR RECEIVED` ahead of its signal.
     pub known: Vec<Option<f64>>,
-    /// Whether the walk read `known`: a walk that did not would be the same again.
-    pub read_known: bool,
+    /// Whether the walk read `known` (a `WAITFOR RECEIVED`, or a condition on `RECEIVED`
+    /// ahead of its signal): a walk that did not would be the same again.
+    pub read_known: std::cell::Cell<bool>,
     pub s: State,
     /// The capabilities being walked, by index: a flag each, so that a chain of N
     /// capabilities asks N times in O(1), not in O(depth).
@@ -172,7 +173,7 @@ impl<'m> Estimator<'m> {
             world,
             airspace: aviary_route::Airspace::of(world),
             known,
-            read_known: false,
+            read_known: std::cell::Cell::new(false),
             calling: vec![false; mission.capabilities.len()],
             motion: mission
                 .capabilities
@@ -266,6 +267,8 @@ impl<'m> Estimator<'m> {
             frame: &ctx.frame,
             drones: &self.s.drones,
             raised: &self.s.raised,
+            known: &self.known,
+            read_known: &self.read_known,
             t,
         }
     }
@@ -532,7 +535,7 @@ impl<'m> Estimator<'m> {
             let at = match self.s.raised[*s] {
                 Some(at) => Some(at),
                 None => {
-                    self.read_known = true;
+                    self.read_known.set(true);
                     self.known[*s]
                 }
             };

@@ -15,6 +15,10 @@ pub struct Scope<'a> {
     pub frame: &'a Frame,
     pub drones: &'a [Flyer],
     pub raised: &'a [Option<f64>],
+    /// The first raise times of the walk before, for a signal this walk has not raised
+    /// yet (a branch walked later may raise it earlier in time), and whether they were read.
+    pub known: &'a [Option<f64>],
+    pub read_known: &'a std::cell::Cell<bool>,
     pub t: f64,
 }
 
@@ -54,7 +58,14 @@ impl Scope<'_> {
             }
             Expr::Elapsed => Value::Number(self.t),
             Expr::Received(s) => {
-                Value::Bool(self.raised.get(*s).copied().flatten().is_some_and(|at| at <= self.t))
+                let at = match self.raised.get(*s).copied().flatten() {
+                    Some(at) => Some(at),
+                    None => {
+                        self.read_known.set(true);
+                        self.known.get(*s).copied().flatten()
+                    }
+                };
+                Value::Bool(at.is_some_and(|at| at <= self.t))
             }
             Expr::Not(x) => Value::Bool(!truth(&self.eval(x)?)?),
             Expr::And(x, y) => {

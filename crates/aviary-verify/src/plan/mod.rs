@@ -73,7 +73,8 @@ pub struct Plan {
 /// Under this fraction of a full battery, a drone has no reserve left (W204).
 const RESERVE: f64 = 0.20;
 
-/// How many walks may pass for `WAITFOR RECEIVED` to learn times raised later in the walk.
+/// How many walks may pass for `WAITFOR RECEIVED`, and conditions on `RECEIVED`, to learn
+/// times raised later in the walk.
 const PASSES: usize = 4;
 
 /// Estimates `mission` on `world`; appends a W204 per drone whose reserve falls under 20%.
@@ -82,7 +83,7 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
     let mut est = Estimator::new(mission, world, known.clone());
     let mut end = est.run();
     for _ in 1..PASSES {
-        if !est.read_known || est.s.raised == known {
+        if !est.read_known.get() || est.s.raised == known {
             break;
         }
         known = est.s.raised.clone();

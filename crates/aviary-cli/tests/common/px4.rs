@@ -162,15 +162,22 @@ impl Px4 {
 
     /// With its gripper (PX4's payload deliverer, started at boot when PD_GRIPPER_EN is
     /// 1): the parameter set and saved, and the vehicle started again.
+    /// PX4 saves a changed parameter at most 2 s (of its time) after the last save, so
+    /// the restart waits, and is made again when the parameter did not survive it (a
+    /// payload deliverer that is not running leaves DO_GRIPPER unanswered).
     pub fn with_gripper(mut self) -> Px4 {
-        {
-            let gcs = self.gcs();
-            gcs.set_param_px4_int("PD_GRIPPER_EN", 1);
+        for _ in 0..3 {
+            {
+                let gcs = self.gcs();
+                if gcs.param("PD_GRIPPER_EN").to_bits() == 1 {
+                    return self;
+                }
+                gcs.set_param_px4_int("PD_GRIPPER_EN", 1);
+            }
+            std::thread::sleep(Duration::from_millis(2500));
+            self.restart();
         }
-        // PX4 saves a changed parameter in its folder at once; a moment for the write.
-        std::thread::sleep(Duration::from_millis(500));
-        self.restart();
-        self
+        panic!("PX4 instance {} kept PD_GRIPPER_EN 0 over three restarts", self.instance);
     }
 
     /// The flight logs (ULog) it wrote.

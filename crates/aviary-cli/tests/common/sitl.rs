@@ -342,6 +342,28 @@ impl Gcs {
         }
     }
 
+    /// A parameter's value as the vehicle sends it (PARAM_REQUEST_READ, asked again
+    /// until it answers, for at most 10 s).
+    pub fn param(&self, name: &str) -> f32 {
+        let deadline = Instant::now() + Duration::from_secs(10);
+        let before = self.seen.lock().unwrap().params.len();
+        loop {
+            self.send(mav::MavMessage::PARAM_REQUEST_READ(mav::PARAM_REQUEST_READ_DATA {
+                param_index: -1,
+                target_system: self.system,
+                target_component: 1,
+                param_id: name.into(),
+            }));
+            std::thread::sleep(Duration::from_millis(300));
+            if let Some((_, v)) =
+                self.seen.lock().unwrap().params[before..].iter().rev().find(|(n, _)| n == name)
+            {
+                return *v;
+            }
+            assert!(Instant::now() < deadline, "the vehicle did not send {name}");
+        }
+    }
+
     /// Sets a parameter and waits for the vehicle to echo it.
     pub fn set_param(&self, name: &str, value: f32) {
         self.set_param_as(name, value, mav::MavParamType::MAV_PARAM_TYPE_REAL32);

@@ -125,9 +125,19 @@ pub struct Estimator<'m> {
     pub airspace: aviary_route::Airspace,
     /// First raise times from the previous pass, for `WAITFOR RECEIVED` ahead of its signal.
     pub known: Vec<Option<f64>>,
+    /// The part of `known` a condition on `RECEIVED` may read ahead of its signal: the
+    /// raises of the walk before that came before its first guess ([`Estimator::guessed`]).
+    /// A guess (an unknown `WAITFOR` counted as no wait) can only make what follows it
+    /// earlier, and a loop ended by so early a raise would be counted short; without a
+    /// sure time the loop runs as before, to its worst case.
+    pub known_sure: Vec<Option<f64>>,
     /// Whether the walk read `known` (a `WAITFOR RECEIVED`, or a condition on `RECEIVED`
     /// ahead of its signal): a walk that did not would be the same again.
     pub read_known: std::cell::Cell<bool>,
+    /// When the walk first guessed (an unknown `WAITFOR` counted as no wait, an unknown
+    /// `DOWHILE` as one round, a drone read where a branch walked before left it, ahead
+    /// of the time read at): its raises from then on are not sure.
+    pub guessed: std::cell::Cell<f64>,
     pub s: State,
     /// The capabilities being walked, by index: a flag each, so that a chain of N
     /// capabilities asks N times in O(1), not in O(depth).
@@ -166,14 +176,21 @@ fn call_budget(mission: &Mission) -> usize {
 const MAX_ROUNDS: usize = 10_000;
 
 impl<'m> Estimator<'m> {
-    pub fn new(mission: &'m Mission, world: &'m World, known: Vec<Option<f64>>) -> Estimator<'m> {
+    pub fn new(
+        mission: &'m Mission,
+        world: &'m World,
+        known: Vec<Option<f64>>,
+        known_sure: Vec<Option<f64>>,
+    ) -> Estimator<'m> {
         let drones: Vec<Flyer> = world.drones.iter().map(Flyer::new).collect();
         Estimator {
             mission,
             world,
             airspace: aviary_route::Airspace::of(world),
             known,
+            known_sure,
             read_known: std::cell::Cell::new(false),
+            guessed: std::cell::Cell::new(f64::INFINITY),
             calling: vec![false; mission.capabilities.len()],
             motion: mission
                 .capabilities
@@ -267,8 +284,9 @@ impl<'m> Estimator<'m> {
             frame: &ctx.frame,
             drones: &self.s.drones,
             raised: &self.s.raised,
-            known: &self.known,
+            known: &self.known_sure,
             read_known: &self.read_known,
+            guessed: &self.guessed,
             t,
         }
     }
@@ -513,6 +531,7 @@ impl<'m> Estimator<'m> {
             match self.scope(ctx, now).condition(condition) {
                 Some(false) => return (now, raises),
                 None => {
+                    self.guessed.set(self.guessed.get().min(now));
                     self.note(ctx.statement, "a DOWHILE whose condition is unknown before flight is counted as one round".into());
                     let (e, r) = self.block(body, ctx, now);
                     raises.extend(r);
@@ -544,6 +563,7 @@ impl<'m> Estimator<'m> {
             }
         }
         if self.scope(ctx, t).condition(condition) != Some(true) {
+            self.guessed.set(self.guessed.get().min(t));
             let what = match condition {
                 Expr::Received(s) => format!("a WAITFOR RECEIVED({}) whose signal the estimate never raises is counted as no wait", self.mission.signals[*s]),
                 _ => "a WAITFOR whose condition is unknown before flight is counted as no wait".into(),

@@ -19,6 +19,8 @@ pub struct Scope<'a> {
     /// yet (a branch walked later may raise it earlier in time), and whether they were read.
     pub known: &'a [Option<f64>],
     pub read_known: &'a std::cell::Cell<bool>,
+    /// When the walk first guessed; a drone read ahead of `t` is a guess.
+    pub guessed: &'a std::cell::Cell<f64>,
     pub t: f64,
 }
 
@@ -95,13 +97,24 @@ impl Scope<'_> {
     fn position(&self, e: &Expr) -> Option<[f64; 2]> {
         match self.eval(e)? {
             Value::Position(p) => Some([p.x, p.y]),
-            Value::Actor(d) => self.drones.get(d).map(|f| [f.pos[0], f.pos[1]]),
+            Value::Actor(d) => self.flyer(d).map(|f| [f.pos[0], f.pos[1]]),
             _ => None,
         }
     }
 
-    fn telemetry(&self, d: DroneId, field: Field) -> Option<Value> {
+    /// A drone as the walk has it. A branch walked before may have taken it past `t`
+    /// (the walk goes branch by branch, not in time): what is read then is its state
+    /// later on, a guess.
+    fn flyer(&self, d: DroneId) -> Option<&Flyer> {
         let f = self.drones.get(d)?;
+        if f.free_at > self.t + 1e-9 {
+            self.guessed.set(self.guessed.get().min(self.t));
+        }
+        Some(f)
+    }
+
+    fn telemetry(&self, d: DroneId, field: Field) -> Option<Value> {
+        let f = self.flyer(d)?;
         Some(match field {
             Field::Position => {
                 Value::Position(Point { x: f.pos[0], y: f.pos[1], z: Some(f.pos[2]) })

@@ -80,14 +80,16 @@ const PASSES: usize = 4;
 /// Estimates `mission` on `world`; appends a W204 per drone whose reserve falls under 20%.
 pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnostic>) -> Plan {
     let mut known = vec![None; mission.signals.len()];
-    let mut est = Estimator::new(mission, world, known.clone());
+    let mut est = Estimator::new(mission, world, known.clone(), known.clone());
     let mut end = est.run();
     for _ in 1..PASSES {
         if !est.read_known.get() || est.s.raised == known {
             break;
         }
         known = est.s.raised.clone();
-        est = Estimator::new(mission, world, known.clone());
+        let guessed = est.guessed.get();
+        let sure = known.iter().map(|at| at.filter(|&at| at < guessed)).collect();
+        est = Estimator::new(mission, world, known.clone(), sure);
         end = est.run();
     }
     // The activities are moved into the plan, not copied (a long mission has millions);

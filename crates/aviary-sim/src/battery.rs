@@ -46,14 +46,19 @@ fn time_home(ground: f64, d: &SimDrone) -> f64 {
 }
 
 /// Drains `dt` seconds of flight (when `airborne`) and raises each alarm at most once.
+/// `factor` (with `[air]`): the drain's factor this tick, for the wind and the battery's
+/// capacity (`crate::air::AirState::drain_factor`).
 // `!(a >= b)` on purpose: a NaN charge or bound counts as "may be due", never as safe.
 #[allow(clippy::neg_cmp_op_on_partial_ord)]
-pub(crate) fn drain(d: &mut SimDrone, dt: f64, airborne: bool) -> Alarms {
+pub(crate) fn drain(d: &mut SimDrone, dt: f64, airborne: bool, factor: Option<f64>) -> Alarms {
     let mut alarms = Alarms { low: false, critical: false, empty: false };
     if !airborne {
         return alarms;
     }
-    d.battery -= dt / d.spec.endurance;
+    match factor {
+        None => d.battery -= dt / d.spec.endurance,
+        Some(k) => d.battery -= dt * k / d.spec.endurance,
+    }
     if d.battery <= 0.0 {
         d.battery = 0.0;
         alarms.empty = true;

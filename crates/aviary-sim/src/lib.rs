@@ -146,6 +146,7 @@
 //! the last `Arc<SimBackend>` is dropped. Simulated time equals tokio time since the start
 //! (as long as the runtime keeps up, as it does with a paused clock).
 
+mod air;
 mod args;
 mod avoid;
 mod backend;

@@ -48,6 +48,9 @@ pub(crate) struct AirDrone {
     /// The gust, along the mean wind and across it (m/s), and its stream.
     pub gust: [f64; 2],
     pub gust_luck: Option<Box<Stream>>,
+    /// Dryden's (intensity, scale) and the height they are for.
+    pub dryden: (f64, f64),
+    pub dryden_at: f64,
     /// The wind at the drone now (mean plus gust), `[east, north]` m/s.
     pub wind: [f64; 2],
     /// The GPS error, `[east, north]` m, its 1-sigma size and its stream.
@@ -121,6 +124,8 @@ impl AirState {
                 AirDrone {
                     gust: [0.0; 2],
                     gust_luck: gusty.then(dummy),
+                    dryden: (0.0, 0.0),
+                    dryden_at: 0.0,
                     wind: wind.as_ref().map_or([0.0; 2], |w| w.mean),
                     gps: [0.0; 2],
                     gps_sigma,
@@ -162,7 +167,8 @@ impl AirState {
             }
             if a.gps_luck.is_some() {
                 let mut luck = Stream::new(seed, Purpose::Gps, id);
-                a.gps = [a.gps_sigma * luck.normal(), a.gps_sigma * luck.normal()];
+                let n = luck.normals();
+                a.gps = [a.gps_sigma * n[0], a.gps_sigma * n[1]];
                 a.gps_luck = Some(Box::new(luck));
             }
             a.capacity = match spread {
@@ -186,13 +192,20 @@ impl AirState {
         let wind = self.wind.as_ref()?;
         let a = &mut self.drones[id];
         if let (Some(w20), Some(luck)) = (wind.w20, a.gust_luck.as_deref_mut()) {
-            let (sigma, scale) = dryden(w20, z);
+            // The standard's figures change slowly with height: worked out again only
+            // when the drone has climbed or descended a metre.
+            if (z - a.dryden_at).abs() >= 1.0 || a.dryden.1 == 0.0 {
+                a.dryden = dryden(w20, z);
+                a.dryden_at = z;
+            }
+            let (sigma, scale) = a.dryden;
             // Taylor's frozen turbulence: the drone flies through it at its airspeed; a
             // hovering drone has the mean wind blow it past.
             let speed = v.max(hypot(wind.mean)).max(1.0);
             let r = (-speed * dt / scale).exp();
             let kick = sigma * (1.0 - r * r).sqrt();
-            a.gust = [r * a.gust[0] + kick * luck.normal(), r * a.gust[1] + kick * luck.normal()];
+            let n = luck.normals();
+            a.gust = [r * a.gust[0] + kick * n[0], r * a.gust[1] + kick * n[1]];
         }
         // Along the mean wind and across it (to its left), back to east and north.
         let m = hypot(wind.mean);
@@ -213,7 +226,8 @@ impl AirState {
         for a in &mut self.drones {
             if let Some(luck) = a.gps_luck.as_deref_mut() {
                 let s = a.gps_sigma * kick;
-                a.gps = [r * a.gps[0] + s * luck.normal(), r * a.gps[1] + s * luck.normal()];
+                let n = luck.normals();
+                a.gps = [r * a.gps[0] + s * n[0], r * a.gps[1] + s * n[1]];
             }
         }
     }

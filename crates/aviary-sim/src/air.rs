@@ -304,32 +304,6 @@ fn hypot(v: [f64; 2]) -> f64 {
     aviary_api::geometry::hypot(v[0], v[1])
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_wind_triangle() {
-        // Head wind, tail wind, and a cross wind of 6 for an airspeed of 10: 8 over the ground.
-        assert!((ground_speed_limit([1.0, 0.0], [-4.0, 0.0], 10.0) - 6.0).abs() < 1e-12);
-        assert!((ground_speed_limit([1.0, 0.0], [4.0, 0.0], 10.0) - 14.0).abs() < 1e-12);
-        assert!((ground_speed_limit([1.0, 0.0], [0.0, 6.0], 10.0) - 8.0).abs() < 1e-12);
-        assert_eq!(ground_speed_limit([1.0, 0.0], [0.0, 12.0], 10.0), 0.0);
-    }
-
-    #[test]
-    fn dryden_figures_of_the_standard() {
-        // At 1000 ft and above the low-altitude formulas give sigma_u = sigma_w (1.0 to
-        // within rounding) and L_u = 1000 ft.
-        let (sigma, scale) = dryden(10.0, 1000.0 * FOOT);
-        assert!((sigma - 1.0).abs() < 1e-3, "{sigma}");
-        assert!((scale - 1000.0 * FOOT).abs() < 1.0, "{scale}");
-        // Lower down the gusts are stronger relative to sigma_w, and shorter.
-        let (low_sigma, low_scale) = dryden(10.0, 10.0);
-        assert!(low_sigma > sigma && low_scale < scale);
-    }
-}
-
 impl crate::fleet::Fleet {
     /// What the air does at the start of a step that ends at `end`: the GPS errors drift,
     /// and, when it is due, the radio looks at who is in reach.
@@ -415,5 +389,31 @@ impl crate::fleet::Fleet {
             self.touch(id);
             self.fire(id, kind, now, now + duration, out);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_wind_triangle() {
+        // Head wind, tail wind, and a cross wind of 6 for an airspeed of 10: 8 over the ground.
+        assert!((ground_speed_limit([1.0, 0.0], [-4.0, 0.0], 10.0) - 6.0).abs() < 1e-12);
+        assert!((ground_speed_limit([1.0, 0.0], [4.0, 0.0], 10.0) - 14.0).abs() < 1e-12);
+        assert!((ground_speed_limit([1.0, 0.0], [0.0, 6.0], 10.0) - 8.0).abs() < 1e-12);
+        assert_eq!(ground_speed_limit([1.0, 0.0], [0.0, 12.0], 10.0), 0.0);
+    }
+
+    #[test]
+    fn dryden_figures_of_the_standard() {
+        // At 1000 ft and above the low-altitude formulas give sigma_u = sigma_w (1.0 to
+        // within rounding) and L_u = 1000 ft.
+        let (sigma, scale) = dryden(10.0, 1000.0 * FOOT);
+        assert!((sigma - 1.0).abs() < 1e-3, "{sigma}");
+        assert!((scale - 1000.0 * FOOT).abs() < 1.0, "{scale}");
+        // Lower down the gusts are stronger relative to sigma_w, and shorter.
+        let (low_sigma, low_scale) = dryden(10.0, 10.0);
+        assert!(low_sigma > sigma && low_scale < scale);
     }
 }

@@ -165,11 +165,17 @@ impl SimDrone {
             }
             Some(&mut Leg::Arc { center, radius, start, total, speed }) => {
                 let left = (total - task.arc_done) * radius;
-                let theta = start - task.arc_done;
+                let limit = match tick.wind {
+                    None => tick.limit(speed),
+                    Some(_) => {
+                        let theta = start - task.arc_done;
+                        tick.along([theta.sin(), -theta.cos()], speed)
+                    }
+                };
                 let step = advance(
                     left,
                     task.arc_speed,
-                    tick.along([theta.sin(), -theta.cos()], speed),
+                    limit,
                     arc_accel(body.spec.accel),
                     dt,
                 );

@@ -172,13 +172,7 @@ impl SimDrone {
                         tick.along([theta.sin(), -theta.cos()], speed)
                     }
                 };
-                let step = advance(
-                    left,
-                    task.arc_speed,
-                    limit,
-                    arc_accel(body.spec.accel),
-                    dt,
-                );
+                let step = advance(left, task.arc_speed, limit, arc_accel(body.spec.accel), dt);
                 task.arc_speed = step.speed;
                 task.arc_done =
                     if step.arrived { total } else { task.arc_done + step.moved / radius };

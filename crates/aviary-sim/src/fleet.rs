@@ -191,8 +191,9 @@ impl Fleet {
     }
 
     /// The fleet, with `seed` the run's seed, from which every chance the world asks for
-    /// is drawn (a fault's time within its range now; a sensor's detections as the drones
-    /// fly). Without it, a fleet's seed is 0. A world that asks for no chance runs the same
+    /// is drawn (a fault's time within its range, and with `[air]` each drone's capacity,
+    /// first GPS error and first random fault times, now; a sensor's detections, gusts,
+    /// GPS drift and later faults as the drones fly). Without it, a fleet's seed is 0. A world that asks for no chance runs the same
     /// whatever the seed.
     pub fn seeded(mut self, seed: u64) -> Fleet {
         self.seed = seed;

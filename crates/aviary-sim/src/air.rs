@@ -64,6 +64,9 @@ pub(crate) struct AirDrone {
     pub relay: Option<f64>,
     /// Its link is down because it is out of the radio's reach.
     pub out_of_reach: bool,
+    /// When a `link_loss` fault it had when it went out of reach ends (0: none): back in
+    /// reach, its link stays lost until then.
+    pub fault_until: f64,
     /// It carries a `wind` sensor.
     pub anemometer: bool,
 }
@@ -136,6 +139,7 @@ impl AirState {
                         .filter(|a| a.relay)
                         .map(|a| a.range.or(air.radio.as_ref().map(|r| r.range)).unwrap_or(0.0)),
                     out_of_reach: false,
+                    fault_until: 0.0,
                     anemometer: d.sensors.iter().any(|s| s == "wind"),
                 }
             })
@@ -310,6 +314,21 @@ impl crate::fleet::Fleet {
     pub(crate) fn air_before(&mut self, end: f64, dt: f64, out: &mut Vec<Report>) {
         let Some(air) = self.air.as_deref_mut() else { return };
         air.drift_gps(dt);
+        if air.radio.is_some() {
+            // A `link_loss` fault that came while a drone is out of reach does not give it
+            // its link back when the fault ends: the outage lasts while it is out of reach.
+            for (a, d) in air.drones.iter_mut().zip(&mut self.drones) {
+                if !a.out_of_reach {
+                    continue;
+                }
+                if let Some(o) = d.rare.as_mut().and_then(|r| r.link_loss.as_mut()) {
+                    if o.until.is_finite() {
+                        a.fault_until = a.fault_until.max(o.until);
+                        o.until = f64::INFINITY;
+                    }
+                }
+            }
+        }
         let every = match &air.radio {
             Some(r) if end + 1e-9 >= air.next_look => r.every,
             _ => return,
@@ -330,21 +349,28 @@ impl crate::fleet::Fleet {
                 continue;
             }
             a.out_of_reach = out_now;
+            let held = std::mem::take(&mut a.fault_until);
             self.touch(id);
-            if out_now {
-                if let Some(o) = self.drones[id].rare.as_mut().and_then(|r| r.link_loss.as_mut()) {
-                    // Lost already (a fault): it stays lost while out of reach.
-                    o.until = f64::INFINITY;
-                    continue;
+            let outage = self.drones[id].rare.as_mut().and_then(|r| r.link_loss.as_mut());
+            match (out_now, outage) {
+                (true, Some(o)) => {
+                    // Lost already (a fault): it stays lost while out of reach, and at
+                    // least as long as the fault says.
+                    let until = std::mem::replace(&mut o.until, f64::INFINITY);
+                    if let Some(air) = self.air.as_deref_mut() {
+                        air.drones[id].fault_until = until;
+                    }
                 }
-                let name = &self.names[id];
-                let reason = format!("{name}: out of radio reach of the station and every relay");
-                self.lose_link(id, end, f64::INFINITY, reason, out);
-            } else if let Some(o) = self.drones[id].rare.as_mut().and_then(|r| r.link_loss.as_mut())
-            {
-                // Back in reach: the outage ends now (`ConnectionRestored`, with the
-                // faults' outages).
-                o.until = end;
+                (true, None) => {
+                    let name = &self.names[id];
+                    let reason =
+                        format!("{name}: out of radio reach of the station and every relay");
+                    self.lose_link(id, end, f64::INFINITY, reason, out);
+                }
+                // Back in reach: the outage ends now, or when a fault's does
+                // (`ConnectionRestored`, with the faults' outages).
+                (false, Some(o)) => o.until = end.max(held),
+                (false, None) => {}
             }
         }
         self.radio_scratch = (at, linked);

@@ -314,3 +314,32 @@ fn a_battery_critical_fault_sets_the_reading() {
     assert!((t.battery - critical).abs() < 1e-3, "{} vs {critical}", t.battery);
     assert!(t.battery < 0.2, "{}", t.battery);
 }
+
+#[test]
+fn a_link_loss_fault_out_of_reach_gives_no_link_back_until_in_reach() {
+    let fault = "[[faults]]\ndrone = \"d\"\nat = 43\nkind = \"link_loss\"\nduration = 2\n";
+    let mut fleet = up(&format!("[drones.d]\nhome = [0, 0]\n{fault}{RADIO}"), 0, 20.0);
+    let go = start(&mut fleet, 0, Function::FlyToPosition, &[pos(500.0, 0.0)]);
+    let run = run_until(&mut fleet, 0, go, 120.0);
+    assert_eq!(run.end, CallEnd::Interrupted);
+    assert!(fleet.time() < 43.0, "out of reach before the fault: {}", fleet.time());
+    let mut restored_at = None;
+    while fleet.time() < 120.0 {
+        for r in fleet.step(DT) {
+            if let Report::Event(DroneEvent::Signal {
+                signal: BuiltinSignal::ConnectionRestored,
+                ..
+            }) = r
+            {
+                restored_at.get_or_insert(fleet.time());
+            }
+        }
+        let t = fleet.telemetry(0).unwrap();
+        if t.position[0] > 300.5 {
+            assert!(!t.link, "linked out of reach at {}: {t:?}", fleet.time());
+        }
+    }
+    let back = restored_at.expect("the link comes back in reach");
+    assert!(back > 45.0, "{back}");
+    assert!(fleet.telemetry(0).unwrap().link);
+}

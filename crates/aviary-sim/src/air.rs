@@ -391,11 +391,13 @@ impl crate::fleet::Fleet {
         }
     }
 
-    /// The drain factor of drone `id` this tick (wind and capacity), 1 without `[air]`.
-    pub(crate) fn air_drain(&self, id: DroneId) -> Option<f64> {
+    /// The drain factor of drone `id` this tick (wind and capacity) and its capacity;
+    /// `None` without `[air]`.
+    pub(crate) fn air_drain(&self, id: DroneId) -> Option<(f64, f64)> {
         let air = self.air.as_deref()?;
         let d = &self.drones[id];
-        Some(air.drain_factor(id, [d.vel[0], d.vel[1]], d.spec.max_speed))
+        let factor = air.drain_factor(id, [d.vel[0], d.vel[1]], d.spec.max_speed);
+        Some((factor, air.drones[id].capacity))
     }
 
     /// The random faults of drone `id` due by its flight time, each fired and the next

@@ -68,6 +68,7 @@ impl Fleet {
         let name = self.names[id].to_owned();
         match kind {
             FaultKind::BatteryCritical => {
+                let capacity = self.capacity(id);
                 let d = &mut self.drones[id];
                 if d.critical_sent {
                     return;
@@ -76,7 +77,7 @@ impl Fleet {
                 d.low_sent = true;
                 // The charge falls to the critical level: what it needs to get home plus
                 // 10 % (never up), so that `drone.battery` reads what the fault says.
-                d.battery = d.battery.min(crate::battery::energy_home(d) + 0.10);
+                d.battery = d.battery.min(crate::battery::energy_home(d) / capacity + 0.10);
                 self.touch(id);
                 self.fault(
                     id,

@@ -262,6 +262,14 @@ fn capacities_spread_from_drone_to_drone() {
     run_for(&mut fleet, 100.0);
     let used = b0 - fleet.telemetry(0).unwrap().battery;
     assert!((used - 100.0 / 1800.0 / c).abs() < 1e-9, "{used} with capacity {c}");
+    // Its critical level is the way home as a part of its own capacity.
+    let fault = "[[faults]]\ndrone = \"d\"\nat = 60\nkind = \"battery_critical\"\n";
+    let mut fleet = up(&format!("{one}{fault}"), 9, 20.0);
+    let go = start(&mut fleet, 0, Function::FlyToPosition, &[pos(800.0, 800.0)]);
+    assert_eq!(run_until(&mut fleet, 0, go, 400.0).end, CallEnd::Interrupted);
+    let level = crate::battery::energy_home(&fleet.drones[0]) / c + 0.10;
+    let reading = fleet.telemetry(0).unwrap().battery;
+    assert!((reading - level).abs() < 1e-3 && (c - 1.0).abs() > 1e-3, "{reading} vs {level}");
 }
 
 /// Every report and telemetry of a flight in all the air there is.

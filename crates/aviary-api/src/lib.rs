@@ -108,6 +108,7 @@ impl Descriptor {
                 ("battery", Ratio),
                 ("state", Symbol),
                 ("link", Symbol),
+                ("wind", Speed),
                 // Not read from the backend's telemetry: the engine keeps what each drone's
                 // last Sweep or FollowPath left (docs/LANGUAGE.md, section 18).
                 ("remaining", Remainder),

@@ -77,6 +77,13 @@ pub struct Telemetry {
     pub battery: f64,
     pub state: FlightState,
     pub link: bool,
+    /// Where the drone's GPS says it is: what a mission reads as its `position` and
+    /// `altitude`. `position` plus the simulated GPS error (`[air.gps]`), the same as
+    /// `position` without one; the trace keeps the true `position`.
+    pub gps_position: [f64; 3],
+    /// The wind at the drone, `[east, north]` m/s (where it blows to), when it carries a
+    /// `wind` sensor and the backend knows the wind: `drone.wind` reads its speed.
+    pub wind: Option<[f64; 2]>,
 }
 
 impl Telemetry {
@@ -88,6 +95,8 @@ impl Telemetry {
         battery: 0.0,
         state: FlightState::Lost,
         link: false,
+        gps_position: [0.0; 3],
+        wind: None,
     };
 }
 

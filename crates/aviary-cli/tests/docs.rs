@@ -359,7 +359,14 @@ fn every_world_key_documented_is_read_and_every_key_read_is_documented() {
     // Tables that reject an unknown key: each documented key is accepted, and the
     // reader's own list of known keys is the documented one.
     type KeyInTable<'a> = (&'a str, &'a dyn Fn(&str) -> String);
-    let tables: [KeyInTable; 6] = [
+    let tables: [KeyInTable; 13] = [
+        ("`[air]`", &|k| format!("[air]\n{k} = 1\n")),
+        ("`[air.wind]`", &|k| format!("[air.wind]\n{k} = 1\n")),
+        ("`[air.radio]`", &|k| format!("[air.radio]\n{k} = 1\n")),
+        ("`[air.gps]`", &|k| format!("[air.gps]\n{k} = 1\n")),
+        ("`[air.detection]`", &|k| format!("[air.detection]\n{k} = 1\n")),
+        ("`[air.battery]`", &|k| format!("[air.battery]\n{k} = 1\n")),
+        ("A drone's `air`", &|k| format!("[drones.d]\nhome = [0, 0]\nair = {{ {k} = 1 }}\n")),
         ("`[site]`", &|k| format!("[site]\n{k} = 1\n")),
         ("`[no_fly.NAME]`", &|k| {
             format!("[no_fly.z]\npolygon = [[0, 0], [9, 0], [9, 9]]\n{k} = 1\n")

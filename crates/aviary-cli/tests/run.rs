@@ -396,3 +396,67 @@ fn a_drone_acting_on_its_own_is_in_the_trace_and_the_summary() {
         "{out}"
     );
 }
+
+/// The paper's world with every part of `[air]`.
+fn paper_in_the_air(dir: &std::path::Path) {
+    let world = std::fs::read_to_string(repo().join("examples/search_and_rescue.world.toml"))
+        .expect("the paper's world");
+    let air = "\n[air.wind]\nspeed = 4\nfrom = 250\nturbulence = \"light\"\n\n[air.gps]\nerror = 2\n\n[air.detection]\nfalloff = \"linear\"\n\n[air.battery]\ncapacity_spread = 0.05\n\n[air.faults]\ngps_loss = 1\n";
+    std::fs::write(dir.join("paper.world.toml"), world + air).unwrap();
+    let mission = std::fs::read_to_string(repo().join("examples/search_and_rescue.mission"))
+        .expect("the paper's mission");
+    std::fs::write(dir.join("paper.mission"), mission).unwrap();
+}
+
+#[test]
+fn with_air_the_same_seed_gives_the_same_trace_and_another_seed_another() {
+    let dir = scratch("air_determinism");
+    paper_in_the_air(&dir);
+    let one = |name| {
+        let trace = dir.join(name);
+        let args = ["run", "paper.mission", "--quiet", "--seed", "3", "--trace"];
+        let mut args: Vec<&str> = args.to_vec();
+        let t = trace.to_string_lossy().into_owned();
+        args.push(&t);
+        let (code, out, err) = aviary(&args, &dir);
+        assert!(code == 0 || code == 1, "{out}\n{err}");
+        std::fs::read(&trace).unwrap()
+    };
+    let (a, b) = (one("a.jsonl"), one("b.jsonl"));
+    assert!(a == b, "seed 3 gave two traces");
+    let other = dir.join("c.jsonl");
+    let t = other.to_string_lossy().into_owned();
+    let (code, _, err) =
+        aviary(&["run", "paper.mission", "--quiet", "--seed", "4", "--trace", &t], &dir);
+    assert!(code == 0 || code == 1, "{err}");
+    assert!(a != std::fs::read(&other).unwrap(), "seeds 3 and 4 gave one trace");
+}
+
+#[test]
+fn a_drone_with_a_wind_sensor_reads_the_wind() {
+    let dir = scratch("wind_reading");
+    std::fs::write(
+        dir.join("m.mission"),
+        "MISSION M:\n    d TakeOff WITH 20m\n    IF d.wind > 3m/s:\n        THROW EXCEPTION Windy\n",
+    )
+    .unwrap();
+    let air = "[air.wind]\nspeed = 5\nfrom = 90\n";
+    for (sensors, code, says) in
+        [("sensors = [\"wind\"]", 1, "unhandled exception Windy"), ("", 0, "mission ok")]
+    {
+        let world = format!("[drones.d]\nhome = [0, 0]\n{sensors}\n{air}");
+        std::fs::write(dir.join("m.world.toml"), world).unwrap();
+        let (got, out, err) = aviary(&["run", "m.mission"], &dir);
+        assert_eq!(got, code, "{sensors}: {out}\n{err}");
+        assert!(out.contains(says), "{out}");
+    }
+    // A wind faster than the drone: refused, nothing flown.
+    std::fs::write(
+        dir.join("m.world.toml"),
+        "[drones.d]\nhome = [0, 0]\n[air.wind]\nspeed = 12\nfrom = 90\n",
+    )
+    .unwrap();
+    let (got, out, err) = aviary(&["run", "m.mission"], &dir);
+    assert_eq!(got, 2, "{out}\n{err}");
+    assert!(err.contains("m.world.toml:4:9") && err.contains("a wind of 12 m/s"), "{err}");
+}

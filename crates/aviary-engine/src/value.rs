@@ -80,7 +80,7 @@ impl Env<'_> {
         match v {
             Value::Position(p) => [p.x, p.y],
             Value::Actor(d) => {
-                let p = self.backend.telemetry(*d).position;
+                let p = self.backend.telemetry(*d).gps_position;
                 [p[0], p[1]]
             }
             Value::Area(poly) => aviary_api::centroid(poly),
@@ -92,15 +92,20 @@ impl Env<'_> {
 fn telemetry(backend: &dyn Backend, d: usize, field: Field) -> Value {
     let t = backend.telemetry(d);
     match field {
-        Field::Position => {
-            Value::Position(Point { x: t.position[0], y: t.position[1], z: Some(t.position[2]) })
-        }
-        Field::Altitude => Value::Number(t.position[2]),
+        // What the GPS says: the true position plus its error, when the backend has one.
+        Field::Position => Value::Position(Point {
+            x: t.gps_position[0],
+            y: t.gps_position[1],
+            z: Some(t.gps_position[2]),
+        }),
+        Field::Altitude => Value::Number(t.gps_position[2]),
         Field::Speed => Value::Number(t.speed),
         Field::Heading => Value::Number(t.heading),
         Field::Battery => Value::Number(t.battery),
         Field::State => Value::Symbol(t.state.as_str().to_string()),
         Field::Link => Value::Symbol(if t.link { "Connected" } else { "Lost" }.to_string()),
+        // Without a wind sensor, as a drone without an attribute reads it.
+        Field::Wind => t.wind.map_or(Value::Bool(false), |w| Value::Number(w[0].hypot(w[1]))),
         // The engine's, not the backend's: read in `Env::eval`.
         Field::Remaining => Value::Bool(false),
     }

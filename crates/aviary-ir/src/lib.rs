@@ -356,6 +356,8 @@ pub enum Field {
     Battery,
     State,
     Link,
+    /// The wind's speed at the drone, read with its `wind` sensor.
+    Wind,
     /// What the drone's last `Sweep` or `FollowPath` left: the engine's, not telemetry.
     Remaining,
 }

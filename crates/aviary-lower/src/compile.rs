@@ -655,6 +655,7 @@ fn telemetry_field(name: &str) -> Option<Field> {
         "battery" => Field::Battery,
         "state" => Field::State,
         "link" => Field::Link,
+        "wind" => Field::Wind,
         "remaining" => Field::Remaining,
         _ => return None,
     })

@@ -346,8 +346,11 @@ impl Backend for MavlinkBackend {
         let state = c.state();
         let seen = c.v.seen();
         let fix = seen.fix;
+        let position = fix.map_or([c.home[0], c.home[1], 0.0], |f| f.pos);
         Telemetry {
-            position: fix.map_or([c.home[0], c.home[1], 0.0], |f| f.pos),
+            position,
+            gps_position: position,
+            wind: None,
             speed: fix.map_or(0.0, |f| f.speed),
             heading: fix.map_or(0.0, |f| f.heading),
             battery: seen.battery.unwrap_or(1.0),

@@ -46,26 +46,39 @@ fn time_home(ground: f64, d: &SimDrone) -> f64 {
 }
 
 /// Drains `dt` seconds of flight (when `airborne`) and raises each alarm at most once.
+/// `air` (with `[air]`): the drain's factor this tick, for the wind and the battery's
+/// capacity (`crate::air::AirState::drain_factor`), and that capacity, as a fraction of
+/// the nominal one: the energy home is a larger part of a smaller battery.
 // `!(a >= b)` on purpose: a NaN charge or bound counts as "may be due", never as safe.
 #[allow(clippy::neg_cmp_op_on_partial_ord)]
-pub(crate) fn drain(d: &mut SimDrone, dt: f64, airborne: bool) -> Alarms {
+pub(crate) fn drain(d: &mut SimDrone, dt: f64, airborne: bool, air: Option<(f64, f64)>) -> Alarms {
     let mut alarms = Alarms { low: false, critical: false, empty: false };
     if !airborne {
         return alarms;
     }
-    d.battery -= dt / d.spec.endurance;
+    // Without `[air]` a capacity of exactly 1: dividing by it changes no bit.
+    let capacity = match air {
+        None => {
+            d.battery -= dt / d.spec.endurance;
+            1.0
+        }
+        Some((k, capacity)) => {
+            d.battery -= dt * k / d.spec.endurance;
+            capacity
+        }
+    };
     if d.battery <= 0.0 {
         d.battery = 0.0;
         alarms.empty = true;
     }
     // Most ticks the bound shows that neither alarm can be due: no square root.
-    let bound = energy_home_bound(d);
+    let bound = energy_home_bound(d) / capacity;
     let may = |k: f64| !(d.battery >= k * bound + 0.10);
     let maybe_due = (!d.low_sent && may(2.0)) || (!d.critical_sent && may(1.0));
     if !maybe_due {
         return alarms;
     }
-    let need = energy_home(d);
+    let need = energy_home(d) / capacity;
     if !d.low_sent && d.battery < 2.0 * need + 0.10 {
         d.low_sent = true;
         alarms.low = true;

@@ -164,7 +164,17 @@ impl Fleet {
         let detections = &mut d.rare_mut().detections;
         detections.retain(|a| a.kind != kind);
         if start {
-            detections.push(Activation { kind, range, probability, found: Vec::new() });
+            let falloff = self.air.as_ref().and_then(|a| a.falloff.clone());
+            let d = &mut self.drones[id];
+            let detections = &mut d.rare_mut().detections;
+            detections.push(Activation {
+                kind,
+                range,
+                probability,
+                found: Vec::new(),
+                falloff,
+                pending: Vec::new(),
+            });
         }
         Ok(Start::Done)
     }

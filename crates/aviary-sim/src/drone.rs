@@ -227,6 +227,8 @@ impl SimDrone {
             battery: self.battery,
             state: self.state,
             link: self.link_loss().is_none(),
+            gps_position: self.pos,
+            wind: None,
         }
     }
 

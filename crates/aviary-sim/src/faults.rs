@@ -2,7 +2,9 @@
 //! the fleet was made), each once. A fault whose `at` is a range `[earliest, latest]`
 //! happens at a time drawn uniformly from it, from the run's seed ([`Fleet::seeded`]).
 //!
-//! - `battery_critical`: `BatteryCritical` (counts as the drone's one battery alarm).
+//! - `battery_critical`: `BatteryCritical` (counts as the drone's one battery alarm); the
+//!   charge falls to the critical level, what the drone needs to get home plus 10 % (if
+//!   it had more), so that the mission reads it in `drone.battery`.
 //! - `crash`: the drone falls (`DroneLost`), as when its battery runs out.
 //! - `motor_failure`: `MotorFailure`; the drone makes an emergency landing where it is and
 //!   refuses every later command.
@@ -55,16 +57,28 @@ impl Fleet {
 
     /// One fault on drone `id`, which is not lost; a link or GPS loss lasts from `at` to
     /// `until`.
-    fn fire(&mut self, id: DroneId, kind: FaultKind, at: f64, until: f64, out: &mut Vec<Report>) {
+    pub(crate) fn fire(
+        &mut self,
+        id: DroneId,
+        kind: FaultKind,
+        at: f64,
+        until: f64,
+        out: &mut Vec<Report>,
+    ) {
         let name = self.names[id].to_owned();
         match kind {
             FaultKind::BatteryCritical => {
+                let capacity = self.capacity(id);
                 let d = &mut self.drones[id];
                 if d.critical_sent {
                     return;
                 }
                 d.critical_sent = true;
                 d.low_sent = true;
+                // The charge falls to the critical level: what it needs to get home plus
+                // 10 % (never up), so that `drone.battery` reads what the fault says.
+                d.battery = d.battery.min(crate::battery::energy_home(d) / capacity + 0.10);
+                self.touch(id);
                 self.fault(
                     id,
                     BuiltinException::BatteryCritical,
@@ -75,16 +89,7 @@ impl Fleet {
             FaultKind::Crash => self.lose(id, format!("{name} crashed (simulated fault)"), out),
             FaultKind::MotorFailure => self.motor_failure(id, &name, out),
             FaultKind::LinkLoss => {
-                self.fault(
-                    id,
-                    BuiltinException::ConnectionLost,
-                    format!("{name}: link lost (simulated fault)"),
-                    out,
-                );
-                self.drones[id].rare_mut().link_loss =
-                    Some(Outage { since: at, until, returned: false });
-                self.outage(id);
-                self.on_its_own(id, AutopilotAction::Hold, "link lost: holds where it is", out);
+                self.lose_link(id, at, until, format!("{name}: link lost (simulated fault)"), out)
             }
             FaultKind::GpsLoss => {
                 self.fault(
@@ -99,6 +104,22 @@ impl Fleet {
                 self.on_its_own(id, AutopilotAction::Hold, "GPS lost: holds where it is", out);
             }
         }
+    }
+
+    /// The link of drone `id` is lost from `at` to `until` (`ConnectionLost`): it holds,
+    /// and returns on its own after `link_loss_rtl_after`.
+    pub(crate) fn lose_link(
+        &mut self,
+        id: DroneId,
+        at: f64,
+        until: f64,
+        reason: String,
+        out: &mut Vec<Report>,
+    ) {
+        self.fault(id, BuiltinException::ConnectionLost, reason, out);
+        self.drones[id].rare_mut().link_loss = Some(Outage { since: at, until, returned: false });
+        self.outage(id);
+        self.on_its_own(id, AutopilotAction::Hold, "link lost: holds where it is", out);
     }
 
     /// `MotorFailure`: the drone refuses every later command, and, in the air, lands
@@ -185,7 +206,7 @@ impl Fleet {
     }
 
     /// Notes that drone `id` has an outage (the list stays ascending, without repeats).
-    fn outage(&mut self, id: usize) {
+    pub(crate) fn outage(&mut self, id: usize) {
         if let Err(at) = self.outages.binary_search(&id) {
             self.outages.insert(at, id);
         }

@@ -8,6 +8,7 @@ use std::sync::Arc;
 use aviary_api::{CallEnd, CallId, DroneEvent, DroneId, Function, Interrupt, Telemetry, Value};
 use aviary_world::{FaultKind, Sensor, Target, World};
 
+use crate::air::AirState;
 use crate::avoid::Track;
 use crate::clearance::Clearance;
 use crate::drone::{SimDrone, Spec};
@@ -104,6 +105,11 @@ pub struct Fleet {
     /// [`Fleet::interrupt`] looks at one drone, not the fleet. Entries go when the call's
     /// end is reported; one left over (a task replaced without an end) only costs a lookup.
     pub(crate) calls: HashMap<CallId, DroneId>,
+    /// `[air]`: wind, radio, GPS noise, detection's falloff, capacities and random
+    /// faults; `None` in a world without it, which then flies as in still air.
+    pub(crate) air: Option<Box<AirState>>,
+    /// Scratch for the radio's looks: where each drone is, and who is linked.
+    pub(crate) radio_scratch: (Vec<Option<[f64; 2]>>, Vec<bool>),
 }
 
 /// Metres on a side of a cell of [`Fleet::sky`]: about the planner's reach.
@@ -185,11 +191,15 @@ impl Fleet {
     }
 
     /// The fleet, with `seed` the run's seed, from which every chance the world asks for
-    /// is drawn (a fault's time within its range now; a sensor's detections as the drones
-    /// fly). Without it, a fleet's seed is 0. A world that asks for no chance runs the same
+    /// is drawn (a fault's time within its range, and with `[air]` each drone's capacity,
+    /// first GPS error and first random fault times, now; a sensor's detections, gusts,
+    /// GPS drift and later faults as the drones fly). Without it, a fleet's seed is 0. A world that asks for no chance runs the same
     /// whatever the seed.
     pub fn seeded(mut self, seed: u64) -> Fleet {
         self.seed = seed;
+        if let Some(air) = self.air.as_deref_mut() {
+            air.reseed(seed);
+        }
         for (j, f) in self.faults.iter_mut().enumerate() {
             if let Some([earliest, latest]) = f.window {
                 let u = Stream::new(seed, Purpose::FaultTime, j).uniform();
@@ -245,6 +255,8 @@ impl Fleet {
             near_targets: vec![None; world.drones.len()],
             calls: HashMap::new(),
             seed: 0,
+            air: AirState::of(world, 0).map(Box::new),
+            radio_scratch: (Vec::new(), Vec::new()),
         };
         fleet.seeded(0)
     }
@@ -264,7 +276,30 @@ impl Fleet {
 
     /// The drone's state now; `None` for an index the world does not have.
     pub fn telemetry(&self, drone: DroneId) -> Option<Telemetry> {
-        self.drones.get(drone).map(SimDrone::telemetry)
+        let mut t = self.drones.get(drone).map(SimDrone::telemetry)?;
+        if let Some(a) = self.air.as_deref().and_then(|air| air.drones.get(drone)) {
+            t.gps_position[0] += a.gps[0];
+            t.gps_position[1] += a.gps[1];
+            if a.anemometer && self.air.as_ref().is_some_and(|air| air.wind.is_some()) {
+                // On the ground it reads the mean wind; in the air, with the gusts.
+                t.wind = Some(a.wind);
+            }
+        }
+        Some(t)
+    }
+
+    /// The wind a drone flies in now (`[east, north]` m/s, mean and gusts), with
+    /// `[air.wind]`.
+    pub fn wind(&self, drone: DroneId) -> Option<[f64; 2]> {
+        let air = self.air.as_deref()?;
+        air.wind.as_ref()?;
+        air.drones.get(drone).map(|a| a.wind)
+    }
+
+    /// The fraction of its nominal capacity that the drone's battery holds
+    /// (`[air.battery] capacity_spread`; 1 without it).
+    pub fn capacity(&self, drone: DroneId) -> f64 {
+        self.air.as_deref().and_then(|a| a.drones.get(drone)).map_or(1.0, |a| a.capacity)
     }
 
     /// (metres flown, seconds in the air) of the drone so far; zeros for an index the

@@ -33,9 +33,12 @@
 //!   centripetal acceleration stays within half of `acceleration`.
 //! - A pause or an abort stops the drone at once, where it is; it then hovers.
 //! - No wind, no sensor noise, no obstacles, no terrain: the ground is z = 0 everywhere.
-//!   Drones keep their separation from each other (below), nothing else.
+//!   Drones keep their separation from each other (below), nothing else. The world's
+//!   `[air]` adds wind with Dryden gusts, a radio's reach with relays, GPS noise, a
+//!   detection chance that falls with range, spread capacities and random faults (the
+//!   `air` module; docs/CAMPAIGNS.md, "The models"); without it, none of them.
 //! - The battery drains only in the air, linearly in time (`1 / endurance` of a full
-//!   battery per second, whatever the drone does).
+//!   battery per second, whatever the drone does; in a wind, more with the airspeed).
 //! - Sensors see every target of their kinds within their range of the drone's ground
 //!   point, whatever the altitude, checked along the way flown in each step; a sensor with
 //!   a `probability` below 1 finds each with that chance, drawn once as it comes within
@@ -146,6 +149,7 @@
 //! the last `Arc<SimBackend>` is dropped. Simulated time equals tokio time since the start
 //! (as long as the runtime keeps up, as it does with a paused clock).
 
+mod air;
 mod args;
 mod avoid;
 mod backend;

@@ -1,9 +1,10 @@
 //! The simulator's randomness: only where the world asks for it (a sensor's
-//! `probability` below 1, a fault whose `at` is a range), and all of it drawn from the
+//! `probability` below 1, a fault whose `at` is a range, the parts of `[air]`), and all of it drawn from the
 //! run's seed, so that the same world, calls and seed give the same run.
 //!
 //! Each thing that draws has a stream of its own: a drone's detections (in the order the
-//! drone meets the targets) and each fault's time. A stream is ChaCha8 (`rand_chacha`),
+//! drone meets the targets), each fault's time, and, with `[air]`, a drone's gusts, its
+//! GPS error, its battery's capacity and each kind of its random faults. A stream is ChaCha8 (`rand_chacha`),
 //! with the key the seed's 8 bytes, little-endian, then 24 zero bytes, and the stream
 //! number `purpose << 56 | index` (a drone's or fault's index in the world file). Nothing
 //! one stream draws moves another, so the draws depend on neither the order drones are
@@ -22,6 +23,15 @@ pub(crate) enum Purpose {
     Detection = 1,
     /// The time of fault `index` (of the world's `[[faults]]`, in file order).
     FaultTime = 2,
+    /// Drone `index`'s turbulence (`[air.wind] turbulence`).
+    Gusts = 3,
+    /// Drone `index`'s GPS error (`[air.gps]`).
+    Gps = 4,
+    /// Drone `index`'s battery capacity (`[air.battery]`).
+    Capacity = 5,
+    /// The random faults of one kind on one drone (`[air.faults]`): index
+    /// `drone * 8 + the kind's place in FaultKind::ALL`.
+    RandomFault = 6,
 }
 
 /// One stream of numbers.
@@ -40,6 +50,27 @@ impl Stream {
     /// A number drawn uniformly from [0, 1).
     pub fn uniform(&mut self) -> f64 {
         (self.0.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// A number drawn from the standard normal distribution: the first of
+    /// [`Stream::normals`] (the second is not kept).
+    pub fn normal(&mut self) -> f64 {
+        self.normals()[0]
+    }
+
+    /// Two independent numbers of the standard normal distribution, from two uniform ones
+    /// (Box-Muller).
+    pub fn normals(&mut self) -> [f64; 2] {
+        let (u1, u2) = (self.uniform(), self.uniform());
+        let r = (-2.0 * (1.0 - u1).ln()).sqrt();
+        let (sin, cos) = (std::f64::consts::TAU * u2).sin_cos();
+        [r * cos, r * sin]
+    }
+
+    /// A waiting time drawn from the exponential distribution of mean `1 / rate`
+    /// (infinite for a rate of 0).
+    pub fn exponential(&mut self, rate: f64) -> f64 {
+        -(1.0 - self.uniform()).ln() / rate
     }
 }
 
@@ -62,6 +93,28 @@ mod tests {
             pinned,
             [0.2564602688623301, 0.40111649128647275, 0.7186812048897427, 0.2898587291835939]
         );
+    }
+
+    #[test]
+    fn normals_have_mean_zero_and_spread_one() {
+        let mut s = Stream::new(7, Purpose::Gps, 3);
+        let draws: Vec<f64> = (0..10_000).flat_map(|_| s.normals()).collect();
+        let mean = draws.iter().sum::<f64>() / draws.len() as f64;
+        let var = draws.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / draws.len() as f64;
+        assert!(mean.abs() < 0.03, "{mean}");
+        assert!((var - 1.0).abs() < 0.04, "{var}");
+        let within = draws.iter().filter(|x| x.abs() < 1.0).count() as f64 / draws.len() as f64;
+        assert!((within - 0.6827).abs() < 0.015, "{within}");
+    }
+
+    #[test]
+    fn exponential_waits_have_mean_one_over_rate() {
+        let mut s = Stream::new(7, Purpose::RandomFault, 9);
+        let draws: Vec<f64> = (0..20_000).map(|_| s.exponential(0.5)).collect();
+        let mean = draws.iter().sum::<f64>() / draws.len() as f64;
+        assert!((mean - 2.0).abs() < 0.06, "{mean}");
+        assert!(draws.iter().all(|&t| t >= 0.0));
+        assert!(Stream::new(1, Purpose::RandomFault, 0).exponential(0.0).is_infinite());
     }
 
     #[test]

@@ -46,6 +46,10 @@ pub(crate) struct MotionTask {
     /// reached, so that where it stops says which point it was flying to
     /// ([`SimDrone::note_stop`]).
     pub path: Option<PathTrack>,
+    /// The wind at the drone this tick, `[east, north]` m/s, with `[air.wind]` (set by the
+    /// fleet before each tick): it limits the speed over the ground (the wind triangle,
+    /// `crate::air::ground_speed_limit`). `None`: still air, no limit but the leg's.
+    pub wind: Option<[f64; 2]>,
 }
 
 /// The points of a `Sweep`'s or `FollowPath`'s path (the contract's, `aviary_api::coverage`)
@@ -95,6 +99,7 @@ impl MotionTask {
             held: 0.0,
             best: (usize::MAX, u8::MAX, f64::INFINITY),
             path: None,
+            wind: None,
         }
     }
 
@@ -137,7 +142,6 @@ impl SimDrone {
     /// The legs of the task: speeds along the path scaled by `scale` (when yielding), and,
     /// when `owns_z`, the altitude left to [`SimDrone::steer_altitude`] and no leg ending.
     fn tick_task(&mut self, dt: f64, scale: Option<f64>, owns_z: bool) -> Option<MotionTask> {
-        let tick = Tick { dt, scale, owns_z };
         let Some(task) = self.motion.as_mut() else {
             self.vel = [0.0; 3];
             return None;
@@ -146,6 +150,8 @@ impl SimDrone {
             self.vel = [0.0; 3];
             return None;
         }
+        let wind = task.wind.map(|w| (w, self.spec.max_speed));
+        let tick = Tick { dt, scale, owns_z, wind };
         let mut body = Body { pos: &mut self.pos, vel: &mut self.vel, spec: &self.spec };
         let done = match task.legs.front_mut() {
             None => true,
@@ -159,13 +165,14 @@ impl SimDrone {
             }
             Some(&mut Leg::Arc { center, radius, start, total, speed }) => {
                 let left = (total - task.arc_done) * radius;
-                let step = advance(
-                    left,
-                    task.arc_speed,
-                    tick.limit(speed),
-                    arc_accel(body.spec.accel),
-                    dt,
-                );
+                let limit = match tick.wind {
+                    None => tick.limit(speed),
+                    Some(_) => {
+                        let theta = start - task.arc_done;
+                        tick.along([theta.sin(), -theta.cos()], speed)
+                    }
+                };
+                let step = advance(left, task.arc_speed, limit, arc_accel(body.spec.accel), dt);
                 task.arc_speed = step.speed;
                 task.arc_done =
                     if step.arrived { total } else { task.arc_done + step.moved / radius };
@@ -217,12 +224,23 @@ struct Tick {
     dt: f64,
     scale: Option<f64>,
     owns_z: bool,
+    /// The wind and the drone's airspeed at most (`max_speed`), with `[air.wind]`.
+    wind: Option<([f64; 2], f64)>,
 }
 
 impl Tick {
     /// A speed limit of the path, scaled while yielding.
     fn limit(self, v: f64) -> f64 {
         self.scale.map_or(v, |s| v * s)
+    }
+
+    /// The speed limit over the ground along the unit direction `u`: the path's, and, in
+    /// a wind, no more than the drone's airspeed allows that way.
+    fn along(self, u: [f64; 2], v: f64) -> f64 {
+        match self.wind {
+            None => self.limit(v),
+            Some((w, va)) => self.limit(v.min(crate::air::ground_speed_limit(u, w, va))),
+        }
     }
 }
 
@@ -246,7 +264,11 @@ impl Body<'_> {
     ) -> bool {
         let here = [self.pos[0], self.pos[1]];
         let d = geom::dist(here, [to[0], to[1]]);
-        let h = advance(d, task.ground_speed, tick.limit(speed), self.spec.accel, tick.dt);
+        let limit = match tick.wind {
+            Some(_) if d > 0.0 => tick.along([(to[0] - here[0]) / d, (to[1] - here[1]) / d], speed),
+            _ => tick.limit(speed),
+        };
+        let h = advance(d, task.ground_speed, limit, self.spec.accel, tick.dt);
         task.ground_speed = h.speed;
         if h.arrived {
             self.pos[0] = to[0];

@@ -3,6 +3,13 @@
 //! `probability` below 1 finds it only with that chance, drawn once, when the target first
 //! comes within range (a target missed stays missed until detection of its kind starts
 //! again); with 1, nothing is drawn.
+//!
+//! With `[air.detection] falloff` the chance falls with the distance `d` from the drone's
+//! ground point: `p(d) = probability * falloff(d / range)`. The one number `u` drawn when
+//! a target first comes within range decides, for the whole activation, the distance
+//! within which it is found: the largest `d` with `p(d) > u`. So a target whose nearest
+//! pass is at `d` is found with the chance `p(d)`, found where the drone comes that near,
+//! and a constant falloff is the hard range of before.
 
 use aviary_api::{DroneEvent, DroneId};
 use aviary_world::{Sensor, Target};
@@ -22,6 +29,13 @@ pub(crate) struct Activation {
     /// few, where a flag per target would cost every drone as much memory as the world
     /// has targets.
     pub found: Vec<usize>,
+    /// `[air.detection] falloff`: the chance falls with the distance, from `probability`
+    /// at 0 m to the curve's value at the range.
+    pub falloff: Option<std::sync::Arc<aviary_world::Falloff>>,
+    /// With a falloff: the targets of `found` not yet found, each with the distance within
+    /// which it will be (its draw `u` against the curve: found where
+    /// `probability * falloff(d / range) > u`), ascending by target.
+    pub pending: Vec<(usize, f64)>,
 }
 
 /// The range at which a drone with `sensors` detects `kind`, and the chance it finds a
@@ -70,22 +84,51 @@ pub(crate) fn scan(
             if at[0] < lo[0] || at[0] > hi[0] || at[1] < lo[1] || at[1] > hi[1] {
                 continue;
             }
-            let Err(place) = act.found.binary_search(&i) else { continue };
+            let place = match act.found.binary_search(&i) {
+                Err(place) => place,
+                Ok(_) if act.pending.is_empty() => continue,
+                Ok(_) => {
+                    // Drawn already: found once the drone comes within its distance.
+                    let Ok(p) = act.pending.binary_search_by_key(&i, |&(t, _)| t) else {
+                        continue;
+                    };
+                    if dist_to_segment(at, from, to) <= act.pending[p].1 {
+                        act.pending.remove(p);
+                        events.push(found(drone, &act.kind, at));
+                    }
+                    continue;
+                }
+            };
             if target.kind != act.kind {
                 continue;
             }
-            if dist_to_segment(at, from, to) <= act.range {
+            let gap = dist_to_segment(at, from, to);
+            if gap <= act.range {
                 act.found.insert(place, i);
-                if act.probability < 1.0 && draw() >= act.probability {
+                if let Some(falloff) = &act.falloff {
+                    let u = draw();
+                    let Some(reach) = (u < act.probability)
+                        .then(|| falloff.reach(u / act.probability))
+                        .flatten()
+                        .map(|f| f * act.range)
+                    else {
+                        continue;
+                    };
+                    if gap > reach {
+                        let p = act.pending.partition_point(|&(t, _)| t < i);
+                        act.pending.insert(p, (i, reach));
+                        continue;
+                    }
+                } else if act.probability < 1.0 && draw() >= act.probability {
                     continue;
                 }
-                events.push(DroneEvent::Detected {
-                    drone,
-                    kind: act.kind.clone(),
-                    location: [at[0], at[1], 0.0],
-                });
+                events.push(found(drone, &act.kind, at));
             }
         }
     }
     events
+}
+
+fn found(drone: DroneId, kind: &str, at: [f64; 2]) -> DroneEvent {
+    DroneEvent::Detected { drone, kind: kind.to_owned(), location: [at[0], at[1], 0.0] }
 }

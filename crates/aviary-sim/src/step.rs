@@ -28,6 +28,9 @@ impl Fleet {
     pub fn step(&mut self, dt: f64) -> Vec<Report> {
         let end = self.time + dt;
         let mut out = Vec::new();
+        if self.air.is_some() {
+            self.air_before(end, dt, &mut out);
+        }
         self.fire_faults(end, &mut out);
         #[cfg(test)]
         self.check_hot();
@@ -123,6 +126,9 @@ impl Fleet {
         let airborne = self.drones[id].state.airborne();
         let from = self.drones[id].xy();
         let before = self.drones[id].pos;
+        if self.air.is_some() {
+            self.air_wind(id, dt);
+        }
         let finished = self.move_drone(id, dt);
         if finished.is_none() {
             if let Some(report) = self.held_back(id, dt) {
@@ -151,6 +157,9 @@ impl Fleet {
         }
         self.detect_along(id, from, to, out);
         self.drain_battery(id, dt, airborne, out);
+        if airborne && self.air.is_some() {
+            self.air_faults(id, self.time + dt, out);
+        }
     }
 
     /// Detection along the way drone `id` flew in this tick, from `from` to `to`.
@@ -182,8 +191,9 @@ impl Fleet {
     /// The battery drained by a tick of `dt`, and the alarms it raises: `BatteryLow`,
     /// `BatteryCritical`, and a drone lost when it is empty.
     fn drain_battery(&mut self, id: DroneId, dt: f64, airborne: bool, out: &mut Vec<Report>) {
+        let factor = if airborne { self.air_drain(id) } else { None };
         let d = &mut self.drones[id];
-        let alarms = battery::drain(d, dt, airborne);
+        let alarms = battery::drain(d, dt, airborne, factor);
         if alarms.low {
             out.push(Report::Event(DroneEvent::Signal {
                 drone: id,

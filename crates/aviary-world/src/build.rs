@@ -9,6 +9,7 @@ use crate::node::{Entry, Node, Value};
 use crate::read::{suggest, Ctx};
 use crate::{Area, Geo, Place, Site, World};
 
+mod air;
 mod drone;
 mod fleet;
 mod no_fly;
@@ -17,8 +18,9 @@ mod sim;
 use drone::Drones;
 use fleet::FleetInfo;
 
-const TABLES: &[&str] =
-    &["site", "places", "areas", "no_fly", "drones", "fleets", "sensors", "targets", "faults"];
+const TABLES: &[&str] = &[
+    "site", "places", "areas", "no_fly", "drones", "fleets", "sensors", "targets", "faults", "air",
+];
 const SITE_KEYS: &[&str] = &[
     "name",
     "origin",
@@ -153,6 +155,9 @@ fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Dia
     if let Some(e) = table("faults") {
         world.faults = sim::faults(cx, &e.node, &drones.names());
     }
+    if let Some(e) = table("air") {
+        world.air = air::air(cx, &e.node);
+    }
     let group_spans = std::mem::take(&mut drones.group_spans);
     world.groups = std::mem::take(&mut drones.groups);
     world.drones = std::mem::take(&mut drones.out);
@@ -160,6 +165,7 @@ fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Dia
     homes_in_fence(cx, &world, &drones.fleets);
     no_fly::homes_outside_zones(cx, &world, &drones.fleets);
     unique_names(cx, &world, &group_spans);
+    air::wind_within_reach(cx, &world);
     (world, std::mem::take(&mut cx.diags))
 }
 

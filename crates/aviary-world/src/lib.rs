@@ -25,8 +25,9 @@ use aviary_diagnostics::{Diagnostic, FileId, Span};
 use serde::Serialize;
 
 /// Sensor kinds a drone may list without a `[sensors.KIND]` table: the video camera,
-/// which streams and detects nothing.
-pub const BUILTIN_SENSORS: &[&str] = &["camera"];
+/// which streams and detects nothing,
+/// and the anemometer, `wind`, with which a drone reads the wind (`drone.wind`).
+pub const BUILTIN_SENSORS: &[&str] = &["camera", "wind"];
 
 /// Reads a world file. Returns the world only when there are no errors; the diagnostics
 /// are sorted by position.
@@ -51,6 +52,9 @@ pub struct World {
     pub sensors: Vec<Sensor>,
     pub targets: Vec<Target>,
     pub faults: Vec<Fault>,
+    /// `[air]`: the simulator's wind, radio, GPS noise, detection curve, battery spread
+    /// and random faults, each off unless declared (docs/WORLD.md).
+    pub air: Air,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -211,6 +215,9 @@ pub struct Drone {
     /// Every other key, in file order: readable as `d.key`. Keys are shared by the
     /// drones that have them.
     pub attributes: Box<[(Arc<str>, AttributeValue)]>,
+    /// The drone's own `air` table: what it changes of `[air]` for this drone (a relay,
+    /// its GPS, its fault rates); `None` for most drones.
+    pub air: Option<Box<DroneAir>>,
     /// The `NAME` of `[drones.NAME]`.
     #[serde(skip)]
     pub span: Span,
@@ -355,6 +362,159 @@ impl FaultKind {
     }
 }
 
+/// `[air]`: the air a simulated mission flies in. Every part is off (`None`, empty)
+/// unless the world declares it; a world without `[air]` flies as in still, perfect air.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct Air {
+    pub wind: Option<Wind>,
+    pub radio: Option<Radio>,
+    pub gps: Option<Gps>,
+    pub detection: Option<Falloff>,
+    /// `[air.battery] capacity_spread`: the 1-sigma spread of a drone's capacity, as a
+    /// fraction of its nominal capacity.
+    pub capacity_spread: Option<f64>,
+    /// `[air.faults]`: each kind's rate per flight hour, in `FaultKind::ALL` order.
+    pub faults: Vec<RandomFault>,
+}
+
+impl Air {
+    /// Whether the world declares any part of the air.
+    pub fn is_still(&self) -> bool {
+        *self == Air::default()
+    }
+}
+
+/// `[air.wind]`: a mean wind, the same everywhere and at every height, and optional
+/// Dryden turbulence (MIL-F-8785C).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Wind {
+    /// Mean speed, m/s.
+    pub speed: f64,
+    /// Where it blows from, degrees clockwise from north (meteorology's convention: a
+    /// wind `from = 270` is a west wind, blowing east).
+    pub from: f64,
+    /// The turbulence's wind speed at 20 ft (W20 of MIL-F-8785C), m/s; `None`: no gusts.
+    pub turbulence: Option<f64>,
+    /// How much the drain grows with airspeed: power is `P(v) = P0 (1 + k (v / max_speed)^2)`.
+    pub drain: f64,
+    /// The `speed` value.
+    #[serde(skip)]
+    pub span: Span,
+}
+
+impl Wind {
+    /// The mean wind's velocity over the ground, `[east, north]` m/s (where it blows to).
+    pub fn velocity(&self) -> [f64; 2] {
+        let rad = self.from.to_radians();
+        [-self.speed * rad.sin(), -self.speed * rad.cos()]
+    }
+}
+
+/// `[air.radio]`: the ground station's radio.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Radio {
+    /// Where the station stands, `[x, y]` m.
+    pub station: [f64; 2],
+    /// How far it reaches, over the ground, m.
+    pub range: f64,
+    /// Seconds between two looks at who is in reach.
+    pub every: f64,
+}
+
+/// `[air.gps]`: the error of the position a mission reads, a first-order Gauss-Markov
+/// process per horizontal axis.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Gps {
+    /// 1-sigma error per axis, m.
+    pub error: f64,
+    /// The error's correlation time, s.
+    pub correlation: f64,
+}
+
+/// `[air.detection] falloff`: how a sensor's chance falls from its `probability` at 0 m
+/// to its range.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub enum Falloff {
+    /// From `probability` at 0 m to 0 at the range.
+    Linear,
+    /// `[[fraction of the range, factor of the probability], ...]`, straight between the
+    /// points: fractions rising from 0 to 1, factors from 1 never rising.
+    Curve(Vec<[f64; 2]>),
+}
+
+impl Falloff {
+    /// The factor of the probability at `fraction` of the range (0 beyond it).
+    pub fn factor(&self, fraction: f64) -> f64 {
+        if !(0.0..=1.0).contains(&fraction) {
+            return if fraction < 0.0 { 1.0 } else { 0.0 };
+        }
+        match self {
+            Falloff::Linear => 1.0 - fraction,
+            Falloff::Curve(points) => {
+                for w in points.windows(2) {
+                    let ([x0, y0], [x1, y1]) = (w[0], w[1]);
+                    if fraction <= x1 {
+                        let t = if x1 > x0 { (fraction - x0) / (x1 - x0) } else { 1.0 };
+                        return y0 + t * (y1 - y0);
+                    }
+                }
+                points.last().map_or(0.0, |p| p[1])
+            }
+        }
+    }
+
+    /// The largest fraction of the range at which the factor is still above `level`
+    /// (`None`: nowhere): a target is found within it.
+    pub fn reach(&self, level: f64) -> Option<f64> {
+        if self.factor(0.0) <= level {
+            return None;
+        }
+        match self {
+            Falloff::Linear => Some(1.0 - level),
+            Falloff::Curve(points) => {
+                let mut last = 0.0;
+                for w in points.windows(2) {
+                    let ([x0, y0], [x1, y1]) = (w[0], w[1]);
+                    if y1 > level {
+                        last = x1;
+                        continue;
+                    }
+                    // y0 > level >= y1: where the segment crosses the level.
+                    return Some(if y0 > y1 {
+                        x0 + (y0 - level) / (y0 - y1) * (x1 - x0)
+                    } else {
+                        x0
+                    });
+                }
+                Some(last)
+            }
+        }
+    }
+}
+
+/// One kind of `[air.faults]`: how often it happens, per hour of flight.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RandomFault {
+    pub kind: FaultKind,
+    /// Per flight hour.
+    pub rate: f64,
+    /// Seconds, for `link_loss` and `gps_loss`.
+    pub duration: Option<f64>,
+}
+
+/// A drone's own `air` table.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct DroneAir {
+    /// It relays the station's link to drones in its reach.
+    pub relay: bool,
+    /// Its radio's reach as a relay, m; `None`: the station's.
+    pub range: Option<f64>,
+    /// Its GPS's 1-sigma error, m, instead of `[air.gps] error`.
+    pub gps_error: Option<f64>,
+    /// Its fault rates, instead of those of `[air.faults]` for these kinds.
+    pub faults: Vec<RandomFault>,
+}
+
 impl World {
     pub fn drone(&self, name: &str) -> Option<&Drone> {
         self.drones.iter().find(|d| d.name == name)
@@ -394,6 +554,7 @@ impl Default for World {
             sensors: Vec::new(),
             targets: Vec::new(),
             faults: Vec::new(),
+            air: Air::default(),
         }
     }
 }

@@ -770,3 +770,71 @@ fn a_world_of_many_drone_tables() {
     assert_eq!(world.drones[499].name, "a499");
     assert_eq!(world.groups.iter().map(|g| g.members.len()).collect::<Vec<_>>(), [167, 167, 166]);
 }
+
+#[test]
+fn a_world_without_air_is_still_and_the_mean_wind_is_where_it_blows_to() {
+    assert!(ok("[drones.d]\nhome = [0, 0]\n").air.is_still());
+    let w = ok("[drones.d]\nhome = [0, 0]\n[air.wind]\nspeed = 5\nfrom = 270\n");
+    let wind = w.air.wind.expect("a wind");
+    // A west wind blows east.
+    let v = wind.velocity();
+    assert!((v[0] - 5.0).abs() < 1e-12 && v[1].abs() < 1e-12, "{v:?}");
+    assert_eq!((wind.turbulence, wind.drain), (None, 0.5));
+    let north = ok("[drones.d]\nhome = [0, 0]\n[air.wind]\nspeed = 2\nfrom = 0\n");
+    let v = north.air.wind.expect("a wind").velocity();
+    assert!(v[0].abs() < 1e-12 && (v[1] + 2.0).abs() < 1e-12, "{v:?}");
+    // A wind of 0 needs no direction.
+    assert!(ok("[drones.d]\nhome = [0, 0]\n[air.wind]\nspeed = 0\n").air.wind.is_some());
+}
+
+#[test]
+fn a_fleets_air_is_each_of_its_drones() {
+    let w = ok("[fleets.r]\ncount = 3\nhomes = { grid = [0, 0], spacing = 10 }\nair = { relay = true, range = 400 }\n");
+    assert!(w
+        .drones
+        .iter()
+        .all(|d| d.air.as_deref().is_some_and(|a| a.relay && a.range == Some(400.0))));
+    let w = ok(
+        "[drones.d]\nhome = [0, 0]\n[drones.d.air]\ngps_error = 1.5\nfaults = { crash = 0.5 }\n",
+    );
+    let air = w.drones[0].air.as_deref().expect("its air");
+    assert_eq!(air.gps_error, Some(1.5));
+    assert_eq!(air.faults, vec![RandomFault { kind: FaultKind::Crash, rate: 0.5, duration: None }]);
+}
+
+#[test]
+fn falloff_curves_and_their_reach() {
+    let linear = Falloff::Linear;
+    assert_eq!((linear.factor(0.0), linear.factor(0.25), linear.factor(1.5)), (1.0, 0.75, 0.0));
+    assert!((linear.reach(0.25).unwrap() - 0.75).abs() < 1e-12);
+    assert_eq!(linear.reach(1.0), None);
+    let curve = Falloff::Curve(vec![[0.0, 1.0], [0.5, 1.0], [1.0, 0.2]]);
+    assert_eq!(curve.factor(0.3), 1.0);
+    assert!((curve.factor(0.75) - 0.6).abs() < 1e-12);
+    // Found within 0.75 of the range for a draw of 0.6, within all of it for 0.1.
+    assert!((curve.reach(0.6).unwrap() - 0.75).abs() < 1e-12);
+    assert_eq!(curve.reach(0.1), Some(1.0));
+    // Every level's reach is where the factor falls to it.
+    for level in [0.21, 0.3, 0.5, 0.9, 0.99] {
+        let r = curve.reach(level).unwrap();
+        assert!((curve.factor(r) - level).abs() < 1e-9, "{level}: {r}");
+    }
+}
+
+#[test]
+fn random_fault_rates_keep_the_kinds_order_and_default_durations() {
+    let w = ok("[drones.d]\nhome = [0, 0]\n[air.faults]\nmotor_failure = 0.01\ngps_loss = 0.5\nlink_loss = { rate = 1, duration = 20 }\n");
+    let got: Vec<(FaultKind, f64, Option<f64>)> =
+        w.air.faults.iter().map(|f| (f.kind, f.rate, f.duration)).collect();
+    assert_eq!(
+        got,
+        vec![
+            (FaultKind::LinkLoss, 1.0, Some(20.0)),
+            (FaultKind::GpsLoss, 0.5, Some(10.0)),
+            (FaultKind::MotorFailure, 0.01, None),
+        ]
+    );
+    let (msg, at, _) = error("[drones.d]\nhome = [0, 0]\n[air.faults]\ngps_loss = -1\n");
+    assert!(msg.contains("zero or more per flight hour"), "{msg}");
+    assert_eq!(at, "-1");
+}

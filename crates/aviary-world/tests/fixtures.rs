@@ -45,6 +45,12 @@ fn shown(path: &Path) -> String {
     for z in &w.no_fly {
         let _ = writeln!(out, "no-fly zone {} up to {:?}: {:?}", z.name, z.up_to, z.polygon);
     }
+    if !w.air.is_still() {
+        let _ = writeln!(out, "air: {:#?}", w.air);
+    }
+    for d in w.drones.iter().filter(|d| d.air.is_some()) {
+        let _ = writeln!(out, "air of {}: {:?}", d.name, d.air);
+    }
     out
 }
 

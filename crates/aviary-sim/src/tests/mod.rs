@@ -1,5 +1,6 @@
 //! Tests of the physics core (plain) and of the backend (tokio, paused clock).
 
+mod air;
 mod backend;
 mod envelope;
 mod flight;

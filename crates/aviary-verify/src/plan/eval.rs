@@ -129,7 +129,8 @@ impl Scope<'_> {
             // Between activities the estimate has the drone at rest.
             Field::Speed => Value::Number(0.0),
             // What a Sweep will leave is known only in flight.
-            Field::Heading | Field::Link | Field::Remaining => return None,
+            // The wind a sensor will read is known only in flight.
+            Field::Heading | Field::Link | Field::Remaining | Field::Wind => return None,
         })
     }
 }

@@ -16,7 +16,7 @@ const BACKEND_KEYS: &[&str] = &["backend", "mavlink", "system_id", "signing_key"
 const SCHEMES: &[&str] =
     &["tcp", "tcpin", "tcpout", "udp", "udpin", "udpout", "udpbcast", "serial"];
 /// Telemetry fields: `d.speed` reads these, so no attribute may take their names.
-const TELEMETRY: &[&str] = &["position", "altitude", "speed", "heading", "state", "link"];
+const TELEMETRY: &[&str] = &["position", "altitude", "speed", "heading", "state", "link", "wind"];
 const ADDRESS_HELP: &str =
     "write `mavlink = \"udp:127.0.0.1:14550\"` or `\"tcp:HOST:PORT\"` (schemes: tcp, tcpin, tcpout, udp, udpin, udpout, udpbcast, serial)";
 
@@ -178,6 +178,7 @@ impl Drones {
                     d.battery_capacity = cx.positive(&what, n).or(d.battery_capacity)
                 }
                 "flight_current" => d.flight_current = cx.positive(&what, n).or(d.flight_current),
+                "air" => d.air = super::air::drone_air(cx, owner, n).map(Box::new),
                 key if BACKEND_KEYS.contains(&key) => {}
                 _ => {
                     if let Some((key, value)) = attribute(cx, owner, k) {
@@ -257,6 +258,7 @@ fn defaults(span: Span) -> Drone {
         flight_current: None,
         backend: Backend::Sim,
         attributes: Box::default(),
+        air: None,
         span,
     }
 }

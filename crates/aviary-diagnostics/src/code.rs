@@ -95,6 +95,7 @@ codes! {
     SignalNeverHeard = "W207", Warning, "a handler of a drone's built-in signal that can never hear it: the drone never works inside its block";
     OperatorSignalTwice = "W208", Warning, "a signal declared twice with OPERATOR SIGNAL";
     SignalCycle = "W209", Warning, "ON EVERY handlers that raise one another's signals at once, in a cycle that takes no time";
+    OutOfRadioReach = "W210", Warning, "a drone's planned path leaves the reach of the station's radio and of every relay";
     // Notes.
     SignalNeverHandled = "N301", Note, "a signal raised but never handled";
     NoWorld = "N302", Note, "no world file, so actors, places and areas were not checked";
@@ -105,7 +106,7 @@ impl Code {
     /// The codes of the pre-flight analyses that run on the compiled mission
     /// (`aviary-verify`), not in the checker.
     pub const PREFLIGHT: &'static [Code] =
-        &[Code::CommandsMayCollide, Code::LowReserve, Code::CommandsQueue];
+        &[Code::CommandsMayCollide, Code::LowReserve, Code::OutOfRadioReach, Code::CommandsQueue];
 }
 
 impl std::fmt::Display for Code {

@@ -60,8 +60,6 @@ pub(crate) struct AirDrone {
     /// Its capacity, as a fraction of the nominal one.
     pub capacity: f64,
     pub faults: Vec<NextFault>,
-    /// It relays the link, with this reach (m).
-    pub relay: Option<f64>,
     /// Its link is down because it is out of the radio's reach.
     pub out_of_reach: bool,
     /// When a `link_loss` fault it had when it went out of reach ends (0: none): back in
@@ -76,6 +74,8 @@ pub(crate) struct AirDrone {
 pub(crate) struct AirState {
     pub wind: Option<WindModel>,
     pub radio: Option<Radio>,
+    /// Each drone's reach as a relay, if it is one (`World::relays`).
+    pub relays: Vec<Option<f64>>,
     pub gps: Option<Gps>,
     pub falloff: Option<std::sync::Arc<Falloff>>,
     pub capacity_spread: Option<f64>,
@@ -135,9 +135,6 @@ impl AirState {
                     gps_luck: (gps_sigma > 0.0).then(dummy),
                     capacity: 1.0,
                     faults,
-                    relay: own
-                        .filter(|a| a.relay)
-                        .map(|a| a.range.or(air.radio.as_ref().map(|r| r.range)).unwrap_or(0.0)),
                     out_of_reach: false,
                     fault_until: 0.0,
                     anemometer: d.sensors.iter().any(|s| s == "wind"),
@@ -148,6 +145,7 @@ impl AirState {
         let mut state = AirState {
             wind,
             radio: air.radio.clone(),
+            relays: world.relays(),
             gps: air.gps.clone(),
             falloff: air.detection.clone().map(std::sync::Arc::new),
             capacity_spread: air.capacity_spread.filter(|&s| s > 0.0),
@@ -248,33 +246,14 @@ impl AirState {
     }
 
     /// Who is in reach of the station, directly or through relays that are: `linked[i]`
-    /// for each drone at `at[i]` (`None`: lost, neither reached nor relaying).
+    /// for each drone at `at[i]` (`None`: lost, neither reached nor relaying); the rule is
+    /// the world's (`Radio::reach`).
     pub fn reach(&self, at: &[Option<[f64; 2]>], linked: &mut Vec<bool>) {
-        linked.clear();
-        linked.resize(at.len(), false);
-        let Some(radio) = &self.radio else {
-            linked.iter_mut().for_each(|l| *l = true);
-            return;
-        };
-        let near = |a: [f64; 2], b: [f64; 2], r: f64| hypot([a[0] - b[0], a[1] - b[1]]) <= r;
-        for (l, p) in linked.iter_mut().zip(at) {
-            *l = p.is_some_and(|p| near(p, radio.station, radio.range));
-        }
-        // Each pass links the drones in reach of the relays linked so far: a chain of n
-        // relays takes n passes.
-        let mut changed = self.drones.iter().any(|d| d.relay.is_some());
-        while changed {
-            changed = false;
-            for j in 0..at.len() {
-                let (Some(q), Some(r), true) = (at[j], self.drones[j].relay, linked[j]) else {
-                    continue;
-                };
-                for i in 0..at.len() {
-                    if !linked[i] && at[i].is_some_and(|p| near(p, q, r)) {
-                        linked[i] = true;
-                        changed = true;
-                    }
-                }
+        match &self.radio {
+            Some(radio) => radio.reach(&self.relays, at, linked),
+            None => {
+                linked.clear();
+                linked.resize(at.len(), true);
             }
         }
     }

@@ -421,6 +421,35 @@ pub struct Radio {
     pub every: f64,
 }
 
+impl Radio {
+    /// Who is in reach: `linked[i]` for the drone at `at[i]` (`None`: lost, neither
+    /// reached nor relaying), in reach of the station or of a relay that is itself linked
+    /// (relays chain); `relays[i]` is drone i's reach as a relay, if it is one
+    /// ([`World::relays`]). The one rule the simulator flies and `aviary check` warns by.
+    pub fn reach(&self, relays: &[Option<f64>], at: &[Option<[f64; 2]>], linked: &mut Vec<bool>) {
+        let near = |a: [f64; 2], b: [f64; 2], r: f64| (a[0] - b[0]).hypot(a[1] - b[1]) <= r;
+        linked.clear();
+        linked.extend(at.iter().map(|p| p.is_some_and(|p| near(p, self.station, self.range))));
+        // Each pass links the drones in reach of the relays linked so far: a chain of n
+        // relays takes n passes.
+        let mut changed = relays.iter().any(Option::is_some);
+        while changed {
+            changed = false;
+            for j in 0..at.len() {
+                let (Some(q), Some(Some(r)), true) = (at[j], relays.get(j), linked[j]) else {
+                    continue;
+                };
+                for i in 0..at.len() {
+                    if !linked[i] && at[i].is_some_and(|p| near(p, q, *r)) {
+                        linked[i] = true;
+                        changed = true;
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// `[air.gps]`: the error of the position a mission reads, a first-order Gauss-Markov
 /// process per horizontal axis.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -516,6 +545,18 @@ pub struct DroneAir {
 }
 
 impl World {
+    /// Each drone's reach as a relay of the station's radio (`air = { relay = true }`,
+    /// its own `range`, else the station's), or `None`.
+    pub fn relays(&self) -> Vec<Option<f64>> {
+        let station = self.air.radio.as_ref().map(|r| r.range);
+        self.drones
+            .iter()
+            .map(|d| {
+                d.air.as_deref().filter(|a| a.relay).map(|a| a.range.or(station).unwrap_or(0.0))
+            })
+            .collect()
+    }
+
     pub fn drone(&self, name: &str) -> Option<&Drone> {
         self.drones.iter().find(|d| d.name == name)
     }

@@ -151,6 +151,10 @@ pub struct Estimator<'m> {
     cut_short: bool,
     /// Whether the walk met a cycle of signals at one instant ([`Fired`]).
     cycled: bool,
+    /// Whether the world has a radio, so the drones' legs are kept for W210 (`radio`).
+    pub radio: bool,
+    /// The mission-level statement of the middle-layer call being costed, for its legs.
+    pub leg_origin: Option<Origin>,
     /// A mission frame with every slot empty, lent to each walk of [`Estimator::bound`]
     /// and given back as empty as it was lent.
     blank: Frame,
@@ -209,6 +213,8 @@ impl<'m> Estimator<'m> {
             cut_short: false,
             cycled: false,
             blank: Vec::new(),
+            radio: world.air.radio.is_some(),
+            leg_origin: None,
             s: State::new(drones, mission.signals.len()),
         }
     }

@@ -5,6 +5,7 @@ use aviary_api::{DroneId, Function, Value};
 use aviary_ir::Origin;
 
 use super::estimate::{number_arg, Estimator, Raise};
+use super::radio::Leg;
 use aviary_api::flight::LOAD_TIME;
 
 /// How long `function` takes on drone `d` from time `t`, and the detections on the way.
@@ -18,6 +19,8 @@ pub fn fly(
 ) -> (f64, Vec<Raise>) {
     let max_altitude = e.world.site.max_altitude;
     let mut raises = Vec::new();
+    e.leg_origin = at;
+    let (before, legs) = (e.s.drones[d].pos, e.s.tracks[d].len());
     let duration = match function {
         Function::TakeOff => {
             let alt = number_arg(args, 0).unwrap_or(10.0);
@@ -95,7 +98,40 @@ pub fn fly(
         | Function::StopStreaming
         | Function::ReleasePayload => 0.0,
     };
+    if e.radio && e.s.tracks[d].len() == legs && duration > 0.0 {
+        // A motion not flown as legs here (an orbit, the way home): its points, in turn.
+        let end = e.s.drones[d].pos;
+        let mut points = vec![[before[0], before[1]]];
+        if let (Function::Orbit, Some(c), Some(r)) = (
+            function,
+            e.position_arg(args.first().unwrap_or(&None), d, at),
+            number_arg(args, 1),
+        ) {
+            let laps = number_arg(args, 2).unwrap_or(1.0);
+            let n = (laps * 24.0).ceil().max(1.0) as usize;
+            let start = (end[1] - c[1]).atan2(end[0] - c[0]);
+            points.extend((0..=n).map(|k| {
+                let a = start - laps * std::f64::consts::TAU * k as f64 / n as f64;
+                [c[0] + r * a.cos(), c[1] + r * a.sin()]
+            }));
+        }
+        points.push([end[0], end[1]]);
+        record_polyline(e, d, &points, t, duration);
+    }
     (duration, raises)
+}
+
+/// Keeps the legs through `points` for the radio's check, the time `took` shared by
+/// their lengths.
+fn record_polyline(e: &mut Estimator, d: DroneId, points: &[[f64; 2]], t: f64, took: f64) {
+    let length = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]).hypot(b[1] - a[1]);
+    let total: f64 = points.windows(2).map(|w| length(w[0], w[1])).sum();
+    let mut at = t;
+    for w in points.windows(2) {
+        let share = if total > 0.0 { took * length(w[0], w[1]) / total } else { 0.0 };
+        e.s.tracks[d].push(Leg { t: at, took: share, from: w[0], to: w[1], at: e.leg_origin });
+        at += share;
+    }
 }
 
 /// `FlyToPosition`: one leg, at the speed asked for (at most the drone's).
@@ -198,5 +234,9 @@ fn leg(
     let from = e.s.drones[d].pos;
     let took = e.s.drones[d].leg_at(to, speed);
     raises.extend(e.scan(d, [from[0], from[1]], [to[0], to[1]], t, took));
+    if e.radio {
+        let leg = Leg { t, took, from: [from[0], from[1]], to: [to[0], to[1]], at: e.leg_origin };
+        e.s.tracks[d].push(leg);
+    }
     took
 }

@@ -8,6 +8,7 @@ mod estimate;
 mod eval;
 mod flight;
 mod model;
+mod radio;
 mod state;
 
 use aviary_api::show::fixed;
@@ -148,6 +149,27 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
                 battery_left: b.2,
             });
         }
+    }
+    for out in radio::out_of_reach(world, &est.s.tracks) {
+        let name = &world.drones[out.drone].name;
+        let reach = world.air.radio.as_ref().map_or(0.0, |r| r.range);
+        diagnostics.push(
+            Diagnostic::new(
+                Code::OutOfRadioReach,
+                out.at.file,
+                out.at.span,
+                format!(
+                    "{name}'s planned path leaves radio reach during this statement: about {} s in, at ({}, {}), it is {} m from the station (its range is {} m) and out of reach of every relay",
+                    fixed(out.t, 0),
+                    fixed(out.place[0], 0),
+                    fixed(out.place[1], 0),
+                    fixed(out.off, 0),
+                    fixed(reach, 0)
+                ),
+            )
+            .label("the link is lost here")
+            .with_help("in flight the drone loses its link there (ConnectionLost), holds, and flies home on its own after `link_loss_rtl_after`; keep its path within reach, move the station (`[air.radio] station`), or give the fleet a relay that stays in reach of both (`air = { relay = true }` on a drone)"),
+        );
     }
     let assumptions = est
         .s

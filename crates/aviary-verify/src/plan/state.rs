@@ -10,6 +10,7 @@
 use aviary_ir::Origin;
 
 use super::model::Flyer;
+use super::radio::Leg;
 use super::Activity;
 
 /// An assumption: where (file, byte), and what.
@@ -31,6 +32,9 @@ pub struct State {
     pub assumptions: Vec<Note>,
     /// Handlers that fired, by address, as they fired.
     pub fired: Vec<usize>,
+    /// Per drone, the legs it flies, when the world has a radio (`super::radio`); only
+    /// ever pushed to, as the activities.
+    pub tracks: Vec<Vec<Leg>>,
 }
 
 /// The state at a moment: the small parts, and the lengths of the growing ones.
@@ -41,6 +45,7 @@ pub struct Mark {
     activities: Vec<usize>,
     assumptions: usize,
     fired: usize,
+    tracks: Vec<usize>,
 }
 
 /// What a walk changed since a [`Mark`]: the small parts as they are after it, and what
@@ -53,6 +58,7 @@ pub struct Tail {
     activities: Vec<Vec<Activity>>,
     assumptions: Vec<Note>,
     fired: Vec<usize>,
+    tracks: Vec<Vec<Leg>>,
 }
 
 impl Mark {
@@ -73,6 +79,7 @@ impl State {
             reserve: vec![None; n],
             assumptions: Vec::new(),
             fired: Vec::new(),
+            tracks: vec![Vec::new(); n],
         }
     }
 
@@ -93,6 +100,7 @@ impl State {
             activities: self.activities.iter().map(Vec::len).collect(),
             assumptions: self.assumptions.len(),
             fired: self.fired.len(),
+            tracks: self.tracks.iter().map(Vec::len).collect(),
         }
     }
 
@@ -110,6 +118,12 @@ impl State {
                 .collect(),
             assumptions: self.assumptions.split_off(mark.assumptions),
             fired: self.fired.split_off(mark.fired),
+            tracks: self
+                .tracks
+                .iter_mut()
+                .zip(&mark.tracks)
+                .map(|(a, &n)| a.split_off(n))
+                .collect(),
         }
     }
 
@@ -120,6 +134,9 @@ impl State {
             a.truncate(n);
         }
         self.fired.truncate(mark.fired);
+        for (a, &n) in self.tracks.iter_mut().zip(&mark.tracks) {
+            a.truncate(n);
+        }
         self.drones = mark.drones;
         self.reserve = mark.reserve;
     }
@@ -131,6 +148,9 @@ impl State {
         }
         self.assumptions.truncate(mark.assumptions);
         self.fired.truncate(mark.fired);
+        for (a, &n) in self.tracks.iter_mut().zip(&mark.tracks) {
+            a.truncate(n);
+        }
         self.unraise(mark.raised);
         self.drones = tail.drones;
         for (signal, after) in tail.raised.into_iter().rev() {
@@ -143,6 +163,9 @@ impl State {
         }
         self.assumptions.extend(tail.assumptions);
         self.fired.extend(tail.fired);
+        for (a, more) in self.tracks.iter_mut().zip(tail.tracks) {
+            a.extend(more);
+        }
     }
 
     /// Undoes the changes to `raised` past the log's length `to`; what each held after.

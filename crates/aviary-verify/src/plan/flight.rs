@@ -102,11 +102,13 @@ pub fn fly(
         // A motion not flown as legs here (an orbit, the way home): its points, in turn.
         let end = e.s.drones[d].pos;
         let mut points = vec![[before[0], before[1]]];
-        if let (Function::Orbit, Some(c), Some(r)) = (
-            function,
-            e.position_arg(args.first().unwrap_or(&None), d, at),
-            number_arg(args, 1),
-        ) {
+        let circle = match function {
+            Function::Orbit => {
+                e.position_arg(args.first().unwrap_or(&None), d, at).zip(number_arg(args, 1))
+            }
+            _ => None,
+        };
+        if let Some((c, r)) = circle {
             let laps = number_arg(args, 2).unwrap_or(1.0);
             let n = (laps * 24.0).ceil().max(1.0) as usize;
             let start = (end[1] - c[1]).atan2(end[0] - c[0]);

@@ -71,9 +71,7 @@ pub fn out_of_reach(world: &World, tracks: &[Vec<Leg>]) -> Vec<Out> {
                 let s = k as f64 / steps as f64;
                 let t = leg.t + leg.took * s;
                 at.clear();
-                at.extend(
-                    tracks.iter().zip(&homes).map(|(tr, &h)| Some(position_at(tr, h, t))),
-                );
+                at.extend(tracks.iter().zip(&homes).map(|(tr, &h)| Some(position_at(tr, h, t))));
                 let here = [
                     leg.from[0] + (leg.to[0] - leg.from[0]) * s,
                     leg.from[1] + (leg.to[1] - leg.from[1]) * s,

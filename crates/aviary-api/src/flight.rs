@@ -78,3 +78,50 @@ mod tests {
         }
     }
 }
+
+/// The fastest a drone of airspeed `airspeed` can go over the ground along the unit
+/// direction `u` in the wind `w` (`[east, north]` m/s, where it blows to): the wind
+/// triangle, `w·u + sqrt(airspeed² − (w×u)²)`, at least 0. The simulator flies by it and
+/// the plan costs by it.
+pub fn ground_speed_limit(u: [f64; 2], w: [f64; 2], airspeed: f64) -> f64 {
+    let along = w[0] * u[0] + w[1] * u[1];
+    let across = w[0] * u[1] - w[1] * u[0];
+    let room = airspeed * airspeed - across * across;
+    if room <= 0.0 {
+        return 0.0;
+    }
+    (along + room.sqrt()).max(0.0)
+}
+
+/// How much faster than in still air a drone drains flying at `ground` (m/s over the
+/// ground, `[east, north]`) in the wind `w`: power grows with airspeed as
+/// `P(v) = P0 (1 + drain (v / max_speed)²)`, and still air's drain is that of the
+/// ground speed (so `endurance` stays the figure of still air):
+/// `P(|ground − w|) / P(|ground|)`.
+pub fn wind_drain(ground: [f64; 2], w: [f64; 2], max_speed: f64, drain: f64) -> f64 {
+    let air = (ground[0] - w[0]).hypot(ground[1] - w[1]) / max_speed;
+    let over = ground[0].hypot(ground[1]) / max_speed;
+    (1.0 + drain * air * air) / (1.0 + drain * over * over)
+}
+
+#[cfg(test)]
+mod wind_tests {
+    use super::{ground_speed_limit, wind_drain};
+
+    #[test]
+    fn the_wind_triangle_along_against_and_across() {
+        assert!((ground_speed_limit([1.0, 0.0], [-4.0, 0.0], 10.0) - 6.0).abs() < 1e-12);
+        assert!((ground_speed_limit([1.0, 0.0], [4.0, 0.0], 10.0) - 14.0).abs() < 1e-12);
+        assert!((ground_speed_limit([1.0, 0.0], [0.0, 6.0], 10.0) - 8.0).abs() < 1e-12);
+        assert_eq!(ground_speed_limit([1.0, 0.0], [0.0, 12.0], 10.0), 0.0);
+    }
+
+    #[test]
+    fn still_air_drains_as_still_air_and_a_head_wind_more() {
+        assert!((wind_drain([5.0, 0.0], [0.0, 0.0], 10.0, 0.5) - 1.0).abs() < 1e-12);
+        // 5 m/s over the ground into 5 m/s: 10 m/s through the air.
+        let head = wind_drain([5.0, 0.0], [-5.0, 0.0], 10.0, 0.5);
+        assert!((head - 1.5 / 1.125).abs() < 1e-12, "{head}");
+        assert_eq!(wind_drain([5.0, 0.0], [-5.0, 0.0], 10.0, 0.0), 1.0);
+    }
+}

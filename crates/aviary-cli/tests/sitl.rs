@@ -356,6 +356,21 @@ mod facts {
     }
 }
 
+/// One SITL copter `d` (`params` set), and `aviary run` flying `mission` on it.
+fn single_copter(
+    tag: &str,
+    params: &[(&str, f64)],
+    world_extra: &str,
+    mission: &str,
+) -> (PathBuf, Sitl, Run) {
+    let dir = scratch(tag);
+    let sitl = Sitl::start(&dir, 20, 1, [0.0, 0.0], params);
+    std::fs::write(dir.join("m.world.toml"), one_copter_world(&sitl, world_extra)).expect("world");
+    std::fs::write(dir.join("m.mission"), mission).expect("mission");
+    let run = start_run(&dir, "m.mission");
+    (dir, sitl, run)
+}
+
 mod single {
     use super::*;
 
@@ -366,13 +381,7 @@ mod single {
         world_extra: &str,
         mission: &str,
     ) -> (PathBuf, Sitl, Run) {
-        let dir = scratch(tag);
-        let sitl = Sitl::start(&dir, 20, 1, [0.0, 0.0], params);
-        std::fs::write(dir.join("m.world.toml"), one_copter_world(&sitl, world_extra))
-            .expect("world");
-        std::fs::write(dir.join("m.mission"), mission).expect("mission");
-        let run = start_run(&dir, "m.mission");
-        (dir, sitl, run)
+        super::single_copter(tag, params, world_extra, mission)
     }
 
     /// Waits until the trace shows the drone in the air (after GPS lock and take-off).
@@ -592,5 +601,96 @@ mod single {
             !events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_call"),
             "nothing flew"
         );
+    }
+}
+
+/// ArduCopter SITL's wind (`SIM_WIND_SPD`, `SIM_WIND_DIR`, no turbulence) against the
+/// simulator's `[air.wind]`: one copter out 400 m and back in still air, along an 8 m/s
+/// wind (a head wind out, a tail wind back), and across it. The still-air flight sets
+/// the simulated twin's battery (its current from what SITL's battery lost); in each
+/// wind, the simulator's flight time and battery used are within 15% of SITL's. The twin
+/// has the copter's figures as SITL showed them: ArduCopter's, an airspeed of 13.6 m/s
+/// (it holds 10 m/s over the ground into the wind as far as its tilt allows), and a
+/// battery whose drain does not grow with airspeed (SITL's drew 0.248 %/s into the wind
+/// and 0.247 %/s with it: `drain = 0`).
+mod wind {
+    use super::*;
+
+    const OUT_AND_BACK: &str = "CAPABILITY Out_And_Back BY drone:\n    PERFORM:\n        drone.FollowPath((0, 400), (0, 0))\n\nMISSION Windy:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 20m\n        d Out_And_Back\n        d Land\n";
+
+    /// SITL's default battery, which the backend reads (BATT_CAPACITY).
+    const CAPACITY_MAH: f64 = 3300.0;
+
+    /// A flight: its time in the air (s) and the share of the battery it used.
+    #[derive(Debug, Clone, Copy)]
+    struct Flight {
+        time: f64,
+        used: f64,
+    }
+
+    fn flight(dir: &Path, out: &str) -> Flight {
+        let flown = events(&dir.join("t.jsonl"));
+        let charge: Vec<f64> = named(&flown, "telemetry")
+            .filter(|e| e["actor"] == "d")
+            .filter_map(|e| e["battery"].as_f64())
+            .collect();
+        let row = common::summary_rows(out).into_iter().find(|r| r.0 == "d").expect("d's row");
+        Flight { time: row.2, used: charge[0] - charge[charge.len() - 1] }
+    }
+
+    /// The route flown on SITL in a wind of `speed` m/s from `from` degrees.
+    fn on_sitl(tag: &str, speed: f64, from: f64) -> Flight {
+        let params = [("SIM_WIND_SPD", speed), ("SIM_WIND_DIR", from), ("SIM_WIND_TURB", 0.0)];
+        let (dir, _sitl, mut run) = super::single_copter(tag, &params, "", OUT_AND_BACK);
+        let (code, out) = finish(&mut run, &dir, Duration::from_secs(600));
+        assert_eq!(code, 0, "{out}");
+        flight(&dir, &out)
+    }
+
+    /// The same route in the simulator, the copter with ArduCopter's figures, the
+    /// battery `current` (A) draws from `CAPACITY_MAH`, and `[air.wind]`.
+    fn simulated(tag: &str, current: f64, speed: f64, from: f64) -> Flight {
+        let dir = scratch(tag);
+        let air = if speed > 0.0 {
+            format!("[air.wind]\nspeed = {speed}\nfrom = {from}\ndrain = 0\n")
+        } else {
+            String::new()
+        };
+        let world = format!(
+            "[site]\nname = \"SITL twin\"\nmax_altitude = 60\n{air}\n[drones.d]\nhome = [0, 0]\n{}max_airspeed = 13.6\nbattery_capacity = {CAPACITY_MAH}\nflight_current = {current}\n",
+            common::ARDUCOPTER
+        );
+        std::fs::write(dir.join("m.world.toml"), world).expect("world");
+        std::fs::write(dir.join("m.mission"), OUT_AND_BACK).expect("mission");
+        let (code, out, err) =
+            aviary(&["run", "m.mission", "--trace", "t.jsonl", "--telemetry-hz", "2"], &dir);
+        assert_eq!(code, 0, "{out}{err}");
+        flight(&dir, &out)
+    }
+
+    #[test]
+    #[cfg_attr(
+        not(arducopter_sitl),
+        ignore = "ArduCopter SITL not named: set AVIARY_SITL=/path/to/arducopter to fly it (docs/REAL_DRONES.md)"
+    )]
+    fn the_simulators_wind_agrees_with_sitls_within_15_percent() {
+        let still = on_sitl("sitl_wind_still", 0.0, 0.0);
+        // The current that empties the battery as SITL's did in still air.
+        let current = still.used * CAPACITY_MAH / 1000.0 / (still.time / 3600.0);
+        let twin = simulated("sim_wind_still", current, 0.0, 0.0);
+        eprintln!("still air: SITL {still:?}, simulator {twin:?} at {current:.1} A");
+        let mut apart = Vec::new();
+        for (what, from) in [("along", 0.0), ("across", 90.0)] {
+            let real = on_sitl(&format!("sitl_wind_{what}"), 8.0, from);
+            let sim = simulated(&format!("sim_wind_{what}"), current, 8.0, from);
+            eprintln!("8 m/s {what}: SITL {real:?}, simulator {sim:?}");
+            for (figure, r, s) in [("time", real.time, sim.time), ("battery", real.used, sim.used)]
+            {
+                if (r - s).abs() > 0.15 * r {
+                    apart.push(format!("{what}: {figure} {r:.3} on SITL, {s:.3} simulated"));
+                }
+            }
+        }
+        assert!(apart.is_empty(), "more than 15% apart:\n{}", apart.join("\n"));
     }
 }

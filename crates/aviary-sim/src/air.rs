@@ -239,10 +239,8 @@ impl AirState {
     pub fn drain_factor(&self, id: DroneId, ground: [f64; 2], max_speed: f64) -> f64 {
         let capacity = self.drones[id].capacity;
         let Some(wind) = &self.wind else { return 1.0 / capacity };
-        let w = self.drones[id].wind;
-        let air = hypot([ground[0] - w[0], ground[1] - w[1]]) / max_speed;
-        let over = hypot(ground) / max_speed;
-        (1.0 + wind.drain * air * air) / (1.0 + wind.drain * over * over) / capacity
+        aviary_api::flight::wind_drain(ground, self.drones[id].wind, max_speed, wind.drain)
+            / capacity
     }
 
     /// Who is in reach of the station, directly or through relays that are: `linked[i]`
@@ -269,18 +267,6 @@ pub(crate) fn dryden(w20: f64, z: f64) -> (f64, f64) {
     let sigma = 0.1 * w20 / base.powf(0.4);
     let scale = h / base.powf(1.2) * FOOT;
     (sigma, scale)
-}
-
-/// The fastest a drone of airspeed `va` can go over the ground along the unit direction
-/// `u` in the wind `w`: the wind triangle, `w.u + sqrt(va^2 - (w x u)^2)`, at least 0.
-pub(crate) fn ground_speed_limit(u: [f64; 2], w: [f64; 2], va: f64) -> f64 {
-    let along = w[0] * u[0] + w[1] * u[1];
-    let across = w[0] * u[1] - w[1] * u[0];
-    let room = va * va - across * across;
-    if room <= 0.0 {
-        return 0.0;
-    }
-    (along + room.sqrt()).max(0.0)
 }
 
 fn hypot(v: [f64; 2]) -> f64 {
@@ -402,15 +388,6 @@ impl crate::fleet::Fleet {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_wind_triangle() {
-        // Head wind, tail wind, and a cross wind of 6 for an airspeed of 10: 8 over the ground.
-        assert!((ground_speed_limit([1.0, 0.0], [-4.0, 0.0], 10.0) - 6.0).abs() < 1e-12);
-        assert!((ground_speed_limit([1.0, 0.0], [4.0, 0.0], 10.0) - 14.0).abs() < 1e-12);
-        assert!((ground_speed_limit([1.0, 0.0], [0.0, 6.0], 10.0) - 8.0).abs() < 1e-12);
-        assert_eq!(ground_speed_limit([1.0, 0.0], [0.0, 12.0], 10.0), 0.0);
-    }
 
     #[test]
     fn dryden_figures_of_the_standard() {

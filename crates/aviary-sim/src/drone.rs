@@ -38,6 +38,8 @@ pub(crate) struct Outage {
 #[derive(Debug, PartialEq)]
 pub(crate) struct Spec {
     pub max_speed: f64,
+    /// Its fastest through the air: what a wind leaves of it over the ground.
+    pub max_airspeed: f64,
     pub climb_rate: f64,
     pub accel: f64,
     pub endurance: f64,
@@ -56,6 +58,7 @@ impl Spec {
     pub fn of(d: &Drone) -> Spec {
         Spec {
             max_speed: d.max_speed,
+            max_airspeed: d.max_airspeed,
             climb_rate: d.climb_rate,
             accel: d.acceleration,
             endurance: d.endurance,
@@ -78,6 +81,7 @@ impl Hash for Spec {
     fn hash<H: Hasher>(&self, h: &mut H) {
         let figures = [
             self.max_speed,
+            self.max_airspeed,
             self.climb_rate,
             self.accel,
             self.endurance,

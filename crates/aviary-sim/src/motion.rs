@@ -48,7 +48,7 @@ pub(crate) struct MotionTask {
     pub path: Option<PathTrack>,
     /// The wind at the drone this tick, `[east, north]` m/s, with `[air.wind]` (set by the
     /// fleet before each tick): it limits the speed over the ground (the wind triangle,
-    /// `crate::air::ground_speed_limit`). `None`: still air, no limit but the leg's.
+    /// `aviary_api::flight::ground_speed_limit`). `None`: still air, no limit but the leg's.
     pub wind: Option<[f64; 2]>,
 }
 
@@ -150,7 +150,7 @@ impl SimDrone {
             self.vel = [0.0; 3];
             return None;
         }
-        let wind = task.wind.map(|w| (w, self.spec.max_speed));
+        let wind = task.wind.map(|w| (w, self.spec.max_airspeed));
         let tick = Tick { dt, scale, owns_z, wind };
         let mut body = Body { pos: &mut self.pos, vel: &mut self.vel, spec: &self.spec };
         let done = match task.legs.front_mut() {
@@ -224,7 +224,7 @@ struct Tick {
     dt: f64,
     scale: Option<f64>,
     owns_z: bool,
-    /// The wind and the drone's airspeed at most (`max_speed`), with `[air.wind]`.
+    /// The wind and the drone's airspeed at most (`max_airspeed`), with `[air.wind]`.
     wind: Option<([f64; 2], f64)>,
 }
 
@@ -239,7 +239,7 @@ impl Tick {
     fn along(self, u: [f64; 2], v: f64) -> f64 {
         match self.wind {
             None => self.limit(v),
-            Some((w, va)) => self.limit(v.min(crate::air::ground_speed_limit(u, w, va))),
+            Some((w, va)) => self.limit(v.min(aviary_api::flight::ground_speed_limit(u, w, va))),
         }
     }
 }

@@ -204,6 +204,12 @@ pub struct Drone {
     /// m/s up, default `climb_rate`: how fast `TakeOff` climbs from the ground (PX4's
     /// MPC_TKO_SPEED, 1.5 m/s, is half its climb rate).
     pub takeoff_speed: f64,
+    /// m/s, default `max_speed`: the fastest it flies through the air. In a wind
+    /// (`[air.wind]`) the speed over the ground along a track is what this airspeed
+    /// leaves (the wind triangle), at most `max_speed`: an autopilot holds its ground
+    /// speed into a head wind as far as its tilt allows (ArduCopter SITL: 13.6 m/s
+    /// through the air for a WPNAV_SPEED of 10 m/s).
+    pub max_airspeed: f64,
     /// m/s, default `max_speed`: `ReturnToLaunch`'s speed over the ground on its way home
     /// (the autopilot's own, PX4's MPC_XY_CRUISE).
     pub return_speed: f64,

@@ -417,6 +417,7 @@ fn speeds_and_endurance_must_be_positive() {
         "land_speed",
         "takeoff_speed",
         "return_speed",
+        "max_airspeed",
         "battery_capacity",
         "flight_current",
     ] {

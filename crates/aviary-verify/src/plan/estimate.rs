@@ -186,7 +186,8 @@ impl<'m> Estimator<'m> {
         known: Vec<Option<f64>>,
         known_sure: Vec<Option<f64>>,
     ) -> Estimator<'m> {
-        let drones: Vec<Flyer> = world.drones.iter().map(Flyer::new).collect();
+        let wind = world.air.wind.as_ref();
+        let drones: Vec<Flyer> = world.drones.iter().map(|d| Flyer::new(d, wind)).collect();
         Estimator {
             mission,
             world,

@@ -34,12 +34,18 @@ pub struct Flyer {
     pub distance: f64,
     /// When its motion is next free: a statement that claims it starts no earlier.
     pub free_at: f64,
+    /// Its fastest through the air, and the world's mean wind (`[east, north]` m/s) with
+    /// its drain figure, if it has one: legs go at what the wind triangle leaves.
+    pub max_airspeed: f64,
+    pub wind: Option<([f64; 2], f64)>,
+    /// Seconds of still-air flight the wind has cost the battery beyond the time flown.
+    pub wind_drain: f64,
     /// Kinds being detected, with the sensor range, and the targets already found.
     pub detecting: Vec<(String, f64, Vec<usize>)>,
 }
 
 impl Flyer {
-    pub fn new(d: &Drone) -> Flyer {
+    pub fn new(d: &Drone, wind: Option<&aviary_world::Wind>) -> Flyer {
         Flyer {
             pos: d.home,
             home: d.home,
@@ -59,13 +65,18 @@ impl Flyer {
             flight_time: 0.0,
             distance: 0.0,
             free_at: 0.0,
+            max_airspeed: d.max_airspeed,
+            wind: wind.map(|w| (w.velocity(), w.drain)),
+            wind_drain: 0.0,
             detecting: Vec::new(),
         }
     }
 
     /// Battery left at time `t`, as a fraction.
     pub fn battery_at(&self, t: f64) -> f64 {
-        let air = self.flight_time + if self.airborne { (t - self.since).max(0.0) } else { 0.0 };
+        let air = self.flight_time
+            + self.wind_drain
+            + if self.airborne { (t - self.since).max(0.0) } else { 0.0 };
         self.battery_start - air / self.endurance
     }
 
@@ -88,13 +99,27 @@ impl Flyer {
         self.leg_at(to, self.max_speed)
     }
 
+    /// A straight leg at up to `speed` over the ground; in the mean wind, at what the wind
+    /// triangle leaves of the drone's airspeed that way (as the simulator flies it, gusts
+    /// aside), its battery drained by the airspeed (`aviary_api::flight::wind_drain`).
     pub fn leg_at(&mut self, to: [f64; 3], speed: f64) -> f64 {
-        let h = ((to[0] - self.pos[0]).powi(2) + (to[1] - self.pos[1]).powi(2)).sqrt();
+        let (dx, dy) = (to[0] - self.pos[0], to[1] - self.pos[1]);
+        let h = dx.hypot(dy);
         let v = (to[2] - self.pos[2]).abs();
         self.distance += (h * h + v * v).sqrt();
         let vertical = if to[2] >= self.pos[2] { self.climb_rate } else { self.descent.rate };
         self.pos = to;
-        trapezoid(h, speed, self.accel).max(trapezoid(v, vertical, self.accel))
+        let mut cruise = speed;
+        let mut drain = 1.0;
+        if let (Some((w, k)), true) = (self.wind, h > 0.0) {
+            let u = [dx / h, dy / h];
+            cruise = speed.min(aviary_api::flight::ground_speed_limit(u, w, self.max_airspeed));
+            let ground = [u[0] * cruise, u[1] * cruise];
+            drain = aviary_api::flight::wind_drain(ground, w, self.max_speed, k);
+        }
+        let across = trapezoid(h, cruise, self.accel);
+        self.wind_drain += across * (drain - 1.0);
+        across.max(trapezoid(v, vertical, self.accel))
     }
 
     /// `TakeOff` from the ground: straight up to `alt` at the take-off speed (as the

@@ -341,25 +341,29 @@ pub(super) fn drone_air(cx: &mut Ctx, owner: Owner, node: &Node) -> Option<Drone
     Some(air)
 }
 
-/// A mean wind at least as fast as a drone's `max_speed` would blow it away: an error at
-/// the wind's speed, naming the drones.
+/// A mean wind at least as fast as a drone's `max_airspeed` would blow it away: an error
+/// at the wind's speed, naming the drones.
 pub(super) fn wind_within_reach(cx: &mut Ctx, world: &World) {
     let Some(wind) = &world.air.wind else { return };
-    let mut slow = world.drones.iter().filter(|d| d.max_speed <= wind.speed);
+    let mut slow = world.drones.iter().filter(|d| d.max_airspeed <= wind.speed);
     let Some(first) = slow.next() else { return };
     let more = slow.count();
     let who = match more {
-        0 => format!("drone `{}` (max_speed {} m/s)", first.name, number(first.max_speed)),
+        0 => format!("drone `{}` (max_airspeed {} m/s)", first.name, number(first.max_airspeed)),
         n => format!(
-            "{} drones, the first `{}` (max_speed {} m/s)",
+            "{} drones, the first `{}` (max_airspeed {} m/s)",
             n + 1,
             first.name,
-            number(first.max_speed)
+            number(first.max_airspeed)
         ),
     };
     let msg = format!(
         "a wind of {} m/s is as fast as {who} or faster: it could not fly against it",
         number(wind.speed)
     );
-    cx.error(wind.span, msg, "lower the wind's `speed`, or give the drones a higher `max_speed`");
+    cx.error(
+        wind.span,
+        msg,
+        "lower the wind's `speed`, or give the drones a higher `max_airspeed` (it defaults to `max_speed`)",
+    );
 }

@@ -174,6 +174,7 @@ impl Drones {
                     d.takeoff_speed = cx.positive(&what, n).unwrap_or(d.takeoff_speed)
                 }
                 "return_speed" => d.return_speed = cx.positive(&what, n).unwrap_or(d.return_speed),
+                "max_airspeed" => d.max_airspeed = cx.positive(&what, n).unwrap_or(d.max_airspeed),
                 "battery_capacity" => {
                     d.battery_capacity = cx.positive(&what, n).or(d.battery_capacity)
                 }
@@ -254,6 +255,7 @@ fn defaults(span: Span) -> Drone {
         return_loiter: 0.0,
         takeoff_speed: f64::NAN,
         return_speed: f64::NAN,
+        max_airspeed: f64::NAN,
         battery_capacity: None,
         flight_current: None,
         backend: Backend::Sim,
@@ -276,6 +278,9 @@ fn follow_other_keys(d: &mut Drone) {
     }
     if d.return_speed.is_nan() {
         d.return_speed = d.max_speed;
+    }
+    if d.max_airspeed.is_nan() {
+        d.max_airspeed = d.max_speed;
     }
     if let Some(endurance) = Drone::endurance_from_battery(d.battery_capacity, d.flight_current) {
         d.endurance = endurance;

@@ -10,6 +10,7 @@ use crate::read::{suggest, Ctx};
 use crate::{Area, Geo, Place, Site, World};
 
 mod drone;
+mod expect;
 mod fleet;
 mod no_fly;
 mod sim;
@@ -17,8 +18,10 @@ mod sim;
 use drone::Drones;
 use fleet::FleetInfo;
 
-const TABLES: &[&str] =
-    &["site", "places", "areas", "no_fly", "drones", "fleets", "sensors", "targets", "faults"];
+const TABLES: &[&str] = &[
+    "site", "places", "areas", "no_fly", "drones", "fleets", "sensors", "targets", "faults",
+    "expect",
+];
 const SITE_KEYS: &[&str] = &[
     "name",
     "origin",
@@ -152,6 +155,9 @@ fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Dia
     }
     if let Some(e) = table("faults") {
         world.faults = sim::faults(cx, &e.node, &drones.names());
+    }
+    if let Some(e) = table("expect") {
+        world.expect = expect::expectations(cx, &e.node, &world.targets);
     }
     let group_spans = std::mem::take(&mut drones.group_spans);
     world.groups = std::mem::take(&mut drones.groups);

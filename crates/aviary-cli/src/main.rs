@@ -17,6 +17,7 @@ mod replay;
 mod report;
 mod run;
 mod serve;
+mod test;
 mod vehicles;
 
 /// mimalloc, tuned before `main` (`aviary_alloc`; docs/BENCHMARKS.md).
@@ -204,6 +205,10 @@ enum Command {
         #[arg(long, value_enum, default_value = "ardupilot")]
         autopilot: vehicles::Autopilot,
     },
+    /// Fly a mission on many seeds of the simulator at once and report how often it
+    /// succeeds, how it fails, and the spread of its time, batteries and finds
+    /// (docs/CAMPAIGNS.md); `aviary test merge`: the reports of shards as one
+    Test(test::TestArgs),
     /// Explain a diagnostic code, such as E107
     Explain { code: String },
     /// Benchmarks on generated missions: the front end (parse), the engine (w), the simulator (swarm)
@@ -354,6 +359,7 @@ fn command(cli: Cli) -> u8 {
                 autopilot,
             })
         }
+        Command::Test(args) => test::run(args),
         Command::Explain { code } => explain(&code),
         Command::Bench { which } => bench::run(which),
     };

@@ -8,6 +8,10 @@
 //! A library: texts in, records and reports out. The terminal (the progress bar, what is
 //! printed, the exit codes) is the CLI's; the HTML report is `aviary_station::campaign`'s.
 
+// No unsafe code, and no panic on any input (tests may unwrap).
+#![forbid(unsafe_code)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 

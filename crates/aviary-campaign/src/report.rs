@@ -42,7 +42,10 @@ impl Seeds {
     /// The seeds of `shard` (all of them without one), in order.
     pub fn of(&self, shard: Option<Shard>) -> Vec<u64> {
         (0..self.runs)
-            .filter(|k| shard.map_or(true, |s| s.holds(*k)))
+            .filter(|k| match shard {
+                None => true,
+                Some(s) => s.holds(*k),
+            })
             .map(|k| self.first + k)
             .collect()
     }
@@ -308,8 +311,11 @@ impl Report {
                 ))
             }
         }
-        serde_json::from_value(value)
-            .map_err(|e| format!("{name} is not a whole campaign report: {e}"))
+        let report: Report = serde_json::from_value(value)
+            .map_err(|e| format!("{name} is not a whole campaign report: {e}"))?;
+        Seeds::new(report.seeds.first, report.seeds.runs)
+            .map_err(|why| format!("{name} has seeds no campaign has: {why}"))?;
+        Ok(report)
     }
 }
 

@@ -37,8 +37,12 @@ impl Report {
         let _ = match self.shard {
             Some(s) => writeln!(
                 out,
-                "seeds {} to {}, shard {s}: {} runs (every {}th run from the {}th)",
-                self.seeds.first, last, self.runs, s.count, s.index
+                "seeds {} to {}, shard {s}: {} runs (run k, from 0, when k mod {} = {})",
+                self.seeds.first,
+                last,
+                self.runs,
+                s.count,
+                s.index - 1
             ),
             None => writeln!(out, "seeds {} to {}: {} runs", self.seeds.first, last, self.runs),
         };

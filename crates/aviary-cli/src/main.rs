@@ -211,7 +211,8 @@ enum Command {
     Test(test::TestArgs),
     /// Explain a diagnostic code, such as E107
     Explain { code: String },
-    /// Benchmarks on generated missions: the front end (parse), the engine (w), the simulator (swarm)
+    /// Benchmarks on generated missions: the front end (parse), the engine (w), the simulator
+    /// (swarm); and a campaign of the paper's mission (campaign)
     Bench {
         #[command(subcommand)]
         which: bench::BenchCommand,

@@ -179,7 +179,7 @@ fn histogram(d: &Distribution, title: &str, unit: &str) -> Result<String, String
 /// percentile, one row per drone.
 fn batteries(report: &Report) -> Result<String, String> {
     let rows = report.lowest_battery.len().max(1);
-    let height = 50 + 26 * rows as u32;
+    let height = 50 + 30 * rows as u32;
     let mut svg = String::new();
     let drawn: Drawn = (|| {
         let root = SVGBackend::with_string(&mut svg, (460, height)).into_drawing_area();
@@ -191,26 +191,18 @@ fn batteries(report: &Report) -> Result<String, String> {
             )
             .margin(8)
             .x_label_area_size(24)
-            .y_label_area_size(110)
+            .y_label_area_size(10)
             .build_cartesian_2d(0.0..100.0, 0.0..rows as f64)?;
-        let names: Vec<String> = report.lowest_battery.iter().map(|d| d.drone.clone()).collect();
-        chart
-            .configure_mesh()
-            .x_labels(6)
-            .y_labels(rows + 1)
-            .y_label_formatter(&|y| {
-                let i = (*y - 0.5).round();
-                if (y - 0.5 - i).abs() < 1e-6 && i >= 0.0 {
-                    names.get(i as usize).map(|n| escape(n)).unwrap_or_default()
-                } else {
-                    String::new()
-                }
-            })
-            .light_line_style(WHITE.mix(0.0))
-            .draw()?;
+        chart.configure_mesh().x_labels(6).y_labels(0).light_line_style(WHITE.mix(0.0)).draw()?;
         for (i, d) in report.lowest_battery.iter().enumerate() {
+            let y = rows as f64 - i as f64 - 0.6;
+            // The drone's name above its row, at the left.
+            chart.draw_series(std::iter::once(Text::new(
+                escape(&d.drone),
+                (1.0, y + 0.45),
+                ("sans-serif", 11).into_font(),
+            )))?;
             let Some(l) = &d.lowest else { continue };
-            let y = i as f64 + 0.5;
             chart.draw_series(std::iter::once(PathElement::new(
                 vec![(l.min * 100.0, y), (l.max * 100.0, y)],
                 colour(i).stroke_width(3),

@@ -273,7 +273,7 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
                     by = stopped.wait_for(Option::is_some) => {
                         let by = by.ok().and_then(|b| *b).unwrap_or("a stop signal");
                         let reason = format!("stopped by {by} while the vehicles connected; nothing flew");
-                        let outcome = Outcome { status: Status::Aborted, reason: Some(reason) };
+                        let outcome = Outcome { status: Status::Aborted, reason: Some(reason), at: None };
                         return Ok(Flown { outcome, flew: false, simulated: sim.time() });
                     }
                 };
@@ -312,6 +312,82 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
             None => Some(sim.with_fleet(|f| f.odometry(d))),
         };
         hooks.landed(&mission, backend, &odometry);
+        Ok(Flown { outcome, flew: true, simulated: sim.time() })
+    })
+}
+
+/// A mission checked and compiled once for its world, to fly many times (`aviary test`):
+/// each flight a fleet of its own from the world, seeded with its own seed.
+pub struct Prepared {
+    pub mission: Mission,
+    pub world: World,
+    /// The texts, for the places [`Outcome::at`] points into.
+    pub sources: SourceMap,
+}
+
+/// The front end and the compiler of [`fly`], once, for a world of simulated drones only
+/// (a campaign cannot fly MAVLink vehicles thousands of times): [`NotFlown::Failed`] for
+/// a world with MAVLink drones.
+pub fn prepare(texts: Texts<'_>) -> Result<Prepared, NotFlown> {
+    let api = aviary_sim::descriptor();
+    let mut sources = SourceMap::new();
+    let world =
+        aviary_check::read_world(&mut sources, texts.world.name, Cow::Owned(texts.world.bytes));
+    let checked = aviary_check::check_against(
+        &mut sources,
+        (texts.mission.name, Cow::Owned(texts.mission.bytes)),
+        Some(world),
+        texts.files,
+        &api,
+    );
+    let (false, Some(program), Some(world)) =
+        (checked.has_errors(), checked.program, checked.world)
+    else {
+        return Err(NotFlown::Errors { diagnostics: checked.diagnostics, sources });
+    };
+    let live = aviary_mavlink::bindings(&world);
+    if let Some((drone, address, ..)) = live.first() {
+        let name = world.drones.get(*drone).map_or("", |d| d.name.as_str());
+        return Err(NotFlown::Failed(format!(
+            "the world binds {name} to a MAVLink vehicle at {address} ({} such drones in all): only simulated drones fly many times",
+            live.len()
+        )));
+    }
+    let mission = aviary_lower::compile(&program, &world, &api).ok_or(NotFlown::NoMission)?;
+    Ok(Prepared { mission, world, sources })
+}
+
+/// One flight of a [`Prepared`] mission on the simulator, with `options.seed`, as fast as
+/// it goes: what [`fly`] does after the compiler for a world of simulated drones, with the
+/// same engine call, so a seed flies here exactly as `aviary run --seed` flies it. Hooks
+/// hear [`Stage::SimStart`] and [`Stage::Flight`] and every event they want.
+pub fn fly_prepared(
+    prepared: &Prepared,
+    options: &Options,
+    hooks: &mut dyn Hooks,
+) -> Result<Flown, NotFlown> {
+    let runtime = simulated_runtime()
+        .map_err(|e| NotFlown::Failed(format!("cannot start the runtime: {e}")))?;
+    let (controller, controls) = Controller::new();
+    let mission = &prepared.mission;
+    runtime.block_on(async {
+        hooks.begin(Stage::SimStart);
+        let fleet = Fleet::new(&prepared.world).seeded(options.seed);
+        let sim = SimBackend::start_with(fleet, SimOptions { speed: None, ..SimOptions::default() });
+        hooks.end(Stage::SimStart);
+        let backend: &dyn Backend = &*sim;
+        let watch = watch_backend(sim.take_driver(), controller.clone());
+        hooks.begin(Stage::Flight);
+        let mut sink = Sink { hooks: &mut *hooks, backend };
+        let outcome = tokio::select! {
+            biased;
+            outcome = aviary_engine::run_controlled(mission, backend, &mut sink, &options.run, controls) => outcome,
+            never = watch => match never {},
+        };
+        hooks.end(Stage::Flight);
+        sim.stop();
+        let odometry = |d: usize| Some(sim.with_fleet(|f| f.odometry(d)));
+        hooks.landed(mission, backend, &odometry);
         Ok(Flown { outcome, flew: true, simulated: sim.time() })
     })
 }

@@ -2,7 +2,7 @@
 //! language (for `aviary bench` and for the tests of the other crates, a dev-dependency
 //! there), and the benchmarks `aviary bench` runs on them, each a function that writes
 //! its report to the `Write` it is given: [`parse()`] (the front end), [`front()`] (all of
-//! `aviary check`), [`w()`] (the engine, W(N, K)) and [`swarm()`] (the simulator). The
+//! `aviary check`), [`w()`] (the engine, W(N, K)) and [`swarm()`] (the simulator) and [`campaign()`] (`aviary test`, many seeds at once). The
 //! scale benchmarks fly through `aviary_backends::fly`, the pipeline of `aviary run`, so
 //! they measure what a user runs.
 //!
@@ -14,6 +14,7 @@
 #![forbid(unsafe_code)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
+mod campaign;
 mod front;
 pub mod generate;
 mod parse;
@@ -23,6 +24,7 @@ mod w;
 
 use std::time::Duration;
 
+pub use campaign::{campaign, PAPER_MISSION, PAPER_WORLD};
 pub use front::{front, Shape};
 pub use parse::parse;
 pub use swarm::swarm;

@@ -81,3 +81,16 @@ fn wrong_sizes_are_usage_errors() {
     assert!(matches!(realistic, Err(Error::Usage(_))));
     assert!(out.is_empty());
 }
+
+#[test]
+fn a_campaign_of_the_papers_mission_flies_every_seed() {
+    let text = report(|out| aviary_bench::campaign(4, 2, None, out));
+    assert!(
+        text.starts_with("aviary campaign mission=Search_and_Rescue runs=4 jobs=2 wall="),
+        "{text}"
+    );
+    assert!(text.contains(" succeeded=4 "), "{text}");
+    let mut out = Vec::new();
+    assert!(matches!(aviary_bench::campaign(0, 2, None, &mut out), Err(Error::Usage(_))));
+    assert!(matches!(aviary_bench::campaign(3, 0, None, &mut out), Err(Error::Usage(_))));
+}

@@ -69,6 +69,23 @@ pub enum BenchCommand {
         #[arg(long)]
         emit_world: bool,
     },
+    /// A campaign (`aviary test`) of the paper's mission, examples/search_and_rescue.mission:
+    /// N seeds at once; prints the wall time and runs per second
+    Campaign {
+        #[arg(long, default_value_t = 1000)]
+        runs: u64,
+        /// Runs at once (default: the number of cores)
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Another world for the paper's mission (default: its own, examples/search_and_rescue.world.toml)
+        #[arg(long, value_name = "FILE")]
+        world: Option<std::path::PathBuf>,
+    },
+}
+
+/// The threads of `bench campaign`: the machine's cores unless told.
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 /// The generated mission's shape (`aviary_bench::Shape`).
@@ -91,6 +108,16 @@ pub fn run(which: BenchCommand) -> u8 {
         }
         BenchCommand::Swarm { drones, emit, emit_world } => {
             aviary_bench::swarm(drones, Emit::of(emit, emit_world), out)
+        }
+        BenchCommand::Campaign { runs, jobs, world } => {
+            let world = match world.as_deref().map(std::fs::read_to_string).transpose() {
+                Ok(w) => w,
+                Err(e) => {
+                    eprintln!("aviary: cannot read the world file: {e}");
+                    return 2;
+                }
+            };
+            aviary_bench::campaign(runs, jobs.unwrap_or_else(cores), world.as_deref(), out)
         }
         BenchCommand::Front { shape, n, runs, emit, emit_world } => {
             let shape = match shape {

@@ -17,6 +17,7 @@ mod replay;
 mod report;
 mod run;
 mod serve;
+mod test;
 mod vehicles;
 
 /// mimalloc, tuned before `main` (`aviary_alloc`; docs/BENCHMARKS.md).
@@ -204,9 +205,14 @@ enum Command {
         #[arg(long, value_enum, default_value = "ardupilot")]
         autopilot: vehicles::Autopilot,
     },
+    /// Fly a mission on many seeds of the simulator at once and report how often it
+    /// succeeds, how it fails, and the spread of its time, batteries and finds
+    /// (docs/CAMPAIGNS.md); `aviary test merge`: the reports of shards as one
+    Test(test::TestArgs),
     /// Explain a diagnostic code, such as E107
     Explain { code: String },
-    /// Benchmarks on generated missions: the front end (parse), the engine (w), the simulator (swarm)
+    /// Benchmarks on generated missions: the front end (parse), the engine (w), the simulator
+    /// (swarm); and a campaign of the paper's mission (campaign)
     Bench {
         #[command(subcommand)]
         which: bench::BenchCommand,
@@ -354,6 +360,7 @@ fn command(cli: Cli) -> u8 {
                 autopilot,
             })
         }
+        Command::Test(args) => test::run(args),
         Command::Explain { code } => explain(&code),
         Command::Bench { which } => bench::run(which),
     };

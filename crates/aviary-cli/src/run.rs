@@ -162,9 +162,10 @@ pub fn run(args: &RunArgs) -> u8 {
         stats: Stats::default(),
         drones: 0,
         summary: String::new(),
+        expected: None,
     };
     let flown = aviary_backends::fly(texts, &options, &mut shown);
-    let Shown { trace, server, progress, summary, .. } = shown;
+    let Shown { trace, server, progress, summary, expected, .. } = shown;
     if let (Ok(flown), Some(trace)) = (&flown, &trace) {
         if !flown.flew {
             // Stopped while the vehicles connected: the trace is whole all the same.
@@ -216,6 +217,26 @@ pub fn run(args: &RunArgs) -> u8 {
             None => outln!("mission {}", outcome.status.as_str()),
         }
     }
+    // What `[expect]` asks, beyond an `ok` end: each one not met is said, and fails the run.
+    let unmet = match expected {
+        Some(Expected { observer, expect, targets }) if !expect.is_empty() => {
+            let record = observer.finish(args.seed, &outcome, &expect, targets, None);
+            let unmet: Vec<String> = expect
+                .iter()
+                .zip(&record.expectations)
+                .filter(|(_, met)| !**met)
+                .map(|(e, _)| e.to_string())
+                .collect();
+            if !unmet.is_empty() {
+                outln!("expectation not met: {}", unmet.join(", "));
+            } else if !args.quiet {
+                let all: Vec<String> = expect.iter().map(ToString::to_string).collect();
+                outln!("expectations met: {}", all.join(", "));
+            }
+            !unmet.is_empty()
+        }
+        _ => false,
+    };
     if let Some(why) = trace.as_ref().and_then(|t| lock(t).failed().map(str::to_owned)) {
         eprintln!(
             "aviary: the trace {} is not whole: {why}",
@@ -223,7 +244,14 @@ pub fn run(args: &RunArgs) -> u8 {
         );
         return 3;
     }
-    u8::from(outcome.status != Status::Ok)
+    u8::from(outcome.status != Status::Ok || unmet)
+}
+
+/// What a run is held to by its world's `[expect]`, and what it did.
+struct Expected {
+    observer: aviary_campaign::Observer,
+    expect: Vec<aviary_world::Expectation>,
+    targets: usize,
 }
 
 /// What a run shows as it goes, and where its trace goes: the hooks of the pipeline.
@@ -243,6 +271,8 @@ struct Shown<'a> {
     stats: Stats,
     drones: usize,
     summary: String,
+    /// Made as the mission is compiled.
+    expected: Option<Expected>,
 }
 
 impl Hooks for Shown<'_> {
@@ -250,6 +280,11 @@ impl Hooks for Shown<'_> {
         if self.args.serve.is_some() {
             self.map = aviary_station::checking::map_of(world);
         }
+        self.expected = Some(Expected {
+            observer: aviary_campaign::Observer::new(mission),
+            expect: world.expect.clone(),
+            targets: world.targets.len(),
+        });
         let out: Box<dyn Write + Send> = match &self.args.trace {
             Some(path) => match std::fs::File::create(path) {
                 Ok(f) => Box::new(f),
@@ -303,6 +338,9 @@ impl Hooks for Shown<'_> {
     }
 
     fn record(&mut self, record: &Record<'_>, backend: &dyn Backend) {
+        if let Some(expected) = &mut self.expected {
+            expected.observer.record(record, backend);
+        }
         if let Some(progress) = &self.progress {
             self.stats.observe(record, progress, backend, self.drones);
         }
@@ -335,6 +373,9 @@ impl Hooks for Shown<'_> {
         odometry: &dyn Fn(usize) -> Option<(f64, f64)>,
     ) {
         self.summary = summary(mission, backend, odometry, &self.stats);
+        if let Some(expected) = &mut self.expected {
+            expected.observer.landed(backend);
+        }
     }
 }
 

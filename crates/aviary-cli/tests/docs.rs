@@ -359,7 +359,7 @@ fn every_world_key_documented_is_read_and_every_key_read_is_documented() {
     // Tables that reject an unknown key: each documented key is accepted, and the
     // reader's own list of known keys is the documented one.
     type KeyInTable<'a> = (&'a str, &'a dyn Fn(&str) -> String);
-    let tables: [KeyInTable; 13] = [
+    let tables: [KeyInTable; 14] = [
         ("`[air]`", &|k| format!("[air]\n{k} = 1\n")),
         ("`[air.wind]`", &|k| format!("[air.wind]\n{k} = 1\n")),
         ("`[air.radio]`", &|k| format!("[air.radio]\n{k} = 1\n")),
@@ -375,6 +375,7 @@ fn every_world_key_documented_is_read_and_every_key_read_is_documented() {
         ("`[sensors.KIND]`", &|k| format!("[sensors.thermal]\n{k} = 1\n")),
         ("`[[targets]]`", &|k| format!("[[targets]]\n{k} = 1\n")),
         ("`[[faults]]`", &|k| format!("[drones.d]\nhome = [0, 0]\n[[faults]]\n{k} = 1\n")),
+        ("`[expect]`", &|k| format!("[[targets]]\nkind = \"P\"\nat = [1, 1]\n[expect]\n{k} = 1\n")),
     ];
     for (heading, world) in tables {
         let keys = keys_under(&doc, heading);

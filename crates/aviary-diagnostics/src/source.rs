@@ -95,6 +95,10 @@ impl SourceMap {
     pub fn add(&mut self, name: impl Into<String>, text: impl Into<String>) -> FileId {
         FileId(self.files.add(name.into(), text.into()) as u32)
     }
+    /// Every file, in the order they were added.
+    pub fn ids(&self) -> impl Iterator<Item = FileId> {
+        (0..self.files.0.len() as u32).map(FileId)
+    }
     pub fn name(&self, file: FileId) -> &str {
         self.files.get(file.0 as usize).map(|f| f.name.as_str()).unwrap_or("<unknown>")
     }

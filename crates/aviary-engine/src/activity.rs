@@ -136,7 +136,7 @@ impl<'m> Engine<'m> {
             drop(held);
             let id = self.m.builtins.exception(BuiltinException::RequirementNotMet);
             let why = format!("a requirement of {} does not hold", cap.name);
-            self.throw(id, vec![Value::Text(why)], actor, &ctx.scope);
+            self.throw(id, vec![Value::Text(why)], actor, &ctx.scope, Some(call.origin));
             return None;
         }
         Some(Started { instance, held, frame, claims, listed, args })
@@ -260,7 +260,13 @@ impl<'m> Engine<'m> {
             depth + 1,
             self.max_call_depth
         );
-        self.throw(id, vec![Value::Text(why)], actors.first().copied(), &ctx.scope);
+        self.throw(
+            id,
+            vec![Value::Text(why)],
+            actors.first().copied(),
+            &ctx.scope,
+            Some(call.origin),
+        );
         true
     }
 

@@ -70,6 +70,7 @@ impl<'m> Engine<'m> {
             a.args.iter().map(|e| env.eval(e)).collect::<Vec<_>>()
         };
         let function = a.function;
+        self.calling(drone, a.origin);
         self.trace(EventKind::ApiCall, || Event::ApiCall {
             actor: self.name(drone).into(),
             function,

@@ -309,6 +309,11 @@ pub(crate) struct Engine<'m> {
     /// How the mission ends early, if it does: failed (an unhandled exception, a lost
     /// backend) or aborted (the operator), and why.
     ending: RefCell<Option<(Status, String)>>,
+    /// Where the first unhandled exception was raised (`Outcome::at`).
+    failed_at: Cell<Option<aviary_ir::Origin>>,
+    /// Per drone, the statement of its latest middle-layer call: where a fault or a
+    /// refusal on it is said to have happened.
+    last_call: RefCell<Vec<Option<aviary_ir::Origin>>>,
     /// False once the backend cannot answer: then nobody can be sent home.
     backend_alive: Cell<bool>,
     /// The operator paused the whole mission.
@@ -368,6 +373,8 @@ impl<'m> Engine<'m> {
             detections: RefCell::new(BTreeMap::new()),
             places: Default::default(),
             ending: RefCell::new(None),
+            failed_at: Cell::new(None),
+            last_call: RefCell::new(vec![None; m.drones.len()]),
             backend_alive: Cell::new(true),
             mission_paused: Cell::new(false),
             steering: Default::default(),
@@ -528,7 +535,14 @@ impl<'m> Engine<'m> {
             status,
             reason: reason.as_deref().map(Cow::Borrowed),
         });
-        Outcome { status, reason }
+        Outcome { status, reason, at: self.failed_at.get() }
+    }
+
+    /// Remembers `origin` as the statement of `drone`'s latest middle-layer call.
+    pub(crate) fn calling(&self, drone: DroneId, origin: aviary_ir::Origin) {
+        if let Some(at) = self.last_call.borrow_mut().get_mut(drone) {
+            *at = Some(origin);
+        }
     }
 
     /// Ends the mission early; the first reason given is the one reported.
@@ -677,7 +691,7 @@ impl<'m> Engine<'m> {
     /// Raises a backend's failure on `drone` as its built-in exception, with the reason.
     pub(crate) fn fail(&self, failure: aviary_api::Failure, drone: DroneId, from: &Rc<Scope<'m>>) {
         let id = self.m.builtins.exception(failure.exception);
-        self.throw(id, vec![Value::Text(failure.reason)], Some(drone), from);
+        self.throw(id, vec![Value::Text(failure.reason)], Some(drone), from, None);
     }
 
     fn matches(&self, by: &Option<ActorFilter>, frame: &[Value], actor: Option<DroneId>) -> bool {
@@ -803,6 +817,7 @@ impl<'m> Engine<'m> {
         args: Vec<Value>,
         actor: Option<DroneId>,
         from: &Rc<Scope<'m>>,
+        at: Option<aviary_ir::Origin>,
     ) {
         self.heed_interrupt();
         if self.stopped() {
@@ -862,6 +877,10 @@ impl<'m> Engine<'m> {
             };
             if let Some(skipped) = skipped {
                 reason = format!("{reason}; its handler {skipped}, so it did not take it again");
+            }
+            if self.ending.borrow().is_none() {
+                let last = || actor.and_then(|d| self.last_call.borrow().get(d).copied().flatten());
+                self.failed_at.set(at.or_else(last));
             }
             self.end_with(Status::Failed, reason, true);
             return;

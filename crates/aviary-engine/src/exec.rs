@@ -270,9 +270,9 @@ impl<'m> Engine<'m> {
                 }
                 Node::Leash(l) => self.leash(l, ctx),
                 Node::Signal { signal, args, .. } => self.signal(*signal, args, ctx),
-                Node::Throw { exception, args, .. } => {
+                Node::Throw { exception, args, origin } => {
                     let args = self.eval_all(args, ctx);
-                    self.throw(*exception, args, ctx.actor, &ctx.scope);
+                    self.throw(*exception, args, ctx.actor, &ctx.scope, Some(*origin));
                 }
                 Node::StartIf { condition, body } => {
                     if self.truth(condition, ctx) {

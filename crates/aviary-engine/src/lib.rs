@@ -100,6 +100,10 @@ impl Default for RunOptions {
 pub struct Outcome {
     pub status: Status,
     pub reason: Option<String>,
+    /// Where the unhandled exception that failed the mission was raised, if one did: the
+    /// `THROW` statement, the capability call whose start failed, or the drone's
+    /// middle-layer call in progress (its latest) when a fault or a refusal raised it.
+    pub at: Option<aviary_ir::Origin>,
 }
 
 /// Runs `mission` to its end. Must be polled inside a tokio runtime (current-thread).

@@ -14,6 +14,7 @@
 //! the station's folder (`dir.rs`); no page loads anything from another site.
 
 mod assets;
+pub mod campaign;
 pub mod checking;
 mod dir;
 mod flight;

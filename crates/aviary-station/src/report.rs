@@ -35,7 +35,7 @@ struct Mission {
     blocks: Vec<(String, f64, Option<f64>)>,
 }
 
-fn escape(text: &str) -> String {
+pub(crate) fn escape(text: &str) -> String {
     text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
@@ -125,11 +125,11 @@ const PALETTE: [RGBColor; 8] = [
     RGBColor(180, 70, 140),
 ];
 
-fn colour(i: usize) -> RGBColor {
+pub(crate) fn colour(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
-type Drawn = Result<(), Box<dyn std::error::Error>>;
+pub(crate) type Drawn = Result<(), Box<dyn std::error::Error>>;
 
 /// The world's no-fly zones: red, filled half-transparent, each named at its centre (with
 /// its height, when it holds only up to one).
@@ -160,6 +160,63 @@ where
             escape(&name),
             (c[0], c[1]),
             ("sans-serif", 12).into_font().color(&red),
+        )))?;
+    }
+    Ok(())
+}
+
+/// The chart of a map in local metres.
+pub(crate) type MapChart<'a, DB> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// The world on a map: its areas, no-fly zones, geofence, places and the drones' homes.
+pub(crate) fn world_layers<DB: DrawingBackend>(
+    chart: &mut MapChart<'_, DB>,
+    w: &aviary_world::World,
+) -> Drawn
+where
+    DB::ErrorType: 'static,
+{
+    for a in &w.areas {
+        let polygon: Vec<(f64, f64)> = a.polygon.iter().map(|p| (p[0], p[1])).collect();
+        chart.draw_series(std::iter::once(Polygon::new(
+            polygon.clone(),
+            RGBColor(28, 100, 209).mix(0.08),
+        )))?;
+        let mut closed = polygon;
+        closed.push(closed[0]);
+        chart.draw_series(std::iter::once(PathElement::new(
+            closed,
+            RGBColor(28, 100, 209).mix(0.6),
+        )))?;
+        let c = a.centroid();
+        chart.draw_series(std::iter::once(Text::new(
+            escape(&a.name),
+            (c[0], c[1]),
+            ("sans-serif", 12).into_font().color(&RGBColor(28, 100, 209)),
+        )))?;
+    }
+    no_fly_zones(chart, w)?;
+    if let Some(fence) = &w.site.geofence {
+        let mut closed: Vec<(f64, f64)> = fence.iter().map(|p| (p[0], p[1])).collect();
+        closed.push(closed[0]);
+        chart.draw_series(std::iter::once(PathElement::new(closed, RED.stroke_width(2))))?;
+    }
+    for p in &w.places {
+        chart.draw_series(std::iter::once(Circle::new((p.at[0], p.at[1]), 3, BLACK.filled())))?;
+        chart.draw_series(std::iter::once(Text::new(
+            escape(&p.name),
+            (p.at[0], p.at[1]),
+            ("sans-serif", 11).into_font(),
+        )))?;
+    }
+    for d in &w.drones {
+        chart.draw_series(std::iter::once(Rectangle::new(
+            [(d.home[0] - 2.0, d.home[1] - 2.0), (d.home[0] + 2.0, d.home[1] + 2.0)],
+            RGBColor(107, 115, 133).filled(),
         )))?;
     }
     Ok(())
@@ -209,50 +266,7 @@ fn map(m: &Mission, world: Option<&aviary_world::World>) -> Result<String, Strin
             .light_line_style(WHITE.mix(0.0))
             .draw()?;
         if let Some(w) = world {
-            for a in &w.areas {
-                let polygon: Vec<(f64, f64)> = a.polygon.iter().map(|p| (p[0], p[1])).collect();
-                chart.draw_series(std::iter::once(Polygon::new(
-                    polygon.clone(),
-                    RGBColor(28, 100, 209).mix(0.08),
-                )))?;
-                let mut closed = polygon;
-                closed.push(closed[0]);
-                chart.draw_series(std::iter::once(PathElement::new(
-                    closed,
-                    RGBColor(28, 100, 209).mix(0.6),
-                )))?;
-                let c = a.centroid();
-                chart.draw_series(std::iter::once(Text::new(
-                    escape(&a.name),
-                    (c[0], c[1]),
-                    ("sans-serif", 12).into_font().color(&RGBColor(28, 100, 209)),
-                )))?;
-            }
-            no_fly_zones(&mut chart, w)?;
-            if let Some(fence) = &w.site.geofence {
-                let mut closed: Vec<(f64, f64)> = fence.iter().map(|p| (p[0], p[1])).collect();
-                closed.push(closed[0]);
-                chart
-                    .draw_series(std::iter::once(PathElement::new(closed, RED.stroke_width(2))))?;
-            }
-            for p in &w.places {
-                chart.draw_series(std::iter::once(Circle::new(
-                    (p.at[0], p.at[1]),
-                    3,
-                    BLACK.filled(),
-                )))?;
-                chart.draw_series(std::iter::once(Text::new(
-                    escape(&p.name),
-                    (p.at[0], p.at[1]),
-                    ("sans-serif", 11).into_font(),
-                )))?;
-            }
-            for d in &w.drones {
-                chart.draw_series(std::iter::once(Rectangle::new(
-                    [(d.home[0] - 2.0, d.home[1] - 2.0), (d.home[0] + 2.0, d.home[1] + 2.0)],
-                    RGBColor(107, 115, 133).filled(),
-                )))?;
-            }
+            world_layers(&mut chart, w)?;
         }
         for (i, (name, d)) in m.drones.iter().enumerate() {
             let track = d.samples.iter().map(|s| (s.1[0], s.1[1]));
@@ -436,7 +450,7 @@ pub fn render(
     Ok(html)
 }
 
-const STYLE: &str = "body{font:14px/1.4 system-ui,sans-serif;color:#1d2330;margin:24px auto;max-width:1000px;padding:0 16px}\
+pub(crate) const STYLE: &str = "body{font:14px/1.4 system-ui,sans-serif;color:#1d2330;margin:24px auto;max-width:1000px;padding:0 16px}\
 h1{font-size:22px}h2{font-size:17px;margin-top:28px;border-bottom:1px solid #d9dde5}h3{font-size:14px;margin:10px 0 4px}\
 table{border-collapse:collapse;font-variant-numeric:tabular-nums}td,th{padding:3px 10px;border-bottom:1px solid #eef0f4;text-align:left}\
 .meta,.note{color:#6b7385;font-size:12px}.map svg{max-width:100%;height:auto}\

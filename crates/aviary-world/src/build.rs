@@ -11,6 +11,7 @@ use crate::{Area, Geo, Place, Site, World};
 
 mod air;
 mod drone;
+mod expect;
 mod fleet;
 mod no_fly;
 mod sim;
@@ -20,6 +21,7 @@ use fleet::FleetInfo;
 
 const TABLES: &[&str] = &[
     "site", "places", "areas", "no_fly", "drones", "fleets", "sensors", "targets", "faults", "air",
+    "expect",
 ];
 const SITE_KEYS: &[&str] = &[
     "name",
@@ -157,6 +159,9 @@ fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Dia
     }
     if let Some(e) = table("air") {
         world.air = air::air(cx, &e.node);
+    }
+    if let Some(e) = table("expect") {
+        world.expect = expect::expectations(cx, &e.node, &world.targets);
     }
     let group_spans = std::mem::take(&mut drones.group_spans);
     world.groups = std::mem::take(&mut drones.groups);

@@ -55,6 +55,35 @@ pub struct World {
     /// `[air]`: the simulator's wind, radio, GPS noise, detection curve, battery spread
     /// and random faults, each off unless declared (docs/WORLD.md).
     pub air: Air,
+    /// `[expect]`, in file order: what success means beyond "no unhandled exception".
+    pub expect: Vec<Expectation>,
+}
+
+/// One line of `[expect]` (docs/CAMPAIGNS.md): a run meets it or not.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
+#[serde(tag = "expect", content = "value", rename_all = "snake_case")]
+pub enum Expectation {
+    /// `all_found = true`: every `[[targets]]` found by some drone.
+    AllFound,
+    /// `min_found = K`: at least K of the targets found.
+    MinFound(u64),
+    /// `max_time = S`: the mission ended (its fleet home) within S seconds.
+    MaxTime(f64),
+    /// `min_battery = F`: no drone's battery went under the fraction F.
+    MinBattery(f64),
+}
+
+impl std::fmt::Display for Expectation {
+    /// As the reports say it: `all targets found`, `time <= 1200 s`, `battery >= 25%`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use aviary_api::show::number;
+        match self {
+            Expectation::AllFound => write!(f, "all targets found"),
+            Expectation::MinFound(k) => write!(f, "at least {k} found"),
+            Expectation::MaxTime(s) => write!(f, "time <= {} s", number(*s)),
+            Expectation::MinBattery(b) => write!(f, "battery >= {}%", number(b * 100.0)),
+        }
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -602,6 +631,7 @@ impl Default for World {
             targets: Vec::new(),
             faults: Vec::new(),
             air: Air::default(),
+            expect: Vec::new(),
         }
     }
 }

@@ -305,3 +305,43 @@ fn failures(report: &Report, world: Option<&aviary_world::World>) -> Result<Stri
     drawn.map_err(|e| format!("cannot draw the map of failures: {e}"))?;
     Ok(svg)
 }
+
+/// The most runs a campaign started from the page may have: enough for a figure to
+/// trust (the interval at 10,000 runs is within a percent), few enough that the station
+/// stays the operator's (the command line has no such bound).
+pub const MOST_RUNS: u64 = 10_000;
+
+/// A campaign of `runs` seeds from `seed` on the mission and world the page has open,
+/// with the files it `USE`s read by `files`, on every core: the report's text and its
+/// page. Refused with the reason for a mission that does not fly or a count out of bounds.
+pub fn fly(
+    mission: &crate::checking::Text,
+    world: &crate::checking::Text,
+    files: &dyn aviary_check::SourceProvider,
+    runs: u64,
+    seed: u64,
+) -> Result<(String, String), String> {
+    use aviary_backends::pipeline::{NotFlown, Source, Texts};
+    use aviary_campaign::report::Flew;
+    use aviary_campaign::{Campaign, Seeds};
+    if !(1..=MOST_RUNS).contains(&runs) {
+        return Err(format!("a campaign from the station has 1 to {MOST_RUNS} runs, not {runs}"));
+    }
+    let seeds = Seeds::new(seed, runs)?;
+    let texts = Texts {
+        mission: Source { name: &mission.path, bytes: mission.text.clone().into_bytes() },
+        world: Source { name: &world.path, bytes: world.text.clone().into_bytes() },
+        files,
+    };
+    let campaign = Campaign::prepare(texts).map_err(|e| match e {
+        NotFlown::Errors { .. } => "the mission cannot fly: fix the errors the check shows".into(),
+        NotFlown::NoMission => format!("{} has no MISSION to run", mission.path),
+        NotFlown::Speed => "a campaign flies simulated drones only: the world has MAVLink drones".into(),
+        NotFlown::Failed(why) => why,
+    })?;
+    let jobs = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let records = campaign.run(&seeds.of(None), jobs, &|_| {})?;
+    let report = aviary_campaign::Report::new(Flew::of(&campaign), seeds, None, records);
+    let page = render(&report, Some(&campaign.prepared.world))?;
+    Ok((report.text(), page))
+}

@@ -38,6 +38,7 @@ pub(crate) fn router(station: Arc<Station>) -> Router {
     let changes = Router::new()
         .route("/api/station/save", post(save))
         .route("/api/station/fly", post(fly))
+        .route("/api/station/campaign", post(campaign))
         .route_layer(middleware::from_fn_with_state(gate.clone(), aviary_server::token));
     Router::new()
         .route("/", get(index))
@@ -229,6 +230,47 @@ async fn fly(
         let trace = trace_for(folder, &request.mission.path);
         match flight::start(station.clone(), request, tree, files, trace) {
             Ok(()) => Json(json!({ "ok": true })).into_response(),
+            Err(why) => error(StatusCode::CONFLICT, why),
+        }
+    };
+    on_a_deep_stack(work).await
+}
+
+#[derive(serde::Deserialize)]
+struct CampaignRequest {
+    mission: Text,
+    world: Text,
+    runs: u64,
+    #[serde(default)]
+    seed: u64,
+}
+
+/// A campaign on the mission and world the page has open (`aviary test`, on every core):
+/// `{text, html}`, the report as `aviary test` prints it and as its `--html` page.
+async fn campaign(
+    State(station): State<Arc<Station>>,
+    Json(request): Json<CampaignRequest>,
+) -> Response {
+    let work = move || {
+        let (report, files) = match checked(&station, &request.mission, &request.world) {
+            Ok(checked) => checked,
+            Err(refusal) => return refusal.into_response(),
+        };
+        if !report.flyable {
+            let mut body =
+                json!({ "error": "the mission cannot fly: fix the errors the check shows" });
+            body["check"] = report.json;
+            return (StatusCode::CONFLICT, Json(body)).into_response();
+        }
+        let flown = crate::campaign::fly(
+            &request.mission,
+            &request.world,
+            &*files,
+            request.runs,
+            request.seed,
+        );
+        match flown {
+            Ok((text, html)) => Json(json!({ "text": text, "html": html })).into_response(),
             Err(why) => error(StatusCode::CONFLICT, why),
         }
     };

@@ -262,6 +262,30 @@ async function station() {
     }
     await watch();
   };
+  $("campaign").onclick = async () => {
+    const runs = Number($("campaign-runs").value);
+    const summary = $("campaign-summary");
+    summary.textContent = `flying ${runs} runs...`;
+    summary.className = "summary";
+    $("campaign").disabled = true;
+    const result = await api.call("POST", "/api/station/campaign", { ...pair(), runs, seed: 0 });
+    $("campaign").disabled = false;
+    if (!result.ok) {
+      summary.textContent = "";
+      if (result.body && result.body.check) showCheck(result.body.check);
+      return refused("campaign", result);
+    }
+    // The report's first lines: the campaign, its seeds and how often it succeeded.
+    const lines = result.body.text.split("\n");
+    summary.textContent = lines.find((l) => l.startsWith("success:")) || lines[0];
+    summary.className = "summary " + (/success: (\d+) of \1 /.test(summary.textContent) ? "good" : "bad");
+    const link = document.createElement("a");
+    link.href = URL.createObjectURL(new Blob([result.body.html], { type: "text/html" }));
+    link.download = editor.files.mission.path.replace(/^.*\//, "").replace(/\.mission$/, "") + "-campaign.html";
+    document.body.appendChild(link);
+    link.click();
+    link.remove();
+  };
   records(listing.traces || [], () => worlds.value);
   if (listing.missions.length) {
     const preferred = listing.missions.find((m) => /search_and_rescue|paper/.test(m)) || listing.missions[0];

@@ -336,7 +336,9 @@ pub fn fly(
     let campaign = Campaign::prepare(texts).map_err(|e| match e {
         NotFlown::Errors { .. } => "the mission cannot fly: fix the errors the check shows".into(),
         NotFlown::NoMission => format!("{} has no MISSION to run", mission.path),
-        NotFlown::Speed => "a campaign flies simulated drones only: the world has MAVLink drones".into(),
+        NotFlown::Speed => {
+            "a campaign flies simulated drones only: the world has MAVLink drones".into()
+        }
         NotFlown::Failed(why) => why,
     })?;
     let jobs = std::thread::available_parallelism().map_or(1, |n| n.get());

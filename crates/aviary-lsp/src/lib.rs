@@ -25,6 +25,7 @@ mod edit;
 mod explain;
 mod hover;
 pub mod index;
+mod more;
 mod nav;
 pub mod overlay;
 pub mod text;
@@ -134,6 +135,17 @@ pub fn capabilities() -> lsp_types::ServerCapabilities {
         document_symbol_provider: Some(OneOf::Left(true)),
         folding_range_provider: Some(FoldingRangeProviderCapability::Simple(true)),
         code_action_provider: Some(CodeActionProviderCapability::Simple(true)),
+        signature_help_provider: Some(SignatureHelpOptions {
+            trigger_characters: Some(vec!["(".into(), ",".into(), " ".into()]),
+            ..SignatureHelpOptions::default()
+        }),
+        semantic_tokens_provider: Some(SemanticTokensServerCapabilities::SemanticTokensOptions(
+            SemanticTokensOptions {
+                legend: more::legend(),
+                full: Some(SemanticTokensFullOptions::Bool(true)),
+                ..SemanticTokensOptions::default()
+            },
+        )),
         ..ServerCapabilities::default()
     }
 }
@@ -189,6 +201,10 @@ impl Server {
             req::DocumentSymbolRequest::METHOD => answer(edit::symbols(self, params(r)?)),
             req::FoldingRangeRequest::METHOD => answer(edit::folding(self, params(r)?)),
             req::CodeActionRequest::METHOD => answer(edit::code_actions(self, params(r)?)),
+            req::SignatureHelpRequest::METHOD => answer(more::signature_help(self, params(r)?)),
+            req::SemanticTokensFullRequest::METHOD => {
+                answer(more::semantic_tokens(self, params(r)?))
+            }
             #[cfg(test)]
             "aviary/panic" => panic!("a handler's bug, on purpose"),
             _ => {

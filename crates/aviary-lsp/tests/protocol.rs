@@ -50,6 +50,31 @@ fn summarize_completion(answer: &mut Value) {
     }
 }
 
+/// Semantic tokens are relative numbers: each as `line:column text type`, with the
+/// legend's names (`aviary_lsp::capabilities`).
+fn decode_tokens(answer: &mut Value, text: &str) {
+    let caps = serde_json::to_value(aviary_lsp::capabilities()).unwrap();
+    let legend = &caps["semanticTokensProvider"]["legend"];
+    let Some(data) = answer["result"]["data"].as_array() else { return };
+    let numbers: Vec<u64> = data.iter().map(|n| n.as_u64().unwrap()).collect();
+    let lines: Vec<&str> = text.lines().collect();
+    let (mut line, mut column) = (0, 0);
+    let mut shown = Vec::new();
+    for t in numbers.chunks(5) {
+        if t[0] > 0 {
+            column = 0;
+        }
+        line += t[0] as usize;
+        column += t[1] as usize;
+        let units: Vec<u16> = lines[line].encode_utf16().collect();
+        let word = String::from_utf16_lossy(&units[column..column + t[2] as usize]);
+        let kind = legend["tokenTypes"][t[3] as usize].as_str().unwrap();
+        let declaration = if t[4] & 1 == 1 { " declaration" } else { "" };
+        shown.push(json!(format!("{}:{column} {word} {kind}{declaration}", line + 1)));
+    }
+    answer["result"] = Value::Array(shown);
+}
+
 fn run_fixture(path: &Path) -> String {
     let dir = fixtures();
     let name = path.file_stem().unwrap().to_string_lossy().into_owned();
@@ -133,6 +158,12 @@ fn run_fixture(path: &Path) -> String {
             ),
             "symbols" => client.request("textDocument/documentSymbol", json!({ "textDocument": doc })),
             "symbols-of" => client.request("textDocument/documentSymbol", json!({ "textDocument": { "uri": uri(&dir.join(rest)) } })),
+            "signatureHelp" => client.request("textDocument/signatureHelp", json!({ "textDocument": doc, "position": at(rest) })),
+            "semanticTokens" => {
+                let mut a = client.request("textDocument/semanticTokens/full", json!({ "textDocument": doc }));
+                decode_tokens(&mut a, &texts[&mission_uri]);
+                a
+            }
             "folding" => client.request("textDocument/foldingRange", json!({ "textDocument": doc })),
             other => panic!("unknown script step `{other}`"),
         };

@@ -19,6 +19,7 @@ use lsp_types::{notification as note, request as req, Uri};
 use serde::de::DeserializeOwned;
 
 pub mod analysis;
+pub mod bench;
 mod complete;
 mod diag;
 mod edit;

@@ -58,3 +58,14 @@ fn a_panicking_handler_is_answered_with_an_error_and_the_server_lives_on() {
         .unwrap();
     thread.join().unwrap().unwrap();
 }
+
+#[test]
+fn the_benchmark_times_each_edit_to_its_diagnostics() {
+    let mission = include_str!("../../../examples/search_and_rescue.mission");
+    let world = include_str!("../../../examples/search_and_rescue.world.toml");
+    let timings = crate::bench::edits(mission, world, 4).unwrap();
+    assert_eq!(timings.edits.len(), 4);
+    assert_eq!(timings.errors, 0);
+    // The paper's mission says five notes (N303 four times, N301 once).
+    assert_eq!(timings.diagnostics, 5);
+}

@@ -145,6 +145,7 @@ pub fn describe(a: &Analysis, sym: &Sym) -> String {
             let origin = if api.is_exception(name) { "built-in exception" } else { "exception" };
             format!("```aviary\nEXCEPTION {name}\n```\n{origin}")
         }
+        Sym::Local { name, what, .. } => format!("```aviary\n{name}\n```\n{what}"),
         Sym::Tag(name) => format!("```aviary\n{name}\n```\nactivity tag: a leash (`{name} PAUSE`, `ABORT`, `RESUME`) names the activity by it"),
     }
 }

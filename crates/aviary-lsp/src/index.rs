@@ -23,6 +23,14 @@ pub enum Sym {
     Group(String),
     /// An activity's tag (`FlyCircle-C1`): the capability's name with its tag.
     Tag(String),
+    /// A name bound in one place (a `FOR` alias or parameter, a handler's binding, a
+    /// capability's actor), known by where it is bound.
+    Local {
+        name: String,
+        what: &'static str,
+        file: FileId,
+        at: Span,
+    },
 }
 
 impl Sym {
@@ -36,7 +44,7 @@ impl Sym {
             | Sym::Drone(n)
             | Sym::Group(n)
             | Sym::Tag(n) => n,
-            Sym::Param { name, .. } => name,
+            Sym::Param { name, .. } | Sym::Local { name, .. } => name,
         }
     }
 }
@@ -56,8 +64,14 @@ pub fn index(
     world: Option<(FileId, &World)>,
     api: &aviary_api::Descriptor,
 ) -> Vec<Occurrence> {
-    let mut walk =
-        Walk { out: Vec::new(), file: FileId(0), world: world.map(|(_, w)| w), cap: None, api };
+    let mut walk = Walk {
+        out: Vec::new(),
+        file: FileId(0),
+        world: world.map(|(_, w)| w),
+        cap: None,
+        api,
+        locals: Vec::new(),
+    };
     if let Some((file, w)) = world {
         for p in &w.places {
             walk.push_at(file, p.span, Sym::Place(p.name.clone()), true);
@@ -76,6 +90,7 @@ pub fn index(
                 Item::Use(_) => {}
                 Item::Mission(m) => {
                     walk.cap = None;
+                    walk.locals.clear();
                     walk.body(&m.body);
                 }
                 Item::Capability(c) => walk.capability(c),
@@ -92,6 +107,8 @@ struct Walk<'a> {
     /// The capability being walked, with its actors and parameters.
     cap: Option<&'a Capability>,
     api: &'a aviary_api::Descriptor,
+    /// The names bound around the walk, innermost last.
+    locals: Vec<Sym>,
 }
 
 impl<'a> Walk<'a> {
@@ -102,7 +119,34 @@ impl<'a> Walk<'a> {
         self.push_at(self.file, span, sym, definition);
     }
 
+    /// Binds `ids` (definitions) for the walk of `inner`.
+    fn bind(
+        &mut self,
+        ids: &[aviary_syntax::ast::Ident],
+        what: &'static str,
+        inner: impl FnOnce(&mut Self),
+    ) {
+        let depth = self.locals.len();
+        for id in ids {
+            let sym = Sym::Local { name: id.name.clone(), what, file: self.file, at: id.span };
+            self.push(id.span, sym.clone(), true);
+            self.locals.push(sym);
+        }
+        inner(self);
+        self.locals.truncate(depth);
+    }
+
+    /// The local `name` bound around the walk, if any.
+    fn bound(&self, name: &str) -> Option<Sym> {
+        self.locals.iter().rev().find(|s| s.name() == name).cloned()
+    }
+
     fn capability(&mut self, c: &'a Capability) {
+        self.locals.clear();
+        self.bind(&c.actors, "actor of the capability", |w| w.capability_inner(c));
+    }
+
+    fn capability_inner(&mut self, c: &'a Capability) {
         self.cap = Some(c);
         self.push(c.name.span, Sym::Capability(c.name.name.clone()), true);
         for p in &c.params {
@@ -143,6 +187,10 @@ impl<'a> Walk<'a> {
 
     /// A name that stands for a drone or a group of the world (else a variable).
     fn actor(&mut self, id: Option<&aviary_syntax::ast::Ident>) {
+        if let Some(sym) = id.and_then(|i| self.bound(&i.name)) {
+            self.push(id.map_or(Span::default(), |i| i.span), sym, false);
+            return;
+        }
         let (Some(id), Some(world)) = (id, self.world) else { return };
         if world.drones.iter().any(|d| d.name == id.name) {
             self.push(id.span, Sym::Drone(id.name.clone()), false);
@@ -206,7 +254,9 @@ impl<'a> Walk<'a> {
                     self.actor(Some(&i.actor));
                     i.values.iter().for_each(|e| self.expr(e));
                 }
-                self.body(&f.body);
+                let mut bound = vec![f.alias.clone()];
+                bound.extend(f.params.iter().cloned());
+                self.bind(&bound, "bound by FOR", |w| w.body(&f.body));
             }
             Stmt::Signal(r) => {
                 self.push(r.name.span, Sym::Signal(r.name.name.clone()), true);
@@ -219,12 +269,12 @@ impl<'a> Walk<'a> {
             Stmt::Handler(h) => {
                 self.push(h.signal.span, Sym::Signal(h.signal.name.clone()), false);
                 self.actor(h.by.as_ref());
-                self.body(&h.body);
+                self.bind(&h.bindings, "value of the signal", |w| w.body(&h.body));
             }
             Stmt::ExceptionHandler(h) => {
                 self.push(h.exception.span, Sym::Exception(h.exception.name.clone()), false);
                 self.actor(h.by.as_ref());
-                self.body(&h.body);
+                self.bind(&h.bindings, "value of the exception", |w| w.body(&h.body));
             }
             Stmt::If(i) => {
                 for (c, b) in &i.branches {
@@ -247,6 +297,10 @@ impl<'a> Walk<'a> {
     fn expr(&mut self, e: &'a Expr) {
         match &e.kind {
             ExprKind::Name(id) => {
+                if let Some(sym) = self.bound(&id.name) {
+                    self.push(id.span, sym, false);
+                    return;
+                }
                 if let Some(c) = self.cap.filter(|_| self.local(&id.name)) {
                     if c.params.iter().any(|p| p.name == id.name) {
                         let sym =

@@ -138,7 +138,7 @@ fn type_of(sym: &Sym) -> u32 {
         Sym::Signal(_) | Sym::Exception(_) => 2,
         Sym::Place(_) => 3,
         Sym::Area(_) => 4,
-        Sym::Drone(_) => 5,
+        Sym::Drone(_) | Sym::Local { .. } => 5,
         Sym::Group(_) => 6,
         Sym::Tag(_) => 7,
     }

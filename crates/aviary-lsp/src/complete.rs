@@ -110,6 +110,8 @@ pub fn complete(server: &Server, p: CompletionParams) -> Option<CompletionRespon
                 items.push(item(k.as_str(), CompletionItemKind::KEYWORD, "keyword", None));
             }
         }
+    } else if words.len() == 1 && words[0].contains('-') {
+        leash_actions(a, words[0], &mut items);
     } else if is_statement(a, &words) && !words.iter().any(|w| Keyword::from_exact(w).is_some()) {
         capabilities(a, &mut items);
     } else {
@@ -319,5 +321,28 @@ fn telemetry(a: &Analysis, out: &mut Vec<CompletionItem>) {
             item(f.name(), CompletionItemKind::METHOD, &f.signature(), Some(f.summary.to_string()));
         it.insert_text = Some(format!("{}(", f.name()));
         out.push(it);
+    }
+}
+
+/// After a tagged activity at the start of a statement (`FlyCircle-C1 `): what a leash
+/// may do to it, `PAUSE`, `RESUME`, `ABORT` and the capability's named `PERFORM`
+/// sections.
+fn leash_actions(a: &Analysis, tagged: &str, out: &mut Vec<CompletionItem>) {
+    for k in [Keyword::Pause, Keyword::Resume, Keyword::Abort] {
+        out.push(item(k.as_str(), CompletionItemKind::KEYWORD, "leash action", None));
+    }
+    let capability = tagged.split('-').next().unwrap_or(tagged);
+    let Some(c) = a.program.as_ref().and_then(|p| p.capability(capability)) else { return };
+    for s in &c.sections {
+        if let aviary_syntax::ast::Section::Perform { name: Some(n), .. } = s {
+            if Keyword::from_exact(&n.name).is_none() {
+                out.push(item(
+                    &n.name,
+                    CompletionItemKind::METHOD,
+                    &format!("PERFORM {} of {capability}", n.name),
+                    None,
+                ));
+            }
+        }
     }
 }

@@ -2,9 +2,9 @@
 //! protocol's types; everything it says comes from the pure front end (aviary-syntax,
 //! aviary-check, aviary-world, aviary-verify), as `aviary check` and `aviary fmt` say it.
 //!
-//! One thread reads messages in order and answers each; every change re-checks the open
+//! One thread reads messages in order and answers each; a change re-checks the open
 //! missions (and a world file open alone) and publishes the diagnostics of every file
-//! they read. A panic in a handler is caught, logged to stderr and answered with an
+//! they read (edits that came meanwhile are applied first and checked with it). A panic in a handler is caught, logged to stderr and answered with an
 //! error; the server lives on.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -66,7 +66,16 @@ pub fn run(connection: Connection, config: Config) -> Result<(), String> {
     connection.initialize(capabilities).map_err(|e| e.to_string())?;
     let mut server =
         Server { config, docs: Docs::new(), analyses: BTreeMap::new(), published: BTreeSet::new() };
-    for message in &connection.receiver {
+    // A message taken while gathering edits, to handle next.
+    let mut pending = None;
+    loop {
+        let message = match pending.take() {
+            Some(m) => m,
+            None => match connection.receiver.recv() {
+                Ok(m) => m,
+                Err(_) => break,
+            },
+        };
         match message {
             Message::Request(request) => {
                 if connection.handle_shutdown(&request).map_err(|e| e.to_string())? {
@@ -76,15 +85,30 @@ pub fn run(connection: Connection, config: Config) -> Result<(), String> {
                 send(&connection, Message::Response(response))?;
             }
             Message::Notification(n) => {
-                let method = n.method.clone();
-                match catch_unwind(AssertUnwindSafe(|| server.notification(n))) {
-                    Ok(publish) => {
-                        for p in publish {
-                            send(&connection, Message::Notification(p))?;
+                let mut changed = server.caught_notification(n);
+                // The edits that came meanwhile (typing faster than a check): applied
+                // together and checked once, so no request waits on stale checks.
+                while let Ok(m) = connection.receiver.try_recv() {
+                    match m {
+                        Message::Notification(n) if is_sync(&n.method) => {
+                            changed |= server.caught_notification(n);
+                        }
+                        other => {
+                            pending = Some(other);
+                            break;
                         }
                     }
-                    Err(panic) => {
-                        eprintln!("aviary lsp: {method} panicked: {}", panic_text(&panic))
+                }
+                if changed {
+                    match catch_unwind(AssertUnwindSafe(|| server.reanalyse())) {
+                        Ok(publish) => {
+                            for p in publish {
+                                send(&connection, Message::Notification(p))?;
+                            }
+                        }
+                        Err(panic) => {
+                            eprintln!("aviary lsp: a check panicked: {}", panic_text(&panic))
+                        }
                     }
                 }
             }
@@ -92,6 +116,17 @@ pub fn run(connection: Connection, config: Config) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// A notification of the documents' texts.
+fn is_sync(method: &str) -> bool {
+    [
+        note::DidOpenTextDocument::METHOD,
+        note::DidChangeTextDocument::METHOD,
+        note::DidCloseTextDocument::METHOD,
+        note::DidSaveTextDocument::METHOD,
+    ]
+    .contains(&method)
 }
 
 fn send(connection: &Connection, message: Message) -> Result<(), String> {
@@ -214,14 +249,23 @@ impl Server {
         }
     }
 
-    /// Handles a notification; returns the diagnostics to publish.
-    fn notification(&mut self, n: Notification) -> Vec<Notification> {
+    /// [`Server::notification`], a panic caught and logged.
+    fn caught_notification(&mut self, n: Notification) -> bool {
+        let method = n.method.clone();
+        catch_unwind(AssertUnwindSafe(|| self.notification(n))).unwrap_or_else(|panic| {
+            eprintln!("aviary lsp: {method} panicked: {}", panic_text(&panic));
+            false
+        })
+    }
+
+    /// Handles a notification; says whether the documents changed.
+    fn notification(&mut self, n: Notification) -> bool {
         match n.method.as_str() {
             note::DidOpenTextDocument::METHOD => {
                 let Ok(p) =
                     serde_json::from_value::<lsp_types::DidOpenTextDocumentParams>(n.params)
                 else {
-                    return Vec::new();
+                    return false;
                 };
                 let d = p.text_document;
                 self.docs
@@ -231,10 +275,10 @@ impl Server {
                 let Ok(p) =
                     serde_json::from_value::<lsp_types::DidChangeTextDocumentParams>(n.params)
                 else {
-                    return Vec::new();
+                    return false;
                 };
                 let Some(doc) = self.docs.get_mut(&uri::key(&p.text_document.uri)) else {
-                    return Vec::new();
+                    return false;
                 };
                 for change in p.content_changes {
                     apply(&mut doc.text, change);
@@ -245,14 +289,14 @@ impl Server {
                 let Ok(p) =
                     serde_json::from_value::<lsp_types::DidCloseTextDocumentParams>(n.params)
                 else {
-                    return Vec::new();
+                    return false;
                 };
                 self.docs.remove(&uri::key(&p.text_document.uri));
             }
             note::DidSaveTextDocument::METHOD | note::DidChangeWatchedFiles::METHOD => {}
-            _ => return Vec::new(),
+            _ => return false,
         }
-        self.reanalyse()
+        true
     }
 
     /// Checks every open mission again (and each open world file no open mission reads),

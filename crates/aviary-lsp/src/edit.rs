@@ -278,8 +278,8 @@ pub fn code_actions(server: &Server, p: CodeActionParams) -> Option<Vec<CodeActi
     Some(out)
 }
 
-/// The edit that puts `name` in place of the name at `span`: the whole span when it is
-/// one name; for a tagged activity (`FlyCircle-C1`), the part the suggestion changes.
+/// The edit that puts `name` in place of the name at `span`, which is one word: a name,
+/// or a tagged activity (`FlyCircle-C1`, whose span and suggestion both hold the tag).
 fn replacement(
     a: &Analysis,
     file: FileId,

@@ -1,7 +1,9 @@
 //! `aviary bench`: the arguments of the benchmarks, which `aviary_bench` runs and
 //! reports (docs/BENCHMARKS.md): `parse` (the front end), `front` (all of `aviary check`),
-//! `w` (the engine) and `swarm` (the simulator). Here only what the command line says and
-//! where the report goes.
+//! `w` (the engine) and `swarm` (the simulator); and `lsp` (the language server: an
+//! edit's time to its diagnostics), which `aviary_lsp::bench` times on a mission of
+//! `aviary_bench`'s generator. Here only what the command line says and where the report
+//! goes.
 
 use aviary_bench::{Emit, Error};
 use clap::{Subcommand, ValueEnum};
@@ -56,6 +58,16 @@ pub enum BenchCommand {
         /// Print the generated world instead of timing it
         #[arg(long)]
         emit_world: bool,
+    },
+    /// The language server: the time from an edit of a generated mission of N lines to
+    /// its diagnostics, through the protocol; prints the median and the slowest
+    Lsp {
+        /// The mission's lines at least (whole waves of the `parse` mission are written)
+        #[arg(long, default_value_t = 5000)]
+        lines: usize,
+        /// How many timed edits
+        #[arg(long, default_value_t = 21)]
+        runs: usize,
     },
     /// N simulated drones, each sweeping its own area with detection on; prints
     /// simulated seconds per wall second
@@ -127,6 +139,7 @@ pub fn run(which: BenchCommand) -> u8 {
             };
             aviary_bench::front(shape, n, runs, Emit::of(emit, emit_world), out)
         }
+        BenchCommand::Lsp { lines, runs } => lsp(lines, runs),
     };
     match ran {
         Ok(()) => 0,
@@ -145,4 +158,38 @@ pub fn run(which: BenchCommand) -> u8 {
             2
         }
     }
+}
+
+/// `aviary bench lsp`: the generated mission of at least `lines` lines, its edits timed.
+fn lsp(lines: usize, runs: usize) -> Result<(), Error> {
+    if lines == 0 || runs == 0 {
+        return Err(Error::Usage("--lines and --runs must be at least 1".into()));
+    }
+    let mut bytes = lines * 30;
+    let (mission, world) = loop {
+        let (m, w) = aviary_bench::generate::large_mission(bytes);
+        if m.lines().count() >= lines {
+            break (m, w);
+        }
+        bytes += bytes / 4;
+    };
+    let timings = aviary_lsp::bench::edits(&mission, &world, runs).map_err(Error::Failed)?;
+    if timings.errors > 0 {
+        return Err(Error::Failed(format!(
+            "the generated mission has {} errors after the edits",
+            timings.errors
+        )));
+    }
+    let mut sorted = timings.edits.clone();
+    sorted.sort_unstable();
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1000.0;
+    outln!(
+        "lsp: {} lines, {} bytes, {} warnings and notes; edit to diagnostics over {runs} edits: median {:.1} ms, slowest {:.1} ms",
+        mission.lines().count(),
+        mission.len(),
+        timings.diagnostics,
+        ms(sorted[sorted.len() / 2]),
+        ms(sorted[sorted.len() - 1])
+    );
+    Ok(())
 }

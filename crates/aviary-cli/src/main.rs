@@ -13,6 +13,7 @@ mod figures;
 mod files;
 mod fmt;
 mod gcs;
+mod lsp;
 mod replay;
 mod report;
 mod run;
@@ -211,8 +212,19 @@ enum Command {
     Test(test::TestArgs),
     /// Explain a diagnostic code, such as E107
     Explain { code: String },
+    /// Serve the Language Server Protocol over stdin and stdout, for editors: diagnostics
+    /// as you type, hover, completion, definition, rename, formatting (docs/EDITORS.md)
+    Lsp {
+        /// A folder whose .mission files USE may read, besides the mission's own (repeatable)
+        #[arg(long, value_name = "DIR", value_parser = folder)]
+        use_root: Vec<PathBuf>,
+        /// Speak over stdin and stdout (the only way; accepted because editors' clients
+        /// such as vscode-languageclient pass it)
+        #[arg(long)]
+        stdio: bool,
+    },
     /// Benchmarks on generated missions: the front end (parse), the engine (w), the simulator
-    /// (swarm); and a campaign of the paper's mission (campaign)
+    /// (swarm), the language server (lsp); and a campaign of the paper's mission (campaign)
     Bench {
         #[command(subcommand)]
         which: bench::BenchCommand,
@@ -362,6 +374,7 @@ fn command(cli: Cli) -> u8 {
         }
         Command::Test(args) => test::run(args),
         Command::Explain { code } => explain(&code),
+        Command::Lsp { use_root, stdio: _ } => lsp::run(&use_root),
         Command::Bench { which } => bench::run(which),
     };
     code

@@ -207,21 +207,32 @@ async fn check(State(station): State<Arc<Station>>, Json(pair): Json<Pair>) -> R
     on_a_deep_stack(work).await
 }
 
+/// The checks of `mission` and `world` when the mission may fly (the fly and the
+/// campaign routes); else the answer that refuses it, with the check for the page.
+fn flyable(
+    station: &Station,
+    mission: &Text,
+    world: &Text,
+) -> Result<(checking::Report, Box<dyn SourceProvider + Send>), Box<Response>> {
+    let (report, files) =
+        checked(station, mission, world).map_err(|r| Box::new(r.into_response()))?;
+    if !report.flyable {
+        let mut body = json!({ "error": "the mission cannot fly: fix the errors the check shows" });
+        body["check"] = report.json;
+        return Err(Box::new((StatusCode::CONFLICT, Json(body)).into_response()));
+    }
+    Ok((report, files))
+}
+
 async fn fly(
     State(station): State<Arc<Station>>,
     Json(request): Json<flight::Request>,
 ) -> Response {
     let work = move || {
-        let (report, files) = match checked(&station, &request.mission, &request.world) {
+        let (report, files) = match flyable(&station, &request.mission, &request.world) {
             Ok(checked) => checked,
-            Err(refusal) => return refusal.into_response(),
+            Err(refused) => return *refused,
         };
-        if !report.flyable {
-            let mut body =
-                json!({ "error": "the mission cannot fly: fix the errors the check shows" });
-            body["check"] = report.json;
-            return (StatusCode::CONFLICT, Json(body)).into_response();
-        }
         let (folder, _) = match folder(&station) {
             Ok(f) => f,
             Err(refusal) => return refusal.into_response(),
@@ -252,16 +263,10 @@ async fn campaign(
     Json(request): Json<CampaignRequest>,
 ) -> Response {
     let work = move || {
-        let (report, files) = match checked(&station, &request.mission, &request.world) {
-            Ok(checked) => checked,
-            Err(refusal) => return refusal.into_response(),
+        let files = match flyable(&station, &request.mission, &request.world) {
+            Ok((_, files)) => files,
+            Err(refused) => return *refused,
         };
-        if !report.flyable {
-            let mut body =
-                json!({ "error": "the mission cannot fly: fix the errors the check shows" });
-            body["check"] = report.json;
-            return (StatusCode::CONFLICT, Json(body)).into_response();
-        }
         let flown = crate::campaign::fly(
             &request.mission,
             &request.world,

@@ -10,7 +10,7 @@ use aviary_campaign::stats::Distribution;
 use aviary_campaign::Report;
 use plotters::prelude::*;
 
-use crate::report::{colour, escape, world_layers, Drawn, STYLE};
+use crate::report::{colour, escape, square_frame, world_layers, Drawn, STYLE};
 
 fn percent(x: f64) -> String {
     format!("{:.1} %", x * 100.0)
@@ -250,16 +250,7 @@ fn failures(report: &Report, world: Option<&aviary_world::World>) -> Result<Stri
     if points.is_empty() {
         return Ok("<p>No run failed where a drone was.</p>".into());
     }
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for p in &points {
-        x0 = x0.min(p[0]);
-        x1 = x1.max(p[0]);
-        y0 = y0.min(p[1]);
-        y1 = y1.max(p[1]);
-    }
-    let span = (x1 - x0).max(y1 - y0).max(10.0) * 1.1;
-    let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
-    let (x0, x1, y0, y1) = (cx - span / 2.0, cx + span / 2.0, cy - span / 2.0, cy + span / 2.0);
+    let (x0, x1, y0, y1) = square_frame(&points);
     let mut svg = String::new();
     let drawn: Drawn = (|| {
         let root = SVGBackend::with_string(&mut svg, (760, 760)).into_drawing_area();

@@ -239,17 +239,7 @@ fn map(m: &Mission, world: Option<&aviary_world::World>) -> Result<String, Strin
     if points.is_empty() {
         return Ok("<p>No positions in the trace.</p>".into());
     }
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for p in &points {
-        x0 = x0.min(p[0]);
-        x1 = x1.max(p[0]);
-        y0 = y0.min(p[1]);
-        y1 = y1.max(p[1]);
-    }
-    // Equal scales on both axes, with a margin.
-    let span = (x1 - x0).max(y1 - y0).max(10.0) * 1.1;
-    let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
-    let (x0, x1, y0, y1) = (cx - span / 2.0, cx + span / 2.0, cy - span / 2.0, cy + span / 2.0);
+    let (x0, x1, y0, y1) = square_frame(&points);
     let mut svg = String::new();
     let drawn: Drawn = (|| {
         let root = SVGBackend::with_string(&mut svg, (760, 760)).into_drawing_area();
@@ -459,3 +449,18 @@ table{border-collapse:collapse;font-variant-numeric:tabular-nums}td,th{padding:3
 .timeline .when{width:90px;text-align:right;color:#6b7385}.events{font-size:12px;margin-top:10px}.events .exception td{color:#c2352b}\
 .events .operator td{color:#7b4bc4}.events .find td{color:#1f8a4c}.plots{display:flex;flex-wrap:wrap;gap:6px}\
 section.drone{break-inside:avoid}@media print{body{margin:0}h2{break-after:avoid}}";
+
+/// A map's frame around `points` (not empty): equal scales on both axes, at least 10 m
+/// across, with a margin of a tenth; `(x0, x1, y0, y1)`.
+pub(crate) fn square_frame(points: &[[f64; 2]]) -> (f64, f64, f64, f64) {
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for p in points {
+        x0 = x0.min(p[0]);
+        x1 = x1.max(p[0]);
+        y0 = y0.min(p[1]);
+        y1 = y1.max(p[1]);
+    }
+    let span = (x1 - x0).max(y1 - y0).max(10.0) * 1.1;
+    let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
+    (cx - span / 2.0, cx + span / 2.0, cy - span / 2.0, cy + span / 2.0)
+}

@@ -181,30 +181,13 @@ pub fn run(args: &RunArgs) -> u8 {
     }
     let outcome = match flown {
         Ok(flown) => flown.outcome,
-        Err(NotFlown::Errors { diagnostics, sources }) => {
-            for d in diagnostics.iter().filter(|d| d.is_error()) {
-                eprint!("{}", render_text(&sources, d, color_wanted()));
-            }
-            eprintln!("aviary: {} has errors, so it was not run", args.file.display());
-            return 2;
-        }
-        Err(NotFlown::NoMission) => {
-            eprintln!(
-                "aviary: {} has no MISSION to run (it holds only capabilities)",
-                args.file.display()
-            );
-            return 2;
-        }
-        Err(NotFlown::Speed) => {
-            eprintln!(
-                "aviary: {} has MAVLink drones, which fly in real time: leave out --speed",
-                world_path.display()
-            );
-            return 2;
-        }
-        Err(NotFlown::Failed(why)) => {
-            eprintln!("aviary: {why}");
-            return 2;
+        Err(not) => {
+            return refused(not, &args.file, &|| {
+                format!(
+                    "{} has MAVLink drones, which fly in real time: leave out --speed",
+                    world_path.display()
+                )
+            })
         }
     };
     if let Some((_, feed)) = &server {
@@ -394,6 +377,29 @@ const GRACE: std::time::Duration = std::time::Duration::from_secs(5);
 /// [`GRACE`] (busy somewhere it does not look), the process stops at once as on a
 /// second signal: a stop must never hang. Once the engine has taken it, the way home
 /// may take as long as it takes.
+/// Says why a mission was not flown (`aviary run`, `aviary test`), on standard error: its
+/// errors, or that it has no MISSION, or the reason; `speed` says why its world's drones
+/// cannot fly as asked. The exit code, 2.
+pub fn refused(not: NotFlown, file: &std::path::Path, speed: &dyn Fn() -> String) -> u8 {
+    match not {
+        NotFlown::Errors { diagnostics, sources } => {
+            for d in diagnostics.iter().filter(|d| d.is_error()) {
+                eprint!("{}", render_text(&sources, d, color_wanted()));
+            }
+            eprintln!("aviary: {} has errors, so it was not run", file.display());
+        }
+        NotFlown::NoMission => {
+            eprintln!(
+                "aviary: {} has no MISSION to run (it holds only capabilities)",
+                file.display()
+            );
+        }
+        NotFlown::Speed => eprintln!("aviary: {}", speed()),
+        NotFlown::Failed(why) => eprintln!("aviary: {why}"),
+    }
+    2
+}
+
 fn on_stop_signals(controller: Controller, stop: Stop, trace: SharedTrace) {
     use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     let mut signals = match signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {

@@ -6,14 +6,13 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use aviary_backends::pipeline::{NotFlown, Source, Texts};
+use aviary_backends::pipeline::{Source, Texts};
 use aviary_campaign::report::Flew;
 use aviary_campaign::{Campaign, Report, Seeds, Shard};
-use aviary_diagnostics::render_text;
 use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use crate::files::{color_wanted, use_roots, world_beside, DiskProvider};
+use crate::files::{use_roots, world_beside, DiskProvider};
 use crate::Format;
 
 #[derive(Args)]
@@ -130,30 +129,10 @@ fn campaign(file: &Path, runs: u64, args: &TestArgs) -> u8 {
     };
     let campaign = match Campaign::prepare(texts) {
         Ok(c) => c,
-        Err(NotFlown::Errors { diagnostics, sources }) => {
-            for d in diagnostics.iter().filter(|d| d.is_error()) {
-                eprint!("{}", render_text(&sources, d, color_wanted()));
-            }
-            eprintln!("aviary: {} has errors, so it was not run", file.display());
-            return 2;
-        }
-        Err(NotFlown::NoMission) => {
-            eprintln!(
-                "aviary: {} has no MISSION to run (it holds only capabilities)",
-                file.display()
-            );
-            return 2;
-        }
-        Err(NotFlown::Failed(why)) => {
-            eprintln!("aviary: {why}");
-            return 2;
-        }
-        Err(NotFlown::Speed) => {
-            eprintln!(
-                "aviary: {} has MAVLink drones: a campaign flies simulated drones only",
-                world_name
-            );
-            return 2;
+        Err(not) => {
+            return crate::run::refused(not, file, &|| {
+                format!("{world_name} has MAVLink drones: a campaign flies simulated drones only")
+            })
         }
     };
     let list = seeds.of(args.shard);

@@ -192,25 +192,7 @@ pub enum NotFlown {
 /// `aviary_check::STACK`: the checker and the engine follow capability calls by recursion.
 pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result<Flown, NotFlown> {
     let api = aviary_sim::descriptor();
-    let mut sources = SourceMap::new();
-    hooks.begin(Stage::World);
-    let world =
-        aviary_check::read_world(&mut sources, texts.world.name, Cow::Owned(texts.world.bytes));
-    hooks.end(Stage::World);
-    hooks.begin(Stage::Check);
-    let checked = aviary_check::check_against(
-        &mut sources,
-        (texts.mission.name, Cow::Owned(texts.mission.bytes)),
-        Some(world),
-        texts.files,
-        &api,
-    );
-    hooks.end(Stage::Check);
-    let (false, Some(program), Some(world)) =
-        (checked.has_errors(), checked.program, checked.world)
-    else {
-        return Err(NotFlown::Errors { diagnostics: checked.diagnostics, sources });
-    };
+    let (program, world, sources) = front_end(texts, &api, hooks)?;
     // Any MAVLink drone: the wall clock, and the simulated drones in real time with it.
     let live = !aviary_mavlink::bindings(&world).is_empty();
     // The source texts are needed only to show errors: they go before the mission is
@@ -316,6 +298,40 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
     })
 }
 
+/// The world read and the mission checked against it ([`Stage::World`], [`Stage::Check`]):
+/// its program, the world and the texts, or its errors.
+fn front_end(
+    texts: Texts<'_>,
+    api: &aviary_api::Descriptor,
+    hooks: &mut dyn Hooks,
+) -> Result<(aviary_check::Program, World, SourceMap), NotFlown> {
+    let mut sources = SourceMap::new();
+    hooks.begin(Stage::World);
+    let world =
+        aviary_check::read_world(&mut sources, texts.world.name, Cow::Owned(texts.world.bytes));
+    hooks.end(Stage::World);
+    hooks.begin(Stage::Check);
+    let checked = aviary_check::check_against(
+        &mut sources,
+        (texts.mission.name, Cow::Owned(texts.mission.bytes)),
+        Some(world),
+        texts.files,
+        api,
+    );
+    hooks.end(Stage::Check);
+    match (checked.has_errors(), checked.program, checked.world) {
+        (false, Some(program), Some(world)) => Ok((program, world, sources)),
+        _ => Err(NotFlown::Errors { diagnostics: checked.diagnostics, sources }),
+    }
+}
+
+/// Hooks that hear nothing.
+struct NoHooks;
+
+impl Hooks for NoHooks {
+    fn record(&mut self, _record: &Record<'_>, _backend: &dyn Backend) {}
+}
+
 /// A mission checked and compiled once for its world, to fly many times (`aviary test`):
 /// each flight a fleet of its own from the world, seeded with its own seed.
 pub struct Prepared {
@@ -330,21 +346,7 @@ pub struct Prepared {
 /// a world with MAVLink drones.
 pub fn prepare(texts: Texts<'_>) -> Result<Prepared, NotFlown> {
     let api = aviary_sim::descriptor();
-    let mut sources = SourceMap::new();
-    let world =
-        aviary_check::read_world(&mut sources, texts.world.name, Cow::Owned(texts.world.bytes));
-    let checked = aviary_check::check_against(
-        &mut sources,
-        (texts.mission.name, Cow::Owned(texts.mission.bytes)),
-        Some(world),
-        texts.files,
-        &api,
-    );
-    let (false, Some(program), Some(world)) =
-        (checked.has_errors(), checked.program, checked.world)
-    else {
-        return Err(NotFlown::Errors { diagnostics: checked.diagnostics, sources });
-    };
+    let (program, world, sources) = front_end(texts, &api, &mut NoHooks)?;
     let live = aviary_mavlink::bindings(&world);
     if let Some((drone, address, ..)) = live.first() {
         let name = world.drones.get(*drone).map_or("", |d| d.name.as_str());

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Runs the same missions with two builds of aviary and compares their traces byte for byte:
 # the paper's mission, the five fault drills, a 40-drone swarm whose cells are close
-# enough for separation and planning to act, and W(40, 3). An optimisation must leave
-# every one of them identical.
+# enough for separation and planning to act, W(40, 3), and the paper's mission in the
+# air (examples/search_and_rescue.air.world.toml) with seeds 1 to 8. An optimisation
+# must leave every one of them identical, telemetry (a sample a second) included.
 #   bench/same_traces.sh BASE_BINARY NEW_BINARY
 # The generated worlds come from NEW_BINARY. A build older than the world file's fleets
 # (`[fleets.NAME]`) cannot read them: it then runs on the world its own generator writes
@@ -59,7 +60,7 @@ for m in "${missions[@]}"; do
         if [[ -f "$work/$who/$name.world.toml" ]]; then
             world=(--world "$work/$who/$name.world.toml")
         fi
-        "$bin" run "$m" "${world[@]}" --quiet --trace "$work/$name.$who.jsonl" || true
+        "$bin" run "$m" "${world[@]}" --quiet --telemetry-hz 1 --trace "$work/$name.$who.jsonl" || true
     done
     lines=$(wc -l <"$work/$name.base.jsonl")
     if cmp -s "$work/$name.base.jsonl" "$work/$name.new.jsonl"; then
@@ -67,6 +68,21 @@ for m in "${missions[@]}"; do
     else
         echo "DIFFERENT $name"; status=1
         diff <(head -c 100000000 "$work/$name.base.jsonl") "$work/$name.new.jsonl" | head -5 || true
+    fi
+done
+air="$here/examples/search_and_rescue.air.world.toml"
+for seed in 1 2 3 4 5 6 7 8; do
+    for who in base new; do
+        bin=${!who}
+        "$bin" run "$here/examples/search_and_rescue.mission" --world "$air" --seed "$seed" \
+            --quiet --telemetry-hz 1 --trace "$work/air$seed.$who.jsonl" || true
+    done
+    lines=$(wc -l <"$work/air$seed.base.jsonl")
+    if cmp -s "$work/air$seed.base.jsonl" "$work/air$seed.new.jsonl"; then
+        echo "same      air, seed $seed ($lines events)"
+    else
+        echo "DIFFERENT air, seed $seed"; status=1
+        diff "$work/air$seed.base.jsonl" "$work/air$seed.new.jsonl" | head -5 || true
     fi
 done
 exit $status

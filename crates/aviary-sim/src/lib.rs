@@ -168,6 +168,7 @@ mod motion;
 mod nearby;
 mod pace;
 mod profile;
+mod reach_box;
 mod sensors;
 mod separation;
 mod step;

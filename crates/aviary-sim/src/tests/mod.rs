@@ -9,6 +9,7 @@ mod link;
 mod luck;
 mod no_fly;
 mod remainder;
+mod reach_box;
 mod rules;
 mod separation;
 mod sky;

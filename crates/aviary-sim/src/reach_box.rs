@@ -29,9 +29,9 @@ impl Bounds {
     }
 
     fn take(&mut self, p: [f64; 3]) {
-        for a in 0..3 {
-            self.lo[a] = self.lo[a].min(p[a]);
-            self.hi[a] = self.hi[a].max(p[a]);
+        for ((lo, hi), x) in self.lo.iter_mut().zip(&mut self.hi).zip(p) {
+            *lo = lo.min(x);
+            *hi = hi.max(x);
         }
     }
 
@@ -85,7 +85,8 @@ pub(crate) fn reach_box(d: &SimDrone, time: f64) -> Option<Bounds> {
     // The time the legs so far take at least, and where the next one begins.
     let (mut spent, mut at) = (0.0, d.pos);
     for (k, leg) in task.legs.iter().enumerate() {
-        if !(spent < time) {
+        // Also when the time spent is NaN: the check after the loop gives up then.
+        if spent.partial_cmp(&time) != Some(std::cmp::Ordering::Less) {
             break;
         }
         let left = time - spent;

@@ -59,6 +59,32 @@ pub fn hypot(x: f64, y: f64) -> f64 {
     }
 }
 
+/// The length of `v`, `hypot(hypot(v[0], v[1]), v[2])`.
+#[inline]
+pub fn norm(v: [f64; 3]) -> f64 {
+    hypot(hypot(v[0], v[1]), v[2])
+}
+
+/// Exactly `norm(v) < limit`, mostly without computing the norm (the simulator asks it
+/// of every pair of drones near each other, every tick): a side as long as `limit` says
+/// no; a sum of squares short of `limit²` by far more than the rounding of either says
+/// yes; only the rest are measured.
+#[inline]
+pub fn norm_below(v: [f64; 3], limit: f64) -> bool {
+    let longest = v[0].abs().max(v[1].abs()).max(v[2].abs());
+    if longest >= limit {
+        return false;
+    }
+    // Within these bounds no square underflows or overflows enough to matter.
+    if limit > 1e-140 && limit < 1e140 {
+        let squares = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        if squares < limit * limit * (1.0 - 1e-9) {
+            return true;
+        }
+    }
+    norm(v) < limit
+}
+
 /// Distance from `p` to the segment `a`-`b`.
 pub fn dist_to_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
@@ -186,6 +212,38 @@ mod tests {
         assert_eq!(self_crossing(&circle), None);
         let star: Vec<[f64; 2]> = (0..7).map(|i| circle[(i * 3 * n / 7) % n]).collect();
         assert!(self_crossing(&star).is_some());
+    }
+
+    #[test]
+    fn norm_below_is_the_norm_compared() {
+        // A fixed walk through lengths near the limit, every scale and every sign.
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..200_000 {
+            let scale = 10f64.powf(next() * 12.0 - 6.0);
+            let v = [(next() - 0.5) * scale, (next() - 0.5) * scale, (next() - 0.5) * scale];
+            let n = norm(v);
+            // The limit at the norm, an ulp or a hair either side, or anywhere.
+            let limit = match (next() * 5.0) as u8 {
+                0 => n,
+                1 => f64::from_bits(n.to_bits() + 1),
+                2 => f64::from_bits(n.to_bits().saturating_sub(1)),
+                3 => n * (1.0 + (next() - 0.5) * 1e-8),
+                _ => next() * scale,
+            };
+            assert_eq!(norm_below(v, limit), n < limit, "{v:?} {limit}");
+        }
+        for x in [0.0, f64::NAN, f64::INFINITY, 1e-200, 1e200] {
+            for limit in [0.0, 1.0, f64::NAN, f64::INFINITY, 1e-150, 1e150] {
+                let v = [x, 0.5, -x];
+                assert_eq!(norm_below(v, limit), norm(v) < limit, "{v:?} {limit}");
+            }
+        }
     }
 
     #[test]

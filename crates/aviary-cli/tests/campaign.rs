@@ -61,7 +61,7 @@ fn the_json_report_holds_every_figure_and_every_run() {
         .iter()
         .map(|m| m["expectation"].as_str().unwrap())
         .collect();
-    assert_eq!(met, ["all targets found", "time <= 400 s", "battery >= 80%"]);
+    assert_eq!(met, ["all targets found", "time <= 400 s", "battery >= 78.5%"]);
     let failure = records.iter().find_map(|r| r["failure"].as_object()).expect("a failed run");
     assert_eq!(failure["exception"], "MotorFailure");
     assert_eq!(failure["drone"], "carrier");
@@ -171,7 +171,7 @@ fn bad_input_gets_a_clear_error_and_runs_nothing() {
         ("min_found = 3", "min_found", "the world has 2 targets"),
         ("within = 20", "within", "unknown key `within` in [expect]"),
     ] {
-        let text = world.replace("max_time = 400", bad).replace("min_battery = 0.8\n", "");
+        let text = world.replace("max_time = 400", bad).replace("min_battery = 0.785\n", "");
         std::fs::write(scratch.join("patrol.world.toml"), &text).unwrap();
         let (code, out, err) = aviary(&["test", "patrol.mission", "--runs", "3"], &scratch);
         assert_eq!(code, 2, "{bad}: {err}");

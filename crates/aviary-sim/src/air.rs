@@ -19,6 +19,14 @@ use crate::luck::{Purpose, Stream};
 /// Metres in a foot: MIL-F-8785C gives its scales in feet.
 const FOOT: f64 = 0.3048;
 
+/// Seconds of simulated time between two moves of the air's slow processes, the gusts and
+/// the GPS errors: every fifth step of 0.05 s. Each move is their exact transition over
+/// the time since the last one, so their statistics do not change; their time constants
+/// (seconds for gusts, a minute for GPS) are far longer, and a receiver's fix comes a few
+/// times a second. Moving them every step cost a fifth of a campaign's time (issue 26's
+/// speed target): four normal numbers, a `ln`, two `sin_cos` and an `exp` per drone.
+pub(crate) const AIR_STEP: f64 = 0.25;
+
 /// The wind, as the fleet flies in it.
 #[derive(Clone, Debug)]
 pub(crate) struct WindModel {
@@ -81,6 +89,10 @@ pub(crate) struct AirState {
     pub capacity_spread: Option<f64>,
     /// The simulated time of the radio's next look.
     pub next_look: f64,
+    /// Seconds since the gusts and GPS errors last moved, and, in a step in which they
+    /// move, the time they move by (see [`AIR_STEP`]).
+    pub since: f64,
+    pub span: Option<f64>,
     pub drones: Vec<AirDrone>,
     /// Whether any drone has random faults.
     pub any_faults: bool,
@@ -150,6 +162,8 @@ impl AirState {
             falloff: air.detection.clone().map(std::sync::Arc::new),
             capacity_spread: air.capacity_spread.filter(|&s| s > 0.0),
             next_look: 0.0,
+            since: 0.0,
+            span: None,
             drones,
             any_faults,
         };
@@ -162,8 +176,11 @@ impl AirState {
     /// of each of its random faults.
     pub fn reseed(&mut self, seed: u64) {
         let spread = self.capacity_spread;
+        let mean = self.wind.as_ref().map_or([0.0; 2], |w| w.mean);
+        (self.since, self.span) = (0.0, None);
         for (id, a) in self.drones.iter_mut().enumerate() {
             a.gust = [0.0; 2];
+            a.wind = mean;
             if a.gust_luck.is_some() {
                 a.gust_luck = Some(Box::new(Stream::new(seed, Purpose::Gusts, id)));
             }
@@ -278,7 +295,11 @@ impl crate::fleet::Fleet {
     /// and, when it is due, the radio looks at who is in reach.
     pub(crate) fn air_before(&mut self, end: f64, dt: f64, out: &mut Vec<Report>) {
         let Some(air) = self.air.as_deref_mut() else { return };
-        air.drift_gps(dt);
+        air.since += dt;
+        air.span = (air.since >= AIR_STEP - 1e-9).then(|| std::mem::take(&mut air.since));
+        if let Some(span) = air.span {
+            air.drift_gps(span);
+        }
         if air.radio.is_some() {
             // A `link_loss` fault that came while a drone is out of reach does not give it
             // its link back when the fault ends: the outage lasts while it is out of reach.
@@ -341,16 +362,22 @@ impl crate::fleet::Fleet {
         self.radio_scratch = (at, linked);
     }
 
-    /// Drone `id`'s gusts for a tick of `dt`, and the wind its motion flies in.
-    pub(crate) fn air_wind(&mut self, id: DroneId, dt: f64) {
+    /// Drone `id`'s gusts, in a step in which they move (see [`AIR_STEP`]), and the wind
+    /// its motion flies in.
+    pub(crate) fn air_wind(&mut self, id: DroneId) {
         let Some(air) = self.air.as_deref_mut() else { return };
         let d = &mut self.drones[id];
         if air.wind.is_none() || !d.state.airborne() {
             return;
         }
         let v = air.drones[id].wind;
-        let airspeed = aviary_api::geometry::hypot(d.vel[0] - v[0], d.vel[1] - v[1]);
-        let wind = air.blow(id, d.pos[2], airspeed, dt);
+        let wind = match air.span {
+            Some(span) => {
+                let airspeed = aviary_api::geometry::hypot(d.vel[0] - v[0], d.vel[1] - v[1]);
+                air.blow(id, d.pos[2], airspeed, span)
+            }
+            None => Some(v),
+        };
         if let Some(task) = d.motion.as_mut() {
             task.wind = wind;
         }

@@ -35,7 +35,7 @@
 //! would fly without yielding), until its yield is over: this breaks the standstills in
 //! which the drone with priority is the one that has to move.
 
-use aviary_api::geometry::hypot;
+use aviary_api::geometry::{norm, norm_below};
 use aviary_api::DroneId;
 
 use crate::drone::SimDrone;
@@ -103,10 +103,6 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
-fn norm(v: [f64; 3]) -> f64 {
-    hypot(hypot(v[0], v[1]), v[2])
-}
-
 /// The smallest distance between two tracks sampled at the same times, moving straight
 /// between samples.
 pub(crate) fn closest(a: &Track, b: &Track) -> f64 {
@@ -116,18 +112,28 @@ pub(crate) fn closest(a: &Track, b: &Track) -> f64 {
             continue;
         };
         let r0 = sub(p, q);
-        best = best.min(norm(r0));
+        best = nearer(best, r0);
         if let (Some(Some(p1)), Some(Some(q1))) = (a.get(k + 1), b.get(k + 1)) {
             let r1 = sub(*p1, *q1);
             let dr = sub(r1, r0);
             let len2 = dr[0] * dr[0] + dr[1] * dr[1] + dr[2] * dr[2];
             if len2 > 0.0 {
                 let t = (-(r0[0] * dr[0] + r0[1] * dr[1] + r0[2] * dr[2]) / len2).clamp(0.0, 1.0);
-                best = best.min(norm([r0[0] + t * dr[0], r0[1] + t * dr[1], r0[2] + t * dr[2]]));
+                best = nearer(best, [r0[0] + t * dr[0], r0[1] + t * dr[1], r0[2] + t * dr[2]]);
             }
         }
     }
     best
+}
+
+/// `best.min(norm(r))`, without the norm when `r` is clearly the longer: its sum of
+/// squares beyond `best²` by far more than the rounding of either.
+fn nearer(best: f64, r: [f64; 3]) -> f64 {
+    let squares = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    if best < 1e140 && squares.is_finite() && squares > best * best * (1.0 + 1e-9) {
+        return best;
+    }
+    best.min(norm(r))
 }
 
 /// The distance between two tracks at their first common point.
@@ -276,7 +282,7 @@ impl Fleet {
             .filter(|&j| j < id || (humble && j != id))
             .filter(|&j| {
                 let o = &self.drones[j];
-                o.state.airborne() && norm(sub(o.pos, d.pos)) < range(o)
+                o.state.airborne() && norm_below(sub(o.pos, d.pos), range(o))
             })
             .collect()
     }

@@ -22,7 +22,7 @@
 //! Neither can make room where there is none (two drones sent to the same point), so a
 //! call that separation holds back for too long ends: see [`Fleet::held_back`].
 
-use aviary_api::geometry::hypot;
+use aviary_api::geometry::{hypot, norm_below};
 use aviary_api::{BuiltinException, CallEnd, DroneId, Failure, FlightState};
 
 use crate::avoid::MARGIN;
@@ -292,8 +292,8 @@ impl Fleet {
             .filter(|&&j| j != id && counts(&self.drones[j]))
             .map(|&j| (self.drones[j].pos, envelope(&self.drones[j])))
             .filter(|(p, e)| {
-                let apart = hypot(hypot(p[0] - here[0], p[1] - here[1]), p[2] - here[2]);
-                apart < self.min_separation + reach + extent(e)
+                let apart = [p[0] - here[0], p[1] - here[1], p[2] - here[2]];
+                norm_below(apart, self.min_separation + reach + extent(e))
             })
             .map(|(_, e)| e)
             .collect()

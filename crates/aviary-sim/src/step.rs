@@ -127,7 +127,7 @@ impl Fleet {
         let from = self.drones[id].xy();
         let before = self.drones[id].pos;
         if self.air.is_some() {
-            self.air_wind(id, dt);
+            self.air_wind(id);
         }
         let finished = self.move_drone(id, dt);
         if finished.is_none() {
@@ -143,7 +143,9 @@ impl Fleet {
         }
         // A call set aside for the one that just ended (or gave up) is back.
         d.bring_back();
-        if hypot(d.vel[0], d.vel[1]) > 1e-9 {
+        // The hypotenuse is at least either side: most ticks need not compute it.
+        let [vx, vy, _] = d.vel;
+        if vx.abs() > 1e-9 || vy.abs() > 1e-9 || hypot(vx, vy) > 1e-9 {
             d.heading = heading(d.vel[0], d.vel[1]);
         }
         if let Some(rare) = d.rare.as_deref_mut() {

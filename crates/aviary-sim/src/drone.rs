@@ -138,7 +138,10 @@ pub(crate) struct SimDrone {
     pub pos: [f64; 3],
     /// Instantaneous velocity, m/s.
     pub vel: [f64; 3],
-    pub heading: f64,
+    /// The horizontal velocity of the last step in which the drone moved over the
+    /// ground: its heading, worked out only when read ([`SimDrone::heading`]; an `atan2`
+    /// per drone and step was a fiftieth of a campaign). North until it first moves.
+    pub facing: [f64; 2],
     /// Fraction of a full battery.
     pub battery: f64,
     pub state: FlightState,
@@ -169,7 +172,7 @@ impl SimDrone {
             spec,
             pos: [d.home[0], d.home[1], 0.0],
             vel: [0.0; 3],
-            heading: 0.0,
+            facing: [0.0, 1.0],
             battery: d.battery / 100.0,
             state: FlightState::Landed,
             armed: false,
@@ -210,6 +213,11 @@ impl SimDrone {
         self.rare.as_ref()?.disabled.as_ref()
     }
 
+    /// Degrees clockwise from north of where it last flew.
+    pub fn heading(&self) -> f64 {
+        crate::geom::heading(self.facing[0], self.facing[1])
+    }
+
     pub fn xy(&self) -> [f64; 2] {
         [self.pos[0], self.pos[1]]
     }
@@ -227,7 +235,7 @@ impl SimDrone {
         Telemetry {
             position: self.pos,
             speed: hypot(self.vel[0], self.vel[1]),
-            heading: self.heading,
+            heading: self.heading(),
             battery: self.battery,
             state: self.state,
             link: self.link_loss().is_none(),

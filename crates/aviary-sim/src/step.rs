@@ -9,7 +9,6 @@ use aviary_api::{
 use crate::battery;
 use crate::drone::Rare;
 use crate::fleet::{Fleet, Report};
-use crate::geom::heading;
 use crate::hot::Hot;
 use crate::luck::{Purpose, Stream};
 use crate::sensors::scan;
@@ -146,7 +145,7 @@ impl Fleet {
         // The hypotenuse is at least either side: most ticks need not compute it.
         let [vx, vy, _] = d.vel;
         if vx.abs() > 1e-9 || vy.abs() > 1e-9 || hypot(vx, vy) > 1e-9 {
-            d.heading = heading(d.vel[0], d.vel[1]);
+            d.facing = [vx, vy];
         }
         if let Some(rare) = d.rare.as_deref_mut() {
             tick_loading(rare, dt, out);

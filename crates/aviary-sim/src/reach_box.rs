@@ -113,11 +113,8 @@ pub(crate) fn reach_box(d: &SimDrone, time: f64) -> Option<Bounds> {
                 let r = radius.abs();
                 b.take([center[0] - r, center[1] - r, at[2]]);
                 b.take([center[0] + r, center[1] + r, at[2]]);
-                let (done, v) = if k == 0 {
-                    (task.arc_done, speed.max(task.arc_speed))
-                } else {
-                    (0.0, speed)
-                };
+                let (done, v) =
+                    if k == 0 { (task.arc_done, speed.max(task.arc_speed)) } else { (0.0, speed) };
                 spent += least_time((total - done) * radius, v);
                 let theta = start - total;
                 at = [center[0] + radius * theta.cos(), center[1] + radius * theta.sin(), at[2]];

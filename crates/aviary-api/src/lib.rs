@@ -109,6 +109,7 @@ impl Descriptor {
                 ("state", Symbol),
                 ("link", Symbol),
                 ("wind", Speed),
+                ("payload", Symbol),
                 // Not read from the backend's telemetry: the engine keeps what each drone's
                 // last Sweep or FollowPath left (docs/LANGUAGE.md, section 18).
                 ("remaining", Remainder),

@@ -193,6 +193,10 @@ pub trait Backend {
     fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall;
     fn interrupt(&self, call: CallId, how: Interrupt);
     fn telemetry(&self, drone: DroneId) -> Telemetry;
+    /// The kind of payload drone `drone` carries now (`drone.payload`), `None` when it
+    /// carries nothing or the backend does not know it. Apart from [`Telemetry`], which is
+    /// `Copy` and read many times a step: this is read only when a mission asks.
+    fn payload(&self, drone: DroneId) -> Option<String>;
     /// Where drone `drone`'s last `Sweep` or `FollowPath` stopped, once it ended other
     /// than done (a fault, an abort, a failure on the way): the point of its path it was
     /// flying to and where the drone was ([`crate::Progress`]; the path is the contract's,

@@ -113,6 +113,14 @@ impl Backend for Mixed {
         }
     }
 
+    fn payload(&self, drone: DroneId) -> Option<String> {
+        if self.mavlink.serves(drone) {
+            self.mavlink.payload(drone)
+        } else {
+            self.sim.payload(drone)
+        }
+    }
+
     fn stopped(&self, drone: DroneId) -> Option<Progress> {
         if self.mavlink.serves(drone) {
             self.mavlink.stopped(drone)

@@ -106,6 +106,8 @@ fn telemetry(backend: &dyn Backend, d: usize, field: Field) -> Value {
         Field::Link => Value::Symbol(if t.link { "Connected" } else { "Lost" }.to_string()),
         // Without a wind sensor, as a drone without an attribute reads it.
         Field::Wind => t.wind.map_or(Value::Bool(false), |w| Value::Number(w[0].hypot(w[1]))),
+        // Carrying nothing, as a drone without an attribute reads it.
+        Field::Payload => backend.payload(d).map_or(Value::Bool(false), Value::Symbol),
         // The engine's, not the backend's: read in `Env::eval`.
         Field::Remaining => Value::Bool(false),
     }

@@ -62,6 +62,10 @@ impl Backend for Scripted {
         None
     }
 
+    fn payload(&self, _: DroneId) -> Option<String> {
+        None
+    }
+
     fn telemetry(&self, _: DroneId) -> Telemetry {
         Telemetry { state: FlightState::Landed, link: true, battery: 1.0, ..Telemetry::LOST }
     }

@@ -713,3 +713,18 @@ fn sequential_on_every_one_at_a_time_starts_after_the_block_then_in_turn() {
         .collect();
     assert_eq!(hovers, [3.0, 2.0, 1.0], "in the order of the signals");
 }
+
+#[test]
+fn payload_reads_the_kind_carried_and_nothing_before_or_after() {
+    let r = run(&fixture("payload_reads_the_kind_carried_and_nothing_before_or_after"));
+    assert_eq!(r.outcome.status, Status::Ok);
+    // Only the Hover between LoadPayload and ReleasePayload, once the load is done.
+    let hovers = r.ends("Hover", "a");
+    assert_eq!(hovers.len(), 1);
+    assert_eq!(hovers[0]["args"]["duration"].as_f64(), Some(2.0));
+    let loaded = r.t("api_done", "function", "LoadPayload");
+    assert!(close(hovers[0]["t"].as_f64().unwrap() - 2.0, loaded));
+    // After the release `a` reads nothing: the ELSE runs.
+    let released = r.t("api_done", "function", "ReleasePayload");
+    assert!(close(r.ends("Hover", "b")[0]["t"].as_f64().unwrap() - 3.0, released));
+}

@@ -358,6 +358,8 @@ pub enum Field {
     Link,
     /// The wind's speed at the drone, read with its `wind` sensor.
     Wind,
+    /// The kind of payload the drone carries, if any.
+    Payload,
     /// What the drone's last `Sweep` or `FollowPath` left: the engine's, not telemetry.
     Remaining,
 }

@@ -656,6 +656,7 @@ fn telemetry_field(name: &str) -> Option<Field> {
         "state" => Field::State,
         "link" => Field::Link,
         "wind" => Field::Wind,
+        "payload" => Field::Payload,
         "remaining" => Field::Remaining,
         _ => return None,
     })

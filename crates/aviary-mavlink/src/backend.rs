@@ -339,6 +339,14 @@ impl Backend for MavlinkBackend {
         }
     }
 
+    /// What this run's `LoadPayload` loaded and no `ReleasePayload` has dropped since: a
+    /// gripper reports no kind (MAVLink has no message for what it holds), so this is
+    /// what Aviary asked for and the autopilot accepted, not what a sensor saw.
+    fn payload(&self, drone: DroneId) -> Option<String> {
+        let Some(Some(c)) = self.inner.crafts.get(drone) else { return None };
+        lock(&c.carrying).clone()
+    }
+
     fn telemetry(&self, drone: DroneId) -> Telemetry {
         let Some(Some(c)) = self.inner.crafts.get(drone) else {
             return Telemetry::LOST;

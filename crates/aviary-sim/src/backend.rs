@@ -235,6 +235,10 @@ impl Backend for SimBackend {
         lock(&self.state).fleet.telemetry(drone).unwrap_or(Telemetry::LOST)
     }
 
+    fn payload(&self, drone: DroneId) -> Option<String> {
+        lock(&self.state).fleet.carrying(drone).map(str::to_owned)
+    }
+
     fn stopped(&self, drone: DroneId) -> Option<aviary_api::Progress> {
         lock(&self.state).fleet.stopped(drone)
     }

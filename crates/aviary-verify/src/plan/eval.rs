@@ -130,7 +130,9 @@ impl Scope<'_> {
             Field::Speed => Value::Number(0.0),
             // What a Sweep will leave is known only in flight.
             // The wind a sensor will read is known only in flight.
-            Field::Heading | Field::Link | Field::Remaining | Field::Wind => return None,
+            Field::Heading | Field::Link | Field::Remaining | Field::Wind | Field::Payload => {
+                return None
+            }
         })
     }
 }

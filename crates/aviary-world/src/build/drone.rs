@@ -13,6 +13,34 @@ use crate::read::{quoted, suggest, toml_text, Ctx};
 use crate::{AttributeValue, Backend, Drone, Group, Mavlink, BUILTIN_SENSORS};
 
 const BACKEND_KEYS: &[&str] = &["backend", "mavlink", "system_id", "signing_key"];
+/// Every key `read_keys` reads (the backend's too): a key a small edit from one of these
+/// is taken for a misspelling of it, not for an attribute (docs/WORLD.md).
+const DRONE_KEYS: &[&str] = &[
+    "home",
+    "group",
+    "sensors",
+    "payload",
+    "max_speed",
+    "max_airspeed",
+    "climb_rate",
+    "descent_rate",
+    "acceleration",
+    "land_speed",
+    "land_speed_below",
+    "return_altitude",
+    "return_loiter",
+    "takeoff_speed",
+    "return_speed",
+    "battery",
+    "endurance",
+    "battery_capacity",
+    "flight_current",
+    "air",
+    "backend",
+    "mavlink",
+    "system_id",
+    "signing_key",
+];
 const SCHEMES: &[&str] =
     &["tcp", "tcpin", "tcpout", "udp", "udpin", "udpout", "udpbcast", "serial"];
 /// Telemetry fields: `d.speed` reads these, so no attribute may take their names.
@@ -319,6 +347,14 @@ fn attribute<'e>(cx: &mut Ctx, owner: Owner, e: &'e Entry) -> Option<(&'e str, A
         cx.error(e.key_span, msg, help);
         return None;
     }
+    if let Some(known) = misspelt_key(key, owner) {
+        let msg = format!("unknown key `{key}` in {owner}: too close to the key `{known}` to be taken for an attribute");
+        let help = format!(
+            "did you mean `{known}`? An attribute of a drone must not be a small edit away from a key of its table; rename it if it is meant as one"
+        );
+        cx.error(e.key_span, msg, help);
+        return None;
+    }
     if !cx.identifier("attribute", key, e.key_span) {
         return None;
     }
@@ -331,6 +367,16 @@ fn attribute<'e>(cx: &mut Ctx, owner: Owner, e: &'e Entry) -> Option<(&'e str, A
         _ => AttributeValue::Other(toml_text(&e.node)),
     };
     Some((key, value))
+}
+
+/// The known key that `key`, unknown in `owner`'s table, is likely a misspelling of: a
+/// drone's keys, and a fleet's own too for a fleet.
+fn misspelt_key(key: &str, owner: Owner) -> Option<&'static str> {
+    let fleet_keys = match owner {
+        Owner::Drone(_) => &[][..],
+        Owner::Fleet(_) => super::fleet::FLEET_KEYS,
+    };
+    suggest(key, DRONE_KEYS.iter().chain(fleet_keys).copied())
 }
 
 fn backend(cx: &mut Ctx, owner: Owner, keys: &[Entry]) -> Backend {

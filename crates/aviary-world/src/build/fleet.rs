@@ -28,7 +28,7 @@ const MAX_FIRST: i64 = 1_000_000_000;
 /// The widest zero-padded number in a pattern (`{i:020}`: every `u64`).
 const MAX_WIDTH: usize = 20;
 /// A fleet's own keys; the others are a drone's, for every drone of the fleet.
-const FLEET_KEYS: &[&str] = &["count", "names", "first", "homes", "areas"];
+pub(super) const FLEET_KEYS: &[&str] = &["count", "names", "first", "homes", "areas"];
 const HOMES_KEYS: &[&str] = &["grid", "spacing", "columns", "ring", "radius"];
 const AREAS_KEYS: &[&str] = &["names", "polygon"];
 /// The MAVLink system ids of one address.

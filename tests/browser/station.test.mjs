@@ -59,6 +59,13 @@ test("the paper's mission flies from the page: 7 drones move on the map and the 
   assert.equal(end.moved, 7, "every drone moved");
   assert.ok(end.done > 10, `blocks and activities done in the tree: ${end.done}`);
   assert.equal(end.running, 0, "nothing is left running");
+  // Every drone is down at the end, in the grid and in /api/state: the trace ends with
+  // their state at the end, not the last periodic sample (one was still "Landing").
+  const states = await page.evaluate(() => [...document.querySelectorAll("#fleet tbody tr td:nth-child(2)")].map((td) => td.textContent));
+  assert.deepEqual(states, Array(7).fill("Landed"), `the grid at the end: ${states}`);
+  const api = await page.evaluate(async (token) => (await fetch("/api/state", { headers: { Authorization: "Bearer " + token } })).json(), station.token);
+  const down = api.drones.map((d) => d.state);
+  assert.deepEqual(down, Array(7).fill("Landed"), `/api/state at the end: ${JSON.stringify(api.drones)}`);
   await page.waitForTimeout(300);
   await shot(page, "done");
   // The flight's trace is in the folder, whole, with telemetry to replay it.

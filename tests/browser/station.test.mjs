@@ -3,9 +3,10 @@
 
 import { test, before, after } from "node:test";
 import assert from "node:assert/strict";
-import { readFileSync } from "node:fs";
+import { spawnSync } from "node:child_process";
+import { copyFileSync, readFileSync } from "node:fs";
 import { join } from "node:path";
-import { browser, examples, open, shot, start } from "./harness.mjs";
+import { AVIARY, browser, examples, open, shot, start } from "./harness.mjs";
 
 let station, chromium, dir;
 
@@ -58,6 +59,13 @@ test("the paper's mission flies from the page: 7 drones move on the map and the 
   assert.equal(end.moved, 7, "every drone moved");
   assert.ok(end.done > 10, `blocks and activities done in the tree: ${end.done}`);
   assert.equal(end.running, 0, "nothing is left running");
+  // Every drone is down at the end, in the grid and in /api/state: the trace ends with
+  // their state at the end, not the last periodic sample (one was still "Landing").
+  const states = await page.evaluate(() => [...document.querySelectorAll("#fleet tbody tr td:nth-child(2)")].map((td) => td.textContent));
+  assert.deepEqual(states, Array(7).fill("Landed"), `the grid at the end: ${states}`);
+  const api = await page.evaluate(async (token) => (await fetch("/api/state", { headers: { Authorization: "Bearer " + token } })).json(), station.token);
+  const down = api.drones.map((d) => d.state);
+  assert.deepEqual(down, Array(7).fill("Landed"), `/api/state at the end: ${JSON.stringify(api.drones)}`);
   await page.waitForTimeout(300);
   await shot(page, "done");
   // The flight's trace is in the folder, whole, with telemetry to replay it.
@@ -132,4 +140,31 @@ test("control needs the token and other sites are refused", async () => {
     ws.onerror = () => resolve("refused");
   }), station.url);
   assert.equal(socket, "refused");
+});
+
+test("a mission with no world beside it is checked without one, as aviary check does, and notes are counted as notes", async () => {
+  // A mission alone in the folder: `aviary check` takes no world and says what it could not check.
+  copyFileSync(join(dir, "search_and_rescue.mission"), join(dir, "alone.mission"));
+  const cli = (args) => spawnSync(AVIARY, ["check", ...args], { cwd: dir, encoding: "utf8" });
+  const alone = cli(["alone.mission"]);
+  assert.equal(alone.status, 0, alone.stderr);
+  assert.match(alone.stdout, /alone\.mission: ok \(2 notes\)/);
+  const page = await open(chromium, station);
+  await page.waitForSelector("#check-summary.good");
+  // The paper's mission with its world: the notes of `aviary check`, not warnings.
+  const paper = cli(["search_and_rescue.mission"]).stdout.match(/: ok \((.*)\)/)[1];
+  assert.equal(await page.textContent("#check-summary"), `no errors, ${paper}: ready to fly`);
+  await page.selectOption("#mission-file", "alone.mission");
+  await page.waitForFunction(() => /choose a world/.test(document.getElementById("check-summary").textContent));
+  assert.equal(await page.inputValue("#world-file"), "", "no world chosen");
+  assert.equal(await page.textContent("#check-summary"), "no errors, 2 notes: choose a world to fly");
+  assert.ok(await page.isDisabled("#fly"), "it cannot fly without a world");
+  const codes = await page.evaluate(() => window.aviary.checked.diagnostics.map((d) => d.code));
+  assert.deepEqual(codes.sort(), ["N301", "N302"], "the notes aviary check gives");
+  // Choosing a world checks against it, and it may fly.
+  await page.selectOption("#world-file", "search_and_rescue.world.toml");
+  await page.waitForSelector("#check-summary.good");
+  await page.waitForFunction(() => /ready to fly/.test(document.getElementById("check-summary").textContent));
+  assert.ok(!(await page.isDisabled("#fly")));
+  assert.deepEqual(page.foreign, [], "nothing from elsewhere");
 });

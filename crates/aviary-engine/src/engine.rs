@@ -531,6 +531,12 @@ impl<'m> Engine<'m> {
         }
         let said: Vec<String> = reason.into_iter().chain(home.stranded).chain(home.notes).collect();
         reason = (!said.is_empty()).then(|| said.join("; "));
+        // The drones as they are at the end: the last periodic sample may be older (a
+        // drone a centimetre above the field, still `Landing`), and a page that shows the
+        // trace must not leave it there.
+        if options.telemetry_hz.is_some_and(|h| h > 0.0) && self.backend_alive.get() {
+            self.sample_telemetry();
+        }
         self.trace(EventKind::MissionEnd, || Event::MissionEnd {
             status,
             reason: reason.as_deref().map(Cow::Borrowed),
@@ -589,17 +595,22 @@ impl<'m> Engine<'m> {
         let period = std::time::Duration::from_secs_f64(1.0 / hz);
         let mut next = Instant::now();
         loop {
-            for d in 0..self.m.drones.len() {
-                let t = self.backend.telemetry(d);
-                self.trace(EventKind::Telemetry, || Event::Telemetry {
-                    actor: self.name(d).into(),
-                    position: t.position,
-                    battery: t.battery,
-                    state: t.state,
-                });
-            }
+            self.sample_telemetry();
             next += period;
             tokio::time::sleep_until(next).await;
+        }
+    }
+
+    /// One telemetry sample of every drone, in the trace.
+    fn sample_telemetry(&self) {
+        for d in 0..self.m.drones.len() {
+            let t = self.backend.telemetry(d);
+            self.trace(EventKind::Telemetry, || Event::Telemetry {
+                actor: self.name(d).into(),
+                position: t.position,
+                battery: t.battery,
+                state: t.state,
+            });
         }
     }
 

@@ -25,14 +25,15 @@ pub struct Report {
     pub json: Value,
 }
 
-/// Checks `mission` against `world`, reading what it `USE`s through `files`.
-pub fn check(mission: &Text, world: &Text, files: &dyn SourceProvider) -> Report {
+/// Checks `mission` against `world` (none: as `aviary check` with no world file, a note
+/// says what was not checked), reading what it `USE`s through `files`.
+pub fn check(mission: &Text, world: Option<&Text>, files: &dyn SourceProvider) -> Report {
     let api = aviary_sim::descriptor();
     let mut sources = SourceMap::new();
     let mut checked = aviary_check::check_sources(
         &mut sources,
         (&mission.path, mission.text.as_bytes()),
-        Some((&world.path, world.text.as_bytes())),
+        world.map(|w| (w.path.as_str(), w.text.as_bytes())),
         files,
         &api,
     );
@@ -57,6 +58,8 @@ pub fn check(mission: &Text, world: &Text, files: &dyn SourceProvider) -> Report
         json: json!({
             "flyable": flyable,
             "errors": errors,
+            // Errors, warnings and notes counted as `aviary check` counts them.
+            "summary": aviary_diagnostics::summary_line(&diagnostics),
             "diagnostics": shown,
             "plan": plan,
             "tree": tree,

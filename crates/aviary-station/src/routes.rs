@@ -193,7 +193,12 @@ fn checked(
         folder.place(path, dir::Access::Save).map_err(|w| Refusal(StatusCode::BAD_REQUEST, w))
     };
     let path = place(&mission.path)?;
-    place(&world.path)?;
+    // No world chosen (a mission with none beside it): checked without one, as
+    // `aviary check` does, and it cannot fly.
+    let world = (!world.path.is_empty()).then_some(world);
+    if let Some(world) = world {
+        place(&world.path)?;
+    }
     let files = files_for(&path).map_err(|w| Refusal(StatusCode::CONFLICT, w))?;
     Ok((checking::check(mission, world, &*files), files))
 }
@@ -217,7 +222,12 @@ fn flyable(
     let (report, files) =
         checked(station, mission, world).map_err(|r| Box::new(r.into_response()))?;
     if !report.flyable {
-        let mut body = json!({ "error": "the mission cannot fly: fix the errors the check shows" });
+        let why = if world.path.is_empty() {
+            "the mission cannot fly without a world: choose one"
+        } else {
+            "the mission cannot fly: fix the errors the check shows"
+        };
+        let mut body = json!({ "error": why });
         body["check"] = report.json;
         return Err(Box::new((StatusCode::CONFLICT, Json(body)).into_response()));
     }

@@ -214,17 +214,20 @@ async function station() {
   const listing = (await api.call("GET", "/api/station/files")).body || { missions: [], worlds: [] };
   const missions = $("mission-file"), worlds = $("world-file");
   for (const m of listing.missions) missions.appendChild(new Option(m));
+  // "No world", as `aviary check` has for a mission with none beside it.
+  worlds.appendChild(new Option("(no world)", ""));
   for (const w of listing.worlds) worlds.appendChild(new Option(w));
   const open = async (which, path) => {
-    if (!path) return;
+    if (!path) { editor.load(which, "", ""); return; }
     const file = await api.call("GET", `/api/station/file?path=${encodeURIComponent(path)}`);
     if (file.ok) editor.load(which, path, file.body.text);
     else refused(`open ${path}`, file);
   };
   missions.onchange = async () => {
     const stem = missions.value.replace(/\.mission$/, "");
+    // The world beside the mission, as `aviary check` takes it; none when there is none.
     const beside = listing.worlds.find((w) => w === `${stem}.world.toml`);
-    if (beside) worlds.value = beside;
+    worlds.value = beside || "";
     await open("mission", missions.value);
     await open("world", worlds.value);
     check();
@@ -331,10 +334,15 @@ function showCheck(report) {
   page.checked = report;
   page.editor.mark(report.diagnostics);
   const summary = $("check-summary");
-  const warnings = report.diagnostics.length - report.errors;
+  // The server's count, as `aviary check` prints it: notes are not warnings.
+  const counted = report.summary ? `, ${report.summary}` : "";
   summary.textContent = report.errors
-    ? `${report.errors} error${report.errors > 1 ? "s" : ""}: the mission cannot fly`
-    : `no errors${warnings ? `, ${warnings} warning${warnings > 1 ? "s" : ""}` : ""}: ready to fly`;
+    ? `${report.summary}: the mission cannot fly`
+    : report.flyable
+      ? `no errors${counted}: ready to fly`
+      : !page.editor.files.world.path
+        ? `no errors${counted}: choose a world to fly`
+        : `no errors${counted}: no MISSION to fly`;
   summary.className = "summary " + (report.errors ? "bad" : "good");
   $("fly").disabled = !report.flyable;
   showPlan(report.plan);

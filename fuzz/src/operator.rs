@@ -52,7 +52,8 @@ fn kinds() -> Kinds {
     // `Bare` is heard by the mission but not declared: the operator may not raise it.
     k.operator_signal("Go");
     k.operator_signal("Any");
-    k
+    // An origin, so that a position by latitude and longitude is placed, not refused.
+    k.with_origin(aviary_api::geo::Origin { lat: 47.45, lon: 13.1, alt: 500.0 })
 }
 
 pub fn operator(data: &[u8]) {

@@ -209,14 +209,14 @@ fn events(base: &str, token: Option<&str>) -> u8 {
 
 fn refuse_value(text: &str, why: &str) -> u8 {
     eprintln!("aviary: cannot read `{text}` as a value: {why}");
-    eprintln!("  write a number with its unit (200m, 2min, 5m/s, 25%), a position (100, 50) or (100, 50, 20m), a name (Body), or a string in quotes");
+    eprintln!("  write a number with its unit (200m, 2min, 5m/s, 25%), a position (100, 50), (100, 50, 20m) or GEO(47.45, 13.1), a name (Body), or a string in quotes");
     2
 }
 
 /// A value read by the language's rules (`aviary_syntax::parse_value`), as the operator
 /// API takes it: a number keeps its unit (`{"number": 10, "unit": "s"}`), so that the
 /// server can refuse `10s` where a length is expected; a position is `[x, y(, z)]` in
-/// metres; a name or a string is a string.
+/// metres, or `{"lat", "lon"(, "alt")}` for `GEO(...)`; a name or a string is a string.
 fn value(text: &str) -> Result<Value, String> {
     let expr = aviary_syntax::parse_value(text)
         .map_err(|d| d.first().map(|d| d.message.clone()).unwrap_or_default())?;
@@ -252,6 +252,29 @@ fn to_json(expr: &Expr) -> Result<Value, String> {
             }
             Ok(json!(metres))
         }
-        _ => Err("only a number, a position, a name or a string can be sent".into()),
+        // GEO(lat, lon[, alt]): the server places it about the world's origin.
+        ExprKind::Geo(parts) => {
+            let mut n = Vec::new();
+            for p in parts {
+                match &p.kind {
+                    ExprKind::Number { value, unit: None, .. } => n.push(*value),
+                    ExprKind::Number { value, unit: Some(aviary_syntax::ast::Unit::Metre), .. }
+                        if n.len() == 2 =>
+                    {
+                        n.push(*value)
+                    }
+                    _ => return Err("GEO takes degrees of latitude and longitude, and an altitude in metres above sea level: GEO(47.45, 13.1) or GEO(47.45, 13.1, 520)".into()),
+                }
+            }
+            match n[..] {
+                [lat, lon] => Ok(json!({ "lat": lat, "lon": lon })),
+                [lat, lon, alt] => Ok(json!({ "lat": lat, "lon": lon, "alt": alt })),
+                _ => Err("GEO takes a latitude and a longitude, and an altitude if the height matters: GEO(47.45, 13.1)".into()),
+            }
+        }
+        _ => Err(
+            "only a number, a position ((x, y) or GEO(lat, lon)), a name or a string can be sent"
+                .into(),
+        ),
     }
 }

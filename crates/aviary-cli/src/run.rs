@@ -158,6 +158,7 @@ pub fn run(args: &RunArgs) -> u8 {
         server: None,
         feed: None,
         map: serde_json::Value::Null,
+        bounds: None,
         progress: None,
         stats: Stats::default(),
         drones: 0,
@@ -247,8 +248,10 @@ struct Shown<'a> {
     /// The station serving this run, and where the run's events go.
     server: Option<(aviary_station::Serving, aviary_server::Feed)>,
     feed: Option<aviary_server::Feed>,
-    /// The world as the station's map draws it, kept from `compiled` for `starting`.
+    /// The world as the station's map draws it, and where it lets the operator send a
+    /// drone, kept from `compiled` for `starting`.
     map: serde_json::Value,
+    bounds: Option<aviary_server::Bounds>,
     /// Made once the run starts.
     progress: Option<ProgressBar>,
     stats: Stats,
@@ -262,6 +265,7 @@ impl Hooks for Shown<'_> {
     fn compiled(&mut self, mission: &Mission, world: &World) -> Result<(), String> {
         if self.args.serve.is_some() {
             self.map = aviary_station::checking::map_of(world);
+            self.bounds = Some(aviary_server::Bounds::of(world));
         }
         self.expected = Some(Expected {
             observer: aviary_campaign::Observer::new(mission),
@@ -301,7 +305,11 @@ impl Hooks for Shown<'_> {
         self.controller = Some(controller.clone());
         if let Some(serve) = &self.args.serve {
             let map = std::mem::take(&mut self.map);
-            let (serving, feed) = crate::serve::start(serve, mission, map, controller.clone())?;
+            let Some(bounds) = self.bounds.take() else {
+                return Err("the run starts before its world was read".into());
+            };
+            let (serving, feed) =
+                crate::serve::start(serve, mission, bounds, map, controller.clone())?;
             self.feed = Some(feed.clone());
             self.server = Some((serving, feed));
         }

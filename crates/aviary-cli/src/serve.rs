@@ -5,7 +5,7 @@ use std::net::SocketAddr;
 
 use aviary_engine::Controller;
 use aviary_ir::Mission;
-use aviary_server::Feed;
+use aviary_server::{Bounds, Feed};
 use aviary_station::{Mode, Options, Serving};
 
 /// Where and how to serve.
@@ -57,12 +57,13 @@ fn announce(serving: &Serving) {
 pub fn start(
     serve: &Serve,
     mission: &Mission,
+    bounds: Bounds,
     map: serde_json::Value,
     controller: Controller,
 ) -> Result<(Serving, Feed), String> {
     let options = Options { address: serve.address, allowed_hosts: serve.allowed_hosts.clone() };
     let serving = aviary_station::serve(&options, Mode::Run, serde_json::Value::Null)?;
-    let feed = serving.serve_run(controller, mission, map);
+    let feed = serving.serve_run(controller, mission, bounds, map);
     announce(&serving);
     Ok((serving, feed))
 }

@@ -1,8 +1,8 @@
 //! The operator API through the real server and `aviary ctl`: a leash round trip (pause
 //! holds the drone, resume goes on, abort ends the activity `aborted`), the state, the
 //! event stream, and refusal without the token. `operator/` holds the checks of who
-//! may call (`guard.rs`), of what an operator may send (`args.rs`), and of steering one
-//! drone (`drone.rs`).
+//! may call (`guard.rs`), of what an operator may send (`args.rs`, and its positions in
+//! `positions.rs`), and of steering one drone (`drone.rs`).
 
 #[path = "operator/args.rs"]
 mod args;
@@ -13,6 +13,8 @@ mod common;
 mod drone;
 #[path = "operator/guard.rs"]
 mod guard;
+#[path = "operator/positions.rs"]
+mod positions;
 #[path = "operator/serve.rs"]
 mod serve;
 

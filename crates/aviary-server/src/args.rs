@@ -5,10 +5,15 @@
 //! The JSON forms of a value: a number (in SI units: metres, seconds, m/s, degrees, a
 //! fraction for a ratio), `{"number": 200, "unit": "m"}` (a number as the language
 //! writes it; `aviary ctl` sends this form), a string (a symbol or text), `true`/`false`,
-//! and `[x, y]` or `[x, y, z]` (a position in metres).
+//! and a position: `[x, y]` or `[x, y, z]` in metres, or `{"lat": 47.45, "lon": 13.1}`
+//! (with `"alt"` above sea level: `GEO(lat, lon, alt)` as the language writes it),
+//! placed by the world's one projection (`aviary_api::geo`) about the mission's origin.
+//! A position, however written, must lie where the world lets a drone fly (`bounds.rs`).
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
+use aviary_api::geo::Origin;
 use aviary_api::{Kind, Point, Value};
 use aviary_syntax::ast::Unit;
 use serde_json::{Map, Value as JsonValue};
@@ -26,6 +31,10 @@ pub struct Kinds {
     /// The signals the mission declares with `OPERATOR SIGNAL`, in the order written: the
     /// only ones an operator may raise.
     operator: Vec<String>,
+    /// The world's `origin`, which places a `{"lat", "lon"}` position; `None` without one.
+    origin: Option<Origin>,
+    /// Where a position may be; `None`: anywhere (no world was given).
+    bounds: Option<Arc<crate::Bounds>>,
 }
 
 impl Kinds {
@@ -47,7 +56,20 @@ impl Kinds {
                 kinds.operator_signal(name);
             }
         }
+        kinds.origin = mission.origin;
         kinds
+    }
+
+    /// These kinds, with positions held to the world's limits.
+    pub fn within(mut self, bounds: crate::Bounds) -> Kinds {
+        self.bounds = Some(Arc::new(bounds));
+        self
+    }
+
+    /// Places `{"lat", "lon"}` positions about `origin` (the mission's, from its world).
+    pub fn with_origin(mut self, origin: Origin) -> Kinds {
+        self.origin = Some(origin);
+        self
     }
 
     /// A capability's parameters, in order, with each one's kind (`None`: any).
@@ -69,6 +91,14 @@ impl Kinds {
     /// The signals an operator may raise, in the order the mission declares them.
     pub fn operator_signals(&self) -> &[String] {
         &self.operator
+    }
+
+    /// The kinds of the values each operator signal carries, in its order (`None`: any
+    /// value), as the ground station's Raise form reads them.
+    pub fn operator_signal_values(&self) -> impl Iterator<Item = (&str, &[Option<Kind>])> {
+        self.operator
+            .iter()
+            .map(|n| (n.as_str(), self.signals.get(n).map_or(&[][..], Vec::as_slice)))
     }
 
     /// Whether the operator may raise `name`; if not, why, with the signals the mission
@@ -115,7 +145,7 @@ impl Kinds {
                 },
                 None => None,
             };
-            out.push((name.clone(), value(v, kind, &format!("`{name}` of {capability}"))?));
+            out.push((name.clone(), self.value(v, kind, &format!("`{name}` of {capability}"))?));
         }
         Ok(out)
     }
@@ -127,7 +157,7 @@ impl Kinds {
             return args
                 .iter()
                 .enumerate()
-                .map(|(i, v)| value(v, None, &format!("value {} of {name}", i + 1)))
+                .map(|(i, v)| self.value(v, None, &format!("value {} of {name}", i + 1)))
                 .collect();
         };
         if args.len() != kinds.len() {
@@ -144,8 +174,21 @@ impl Kinds {
         args.iter()
             .zip(kinds)
             .enumerate()
-            .map(|(i, (v, kind))| value(v, *kind, &format!("value {} of {name}", i + 1)))
+            .map(|(i, (v, kind))| self.value(v, *kind, &format!("value {} of {name}", i + 1)))
             .collect()
+    }
+
+    /// `what` (such as "`radius` of FlyCircle") takes `kind`: the engine's value, or why
+    /// not. A position must also lie where the world lets a drone fly.
+    fn value(&self, v: &JsonValue, kind: Option<Kind>, what: &str) -> Result<Value, String> {
+        let given = read(v).map_err(|why| format!("{what}: {why}"))?;
+        let (value, shown) = convert(v, kind, given, what, self.origin)?;
+        if let (Value::Position(p), Some(shown), Some(bounds)) = (&value, shown, &self.bounds) {
+            if let Some(why) = bounds.refusal(*p, &shown) {
+                return Err(format!("{what}: {why}"));
+            }
+        }
+        Ok(value)
     }
 }
 
@@ -157,11 +200,18 @@ enum Given {
     Word(String),
     Bool(bool),
     Position(Point),
+    /// `{"lat": .., "lon": .., "alt": ..}`: degrees, and metres above sea level.
+    Geo {
+        lat: f64,
+        lon: f64,
+        alt: Option<f64>,
+    },
 }
 
 fn read(v: &JsonValue) -> Result<Given, String> {
-    let form = "write a number in SI units, {\"number\": 20, \"unit\": \"m\"}, a string, true or false, or [x, y]";
+    let form = "write a number in SI units, {\"number\": 20, \"unit\": \"m\"}, a string, true or false, [x, y] or {\"lat\": 47.45, \"lon\": 13.1}";
     match v {
+        JsonValue::Object(o) if o.contains_key("lat") || o.contains_key("lon") => geo(o),
         JsonValue::Number(n) => n
             .as_f64()
             .map(|x| Given::Number(x, None))
@@ -198,6 +248,57 @@ fn read(v: &JsonValue) -> Result<Given, String> {
     }
 }
 
+/// `{"lat": 47.45, "lon": 13.1}`, or with `"alt"`: `GEO(lat, lon[, alt])` in JSON.
+fn geo(o: &serde_json::Map<String, JsonValue>) -> Result<Given, String> {
+    let form = "write {\"lat\": 47.45, \"lon\": 13.1} in degrees, with \"alt\" in metres above sea level if the height matters";
+    if let Some(k) = o.keys().find(|k| !matches!(k.as_str(), "lat" | "lon" | "alt")) {
+        return Err(format!("a position by latitude and longitude has no `{k}`: {form}"));
+    }
+    let degrees = |key: &str, limit: f64| match o.get(key) {
+        Some(JsonValue::Number(n)) => match n.as_f64() {
+            Some(d) if d.abs() <= limit => Ok(d),
+            _ => Err(format!("`{key}` is {n}, and must be within ±{limit} degrees")),
+        },
+        Some(other) => Err(format!("`{key}` must be a number of degrees, not {other}: {form}")),
+        None => Err(format!("`{key}` is missing: {form}")),
+    };
+    let (lat, lon) = (degrees("lat", 90.0)?, degrees("lon", 180.0)?);
+    let alt = match o.get("alt") {
+        None | Some(JsonValue::Null) => None,
+        Some(JsonValue::Number(n)) => match n.as_f64() {
+            Some(a) if a.abs() <= MAX_MAGNITUDE => Some(a),
+            _ => {
+                return Err(format!(
+                    "`alt` is {n}: give metres above sea level, at most {MAX_MAGNITUDE:e}"
+                ))
+            }
+        },
+        Some(other) => {
+            return Err(format!("`alt` must be a number of metres above sea level, not {other}"))
+        }
+    };
+    Ok(Given::Geo { lat, lon, alt })
+}
+
+/// A kind as `GET /api/state` names it (`operator_signal_values`): one word, stable.
+pub(crate) fn kind_name(kind: Kind) -> &'static str {
+    match kind {
+        Kind::Length => "length",
+        Kind::Duration => "duration",
+        Kind::Speed => "speed",
+        Kind::Angle => "angle",
+        Kind::Ratio => "ratio",
+        Kind::Number => "number",
+        Kind::Text => "string",
+        Kind::Bool => "bool",
+        Kind::Position => "position",
+        Kind::Area => "area",
+        Kind::Symbol => "symbol",
+        Kind::Actor => "actor",
+        Kind::Remainder => "remainder",
+    }
+}
+
 /// The kind a unit gives a number, as the checker reads it (`aviary_check`'s `unit_kind`).
 fn unit_kind(unit: Unit) -> Kind {
     match unit {
@@ -216,10 +317,40 @@ fn numeric(kind: Kind) -> bool {
     )
 }
 
-/// `what` (such as "`radius` of FlyCircle") takes `kind`: the engine's value, or why not.
-pub(crate) fn value(v: &JsonValue, kind: Option<Kind>, what: &str) -> Result<Value, String> {
-    let given = read(v).map_err(|why| format!("{what}: {why}"))?;
-    match (kind, given) {
+/// `given` as the engine's value for `kind`, or why not; a position with how to show it
+/// to the operator. `origin` places a position by latitude and longitude.
+fn convert(
+    v: &JsonValue,
+    kind: Option<Kind>,
+    given: Given,
+    what: &str,
+    origin: Option<Origin>,
+) -> Result<(Value, Option<String>), String> {
+    let value = match (kind, given) {
+        (Some(Kind::Position) | None, Given::Position(p)) => {
+            for c in [Some(p.x), Some(p.y), p.z].into_iter().flatten() {
+                number(c, v, what)?;
+            }
+            return Ok((Value::Position(p), Some(aviary_api::show::point(&p))));
+        }
+        (Some(Kind::Position) | None, Given::Geo { lat, lon, alt }) => {
+            let Some(origin) = origin else {
+                return Err(format!(
+                    "{what}: a position by latitude and longitude needs the world's `origin`, and this world has none: send [x, y] in metres"
+                ));
+            };
+            let [x, y, z] = origin.place(lat, lon, alt);
+            let p = Point { x, y, z: alt.map(|_| z) };
+            // Where it lands, to the decimetre, so that a refusal shows the local figures.
+            let near = |c: f64| (c * 10.0).round() / 10.0;
+            let local =
+                aviary_api::show::point(&Point { x: near(x), y: near(y), z: p.z.map(near) });
+            let written = match alt {
+                Some(alt) => format!("GEO({lat}, {lon}, {alt})"),
+                None => format!("GEO({lat}, {lon})"),
+            };
+            return Ok((Value::Position(p), Some(format!("{written}, at {local},"))));
+        }
         (Some(k), Given::Number(x, written)) if numeric(k) => {
             match written {
                 Some(Kind::Number) if k != Kind::Number => {
@@ -247,12 +378,6 @@ pub(crate) fn value(v: &JsonValue, kind: Option<Kind>, what: &str) -> Result<Val
             number(x, v, what).map(Value::Number)
         }
         (None, Given::Number(x, _)) => number(x, v, what).map(Value::Number),
-        (Some(Kind::Position) | None, Given::Position(p)) => {
-            for c in [Some(p.x), Some(p.y), p.z].into_iter().flatten() {
-                number(c, v, what)?;
-            }
-            Ok(Value::Position(p))
-        }
         (Some(Kind::Symbol) | None, Given::Word(s)) => Ok(Value::Symbol(s)),
         (Some(Kind::Text), Given::Word(s)) => Ok(Value::Text(s)),
         (Some(Kind::Bool) | None, Given::Bool(b)) => Ok(Value::Bool(b)),
@@ -260,7 +385,8 @@ pub(crate) fn value(v: &JsonValue, kind: Option<Kind>, what: &str) -> Result<Val
             Err(format!("{what} is {}, which the operator API cannot send", k.describe()))
         }
         (Some(k), _) => Err(format!("{what} is {}, and {v} is not: {}", k.describe(), example(k))),
-    }
+    };
+    value.map(|value| (value, None))
 }
 
 /// A finite number within [`MAX_MAGNITUDE`].
@@ -282,7 +408,9 @@ fn example(kind: Kind) -> String {
         Kind::Angle => "deg",
         Kind::Ratio => "%",
         Kind::Number => return "write a number such as 2".into(),
-        Kind::Position => return "write [x, y] or [x, y, z] in metres".into(),
+        Kind::Position => {
+            return "write [x, y] or [x, y, z] in metres, or {\"lat\": 47.45, \"lon\": 13.1} in degrees".into()
+        }
         Kind::Symbol | Kind::Text => return "write a string such as \"Body\"".into(),
         Kind::Bool => return "write true or false".into(),
         Kind::Area | Kind::Actor | Kind::Remainder => return String::new(),

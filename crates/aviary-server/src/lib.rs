@@ -9,11 +9,13 @@
 //! Invariants: every request names this server (`Host`) and comes from no other site's
 //! page (`Origin`); every control call needs the run's token, and so does reading when
 //! the server is bound beyond loopback (`guard.rs`); an operator's arguments are checked
-//! against the mission's kinds before it hears them (`args.rs`); every error is JSON
+//! against the mission's kinds, and its positions against the world's limits, before it
+//! hears them (`args.rs`, `bounds.rs`); every error is JSON
 //! (`reply.rs`). The server binds the address it is given; the CLI gives loopback unless
 //! told otherwise.
 
 mod args;
+mod bounds;
 mod guard;
 mod reply;
 mod routes;
@@ -21,6 +23,7 @@ mod state;
 mod stream;
 
 pub use args::{Kinds, MAX_MAGNITUDE};
+pub use bounds::Bounds;
 pub use guard::{read_token, same_origin, token, Gate, TOKEN_PROTOCOL};
 pub use reply::{json_errors, BODY_LIMIT};
 

@@ -14,6 +14,7 @@ use axum::routing::{get, post};
 use axum::{middleware, Json, Router};
 use serde_json::{json, Value as JsonValue};
 
+use crate::args::kind_name;
 use crate::reply::{error, Object, BODY_LIMIT};
 use crate::{guard, reply, stream, Shared};
 
@@ -52,6 +53,15 @@ async fn control(shared: &Shared, control: Control) -> Response {
 async fn state(State(shared): State<Arc<Shared>>) -> Json<JsonValue> {
     let mut state = shared.state().to_json();
     state["operator_signals"] = json!(shared.kinds.operator_signals());
+    // What each carries, so that a form can read `x, y` as the one position it takes.
+    let values: serde_json::Map<String, JsonValue> = shared
+        .kinds
+        .operator_signal_values()
+        .map(|(name, kinds)| {
+            (name.to_string(), json!(kinds.iter().map(|k| k.map(kind_name)).collect::<Vec<_>>()))
+        })
+        .collect();
+    state["operator_signal_values"] = JsonValue::Object(values);
     Json(state)
 }
 

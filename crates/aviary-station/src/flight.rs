@@ -87,6 +87,7 @@ pub fn start(
                 trace,
                 file: None,
                 controller: None,
+                bounds: None,
             };
             let flown = aviary_backends::fly(texts, &options, &mut hooks);
             landed.flying.store(false, std::sync::atomic::Ordering::SeqCst);
@@ -132,11 +133,14 @@ struct Flight {
     file: Option<SharedTrace>,
     /// The flight's, once it starts: a trace at its size limit stops it.
     controller: Option<Controller>,
+    /// Where the world lets the operator send a drone, from `compiled` for `starting`.
+    bounds: Option<aviary_server::Bounds>,
 }
 
 impl Hooks for Flight {
     fn compiled(&mut self, mission: &Mission, world: &World) -> Result<(), String> {
         self.station.set_map(map_of(world));
+        self.bounds = Some(aviary_server::Bounds::of(world));
         // Made as every file of the folder is reached: checked by `Folder::place`.
         let Mode::Folder { folder, .. } = &self.station.mode else {
             return Err("a flight from the page needs the station's folder".into());
@@ -162,7 +166,10 @@ impl Hooks for Flight {
         self.controller = Some(controller.clone());
         let tree = std::mem::take(&mut self.tree);
         let trace = Some(self.trace.shown.clone());
-        self.feed = Some(self.station.start_run(controller.clone(), mission, tree, trace));
+        let Some(bounds) = self.bounds.take() else {
+            return Err("the flight starts before its world was read".into());
+        };
+        self.feed = Some(self.station.start_run(controller.clone(), mission, bounds, tree, trace));
         if let Some(ready) = self.ready.take() {
             let _ = ready.send(Ok(()));
         }

@@ -30,7 +30,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 
 use aviary_check::SourceProvider;
 use aviary_engine::Controller;
-use aviary_server::{Feed, Gate, Kinds};
+use aviary_server::{Bounds, Feed, Gate, Kinds};
 use serde_json::Value;
 
 pub use dir::{refused_name, Access, Folder, Listing};
@@ -86,17 +86,22 @@ impl Station {
     }
 
     /// Serves the operator API of a run of `mission` from now on (the last one's goes);
-    /// its events go to the feed returned. `tree` is what the page shows of the mission,
-    /// `trace` where its trace is written, if the station writes it.
+    /// its events go to the feed returned. `bounds` are where its world lets the operator
+    /// send a drone, `tree` is what the page shows of the mission, `trace` where its trace
+    /// is written, if the station writes it.
     pub fn start_run(
         &self,
         controller: Controller,
         mission: &aviary_ir::Mission,
+        bounds: Bounds,
         tree: Value,
         trace: Option<String>,
     ) -> Feed {
-        let (router, feed) =
-            aviary_server::router_behind(self.gate.clone(), controller, Kinds::of(mission));
+        let (router, feed) = aviary_server::router_behind(
+            self.gate.clone(),
+            controller,
+            Kinds::of(mission).within(bounds),
+        );
         *Self::lock(&self.run) = Some(Run { router, mission: mission.name.clone(), tree, trace });
         feed
     }
@@ -150,15 +155,17 @@ impl Serving {
     }
 
     /// For `aviary run --serve`: the operator API of the run, and where its events go.
-    /// `tree` and `map` are what the page shows of the mission and its world.
+    /// `map` is what the page shows of its world, `bounds` where the world lets the
+    /// operator send a drone.
     pub fn serve_run(
         &self,
         controller: Controller,
         mission: &aviary_ir::Mission,
+        bounds: Bounds,
         map: Value,
     ) -> Feed {
         self.station.set_map(map);
-        self.station.start_run(controller, mission, tree::of(mission, None), None)
+        self.station.start_run(controller, mission, bounds, tree::of(mission, None), None)
     }
 }
 

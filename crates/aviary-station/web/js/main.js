@@ -114,7 +114,7 @@ async function watch() {
   $("trace-file").textContent = about.run.trace ? `trace ${about.run.trace}` : "";
   for (const d of (about.map && about.map.drones) || []) drone(page.model, d.name).pos = d.home;
   const state = await api.call("GET", "/api/state");
-  fillSignals((state.ok && state.body.operator_signals) || []);
+  fillSignals((state.ok && state.body.operator_signals) || [], (state.ok && state.body.operator_signal_values) || {});
   if (state.ok) {
     const s = state.body;
     const m = page.model;
@@ -149,17 +149,41 @@ function fillLists(tree) {
 }
 
 /// The signals the operator may raise: those the mission declares (OPERATOR SIGNAL), as
-/// the state lists them; the API refuses any other.
-function fillSignals(names) {
+/// the state lists them; the API refuses any other. `values` are the kinds each carries
+/// (`"position"`, ..., null for any), which say how the values field is read.
+function fillSignals(names, values) {
   $("signals").innerHTML = "";
   for (const s of names) $("signals").appendChild(new Option(s));
   $("signal-name").placeholder = names.length ? names.join(", ") : "the mission declares no operator signal";
+  page.signalValues = values;
+  hintValues();
+}
+
+/// The values field's hint for the signal named: what it carries, a position's two forms.
+function hintValues() {
+  const kinds = (page.signalValues || {})[$("signal-name").value.trim()];
+  const shown = (k) => (k === "position" ? "GEO(lat, lon) or x, y" : k || "a value");
+  $("signal-args").placeholder = !kinds ? "values, comma-separated" : kinds.length ? kinds.map(shown).join("; ") : "no values";
+}
+
+/// The values field of the Raise form: a signal that carries one value takes the whole
+/// field as that value (`120, 40` is one position); several are split at the commas
+/// outside parentheses (`(120, 40), Body`).
+function signalValues(name, raw) {
+  if (!raw) return [];
+  const kinds = (page.signalValues || {})[name];
+  if (kinds && kinds.length === 1) return [value(raw)];
+  return raw.split(/,(?![^(]*\))/).map(value);
 }
 
 /// `radius=200m, rounds=2` as the operator API's values: a number with its unit, a
-/// position, TRUE/FALSE, or a name.
+/// position (`x, y`, `(x, y, z)`, or `GEO(lat, lon[, alt])`, which the server places about
+/// the world's origin), TRUE/FALSE, or a name.
 function value(text) {
   const t = text.trim();
+  const geo = t.match(/^GEO\(\s*(-?[\d.]+)\s*,\s*(-?[\d.]+)\s*(?:,\s*(-?[\d.]+)\s*m?)?\)$/i);
+  if (geo) return geo[3] === undefined ? { lat: Number(geo[1]), lon: Number(geo[2]) }
+    : { lat: Number(geo[1]), lon: Number(geo[2]), alt: Number(geo[3]) };
   const unit = t.match(/^(-?\d+(?:\.\d+)?)\s*(m|km|s|min|h|m\/s|km\/h|deg|%)?$/);
   if (unit) return unit[2] ? { number: Number(unit[1]), unit: unit[2] } : { number: Number(unit[1]) };
   const pos = t.match(/^\(?\s*(-?[\d.]+)\s*,\s*(-?[\d.]+)\s*(?:,\s*(-?[\d.]+)\s*m?)?\)?$/);
@@ -195,10 +219,11 @@ function wireControls() {
   };
   $("signal-form").onsubmit = (ev) => {
     ev.preventDefault();
-    const raw = $("signal-args").value.trim();
-    const args = raw ? raw.split(/,(?![^(]*\))/).map(value) : [];
-    control("/api/signal", { name: $("signal-name").value.trim(), args }, `signal ${$("signal-name").value}`);
+    const name = $("signal-name").value.trim();
+    const args = signalValues(name, $("signal-args").value.trim());
+    control("/api/signal", { name, args }, `signal ${name}`);
   };
+  $("signal-name").oninput = hintValues;
   window.addEventListener("keydown", (e) => {
     if (e.key === " " && e.target === document.body && page.about && page.about.mode !== "replay") {
       e.preventDefault();

@@ -2,7 +2,7 @@
 //! checked against the kinds the checker inferred (400, naming the kind) before the
 //! mission hears them, and `aviary ctl` reads values by the language's rules.
 
-use super::serve::{bearer, http, serve, Run};
+use super::serve::{bearer, http, raise, serve, Run};
 use crate::common::{aviary, scratch};
 
 /// `Watch`'s `radius` is a length (its default); `Go` carries a position and a duration
@@ -47,15 +47,7 @@ fn widen(run: &Run, radius: &str) -> (u16, String) {
 }
 
 fn go(run: &Run, args: &str) -> (u16, String) {
-    let body = format!("{{\"name\": \"Go\", \"args\": {args}}}");
-    let a = http(
-        run,
-        "POST",
-        "/api/signal",
-        &[("Authorization", &bearer(run)), ("Content-Type", "application/json")],
-        &body,
-    );
-    (a.status, if a.status == 200 { a.body } else { a.error() })
+    raise(run, "Go", args)
 }
 
 #[test]

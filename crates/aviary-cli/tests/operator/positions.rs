@@ -3,7 +3,7 @@
 //! (the geofence, a no-fly zone under its top, `max_altitude`) refused with the limit and
 //! by how much, before the mission hears it, while the run goes on to its end.
 
-use super::serve::{bearer, http, serve, Run};
+use super::serve::{http, raise, serve, Run};
 use crate::common::{aviary, scratch};
 
 /// `Go` carries where `b` is to fly; `a` hovers meanwhile, so the run lasts 60 s.
@@ -33,15 +33,7 @@ home = [10, 0]
 ";
 
 fn go(run: &Run, args: &str) -> (u16, String) {
-    let body = format!("{{\"name\": \"Go\", \"args\": {args}}}");
-    let a = http(
-        run,
-        "POST",
-        "/api/signal",
-        &[("Authorization", &bearer(run)), ("Content-Type", "application/json")],
-        &body,
-    );
-    (a.status, if a.status == 200 { a.body } else { a.error() })
+    raise(run, "Go", args)
 }
 
 #[test]

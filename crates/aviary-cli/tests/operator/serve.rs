@@ -127,3 +127,17 @@ pub fn upgrade(run: &Run, headers: &[(&str, &str)]) -> Answer {
 pub fn bearer(run: &Run) -> String {
     format!("Bearer {}", run.token)
 }
+
+/// The operator raises `name` with the JSON `args`: the status, and the body (200) or
+/// the error's message.
+pub fn raise(run: &Run, name: &str, args: &str) -> (u16, String) {
+    let body = format!("{{\"name\": \"{name}\", \"args\": {args}}}");
+    let a = http(
+        run,
+        "POST",
+        "/api/signal",
+        &[("Authorization", &bearer(run)), ("Content-Type", "application/json")],
+        &body,
+    );
+    (a.status, if a.status == 200 { a.body } else { a.error() })
+}

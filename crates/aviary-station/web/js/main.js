@@ -343,7 +343,8 @@ function records(traces, world) {
     location.href = `/?${q}`;
   };
   $("report-trace").onclick = async () => {
-    const q = new URLSearchParams({ path: list.value, world: world() });
+    // "(no world)" chosen: the report draws the trace without one.
+    const q = new URLSearchParams({ path: list.value, ...(world() ? { world: world() } : {}) });
     const response = await api.raw(`/api/station/report?${q}`);
     if (!response.ok) return refused(`report of ${list.value}`, { status: response.status, body: await response.json().catch(() => null) });
     const link = document.createElement("a");

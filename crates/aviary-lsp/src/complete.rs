@@ -14,7 +14,7 @@ use lsp_types::{
 use crate::analysis::Analysis;
 use crate::hover::{capability, describe};
 use crate::index::Sym;
-use crate::text::LineIndex;
+use crate::text::line_before;
 use crate::Server;
 
 /// Keywords that start a statement.
@@ -56,9 +56,7 @@ pub fn complete(server: &Server, p: CompletionParams) -> Option<CompletionRespon
     let at = p.text_document_position;
     let (_, a, file) = server.lookup(&at.text_document.uri)?;
     let text = a.sources.text(file);
-    let offset = LineIndex::new(text).offset(at.position);
-    let line_start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
-    let before = &text[line_start..offset];
+    let (offset, before) = line_before(text, at.position);
     let head = before.trim_end_matches(is_word);
     let words: Vec<&str> =
         head.split(|c: char| c.is_whitespace() || c == ',').filter(|w| !w.is_empty()).collect();

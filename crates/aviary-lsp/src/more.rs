@@ -10,7 +10,7 @@ use lsp_types::{
 
 use crate::hover::{capability, describe};
 use crate::index::Sym;
-use crate::text::LineIndex;
+use crate::text::{line_before, LineIndex};
 use crate::Server;
 
 /// The arguments written so far after `open` in `before`: how many commas at depth 0,
@@ -39,9 +39,7 @@ pub fn signature_help(server: &Server, p: SignatureHelpParams) -> Option<Signatu
     let at = p.text_document_position_params;
     let (_, a, file) = server.lookup(&at.text_document.uri)?;
     let text = a.sources.text(file);
-    let offset = LineIndex::new(text).offset(at.position);
-    let line_start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
-    let before = &text[line_start..offset];
+    let (_, before) = line_before(text, at.position);
     let api = aviary_api::Descriptor::standard();
     // `drone.Function(args`: the innermost open parenthesis after a function's name.
     if let Some(open) = before.rfind('(') {

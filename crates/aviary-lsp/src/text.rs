@@ -50,6 +50,14 @@ impl<'a> LineIndex<'a> {
     }
 }
 
+/// The byte offset of `position` in `text`, and its line's text up to it (what completion
+/// and signature help read the context from).
+pub fn line_before(text: &str, position: Position) -> (usize, &str) {
+    let offset = LineIndex::new(text).offset(position);
+    let line_start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
+    (offset, &text[line_start..offset])
+}
+
 /// A word of the language (a name, a keyword, a code such as `E107`) that covers or
 /// ends at `offset`, with its byte range.
 pub fn word_at(text: &str, offset: usize) -> Option<(usize, usize)> {

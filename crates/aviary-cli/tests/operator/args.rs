@@ -2,7 +2,7 @@
 //! checked against the kinds the checker inferred (400, naming the kind) before the
 //! mission hears them, and `aviary ctl` reads values by the language's rules.
 
-use super::serve::{bearer, http, raise, serve, Run};
+use super::serve::{http, post, raise, serve, Run};
 use crate::common::{aviary, scratch};
 
 /// `Watch`'s `radius` is a length (its default); `Go` carries a position and a duration
@@ -36,14 +36,7 @@ fn widen(run: &Run, radius: &str) -> (u16, String) {
     let body = format!(
         "{{\"activity\": \"Watch-W1\", \"action\": \"Widen\", \"args\": {{\"radius\": {radius}}}}}"
     );
-    let a = http(
-        run,
-        "POST",
-        "/api/leash",
-        &[("Authorization", &bearer(run)), ("Content-Type", "application/json")],
-        &body,
-    );
-    (a.status, if a.status == 200 { a.body } else { a.error() })
+    post(run, "/api/leash", &body)
 }
 
 fn go(run: &Run, args: &str) -> (u16, String) {
@@ -81,16 +74,9 @@ fn leash_arguments_and_signal_values_are_checked_against_the_mission_kinds() {
     let (status, why) = widen(&run, "1e999");
     assert_eq!(status, 400, "a number JSON cannot hold: {why}");
     let body = "{\"activity\": \"Watch-W1\", \"action\": \"Widen\", \"args\": {\"radios\": 5}}";
-    let a = http(
-        &run,
-        "POST",
-        "/api/leash",
-        &[("Authorization", &bearer(&run)), ("Content-Type", "application/json")],
-        body,
-    );
     assert_eq!(
-        (a.status, a.error().as_str()),
-        (400, "Watch has no parameter `radios`; its parameters are: radius")
+        post(&run, "/api/leash", body),
+        (400, "Watch has no parameter `radios`; its parameters are: radius".to_string())
     );
 
     let (status, why) = go(&run, "[]");
@@ -104,16 +90,13 @@ fn leash_arguments_and_signal_values_are_checked_against_the_mission_kinds() {
 
     // Only a signal the mission declares: `Widened` is the mission's own, `Og` a slip.
     let body = "{\"name\": \"Widened\", \"args\": [5]}";
-    let a = http(
-        &run,
-        "POST",
-        "/api/signal",
-        &[("Authorization", &bearer(&run)), ("Content-Type", "application/json")],
-        body,
-    );
     assert_eq!(
-        (a.status, a.error().as_str()),
-        (409, "the mission does not declare Widened as an operator signal: it declares Go")
+        post(&run, "/api/signal", body),
+        (
+            409,
+            "the mission does not declare Widened as an operator signal: it declares Go"
+                .to_string()
+        )
     );
     let a = http(&run, "GET", "/api/state", &[], "");
     let state: serde_json::Value = serde_json::from_str(&a.body).unwrap();

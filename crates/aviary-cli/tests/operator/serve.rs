@@ -128,16 +128,16 @@ pub fn bearer(run: &Run) -> String {
     format!("Bearer {}", run.token)
 }
 
-/// The operator raises `name` with the JSON `args`: the status, and the body (200) or
-/// the error's message.
-pub fn raise(run: &Run, name: &str, args: &str) -> (u16, String) {
-    let body = format!("{{\"name\": \"{name}\", \"args\": {args}}}");
-    let a = http(
-        run,
-        "POST",
-        "/api/signal",
-        &[("Authorization", &bearer(run)), ("Content-Type", "application/json")],
-        &body,
-    );
+/// A control call: `body` POSTed to `path` with the token; the status, and the body
+/// (200) or the error's message.
+pub fn post(run: &Run, path: &str, body: &str) -> (u16, String) {
+    let headers = [("Authorization", bearer(run)), ("Content-Type", "application/json".into())];
+    let headers: Vec<(&str, &str)> = headers.iter().map(|(k, v)| (*k, v.as_str())).collect();
+    let a = http(run, "POST", path, &headers, body);
     (a.status, if a.status == 200 { a.body } else { a.error() })
+}
+
+/// The operator raises `name` with the JSON `args`.
+pub fn raise(run: &Run, name: &str, args: &str) -> (u16, String) {
+    post(run, "/api/signal", &format!("{{\"name\": \"{name}\", \"args\": {args}}}"))
 }

@@ -50,8 +50,20 @@ for who in new base; do
     done
 done
 
-missions=("$here/examples/search_and_rescue.mission" "$here"/examples/faults/*.mission "$work/swarm.mission" "$work/w.mission")
+# Compares the two traces $work/NAME.base.jsonl and $work/NAME.new.jsonl, said as LABEL.
 status=0
+compare() { # NAME LABEL
+    local lines
+    lines=$(wc -l <"$work/$1.base.jsonl")
+    if cmp -s "$work/$1.base.jsonl" "$work/$1.new.jsonl"; then
+        echo "same      $2 ($lines events)"
+    else
+        echo "DIFFERENT $2"; status=1
+        diff <(head -c 100000000 "$work/$1.base.jsonl") "$work/$1.new.jsonl" | head -5 || true
+    fi
+}
+
+missions=("$here/examples/search_and_rescue.mission" "$here"/examples/faults/*.mission "$work/swarm.mission" "$work/w.mission")
 for m in "${missions[@]}"; do
     name=$(basename "$m" .mission)
     for who in base new; do
@@ -62,13 +74,7 @@ for m in "${missions[@]}"; do
         fi
         "$bin" run "$m" "${world[@]}" --quiet --telemetry-hz 1 --trace "$work/$name.$who.jsonl" || true
     done
-    lines=$(wc -l <"$work/$name.base.jsonl")
-    if cmp -s "$work/$name.base.jsonl" "$work/$name.new.jsonl"; then
-        echo "same      $name ($lines events)"
-    else
-        echo "DIFFERENT $name"; status=1
-        diff <(head -c 100000000 "$work/$name.base.jsonl") "$work/$name.new.jsonl" | head -5 || true
-    fi
+    compare "$name" "$name"
 done
 air="$here/examples/search_and_rescue.air.world.toml"
 for seed in 1 2 3 4 5 6 7 8; do
@@ -77,12 +83,6 @@ for seed in 1 2 3 4 5 6 7 8; do
         "$bin" run "$here/examples/search_and_rescue.mission" --world "$air" --seed "$seed" \
             --quiet --telemetry-hz 1 --trace "$work/air$seed.$who.jsonl" || true
     done
-    lines=$(wc -l <"$work/air$seed.base.jsonl")
-    if cmp -s "$work/air$seed.base.jsonl" "$work/air$seed.new.jsonl"; then
-        echo "same      air, seed $seed ($lines events)"
-    else
-        echo "DIFFERENT air, seed $seed"; status=1
-        diff "$work/air$seed.base.jsonl" "$work/air$seed.new.jsonl" | head -5 || true
-    fi
+    compare "air$seed" "air, seed $seed"
 done
 exit $status

@@ -224,38 +224,36 @@ impl Fleet {
         let Some(mine) = reach_box(&self.drones[id], dt + HORIZON) else {
             return false;
         };
-        let mut boxes = Vec::with_capacity(higher.len());
         for &j in higher {
-            let theirs = match reach_box(&self.drones[j], HORIZON) {
-                Some(b) => Some(b),
-                None => Bounds::of_points(self.track(j, id).iter().flatten()),
-            };
-            if theirs.is_some_and(|b| !mine.apart(&b, sep)) {
+            if self.their_box(j, id).is_some_and(|b| !mine.apart(&b, sep)) {
                 return false;
             }
-            boxes.push((j, theirs));
         }
         #[cfg(debug_assertions)]
-        self.check_boxes(id, dt, mine, &boxes);
+        self.check_boxes(id, dt, mine, higher);
         true
+    }
+
+    /// Where drone `j` can be over the horizon, for the planning of drone `id`: the box
+    /// of its legs, or, when it yields, of its predicted track (`None`: never in the air).
+    fn their_box(&mut self, j: DroneId, id: DroneId) -> Option<Bounds> {
+        match reach_box(&self.drones[j], HORIZON) {
+            Some(b) => Some(b),
+            None => Bounds::of_points(self.track(j, id).iter().flatten()),
+        }
     }
 
     /// That the boxes [`Fleet::clear_ahead`] judged by hold the tracks the planner would
     /// have predicted (a debug build's check of [`reach_box`]'s reasoning).
     #[cfg(debug_assertions)]
-    fn check_boxes(
-        &mut self,
-        id: DroneId,
-        dt: f64,
-        mine: Bounds,
-        theirs: &[(DroneId, Option<Bounds>)],
-    ) {
+    fn check_boxes(&mut self, id: DroneId, dt: f64, mine: Bounds, higher: &[DroneId]) {
         let (track, _) = predict_with(&self.drones[id], None, dt, &[], self.min_separation);
         let outside = |t: &Track, b: Bounds| t.iter().flatten().find(|p| !b.holds(**p)).copied();
         if let Some(p) = outside(&track, mine) {
             panic!("drone {id} reaches {p:?} outside its box {mine:?}");
         }
-        for &(j, b) in theirs {
+        for &j in higher {
+            let b = self.their_box(j, id);
             let track = self.track(j, id);
             match b {
                 Some(b) => {

@@ -53,10 +53,12 @@ pub enum BuiltinException {
     CommandFailed,
     RequirementNotMet,
     Timeout,
+    /// An `ANY` found no drone free and fit in time, or too few are left in the mission.
+    NoDroneAvailable,
 }
 
 impl BuiltinException {
-    pub const ALL: [BuiltinException; 9] = [
+    pub const ALL: [BuiltinException; 10] = [
         BuiltinException::BatteryCritical,
         BuiltinException::ConnectionLost,
         BuiltinException::DroneLost,
@@ -66,6 +68,7 @@ impl BuiltinException {
         BuiltinException::CommandFailed,
         BuiltinException::RequirementNotMet,
         BuiltinException::Timeout,
+        BuiltinException::NoDroneAvailable,
     ];
 
     /// The name a mission handles it by (`ON EXCEPTION BatteryCritical`).
@@ -80,6 +83,7 @@ impl BuiltinException {
             BuiltinException::CommandFailed => "CommandFailed",
             BuiltinException::RequirementNotMet => "RequirementNotMet",
             BuiltinException::Timeout => "Timeout",
+            BuiltinException::NoDroneAvailable => "NoDroneAvailable",
         }
     }
 

@@ -79,11 +79,14 @@ fn walk<'a>(
         let (inner_parallel, inner_copies) = match stmt {
             Stmt::Block(b) => (b.kind == BlockKind::Parallel, false),
             Stmt::For(f) => (false, f.kind == BlockKind::Parallel),
+            // `ANY 2 d IN ...` runs its body once per drone taken, at once.
+            Stmt::Any(a) => (false, a.count.is_some()),
             Stmt::Handler(h) => (false, h.every),
             Stmt::ExceptionHandler(_) => (false, true),
             _ => (false, false),
         };
-        let inner_for = in_for || matches!(stmt, Stmt::For(_));
+        let inner_for =
+            in_for || matches!(stmt, Stmt::For(_) | Stmt::Any(AnyBlock { count: Some(_), .. }));
         stmt.for_each_body(|inner| walk(inner, inner_parallel, inner_copies, inner_for, path, out));
         path.pop();
     }

@@ -136,6 +136,11 @@ impl Walker<'_> {
                     }
                     self.body(&f.body, &inner, file, depth);
                 }
+                Stmt::Any(a) => {
+                    let mut inner = env.clone();
+                    inner.actors.insert(a.alias.name.clone(), self.drones(&a.group, env));
+                    self.body(&a.body, &inner, file, depth);
+                }
                 other => other.for_each_body(|b| self.body(b, env, file, depth)),
             }
         }

@@ -84,6 +84,9 @@ pub(crate) fn stmt_exprs(stmt: &Stmt) -> Vec<&Expr> {
         Stmt::Api(a) => a.args.iter().collect(),
         Stmt::Requirement(r) => vec![&r.condition],
         Stmt::For(f) => f.instances.iter().flat_map(|i| i.values.iter()).collect(),
+        Stmt::Any(a) => {
+            [&a.count, &a.condition, &a.nearest, &a.within].into_iter().flatten().collect()
+        }
         Stmt::Signal(r) | Stmt::Throw(r) => args(&r.args),
         Stmt::If(i) => i.branches.iter().map(|(c, _)| c).collect(),
         _ => Vec::new(),

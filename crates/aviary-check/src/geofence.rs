@@ -141,6 +141,14 @@ impl Walker<'_> {
                         self.body(&f.body, &inner, site, file, depth);
                     }
                 }
+                Stmt::Any(a) => {
+                    let mut inner = values.clone();
+                    inner.remove(&a.alias.name);
+                    if let Some(Known::Drones(d)) = self.actor(&a.group.name, values) {
+                        inner.insert(a.alias.name.clone(), Known::Drones(d));
+                    }
+                    self.body(&a.body, &inner, site, file, depth);
+                }
                 Stmt::Handler(h) => {
                     self.body(&h.body, &without(values, &h.bindings), site, file, depth)
                 }

@@ -65,6 +65,7 @@ fn visit<'a>(body: &'a Body, f: &mut dyn FnMut(&'a Statement)) {
             Stmt::Statement(s) => f(s),
             Stmt::Block(b) => visit(&b.body, f),
             Stmt::For(x) => visit(&x.body, f),
+            Stmt::Any(x) => visit(&x.body, f),
             Stmt::Requirement(r) if r.kind == RequirementKind::WaitFor => {
                 r.body.iter().for_each(|b| visit(b, f))
             }

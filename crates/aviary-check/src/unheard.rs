@@ -164,6 +164,12 @@ impl<'a> Pass<'a> {
             }
             inner.aliases.push((f.alias.name.as_str(), Rc::new(drones)));
         }
+        // The drone an ANY takes is one of its group.
+        if let Stmt::Any(a) = stmt {
+            let mut drones = Drones::default();
+            drones.add(&self.resolve(&a.group.name, scope));
+            inner.aliases.push((a.alias.name.as_str(), Rc::new(drones)));
+        }
         inner
     }
 

@@ -85,6 +85,8 @@ codes! {
     OneAtATimeNotEvery = "E129", Error, "`ONE AT A TIME` on a handler that is not an `ON EVERY`";
     OperatorSignalBuiltin = "E130", Error, "an OPERATOR SIGNAL that names a built-in signal, which only a drone raises";
     GroupRemainder = "E131", Error, "`group.remaining`: a remainder is one drone's, not a group's";
+    AnyNotGroup = "E140", Error, "an ANY that chooses from something that is not a group of the world";
+    AnyCount = "E141", Error, "an ANY that asks for a number of drones its group cannot give (not a whole number from 1 to the group's size)";
     // Warnings.
     HandlerNeverFires = "W201", Warning, "a handler for a signal that nothing raises";
     UnknownException = "W202", Warning, "an ON EXCEPTION for a name neither built in nor thrown";

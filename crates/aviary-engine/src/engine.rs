@@ -345,6 +345,8 @@ pub(crate) struct Engine<'m> {
     entered: RefCell<BTreeMap<usize, Rc<Entry>>>,
     /// What each drone's last `Sweep` or `FollowPath` left (`coverage.rs`).
     pub coverage: crate::coverage::Coverage,
+    /// The drones each `ANY` holds (`choose.rs`).
+    pub taken: crate::choose::Taken,
     /// How many times the runtime has polled the mission. Within one poll the engine has
     /// not waited for anything: with the wall clock (MAVLink drones), whose every reading
     /// differs, that is what "at one instant" is.
@@ -393,6 +395,7 @@ impl<'m> Engine<'m> {
             polls: Cell::new(0),
             interrupt: std::cell::OnceCell::new(),
             coverage: crate::coverage::Coverage::new(m.drones.len()),
+            taken: Default::default(),
         }
     }
 

@@ -295,6 +295,7 @@ impl<'m> Engine<'m> {
                         }
                     }
                 }
+                Node::Any(a) => self.any(a, ctx).await,
                 Node::If { branches, otherwise } => {
                     let chosen = branches
                         .iter()
@@ -315,7 +316,7 @@ impl<'m> Engine<'m> {
         self.raise(signal, args, ctx.actor, &ctx.scope);
     }
 
-    fn eval_all(&self, exprs: &[Expr], ctx: &Ctx<'m>) -> Vec<Value> {
+    pub(crate) fn eval_all(&self, exprs: &[Expr], ctx: &Ctx<'m>) -> Vec<Value> {
         let received = self.received.borrow();
         let env = self.env(&ctx.frame, &received);
         exprs.iter().map(|e| env.eval(e)).collect()

@@ -14,6 +14,7 @@ mod activity;
 mod api;
 mod arbiter;
 mod cancel;
+mod choose;
 mod control;
 mod coverage;
 mod engine;

@@ -728,3 +728,74 @@ fn payload_reads_the_kind_carried_and_nothing_before_or_after() {
     let released = r.t("api_done", "function", "ReleasePayload");
     assert!(close(r.ends("Hover", "b")[0]["t"].as_f64().unwrap() - 3.0, released));
 }
+
+/// Each `(start, end)` of `capability` on `actor`, in order.
+fn spans_of(r: &harness::Run, capability: &str, actor: &str) -> Vec<(f64, f64)> {
+    let at = |event: &str| -> Vec<f64> {
+        r.trace
+            .iter()
+            .filter(|e| e["event"] == event && e["capability"] == capability && e["actor"] == actor)
+            .map(|e| e["t"].as_f64().unwrap())
+            .collect()
+    };
+    at("capability_start").into_iter().zip(at("capability_end")).collect()
+}
+
+#[test]
+fn any_takes_the_nearest_free_drone() {
+    let r = run_rule("any_takes_the_nearest_free_drone");
+    assert_eq!(r.outcome.status, Status::Ok);
+    assert_eq!(r.first("capability_start", "capability", "FlyTo")["actor"], "near");
+    // The second ANY looks while the first holds `near`: the next nearest.
+    assert_eq!(r.first("capability_start", "capability", "Hover")["actor"], "middle");
+    assert!(r.find("capability_start", "actor", "far").is_empty(), "far is never taken");
+    assert!(close(r.t("capability_start", "capability", "Hover"), 0.0), "no wait: both at once");
+}
+
+#[test]
+fn two_any_never_hold_one_drone_at_once() {
+    let r = run_rule("two_any_never_hold_one_drone_at_once");
+    assert_eq!(r.outcome.status, Status::Ok);
+    for drone in ["far", "middle"] {
+        let spans = spans_of(&r, "Hover", drone);
+        for pair in spans.windows(2) {
+            assert!(pair[1].0 >= pair[0].1, "{drone} held twice at once: {spans:?}");
+        }
+    }
+    // The third request waits for the first drone let go: `far`, at the end of its 10 s.
+    let third = r
+        .trace
+        .iter()
+        .find(|e| e["event"] == "capability_start" && e["args"]["duration"] == 5.0)
+        .expect("the third ANY ran");
+    assert_eq!(third["actor"], "far");
+    assert!(close(third["t"].as_f64().unwrap(), 10.0), "{third}");
+    assert!(spans_of(&r, "Hover", "near").len() == 1, "near, excluded by WHERE, did only its own");
+}
+
+#[test]
+fn any_within_raises_no_drone_available_on_time() {
+    let r = run_rule("any_within_raises_no_drone_available_on_time");
+    assert_eq!(r.outcome.status, Status::Ok);
+    let e = r.first("exception", "name", "NoDroneAvailable");
+    assert!(close(e["t"].as_f64().unwrap(), 8.0), "{e}");
+    assert_eq!(e["handled"], true);
+    assert!(e["args"][0].as_str().unwrap().contains("within 8 s"), "{e}");
+    // The aborted block's later statement never runs; the handler does.
+    assert!(r.find("capability_start", "capability", "Hover").is_empty());
+    assert!(close(r.t("signal", "name", "Gave_Up"), 8.0));
+}
+
+#[test]
+fn any_two_runs_its_body_once_for_each() {
+    let r = run_rule("any_two_runs_its_body_once_for_each");
+    assert_eq!(r.outcome.status, Status::Ok);
+    let done: Vec<&str> =
+        r.find("signal", "name", "Done").iter().map(|e| e["actor"].as_str().unwrap()).collect();
+    assert_eq!(done, ["far", "middle"], "the two nearest to Home, each once");
+    // `far`'s own statement waits for the ANY's Hover, and the later ANY takes `far` again
+    // once both let it go.
+    let far = spans_of(&r, "Hover", "far");
+    assert_eq!(far.len(), 3, "{far:?}");
+    assert!(close(far[1].0, 3.0) && close(far[2].0, 4.0), "{far:?}");
+}

@@ -222,6 +222,7 @@ impl Block {
                 | Node::DoWhile { body: b, .. }
                 | Node::WaitFor { body: Some(b), .. } => b.visit(f),
                 Node::For(x) => x.body.visit(f),
+                Node::Any(x) => x.body.visit(f),
                 Node::If { branches, otherwise } => {
                     for (_, b) in branches {
                         b.visit(f);
@@ -248,6 +249,7 @@ pub enum Node {
     WaitFor { condition: Expr, body: Option<Block> },
     DoWhile { condition: Expr, body: Block },
     For(For),
+    Any(Any),
     If { branches: Vec<(Expr, Block)>, otherwise: Option<Block> },
 }
 
@@ -308,6 +310,25 @@ pub struct For {
     pub alias: Slot,
     pub params: Vec<Slot>,
     pub body: Block,
+}
+
+/// `ANY [k] d IN group WHERE c NEAREST TO p WITHIN t:`: waits until `count` of
+/// `candidates` are held by no other `ANY` and meet `condition` (read with `alias` bound
+/// to each), holds the `count` nearest to `nearest` (ties: the group's order), and runs
+/// `body` once for each, at once, with `alias` bound to it; each is let go as its body
+/// ends. Past `within` seconds without them, `NoDroneAvailable` is thrown where it stands.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Any {
+    /// The group's name, for the reason of a `NoDroneAvailable`.
+    pub group: String,
+    pub candidates: Vec<DroneId>,
+    pub count: usize,
+    pub alias: Slot,
+    pub condition: Option<Expr>,
+    pub nearest: Option<Expr>,
+    pub within: Option<Expr>,
+    pub body: Block,
+    pub origin: Origin,
 }
 
 /// Which signalling actors a `BY` accepts.
@@ -472,7 +493,7 @@ mod column_tests {
             attribute_names: vec![],
             attributes,
             origin: None,
-            builtins: Builtins { signals: [0; 3], exceptions: [0; 9] },
+            builtins: Builtins { signals: [0; 3], exceptions: [0; 10] },
         }
     }
 

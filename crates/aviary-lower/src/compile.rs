@@ -183,6 +183,11 @@ impl<'a> Compiler<'a> {
                 }
                 self.aliases.entry(f.alias.name.clone()).or_default().extend(drones);
             }
+            if let ast::Stmt::Any(a) = stmt {
+                if let ActorRef::Group(g) = self.actor(&a.group.name) {
+                    self.aliases.entry(a.alias.name.clone()).or_default().extend(g);
+                }
+            }
             stmt.for_each_body(|b| self.collect_aliases(b));
         }
     }
@@ -446,6 +451,34 @@ impl<'a> Compiler<'a> {
                         alias: slots[0],
                         params: slots[1..].to_vec(),
                         body: c.body(&f.body, &path, BlockKind::Sequential, false),
+                    })
+                })
+            }
+            ast::Stmt::Any(a) => {
+                let candidates = match self.actor(&a.group.name) {
+                    ActorRef::Group(g) => g,
+                    ActorRef::Drone(d) => vec![d],
+                    ActorRef::Slot(_) => Vec::new(),
+                };
+                let count = match a.count.as_ref().map(|c| &c.kind) {
+                    Some(ast::ExprKind::Number { value, .. }) => *value as usize,
+                    _ => 1,
+                };
+                let nearest = a.nearest.as_ref().map(|p| self.expr(p));
+                let within = a.within.as_ref().map(|t| self.expr(t));
+                let path = format!("{parent}/ANY {}", a.alias.name);
+                let origin = self.origin(a.span);
+                self.bound_scope([(a.alias.name.clone(), true)], |c, slots| {
+                    Node::Any(Any {
+                        group: a.group.name.clone(),
+                        candidates,
+                        count,
+                        alias: slots[0],
+                        condition: a.condition.as_ref().map(|e| c.expr(e)),
+                        nearest,
+                        within,
+                        body: c.body(&a.body, &path, BlockKind::Sequential, false),
+                        origin,
                     })
                 })
             }

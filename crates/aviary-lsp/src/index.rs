@@ -258,6 +258,16 @@ impl<'a> Walk<'a> {
                 bound.extend(f.params.iter().cloned());
                 self.bind(&bound, "bound by FOR", |w| w.body(&f.body));
             }
+            Stmt::Any(a) => {
+                self.actor(Some(&a.group));
+                [&a.count, &a.nearest, &a.within].into_iter().flatten().for_each(|e| self.expr(e));
+                self.bind(std::slice::from_ref(&a.alias), "the drone ANY takes", |w| {
+                    if let Some(c) = &a.condition {
+                        w.expr(c);
+                    }
+                    w.body(&a.body)
+                });
+            }
             Stmt::Signal(r) => {
                 self.push(r.name.span, Sym::Signal(r.name.name.clone()), true);
                 r.args.iter().for_each(|a| self.expr(&a.value));

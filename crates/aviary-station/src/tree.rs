@@ -106,6 +106,13 @@ impl Tree<'_> {
                 v["instances"] = f.instances.len().into();
                 v
             }
+            Node::Any(a) => {
+                let mut v = self.wrapped("any", &a.body);
+                v["group"] = a.group.as_str().into();
+                v["count"] = a.count.into();
+                v["line"] = self.line(&a.origin);
+                v
+            }
             Node::If { branches, otherwise } => {
                 let mut children: Vec<Value> =
                     branches.iter().map(|(_, b)| self.wrapped("branch", b)).collect();

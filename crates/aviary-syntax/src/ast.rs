@@ -144,6 +144,8 @@ pub enum Stmt {
     /// `OPERATOR SIGNAL A, B`: the signals an operator may raise while the mission runs.
     /// Allowed only directly in the MISSION body (the checker says so elsewhere).
     OperatorSignals(OperatorSignals),
+    /// `ANY d IN group WHERE c NEAREST TO p WITHIN t:`: a drone chosen at run time.
+    Any(AnyBlock),
     /// A line that could not be read. It was reported; later stages skip it.
     Error(Span),
 }
@@ -155,6 +157,7 @@ impl Stmt {
             Stmt::Block(b) => f(&b.body),
             Stmt::Requirement(r) => r.body.iter().for_each(f),
             Stmt::For(x) => f(&x.body),
+            Stmt::Any(x) => f(&x.body),
             Stmt::Handler(h) => f(&h.body),
             Stmt::ExceptionHandler(h) => f(&h.body),
             Stmt::If(i) => {
@@ -241,6 +244,23 @@ pub struct ForBlock {
     pub instances: Vec<Instance>,
     pub alias: Ident,
     pub params: Vec<Ident>,
+    pub body: Body,
+    pub span: Span,
+}
+
+/// `ANY [k] d IN group [WHERE c] [NEAREST TO p] [WITHIN t]: body`: waits until `k` drones
+/// of the group are free of every other `ANY` and meet `c`, takes the `k` nearest to `p`,
+/// and runs the body once for each, with `d` bound to it, holding it until the body ends.
+/// `ANY`, `IN`, `WHERE`, `NEAREST TO` and `WITHIN` are words only in such a header.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AnyBlock {
+    /// How many drones (`ANY 2 d IN ...`); `None` for one.
+    pub count: Option<Expr>,
+    pub alias: Ident,
+    pub group: Ident,
+    pub condition: Option<Expr>,
+    pub nearest: Option<Expr>,
+    pub within: Option<Expr>,
     pub body: Body,
     pub span: Span,
 }

@@ -259,6 +259,14 @@ impl Walk<'_> {
                     self.env[f.alias] = saved;
                 }
             }
+            // The drone an ANY takes, no other ANY holds while its body runs: what the body
+            // claims through its alias is compared with nothing (docs/LANGUAGE.md, ANY).
+            Node::Any(a) => {
+                let id = self.construct(Construct::Wrapper);
+                let saved = std::mem::take(&mut self.env[a.alias]);
+                self.under(id, Key::Body, |w| w.block(&a.body));
+                self.env[a.alias] = saved;
+            }
             // Detection raises `Detected` where it is started (docs/LANGUAGE.md, section 16).
             Node::Api(a) if a.function == Function::StartDetection => {
                 let signal = self.mission.builtins.signal(BuiltinSignal::Detected);

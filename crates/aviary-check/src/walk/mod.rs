@@ -38,6 +38,9 @@ pub(crate) fn check_program(
                     Stmt::For(f) => {
                         aliases.insert(f.alias.name.as_str());
                     }
+                    Stmt::Any(a) => {
+                        aliases.insert(a.alias.name.as_str());
+                    }
                     _ => {}
                 });
             }
@@ -264,6 +267,7 @@ impl<'a> Checker<'a> {
                 }
             }
             Stmt::For(f) => self.for_block(f),
+            Stmt::Any(a) => self.any_block(a),
             Stmt::Signal(r) | Stmt::Throw(r) => r.args.iter().for_each(|a| {
                 self.value(&a.value, None, "a value");
             }),
@@ -418,6 +422,79 @@ impl<'a> Checker<'a> {
         self.scopes.push(scope);
         self.body(&f.body);
         self.scopes.pop();
+    }
+
+    /// `ANY [k] d IN group WHERE c NEAREST TO p WITHIN t:`: the group is one of the world's,
+    /// `k` a whole number it can give; `c` reads `d`, which the body holds.
+    fn any_block(&mut self, a: &'a AnyBlock) {
+        let size = self.any_group(&a.group);
+        if let Some(k) = &a.count {
+            let fits = match (&k.kind, size) {
+                (ExprKind::Number { value, unit: None, .. }, size) => {
+                    value.fract() == 0.0 && *value >= 1.0 && size.is_none_or(|n| *value <= n as f64)
+                }
+                _ => false,
+            };
+            if !fits {
+                let group = &a.group.name;
+                let d = self.report(
+                    Code::AnyCount,
+                    k.span,
+                    match size {
+                        Some(n) => format!(
+                            "`{group}` has {}, so ANY can take from 1 to {n} of them",
+                            count(n, "drone")
+                        ),
+                        None => "ANY takes a whole number of drones, 1 or more".into(),
+                    },
+                );
+                d.help = Some(format!(
+                    "write a plain whole number before the alias: `ANY 2 {} IN {group}:`",
+                    a.alias.name
+                ));
+            }
+        }
+        if let Some(p) = &a.nearest {
+            self.value(p, Some(Kind::Position), "the place after NEAREST TO");
+        }
+        if let Some(t) = &a.within {
+            self.value(t, Some(Kind::Duration), "the time after WITHIN");
+        }
+        self.scopes.push(vec![(a.alias.name.as_str(), Binding::Actor)]);
+        if let Some(c) = &a.condition {
+            self.condition(c);
+        }
+        self.body(&a.body);
+        self.scopes.pop();
+    }
+
+    /// The group an ANY chooses from: its size, when the world is known and it is one.
+    fn any_group(&mut self, id: &Ident) -> Option<usize> {
+        let what = match self.lookup(&id.name) {
+            Meaning::Group => {
+                return self.world.and_then(|w| w.group(&id.name)).map(|g| g.members.len())
+            }
+            Meaning::Unbound if !self.names_are_known() => return None,
+            Meaning::Drone => "a drone, not a group: ANY chooses one drone of a group",
+            Meaning::Local(_) => "an alias or a parameter, not a group of the world",
+            Meaning::Place => "a place, not a group",
+            Meaning::Area => "an area, not a group",
+            Meaning::Unbound => "no group of the world",
+        };
+        let groups: Vec<&str> = self
+            .world
+            .map(|w| w.groups.iter().map(|g| g.name.as_str()).collect())
+            .unwrap_or_default();
+        let help = did_you_mean(&id.name, groups.iter().copied()).unwrap_or_else(|| {
+            if groups.is_empty() {
+                "declare the drones to choose from as a group in the world file: `[groups] couriers = [\"c1\", \"c2\"]`".into()
+            } else {
+                format!("the groups of the world are: {}", groups.join(", "))
+            }
+        });
+        let d = self.report(Code::AnyNotGroup, id.span, format!("`{}` is {what}", id.name));
+        d.help = Some(help);
+        None
     }
 
     /// A name used as an actor: a drone, a group, an alias or a BY parameter.

@@ -64,6 +64,11 @@ export class TreeView {
         status = (m) => activityStatus(m, n.capability, n.tag, actors.length === (n.actors || []).length ? actors : null);
         break;
       }
+      case "any":
+        // The drones are chosen in flight: the line names the group they come from.
+        kind.textContent = "ANY";
+        label.textContent = `${n.count > 1 ? `${n.count} ` : ""}IN ${n.group}`;
+        break;
       default:
         kind.textContent = n.kind.toUpperCase();
         label.textContent = n.signal || n.exception || (n.capability ? `${n.capability}-${n.tag} ${n.action}` : "");

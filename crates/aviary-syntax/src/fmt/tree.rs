@@ -203,6 +203,29 @@ impl Printer<'_> {
                 }
             }
             Stmt::For(f) => self.for_block(f, depth),
+            Stmt::Any(a) => {
+                let mut text = String::from("ANY ");
+                if let Some(count) = &a.count {
+                    text.push_str(&expr_text(count, self.source));
+                    text.push(' ');
+                }
+                text.push_str(&format!("{} IN {}", a.alias.name, a.group.name));
+                if let Some(c) = &a.condition {
+                    text.push_str(" WHERE ");
+                    text.push_str(&expr_text(c, self.source));
+                }
+                if let Some(p) = &a.nearest {
+                    text.push_str(" NEAREST TO ");
+                    text.push_str(&expr_text(p, self.source));
+                }
+                if let Some(t) = &a.within {
+                    text.push_str(" WITHIN ");
+                    text.push_str(&expr_text(t, self.source));
+                }
+                text.push(':');
+                self.line(depth, &text, Last::Header, start, a.body.header_end as usize);
+                self.body(&a.body, depth + 1, span.start);
+            }
             Stmt::Signal(r) => {
                 let mut text = format!("SIGNAL {}", r.name.name);
                 write_args(&mut text, &r.args, self.source);
@@ -358,6 +381,7 @@ pub(super) fn stmt_span(stmt: &Stmt) -> aviary_diagnostics::Span {
         Stmt::Api(a) => a.span,
         Stmt::Requirement(r) => r.span,
         Stmt::For(f) => f.span,
+        Stmt::Any(a) => a.span,
         Stmt::Signal(r) | Stmt::Throw(r) => r.span,
         Stmt::Handler(h) => h.span,
         Stmt::ExceptionHandler(h) => h.span,

@@ -67,6 +67,11 @@ impl Parser<'_> {
             {
                 self.operator_signals()
             }
+            // `ANY` is a word only at the start of a header: a drone or capability called
+            // `ANY` stays what it was (a statement never ends in `:`).
+            TokenKind::Ident if self.text_of(start) == "ANY" && self.line_ends_in_colon() => {
+                self.any_block()
+            }
             TokenKind::Ident => self.statement(),
             TokenKind::Unknown => {
                 self.recover_line();
@@ -578,6 +583,81 @@ impl Parser<'_> {
             instances,
             alias,
             params,
+            body,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        })
+    }
+
+    /// Whether the logical line from here ends in `:`.
+    fn line_ends_in_colon(&self) -> bool {
+        let end = (self.pos..self.tokens.len())
+            .find(|&i| matches!(self.tokens[i].kind, TokenKind::Newline | TokenKind::Eof))
+            .unwrap_or(self.pos);
+        end > self.pos && self.tokens[end - 1].kind == TokenKind::Colon
+    }
+
+    /// A word of a header that is no keyword elsewhere (`IN`, `WHERE`), upper case.
+    fn eat_word(&mut self, word: &str) -> Option<Span> {
+        (self.at(TokenKind::Ident) && self.text_of(self.span()) == word).then(|| self.bump().span)
+    }
+
+    /// `ANY [k] d IN group [WHERE c] [NEAREST TO p] [WITHIN t]:` and its body. The clauses
+    /// after the group may come in any order, each once.
+    fn any_block(&mut self) -> Stmt {
+        const FORM: &str = "write `ANY d IN group WHERE condition NEAREST TO place WITHIN 5min:` (WHERE, NEAREST TO and WITHIN may each be left out)";
+        let start = self.bump().span;
+        let count = self.at(TokenKind::Number).then(|| self.value());
+        let Some(alias) = self.ident() else {
+            self.expected("the name of the chosen drone after ANY", Some(FORM));
+            self.recover_line();
+            return Stmt::Error(Span::new(start.start as usize, self.last_end as usize));
+        };
+        let group = match self.eat_word("IN") {
+            Some(_) => self.ident(),
+            None => None,
+        };
+        let Some(group) = group else {
+            self.expected("IN and the group to choose from", Some(FORM));
+            self.recover_line();
+            return Stmt::Error(Span::new(start.start as usize, self.last_end as usize));
+        };
+        let (mut condition, mut nearest, mut within) = (None, None, None);
+        loop {
+            let (word, slot) = if let Some(w) = self.eat_word("WHERE") {
+                let c = self.condition();
+                (w, condition.replace(c))
+            } else if let Some(w) = self.eat_word("NEAREST") {
+                if self.eat_word("TO").is_none() {
+                    self.expected("TO after NEAREST", Some("write `NEAREST TO Depot`"));
+                }
+                let p = self.value();
+                (w, nearest.replace(p))
+            } else if let Some(w) = self.eat_word("WITHIN") {
+                let t = self.value();
+                (w, within.replace(t))
+            } else {
+                break;
+            };
+            if slot.is_some() {
+                let text = self.text_of(word).to_string();
+                let d = self
+                    .error(Code::Syntax, word, format!("{text} is written twice in one ANY header"))
+                    .with_help(format!("keep one {text}; join conditions with AND"));
+                self.report(d);
+            }
+        }
+        let body = if self.header_colon(start, "the ANY header") {
+            self.body("the ANY block")
+        } else {
+            self.recover_body()
+        };
+        Stmt::Any(AnyBlock {
+            count,
+            alias,
+            group,
+            condition,
+            nearest,
+            within,
             body,
             span: Span::new(start.start as usize, self.last_end as usize),
         })

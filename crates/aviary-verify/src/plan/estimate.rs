@@ -428,6 +428,7 @@ impl<'m> Estimator<'m> {
             }
             Node::DoWhile { condition, body } => self.repeat(condition, body, ctx, t),
             Node::For(f) => self.for_each(f, ctx, t),
+            Node::Any(a) => self.any(a, ctx, t),
             Node::If { branches, otherwise } => self.choose(branches, otherwise.as_ref(), ctx, t),
         }
     }
@@ -489,6 +490,28 @@ impl<'m> Estimator<'m> {
                 end = end.max(e);
                 raises.extend(r);
             }
+        }
+        (end, raises)
+    }
+
+    /// An `ANY`: which drones it takes is known only in flight. The plan counts its body
+    /// as flown by the first drones of its group, at once, and says so.
+    #[inline(never)]
+    fn any(&mut self, a: &aviary_ir::Any, ctx: &mut Ctx, t: f64) -> (f64, Vec<Raise>) {
+        self.note(
+            ctx.statement,
+            format!(
+                "an ANY takes its drones in flight; the estimate counts the first {} of {}",
+                a.count, a.group
+            ),
+        );
+        let mut end = t;
+        let mut raises = Vec::new();
+        for &d in a.candidates.iter().take(a.count) {
+            let slots = vec![(a.alias, Some(Value::Actor(d)))];
+            let (e, r) = self.with(ctx, slots, Some(d), |est, ctx| est.block(&a.body, ctx, t));
+            end = end.max(e);
+            raises.extend(r);
         }
         (end, raises)
     }

@@ -1,0 +1,89 @@
+//! The parcel-delivery example as a user runs it (`aviary run
+//! examples/parcel_delivery.mission --trace OUT`): two parcels leave the depot, each with
+//! whichever courier is free (`ANY ... NEAREST TO Depot`); courier1's motor fails on the
+//! way to the farm, and the farm's parcel goes with the nearest courier still free at
+//! the depot. From the trace: who delivered what, that no courier ever carried two
+//! deliveries at once, and that the one at the north hub, too far from the depot, is
+//! never taken.
+
+mod common;
+
+use common::{aviary, repo, scratch};
+use serde_json::Value;
+
+const MISSION: &str = "examples/parcel_delivery.mission";
+
+#[test]
+fn a_failed_couriers_parcel_goes_with_the_nearest_free_courier() {
+    let (code, out, err) = aviary(&["check", MISSION], &repo());
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(!out.contains("warning"), "checks with no warning: {out}");
+    let (code, out, err) = aviary(&["fmt", "--check", MISSION], &repo());
+    assert_eq!(code, 0, "in canonical layout: {out}{err}");
+
+    let trace = scratch("parcel_delivery").join("parcels.jsonl");
+    let (code, out, err) =
+        aviary(&["run", MISSION, "--quiet", "--trace", &trace.to_string_lossy()], &repo());
+    assert_eq!(code, 0, "runs to its end: {out}{err}");
+    let events: Vec<Value> = std::fs::read_to_string(&trace)
+        .expect("the trace")
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("a trace line"))
+        .collect();
+    assert_eq!(events.last().unwrap()["status"], "ok");
+
+    // Each Deliver: (courier, destination, start, end, status).
+    let delivers: Vec<(&str, Value, f64, f64, &str)> = events
+        .iter()
+        .filter(|e| e["event"] == "capability_start" && e["capability"] == "Deliver")
+        .map(|s| {
+            let end = events
+                .iter()
+                .find(|e| {
+                    e["event"] == "capability_end"
+                        && e["capability"] == "Deliver"
+                        && e["actor"] == s["actor"]
+                        && e["t"].as_f64() >= s["t"].as_f64()
+                })
+                .expect("every delivery ends");
+            (
+                s["actor"].as_str().unwrap(),
+                s["args"]["destination"].clone(),
+                s["t"].as_f64().unwrap(),
+                end["t"].as_f64().unwrap(),
+                end["status"].as_str().unwrap(),
+            )
+        })
+        .collect();
+    let farm = serde_json::json!([600.0, 300.0]);
+    let clinic = serde_json::json!([-500.0, 400.0]);
+    // At the start the two nearest to the depot take the parcels, in the order asked.
+    assert_eq!((delivers[0].0, &delivers[0].1, delivers[0].2), ("courier1", &farm, 0.0));
+    assert_eq!((delivers[1].0, &delivers[1].1, delivers[1].2), ("courier2", &clinic, 0.0));
+    // courier1's motor fails at 30 s; at that instant the farm's parcel goes with the
+    // nearest courier free at the depot: courier4 (courier2 is busy, courier3 at the hub).
+    let failure = events
+        .iter()
+        .find(|e| e["event"] == "exception" && e["name"] == "MotorFailure")
+        .expect("the motor failure");
+    assert_eq!((failure["actor"].as_str(), failure["t"].as_f64()), (Some("courier1"), Some(30.0)));
+    assert_eq!(delivers.len(), 3, "{delivers:?}");
+    assert_eq!((delivers[2].0, &delivers[2].1, delivers[2].2), ("courier4", &farm, 30.0));
+    assert_eq!(delivers[2].4, "ok");
+    // Both parcels were released at their destination, each by the courier that got there.
+    let released: Vec<&str> = events
+        .iter()
+        .filter(|e| {
+            e["event"] == "api_done" && e["function"] == "ReleasePayload" && e["status"] == "ok"
+        })
+        .map(|e| e["actor"].as_str().unwrap())
+        .collect();
+    assert_eq!(released, ["courier2", "courier4"]);
+    // No courier carries two deliveries at once; courier3 is never taken.
+    for (i, a) in delivers.iter().enumerate() {
+        for b in &delivers[i + 1..] {
+            assert!(a.0 != b.0 || b.2 >= a.3, "{} held twice at once: {a:?} {b:?}", a.0);
+        }
+    }
+    assert!(delivers.iter().all(|d| d.0 != "courier3"));
+}

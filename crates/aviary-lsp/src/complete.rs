@@ -76,6 +76,8 @@ pub fn complete(server: &Server, p: CompletionParams) -> Option<CompletionRespon
             items.push(item("EVERY", CompletionItemKind::KEYWORD, "keyword", None));
             items.push(item("EXCEPTION", CompletionItemKind::KEYWORD, "keyword", None));
         }
+    } else if words.first() == Some(&"ANY") {
+        any_header(a, &words, &mut items);
     } else if last == "SIGNAL" && words.len() == 1 {
         signals(a, &mut items);
     } else if last == "EXCEPTION" {
@@ -103,6 +105,12 @@ pub fn complete(server: &Server, p: CompletionParams) -> Option<CompletionRespon
         if in_capability.is_none() {
             items.push(item("OPERATOR SIGNAL", CompletionItemKind::KEYWORD, "keyword", None));
         }
+        items.push(item(
+            "ANY",
+            CompletionItemKind::KEYWORD,
+            "ANY d IN group WHERE condition NEAREST TO place WITHIN time:",
+            Some("a drone of a group chosen in flight, held while the body runs".into()),
+        ));
         if head.is_empty() {
             for k in [Keyword::Mission, Keyword::Capability, Keyword::Use] {
                 items.push(item(k.as_str(), CompletionItemKind::KEYWORD, "keyword", None));
@@ -119,6 +127,29 @@ pub fn complete(server: &Server, p: CompletionParams) -> Option<CompletionRespon
         positions(a, &mut items);
     }
     Some(CompletionResponse::Array(items))
+}
+
+/// In an `ANY` header: the groups after `IN`, positions after `NEAREST TO`, and the
+/// clauses not written yet.
+fn any_header(a: &Analysis, words: &[&str], out: &mut Vec<CompletionItem>) {
+    match words.last().copied().unwrap_or("") {
+        "IN" => {
+            for g in a.world.iter().flat_map(|w| &w.groups) {
+                let doc = Some(describe(a, &Sym::Group(g.name.clone())));
+                out.push(item(&g.name, CompletionItemKind::MODULE, "group", doc));
+            }
+        }
+        "TO" => positions(a, out),
+        _ if words.contains(&"IN") => {
+            for clause in ["WHERE", "NEAREST TO", "WITHIN"] {
+                let first = clause.split(' ').next().unwrap_or(clause);
+                if !words.contains(&first) {
+                    out.push(item(clause, CompletionItemKind::KEYWORD, "keyword", None));
+                }
+            }
+        }
+        _ => {}
+    }
 }
 
 /// The capability the cursor is in: the last item that starts before it, if a capability

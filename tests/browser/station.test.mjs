@@ -6,7 +6,7 @@ import assert from "node:assert/strict";
 import { spawnSync } from "node:child_process";
 import { copyFileSync, readFileSync } from "node:fs";
 import { join } from "node:path";
-import { AVIARY, browser, examples, open, shot, start } from "./harness.mjs";
+import { AVIARY, browser, choose, examples, open, shot, start } from "./harness.mjs";
 
 let station, chromium, dir;
 
@@ -167,4 +167,38 @@ test("a mission with no world beside it is checked without one, as aviary check 
   await page.waitForFunction(() => /ready to fly/.test(document.getElementById("check-summary").textContent));
   assert.ok(!(await page.isDisabled("#fly")));
   assert.deepEqual(page.foreign, [], "nothing from elsewhere");
+});
+
+test("the grid names the capability a drone works in, and a page opened after the run shows its times and heights", async () => {
+  const page = await open(chromium, station);
+  await choose(page, "parcel_delivery.mission");
+  await page.fill("#speed", "20");
+  await page.click("#fly");
+  // courier2 flies to the clinic inside Deliver: its FlyTo's TakeOff ends, and the grid
+  // still names what it does (it showed "–" between the TakeOff and the end of Deliver).
+  await page.waitForFunction(() => window.aviary.model.mission === "Parcel_Delivery" && window.aviary.model.t > 12);
+  await page.waitForTimeout(300);
+  const working = await page.evaluate(() => {
+    const row = [...document.querySelectorAll("#fleet tbody tr")].find((r) => r.cells[0].textContent.includes("courier2"));
+    return row.cells[6].textContent;
+  });
+  assert.equal(working, "Deliver › FlyTo");
+  await page.waitForFunction(() => window.aviary.model.mission === "Parcel_Delivery" && window.aviary.model.status === "ok", null, { timeout: 120000 });
+  // A page opened after the run: the state at its end, then every event since the start.
+  const late = await open(chromium, station);
+  await late.waitForFunction(() => window.aviary.model.mission === "Parcel_Delivery" && window.aviary.model.status === "ok" && window.aviary.model.alarms.length > 0);
+  await late.waitForTimeout(300);
+  const seen = await late.evaluate(() => ({
+    alarms: window.aviary.model.alarms.map((a) => [a.kind, a.who, a.t]),
+    shown: [...document.querySelectorAll("#alarms .alarm span")].map((s) => s.textContent),
+    courier1: window.aviary.model.drones.get("courier1").pos,
+    height: [...document.querySelectorAll("#fleet tbody tr")].find((r) => r.cells[0].textContent.includes("courier1")).cells[3].textContent,
+  }));
+  // The motor failure at 30 s is shown at 30 s, not at the end of the run.
+  assert.deepEqual(seen.alarms.find((a) => a[0] === "MotorFailure"), ["MotorFailure", "courier1", 30]);
+  assert.ok(seen.shown.some((s) => s.startsWith("t = 30.0 s")), `alarms as shown: ${seen.shown}`);
+  // courier1 landed in a field: on the ground, not at the height of its last command.
+  assert.ok(seen.courier1[2] < 1, `courier1 at ${seen.courier1}`);
+  assert.match(seen.height, /^0\.\d m$/, `its height in the grid: ${seen.height}`);
+  await shot(late, "opened-after-the-run");
 });

@@ -125,6 +125,9 @@ async function watch() {
       if (d.position) { x.pos = d.position; x.trail.push([d.position[0], d.position[1]]); }
       if (d.battery !== undefined) x.battery = d.battery;
       if (d.state) x.state = d.state;
+      // What the state says is as of its time: the events since the start, read next,
+      // are older and leave it be.
+      if (d.position) x.lastT = m.t;
     }
   }
   if (page.socket) page.socket.close();

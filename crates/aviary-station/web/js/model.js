@@ -24,7 +24,7 @@ export function drone(model, name) {
   let d = model.drones.get(name);
   if (!d) {
     d = { name, pos: null, battery: null, state: "unknown", speed: 0, heading: 0, trail: [],
-          activity: "", link: "ok", held: false, withdrawn: false, lastT: null, alarms: new Set() };
+          activity: "", working: [], link: "ok", held: false, withdrawn: false, lastT: null, alarms: new Set() };
     model.drones.set(name, d);
   }
   return d;
@@ -43,10 +43,20 @@ function bump(map, k, field, by) {
   return v;
 }
 
-function alarm(model, kind, who, text, severe = true) {
+/// An alarm raised by event `e`, at the event's own time: a page opened after the run
+/// reads the whole run's events after the state at its end, so the clock is no guide.
+function alarm(model, e, kind, who, text, severe = true) {
   const id = `${kind}|${who || ""}`;
   if (model.alarms.some((a) => a.id === id && !a.acknowledged)) return;
-  model.alarms.push({ id, kind, who, text, t: model.t, severe, acknowledged: false });
+  const t = typeof e.t === "number" ? e.t : model.t;
+  model.alarms.push({ id, kind, who, text, t, severe, acknowledged: false });
+}
+
+/// Whether `e` is no older than what the model already knows of drone `d`: a page opened
+/// late gets the state now, then the events since the start, which must not move a drone
+/// back to where it was.
+function current(d, e) {
+  return d.lastT === null || !(e.t < d.lastT);
 }
 
 /// Folds one event into the model; returns whether it is worth a line in the log.
@@ -59,7 +69,7 @@ export function observe(model, e) {
     case "mission_end":
       model.status = e.status; model.reason = e.reason || null;
       model.marks.push({ t: e.t, kind: "end", text: `mission ${e.status}` });
-      if (e.status === "failed") alarm(model, "failed", null, `mission failed: ${e.reason || ""}`);
+      if (e.status === "failed") alarm(model, e, "failed", null, `mission failed: ${e.reason || ""}`);
       break;
     case "block_start": model.blocks.set(e.block, "running"); break;
     case "block_end": model.blocks.set(e.block, e.status === "ok" ? "done" : e.status); break;
@@ -70,8 +80,11 @@ export function observe(model, e) {
     case "capability_start": {
       for (const a of e.actor.split(" ")) {
         bump(model.activities, key(e.capability, e.tag, a), "running", 1);
+        // What the drone works on, outermost first: a capability and the ones it calls
+        // (`Deliver › FlyTo › TakeOff`), each gone when it ends.
         const d = drone(model, a);
-        d.activity = e.tag ? `${e.capability}-${e.tag}` : e.capability;
+        d.working.push(e.tag ? `${e.capability}-${e.tag}` : e.capability);
+        d.activity = d.working.join(" › ");
       }
       break;
     }
@@ -80,7 +93,9 @@ export function observe(model, e) {
         const v = bump(model.activities, key(e.capability, e.tag, a), "running", -1);
         v[e.status === "ok" ? "done" : e.status === "failed" ? "failed" : "aborted"]++;
         const d = drone(model, a);
-        if (d.activity === (e.tag ? `${e.capability}-${e.tag}` : e.capability)) d.activity = "";
+        const i = d.working.lastIndexOf(e.tag ? `${e.capability}-${e.tag}` : e.capability);
+        if (i >= 0) d.working.splice(i, 1);
+        d.activity = d.working.join(" › ");
       }
       break;
     }
@@ -96,7 +111,7 @@ export function observe(model, e) {
     }
     case "signal":
       model.marks.push({ t: e.t, kind: "signal", text: e.name });
-      if (e.name === "BatteryLow" && e.actor) alarm(model, "battery", e.actor, `${e.actor}: battery low`, false);
+      if (e.name === "BatteryLow" && e.actor) alarm(model, e, "battery", e.actor, `${e.actor}: battery low`, false);
       if (e.name === "ConnectionRestored" && e.actor) drone(model, e.actor).link = "ok";
       break;
     case "exception": {
@@ -105,12 +120,12 @@ export function observe(model, e) {
         if (e.name === "ConnectionLost") drone(model, e.actor).link = "lost";
       }
       const what = `${e.name}${e.actor ? " on " + e.actor : ""}`;
-      if (!e.handled) alarm(model, "unhandled", e.actor, `unhandled exception ${what}`);
+      if (!e.handled) alarm(model, e, "unhandled", e.actor, `unhandled exception ${what}`);
       else if (["ConnectionLost", "BatteryCritical", "MotorFailure", "PositionLost", "DroneLost", "GeofenceViolation"].includes(e.name))
-        alarm(model, e.name, e.actor, `${what}: ${(e.args || []).join(" ")}`);
+        alarm(model, e, e.name, e.actor, `${what}: ${(e.args || []).join(" ")}`);
       // The simulator's separation layer: "scout waited 30 s for carrier to make room".
       else if (e.name === "Timeout" && /make room|separation/i.test((e.args || []).join(" ")))
-        alarm(model, "separation", e.actor, `${what}: ${(e.args || []).join(" ")}`, false);
+        alarm(model, e, "separation", e.actor, `${what}: ${(e.args || []).join(" ")}`, false);
       break;
     }
     case "operator":
@@ -126,7 +141,7 @@ export function observe(model, e) {
     case "autopilot":
       // A drone acting on its own (a failsafe): the operator must see it at once.
       model.marks.push({ t: e.t, kind: "exception", text: `${e.actor}: ${e.action}` });
-      alarm(model, "autopilot", e.actor, `${e.actor}, on its own: ${e.action.replace("_", " ")} (${e.reason})`, e.action !== "hold");
+      alarm(model, e, "autopilot", e.actor, `${e.actor}, on its own: ${e.action.replace("_", " ")} (${e.reason})`, e.action !== "hold");
       break;
     case "detection":
       model.finds.push({ t: e.t, actor: e.actor, kind: e.kind, at: e.location });
@@ -134,6 +149,7 @@ export function observe(model, e) {
       break;
     case "telemetry": {
       const d = drone(model, e.actor);
+      if (!current(d, e)) return false;
       const [x, y, z] = e.position;
       if (d.pos && d.lastT !== null && e.t > d.lastT) {
         const dx = x - d.pos[0], dy = y - d.pos[1], dz = z - d.pos[2];
@@ -146,13 +162,14 @@ export function observe(model, e) {
       // Trimmed now and then, not at every sample: a shift per sample is the most a
       // thousand drones' telemetry would cost.
       if (d.trail.length > TRAIL * 1.5) d.trail.splice(0, d.trail.length - TRAIL);
-      if (e.battery < 0.2) alarm(model, "battery", e.actor, `${e.actor}: battery ${(e.battery * 100).toFixed(0)} %`, e.battery < 0.1);
+      if (e.battery < 0.2) alarm(model, e, "battery", e.actor, `${e.actor}: battery ${(e.battery * 100).toFixed(0)} %`, e.battery < 0.1);
       return false;
     }
     case "api_done": {
       // Where the call left the drone: the last word on a landing, which may come
       // between two telemetry samples (the fleet's return at the end, an abort).
       const d = drone(model, e.actor);
+      if (!current(d, e)) return false;
       if (e.position) d.pos = e.position;
       if (e.status === "ok" && (e.function === "Land" || e.function === "ReturnToLaunch")) {
         d.state = "Landed"; d.speed = 0;

@@ -34,6 +34,9 @@ test("a flight's record replays in the page and its report is saved from it", as
   await page.waitForFunction((t) => document.getElementById("trace-list").value === t, shownTrace);
   const events = readFileSync(join(dir, shownTrace), "utf8").trim().split("\n").map((l) => JSON.parse(l));
 
+  // Another world chosen above does not change what the record is drawn on: the trace
+  // names the world it was flown in.
+  await page.selectOption("#world-file", "search_and_rescue.world.toml");
   // Report: one HTML file, saved as a download, with every drone's track and plots.
   const [download] = await Promise.all([page.waitForEvent("download"), page.click("#report-trace")]);
   assert.match(download.suggestedFilename(), /^patrol-.*\.html$/);
@@ -44,6 +47,9 @@ test("a flight's record replays in the page and its report is saved from it", as
   for (const d of ["scout", "carrier", "spare"]) assert.ok(html.includes(d), `${d} in the report`);
   assert.ok((html.match(/<svg/g) || []).length >= 4, "a map and plots");
   assert.ok(!/<script/i.test(html), "no script");
+
+  assert.ok(html.includes("Tower") && html.includes("Bridge"), "drawn on the patrol's world, with its places");
+  assert.ok(!html.includes("BuildingA") && !html.includes("Facility"), "not on the world chosen above");
 
   // Replay: the same page plays the record back on its world, and leads back.
   await page.click("#replay-trace");
@@ -64,6 +70,9 @@ test("a flight's record replays in the page and its report is saved from it", as
   assert.ok(Object.keys(want).length === 3, "telemetry of the three drones");
   for (const [name, p] of Object.entries(want)) assert.deepEqual(shown[name], p, `${name} at t = ${t}`);
   assert.ok(await page.evaluate(() => window.aviary.map.world.getLayers().length > 3), "the world is drawn");
+  // Only the drones that flew: none of the world chosen above appears as an "unknown" drone.
+  const drones = await page.evaluate(() => [...window.aviary.model.drones.keys()].sort());
+  assert.deepEqual(drones, ["carrier", "scout", "spare"]);
   assert.equal(await page.isVisible("#leave-replay"), true);
   await shot(page, "records");
   assert.deepEqual(page.foreign, [], "nothing from elsewhere");

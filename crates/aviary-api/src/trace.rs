@@ -36,6 +36,40 @@ pub struct Record<'a> {
 /// Text an event borrows from the run, or owns once read back.
 pub type Text<'a> = Cow<'a, str>;
 
+/// The world a run flew in: its file, as the run named it, and the SHA-256 of its bytes.
+/// A replay or a report of the trace draws that world, and refuses another.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct WorldStamp<'a> {
+    pub file: Text<'a>,
+    pub sha256: Text<'a>,
+}
+
+impl WorldStamp<'static> {
+    pub fn of(file: &str, bytes: &[u8]) -> Self {
+        use sha2::Digest;
+        let digest = sha2::Sha256::digest(bytes);
+        let sha256 = digest.iter().map(|b| format!("{b:02x}")).collect::<String>();
+        WorldStamp { file: Cow::Owned(file.to_string()), sha256: Cow::Owned(sha256) }
+    }
+}
+
+impl WorldStamp<'_> {
+    /// Why the world file `file`, of `bytes`, is not the one this stamp names; `None`
+    /// when it is (its bytes are the same, whatever its name).
+    pub fn refuses(&self, file: &str, bytes: &[u8]) -> Option<String> {
+        let other = WorldStamp::of(file, bytes);
+        let short = |s: &str| s.get(..12).unwrap_or(s).to_string();
+        (other.sha256 != self.sha256).then(|| {
+            format!(
+                "{file} is not the world this trace was flown in: the trace names {} (SHA-256 {}…), and {file} is another (SHA-256 {}…); give that world, or none to draw the trace alone",
+                self.file,
+                short(&self.sha256),
+                short(&other.sha256)
+            )
+        })
+    }
+}
+
 /// What happened (docs/TRACE.md, "Every event"). The fields are in the order the trace
 /// writes them.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -43,6 +77,9 @@ pub type Text<'a> = Cow<'a, str>;
 pub enum Event<'a> {
     MissionStart {
         mission: Text<'a>,
+        /// The world the run flew in, when it was flown from a world file.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        world: Option<WorldStamp<'a>>,
     },
     MissionEnd {
         status: Status,

@@ -192,6 +192,9 @@ pub enum NotFlown {
 /// `aviary_check::STACK`: the checker and the engine follow capability calls by recursion.
 pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result<Flown, NotFlown> {
     let api = aviary_sim::descriptor();
+    // The trace names the world it was flown in, so that a replay draws that one.
+    let stamp = aviary_api::trace::WorldStamp::of(texts.world.name, &texts.world.bytes);
+    let run = RunOptions { world: Some(stamp), ..options.run.clone() };
     let (program, world, sources) = front_end(texts, &api, hooks)?;
     // Any MAVLink drone: the wall clock, and the simulated drones in real time with it.
     let live = !aviary_mavlink::bindings(&world).is_empty();
@@ -283,7 +286,7 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
         let mut sink = Sink { hooks: &mut *hooks, backend };
         let outcome = tokio::select! {
             biased;
-            outcome = aviary_engine::run_controlled(&mission, backend, &mut sink, &options.run, controls) => outcome,
+            outcome = aviary_engine::run_controlled(&mission, backend, &mut sink, &run, controls) => outcome,
             never = watch => match never {},
         };
         hooks.end(Stage::Flight);

@@ -181,7 +181,7 @@ impl TraceFile {
     pub fn close_now(&mut self, reason: &str) -> Option<Cut> {
         if !self.started {
             let mission = self.mission.clone();
-            let start = Event::MissionStart { mission: mission.into() };
+            let start = Event::MissionStart { mission: mission.into(), world: None };
             if let Some(why) = self.write(&Record { t: 0.0, event: start }) {
                 return Some(why);
             }
@@ -218,7 +218,8 @@ mod tests {
         let out = Shared::default();
         let trace = TraceFile::new(Box::new(out.clone()), "t.jsonl".into(), "M".into(), 4096);
         let mut trace = lock(&trace);
-        let start = Record { t: 0.0, event: Event::MissionStart { mission: "M".into() } };
+        let start =
+            Record { t: 0.0, event: Event::MissionStart { mission: "M".into(), world: None } };
         assert_eq!(trace.write(&start), None);
         let mut cuts = Vec::new();
         for i in 0..1000 {

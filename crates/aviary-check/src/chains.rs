@@ -85,8 +85,8 @@ fn walk<'a>(
             Stmt::ExceptionHandler(_) => (false, true),
             _ => (false, false),
         };
-        let inner_for =
-            in_for || matches!(stmt, Stmt::For(_) | Stmt::Any(AnyBlock { count: Some(_), .. }));
+        let inner_for = in_for
+            || (matches!(stmt, Stmt::For(_)) || matches!(stmt, Stmt::Any(a) if a.count.is_some()));
         stmt.for_each_body(|inner| walk(inner, inner_parallel, inner_copies, inner_for, path, out));
         path.pop();
     }

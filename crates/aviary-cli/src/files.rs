@@ -138,6 +138,52 @@ pub fn color_wanted() -> bool {
 pub fn world_alone(path: &Path) -> Result<aviary_world::World, String> {
     let bytes = std::fs::read(path)
         .map_err(|e| format!("aviary: cannot read the world file {}: {e}\n", path.display()))?;
+    world_of_bytes(path, bytes)
+}
+
+/// The world to draw a recorded trace on (`aviary replay`, `aviary report`): the one given,
+/// unless the trace names another (then why not); with none given, the one the trace
+/// names, found as it was named, or beside the trace or in the folder above it, with the
+/// same bytes. `None` (and a line on standard error that says why) when there is none.
+pub fn world_of_trace(
+    trace: &Path,
+    bytes: &[u8],
+    given: Option<&Path>,
+) -> Result<Option<aviary_world::World>, String> {
+    let stamp = aviary_station::replay::world_stamp(bytes);
+    if let Some(path) = given {
+        let world = std::fs::read(path)
+            .map_err(|e| format!("aviary: cannot read the world file {}: {e}\n", path.display()))?;
+        if let Some(why) =
+            stamp.as_ref().and_then(|s| s.refuses(&path.display().to_string(), &world))
+        {
+            return Err(format!("aviary: {why}\n"));
+        }
+        return world_of_bytes(path, world).map(Some);
+    }
+    let Some(stamp) = stamp else { return Ok(None) };
+    let named = Path::new(stamp.file.as_ref());
+    let beside = trace.parent().unwrap_or(Path::new(""));
+    let mut candidates = vec![named.to_path_buf(), beside.join(named)];
+    if let Some(file) = named.file_name() {
+        candidates.push(beside.join(file));
+        candidates.extend(beside.parent().map(|above| above.join(file)));
+    }
+    for path in candidates {
+        let Ok(world) = std::fs::read(&path) else { continue };
+        if stamp.refuses(&path.display().to_string(), &world).is_none() {
+            eprintln!("aviary: the trace was flown in {}: drawn on it", path.display());
+            return world_of_bytes(&path, world).map(Some);
+        }
+    }
+    eprintln!(
+        "aviary: the trace was flown in {}, which is not here as it was: drawn without a world (give it with --world)",
+        stamp.file
+    );
+    Ok(None)
+}
+
+fn world_of_bytes(path: &Path, bytes: Vec<u8>) -> Result<aviary_world::World, String> {
     let mut sources = aviary_diagnostics::SourceMap::new();
     let read = aviary_check::read_world(
         &mut sources,

@@ -17,6 +17,13 @@ pub fn run(trace: &Path, world: Option<&Path>, serve: &Serve) -> u8 {
             return 2;
         }
     };
+    let world = match crate::files::world_of_trace(trace, &bytes, world) {
+        Ok(w) => w,
+        Err(shown) => {
+            eprint!("{shown}");
+            return 2;
+        }
+    };
     let text = match aviary_station::replay::read(&name, bytes) {
         Ok(t) => t,
         Err(why) => {
@@ -24,13 +31,7 @@ pub fn run(trace: &Path, world: Option<&Path>, serve: &Serve) -> u8 {
             return 2;
         }
     };
-    let map = match world.map(crate::files::world_alone).transpose() {
-        Ok(w) => w.as_ref().map(aviary_station::checking::map_of).unwrap_or_default(),
-        Err(shown) => {
-            eprint!("{shown}");
-            return 2;
-        }
-    };
+    let map = world.as_ref().map(aviary_station::checking::map_of).unwrap_or_default();
     match crate::serve::station(serve, Mode::Replay { name: name.clone(), trace: text }, map) {
         Ok(_serving) => {
             // Not `eprintln!`: a script that closed standard error must not stop the replay.

@@ -11,7 +11,7 @@ pub fn run(trace: &Path, world: Option<&Path>, out: &Path) -> u8 {
             return 2;
         }
     };
-    let world = match world.map(crate::files::world_alone).transpose() {
+    let world = match crate::files::world_of_trace(trace, &bytes, world) {
         Ok(w) => w,
         Err(shown) => {
             eprint!("{shown}");

@@ -446,6 +446,7 @@ impl<'m> Engine<'m> {
         });
         self.trace(EventKind::MissionStart, || Event::MissionStart {
             mission: self.m.name.as_str().into(),
+            world: options.world.clone(),
         });
         let root = Rc::new(Scope {
             parent: None,

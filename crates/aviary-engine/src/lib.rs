@@ -77,6 +77,10 @@ pub struct RunOptions {
     /// one instant, the trace growing without end, and the engine's thread, never
     /// waiting, would not even read its controls.
     pub max_handler_reentries: usize,
+    /// The world file the run flies in, named in its `mission_start` (a replay or a
+    /// report draws that world and refuses another); `None` for a mission flown without
+    /// one (the tests' own worlds).
+    pub world: Option<aviary_api::trace::WorldStamp<'static>>,
 }
 
 /// The default [`RunOptions::max_call_depth`]: twice the 5,000-deep chain the CLI's tests
@@ -93,6 +97,7 @@ impl Default for RunOptions {
             telemetry_hz: None,
             max_call_depth: MAX_CALL_DEPTH,
             max_handler_reentries: MAX_HANDLER_REENTRIES,
+            world: None,
         }
     }
 }

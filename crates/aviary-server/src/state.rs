@@ -45,7 +45,7 @@ impl MissionState {
             self.t = record.t;
         }
         match &record.event {
-            Event::MissionStart { mission } => {
+            Event::MissionStart { mission, .. } => {
                 self.mission = Some(mission.to_string());
                 self.status = "running";
             }

@@ -12,6 +12,20 @@ pub fn read(name: &str, bytes: Vec<u8>) -> Result<String, String> {
     Ok(text)
 }
 
+/// The world a trace names in its `mission_start` (its first event), if it names one.
+pub fn world_stamp(bytes: &[u8]) -> Option<aviary_api::trace::WorldStamp<'static>> {
+    let first = bytes.split(|&b| b == b'\n').find(|l| !l.iter().all(u8::is_ascii_whitespace))?;
+    match serde_json::from_slice::<Record>(first).ok()?.event {
+        aviary_api::trace::Event::MissionStart { world: Some(w), .. } => {
+            Some(aviary_api::trace::WorldStamp {
+                file: w.file.into_owned().into(),
+                sha256: w.sha256.into_owned().into(),
+            })
+        }
+        _ => None,
+    }
+}
+
 /// The bytes of a trace as text, or why they are none.
 pub fn text(name: &str, bytes: Vec<u8>) -> Result<String, String> {
     String::from_utf8(bytes).map_err(|e| {

@@ -45,7 +45,7 @@ fn read(name: &str, trace: &str) -> Result<Mission, String> {
         let t = record.t;
         m.end = m.end.max(t);
         match record.event {
-            Event::MissionStart { mission } => m.name = mission.into_owned(),
+            Event::MissionStart { mission, .. } => m.name = mission.into_owned(),
             Event::MissionEnd { status, reason } => {
                 m.status = status.as_str().to_string();
                 m.reason = reason.map(|r| r.into_owned());

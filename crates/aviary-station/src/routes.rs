@@ -296,7 +296,8 @@ async fn campaign(
 struct Recorded {
     /// A trace of the station's folder (`traces/NAME-TIME.jsonl`); none in a replay.
     path: Option<String>,
-    /// The world to draw it on, in the folder (a report's map).
+    /// The world to draw it on, in the folder (a report's map); by default the one the
+    /// trace names, when the folder has it as it was.
     world: Option<String>,
 }
 
@@ -363,7 +364,7 @@ async fn report(State(station): State<Arc<Station>>, Query(asked): Query<Recorde
             Ok(text) => text,
             Err(refusal) => return refusal.into_response(),
         };
-        let world = match asked.world.map(|w| world_of(folder, &w)).transpose() {
+        let world = match world_of_trace(folder, &text, asked.world.as_deref()) {
             Ok(world) => world,
             Err(refusal) => return refusal.into_response(),
         };
@@ -401,17 +402,74 @@ async fn report(State(station): State<Arc<Station>>, Query(asked): Query<Recorde
     on_a_deep_stack(work).await
 }
 
-/// What the map shows of a world of the folder: `GET /api/station/world?path=W.toml`
-/// (for a replay of one of the folder's traces on its world).
-async fn world_map(State(station): State<Arc<Station>>, Query(named): Query<Named>) -> Response {
+#[derive(serde::Deserialize)]
+struct WorldAsked {
+    /// A world of the folder.
+    path: Option<String>,
+    /// A trace of the folder: the world it was flown in.
+    trace: Option<String>,
+}
+
+/// What the map shows of a world of the folder: `GET /api/station/world?path=W.toml`, or
+/// the world a trace of the folder was flown in, `?trace=traces/X.jsonl` (for its replay):
+/// `null` when the trace names none, refused when the folder's copy is not the one flown.
+async fn world_map(
+    State(station): State<Arc<Station>>,
+    Query(asked): Query<WorldAsked>,
+) -> Response {
     let (folder, _) = match folder(&station) {
         Ok(f) => f,
         Err(refusal) => return refusal.into_response(),
     };
-    match world_of(folder, &named.path) {
-        Ok(world) => Json(checking::map_of(&world)).into_response(),
+    let world = match (asked.path, asked.trace) {
+        (Some(path), None) => world_of(folder, &path).map(Some),
+        (None, Some(trace)) => trace_text(folder, &trace).and_then(|text| {
+            let stamp = crate::replay::world_stamp(text.as_bytes());
+            match stamp {
+                Some(stamp) => world_of_trace(folder, &text, Some(&stamp.file)),
+                None => Ok(None),
+            }
+        }),
+        _ => Err(Refusal(
+            StatusCode::BAD_REQUEST,
+            "name a world (?path=W.toml) or a trace (?trace=traces/X.jsonl)".into(),
+        )),
+    };
+    match world {
+        Ok(world) => Json(world.as_ref().map(checking::map_of)).into_response(),
         Err(refusal) => refusal.into_response(),
     }
+}
+
+/// The world to draw a trace of the folder on: `given`, unless the trace names another
+/// (refused, with why); with none given, the one it names when the folder has it as it
+/// was flown, else none.
+fn world_of_trace(
+    folder: &dir::Folder,
+    trace: &str,
+    given: Option<&str>,
+) -> Result<Option<aviary_world::World>, Refusal> {
+    let stamp = crate::replay::world_stamp(trace.as_bytes());
+    let path = match (given, &stamp) {
+        (Some(path), _) => path.to_string(),
+        (None, Some(stamp)) => stamp.file.to_string(),
+        (None, None) => return Ok(None),
+    };
+    if dir::FileKind::of(&path) != Some(dir::FileKind::World) {
+        return Err(Refusal(StatusCode::BAD_REQUEST, format!("`{path}` is not a world (.toml)")));
+    }
+    let text = match folder.read(&path) {
+        Ok(text) => text,
+        Err(_) if given.is_none() => return Ok(None),
+        Err(why) => return Err(Refusal(StatusCode::NOT_FOUND, why)),
+    };
+    if let Some(why) = stamp.as_ref().and_then(|s| s.refuses(&path, text.as_bytes())) {
+        return match given {
+            Some(_) => Err(Refusal(StatusCode::CONFLICT, why)),
+            None => Ok(None),
+        };
+    }
+    world_of(folder, &path).map(Some)
 }
 
 /// A world of the folder, read; refused with its first error.

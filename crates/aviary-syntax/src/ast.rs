@@ -145,7 +145,7 @@ pub enum Stmt {
     /// Allowed only directly in the MISSION body (the checker says so elsewhere).
     OperatorSignals(OperatorSignals),
     /// `ANY d IN group WHERE c NEAREST TO p WITHIN t:`: a drone chosen at run time.
-    Any(AnyBlock),
+    Any(Box<AnyBlock>),
     /// A line that could not be read. It was reported; later stages skip it.
     Error(Span),
 }

@@ -175,7 +175,12 @@ fn opt(s: impl Strategy<Value = Text<'static>>) -> impl Strategy<Value = Option<
 
 fn event() -> impl Strategy<Value = Event<'static>> {
     prop_oneof![
-        text().prop_map(|mission| Event::MissionStart { mission }),
+        (text(), proptest::option::of((text(), text()))).prop_map(|(mission, world)| {
+            Event::MissionStart {
+                mission,
+                world: world.map(|(file, sha256)| WorldStamp { file, sha256 }),
+            }
+        }),
         (status(), opt(text())).prop_map(|(status, reason)| Event::MissionEnd { status, reason }),
         text().prop_map(|block| Event::BlockStart { block }),
         (text(), status()).prop_map(|(block, status)| Event::BlockEnd { block, status }),

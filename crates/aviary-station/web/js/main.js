@@ -317,7 +317,7 @@ async function station() {
     link.click();
     link.remove();
   };
-  records(listing.traces || [], () => worlds.value);
+  records(listing.traces || []);
   if (listing.missions.length) {
     const preferred = listing.missions.find((m) => /search_and_rescue|paper/.test(m)) || listing.missions[0];
     missions.value = preferred;
@@ -326,8 +326,8 @@ async function station() {
 }
 
 /// The folder's recorded flights (`traces/`): replayed in this page, or their report
-/// saved, on the world chosen above (`world()`).
-function records(traces, world) {
+/// saved, each on the world it was flown in (the trace names it).
+function records(traces) {
   const list = $("trace-list");
   const fill = (paths, chosen) => {
     list.textContent = "";
@@ -342,12 +342,12 @@ function records(traces, world) {
     if (listing) fill(listing.traces || [], trace);
   };
   $("replay-trace").onclick = () => {
-    const q = new URLSearchParams({ replay: list.value, world: world() });
+    const q = new URLSearchParams({ replay: list.value });
     location.href = `/?${q}`;
   };
   $("report-trace").onclick = async () => {
-    // "(no world)" chosen: the report draws the trace without one.
-    const q = new URLSearchParams({ path: list.value, ...(world() ? { world: world() } : {}) });
+    // On the world the trace names, as the station has it; without one if it changed.
+    const q = new URLSearchParams({ path: list.value });
     const response = await api.raw(`/api/station/report?${q}`);
     if (!response.ok) return refused(`report of ${list.value}`, { status: response.status, body: await response.json().catch(() => null) });
     const link = document.createElement("a");
@@ -413,7 +413,7 @@ function showPlan(plan) {
 
 // A recorded trace, played back: the controls steer nothing, the scrubber picks the time.
 // `aviary replay` serves one trace; in `aviary gcs` the page replays one of the folder's
-// (`recorded`: its path, and the world to draw it on).
+// (`recorded`: its path), on the world it was flown in, whatever world is chosen above.
 async function replay(recorded) {
   for (const id of ["pause", "resume", "abort"]) $(id).hidden = true;
   for (const id of ["leash-form", "signal-form"]) $(id).hidden = true;
@@ -428,8 +428,10 @@ async function replay(recorded) {
   let world = page.about.map;
   if (recorded) {
     $("leave-replay").hidden = false;
-    const shown = recorded.world ? await api.call("GET", `/api/station/world?path=${encodeURIComponent(recorded.world)}`) : null;
-    world = shown && shown.ok ? shown.body : null;
+    const shown = await api.call("GET", `/api/station/world?trace=${encodeURIComponent(recorded.path)}`);
+    // The folder's copy of that world changed since the flight: said, and drawn without.
+    if (!shown.ok) refused("the world of this trace", shown);
+    world = shown.ok ? shown.body : null;
   }
   page.map.setWorld(world);
   page.tree.show(treeOf(events));
@@ -473,7 +475,7 @@ async function start() {
   const asked = new URLSearchParams(location.search);
   if (about.mode === "station" && asked.get("replay")) {
     document.querySelector("main").classList.add("no-files");
-    return replay({ path: asked.get("replay"), world: asked.get("world") });
+    return replay({ path: asked.get("replay") });
   }
   if (about.mode === "station") await station();
   if (about.mode === "replay") return replay();

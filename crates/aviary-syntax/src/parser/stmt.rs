@@ -651,7 +651,7 @@ impl Parser<'_> {
         } else {
             self.recover_body()
         };
-        Stmt::Any(AnyBlock {
+        Stmt::Any(Box::new(AnyBlock {
             count,
             alias,
             group,
@@ -660,7 +660,7 @@ impl Parser<'_> {
             within,
             body,
             span: Span::new(start.start as usize, self.last_end as usize),
-        })
+        }))
     }
 
     /// Handler headers: `BY actor` and `WITH a, b` after the name.

@@ -18,7 +18,6 @@ use aviary_check::SourceProvider;
 use aviary_diagnostics::{Diagnostic, SourceMap};
 use aviary_engine::{Control, Controller, Outcome, RunOptions, TraceSink};
 use aviary_ir::Mission;
-use aviary_mavlink::Facts;
 use aviary_sim::{Fleet, SimBackend, SimOptions};
 use aviary_world::World;
 use tokio::sync::watch;
@@ -113,16 +112,10 @@ pub trait Hooks {
         Ok(())
     }
 
-    /// The MAVLink vehicles answered, with their own figures; nothing has flown yet.
-    /// `sources` holds the texts, for diagnostics that point into them.
-    fn connected(
-        &mut self,
-        _mission: &Mission,
-        _world: &World,
-        _facts: &[Facts],
-        _sources: &SourceMap,
-    ) {
-    }
+    /// The MAVLink vehicles answered, with their own figures, and the plan was made again
+    /// with them; nothing has flown yet. `sources` holds the texts, for diagnostics that
+    /// point into them.
+    fn connected(&mut self, _replan: &crate::replan::Replan, _sources: &SourceMap) {}
 
     /// As [`TraceSink::wants`]: asked once per kind as the engine starts.
     fn wants(&self, _kind: EventKind) -> bool {
@@ -263,7 +256,8 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
                     }
                 };
                 if let Some(sources) = &sources {
-                    hooks.connected(&mission, world, mavlink.facts(), sources);
+                    let replan = crate::replan::replan(&mission, world, mavlink.facts());
+                    hooks.connected(&replan, sources);
                 }
                 if let (Some(pace), LiveClock::Vehicles) = (&pace, options.clock) {
                     let mut clocks = mavlink.clocks();

@@ -121,7 +121,7 @@ fn check_one(
             let mut doc = serde_json::json!({ "file": path.display().to_string(), "plan": plan, "diagnostics": diagnostics });
             match &figures {
                 Some(Ok(f)) if !f.is_empty() => {
-                    doc["vehicles"] = f.iter().map(crate::figures::Source::json).collect()
+                    doc["vehicles"] = f.iter().map(crate::figures::json).collect()
                 }
                 Some(Err(why)) => doc["vehicles_not_asked"] = why.as_str().into(),
                 _ => {}

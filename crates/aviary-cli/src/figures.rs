@@ -4,8 +4,7 @@
 
 use std::time::Duration;
 
-use aviary_diagnostics::{render_text, Code, SourceMap};
-use aviary_mavlink::Facts;
+use aviary_diagnostics::{render_text, SourceMap};
 use aviary_world::World;
 
 use crate::files::color_wanted;
@@ -13,24 +12,7 @@ use crate::files::color_wanted;
 /// How long `aviary check --plan` waits for the vehicles, all at once.
 pub const ASK_WAIT: Duration = Duration::from_secs(5);
 
-/// Where one drone's figures came from, and what differs from the world's.
-pub struct Source {
-    pub drone: String,
-    pub source: String,
-    pub differences: Vec<String>,
-}
-
-/// Applies each vehicle's facts to its drone in `world`.
-pub fn apply(world: &mut World, facts: &[Facts]) -> Vec<Source> {
-    facts
-        .iter()
-        .filter_map(|f| {
-            let d = world.drones.get_mut(f.drone)?;
-            let differences = f.apply(d);
-            Some(Source { drone: f.name.clone(), source: f.source(), differences })
-        })
-        .collect()
-}
+pub use aviary_backends::replan::{apply, Figures as Source};
 
 /// Asks the MAVLink drones of `world` for their facts (within [`ASK_WAIT`]) and applies
 /// them. A world without MAVLink drones is not asked.
@@ -46,10 +28,9 @@ pub fn ask(world: &mut World) -> Result<Vec<Source>, String> {
     Ok(apply(world, &facts))
 }
 
-impl Source {
-    pub fn json(&self) -> serde_json::Value {
-        serde_json::json!({ "drone": self.drone, "source": self.source, "differences": self.differences })
-    }
+/// A drone's figures as `aviary check --plan --format json` writes them.
+pub fn json(s: &Source) -> serde_json::Value {
+    serde_json::json!({ "drone": s.drone, "source": s.source, "differences": s.differences })
 }
 
 /// The sources as text: each drone's line, then what differs, indented.
@@ -64,38 +45,29 @@ pub fn render(sources: &[Source]) -> String {
     out
 }
 
-/// Before a run with MAVLink drones: the plan again, on `world` with the vehicles' facts
-/// applied, and its battery warnings (W204) on standard error. A drone whose battery the
-/// plan says runs out still flies: the mission's handlers (BatteryLow, BatteryCritical)
-/// and the autopilot's failsafe may bring it home, and only the operator knows whether
-/// the estimate is too cautious. So it is said loudly, even with `--quiet`, and the
-/// operator can stop (Ctrl-C) before take-off. Returns the drones that run out.
+/// Before a run with MAVLink drones: the plan made again with the vehicles' facts
+/// (`aviary_backends::replan`, as the station shows it), and its battery warnings (W204)
+/// on standard error. A drone whose battery the plan says runs out still flies: the
+/// mission's handlers (BatteryLow, BatteryCritical) and the autopilot's failsafe may bring
+/// it home, and only the operator knows whether the estimate is too cautious. So it is
+/// said loudly, even with `--quiet`, and the operator can stop (Ctrl-C) before take-off.
+/// Returns the drones that run out.
 pub fn before_flight(
-    mission: &aviary_ir::Mission,
-    world: &World,
-    facts: &[Facts],
+    replan: &aviary_backends::replan::Replan,
     sources: &SourceMap,
     quiet: bool,
 ) -> Vec<String> {
-    let mut world = world.clone();
-    let applied = apply(&mut world, facts);
-    let verification = aviary_verify::verify(mission, &world);
     if !quiet {
-        eprint!("aviary: the MAVLink drones' figures:\n{}", render(&applied));
-        for d in verification.diagnostics.iter().filter(|d| d.code == Code::LowReserve) {
+        eprint!("aviary: the MAVLink drones' figures:\n{}", render(&replan.figures));
+        for d in &replan.low_reserve {
             eprint!("{}", render_text(sources, d, color_wanted()));
         }
     }
-    let empty: Vec<&aviary_verify::plan::DronePlan> =
-        verification.plan.drones.iter().filter(|p| p.battery_left <= 0.0).collect();
-    for p in &empty {
-        let start = world.drones.iter().find(|d| d.name == p.drone).map_or(100.0, |d| d.battery);
+    for r in &replan.runs_out {
         eprintln!(
-            "aviary: WARNING: with its vehicle's figures, the plan says {}'s battery runs out before the mission ends: it needs about {:.0}% of a full battery and starts with {:.0}%. Flying anyway: its BatteryLow and BatteryCritical handlers and the autopilot's battery failsafe must bring it home; Ctrl-C ends the mission and brings the fleet home",
-            p.drone,
-            start - p.battery_left * 100.0,
-            start
+            "aviary: WARNING: {}; Ctrl-C ends the mission and brings the fleet home",
+            r.warning()
         );
     }
-    empty.iter().map(|p| p.drone.clone()).collect()
+    replan.runs_out.iter().map(|r| r.drone.clone()).collect()
 }

@@ -12,7 +12,6 @@ use aviary_backends::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
 use aviary_diagnostics::{render_text, SourceMap};
 use aviary_engine::{Controller, RunOptions, Status};
 use aviary_ir::Mission;
-use aviary_mavlink::Facts;
 use aviary_world::World;
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -318,14 +317,8 @@ impl Hooks for Shown<'_> {
         Ok(())
     }
 
-    fn connected(
-        &mut self,
-        mission: &Mission,
-        world: &World,
-        facts: &[Facts],
-        sources: &SourceMap,
-    ) {
-        crate::figures::before_flight(mission, world, facts, sources, self.args.quiet);
+    fn connected(&mut self, replan: &aviary_backends::replan::Replan, sources: &SourceMap) {
+        crate::figures::before_flight(replan, sources, self.args.quiet);
     }
 
     fn record(&mut self, record: &Record<'_>, backend: &dyn Backend) {

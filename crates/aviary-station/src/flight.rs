@@ -88,6 +88,7 @@ pub fn start(
                 file: None,
                 controller: None,
                 bounds: None,
+                live: false,
             };
             let flown = aviary_backends::fly(texts, &options, &mut hooks);
             landed.flying.store(false, std::sync::atomic::Ordering::SeqCst);
@@ -135,12 +136,16 @@ struct Flight {
     controller: Option<Controller>,
     /// Where the world lets the operator send a drone, from `compiled` for `starting`.
     bounds: Option<aviary_server::Bounds>,
+    /// The world has MAVLink drones: the plan is made again when they answer.
+    live: bool,
 }
 
 impl Hooks for Flight {
     fn compiled(&mut self, mission: &Mission, world: &World) -> Result<(), String> {
         self.station.set_map(map_of(world));
         self.bounds = Some(aviary_server::Bounds::of(world));
+        self.live =
+            world.drones.iter().any(|d| matches!(d.backend, aviary_world::Backend::Mavlink(_)));
         // Made as every file of the folder is reached: checked by `Folder::place`.
         let Mode::Folder { folder, .. } = &self.station.mode else {
             return Err("a flight from the page needs the station's folder".into());
@@ -170,10 +175,37 @@ impl Hooks for Flight {
             return Err("the flight starts before its world was read".into());
         };
         self.feed = Some(self.station.start_run(controller.clone(), mission, bounds, tree, trace));
+        if self.live {
+            self.station.set_vehicle_plan(crate::VehiclePlan::Due);
+        }
         if let Some(ready) = self.ready.take() {
             let _ = ready.send(Ok(()));
         }
         Ok(())
+    }
+
+    /// The plan again with the vehicles' figures, as `aviary run` makes it: its warnings
+    /// go to the page, which shows each as an alarm before the drones are far.
+    fn connected(
+        &mut self,
+        replan: &aviary_backends::replan::Replan,
+        _sources: &aviary_diagnostics::SourceMap,
+    ) {
+        let mut warnings: Vec<serde_json::Value> = replan
+            .low_reserve
+            .iter()
+            .map(|d| {
+                let text = match &d.help {
+                    Some(help) => format!("{} ({help})", d.message),
+                    None => d.message.clone(),
+                };
+                serde_json::json!({ "code": d.code.as_str(), "text": text, "severe": false })
+            })
+            .collect();
+        warnings.extend(replan.runs_out.iter().map(|r| {
+            serde_json::json!({ "drone": r.drone, "code": "W204", "text": r.warning(), "severe": true })
+        }));
+        self.station.set_vehicle_plan(crate::VehiclePlan::Made(warnings));
     }
 
     fn record(&mut self, record: &Record<'_>, _backend: &dyn Backend) {

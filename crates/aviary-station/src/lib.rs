@@ -68,6 +68,21 @@ pub(crate) struct Run {
     pub tree: Value,
     /// Where its trace is written, for a flight from the page.
     pub trace: Option<String>,
+    /// With MAVLink drones, the plan made again with the vehicles' figures: `None` until
+    /// they answered, then its warnings (`vehicle_plan` of `/api/station`).
+    pub vehicle_plan: VehiclePlan,
+}
+
+/// What the page is told of the plan made with the MAVLink vehicles' own figures.
+#[derive(Clone, Debug, Default)]
+pub(crate) enum VehiclePlan {
+    /// No MAVLink drone: nothing to plan again.
+    #[default]
+    None,
+    /// The vehicles are being asked.
+    Due,
+    /// Its warnings, each `{drone, code, text, severe}`.
+    Made(Vec<Value>),
 }
 
 pub(crate) struct Station {
@@ -102,8 +117,18 @@ impl Station {
             controller,
             Kinds::of(mission).within(bounds),
         );
-        *Self::lock(&self.run) = Some(Run { router, mission: mission.name.clone(), tree, trace });
+        let vehicle_plan = VehiclePlan::None;
+        *Self::lock(&self.run) =
+            Some(Run { router, mission: mission.name.clone(), tree, trace, vehicle_plan });
         feed
+    }
+
+    /// The run's plan with the vehicles' figures: `Due` from the start of a flight with
+    /// MAVLink drones, then what it says.
+    pub(crate) fn set_vehicle_plan(&self, plan: VehiclePlan) {
+        if let Some(run) = Self::lock(&self.run).as_mut() {
+            run.vehicle_plan = plan;
+        }
     }
 
     pub fn set_map(&self, map: Value) {
@@ -117,8 +142,13 @@ impl Station {
     /// The routes of the flight in progress (or the last one), and what the page shows of it.
     pub fn run(&self) -> Option<(axum::Router, Value)> {
         Self::lock(&self.run).as_ref().map(|r| {
-            let shown =
+            let mut shown =
                 serde_json::json!({ "mission": r.mission, "tree": r.tree, "trace": r.trace });
+            match &r.vehicle_plan {
+                VehiclePlan::None => {}
+                VehiclePlan::Due => shown["vehicle_plan"] = "due".into(),
+                VehiclePlan::Made(w) => shown["vehicle_plan"] = w.clone().into(),
+            }
             (r.router.clone(), shown)
         })
     }

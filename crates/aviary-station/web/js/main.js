@@ -130,6 +130,7 @@ async function watch() {
       if (d.position) x.lastT = m.t;
     }
   }
+  vehiclePlan(about.run);
   if (page.socket) page.socket.close();
   page.socket = api.events((e) => {
     if (observe(page.model, e)) page.log.add(e);
@@ -137,6 +138,27 @@ async function watch() {
     queueRender();
   }, () => queueRender());
   render();
+}
+
+/// With MAVLink drones the station plans again with each vehicle's own figures once they
+/// answer, as `aviary run` does: its warnings (a reserve under 20 %, a battery the plan
+/// says runs out) are alarms, looked for until the plan is made.
+async function vehiclePlan(run) {
+  let plan = run && run.vehicle_plan;
+  while (plan === "due") {
+    await new Promise((r) => setTimeout(r, 500));
+    const about = (await api.call("GET", "/api/station")).body;
+    if (!about || !about.run || about.run.mission !== run.mission) return;
+    plan = about.run.vehicle_plan;
+  }
+  if (!Array.isArray(plan)) return;
+  for (const w of plan) {
+    page.model.alarms.push({
+      id: `plan|${w.drone || ""}|${w.text}`, kind: "plan", who: w.drone || null,
+      text: `plan with the vehicles' figures: ${w.code}: ${w.text}`, severe: !!w.severe, acknowledged: false,
+    });
+  }
+  showAlarms();
 }
 
 function fillLists(tree) {

@@ -99,6 +99,10 @@ pub enum Event<'a> {
         capability: Text<'a>,
         tag: Option<Text<'a>>,
         args: Params<'a>,
+        /// The line of the statement in the MISSION's file, when it is there: what
+        /// identifies the statement to a page that follows the run.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        line: Option<u32>,
     },
     CapabilityEnd {
         actor: Text<'a>,
@@ -106,6 +110,10 @@ pub enum Event<'a> {
         tag: Option<Text<'a>>,
         args: Params<'a>,
         status: Status,
+        /// The line of the statement in the MISSION's file, when it is there: what
+        /// identifies the statement to a page that follows the run.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        line: Option<u32>,
     },
     HandlerStart {
         signal: Text<'a>,
@@ -138,6 +146,10 @@ pub enum Event<'a> {
         name: Text<'a>,
         actor: Option<Text<'a>>,
         args: Vec<Shown<'a>>,
+        /// The line of the statement in the MISSION's file, when it is there: what
+        /// identifies the statement to a page that follows the run.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        line: Option<u32>,
     },
     /// `args` of a built-in exception: the reason, in words. `during` is `return home` for
     /// a fault after the mission's body has ended, which no handler can take. `skipped`:
@@ -153,12 +165,20 @@ pub enum Event<'a> {
         during: Option<Text<'a>>,
         #[serde(default, skip_serializing_if = "Option::is_none")]
         skipped: Option<Text<'a>>,
+        /// The line of the statement in the MISSION's file, when it is there: what
+        /// identifies the statement to a page that follows the run.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        line: Option<u32>,
     },
     /// `action`: `PAUSE`, `RESUME`, `ABORT` or a section's name.
     Leash {
         capability: Text<'a>,
         tag: Text<'a>,
         action: Text<'a>,
+        /// The line of the statement in the MISSION's file, when it is there: what
+        /// identifies the statement to a page that follows the run.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        line: Option<u32>,
     },
     Detection {
         actor: Text<'a>,

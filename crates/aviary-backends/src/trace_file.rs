@@ -210,7 +210,10 @@ mod tests {
     }
 
     fn signal(t: f64) -> Record<'static> {
-        Record { t, event: Event::Signal { name: "X".into(), actor: None, args: Vec::new() } }
+        Record {
+            t,
+            event: Event::Signal { name: "X".into(), actor: None, args: Vec::new(), line: None },
+        }
     }
 
     #[test]

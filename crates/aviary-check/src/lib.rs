@@ -82,6 +82,11 @@ impl Program {
             _ => None,
         }
     }
+    /// The file that holds the MISSION, and its tree.
+    pub fn mission_file(&self) -> Option<(FileId, &SourceFile)> {
+        let r = self.mission?;
+        Some((r.file, self.file(r.file)?))
+    }
     pub fn mission(&self) -> Option<&Mission> {
         let r = self.mission?;
         match self.file(r.file)?.items.get(r.index)? {

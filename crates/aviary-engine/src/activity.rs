@@ -345,9 +345,12 @@ impl<'m> Engine<'m> {
             all => Cow::Owned(all.iter().map(|d| self.name(*d)).collect::<Vec<_>>().join(" ")),
         };
         let capability = Cow::Borrowed(cap.name.as_str());
+        let line = self.m.line_of(&call.origin);
         match end {
-            None => Event::CapabilityStart { actor, capability, tag, args: params },
-            Some(status) => Event::CapabilityEnd { actor, capability, tag, args: params, status },
+            None => Event::CapabilityStart { actor, capability, tag, args: params, line },
+            Some(status) => {
+                Event::CapabilityEnd { actor, capability, tag, args: params, status, line }
+            }
         }
     }
 

@@ -267,7 +267,7 @@ impl<'m> Engine<'m> {
                         spaced(mean)
                     )
                 })?;
-                self.leash_by_id(cap, tag_id, action_kind, &action, values);
+                self.leash_by_id(cap, tag_id, action_kind, &action, values, None);
                 Ok(())
             }
             Control::Signal { name, args } => {

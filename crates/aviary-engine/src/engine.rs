@@ -674,12 +674,12 @@ impl<'m> Engine<'m> {
                         Value::Symbol(kind),
                         Value::Position(aviary_api::Point::flat(location[0], location[1])),
                     ];
-                    self.raise(id, args, Some(drone), &scope);
+                    self.raise(id, args, Some(drone), &scope, None);
                 }
             }
             DroneEvent::Signal { drone, signal } => {
                 let scope = self.actor_scope(drone);
-                self.raise(self.m.builtins.signal(signal), Vec::new(), Some(drone), &scope);
+                self.raise(self.m.builtins.signal(signal), Vec::new(), Some(drone), &scope, None);
             }
             DroneEvent::Fault { drone, failure } => {
                 // What a path call in progress left, before a handler can read it.
@@ -726,6 +726,7 @@ impl<'m> Engine<'m> {
             name: self.m.signals[signal].as_str().into(),
             actor: None,
             args: self.values(&args),
+            line: None,
         });
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {
             *r = true;
@@ -743,12 +744,14 @@ impl<'m> Engine<'m> {
     }
 
     /// `SIGNAL`: recorded, then heard by every matching handler of every scope up the chain.
+    /// `line`: the `SIGNAL` statement's, in the MISSION's file; none for a drone's signal.
     pub fn raise(
         &self,
         signal: usize,
         args: Vec<Value>,
         actor: Option<DroneId>,
         from: &Rc<Scope<'m>>,
+        line: Option<u32>,
     ) {
         self.heed_interrupt();
         if self.stopped() {
@@ -758,6 +761,7 @@ impl<'m> Engine<'m> {
             name: self.m.signals[signal].as_str().into(),
             actor: actor.map(|a| self.name(a).into()),
             args: self.values(&args),
+            line,
         });
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {
             *r = true;
@@ -877,6 +881,7 @@ impl<'m> Engine<'m> {
                 .map(|(s, _, _)| Cow::Owned(format!("{}/ON EXCEPTION {name}", s.path))),
             during: None,
             skipped: skipped.as_deref().map(Cow::Borrowed),
+            line: at.as_ref().and_then(|o| self.m.line_of(o)),
         });
         let Some((handler_scope, index, reentry)) = found else {
             for scope in from.chain() {

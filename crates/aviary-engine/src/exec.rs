@@ -218,9 +218,9 @@ impl<'m> Engine<'m> {
                     self.api(a, ctx).await;
                 }
             }
-            Node::Signal { signal, args, .. } => {
+            Node::Signal { signal, args, origin } => {
                 if !self.stopped() {
-                    self.signal(*signal, args, ctx);
+                    self.signal(*signal, args, origin, ctx);
                 }
             }
             Node::Call(c) if self.instant[c.capability] => self.instant_statement(c, ctx).await,
@@ -269,7 +269,7 @@ impl<'m> Engine<'m> {
                     unreachable!("boxed apart in `node`")
                 }
                 Node::Leash(l) => self.leash(l, ctx),
-                Node::Signal { signal, args, .. } => self.signal(*signal, args, ctx),
+                Node::Signal { signal, args, origin } => self.signal(*signal, args, origin, ctx),
                 Node::Throw { exception, args, origin } => {
                     let args = self.eval_all(args, ctx);
                     self.throw(*exception, args, ctx.actor, &ctx.scope, Some(*origin));
@@ -311,9 +311,9 @@ impl<'m> Engine<'m> {
     }
 
     /// `SIGNAL`: raised by the actor of this place, from its scope.
-    fn signal(&self, signal: usize, args: &[Expr], ctx: &Ctx<'m>) {
+    fn signal(&self, signal: usize, args: &[Expr], origin: &aviary_ir::Origin, ctx: &Ctx<'m>) {
         let args = self.eval_all(args, ctx);
-        self.raise(signal, args, ctx.actor, &ctx.scope);
+        self.raise(signal, args, ctx.actor, &ctx.scope, self.m.line_of(origin));
     }
 
     pub(crate) fn eval_all(&self, exprs: &[Expr], ctx: &Ctx<'m>) -> Vec<Value> {
@@ -497,7 +497,8 @@ impl<'m> Engine<'m> {
             let env = self.env(&ctx.frame, &received);
             l.args.iter().map(|(p, e)| (*p, env.eval(e))).collect()
         };
-        self.leash_by_id(l.capability, l.tag, l.action, &l.action_name, values);
+        let line = self.m.line_of(&l.origin);
+        self.leash_by_id(l.capability, l.tag, l.action, &l.action_name, values, line);
     }
 
     /// A leash on every running activity of `capability` tagged `tag`; recorded even when
@@ -509,12 +510,14 @@ impl<'m> Engine<'m> {
         action: LeashAction,
         action_name: &str,
         values: Vec<(usize, Value)>,
+        line: Option<u32>,
     ) {
         let cap = &self.m.capabilities[capability];
         self.trace(EventKind::Leash, || Event::Leash {
             capability: cap.name.as_str().into(),
             tag: self.m.tags[tag].as_str().into(),
             action: action_name.into(),
+            line,
         });
         let targets: Vec<(Rc<Instance>, Rc<Scope<'m>>)> =
             self.instances.borrow().tagged(capability, tag).cloned().collect();

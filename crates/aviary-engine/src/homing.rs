@@ -258,6 +258,7 @@ impl<'m> Engine<'m> {
                     handler: None,
                     during: Some("return home".into()),
                     skipped: None,
+                    line: None,
                 });
             }
             DroneEvent::Signal { drone, signal } => {
@@ -265,6 +266,7 @@ impl<'m> Engine<'m> {
                     name: signal.name().into(),
                     actor: Some(self.name(drone).into()),
                     args: Vec::new(),
+                    line: None,
                 });
             }
             DroneEvent::Detected { drone, kind, location } => {

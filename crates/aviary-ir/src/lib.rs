@@ -63,6 +63,17 @@ pub struct Mission {
     /// The ids of the built-in signals and exceptions, resolved here so that the engine
     /// looks up no name when a backend or the engine itself raises one.
     pub builtins: Builtins,
+    /// The lines of the file that holds the MISSION: a trace event of a statement of that
+    /// file names its line, which is what identifies the statement to a page that follows
+    /// the run (one statement a line).
+    pub lines: Lines,
+}
+
+/// Where each line of one file starts (byte offsets), and which file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Lines {
+    pub file: FileId,
+    pub starts: Vec<u32>,
 }
 
 /// Every built-in signal and exception's id in this mission, whether or not the mission
@@ -112,6 +123,13 @@ impl Mission {
         }
         let declared: Vec<&str> = ops.iter().map(|&s| self.signals[s].as_str()).collect();
         Err(undeclared_signal(name, &declared))
+    }
+
+    /// The line (from 1) of a statement at `origin`, when it is in the MISSION's file.
+    pub fn line_of(&self, origin: &Origin) -> Option<u32> {
+        let lines = &self.lines;
+        (origin.file == lines.file && !lines.starts.is_empty())
+            .then(|| lines.starts.partition_point(|&s| s <= origin.span.start) as u32)
     }
 
     /// Attribute `a` of drone `d`, if the world gives the drone one.
@@ -494,6 +512,7 @@ mod column_tests {
             attributes,
             origin: None,
             builtins: Builtins { signals: [0; 3], exceptions: [0; 10] },
+            lines: Lines::default(),
         }
     }
 

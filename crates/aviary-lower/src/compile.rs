@@ -71,6 +71,10 @@ pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mis
             alt: o.alt,
         }),
         builtins,
+        lines: program
+            .mission_file()
+            .map(|(file, tree)| Lines { file, starts: tree.line_offsets.clone() })
+            .unwrap_or_default(),
     };
     compute_claims(&mut out.capabilities);
     Some(out)

@@ -59,7 +59,7 @@ impl MissionState {
                     self.blocks.remove(i);
                 }
             }
-            Event::CapabilityStart { actor, capability, tag, args } => {
+            Event::CapabilityStart { actor, capability, tag, args, .. } => {
                 self.activities.push(Activity {
                     capability: capability.to_string(),
                     tag: tag.as_deref().map(str::to_string),
@@ -79,7 +79,7 @@ impl MissionState {
                     self.activities.remove(i);
                 }
             }
-            Event::Leash { capability, tag, action } => {
+            Event::Leash { capability, tag, action, .. } => {
                 let paused = match action.as_ref() {
                     "PAUSE" => Some(true),
                     "RESUME" => Some(false),

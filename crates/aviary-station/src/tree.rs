@@ -1,8 +1,7 @@
 //! The mission's block tree as the page shows it: blocks, the activities their statements
 //! start, handlers and what else a body does, with the names the trace uses, so that the
 //! page can give each node the live status the trace's events say (a block by its
-//! `block` name, an activity by capability, tag and actor, a handler by its `handler`
-//! name).
+//! `block` name, a statement by its `line`, a handler by its `handler` name).
 
 use aviary_diagnostics::SourceMap;
 use aviary_ir::{ActorFilter, ActorRef, Block, BlockKind, Mission, Node, Origin};
@@ -19,10 +18,13 @@ struct Tree<'a> {
 }
 
 impl Tree<'_> {
+    /// The node's line, as the trace's events name it (`Mission::line_of`): what the page
+    /// follows each statement by.
     fn line(&self, origin: &Origin) -> Value {
-        match self.sources {
-            Some(s) => s.line_col(origin.file, origin.span.start).line.into(),
-            None => Value::Null,
+        match (self.m.line_of(origin), self.sources) {
+            (Some(line), _) => line.into(),
+            (None, Some(s)) => s.line_col(origin.file, origin.span.start).line.into(),
+            (None, None) => Value::Null,
         }
     }
 

@@ -96,6 +96,10 @@ fn every_kind_is_listed_once_at_its_own_index() {
     assert_eq!(names.len(), EventKind::ALL.len());
 }
 
+fn line() -> impl Strategy<Value = Option<u32>> {
+    proptest::option::of(1u32..100_000)
+}
+
 fn text() -> impl Strategy<Value = Text<'static>> {
     "[a-zA-Z0-9 _/é\"\\\\\n\u{1}]{0,8}".prop_map(Cow::Owned)
 }
@@ -184,16 +188,23 @@ fn event() -> impl Strategy<Value = Event<'static>> {
         (status(), opt(text())).prop_map(|(status, reason)| Event::MissionEnd { status, reason }),
         text().prop_map(|block| Event::BlockStart { block }),
         (text(), status()).prop_map(|(block, status)| Event::BlockEnd { block, status }),
-        (text(), text(), opt(text()), params()).prop_map(|(actor, capability, tag, args)| {
-            Event::CapabilityStart { actor, capability, tag, args }
-        }),
-        (text(), text(), opt(text()), params(), status()).prop_map(
-            |(actor, capability, tag, args, status)| Event::CapabilityEnd {
+        (text(), text(), opt(text()), params(), line()).prop_map(
+            |(actor, capability, tag, args, line)| Event::CapabilityStart {
                 actor,
                 capability,
                 tag,
                 args,
-                status
+                line
+            }
+        ),
+        (text(), text(), opt(text()), params(), status(), line()).prop_map(
+            |(actor, capability, tag, args, status, line)| Event::CapabilityEnd {
+                actor,
+                capability,
+                tag,
+                args,
+                status,
+                line
             }
         ),
         (text(), text(), opt(text())).prop_map(|(signal, handler, actor)| Event::HandlerStart {
@@ -220,19 +231,19 @@ fn event() -> impl Strategy<Value = Event<'static>> {
                 position,
                 left
             }),
-        (text(), opt(text()), values()).prop_map(|(name, actor, args)| Event::Signal {
-            name,
-            actor,
-            args
-        }),
-        (text(), opt(text()), values(), any::<bool>(), opt(text()), opt(text()), opt(text()))
-            .prop_map(|(name, actor, args, handled, handler, during, skipped)| {
-                Event::Exception { name, actor, args, handled, handler, during, skipped }
-            }),
-        (text(), text(), text()).prop_map(|(capability, tag, action)| Event::Leash {
-            capability,
-            tag,
-            action
+        (text(), opt(text()), values(), line())
+            .prop_map(|(name, actor, args, line)| { Event::Signal { name, actor, args, line } }),
+        (
+            (text(), opt(text()), values(), any::<bool>()),
+            (opt(text()), opt(text()), opt(text()), line())
+        )
+            .prop_map(
+                |((name, actor, args, handled), (handler, during, skipped, line))| {
+                    Event::Exception { name, actor, args, handled, handler, during, skipped, line }
+                }
+            ),
+        (text(), text(), text(), line()).prop_map(|(capability, tag, action, line)| {
+            Event::Leash { capability, tag, action, line }
         }),
         (text(), text(), point()).prop_map(|(actor, kind, location)| Event::Detection {
             actor,

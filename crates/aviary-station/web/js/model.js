@@ -12,6 +12,7 @@ export function newModel() {
     blocks: new Map(),     // block name -> status
     handlers: new Map(),   // handler name -> {running, done}
     activities: new Map(), // "capability|tag|actor" -> {running, done, aborted, failed, paused}
+    statements: new Map(), // line of a statement of the MISSION's file -> {running, done, aborted, failed, paused}
     finds: [],
     marks: [],             // timeline: {t, kind, text}
     log: [],
@@ -78,6 +79,9 @@ export function observe(model, e) {
       const v = bump(model.handlers, e.handler, "running", -1); v.done++; break;
     }
     case "capability_start": {
+      // The statement itself, by its line: what the tree follows (two statements of one
+      // drone and capability are two lines).
+      if (e.line) bump(model.statements, e.line, "running", 1);
       for (const a of e.actor.split(" ")) {
         bump(model.activities, key(e.capability, e.tag, a), "running", 1);
         // What the drone works on, outermost first: a capability and the ones it calls
@@ -89,6 +93,10 @@ export function observe(model, e) {
       break;
     }
     case "capability_end": {
+      if (e.line) {
+        const v = bump(model.statements, e.line, "running", -1);
+        v[e.status === "ok" ? "done" : e.status === "failed" ? "failed" : "aborted"]++;
+      }
       for (const a of e.actor.split(" ")) {
         const v = bump(model.activities, key(e.capability, e.tag, a), "running", -1);
         v[e.status === "ok" ? "done" : e.status === "failed" ? "failed" : "aborted"]++;
@@ -100,6 +108,7 @@ export function observe(model, e) {
       break;
     }
     case "leash": {
+      if (e.line) bump(model.statements, e.line, "done", 1);
       model.marks.push({ t: e.t, kind: "operator", text: `${e.capability}-${e.tag} ${e.action}` });
       for (const [k, v] of model.activities) {
         if (k.startsWith(`${e.capability}|${e.tag}|`)) {
@@ -110,11 +119,13 @@ export function observe(model, e) {
       return true;
     }
     case "signal":
+      if (e.line) bump(model.statements, e.line, "done", 1);
       model.marks.push({ t: e.t, kind: "signal", text: e.name });
       if (e.name === "BatteryLow" && e.actor) alarm(model, e, "battery", e.actor, `${e.actor}: battery low`, false);
       if (e.name === "ConnectionRestored" && e.actor) drone(model, e.actor).link = "ok";
       break;
     case "exception": {
+      if (e.line) bump(model.statements, e.line, "done", 1);
       model.marks.push({ t: e.t, kind: "exception", text: e.name });
       if (e.actor) {
         if (e.name === "ConnectionLost") drone(model, e.actor).link = "lost";
@@ -180,6 +191,18 @@ export function observe(model, e) {
       return false;
   }
   return true;
+}
+
+/// The status of the statement on `line` (of the MISSION's file), from the events that
+/// name it; `held`: whether a drone it runs on is held by the operator or paused.
+export function statementStatus(model, line, held = false) {
+  const v = model.statements.get(line);
+  if (!v) return "waiting";
+  if ((v.paused || held || model.paused) && v.running) return "paused";
+  if (v.running) return "running";
+  if (v.failed) return "failed";
+  if (v.aborted && !v.done) return "aborted";
+  return "done";
 }
 
 /// The status of an activity node: its drones' instances, summed.

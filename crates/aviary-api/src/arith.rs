@@ -88,4 +88,49 @@ mod tests {
         assert_eq!(sum, Some(Value::Number(1.0)));
         assert_eq!(add(&Value::Number(3.0), &Value::Text("x".into()), 1.0), None);
     }
+
+    mod laws {
+        use super::super::*;
+        use proptest::prelude::*;
+
+        fn point() -> impl Strategy<Value = Point> {
+            (-5000.0..5000.0f64, -5000.0..5000.0f64, prop::option::of(0.0..120.0f64))
+                .prop_map(|(x, y, z)| Point { x, y, z })
+        }
+
+        fn ground(a: Point, b: Point) -> f64 {
+            (a.x - b.x).hypot(a.y - b.y)
+        }
+
+        proptest! {
+            /// `OFFSET(p, d, b)` is `d` from `p` over the ground, for every bearing, at
+            /// `p`'s height; going back on the opposite bearing returns to `p`.
+            #[test]
+            fn an_offset_is_its_distance_away(p in point(), d in 0.0..2000.0f64, b in -720.0..720.0f64) {
+                let q = offset(p, d, b);
+                prop_assert!((ground(p, q) - d).abs() < 1e-6);
+                prop_assert_eq!(q.z, p.z);
+                let back = offset(q, d, b + 180.0);
+                prop_assert!(ground(back, p) < 1e-6);
+            }
+
+            /// `MIDPOINT(a, b)` is as far from `a` as from `b`, half the way.
+            #[test]
+            fn a_midpoint_is_equidistant(a in point(), b in point()) {
+                let m = midpoint(a, b);
+                prop_assert!((ground(a, m) - ground(m, b)).abs() < 1e-6);
+                prop_assert!((2.0 * ground(a, m) - ground(a, b)).abs() < 1e-6);
+            }
+
+            /// Moving by an offset and back by it returns to the start.
+            #[test]
+            fn plus_then_minus_is_nothing(p in point(), by in point()) {
+                let there = shift(shift(p, by, 1.0), by, -1.0);
+                prop_assert!(ground(there, p) < 1e-6);
+                if let (Some(z), Some(back)) = (p.z, there.z) {
+                    prop_assert!((z - back).abs() < 1e-6);
+                }
+            }
+        }
+    }
 }

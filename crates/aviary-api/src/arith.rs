@@ -36,7 +36,10 @@ pub fn shift(p: Point, by: Point, sign: f64) -> Point {
 /// clockwise from north (90 is east); its height is `p`'s.
 pub fn offset(p: Point, distance: f64, bearing: f64) -> Point {
     let (sin, cos) = bearing.to_radians().sin_cos();
-    Point { x: p.x + distance * sin, y: p.y + distance * cos, z: p.z }
+    // To the nanometre: 90deg is due east, not 1e-13 m north of it (which a message
+    // would show).
+    let nano = |v: f64| (v * 1e9).round() / 1e9;
+    Point { x: p.x + nano(distance * sin), y: p.y + nano(distance * cos), z: p.z }
 }
 
 /// Halfway between `a` and `b`; at the mean height when both have one, else without.

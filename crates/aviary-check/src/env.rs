@@ -51,8 +51,16 @@ pub(crate) fn visit_exprs<'a>(expr: &'a Expr, f: &mut dyn FnMut(&'a Expr)) {
         ExprKind::Coordinates(parts) | ExprKind::Geo(parts) => {
             parts.iter().for_each(|p| visit_exprs(p, f))
         }
-        ExprKind::Distance(a, b) | ExprKind::Binary(a, _, b) => {
+        ExprKind::Distance(a, b)
+        | ExprKind::Binary(a, _, b)
+        | ExprKind::Arith(a, _, b)
+        | ExprKind::Midpoint(a, b) => {
             visit_exprs(a, f);
+            visit_exprs(b, f);
+        }
+        ExprKind::Offset(a, d, b) => {
+            visit_exprs(a, f);
+            visit_exprs(d, f);
             visit_exprs(b, f);
         }
         ExprKind::Not(e) | ExprKind::Paren(e) => visit_exprs(e, f),
@@ -89,6 +97,7 @@ pub(crate) fn stmt_exprs(stmt: &Stmt) -> Vec<&Expr> {
         }
         Stmt::Signal(r) | Stmt::Throw(r) => args(&r.args),
         Stmt::If(i) => i.branches.iter().map(|(c, _)| c).collect(),
+        Stmt::Let(l) => vec![&l.value],
         _ => Vec::new(),
     }
 }
@@ -101,6 +110,9 @@ pub(crate) fn literal_kind(expr: &Expr) -> Option<Kind> {
         ExprKind::Bool(_) => Some(Kind::Bool),
         ExprKind::Coordinates(_) | ExprKind::Geo(_) => Some(Kind::Position),
         ExprKind::Distance(..) => Some(Kind::Length),
+        ExprKind::Offset(..) | ExprKind::Midpoint(..) => Some(Kind::Position),
+        // `20m + 5m` is a length, `(0, 0) + (20m, 0m)` a position: the left side says.
+        ExprKind::Arith(l, _, _) => literal_kind(l),
         ExprKind::Elapsed => Some(Kind::Duration),
         ExprKind::Paren(e) => literal_kind(e),
         _ => None,

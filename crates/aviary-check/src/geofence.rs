@@ -11,7 +11,7 @@ use std::collections::BTreeMap;
 
 use aviary_api::geometry::{circle_inside, contains, segment_inside};
 use aviary_api::show::number;
-use aviary_api::Function;
+use aviary_api::{arith, Function, Point};
 use aviary_diagnostics::{Code, Diagnostic, FileId, Label, Span};
 use aviary_syntax::ast::*;
 use aviary_world::World;
@@ -32,6 +32,22 @@ pub(crate) enum Known {
 }
 
 pub(crate) type Values = BTreeMap<String, Known>;
+
+/// Where a known value stands: a point, or an area's centroid.
+fn point_of(k: &Known) -> Option<Point> {
+    match k {
+        Known::Point([x, y], z) => Some(Point { x: *x, y: *y, z: *z }),
+        Known::Area(poly) => {
+            let [x, y] = aviary_api::centroid(poly);
+            Some(Point::flat(x, y))
+        }
+        Known::Number(_) | Known::Drones(_) => None,
+    }
+}
+
+fn known_point(p: Point) -> Known {
+    Known::Point([p.x, p.y], p.z)
+}
 
 pub(crate) fn check_geofence(program: &Program, world: &World, diagnostics: &mut Vec<Diagnostic>) {
     let (fence, ceiling) = (world.site.geofence.as_deref(), world.site.max_altitude);
@@ -106,6 +122,32 @@ impl Walker<'_> {
                 self.world.area(&id.name).map(|a| Known::Area(a.polygon.clone()))
             }
             ExprKind::Paren(inner) => self.value(inner, values),
+            // Worked out as the compiler folds it (`aviary_api::arith`), when all is known.
+            ExprKind::Arith(l, op, r) => {
+                let sign = if *op == ArithOp::Add { 1.0 } else { -1.0 };
+                match (self.value(l, values)?, self.value(r, values)?) {
+                    (Known::Number(a), Known::Number(b)) => Some(Known::Number(a + sign * b)),
+                    (p, Known::Point(by, dz)) => {
+                        let by = Point { x: by[0], y: by[1], z: dz };
+                        Some(known_point(arith::shift(point_of(&p)?, by, sign)))
+                    }
+                    _ => None,
+                }
+            }
+            ExprKind::Offset(p, d, b) => {
+                let p = point_of(&self.value(p, values)?)?;
+                match (self.value(d, values)?, self.value(b, values)?) {
+                    (Known::Number(d), Known::Number(b)) => {
+                        Some(known_point(arith::offset(p, d, b)))
+                    }
+                    _ => None,
+                }
+            }
+            ExprKind::Midpoint(a, b) => {
+                let (a, b) =
+                    (point_of(&self.value(a, values)?)?, point_of(&self.value(b, values)?)?);
+                Some(known_point(arith::midpoint(a, b)))
+            }
             _ => None,
         }
     }
@@ -119,7 +161,20 @@ impl Walker<'_> {
         file: FileId,
         depth: usize,
     ) {
+        // The values with those of the LETs reached so far.
+        let mut own: Option<Values> = None;
         for stmt in &body.items {
+            if let Stmt::Let(l) = stmt {
+                let current = own.as_ref().unwrap_or(values);
+                let mut next = current.clone();
+                match self.value(&l.value, current) {
+                    Some(k) => next.insert(l.name.name.clone(), k),
+                    None => next.remove(&l.name.name),
+                };
+                own = Some(next);
+                continue;
+            }
+            let values = own.as_ref().unwrap_or(values);
             match stmt {
                 Stmt::Statement(s) => {
                     self.statement(s, values, site.or(Some((file, s.span))), depth)

@@ -85,6 +85,8 @@ codes! {
     OneAtATimeNotEvery = "E129", Error, "`ONE AT A TIME` on a handler that is not an `ON EVERY`";
     OperatorSignalBuiltin = "E130", Error, "an OPERATOR SIGNAL that names a built-in signal, which only a drone raises";
     GroupRemainder = "E131", Error, "`group.remaining`: a remainder is one drone's, not a group's";
+    LetTaken = "E132", Error, "a LET of a name that is already bound here (another LET, a parameter, an alias, a drone, a place, ...)";
+    LetNotHere = "E133", Error, "a name used where its LET does not reach: before it, outside its body, or in a handler that may fire before it";
     AnyNotGroup = "E140", Error, "an ANY that chooses from something that is not a group of the world";
     AnyCount = "E141", Error, "an ANY that asks for a number of drones its group cannot give (not a whole number from 1 to the group's size)";
     // Warnings.

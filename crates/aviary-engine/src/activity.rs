@@ -166,7 +166,7 @@ impl<'m> Engine<'m> {
             handlers: &[],
             fired: RefCell::new(Vec::new()),
             exception_handlers: &cap.exception_handlers,
-            frame: frame.clone(),
+            frame: RefCell::new(frame.clone()),
             jobs: Jobs::default(),
             unwinding: Cell::new(false),
             deferred: RefCell::new(Vec::new()),

@@ -134,7 +134,9 @@ pub(crate) struct Scope<'m> {
     pub handlers: &'m [Handler],
     pub fired: RefCell<Vec<bool>>,
     pub exception_handlers: &'m [ExceptionHandler],
-    pub frame: Frame,
+    /// The frame the body's handlers start from: the body's, with the LETs it has
+    /// reached so far (`Engine::bind`).
+    pub frame: RefCell<Frame>,
     pub jobs: Jobs<'m>,
     /// Set when an exception aborts the sequential chain through this scope.
     pub unwinding: Cell<bool>,
@@ -455,7 +457,7 @@ impl<'m> Engine<'m> {
             handlers: &[],
             fired: RefCell::new(Vec::new()),
             exception_handlers: &[],
-            frame: Rc::from(vec![Value::Bool(false); self.m.frame_size]),
+            frame: RefCell::new(Rc::from(vec![Value::Bool(false); self.m.frame_size])),
             jobs: Jobs::default(),
             unwinding: Cell::new(false),
             deferred: RefCell::new(Vec::new()),
@@ -468,7 +470,7 @@ impl<'m> Engine<'m> {
         *self.root.borrow_mut() = Some(root.clone());
         let ctx = Ctx {
             scope: root.clone(),
-            frame: root.frame.clone(),
+            frame: root.frame.borrow().clone(),
             actor: None,
             instance: None,
             claims: Claims::default(),
@@ -803,7 +805,7 @@ impl<'m> Engine<'m> {
     ) {
         let handlers: &'m [Handler] = scope.handlers;
         for (i, h) in handlers.iter().enumerate() {
-            if h.signal != signal || !self.matches(&h.by, &scope.frame, actor) {
+            if h.signal != signal || !self.matches(&h.by, &scope.frame.borrow(), actor) {
                 continue;
             }
             if !h.every {
@@ -850,7 +852,7 @@ impl<'m> Engine<'m> {
         let found = from.chain().find_map(|scope| {
             let handlers: &'m [ExceptionHandler] = scope.exception_handlers;
             let i = handlers.iter().position(|h| {
-                h.exception == exception && self.matches(&h.by, &scope.frame, actor)
+                h.exception == exception && self.matches(&h.by, &scope.frame.borrow(), actor)
             })?;
             let reentry = self.reentries(Taker::exception(&handlers[i]), &cause);
             let reentries = reentry.unwrap_or(0);

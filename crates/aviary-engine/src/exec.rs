@@ -113,7 +113,7 @@ impl<'m> Engine<'m> {
             handlers: &block.handlers,
             fired: RefCell::new(vec![false; block.handlers.len()]),
             exception_handlers: &block.exception_handlers,
-            frame: ctx.frame.clone(),
+            frame: RefCell::new(ctx.frame.clone()),
             jobs: Jobs::default(),
             unwinding: Cell::new(false),
             deferred: RefCell::new(Vec::new()),
@@ -173,6 +173,15 @@ impl<'m> Engine<'m> {
         match block.kind {
             BlockKind::Sequential => self.sequence(&block.items, ctx).await,
             BlockKind::Parallel => {
+                // Every item starts at this instant: the LETs are taken first, in order,
+                // and every branch starts from the frame with their values.
+                let mut bound: Option<Ctx<'m>> = None;
+                for node in &block.items {
+                    if let Node::Let { slot, value, .. } = node {
+                        bound = Some(self.bind(*slot, value, bound.as_ref().unwrap_or(ctx)));
+                    }
+                }
+                let ctx = bound.as_ref().unwrap_or(ctx);
                 let branches = block.items.iter().map(|n| self.node(n, ctx));
                 if block.items.len() <= SMALL {
                     join_in_order(branches).await;
@@ -183,11 +192,18 @@ impl<'m> Engine<'m> {
         }
     }
 
-    /// Statements one after another, until the scope unwinds.
+    /// Statements one after another, until the scope unwinds. A LET gives the items
+    /// after it a frame with its value.
     pub(crate) async fn sequence(&self, items: &'m [Node], ctx: &Ctx<'m>) {
+        let mut bound: Option<Ctx<'m>> = None;
         for node in items {
+            let ctx = bound.as_ref().unwrap_or(ctx);
             if ctx.scope.unwinding.get() {
                 break;
+            }
+            if let Node::Let { slot, value, .. } = node {
+                bound = Some(self.bind(*slot, value, ctx));
+                continue;
             }
             // Long runs of statements that end at once (W's steps) never let the engine
             // wait: a stop from outside is looked for before each.
@@ -195,6 +211,21 @@ impl<'m> Engine<'m> {
             self.statement(node, ctx).await;
             self.caught(ctx).await;
         }
+    }
+
+    /// `LET`: the value taken now, once (a drone's position read now stays what it
+    /// was), into `slot` of a new frame for the items after it; the body's handlers
+    /// that start from now on start from it too.
+    fn bind(&self, slot: usize, value: &Expr, ctx: &Ctx<'m>) -> Ctx<'m> {
+        let value = {
+            let received = self.received.borrow();
+            self.env(&ctx.frame, &received).eval(value)
+        };
+        let mut frame = ctx.frame.to_vec();
+        set(&mut frame, slot, value);
+        let frame: Frame = Rc::from(frame);
+        *ctx.scope.frame.borrow_mut() = frame.clone();
+        Ctx { frame, ..ctx.clone() }
     }
 
     /// A handler caught here takes the place of what it aborted: waits for it.
@@ -269,6 +300,8 @@ impl<'m> Engine<'m> {
                     unreachable!("boxed apart in `node`")
                 }
                 Node::Leash(l) => self.leash(l, ctx),
+                // Taken by the sequence or the PARALLEL block that holds it.
+                Node::Let { .. } => {}
                 Node::Signal { signal, args, origin } => self.signal(*signal, args, origin, ctx),
                 Node::Throw { exception, args, origin } => {
                     let args = self.eval_all(args, ctx);
@@ -442,7 +475,7 @@ impl<'m> Engine<'m> {
                     scope.firing_ended(handler);
                     return;
                 }
-                let mut frame = scope.frame.to_vec();
+                let mut frame = scope.frame.borrow().to_vec();
                 for (slot, v) in handler.bindings.iter().zip(args) {
                     set(&mut frame, *slot, v);
                 }
@@ -465,7 +498,7 @@ impl<'m> Engine<'m> {
                 scope.firing_ended(handler);
             }
             Job::Exception { handler, args, entry } => {
-                let mut frame = scope.frame.to_vec();
+                let mut frame = scope.frame.borrow().to_vec();
                 for (slot, v) in handler.bindings.iter().zip(args) {
                     set(&mut frame, *slot, v);
                 }
@@ -534,7 +567,7 @@ impl<'m> Engine<'m> {
                     self.rehold(&instance, before);
                 }
                 LeashAction::Section(i) => {
-                    let mut frame = scope.frame.to_vec();
+                    let mut frame = scope.frame.borrow().to_vec();
                     for (p, v) in &values {
                         set(&mut frame, cap.actors + p, v.clone());
                     }

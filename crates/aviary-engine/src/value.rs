@@ -1,6 +1,6 @@
 //! Evaluating expressions at run time.
 
-use aviary_api::{Backend, Point, Value};
+use aviary_api::{arith, Backend, Point, Value};
 use aviary_ir::{ActorRef, Expr, Field, Mission};
 
 /// What an expression needs from the run: the frame, telemetry, signals, the clock.
@@ -60,6 +60,28 @@ impl Env<'_> {
                 let (a, b) = (self.position(&self.eval(a)), self.position(&self.eval(b)));
                 Value::Number(((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt())
             }
+            Expr::Add(a, b) | Expr::Sub(a, b) => {
+                let sign = if matches!(e, Expr::Add(..)) { 1.0 } else { -1.0 };
+                let (a, b) = (self.placed(self.eval(a)), self.eval(b));
+                arith::add(&a, &b, sign).unwrap_or(Value::Bool(false))
+            }
+            Expr::Offset(p, d, b) => {
+                let p = arith::point_of(&self.placed(self.eval(p)));
+                match (p, self.eval(d), self.eval(b)) {
+                    (Some(p), Value::Number(d), Value::Number(b)) => {
+                        Value::Position(arith::offset(p, d, b))
+                    }
+                    _ => Value::Bool(false),
+                }
+            }
+            Expr::Midpoint(a, b) => {
+                let a = arith::point_of(&self.placed(self.eval(a)));
+                let b = arith::point_of(&self.placed(self.eval(b)));
+                match (a, b) {
+                    (Some(a), Some(b)) => Value::Position(arith::midpoint(a, b)),
+                    _ => Value::Bool(false),
+                }
+            }
             Expr::Elapsed => {
                 Value::Number((tokio::time::Instant::now() - self.start).as_secs_f64())
             }
@@ -73,6 +95,15 @@ impl Env<'_> {
 
     pub fn truth(&self, e: &Expr) -> bool {
         truth(&self.eval(e))
+    }
+
+    /// A drone as where it is now (its position, as `drone.position` reads it); any
+    /// other value as it is. What position arithmetic starts from.
+    fn placed(&self, v: Value) -> Value {
+        match v {
+            Value::Actor(d) => telemetry(self.backend, d, Field::Position),
+            v => v,
+        }
     }
 
     /// Where a value is, on the ground: a drone now, an area's centroid, a point.

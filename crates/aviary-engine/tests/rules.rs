@@ -799,3 +799,52 @@ fn any_two_runs_its_body_once_for_each() {
     assert_eq!(far.len(), 3, "{far:?}");
     assert!(close(far[1].0, 3.0) && close(far[2].0, 4.0), "{far:?}");
 }
+
+/// Where `actor` was when its `FlyToPosition` number `i` was done (the trace says).
+fn at_end_of_fly_to(r: &harness::Run, actor: &str, i: usize) -> [f64; 3] {
+    let done: Vec<&serde_json::Value> = r
+        .trace
+        .iter()
+        .filter(|e| {
+            e["event"] == "api_done" && e["actor"] == actor && e["function"] == "FlyToPosition"
+        })
+        .collect();
+    let p = &done[i]["position"];
+    [0, 1, 2].map(|k| p[k].as_f64().unwrap())
+}
+
+/// How far apart over the ground.
+fn ground(p: [f64; 3], q: [f64; 3]) -> f64 {
+    (p[0] - q[0]).hypot(p[1] - q[1])
+}
+
+#[test]
+fn two_drones_sent_beside_one_find_end_apart() {
+    let r = run(&fixture("two_drones_sent_beside_one_find_end_apart"));
+    assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
+    let (a, b) = (at_end_of_fly_to(&r, "a", 0), at_end_of_fly_to(&r, "b", 0));
+    let c = at_end_of_fly_to(&r, "c", 0);
+    assert!((ground(a, b) - 40.0).abs() < 0.5, "{a:?} {b:?}");
+    assert!(
+        (ground(a, c) - 20.0).abs() < 0.5 && (a[0] - c[0] - 20.0).abs() < 0.5,
+        "a east of the find"
+    );
+    assert!((ground(b, c) - 20.0).abs() < 0.5 && (c[0] - b[0] - 20.0).abs() < 0.5, "b west of it");
+    // At the find's height: the offsets keep it.
+    assert!((a[2] - c[2]).abs() < 0.5 && (b[2] - c[2]).abs() < 0.5, "{a:?} {b:?} {c:?}");
+}
+
+#[test]
+fn a_let_keeps_the_value_it_took() {
+    let r = run(&fixture("a_let_keeps_the_value_it_took"));
+    assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
+    // `there` is where `a` stood after its take-off, though `a` flew on to (100, 0).
+    let b = at_end_of_fly_to(&r, "b", 0);
+    assert!(ground(b, [0.0, 0.0, 0.0]) < 0.5 && (b[2] - 20.0).abs() < 0.5, "{b:?}");
+    // `beside` was taken as the PARALLEL started, with `a` at (100, 0).
+    let c = at_end_of_fly_to(&r, "c", 0);
+    assert!(ground(c, [50.0, 0.0, 0.0]) < 0.5, "{c:?}");
+    // `above` is `there` 10 m higher.
+    let a = at_end_of_fly_to(&r, "a", 1);
+    assert!(ground(a, [0.0, 0.0, 0.0]) < 0.5 && (a[2] - 30.0).abs() < 0.5, "{a:?}");
+}

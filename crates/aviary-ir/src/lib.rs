@@ -39,7 +39,7 @@ pub struct Origin {
 pub struct Mission {
     pub name: String,
     pub body: Block,
-    /// Variables of the mission frame (FOR aliases and parameters, handler bindings).
+    /// Variables of the mission frame (FOR aliases and parameters, handler bindings, LETs).
     pub frame_size: usize,
     pub capabilities: Vec<Capability>,
     /// Drone names, by `DroneId`.
@@ -261,14 +261,41 @@ pub enum Node {
     Call(Call),
     Leash(Leash),
     Api(ApiCall),
-    Signal { signal: SignalId, args: Vec<Expr>, origin: Origin },
-    Throw { exception: ExceptionId, args: Vec<Expr>, origin: Origin },
-    StartIf { condition: Expr, body: Block },
-    WaitFor { condition: Expr, body: Option<Block> },
-    DoWhile { condition: Expr, body: Block },
+    Signal {
+        signal: SignalId,
+        args: Vec<Expr>,
+        origin: Origin,
+    },
+    Throw {
+        exception: ExceptionId,
+        args: Vec<Expr>,
+        origin: Origin,
+    },
+    StartIf {
+        condition: Expr,
+        body: Block,
+    },
+    WaitFor {
+        condition: Expr,
+        body: Option<Block>,
+    },
+    DoWhile {
+        condition: Expr,
+        body: Block,
+    },
     For(For),
     Any(Any),
-    If { branches: Vec<(Expr, Block)>, otherwise: Option<Block> },
+    If {
+        branches: Vec<(Expr, Block)>,
+        otherwise: Option<Block>,
+    },
+    /// `LET name = value`: `value` taken once, when reached, into `slot` of the frame,
+    /// which the items after it (and the handlers of its body) read.
+    Let {
+        slot: Slot,
+        value: Expr,
+        origin: Origin,
+    },
 }
 
 /// Who a statement or a call is about.
@@ -461,6 +488,15 @@ pub enum Expr {
     /// `GEO(lat, lon[, alt])` with a part that is not a literal.
     Geo(Vec<Expr>),
     Distance(Box<Expr>, Box<Expr>),
+    /// `a + b`: two quantities of one kind, or a position and an offset in metres
+    /// (`aviary_api::arith::add`).
+    Add(Box<Expr>, Box<Expr>),
+    /// `a - b`, as `Add`.
+    Sub(Box<Expr>, Box<Expr>),
+    /// `OFFSET(position, distance, bearing)` (`aviary_api::arith::offset`).
+    Offset(Box<Expr>, Box<Expr>, Box<Expr>),
+    /// `MIDPOINT(a, b)` (`aviary_api::arith::midpoint`).
+    Midpoint(Box<Expr>, Box<Expr>),
     Elapsed,
     Received(SignalId),
     Not(Box<Expr>),

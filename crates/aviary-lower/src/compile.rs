@@ -2,7 +2,7 @@
 
 use std::collections::BTreeMap;
 
-use aviary_api::{BuiltinException, BuiltinSignal, Descriptor, DroneId, Point, Value};
+use aviary_api::{arith, BuiltinException, BuiltinSignal, Descriptor, DroneId, Point, Value};
 use aviary_check::{bind_args, Program};
 use aviary_diagnostics::FileId;
 use aviary_syntax::ast;
@@ -308,8 +308,18 @@ impl<'a> Compiler<'a> {
             handlers: Vec::new(),
             exception_handlers: Vec::new(),
         };
+        // The LETs of this body, seen to its end.
+        self.scopes.push(Vec::new());
         for stmt in &body.items {
             match stmt {
+                ast::Stmt::Let(l) => {
+                    let value = self.expr(&l.value);
+                    let slot = self.slot();
+                    if let Some(scope) = self.scopes.last_mut() {
+                        scope.push((l.name.name.clone(), slot, false));
+                    }
+                    block.items.push(Node::Let { slot, value, origin: self.origin(l.span) });
+                }
                 ast::Stmt::Handler(h) => {
                     let handler = self.handler(h, path);
                     block.handlers.push(handler);
@@ -325,6 +335,7 @@ impl<'a> Compiler<'a> {
                 }
             }
         }
+        self.scopes.pop();
         block
     }
 
@@ -499,8 +510,10 @@ impl<'a> Compiler<'a> {
                     .map(|b| self.body(b, &format!("{parent}/ELSE"), BlockKind::Sequential, false));
                 Node::If { branches, otherwise }
             }
+            // Handlers and LETs are `body`'s, which sees their place in the body.
             ast::Stmt::Handler(_)
             | ast::Stmt::ExceptionHandler(_)
+            | ast::Stmt::Let(_)
             | ast::Stmt::OperatorSignals(_)
             | ast::Stmt::Error(_) => return None,
         })
@@ -615,6 +628,44 @@ impl<'a> Compiler<'a> {
                 }
             }
             K::Distance(a, b) => Expr::Distance(Box::new(self.expr(a)), Box::new(self.expr(b))),
+            K::Arith(l, op, r) => {
+                let (l, r) = (self.expr(l), self.expr(r));
+                let sign = if *op == ast::ArithOp::Add { 1.0 } else { -1.0 };
+                // What is known now is worked out now: the plan and the geofence see it.
+                if let (Expr::Const(a), Expr::Const(b)) = (&l, &r) {
+                    if let Some(v) = arith::add(a, b, sign) {
+                        return Expr::Const(v);
+                    }
+                }
+                let (l, r) = (Box::new(l), Box::new(r));
+                match op {
+                    ast::ArithOp::Add => Expr::Add(l, r),
+                    ast::ArithOp::Sub => Expr::Sub(l, r),
+                }
+            }
+            K::Offset(p, d, b) => {
+                let (p, d, b) = (self.expr(p), self.expr(d), self.expr(b));
+                if let (
+                    Expr::Const(p),
+                    Expr::Const(Value::Number(d)),
+                    Expr::Const(Value::Number(b)),
+                ) = (&p, &d, &b)
+                {
+                    if let Some(p) = arith::point_of(p) {
+                        return Expr::Const(Value::Position(arith::offset(p, *d, *b)));
+                    }
+                }
+                Expr::Offset(Box::new(p), Box::new(d), Box::new(b))
+            }
+            K::Midpoint(a, b) => {
+                let (a, b) = (self.expr(a), self.expr(b));
+                if let (Expr::Const(x), Expr::Const(y)) = (&a, &b) {
+                    if let (Some(x), Some(y)) = (arith::point_of(x), arith::point_of(y)) {
+                        return Expr::Const(Value::Position(arith::midpoint(x, y)));
+                    }
+                }
+                Expr::Midpoint(Box::new(a), Box::new(b))
+            }
             K::Received(s) => Expr::Received(self.signals.id(&s.name)),
             K::Elapsed => Expr::Elapsed,
             K::Not(inner) => Expr::Not(Box::new(self.expr(inner))),

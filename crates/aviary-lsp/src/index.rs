@@ -205,10 +205,13 @@ impl<'a> Walk<'a> {
         })
     }
 
+    /// A body's items; the LETs it binds are seen to its end.
     fn body(&mut self, body: &'a Body) {
+        let depth = self.locals.len();
         for s in &body.items {
             self.stmt(s);
         }
+        self.locals.truncate(depth);
     }
 
     fn args(&mut self, capability: &str, args: &'a [Arg]) {
@@ -300,6 +303,13 @@ impl<'a> Walk<'a> {
                     self.push(n.span, Sym::Signal(n.name.clone()), true);
                 }
             }
+            Stmt::Let(l) => {
+                self.expr(&l.value);
+                let (name, at) = (l.name.name.clone(), l.name.span);
+                let sym = Sym::Local { name, what: "value of a LET", file: self.file, at };
+                self.push(at, sym.clone(), true);
+                self.locals.push(sym);
+            }
             Stmt::Error(_) => {}
         }
     }
@@ -338,8 +348,16 @@ impl<'a> Walk<'a> {
                 self.push(id.span, sym, false);
             }
             ExprKind::Coordinates(v) | ExprKind::Geo(v) => v.iter().for_each(|x| self.expr(x)),
-            ExprKind::Distance(a, b) | ExprKind::Binary(a, _, b) => {
+            ExprKind::Distance(a, b)
+            | ExprKind::Binary(a, _, b)
+            | ExprKind::Arith(a, _, b)
+            | ExprKind::Midpoint(a, b) => {
                 self.expr(a);
+                self.expr(b);
+            }
+            ExprKind::Offset(p, d, b) => {
+                self.expr(p);
+                self.expr(d);
                 self.expr(b);
             }
             ExprKind::Not(a) | ExprKind::Paren(a) => self.expr(a),

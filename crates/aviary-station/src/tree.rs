@@ -124,7 +124,8 @@ impl Tree<'_> {
                 json!({ "kind": "if", "children": children })
             }
             // A middle-layer call is written only inside capabilities.
-            Node::Api(_) => return None,
+            // A value taken, not work: the tree shows what runs.
+            Node::Api(_) | Node::Let { .. } => return None,
         })
     }
 

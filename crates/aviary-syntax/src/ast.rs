@@ -146,6 +146,8 @@ pub enum Stmt {
     OperatorSignals(OperatorSignals),
     /// `ANY d IN group WHERE c NEAREST TO p WITHIN t:`: a drone chosen at run time.
     Any(Box<AnyBlock>),
+    /// `LET name = value`: an immutable name for a value, taken once when reached.
+    Let(Let),
     /// A line that could not be read. It was reported; later stages skip it.
     Error(Span),
 }
@@ -170,6 +172,7 @@ impl Stmt {
             | Stmt::Signal(_)
             | Stmt::Throw(_)
             | Stmt::OperatorSignals(_)
+            | Stmt::Let(_)
             | Stmt::Error(_) => {}
         }
     }
@@ -302,6 +305,16 @@ pub struct OperatorSignals {
     pub span: Span,
 }
 
+/// `LET name = value`: `LET` is a word only at the start of such a line, so a drone or
+/// capability called `LET` stays what it was. The name is visible from the next item of
+/// its body to the end of that body (docs/LANGUAGE.md, section 3).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Let {
+    pub name: Ident,
+    pub value: Expr,
+    pub span: Span,
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct ExceptionHandler {
     pub exception: Ident,
@@ -406,6 +419,23 @@ impl BinaryOp {
     }
 }
 
+/// `+` and `-` between values: a position and an offset `(east, north[, up])` in metres,
+/// or two quantities of one kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ArithOp {
+    Add,
+    Sub,
+}
+
+impl ArithOp {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ArithOp::Add => "+",
+            ArithOp::Sub => "-",
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Expr {
     pub kind: ExprKind,
@@ -430,6 +460,13 @@ pub enum ExprKind {
     /// `a.b`: telemetry or an attribute.
     Path(Ident, Ident),
     Distance(Box<Expr>, Box<Expr>),
+    /// `a + b`, `a - b`: left-associative, looser than everything but comparisons.
+    Arith(Box<Expr>, ArithOp, Box<Expr>),
+    /// `OFFSET(position, distance, bearing)`: the point `distance` away on the ground,
+    /// the bearing in degrees clockwise from north.
+    Offset(Box<Expr>, Box<Expr>, Box<Expr>),
+    /// `MIDPOINT(a, b)`: the point halfway between two positions.
+    Midpoint(Box<Expr>, Box<Expr>),
     Received(Ident),
     Elapsed,
     Not(Box<Expr>),

@@ -173,6 +173,7 @@ impl Lexer<'_> {
             b')' => self.one(TokenKind::RParen),
             b'.' => self.one(TokenKind::Dot),
             b'-' => self.one(TokenKind::Minus),
+            b'+' => self.one(TokenKind::Plus),
             b'/' => self.one(TokenKind::Slash),
             b'=' if self.peek(1) == b'=' => {
                 self.pos += 2;

@@ -60,6 +60,8 @@ pub enum TokenKind {
     Gt,
     Ge,
     Minus,
+    /// `+`: only between values (`where + (20m, 0m)`).
+    Plus,
     Slash,
     /// A character with no meaning; the lexer has already reported it.
     Unknown,
@@ -95,6 +97,7 @@ impl TokenKind {
             TokenKind::Gt => "`>`".into(),
             TokenKind::Ge => "`>=`".into(),
             TokenKind::Minus => "`-`".into(),
+            TokenKind::Plus => "`+`".into(),
             TokenKind::Slash => "`/`".into(),
             TokenKind::Unknown => "an unknown character".into(),
             TokenKind::Newline => "the end of the line".into(),

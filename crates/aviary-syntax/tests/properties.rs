@@ -83,7 +83,7 @@ fn check_bytes(bytes: &[u8]) {
 const FRAGMENTS: &[&str] = &[
     "MISSION", "SEQUENTIAL", "PARALLEL", "ON", "EVERY", "BY", "WITH", "FOR", "AND", "AS", "SIGNAL", "THROW", "EXCEPTION",
     "STARTIF", "WAITFOR", "DOWHILE", "IF", "ELSE", "CAPABILITY", "REQUIREMENTS", "DEFAULTS", "PERFORM", "EXCEPTIONS",
-    "ABORT", "PAUSE", "RESUME", "USE", "NOT", "OR", "TRUE", "FALSE", "ELAPSED", "RECEIVED(", "distance(", "GEO(",
+    "ABORT", "PAUSE", "RESUME", "USE", "NOT", "OR", "TRUE", "FALSE", "ELAPSED", "RECEIVED(", "distance(", "GEO(", "OFFSET(", "MIDPOINT(", "LET", "+",
     "mission", "With", "drone", "d1", "Area", "Home", "FlyTo", "Cap-Tag", "x.y", "drone.Land()", ":", ":", ",", "(", ")",
     ".", "=", "!=", "<", "<=", ">", ">=", "==", "-", "/", "%", "20m", "20 m", "5m/s", "5 km/h", "25%", "-3", "1.5",
     "1e9", "99999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999m",
@@ -304,8 +304,20 @@ impl Gen {
         text
     }
 
+    /// A value, sometimes a sum of terms (`a + (20m, 0m) - b`).
     fn value(&mut self, depth: u32) -> String {
-        let choice = if depth == 0 { self.below(5) } else { self.below(10) };
+        let mut text = self.term(depth);
+        while depth > 0 && self.chance(15) {
+            let op = self.pick(&["+", "-"]);
+            let (s1, s2) = (self.sp(), self.sp());
+            let right = self.term(depth - 1);
+            text = format!("{text}{s1}{op}{s2}{right}");
+        }
+        text
+    }
+
+    fn term(&mut self, depth: u32) -> String {
+        let choice = if depth == 0 { self.below(5) } else { self.below(12) };
         match choice {
             0 | 1 => self.number(),
             2 => self.name(),
@@ -329,6 +341,14 @@ impl Gen {
             8 => {
                 let (a, b) = (self.value(depth - 1), self.value(depth - 1));
                 format!("distance({a},{}{b})", self.sp())
+            }
+            9 => {
+                let (a, d, b) = (self.value(depth - 1), self.value(depth - 1), self.number());
+                format!("OFFSET({a},{}{d}, {b})", self.sp())
+            }
+            10 => {
+                let (a, b) = (self.value(depth - 1), self.value(depth - 1));
+                format!("MIDPOINT({}{a},{}{b})", self.osp(), self.sp())
             }
             _ => self.number(),
         }
@@ -466,6 +486,13 @@ impl Gen {
     }
 
     fn item(&mut self, indent: usize, depth: u32, in_capability: bool) {
+        if self.chance(6) {
+            let value = self.value(2);
+            let text =
+                format!("LET{}{}{}={}{value}", self.sp(), self.name(), self.osp(), self.osp());
+            self.line(indent, &text);
+            return;
+        }
         let choice = if depth == 0 { self.below(6) } else { self.below(16) };
         match choice {
             0 | 1 => {

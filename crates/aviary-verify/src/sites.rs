@@ -275,7 +275,8 @@ impl Walk<'_> {
             Node::WaitFor { body: None, .. }
             | Node::Leash(_)
             | Node::Api(_)
-            | Node::Throw { .. } => {}
+            | Node::Throw { .. }
+            | Node::Let { .. } => {}
         }
     }
 

@@ -246,6 +246,7 @@ impl<'a> Checker<'a> {
                 Meaning::Local(Binding::Value(k)) => k,
                 Meaning::Place => Some(Kind::Position),
                 Meaning::Area => Some(Kind::Area),
+                Meaning::Unbound if self.let_not_here(id) => None,
                 Meaning::Unbound if self.names_are_known() => Some(Kind::Symbol),
                 Meaning::Unbound => None,
             },
@@ -285,6 +286,18 @@ impl<'a> Checker<'a> {
                     }
                 }
                 Some(Kind::Length)
+            }
+            ExprKind::Arith(l, op, r) => self.arith(l, *op, r),
+            ExprKind::Offset(p, d, b) => {
+                self.place_value(p, "`OFFSET`'s position");
+                self.value(d, Some(Kind::Length), "`OFFSET`'s distance");
+                self.value(b, Some(Kind::Angle), "`OFFSET`'s bearing (clockwise from north)");
+                Some(Kind::Position)
+            }
+            ExprKind::Midpoint(a, b) => {
+                self.place_value(a, "`MIDPOINT`'s first position");
+                self.place_value(b, "`MIDPOINT`'s second position");
+                Some(Kind::Position)
             }
             ExprKind::Received(_) => Some(Kind::Bool),
             ExprKind::Not(inner) => {
@@ -328,6 +341,93 @@ impl<'a> Checker<'a> {
         }
     }
 
+    /// A position, where a drone stands for where it is (as in `distance`).
+    fn place_value(&mut self, e: &'a Expr, what: &str) {
+        if self.kind_of_quietly(e) != Some(Kind::Actor) {
+            self.value(e, Some(Kind::Position), what);
+        }
+    }
+
+    /// `a + b`, `a - b`: a position and an offset written as coordinates, or two
+    /// quantities of one kind. The kind of the sum.
+    fn arith(&mut self, l: &'a Expr, op: ArithOp, r: &'a Expr) -> Option<Kind> {
+        let sign = op.as_str();
+        let left = if self.kind_of_quietly(l) == Some(Kind::Actor) {
+            Some(Kind::Position)
+        } else {
+            self.kind_of(l)
+        };
+        let offset = matches!(unparen(r).kind, ExprKind::Coordinates(_));
+        match left {
+            Some(Kind::Position | Kind::Area) => {
+                if offset {
+                    self.kind_of(r);
+                } else {
+                    let right = self.kind_of(r);
+                    let d = self.report(
+                        Code::WrongKind,
+                        r.span,
+                        format!(
+                            "a position moves by an offset in metres written as coordinates, and this is {}",
+                            right.map_or("not coordinates", |k| k.describe())
+                        ),
+                    );
+                    d.primary.message = "expected (east, north) in metres".into();
+                    let base = shown(l).unwrap_or_else(|| "where".into());
+                    d.help = Some(format!(
+                        "write `{base} {sign} (20m, 0m)` for 20 m east, `(0m, 20m)` north, `(0m, 0m, 5m)` up; or `OFFSET({base}, 20m, 90deg)` by bearing"
+                    ));
+                }
+                Some(Kind::Position)
+            }
+            Some(
+                k @ (Kind::Length
+                | Kind::Duration
+                | Kind::Speed
+                | Kind::Angle
+                | Kind::Ratio
+                | Kind::Number),
+            ) => {
+                let verb = if op == ArithOp::Add { "added to" } else { "taken from" };
+                let what = shown(l).map_or_else(
+                    || format!("the other side of `{sign}`"),
+                    |l| format!("what is {verb} `{l}`"),
+                );
+                self.value(r, Some(k), &what);
+                Some(k)
+            }
+            Some(k) => {
+                let d = self.report(
+                    Code::WrongKind,
+                    l.span,
+                    format!("`{sign}` joins quantities of one kind, or a position and an offset, and this is {}", k.describe()),
+                );
+                d.primary.message = format!("{} has no `{sign}`", k.describe());
+                d.help = Some("add lengths to lengths (`20m + 5m`), or move a position by metres (`where + (20m, 0m)`)".into());
+                self.kind_of(r);
+                None
+            }
+            None => {
+                let right = self.kind_of(r);
+                if offset {
+                    Some(Kind::Position)
+                } else {
+                    right.filter(|k| {
+                        matches!(
+                            k,
+                            Kind::Length
+                                | Kind::Duration
+                                | Kind::Speed
+                                | Kind::Angle
+                                | Kind::Ratio
+                                | Kind::Number
+                        )
+                    })
+                }
+            }
+        }
+    }
+
     /// `a.field`: telemetry, or an attribute from the world file.
     pub(super) fn path(&mut self, a: &'a Ident, field: &'a Ident) -> Option<Kind> {
         self.actor(a);
@@ -368,6 +468,14 @@ impl<'a> Checker<'a> {
                 None
             }
         }
+    }
+}
+
+/// An expression without the parentheses around it.
+fn unparen(e: &Expr) -> &Expr {
+    match &e.kind {
+        ExprKind::Paren(inner) => unparen(inner),
+        _ => e,
     }
 }
 

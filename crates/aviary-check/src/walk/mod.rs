@@ -13,6 +13,7 @@ use aviary_diagnostics::suggest::did_you_mean;
 
 mod calls;
 mod kinds;
+mod lets;
 
 pub(crate) fn check_program(
     program: &Program,
@@ -61,6 +62,8 @@ pub(crate) fn check_program(
         aliases,
         world_names,
         top_level: HashSet::new(),
+        lets: Vec::new(),
+        hidden: Vec::new(),
     };
     for (file, tree) in &program.files {
         checker.file = *file;
@@ -80,6 +83,7 @@ pub(crate) fn check_program(
                         checker.diagnostics.push(d);
                     }
                     checker.capability = None;
+                    checker.lets = lets::all_lets(&[&m.body]);
                     checker.operator_signals(&m.body);
                     checker.body(&m.body);
                 }
@@ -114,6 +118,12 @@ struct Checker<'a> {
     /// Where the `OPERATOR SIGNAL` lines directly in the MISSION body start: those are
     /// in their place; any other is misplaced.
     top_level: HashSet<(u32, u32)>,
+    /// Every LET of the mission or capability being checked, in source order: what a
+    /// name that no scope binds is checked against (E133).
+    lets: Vec<&'a Let>,
+    /// The LETs of a body that its handler being checked cannot see, since the handler
+    /// may fire before they are reached (E133).
+    hidden: Vec<&'a Let>,
 }
 
 /// The world's names: a drone before a group of the same name, then places, then
@@ -210,6 +220,7 @@ impl<'a> Checker<'a> {
                 .map(|(i, p)| (p.name.as_str(), Binding::Value(kinds.get(i).copied().flatten()))),
         );
         self.scopes.push(scope);
+        self.lets = lets::all_lets(&capability_bodies(c));
         for section in &c.sections {
             match section {
                 Section::Requirements { conditions, .. } => {
@@ -248,10 +259,37 @@ impl<'a> Checker<'a> {
         self.capability = None;
     }
 
+    /// A body, in a scope of its own for the LETs it holds.
     fn body(&mut self, body: &'a Body) {
+        self.scopes.push(Vec::new());
+        // Whether every item so far takes no time (LETs, handlers): a LET then is
+        // reached before anything in the body can raise a signal.
+        let mut at_start = true;
+        let mut late: Vec<&'a Let> = Vec::new();
         for stmt in &body.items {
-            self.stmt(stmt);
+            match stmt {
+                Stmt::Let(l) => {
+                    self.let_stmt(l);
+                    if !at_start {
+                        late.push(l);
+                    }
+                }
+                Stmt::Handler(_) | Stmt::ExceptionHandler(_) if !late.is_empty() => {
+                    let saved = self.hide(&late);
+                    self.stmt(stmt);
+                    self.unhide(saved);
+                }
+                Stmt::Handler(_)
+                | Stmt::ExceptionHandler(_)
+                | Stmt::OperatorSignals(_)
+                | Stmt::Error(_) => self.stmt(stmt),
+                _ => {
+                    at_start = false;
+                    self.stmt(stmt);
+                }
+            }
         }
+        self.scopes.pop();
     }
 
     fn stmt(&mut self, stmt: &'a Stmt) {
@@ -313,6 +351,8 @@ impl<'a> Checker<'a> {
                 ));
             }
             Stmt::OperatorSignals(_) | Stmt::Error(_) => {}
+            // Bound by `body`, which sees where in its body the LET stands.
+            Stmt::Let(_) => {}
         }
     }
 

@@ -41,6 +41,37 @@ pub(super) fn write_expr(out: &mut String, e: &Expr, source: &str) {
             write_expr(out, b, source);
             out.push(')');
         }
+        ExprKind::Arith(..) => {
+            let mut rights = Vec::new();
+            let mut leftmost = e;
+            while let ExprKind::Arith(left, op, right) = &leftmost.kind {
+                rights.push((*op, &**right));
+                leftmost = left;
+            }
+            write_expr(out, leftmost, source);
+            for (op, right) in rights.into_iter().rev() {
+                out.push(' ');
+                out.push_str(op.as_str());
+                out.push(' ');
+                write_expr(out, right, source);
+            }
+        }
+        ExprKind::Offset(p, d, b) => {
+            out.push_str("OFFSET(");
+            write_expr(out, p, source);
+            out.push_str(", ");
+            write_expr(out, d, source);
+            out.push_str(", ");
+            write_expr(out, b, source);
+            out.push(')');
+        }
+        ExprKind::Midpoint(a, b) => {
+            out.push_str("MIDPOINT(");
+            write_expr(out, a, source);
+            out.push_str(", ");
+            write_expr(out, b, source);
+            out.push(')');
+        }
         ExprKind::Received(signal) => {
             out.push_str("RECEIVED(");
             out.push_str(&signal.name);

@@ -10,7 +10,8 @@
 //! - Single spaces between words; `, ` between list items; `name=value` for named
 //!   arguments (no spaces around `=`); single spaces around condition operators
 //!   (`drone.battery > 25%`, `NOT x`, `a AND b`); `(x, y)`, `GEO(lat, lon)`,
-//!   `distance(a, b)`, `RECEIVED(S)`, `drone.DescendTo(3m)`, `drone.Land()`. Numbers are
+//!   `distance(a, b)`, `OFFSET(p, d, b)`, `MIDPOINT(a, b)`, `RECEIVED(S)`, `LET x = v`,
+//!   single spaces around `+` and `-` between values (`where + (20m, 0m)`), `drone.DescendTo(3m)`, `drone.Land()`. Numbers are
 //!   printed as written (sign included) with the unit glued on (`20 m` becomes `20m`);
 //!   parentheses stay exactly where the source has them.
 //! - Headers end in `:` and their body follows one level deeper. `ELSE IF c:` and

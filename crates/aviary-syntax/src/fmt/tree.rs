@@ -257,6 +257,10 @@ impl Printer<'_> {
                 let text = format!("OPERATOR SIGNAL {}", names(&o.names));
                 self.line(depth, &text, Last::Code, start, end);
             }
+            Stmt::Let(l) => {
+                let text = format!("LET {} = {}", l.name.name, expr_text(&l.value, self.source));
+                self.line(depth, &text, Last::Code, start, end);
+            }
             // Only in trees with errors, which are never formatted: the text as written.
             Stmt::Error(span) => {
                 let text = verbatim(self.source, span.start as usize, span.end as usize);
@@ -387,6 +391,7 @@ pub(super) fn stmt_span(stmt: &Stmt) -> aviary_diagnostics::Span {
         Stmt::ExceptionHandler(h) => h.span,
         Stmt::If(i) => i.span,
         Stmt::OperatorSignals(o) => o.span,
+        Stmt::Let(l) => l.span,
         Stmt::Error(span) => *span,
     }
 }

@@ -1,4 +1,5 @@
-//! Values (arguments: no operators) and conditions (comparisons, NOT, AND, OR).
+//! Values (arguments, with `+` and `-` between them) and conditions (comparisons, NOT,
+//! AND, OR).
 
 use aviary_diagnostics::{Code, Span};
 
@@ -56,8 +57,68 @@ impl Parser<'_> {
         self.at(TokenKind::Colon) && matches!(self.peek_at(1), TokenKind::Newline | TokenKind::Eof)
     }
 
-    /// A value: a literal, coordinates, a name, `a.b`, `distance(a, b)`, `GEO(...)`.
+    /// A value: terms joined by `+` and `-` (`where + (20m, 0m)`), left to right.
     pub(super) fn value(&mut self) -> Expr {
+        let first = self.term();
+        self.sum_from(first)
+    }
+
+    /// The rest of a sum after its first term. Each operator counts against `MAX_DEPTH`,
+    /// as AND and OR do, since the tree of `a + b + c ...` is as deep as the chain is long.
+    fn sum_from(&mut self, first: Expr) -> Expr {
+        let base = self.depth;
+        let mut left = first;
+        loop {
+            let op = match self.peek() {
+                TokenKind::Plus => ArithOp::Add,
+                TokenKind::Minus => ArithOp::Sub,
+                _ => break,
+            };
+            if self.depth >= MAX_DEPTH {
+                let span = self.span();
+                let d = self
+                    .error(
+                        Code::NestingTooDeep,
+                        span,
+                        format!("a sum of more than {MAX_DEPTH} parts"),
+                    )
+                    .with_help("give parts of the sum names of their own with LET");
+                self.report(d);
+                while !self.at_line_end() && !self.at_header_colon() {
+                    self.bump();
+                }
+                break;
+            }
+            self.depth += 1;
+            self.bump();
+            let right = self.term();
+            let span = left.span.to(right.span);
+            left = Expr { kind: ExprKind::Arith(Box::new(left), op, Box::new(right)), span };
+        }
+        self.depth = base;
+        left
+    }
+
+    /// `(a, b)` after `OFFSET` or `MIDPOINT` and its `(`: exactly `n` values and `)`.
+    fn call_values(&mut self, n: usize, form: &str) -> Result<Vec<Expr>, Expr> {
+        let mut values = Vec::with_capacity(n);
+        for i in 0..n {
+            if i > 0 && self.eat(TokenKind::Comma).is_none() {
+                let help = format!("write `{form}`");
+                return Err(self.error_expr(&format!("`,` and {}", ordinal_value(i)), Some(&help)));
+            }
+            values.push(self.value());
+        }
+        if self.eat(TokenKind::RParen).is_none() {
+            let help = format!("write `{form}`");
+            return Err(self.error_expr(&format!("`)` to close {form}"), Some(&help)));
+        }
+        Ok(values)
+    }
+
+    /// A term of a value: a literal, coordinates, a name, `a.b`, `distance(a, b)`,
+    /// `OFFSET(p, d, b)`, `MIDPOINT(a, b)`, `GEO(...)`.
+    fn term(&mut self) -> Expr {
         let start = self.span();
         match self.peek() {
             TokenKind::Number => self.number(false),
@@ -152,6 +213,40 @@ impl Parser<'_> {
                             return p.error_expr("`)` to close distance(a, b)", None);
                         }
                         p.expr(ExprKind::Distance(Box::new(a), Box::new(b)), start)
+                    },
+                    |span| Expr { kind: ExprKind::Error, span },
+                );
+            }
+            "OFFSET" if call => {
+                self.bump();
+                self.bump();
+                return self.deeper(
+                    |p| match p.call_values(3, "OFFSET(position, distance, bearing)") {
+                        Ok(v) => {
+                            let mut v = v.into_iter();
+                            let (Some(a), Some(d), Some(b)) = (v.next(), v.next(), v.next()) else {
+                                return Expr { kind: ExprKind::Error, span: start };
+                            };
+                            p.expr(ExprKind::Offset(Box::new(a), Box::new(d), Box::new(b)), start)
+                        }
+                        Err(e) => e,
+                    },
+                    |span| Expr { kind: ExprKind::Error, span },
+                );
+            }
+            "MIDPOINT" if call => {
+                self.bump();
+                self.bump();
+                return self.deeper(
+                    |p| match p.call_values(2, "MIDPOINT(a, b)") {
+                        Ok(v) => {
+                            let mut v = v.into_iter();
+                            let (Some(a), Some(b)) = (v.next(), v.next()) else {
+                                return Expr { kind: ExprKind::Error, span: start };
+                            };
+                            p.expr(ExprKind::Midpoint(Box::new(a), Box::new(b)), start)
+                        }
+                        Err(e) => e,
                     },
                     |span| Expr { kind: ExprKind::Error, span },
                 );
@@ -364,7 +459,7 @@ impl Parser<'_> {
             return self.value();
         }
         let start = self.span();
-        self.deeper(
+        let first = self.deeper(
             |p| {
                 p.bump();
                 let inner = p.or_expr();
@@ -381,7 +476,20 @@ impl Parser<'_> {
                 p.expr(ExprKind::Paren(Box::new(inner)), start)
             },
             |span| Expr { kind: ExprKind::Error, span },
-        )
+        );
+        if first.kind == ExprKind::Error {
+            return first;
+        }
+        self.sum_from(first)
+    }
+}
+
+/// `a second value`, `a third value`: what comes after the `i`th comma of a form.
+fn ordinal_value(i: usize) -> &'static str {
+    match i {
+        1 => "a second value",
+        2 => "a third value",
+        _ => "another value",
     }
 }
 

@@ -72,6 +72,15 @@ impl Parser<'_> {
             TokenKind::Ident if self.text_of(start) == "ANY" && self.line_ends_in_colon() => {
                 self.any_block()
             }
+            // `LET` is a word only before `name =` at the start of a line, as `OPERATOR`
+            // is: a drone or capability called `LET` stays what it was.
+            TokenKind::Ident
+                if self.text_of(start).eq_ignore_ascii_case("LET")
+                    && self.peek_at(1) == TokenKind::Ident
+                    && self.peek_at(2) == TokenKind::Eq =>
+            {
+                self.let_stmt()
+            }
             TokenKind::Ident => self.statement(),
             TokenKind::Unknown => {
                 self.recover_line();
@@ -733,6 +742,41 @@ impl Parser<'_> {
     }
 
     /// `OPERATOR SIGNAL Name, Name`.
+    /// `LET name = value`.
+    fn let_stmt(&mut self) -> Stmt {
+        let start = self.bump().span; // LET
+        if self.text_of(start) != "LET" {
+            let d = self
+                .error(
+                    Code::KeywordCase,
+                    start,
+                    "the words of the language are written in upper case: `LET`",
+                )
+                .with_help("write `LET name = value`");
+            self.report(d);
+        }
+        let t = self.bump(); // the name
+        let name = self.ident_at(t.span);
+        self.bump(); // =
+        let value = if self.at_line_end() { self.error_value_after_let() } else { self.value() };
+        let span = Span::new(start.start as usize, self.last_end as usize);
+        if value.kind == ExprKind::Error {
+            self.skip_line();
+        } else {
+            self.end_line("the LET's value");
+        }
+        Stmt::Let(Let { name, value, span })
+    }
+
+    fn error_value_after_let(&mut self) -> Expr {
+        let span = self.span();
+        self.expected(
+            "a value after `=`",
+            Some("write `LET name = value`, such as `LET east = OFFSET(where, 20m, 90deg)`"),
+        );
+        Expr { kind: ExprKind::Error, span }
+    }
+
     fn operator_signals(&mut self) -> Stmt {
         let start = self.bump().span; // OPERATOR
         if self.text_of(start) != "OPERATOR" {

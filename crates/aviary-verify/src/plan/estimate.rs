@@ -430,6 +430,15 @@ impl<'m> Estimator<'m> {
             Node::For(f) => self.for_each(f, ctx, t),
             Node::Any(a) => self.any(a, ctx, t),
             Node::If { branches, otherwise } => self.choose(branches, otherwise.as_ref(), ctx, t),
+            // Taken when reached, as the engine takes it: unknown before flight (`None`)
+            // where what it reads is, as a signal's values are.
+            Node::Let { slot, value, .. } => {
+                let value = self.scope(ctx, t).eval(value);
+                if let Some(s) = ctx.frame.get_mut(*slot) {
+                    *s = value;
+                }
+                (t, Vec::new())
+            }
         }
     }
 

@@ -1,7 +1,7 @@
 //! Values and conditions as the estimate can know them before flight: `None` is unknown
 //! (a binding of a signal nobody can predict, telemetry the model does not follow).
 
-use aviary_api::{DroneId, FlightState, Point, Value};
+use aviary_api::{arith, DroneId, FlightState, Point, Value};
 use aviary_ir::{ActorRef, Expr, Field, Mission};
 
 use super::model::Flyer;
@@ -58,6 +58,20 @@ impl Scope<'_> {
                 let (p, q) = (self.position(a)?, self.position(b)?);
                 Value::Number(((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt())
             }
+            Expr::Add(a, b) | Expr::Sub(a, b) => {
+                let sign = if matches!(e, Expr::Add(..)) { 1.0 } else { -1.0 };
+                arith::add(&self.placed(a)?, &self.eval(b)?, sign)?
+            }
+            Expr::Offset(p, d, b) => {
+                let p = arith::point_of(&self.placed(p)?)?;
+                let (d, b) = (number(&self.eval(d)?)?, number(&self.eval(b)?)?);
+                Value::Position(arith::offset(p, d, b))
+            }
+            Expr::Midpoint(a, b) => {
+                let (a, b) =
+                    (arith::point_of(&self.placed(a)?)?, arith::point_of(&self.placed(b)?)?);
+                Value::Position(arith::midpoint(a, b))
+            }
             Expr::Elapsed => Value::Number(self.t),
             Expr::Received(s) => {
                 let at = match self.raised.get(*s).copied().flatten() {
@@ -92,6 +106,15 @@ impl Scope<'_> {
 
     pub fn condition(&self, e: &Expr) -> Option<bool> {
         truth(&self.eval(e)?)
+    }
+
+    /// A value where a drone stands for where the estimate has it, as the engine reads
+    /// `drone.position`: what position arithmetic starts from.
+    fn placed(&self, e: &Expr) -> Option<Value> {
+        match self.eval(e)? {
+            Value::Actor(d) => self.telemetry(d, Field::Position),
+            v => Some(v),
+        }
     }
 
     fn position(&self, e: &Expr) -> Option<[f64; 2]> {

@@ -85,6 +85,8 @@ codes! {
     OneAtATimeNotEvery = "E129", Error, "`ONE AT A TIME` on a handler that is not an `ON EVERY`";
     OperatorSignalBuiltin = "E130", Error, "an OPERATOR SIGNAL that names a built-in signal, which only a drone raises";
     GroupRemainder = "E131", Error, "`group.remaining`: a remainder is one drone's, not a group's";
+    AllowInvalid = "E132", Error, "an ALLOW of a code that is no warning's, or with no item after it";
+    UnknownBlock = "E133", Error, "a block's ABORT that names no named SEQUENTIAL or PARALLEL block";
     // Warnings.
     HandlerNeverFires = "W201", Warning, "a handler for a signal that nothing raises";
     UnknownException = "W202", Warning, "an ON EXCEPTION for a name neither built in nor thrown";
@@ -96,6 +98,7 @@ codes! {
     OperatorSignalTwice = "W208", Warning, "a signal declared twice with OPERATOR SIGNAL";
     SignalCycle = "W209", Warning, "ON EVERY handlers that raise one another's signals at once, in a cycle that takes no time";
     OutOfRadioReach = "W210", Warning, "a drone's planned path leaves the reach of the station's radio and of every relay";
+    AllowUnused = "W211", Warning, "an ALLOW that matches no warning on the item after it";
     // Notes.
     SignalNeverHandled = "N301", Note, "a signal raised but never handled";
     NoWorld = "N302", Note, "no world file, so actors, places and areas were not checked";

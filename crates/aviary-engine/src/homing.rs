@@ -265,6 +265,7 @@ impl<'m> Engine<'m> {
                     name: signal.name().into(),
                     actor: Some(self.name(drone).into()),
                     args: Vec::new(),
+                    by: None,
                 });
             }
             DroneEvent::Detected { drone, kind, location } => {

@@ -290,7 +290,8 @@ impl<'a> Walk<'a> {
                     self.push(n.span, Sym::Signal(n.name.clone()), true);
                 }
             }
-            Stmt::Error(_) => {}
+            // A block's name is no symbol the index follows (blocks are not definitions).
+            Stmt::StopBlock(_) | Stmt::Allow(_) | Stmt::Error(_) => {}
         }
     }
 

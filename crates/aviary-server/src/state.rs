@@ -79,7 +79,7 @@ impl MissionState {
                     self.activities.remove(i);
                 }
             }
-            Event::Leash { capability, tag, action } => {
+            Event::Leash { capability, tag, action, .. } => {
                 let paused = match action.as_ref() {
                     "PAUSE" => Some(true),
                     "RESUME" => Some(false),

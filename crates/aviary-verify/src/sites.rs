@@ -266,6 +266,7 @@ impl Walk<'_> {
             }
             Node::WaitFor { body: None, .. }
             | Node::Leash(_)
+            | Node::StopBlock { .. }
             | Node::Api(_)
             | Node::Throw { .. } => {}
         }

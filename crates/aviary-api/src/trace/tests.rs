@@ -215,19 +215,15 @@ fn event() -> impl Strategy<Value = Event<'static>> {
                 position,
                 left
             }),
-        (text(), opt(text()), values()).prop_map(|(name, actor, args)| Event::Signal {
-            name,
-            actor,
-            args
+        (text(), opt(text()), values(), any::<bool>()).prop_map(|(name, actor, args, operator)| {
+            Event::Signal { name, actor, args, by: operator.then_some(RaisedBy::Operator) }
         }),
         (text(), opt(text()), values(), any::<bool>(), opt(text()), opt(text()), opt(text()))
             .prop_map(|(name, actor, args, handled, handler, during, skipped)| {
                 Event::Exception { name, actor, args, handled, handler, during, skipped }
             }),
-        (text(), text(), text()).prop_map(|(capability, tag, action)| Event::Leash {
-            capability,
-            tag,
-            action
+        (text(), text(), text(), any::<bool>()).prop_map(|(capability, tag, action, block)| {
+            Event::Leash { capability, tag, action, block }
         }),
         (text(), text(), point()).prop_map(|(actor, kind, location)| Event::Detection {
             actor,

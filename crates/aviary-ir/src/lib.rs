@@ -242,39 +242,16 @@ pub enum Node {
     Call(Call),
     Leash(Leash),
     Api(ApiCall),
-    Signal {
-        signal: SignalId,
-        args: Vec<Expr>,
-        origin: Origin,
-    },
-    Throw {
-        exception: ExceptionId,
-        args: Vec<Expr>,
-        origin: Origin,
-    },
-    StartIf {
-        condition: Expr,
-        body: Block,
-    },
-    WaitFor {
-        condition: Expr,
-        body: Option<Block>,
-    },
-    DoWhile {
-        condition: Expr,
-        body: Block,
-    },
+    Signal { signal: SignalId, args: Vec<Expr>, origin: Origin },
+    Throw { exception: ExceptionId, args: Vec<Expr>, origin: Origin },
+    StartIf { condition: Expr, body: Block },
+    WaitFor { condition: Expr, body: Option<Block> },
+    DoWhile { condition: Expr, body: Block },
     For(For),
-    If {
-        branches: Vec<(Expr, Block)>,
-        otherwise: Option<Block>,
-    },
-    /// `Name ABORT`: ends every running instance of the traced block whose path is
-    /// `block` (a named block's path is its name).
-    StopBlock {
-        block: String,
-        origin: Origin,
-    },
+    If { branches: Vec<(Expr, Block)>, otherwise: Option<Block> },
+    // `Name ABORT`: ends every running instance of the traced block whose path is
+    // `block` (a named block's path is its name).
+    StopBlock { block: String, origin: Origin },
 }
 
 /// Who a statement or a call is about.

@@ -142,10 +142,14 @@ pub enum Event<'a> {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         left: Option<f64>,
     },
+    /// `by`: `operator` for a signal the operator raised (an `OPERATOR SIGNAL`, through
+    /// the operator API); absent for the mission's and the drones' own.
     Signal {
         name: Text<'a>,
         actor: Option<Text<'a>>,
         args: Vec<Shown<'a>>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        by: Option<RaisedBy>,
         /// The line of the statement in the MISSION's file, when it is there: what
         /// identifies the statement to a page that follows the run.
         #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -171,10 +175,14 @@ pub enum Event<'a> {
         line: Option<u32>,
     },
     /// `action`: `PAUSE`, `RESUME`, `ABORT` or a section's name.
+    /// A block stopped (`Name ABORT`) is a leash on the block: `block` is `true`,
+    /// `capability` holds the block's name and `tag` is empty.
     Leash {
         capability: Text<'a>,
         tag: Text<'a>,
         action: Text<'a>,
+        #[serde(default, skip_serializing_if = "is_false")]
+        block: bool,
         /// The line of the statement in the MISSION's file, when it is there: what
         /// identifies the statement to a page that follows the run.
         #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -208,6 +216,19 @@ pub enum Event<'a> {
         action: AutopilotAction,
         reason: Text<'a>,
     },
+}
+
+/// Who raised a signal from outside the mission (`signal` events' `by`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RaisedBy {
+    /// The operator, through the operator API (`aviary ctl signal`, the station).
+    Operator,
+}
+
+/// Whether a flag is unset: such a field is left out of the trace line.
+fn is_false(flag: &bool) -> bool {
+    !*flag
 }
 
 /// What a drone's autopilot did on its own (`autopilot` events).

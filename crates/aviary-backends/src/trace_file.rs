@@ -212,7 +212,13 @@ mod tests {
     fn signal(t: f64) -> Record<'static> {
         Record {
             t,
-            event: Event::Signal { name: "X".into(), actor: None, args: Vec::new(), line: None },
+            event: Event::Signal {
+                name: "X".into(),
+                actor: None,
+                args: Vec::new(),
+                by: None,
+                line: None,
+            },
         }
     }
 

@@ -17,6 +17,9 @@ pub struct Checked {
     /// `None` when there is no world file, or it has errors.
     pub world: Option<World>,
     pub diagnostics: Vec<Diagnostic>,
+    /// The program's ALLOW lines, kept here since a caller may take the program away
+    /// (`aviary_verify::preflight`): for [`crate::acknowledge`] once every diagnostic is in.
+    pub allows: Vec<crate::Allow>,
 }
 
 impl Checked {
@@ -79,15 +82,17 @@ pub fn check_against(
     let (text, invalid) = decode(mission.1);
     let root = sources.add(mission.0, text);
     let mut program = None;
+    let mut allows = Vec::new();
     if let Some(at) = invalid {
         diagnostics.push(aviary_syntax::invalid_utf8(root, at));
     } else {
         let (p, d) = crate::check(sources, root, parsed_world.as_ref(), provider, api);
+        allows = p.allows.clone();
         program = Some(p);
         // With a broken world, its own errors say why names went unchecked.
         diagnostics.extend(d.into_iter().filter(|d| !(world_failed && d.code == Code::NoWorld)));
     }
-    Checked { program, world: parsed_world, diagnostics }
+    Checked { program, world: parsed_world, diagnostics, allows }
 }
 
 fn decode(bytes: Cow<'_, [u8]>) -> (String, Option<usize>) {

@@ -10,6 +10,7 @@
 #![forbid(unsafe_code)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
+mod allow;
 mod chains;
 mod endurance;
 mod env;
@@ -33,6 +34,7 @@ use aviary_diagnostics::{Diagnostic, FileId, SourceMap};
 use aviary_syntax::ast::{Capability, Mission, SourceFile};
 use aviary_world::World;
 
+pub use allow::{acknowledge, Allow};
 pub use env::{bind_args, ArgBinding, BindProblem};
 pub use infer::KindOrigin;
 pub use inputs::{check_against, check_sources, normalize_path, read_world, Checked, WorldRead};
@@ -62,6 +64,9 @@ pub struct Program {
     /// The values each signal carries, by name, with each one's kind where it is known
     /// (see `signal_values.rs`): what an operator's signal is checked against.
     pub signal_values: BTreeMap<String, Vec<Option<Kind>>>,
+    /// The ALLOW lines that can apply, for [`acknowledge`] (empty when a file has a
+    /// syntax error).
+    pub allows: Vec<Allow>,
     /// The paths of `USE`s that could not be read (reported as E113).
     pub unreadable: Vec<String>,
     /// The capability each name means, after user definitions override the library. By
@@ -227,6 +232,9 @@ pub fn check(
         let (found, more) = both(large, names, walks);
         diagnostics.extend(found);
         diagnostics.extend(more);
+    }
+    if syntax_ok {
+        program.allows = allow::collect(&program, &mut diagnostics);
     }
     // Sorted, so the order in which the passes ran does not show.
     aviary_diagnostics::sort(&mut diagnostics);

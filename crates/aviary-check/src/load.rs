@@ -110,6 +110,7 @@ pub(crate) fn load(
         param_origins: Default::default(),
         signal_values: BTreeMap::new(),
         unreadable,
+        allows: Vec::new(),
         index: Default::default(),
     };
     index_definitions(&mut program, std_id, diagnostics);

@@ -139,7 +139,7 @@ fn at_once<'a>(
             }
             // Declarations run nothing; a leash takes no time.
             Stmt::Handler(_) | Stmt::ExceptionHandler(_) | Stmt::Leash(_) => true,
-            Stmt::OperatorSignals(_) | Stmt::Error(_) => true,
+            Stmt::OperatorSignals(_) | Stmt::Allow(_) | Stmt::Error(_) => true,
             Stmt::Block(b) => {
                 inside.push(&b.body);
                 let instant = at_once(&b.body, b.kind == BlockKind::Parallel, inside, out);

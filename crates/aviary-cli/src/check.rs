@@ -85,11 +85,12 @@ fn check_one(
     let verified = aviary_verify::preflight(&mut checked, &api);
     let mut diagnostics = checked.diagnostics;
     let mut plan = None;
+    let preflight = verified.is_some();
     if let Some((_, v)) = verified {
         diagnostics.extend(v.diagnostics);
-        aviary_diagnostics::sort(&mut diagnostics);
         plan = Some(v.plan);
     }
+    aviary_check::acknowledge(&checked.allows, &mut diagnostics, preflight);
     let failed = u8::from(diagnostics.iter().any(Diagnostic::is_error));
     if !want_plan {
         print(&sources, &diagnostics, format, path);

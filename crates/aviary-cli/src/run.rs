@@ -6,7 +6,7 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use aviary_api::trace::{Event, Record};
+use aviary_api::trace::{Event, RaisedBy, Record};
 use aviary_api::Backend;
 use aviary_backends::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
 use aviary_diagnostics::{render_text, SourceMap};
@@ -516,10 +516,16 @@ impl Stats {
             Event::CapabilityStart { .. } => self.running += 1,
             Event::CapabilityEnd { .. } => self.running -= 1,
             Event::Detection { .. } => self.detections += 1,
-            Event::Signal { name, .. } => match self.signals.iter_mut().find(|(n, _)| n == name) {
-                Some((_, count)) => *count += 1,
-                None => self.signals.push((name.to_string(), 1)),
-            },
+            Event::Signal { name, by, .. } => {
+                // A signal the operator raised is one of the operator's actions too.
+                if let Some(RaisedBy::Operator) = by {
+                    self.operator.push(format!("signal {name} at {:.1} s", record.t));
+                }
+                match self.signals.iter_mut().find(|(n, _)| n == name) {
+                    Some((_, count)) => *count += 1,
+                    None => self.signals.push((name.to_string(), 1)),
+                }
+            }
             Event::Exception { name, actor, handled, .. } => {
                 let raised = Raised {
                     name: name.to_string(),
@@ -641,6 +647,8 @@ mod tests {
         for line in [
             r#"{"t":3.0,"event":"operator","action":"hold","drone":"a"}"#,
             r#"{"t":4.25,"event":"operator","action":"resume","drone":"a"}"#,
+            r#"{"t":4.5,"event":"signal","name":"Go_Home","actor":null,"args":[],"by":"operator"}"#,
+            r#"{"t":4.75,"event":"signal","name":"Found","actor":"a","args":[]}"#,
             r#"{"t":5.0,"event":"exception","name":"ConnectionLost","actor":"b","args":["b: link lost"],"handled":true,"handler":"M/ON EXCEPTION ConnectionLost"}"#,
             r#"{"t":5.0,"event":"autopilot","actor":"b","action":"hold","reason":"b: link lost: holds where it is"}"#,
             r#"{"t":6.0,"event":"exception","name":"CommandFailed","actor":"a","args":["no"],"handled":true,"handler":"H"}"#,
@@ -654,7 +662,8 @@ mod tests {
             what_happened(&stats),
             "exceptions: ConnectionLost on b (handled), CommandFailed on a (handled) ×2, \
              Late (unhandled)\n\
-             operator actions: hold a at 3.0 s, resume a at 4.2 s, abort at 8.0 s\n\
+             operator actions: hold a at 3.0 s, resume a at 4.2 s, signal Go_Home at 4.5 s, \
+             abort at 8.0 s\n\
              autopilot, on its own: b: link lost: holds where it is (at 5.0 s)\n"
         );
         assert_eq!(

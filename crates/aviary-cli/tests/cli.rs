@@ -285,3 +285,50 @@ fn a_reader_that_stops_reading_ends_the_output_not_in_a_panic() {
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert!(stderr.is_empty(), "a closed pipe is not an error to report: {stderr}");
 }
+
+/// `ALLOW W203 "reason"` before one of the two statements: `aviary check` shows the
+/// warning as an acknowledged note with its reason, and exits 0 with no warning; the same
+/// ALLOW where no W203 is warns that it matches nothing.
+#[test]
+fn an_allow_acknowledges_a_preflight_warning_and_an_unused_one_warns() {
+    let dir = scratch("allow");
+    let world = "[places]\nNorth = [0, 100]\nEast = [100, 0]\n[drones.d1]\nhome = [0, 0]\n";
+    std::fs::write(dir.join("m.world.toml"), world).unwrap();
+    let both = |allow_at: usize| {
+        let mut lines = vec![
+            "MISSION M:",
+            "    d1 TakeOff WITH 20m",
+            "    PARALLEL Both:",
+            "        d1 FlyTo WITH North",
+            "        d1 FlyTo WITH East",
+            "    d1 ReturnHome",
+        ];
+        lines.insert(allow_at, "        ALLOW W203 \"the second flight is meant to wait\"");
+        lines.join("\n") + "\n"
+    };
+    std::fs::write(dir.join("m.mission"), both(3)).unwrap();
+    let (code, out, _) = aviary(&["check", "m.mission"], &dir);
+    assert_eq!(code, 0, "{out}");
+    assert!(out.contains("note[W203]"), "{out}");
+    assert!(out.contains("acknowledged: the second flight is meant to wait"), "{out}");
+    assert!(!out.contains("warning["), "{out}");
+    assert!(out.contains("m.mission: ok (1 note)"), "{out}");
+    // The other statement of the pair acknowledges it too: the warning shows both.
+    std::fs::write(dir.join("m.mission"), both(4)).unwrap();
+    let (code, out, _) = aviary(&["check", "m.mission"], &dir);
+    assert_eq!((code, out.contains("note[W203]")), (0, true), "{out}");
+    // Before the block's return, where nothing conflicts, it matches nothing.
+    let unused = both(3).replace("        ALLOW", "    ALLOW").replace(
+        "    PARALLEL Both:\n    ALLOW W203 \"the second flight is meant to wait\"\n        d1 FlyTo WITH North\n",
+        "    PARALLEL Both:\n        d1 FlyTo WITH North\n",
+    );
+    let unused = unused.replace(
+        "    d1 ReturnHome\n",
+        "    ALLOW W203 \"the second flight is meant to wait\"\n    d1 ReturnHome\n",
+    );
+    std::fs::write(dir.join("m.mission"), &unused).unwrap();
+    let (code, out, _) = aviary(&["check", "m.mission"], &dir);
+    assert_eq!(code, 0, "{out}");
+    assert!(out.contains("warning[W211]: ALLOW W203 matches no warning here; remove it"), "{out}");
+    assert!(out.contains("warning[W203]"), "the W203 it did not reach stays: {out}");
+}

@@ -87,6 +87,8 @@ codes! {
     GroupRemainder = "E131", Error, "`group.remaining`: a remainder is one drone's, not a group's";
     LetTaken = "E132", Error, "a LET of a name that is already bound here (another LET, a parameter, an alias, a drone, a place, ...)";
     LetNotHere = "E133", Error, "a name used where its LET does not reach: before it, outside its body, or in a handler that may fire before it";
+    AllowInvalid = "E134", Error, "an ALLOW of a code that is no warning's, or with no item after it";
+    UnknownBlock = "E135", Error, "a block's ABORT that names no named SEQUENTIAL or PARALLEL block";
     AnyNotGroup = "E140", Error, "an ANY that chooses from something that is not a group of the world";
     AnyCount = "E141", Error, "an ANY that asks for a number of drones its group cannot give (not a whole number from 1 to the group's size)";
     // Warnings.
@@ -100,6 +102,7 @@ codes! {
     OperatorSignalTwice = "W208", Warning, "a signal declared twice with OPERATOR SIGNAL";
     SignalCycle = "W209", Warning, "ON EVERY handlers that raise one another's signals at once, in a cycle that takes no time";
     OutOfRadioReach = "W210", Warning, "a drone's planned path leaves the reach of the station's radio and of every relay";
+    AllowUnused = "W211", Warning, "an ALLOW that matches no warning on the item after it";
     // Notes.
     SignalNeverHandled = "N301", Note, "a signal raised but never handled";
     NoWorld = "N302", Note, "no world file, so actors, places and areas were not checked";

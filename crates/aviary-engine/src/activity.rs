@@ -175,6 +175,7 @@ impl<'m> Engine<'m> {
             caught: Notify::new(),
             instance: Some(instance.clone()),
             section: Cell::new(ctx.scope.section.get()),
+            stop: ctx.scope.stop.clone(),
         });
         if listed {
             self.instances.borrow_mut().set_scope(&instance, scope.clone());
@@ -298,7 +299,7 @@ impl<'m> Engine<'m> {
             token: ctx
                 .instance
                 .as_ref()
-                .map_or_else(|| self.stop.child_token(), |p| p.token.child_token()),
+                .map_or_else(|| self.mission_level_token(ctx), |p| p.token.child_token()),
             // Only the capability's own exception handler cancels its PERFORM body.
             perform: (!cap.exception_handlers.is_empty()).then(CancellationToken::new),
             by_leash: Cell::new(false),

@@ -9,7 +9,7 @@ use std::rc::Rc;
 
 use std::borrow::Cow;
 
-use aviary_api::trace::{AutopilotAction, CallStatus, Event, EventKind, Record, Shown};
+use aviary_api::trace::{AutopilotAction, CallStatus, Event, EventKind, RaisedBy, Record, Shown};
 use aviary_api::{Backend, DroneEvent, DroneId, Function, Value};
 use aviary_ir::{ActorFilter, ExceptionHandler, Handler, Mission};
 use tokio::sync::{mpsc, Notify};
@@ -155,9 +155,18 @@ pub(crate) struct Scope<'m> {
     /// held while the sections hold the activity's body (`section.rs`). Set on the
     /// section's block, and taken over by every scope made inside one.
     pub section: Cell<bool>,
+    /// The token of the innermost block around this scope that a `Name ABORT` may stop
+    /// (`None` outside every such block, as in most missions): the activities started at
+    /// mission level under it are its children, and sequences end once it is cancelled.
+    pub stop: Option<CancellationToken>,
 }
 
 impl<'m> Scope<'m> {
+    /// Whether a block around this scope was stopped (`Name ABORT`): nothing more starts.
+    pub fn block_stopped(&self) -> bool {
+        self.stop.as_ref().is_some_and(CancellationToken::is_cancelled)
+    }
+
     /// Starts a firing of one of this scope's handlers; a firing of a `ONE AT A TIME`
     /// handler that has one running waits behind it instead (docs/LANGUAGE.md, section 11).
     pub fn fire(&self, job: Job<'m>) {
@@ -332,6 +341,10 @@ pub(crate) struct Engine<'m> {
     /// outside the mission, which every running block hears).
     pub listeners: RefCell<Vec<std::rc::Weak<Scope<'m>>>>,
     pub stop: CancellationToken,
+    /// The paths of the blocks some `Name ABORT` names (in no order; few).
+    pub stoppable: Vec<&'m str>,
+    /// The instances of those blocks running now, each with its scope.
+    pub stoppable_running: RefCell<Vec<Rc<Scope<'m>>>>,
     events: RefCell<Option<mpsc::UnboundedReceiver<DroneEvent>>>,
     root: RefCell<Option<Rc<Scope<'m>>>>,
     /// The MISSION body's own block: "mission level", where an idle drone's events are raised.
@@ -386,6 +399,8 @@ impl<'m> Engine<'m> {
             over: Cell::new(false),
             listeners: RefCell::new(Vec::new()),
             stop: CancellationToken::new(),
+            stoppable: crate::exec::stoppable_blocks(m),
+            stoppable_running: RefCell::new(Vec::new()),
             events: RefCell::new(backend.events()),
             root: RefCell::new(None),
             mission_scope: RefCell::new(None),
@@ -466,6 +481,7 @@ impl<'m> Engine<'m> {
             caught: Notify::new(),
             instance: None,
             section: Cell::new(false),
+            stop: None,
         });
         *self.root.borrow_mut() = Some(root.clone());
         let ctx = Ctx {
@@ -728,6 +744,7 @@ impl<'m> Engine<'m> {
             name: self.m.signals[signal].as_str().into(),
             actor: None,
             args: self.values(&args),
+            by: Some(RaisedBy::Operator),
             line: None,
         });
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {
@@ -763,6 +780,7 @@ impl<'m> Engine<'m> {
             name: self.m.signals[signal].as_str().into(),
             actor: actor.map(|a| self.name(a).into()),
             args: self.values(&args),
+            by: None,
             line,
         });
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {

@@ -9,7 +9,9 @@ use std::task::Poll;
 use std::time::Duration;
 
 use aviary_api::{DroneId, Value};
-use aviary_ir::{ActorRef, Block, BlockKind, Call, Expr, For, Leash, LeashAction, Node};
+use aviary_ir::{ActorRef, Block, BlockKind, Call, Expr, For, Leash, LeashAction, Mission, Node};
+
+use crate::cancel::Token as CancellationToken;
 use futures_util::future::{Either, LocalBoxFuture};
 use futures_util::stream::{FuturesUnordered, StreamExt};
 use tokio::sync::Notify;
@@ -122,6 +124,11 @@ impl<'m> Engine<'m> {
             caught: Notify::new(),
             instance,
             section: Cell::new(ctx.scope.section.get()),
+            stop: if self.is_stoppable(block) {
+                Some(self.mission_level_token(ctx))
+            } else {
+                ctx.scope.stop.clone()
+            },
         });
         if !block.handlers.is_empty() {
             self.listeners.borrow_mut().push(Rc::downgrade(&scope));
@@ -155,13 +162,17 @@ impl<'m> Engine<'m> {
                 block: block.path.as_str().into(),
             });
         }
+        // A block that a `Name ABORT` may stop is found by its name while it runs.
+        let _listed = self.is_stoppable(block).then(|| Listed::new(self, &scope));
         let inner = Ctx { scope: scope.clone(), ..ctx.clone() };
         // Futures made in place and passed pinned: moving a large future into the
         // next one's state is a copy of all of it, at every step.
         let items = pin!(self.items(block, &inner));
         self.drive(&scope, items).await;
         if block.traced {
-            let status = if scope.unwinding.get() { Status::Aborted } else { Status::Ok };
+            // A block inside a stopped one ends aborted with it.
+            let stopped = scope.unwinding.get() || scope.block_stopped();
+            let status = if stopped { Status::Aborted } else { Status::Ok };
             self.trace(EventKind::BlockEnd, || Event::BlockEnd {
                 block: block.path.as_str().into(),
                 status,
@@ -192,13 +203,13 @@ impl<'m> Engine<'m> {
         }
     }
 
-    /// Statements one after another, until the scope unwinds. A LET gives the items
-    /// after it a frame with its value.
+    /// Statements one after another, until the scope unwinds or a block around it is
+    /// stopped. A LET gives the items after it a frame with its value.
     pub(crate) async fn sequence(&self, items: &'m [Node], ctx: &Ctx<'m>) {
         let mut bound: Option<Ctx<'m>> = None;
         for node in items {
             let ctx = bound.as_ref().unwrap_or(ctx);
-            if ctx.scope.unwinding.get() {
+            if ctx.scope.unwinding.get() || ctx.scope.block_stopped() {
                 break;
             }
             if let Node::Let { slot, value, .. } = node {
@@ -302,6 +313,7 @@ impl<'m> Engine<'m> {
                 Node::Leash(l) => self.leash(l, ctx),
                 // Taken by the sequence or the PARALLEL block that holds it.
                 Node::Let { .. } => {}
+                Node::StopBlock { block, origin } => self.stop_block(block, self.m.line_of(origin)),
                 Node::Signal { signal, args, origin } => self.signal(*signal, args, origin, ctx),
                 Node::Throw { exception, args, origin } => {
                     let args = self.eval_all(args, ctx);
@@ -319,7 +331,10 @@ impl<'m> Engine<'m> {
                     }
                 }
                 Node::DoWhile { condition, body } => {
-                    while self.truth(condition, ctx) && !ctx.scope.unwinding.get() {
+                    while self.truth(condition, ctx)
+                        && !ctx.scope.unwinding.get()
+                        && !ctx.scope.block_stopped()
+                    {
                         let before = self.now();
                         self.block(body, ctx).await;
                         // A round that takes no time must not starve the clock.
@@ -360,14 +375,23 @@ impl<'m> Engine<'m> {
         self.env(&ctx.frame, &received).truth(e)
     }
 
+    /// Until `condition` holds, or a block around the wait is stopped.
     async fn wait_until(&self, condition: &Expr, ctx: &Ctx<'m>) {
+        let stopped = async {
+            match &ctx.scope.stop {
+                Some(token) => token.cancelled().await,
+                None => std::future::pending().await,
+            }
+        };
+        let mut stopped = pin!(stopped);
         loop {
             let changed = self.changed.notified();
-            if self.truth(condition, ctx) {
+            if self.truth(condition, ctx) || ctx.scope.block_stopped() {
                 return;
             }
             tokio::select! {
                 biased;
+                _ = stopped.as_mut() => return,
                 _ = changed => {}
                 _ = tokio::time::sleep(RECHECK) => {}
             }
@@ -411,7 +435,7 @@ impl<'m> Engine<'m> {
             join_eager(runs.map(|c| async move { self.block(body, &c).await })).await;
         } else {
             for c in runs {
-                if ctx.scope.unwinding.get() {
+                if ctx.scope.unwinding.get() || ctx.scope.block_stopped() {
                     break;
                 }
                 self.block(body, &c).await;
@@ -550,6 +574,7 @@ impl<'m> Engine<'m> {
             capability: cap.name.as_str().into(),
             tag: self.m.tags[tag].as_str().into(),
             action: action_name.into(),
+            block: false,
             line,
         });
         let targets: Vec<(Rc<Instance>, Rc<Scope<'m>>)> =
@@ -577,6 +602,79 @@ impl<'m> Engine<'m> {
                 }
             }
         }
+    }
+}
+
+impl<'m> Engine<'m> {
+    /// Whether some `Name ABORT` names this block (most missions have none).
+    fn is_stoppable(&self, block: &Block) -> bool {
+        block.traced && !self.stoppable.is_empty() && self.stoppable.contains(&block.path.as_str())
+    }
+
+    /// The token of an activity started at mission level here: a child of the innermost
+    /// stoppable block's, or of the mission's.
+    pub(crate) fn mission_level_token(&self, ctx: &Ctx<'m>) -> CancellationToken {
+        ctx.scope.stop.as_ref().unwrap_or(&self.stop).child_token()
+    }
+
+    /// `Name ABORT`: every running instance of the block `path` ends at once: its
+    /// activities are aborted (as a leash's ABORT aborts one), nothing more in it starts,
+    /// and its `block_end` says `aborted`. Recorded as a `leash` event (`block: true`)
+    /// even when no instance runs (docs/LANGUAGE.md, section 14).
+    fn stop_block(&self, path: &str, line: Option<u32>) {
+        self.trace(EventKind::Leash, || Event::Leash {
+            capability: path.into(),
+            tag: "".into(),
+            action: "ABORT".into(),
+            block: true,
+            line,
+        });
+        let running: Vec<Rc<Scope<'m>>> =
+            self.stoppable_running.borrow().iter().filter(|s| s.path == path).cloned().collect();
+        for scope in running {
+            scope.unwinding.set(true);
+            if let Some(token) = &scope.stop {
+                token.cancel();
+            }
+        }
+    }
+}
+
+/// The paths of the blocks that some `Name ABORT` of the mission names.
+pub(crate) fn stoppable_blocks<'m>(m: &'m Mission) -> Vec<&'m str> {
+    let mut out: Vec<&str> = Vec::new();
+    let mut see = |node: &'m Node| {
+        if let Node::StopBlock { block, .. } = node {
+            if !out.contains(&block.as_str()) {
+                out.push(block.as_str());
+            }
+        }
+    };
+    m.body.visit(&mut see);
+    for cap in &m.capabilities {
+        for body in cap.bodies() {
+            body.visit(&mut see);
+        }
+    }
+    out
+}
+
+/// A stoppable block's scope listed among the running ones while it runs.
+struct Listed<'e, 'm> {
+    engine: &'e Engine<'m>,
+    scope: Rc<Scope<'m>>,
+}
+
+impl<'e, 'm> Listed<'e, 'm> {
+    fn new(engine: &'e Engine<'m>, scope: &Rc<Scope<'m>>) -> Self {
+        engine.stoppable_running.borrow_mut().push(scope.clone());
+        Listed { engine, scope: scope.clone() }
+    }
+}
+
+impl Drop for Listed<'_, '_> {
+    fn drop(&mut self) {
+        self.engine.stoppable_running.borrow_mut().retain(|s| !Rc::ptr_eq(s, &self.scope));
     }
 }
 

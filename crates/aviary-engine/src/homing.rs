@@ -266,6 +266,7 @@ impl<'m> Engine<'m> {
                     name: signal.name().into(),
                     actor: Some(self.name(drone).into()),
                     args: Vec::new(),
+                    by: None,
                     line: None,
                 });
             }

@@ -848,3 +848,30 @@ fn a_let_keeps_the_value_it_took() {
     let a = at_end_of_fly_to(&r, "a", 1);
     assert!(ground(a, [0.0, 0.0, 0.0]) < 0.5 && (a[2] - 30.0).abs() < 0.5, "{a:?}");
 }
+
+#[test]
+fn a_stopped_block_ends_at_once_and_frees_its_drones() {
+    let r = run(&fixture("a_stopped_block_ends_at_once_and_frees_its_drones"));
+    assert_eq!(r.outcome.status, Status::Ok, "a stopped block does not change the outcome");
+    let stops: Vec<&serde_json::Value> =
+        r.trace.iter().filter(|e| e["event"] == "leash" && e["block"] == true).collect();
+    assert_eq!(stops.len(), 2, "each stop is recorded, the second with nothing to stop");
+    assert!(stops.iter().all(|e| e["capability"] == "Valley_Search" && e["action"] == "ABORT"));
+    let at = stops[0]["t"].as_f64().unwrap();
+    assert!(close(at, 15.0), "{at}");
+    // Its running statements end aborted at the instant of the stop, its waits too.
+    let fly = r.ends("FlyTo", "a")[0];
+    assert_eq!((fly["status"].as_str(), fly["t"].as_f64()), (Some("aborted"), Some(at)));
+    for block in ["Sweep_And_Watch", "Valley_Search"] {
+        let end = r.first("block_end", "block", block);
+        assert_eq!((end["status"].as_str(), end["t"].as_f64()), (Some("aborted"), Some(at)));
+    }
+    // Its later statements never start.
+    assert!(r.find("capability_start", "capability", "ReturnHome").is_empty(), "{}", r.dump());
+    // The handler's orders take the drone at once: no wait for the block's statement.
+    let starts = r.find("capability_start", "capability", "FlyTo");
+    assert_eq!(starts.len(), 2);
+    assert_eq!(starts[1]["t"].as_f64(), Some(at));
+    assert_eq!(starts[1]["args"]["target"], serde_json::json!([0.0, 100.0]), "North");
+    assert_eq!(r.ends("Land", "a")[0]["status"], "ok");
+}

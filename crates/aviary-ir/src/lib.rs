@@ -296,6 +296,12 @@ pub enum Node {
         value: Expr,
         origin: Origin,
     },
+    /// `Name ABORT`: ends every running instance of the traced block whose path is
+    /// `block` (a named block's path is its name).
+    StopBlock {
+        block: String,
+        origin: Origin,
+    },
 }
 
 /// Who a statement or a call is about.

@@ -415,6 +415,9 @@ impl<'a> Compiler<'a> {
             }
             ast::Stmt::Statement(s) => Node::Call(self.call(s)?),
             ast::Stmt::Leash(l) => Node::Leash(self.leash(l)?),
+            ast::Stmt::StopBlock(s) => {
+                Node::StopBlock { block: s.block.name.clone(), origin: self.origin(s.span) }
+            }
             ast::Stmt::Api(a) => Node::Api(ApiCall {
                 actor: self.actor(&a.actor.name),
                 function: self.api.function(&a.function.name)?.function,
@@ -515,6 +518,8 @@ impl<'a> Compiler<'a> {
             | ast::Stmt::ExceptionHandler(_)
             | ast::Stmt::Let(_)
             | ast::Stmt::OperatorSignals(_)
+            // An ALLOW is for the checks before flight only.
+            | ast::Stmt::Allow(_)
             | ast::Stmt::Error(_) => return None,
         })
     }

@@ -93,14 +93,17 @@ pub fn mission(key: &str, docs: &Docs, config: &Config) -> Analysis {
     let mut diagnostics = checked.diagnostics;
     let program = checked.program;
     let world = checked.world;
+    let mut preflight = false;
     if !diagnostics.iter().any(Diagnostic::is_error) {
         if let (Some(p), Some(w)) = (&program, &world) {
             if let Some(compiled) = aviary_lower::compile(p, w, &api) {
                 diagnostics.extend(aviary_verify::verify(&compiled, w).diagnostics);
+                preflight = true;
             }
         }
     }
-    aviary_diagnostics::sort(&mut diagnostics);
+    // As `aviary check` and the station: one function applies the ALLOW lines.
+    aviary_check::acknowledge(&checked.allows, &mut diagnostics, preflight);
     let occurrences = match &program {
         Some(p) => {
             let files: Vec<_> = p.files.iter().map(|(f, t)| (*f, t)).collect();

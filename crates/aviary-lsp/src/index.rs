@@ -310,7 +310,8 @@ impl<'a> Walk<'a> {
                 self.push(at, sym.clone(), true);
                 self.locals.push(sym);
             }
-            Stmt::Error(_) => {}
+            // A block's name is no symbol the index follows (blocks are not definitions).
+            Stmt::StopBlock(_) | Stmt::Allow(_) | Stmt::Error(_) => {}
         }
     }
 

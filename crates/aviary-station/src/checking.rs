@@ -45,12 +45,12 @@ pub fn check(mission: &Text, world: Option<&Text>, files: &dyn SourceProvider) -
     let flyable = verified.is_some();
     if let Some((compiled, v)) = verified {
         diagnostics.extend(v.diagnostics);
-        aviary_diagnostics::sort(&mut diagnostics);
         let mut v_plan = v.plan;
         v_plan.locate_in(&sources);
         plan = serde_json::to_value(&v_plan).unwrap_or(Value::Null);
         tree = tree::of(&compiled, Some(&sources));
     }
+    aviary_check::acknowledge(&checked.allows, &mut diagnostics, flyable);
     let errors = diagnostics.iter().filter(|d| d.is_error()).count();
     let shown: Vec<Value> = diagnostics.iter().map(|d| rendered(&sources, d)).collect();
     Report {

@@ -82,6 +82,9 @@ fn read(name: &str, trace: &str) -> Result<Mission, String> {
                         .push((t, name.into_owned()));
                 }
             }
+            Event::Leash { capability, action, block: true, .. } => {
+                m.marks.push((t, format!("{capability} {action}"), "operator"));
+            }
             Event::Leash { capability, tag, action, .. } => {
                 m.marks.push((t, format!("{capability}-{tag} {action}"), "operator"));
             }

@@ -88,6 +88,12 @@ impl Tree<'_> {
                 "action": l.action_name,
                 "line": self.line(&l.origin),
             }),
+            Node::StopBlock { block, origin } => json!({
+                "kind": "leash",
+                "block": block,
+                "action": "ABORT",
+                "line": self.line(origin),
+            }),
             Node::Signal { signal, origin, .. } => json!({
                 "kind": "signal",
                 "signal": self.m.signals.get(*signal),

@@ -148,11 +148,38 @@ pub enum Stmt {
     Any(Box<AnyBlock>),
     /// `LET name = value`: an immutable name for a value, taken once when reached.
     Let(Let),
+    /// `ALLOW W203 "reason"`: the warning is acknowledged on the item after it. The
+    /// checker and the pre-flight analyses read it; the lowering and the engine skip it.
+    Allow(Allow),
+    /// `Block_Name ABORT`: every running instance of the named block is ended.
+    StopBlock(StopBlock),
     /// A line that could not be read. It was reported; later stages skip it.
     Error(Span),
 }
 
 impl Stmt {
+    /// The item's whole text, its body included.
+    pub fn span(&self) -> Span {
+        match self {
+            Stmt::Block(b) => b.span,
+            Stmt::Statement(s) => s.span,
+            Stmt::Leash(l) => l.span,
+            Stmt::Api(a) => a.span,
+            Stmt::Requirement(r) => r.span,
+            Stmt::For(f) => f.span,
+            Stmt::Any(a) => a.span,
+            Stmt::Signal(r) | Stmt::Throw(r) => r.span,
+            Stmt::Handler(h) => h.span,
+            Stmt::ExceptionHandler(h) => h.span,
+            Stmt::If(i) => i.span,
+            Stmt::OperatorSignals(o) => o.span,
+            Stmt::Let(l) => l.span,
+            Stmt::Allow(a) => a.span,
+            Stmt::StopBlock(s) => s.span,
+            Stmt::Error(span) => *span,
+        }
+    }
+
     /// Calls `f` on each body directly inside this item, in source order.
     pub fn for_each_body<'a>(&'a self, mut f: impl FnMut(&'a Body)) {
         match self {
@@ -173,6 +200,8 @@ impl Stmt {
             | Stmt::Throw(_)
             | Stmt::OperatorSignals(_)
             | Stmt::Let(_)
+            | Stmt::Allow(_)
+            | Stmt::StopBlock(_)
             | Stmt::Error(_) => {}
         }
     }
@@ -312,6 +341,23 @@ pub struct OperatorSignals {
 pub struct Let {
     pub name: Ident,
     pub value: Expr,
+    pub span: Span,
+}
+
+/// `ALLOW CODE "reason"`: `ALLOW` is a word only at the start of a line, before a code.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Allow {
+    /// The code as written (`W203`); the checker says whether it is a warning's.
+    pub code: Ident,
+    /// Why the warning is acknowledged, without its quotes.
+    pub reason: String,
+    pub span: Span,
+}
+
+/// `Block_Name ABORT`: stops the named SEQUENTIAL or PARALLEL block wherever it runs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StopBlock {
+    pub block: Ident,
     pub span: Span,
 }
 

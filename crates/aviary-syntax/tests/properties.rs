@@ -506,6 +506,15 @@ impl Gen {
                 let text = format!("{}{}{cap}{args}", actors.join(self.sp()), self.sp());
                 self.line(indent, &text);
             }
+            2 if self.chance(20) => {
+                let code = self.pick(&["W203", "W201", "W204"]);
+                let text = format!("ALLOW{}{code}{}\"expected here\"", self.sp(), self.sp());
+                self.line(indent, &text);
+            }
+            2 if self.chance(20) => {
+                let text = format!("{}{}ABORT", self.name(), self.sp());
+                self.line(indent, &text);
+            }
             2 => {
                 let action = self.pick(&["PAUSE", "RESUME", "ABORT", "Widen"]);
                 let args = self.args();

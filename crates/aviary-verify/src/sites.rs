@@ -274,6 +274,7 @@ impl Walk<'_> {
             }
             Node::WaitFor { body: None, .. }
             | Node::Leash(_)
+            | Node::StopBlock { .. }
             | Node::Api(_)
             | Node::Throw { .. }
             | Node::Let { .. } => {}

@@ -231,8 +231,15 @@ fn event() -> impl Strategy<Value = Event<'static>> {
                 position,
                 left
             }),
-        (text(), opt(text()), values(), line())
-            .prop_map(|(name, actor, args, line)| { Event::Signal { name, actor, args, line } }),
+        (text(), opt(text()), values(), any::<bool>(), line()).prop_map(
+            |(name, actor, args, operator, line)| Event::Signal {
+                name,
+                actor,
+                args,
+                by: operator.then_some(RaisedBy::Operator),
+                line
+            }
+        ),
         (
             (text(), opt(text()), values(), any::<bool>()),
             (opt(text()), opt(text()), opt(text()), line())
@@ -242,9 +249,15 @@ fn event() -> impl Strategy<Value = Event<'static>> {
                     Event::Exception { name, actor, args, handled, handler, during, skipped, line }
                 }
             ),
-        (text(), text(), text(), line()).prop_map(|(capability, tag, action, line)| {
-            Event::Leash { capability, tag, action, line }
-        }),
+        (text(), text(), text(), any::<bool>(), line()).prop_map(
+            |(capability, tag, action, block, line)| Event::Leash {
+                capability,
+                tag,
+                action,
+                block,
+                line
+            }
+        ),
         (text(), text(), point()).prop_map(|(actor, kind, location)| Event::Detection {
             actor,
             kind,

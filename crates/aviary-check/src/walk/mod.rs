@@ -24,6 +24,7 @@ pub(crate) fn check_program(
 ) {
     let mut tags = Vec::new();
     let mut aliases = HashSet::new();
+    let mut blocks = Vec::new();
     for (_, tree) in &program.files {
         for item in &tree.items {
             let bodies = match item {
@@ -42,6 +43,7 @@ pub(crate) fn check_program(
                     Stmt::Any(a) => {
                         aliases.insert(a.alias.name.as_str());
                     }
+                    Stmt::Block(Block { name: Some(name), .. }) => blocks.push(name.name.as_str()),
                     _ => {}
                 });
             }
@@ -60,6 +62,7 @@ pub(crate) fn check_program(
         tags,
         tag_set,
         aliases,
+        blocks,
         world_names,
         top_level: HashSet::new(),
         lets: Vec::new(),
@@ -113,6 +116,8 @@ struct Checker<'a> {
     tag_set: HashSet<(&'a str, &'a str)>,
     /// Every FOR alias of the mission: a `BY` filter may name one from anywhere.
     aliases: HashSet<&'a str>,
+    /// The names of the named SEQUENTIAL and PARALLEL blocks, which `Name ABORT` stops.
+    blocks: Vec<&'a str>,
     /// What each name of the world means (see [`world_names`]).
     world_names: foldhash::HashMap<&'a str, Meaning>,
     /// Where the `OPERATOR SIGNAL` lines directly in the MISSION body start: those are
@@ -350,9 +355,24 @@ impl<'a> Checker<'a> {
                     o.names.iter().map(|n| n.name.as_str()).collect::<Vec<_>>().join(", ")
                 ));
             }
-            Stmt::OperatorSignals(_) | Stmt::Error(_) => {}
+            Stmt::StopBlock(s) if !self.blocks.contains(&s.block.name.as_str()) => {
+                let name = s.block.name.clone();
+                let guess = did_you_mean(&name, self.blocks.iter().copied());
+                let d = self.report(
+                    Code::UnknownBlock,
+                    s.block.span,
+                    format!("no named SEQUENTIAL or PARALLEL block is called `{name}`"),
+                );
+                let help = "`Name ABORT` stops a block by its name, written `SEQUENTIAL Name:`; to stop an activity, tag its statement and write `Capability-Tag ABORT`";
+                d.help = Some(match guess {
+                    Some(g) => format!("{g} ({help})"),
+                    None => help.to_string(),
+                });
+            }
             // Bound by `body`, which sees where in its body the LET stands.
             Stmt::Let(_) => {}
+            // ALLOW lines are read by `crate::allow`.
+            Stmt::OperatorSignals(_) | Stmt::Allow(_) | Stmt::StopBlock(_) | Stmt::Error(_) => {}
         }
     }
 

@@ -147,6 +147,13 @@ fn leash_arguments_and_signal_values_are_checked_against_the_mission_kinds() {
         .map(|e| e["args"].to_string())
         .collect();
     assert_eq!(signals, ["[[100.0,-50.0],120.0]", "[[3.0,4.0,5.0],7.0]"]);
+    // The operator's signals say so (`by`), for the summary's operator actions; the
+    // mission's own signals do not.
+    for e in events.iter().filter(|e| e["event"] == "signal") {
+        let by_operator = e["name"] == "Go";
+        assert_eq!(e["by"] == "operator", by_operator, "{e}");
+        assert_eq!(e.get("by").is_some(), by_operator, "no `by` on the mission's own: {e}");
+    }
     let widened: Vec<String> = events
         .iter()
         .filter(|e| e["event"] == "signal" && e["name"] == "Widened")

@@ -110,7 +110,7 @@ export class TreeView {
         break;
       default:
         kind.textContent = n.kind.toUpperCase();
-        label.textContent = n.signal || n.exception || (n.capability ? `${n.capability}-${n.tag} ${n.action}` : "");
+        label.textContent = n.signal || n.exception || (n.capability ? `${n.capability}-${n.tag} ${n.action}` : n.block ? `${n.block} ${n.action}` : "");
         // A SIGNAL, a leash or a THROW: done once an event names its line.
         if (n.line && ["signal", "leash", "throw"].includes(n.kind)) own = (m) => statementStatus(m, n.line);
     }

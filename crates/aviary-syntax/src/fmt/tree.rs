@@ -261,6 +261,14 @@ impl Printer<'_> {
                 let text = format!("LET {} = {}", l.name.name, expr_text(&l.value, self.source));
                 self.line(depth, &text, Last::Code, start, end);
             }
+            Stmt::Allow(a) => {
+                let text = format!("ALLOW {} \"{}\"", a.code.name, a.reason);
+                self.line(depth, &text, Last::Code, start, end);
+            }
+            Stmt::StopBlock(s) => {
+                let text = format!("{} ABORT", s.block.name);
+                self.line(depth, &text, Last::Code, start, end);
+            }
             // Only in trees with errors, which are never formatted: the text as written.
             Stmt::Error(span) => {
                 let text = verbatim(self.source, span.start as usize, span.end as usize);
@@ -378,20 +386,5 @@ fn section_span(section: &Section) -> aviary_diagnostics::Span {
 }
 
 pub(super) fn stmt_span(stmt: &Stmt) -> aviary_diagnostics::Span {
-    match stmt {
-        Stmt::Block(b) => b.span,
-        Stmt::Statement(s) => s.span,
-        Stmt::Leash(l) => l.span,
-        Stmt::Api(a) => a.span,
-        Stmt::Requirement(r) => r.span,
-        Stmt::For(f) => f.span,
-        Stmt::Any(a) => a.span,
-        Stmt::Signal(r) | Stmt::Throw(r) => r.span,
-        Stmt::Handler(h) => h.span,
-        Stmt::ExceptionHandler(h) => h.span,
-        Stmt::If(i) => i.span,
-        Stmt::OperatorSignals(o) => o.span,
-        Stmt::Let(l) => l.span,
-        Stmt::Error(span) => *span,
-    }
+    stmt.span()
 }

@@ -81,6 +81,24 @@ impl Parser<'_> {
             {
                 self.let_stmt()
             }
+            // `ALLOW` is a word only before a diagnostic's code at the start of a line: a
+            // drone or capability called `ALLOW` stays what it was.
+            TokenKind::Ident
+                if self.text_of(start).eq_ignore_ascii_case("ALLOW")
+                    && self.peek_at(1) == TokenKind::Ident
+                    && looks_like_code(self.text_of(self.span_at(1))) =>
+            {
+                self.allow()
+            }
+            // `Name ABORT`: a block stopped (a leash names a tagged capability instead).
+            TokenKind::Ident
+                if matches!(
+                    self.peek_at(1),
+                    TokenKind::Keyword(Keyword::Abort | Keyword::Pause | Keyword::Resume)
+                ) =>
+            {
+                self.stop_block()
+            }
             TokenKind::Ident => self.statement(),
             TokenKind::Unknown => {
                 self.recover_line();
@@ -815,6 +833,77 @@ impl Parser<'_> {
         })
     }
 
+    /// `ALLOW W203 "reason"`.
+    fn allow(&mut self) -> Stmt {
+        let start = self.bump().span; // ALLOW
+        if self.text_of(start) != "ALLOW" {
+            let d = self
+                .error(
+                    Code::KeywordCase,
+                    start,
+                    "the words of the language are written in upper case: `ALLOW`",
+                )
+                .with_help("write `ALLOW W203 \"why the warning is expected\"`");
+            self.report(d);
+        }
+        let code = self.ident().unwrap_or_else(|| self.ident_at(start));
+        let Some(reason) = self.eat(TokenKind::String).map(|t| t.span) else {
+            let span = self.span();
+            let d = self
+                .error(Code::Syntax, span.to(code.span), format!("`ALLOW {}` needs a reason", code.name))
+                .with_help(format!(
+                    "say in quotes why the warning is expected: `ALLOW {} \"the drone is made free first\"`",
+                    code.name
+                ));
+            self.report(d);
+            self.recover_line();
+            return Stmt::Error(Span::new(start.start as usize, self.last_end as usize));
+        };
+        let raw = self.text_of(reason);
+        let reason_text = raw
+            .strip_prefix('"')
+            .map(|r| r.strip_suffix('"').unwrap_or(r))
+            .unwrap_or(raw)
+            .trim()
+            .to_string();
+        if reason_text.is_empty() {
+            let d = self
+                .error(Code::Syntax, reason, "an ALLOW's reason is empty")
+                .with_help("say why the warning is expected, for the next reader of the mission");
+            self.report(d);
+        }
+        self.end_line("the ALLOW line");
+        Stmt::Allow(Allow {
+            code,
+            reason: reason_text,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        })
+    }
+
+    /// `Block_Name ABORT`; `PAUSE` and `RESUME` are a leash's only.
+    fn stop_block(&mut self) -> Stmt {
+        let start = self.span();
+        let block = self.ident().unwrap_or_else(|| self.ident_at(start));
+        let action = self.bump();
+        if action.kind != TokenKind::Keyword(Keyword::Abort) {
+            let word = self.text_of(action.span).to_string();
+            let d = self
+                .error(Code::Syntax, action.span, format!("a block cannot be told {word}: only ABORT stops a block"))
+                .with_help(format!(
+                    "write `{} ABORT` to end the block, or {word} a tagged activity inside it: `Capability-Tag {word}`",
+                    block.name
+                ));
+            self.report(d);
+            self.recover_line();
+            return Stmt::Error(Span::new(start.start as usize, self.last_end as usize));
+        }
+        self.end_line("the block's ABORT");
+        Stmt::StopBlock(StopBlock {
+            block,
+            span: Span::new(start.start as usize, self.last_end as usize),
+        })
+    }
+
     fn handler(&mut self, mode: Option<BlockKind>, start: Span) -> Stmt {
         self.bump(); // ON
         let every = self.eat_keyword(Keyword::Every).is_some();
@@ -880,4 +969,10 @@ impl Parser<'_> {
             span: Span::new(start.start as usize, self.last_end as usize),
         })
     }
+}
+
+/// Whether `word` is written as a diagnostic's code: a letter and three digits (`W203`).
+fn looks_like_code(word: &str) -> bool {
+    let b = word.as_bytes();
+    b.len() == 4 && b[0].is_ascii_alphabetic() && b[1..].iter().all(u8::is_ascii_digit)
 }

@@ -417,7 +417,8 @@ impl<'m> Estimator<'m> {
             Node::Call(c) => self.call(c, ctx, t),
             Node::Api(a) => self.api(a, ctx, t),
             Node::Signal { signal, args, .. } => self.signal(*signal, args, ctx, t),
-            Node::Leash(_) | Node::Throw { .. } => (t, Vec::new()),
+            // A stopped block's drones are free at once: the plan cannot know when.
+            Node::Leash(_) | Node::StopBlock { .. } | Node::Throw { .. } => (t, Vec::new()),
             Node::StartIf { condition, body } => self.start_if(condition, body, ctx, t),
             Node::WaitFor { condition, body } => {
                 let t = self.wait(condition, ctx, t);

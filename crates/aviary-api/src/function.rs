@@ -145,7 +145,9 @@ impl Function {
                 (vec![p("kind", Symbol)], "load a payload (landed or below 5 m)")
             }
             Function::ReleasePayload => (vec![], "release the payload carried"),
-            Function::FollowPath => (vec![p("points", Position)], "fly through positions in order"),
+            Function::FollowPath => {
+                (vec![p("points", Path)], "fly through positions (or a line) in order")
+            }
         };
         Signature { function: self, params, variadic: self == Function::FollowPath, summary }
     }

@@ -102,6 +102,9 @@ fn merge(known: Option<Kind>, used: Kind) -> Option<Kind> {
     match known {
         None => Some(used),
         Some(Kind::Position) if used == Kind::Area => Some(Kind::Area),
+        // A path (what `FollowPath` flies) used as a single position too is a position
+        // (or an area): a line could not stand for one point.
+        Some(Kind::Path) if matches!(used, Kind::Position | Kind::Area) => Some(used),
         known => known,
     }
 }

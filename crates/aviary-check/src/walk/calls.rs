@@ -70,6 +70,14 @@ impl<'a> Checker<'a> {
             }
             Meaning::Place => Some(("a place, not a capability", fly_there)),
             Meaning::Area => Some(("an area, not a capability", fly_there)),
+            Meaning::Line => Some((
+                "a line, not a capability",
+                format!(
+                    "to fly along it, write `{} FollowPath WITH {}`",
+                    actors.join(" "),
+                    s.capability.name
+                ),
+            )),
             _ => None,
         };
         if let Some((what, help)) = what {

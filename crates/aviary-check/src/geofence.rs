@@ -356,6 +356,18 @@ impl Walker<'_> {
         file: FileId,
     ) {
         let (at_file, at) = site.unwrap_or((file, call.span));
+        // Once per statement and finding: a capability that flies the same way on each
+        // branch of an IF (the standard library's `FlyTo`, with and without a speed) is
+        // one problem of the statement.
+        let same = |d: &Diagnostic| {
+            d.code == code
+                && d.primary.file == at_file
+                && d.primary.span == at
+                && d.message == message
+        };
+        if site.is_some() && self.diagnostics.iter().any(same) {
+            return;
+        }
         let mut d = Diagnostic::new(code, at_file, at, message).with_help(help);
         if site.is_some() {
             d.secondary.push(Label {

@@ -127,8 +127,14 @@ pub fn sweep_lanes(area: &Value, spacing: f64) -> Result<Vec<Lane>, String> {
 /// The points `FollowPath(points...)` flies through, in order: a position is itself, an
 /// area its centroid, a remainder the points of its path. A position whose coordinates
 /// are not finite, or any other value, is refused, with the reason.
+/// A last argument that is a number is the speed (`FollowPath(points...[, speed])`,
+/// [`follow_speed`]), and is not a point.
 pub fn follow_points(args: &[Value]) -> Result<Vec<Point>, String> {
     let mut out = Vec::new();
+    let args = match args.split_last() {
+        Some((Value::Number(_), points)) => points,
+        _ => args,
+    };
     for (i, v) in args.iter().enumerate() {
         match v {
             Value::Position(p)
@@ -151,6 +157,18 @@ pub fn follow_points(args: &[Value]) -> Result<Vec<Point>, String> {
         }
     }
     Ok(out)
+}
+
+/// The speed `FollowPath(points...[, speed])` was asked to fly at: its last argument when
+/// that is a number (m/s), above 0; `None` when it has none (the drone's own speed).
+pub fn follow_speed(args: &[Value]) -> Result<Option<f64>, String> {
+    match args.last() {
+        Some(Value::Number(s)) if s.is_finite() && *s > 0.0 => Ok(Some(*s)),
+        Some(Value::Number(s)) => {
+            Err(format!("`speed` must be above 0 m/s, not {} m/s", crate::show::number(*s)))
+        }
+        _ => Ok(None),
+    }
 }
 
 /// What a call of `function` with `args` left when it stopped at `progress` (`None`: it

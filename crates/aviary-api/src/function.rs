@@ -145,9 +145,18 @@ impl Function {
                 (vec![p("kind", Symbol)], "load a payload (landed or below 5 m)")
             }
             Function::ReleasePayload => (vec![], "release the payload carried"),
-            Function::FollowPath => (vec![p("points", Position)], "fly through positions in order"),
+            Function::FollowPath => {
+                (vec![p("points", Path)], "fly through positions (or a line) in order")
+            }
         };
-        Signature { function: self, params, variadic: self == Function::FollowPath, summary }
+        let trailing = (self == Function::FollowPath).then(|| opt("speed", Speed));
+        Signature {
+            function: self,
+            params,
+            variadic: self == Function::FollowPath,
+            trailing,
+            summary,
+        }
     }
 }
 
@@ -172,6 +181,9 @@ pub struct Signature {
     pub params: Vec<Param>,
     /// The last parameter repeats (`FollowPath(points...)`).
     pub variadic: bool,
+    /// An optional parameter after the repeated one (`FollowPath(points...[, speed])`),
+    /// told apart from it by its kind: a last argument of this kind is this parameter.
+    pub trailing: Option<Param>,
     pub summary: &'static str,
 }
 
@@ -190,6 +202,17 @@ impl Signature {
     pub fn required(&self) -> usize {
         self.params.iter().filter(|p| !p.optional).count()
     }
+    /// The parameter that argument `j` of `n` goes to, `last` being the kind of the last
+    /// argument when known: a repeated parameter takes every argument from its place on,
+    /// except a last one of the [`Signature::trailing`] parameter's kind.
+    pub fn param_at(&self, j: usize, n: usize, last: Option<Kind>) -> Option<&Param> {
+        if let Some(t) = &self.trailing {
+            if j + 1 == n && j >= self.required() && last.is_some_and(|k| t.kind.accepts(k)) {
+                return Some(t);
+            }
+        }
+        self.params.get(j).or(if self.variadic { self.params.last() } else { None })
+    }
     /// `FlyToPosition(pos[, speed])`, for messages.
     pub fn signature(&self) -> String {
         let mut out = format!("{}(", self.name());
@@ -203,6 +226,9 @@ impl Signature {
         }
         if self.variadic {
             out.push_str("...");
+        }
+        if let Some(t) = &self.trailing {
+            out.push_str(&format!("[, {}]", t.name));
         }
         out.push(')');
         out

@@ -17,6 +17,11 @@ pub enum Kind {
     /// A name that only equals itself (`Body`, `Landed`).
     Symbol,
     Actor,
+    /// A line of the world file's `[lines]`: points in order, flown by `FollowPath`.
+    Line,
+    /// What `FollowPath` flies through: positions, a line of the world file, or what a
+    /// `Sweep` or `FollowPath` left.
+    Path,
     /// What a `Sweep` or `FollowPath` left (`drone.remaining`): taken by `Sweep` in place
     /// of an area and by `FollowPath` in place of its points, and nowhere else.
     Remainder,
@@ -38,6 +43,8 @@ impl Kind {
             Kind::Area => "an area",
             Kind::Symbol => "a symbol",
             Kind::Actor => "a drone or group",
+            Kind::Line => "a line (of the world file's [lines])",
+            Kind::Path => "a path (positions, a line of the world file, or what a FollowPath left)",
             Kind::Remainder => "what a Sweep or FollowPath left (`drone.remaining`)",
         }
     }
@@ -49,6 +56,7 @@ impl Kind {
                 (self, value),
                 (Kind::Position, Kind::Area)
                     | (Kind::Area, Kind::Remainder)
+                    | (Kind::Path, Kind::Position | Kind::Area | Kind::Line | Kind::Remainder)
                     | (Kind::Symbol, Kind::Text)
                     | (Kind::Text, Kind::Symbol)
             )
@@ -69,6 +77,8 @@ impl Kind {
             Kind::Area => "an area from the world file",
             Kind::Symbol => "Body",
             Kind::Actor => "a drone's name",
+            Kind::Line => "a line from the world file",
+            Kind::Path => "(100, 50), (200, 50)",
             Kind::Remainder => "drone.remaining",
         }
     }

@@ -217,8 +217,7 @@ impl Walker<'_> {
     fn api_call(&mut self, call: &ApiCall, env: &Env, file: FileId) {
         let Some(f) = self.api.function(&call.function.name) else { return };
         for (j, arg) in call.args.iter().enumerate() {
-            let Some(p) = f.params.get(j).or(if f.variadic { f.params.last() } else { None })
-            else {
+            let Some(p) = f.param_at(j, call.args.len(), None) else {
                 continue;
             };
             if p.kind != Kind::Duration {

@@ -19,6 +19,8 @@ pub(crate) enum Meaning {
     Group,
     Place,
     Area,
+    /// A line of the world file's `[lines]`.
+    Line,
     /// Not a name of anything: a symbol (when the world is known).
     Unbound,
 }

@@ -26,6 +26,8 @@ const MAX_CALLS: usize = 16;
 pub(crate) enum Known {
     Point([f64; 2], Option<f64>),
     Area(Vec<[f64; 2]>),
+    /// A line of the world file: its points, each with its height if it has one.
+    Path(Vec<([f64; 2], Option<f64>)>),
     Number(f64),
     /// An actor: the world's drones it stands for (indices), for where they start from.
     Drones(Vec<usize>),
@@ -41,7 +43,8 @@ fn point_of(k: &Known) -> Option<Point> {
             let [x, y] = aviary_api::centroid(poly);
             Some(Point::flat(x, y))
         }
-        Known::Number(_) | Known::Drones(_) => None,
+        // A line stands nowhere as a point (`FlyTo` refuses one, E107).
+        Known::Number(_) | Known::Drones(_) | Known::Path(_) => None,
     }
 }
 
@@ -118,6 +121,10 @@ impl Walker<'_> {
                 }
                 if let Some(p) = self.world.place(&id.name) {
                     return Some(Known::Point([p.at[0], p.at[1]], p.has_z.then_some(p.at[2])));
+                }
+                if let Some(l) = self.world.line(&id.name) {
+                    let points = l.points.iter().map(|(p, z)| ([p[0], p[1]], z.then_some(p[2])));
+                    return Some(Known::Path(points.collect()));
                 }
                 self.world.area(&id.name).map(|a| Known::Area(a.polygon.clone()))
             }
@@ -314,8 +321,15 @@ impl Walker<'_> {
             Function::FollowPath => {
                 // A point without a height keeps the one before (unknown before the first).
                 let mut z = None;
-                for e in &call.args {
-                    match self.value(e, values) {
+                // A line stands for its points, in order.
+                let known = call.args.iter().flat_map(|e| match self.value(e, values) {
+                    Some(Known::Path(points)) => {
+                        points.into_iter().map(|(p, h)| Some(Known::Point(p, h))).collect()
+                    }
+                    k => vec![k],
+                });
+                for k in known.collect::<Vec<_>>() {
+                    match k {
                         Some(k) => {
                             self.point(&k, call, site, file);
                             self.zone_point(&k, z, call, values, site, file);
@@ -406,6 +420,18 @@ impl Walker<'_> {
         file: FileId,
     ) {
         let (at_file, at) = site.unwrap_or((file, call.span));
+        // Once per statement and finding: a capability that flies the same way on each
+        // branch of an IF (the standard library's `FlyTo`, with and without a speed) is
+        // one problem of the statement.
+        let same = |d: &Diagnostic| {
+            d.code == code
+                && d.primary.file == at_file
+                && d.primary.span == at
+                && d.message == message
+        };
+        if site.is_some() && self.diagnostics.iter().any(same) {
+            return;
+        }
         let mut d = Diagnostic::new(code, at_file, at, message).with_help(help);
         if site.is_some() {
             d.secondary.push(Label {
@@ -433,7 +459,7 @@ pub(crate) fn ground(k: &Known) -> Option<[f64; 2]> {
     match k {
         Known::Point(p, _) => Some(*p),
         Known::Area(a) => Some(aviary_api::centroid(a)),
-        Known::Number(_) | Known::Drones(_) => None,
+        Known::Path(_) | Known::Number(_) | Known::Drones(_) => None,
     }
 }
 

@@ -102,6 +102,9 @@ fn merge(known: Option<Kind>, used: Kind) -> Option<Kind> {
     match known {
         None => Some(used),
         Some(Kind::Position) if used == Kind::Area => Some(Kind::Area),
+        // A path (what `FollowPath` flies) used as a single position too is a position
+        // (or an area): a line could not stand for one point.
+        Some(Kind::Path) if matches!(used, Kind::Position | Kind::Area) => Some(used),
         known => known,
     }
 }
@@ -154,8 +157,9 @@ impl Uses<'_> {
     /// A parameter passed to a middle-layer function takes the kind of its parameter.
     fn api_call(&self, c: &Capability, call: &ApiCall, learned: &mut Vec<Learned>) {
         let Some(f) = self.api.function(&call.function.name) else { return };
+        let last = call.args.last().and_then(literal_kind);
         for (j, arg) in call.args.iter().enumerate() {
-            let p = f.params.get(j).or(if f.variadic { f.params.last() } else { None });
+            let p = f.param_at(j, call.args.len(), last);
             if let (Some(i), Some(p)) = (param_index(c, arg), p) {
                 let why = format!(
                     "`{}` goes to the middle layer's {}: {}",

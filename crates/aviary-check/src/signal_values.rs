@@ -110,8 +110,9 @@ fn binding_kind(program: &Program, api: &Descriptor, name: &str, body: &Body) ->
                 let Some(f) = api.function(&call.function.name) else {
                     return;
                 };
+                let last = call.args.last().and_then(literal_kind);
                 found = call.args.iter().enumerate().find_map(|(j, arg)| {
-                    let p = f.params.get(j).or(if f.variadic { f.params.last() } else { None })?;
+                    let p = f.param_at(j, call.args.len(), last)?;
                     is_binding(arg).then_some(p.kind)
                 });
             }

@@ -655,7 +655,11 @@ fn one_at_a_time_runs_firings_one_after_another() {
             .collect();
         assert_eq!(caps.len(), 3, "{caps:?}");
         assert!(caps[0].starts_with("TakeOff"), "{caps:?}");
-        assert_eq!(caps[1], format!("FlyTo {{\"target\":{target}}}"), "in signal order");
+        assert_eq!(
+            caps[1],
+            format!("FlyTo {{\"target\":{target},\"speed\":0.0}}"),
+            "in signal order"
+        );
         assert!(caps[2].starts_with("ReturnHome"), "{caps:?}");
     }
     // Never two activities of the drone at once: each capability ends before the next starts.

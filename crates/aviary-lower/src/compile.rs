@@ -714,6 +714,13 @@ impl<'a> Compiler<'a> {
         if let Some(a) = w.areas.get(name) {
             return Expr::Const(Value::Area(a.polygon.clone()));
         }
+        if let Some(l) = w.lines.get(name) {
+            // A line runs as a path's points, as what a FollowPath left does: the one
+            // value `FollowPath` flies in place of its points (the trace shows it as
+            // `{"points": ...}`).
+            let path = aviary_api::Remainder::points(l.path());
+            return Expr::Const(Value::Remainder(std::sync::Arc::new(path)));
+        }
         Expr::Const(Value::Symbol(name.to_string()))
     }
 }
@@ -855,7 +862,7 @@ fn visit_calls<'b>(block: &'b Block, out: &mut Vec<&'b Call>) {
     });
 }
 
-/// The world's drones, groups, places and areas by name (the first of a name wins, as a
+/// The world's drones, groups, places, areas and lines by name (the first of a name wins, as a
 /// scan in file order would find it).
 /// Hashed with foldhash (seeded per process): a quick hash for keys no attacker chooses,
 /// since the names come from the operator's own world file, and a large world has one a
@@ -865,6 +872,7 @@ struct WorldIndex<'w> {
     groups: foldhash::HashMap<&'w str, &'w aviary_world::Group>,
     places: foldhash::HashMap<&'w str, &'w aviary_world::Place>,
     areas: foldhash::HashMap<&'w str, &'w aviary_world::Area>,
+    lines: foldhash::HashMap<&'w str, &'w aviary_world::Line>,
 }
 
 impl<'w> WorldIndex<'w> {
@@ -884,6 +892,7 @@ impl<'w> WorldIndex<'w> {
             groups: first(w.groups.iter().map(|g| (g.name.as_str(), g))),
             places: first(w.places.iter().map(|p| (p.name.as_str(), p))),
             areas: first(w.areas.iter().map(|a| (a.name.as_str(), a))),
+            lines: first(w.lines.iter().map(|l| (l.name.as_str(), l))),
         }
     }
 }

@@ -145,8 +145,11 @@ async fn sweep(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure>
 
 /// `FollowPath`: through the points (a remainder's in its place), each a transit around
 /// the no-fly zones from the one before; one without an altitude keeps the one before.
+/// At the speed asked for (its last argument), at most the drone's, as `FlyToPosition`.
 async fn follow_path(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
     let points = aviary_api::coverage::follow_points(args).map_err(failed)?;
+    let speed = aviary_api::coverage::follow_speed(args).map_err(failed)?;
+    let speed = speed.map_or(c.max_speed, |s| s.min(c.max_speed));
     if points.is_empty() {
         return Ok(());
     }
@@ -158,7 +161,7 @@ async fn follow_path(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Fa
         path.push([p.x, p.y, z]);
     }
     let way = routed(c, here, &path)?;
-    fly_through(c, &way, c.max_speed, paused).await
+    fly_through(c, &way, speed, paused).await
 }
 
 /// `StartStreaming` and `StopStreaming`. Video is not carried over MAVLink: this records

@@ -296,6 +296,8 @@ pub(crate) fn kind_name(kind: Kind) -> &'static str {
         Kind::Symbol => "symbol",
         Kind::Actor => "actor",
         Kind::Remainder => "remainder",
+        Kind::Line => "line",
+        Kind::Path => "path",
     }
 }
 
@@ -381,7 +383,7 @@ fn convert(
         (Some(Kind::Symbol) | None, Given::Word(s)) => Ok(Value::Symbol(s)),
         (Some(Kind::Text), Given::Word(s)) => Ok(Value::Text(s)),
         (Some(Kind::Bool) | None, Given::Bool(b)) => Ok(Value::Bool(b)),
-        (Some(k @ (Kind::Area | Kind::Actor | Kind::Remainder)), _) => {
+        (Some(k @ (Kind::Area | Kind::Actor | Kind::Remainder | Kind::Line | Kind::Path)), _) => {
             Err(format!("{what} is {}, which the operator API cannot send", k.describe()))
         }
         (Some(k), _) => Err(format!("{what} is {}, and {v} is not: {}", k.describe(), example(k))),
@@ -413,7 +415,9 @@ fn example(kind: Kind) -> String {
         }
         Kind::Symbol | Kind::Text => return "write a string such as \"Body\"".into(),
         Kind::Bool => return "write true or false".into(),
-        Kind::Area | Kind::Actor | Kind::Remainder => return String::new(),
+        Kind::Area | Kind::Actor | Kind::Remainder | Kind::Line | Kind::Path => {
+            return String::new()
+        }
     };
     let si = if kind == Kind::Ratio { "a fraction such as 0.25" } else { "a number in SI units" };
     format!("write {si}, or {{\"number\": 20, \"unit\": \"{unit}\"}}")

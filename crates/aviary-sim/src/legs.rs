@@ -194,10 +194,13 @@ impl Mover<'_> {
 
     /// `FollowPath`: through the points (a remainder's in its place), each a transit from
     /// the one before (around the zones); one without an altitude keeps the one before.
+    /// At the speed asked for (its last argument), at most the drone's, as `FlyToPosition`.
     /// With the legs, the points, as for `Sweep`.
     pub fn follow_path(&self, args: &[Value]) -> Result<(Vec<Leg>, Vec<[f64; 3]>), Failure> {
         let d = self.d;
         self.in_air()?;
+        let speed = coverage::follow_speed(args).map_err(failed)?;
+        let speed = speed.map_or(d.spec.max_speed, |s| s.min(d.spec.max_speed));
         let mut z = d.level();
         let mut path = Vec::new();
         for p in coverage::follow_points(args).map_err(failed)? {
@@ -210,7 +213,7 @@ impl Mover<'_> {
         let mut legs = Vec::new();
         let mut from = d.pos;
         for &to in &path {
-            legs.extend(self.transit(from, to, d.spec.max_speed)?);
+            legs.extend(self.transit(from, to, speed)?);
             from = to;
         }
         self.limits.path(d.pos, &Self::points(&legs))?;

@@ -244,6 +244,7 @@ fn failures(report: &Report, world: Option<&aviary_world::World>) -> Result<Stri
     if let Some(w) = world {
         points.extend(w.site.geofence.iter().flatten().copied());
         points.extend(w.areas.iter().flat_map(|a| a.polygon.iter().copied()));
+        points.extend(w.lines.iter().flat_map(|l| l.ground()));
         points.extend(w.places.iter().map(|p| [p.at[0], p.at[1]]));
         points.extend(w.drones.iter().map(|d| [d.home[0], d.home[1]]));
     }

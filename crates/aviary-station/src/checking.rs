@@ -75,9 +75,9 @@ fn rendered(sources: &SourceMap, d: &Diagnostic) -> Value {
     value
 }
 
-/// What the map shows of a world: the site, places, areas, no-fly zones (`no_fly`: name,
-/// polygon, `up_to`), homes and targets, in the local frame (metres east and north of the
-/// origin).
+/// What the map shows of a world: the site, places, areas, lines (`lines`: name, points
+/// `[x, y]`), no-fly zones (`no_fly`: name, polygon, `up_to`), homes and targets, in the
+/// local frame (metres east and north of the origin).
 pub fn map_of(world: &aviary_world::World) -> Value {
     let drones: Vec<Value> = world
         .drones
@@ -96,6 +96,11 @@ pub fn map_of(world: &aviary_world::World) -> Value {
         "base": crate::tiles::base_map(world),
         "places": world.places,
         "areas": world.areas,
+        "lines": world
+            .lines
+            .iter()
+            .map(|l| json!({ "name": l.name, "points": l.ground() }))
+            .collect::<Vec<Value>>(),
         "no_fly": world.no_fly,
         "drones": drones,
         "targets": world.targets,

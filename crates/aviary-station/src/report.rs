@@ -175,7 +175,8 @@ pub(crate) type MapChart<'a, DB> = ChartContext<
     Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
 >;
 
-/// The world on a map: its areas, no-fly zones, geofence, places and the drones' homes.
+/// The world on a map: its areas, lines, no-fly zones, geofence, places and the drones'
+/// homes.
 pub(crate) fn world_layers<DB: DrawingBackend>(
     chart: &mut MapChart<'_, DB>,
     w: &aviary_world::World,
@@ -200,6 +201,18 @@ where
             escape(&a.name),
             (c[0], c[1]),
             ("sans-serif", 12).into_font().color(&RGBColor(28, 100, 209)),
+        )))?;
+    }
+    // Lines (a pipeline, a road, a river): a path in teal, named at its first point.
+    let teal = RGBColor(15, 138, 126);
+    for l in &w.lines {
+        let path: Vec<(f64, f64)> = l.ground().iter().map(|p| (p[0], p[1])).collect();
+        let Some(&first) = path.first() else { continue };
+        chart.draw_series(std::iter::once(PathElement::new(path, teal.stroke_width(3))))?;
+        chart.draw_series(std::iter::once(Text::new(
+            escape(&format!("line: {}", l.name)),
+            first,
+            ("sans-serif", 12).into_font().color(&teal),
         )))?;
     }
     no_fly_zones(chart, w)?;
@@ -236,6 +249,7 @@ fn map(m: &Mission, world: Option<&aviary_world::World>) -> Result<String, Strin
         points.extend(w.site.geofence.iter().flatten().copied());
         points.extend(w.areas.iter().flat_map(|a| a.polygon.iter().copied()));
         points.extend(w.no_fly.iter().flat_map(|z| z.polygon.iter().copied()));
+        points.extend(w.lines.iter().flat_map(|l| l.ground()));
         points.extend(w.places.iter().map(|p| [p.at[0], p.at[1]]));
     }
     points.extend(m.finds.iter().map(|f| [f.3[0], f.3[1]]));
@@ -466,4 +480,26 @@ pub(crate) fn square_frame(points: &[[f64; 2]]) -> (f64, f64, f64, f64) {
     let span = (x1 - x0).max(y1 - y0).max(10.0) * 1.1;
     let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
     (cx - span / 2.0, cx + span / 2.0, cy - span / 2.0, cy + span / 2.0)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_report_and_the_station_map_draw_the_world_lines() {
+        let text =
+            "[lines]\nPipeline = [[0, 0], [100, 0, 30], [100, 80]]\n[drones.a]\nhome = [0, 0]\n";
+        let (world, diags) = aviary_world::parse_world(aviary_diagnostics::FileId(0), text);
+        let world = world.unwrap_or_else(|| panic!("{diags:?}"));
+        let trace = concat!(
+            "{\"t\":0.0,\"event\":\"mission_start\",\"mission\":\"M\"}\n",
+            "{\"t\":1.0,\"event\":\"mission_end\",\"status\":\"ok\",\"reason\":null}\n",
+        );
+        let html = super::render("t.jsonl", trace.as_bytes().to_vec(), Some(&world)).unwrap();
+        assert!(html.contains("line: Pipeline"), "{html}");
+        let map = crate::checking::map_of(&world);
+        assert_eq!(
+            map["lines"],
+            serde_json::json!([{"name": "Pipeline", "points": [[0.0, 0.0], [100.0, 0.0], [100.0, 80.0]]}])
+        );
+    }
 }

@@ -7,7 +7,7 @@ use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 use crate::hash::QuickMap;
 use crate::node::{Entry, Node, Value};
 use crate::read::{suggest, Ctx};
-use crate::{Area, Geo, Place, Site, World};
+use crate::{Area, Geo, Line, Place, Site, World};
 
 mod air;
 mod drone;
@@ -20,8 +20,8 @@ use drone::Drones;
 use fleet::FleetInfo;
 
 const TABLES: &[&str] = &[
-    "site", "places", "areas", "no_fly", "drones", "fleets", "sensors", "targets", "faults", "air",
-    "expect",
+    "site", "places", "areas", "lines", "no_fly", "drones", "fleets", "sensors", "targets",
+    "faults", "air", "expect",
 ];
 const SITE_KEYS: &[&str] = &[
     "name",
@@ -134,6 +134,9 @@ fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Dia
     }
     if let Some(e) = table("areas") {
         world.areas = areas(cx, &e.node);
+    }
+    if let Some(e) = table("lines") {
+        world.lines = lines(cx, &e.node);
     }
     if let Some(e) = table("no_fly") {
         world.no_fly = no_fly::zones(cx, &e.node);
@@ -314,6 +317,51 @@ fn areas(cx: &mut Ctx, node: &Node) -> Vec<Area> {
     out
 }
 
+/// `[lines]`: `NAME = [[x, y], [x, y, z], ...]`, at least two points. A line outside the
+/// geofence is allowed, as a place or an area is: a mission that flies it is told where.
+fn lines(cx: &mut Ctx, node: &Node) -> Vec<Line> {
+    let help = "write `[lines]` followed by lines `NAME = [[x, y], [x, y], ...]` (a point may be `[x, y, z]`)";
+    let Some(entries) = cx.table(&"`lines`", node, help) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for e in entries {
+        cx.identifier("line", &e.key, e.key_span);
+        let what = format!("line `{}`", e.key);
+        let Value::Array(items) = &e.node.value else {
+            let msg = format!(
+                "{what} must be a list of points [[x, y], ...], found {}",
+                e.node.describe()
+            );
+            cx.error(e.node.span, msg, help);
+            continue;
+        };
+        if items.len() < 2 {
+            let msg = format!(
+                "{what} has {}; a line needs at least 2",
+                crate::read::count(items.len(), "point")
+            );
+            cx.error(e.node.span, msg, help);
+            continue;
+        }
+        let mut points = Some(Vec::with_capacity(items.len()));
+        for item in items {
+            let point = cx
+                .point(&format!("a point of {what}"), item)
+                .filter(|(at, _)| cx.above_ground(&format!("a point of {what}"), item, at[2]));
+            match (point, points.as_mut()) {
+                (Some(p), Some(points)) => points.push(p),
+                (None, _) => points = None,
+                _ => {}
+            }
+        }
+        if let Some(points) = points {
+            out.push(Line { name: e.key.clone(), points, span: e.key_span });
+        }
+    }
+    out
+}
+
 /// Every drone starts and lands at its home: one outside the geofence (its line counts as
 /// inside, as for a flight) would take off outside it (and the simulator would fly it back
 /// in from there). Reported at the `home` value, or once per fleet at its `homes`; the
@@ -438,16 +486,17 @@ pub(super) fn home_spans(text: &str) -> std::collections::HashMap<String, Span> 
     out
 }
 
-/// A name stands for one drone, group, place or area: mission code names them alike.
+/// A name stands for one drone, group, place, area or line: mission code names them alike.
 /// Within each kind names are unique already (TOML keys, one group per name), so only
 /// names of two kinds can clash: the drones, the many, are looked up among the others.
 fn unique_names(cx: &mut Ctx, world: &World, group_spans: &[Span]) {
     let mut named: QuickMap<&str, Vec<(&str, Span)>> = QuickMap::default();
     let places = world.places.iter().map(|p| (p.name.as_str(), "a place", p.span));
     let areas = world.areas.iter().map(|a| (a.name.as_str(), "an area", a.span));
+    let lines = world.lines.iter().map(|l| (l.name.as_str(), "a line", l.span));
     let groups =
         world.groups.iter().zip(group_spans).map(|(g, span)| (g.name.as_str(), "a group", *span));
-    for (name, what, span) in places.chain(areas).chain(groups) {
+    for (name, what, span) in places.chain(areas).chain(lines).chain(groups) {
         named.entry(name).or_default().push((what, span));
     }
     for d in &world.drones {
@@ -466,7 +515,7 @@ fn unique_names(cx: &mut Ctx, world: &World, group_spans: &[Span]) {
                 "the name `{name}` is used for {first} and for {what}, so mission code could not tell which is meant"
             );
             let help =
-                "rename one of them: drones, groups, places and areas share one set of names";
+                "rename one of them: drones, groups, places, areas and lines share one set of names";
             let d = Diagnostic::new(Code::WorldFile, cx.file, span, msg).with_help(help).also(
                 cx.file,
                 first_span,

@@ -42,6 +42,9 @@ pub struct World {
     pub places: Vec<Place>,
     /// In file order.
     pub areas: Vec<Area>,
+    /// `[lines]`, in file order: paths on the ground (a pipeline, a road, a river) that
+    /// `FollowPath` flies through.
+    pub lines: Vec<Line>,
     /// `[no_fly.NAME]`, in file order: where no drone may fly (docs/WORLD.md).
     pub no_fly: Vec<NoFly>,
     /// In file order: a group expands to its members in this order.
@@ -172,6 +175,35 @@ impl Area {
     /// Whether a ground point lies inside the polygon.
     pub fn contains(&self, p: [f64; 2]) -> bool {
         contains(&self.polygon, p)
+    }
+}
+
+/// One line of `[lines]`: points in order, at least two, each `[x, y]` (flown at the
+/// drone's altitude) or `[x, y, z]`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Line {
+    pub name: String,
+    /// Each point and whether its height was written (z = 0 when it was not).
+    pub points: Vec<([f64; 3], bool)>,
+    /// The name's key.
+    #[serde(skip)]
+    pub span: Span,
+}
+
+impl Line {
+    /// The points a `FollowPath` of the line flies through, in order.
+    pub fn path(&self) -> Vec<aviary_api::Point> {
+        let point = |&(p, has_z): &([f64; 3], bool)| aviary_api::Point {
+            x: p[0],
+            y: p[1],
+            z: has_z.then_some(p[2]),
+        };
+        self.points.iter().map(point).collect()
+    }
+
+    /// Its points on the ground.
+    pub fn ground(&self) -> Vec<[f64; 2]> {
+        self.points.iter().map(|(p, _)| [p[0], p[1]]).collect()
     }
 }
 
@@ -604,16 +636,21 @@ impl World {
     pub fn area(&self, name: &str) -> Option<&Area> {
         self.areas.iter().find(|a| a.name == name)
     }
+    pub fn line(&self, name: &str) -> Option<&Line> {
+        self.lines.iter().find(|l| l.name == name)
+    }
     pub fn sensor(&self, kind: &str) -> Option<&Sensor> {
         self.sensors.iter().find(|s| s.kind == kind)
     }
-    /// Every name a mission may use (drones, groups, places, areas), for "did you mean".
+    /// Every name a mission may use (drones, groups, places, areas, lines), for "did you
+    /// mean".
     pub fn names(&self) -> impl Iterator<Item = &str> {
         let drones = self.drones.iter().map(|d| d.name.as_str());
         let groups = self.groups.iter().map(|g| g.name.as_str());
         let places = self.places.iter().map(|p| p.name.as_str());
         let areas = self.areas.iter().map(|a| a.name.as_str());
-        drones.chain(groups).chain(places).chain(areas)
+        let lines = self.lines.iter().map(|l| l.name.as_str());
+        drones.chain(groups).chain(places).chain(areas).chain(lines)
     }
 }
 
@@ -624,6 +661,7 @@ impl Default for World {
             site: Site::default(),
             places: Vec::new(),
             areas: Vec::new(),
+            lines: Vec::new(),
             no_fly: Vec::new(),
             drones: Vec::new(),
             groups: Vec::new(),

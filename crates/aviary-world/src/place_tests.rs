@@ -85,3 +85,61 @@ fn a_fence_must_enclose_an_area_and_not_cross_itself() {
     let ok = "[site]\ngeofence = [[0, 0], [100, 0], [100, 100], [0, 100]]\n[areas]\nA = [[10, 10], [20, 10], [20, 20]]\n[drones.d]\nhome = [100, 50]\n";
     assert!(problems(ok).is_empty());
 }
+
+#[test]
+fn a_line_is_points_in_order_each_with_or_without_a_height() {
+    let text =
+        "[lines]\nPipeline = [[0, 0], [100, 0, 30], [100, 200]]\n[drones.d]\nhome = [0, 0]\n";
+    let (world, diags) = parse_world(FileId(0), text);
+    assert!(diags.is_empty(), "{diags:?}");
+    let line = world.unwrap().line("Pipeline").cloned().unwrap();
+    assert_eq!(
+        line.points,
+        vec![([0.0, 0.0, 0.0], false), ([100.0, 0.0, 30.0], true), ([100.0, 200.0, 0.0], false)]
+    );
+    assert_eq!(line.path()[1].z, Some(30.0));
+    assert_eq!(line.path()[2].z, None);
+}
+
+#[test]
+fn a_line_of_one_point_or_of_bad_points_is_an_error_at_it() {
+    let text = "[lines]\nShort = [[0, 0]]\nDeep = [[0, 0], [5, 5, -1]]\nFlat = [0, 0]\nBad-name = [[0, 0], [1, 1]]\n[drones.d]\nhome = [0, 0]\n";
+    let found = problems(text);
+    assert_eq!(
+        found,
+        vec![
+            (
+                "line `Short` has 1 point; a line needs at least 2".to_string(),
+                "[[0, 0]]".to_string()
+            ),
+            (
+                "a point of line `Deep` is below the ground: z = -1 m".to_string(),
+                "[5, 5, -1]".to_string()
+            ),
+            (
+                "a point of line `Flat` must be a position [x, y] or [x, y, z], found an integer"
+                    .to_string(),
+                "0".to_string()
+            ),
+            (
+                "a point of line `Flat` must be a position [x, y] or [x, y, z], found an integer"
+                    .to_string(),
+                "0".to_string()
+            ),
+            (
+                "line `Bad-name` is not a valid name, so mission code could not refer to it"
+                    .to_string(),
+                "Bad-name".to_string()
+            ),
+        ]
+    );
+}
+
+#[test]
+fn a_line_shares_the_names_of_places_and_areas() {
+    let text =
+        "[places]\nRiver = [0, 0]\n[lines]\nRiver = [[0, 0], [1, 1]]\n[drones.d]\nhome = [0, 0]\n";
+    let found = problems(text);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(found[0].0.contains("used for a place and for a line"), "{found:?}");
+}

@@ -162,3 +162,21 @@ fn a_remainder_is_written_and_read_back_as_it_was() {
         assert_eq!(&serde_json::from_str::<Remainder>(w).unwrap(), r);
     }
 }
+
+#[test]
+fn a_last_number_of_follow_path_is_its_speed_and_no_point() {
+    use crate::coverage::{follow_points, follow_speed};
+    let a = Value::Position(Point::flat(1.0, 2.0));
+    let args = [a.clone(), Value::Number(3.0)];
+    assert_eq!(follow_points(&args), Ok(vec![Point::flat(1.0, 2.0)]));
+    assert_eq!(follow_speed(&args), Ok(Some(3.0)));
+    assert_eq!(follow_speed(std::slice::from_ref(&a)), Ok(None));
+    assert!(follow_speed(&[a.clone(), Value::Number(0.0)]).is_err());
+    // A number among the points is no point.
+    assert!(follow_points(&[Value::Number(3.0), a]).is_err());
+    let f = crate::Function::FollowPath.signature();
+    assert_eq!(f.signature(), "FollowPath(points...[, speed])");
+    assert_eq!(f.param_at(1, 2, Some(crate::Kind::Speed)).map(|p| p.name), Some("speed"));
+    assert_eq!(f.param_at(1, 2, Some(crate::Kind::Position)).map(|p| p.name), Some("points"));
+    assert_eq!(f.param_at(0, 1, Some(crate::Kind::Speed)).map(|p| p.name), Some("points"));
+}

@@ -1,6 +1,7 @@
 //! The calls of the mission and its capabilities: a capability statement (its
 //! capability, actors and arguments), a leash call, and a middle-layer call.
 
+use aviary_api::Kind;
 use aviary_diagnostics::{Code, Span};
 use aviary_syntax::ast::*;
 
@@ -70,6 +71,14 @@ impl<'a> Checker<'a> {
             }
             Meaning::Place => Some(("a place, not a capability", fly_there)),
             Meaning::Area => Some(("an area, not a capability", fly_there)),
+            Meaning::Line => Some((
+                "a line, not a capability",
+                format!(
+                    "to fly along it, write `{} FollowPath WITH {}`",
+                    actors.join(" "),
+                    s.capability.name
+                ),
+            )),
             _ => None,
         };
         if let Some((what, help)) = what {
@@ -334,12 +343,13 @@ impl<'a> Checker<'a> {
             return;
         };
         self.api_argument_count(call, f);
-        for (j, arg) in call.args.iter().enumerate() {
-            let p = f.params.get(j).or(if f.variadic { f.params.last() } else { None });
+        let kinds: Vec<Option<Kind>> = call.args.iter().map(|arg| self.kind_of(arg)).collect();
+        let (n, last) = (call.args.len(), kinds.last().copied().flatten());
+        for ((j, arg), actual) in call.args.iter().enumerate().zip(kinds) {
+            let p = f.param_at(j, n, last);
             let what = p.map_or(format!("`{}`'s argument", f.name()), |p| {
                 format!("`{}`'s `{}`", f.name(), p.name)
             });
-            let actual = self.kind_of(arg);
             if let (Some(p), Some(k)) = (p, actual) {
                 if f.accepts(p, k) {
                     continue;

@@ -57,18 +57,32 @@ impl<'a> Checker<'a> {
             return Some(actual);
         }
         if let ExprKind::Name(id) = &e.kind {
-            if actual == Kind::Symbol && matches!(expected, Kind::Position | Kind::Area) {
-                let noun = if expected == Kind::Area { "area" } else { "place" };
+            if actual == Kind::Symbol
+                && matches!(expected, Kind::Position | Kind::Area | Kind::Path)
+            {
+                let noun = match expected {
+                    Kind::Area => "area",
+                    Kind::Path => "line or place",
+                    _ => "place",
+                };
                 let candidates: Vec<&str> = self.world.map_or(Vec::new(), |w| {
                     let areas = w.areas.iter().map(|a| a.name.as_str());
-                    if expected == Kind::Area {
-                        areas.collect()
-                    } else {
-                        w.places.iter().map(|p| p.name.as_str()).chain(areas).collect()
+                    let places = w.places.iter().map(|p| p.name.as_str());
+                    match expected {
+                        Kind::Area => areas.collect(),
+                        Kind::Path => w
+                            .lines
+                            .iter()
+                            .map(|l| l.name.as_str())
+                            .chain(places)
+                            .chain(areas)
+                            .collect(),
+                        _ => places.chain(areas).collect(),
                     }
                 });
+                let table = if expected == Kind::Path { "lines] or [places" } else { noun };
                 let help = did_you_mean(&id.name, candidates.iter().copied())
-                    .unwrap_or_else(|| format!("define it in the world file's [{noun}s], or use coordinates such as (100, 50)"));
+                    .unwrap_or_else(|| format!("define it in the world file's [{table}s], or use coordinates such as (100, 50)"));
                 let d = self.report(
                     Code::UnknownPlace,
                     id.span,
@@ -154,6 +168,13 @@ impl<'a> Checker<'a> {
             (Kind::Area, _) => match world_example(true) {
                 Some(area) => format!("write the name of an area of the world file's [areas], such as `{area}`"),
                 None => "write the name of an area of the world file's [areas]".to_string(),
+            },
+            (Kind::Position, Kind::Line) => {
+                "a line is many points: fly along it with `FollowPath` (`drone FollowPath WITH line`), or name one place of it".to_string()
+            }
+            (Kind::Path, _) => match self.world.and_then(|w| w.lines.first()) {
+                Some(line) => format!("write positions, or a line of the world file's [lines] such as `{}`", line.name),
+                None => "write positions such as `(100, 50)`, or a line of the world file's [lines]".to_string(),
             },
             (Kind::Position, _) => match world_example(false) {
                 Some(place) => format!("write a position: a place of the world file such as `{place}`, an area (its centre), or coordinates such as `(100, 50)`"),
@@ -247,6 +268,7 @@ impl<'a> Checker<'a> {
                 Meaning::Place => Some(Kind::Position),
                 Meaning::Area => Some(Kind::Area),
                 Meaning::Unbound if self.let_not_here(id) => None,
+                Meaning::Line => Some(Kind::Line),
                 Meaning::Unbound if self.names_are_known() => Some(Kind::Symbol),
                 Meaning::Unbound => None,
             },

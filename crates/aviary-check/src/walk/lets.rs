@@ -84,6 +84,7 @@ impl<'a> Checker<'a> {
             Meaning::Group => "a group of the world",
             Meaning::Place => "a place of the world",
             Meaning::Area => "an area of the world",
+            Meaning::Line => "a line of the world",
         };
         let d = self.report(
             Code::LetTaken,

@@ -137,13 +137,14 @@ struct Checker<'a> {
 /// quick hash for keys no attacker chooses, since the names come from the operator's own
 /// world file.
 fn world_names(w: &World) -> foldhash::HashMap<&str, Meaning> {
-    let count = w.drones.len() + w.groups.len() + w.places.len() + w.areas.len();
+    let count = w.drones.len() + w.groups.len() + w.places.len() + w.areas.len() + w.lines.len();
     let mut names = foldhash::HashMap::with_capacity_and_hasher(count, Default::default());
     let drones = w.drones.iter().map(|d| (d.name.as_str(), Meaning::Drone));
     let groups = w.groups.iter().map(|g| (g.name.as_str(), Meaning::Group));
     let places = w.places.iter().map(|p| (p.name.as_str(), Meaning::Place));
     let areas = w.areas.iter().map(|a| (a.name.as_str(), Meaning::Area));
-    for (name, meaning) in drones.chain(groups).chain(places).chain(areas) {
+    let lines = w.lines.iter().map(|l| (l.name.as_str(), Meaning::Line));
+    for (name, meaning) in drones.chain(groups).chain(places).chain(areas).chain(lines) {
         names.entry(name).or_insert(meaning);
     }
     names
@@ -539,6 +540,7 @@ impl<'a> Checker<'a> {
             Meaning::Local(_) => "an alias or a parameter, not a group of the world",
             Meaning::Place => "a place, not a group",
             Meaning::Area => "an area, not a group",
+            Meaning::Line => "a line, not a group",
             Meaning::Unbound => "no group of the world",
         };
         let groups: Vec<&str> = self
@@ -566,6 +568,7 @@ impl<'a> Checker<'a> {
             Meaning::Local(Binding::Value(_)) => "a value, not a drone",
             Meaning::Place => "a place, not a drone",
             Meaning::Area => "an area, not a drone",
+            Meaning::Line => "a line, not a drone",
             // Without a world, a name that no scope binds may still be a drone of the world.
             Meaning::Unbound if !self.names_are_known() => return,
             Meaning::Unbound => "no drone, group or alias",

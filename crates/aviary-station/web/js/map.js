@@ -1,5 +1,5 @@
 // The map: the world in its local frame (metres east and north of the origin; Leaflet's
-// CRS.Simple, one unit a metre), with the geofence, areas, no-fly zones, places, homes, targets and
+// CRS.Simple, one unit a metre), with the geofence, areas, lines, no-fly zones, places, homes, targets and
 // finds as Leaflet layers, and the drones on a canvas of their own over it, redrawn once
 // a frame at most: a thousand moving markers as DOM elements would not keep 30 frames a
 // second. A world with `tiles` and an `origin` is drawn over its base map instead
@@ -84,6 +84,12 @@ export class StationMap {
     for (const a of world.areas || []) {
       const p = L.polygon(a.polygon.map(at), { color: "#1c64d1", weight: 1, fillOpacity: 0.08 });
       p.bindTooltip(a.name, { permanent: true, direction: "center", className: "place-label" }).addTo(this.world);
+      bounds.extend(p.getBounds());
+    }
+    // Lines (a pipeline, a road, a river): a path in teal, named along it.
+    for (const l of world.lines || []) {
+      const p = L.polyline(l.points.map(at), { color: "#0f8a7e", weight: 3, opacity: 0.8 });
+      p.bindTooltip(`line: ${l.name}`, { permanent: true, direction: "center", className: "place-label" }).addTo(this.world);
       bounds.extend(p.getBounds());
     }
     // No-fly zones: red, filled half-transparent, named (with their height, if any).

@@ -170,7 +170,8 @@ fn sweep(e: &mut Estimator, d: DroneId, path: &[[f64; 2]], t: f64, raises: &mut 
     took
 }
 
-/// `FollowPath`: a transit to each point that is known before the flight.
+/// `FollowPath`: a transit to each point that is known before the flight, at the speed
+/// asked for.
 fn follow_path(
     e: &mut Estimator,
     d: DroneId,
@@ -179,11 +180,25 @@ fn follow_path(
     t: f64,
     raises: &mut Vec<Raise>,
 ) -> f64 {
+    let max = e.s.drones[d].max_speed;
+    // `FollowPath(points...[, speed])`: a last number is the speed, at most the drone's.
+    let (speed, args) = match args.split_last() {
+        Some((Some(Value::Number(s)), points)) if *s > 0.0 => (s.min(max), points),
+        _ => (max, args),
+    };
     let mut took = 0.0;
     for v in args {
-        if let Some(to) = e.position_arg(v, d, at) {
-            let speed = e.s.drones[d].max_speed;
-            took += transit(e, d, to, speed, t + took, raises);
+        // A line of the world file (or what a FollowPath left) stands for its points.
+        let points: Vec<Option<Value>> = match v {
+            Some(Value::Remainder(left)) => {
+                left.path().into_iter().map(|p| Some(Value::Position(p))).collect()
+            }
+            other => vec![other.clone()],
+        };
+        for p in &points {
+            if let Some(to) = e.position_arg(p, d, at) {
+                took += transit(e, d, to, speed, t + took, raises);
+            }
         }
     }
     took

@@ -2,7 +2,8 @@
 //! holds the drone, resume goes on, abort ends the activity `aborted`), the state, the
 //! event stream, and refusal without the token. `operator/` holds the checks of who
 //! may call (`guard.rs`), of what an operator may send (`args.rs`, and its positions in
-//! `positions.rs`), and of steering one drone (`drone.rs`).
+//! `positions.rs`), and of steering one drone (`drone.rs`); `hiker.rs` steers the
+//! lost-hiker example with a position from the map.
 
 #[path = "operator/args.rs"]
 mod args;
@@ -13,6 +14,8 @@ mod common;
 mod drone;
 #[path = "operator/guard.rs"]
 mod guard;
+#[path = "operator/hiker.rs"]
+mod hiker;
 #[path = "operator/positions.rs"]
 mod positions;
 #[path = "operator/serve.rs"]

@@ -3,7 +3,7 @@
 // which docs/GCS.md shows.
 
 import { spawn } from "node:child_process";
-import { cpSync, mkdtempSync, mkdirSync } from "node:fs";
+import { cpSync, mkdtempSync, mkdirSync, readFileSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
@@ -86,4 +86,37 @@ export async function open(b, station, { token = true } = {}) {
 export async function shot(page, name) {
   mkdirSync(SHOTS, { recursive: true });
   await page.screenshot({ path: join(SHOTS, `${name}.png`) });
+}
+
+/// Starts `aviary vehicles` (the project's own MAVLink vehicles, here at 10 times real
+/// time) on a free loopback port; resolves to {port, child}.
+function serveVehicles(world) {
+  return new Promise((resolve, reject) => {
+    const child = spawn(AVIARY, ["vehicles", "--world", world, "--listen", "tcp:127.0.0.1:0", "--speed", "10"],
+      { stdio: ["ignore", "pipe", "ignore"] });
+    let out = "";
+    child.stdout.on("data", (c) => {
+      out += c.toString();
+      const m = out.match(/127\.0\.0\.1:(\d+)/);
+      if (m) resolve({ port: Number(m[1]), child });
+    });
+    child.on("exit", (code) => reject(new Error(`aviary vehicles exited ${code}: ${out}`)));
+  });
+}
+
+/// A folder with the tests' missions (`fixtures/`) whose patrol flies three MAVLink drones
+/// of `aviary vehicles`: the vehicles' own world is the patrol's, changed by `vehicleWorld`
+/// (their figures), placed at an origin. Resolves to {dir, vehicles} (the process).
+export async function mavlinkPatrol(prefix, vehicleWorld = (w) => w) {
+  const dir = mkdtempSync(join(tmpdir(), prefix));
+  cpSync(join(ROOT, "tests/browser/fixtures"), dir, { recursive: true });
+  const origin = "origin = { lat = 46.6167, lon = 14.2650, alt = 440.0 }\n";
+  const plain = readFileSync(join(dir, "patrol.world.toml"), "utf8").replace("[site]\n", `[site]\n${origin}`);
+  writeFileSync(join(dir, "vehicles.world.toml.txt"), vehicleWorld(plain));
+  const { port, child } = await serveVehicles(join(dir, "vehicles.world.toml.txt"));
+  let bound = plain;
+  for (const d of ["scout", "carrier", "spare"])
+    bound = bound.replace(`[drones.${d}]\n`, `[drones.${d}]\nmavlink = "tcp:127.0.0.1:${port}"\n`);
+  writeFileSync(join(dir, "patrol.world.toml"), bound);
+  return { dir, vehicles: child };
 }

@@ -4,42 +4,13 @@
 
 import { test, before, after } from "node:test";
 import assert from "node:assert/strict";
-import { spawn } from "node:child_process";
-import { mkdtempSync, readFileSync, writeFileSync, cpSync } from "node:fs";
-import { tmpdir } from "node:os";
-import { join } from "node:path";
-import { AVIARY, ROOT, browser, open, shot, start } from "./harness.mjs";
+import { browser, mavlinkPatrol, open, shot, start } from "./harness.mjs";
 
 let station, chromium, vehicles, dir;
 
-const ORIGIN = "origin = { lat = 46.6167, lon = 14.2650, alt = 440.0 }\n";
-
-/// Starts `aviary vehicles` on a free port; resolves to the port.
-function serveVehicles(world) {
-  return new Promise((resolve, reject) => {
-    vehicles = spawn(AVIARY, ["vehicles", "--world", world, "--listen", "tcp:127.0.0.1:0", "--speed", "10"],
-      { stdio: ["ignore", "pipe", "ignore"] });
-    let out = "";
-    vehicles.stdout.on("data", (c) => {
-      out += c.toString();
-      const m = out.match(/127\.0\.0\.1:(\d+)/);
-      if (m) resolve(Number(m[1]));
-    });
-    vehicles.on("exit", (code) => reject(new Error(`aviary vehicles exited ${code}: ${out}`)));
-  });
-}
-
 before(async () => {
-  dir = mkdtempSync(join(tmpdir(), "aviary-gcs-plan-"));
-  cpSync(join(ROOT, "tests/browser/fixtures"), dir, { recursive: true });
-  const plain = readFileSync(join(dir, "patrol.world.toml"), "utf8").replace("[site]\n", `[site]\n${ORIGIN}`);
   // The vehicles' own world: the scout's battery is nearly empty.
-  writeFileSync(join(dir, "vehicles.world.toml.txt"), plain.replace("[drones.scout]\n", "[drones.scout]\nbattery = 12\n"));
-  const port = await serveVehicles(join(dir, "vehicles.world.toml.txt"));
-  let bound = plain;
-  for (const d of ["scout", "carrier", "spare"])
-    bound = bound.replace(`[drones.${d}]\n`, `[drones.${d}]\nmavlink = "tcp:127.0.0.1:${port}"\n`);
-  writeFileSync(join(dir, "patrol.world.toml"), bound);
+  ({ dir, vehicles } = await mavlinkPatrol("aviary-gcs-plan-", (w) => w.replace("[drones.scout]\n", "[drones.scout]\nbattery = 12\n")));
   station = await start(["gcs", dir, "--listen", "0"]);
   chromium = await browser();
 });

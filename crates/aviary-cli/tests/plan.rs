@@ -142,10 +142,18 @@ fn what_n303_says_waits_does_wait_in_the_engine() {
     );
     assert_eq!(code, 0, "{err}");
     let trace = std::fs::read_to_string(&trace).expect("trace");
-    let flow =
-        activities(&trace, "scout1", "FlyTo", &serde_json::json!({ "target": [300.0, 0.0] }));
-    let handler =
-        activities(&trace, "scout1", "FlyTo", &serde_json::json!({ "target": [0.0, 300.0] }));
+    let flow = activities(
+        &trace,
+        "scout1",
+        "FlyTo",
+        &serde_json::json!({ "target": [300.0, 0.0], "speed": 0.0 }),
+    );
+    let handler = activities(
+        &trace,
+        "scout1",
+        "FlyTo",
+        &serde_json::json!({ "target": [0.0, 300.0], "speed": 0.0 }),
+    );
     assert_eq!((flow.len(), handler.len()), (1, 1), "{trace}");
     assert!(
         handler[0].0 >= flow[0].1,

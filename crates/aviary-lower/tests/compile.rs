@@ -124,7 +124,12 @@ fn units_become_si_and_geo_becomes_local() {
     let Expr::Compare(_, Compare::Lt, limit) = &**speed else { panic!() };
     assert_eq!(**limit, Expr::Const(Value::Number(10.0)));
     let Node::Call(fly) = &body.items[0] else { panic!() };
-    let [Expr::Const(Value::Position(p))] = fly.args.as_slice() else { panic!("{:?}", fly.args) };
+    // FlyTo's `speed` left out: its default, 0 m/s (the drone's own speed).
+    let [Expr::Const(Value::Position(p)), Expr::Const(Value::Number(speed))] = fly.args.as_slice()
+    else {
+        panic!("{:?}", fly.args)
+    };
+    assert_eq!(*speed, 0.0);
     assert!(
         p.x.abs() < 1e-9 && (p.y - 111.19).abs() < 0.01 && (p.z.unwrap() - 20.0).abs() < 1e-9,
         "{p:?}"
@@ -143,7 +148,7 @@ fn for_instances_groups_and_slots() {
     assert_eq!(f.instances[1].0, ActorRef::Drone(2));
     let Node::Call(fly) = &f.body.items[0] else { panic!() };
     assert_eq!(fly.actors, [ActorRef::Slot(f.alias)]);
-    assert_eq!(fly.args, [Expr::Slot(f.params[0])]);
+    assert_eq!(fly.args, [Expr::Slot(f.params[0]), Expr::Const(Value::Number(0.0))]);
     let handler = &m.body.handlers[0];
     assert_eq!(
         handler.by,

@@ -41,21 +41,10 @@ pub(super) fn write_expr(out: &mut String, e: &Expr, source: &str) {
             write_expr(out, b, source);
             out.push(')');
         }
-        ExprKind::Arith(..) => {
-            let mut rights = Vec::new();
-            let mut leftmost = e;
-            while let ExprKind::Arith(left, op, right) = &leftmost.kind {
-                rights.push((*op, &**right));
-                leftmost = left;
-            }
-            write_expr(out, leftmost, source);
-            for (op, right) in rights.into_iter().rev() {
-                out.push(' ');
-                out.push_str(op.as_str());
-                out.push(' ');
-                write_expr(out, right, source);
-            }
-        }
+        ExprKind::Arith(..) => write_chain(out, e, source, |x| match &x.kind {
+            ExprKind::Arith(left, op, right) => Some((&**left, op.as_str(), &**right)),
+            _ => None,
+        }),
         ExprKind::Offset(p, d, b) => {
             out.push_str("OFFSET(");
             write_expr(out, p, source);
@@ -82,21 +71,10 @@ pub(super) fn write_expr(out: &mut String, e: &Expr, source: &str) {
             out.push_str("NOT ");
             write_expr(out, inner, source);
         }
-        ExprKind::Binary(..) => {
-            let mut rights = Vec::new();
-            let mut leftmost = e;
-            while let ExprKind::Binary(left, op, right) = &leftmost.kind {
-                rights.push((*op, &**right));
-                leftmost = left;
-            }
-            write_expr(out, leftmost, source);
-            for (op, right) in rights.into_iter().rev() {
-                out.push(' ');
-                out.push_str(op.as_str());
-                out.push(' ');
-                write_expr(out, right, source);
-            }
-        }
+        ExprKind::Binary(..) => write_chain(out, e, source, |x| match &x.kind {
+            ExprKind::Binary(left, op, right) => Some((&**left, op.as_str(), &**right)),
+            _ => None,
+        }),
         ExprKind::Paren(inner) => {
             out.push('(');
             write_expr(out, inner, source);
@@ -150,4 +128,28 @@ pub(super) fn names(list: &[Ident]) -> String {
 /// Source text on one line, white space collapsed (for nodes that could not be read).
 pub(super) fn verbatim(source: &str, start: usize, end: usize) -> String {
     source.get(start..end).unwrap_or("").split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// A chain of one kind of operator, left-leaning as the parser builds it (`a + b - c`,
+/// `x AND y OR z`), written left to right without recursing down the left side: a long
+/// chain must not take a frame per operator.
+fn write_chain<'e>(
+    out: &mut String,
+    e: &'e Expr,
+    source: &str,
+    split: impl Fn(&'e Expr) -> Option<(&'e Expr, &'static str, &'e Expr)>,
+) {
+    let mut rights = Vec::new();
+    let mut leftmost = e;
+    while let Some((left, op, right)) = split(leftmost) {
+        rights.push((op, right));
+        leftmost = left;
+    }
+    write_expr(out, leftmost, source);
+    for (op, right) in rights.into_iter().rev() {
+        out.push(' ');
+        out.push_str(op);
+        out.push(' ');
+        write_expr(out, right, source);
+    }
 }

@@ -44,6 +44,8 @@ test("the paper's mission flies from the page: 7 drones move on the map and the 
   }));
   assert.match(shown.clock, /^t = (1[2-9]\d|[2-9]\d\d)\.\d s$/, "the clock goes with the mission");
   assert.ok(shown.activities.filter((a) => a !== "–").length >= 3, `running activities in the grid: ${shown.activities}`);
+  // The video drones stream while they circle: the grid says so.
+  assert.ok(shown.activities.some((a) => a.endsWith(" · streaming")), `streaming in the grid: ${shown.activities}`);
   await shot(page, "flying");
   // As the operator sees it: the badge, not the model behind it.
   await page.waitForFunction(() => !["running", "paused"].includes(document.getElementById("status").textContent), null, { timeout: 240000 });

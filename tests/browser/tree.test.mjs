@@ -70,3 +70,42 @@ test("every node of the tree ends in the state the trace gives its own statement
   assert.ok(events.some((e) => e.event === "signal" && e.name === "Go" && e.line === lineOf("SIGNAL Go")));
   await shot(page, "tree");
 });
+
+test("the map marks drops and signals' positions, keeps whole trails, never overlaps names, and shows the world the editor opens after a flight", async () => {
+  const page = await open(chromium, station);
+  await choose(page, "parcel_delivery.mission");
+  await page.fill("#speed", "50");
+  await page.click("#fly");
+  await page.waitForFunction(() => window.aviary.model.mission === "Parcel_Delivery" && window.aviary.model.status === "ok", null, { timeout: 120000 });
+  await page.waitForTimeout(300);
+  // Back at the depot, side by side: one label for the couriers close together.
+  const labels = await page.evaluate(() => window.aviary.map.labels);
+  assert.ok(labels.some((l) => /^courier\d \+\d$/.test(l)), `labels at the depot: ${labels}`);
+  const seen = await page.evaluate(() => ({
+    spots: window.aviary.model.spots.map((s) => [s.kind, s.text]),
+    drops: window.aviary.map.findLayer.getLayers().filter((l) => l.options.className === "spot-drop").length,
+    signals: window.aviary.map.findLayer.getLayers().filter((l) => l.options.className === "spot-signal").length,
+    trail: window.aviary.model.drones.get("courier4").trail,
+  }));
+  // Two parcels released, each marked where it fell; the stranded parcel's signal, where
+  // its destination is.
+  assert.deepEqual(seen.spots.filter((s) => s[0] === "drop").map((s) => s[1]), ["payload dropped by courier2", "payload dropped by courier4"]);
+  assert.equal(seen.drops, 2);
+  assert.ok(seen.spots.some((s) => s[0] === "signal" && s[1] === "Parcel_Stranded from courier1"), JSON.stringify(seen.spots));
+  assert.ok(seen.signals >= 1);
+  // courier4 flew some 300 s at 4 samples a second: its trail still starts at its home.
+  const [x, y] = seen.trail[0];
+  assert.ok(Math.hypot(x - 30, y) < 5, `the trail starts at (${x}, ${y})`);
+  assert.ok(seen.trail.length <= 360, `thinned, not grown without end: ${seen.trail.length}`);
+  await shot(page, "marks");
+  // Another mission opened after the flight: its world on the map, the old drones gone.
+  await page.selectOption("#mission-file", "lost_hiker.mission");
+  await page.waitForFunction(() => window.aviary.editor.files.world.path === "lost_hiker.world.toml" && document.getElementById("check-summary").classList.contains("good"));
+  await page.waitForTimeout(300);
+  const after = await page.evaluate(() => ({
+    names: window.aviary.map.world.getLayers().map((l) => l.getTooltip && l.getTooltip() && l.getTooltip().getContent()).filter(Boolean),
+    drones: window.aviary.model.drones.size,
+  }));
+  assert.ok(after.names.includes("Hut") && !after.names.includes("Depot"), `the map shows: ${after.names}`);
+  assert.equal(after.drones, 0, "the finished flight's drones are gone from the map");
+});

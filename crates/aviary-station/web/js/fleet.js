@@ -74,7 +74,7 @@ export class FleetGrid {
       set(r.cells[3], d.pos ? `${d.pos[2].toFixed(1)} m` : "–");
       set(r.cells[4], `${d.speed.toFixed(1)} m/s`);
       set(r.cells[5], d.link);
-      set(r.cells[6], d.activity || "–");
+      set(r.cells[6], (d.activity || "–") + (d.streaming ? " · streaming" : ""));
     }
   }
 }

@@ -104,6 +104,7 @@ async function watch() {
   const about = (await api.call("GET", "/api/station")).body;
   page.about = about;
   if (!about || !about.run) return;
+  page.showingRun = true;
   page.model = newModel();
   page.map.follow(page.model);
   page.fleet.clear();
@@ -273,7 +274,10 @@ async function station() {
     if (file.ok) editor.load(which, path, file.body.text);
     else refused(`open ${path}`, file);
   };
-  missions.onchange = async () => {
+  // The operator opens another mission or world (an event; the page's own first opening
+  // has none): a flight that has ended leaves the map and the tree to it.
+  missions.onchange = async (event) => {
+    if (event) leaveFinishedRun();
     const stem = missions.value.replace(/\.mission$/, "");
     // The world beside the mission, as `aviary check` takes it; none when there is none.
     const beside = listing.worlds.find((w) => w === `${stem}.world.toml`);
@@ -282,7 +286,10 @@ async function station() {
     await open("world", worlds.value);
     check();
   };
-  worlds.onchange = () => open("world", worlds.value).then(check);
+  worlds.onchange = () => {
+    leaveFinishedRun();
+    return open("world", worlds.value).then(check);
+  };
   $("edit-mission").onclick = () => { editor.show("mission"); tabs("mission"); };
   $("edit-world").onclick = () => { editor.show("world"); tabs("world"); };
   const tabs = (which) => {
@@ -381,6 +388,16 @@ function records(traces) {
   };
 }
 
+/// A flight that has ended gives the map and the tree back to what the editor opens: its
+/// drones leave the map. One under way keeps them.
+function leaveFinishedRun() {
+  if (!page.showingRun || ["running", "paused"].includes(page.model.status)) return;
+  page.showingRun = false;
+  page.model = newModel();
+  page.map.follow(page.model);
+  page.fleet.clear();
+}
+
 function showCheck(report) {
   page.checked = report;
   page.editor.mark(report.diagnostics);
@@ -397,8 +414,10 @@ function showCheck(report) {
   summary.className = "summary " + (report.errors ? "bad" : "good");
   $("fly").disabled = !report.flyable;
   showPlan(report.plan);
-  if (report.map && !(page.about && page.about.run)) page.map.setWorld(report.map);
-  if (report.tree && !(page.about && page.about.run)) page.tree.show(report.tree);
+  // The map and the tree show what the editor has open, unless they show a flight (one
+  // under way, or one that has ended until the operator opens something else).
+  if (report.map && !page.showingRun) page.map.setWorld(report.map);
+  if (report.tree && !page.showingRun) page.tree.show(report.tree);
 }
 
 function showPlan(plan) {

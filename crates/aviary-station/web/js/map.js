@@ -122,6 +122,7 @@ export class StationMap {
   follow(model) {
     this.model = model;
     this.findCount = 0;
+    this.spotCount = 0;
     this.findLayer.clearLayers();
     this.dirty = true;
   }
@@ -148,6 +149,15 @@ export class StationMap {
       L.circleMarker(this.toLatLng(f.at), { radius: 7, color: "#c2352b", weight: 2, fill: false })
         .bindTooltip(`${f.kind} found by ${f.actor} at t = ${f.t.toFixed(1)} s`).addTo(this.findLayer);
     }
+    // Where a signal said (a find, the operator's position) and where a payload was
+    // dropped: a square, violet for a signal, green for a drop.
+    while (this.spotCount < model.spots.length) {
+      const s = model.spots[this.spotCount++];
+      const color = s.kind === "drop" ? "#2e7d32" : "#7b4bc4";
+      const [x, y] = s.at;
+      L.rectangle([this.toLatLng([x - 3, y - 3]), this.toLatLng([x + 3, y + 3])], { color, weight: 2, fillOpacity: 0.25, className: `spot-${s.kind}` })
+        .bindTooltip(`${s.text} at t = ${s.t.toFixed(1)} s`).addTo(this.findLayer);
+    }
     const point = (p) => this.map.latLngToContainerPoint(this.toLatLng(p));
     const many = model.drones.size > 200;
     // Trails first, under every drone.
@@ -167,10 +177,27 @@ export class StationMap {
       ctx.stroke();
     }
     ctx.font = "11px system-ui, sans-serif";
+    // Names of drones close together on the screen are written once, as `first +N`: the
+    // labels never overlap one another.
+    const labels = [];
     for (const d of model.drones.values()) {
       if (!d.pos) continue;
       const q = point(d.pos);
       if (q.x < -20 || q.y < -20 || q.x > size.x + 20 || q.y > size.y + 20) continue;
+      if (!many) {
+        const near = labels.find((l) => Math.abs(l.x - q.x) < 60 && Math.abs(l.y - q.y) < 12);
+        if (near) near.more++;
+        else labels.push({ x: q.x, y: q.y, name: d.name, more: 0 });
+      }
+      if (d.streaming) {
+        ctx.beginPath();
+        ctx.arc(q.x, q.y, 11, 0, 2 * Math.PI);
+        ctx.strokeStyle = "#c2352b";
+        ctx.lineWidth = 1.5;
+        ctx.setLineDash([3, 2]);
+        ctx.stroke();
+        ctx.setLineDash([]);
+      }
       ctx.save();
       ctx.translate(q.x, q.y);
       ctx.rotate(d.heading);
@@ -183,10 +210,9 @@ export class StationMap {
       ctx.strokeStyle = d.held ? "#7b4bc4" : d.link === "lost" ? "#c2352b" : "#16202e";
       ctx.stroke();
       ctx.restore();
-      if (!many) {
-        ctx.fillStyle = "#16202e";
-        ctx.fillText(d.name, q.x + 9, q.y + 4);
-      }
     }
+    ctx.fillStyle = "#16202e";
+    for (const l of labels) ctx.fillText(l.more ? `${l.name} +${l.more}` : l.name, l.x + 9, l.y + 4);
+    this.labels = labels.map((l) => (l.more ? `${l.name} +${l.more}` : l.name));
   }
 }

@@ -14,6 +14,7 @@ export function newModel() {
     activities: new Map(), // "capability|tag|actor" -> {running, done, aborted, failed, paused}
     statements: new Map(), // line of a statement of the MISSION's file -> {running, done, aborted, failed, paused}
     finds: [],
+    spots: [],             // on the map: {t, at, kind: "signal" | "drop", text}
     marks: [],             // timeline: {t, kind, text}
     log: [],
     alarms: [],
@@ -25,13 +26,22 @@ export function drone(model, name) {
   let d = model.drones.get(name);
   if (!d) {
     d = { name, pos: null, battery: null, state: "unknown", speed: 0, heading: 0, trail: [],
-          activity: "", working: [], link: "ok", held: false, withdrawn: false, lastT: null, alarms: new Set() };
+          activity: "", working: [], streaming: false, link: "ok", held: false, withdrawn: false, lastT: null, alarms: new Set() };
     model.drones.set(name, d);
   }
   return d;
 }
 
 const TRAIL = 240;
+
+/// Halves the older part of a trail in place, keeping its first and the recent points.
+function thin(trail) {
+  const older = trail.length - TRAIL / 2;
+  let kept = 0;
+  for (let i = 0; i < older; i += 2) trail[kept++] = trail[i];
+  trail.copyWithin(kept, older);
+  trail.length = kept + (trail.length - older);
+}
 
 function key(capability, tag, actor) {
   return `${capability}|${tag || ""}|${actor}`;
@@ -42,6 +52,11 @@ function bump(map, k, field, by) {
   if (!v) { v = { running: 0, done: 0, aborted: 0, failed: 0, paused: 0 }; map.set(k, v); }
   v[field] = Math.max(0, v[field] + by);
   return v;
+}
+
+/// Whether a trace value is a position: two or three numbers.
+function isPosition(v) {
+  return Array.isArray(v) && (v.length === 2 || v.length === 3) && v.every((x) => typeof x === "number");
 }
 
 /// An alarm raised by event `e`, at the event's own time: a page opened after the run
@@ -118,12 +133,17 @@ export function observe(model, e) {
       }
       return true;
     }
-    case "signal":
+    case "signal": {
       if (e.line) bump(model.statements, e.line, "done", 1);
       model.marks.push({ t: e.t, kind: "signal", text: e.name });
+      // A signal that carries a position (a find, the operator's `Found`) is marked where
+      // it says.
+      const at = (e.args || []).find(isPosition);
+      if (at) model.spots.push({ t: e.t, at, kind: "signal", text: `${e.name}${e.actor ? ` from ${e.actor}` : e.by ? ` from the ${e.by}` : ""}` });
       if (e.name === "BatteryLow" && e.actor) alarm(model, e, "battery", e.actor, `${e.actor}: battery low`, false);
       if (e.name === "ConnectionRestored" && e.actor) drone(model, e.actor).link = "ok";
       break;
+    }
     case "exception": {
       if (e.line) bump(model.statements, e.line, "done", 1);
       model.marks.push({ t: e.t, kind: "exception", text: e.name });
@@ -170,9 +190,10 @@ export function observe(model, e) {
       }
       d.pos = [x, y, z]; d.battery = e.battery; d.state = e.state; d.lastT = e.t;
       d.trail.push([x, y]);
-      // Trimmed now and then, not at every sample: a shift per sample is the most a
-      // thousand drones' telemetry would cost.
-      if (d.trail.length > TRAIL * 1.5) d.trail.splice(0, d.trail.length - TRAIL);
+      // Thinned now and then, not at every sample: the older points are halved, so the
+      // trail keeps the whole flight, finer where it is recent, in at most 1.5 × TRAIL
+      // points (a thousand drones' telemetry stays cheap).
+      if (d.trail.length > TRAIL * 1.5) thin(d.trail);
       if (e.battery < 0.2) alarm(model, e, "battery", e.actor, `${e.actor}: battery ${(e.battery * 100).toFixed(0)} %`, e.battery < 0.1);
       return false;
     }
@@ -180,6 +201,10 @@ export function observe(model, e) {
       // Where the call left the drone: the last word on a landing, which may come
       // between two telemetry samples (the fleet's return at the end, an abort).
       const d = drone(model, e.actor);
+      if (e.status === "ok" && e.function === "ReleasePayload" && e.position)
+        model.spots.push({ t: e.t, at: e.position, kind: "drop", text: `payload dropped by ${e.actor}` });
+      if (e.status === "ok" && (e.function === "StartStreaming" || e.function === "StopStreaming"))
+        d.streaming = e.function === "StartStreaming";
       if (!current(d, e)) return false;
       if (e.position) d.pos = e.position;
       if (e.status === "ok" && (e.function === "Land" || e.function === "ReturnToLaunch")) {

@@ -60,3 +60,53 @@ fn fixtures() {
         insta::assert_snapshot!(shown(path));
     });
 }
+
+/// The files a fixture's `[imports]` names, read beside it (the crate reads none itself).
+struct Beside<'p>(&'p Path);
+
+impl aviary_world::WorldFiles for Beside<'_> {
+    fn read(&self, path: &str) -> Result<Vec<u8>, String> {
+        let folder = self.0.parent().unwrap_or(Path::new("."));
+        std::fs::read(folder.join(path)).map_err(|e| format!("there is no file {path} ({e})"))
+    }
+}
+
+/// What a user sees of the world file at `path` with its imports: its diagnostics, or
+/// the places, lines, areas and no-fly zones it has (the local frame's metres, to the cm).
+fn shown_with_imports(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).expect("a readable fixture");
+    let name =
+        format!("fixtures/imports/{}", path.file_name().unwrap_or_default().to_string_lossy());
+    let mut sources = SourceMap::new();
+    let id = sources.add(&name, text);
+    let (world, diagnostics) = aviary_world::parse_world_with(id, sources.text(id), &Beside(path));
+    let mut out = String::new();
+    for d in &diagnostics {
+        out.push_str(&render_text(&sources, d, false));
+    }
+    let Some(w) = world else { return out };
+    let cm = |v: f64| (v * 100.0).round() / 100.0;
+    let xy = |p: &[f64; 2]| format!("({}, {})", cm(p[0]), cm(p[1]));
+    let corners = |ps: &[[f64; 2]]| ps.iter().map(xy).collect::<Vec<_>>().join(" ");
+    for p in &w.places {
+        let _ = writeln!(out, "place {} at {}", p.name, xy(&[p.at[0], p.at[1]]));
+    }
+    for l in &w.lines {
+        let _ = writeln!(out, "line {}: {}", l.name, corners(&l.ground()));
+    }
+    for a in &w.areas {
+        let _ = writeln!(out, "area {}: {}", a.name, corners(&a.polygon));
+    }
+    for z in &w.no_fly {
+        let _ =
+            writeln!(out, "no-fly zone {} up to {:?}: {}", z.name, z.up_to, corners(&z.polygon));
+    }
+    out
+}
+
+#[test]
+fn imports() {
+    insta::glob!("fixtures/imports/*.world.toml", |path| {
+        insta::assert_snapshot!(shown_with_imports(path));
+    });
+}

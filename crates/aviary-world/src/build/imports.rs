@@ -1,0 +1,329 @@
+//! `[imports]`: places, lines, areas and no-fly zones read from files beside the world
+//! file (docs/WORLD.md). GeoJSON (RFC 7946) is read with georust's `geojson`; every
+//! coordinate goes through the world's one projection, `aviary_api::geo::Origin`, as a
+//! `GEO(...)` position does.
+//!
+//! Pure: the file's bytes come from the caller's [`WorldFiles`]. Every problem is
+//! reported at the string in the world file that names the file, and says which feature
+//! (by its index and name) is at fault.
+
+use aviary_api::geo::Origin;
+use aviary_diagnostics::Span;
+
+use super::get;
+use crate::node::{Node, Value};
+use crate::read::{count, is_identifier, shown, Ctx};
+use crate::{Area, Line, NoFly, Place, Site, WorldFiles};
+
+const KEYS: &[&str] = &["features", "no_fly"];
+const HELP: &str = "write `[imports]` followed by `features = \"fields.geojson\"` (points, lines and polygons become places, lines and areas) or `no_fly = \"airspace.geojson\"` (polygons become no-fly zones); each may be a list of files";
+
+/// What the files of `[imports]` hold, each thing located at the string naming its file.
+#[derive(Default)]
+pub(super) struct Imported {
+    pub places: Vec<Place>,
+    pub lines: Vec<Line>,
+    pub areas: Vec<Area>,
+    pub no_fly: Vec<NoFly>,
+}
+
+/// Which key named a file: what its polygons become.
+#[derive(Clone, Copy, PartialEq)]
+enum Role {
+    Features,
+    NoFly,
+}
+
+pub(super) fn imports(cx: &mut Ctx, node: &Node, site: &Site, files: &dyn WorldFiles) -> Imported {
+    let mut out = Imported::default();
+    let Some(entries) = cx.table(&"`imports`", node, HELP) else {
+        return out;
+    };
+    cx.known_keys(entries, KEYS, "[imports]");
+    let mut named: Vec<(String, Span, Role)> = Vec::new();
+    for e in entries {
+        let role = match e.key.as_str() {
+            "features" => Role::Features,
+            "no_fly" => Role::NoFly,
+            _ => continue,
+        };
+        let what = format!("`{}` in [imports]", e.key);
+        match &e.node.value {
+            Value::Str(s) => named.push((s.clone(), e.node.span, role)),
+            Value::Array(items) => {
+                for item in items {
+                    match &item.value {
+                        Value::Str(s) => named.push((s.clone(), item.span, role)),
+                        _ => {
+                            let msg =
+                                format!("{what} must hold file names, found {}", item.describe());
+                            cx.error(item.span, msg, HELP);
+                        }
+                    }
+                }
+            }
+            _ => {
+                let msg = format!(
+                    "{what} must be a file name or a list of them, found {}",
+                    e.node.describe()
+                );
+                cx.error(e.node.span, msg, HELP);
+            }
+        }
+    }
+    if named.is_empty() {
+        return out;
+    }
+    let Some(o) = &site.origin else {
+        let at = get(entries, "features").or_else(|| get(entries, "no_fly"));
+        cx.error(
+            at.map_or(node.span, |e| e.key_span),
+            "files of `[imports]` hold longitudes and latitudes, which need the site's `origin` to be placed in the local frame",
+            "add `origin = { lat = ..., lon = ..., alt = ... }` to [site]",
+        );
+        return out;
+    };
+    let origin = Origin { lat: o.lat, lon: o.lon, alt: o.alt };
+    for (path, span, role) in named {
+        let Some(kind) = kind_of(&path) else {
+            let msg = format!("`{path}` is not a kind of file `[imports]` reads");
+            cx.error(span, msg, "name a GeoJSON file (`.geojson` or `.json`)");
+            continue;
+        };
+        let bytes = match files.read(&path) {
+            Ok(bytes) => bytes,
+            Err(why) => {
+                cx.error(span, format!("cannot read `{path}`: {why}"), "name a file beside the world file, e.g. `features = \"fields.geojson\"`: the path is relative to the world file's folder");
+                continue;
+            }
+        };
+        let mut file = File { cx, path: &path, span, role, origin, out: &mut out };
+        match kind {
+            Kind::GeoJson => file.geojson(&bytes),
+        }
+    }
+    out
+}
+
+enum Kind {
+    GeoJson,
+}
+
+fn kind_of(path: &str) -> Option<Kind> {
+    let ext = path.rsplit_once('.').map(|(_, e)| e.to_ascii_lowercase())?;
+    match ext.as_str() {
+        "geojson" | "json" => Some(Kind::GeoJson),
+        _ => None,
+    }
+}
+
+/// One imported file being read.
+struct File<'c, 'x, 'o> {
+    cx: &'c mut Ctx<'x>,
+    path: &'o str,
+    span: Span,
+    role: Role,
+    origin: Origin,
+    out: &'o mut Imported,
+}
+
+/// A feature as the file gives it: its shape in degrees (longitude, latitude).
+enum Shape {
+    Point([f64; 2]),
+    Line(Vec<[f64; 2]>),
+    /// The outer ring.
+    Polygon(Vec<[f64; 2]>),
+}
+
+impl File<'_, '_, '_> {
+    fn error(&mut self, message: String, help: &str) {
+        self.cx.error(self.span, message, help);
+    }
+
+    fn geojson(&mut self, bytes: &[u8]) {
+        let Ok(text) = std::str::from_utf8(bytes) else {
+            let msg = format!("`{}` is not GeoJSON: it is not UTF-8 text", self.path);
+            self.error(msg, "name a GeoJSON file, as saved by QGIS, geojson.io or another GIS");
+            return;
+        };
+        let features = match text.parse::<geojson::GeoJson>() {
+            Ok(geojson::GeoJson::FeatureCollection(c)) => c.features,
+            Ok(geojson::GeoJson::Feature(f)) => vec![f],
+            Ok(geojson::GeoJson::Geometry(_)) => {
+                let msg = format!("`{}` holds a bare geometry, with no name", self.path);
+                self.error(msg, "save it as a Feature (or a FeatureCollection) with a `name` property for each, the name missions use");
+                return;
+            }
+            Err(e) => {
+                let msg = format!("`{}` is not valid GeoJSON: {e}", self.path);
+                self.error(msg, "save it again from the GIS that made it, as GeoJSON (RFC 7946)");
+                return;
+            }
+        };
+        for (index, f) in features.into_iter().enumerate() {
+            let name = match f.properties.as_ref().and_then(|p| p.get("name")) {
+                Some(geojson::JsonValue::String(s)) => Some(s.clone()),
+                _ => None,
+            };
+            let up_to = match f.properties.as_ref().and_then(|p| p.get("up_to")) {
+                Some(v) => match v.as_f64() {
+                    Some(u) if u > 0.0 && u.is_finite() => Some(Some(u)),
+                    _ => None,
+                },
+                None => Some(None),
+            };
+            let shape = match f.geometry.map(|g| g.value) {
+                Some(geojson::GeometryValue::Point { coordinates }) => {
+                    degrees(&coordinates).map(Shape::Point)
+                }
+                Some(geojson::GeometryValue::LineString { coordinates }) => {
+                    coordinates.iter().map(degrees).collect::<Result<_, _>>().map(Shape::Line)
+                }
+                Some(geojson::GeometryValue::Polygon { coordinates }) => {
+                    let outer = coordinates.first().map_or(&[][..], |r| &r[..]);
+                    outer.iter().map(degrees).collect::<Result<_, _>>().map(Shape::Polygon)
+                }
+                Some(other) => Err(format!(
+                    "is a {}, which is none of Point, LineString and Polygon",
+                    other.type_name()
+                )),
+                None => Err("has no geometry".to_owned()),
+            };
+            let feature = Feature { index, name: name.as_deref(), up_to };
+            match shape {
+                Ok(shape) => self.feature(&feature, shape),
+                Err(why) => {
+                    let msg = format!("{} of `{}` {why}", feature.shown(), self.path);
+                    self.error(msg, "give each feature one Point, LineString or Polygon (split a Multi... geometry into features of their own)");
+                }
+            }
+        }
+    }
+
+    /// One feature, named and shaped, into the world.
+    fn feature(&mut self, f: &Feature, shape: Shape) {
+        let path = self.path;
+        let Some(name) = f.name else {
+            let msg = format!("{} of `{path}` has no `name` property", f.shown());
+            self.error(msg, "give every feature a `name` property (in the GIS's attribute table): the name missions use for it");
+            return;
+        };
+        if self.role == Role::NoFly && !matches!(shape, Shape::Polygon(_)) {
+            let msg = format!(
+                "{} of `{path}` is not a polygon, and `no_fly` in [imports] reads only polygons",
+                f.shown()
+            );
+            self.error(
+                msg,
+                "import its points and lines with `features`, or remove them from the file",
+            );
+            return;
+        }
+        if self.role == Role::Features && !is_identifier(name) {
+            let msg = format!(
+                "{} of `{path}` has the name `{name}`, which mission code could not refer to",
+                f.shown()
+            );
+            self.error(
+                msg,
+                "rename it in the file: letters, digits and `_`, not starting with a digit",
+            );
+            return;
+        }
+        let local = |p: &[f64; 2]| self.origin.to_local(p[1], p[0]);
+        let span = self.span;
+        match shape {
+            Shape::Point(p) => {
+                let [x, y] = local(&p);
+                self.out.places.push(Place {
+                    name: name.into(),
+                    at: [x, y, 0.0],
+                    has_z: false,
+                    span,
+                });
+            }
+            Shape::Line(points) => {
+                if points.len() < 2 {
+                    let msg = format!(
+                        "{} of `{path}` has {}; a line needs at least 2",
+                        f.shown(),
+                        count(points.len(), "point")
+                    );
+                    self.error(msg, "draw the line with at least two points");
+                    return;
+                }
+                let points = points
+                    .iter()
+                    .map(|p| {
+                        let [x, y] = local(p);
+                        ([x, y, 0.0], false)
+                    })
+                    .collect();
+                self.out.lines.push(Line { name: name.into(), points, span });
+            }
+            Shape::Polygon(mut ring) => {
+                // GeoJSON closes a ring by repeating its first corner; the world does not.
+                if ring.len() > 1 && ring.first() == ring.last() {
+                    ring.pop();
+                }
+                let polygon: Vec<[f64; 2]> = ring.iter().map(local).collect();
+                if polygon.len() < 3 {
+                    let msg = format!(
+                        "{} of `{path}` has {}; a polygon needs at least 3",
+                        f.shown(),
+                        count(polygon.len(), "corner")
+                    );
+                    self.error(msg, "draw the polygon with at least three corners");
+                    return;
+                }
+                let what = format!("{} of `{path}`", f.shown());
+                if !self.cx.outline_at(&what, span, &polygon) {
+                    return;
+                }
+                if self.role == Role::NoFly {
+                    let Some(up_to) = f.up_to else {
+                        let msg = format!(
+                            "the `up_to` property of {what} must be a number of metres above 0"
+                        );
+                        self.error(msg, "write `\"up_to\": 60` in the feature's properties, or leave it out for a zone at every height");
+                        return;
+                    };
+                    self.out.no_fly.push(NoFly { name: name.into(), polygon, up_to, span });
+                } else {
+                    self.out.areas.push(Area { name: name.into(), polygon, span });
+                }
+            }
+        }
+    }
+}
+
+/// A feature as messages name it: its place in the file, and its name if it has one.
+struct Feature<'n> {
+    index: usize,
+    name: Option<&'n str>,
+    /// `None`: a property `up_to` that is not a positive number.
+    up_to: Option<Option<f64>>,
+}
+
+impl Feature<'_> {
+    fn shown(&self) -> String {
+        match self.name {
+            Some(n) => format!("feature {} (`{n}`)", self.index),
+            None => format!("feature {}", self.index),
+        }
+    }
+}
+
+/// A position's longitude and latitude, in range.
+fn degrees(p: &geojson::Position) -> Result<[f64; 2], String> {
+    match p.as_slice() {
+        [lon, lat, ..] if (-180.0..=180.0).contains(lon) && (-90.0..=90.0).contains(lat) => {
+            Ok([*lon, *lat])
+        }
+        [lon, lat, ..] => Err(format!(
+            "has the position {} outside the Earth's degrees (GeoJSON writes longitude first, then latitude)",
+            shown([*lon, *lat])
+        )),
+        _ => Err("has a position with fewer than 2 numbers".to_owned()),
+    }
+}

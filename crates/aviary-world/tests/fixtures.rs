@@ -110,3 +110,44 @@ fn imports() {
         insta::assert_snapshot!(shown_with_imports(path));
     });
 }
+
+/// Serves one file's bytes, whatever the name asked for.
+struct Bytes(Vec<u8>);
+
+impl aviary_world::WorldFiles for Bytes {
+    fn read(&self, _path: &str) -> Result<Vec<u8>, String> {
+        Ok(self.0.clone())
+    }
+}
+
+/// A broken GeoJSON or KML file is an error, never a panic: every imported fixture cut
+/// short at many places, and with bytes changed, read as both kinds.
+#[test]
+fn broken_imports_never_panic() {
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/imports");
+    let world = |file: &str| {
+        format!("[site]\norigin = {{ lat = 46.6, lon = 14.2 }}\n[imports]\nfeatures = \"{file}\"\nno_fly = \"{file}\"\n")
+    };
+    for entry in std::fs::read_dir(&folder).unwrap() {
+        let path = entry.unwrap().path();
+        let Ok(bytes) = std::fs::read(&path) else { continue };
+        if bytes.len() > 64 * 1024 {
+            continue;
+        }
+        let step = (bytes.len() / 40).max(1);
+        for cut in (0..bytes.len()).step_by(step) {
+            let mut changed = bytes.clone();
+            changed[cut] = changed[cut].wrapping_add(7);
+            for served in [bytes[..cut].to_vec(), changed] {
+                for file in ["f.geojson", "f.kml"] {
+                    let provider = Bytes(served.clone());
+                    let (_, _) = aviary_world::parse_world_with(
+                        aviary_diagnostics::FileId(0),
+                        &world(file),
+                        &provider,
+                    );
+                }
+            }
+        }
+    }
+}

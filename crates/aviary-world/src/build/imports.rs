@@ -1,5 +1,6 @@
 //! `[imports]`: places, lines, areas and no-fly zones read from files beside the world
-//! file (docs/WORLD.md). GeoJSON (RFC 7946) is read with georust's `geojson`; every
+//! file (docs/WORLD.md). GeoJSON (RFC 7946) is read with georust's `geojson`, KML with
+//! georust's `kml` (its Placemarks, in document order, named by `<name>`); every
 //! coordinate goes through the world's one projection, `aviary_api::geo::Origin`, as a
 //! `GEO(...)` position does.
 //!
@@ -87,7 +88,7 @@ pub(super) fn imports(cx: &mut Ctx, node: &Node, site: &Site, files: &dyn WorldF
     for (path, span, role) in named {
         let Some(kind) = kind_of(&path) else {
             let msg = format!("`{path}` is not a kind of file `[imports]` reads");
-            cx.error(span, msg, "name a GeoJSON file (`.geojson` or `.json`)");
+            cx.error(span, msg, "name a GeoJSON file (`.geojson` or `.json`) or a KML file (`.kml`; a `.kmz` unzipped)");
             continue;
         };
         let bytes = match files.read(&path) {
@@ -100,6 +101,7 @@ pub(super) fn imports(cx: &mut Ctx, node: &Node, site: &Site, files: &dyn WorldF
         let mut file = File { cx, path: &path, span, role, origin, out: &mut out };
         match kind {
             Kind::GeoJson => file.geojson(&bytes),
+            Kind::Kml => file.kml(&bytes),
         }
     }
     out
@@ -107,12 +109,14 @@ pub(super) fn imports(cx: &mut Ctx, node: &Node, site: &Site, files: &dyn WorldF
 
 enum Kind {
     GeoJson,
+    Kml,
 }
 
 fn kind_of(path: &str) -> Option<Kind> {
     let ext = path.rsplit_once('.').map(|(_, e)| e.to_ascii_lowercase())?;
     match ext.as_str() {
         "geojson" | "json" => Some(Kind::GeoJson),
+        "kml" => Some(Kind::Kml),
         _ => None,
     }
 }
@@ -189,7 +193,7 @@ impl File<'_, '_, '_> {
                 )),
                 None => Err("has no geometry".to_owned()),
             };
-            let feature = Feature { index, name: name.as_deref(), up_to };
+            let feature = Feature { noun: "feature", index, name: name.as_deref(), up_to };
             match shape {
                 Ok(shape) => self.feature(&feature, shape),
                 Err(why) => {
@@ -200,12 +204,96 @@ impl File<'_, '_, '_> {
         }
     }
 
+    fn kml(&mut self, bytes: &[u8]) {
+        let Ok(text) = std::str::from_utf8(bytes) else {
+            let msg = format!("`{}` is not KML: it is not UTF-8 text", self.path);
+            self.error(msg, "name a KML file, as saved by Google Earth, QGIS or another GIS");
+            return;
+        };
+        if let Err(why) = well_formed(text) {
+            let msg = format!("`{}` is not valid KML: {why}", self.path);
+            self.error(msg, "save it again from the program that made it, as KML");
+            return;
+        }
+        let root = match text.parse::<kml::Kml<f64>>() {
+            Ok(root) => root,
+            Err(e) => {
+                let msg = format!("`{}` is not valid KML: {e}", self.path);
+                self.error(msg, "save it again from the program that made it, as KML");
+                return;
+            }
+        };
+        // Placemarks in document order, through documents and folders, without recursion.
+        let mut stack = vec![root];
+        let mut index = 0;
+        while let Some(element) = stack.pop() {
+            let placemark = match element {
+                kml::Kml::KmlDocument(d) => {
+                    stack.extend(d.elements.into_iter().rev());
+                    continue;
+                }
+                kml::Kml::Document { elements, .. } => {
+                    stack.extend(elements.into_iter().rev());
+                    continue;
+                }
+                kml::Kml::Folder(f) => {
+                    stack.extend(f.elements.into_iter().rev());
+                    continue;
+                }
+                kml::Kml::Placemark(p) => p,
+                _ => continue,
+            };
+            let feature = Feature {
+                noun: "placemark",
+                index,
+                name: placemark.name.as_deref(),
+                up_to: Some(None),
+            };
+            index += 1;
+            let ring = |coords: &[kml::types::Coord<f64>]| {
+                coords.iter().map(|c| lon_lat(c.x, c.y)).collect::<Result<Vec<_>, _>>()
+            };
+            let shape = match &placemark.geometry {
+                Some(kml::types::Geometry::Point(p)) => {
+                    lon_lat(p.coord.x, p.coord.y).map(Shape::Point)
+                }
+                Some(kml::types::Geometry::LineString(l)) => ring(&l.coords).map(Shape::Line),
+                Some(kml::types::Geometry::LinearRing(r)) => ring(&r.coords).map(Shape::Polygon),
+                Some(kml::types::Geometry::Polygon(p)) => ring(&p.outer.coords).map(Shape::Polygon),
+                Some(kml::types::Geometry::MultiGeometry(_)) => {
+                    Err("is a MultiGeometry, which is none of Point, LineString and Polygon"
+                        .to_owned())
+                }
+                Some(_) => {
+                    Err("is a model, which is none of Point, LineString and Polygon".to_owned())
+                }
+                None => Err("has no geometry".to_owned()),
+            };
+            match shape {
+                Ok(shape) => self.feature(&feature, shape),
+                Err(why) => {
+                    let msg = format!("{} of `{}` {why}", feature.shown(), self.path);
+                    self.error(msg, "give each placemark one Point, LineString or Polygon (split a MultiGeometry into placemarks of their own)");
+                }
+            }
+        }
+    }
+
     /// One feature, named and shaped, into the world.
     fn feature(&mut self, f: &Feature, shape: Shape) {
         let path = self.path;
-        let Some(name) = f.name else {
-            let msg = format!("{} of `{path}` has no `name` property", f.shown());
-            self.error(msg, "give every feature a `name` property (in the GIS's attribute table): the name missions use for it");
+        let Some(name) = f.name.filter(|n| !n.is_empty()) else {
+            let (msg, help) = match f.noun {
+                "placemark" => (
+                    format!("{} of `{path}` has no `<name>`", f.shown()),
+                    "give every placemark a `<name>` (its name in Google Earth or the GIS): the name missions use for it",
+                ),
+                _ => (
+                    format!("{} of `{path}` has no `name` property", f.shown()),
+                    "give every feature a `name` property (in the GIS's attribute table): the name missions use for it",
+                ),
+            };
+            self.error(msg, help);
             return;
         };
         if self.role == Role::NoFly && !matches!(shape, Shape::Polygon(_)) {
@@ -299,6 +387,8 @@ impl File<'_, '_, '_> {
 
 /// A feature as messages name it: its place in the file, and its name if it has one.
 struct Feature<'n> {
+    /// "feature" (GeoJSON) or "placemark" (KML).
+    noun: &'static str,
     index: usize,
     name: Option<&'n str>,
     /// `None`: a property `up_to` that is not a positive number.
@@ -308,22 +398,52 @@ struct Feature<'n> {
 impl Feature<'_> {
     fn shown(&self) -> String {
         match self.name {
-            Some(n) => format!("feature {} (`{n}`)", self.index),
-            None => format!("feature {}", self.index),
+            Some(n) => format!("{} {} (`{n}`)", self.noun, self.index),
+            None => format!("{} {}", self.noun, self.index),
         }
     }
 }
 
-/// A position's longitude and latitude, in range.
+/// Whether `text` is XML whose elements are all closed, each by its own end tag: kml 0.15
+/// reads a Placemark until its end tag and, with none, forever (at the end of the text it
+/// is handed end after end). Its own reader, quick-xml, checks the names of end tags.
+fn well_formed(text: &str) -> Result<(), String> {
+    let mut reader = quick_xml::Reader::from_str(text);
+    let mut open = 0usize;
+    loop {
+        match reader.read_event() {
+            Ok(quick_xml::events::Event::Start(_)) => open += 1,
+            Ok(quick_xml::events::Event::End(_)) => open = open.saturating_sub(1),
+            Ok(quick_xml::events::Event::Eof) if open == 0 => return Ok(()),
+            Ok(quick_xml::events::Event::Eof) => {
+                return Err(format!(
+                    "it ends with {} not closed (is the file cut short?)",
+                    count(open, "element")
+                ))
+            }
+            Ok(_) => {}
+            Err(e) => {
+                return Err(format!("{e} (at byte {})", reader.error_position()));
+            }
+        }
+    }
+}
+
+/// A GeoJSON position's longitude and latitude, in range.
 fn degrees(p: &geojson::Position) -> Result<[f64; 2], String> {
     match p.as_slice() {
-        [lon, lat, ..] if (-180.0..=180.0).contains(lon) && (-90.0..=90.0).contains(lat) => {
-            Ok([*lon, *lat])
-        }
-        [lon, lat, ..] => Err(format!(
-            "has the position {} outside the Earth's degrees (GeoJSON writes longitude first, then latitude)",
-            shown([*lon, *lat])
-        )),
+        [lon, lat, ..] => lon_lat(*lon, *lat),
         _ => Err("has a position with fewer than 2 numbers".to_owned()),
     }
+}
+
+/// A longitude and a latitude, in range.
+fn lon_lat(lon: f64, lat: f64) -> Result<[f64; 2], String> {
+    if (-180.0..=180.0).contains(&lon) && (-90.0..=90.0).contains(&lat) {
+        return Ok([lon, lat]);
+    }
+    Err(format!(
+        "has the position {} outside the Earth's degrees (GeoJSON and KML write longitude first, then latitude)",
+        shown([lon, lat])
+    ))
 }

@@ -537,9 +537,18 @@ fn unique_names(cx: &mut Ctx, world: &World, group_spans: &[Span]) {
         uses.sort_by_key(|(_, span)| (span.start, span.end));
         let (first, first_span) = uses[0];
         for &(what, span) in &uses[1..] {
-            let msg = format!(
-                "the name `{name}` is used for {first} and for {what}, so mission code could not tell which is meant"
-            );
+            // Two of one kind: a file of `[imports]` names one the world file has too.
+            let msg = if what == first {
+                let plural = match what {
+                    "a place" => "places",
+                    "an area" => "areas",
+                    "a line" => "lines",
+                    _ => "groups",
+                };
+                format!("the name `{name}` is used for two {plural}, so mission code could not tell which is meant")
+            } else {
+                format!("the name `{name}` is used for {first} and for {what}, so mission code could not tell which is meant")
+            };
             let help =
                 "rename one of them: drones, groups, places, areas and lines share one set of names";
             let d = Diagnostic::new(Code::WorldFile, cx.file, span, msg).with_help(help).also(

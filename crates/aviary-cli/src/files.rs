@@ -172,6 +172,13 @@ fn read_bounded(path: &Path, name: &str, rules: &Bounded) -> Result<(String, Vec
     Ok((name.to_string(), bytes))
 }
 
+/// The provider of a world read without a mission (`aviary vehicles`, `replay`,
+/// `report`): its `[imports]` beside it, and no USE (the provider's roots play no part in
+/// a world's files).
+pub fn world_files() -> DiskProvider {
+    DiskProvider { roots: Vec::new() }
+}
+
 /// `NAME.world.toml` beside `NAME.mission`, if it exists.
 pub fn world_beside(mission: &Path) -> Option<PathBuf> {
     let stem = mission.file_stem()?.to_string_lossy().into_owned();
@@ -236,13 +243,11 @@ pub fn world_of_trace(
 
 fn world_of_bytes(path: &Path, bytes: Vec<u8>) -> Result<aviary_world::World, String> {
     let mut sources = aviary_diagnostics::SourceMap::new();
-    // Its `[imports]` beside it (the provider's USE roots play no part in them).
-    let files = DiskProvider { roots: Vec::new() };
     let read = aviary_check::read_world(
         &mut sources,
         &path.display().to_string(),
         std::borrow::Cow::Owned(bytes),
-        &files,
+        &world_files(),
     );
     read.world.ok_or_else(|| {
         let mut shown = String::new();

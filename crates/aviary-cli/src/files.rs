@@ -121,7 +121,7 @@ const USED: Bounded = Bounded {
 
 const IMPORTED: Bounded = Bounded {
     what: "a world's imported file",
-    regular: "name a GeoJSON or KML file",
+    regular: "name a GeoJSON, KML or QGroundControl plan file",
     split: "split it into several files, each named in [imports]",
 };
 

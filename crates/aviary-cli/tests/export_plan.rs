@@ -112,3 +112,34 @@ fn an_unknown_drone_or_a_world_without_origin_writes_nothing() {
     assert!(err.contains("add `origin"), "{err}");
     assert!(!dir.join("x.plan").exists());
 }
+
+/// An exported plan imported again (`[imports]`): its waypoints are a line a mission can
+/// follow, its items places, at the heights written.
+#[test]
+fn an_exported_plan_imports_as_a_line_and_places() {
+    let dir = scratch("export_plan_again");
+    let (code, _, err) = aviary(
+        &[
+            "export-plan",
+            "examples/fire_front.mission",
+            "--drone",
+            "scout1",
+            "-o",
+            dir.join("route.plan").to_str().unwrap(),
+        ],
+        &repo(),
+    );
+    assert_eq!(code, 0, "{err}");
+    std::fs::write(
+        dir.join("m.world.toml"),
+        "[site]\norigin = { lat = 47.07, lon = 15.44, alt = 350.0 }\n[imports]\nfeatures = \"route.plan\"\n[drones.d1]\nhome = [0, 0]\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("m.mission"),
+        "MISSION Again:\n    d1 TakeOff WITH 30m\n    d1 FollowPath WITH route\n    d1 FlyTo WITH route_3\n    d1 ReturnHome\n",
+    )
+    .unwrap();
+    let (code, out, err) = aviary(&["check", "m.mission"], &dir);
+    assert_eq!(code, 0, "{out}{err}");
+}

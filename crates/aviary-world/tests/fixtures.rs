@@ -88,11 +88,18 @@ fn shown_with_imports(path: &Path) -> String {
     let cm = |v: f64| (v * 100.0).round() / 100.0;
     let xy = |p: &[f64; 2]| format!("({}, {})", cm(p[0]), cm(p[1]));
     let corners = |ps: &[[f64; 2]]| ps.iter().map(xy).collect::<Vec<_>>().join(" ");
+    let z = |z: f64, has_z: bool| if has_z { format!(" z {}", cm(z)) } else { String::new() };
     for p in &w.places {
-        let _ = writeln!(out, "place {} at {}", p.name, xy(&[p.at[0], p.at[1]]));
+        let _ =
+            writeln!(out, "place {} at {}{}", p.name, xy(&[p.at[0], p.at[1]]), z(p.at[2], p.has_z));
     }
     for l in &w.lines {
-        let _ = writeln!(out, "line {}: {}", l.name, corners(&l.ground()));
+        let points: Vec<String> = l
+            .points
+            .iter()
+            .map(|(p, has_z)| format!("{}{}", xy(&[p[0], p[1]]), z(p[2], *has_z)))
+            .collect();
+        let _ = writeln!(out, "line {}: {}", l.name, points.join(" "));
     }
     for a in &w.areas {
         let _ = writeln!(out, "area {}: {}", a.name, corners(&a.polygon));
@@ -120,8 +127,8 @@ impl aviary_world::WorldFiles for Bytes {
     }
 }
 
-/// A broken GeoJSON or KML file is an error, never a panic: every imported fixture cut
-/// short at many places, and with bytes changed, read as both kinds.
+/// A broken GeoJSON, KML or plan file is an error, never a panic: every imported fixture cut
+/// short at many places, and with bytes changed, read as each kind.
 #[test]
 fn broken_imports_never_panic() {
     let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/imports");
@@ -139,7 +146,7 @@ fn broken_imports_never_panic() {
             let mut changed = bytes.clone();
             changed[cut] = changed[cut].wrapping_add(7);
             for served in [bytes[..cut].to_vec(), changed] {
-                for file in ["f.geojson", "f.kml"] {
+                for file in ["f.geojson", "f.kml", "f.plan"] {
                     let provider = Bytes(served.clone());
                     let (_, _) = aviary_world::parse_world_with(
                         aviary_diagnostics::FileId(0),

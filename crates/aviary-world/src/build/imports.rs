@@ -1,6 +1,8 @@
 //! `[imports]`: places, lines, areas and no-fly zones read from files beside the world
 //! file (docs/WORLD.md). GeoJSON (RFC 7946) is read with georust's `geojson`, KML with
-//! georust's `kml` (its Placemarks, in document order, named by `<name>`); every
+//! georust's `kml` (its Placemarks, in document order, named by `<name>`), a
+//! QGroundControl `.plan` with serde_json (its items as places, its waypoints as a line,
+//! named after the file); every
 //! coordinate goes through the world's one projection, `aviary_api::geo::Origin`, as a
 //! `GEO(...)` position does.
 //!
@@ -88,7 +90,7 @@ pub(super) fn imports(cx: &mut Ctx, node: &Node, site: &Site, files: &dyn WorldF
     for (path, span, role) in named {
         let Some(kind) = kind_of(&path) else {
             let msg = format!("`{path}` is not a kind of file `[imports]` reads");
-            cx.error(span, msg, "name a GeoJSON file (`.geojson` or `.json`) or a KML file (`.kml`; a `.kmz` unzipped)");
+            cx.error(span, msg, "name a GeoJSON file (`.geojson` or `.json`), a KML file (`.kml`; a `.kmz` unzipped) or a QGroundControl plan (`.plan`)");
             continue;
         };
         let bytes = match files.read(&path) {
@@ -102,6 +104,7 @@ pub(super) fn imports(cx: &mut Ctx, node: &Node, site: &Site, files: &dyn WorldF
         match kind {
             Kind::GeoJson => file.geojson(&bytes),
             Kind::Kml => file.kml(&bytes),
+            Kind::Plan => file.plan(&bytes),
         }
     }
     out
@@ -110,6 +113,7 @@ pub(super) fn imports(cx: &mut Ctx, node: &Node, site: &Site, files: &dyn WorldF
 enum Kind {
     GeoJson,
     Kml,
+    Plan,
 }
 
 fn kind_of(path: &str) -> Option<Kind> {
@@ -117,6 +121,7 @@ fn kind_of(path: &str) -> Option<Kind> {
     match ext.as_str() {
         "geojson" | "json" => Some(Kind::GeoJson),
         "kml" => Some(Kind::Kml),
+        "plan" => Some(Kind::Plan),
         _ => None,
     }
 }
@@ -279,6 +284,119 @@ impl File<'_, '_, '_> {
         }
     }
 
+    /// QGroundControl's plan: with `features`, each mission item with a position a place
+    /// `STEM_N` (N its `doJumpId`) and each rally point `STEM_rally_N`, and the navigation
+    /// items (takeoff, waypoints, loiters, land) in order the line `STEM`; with `no_fly`,
+    /// each exclusion polygon of its geofence a zone `STEM_fence_N`.
+    fn plan(&mut self, bytes: &[u8]) {
+        let path = self.path;
+        let help = "save it again from QGroundControl (Plan View, File, Save)";
+        let doc: serde_json::Value = match serde_json::from_slice(bytes) {
+            Ok(doc) => doc,
+            Err(e) => {
+                self.error(format!("`{path}` is not a QGroundControl plan: {e}"), help);
+                return;
+            }
+        };
+        if doc["fileType"] != "Plan" {
+            let msg =
+                format!("`{path}` is not a QGroundControl plan: its `fileType` is not \"Plan\"");
+            self.error(msg, help);
+            return;
+        }
+        let file_name = path.rsplit(['/', '\\']).next().unwrap_or(path);
+        let stem = file_name.rsplit_once('.').map_or(file_name, |(s, _)| s);
+        if !is_identifier(stem) {
+            let msg = format!("the things of `{path}` are named after the file, and `{stem}` is not a name mission code could refer to");
+            self.error(
+                msg,
+                "rename the file: letters, digits and `_`, not starting with a digit, then `.plan`",
+            );
+            return;
+        }
+        let span = self.span;
+        if self.role == Role::NoFly {
+            let polygons = doc["geoFence"]["polygons"].as_array().map_or(&[][..], |p| &p[..]);
+            for (n, p) in polygons.iter().enumerate() {
+                if p["inclusion"].as_bool() != Some(false) {
+                    continue;
+                }
+                let name = format!("{stem}_fence_{}", n + 1);
+                let corners: Option<Vec<[f64; 2]>> = p["polygon"]
+                    .as_array()
+                    .and_then(|cs| cs.iter().map(|c| lat_lon_of(&c[0], &c[1])).collect());
+                let Some(corners) = corners.filter(|c| c.len() >= 3) else {
+                    let msg = format!("geofence polygon {n} of `{path}` is not a list of at least 3 [latitude, longitude] corners");
+                    self.error(msg, help);
+                    continue;
+                };
+                let polygon: Vec<[f64; 2]> =
+                    corners.iter().map(|c| self.origin.to_local(c[1], c[0])).collect();
+                let what = format!("geofence polygon {n} of `{path}`");
+                if self.cx.outline_at(&what, span, &polygon) {
+                    self.out.no_fly.push(NoFly { name, polygon, up_to: None, span });
+                }
+            }
+            return;
+        }
+        let Some(items) = doc["mission"]["items"].as_array() else {
+            self.error(format!("`{path}` has no `mission.items`"), help);
+            return;
+        };
+        let mut line = Vec::new();
+        for (index, item) in items.iter().enumerate() {
+            // Complex items (surveys, corridor scans) and items without a position (a
+            // speed change, a return to launch) are not read.
+            if item["type"] != "SimpleItem" {
+                continue;
+            }
+            let params = item["params"].as_array().map_or(&[][..], |p| &p[..]);
+            let (Some(lat), Some(lon)) = (params.get(4), params.get(5)) else { continue };
+            let (Some(lat), Some(lon)) = (lat.as_f64(), lon.as_f64()) else { continue };
+            let at = match lon_lat(lon, lat) {
+                Ok(lon_lat) => lon_lat,
+                Err(why) => {
+                    let msg = format!("mission item {index} of `{path}` {why}");
+                    self.error(msg, help);
+                    continue;
+                }
+            };
+            if at == [0.0, 0.0] {
+                continue;
+            }
+            let [x, y] = self.origin.to_local(at[1], at[0]);
+            let alt = params.get(6).and_then(serde_json::Value::as_f64);
+            // Heights above home (3) or the terrain (10) are the world's; above sea level
+            // (0) less the origin's altitude; any other frame, none.
+            let z = match (item["frame"].as_u64(), alt) {
+                (Some(3 | 10), Some(a)) => Some(a),
+                (Some(0), Some(a)) => Some(a - self.origin.alt),
+                _ => None,
+            };
+            let z = z.filter(|z| *z >= 0.0 && z.is_finite());
+            let id = item["doJumpId"].as_u64().unwrap_or(index as u64 + 1);
+            let name = format!("{stem}_{id}");
+            let point = ([x, y, z.unwrap_or(0.0)], z.is_some());
+            self.out.places.push(Place { name, at: point.0, has_z: point.1, span });
+            // MAV_CMD_NAV_WAYPOINT, LOITER_UNLIM, LOITER_TURNS, LOITER_TIME, LAND,
+            // TAKEOFF, SPLINE_WAYPOINT: where the vehicle flies.
+            if matches!(item["command"].as_u64(), Some(16..=19 | 21 | 22 | 82)) {
+                line.push(point);
+            }
+        }
+        let rally = doc["rallyPoints"]["points"].as_array().map_or(&[][..], |p| &p[..]);
+        for (n, p) in rally.iter().enumerate() {
+            if let Some(at) = lat_lon_of(&p[0], &p[1]) {
+                let [x, y] = self.origin.to_local(at[1], at[0]);
+                let name = format!("{stem}_rally_{}", n + 1);
+                self.out.places.push(Place { name, at: [x, y, 0.0], has_z: false, span });
+            }
+        }
+        if line.len() >= 2 {
+            self.out.lines.push(Line { name: stem.to_owned(), points: line, span });
+        }
+    }
+
     /// One feature, named and shaped, into the world.
     fn feature(&mut self, f: &Feature, shape: Shape) {
         let path = self.path;
@@ -427,6 +545,13 @@ fn well_formed(text: &str) -> Result<(), String> {
             }
         }
     }
+}
+
+/// A plan's latitude and longitude (in that order, as QGC writes them) as
+/// `[longitude, latitude]`, when both are numbers in range.
+fn lat_lon_of(lat: &serde_json::Value, lon: &serde_json::Value) -> Option<[f64; 2]> {
+    let (lat, lon) = (lat.as_f64()?, lon.as_f64()?);
+    lon_lat(lon, lat).ok()
 }
 
 /// A GeoJSON position's longitude and latitude, in range.

@@ -36,7 +36,7 @@ pub struct Texts<'a> {
     pub mission: Source<'a>,
     pub world: Source<'a>,
     /// The files the mission `USE`s (the CLI's reads the disk under the rules of
-    /// `aviary_check::uses`).
+    /// `aviary_check::uses`) and those the world's `[imports]` names.
     pub files: &'a dyn SourceProvider,
 }
 
@@ -304,8 +304,12 @@ fn front_end(
 ) -> Result<(aviary_check::Program, World, SourceMap), NotFlown> {
     let mut sources = SourceMap::new();
     hooks.begin(Stage::World);
-    let world =
-        aviary_check::read_world(&mut sources, texts.world.name, Cow::Owned(texts.world.bytes));
+    let world = aviary_check::read_world(
+        &mut sources,
+        texts.world.name,
+        Cow::Owned(texts.world.bytes),
+        texts.files,
+    );
     hooks.end(Stage::World);
     hooks.begin(Stage::Check);
     let checked = aviary_check::check_against(

@@ -36,7 +36,8 @@ pub fn check_sources(
     provider: &dyn SourceProvider,
     api: &Descriptor,
 ) -> Checked {
-    let world = world.map(|(name, bytes)| read_world(sources, name, Cow::Borrowed(bytes)));
+    let world =
+        world.map(|(name, bytes)| read_world(sources, name, Cow::Borrowed(bytes), provider));
     check_against(sources, (mission.0, Cow::Borrowed(mission.1)), world, provider, api)
 }
 
@@ -47,9 +48,15 @@ pub struct WorldRead {
     pub diagnostics: Vec<Diagnostic>,
 }
 
-/// The first half of [`check_sources`]: the world file `name`, into `sources`. Bytes
+/// The first half of [`check_sources`]: the world file `name`, into `sources`, with the
+/// files its `[imports]` names from `provider` ([`SourceProvider::world_file`]). Bytes
 /// handed over (`Cow::Owned`) become its text without a copy.
-pub fn read_world(sources: &mut SourceMap, name: &str, bytes: Cow<'_, [u8]>) -> WorldRead {
+pub fn read_world(
+    sources: &mut SourceMap,
+    name: &str,
+    bytes: Cow<'_, [u8]>,
+    provider: &dyn SourceProvider,
+) -> WorldRead {
     let (text, invalid) = decode(bytes);
     let id = sources.add(name, text);
     match invalid {
@@ -57,9 +64,25 @@ pub fn read_world(sources: &mut SourceMap, name: &str, bytes: Cow<'_, [u8]>) -> 
             WorldRead { world: None, diagnostics: vec![aviary_syntax::invalid_utf8(id, at)] }
         }
         None => {
-            let (world, diagnostics) = aviary_world::parse_world(id, sources.text(id));
+            let files = Imports { provider, world: name };
+            let (world, diagnostics) = aviary_world::parse_world_with(id, sources.text(id), &files);
             WorldRead { world, diagnostics }
         }
+    }
+}
+
+/// The files a world imports, from the mission's provider.
+struct Imports<'a> {
+    provider: &'a dyn SourceProvider,
+    world: &'a str,
+}
+
+impl aviary_world::WorldFiles for Imports<'_> {
+    fn read(&self, path: &str) -> Result<Vec<u8>, String> {
+        self.provider.world_file(self.world, path).map_err(|e| match e {
+            crate::LoadError::Unreadable(why) => why,
+            crate::LoadError::Refused { why, help } => format!("{why} ({help})"),
+        })
     }
 }
 

@@ -20,6 +20,14 @@ pub trait SourceProvider {
     /// may not be (`crate::uses`). Only paths that pass [`uses::check_written`] are asked
     /// for.
     fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), LoadError>;
+
+    /// The file `path` that the world file named `world` imports (`[imports]` in
+    /// docs/WORLD.md: GeoJSON beside it): its bytes, or why not. By default none is
+    /// served, as by [`NoFiles`].
+    fn world_file(&self, world: &str, path: &str) -> Result<Vec<u8>, LoadError> {
+        let _ = (world, path);
+        Err(LoadError::Unreadable("the world file is read here without the files beside it".into()))
+    }
 }
 
 /// The provider of a mission that stands alone, held in memory (tests, the benchmarks,

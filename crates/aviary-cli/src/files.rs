@@ -72,14 +72,64 @@ impl SourceProvider for DiskProvider {
         if !is_mission_name(&resolved) {
             return Err(not_a_mission());
         }
-        read_bounded(&resolved, &name)
+        read_bounded(&resolved, &name, &USED)
+    }
+
+    /// A file a world's `[imports]` names: relative to the world file, inside its folder
+    /// (resolved, as for a USE), a regular file of at most 16 MiB. The folder is the world
+    /// file's, not the mission's: a world is read with its own files wherever it lies.
+    fn world_file(&self, world: &str, path: &str) -> Result<Vec<u8>, LoadError> {
+        let base = match Path::new(world).parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        let full = aviary_check::normalize_path(&base.join(path));
+        let name = full.to_string_lossy().into_owned();
+        let folder = std::fs::canonicalize(base)
+            .map_err(|e| format!("cannot find the world file's folder {}: {e}", base.display()))?;
+        let resolved = match std::fs::canonicalize(&full) {
+            Ok(p) => p,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                return Err(format!("there is no file {name}").into())
+            }
+            Err(e) => {
+                return Err(format!("{} ({name})", e.kind().to_string().to_lowercase()).into())
+            }
+        };
+        if !within_roots(&resolved, std::slice::from_ref(&folder)) {
+            return Err(LoadError::Refused {
+                why: format!("{name} is outside the world file's folder {}", folder.display()),
+                help: "keep the imported files in the world file's folder, or below it".into(),
+            });
+        }
+        read_bounded(&resolved, &name, &IMPORTED).map(|(_, bytes)| bytes)
     }
 }
+
+/// What a file read by [`read_bounded`] is, for its refusals.
+struct Bounded {
+    what: &'static str,
+    regular: &'static str,
+    split: &'static str,
+}
+
+const USED: Bounded = Bounded {
+    what: "a USEd file",
+    regular: "USE a .mission file",
+    split: "split the library into several files, each USEd",
+};
+
+const IMPORTED: Bounded = Bounded {
+    what: "a world's imported file",
+    regular: "name a GeoJSON, KML or QGroundControl plan file",
+    split: "split it into several files, each named in [imports]",
+};
 
 /// The bytes of a regular file of at most `MAX_USE_BYTES`. Opened without blocking, so a
 /// FIFO does not wait for a writer, and judged by what was opened, so nothing can be
 /// swapped in between.
-fn read_bounded(path: &Path, name: &str) -> Result<(String, Vec<u8>), LoadError> {
+/// `rules` says what the file is for: a USEd file or a world's import.
+fn read_bounded(path: &Path, name: &str, rules: &Bounded) -> Result<(String, Vec<u8>), LoadError> {
     let mut options = std::fs::OpenOptions::new();
     options.read(true);
     #[cfg(unix)]
@@ -97,15 +147,16 @@ fn read_bounded(path: &Path, name: &str) -> Result<(String, Vec<u8>), LoadError>
         let what = if meta.is_dir() { "a folder" } else { "a device, pipe or socket" };
         return Err(LoadError::Refused {
             why: format!("{name} is {what}, not a regular file"),
-            help: "USE a .mission file".into(),
+            help: rules.regular.into(),
         });
     }
     let too_large = |size: u64| LoadError::Refused {
         why: format!(
-            "{name} has {size} bytes, more than the {} MiB a USEd file may have",
-            MAX_USE_BYTES >> 20
+            "{name} has {size} bytes, more than the {} MiB {} may have",
+            MAX_USE_BYTES >> 20,
+            rules.what
         ),
-        help: "split the library into several files, each USEd".into(),
+        help: rules.split.into(),
     };
     if meta.len() > MAX_USE_BYTES {
         return Err(too_large(meta.len()));
@@ -119,6 +170,13 @@ fn read_bounded(path: &Path, name: &str) -> Result<(String, Vec<u8>), LoadError>
         return Err(too_large(bytes.len() as u64));
     }
     Ok((name.to_string(), bytes))
+}
+
+/// The provider of a world read without a mission (`aviary vehicles`, `replay`,
+/// `report`): its `[imports]` beside it, and no USE (the provider's roots play no part in
+/// a world's files).
+pub fn world_files() -> DiskProvider {
+    DiskProvider { roots: Vec::new() }
 }
 
 /// `NAME.world.toml` beside `NAME.mission`, if it exists.
@@ -189,6 +247,7 @@ fn world_of_bytes(path: &Path, bytes: Vec<u8>) -> Result<aviary_world::World, St
         &mut sources,
         &path.display().to_string(),
         std::borrow::Cow::Owned(bytes),
+        &world_files(),
     );
     read.world.ok_or_else(|| {
         let mut shown = String::new();

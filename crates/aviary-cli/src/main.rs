@@ -9,6 +9,7 @@ mod bench;
 mod check;
 mod ctl;
 mod ctl_table;
+mod export_plan;
 mod figures;
 mod files;
 mod fmt;
@@ -176,6 +177,25 @@ enum Command {
         /// Where to write the report
         #[arg(short, long, value_name = "OUT.html", value_parser = report_file)]
         output: PathBuf,
+    },
+    /// Write one drone's part of a mission as a QGroundControl plan (.plan): the waypoints
+    /// its plan flies through (as `aviary check --plan` times them), the world's geofence
+    /// and no-fly zones as the geofence, its places as rally points
+    ExportPlan {
+        #[arg(value_parser = mission_file)]
+        mission: PathBuf,
+        /// The world file (default: NAME.world.toml beside NAME.mission)
+        #[arg(long, value_parser = world_file)]
+        world: Option<PathBuf>,
+        /// The drone whose waypoints are written
+        #[arg(long)]
+        drone: String,
+        /// Where to write the plan
+        #[arg(short, long, value_name = "OUT.plan")]
+        output: PathBuf,
+        /// A folder whose .mission files USE may read, besides the mission's own (repeatable)
+        #[arg(long = "use-root", value_name = "DIR")]
+        use_root: Vec<PathBuf>,
     },
     /// Talk to a running mission's operator API (see `aviary run --serve`)
     Ctl {
@@ -362,6 +382,9 @@ fn command(cli: Cli) -> u8 {
             }
         },
         Command::Report { trace, world, output } => report::run(&trace, world.as_deref(), &output),
+        Command::ExportPlan { mission, world, drone, output, use_root } => {
+            export_plan::run(&mission, world.as_deref(), &drone, &output, &use_root)
+        }
         Command::Ctl { url, token, command } => ctl::run(&url, token.as_deref(), command),
         Command::Vehicles { world, listen, speed, signing_key, autopilot } => {
             vehicles::run(&vehicles::VehiclesArgs {

@@ -45,9 +45,14 @@ pub fn run(args: &VehiclesArgs) -> u8 {
     };
     let mut sources = SourceMap::new();
     let name = args.world.display().to_string();
-    let text = String::from_utf8_lossy(&bytes).into_owned();
-    let file = sources.add(name.clone(), text.clone());
-    let (world, diagnostics) = aviary_world::parse_world(file, &text);
+    // With its `[imports]`, read beside it.
+    let read = aviary_check::read_world(
+        &mut sources,
+        &name,
+        std::borrow::Cow::Owned(bytes),
+        &crate::files::world_files(),
+    );
+    let (world, diagnostics) = (read.world, read.diagnostics);
     let errors: Vec<_> = diagnostics.iter().filter(|d| d.is_error()).collect();
     let Some(world) = world.filter(|_| errors.is_empty()) else {
         for d in errors {

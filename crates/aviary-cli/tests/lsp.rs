@@ -109,3 +109,79 @@ fn initialize_open_diagnostics_shutdown_over_stdio() {
     let code = common::wait_at_most(&mut child, std::time::Duration::from_secs(30), "aviary lsp");
     assert_eq!(code, 0);
 }
+
+/// A world's `[imports]` as the editor sees them: the places of a GeoJSON file beside the
+/// world are known (a typo is told the imported name), and a rename of one is refused,
+/// since its definition is the file's name in the world, not a key.
+#[test]
+fn the_places_a_world_imports_are_known_and_not_renamed_over_the_files_name() {
+    let dir = common::scratch("lsp_imports");
+    std::fs::copy(
+        common::repo().join("crates/aviary-world/tests/fixtures/imports/farm.geojson"),
+        dir.join("farm.geojson"),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("farm.world.toml"),
+        "[site]\norigin = { lat = 46.6167, lon = 14.2650 }\n\n[imports]\nfeatures = \"farm.geojson\"\n\n[drones.scout]\nhome = [0, 0]\n",
+    )
+    .unwrap();
+    let mission =
+        "MISSION Farm:\n    scout TakeOff\n    scout FlyTo WITH Barn\n    scout FlyTo WITH Bran\n";
+    std::fs::write(dir.join("farm.mission"), mission).unwrap();
+    let dir = std::fs::canonicalize(&dir).unwrap();
+    let uri = format!("file://{}/farm.mission", dir.display());
+
+    let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .arg("lsp")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .expect("start aviary lsp");
+    let mut stdin = child.stdin.take().unwrap();
+    let mut stdout = BufReader::new(child.stdout.take().unwrap());
+    send(
+        &mut stdin,
+        &json!({ "jsonrpc": "2.0", "id": 1, "method": "initialize", "params": { "processId": null, "rootUri": null, "capabilities": {} } }),
+    );
+    assert_eq!(receive(&mut stdout)["id"], 1);
+    send(&mut stdin, &json!({ "jsonrpc": "2.0", "method": "initialized", "params": {} }));
+    send(
+        &mut stdin,
+        &json!({ "jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {
+        "textDocument": { "uri": uri, "languageId": "aviary", "version": 1, "text": mission } } }),
+    );
+    let codes = loop {
+        let m = receive(&mut stdout);
+        if m["params"]["uri"] == uri.as_str() {
+            let all = m["params"]["diagnostics"].as_array().unwrap().clone();
+            break all
+                .iter()
+                .map(|d| {
+                    format!("{} {}", d["code"].as_str().unwrap(), d["message"].as_str().unwrap())
+                })
+                .collect::<Vec<_>>();
+        }
+    };
+    assert_eq!(codes, ["E103 unknown place `Bran`\nhelp: did you mean `Barn`?"], "{codes:?}");
+    send(
+        &mut stdin,
+        &json!({ "jsonrpc": "2.0", "id": 2, "method": "textDocument/rename", "params": {
+        "textDocument": { "uri": uri }, "position": { "line": 2, "character": 24 }, "newName": "Shed" } }),
+    );
+    let answer = loop {
+        let m = receive(&mut stdout);
+        if m["id"] == 2 {
+            break m;
+        }
+    };
+    let why = answer["error"]["message"].as_str().unwrap_or_default();
+    assert!(why.contains("a file the world imports (\"farm.geojson\")"), "{answer}");
+    send(&mut stdin, &json!({ "jsonrpc": "2.0", "id": 3, "method": "shutdown", "params": null }));
+    while receive(&mut stdout)["id"] != 3 {}
+    send(&mut stdin, &json!({ "jsonrpc": "2.0", "method": "exit", "params": null }));
+    drop(stdin);
+    let code = common::wait_at_most(&mut child, std::time::Duration::from_secs(30), "aviary lsp");
+    assert_eq!(code, 0);
+}

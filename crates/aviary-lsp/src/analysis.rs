@@ -115,12 +115,22 @@ pub fn mission(key: &str, docs: &Docs, config: &Config) -> Analysis {
 }
 
 /// The world file `key` read alone.
-pub fn world_alone(key: &str, docs: &Docs) -> Analysis {
+pub fn world_alone(key: &str, docs: &Docs, config: &Config) -> Analysis {
     let api = aviary_api::Descriptor::standard();
     let text = docs.get(key).map(|d| d.text.clone()).unwrap_or_default();
     let mut sources = SourceMap::new();
-    let read =
-        aviary_check::read_world(&mut sources, key, std::borrow::Cow::Owned(text.into_bytes()));
+    // The files its `[imports]` names, from the disk beside it.
+    let path = Path::new(key);
+    let disk: Box<dyn SourceProvider> = match path.is_absolute().then(|| (config.disk)(path)) {
+        Some(Ok(disk)) => disk,
+        _ => Box::new(aviary_check::NoFiles),
+    };
+    let read = aviary_check::read_world(
+        &mut sources,
+        key,
+        std::borrow::Cow::Owned(text.into_bytes()),
+        &*disk,
+    );
     let occurrences = index::index(&[], read.world.as_ref().map(|w| (FileId(0), w)), &api);
     Analysis {
         sources,

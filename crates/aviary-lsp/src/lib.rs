@@ -317,7 +317,8 @@ impl Server {
                 .values()
                 .any(|a| a.world_file.is_some_and(|w| a.sources.name(w) == key));
             if !read {
-                self.analyses.insert(key.clone(), analysis::world_alone(&key, &self.docs));
+                self.analyses
+                    .insert(key.clone(), analysis::world_alone(&key, &self.docs, &self.config));
             }
         }
         let mut by_file = diag::by_file(self.analyses.values(), &self.docs);

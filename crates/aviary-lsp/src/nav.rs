@@ -72,6 +72,17 @@ fn refusal(a: &Analysis, sym: &Sym, all: &[&Occurrence]) -> Option<String> {
             "`{}` is defined in the standard library, which cannot be edited",
             sym.name()
         )),
+        // A place or area of a file the world imports: its occurrence in the world is the
+        // string naming the file, which a rename must not overwrite.
+        Sym::Place(n) | Sym::Area(n) => {
+            let text = |o: &&&Occurrence| a.sources.text(o.file).get(o.span.range()).unwrap_or("");
+            all.iter().find(|o| text(o).trim_matches(['"', '\'']) != n).map(|o| {
+                format!(
+                    "`{n}` is defined in a file the world imports ({}): rename it there",
+                    text(&o)
+                )
+            })
+        }
         _ => None,
     }
 }

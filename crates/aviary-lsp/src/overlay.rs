@@ -47,6 +47,12 @@ impl SourceProvider for Overlay<'_> {
         }
         Ok((name, doc.text.as_bytes().to_vec()))
     }
+
+    /// A world's imports are read from the disk, as saved (they are not missions, which
+    /// an editor has open).
+    fn world_file(&self, world: &str, path: &str) -> Result<Vec<u8>, LoadError> {
+        self.disk.world_file(world, path)
+    }
 }
 
 /// A path without symlinks: the file's own when it exists, else its folder's (an open

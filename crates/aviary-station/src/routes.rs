@@ -353,7 +353,7 @@ fn trace_text(folder: &dir::Folder, path: &str) -> Result<String, Refusal> {
 /// file to save: `GET /api/station/report?path=traces/X.jsonl&world=W.toml`.
 async fn report(State(station): State<Arc<Station>>, Query(asked): Query<Recorded>) -> Response {
     let work = move || {
-        let (folder, _) = match folder(&station) {
+        let (folder, files) = match folder(&station) {
             Ok(f) => f,
             Err(refusal) => return refusal.into_response(),
         };
@@ -364,7 +364,7 @@ async fn report(State(station): State<Arc<Station>>, Query(asked): Query<Recorde
             Ok(text) => text,
             Err(refusal) => return refusal.into_response(),
         };
-        let world = match world_of_trace(folder, &text, asked.world.as_deref()) {
+        let world = match world_of_trace(folder, files, &text, asked.world.as_deref()) {
             Ok(world) => world,
             Err(refusal) => return refusal.into_response(),
         };
@@ -417,16 +417,16 @@ async fn world_map(
     State(station): State<Arc<Station>>,
     Query(asked): Query<WorldAsked>,
 ) -> Response {
-    let (folder, _) = match folder(&station) {
+    let (folder, files) = match folder(&station) {
         Ok(f) => f,
         Err(refusal) => return refusal.into_response(),
     };
     let world = match (asked.path, asked.trace) {
-        (Some(path), None) => world_of(folder, &path).map(Some),
+        (Some(path), None) => world_of(folder, files, &path).map(Some),
         (None, Some(trace)) => trace_text(folder, &trace).and_then(|text| {
             let stamp = crate::replay::world_stamp(text.as_bytes());
             match stamp {
-                Some(stamp) => world_of_trace(folder, &text, Some(&stamp.file)),
+                Some(stamp) => world_of_trace(folder, files, &text, Some(&stamp.file)),
                 None => Ok(None),
             }
         }),
@@ -446,6 +446,7 @@ async fn world_map(
 /// was flown, else none.
 fn world_of_trace(
     folder: &dir::Folder,
+    files: &crate::FilesFor,
     trace: &str,
     given: Option<&str>,
 ) -> Result<Option<aviary_world::World>, Refusal> {
@@ -469,16 +470,34 @@ fn world_of_trace(
             None => Ok(None),
         };
     }
-    world_of(folder, &path).map(Some)
+    world_of(folder, files, &path).map(Some)
 }
 
 /// A world of the folder, read; refused with its first error.
-fn world_of(folder: &dir::Folder, path: &str) -> Result<aviary_world::World, Refusal> {
+/// Its `[imports]` are read beside it by the command line's provider, as for a flight.
+fn world_of(
+    folder: &dir::Folder,
+    files: &crate::FilesFor,
+    path: &str,
+) -> Result<aviary_world::World, Refusal> {
     if dir::FileKind::of(path) != Some(dir::FileKind::World) {
         return Err(Refusal(StatusCode::BAD_REQUEST, format!("`{path}` is not a world (.toml)")));
     }
     let text = folder.read(path).map_err(|why| Refusal(StatusCode::NOT_FOUND, why))?;
-    match aviary_world::parse_world(aviary_diagnostics::FileId(0), &text) {
+    let full = folder.root().join(path);
+    let provider: Box<dyn SourceProvider> = match files(&full) {
+        Ok(p) => p,
+        Err(_) => Box::new(aviary_check::NoFiles),
+    };
+    let mut sources = aviary_diagnostics::SourceMap::new();
+    let name = full.display().to_string();
+    let read = aviary_check::read_world(
+        &mut sources,
+        &name,
+        std::borrow::Cow::Owned(text.into_bytes()),
+        &*provider,
+    );
+    match (read.world, read.diagnostics) {
         (Some(world), _) => Ok(world),
         (None, diagnostics) => {
             let first = diagnostics.first().map(|d| d.message.clone()).unwrap_or_default();

@@ -14,12 +14,19 @@ pub(crate) fn image_sources(station: &Station) -> Vec<String> {
     if let Some(url) = station.map()["site"]["tiles"].as_str() {
         urls.push(url.to_owned());
     }
-    if let Mode::Folder { folder, .. } = &station.mode {
+    if let Mode::Folder { folder, files } = &station.mode {
         for world in folder.list().worlds {
             let Ok(text) = folder.read(&world) else { continue };
-            if let (Some(w), _) = aviary_world::parse_world(aviary_diagnostics::FileId(0), &text) {
-                urls.extend(w.site.tiles);
-            }
+            // With its `[imports]`, read beside it, as for a flight.
+            let full = folder.root().join(&world);
+            let Ok(provider) = files(&full) else { continue };
+            let read = aviary_check::read_world(
+                &mut aviary_diagnostics::SourceMap::new(),
+                &full.display().to_string(),
+                std::borrow::Cow::Owned(text.into_bytes()),
+                &*provider,
+            );
+            urls.extend(read.world.and_then(|w| w.site.tiles));
         }
     }
     let mut sources: Vec<String> = urls.iter().filter_map(|u| source(u)).collect();

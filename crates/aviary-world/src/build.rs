@@ -13,6 +13,7 @@ mod air;
 mod drone;
 mod expect;
 mod fleet;
+mod imports;
 mod no_fly;
 mod sim;
 
@@ -21,7 +22,7 @@ use fleet::FleetInfo;
 
 const TABLES: &[&str] = &[
     "site", "places", "areas", "lines", "no_fly", "drones", "fleets", "sensors", "targets",
-    "faults", "air", "expect",
+    "faults", "air", "expect", "imports",
 ];
 const SITE_KEYS: &[&str] = &[
     "name",
@@ -36,8 +37,12 @@ const SITE_KEYS: &[&str] = &[
 ];
 const ORIGIN_KEYS: &[&str] = &["lat", "lon", "alt"];
 
-pub(crate) fn parse(file: FileId, text: &str) -> (Option<World>, Vec<Diagnostic>) {
-    let (world, mut diags) = match read(file, text) {
+pub(crate) fn parse(
+    file: FileId,
+    text: &str,
+    files: &dyn crate::WorldFiles,
+) -> (Option<World>, Vec<Diagnostic>) {
+    let (world, mut diags) = match read(file, text, files) {
         Ok(read) => read,
         Err(e) => return (None, vec![syntax_error(file, text, &e)]),
     };
@@ -50,12 +55,21 @@ pub(crate) fn parse(file: FileId, text: &str) -> (Option<World>, Vec<Diagnostic>
 }
 
 /// The world and its diagnostics (unsorted), or the TOML parser's error.
-pub(crate) fn read(file: FileId, text: &str) -> Result<(World, Vec<Diagnostic>), toml::de::Error> {
-    Ok(read_tree(file, text, Node::parse_serde(text)?))
+pub(crate) fn read(
+    file: FileId,
+    text: &str,
+    files: &dyn crate::WorldFiles,
+) -> Result<(World, Vec<Diagnostic>), toml::de::Error> {
+    Ok(read_tree(file, text, Node::parse_serde(text)?, files))
 }
 
 /// The world of the spanned tree of `text`.
-pub(crate) fn read_tree(file: FileId, text: &str, mut root: Node) -> (World, Vec<Diagnostic>) {
+pub(crate) fn read_tree(
+    file: FileId,
+    text: &str,
+    mut root: Node,
+    files: &dyn crate::WorldFiles,
+) -> (World, Vec<Diagnostic>) {
     let mut cx = Ctx { file, text, diags: Vec::new() };
     let mut drones = Drones::default();
     if let Value::Table(top) = &mut root.value {
@@ -78,7 +92,7 @@ pub(crate) fn read_tree(file: FileId, text: &str, mut root: Node) -> (World, Vec
             drones.fleet(&mut cx, &f);
         }
     }
-    build(cx, root, drones)
+    build(cx, root, drones, files)
 }
 
 fn syntax_error(file: FileId, text: &str, e: &toml::de::Error) -> Diagnostic {
@@ -107,7 +121,12 @@ pub(crate) fn get<'n>(entries: &'n [Entry], key: &str) -> Option<&'n Entry> {
 
 /// Everything but the drones' own tables, which `drones` has read (`[drones]` is left
 /// without its entries).
-fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Diagnostic>) {
+fn build<'t>(
+    mut cx: Ctx<'t>,
+    root: Node,
+    mut drones: Drones,
+    files: &dyn crate::WorldFiles,
+) -> (World, Vec<Diagnostic>) {
     let cx = &mut cx;
     let mut world = World::default();
     let Value::Table(top) = &root.value else {
@@ -140,6 +159,13 @@ fn build<'t>(mut cx: Ctx<'t>, root: Node, mut drones: Drones) -> (World, Vec<Dia
     }
     if let Some(e) = table("no_fly") {
         world.no_fly = no_fly::zones(cx, &e.node);
+    }
+    if let Some(e) = table("imports") {
+        let imported = imports::imports(cx, &e.node, &world.site, files);
+        world.places.extend(imported.places);
+        world.lines.extend(imported.lines);
+        world.areas.extend(imported.areas);
+        world.no_fly.extend(imported.no_fly);
     }
     let sensor_kinds = keys_of(table("sensors"));
     if let Some(e) = table("sensors") {
@@ -511,9 +537,18 @@ fn unique_names(cx: &mut Ctx, world: &World, group_spans: &[Span]) {
         uses.sort_by_key(|(_, span)| (span.start, span.end));
         let (first, first_span) = uses[0];
         for &(what, span) in &uses[1..] {
-            let msg = format!(
-                "the name `{name}` is used for {first} and for {what}, so mission code could not tell which is meant"
-            );
+            // Two of one kind: a file of `[imports]` names one the world file has too.
+            let msg = if what == first {
+                let plural = match what {
+                    "a place" => "places",
+                    "an area" => "areas",
+                    "a line" => "lines",
+                    _ => "groups",
+                };
+                format!("the name `{name}` is used for two {plural}, so mission code could not tell which is meant")
+            } else {
+                format!("the name `{name}` is used for {first} and for {what}, so mission code could not tell which is meant")
+            };
             let help =
                 "rename one of them: drones, groups, places, areas and lines share one set of names";
             let d = Diagnostic::new(Code::WorldFile, cx.file, span, msg).with_help(help).also(

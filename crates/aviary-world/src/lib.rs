@@ -32,7 +32,35 @@ pub const BUILTIN_SENSORS: &[&str] = &["camera", "wind"];
 /// Reads a world file. Returns the world only when there are no errors; the diagnostics
 /// are sorted by position.
 pub fn parse_world(file: FileId, text: &str) -> (Option<World>, Vec<Diagnostic>) {
-    build::parse(file, text)
+    build::parse(file, text, &NoWorldFiles)
+}
+
+/// [`parse_world`] with the files that `[imports]` names, served by `files`.
+pub fn parse_world_with(
+    file: FileId,
+    text: &str,
+    files: &dyn WorldFiles,
+) -> (Option<World>, Vec<Diagnostic>) {
+    build::parse(file, text, files)
+}
+
+/// Supplies the files a world file's `[imports]` names (GeoJSON), as
+/// `aviary_check::SourceProvider` supplies the files a mission `USE`s: the crate reads
+/// none itself. The CLI's reads the disk beside the world file.
+pub trait WorldFiles {
+    /// The bytes of the file `path`, as written in the world file (relative to its
+    /// folder), or why it cannot be read or may not be.
+    fn read(&self, path: &str) -> Result<Vec<u8>, String>;
+}
+
+/// The files of a world read alone, held in memory: none, so every import is an error.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoWorldFiles;
+
+impl WorldFiles for NoWorldFiles {
+    fn read(&self, _path: &str) -> Result<Vec<u8>, String> {
+        Err("the world file is read here without the files beside it".into())
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]

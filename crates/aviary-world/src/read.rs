@@ -163,6 +163,11 @@ impl Ctx<'_> {
     /// whose corners lie on one line holds nothing, and one whose edges cross (corners
     /// listed out of order) has no clear inside. Reported at the polygon; false then.
     pub fn outline(&mut self, what: &dyn Display, node: &Node, polygon: &[[f64; 2]]) -> bool {
+        self.outline_at(what, node.span, polygon)
+    }
+
+    /// [`Ctx::outline`], reported at `span`.
+    pub fn outline_at(&mut self, what: &dyn Display, span: Span, polygon: &[[f64; 2]]) -> bool {
         let help = "list the corners in order around the area, clockwise or counter-clockwise, e.g. `[[0, 0], [100, 0], [100, 100], [0, 100]]`";
         if let Some((i, j)) = aviary_api::geometry::self_crossing(polygon) {
             let n = polygon.len();
@@ -173,16 +178,12 @@ impl Ctx<'_> {
                 shown(polygon[j]),
                 shown(polygon[(j + 1) % n])
             );
-            self.error(node.span, msg, help);
+            self.error(span, msg, help);
             return false;
         }
         // Square metres: less than this is a line, whatever the units' rounding.
         if aviary_api::geometry::signed_area(polygon).abs() < 1e-6 {
-            self.error(
-                node.span,
-                format!("{what} encloses no area: its corners lie on one line"),
-                help,
-            );
+            self.error(span, format!("{what} encloses no area: its corners lie on one line"), help);
             return false;
         }
         true

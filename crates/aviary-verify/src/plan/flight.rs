@@ -131,7 +131,8 @@ fn record_polyline(e: &mut Estimator, d: DroneId, points: &[[f64; 2]], t: f64, t
     let mut at = t;
     for w in points.windows(2) {
         let share = if total > 0.0 { took * length(w[0], w[1]) / total } else { 0.0 };
-        e.s.tracks[d].push(Leg { t: at, took: share, from: w[0], to: w[1], at: e.leg_origin });
+        let z = e.s.drones[d].pos[2];
+        e.s.tracks[d].push(Leg { t: at, took: share, from: w[0], to: w[1], z, at: e.leg_origin });
         at += share;
     }
 }
@@ -252,7 +253,14 @@ fn leg(
     let took = e.s.drones[d].leg_at(to, speed);
     raises.extend(e.scan(d, [from[0], from[1]], [to[0], to[1]], t, took));
     if e.radio {
-        let leg = Leg { t, took, from: [from[0], from[1]], to: [to[0], to[1]], at: e.leg_origin };
+        let leg = Leg {
+            t,
+            took,
+            from: [from[0], from[1]],
+            to: [to[0], to[1]],
+            z: to[2],
+            at: e.leg_origin,
+        };
         e.s.tracks[d].push(leg);
     }
     took

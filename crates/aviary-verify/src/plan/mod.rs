@@ -71,6 +71,34 @@ pub struct Plan {
     pub assumptions: Vec<Assumption>,
 }
 
+/// Each drone's way as the plan flies it (what `aviary check --plan` times): the end of
+/// every leg, `[x, y, z]` in the local frame, in order (`aviary export-plan`'s waypoints).
+/// A takeoff, a landing or a climb where the drone stands is no leg; a detour around a
+/// no-fly zone is a leg per corner.
+pub fn waypoints(mission: &Mission, world: &World) -> Vec<Vec<[f64; 3]>> {
+    let mut known = vec![None; mission.signals.len()];
+    let new = |known: Vec<Option<f64>>, sure: Vec<Option<f64>>| {
+        let mut est = Estimator::new(mission, world, known, sure);
+        // The legs are kept as for the radio's check.
+        est.radio = true;
+        est
+    };
+    let mut est = new(known.clone(), known.clone());
+    est.run();
+    for _ in 1..PASSES {
+        if !est.read_known.get() || est.s.raised == known {
+            break;
+        }
+        known = est.s.raised.clone();
+        let guessed = est.guessed.get();
+        let sure = known.iter().map(|at| at.filter(|&at| at < guessed)).collect();
+        est = new(known.clone(), sure);
+        est.run();
+    }
+    let point = |l: &radio::Leg| [l.to[0], l.to[1], l.z];
+    est.s.tracks.iter().map(|legs| legs.iter().map(point).collect()).collect()
+}
+
 /// Under this fraction of a full battery, a drone has no reserve left (W204).
 const RESERVE: f64 = 0.20;
 

@@ -14,6 +14,8 @@ pub struct Leg {
     pub took: f64,
     pub from: [f64; 2],
     pub to: [f64; 2],
+    /// The height at its end (`aviary export-plan`'s waypoints).
+    pub z: f64,
     pub at: Option<Origin>,
 }
 
@@ -102,8 +104,8 @@ mod tests {
     #[test]
     fn a_drone_is_on_its_leg_then_where_the_leg_ended_and_home_before_any() {
         let track = [
-            Leg { t: 10.0, took: 10.0, from: [0.0, 0.0], to: [100.0, 0.0], at: None },
-            Leg { t: 30.0, took: 5.0, from: [100.0, 0.0], to: [100.0, 50.0], at: None },
+            Leg { t: 10.0, took: 10.0, from: [0.0, 0.0], to: [100.0, 0.0], z: 0.0, at: None },
+            Leg { t: 30.0, took: 5.0, from: [100.0, 0.0], to: [100.0, 50.0], z: 0.0, at: None },
         ];
         let home = [-5.0, -5.0];
         assert_eq!(position_at(&track, home, 0.0), home);

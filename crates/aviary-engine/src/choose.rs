@@ -118,7 +118,12 @@ impl<'m> Engine<'m> {
                 (inner, Release { engine: self, drone: d })
             })
             .collect();
-        join_in_order(runs.iter().map(|(c, _)| self.block(&a.body, c))).await;
+        // Each drone is let go as its own body ends, not when the last of them does.
+        join_in_order(runs.into_iter().map(|(c, release)| async move {
+            self.block(&a.body, &c).await;
+            drop(release);
+        }))
+        .await;
     }
 
     /// The drones `a` takes now, nearest first, or why it cannot take them.

@@ -879,3 +879,15 @@ fn a_stopped_block_ends_at_once_and_frees_its_drones() {
     assert_eq!(starts[1]["args"]["target"], serde_json::json!([0.0, 100.0]), "North");
     assert_eq!(r.ends("Land", "a")[0]["status"], "ok");
 }
+
+#[test]
+fn any_two_lets_each_go_as_its_own_body_ends() {
+    let r = run_rule("any_two_lets_each_go_as_its_own_body_ends");
+    assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
+    let far = spans_of(&r, "Hover", "far");
+    assert_eq!(far.len(), 2, "{far:?}");
+    assert!(close(far[0].1, 1.0), "{far:?}");
+    // Taken again at once, while middle's body still runs (to 5 s).
+    assert!(close(far[1].0, 1.0), "far is let go when its own body ends: {far:?}");
+    assert!(close(spans_of(&r, "Hover", "middle")[0].1, 5.0));
+}

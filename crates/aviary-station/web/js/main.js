@@ -146,7 +146,9 @@ async function watch() {
 /// says runs out) are alarms, looked for until the plan is made.
 async function vehiclePlan(run) {
   let plan = run && run.vehicle_plan;
-  while (plan === "due") {
+  // Until the plan is made, or the flight has ended without it (the vehicles never
+  // answered).
+  while (plan === "due" && !["ok", "failed", "aborted"].includes(page.model.status)) {
     await new Promise((r) => setTimeout(r, 500));
     const about = (await api.call("GET", "/api/station")).body;
     if (!about || !about.run || about.run.mission !== run.mission) return;

@@ -13,11 +13,8 @@ use aviary_api::{BuiltinException, DroneId, FlightState, Value};
 use aviary_ir::Any;
 
 use crate::engine::{Ctx, Engine};
-use crate::exec::set;
+use crate::exec::{set, RECHECK};
 use crate::join::join_in_order;
-
-/// Conditions are looked at again at least this often, as `WAITFOR`'s are.
-const RECHECK: Duration = Duration::from_millis(100);
 
 /// Which drones an `ANY` holds, by drone.
 #[derive(Default)]

@@ -23,7 +23,7 @@ use crate::join::{join_eager, join_in_order, join_woken, SMALL};
 use aviary_api::trace::{Event, EventKind, Status};
 
 /// Conditions are looked at again at least this often (docs/LANGUAGE.md, section 7).
-const RECHECK: Duration = Duration::from_millis(100);
+pub(crate) const RECHECK: Duration = Duration::from_millis(100);
 
 impl<'m> Engine<'m> {
     /// Runs `items` in `scope`, with the handlers that scope starts, until all are done.

@@ -891,3 +891,13 @@ fn any_two_lets_each_go_as_its_own_body_ends() {
     assert!(close(far[1].0, 1.0), "far is let go when its own body ends: {far:?}");
     assert!(close(spans_of(&r, "Hover", "middle")[0].1, 5.0));
 }
+
+#[test]
+fn any_with_no_drone_left_raises_at_once() {
+    let r = run_rule("any_with_no_drone_left_raises_at_once");
+    assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
+    let e = r.first("exception", "name", "NoDroneAvailable");
+    assert!(close(e["t"].as_f64().unwrap(), 3.0), "at once, not after a wait: {e}");
+    assert!(e["args"][0].as_str().unwrap().contains("only 0 of them"), "{e}");
+    assert!(r.find("capability_start", "capability", "Land").is_empty());
+}

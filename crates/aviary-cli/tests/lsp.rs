@@ -5,7 +5,7 @@
 mod common;
 
 use std::io::{BufRead, BufReader, Write};
-use std::process::{Command, Stdio};
+use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
 
 use serde_json::{json, Value};
 
@@ -13,6 +13,28 @@ fn send(stdin: &mut impl Write, message: &Value) {
     let body = message.to_string();
     write!(stdin, "Content-Length: {}\r\n\r\n{body}", body.len()).unwrap();
     stdin.flush().unwrap();
+}
+
+/// `aviary lsp` started as an editor starts it, through `initialize` and `initialized`:
+/// the process, its input, its output and the answer to `initialize`.
+fn start() -> (Child, ChildStdin, BufReader<ChildStdout>, Value) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .arg("lsp")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .expect("start aviary lsp");
+    let mut stdin = child.stdin.take().unwrap();
+    let mut stdout = BufReader::new(child.stdout.take().unwrap());
+    send(
+        &mut stdin,
+        &json!({ "jsonrpc": "2.0", "id": 1, "method": "initialize", "params": { "processId": null, "rootUri": null, "capabilities": {} } }),
+    );
+    let init = receive(&mut stdout);
+    assert_eq!(init["id"], 1);
+    send(&mut stdin, &json!({ "jsonrpc": "2.0", "method": "initialized", "params": {} }));
+    (child, stdin, stdout, init)
 }
 
 fn receive(stdout: &mut impl BufRead) -> Value {
@@ -53,24 +75,8 @@ fn initialize_open_diagnostics_shutdown_over_stdio() {
     let uri = format!("file://{}/site.mission", dir.display());
     let lib_uri = format!("file://{}/lib/moves.mission", dir.display());
 
-    let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
-        .arg("lsp")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::inherit())
-        .spawn()
-        .expect("start aviary lsp");
-    let mut stdin = child.stdin.take().unwrap();
-    let mut stdout = BufReader::new(child.stdout.take().unwrap());
-
-    send(
-        &mut stdin,
-        &json!({ "jsonrpc": "2.0", "id": 1, "method": "initialize", "params": { "processId": null, "rootUri": null, "capabilities": {} } }),
-    );
-    let init = receive(&mut stdout);
-    assert_eq!(init["id"], 1);
+    let (mut child, mut stdin, mut stdout, init) = start();
     assert_eq!(init["result"]["capabilities"]["textDocumentSync"], 2, "{init}");
-    send(&mut stdin, &json!({ "jsonrpc": "2.0", "method": "initialized", "params": {} }));
     send(
         &mut stdin,
         &json!({ "jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {
@@ -132,21 +138,7 @@ fn the_places_a_world_imports_are_known_and_not_renamed_over_the_files_name() {
     let dir = std::fs::canonicalize(&dir).unwrap();
     let uri = format!("file://{}/farm.mission", dir.display());
 
-    let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
-        .arg("lsp")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::inherit())
-        .spawn()
-        .expect("start aviary lsp");
-    let mut stdin = child.stdin.take().unwrap();
-    let mut stdout = BufReader::new(child.stdout.take().unwrap());
-    send(
-        &mut stdin,
-        &json!({ "jsonrpc": "2.0", "id": 1, "method": "initialize", "params": { "processId": null, "rootUri": null, "capabilities": {} } }),
-    );
-    assert_eq!(receive(&mut stdout)["id"], 1);
-    send(&mut stdin, &json!({ "jsonrpc": "2.0", "method": "initialized", "params": {} }));
+    let (mut child, mut stdin, mut stdout, _) = start();
     send(
         &mut stdin,
         &json!({ "jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {

@@ -99,21 +99,38 @@ impl Parser<'_> {
         left
     }
 
-    /// `(a, b)` after `OFFSET` or `MIDPOINT` and its `(`: exactly `n` values and `)`.
-    fn call_values(&mut self, n: usize, form: &str) -> Result<Vec<Expr>, Expr> {
-        let mut values = Vec::with_capacity(n);
-        for i in 0..n {
-            if i > 0 && self.eat(TokenKind::Comma).is_none() {
-                let help = format!("write `{form}`");
-                return Err(self.error_expr(&format!("`,` and {}", ordinal_value(i)), Some(&help)));
-            }
-            values.push(self.value());
-        }
-        if self.eat(TokenKind::RParen).is_none() {
-            let help = format!("write `{form}`");
-            return Err(self.error_expr(&format!("`)` to close {form}"), Some(&help)));
-        }
-        Ok(values)
+    /// A call of a form of `N` values (`OFFSET(p, d, b)`, `MIDPOINT(a, b)`), its name and
+    /// `(` next: the values, `,` between them and `)`, made into the expression `make`
+    /// says; what is missing is reported with the form to write.
+    fn fixed_call<const N: usize>(
+        &mut self,
+        start: Span,
+        form: &str,
+        make: impl FnOnce([Box<Expr>; N]) -> ExprKind,
+    ) -> Expr {
+        self.bump();
+        self.bump();
+        self.deeper(
+            |p| {
+                let mut values = Vec::with_capacity(N);
+                for i in 0..N {
+                    if i > 0 && p.eat(TokenKind::Comma).is_none() {
+                        let help = format!("write `{form}`");
+                        return p.error_expr(&format!("`,` and {}", ordinal_value(i)), Some(&help));
+                    }
+                    values.push(Box::new(p.value()));
+                }
+                if p.eat(TokenKind::RParen).is_none() {
+                    let help = format!("write `{form}`");
+                    return p.error_expr(&format!("`)` to close {form}"), Some(&help));
+                }
+                match <[Box<Expr>; N]>::try_from(values) {
+                    Ok(values) => p.expr(make(values), start),
+                    Err(_) => Expr { kind: ExprKind::Error, span: start },
+                }
+            },
+            |span| Expr { kind: ExprKind::Error, span },
+        )
     }
 
     /// A term of a value: a literal, coordinates, a name, `a.b`, `distance(a, b)`,
@@ -218,38 +235,14 @@ impl Parser<'_> {
                 );
             }
             "OFFSET" if call => {
-                self.bump();
-                self.bump();
-                return self.deeper(
-                    |p| match p.call_values(3, "OFFSET(position, distance, bearing)") {
-                        Ok(v) => {
-                            let mut v = v.into_iter();
-                            let (Some(a), Some(d), Some(b)) = (v.next(), v.next(), v.next()) else {
-                                return Expr { kind: ExprKind::Error, span: start };
-                            };
-                            p.expr(ExprKind::Offset(Box::new(a), Box::new(d), Box::new(b)), start)
-                        }
-                        Err(e) => e,
-                    },
-                    |span| Expr { kind: ExprKind::Error, span },
+                return self.fixed_call(
+                    start,
+                    "OFFSET(position, distance, bearing)",
+                    |[a, d, b]| ExprKind::Offset(a, d, b),
                 );
             }
             "MIDPOINT" if call => {
-                self.bump();
-                self.bump();
-                return self.deeper(
-                    |p| match p.call_values(2, "MIDPOINT(a, b)") {
-                        Ok(v) => {
-                            let mut v = v.into_iter();
-                            let (Some(a), Some(b)) = (v.next(), v.next()) else {
-                                return Expr { kind: ExprKind::Error, span: start };
-                            };
-                            p.expr(ExprKind::Midpoint(Box::new(a), Box::new(b)), start)
-                        }
-                        Err(e) => e,
-                    },
-                    |span| Expr { kind: ExprKind::Error, span },
-                );
+                return self.fixed_call(start, "MIDPOINT(a, b)", |[a, b]| ExprKind::Midpoint(a, b));
             }
             "GEO" if call => {
                 self.bump();

@@ -786,6 +786,25 @@ fn ten_thousand_nots() {
 }
 
 #[test]
+fn ten_thousand_ands_and_ten_thousand_pluses() {
+    let messages = |text: &str| -> Vec<(Code, String)> {
+        parse(FileId(0), text).diagnostics.iter().map(|d| (d.code, d.message.clone())).collect()
+    };
+    let ands = format!("MISSION M:\n    WAITFOR x{}\n", " AND x".repeat(10_000));
+    let found = messages(&ands);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!(found[0].0, Code::NestingTooDeep);
+    assert!(found[0].1.contains("joins more than"), "{found:?}");
+    // A sum in a header: reported once, and the header's `:` is still its own.
+    let sum =
+        format!("MISSION M:\n    IF d.altitude < 1m{}:\n        d Land\n", " + 1m".repeat(10_000));
+    let found = messages(&sum);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!(found[0].0, Code::NestingTooDeep);
+    assert!(found[0].1.starts_with("a sum of more than"), "{found:?}");
+}
+
+#[test]
 fn five_thousand_nested_blocks() {
     let mut text = String::from("MISSION M:\n");
     for depth in 1..=5_000 {

@@ -74,22 +74,15 @@ impl Parser<'_> {
                 TokenKind::Minus => ArithOp::Sub,
                 _ => break,
             };
-            if self.depth >= MAX_DEPTH {
-                let span = self.span();
-                let d = self
-                    .error(
-                        Code::NestingTooDeep,
-                        span,
-                        format!("a sum of more than {MAX_DEPTH} parts"),
-                    )
-                    .with_help("give parts of the sum names of their own with LET");
-                self.report(d);
-                while !self.at_line_end() && !self.at_header_colon() {
-                    self.bump();
-                }
+            let too_long = format!("a sum of more than {MAX_DEPTH} parts");
+            // A value may end a header: its `:` is kept for the header.
+            if !self.link_deeper(
+                &too_long,
+                "give parts of the sum names of their own with LET",
+                true,
+            ) {
                 break;
             }
-            self.depth += 1;
             self.bump();
             let right = self.term();
             let span = left.span.to(right.span);
@@ -399,19 +392,21 @@ impl Parser<'_> {
     /// parenthesis (the caller restores the depth). Past the bound the rest of the line
     /// is reported and skipped.
     fn chain_deeper(&mut self) -> bool {
+        let too_long = format!("a condition that joins more than {MAX_DEPTH} parts with AND or OR");
+        let help = "split the condition: give parts of it their own WAITFOR, STARTIF or IF";
+        self.link_deeper(&too_long, help, false)
+    }
+
+    /// One more link of a chain of operators (AND, OR, `+`, `-`), which nests the tree one
+    /// level deeper: false, reported as `too_long` with `help` and the rest of the line
+    /// skipped (up to a header's `:` when `keep_colon`), past `MAX_DEPTH`.
+    fn link_deeper(&mut self, too_long: &str, help: &str, keep_colon: bool) -> bool {
         if self.depth >= MAX_DEPTH {
             let span = self.span();
-            let d = self
-                .error(
-                    Code::NestingTooDeep,
-                    span,
-                    format!("a condition that joins more than {MAX_DEPTH} parts with AND or OR"),
-                )
-                .with_help(
-                    "split the condition: give parts of it their own WAITFOR, STARTIF or IF",
-                );
+            let d = self.error(Code::NestingTooDeep, span, too_long).with_help(help);
             self.report(d);
-            while !self.at_line_end() {
+            let at_end = |p: &Self| p.at_line_end() || (keep_colon && p.at_header_colon());
+            while !at_end(self) {
                 self.bump();
             }
             return false;

@@ -76,25 +76,8 @@ pub struct Plan {
 /// A takeoff, a landing or a climb where the drone stands is no leg; a detour around a
 /// no-fly zone is a leg per corner.
 pub fn waypoints(mission: &Mission, world: &World) -> Vec<Vec<[f64; 3]>> {
-    let mut known = vec![None; mission.signals.len()];
-    let new = |known: Vec<Option<f64>>, sure: Vec<Option<f64>>| {
-        let mut est = Estimator::new(mission, world, known, sure);
-        // The legs are kept as for the radio's check.
-        est.radio = true;
-        est
-    };
-    let mut est = new(known.clone(), known.clone());
-    est.run();
-    for _ in 1..PASSES {
-        if !est.read_known.get() || est.s.raised == known {
-            break;
-        }
-        known = est.s.raised.clone();
-        let guessed = est.guessed.get();
-        let sure = known.iter().map(|at| at.filter(|&at| at < guessed)).collect();
-        est = new(known.clone(), sure);
-        est.run();
-    }
+    // The legs are kept as for the radio's check.
+    let (est, _) = walked(mission, world, true);
     let point = |l: &radio::Leg| [l.to[0], l.to[1], l.z];
     est.s.tracks.iter().map(|legs| legs.iter().map(point).collect()).collect()
 }
@@ -106,10 +89,17 @@ const RESERVE: f64 = 0.20;
 /// times raised later in the walk.
 const PASSES: usize = 4;
 
-/// Estimates `mission` on `world`; appends a W204 per drone whose reserve falls under 20%.
-pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnostic>) -> Plan {
+/// The estimator after its walks, each learning from the one before when signals are
+/// raised (at most [`PASSES`]), and the end the last one found. `keep_legs`: every leg is
+/// kept, as for the radio's check, even without a radio.
+fn walked<'m>(mission: &'m Mission, world: &'m World, keep_legs: bool) -> (Estimator<'m>, f64) {
+    let new = |known: Vec<Option<f64>>, sure: Vec<Option<f64>>| {
+        let mut est = Estimator::new(mission, world, known, sure);
+        est.radio |= keep_legs;
+        est
+    };
     let mut known = vec![None; mission.signals.len()];
-    let mut est = Estimator::new(mission, world, known.clone(), known.clone());
+    let mut est = new(known.clone(), known.clone());
     let mut end = est.run();
     for _ in 1..PASSES {
         if !est.read_known.get() || est.s.raised == known {
@@ -118,9 +108,15 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
         known = est.s.raised.clone();
         let guessed = est.guessed.get();
         let sure = known.iter().map(|at| at.filter(|&at| at < guessed)).collect();
-        est = Estimator::new(mission, world, known.clone(), sure);
+        est = new(known.clone(), sure);
         end = est.run();
     }
+    (est, end)
+}
+
+/// Estimates `mission` on `world`; appends a W204 per drone whose reserve falls under 20%.
+pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnostic>) -> Plan {
+    let (mut est, end) = walked(mission, world, false);
     // The activities are moved into the plan, not copied (a long mission has millions);
     // the worst-case walks below go on with empty lists, which the plan does not read.
     let empty = vec![Vec::new(); est.s.activities.len()];

@@ -40,20 +40,20 @@ pub fn use_roots(dirs: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
         .collect()
 }
 
+/// Where `full` (shown as `name`) leads, links followed; or why it cannot be read.
+fn canonical(full: &Path, name: &str) -> Result<std::path::PathBuf, LoadError> {
+    std::fs::canonicalize(full).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => format!("there is no file {name}").into(),
+        kind => format!("{} ({name})", kind.to_string().to_lowercase()).into(),
+    })
+}
+
 impl SourceProvider for DiskProvider {
     fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), LoadError> {
         let base = Path::new(from).parent().unwrap_or(Path::new(""));
         let full = aviary_check::normalize_path(&base.join(path));
         let name = full.to_string_lossy().into_owned();
-        let resolved = match std::fs::canonicalize(&full) {
-            Ok(p) => p,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                return Err(format!("there is no file {name}").into())
-            }
-            Err(e) => {
-                return Err(format!("{} ({name})", e.kind().to_string().to_lowercase()).into())
-            }
-        };
+        let resolved = canonical(&full, &name)?;
         if !within_roots(&resolved, &self.roots) {
             let shown: Vec<String> = self.roots.iter().map(|r| r.display().to_string()).collect();
             let leads = if resolved != std::path::absolute(&full).unwrap_or_default() {
@@ -87,15 +87,7 @@ impl SourceProvider for DiskProvider {
         let name = full.to_string_lossy().into_owned();
         let folder = std::fs::canonicalize(base)
             .map_err(|e| format!("cannot find the world file's folder {}: {e}", base.display()))?;
-        let resolved = match std::fs::canonicalize(&full) {
-            Ok(p) => p,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                return Err(format!("there is no file {name}").into())
-            }
-            Err(e) => {
-                return Err(format!("{} ({name})", e.kind().to_string().to_lowercase()).into())
-            }
-        };
+        let resolved = canonical(&full, &name)?;
         if !within_roots(&resolved, std::slice::from_ref(&folder)) {
             return Err(LoadError::Refused {
                 why: format!("{name} is outside the world file's folder {}", folder.display()),

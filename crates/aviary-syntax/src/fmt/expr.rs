@@ -34,33 +34,13 @@ pub(super) fn write_expr(out: &mut String, e: &Expr, source: &str) {
             out.push('.');
             out.push_str(&b.name);
         }
-        ExprKind::Distance(a, b) => {
-            out.push_str("distance(");
-            write_expr(out, a, source);
-            out.push_str(", ");
-            write_expr(out, b, source);
-            out.push(')');
-        }
+        ExprKind::Distance(a, b) => write_call(out, "distance", &[a, b], source),
         ExprKind::Arith(..) => write_chain(out, e, source, |x| match &x.kind {
             ExprKind::Arith(left, op, right) => Some((&**left, op.as_str(), &**right)),
             _ => None,
         }),
-        ExprKind::Offset(p, d, b) => {
-            out.push_str("OFFSET(");
-            write_expr(out, p, source);
-            out.push_str(", ");
-            write_expr(out, d, source);
-            out.push_str(", ");
-            write_expr(out, b, source);
-            out.push(')');
-        }
-        ExprKind::Midpoint(a, b) => {
-            out.push_str("MIDPOINT(");
-            write_expr(out, a, source);
-            out.push_str(", ");
-            write_expr(out, b, source);
-            out.push(')');
-        }
+        ExprKind::Offset(p, d, b) => write_call(out, "OFFSET", &[p, d, b], source),
+        ExprKind::Midpoint(a, b) => write_call(out, "MIDPOINT", &[a, b], source),
         ExprKind::Received(signal) => {
             out.push_str("RECEIVED(");
             out.push_str(&signal.name);
@@ -152,4 +132,17 @@ fn write_chain<'e>(
         out.push(' ');
         write_expr(out, right, source);
     }
+}
+
+/// `name(a, b, ...)`: a form written as a call (`distance`, `OFFSET`, `MIDPOINT`).
+fn write_call(out: &mut String, name: &str, args: &[&Expr], source: &str) {
+    out.push_str(name);
+    out.push('(');
+    for (i, a) in args.iter().enumerate() {
+        if i > 0 {
+            out.push_str(", ");
+        }
+        write_expr(out, a, source);
+    }
+    out.push(')');
 }

@@ -763,14 +763,14 @@ impl<'m> Engine<'m> {
     }
 
     /// `SIGNAL`: recorded, then heard by every matching handler of every scope up the chain.
-    /// `line`: the `SIGNAL` statement's, in the MISSION's file; none for a drone's signal.
+    /// `at`: the `SIGNAL` statement, whose line the trace names; none for a drone's signal.
     pub fn raise(
         &self,
         signal: usize,
         args: Vec<Value>,
         actor: Option<DroneId>,
         from: &Rc<Scope<'m>>,
-        line: Option<u32>,
+        at: Option<&aviary_ir::Origin>,
     ) {
         self.heed_interrupt();
         if self.stopped() {
@@ -781,7 +781,7 @@ impl<'m> Engine<'m> {
             actor: actor.map(|a| self.name(a).into()),
             args: self.values(&args),
             by: None,
-            line,
+            line: at.and_then(|o| self.m.line_of(o)),
         });
         if let Some(r) = self.received.borrow_mut().get_mut(signal) {
             *r = true;

@@ -313,7 +313,7 @@ impl<'m> Engine<'m> {
                 Node::Leash(l) => self.leash(l, ctx),
                 // Taken by the sequence or the PARALLEL block that holds it.
                 Node::Let { .. } => {}
-                Node::StopBlock { block, origin } => self.stop_block(block, self.m.line_of(origin)),
+                Node::StopBlock { block, origin } => self.stop_block(block, origin),
                 Node::Signal { signal, args, origin } => self.signal(*signal, args, origin, ctx),
                 Node::Throw { exception, args, origin } => {
                     let args = self.eval_all(args, ctx);
@@ -361,7 +361,7 @@ impl<'m> Engine<'m> {
     /// `SIGNAL`: raised by the actor of this place, from its scope.
     fn signal(&self, signal: usize, args: &[Expr], origin: &aviary_ir::Origin, ctx: &Ctx<'m>) {
         let args = self.eval_all(args, ctx);
-        self.raise(signal, args, ctx.actor, &ctx.scope, self.m.line_of(origin));
+        self.raise(signal, args, ctx.actor, &ctx.scope, Some(origin));
     }
 
     pub(crate) fn eval_all(&self, exprs: &[Expr], ctx: &Ctx<'m>) -> Vec<Value> {
@@ -554,8 +554,7 @@ impl<'m> Engine<'m> {
             let env = self.env(&ctx.frame, &received);
             l.args.iter().map(|(p, e)| (*p, env.eval(e))).collect()
         };
-        let line = self.m.line_of(&l.origin);
-        self.leash_by_id(l.capability, l.tag, l.action, &l.action_name, values, line);
+        self.leash_by_id(l.capability, l.tag, l.action, &l.action_name, values, Some(&l.origin));
     }
 
     /// A leash on every running activity of `capability` tagged `tag`; recorded even when
@@ -567,7 +566,7 @@ impl<'m> Engine<'m> {
         action: LeashAction,
         action_name: &str,
         values: Vec<(usize, Value)>,
-        line: Option<u32>,
+        at: Option<&aviary_ir::Origin>,
     ) {
         let cap = &self.m.capabilities[capability];
         self.trace(EventKind::Leash, || Event::Leash {
@@ -575,7 +574,7 @@ impl<'m> Engine<'m> {
             tag: self.m.tags[tag].as_str().into(),
             action: action_name.into(),
             block: false,
-            line,
+            line: at.and_then(|o| self.m.line_of(o)),
         });
         let targets: Vec<(Rc<Instance>, Rc<Scope<'m>>)> =
             self.instances.borrow().tagged(capability, tag).cloned().collect();
@@ -621,13 +620,13 @@ impl<'m> Engine<'m> {
     /// activities are aborted (as a leash's ABORT aborts one), nothing more in it starts,
     /// and its `block_end` says `aborted`. Recorded as a `leash` event (`block: true`)
     /// even when no instance runs (docs/LANGUAGE.md, section 14).
-    fn stop_block(&self, path: &str, line: Option<u32>) {
+    fn stop_block(&self, path: &str, at: &aviary_ir::Origin) {
         self.trace(EventKind::Leash, || Event::Leash {
             capability: path.into(),
             tag: "".into(),
             action: "ABORT".into(),
             block: true,
-            line,
+            line: self.m.line_of(at),
         });
         let running: Vec<Rc<Scope<'m>>> =
             self.stoppable_running.borrow().iter().filter(|s| s.path == path).cloned().collect();

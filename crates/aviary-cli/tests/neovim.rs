@@ -1,5 +1,6 @@
 //! Neovim's own LSP client (`nvim --headless`, tests/neovim/lsp.lua) against the real
-//! `aviary lsp`: diagnostics, hover, definition into the world file, completion, rename
+//! `aviary lsp`: diagnostics, hover, definition into the world file and into the standard
+//! library, completion, rename
 //! and formatting, as a newcomer editing the paper's mission would use them. Runs where
 //! `nvim` is installed (.ci/run installs Debian's); elsewhere it says so in one line.
 
@@ -35,6 +36,8 @@ fn neovim_uses_the_language_server() {
         .current_dir(&dir)
         .env("AVIARY_BIN", env!("CARGO_BIN_EXE_aviary"))
         .env("AVIARY_NVIM_OUT", &out)
+        // Where the server writes the standard library for go to definition.
+        .env("XDG_CACHE_HOME", dir.join("cache"))
         .spawn()
         .expect("start nvim");
     let code = common::wait_at_most(&mut child, Duration::from_secs(120), "nvim --headless");
@@ -54,6 +57,15 @@ fn neovim_uses_the_language_server() {
     assert!(hover.contains("`laps`: a plain number, default `1`"), "{hover}");
     assert!(seen["definition"]["uri"].as_str().unwrap().ends_with("/paper.world.toml"), "{seen:#}");
     assert_eq!(seen["definition"]["line"], 10, "BuildingA is on the world file's line 11");
+    // FlyCircle's definition: the standard library's file, at its CAPABILITY line.
+    let std = seen["std"]["name"].as_str().unwrap();
+    assert!(
+        std.starts_with(dir.join("cache/aviary").to_str().unwrap())
+            && std.ends_with("/standard.mission"),
+        "{seen:#}"
+    );
+    assert_eq!(std::fs::read_to_string(std).unwrap(), aviary_check::STD_SOURCE);
+    assert!(seen["std"]["line"].as_str().unwrap().starts_with("CAPABILITY FlyCircle BY drone"));
     let completion: Vec<&str> =
         seen["completion"].as_array().unwrap().iter().map(|c| c.as_str().unwrap()).collect();
     for wanted in ["center=", "radius=", "laps=", "BuildingA", "Area1"] {

@@ -82,6 +82,15 @@ pub fn index(
         for d in &w.drones {
             walk.push_at(file, d.span, Sym::Drone(d.name.clone()), true);
         }
+        // A group is defined by each `group = "NAME"` that names it: the name inside the
+        // quotes.
+        for g in &w.groups {
+            for s in &g.spans {
+                let inner =
+                    Span { start: s.start + 1, end: s.end.saturating_sub(1).max(s.start + 1) };
+                walk.push_at(file, inner, Sym::Group(g.name.clone()), true);
+            }
+        }
     }
     for (file, tree) in files {
         walk.file = *file;

@@ -2,20 +2,20 @@
 //! protocol's types; everything it says comes from the pure front end (aviary-syntax,
 //! aviary-check, aviary-world, aviary-verify), as `aviary check` and `aviary fmt` say it.
 //!
-//! One thread reads messages in order and answers each; a change re-checks the open
-//! missions (and a world file open alone) and publishes the diagnostics of every file
-//! they read (edits that came meanwhile are applied first and checked with it). A panic in a handler is caught, logged to stderr and answered with an
-//! error; the server lives on.
+//! A change re-checks the open missions (and a world file open alone) and publishes the
+//! diagnostics of every file they read; requests are answered each on a thread of its
+//! own, over the last check (`serve` says how the two are ordered). A panic in a handler
+//! is caught, logged to stderr and answered with an error; the server lives on.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use aviary_check::SourceProvider;
 use lsp_server::{Connection, ErrorCode, Message, Notification, Request, Response};
-use lsp_types::notification::Notification as _;
 use lsp_types::request::Request as _;
-use lsp_types::{notification as note, request as req, Uri};
+use lsp_types::{request as req, Uri};
 use serde::de::DeserializeOwned;
 
 pub mod analysis;
@@ -29,6 +29,7 @@ pub mod index;
 mod more;
 mod nav;
 pub mod overlay;
+mod serve;
 pub mod text;
 pub mod uri;
 
@@ -44,12 +45,19 @@ pub struct Config {
     pub disk: Box<DiskFactory>,
     /// The `--use-root` folders, resolved.
     pub use_roots: Vec<PathBuf>,
+    /// A file holding the standard library's text (`aviary_check::STD_SOURCE`), which
+    /// is compiled in: go to definition goes there. `None`: it has no file to go to.
+    pub std_file: Option<PathBuf>,
 }
 
 impl Config {
     /// Reads no file from disk: only open documents are `USE`d.
     pub fn open_documents_only() -> Config {
-        Config { disk: Box::new(|_| Ok(Box::new(aviary_check::NoFiles))), use_roots: Vec::new() }
+        Config {
+            disk: Box::new(|_| Ok(Box::new(aviary_check::NoFiles))),
+            use_roots: Vec::new(),
+            std_file: None,
+        }
     }
 }
 
@@ -60,73 +68,10 @@ pub fn serve_stdio(config: Config) -> Result<(), String> {
     io.join().map_err(|e| e.to_string())
 }
 
-/// Serves over `connection` (stdio, or `Connection::memory()` in tests).
+/// Serves over `connection` (stdio, or `Connection::memory()` in tests and the station)
+/// until the client says `exit`.
 pub fn run(connection: Connection, config: Config) -> Result<(), String> {
-    let capabilities = serde_json::to_value(capabilities()).map_err(|e| e.to_string())?;
-    connection.initialize(capabilities).map_err(|e| e.to_string())?;
-    let mut server =
-        Server { config, docs: Docs::new(), analyses: BTreeMap::new(), published: BTreeSet::new() };
-    // A message taken while gathering edits, to handle next.
-    let mut pending = None;
-    loop {
-        let message = match pending.take() {
-            Some(m) => m,
-            None => match connection.receiver.recv() {
-                Ok(m) => m,
-                Err(_) => break,
-            },
-        };
-        match message {
-            Message::Request(request) => {
-                if connection.handle_shutdown(&request).map_err(|e| e.to_string())? {
-                    return Ok(());
-                }
-                let response = server.request(request);
-                send(&connection, Message::Response(response))?;
-            }
-            Message::Notification(n) => {
-                let mut changed = server.caught_notification(n);
-                // The edits that came meanwhile (typing faster than a check): applied
-                // together and checked once, so no request waits on stale checks.
-                while let Ok(m) = connection.receiver.try_recv() {
-                    match m {
-                        Message::Notification(n) if is_sync(&n.method) => {
-                            changed |= server.caught_notification(n);
-                        }
-                        other => {
-                            pending = Some(other);
-                            break;
-                        }
-                    }
-                }
-                if changed {
-                    match catch_unwind(AssertUnwindSafe(|| server.reanalyse())) {
-                        Ok(publish) => {
-                            for p in publish {
-                                send(&connection, Message::Notification(p))?;
-                            }
-                        }
-                        Err(panic) => {
-                            eprintln!("aviary lsp: a check panicked: {}", panic_text(&panic))
-                        }
-                    }
-                }
-            }
-            Message::Response(_) => {}
-        }
-    }
-    Ok(())
-}
-
-/// A notification of the documents' texts.
-fn is_sync(method: &str) -> bool {
-    [
-        note::DidOpenTextDocument::METHOD,
-        note::DidChangeTextDocument::METHOD,
-        note::DidCloseTextDocument::METHOD,
-        note::DidSaveTextDocument::METHOD,
-    ]
-    .contains(&method)
+    serve::run(connection, config)
 }
 
 fn send(connection: &Connection, message: Message) -> Result<(), String> {
@@ -198,17 +143,21 @@ fn answer<R: serde::Serialize>(r: R) -> Result<serde_json::Value, Failure> {
     serde_json::to_value(r).map_err(|e| (ErrorCode::InternalError, e.to_string()))
 }
 
+/// What the server knows after a check: the documents as checked, and each open mission's
+/// analysis. Requests read it, each on a thread of its own (`serve`).
 pub(crate) struct Server {
-    config: Config,
+    config: Arc<Config>,
     docs: Docs,
     /// By the key of the analysed document.
     analyses: BTreeMap<String, Analysis>,
-    /// The URIs last published with diagnostics, to clear those that have none now.
-    published: BTreeSet<String>,
 }
 
 impl Server {
-    fn request(&mut self, request: Request) -> Response {
+    fn new(config: Arc<Config>, docs: Docs) -> Server {
+        Server { config, docs, analyses: BTreeMap::new() }
+    }
+
+    fn request(&self, request: Request) -> Response {
         let id = request.id.clone();
         match catch_unwind(AssertUnwindSafe(|| self.dispatch(&request))) {
             Ok(Ok(value)) => Response::new_ok(id, value),
@@ -225,7 +174,7 @@ impl Server {
         }
     }
 
-    fn dispatch(&mut self, r: &Request) -> Result<serde_json::Value, Failure> {
+    fn dispatch(&self, r: &Request) -> Result<serde_json::Value, Failure> {
         match r.method.as_str() {
             req::HoverRequest::METHOD => answer(hover::hover(self, params(r)?)),
             req::Completion::METHOD => answer(complete::complete(self, params(r)?)),
@@ -243,69 +192,30 @@ impl Server {
             }
             #[cfg(test)]
             "aviary/panic" => panic!("a handler's bug, on purpose"),
+            #[cfg(test)]
+            "aviary/slow" => {
+                std::thread::sleep(std::time::Duration::from_millis(1500));
+                answer("slow")
+            }
             _ => {
                 Err((ErrorCode::MethodNotFound, format!("aviary lsp does not answer {}", r.method)))
             }
         }
     }
 
-    /// [`Server::notification`], a panic caught and logged.
-    fn caught_notification(&mut self, n: Notification) -> bool {
-        let method = n.method.clone();
-        catch_unwind(AssertUnwindSafe(|| self.notification(n))).unwrap_or_else(|panic| {
-            eprintln!("aviary lsp: {method} panicked: {}", panic_text(&panic));
-            false
-        })
+    /// The key of the standard library's file, if the editor was given one.
+    fn std_key(&self) -> Option<String> {
+        self.config.std_file.as_ref().map(|p| p.to_string_lossy().into_owned())
     }
 
-    /// Handles a notification; says whether the documents changed.
-    fn notification(&mut self, n: Notification) -> bool {
-        match n.method.as_str() {
-            note::DidOpenTextDocument::METHOD => {
-                let Ok(p) =
-                    serde_json::from_value::<lsp_types::DidOpenTextDocumentParams>(n.params)
-                else {
-                    return false;
-                };
-                let d = p.text_document;
-                self.docs
-                    .insert(uri::key(&d.uri), Doc { uri: d.uri, text: d.text, version: d.version });
-            }
-            note::DidChangeTextDocument::METHOD => {
-                let Ok(p) =
-                    serde_json::from_value::<lsp_types::DidChangeTextDocumentParams>(n.params)
-                else {
-                    return false;
-                };
-                let Some(doc) = self.docs.get_mut(&uri::key(&p.text_document.uri)) else {
-                    return false;
-                };
-                for change in p.content_changes {
-                    apply(&mut doc.text, change);
-                }
-                doc.version = p.text_document.version;
-            }
-            note::DidCloseTextDocument::METHOD => {
-                let Ok(p) =
-                    serde_json::from_value::<lsp_types::DidCloseTextDocumentParams>(n.params)
-                else {
-                    return false;
-                };
-                self.docs.remove(&uri::key(&p.text_document.uri));
-            }
-            note::DidSaveTextDocument::METHOD | note::DidChangeWatchedFiles::METHOD => {}
-            _ => return false,
-        }
-        true
-    }
-
-    /// Checks every open mission again (and each open world file no open mission reads),
-    /// and publishes every file's diagnostics: each open document's always, and an empty
-    /// list for a file that had some and has none now.
-    fn reanalyse(&mut self) -> Vec<Notification> {
-        self.analyses.clear();
+    /// Checks every open mission (and each open world file no open mission reads), and
+    /// says every file's diagnostics: each open document's always, and an empty list for
+    /// a file in `published` (the files that had some) that has none now.
+    fn analyse(&mut self, published: &mut BTreeSet<String>) -> Vec<Notification> {
+        let std_key = self.std_key();
         for key in self.docs.keys() {
-            if !analysis::is_world(key) {
+            // The standard library's file is read with every mission, not as one.
+            if !analysis::is_world(key) && Some(key) != std_key.as_ref() {
                 self.analyses.insert(key.clone(), analysis::mission(key, &self.docs, &self.config));
             }
         }
@@ -330,23 +240,24 @@ impl Server {
         let mut out = Vec::new();
         let now: BTreeSet<String> =
             by_file.iter().filter(|(_, (_, d))| !d.is_empty()).map(|(k, _)| k.clone()).collect();
-        for gone in self.published.difference(&now) {
+        for gone in published.difference(&now) {
             if by_file.contains_key(gone) {
                 continue;
             }
             if let Ok(uri) = gone.parse::<Uri>() {
-                out.push(publish(uri, Vec::new(), None));
+                out.push(serve::publish(uri, Vec::new(), None));
             }
         }
         for (_, (uri, diagnostics)) in by_file {
             let version = self.docs.get(&uri::key(&uri)).map(|d| d.version);
-            out.push(publish(uri, diagnostics, version));
+            out.push(serve::publish(uri, diagnostics, version));
         }
-        self.published = now;
+        *published = now;
         out
     }
 
-    /// The open document `uri` and the analysis that read it (its own if it is a mission).
+    /// The open document `uri` and the analysis that read it (its own if it is a mission;
+    /// any mission's for the standard library's file).
     pub(crate) fn lookup(
         &self,
         uri: &Uri,
@@ -356,33 +267,27 @@ impl Server {
         if let Some(a) = self.analyses.get(&key) {
             return Some((doc, a, a.root));
         }
-        self.analyses.values().find_map(|a| a.file(&key).map(|f| (doc, a, f)))
+        let name =
+            if Some(&key) == self.std_key().as_ref() { aviary_check::STD_NAME } else { &key };
+        self.analyses.values().find_map(|a| a.file(name).map(|f| (doc, a, f)))
+    }
+
+    /// The URI of a file an analysis read: the open document's, its path's, and for the
+    /// standard library the file it was written to.
+    pub(crate) fn uri_of(&self, a: &Analysis, file: aviary_diagnostics::FileId) -> Option<Uri> {
+        if a.sources.name(file) == aviary_check::STD_NAME {
+            return uri::from_path(self.config.std_file.as_deref()?);
+        }
+        diag::uri_of(a, file, &self.docs)
     }
 
     pub(crate) fn docs(&self) -> &Docs {
         &self.docs
     }
-}
 
-fn publish(
-    uri: Uri,
-    diagnostics: Vec<lsp_types::Diagnostic>,
-    version: Option<i32>,
-) -> Notification {
-    let params = lsp_types::PublishDiagnosticsParams { uri, diagnostics, version };
-    Notification::new(note::PublishDiagnostics::METHOD.to_string(), params)
-}
-
-/// Applies one change to a document's text: a range's replacement, or the whole text.
-fn apply(text: &mut String, change: lsp_types::TextDocumentContentChangeEvent) {
-    match change.range {
-        Some(range) => {
-            let index = text::LineIndex::new(text);
-            let start = index.offset(range.start);
-            let end = index.offset(range.end).max(start);
-            text.replace_range(start..end, &change.text);
-        }
-        None => *text = change.text,
+    /// Every analysis: each open mission's, and each world file's read alone.
+    pub(crate) fn analyses(&self) -> impl Iterator<Item = &Analysis> {
+        self.analyses.values()
     }
 }
 

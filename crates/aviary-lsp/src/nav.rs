@@ -1,6 +1,7 @@
 //! Go to definition, find references and rename, over the analysis's index: mission
-//! files, the files they `USE`, and the world file's keys (places, areas, drones). The
-//! standard library is compiled in and has no file to go to or edit.
+//! files, the files they `USE` (and the other open missions that `USE` them too), and
+//! the world file's keys (places, areas, drones) and `group` strings. The standard library can be gone to (its text is written to a file
+//! of its own) but not edited.
 
 use lsp_server::ErrorCode;
 use lsp_types::{
@@ -10,7 +11,7 @@ use lsp_types::{
 };
 
 use crate::analysis::Analysis;
-use crate::diag::{uri_of, Ranges};
+use crate::diag::Ranges;
 use crate::index::{self, Occurrence, Sym};
 use crate::text::LineIndex;
 use crate::{Failure, Server};
@@ -25,36 +26,64 @@ fn under<'a>(
     Some((a, index::at(&a.occurrences, file, offset as u32)?))
 }
 
-fn locations<'a>(
+/// `a` and the other open missions' analyses that read a file in which `a` defines
+/// `sym` (a library two missions `USE`): a rename or a search covers them all. A local
+/// name is its file's alone; nothing is shared through the standard library, which is
+/// not edited.
+fn sharing<'a>(server: &'a Server, a: &'a Analysis, sym: &Sym) -> Vec<&'a Analysis> {
+    let mut out = vec![a];
+    if matches!(sym, Sym::Local { .. }) {
+        return out;
+    }
+    let homes: Vec<&str> = a
+        .occurrences
+        .iter()
+        .filter(|o| o.definition && &o.sym == sym)
+        .map(|o| a.sources.name(o.file))
+        .filter(|name| *name != aviary_check::STD_NAME)
+        .collect();
+    for b in server.analyses() {
+        if !std::ptr::eq(a, b) && homes.iter().any(|name| b.file(name).is_some()) {
+            out.push(b);
+        }
+    }
+    out
+}
+
+/// The locations of the occurrences of `sym` that `keep` keeps, in every analysis of
+/// `sharing`, each once.
+fn locations(
     server: &Server,
-    a: &Analysis,
-    of: impl Iterator<Item = &'a Occurrence>,
+    analyses: &[&Analysis],
+    sym: &Sym,
+    keep: impl Fn(&Occurrence) -> bool,
 ) -> Vec<Location> {
-    let mut ranges = Ranges::new(a);
-    of.filter_map(|o| {
-        Some(Location {
-            uri: uri_of(a, o.file, server.docs())?,
-            range: ranges.range(o.file, o.span),
-        })
-    })
-    .collect()
+    let mut out: Vec<Location> = Vec::new();
+    for a in analyses {
+        let mut ranges = Ranges::new(a);
+        for o in a.occurrences.iter().filter(|o| &o.sym == sym && keep(o)) {
+            let Some(uri) = server.uri_of(a, o.file) else { continue };
+            let at = Location { uri, range: ranges.range(o.file, o.span) };
+            if !out.contains(&at) {
+                out.push(at);
+            }
+        }
+    }
+    out
 }
 
 pub fn definition(server: &Server, p: GotoDefinitionParams) -> Option<GotoDefinitionResponse> {
     let (a, o) = under(server, &p.text_document_position_params)?;
-    let defs =
-        locations(server, a, a.occurrences.iter().filter(|x| x.definition && x.sym == o.sym));
+    let defs = locations(server, &[a], &o.sym, |x| x.definition);
     (!defs.is_empty()).then_some(GotoDefinitionResponse::Array(defs))
 }
 
 pub fn references(server: &Server, p: ReferenceParams) -> Option<Vec<Location>> {
     let (a, o) = under(server, &p.text_document_position)?;
     let with_definitions = p.context.include_declaration;
-    Some(locations(
-        server,
-        a,
-        a.occurrences.iter().filter(|x| x.sym == o.sym && (with_definitions || !x.definition)),
-    ))
+    Some(locations(server, &sharing(server, a, &o.sym), &o.sym, |x| {
+        with_definitions || !x.definition
+    }))
 }
 
 /// Why `sym` cannot be renamed here, if it cannot.
@@ -62,10 +91,6 @@ fn refusal(a: &Analysis, sym: &Sym, all: &[&Occurrence]) -> Option<String> {
     let in_std = all.iter().any(|o| a.sources.name(o.file) == aviary_check::STD_NAME);
     let api = aviary_api::Descriptor::standard();
     match sym {
-        Sym::Group(_) => Some(
-            "a group is named by each drone's `group` key in the world file: rename it there"
-                .into(),
-        ),
         Sym::Signal(n) if api.signal(n).is_some() => Some(format!("`{n}` is a built-in signal")),
         Sym::Exception(n) if api.is_exception(n) => Some(format!("`{n}` is a built-in exception")),
         _ if in_std => Some(format!(
@@ -119,24 +144,15 @@ pub fn rename(server: &Server, p: RenameParams) -> Result<Option<WorkspaceEdit>,
     if let Some(why) = refusal(a, &o.sym, &all) {
         return Err((ErrorCode::InvalidRequest, why));
     }
-    let mut ranges = Ranges::new(a);
     let mut edits: Vec<TextDocumentEdit> = Vec::new();
-    for x in all {
-        let Some(uri) = uri_of(a, x.file, server.docs()) else { continue };
-        let edit = OneOf::Left(TextEdit {
-            range: ranges.range(x.file, x.span),
-            new_text: new.to_string(),
-        });
-        match edits.iter_mut().find(|e| e.text_document.uri == uri) {
-            Some(e) => {
-                if !e.edits.contains(&edit) {
-                    e.edits.push(edit);
-                }
-            }
+    for at in locations(server, &sharing(server, a, &o.sym), &o.sym, |_| true) {
+        let edit = OneOf::Left(TextEdit { range: at.range, new_text: new.to_string() });
+        match edits.iter_mut().find(|e| e.text_document.uri == at.uri) {
+            Some(e) => e.edits.push(edit),
             None => {
-                let version = server.docs().get(&crate::uri::key(&uri)).map(|d| d.version);
+                let version = server.docs().get(&crate::uri::key(&at.uri)).map(|d| d.version);
                 edits.push(TextDocumentEdit {
-                    text_document: OptionalVersionedTextDocumentIdentifier { uri, version },
+                    text_document: OptionalVersionedTextDocumentIdentifier { uri: at.uri, version },
                     edits: vec![edit],
                 });
             }

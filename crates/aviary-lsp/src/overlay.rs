@@ -9,6 +9,7 @@ use aviary_check::uses::{is_mission_name, not_a_mission, within_roots, OUTSIDE_H
 use aviary_check::{LoadError, SourceProvider};
 
 /// An open document.
+#[derive(Clone)]
 pub struct Doc {
     pub uri: lsp_types::Uri,
     pub text: String,

@@ -1,4 +1,5 @@
-//! A panic in a request handler is answered with an error, and the server lives on.
+//! A panic in a request handler is answered with an error, and the server lives on; a
+//! slow request does not hold a quick one.
 
 use lsp_server::{Connection, Message, Notification, Request, RequestId};
 use serde_json::json;
@@ -68,4 +69,53 @@ fn the_benchmark_times_each_edit_to_its_diagnostics() {
     assert_eq!(timings.errors, 0);
     // The paper's mission says five notes (N303 four times, N301 once).
     assert_eq!(timings.diagnostics, 5);
+}
+
+#[test]
+fn a_slow_request_does_not_hold_a_quick_one() {
+    let (server, client) = Connection::memory();
+    let thread = std::thread::Builder::new()
+        .stack_size(aviary_check::STACK)
+        .spawn(move || crate::run(server, crate::Config::open_documents_only()))
+        .unwrap();
+    answer(&client, 1, "initialize", json!({ "capabilities": {} }));
+    client
+        .sender
+        .send(Message::Notification(Notification::new("initialized".into(), json!({}))))
+        .unwrap();
+    let uri = "untitled:slow.mission";
+    let open = json!({ "textDocument": { "uri": uri, "languageId": "aviary", "version": 1, "text": "MISSION M:\n    d TakeOff\n" } });
+    client
+        .sender
+        .send(Message::Notification(Notification::new("textDocument/didOpen".into(), open)))
+        .unwrap();
+    let hover =
+        json!({ "textDocument": { "uri": uri }, "position": { "line": 1, "character": 8 } });
+    // Answered once the document is checked, so the next two start at once.
+    answer(&client, 2, "textDocument/hover", hover.clone());
+    let send = |id: i32, method: &str, params: serde_json::Value| {
+        let r = Request::new(RequestId::from(id), method.to_string(), params);
+        client.sender.send(Message::Request(r)).unwrap();
+    };
+    // `aviary/slow` (a test build's) takes 1.5 s; the hover sent after it comes first.
+    let began = std::time::Instant::now();
+    send(3, "aviary/slow", json!({}));
+    send(4, "textDocument/hover", hover);
+    let mut order = Vec::new();
+    while order.len() < 2 {
+        let m = client.receiver.recv_timeout(std::time::Duration::from_secs(60)).unwrap();
+        if let Message::Response(r) = m {
+            order.push((r.id, began.elapsed()));
+        }
+    }
+    assert_eq!(order[0].0, RequestId::from(4), "{order:?}");
+    assert_eq!(order[1].0, RequestId::from(3), "{order:?}");
+    assert!(order[0].1 < std::time::Duration::from_millis(1500), "{order:?}");
+    assert!(order[1].1 >= std::time::Duration::from_millis(1500), "{order:?}");
+    answer(&client, 5, "shutdown", serde_json::Value::Null);
+    client
+        .sender
+        .send(Message::Notification(Notification::new("exit".into(), serde_json::Value::Null)))
+        .unwrap();
+    thread.join().unwrap().unwrap();
 }

@@ -174,7 +174,9 @@ fn run_fixture(path: &Path) -> String {
     }
     client.shutdown();
     let shown = serde_json::to_string_pretty(&log).unwrap();
-    shown.replace(&format!("file://{}", dir.display()), "file://$FIXTURES")
+    shown
+        .replace(&format!("file://{}", dir.display()), "file://$FIXTURES")
+        .replace(&format!("file://{}", support::std_file().display()), "file://$STD")
 }
 
 #[test]

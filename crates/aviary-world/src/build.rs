@@ -192,13 +192,12 @@ fn build<'t>(
     if let Some(e) = table("expect") {
         world.expect = expect::expectations(cx, &e.node, &world.targets);
     }
-    let group_spans = std::mem::take(&mut drones.group_spans);
     world.groups = std::mem::take(&mut drones.groups);
     world.drones = std::mem::take(&mut drones.out);
     one_name_per_drone(cx, &world.drones, &drones.fleets);
     homes_in_fence(cx, &world, &drones.fleets);
     no_fly::homes_outside_zones(cx, &world, &drones.fleets);
-    unique_names(cx, &world, &group_spans);
+    unique_names(cx, &world);
     air::wind_within_reach(cx, &world);
     (world, std::mem::take(&mut cx.diags))
 }
@@ -515,13 +514,14 @@ pub(super) fn home_spans(text: &str) -> std::collections::HashMap<String, Span> 
 /// A name stands for one drone, group, place, area or line: mission code names them alike.
 /// Within each kind names are unique already (TOML keys, one group per name), so only
 /// names of two kinds can clash: the drones, the many, are looked up among the others.
-fn unique_names(cx: &mut Ctx, world: &World, group_spans: &[Span]) {
+fn unique_names(cx: &mut Ctx, world: &World) {
     let mut named: QuickMap<&str, Vec<(&str, Span)>> = QuickMap::default();
     let places = world.places.iter().map(|p| (p.name.as_str(), "a place", p.span));
     let areas = world.areas.iter().map(|a| (a.name.as_str(), "an area", a.span));
     let lines = world.lines.iter().map(|l| (l.name.as_str(), "a line", l.span));
+    // Where each group is first named.
     let groups =
-        world.groups.iter().zip(group_spans).map(|(g, span)| (g.name.as_str(), "a group", *span));
+        world.groups.iter().filter_map(|g| Some((g.name.as_str(), "a group", *g.spans.first()?)));
     for (name, what, span) in places.chain(areas).chain(lines).chain(groups) {
         named.entry(name).or_default().push((what, span));
     }

@@ -378,6 +378,10 @@ pub struct Group {
     pub name: String,
     /// Indices into [`World::drones`], in the drones' file order.
     pub members: Vec<usize>,
+    /// Every `group = "NAME"` string that names it, quotes included, in file order: one
+    /// per drone, or one for a fleet's drones (the editor's rename edits each).
+    #[serde(skip)]
+    pub spans: Vec<Span>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]

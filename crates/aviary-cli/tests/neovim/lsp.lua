@@ -52,6 +52,17 @@ local ok, err = pcall(function()
   local definition = request("textDocument/definition", { position = at("BuildingA") })
   out.definition = { uri = definition[1].uri, line = definition[1].range.start.line }
 
+  -- Into the standard library: the file `aviary lsp` wrote it to, opened as Neovim
+  -- opens any location, read-only.
+  local std = request("textDocument/definition", { position = at("FlyCircle WITH") })
+  if vim.lsp.util.show_document then
+    vim.lsp.util.show_document(std[1], "utf-16", { focus = true })
+  else
+    vim.lsp.util.jump_to_location(std[1], "utf-16")
+  end
+  out.std = { name = vim.api.nvim_buf_get_name(0), line = vim.api.nvim_get_current_line() }
+  vim.api.nvim_set_current_buf(buf)
+
   local completion = request("textDocument/completion", { position = { line = at("FlyCircle WITH").line, character = at("FlyCircle WITH").character + #"FlyCircle WITH" } })
   out.completion = {}
   for _, item in ipairs(completion.items or completion) do

@@ -19,12 +19,18 @@ pub struct Client {
 
 impl Client {
     /// Starts a server that reads only open documents (and the world beside a mission on
-    /// disk), and initializes it.
+    /// disk) and has the standard library in [`std_file`], and initializes it.
     pub fn start() -> Client {
         let (server_side, client_side) = Connection::memory();
         let server = std::thread::Builder::new()
             .stack_size(aviary_check::STACK)
-            .spawn(move || aviary_lsp::run(server_side, aviary_lsp::Config::open_documents_only()))
+            .spawn(move || {
+                let config = aviary_lsp::Config {
+                    std_file: Some(std_file()),
+                    ..aviary_lsp::Config::open_documents_only()
+                };
+                aviary_lsp::run(server_side, config)
+            })
             .expect("a thread for the server");
         let mut client = Client {
             connection: client_side,
@@ -101,6 +107,16 @@ impl Client {
         let server = self.server.take().expect("started");
         server.join().expect("the server thread ends").expect("the server ends cleanly");
     }
+}
+
+/// The standard library's text in a file, as `aviary lsp` writes it for go to definition.
+pub fn std_file() -> std::path::PathBuf {
+    let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join("std/standard.mission");
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    if std::fs::read_to_string(&path).ok().as_deref() != Some(aviary_check::STD_SOURCE) {
+        std::fs::write(&path, aviary_check::STD_SOURCE).unwrap();
+    }
+    path
 }
 
 /// The `file:` URI of a path (no character of the fixtures' paths needs escaping).

@@ -59,8 +59,6 @@ pub(super) struct Drones {
     pub areas: Vec<crate::Area>,
     /// In order of first appearance, members in the drones' file order.
     pub groups: Vec<Group>,
-    /// Where each group of `groups` is first named.
-    pub group_spans: Vec<Span>,
     /// Each group's index and shared name.
     group_index: QuickMap<String, (usize, Arc<str>)>,
     /// Attribute keys, each kept once.
@@ -233,16 +231,25 @@ impl Drones {
         if !cx.identifier("group", group, n.span) {
             return None;
         }
-        Some(match self.group_index.get(group.as_str()) {
+        let (g, shared) = match self.group_index.get(group.as_str()) {
             Some((g, shared)) => (*g, shared.clone()),
             None => {
                 let shared: Arc<str> = group.as_str().into();
                 self.group_index.insert(group.clone(), (self.groups.len(), shared.clone()));
-                self.groups.push(Group { name: group.clone(), members: Vec::new() });
-                self.group_spans.push(n.span);
+                self.groups.push(Group {
+                    name: group.clone(),
+                    members: Vec::new(),
+                    spans: Vec::new(),
+                });
                 (self.groups.len() - 1, shared)
             }
-        })
+        };
+        // A fleet's drones share its one `group` string.
+        let spans = &mut self.groups[g].spans;
+        if !spans.contains(&n.span) {
+            spans.push(n.span);
+        }
+        Some((g, shared))
     }
 
     /// `sensors = [...]`, each kept to be checked against `[sensors]` once that is read

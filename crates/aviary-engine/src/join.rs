@@ -20,7 +20,9 @@ use futures_util::stream::{FuturesOrdered, FuturesUnordered, StreamExt};
 
 /// At most this many futures are joined in index order. The engine's own figure, which
 /// decides traces: it is the size up to which `join_all` polls in index order, so the
-/// traces of missions are those they had when the engine joined with `join_all`.
+/// traces of missions are those they had when the engine joined with `join_all`. Users
+/// read it in docs/LANGUAGE.md, section 4 ("Order at one instant"); polling every branch
+/// at once for all sizes changes traces (a leash's steps at its instant), so it stays.
 pub(crate) const SMALL: usize = 30;
 
 /// Runs every future to its end: at every wake, each pending one is polled, in order.

@@ -394,6 +394,41 @@ fn parallel_branches_woken_at_one_instant_go_on_in_written_order() {
     }
 }
 
+/// A branch that another's `SIGNAL` wakes goes on at the signal, before the branches the
+/// clock woke at that instant and written after the signal's: with 30 branches, and with
+/// 31, past the size at which the engine joins branches another way (docs/LANGUAGE.md,
+/// section 4, "Order at one instant").
+#[test]
+fn a_branch_a_signal_wakes_goes_on_at_the_signal_whatever_the_number_of_branches() {
+    for n in [30, 31] {
+        let mut mission = String::from(
+            "MISSION M:\n    PARALLEL:\n        SEQUENTIAL:\n            WAITFOR ELAPSED >= 1s\n            SIGNAL Go\n        SEQUENTIAL:\n            WAITFOR RECEIVED(Go)\n            SIGNAL First\n",
+        );
+        for i in 2..n {
+            mission += &format!(
+                "        SEQUENTIAL:\n            WAITFOR ELAPSED >= 1s\n            SIGNAL S{i}\n"
+            );
+        }
+        let r = run(&mission);
+        assert_eq!(r.outcome.status, Status::Ok);
+        let raised: Vec<String> = r
+            .trace
+            .iter()
+            .filter(|e| e["event"] == "signal")
+            .map(|e| e["name"].as_str().unwrap_or("").to_string())
+            .collect();
+        let others = (2..n).map(|i| format!("S{i}"));
+        let expected: Vec<String> =
+            ["Go".to_string(), "First".to_string()].into_iter().chain(others).collect();
+        assert_eq!(raised, expected, "{n} branches");
+        assert!(r
+            .trace
+            .iter()
+            .filter(|e| e["event"] == "signal")
+            .all(|e| close(e["t"].as_f64().unwrap_or(0.0), 1.0)));
+    }
+}
+
 #[test]
 fn a_handler_re_entered_at_one_instant_is_passed_over() {
     // `c` has no camera: `c Ping` fails as it starts, in the handler's body as in the

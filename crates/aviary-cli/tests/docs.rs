@@ -678,6 +678,61 @@ fn the_architecture_maps_every_crate() {
     assert_eq!(mapped, crates, "docs/ARCHITECTURE.md's code map and crates/ differ");
 }
 
+/// Each crate's section of the code map names every Rust file of its `src/` (but
+/// `lib.rs` and `main.rs`, and the files of a folder it names, `walk/`), and every file
+/// it names in backticks is one of the crate's.
+#[test]
+fn each_crates_section_names_its_files_and_only_those() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let map = std::fs::read_to_string(root.join("docs/ARCHITECTURE.md")).expect("ARCHITECTURE.md");
+    let mut problems = Vec::new();
+    let sections: Vec<&str> = map.split("\n### `crates/").skip(1).collect();
+    for section in sections {
+        let Some((name, text)) = section.split_once("`\n") else { continue };
+        // The section ends at the next heading.
+        let text = text.split("\n## ").next().unwrap_or(text);
+        let dir = root.join("crates").join(name);
+        let mut files = Vec::new();
+        files_under(&dir.join("src"), &|p| p.extension().is_some_and(|e| e == "rs"), &mut files);
+        let relative: Vec<String> = files
+            .iter()
+            .filter_map(|f| f.strip_prefix(dir.join("src")).ok())
+            .map(|f| f.to_string_lossy().into_owned())
+            .collect();
+        let named: BTreeSet<String> = backticked(text)
+            .into_iter()
+            .flat_map(|b| b.split([' ', ',', '(']).map(str::to_string).collect::<Vec<_>>())
+            .filter(|w| w.ends_with(".rs") || w.ends_with('/'))
+            .collect();
+        for file in &relative {
+            // Unit tests beside the code are not in the map.
+            let base = file.rsplit('/').next().unwrap_or(file);
+            if ["lib.rs", "main.rs", "tests.rs"].contains(&base) || base.ends_with("_tests.rs") {
+                continue;
+            }
+            let in_folder = file.contains('/')
+                && named
+                    .iter()
+                    .any(|n| n.ends_with('/') && file.starts_with(n.trim_start_matches("src/")));
+            if !named.contains(file) && !named.contains(base) && !in_folder {
+                problems.push(format!("crates/{name}: src/{file} is not in its section"));
+            }
+        }
+        let own = format!("crates/{name}/");
+        for n in named.iter().filter(|n| n.ends_with(".rs")) {
+            let n = n.trim_start_matches(own.as_str()).trim_start_matches("src/");
+            let exists = relative.iter().any(|f| f == n || f.ends_with(&format!("/{n}")))
+                || dir.join(n).is_file();
+            if !exists {
+                problems.push(format!(
+                    "crates/{name}: its section names `{n}`, which it does not have"
+                ));
+            }
+        }
+    }
+    assert!(problems.is_empty(), "docs/ARCHITECTURE.md:\n{}", problems.join("\n"));
+}
+
 /// The long flags a command's `--help` lists (but `--help` itself).
 fn flags_of(command: &str) -> BTreeSet<String> {
     let (code, help, err) = aviary(&[command, "--help"], &repo());

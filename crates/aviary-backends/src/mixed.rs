@@ -1,9 +1,10 @@
 //! A world with MAVLink drones: each drone goes to the backend that flies it, the
 //! simulator (then in real time) or MAVLink, behind one [`Backend`] for the engine.
 
+use parking_lot::Mutex;
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use aviary_api::{
     Backend, CallId, Descriptor, DroneEvent, DroneId, Ending, Function, Interrupt, PendingCall,
@@ -78,13 +79,13 @@ impl Backend for Mixed {
             Ending::Now(end) => return PendingCall { id, end: Ending::Now(end) },
             Ending::Later(rx) => rx,
         };
-        self.calls.lock().unwrap_or_else(|p| p.into_inner()).insert(id, (by_mavlink, inner.id));
+        self.calls.lock().insert(id, (by_mavlink, inner.id));
         // Pass the end on, and forget the call once it has ended.
         let (tx, rx) = oneshot::channel();
         let calls = Arc::clone(&self.calls);
         tokio::spawn(async move {
             let end = inner_end.await;
-            calls.lock().unwrap_or_else(|p| p.into_inner()).remove(&id);
+            calls.lock().remove(&id);
             if let Ok(end) = end {
                 let _ = tx.send(end);
             }
@@ -93,9 +94,7 @@ impl Backend for Mixed {
     }
 
     fn interrupt(&self, call: CallId, how: Interrupt) {
-        let Some((by_mavlink, inner)) =
-            self.calls.lock().unwrap_or_else(|p| p.into_inner()).get(&call).copied()
-        else {
+        let Some((by_mavlink, inner)) = self.calls.lock().get(&call).copied() else {
             return;
         };
         if by_mavlink {
@@ -130,7 +129,7 @@ impl Backend for Mixed {
     }
 
     fn events(&self) -> Option<mpsc::UnboundedReceiver<DroneEvent>> {
-        self.events.lock().unwrap_or_else(|p| p.into_inner()).take()
+        self.events.lock().take()
     }
 }
 

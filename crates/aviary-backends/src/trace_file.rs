@@ -15,8 +15,9 @@
 //! run, whose fleet goes home. A mission that makes events without end (a cycle at one
 //! instant the run's bounds do not see) would otherwise fill the disk.
 
+use parking_lot::Mutex;
 use std::io::Write;
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::Arc;
 
 use aviary_api::trace::{Event, Record, Status};
 
@@ -80,10 +81,6 @@ pub struct TraceFile {
 }
 
 pub type SharedTrace = Arc<Mutex<TraceFile>>;
-
-pub fn lock(trace: &SharedTrace) -> MutexGuard<'_, TraceFile> {
-    trace.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
-}
 
 impl TraceFile {
     /// A trace written to `out`, at most `max_bytes` long (at least [`MIN_MAX_BYTES`]).
@@ -201,7 +198,7 @@ mod tests {
 
     impl Write for Shared {
         fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-            self.0.lock().unwrap().extend_from_slice(buf);
+            self.0.lock().extend_from_slice(buf);
             Ok(buf.len())
         }
         fn flush(&mut self) -> std::io::Result<()> {
@@ -226,7 +223,7 @@ mod tests {
     fn a_trace_at_its_limit_is_closed_within_it_and_says_why() {
         let out = Shared::default();
         let trace = TraceFile::new(Box::new(out.clone()), "t.jsonl".into(), "M".into(), 4096);
-        let mut trace = lock(&trace);
+        let mut trace = trace.lock();
         let start =
             Record { t: 0.0, event: Event::MissionStart { mission: "M".into(), world: None } };
         assert_eq!(trace.write(&start), None);
@@ -237,7 +234,7 @@ mod tests {
         assert_eq!(cuts, [Cut::Full { name: "t.jsonl".into(), limit: 4096 }], "said once");
         assert_eq!(cuts[0].to_string(), "the trace t.jsonl reached its size limit of 4 KiB");
         assert_eq!(trace.failed(), Some("it reached its size limit of 4 KiB"));
-        let text = String::from_utf8(out.0.lock().unwrap().clone()).unwrap();
+        let text = String::from_utf8(out.0.lock().clone()).unwrap();
         assert!(text.len() <= 4096, "{} bytes", text.len());
         let last: serde_json::Value = serde_json::from_str(text.lines().last().unwrap()).unwrap();
         assert_eq!(last["event"], "mission_end");
@@ -250,7 +247,7 @@ mod tests {
         assert!(text.len() > 4096 - 2 * CLOSING_ROOM as usize, "{} bytes", text.len());
         let end = Record { t: 9.0, event: Event::MissionEnd { status: Status::Ok, reason: None } };
         assert_eq!(trace.write(&end), None, "nothing after");
-        assert_eq!(out.0.lock().unwrap().len(), text.len());
+        assert_eq!(out.0.lock().len(), text.len());
     }
 
     #[test]

@@ -12,8 +12,8 @@
 #![forbid(unsafe_code)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
+use parking_lot::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
 
 use aviary_api::trace::{EventKind, Record};
 use aviary_api::Backend;
@@ -99,14 +99,10 @@ impl Campaign {
             match self.fly(*seed) {
                 Ok(record) => {
                     done(&record);
-                    if let Ok(mut records) = records.lock() {
-                        records[k] = Some(record);
-                    }
+                    records.lock()[k] = Some(record);
                 }
                 Err(why) => {
-                    if let Ok(mut failed) = failed.lock() {
-                        failed.get_or_insert(format!("seed {seed}: {why}"));
-                    }
+                    failed.lock().get_or_insert(format!("seed {seed}: {why}"));
                     // No more work: the campaign has failed.
                     next.store(seeds.len(), Ordering::Relaxed);
                 }
@@ -125,9 +121,7 @@ impl Campaign {
                 match spawned {
                     Ok(w) => workers.push(w),
                     Err(e) => {
-                        if let Ok(mut failed) = failed.lock() {
-                            failed.get_or_insert(format!("cannot start a thread: {e}"));
-                        }
+                        failed.lock().get_or_insert(format!("cannot start a thread: {e}"));
                     }
                 }
             }
@@ -135,16 +129,14 @@ impl Campaign {
             work();
             for w in workers {
                 if w.join().is_err() {
-                    if let Ok(mut failed) = failed.lock() {
-                        failed.get_or_insert("a run panicked".to_owned());
-                    }
+                    failed.lock().get_or_insert("a run panicked".to_owned());
                 }
             }
         });
-        if let Some(why) = failed.into_inner().ok().flatten() {
+        if let Some(why) = failed.into_inner() {
             return Err(why);
         }
-        let records = records.into_inner().map_err(|_| "a run panicked".to_owned())?;
+        let records = records.into_inner();
         records.into_iter().map(|r| r.ok_or_else(|| "a run did not end".to_owned())).collect()
     }
 }

@@ -16,7 +16,7 @@ use aviary_world::World;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::files::{color_wanted, use_roots, world_beside, DiskProvider};
-use aviary_backends::trace_file::{lock, show_size, Cut, SharedTrace, TraceFile};
+use aviary_backends::trace_file::{show_size, Cut, SharedTrace, TraceFile};
 
 pub struct RunArgs {
     pub file: PathBuf,
@@ -170,7 +170,7 @@ pub fn run(args: &RunArgs) -> u8 {
         if !flown.flew {
             // Stopped while the vehicles connected: the trace is whole all the same.
             if let Some(why) =
-                lock(trace).close_now(flown.outcome.reason.as_deref().unwrap_or_default())
+                trace.lock().close_now(flown.outcome.reason.as_deref().unwrap_or_default())
             {
                 eprintln!("aviary: {why}");
             }
@@ -220,7 +220,7 @@ pub fn run(args: &RunArgs) -> u8 {
         }
         _ => false,
     };
-    if let Some(why) = trace.as_ref().and_then(|t| lock(t).failed().map(str::to_owned)) {
+    if let Some(why) = trace.as_ref().and_then(|t| t.lock().failed().map(str::to_owned)) {
         eprintln!(
             "aviary: the trace {} is not whole: {why}",
             args.trace.as_ref().map(|p| p.display().to_string()).unwrap_or_default()
@@ -329,7 +329,7 @@ impl Hooks for Shown<'_> {
             self.stats.observe(record, progress, backend, self.drones);
         }
         if let Some(trace) = &self.trace {
-            let cut = lock(trace).write(record);
+            let cut = trace.lock().write(record);
             match cut {
                 Some(Cut::Failed(why)) => eprintln!(
                     "\naviary: {why}; the mission goes on without it, and aviary will exit 3"
@@ -426,7 +426,7 @@ fn on_stop_signals(controller: Controller, stop: Stop, trace: SharedTrace) {
                 unless_heard(controller.clone(), trace.clone(), by);
             } else {
                 if let Some(why) =
-                    lock(&trace).close_now(&format!("stopped at once by a second {by}"))
+                    trace.lock().close_now(&format!("stopped at once by a second {by}"))
                 {
                     eprintln!("aviary: {why}");
                 }
@@ -452,7 +452,7 @@ fn unless_heard(controller: Controller, trace: SharedTrace, by: &'static str) {
             GRACE.as_secs()
         );
         eprintln!("aviary: {reason}");
-        if let Some(why) = lock(&trace).close_now(&reason) {
+        if let Some(why) = trace.lock().close_now(&reason) {
             eprintln!("aviary: {why}");
         }
         std::process::exit(130);

@@ -4,8 +4,9 @@
 //! to the trace as an `operator` event; leashes and signals are written as the mission's
 //! own are.
 
+use parking_lot::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use aviary_api::trace::{Event, EventKind, OperatorAction};
 use aviary_api::Value;
@@ -113,7 +114,7 @@ impl Interrupt {
     }
 
     pub fn reason(&self) -> String {
-        let reason = self.reason.lock().unwrap_or_else(|p| p.into_inner());
+        let reason = self.reason.lock();
         reason.clone().unwrap_or_else(|| "interrupted".into())
     }
 
@@ -147,7 +148,7 @@ impl Controller {
     /// that reached its size limit. The first reason given stands.
     pub fn interrupt(&self, reason: String) {
         {
-            let mut held = self.interrupt.reason.lock().unwrap_or_else(|p| p.into_inner());
+            let mut held = self.interrupt.reason.lock();
             held.get_or_insert_with(|| reason.clone());
         }
         self.interrupt.asked.store(true, Ordering::Release);

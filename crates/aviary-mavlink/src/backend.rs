@@ -3,9 +3,10 @@
 //! (and its return into `ConnectionRestored`), and an RTL or LAND the autopilot chose by
 //! itself into the matching exception. A fault ends the drone's calls `Interrupted`.
 
+use parking_lot::Mutex;
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::Arc;
 use std::time::Duration;
 
 use aviary_api::{
@@ -40,10 +41,6 @@ pub(crate) struct Inner {
     battery: Mutex<Vec<(bool, bool)>>,
     /// Per drone: where its last `Sweep` or `FollowPath` stopped (`Backend::stopped`).
     stops: Mutex<Vec<Option<Progress>>>,
-}
-
-fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|p| p.into_inner())
 }
 
 /// MAVLink drones as a [`Backend`]. Drones of the world that are not MAVLink drones are
@@ -108,13 +105,13 @@ impl MavlinkBackend {
     /// Whether the video stream is on, and what the drone carries.
     pub fn payload_state(&self, drone: DroneId) -> Option<(bool, Option<String>)> {
         let c = self.inner.crafts.get(drone)?.as_ref()?;
-        Some((c.streaming(), lock(&c.carrying).clone()))
+        Some((c.streaming(), c.carrying.lock().clone()))
     }
 }
 
 impl Inner {
     fn finish(&self, call: CallId, end: CallEnd) {
-        if let Some(slot) = lock(&self.calls).remove(&call) {
+        if let Some(slot) = self.calls.lock().remove(&call) {
             if end != CallEnd::Done {
                 self.note_stop(&slot);
             }
@@ -131,7 +128,7 @@ impl Inner {
         }
         let Some(Some(c)) = self.crafts.get(slot.drone) else { return };
         let (Some(next), Some(fix)) = (c.flying_to(), c.fix()) else { return };
-        if let Some(stop) = lock(&self.stops).get_mut(slot.drone) {
+        if let Some(stop) = self.stops.lock().get_mut(slot.drone) {
             *stop = Some(Progress { next, at: fix.pos });
         }
     }
@@ -142,14 +139,14 @@ impl Inner {
         if failure.exception == BuiltinException::BatteryCritical {
             // The rule below and the autopilot's battery failsafe may both see it: one
             // fault, one exception.
-            let mut flags = lock(&self.battery);
+            let mut flags = self.battery.lock();
             if flags[drone].1 {
                 return;
             }
             flags[drone].1 = true;
         }
         let cut: Vec<Slot> = {
-            let mut calls = lock(&self.calls);
+            let mut calls = self.calls.lock();
             let ids: Vec<CallId> =
                 calls.iter().filter(|(_, s)| s.drone == drone).map(|(id, _)| *id).collect();
             ids.into_iter().filter_map(|id| calls.remove(&id)).collect()
@@ -190,9 +187,9 @@ impl Inner {
         let home = aviary_api::geometry::dist([fix.pos[0], fix.pos[1]], c.home);
         let need = c.battery.need(home, fix.pos[2], drawn);
         let (is_low, is_critical) = crate::battery::alarms(battery, need);
-        let (low, critical) = lock(&self.battery)[drone];
+        let (low, critical) = self.battery.lock()[drone];
         if !low && is_low {
-            lock(&self.battery)[drone].0 = true;
+            self.battery.lock()[drone].0 = true;
             let _ =
                 self.events.send(DroneEvent::Signal { drone, signal: BuiltinSignal::BatteryLow });
         }
@@ -237,9 +234,9 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
                 seen.heartbeat.is_some_and(|t| now.duration_since(t) < limit)
                     || seen.heartbeat_wall.is_some_and(|t| t.elapsed() < limit)
             };
-            let was_lost = lock(&inner.lost)[drone];
+            let was_lost = inner.lost.lock()[drone];
             if was_lost == fresh {
-                lock(&inner.lost)[drone] = !fresh;
+                inner.lost.lock()[drone] = !fresh;
                 if fresh {
                     let _ = inner.events.send(DroneEvent::Signal {
                         drone,
@@ -281,9 +278,9 @@ impl Backend for MavlinkBackend {
             // A motion call forgets where the last path call stopped, before anything can
             // refuse it: a refused call has not moved.
             craft.set_flying_to(None);
-            lock(&self.inner.stops)[drone] = None;
+            self.inner.stops.lock()[drone] = None;
         }
-        if lock(&self.inner.lost)[drone] {
+        if self.inner.lost.lock()[drone] {
             // The drone stays lost to the mission until its link is back: what is asked
             // of it meanwhile raises the exception a handler of the loss already knows.
             let _ = tx.send(CallEnd::Failed(Failure {
@@ -299,7 +296,7 @@ impl Backend for MavlinkBackend {
         let inner = Arc::clone(&self.inner);
         let args = args.to_vec();
         // Hold the table while spawning, so that a call that ends at once finds its slot.
-        let mut calls = lock(&self.inner.calls);
+        let mut calls = self.inner.calls.lock();
         let task = tokio::spawn(async move {
             let end = match flight::run(&craft, function, &args, paused_rx, &inner.sensors).await {
                 Ok(()) => CallEnd::Done,
@@ -317,7 +314,7 @@ impl Backend for MavlinkBackend {
     fn interrupt(&self, call: CallId, how: Interrupt) {
         match how {
             Interrupt::Abort => {
-                let Some(slot) = lock(&self.inner.calls).remove(&call) else {
+                let Some(slot) = self.inner.calls.lock().remove(&call) else {
                     return;
                 };
                 slot.task.abort();
@@ -332,7 +329,7 @@ impl Backend for MavlinkBackend {
                 let _ = slot.end.send(CallEnd::Interrupted);
             }
             Interrupt::Pause | Interrupt::Resume => {
-                if let Some(slot) = lock(&self.inner.calls).get(&call) {
+                if let Some(slot) = self.inner.calls.lock().get(&call) {
                     let _ = slot.paused.send(how == Interrupt::Pause);
                 }
             }
@@ -344,7 +341,7 @@ impl Backend for MavlinkBackend {
     /// what Aviary asked for and the autopilot accepted, not what a sensor saw.
     fn payload(&self, drone: DroneId) -> Option<String> {
         let Some(Some(c)) = self.inner.crafts.get(drone) else { return None };
-        lock(&c.carrying).clone()
+        c.carrying.lock().clone()
     }
 
     fn telemetry(&self, drone: DroneId) -> Telemetry {
@@ -363,15 +360,15 @@ impl Backend for MavlinkBackend {
             heading: fix.map_or(0.0, |f| f.heading),
             battery: seen.battery.unwrap_or(1.0),
             state,
-            link: !lock(&self.inner.lost)[drone],
+            link: !self.inner.lost.lock()[drone],
         }
     }
 
     fn stopped(&self, drone: DroneId) -> Option<Progress> {
-        lock(&self.inner.stops).get(drone).copied().flatten()
+        self.inner.stops.lock().get(drone).copied().flatten()
     }
 
     fn events(&self) -> Option<mpsc::UnboundedReceiver<DroneEvent>> {
-        lock(&self.inner.taken).take()
+        self.inner.taken.lock().take()
     }
 }

@@ -2,8 +2,9 @@
 //! vehicle heard, its facts read and applied, its telemetry streams asked for, and its
 //! home checked against the world's before anything flies.
 
+use parking_lot::Mutex;
 use std::collections::BTreeMap;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use aviary_api::flight::Descent;
 use aviary_api::DroneId;

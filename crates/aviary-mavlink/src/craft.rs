@@ -2,8 +2,9 @@
 //! commands with ACK, retries and the autopilot's reason; mode changes confirmed by
 //! HEARTBEAT; position targets; waits that always end.
 
+use parking_lot::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::Duration;
 
 use aviary_api::{BuiltinException, Failure, FlightState};
@@ -78,10 +79,6 @@ pub fn timeout(reason: impl Into<String>) -> Failure {
     Failure { exception: BuiltinException::Timeout, reason: reason.into() }
 }
 
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|p| p.into_inner())
-}
-
 impl Craft {
     pub fn fix(&self) -> Option<Fix> {
         self.v.seen().fix
@@ -89,29 +86,29 @@ impl Craft {
 
     /// The altitude a flight without one keeps.
     pub fn level(&self) -> f64 {
-        lock(&self.level).or_else(|| self.fix().map(|f| f.pos[2])).unwrap_or(f64::NAN)
+        self.level.lock().or_else(|| self.fix().map(|f| f.pos[2])).unwrap_or(f64::NAN)
     }
 
     pub fn set_level(&self, z: Option<f64>) {
-        *lock(&self.level) = z;
+        *self.level.lock() = z;
     }
 
     pub fn flying_to(&self) -> Option<usize> {
-        *lock(&self.flying_to)
+        *self.flying_to.lock()
     }
 
     pub fn set_flying_to(&self, point: Option<usize>) {
-        *lock(&self.flying_to) = point;
+        *self.flying_to.lock() = point;
     }
 
     pub fn set_doing(&self, doing: Doing) {
-        *lock(&self.doing) = doing;
+        *self.doing.lock() = doing;
     }
 
     pub fn state(&self) -> FlightState {
         let seen = self.v.seen();
         let z = seen.fix.map_or(0.0, |f| f.pos[2]);
-        match *lock(&self.doing) {
+        match *self.doing.lock() {
             _ if !seen.armed => FlightState::Landed,
             Doing::TakingOff => FlightState::TakingOff,
             Doing::Landing => FlightState::Landing,
@@ -299,7 +296,7 @@ impl Craft {
 
     /// Sets the ground speed (only when it changes: each is a command with an ACK).
     pub async fn speed(&self, speed: f64) -> Result<(), Failure> {
-        if lock(&self.speed).is_some_and(|s| (s - speed).abs() < 1e-6) {
+        if self.speed.lock().is_some_and(|s| (s - speed).abs() < 1e-6) {
             return Ok(());
         }
         self.command(
@@ -307,7 +304,7 @@ impl Craft {
             [1.0, speed as f32, -1.0, 0.0, 0.0, 0.0, 0.0],
         )
         .await?;
-        *lock(&self.speed) = Some(speed);
+        *self.speed.lock() = Some(speed);
         Ok(())
     }
 
@@ -326,7 +323,7 @@ impl Craft {
                 };
                 // param1: the ground speed last set (-1: PX4's cruise speed); bit 0 of
                 // param2: switch to HOLD, where a reposition is flown.
-                let speed = lock(&self.speed).map_or(-1.0, |s| s as f32);
+                let speed = self.speed.lock().map_or(-1.0, |s| s as f32);
                 self.set_targeted();
                 self.command_int(
                     MavCmd::MAV_CMD_DO_REPOSITION,
@@ -373,7 +370,7 @@ impl Craft {
 
     /// Notes that a target is about to be sent, for [`Craft::refused`].
     pub fn set_targeted(&self) {
-        *lock(&self.targeted) = Some(Instant::now());
+        *self.targeted.lock() = Some(Instant::now());
     }
 
     /// Fails the call when the autopilot refused its last target in words only. PX4
@@ -381,7 +378,7 @@ impl Craft {
     /// at them, and the navigator refuses one in words alone (`crate::px4::refuses`):
     /// without this the drone would wait where it is until the call's time ran out.
     pub fn refused(&self) -> Result<(), Failure> {
-        let Some(sent) = *lock(&self.targeted) else { return Ok(()) };
+        let Some(sent) = *self.targeted.lock() else { return Ok(()) };
         match self.v.words_since(sent).into_iter().find(|w| crate::px4::refuses(w)) {
             Some(words) => Err(failed(format!("{} refused where it was sent: {words}", self.name))),
             None => Ok(()),

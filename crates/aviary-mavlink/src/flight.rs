@@ -176,11 +176,11 @@ fn streaming(c: &Craft, on: bool) -> Result<(), Failure> {
 
 /// `ReleasePayload`: opens the gripper (MAV_CMD_DO_GRIPPER release).
 async fn release(c: &Craft) -> Result<(), Failure> {
-    if c.carrying.lock().unwrap_or_else(|p| p.into_inner()).is_none() {
+    if c.carrying.lock().is_none() {
         return Err(failed(format!("{} carries nothing to release", c.name)));
     }
     c.command(MavCmd::MAV_CMD_DO_GRIPPER, [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]).await?;
-    *c.carrying.lock().unwrap_or_else(|p| p.into_inner()) = None;
+    *c.carrying.lock() = None;
     Ok(())
 }
 
@@ -244,7 +244,7 @@ async fn load(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> 
     if !c.payload.contains(&kind) {
         return Err(failed(format!("{} cannot carry {kind}", c.name)));
     }
-    if let Some(held) = c.carrying.lock().unwrap_or_else(|p| p.into_inner()).as_ref() {
+    if let Some(held) = c.carrying.lock().as_ref() {
         return Err(failed(format!("{} already carries {held}: release it first", c.name)));
     }
     let z = c.fix().map_or(0.0, |f| f.pos[2]);
@@ -256,7 +256,7 @@ async fn load(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> 
     }
     c.command(MavCmd::MAV_CMD_DO_GRIPPER, [1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0]).await?;
     hover(LOAD_TIME, paused).await?;
-    *c.carrying.lock().unwrap_or_else(|p| p.into_inner()) = Some(kind);
+    *c.carrying.lock() = Some(kind);
     Ok(())
 }
 

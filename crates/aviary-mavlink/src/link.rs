@@ -2,9 +2,10 @@
 //! on it: messages are routed to vehicles by system id. A lost TCP connection is opened
 //! again every second, so a link that comes back is noticed (`ConnectionRestored`).
 
+use parking_lot::Mutex;
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicU8, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::Duration;
 
 use mavlink::dialects::ardupilotmega::{
@@ -83,8 +84,8 @@ impl Link {
         Ok(link)
     }
 
-    fn slot(&self) -> std::sync::MutexGuard<'_, Option<Arc<Conn>>> {
-        self.conn.lock().unwrap_or_else(|p| p.into_inner())
+    fn slot(&self) -> parking_lot::MutexGuard<'_, Option<Arc<Conn>>> {
+        self.conn.lock()
     }
 
     async fn connect(&self) -> Result<Arc<Conn>, String> {
@@ -105,12 +106,12 @@ impl Link {
     }
 
     pub fn add(&self, vehicle: Arc<Vehicle>) {
-        self.vehicles.lock().unwrap_or_else(|p| p.into_inner()).insert(vehicle.system, vehicle);
+        self.vehicles.lock().insert(vehicle.system, vehicle);
     }
 
     fn vehicle(&self, system: u32) -> Option<Arc<Vehicle>> {
         let system = u8::try_from(system).ok()?;
-        self.vehicles.lock().unwrap_or_else(|p| p.into_inner()).get(&system).cloned()
+        self.vehicles.lock().get(&system).cloned()
     }
 
     /// Sends one message as the ground station. Without a connection (it is being

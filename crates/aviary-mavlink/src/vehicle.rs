@@ -1,8 +1,8 @@
 //! What the backend knows of one vehicle: the last of each message it sent, the answers
 //! commands wait for, and detection (a geometric sensor over the reported track).
 
+use parking_lot::{Mutex, MutexGuard};
 use std::collections::BTreeMap;
-use std::sync::{Mutex, MutexGuard};
 
 use aviary_api::geometry::dist_to_segment;
 use aviary_api::trace::AutopilotAction;
@@ -193,7 +193,7 @@ impl Vehicle {
     }
 
     pub fn seen(&self) -> MutexGuard<'_, Seen> {
-        self.seen.lock().unwrap_or_else(|p| p.into_inner())
+        self.seen.lock()
     }
 
     pub fn origin(&self) -> Origin {

@@ -27,8 +27,9 @@ pub use bounds::Bounds;
 pub use guard::{read_token, same_origin, token, Gate, TOKEN_PROTOCOL};
 pub use reply::{json_errors, BODY_LIMIT};
 
+use parking_lot::{Mutex, MutexGuard};
 use std::net::SocketAddr;
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::Arc;
 
 use aviary_api::trace::Record;
 use aviary_engine::Controller;
@@ -85,11 +86,11 @@ pub struct Options {
 
 impl Shared {
     pub fn state(&self) -> MutexGuard<'_, MissionState> {
-        self.state.lock().unwrap_or_else(|p| p.into_inner())
+        self.state.lock()
     }
 
     pub fn history(&self) -> MutexGuard<'_, History> {
-        self.history.lock().unwrap_or_else(|p| p.into_inner())
+        self.history.lock()
     }
 }
 

@@ -7,8 +7,9 @@
 //! window's worth of telemetry (a sample per drone) and `QUEUE` other events; beyond
 //! that the oldest are let go, and the next batch says how many.
 
+use parking_lot::Mutex;
 use std::collections::{BTreeMap, VecDeque};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::Duration;
 
 use axum::extract::ws::{Message, WebSocket};
@@ -88,10 +89,6 @@ struct Waiting {
     ended: bool,
 }
 
-fn lock(w: &Mutex<Waiting>) -> std::sync::MutexGuard<'_, Waiting> {
-    w.lock().unwrap_or_else(|p| p.into_inner())
-}
-
 /// Batches every `every`: the window's events, then each drone's latest telemetry, as one
 /// JSON array; `{"dropped": N}` first in the array when events were let go.
 pub(crate) async fn batched(
@@ -112,7 +109,7 @@ pub(crate) async fn batched(
         tokio::spawn(async move {
             loop {
                 let got = rx.recv().await;
-                let mut w = lock(&waiting);
+                let mut w = waiting.lock();
                 match got {
                     Ok(line) => {
                         let end = line.end;
@@ -153,7 +150,7 @@ pub(crate) async fn batched(
             _ = tick.tick() => {}
         }
         let (batch, ended) = {
-            let mut w = lock(&waiting);
+            let mut w = waiting.lock();
             let taken = std::mem::take(&mut *w);
             w.ended = taken.ended;
             (taken, w.ended)

@@ -7,9 +7,10 @@
 //! moves to the next tick at once. With [`SimOptions::speed`] the driver also waits for
 //! the wall clock, off the engine's thread (see [`drive`]).
 
+use parking_lot::Mutex;
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex, MutexGuard, Weak};
+use std::sync::{Arc, Weak};
 use std::time::Duration;
 
 use aviary_api::{
@@ -75,10 +76,6 @@ pub struct SimBackend {
     driver: Mutex<Option<JoinHandle<()>>>,
 }
 
-fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
-}
-
 impl SimBackend {
     /// Builds the fleet of `world` and spawns the driver task. Call it inside a tokio
     /// runtime (for determinism and speed, a current-thread one with a paused clock).
@@ -108,7 +105,7 @@ impl SimBackend {
             driver: Mutex::new(None),
         });
         let handle = tokio::spawn(drive(Arc::downgrade(&backend), options));
-        *lock(&backend.driver) = Some(handle);
+        *backend.driver.lock() = Some(handle);
         backend
     }
 
@@ -120,7 +117,7 @@ impl SimBackend {
     /// Stops the driver and waits until it has ended.
     pub async fn shutdown(&self) {
         self.stop();
-        let handle = lock(&self.driver).take();
+        let handle = self.driver.lock().take();
         if let Some(handle) = handle {
             let _ = handle.await;
         }
@@ -128,27 +125,27 @@ impl SimBackend {
 
     /// The driver task's handle (once), to await its end elsewhere.
     pub fn take_driver(&self) -> Option<JoinHandle<()>> {
-        lock(&self.driver).take()
+        self.driver.lock().take()
     }
 
     /// Simulated seconds so far.
     pub fn time(&self) -> f64 {
-        lock(&self.state).fleet.time()
+        self.state.lock().fleet.time()
     }
 
     /// Every `ReleasePayload` so far (drone, kind, position, time).
     pub fn releases(&self) -> Vec<Release> {
-        lock(&self.state).fleet.releases().to_vec()
+        self.state.lock().fleet.releases().to_vec()
     }
 
     /// Reads the physics core (under the lock: keep it short).
     pub fn with_fleet<R>(&self, f: impl FnOnce(&Fleet) -> R) -> R {
-        f(&lock(&self.state).fleet)
+        f(&self.state.lock().fleet)
     }
 
     /// One physics step: answers the calls that ended and sends the events.
     fn tick(&self, dt: f64) {
-        let mut state = lock(&self.state);
+        let mut state = self.state.lock();
         for report in state.fleet.step(dt) {
             match report {
                 Report::Ended { call, end } => state.answer(call, end),
@@ -211,7 +208,7 @@ impl Backend for SimBackend {
     }
 
     fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall {
-        let mut state = lock(&self.state);
+        let mut state = self.state.lock();
         let (id, end) = state.fleet.call(drone, function, args);
         let end = match end {
             Some(end) => Ending::Now(end),
@@ -225,25 +222,25 @@ impl Backend for SimBackend {
     }
 
     fn interrupt(&self, call: CallId, how: Interrupt) {
-        let mut state = lock(&self.state);
+        let mut state = self.state.lock();
         if let Some(end) = state.fleet.interrupt(call, how) {
             state.answer(call, end);
         }
     }
 
     fn telemetry(&self, drone: DroneId) -> Telemetry {
-        lock(&self.state).fleet.telemetry(drone).unwrap_or(Telemetry::LOST)
+        self.state.lock().fleet.telemetry(drone).unwrap_or(Telemetry::LOST)
     }
 
     fn payload(&self, drone: DroneId) -> Option<String> {
-        lock(&self.state).fleet.carrying(drone).map(str::to_owned)
+        self.state.lock().fleet.carrying(drone).map(str::to_owned)
     }
 
     fn stopped(&self, drone: DroneId) -> Option<aviary_api::Progress> {
-        lock(&self.state).fleet.stopped(drone)
+        self.state.lock().fleet.stopped(drone)
     }
 
     fn events(&self) -> Option<mpsc::UnboundedReceiver<DroneEvent>> {
-        lock(&self.events).take()
+        self.events.lock().take()
     }
 }

@@ -5,7 +5,7 @@
 //! connect), then, once [`Pace::follow`] names one, the vehicles' own clocks, so that a
 //! SITL running five times faster than real time has a mission five times faster too.
 
-use std::sync::Mutex;
+use parking_lot::Mutex;
 use std::time::Instant;
 
 /// Seconds a clock has moved on since it was last asked, or `None` when it cannot say
@@ -33,13 +33,13 @@ impl Default for Pace {
 impl Pace {
     /// From now on, time moves as `source` says (as the wall clock when it says nothing).
     pub fn follow(&self, source: Source) {
-        let mut s = self.state.lock().unwrap_or_else(|p| p.into_inner());
+        let mut s = self.state.lock();
         s.source = Some(source);
     }
 
     /// The reference now, in seconds since the pace began: never falls.
     pub fn now(&self) -> f64 {
-        let mut s = self.state.lock().unwrap_or_else(|p| p.into_inner());
+        let mut s = self.state.lock();
         let wall = Instant::now();
         let by_wall = (wall - s.wall).as_secs_f64();
         s.wall = wall;

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use aviary_api::trace::Record;
 use aviary_api::Backend;
 use aviary_backends::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
-use aviary_backends::trace_file::{lock, Cut, SharedTrace, TraceFile, DEFAULT_MAX_BYTES};
+use aviary_backends::trace_file::{Cut, SharedTrace, TraceFile, DEFAULT_MAX_BYTES};
 use aviary_check::SourceProvider;
 use aviary_engine::{Controller, RunOptions};
 use aviary_ir::Mission;
@@ -210,7 +210,7 @@ impl Hooks for Flight {
 
     fn record(&mut self, record: &Record<'_>, _backend: &dyn Backend) {
         if let Some(file) = &self.file {
-            let cut = lock(file).write(record);
+            let cut = file.lock().write(record);
             match cut {
                 Some(Cut::Failed(why)) => eprintln!("aviary: {why}; the flight goes on without it"),
                 // As `aviary run`'s: a flight that makes events without end stops, and its

@@ -19,7 +19,7 @@
 use std::collections::{HashMap, VecDeque};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use std::sync::{Mutex, MutexGuard};
+use parking_lot::Mutex;
 
 use aviary_mavlink::mavlink::{MavHeader, Message};
 use tokio::sync::Notify;
@@ -86,10 +86,6 @@ pub struct Client {
     pub tasks: Mutex<Vec<AbortHandle>>,
 }
 
-fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|p| p.into_inner())
-}
-
 static NEXT_ID: AtomicU64 = AtomicU64::new(1);
 
 impl Client {
@@ -104,7 +100,7 @@ impl Client {
     }
 
     pub fn heartbeat(&self, o: Out) {
-        let mut l = lock(&self.lanes);
+        let mut l = self.lanes.lock();
         let mine = |b: &Out| is_heartbeat(b) && b.system == o.system;
         if l.events.iter().filter(|b| mine(b)).count() >= BEAT_BACKLOG {
             if let Some(k) = l.events.iter().position(mine) {
@@ -117,7 +113,7 @@ impl Client {
     }
 
     pub fn event(&self, o: Out) {
-        let mut l = lock(&self.lanes);
+        let mut l = self.lanes.lock();
         if l.events.len() >= EVENTS_MAX {
             return;
         }
@@ -128,7 +124,7 @@ impl Client {
 
     /// A stream message: replaces one of the same kind from the same vehicle still waiting.
     pub fn telemetry(&self, o: Out) {
-        let mut l = lock(&self.lanes);
+        let mut l = self.lanes.lock();
         let id = o.msg.message_id();
         match l.telemetry.iter_mut().find(|t| t.system == o.system && t.msg.message_id() == id) {
             Some(waiting) => *waiting = o,
@@ -139,7 +135,7 @@ impl Client {
     }
 
     pub(crate) fn pop(&self) -> Option<Out> {
-        let mut l = lock(&self.lanes);
+        let mut l = self.lanes.lock();
         l.events.pop_front().or_else(|| l.telemetry.pop_front())
     }
 
@@ -154,7 +150,7 @@ impl Client {
     }
 
     pub fn abort(&self) {
-        for t in lock(&self.tasks).iter() {
+        for t in self.tasks.lock().iter() {
             t.abort();
         }
     }
@@ -182,19 +178,19 @@ pub struct Registry(Mutex<Vec<std::sync::Arc<Client>>>);
 
 impl Registry {
     pub fn add(&self, c: std::sync::Arc<Client>) {
-        lock(&self.0).push(c);
+        self.0.lock().push(c);
     }
 
     pub fn remove(&self, id: u64) {
-        lock(&self.0).retain(|c| c.id != id);
+        self.0.lock().retain(|c| c.id != id);
     }
 
     pub fn all(&self) -> Vec<std::sync::Arc<Client>> {
-        lock(&self.0).clone()
+        self.0.lock().clone()
     }
 
     pub fn len(&self) -> usize {
-        lock(&self.0).len()
+        self.0.lock().len()
     }
 }
 

@@ -144,7 +144,7 @@ pub fn dispatch(
             (MavMessage::REQUEST_DATA_STREAM(r), _) => {
                 let hz =
                     if r.start_stop == 1 { f64::from(r.req_message_rate).min(MAX_HZ) } else { 0.0 };
-                let mut s = client.schedule.lock().unwrap_or_else(|p| p.into_inner());
+                let mut s = client.schedule.lock();
                 for id in stream_group(r.req_stream_id as u8) {
                     s.set(me, *id, Some(hz));
                 }
@@ -324,7 +324,7 @@ fn set_interval(
     } else {
         Some((1e6 / f64::from(interval_us)).min(MAX_HZ))
     };
-    let mut s = client.schedule.lock().unwrap_or_else(|p| p.into_inner());
+    let mut s = client.schedule.lock();
     s.set(system, id, hz);
     MavResult::MAV_RESULT_ACCEPTED
 }

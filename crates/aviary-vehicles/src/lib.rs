@@ -52,8 +52,9 @@ mod telemetry;
 mod udp;
 mod wire;
 
+use parking_lot::Mutex;
 use std::net::SocketAddr;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use aviary_world::World;
 use tokio::net::{TcpListener, UdpSocket};
@@ -136,7 +137,7 @@ pub async fn answer(
     let tick = tick();
     let ticks = (seconds.clamp(0.0, 3600.0) / tick).round() as usize;
     for k in 1..=ticks {
-        let mut ap = server::lock(&ap);
+        let mut ap = ap.lock();
         let events = ap.step(tick);
         // Streams are due by the simulated time here, as if it passed in real time.
         server::tell(&ap, &clients.all(), events, k as f64 * tick);

@@ -3,8 +3,9 @@
 //! simulation at `speed` times real time and fills every client's queue with the streams
 //! it asked for.
 
+use parking_lot::Mutex;
 use std::net::SocketAddr;
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::Arc;
 use std::time::Duration;
 
 use aviary_mavlink::mavlink::dialects::ardupilotmega::MavMessage;
@@ -41,10 +42,6 @@ pub fn parse_listen(text: &str) -> Result<Listen, String> {
 
 pub(crate) type Shared = Arc<Mutex<Autopilot>>;
 
-pub(crate) fn lock(ap: &Shared) -> MutexGuard<'_, Autopilot> {
-    ap.lock().unwrap_or_else(|p| p.into_inner())
-}
-
 /// Steps the simulation in real time × `speed` (whole physics ticks, so the simulator
 /// behaves as in `aviary run`), tells every client what happened, and queues each client
 /// the streams that are due for it, at the rates it asked for, of the vehicles' own time:
@@ -58,7 +55,7 @@ pub(crate) async fn pace(ap: Shared, clients: Arc<Registry>, tick: f64, speed: f
     loop {
         every.tick().await;
         let wall = start.elapsed().as_secs_f64();
-        let mut ap = lock(&ap);
+        let mut ap = ap.lock();
         let mut events = Vec::new();
         while (ticks as f64 + 1.0) * tick <= wall * speed {
             events.extend(ap.step(tick));
@@ -78,7 +75,7 @@ pub(crate) fn tell(ap: &Autopilot, clients: &[Arc<Client>], mut events: Vec<Out>
         for e in &events {
             c.event(e.clone());
         }
-        let mut schedule = c.schedule.lock().unwrap_or_else(|p| p.into_inner());
+        let mut schedule = c.schedule.lock();
         for &i in &up {
             let system = ap.copters[i].system;
             for &(id, hz) in ap.streams() {
@@ -106,7 +103,7 @@ pub(crate) fn signing(key: Option<[u8; 32]>) -> Option<SigningData> {
 fn receive(ap: &Shared, client: &Client, clients: &Registry, raw: &MAVLinkMessageRaw) {
     let from = (u8::try_from(raw.system_id()).unwrap_or(0), raw.component_id());
     let replies = {
-        let mut ap = lock(ap);
+        let mut ap = ap.lock();
         match MavMessage::parse(raw.version(), raw.message_id(), raw.payload()) {
             Ok(msg) => dispatch(&mut ap, client, from, &msg),
             Err(_) => match unparsed_command(raw.message_id(), raw.payload()) {
@@ -217,6 +214,6 @@ fn connection(
         writer.abort();
         clients.remove(c.id);
     });
-    let mut tasks = client.tasks.lock().unwrap_or_else(|p| p.into_inner());
+    let mut tasks = client.tasks.lock();
     tasks.extend([writer_handle, reader.abort_handle()]);
 }

@@ -79,7 +79,7 @@ fn peer(to: SocketAddr, socket: Arc<UdpSocket>, sign: Arc<Option<SigningData>>) 
             }
         }
     });
-    client.tasks.lock().unwrap_or_else(|p| p.into_inner()).push(writer.abort_handle());
+    client.tasks.lock().push(writer.abort_handle());
     client
 }
 

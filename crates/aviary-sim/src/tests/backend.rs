@@ -135,14 +135,14 @@ fn a_runtime_with_the_simulator_finishes() {
 /// Runs a scripted mission through the backend; the telemetry every 0.25 s.
 async fn scripted() -> Vec<Telemetry> {
     let sim = SimBackend::start(&one_drone(), SimOptions::default());
-    let log = Arc::new(std::sync::Mutex::new(Vec::new()));
+    let log = Arc::new(parking_lot::Mutex::new(Vec::new()));
     let sampler = {
         let (sim, log) = (sim.clone(), log.clone());
         tokio::spawn(async move {
             let mut every = tokio::time::interval(Duration::from_millis(250));
             for _ in 0..600 {
                 every.tick().await;
-                log.lock().unwrap().push(sim.telemetry(0));
+                log.lock().push(sim.telemetry(0));
             }
         })
     };
@@ -154,7 +154,7 @@ async fn scripted() -> Vec<Telemetry> {
     done(sim.call(0, Function::ReturnToLaunch, &[])).await;
     sampler.await.unwrap();
     sim.shutdown().await;
-    let log = log.lock().unwrap().clone();
+    let log = log.lock().clone();
     log
 }
 

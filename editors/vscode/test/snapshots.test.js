@@ -44,3 +44,10 @@ for (const file of FIXTURES) {
     }
   });
 }
+
+test('every snapshot belongs to a fixture', () => {
+  const names = new Set(FIXTURES.map((file) => `${path.basename(file, '.mission')}.snap`));
+  assert.strictEqual(names.size, FIXTURES.length, 'two fixtures of one name');
+  const stale = fs.readdirSync(path.join(__dirname, 'snapshots')).filter((n) => !names.has(n));
+  assert.deepStrictEqual(stale, [], 'snapshots of no fixture: delete them');
+});

@@ -40,9 +40,15 @@ async function stop() {
   }
 }
 
-async function restart() {
-  await stop();
-  await start();
+// Restarts one after the other: two quick changes of the settings must not start two
+// servers.
+let restarting = Promise.resolve();
+function restart() {
+  restarting = restarting.then(async () => {
+    await stop();
+    await start();
+  });
+  return restarting;
 }
 
 /** @param {vscode.ExtensionContext} context */

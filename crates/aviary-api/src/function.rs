@@ -15,7 +15,19 @@ use crate::{Kind, Resource};
 
 /// A middle-layer function, as a mission calls it: `drone.FlyToPosition(pos)`. Written to
 /// the trace by its name.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    Serialize,
+    Deserialize,
+    schemars::JsonSchema,
+)]
 pub enum Function {
     Arm,
     Disarm,

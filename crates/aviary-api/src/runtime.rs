@@ -39,7 +39,7 @@ pub enum Value {
 }
 
 /// What a drone is doing, as telemetry's `state` reports it (and the trace writes it).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, schemars::JsonSchema)]
 pub enum FlightState {
     Landed,
     TakingOff,

@@ -18,13 +18,14 @@ mod shown;
 
 use std::borrow::Cow;
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::{FlightState, Function};
 pub use shown::{Params, Shown};
 
 /// One line of the trace: when, and what happened.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct Record<'a> {
     /// Seconds of mission time since the start.
     #[serde(deserialize_with = "shown::number")]
@@ -38,7 +39,7 @@ pub type Text<'a> = Cow<'a, str>;
 
 /// The world a run flew in: its file, as the run named it, and the SHA-256 of its bytes.
 /// A replay or a report of the trace draws that world, and refuses another.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 pub struct WorldStamp<'a> {
     pub file: Text<'a>,
     pub sha256: Text<'a>,
@@ -72,7 +73,7 @@ impl WorldStamp<'_> {
 
 /// What happened (docs/TRACE.md, "Every event"). The fields are in the order the trace
 /// writes them.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(tag = "event", rename_all = "snake_case")]
 pub enum Event<'a> {
     MissionStart {
@@ -137,7 +138,9 @@ pub enum Event<'a> {
         function: Function,
         args: Vec<Shown<'a>>,
         status: CallStatus,
+        // A coordinate that is not finite is written null.
         #[serde(deserialize_with = "shown::coordinates")]
+        #[schemars(with = "[Option<f64>; 3]")]
         position: [f64; 3],
         #[serde(default, skip_serializing_if = "Option::is_none")]
         left: Option<f64>,
@@ -191,14 +194,20 @@ pub enum Event<'a> {
     Detection {
         actor: Text<'a>,
         kind: Text<'a>,
+        // A coordinate that is not finite is written null.
         #[serde(deserialize_with = "shown::coordinates")]
+        #[schemars(with = "[Option<f64>; 3]")]
         location: [f64; 3],
     },
     Telemetry {
         actor: Text<'a>,
+        // A coordinate that is not finite is written null.
         #[serde(deserialize_with = "shown::coordinates")]
+        #[schemars(with = "[Option<f64>; 3]")]
         position: [f64; 3],
+        // Not known (not finite): written null.
         #[serde(deserialize_with = "shown::number")]
+        #[schemars(with = "Option<f64>")]
         battery: f64,
         state: FlightState,
     },
@@ -219,7 +228,7 @@ pub enum Event<'a> {
 }
 
 /// Who raised a signal from outside the mission (`signal` events' `by`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum RaisedBy {
     /// The operator, through the operator API (`aviary ctl signal`, the station).
@@ -232,7 +241,7 @@ fn is_false(flag: &bool) -> bool {
 }
 
 /// What a drone's autopilot did on its own (`autopilot` events).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum AutopilotAction {
     /// Stopped and held where it was (a lost link or position).
@@ -255,7 +264,7 @@ impl AutopilotAction {
 }
 
 /// What the operator did (`operator` events).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum OperatorAction {
     /// Held every activity where it is (the whole mission).
@@ -287,7 +296,7 @@ impl OperatorAction {
 }
 
 /// How a mission, a block or an activity ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Status {
     Ok,
@@ -308,7 +317,7 @@ impl Status {
 }
 
 /// How a middle-layer call ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum CallStatus {
     Ok,
@@ -415,3 +424,21 @@ impl Event<'_> {
 
 #[cfg(test)]
 mod tests;
+
+/// The JSON Schema of one line of a trace, made from the types above (the file
+/// docs/trace.schema.json is this, and a test holds it so): every event with its fields,
+/// and no field the types do not have.
+pub fn schema() -> serde_json::Value {
+    let mut schema = schemars::schema_for!(Record<'static>);
+    schema.insert(
+        "title".into(),
+        "One event of an Aviary trace (one line of the JSON Lines file)".into(),
+    );
+    schema.insert(
+        "description".into(),
+        "Values are SI (m, s, m/s); positions are [x, y, z] in the world's local frame (x east, y north, z up). Made from the types of crates/aviary-api/src/trace.rs: do not edit by hand.".into(),
+    );
+    // A field the types do not know is an error: a new field comes with its type.
+    schema.insert("unevaluatedProperties".into(), false.into());
+    schema.to_value()
+}

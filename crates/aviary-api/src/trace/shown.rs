@@ -251,3 +251,39 @@ impl<'de, 'a> Deserialize<'de> for Params<'a> {
         d.deserialize_map(ParamsVisitor)
     }
 }
+
+/// A value in the trace's JSON Schema: what [`Shown`]'s `Serialize` writes.
+impl schemars::JsonSchema for Shown<'_> {
+    fn schema_name() -> Cow<'static, str> {
+        "Value".into()
+    }
+
+    fn json_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        let coordinate = schemars::json_schema!({ "type": ["number", "null"] });
+        schemars::json_schema!({
+            "description": "A value as the trace shows it: a number in SI units (null when not finite), text (a string, a symbol, a drone's name), a boolean, a position [x, y] or [x, y, z], an area's corners [[x, y], ...], what a Sweep or FollowPath left ({\"lanes\": ..., \"spacing\": ...} or {\"points\": ...}), or null (a drone the fleet does not have)",
+            "anyOf": [
+                { "type": ["number", "string", "boolean", "null"] },
+                { "type": "array", "items": coordinate, "minItems": 2, "maxItems": 3 },
+                { "type": "array", "items": { "type": "array", "items": coordinate, "minItems": 2, "maxItems": 2 } },
+                { "type": "object" }
+            ]
+        })
+    }
+}
+
+/// A capability's values by parameter name, in the trace's JSON Schema.
+impl schemars::JsonSchema for Params<'_> {
+    fn schema_name() -> Cow<'static, str> {
+        "Params".into()
+    }
+
+    fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        let value = generator.subschema_for::<Shown>();
+        schemars::json_schema!({
+            "description": "The capability's values by parameter name, in the order of its signature",
+            "type": "object",
+            "additionalProperties": value
+        })
+    }
+}

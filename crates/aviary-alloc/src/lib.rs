@@ -11,6 +11,10 @@
 //! texts; a command calls [`short_lived`]. In a process whose allocator is another (a
 //! test), the tuning functions touch only mimalloc's own, unused, state: they change
 //! nothing and cost next to nothing.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+// The one crate whose work is unsafe: a global allocator and the C calls that tune it
+// (each block says why it is sound).
+#![allow(unsafe_code)]
 
 use std::alloc::{GlobalAlloc, Layout};
 use std::ffi::c_void;

@@ -7,6 +7,7 @@
 //!
 //! The one crate that names both backends: the simulator and `aviary-mavlink` know nothing
 //! of each other, and the engine knows neither. No IO of its own: texts in, an outcome out.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
 mod mixed;
 pub mod pipeline;

@@ -2,6 +2,7 @@
 //!
 //! Exit codes (README.md): 0 success, 1 the files have errors (or `fmt --check` would
 //! change them), 2 usage or IO problems.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
 #[macro_use]
 mod out;
@@ -29,6 +30,9 @@ static ALLOCATOR: aviary_alloc::MiMalloc = aviary_alloc::MiMalloc;
 /// Before `main`, so before the first allocation: the first arena takes the options it
 /// finds then (`aviary_alloc::tune`). Declared here rather than in the library: a
 /// constructor in a library is linked only when something else of its object file is.
+// `ctor` places the function in the constructors' section, which is `unsafe` to do: it
+// runs before `main`, and touches only the allocator's options (no std runtime needed).
+#[allow(unsafe_code)]
 #[ctor::ctor(unsafe)]
 fn tune_the_allocator() {
     aviary_alloc::tune();

@@ -585,6 +585,8 @@ impl<'m> Engine<'m> {
         self.stop.cancel();
     }
 
+    // `run` sets the root scope before it starts anything that can ask for it.
+    #[allow(clippy::expect_used)]
     pub fn root_scope(&self) -> Rc<Scope<'m>> {
         self.root.borrow().clone().expect("the run has a root scope")
     }

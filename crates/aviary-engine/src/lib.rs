@@ -9,6 +9,7 @@
 //! inputs give the same trace.
 //!
 //! Invariant: the engine knows no backend; it talks to `aviary_api::Backend` only.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
 mod activity;
 mod api;

@@ -6,6 +6,7 @@
 //! diagnostics of every file they read; requests are answered each on a thread of its
 //! own, over the last check (`serve` says how the two are ordered). A panic in a handler
 //! is caught, logged to stderr and answered with an error; the server lives on.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::panic::{catch_unwind, AssertUnwindSafe};

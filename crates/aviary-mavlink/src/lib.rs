@@ -19,6 +19,7 @@
 //! This crate does network IO (it is an outer crate, like `aviary-server`); the engine
 //! never names it. Detection is geometric: the world's `[[targets]]` seen by the world's
 //! sensors along the track the vehicle reports (there is no camera pipeline).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
 mod backend;
 pub mod battery;

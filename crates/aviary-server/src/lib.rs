@@ -13,6 +13,7 @@
 //! hears them (`args.rs`, `bounds.rs`); every error is JSON
 //! (`reply.rs`). The server binds the address it is given; the CLI gives loopback unless
 //! told otherwise.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
 mod args;
 mod bounds;

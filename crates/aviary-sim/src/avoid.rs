@@ -246,6 +246,7 @@ impl Fleet {
     /// That the boxes [`Fleet::clear_ahead`] judged by hold the tracks the planner would
     /// have predicted (a debug build's check of [`reach_box`]'s reasoning).
     #[cfg(debug_assertions)]
+    #[allow(clippy::panic)] // a debug build's own check of its reasoning: it must stop loudly
     fn check_boxes(&mut self, id: DroneId, dt: f64, mine: Bounds, higher: &[DroneId]) {
         let (track, _) = predict_with(&self.drones[id], None, dt, &[], self.min_separation);
         let outside = |t: &Track, b: Bounds| t.iter().flatten().find(|p| !b.holds(**p)).copied();

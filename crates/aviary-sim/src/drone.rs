@@ -353,6 +353,7 @@ impl SimDrone {
 
 /// Asks the CPU to start loading the cache line at `p`; never faults, reads nothing.
 #[inline]
+#[allow(unsafe_code)] // the intrinsic is `unsafe`; a prefetch touches no memory
 fn prefetch<T>(p: *const T) {
     #[cfg(target_arch = "x86_64")]
     // SAFETY: a prefetch is a hint; it does not access memory (any address is allowed).

@@ -148,6 +148,7 @@
 //! [`SimBackend::stop`] (or [`SimBackend::shutdown`], which also waits for it), or once
 //! the last `Arc<SimBackend>` is dropped. Simulated time equals tokio time since the start
 //! (as long as the runtime keeps up, as it does with a paused clock).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
 mod air;
 mod args;

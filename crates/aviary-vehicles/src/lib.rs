@@ -38,6 +38,7 @@
 //! drone (no messages either way) for its duration; a `battery_critical` fault is
 //! ArduCopter's battery failsafe (STATUSTEXT, then RTL); a `crash` says "Crash: ..." and
 //! turns the state to EMERGENCY.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
 mod autopilot;
 mod client;

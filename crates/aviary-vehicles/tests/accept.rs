@@ -10,6 +10,7 @@ use std::time::Duration;
 use aviary_mavlink::mavlink::dialects::ardupilotmega::MavMessage;
 use common::{fleet, quick, serve, Gcs};
 
+#[allow(unsafe_code)] // the C call that reads the process's limit
 fn limit() -> libc::rlimit {
     let mut l = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
     // SAFETY: getrlimit writes the struct it is given.
@@ -17,6 +18,7 @@ fn limit() -> libc::rlimit {
     l
 }
 
+#[allow(unsafe_code)] // the C call that sets it
 fn set_limit(l: libc::rlimit) {
     // SAFETY: setrlimit reads the struct it is given.
     assert_eq!(unsafe { libc::setrlimit(libc::RLIMIT_NOFILE, &l) }, 0);

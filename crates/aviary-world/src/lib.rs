@@ -7,6 +7,7 @@
 //!   key or value at fault in that text, and says what to write instead.
 //! - One pass reports every problem; a [`World`] is returned only when there is none.
 //! - No input makes it panic.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
 mod build;
 #[cfg(test)]

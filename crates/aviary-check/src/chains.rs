@@ -8,7 +8,9 @@ use aviary_api::Descriptor;
 use aviary_diagnostics::{Code, Diagnostic, FileId};
 use aviary_syntax::ast::*;
 
-use crate::env::{capability_bodies, operator_signals, visit_stmts};
+use aviary_syntax::visit::for_each_stmt;
+
+use crate::env::{capability_bodies, operator_signals};
 use crate::Program;
 
 /// The names of the signals `SIGNAL`ed anywhere in the capabilities that run.
@@ -16,7 +18,7 @@ fn raised_in_capabilities(program: &Program) -> HashSet<&str> {
     let mut out = HashSet::new();
     for (_, c) in program.active_capabilities() {
         for body in capability_bodies(c) {
-            visit_stmts(body, &mut |stmt| {
+            for_each_stmt(body, |stmt| {
                 if let Stmt::Signal(r) = stmt {
                     out.insert(r.name.name.as_str());
                 }

@@ -17,6 +17,7 @@ use aviary_api::show::number;
 use aviary_api::{Descriptor, Kind};
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 use aviary_syntax::ast::*;
+use aviary_syntax::visit::for_each_stmt;
 use aviary_world::World;
 
 use crate::env::{bind_args, capability_bodies};
@@ -81,7 +82,7 @@ fn timed_capabilities<'p>(program: &'p Program, api: &Descriptor) -> foldhash::H
     let mut pending: Vec<&str> = Vec::new();
     for (_, c) in program.active_capabilities() {
         for body in capability_bodies(c) {
-            crate::env::visit_stmts(body, &mut |stmt| match stmt {
+            for_each_stmt(body, |stmt| match stmt {
                 Stmt::Statement(s) => callers
                     .entry(s.capability.name.as_str())
                     .or_default()

@@ -14,6 +14,7 @@ use aviary_api::show::number;
 use aviary_api::{arith, Function, Point};
 use aviary_diagnostics::{Code, Diagnostic, FileId, Label, Span};
 use aviary_syntax::ast::*;
+use aviary_syntax::visit::for_each_stmt;
 use aviary_world::World;
 
 use crate::env::{bind_args, capability_bodies};
@@ -92,7 +93,7 @@ pub(crate) struct Walker<'a> {
 /// before flight; the simulator still refuses such a flight (`GeofenceViolation`).
 pub(crate) fn follow_budget(mission: &Body) -> usize {
     let mut statements = 0usize;
-    crate::env::visit_stmts(mission, &mut |s| {
+    for_each_stmt(mission, |s| {
         statements += usize::from(matches!(s, Stmt::Statement(_)))
     });
     statements.saturating_mul(64).saturating_add(1_000_000)

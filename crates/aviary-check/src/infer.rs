@@ -12,7 +12,9 @@ use aviary_api::{Descriptor, Kind};
 use aviary_diagnostics::Span;
 use aviary_syntax::ast::*;
 
-use crate::env::{bind_args, capability_bodies, literal_kind, visit_stmts};
+use aviary_syntax::visit::for_each_stmt;
+
+use crate::env::{bind_args, capability_bodies, literal_kind};
 use crate::{ByName, Program};
 
 /// Where a parameter's kind was fixed: the place in its capability, why, and the callee
@@ -145,7 +147,7 @@ impl Uses<'_> {
     fn of(&self, c: &Capability) -> Vec<Learned> {
         let mut learned = Vec::new();
         for body in capability_bodies(c) {
-            visit_stmts(body, &mut |stmt| match stmt {
+            for_each_stmt(body, |stmt| match stmt {
                 Stmt::Api(call) => self.api_call(c, call, &mut learned),
                 Stmt::Statement(s) => self.capability_call(c, s, &mut learned),
                 _ => {}
@@ -227,7 +229,7 @@ fn callers(
     for (ci, c) in caps.iter().enumerate() {
         let Some(c) = c else { continue };
         for body in capability_bodies(c) {
-            visit_stmts(body, &mut |stmt| {
+            for_each_stmt(body, |stmt| {
                 if let Stmt::Statement(s) = stmt {
                     if let Some(&callee) = index.get(s.capability.name.as_str()) {
                         out[callee].push(ci);

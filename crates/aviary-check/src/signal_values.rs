@@ -13,7 +13,9 @@ use std::collections::BTreeMap;
 use aviary_api::{Descriptor, Kind};
 use aviary_syntax::ast::*;
 
-use crate::env::{bind_args, literal_kind, visit_stmts};
+use aviary_syntax::visit::for_each_stmt;
+
+use crate::env::{bind_args, literal_kind};
 use crate::Program;
 
 pub(crate) fn signal_values(
@@ -53,7 +55,7 @@ pub(crate) fn signal_values(
                 *program.param_kinds.get(&c.name.name)?.get(i)?
             };
             for body in bodies {
-                visit_stmts(body, &mut |stmt| match stmt {
+                for_each_stmt(body, |stmt| match stmt {
                     Stmt::Signal(r) if !builtin(&r.name.name) => {
                         for (i, a) in r.args.iter().enumerate() {
                             learn(
@@ -87,7 +89,7 @@ pub(crate) fn signal_values(
 fn binding_kind(program: &Program, api: &Descriptor, name: &str, body: &Body) -> Option<Kind> {
     let is_binding = |e: &Expr| matches!(&e.kind, ExprKind::Name(id) if id.name == name);
     let mut found = None;
-    visit_stmts(body, &mut |stmt| {
+    for_each_stmt(body, |stmt| {
         if found.is_some() {
             return;
         }

@@ -33,7 +33,9 @@ use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 use aviary_syntax::ast::*;
 use aviary_world::World;
 
-use crate::env::{capability_bodies, visit_stmts};
+use aviary_syntax::visit::for_each_stmt;
+
+use crate::env::capability_bodies;
 use crate::Program;
 
 /// The drones that may get work somewhere: world drones and a capability's own `BY`
@@ -74,7 +76,7 @@ pub(crate) fn check_unheard(
     let mission = program.mission().map(|m| &m.body);
     let capabilities = program.active_capabilities().flat_map(|(_, c)| capability_bodies(c));
     for body in mission.into_iter().chain(capabilities) {
-        visit_stmts(body, &mut |stmt| {
+        for_each_stmt(body, |stmt| {
             judged |= matches!(stmt, Stmt::Handler(h)
                 if h.by.is_some() && api.signal(&h.signal.name).is_some());
         });
@@ -275,7 +277,7 @@ impl<'a> Pass<'a> {
             let scope = Scope { file: FileId::default(), own: &c.actors, aliases: Vec::new() };
             let mut calls = Vec::new();
             for body in capability_bodies(c) {
-                visit_stmts(body, &mut |stmt| {
+                for_each_stmt(body, |stmt| {
                     if let Stmt::Statement(s) = stmt {
                         calls.push(s);
                     }
@@ -314,7 +316,7 @@ impl<'a> Pass<'a> {
             }
         }
         for body in capability_bodies(c) {
-            visit_stmts(body, &mut |stmt| match stmt {
+            for_each_stmt(body, |stmt| match stmt {
                 Stmt::ExceptionHandler(h) if caught(&h.exception.name) => found = true,
                 Stmt::Statement(s) => calls.push(s.capability.name.as_str()),
                 _ => {}
@@ -343,7 +345,7 @@ impl<'a> Pass<'a> {
         };
         let restored = BuiltinSignal::ConnectionRestored.name();
         let mut handlers = Vec::new();
-        visit_stmts(perform, &mut |stmt| {
+        for_each_stmt(perform, |stmt| {
             if let Stmt::Handler(h) = stmt {
                 if h.signal.name == restored {
                     handlers.push(h);

@@ -5,6 +5,7 @@ use std::collections::HashSet;
 use aviary_api::{Descriptor, Kind};
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 use aviary_syntax::ast::*;
+use aviary_syntax::visit::for_each_stmt;
 use aviary_world::World;
 
 use crate::env::*;
@@ -33,7 +34,7 @@ pub(crate) fn check_program(
                 Item::Use(_) => vec![],
             };
             for body in bodies {
-                visit_stmts(body, &mut |stmt| match stmt {
+                for_each_stmt(body, |stmt| match stmt {
                     Stmt::Statement(Statement { capability, tag: Some(tag), .. }) => {
                         tags.push((capability.name.as_str(), tag.name.as_str()))
                     }

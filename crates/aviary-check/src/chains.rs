@@ -76,7 +76,22 @@ fn walk<'a>(
                 }
             }
             Stmt::Handler(Handler { signal, by: Some(by), .. }) => out.filtered.push((signal, by)),
-            _ => {}
+            Stmt::Block(_)
+            | Stmt::Statement(_)
+            | Stmt::Leash(_)
+            | Stmt::Api(_)
+            | Stmt::Requirement(_)
+            | Stmt::For(_)
+            | Stmt::Throw(_)
+            | Stmt::Handler(_)
+            | Stmt::ExceptionHandler(_)
+            | Stmt::If(_)
+            | Stmt::OperatorSignals(_)
+            | Stmt::Any(_)
+            | Stmt::Let(_)
+            | Stmt::Allow(_)
+            | Stmt::StopBlock(_)
+            | Stmt::Error(_) => {}
         }
         let (inner_parallel, inner_copies) = match stmt {
             Stmt::Block(b) => (b.kind == BlockKind::Parallel, false),
@@ -85,7 +100,18 @@ fn walk<'a>(
             Stmt::Any(a) => (false, a.count.is_some()),
             Stmt::Handler(h) => (false, h.every),
             Stmt::ExceptionHandler(_) => (false, true),
-            _ => (false, false),
+            Stmt::Statement(_)
+            | Stmt::Leash(_)
+            | Stmt::Api(_)
+            | Stmt::Requirement(_)
+            | Stmt::Signal(_)
+            | Stmt::Throw(_)
+            | Stmt::If(_)
+            | Stmt::OperatorSignals(_)
+            | Stmt::Let(_)
+            | Stmt::Allow(_)
+            | Stmt::StopBlock(_)
+            | Stmt::Error(_) => (false, false),
         };
         let inner_for = in_for
             || (matches!(stmt, Stmt::For(_)) || matches!(stmt, Stmt::Any(a) if a.count.is_some()));
@@ -104,7 +130,21 @@ fn required_signals(e: &Expr) -> Vec<&Ident> {
             out.extend(required_signals(r));
             out
         }
-        _ => Vec::new(),
+        ExprKind::Number { .. }
+        | ExprKind::String(_)
+        | ExprKind::Bool(_)
+        | ExprKind::Coordinates(_)
+        | ExprKind::Geo(_)
+        | ExprKind::Name(_)
+        | ExprKind::Path(..)
+        | ExprKind::Distance(..)
+        | ExprKind::Arith(..)
+        | ExprKind::Offset(..)
+        | ExprKind::Midpoint(..)
+        | ExprKind::Elapsed
+        | ExprKind::Not(_)
+        | ExprKind::Binary(..)
+        | ExprKind::Error => Vec::new(),
     }
 }
 

@@ -86,6 +86,8 @@ pub(crate) fn unit_kind(unit: Option<Unit>) -> Kind {
 }
 
 /// The unit to suggest for a bare number where `kind` is expected.
+// Kinds of value, not constructs: only quantities have a unit.
+#[allow(clippy::wildcard_enum_match_arm)]
 pub(crate) fn unit_for(kind: Kind) -> Option<&'static str> {
     match kind {
         Kind::Length => Some("m"),

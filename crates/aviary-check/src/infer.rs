@@ -150,7 +150,21 @@ impl Uses<'_> {
             for_each_stmt(body, |stmt| match stmt {
                 Stmt::Api(call) => self.api_call(c, call, &mut learned),
                 Stmt::Statement(s) => self.capability_call(c, s, &mut learned),
-                _ => {}
+                Stmt::Block(_)
+                | Stmt::Leash(_)
+                | Stmt::Requirement(_)
+                | Stmt::For(_)
+                | Stmt::Signal(_)
+                | Stmt::Throw(_)
+                | Stmt::Handler(_)
+                | Stmt::ExceptionHandler(_)
+                | Stmt::If(_)
+                | Stmt::OperatorSignals(_)
+                | Stmt::Any(_)
+                | Stmt::Let(_)
+                | Stmt::Allow(_)
+                | Stmt::StopBlock(_)
+                | Stmt::Error(_) => {}
             });
         }
         learned
@@ -211,7 +225,22 @@ impl Uses<'_> {
 fn param_index(c: &Capability, e: &Expr) -> Option<usize> {
     match &e.kind {
         ExprKind::Name(id) => c.params.iter().position(|p| p.name == id.name),
-        _ => None,
+        ExprKind::Number { .. }
+        | ExprKind::String(_)
+        | ExprKind::Bool(_)
+        | ExprKind::Coordinates(_)
+        | ExprKind::Geo(_)
+        | ExprKind::Path(..)
+        | ExprKind::Distance(..)
+        | ExprKind::Arith(..)
+        | ExprKind::Offset(..)
+        | ExprKind::Midpoint(..)
+        | ExprKind::Received(_)
+        | ExprKind::Elapsed
+        | ExprKind::Not(_)
+        | ExprKind::Binary(..)
+        | ExprKind::Paren(_)
+        | ExprKind::Error => None,
     }
 }
 

@@ -44,7 +44,7 @@ pub(crate) fn signal_values(
             let Some(bodies) = program.walked_bodies(*file, item) else { continue };
             let capability = match item {
                 Item::Capability(c) => Some(c),
-                _ => None,
+                Item::Use(_) | Item::Mission(_) => None,
             };
             // A parameter of the capability being read, with the kind inference gave it.
             let param_kind = |e: &Expr| -> Option<Kind> {
@@ -76,7 +76,23 @@ pub(crate) fn signal_values(
                             );
                         }
                     }
-                    _ => {}
+                    Stmt::Block(_)
+                    | Stmt::Statement(_)
+                    | Stmt::Leash(_)
+                    | Stmt::Api(_)
+                    | Stmt::Requirement(_)
+                    | Stmt::For(_)
+                    | Stmt::Signal(_)
+                    | Stmt::Throw(_)
+                    | Stmt::Handler(_)
+                    | Stmt::ExceptionHandler(_)
+                    | Stmt::If(_)
+                    | Stmt::OperatorSignals(_)
+                    | Stmt::Any(_)
+                    | Stmt::Let(_)
+                    | Stmt::Allow(_)
+                    | Stmt::StopBlock(_)
+                    | Stmt::Error(_) => {}
                 });
             }
         }
@@ -118,7 +134,21 @@ fn binding_kind(program: &Program, api: &Descriptor, name: &str, body: &Body) ->
                     is_binding(arg).then_some(p.kind)
                 });
             }
-            _ => {}
+            Stmt::Block(_)
+            | Stmt::Leash(_)
+            | Stmt::Requirement(_)
+            | Stmt::For(_)
+            | Stmt::Signal(_)
+            | Stmt::Throw(_)
+            | Stmt::Handler(_)
+            | Stmt::ExceptionHandler(_)
+            | Stmt::If(_)
+            | Stmt::OperatorSignals(_)
+            | Stmt::Any(_)
+            | Stmt::Let(_)
+            | Stmt::Allow(_)
+            | Stmt::StopBlock(_)
+            | Stmt::Error(_) => {}
         }
     });
     found

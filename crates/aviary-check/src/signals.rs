@@ -77,7 +77,19 @@ impl<'a> Uses<'a> {
                             Stmt::ExceptionHandler(h) => {
                                 uses.exception_handlers.push((*file, &h.exception))
                             }
-                            _ => {}
+                            Stmt::Block(_)
+                            | Stmt::Statement(_)
+                            | Stmt::Leash(_)
+                            | Stmt::Api(_)
+                            | Stmt::Requirement(_)
+                            | Stmt::For(_)
+                            | Stmt::If(_)
+                            | Stmt::OperatorSignals(_)
+                            | Stmt::Any(_)
+                            | Stmt::Let(_)
+                            | Stmt::Allow(_)
+                            | Stmt::StopBlock(_)
+                            | Stmt::Error(_) => {}
                         }
                         for e in stmt_exprs(stmt) {
                             collect_received(*file, e, &mut uses);

@@ -107,7 +107,7 @@ pub(crate) fn check_unheard(
                         pass.body(&h.body, &scope, Place::Nested, out);
                     }
                 }
-                _ => {}
+                Section::Requirements { .. } | Section::Defaults { .. } => {}
             }
         }
         pass.restored_after_loss(c, file, &reported, out);
@@ -202,6 +202,8 @@ impl<'a> Pass<'a> {
             return;
         }
         let who = &by.name;
+        // Built-in signals, not constructs: only `Detected` comes from a call of its own.
+        #[allow(clippy::wildcard_enum_match_arm)]
         let raised = match signal {
             BuiltinSignal::Detected => "where it called `StartDetection`",
             _ => "where its work is (at mission level when it runs nothing)",
@@ -230,7 +232,21 @@ impl<'a> Pass<'a> {
                 }
                 Stmt::Api(a) => work.add(&self.resolve(&a.actor.name, scope)),
                 Stmt::Handler(h) if std::ptr::eq(h, except) => continue,
-                _ => {}
+                Stmt::Block(_)
+                | Stmt::Leash(_)
+                | Stmt::Requirement(_)
+                | Stmt::For(_)
+                | Stmt::Signal(_)
+                | Stmt::Throw(_)
+                | Stmt::Handler(_)
+                | Stmt::ExceptionHandler(_)
+                | Stmt::If(_)
+                | Stmt::OperatorSignals(_)
+                | Stmt::Any(_)
+                | Stmt::Let(_)
+                | Stmt::Allow(_)
+                | Stmt::StopBlock(_)
+                | Stmt::Error(_) => {}
             }
             let inner = self.inside(stmt, scope);
             stmt.for_each_body(|b| self.work(b, &inner, except, work));
@@ -319,7 +335,22 @@ impl<'a> Pass<'a> {
             for_each_stmt(body, |stmt| match stmt {
                 Stmt::ExceptionHandler(h) if caught(&h.exception.name) => found = true,
                 Stmt::Statement(s) => calls.push(s.capability.name.as_str()),
-                _ => {}
+                Stmt::Block(_)
+                | Stmt::Leash(_)
+                | Stmt::Api(_)
+                | Stmt::Requirement(_)
+                | Stmt::For(_)
+                | Stmt::Signal(_)
+                | Stmt::Throw(_)
+                | Stmt::Handler(_)
+                | Stmt::ExceptionHandler(_)
+                | Stmt::If(_)
+                | Stmt::OperatorSignals(_)
+                | Stmt::Any(_)
+                | Stmt::Let(_)
+                | Stmt::Allow(_)
+                | Stmt::StopBlock(_)
+                | Stmt::Error(_) => {}
             });
         }
         for callee in calls {
@@ -339,7 +370,10 @@ impl<'a> Pass<'a> {
     ) {
         let Some(perform) = c.sections.iter().find_map(|s| match s {
             Section::Perform { name: None, body, .. } => Some(body),
-            _ => None,
+            Section::Requirements { .. }
+            | Section::Defaults { .. }
+            | Section::Perform { .. }
+            | Section::Exceptions { .. } => None,
         }) else {
             return;
         };

@@ -175,7 +175,7 @@ impl<'a> Compiler<'a> {
     }
 
     fn collect_aliases(&mut self, body: &ast::Body) {
-        for stmt in &body.items {
+        aviary_syntax::visit::for_each_stmt(body, |stmt| {
             if let ast::Stmt::For(f) = stmt {
                 let mut drones = Vec::new();
                 for inst in &f.instances {
@@ -192,8 +192,7 @@ impl<'a> Compiler<'a> {
                     self.aliases.entry(a.alias.name.clone()).or_default().extend(g);
                 }
             }
-            stmt.for_each_body(|b| self.collect_aliases(b));
-        }
+        });
     }
 
     fn actor(&self, name: &str) -> ActorRef {

@@ -236,8 +236,9 @@ pub fn folding(server: &Server, p: FoldingRangeParams) -> Option<Vec<FoldingRang
     Some(out)
 }
 
+/// The spans of the statements in `body` that fold, nested ones included, outer first.
 fn body_spans(body: &Body, out: &mut Vec<Span>) {
-    for s in &body.items {
+    aviary_syntax::visit::for_each_stmt(body, |s| {
         let span = match s {
             Stmt::Block(b) => Some(b.span),
             Stmt::For(f) => Some(f.span),
@@ -259,8 +260,7 @@ fn body_spans(body: &Body, out: &mut Vec<Span>) {
             | Stmt::Error(_) => None,
         };
         out.extend(span);
-        s.for_each_body(|b| body_spans(b, out));
-    }
+    });
 }
 
 /// The name a "did you mean `X`?" help offers.

@@ -8,7 +8,9 @@ use aviary_api::Descriptor;
 use aviary_diagnostics::{Code, Diagnostic, FileId};
 use aviary_syntax::ast::*;
 
-use crate::env::{capability_bodies, operator_signals, visit_stmts};
+use aviary_syntax::visit::for_each_stmt;
+
+use crate::env::{capability_bodies, operator_signals};
 use crate::Program;
 
 /// The names of the signals `SIGNAL`ed anywhere in the capabilities that run.
@@ -16,7 +18,7 @@ fn raised_in_capabilities(program: &Program) -> HashSet<&str> {
     let mut out = HashSet::new();
     for (_, c) in program.active_capabilities() {
         for body in capability_bodies(c) {
-            visit_stmts(body, &mut |stmt| {
+            for_each_stmt(body, |stmt| {
                 if let Stmt::Signal(r) = stmt {
                     out.insert(r.name.name.as_str());
                 }
@@ -74,7 +76,22 @@ fn walk<'a>(
                 }
             }
             Stmt::Handler(Handler { signal, by: Some(by), .. }) => out.filtered.push((signal, by)),
-            _ => {}
+            Stmt::Block(_)
+            | Stmt::Statement(_)
+            | Stmt::Leash(_)
+            | Stmt::Api(_)
+            | Stmt::Requirement(_)
+            | Stmt::For(_)
+            | Stmt::Throw(_)
+            | Stmt::Handler(_)
+            | Stmt::ExceptionHandler(_)
+            | Stmt::If(_)
+            | Stmt::OperatorSignals(_)
+            | Stmt::Any(_)
+            | Stmt::Let(_)
+            | Stmt::Allow(_)
+            | Stmt::StopBlock(_)
+            | Stmt::Error(_) => {}
         }
         let (inner_parallel, inner_copies) = match stmt {
             Stmt::Block(b) => (b.kind == BlockKind::Parallel, false),
@@ -83,7 +100,18 @@ fn walk<'a>(
             Stmt::Any(a) => (false, a.count.is_some()),
             Stmt::Handler(h) => (false, h.every),
             Stmt::ExceptionHandler(_) => (false, true),
-            _ => (false, false),
+            Stmt::Statement(_)
+            | Stmt::Leash(_)
+            | Stmt::Api(_)
+            | Stmt::Requirement(_)
+            | Stmt::Signal(_)
+            | Stmt::Throw(_)
+            | Stmt::If(_)
+            | Stmt::OperatorSignals(_)
+            | Stmt::Let(_)
+            | Stmt::Allow(_)
+            | Stmt::StopBlock(_)
+            | Stmt::Error(_) => (false, false),
         };
         let inner_for = in_for
             || (matches!(stmt, Stmt::For(_)) || matches!(stmt, Stmt::Any(a) if a.count.is_some()));
@@ -102,7 +130,21 @@ fn required_signals(e: &Expr) -> Vec<&Ident> {
             out.extend(required_signals(r));
             out
         }
-        _ => Vec::new(),
+        ExprKind::Number { .. }
+        | ExprKind::String(_)
+        | ExprKind::Bool(_)
+        | ExprKind::Coordinates(_)
+        | ExprKind::Geo(_)
+        | ExprKind::Name(_)
+        | ExprKind::Path(..)
+        | ExprKind::Distance(..)
+        | ExprKind::Arith(..)
+        | ExprKind::Offset(..)
+        | ExprKind::Midpoint(..)
+        | ExprKind::Elapsed
+        | ExprKind::Not(_)
+        | ExprKind::Binary(..)
+        | ExprKind::Error => Vec::new(),
     }
 }
 

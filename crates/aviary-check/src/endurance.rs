@@ -17,6 +17,7 @@ use aviary_api::show::number;
 use aviary_api::{Descriptor, Kind};
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 use aviary_syntax::ast::*;
+use aviary_syntax::visit::for_each_stmt;
 use aviary_world::World;
 
 use crate::env::{bind_args, capability_bodies};
@@ -81,7 +82,7 @@ fn timed_capabilities<'p>(program: &'p Program, api: &Descriptor) -> foldhash::H
     let mut pending: Vec<&str> = Vec::new();
     for (_, c) in program.active_capabilities() {
         for body in capability_bodies(c) {
-            crate::env::visit_stmts(body, &mut |stmt| match stmt {
+            for_each_stmt(body, |stmt| match stmt {
                 Stmt::Statement(s) => callers
                     .entry(s.capability.name.as_str())
                     .or_default()
@@ -93,7 +94,22 @@ fn timed_capabilities<'p>(program: &'p Program, api: &Descriptor) -> foldhash::H
                 {
                     pending.push(c.name.name.as_str())
                 }
-                _ => {}
+                Stmt::Block(_)
+                | Stmt::Leash(_)
+                | Stmt::Api(_)
+                | Stmt::Requirement(_)
+                | Stmt::For(_)
+                | Stmt::Signal(_)
+                | Stmt::Throw(_)
+                | Stmt::Handler(_)
+                | Stmt::ExceptionHandler(_)
+                | Stmt::If(_)
+                | Stmt::OperatorSignals(_)
+                | Stmt::Any(_)
+                | Stmt::Let(_)
+                | Stmt::Allow(_)
+                | Stmt::StopBlock(_)
+                | Stmt::Error(_) => {}
             });
         }
     }
@@ -141,7 +157,19 @@ impl Walker<'_> {
                     inner.actors.insert(a.alias.name.clone(), self.drones(&a.group, env));
                     self.body(&a.body, &inner, file, depth);
                 }
-                other => other.for_each_body(|b| self.body(b, env, file, depth)),
+                other @ (Stmt::Block(_)
+                | Stmt::Leash(_)
+                | Stmt::Requirement(_)
+                | Stmt::Signal(_)
+                | Stmt::Throw(_)
+                | Stmt::Handler(_)
+                | Stmt::ExceptionHandler(_)
+                | Stmt::If(_)
+                | Stmt::OperatorSignals(_)
+                | Stmt::Let(_)
+                | Stmt::Allow(_)
+                | Stmt::StopBlock(_)
+                | Stmt::Error(_)) => other.for_each_body(|b| self.body(b, env, file, depth)),
             }
         }
     }
@@ -169,7 +197,21 @@ impl Walker<'_> {
             } => Some(Written { seconds: value * unit.to_si(), file, span: e.span }),
             ExprKind::Name(id) => env.durations.get(&id.name).copied(),
             ExprKind::Paren(inner) => self.duration(inner, env, file),
-            _ => None,
+            ExprKind::Number { .. }
+            | ExprKind::String(_)
+            | ExprKind::Bool(_)
+            | ExprKind::Coordinates(_)
+            | ExprKind::Geo(_)
+            | ExprKind::Path(..)
+            | ExprKind::Distance(..)
+            | ExprKind::Arith(..)
+            | ExprKind::Offset(..)
+            | ExprKind::Midpoint(..)
+            | ExprKind::Received(_)
+            | ExprKind::Elapsed
+            | ExprKind::Not(_)
+            | ExprKind::Binary(..)
+            | ExprKind::Error => None,
         }
     }
 

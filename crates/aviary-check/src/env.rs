@@ -1,4 +1,5 @@
-//! What names mean where: scopes of bindings over the world's names, and walking a body.
+//! What names mean where: scopes of bindings over the world's names; the bodies of a
+//! capability. (The walk over a body is `aviary_syntax::visit`.)
 
 use aviary_api::Kind;
 use aviary_syntax::ast::*;
@@ -25,14 +26,6 @@ pub(crate) enum Meaning {
     Unbound,
 }
 
-/// Calls `f` on every statement in `body`, nested bodies included, outer first.
-pub(crate) fn visit_stmts<'a>(body: &'a Body, f: &mut dyn FnMut(&'a Stmt)) {
-    for stmt in &body.items {
-        f(stmt);
-        stmt.for_each_body(|inner| visit_stmts(inner, f));
-    }
-}
-
 /// Every body of a capability: PERFORM sections and exception handlers.
 pub(crate) fn capability_bodies(c: &Capability) -> Vec<&Body> {
     let mut out = Vec::new();
@@ -40,34 +33,10 @@ pub(crate) fn capability_bodies(c: &Capability) -> Vec<&Body> {
         match section {
             Section::Perform { body, .. } => out.push(body),
             Section::Exceptions { handlers, .. } => out.extend(handlers.iter().map(|h| &h.body)),
-            _ => {}
+            Section::Requirements { .. } | Section::Defaults { .. } => {}
         }
     }
     out
-}
-
-/// Calls `f` on `expr` and every expression inside it.
-pub(crate) fn visit_exprs<'a>(expr: &'a Expr, f: &mut dyn FnMut(&'a Expr)) {
-    f(expr);
-    match &expr.kind {
-        ExprKind::Coordinates(parts) | ExprKind::Geo(parts) => {
-            parts.iter().for_each(|p| visit_exprs(p, f))
-        }
-        ExprKind::Distance(a, b)
-        | ExprKind::Binary(a, _, b)
-        | ExprKind::Arith(a, _, b)
-        | ExprKind::Midpoint(a, b) => {
-            visit_exprs(a, f);
-            visit_exprs(b, f);
-        }
-        ExprKind::Offset(a, d, b) => {
-            visit_exprs(a, f);
-            visit_exprs(d, f);
-            visit_exprs(b, f);
-        }
-        ExprKind::Not(e) | ExprKind::Paren(e) => visit_exprs(e, f),
-        _ => {}
-    }
 }
 
 /// The signals the MISSION declares with `OPERATOR SIGNAL` (directly in its body, the
@@ -83,27 +52,6 @@ pub(crate) fn operator_signals(program: &crate::Program) -> Vec<&Ident> {
         .collect()
 }
 
-/// The expressions a statement holds directly (not those of nested bodies).
-pub(crate) fn stmt_exprs(stmt: &Stmt) -> Vec<&Expr> {
-    fn args(args: &[Arg]) -> Vec<&Expr> {
-        args.iter().map(|a| &a.value).collect()
-    }
-    match stmt {
-        Stmt::Statement(s) => args(&s.args),
-        Stmt::Leash(l) => args(&l.args),
-        Stmt::Api(a) => a.args.iter().collect(),
-        Stmt::Requirement(r) => vec![&r.condition],
-        Stmt::For(f) => f.instances.iter().flat_map(|i| i.values.iter()).collect(),
-        Stmt::Any(a) => {
-            [&a.count, &a.condition, &a.nearest, &a.within].into_iter().flatten().collect()
-        }
-        Stmt::Signal(r) | Stmt::Throw(r) => args(&r.args),
-        Stmt::If(i) => i.branches.iter().map(|(c, _)| c).collect(),
-        Stmt::Let(l) => vec![&l.value],
-        _ => Vec::new(),
-    }
-}
-
 /// The kind a literal has by itself; names and paths need the environment.
 pub(crate) fn literal_kind(expr: &Expr) -> Option<Kind> {
     match &expr.kind {
@@ -117,7 +65,12 @@ pub(crate) fn literal_kind(expr: &Expr) -> Option<Kind> {
         ExprKind::Arith(l, _, _) => literal_kind(l),
         ExprKind::Elapsed => Some(Kind::Duration),
         ExprKind::Paren(e) => literal_kind(e),
-        _ => None,
+        ExprKind::Name(_)
+        | ExprKind::Path(..)
+        | ExprKind::Received(_)
+        | ExprKind::Not(_)
+        | ExprKind::Binary(..)
+        | ExprKind::Error => None,
     }
 }
 
@@ -133,6 +86,8 @@ pub(crate) fn unit_kind(unit: Option<Unit>) -> Kind {
 }
 
 /// The unit to suggest for a bare number where `kind` is expected.
+// Kinds of value, not constructs: only quantities have a unit.
+#[allow(clippy::wildcard_enum_match_arm)]
 pub(crate) fn unit_for(kind: Kind) -> Option<&'static str> {
     match kind {
         Kind::Length => Some("m"),

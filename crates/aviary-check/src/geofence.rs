@@ -14,6 +14,7 @@ use aviary_api::show::number;
 use aviary_api::{arith, Function, Point};
 use aviary_diagnostics::{Code, Diagnostic, FileId, Label, Span};
 use aviary_syntax::ast::*;
+use aviary_syntax::visit::for_each_stmt;
 use aviary_world::World;
 
 use crate::env::{bind_args, capability_bodies};
@@ -92,9 +93,7 @@ pub(crate) struct Walker<'a> {
 /// before flight; the simulator still refuses such a flight (`GeofenceViolation`).
 pub(crate) fn follow_budget(mission: &Body) -> usize {
     let mut statements = 0usize;
-    crate::env::visit_stmts(mission, &mut |s| {
-        statements += usize::from(matches!(s, Stmt::Statement(_)))
-    });
+    for_each_stmt(mission, |s| statements += usize::from(matches!(s, Stmt::Statement(_))));
     statements.saturating_mul(64).saturating_add(1_000_000)
 }
 
@@ -155,7 +154,16 @@ impl Walker<'_> {
                     (point_of(&self.value(a, values)?)?, point_of(&self.value(b, values)?)?);
                 Some(known_point(arith::midpoint(a, b)))
             }
-            _ => None,
+            ExprKind::String(_)
+            | ExprKind::Bool(_)
+            | ExprKind::Geo(_)
+            | ExprKind::Path(..)
+            | ExprKind::Distance(..)
+            | ExprKind::Received(_)
+            | ExprKind::Elapsed
+            | ExprKind::Not(_)
+            | ExprKind::Binary(..)
+            | ExprKind::Error => None,
         }
     }
 
@@ -217,7 +225,19 @@ impl Walker<'_> {
                 Stmt::ExceptionHandler(h) => {
                     self.body(&h.body, &without(values, &h.bindings), site, file, depth)
                 }
-                other => other.for_each_body(|b| self.body(b, values, site, file, depth)),
+                other @ (Stmt::Block(_)
+                | Stmt::Leash(_)
+                | Stmt::Requirement(_)
+                | Stmt::Signal(_)
+                | Stmt::Throw(_)
+                | Stmt::If(_)
+                | Stmt::OperatorSignals(_)
+                | Stmt::Let(_)
+                | Stmt::Allow(_)
+                | Stmt::StopBlock(_)
+                | Stmt::Error(_)) => {
+                    other.for_each_body(|b| self.body(b, values, site, file, depth))
+                }
             }
         }
     }
@@ -399,6 +419,8 @@ impl Walker<'_> {
         site: Option<(FileId, Span)>,
         file: FileId,
     ) {
+        // Diagnostic codes, not constructs: the one above the ceiling has help of its own.
+        #[allow(clippy::wildcard_enum_match_arm)]
         let help = match code {
             Code::AboveCeiling => "fly lower, or raise `max_altitude` in the world file's [site]",
             _ => {
@@ -451,7 +473,7 @@ pub(crate) fn default_of<'c>(callee: &'c Capability, name: &str) -> Option<&'c E
         Section::Defaults { entries, .. } => {
             entries.iter().rev().find(|e| e.name.name == name).map(|e| &e.value)
         }
-        _ => None,
+        Section::Requirements { .. } | Section::Perform { .. } | Section::Exceptions { .. } => None,
     })
 }
 

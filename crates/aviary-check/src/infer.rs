@@ -12,7 +12,9 @@ use aviary_api::{Descriptor, Kind};
 use aviary_diagnostics::Span;
 use aviary_syntax::ast::*;
 
-use crate::env::{bind_args, capability_bodies, literal_kind, visit_stmts};
+use aviary_syntax::visit::for_each_stmt;
+
+use crate::env::{bind_args, capability_bodies, literal_kind};
 use crate::{ByName, Program};
 
 /// Where a parameter's kind was fixed: the place in its capability, why, and the callee
@@ -145,10 +147,24 @@ impl Uses<'_> {
     fn of(&self, c: &Capability) -> Vec<Learned> {
         let mut learned = Vec::new();
         for body in capability_bodies(c) {
-            visit_stmts(body, &mut |stmt| match stmt {
+            for_each_stmt(body, |stmt| match stmt {
                 Stmt::Api(call) => self.api_call(c, call, &mut learned),
                 Stmt::Statement(s) => self.capability_call(c, s, &mut learned),
-                _ => {}
+                Stmt::Block(_)
+                | Stmt::Leash(_)
+                | Stmt::Requirement(_)
+                | Stmt::For(_)
+                | Stmt::Signal(_)
+                | Stmt::Throw(_)
+                | Stmt::Handler(_)
+                | Stmt::ExceptionHandler(_)
+                | Stmt::If(_)
+                | Stmt::OperatorSignals(_)
+                | Stmt::Any(_)
+                | Stmt::Let(_)
+                | Stmt::Allow(_)
+                | Stmt::StopBlock(_)
+                | Stmt::Error(_) => {}
             });
         }
         learned
@@ -209,7 +225,22 @@ impl Uses<'_> {
 fn param_index(c: &Capability, e: &Expr) -> Option<usize> {
     match &e.kind {
         ExprKind::Name(id) => c.params.iter().position(|p| p.name == id.name),
-        _ => None,
+        ExprKind::Number { .. }
+        | ExprKind::String(_)
+        | ExprKind::Bool(_)
+        | ExprKind::Coordinates(_)
+        | ExprKind::Geo(_)
+        | ExprKind::Path(..)
+        | ExprKind::Distance(..)
+        | ExprKind::Arith(..)
+        | ExprKind::Offset(..)
+        | ExprKind::Midpoint(..)
+        | ExprKind::Received(_)
+        | ExprKind::Elapsed
+        | ExprKind::Not(_)
+        | ExprKind::Binary(..)
+        | ExprKind::Paren(_)
+        | ExprKind::Error => None,
     }
 }
 
@@ -227,7 +258,7 @@ fn callers(
     for (ci, c) in caps.iter().enumerate() {
         let Some(c) = c else { continue };
         for body in capability_bodies(c) {
-            visit_stmts(body, &mut |stmt| {
+            for_each_stmt(body, |stmt| {
                 if let Stmt::Statement(s) = stmt {
                     if let Some(&callee) = index.get(s.capability.name.as_str()) {
                         out[callee].push(ci);

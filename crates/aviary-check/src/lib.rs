@@ -9,6 +9,10 @@
 // A pure stage: no unsafe code, and no panic on any input (tests may unwrap).
 #![forbid(unsafe_code)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+// A pass says what it does with every kind of node: a new statement, expression or IR
+// node is then a compile error in each pass (with clippy), not one it silently skips. An
+// enum that is no language construct may be matched with `_`, allowed where it is.
+#![deny(clippy::wildcard_enum_match_arm)]
 
 mod allow;
 mod chains;
@@ -31,7 +35,7 @@ use std::collections::BTreeMap;
 
 use aviary_api::{Descriptor, Kind};
 use aviary_diagnostics::{Diagnostic, FileId, SourceMap};
-use aviary_syntax::ast::{Capability, Mission, SourceFile};
+use aviary_syntax::ast::{Capability, Item, Mission, SourceFile};
 use aviary_world::World;
 
 pub use allow::{acknowledge, Allow};
@@ -83,8 +87,8 @@ impl Program {
     pub fn capability(&self, name: &str) -> Option<&Capability> {
         let r = self.index.get(name)?;
         match self.file(r.file)?.items.get(r.index)? {
-            aviary_syntax::ast::Item::Capability(c) => Some(c),
-            _ => None,
+            Item::Capability(c) => Some(c),
+            Item::Use(_) | Item::Mission(_) => None,
         }
     }
     /// The file that holds the MISSION, and its tree.
@@ -95,18 +99,16 @@ impl Program {
     pub fn mission(&self) -> Option<&Mission> {
         let r = self.mission?;
         match self.file(r.file)?.items.get(r.index)? {
-            aviary_syntax::ast::Item::Mission(m) => Some(m),
-            _ => None,
+            Item::Mission(m) => Some(m),
+            Item::Use(_) | Item::Capability(_) => None,
         }
     }
     /// The capabilities that run: user definitions, and library ones no user one replaces.
     pub fn active_capabilities(&self) -> impl Iterator<Item = (FileId, &Capability)> {
         self.files.iter().flat_map(move |(file, tree)| {
             tree.items.iter().filter_map(move |item| match item {
-                aviary_syntax::ast::Item::Capability(c) if self.is_active(*file, c) => {
-                    Some((*file, c))
-                }
-                _ => None,
+                Item::Capability(c) if self.is_active(*file, c) => Some((*file, c)),
+                Item::Use(_) | Item::Capability(_) | Item::Mission(_) => None,
             })
         })
     }
@@ -116,14 +118,12 @@ impl Program {
     pub fn walked_bodies<'a>(
         &self,
         file: FileId,
-        item: &'a aviary_syntax::ast::Item,
+        item: &'a Item,
     ) -> Option<Vec<&'a aviary_syntax::ast::Body>> {
         match item {
-            aviary_syntax::ast::Item::Mission(m) => Some(vec![&m.body]),
-            aviary_syntax::ast::Item::Capability(c) if self.is_active(file, c) => {
-                Some(env::capability_bodies(c))
-            }
-            _ => None,
+            Item::Mission(m) => Some(vec![&m.body]),
+            Item::Capability(c) if self.is_active(file, c) => Some(env::capability_bodies(c)),
+            Item::Use(_) | Item::Capability(_) => None,
         }
     }
     /// Whether this definition is the one its name means (not overridden, not a duplicate).
@@ -139,8 +139,8 @@ impl Program {
     /// Each name that means a capability, with the capability it means, in no order.
     pub fn capabilities(&self) -> impl Iterator<Item = (&str, &Capability)> {
         self.index.iter().filter_map(|(name, r)| match self.file(r.file)?.items.get(r.index)? {
-            aviary_syntax::ast::Item::Capability(c) => Some((&**name, c)),
-            _ => None,
+            Item::Capability(c) => Some((&**name, c)),
+            Item::Use(_) | Item::Mission(_) => None,
         })
     }
     /// How many names mean a capability.

@@ -14,7 +14,8 @@
 use std::collections::{HashMap, VecDeque};
 
 use aviary_diagnostics::{Code, Diagnostic, FileId};
-use aviary_syntax::ast::{Body, Capability, RequirementKind, Section, Statement, Stmt};
+use aviary_syntax::ast::{Capability, Expr, RequirementKind, Section, Statement, Stmt};
+use aviary_syntax::visit::{walk_stmt, Visitor};
 
 use crate::Program;
 
@@ -54,24 +55,37 @@ fn unconditional_calls<'a>(c: &'a Capability, f: &mut dyn FnMut(&'a Statement)) 
     }
     for section in &c.sections {
         if let Section::Perform { name: None, body, .. } = section {
-            visit(body, f);
+            Unconditional(&mut *f).visit_body(body);
         }
     }
 }
 
-fn visit<'a>(body: &'a Body, f: &mut dyn FnMut(&'a Statement)) {
-    for stmt in &body.items {
+/// The calls of a body that run whenever it runs: in plain blocks, `FOR`, `ANY` and after
+/// a `WAITFOR`, not under anything that decides whether its body runs.
+struct Unconditional<'f, 'a>(&'f mut dyn FnMut(&'a Statement));
+
+impl<'a> Visitor<'a> for Unconditional<'_, 'a> {
+    fn visit_stmt(&mut self, stmt: &'a Stmt) {
         match stmt {
-            Stmt::Statement(s) => f(s),
-            Stmt::Block(b) => visit(&b.body, f),
-            Stmt::For(x) => visit(&x.body, f),
-            Stmt::Any(x) => visit(&x.body, f),
-            Stmt::Requirement(r) if r.kind == RequirementKind::WaitFor => {
-                r.body.iter().for_each(|b| visit(b, f))
-            }
-            _ => {}
+            Stmt::Statement(s) => (self.0)(s),
+            Stmt::Block(_) | Stmt::For(_) | Stmt::Any(_) => walk_stmt(self, stmt),
+            Stmt::Requirement(r) => match r.kind {
+                RequirementKind::WaitFor => walk_stmt(self, stmt),
+                RequirementKind::StartIf | RequirementKind::DoWhile => {}
+            },
+            Stmt::If(_) | Stmt::Handler(_) | Stmt::ExceptionHandler(_) => {}
+            Stmt::Leash(_)
+            | Stmt::Api(_)
+            | Stmt::Signal(_)
+            | Stmt::Throw(_)
+            | Stmt::OperatorSignals(_)
+            | Stmt::Let(_)
+            | Stmt::Allow(_)
+            | Stmt::StopBlock(_)
+            | Stmt::Error(_) => {}
         }
     }
+    fn visit_expr(&mut self, _: &'a Expr) {}
 }
 
 /// The components of the call graph that hold a cycle (two or more capabilities, or

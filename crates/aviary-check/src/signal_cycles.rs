@@ -147,7 +147,15 @@ fn at_once<'a>(
                 instant
             }
             // A THROW ends the body; the rest may take time or may not run.
-            _ => false,
+            Stmt::Statement(_)
+            | Stmt::Api(_)
+            | Stmt::Requirement(_)
+            | Stmt::For(_)
+            | Stmt::Throw(_)
+            | Stmt::If(_)
+            | Stmt::Any(_)
+            | Stmt::Let(_)
+            | Stmt::StopBlock(_) => false,
         };
         if !instant {
             // In a PARALLEL block every item starts at once; in a sequence the next waits.

@@ -13,7 +13,9 @@ use std::collections::BTreeMap;
 use aviary_api::{Descriptor, Kind};
 use aviary_syntax::ast::*;
 
-use crate::env::{bind_args, literal_kind, visit_stmts};
+use aviary_syntax::visit::for_each_stmt;
+
+use crate::env::{bind_args, literal_kind};
 use crate::Program;
 
 pub(crate) fn signal_values(
@@ -42,7 +44,7 @@ pub(crate) fn signal_values(
             let Some(bodies) = program.walked_bodies(*file, item) else { continue };
             let capability = match item {
                 Item::Capability(c) => Some(c),
-                _ => None,
+                Item::Use(_) | Item::Mission(_) => None,
             };
             // A parameter of the capability being read, with the kind inference gave it.
             let param_kind = |e: &Expr| -> Option<Kind> {
@@ -53,7 +55,7 @@ pub(crate) fn signal_values(
                 *program.param_kinds.get(&c.name.name)?.get(i)?
             };
             for body in bodies {
-                visit_stmts(body, &mut |stmt| match stmt {
+                for_each_stmt(body, |stmt| match stmt {
                     Stmt::Signal(r) if !builtin(&r.name.name) => {
                         for (i, a) in r.args.iter().enumerate() {
                             learn(
@@ -74,7 +76,23 @@ pub(crate) fn signal_values(
                             );
                         }
                     }
-                    _ => {}
+                    Stmt::Block(_)
+                    | Stmt::Statement(_)
+                    | Stmt::Leash(_)
+                    | Stmt::Api(_)
+                    | Stmt::Requirement(_)
+                    | Stmt::For(_)
+                    | Stmt::Signal(_)
+                    | Stmt::Throw(_)
+                    | Stmt::Handler(_)
+                    | Stmt::ExceptionHandler(_)
+                    | Stmt::If(_)
+                    | Stmt::OperatorSignals(_)
+                    | Stmt::Any(_)
+                    | Stmt::Let(_)
+                    | Stmt::Allow(_)
+                    | Stmt::StopBlock(_)
+                    | Stmt::Error(_) => {}
                 });
             }
         }
@@ -87,7 +105,7 @@ pub(crate) fn signal_values(
 fn binding_kind(program: &Program, api: &Descriptor, name: &str, body: &Body) -> Option<Kind> {
     let is_binding = |e: &Expr| matches!(&e.kind, ExprKind::Name(id) if id.name == name);
     let mut found = None;
-    visit_stmts(body, &mut |stmt| {
+    for_each_stmt(body, |stmt| {
         if found.is_some() {
             return;
         }
@@ -116,7 +134,21 @@ fn binding_kind(program: &Program, api: &Descriptor, name: &str, body: &Body) ->
                     is_binding(arg).then_some(p.kind)
                 });
             }
-            _ => {}
+            Stmt::Block(_)
+            | Stmt::Leash(_)
+            | Stmt::Requirement(_)
+            | Stmt::For(_)
+            | Stmt::Signal(_)
+            | Stmt::Throw(_)
+            | Stmt::Handler(_)
+            | Stmt::ExceptionHandler(_)
+            | Stmt::If(_)
+            | Stmt::OperatorSignals(_)
+            | Stmt::Any(_)
+            | Stmt::Let(_)
+            | Stmt::Allow(_)
+            | Stmt::StopBlock(_)
+            | Stmt::Error(_) => {}
         }
     });
     found

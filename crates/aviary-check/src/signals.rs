@@ -8,7 +8,9 @@ use aviary_api::Descriptor;
 use aviary_diagnostics::{Code, Diagnostic, FileId};
 use aviary_syntax::ast::*;
 
-use crate::env::{operator_signals, stmt_exprs, visit_exprs, visit_stmts};
+use aviary_syntax::visit::{for_each_expr, for_each_stmt, stmt_exprs};
+
+use crate::env::operator_signals;
 use crate::Program;
 use aviary_diagnostics::suggest::did_you_mean;
 
@@ -67,7 +69,7 @@ impl<'a> Uses<'a> {
                     }
                 }
                 for body in bodies.drain(..) {
-                    visit_stmts(body, &mut |stmt| {
+                    for_each_stmt(body, |stmt| {
                         match stmt {
                             Stmt::Signal(r) => uses.raised.push((*file, &r.name)),
                             Stmt::Throw(r) => uses.thrown.push(&r.name.name),
@@ -75,7 +77,19 @@ impl<'a> Uses<'a> {
                             Stmt::ExceptionHandler(h) => {
                                 uses.exception_handlers.push((*file, &h.exception))
                             }
-                            _ => {}
+                            Stmt::Block(_)
+                            | Stmt::Statement(_)
+                            | Stmt::Leash(_)
+                            | Stmt::Api(_)
+                            | Stmt::Requirement(_)
+                            | Stmt::For(_)
+                            | Stmt::If(_)
+                            | Stmt::OperatorSignals(_)
+                            | Stmt::Any(_)
+                            | Stmt::Let(_)
+                            | Stmt::Allow(_)
+                            | Stmt::StopBlock(_)
+                            | Stmt::Error(_) => {}
                         }
                         for e in stmt_exprs(stmt) {
                             collect_received(*file, e, &mut uses);
@@ -215,7 +229,7 @@ fn never_handled(
 }
 
 fn collect_received<'a>(file: FileId, e: &'a Expr, uses: &mut Uses<'a>) {
-    visit_exprs(e, &mut |x| {
+    for_each_expr(e, |x| {
         if let ExprKind::Received(id) = &x.kind {
             uses.received.push((file, id));
         }
@@ -252,7 +266,7 @@ fn rethrows(program: &Program, diagnostics: &mut Vec<Diagnostic>) {
                 }
             }
             for body in bodies {
-                visit_stmts(body, &mut |stmt| {
+                for_each_stmt(body, |stmt| {
                     if let Stmt::ExceptionHandler(h) = stmt {
                         check(h);
                     }

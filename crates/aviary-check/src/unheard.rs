@@ -33,7 +33,9 @@ use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 use aviary_syntax::ast::*;
 use aviary_world::World;
 
-use crate::env::{capability_bodies, visit_stmts};
+use aviary_syntax::visit::for_each_stmt;
+
+use crate::env::capability_bodies;
 use crate::Program;
 
 /// The drones that may get work somewhere: world drones and a capability's own `BY`
@@ -74,7 +76,7 @@ pub(crate) fn check_unheard(
     let mission = program.mission().map(|m| &m.body);
     let capabilities = program.active_capabilities().flat_map(|(_, c)| capability_bodies(c));
     for body in mission.into_iter().chain(capabilities) {
-        visit_stmts(body, &mut |stmt| {
+        for_each_stmt(body, |stmt| {
             judged |= matches!(stmt, Stmt::Handler(h)
                 if h.by.is_some() && api.signal(&h.signal.name).is_some());
         });
@@ -105,7 +107,7 @@ pub(crate) fn check_unheard(
                         pass.body(&h.body, &scope, Place::Nested, out);
                     }
                 }
-                _ => {}
+                Section::Requirements { .. } | Section::Defaults { .. } => {}
             }
         }
         pass.restored_after_loss(c, file, &reported, out);
@@ -200,6 +202,8 @@ impl<'a> Pass<'a> {
             return;
         }
         let who = &by.name;
+        // Built-in signals, not constructs: only `Detected` comes from a call of its own.
+        #[allow(clippy::wildcard_enum_match_arm)]
         let raised = match signal {
             BuiltinSignal::Detected => "where it called `StartDetection`",
             _ => "where its work is (at mission level when it runs nothing)",
@@ -228,7 +232,21 @@ impl<'a> Pass<'a> {
                 }
                 Stmt::Api(a) => work.add(&self.resolve(&a.actor.name, scope)),
                 Stmt::Handler(h) if std::ptr::eq(h, except) => continue,
-                _ => {}
+                Stmt::Block(_)
+                | Stmt::Leash(_)
+                | Stmt::Requirement(_)
+                | Stmt::For(_)
+                | Stmt::Signal(_)
+                | Stmt::Throw(_)
+                | Stmt::Handler(_)
+                | Stmt::ExceptionHandler(_)
+                | Stmt::If(_)
+                | Stmt::OperatorSignals(_)
+                | Stmt::Any(_)
+                | Stmt::Let(_)
+                | Stmt::Allow(_)
+                | Stmt::StopBlock(_)
+                | Stmt::Error(_) => {}
             }
             let inner = self.inside(stmt, scope);
             stmt.for_each_body(|b| self.work(b, &inner, except, work));
@@ -275,7 +293,7 @@ impl<'a> Pass<'a> {
             let scope = Scope { file: FileId::default(), own: &c.actors, aliases: Vec::new() };
             let mut calls = Vec::new();
             for body in capability_bodies(c) {
-                visit_stmts(body, &mut |stmt| {
+                for_each_stmt(body, |stmt| {
                     if let Stmt::Statement(s) = stmt {
                         calls.push(s);
                     }
@@ -314,10 +332,25 @@ impl<'a> Pass<'a> {
             }
         }
         for body in capability_bodies(c) {
-            visit_stmts(body, &mut |stmt| match stmt {
+            for_each_stmt(body, |stmt| match stmt {
                 Stmt::ExceptionHandler(h) if caught(&h.exception.name) => found = true,
                 Stmt::Statement(s) => calls.push(s.capability.name.as_str()),
-                _ => {}
+                Stmt::Block(_)
+                | Stmt::Leash(_)
+                | Stmt::Api(_)
+                | Stmt::Requirement(_)
+                | Stmt::For(_)
+                | Stmt::Signal(_)
+                | Stmt::Throw(_)
+                | Stmt::Handler(_)
+                | Stmt::ExceptionHandler(_)
+                | Stmt::If(_)
+                | Stmt::OperatorSignals(_)
+                | Stmt::Any(_)
+                | Stmt::Let(_)
+                | Stmt::Allow(_)
+                | Stmt::StopBlock(_)
+                | Stmt::Error(_) => {}
             });
         }
         for callee in calls {
@@ -337,13 +370,16 @@ impl<'a> Pass<'a> {
     ) {
         let Some(perform) = c.sections.iter().find_map(|s| match s {
             Section::Perform { name: None, body, .. } => Some(body),
-            _ => None,
+            Section::Requirements { .. }
+            | Section::Defaults { .. }
+            | Section::Perform { .. }
+            | Section::Exceptions { .. } => None,
         }) else {
             return;
         };
         let restored = BuiltinSignal::ConnectionRestored.name();
         let mut handlers = Vec::new();
-        visit_stmts(perform, &mut |stmt| {
+        for_each_stmt(perform, |stmt| {
             if let Stmt::Handler(h) = stmt {
                 if h.signal.name == restored {
                     handlers.push(h);

@@ -16,6 +16,10 @@
 // A pure stage: no unsafe code, and no panic on any input (tests may unwrap).
 #![forbid(unsafe_code)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+// A pass says what it does with every kind of node: a new statement, expression or IR
+// node is then a compile error in each pass (with clippy), not one it silently skips. An
+// enum that is no language construct may be matched with `_`, allowed where it is.
+#![deny(clippy::wildcard_enum_match_arm)]
 
 use aviary_api::{BuiltinException, BuiltinSignal, DroneId, Function, Kind, Resource, Value};
 use aviary_diagnostics::{FileId, Span};
@@ -222,7 +226,8 @@ pub struct Block {
 
 impl Block {
     /// Calls `f` on every node below this block: items, nested bodies, and the bodies of
-    /// its handlers and exception handlers.
+    /// its handlers and exception handlers. The one walk over the IR: it names every kind
+    /// of node, so a new one is a compile error here rather than a body left unvisited.
     pub fn visit<'b>(&'b self, f: &mut dyn FnMut(&'b Node)) {
         for body in self
             .handlers
@@ -249,7 +254,14 @@ impl Block {
                         b.visit(f);
                     }
                 }
-                _ => {}
+                Node::WaitFor { body: None, .. }
+                | Node::Call(_)
+                | Node::Leash(_)
+                | Node::Api(_)
+                | Node::Signal { .. }
+                | Node::Throw { .. }
+                | Node::Let { .. }
+                | Node::StopBlock { .. } => {}
             }
         }
     }
@@ -465,7 +477,12 @@ impl Compare {
         fn text(v: &Value) -> Option<&str> {
             match v {
                 Value::Text(s) | Value::Symbol(s) => Some(s),
-                _ => None,
+                Value::Number(_)
+                | Value::Bool(_)
+                | Value::Position(_)
+                | Value::Area(_)
+                | Value::Actor(_)
+                | Value::Remainder(_) => None,
             }
         }
         let equal = match (text(a), text(b)) {
@@ -475,7 +492,7 @@ impl Compare {
         match self {
             Compare::Eq => equal,
             Compare::Ne => !equal,
-            _ => false,
+            Compare::Lt | Compare::Le | Compare::Gt | Compare::Ge => false,
         }
     }
 }

@@ -175,7 +175,7 @@ impl<'a> Compiler<'a> {
     }
 
     fn collect_aliases(&mut self, body: &ast::Body) {
-        for stmt in &body.items {
+        aviary_syntax::visit::for_each_stmt(body, |stmt| {
             if let ast::Stmt::For(f) = stmt {
                 let mut drones = Vec::new();
                 for inst in &f.instances {
@@ -192,8 +192,7 @@ impl<'a> Compiler<'a> {
                     self.aliases.entry(a.alias.name.clone()).or_default().extend(g);
                 }
             }
-            stmt.for_each_body(|b| self.collect_aliases(b));
-        }
+        });
     }
 
     fn actor(&self, name: &str) -> ActorRef {
@@ -328,7 +327,20 @@ impl<'a> Compiler<'a> {
                     let handler = self.exception_handler(h, path);
                     block.exception_handlers.push(handler);
                 }
-                other => {
+                other @ (ast::Stmt::Block(_)
+                | ast::Stmt::Statement(_)
+                | ast::Stmt::Leash(_)
+                | ast::Stmt::Api(_)
+                | ast::Stmt::Requirement(_)
+                | ast::Stmt::For(_)
+                | ast::Stmt::Signal(_)
+                | ast::Stmt::Throw(_)
+                | ast::Stmt::If(_)
+                | ast::Stmt::OperatorSignals(_)
+                | ast::Stmt::Any(_)
+                | ast::Stmt::Allow(_)
+                | ast::Stmt::StopBlock(_)
+                | ast::Stmt::Error(_)) => {
                     if let Some(node) = self.node(other, path) {
                         block.items.push(node);
                     }
@@ -564,7 +576,10 @@ impl<'a> Compiler<'a> {
             name => {
                 let sections = callee.sections.iter().filter_map(|s| match s {
                     ast::Section::Perform { name: Some(n), .. } => Some(n.name.as_str()),
-                    _ => None,
+                    ast::Section::Requirements { .. }
+                    | ast::Section::Defaults { .. }
+                    | ast::Section::Perform { .. }
+                    | ast::Section::Exceptions { .. } => None,
                 });
                 LeashAction::Section(sections.enumerate().find(|(_, n)| *n == name)?.0)
             }
@@ -741,7 +756,24 @@ fn literal_numbers(parts: &[Expr]) -> Option<Vec<f64>> {
         .iter()
         .map(|p| match p {
             Expr::Const(Value::Number(n)) => Some(*n),
-            _ => None,
+            Expr::Const(_)
+            | Expr::Slot(_)
+            | Expr::Actor(_)
+            | Expr::Telemetry(..)
+            | Expr::Attribute(..)
+            | Expr::Point(_)
+            | Expr::Geo(_)
+            | Expr::Distance(..)
+            | Expr::Add(..)
+            | Expr::Sub(..)
+            | Expr::Offset(..)
+            | Expr::Midpoint(..)
+            | Expr::Elapsed
+            | Expr::Received(_)
+            | Expr::Not(_)
+            | Expr::And(..)
+            | Expr::Or(..)
+            | Expr::Compare(..) => None,
         })
         .collect()
 }

@@ -3,8 +3,12 @@
 //! place, area, drone, group or tag, definitions marked. Hover, go to definition, find
 //! references, rename and semantic tokens all read it.
 
+// Each statement and expression is named: a new one is a compile error here.
+#![deny(clippy::wildcard_enum_match_arm)]
+
 use aviary_diagnostics::{FileId, Span};
 use aviary_syntax::ast::{Arg, Body, Capability, Expr, ExprKind, Item, Section, SourceFile, Stmt};
+use aviary_syntax::visit::{walk_expr, Visitor};
 use aviary_world::World;
 
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -357,26 +361,28 @@ impl<'a> Walk<'a> {
                 };
                 self.push(id.span, sym, false);
             }
-            ExprKind::Coordinates(v) | ExprKind::Geo(v) => v.iter().for_each(|x| self.expr(x)),
-            ExprKind::Distance(a, b)
-            | ExprKind::Binary(a, _, b)
-            | ExprKind::Arith(a, _, b)
-            | ExprKind::Midpoint(a, b) => {
-                self.expr(a);
-                self.expr(b);
-            }
-            ExprKind::Offset(p, d, b) => {
-                self.expr(p);
-                self.expr(d);
-                self.expr(b);
-            }
-            ExprKind::Not(a) | ExprKind::Paren(a) => self.expr(a),
+            ExprKind::Coordinates(_)
+            | ExprKind::Geo(_)
+            | ExprKind::Distance(..)
+            | ExprKind::Binary(..)
+            | ExprKind::Arith(..)
+            | ExprKind::Midpoint(..)
+            | ExprKind::Offset(..)
+            | ExprKind::Not(_)
+            | ExprKind::Paren(_) => walk_expr(self, e),
             ExprKind::Number { .. }
             | ExprKind::String(_)
             | ExprKind::Bool(_)
             | ExprKind::Elapsed
             | ExprKind::Error => {}
         }
+    }
+}
+
+/// The expressions inside an expression: the tree's own walk, back into `Walk::expr`.
+impl<'a> Visitor<'a> for Walk<'a> {
+    fn visit_expr(&mut self, e: &'a Expr) {
+        self.expr(e);
     }
 }
 

@@ -181,29 +181,8 @@ impl Stmt {
     }
 
     /// Calls `f` on each body directly inside this item, in source order.
-    pub fn for_each_body<'a>(&'a self, mut f: impl FnMut(&'a Body)) {
-        match self {
-            Stmt::Block(b) => f(&b.body),
-            Stmt::Requirement(r) => r.body.iter().for_each(f),
-            Stmt::For(x) => f(&x.body),
-            Stmt::Any(x) => f(&x.body),
-            Stmt::Handler(h) => f(&h.body),
-            Stmt::ExceptionHandler(h) => f(&h.body),
-            Stmt::If(i) => {
-                i.branches.iter().for_each(|(_, b)| f(b));
-                i.otherwise.iter().for_each(f);
-            }
-            Stmt::Statement(_)
-            | Stmt::Leash(_)
-            | Stmt::Api(_)
-            | Stmt::Signal(_)
-            | Stmt::Throw(_)
-            | Stmt::OperatorSignals(_)
-            | Stmt::Let(_)
-            | Stmt::Allow(_)
-            | Stmt::StopBlock(_)
-            | Stmt::Error(_) => {}
-        }
+    pub fn for_each_body<'a>(&'a self, f: impl FnMut(&'a Body)) {
+        crate::visit::stmt_bodies(self, f)
     }
 }
 

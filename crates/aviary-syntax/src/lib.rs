@@ -14,6 +14,7 @@ mod layout;
 mod lexer;
 mod parser;
 pub mod token;
+pub mod visit;
 
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 

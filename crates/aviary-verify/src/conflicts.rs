@@ -226,6 +226,9 @@ impl Bucket<'_> {
         }
         for same in children.chunk_by(|a, b| a.0 .0 == b.0 .0) {
             let id = same[0].0 .0;
+            // The analysis's own kinds of step, not the IR's nodes (`sites.rs` names those):
+            // only parallel blocks and FOR order nothing.
+            #[allow(clippy::wildcard_enum_match_arm)]
             match self.sites.constructs[id] {
                 // A SEQUENTIAL block without handlers orders all it holds: nothing here.
                 Construct::Block(kind)
@@ -447,6 +450,8 @@ fn report(
     let cap = |s: &ClaimSite| mission.capabilities[s.capability].name.clone();
     let signal = |s: &SignalId| mission.signals[*s].clone();
     let res = resource.as_str();
+    // Kinds of finding, not constructs: several share one wording.
+    #[allow(clippy::wildcard_enum_match_arm)]
     let (code, message, help) = match why {
         Overlap::Firings(s) => (
             Code::CommandsQueue,

@@ -415,7 +415,19 @@ fn section_raises(mission: &Mission, raises_of: &[BTreeSet<SignalId>]) -> Vec<BT
                     Node::Api(a) if a.function == Function::StartDetection => {
                         raised.insert(detected);
                     }
-                    _ => {}
+                    // Nothing raised by the node itself: `visit` goes into its bodies.
+                    Node::Block(_)
+                    | Node::Leash(_)
+                    | Node::Api(_)
+                    | Node::Throw { .. }
+                    | Node::StartIf { .. }
+                    | Node::WaitFor { .. }
+                    | Node::DoWhile { .. }
+                    | Node::For(_)
+                    | Node::Any(_)
+                    | Node::If { .. }
+                    | Node::Let { .. }
+                    | Node::StopBlock { .. } => {}
                 });
             }
             raised
@@ -442,7 +454,19 @@ fn capability_raises(mission: &Mission) -> Vec<BTreeSet<SignalId>> {
                 Node::Api(a) if a.function == Function::StartDetection => {
                     raised.insert(detected);
                 }
-                _ => {}
+                // Nothing raised by the node itself: `visit` goes into its bodies.
+                Node::Block(_)
+                | Node::Leash(_)
+                | Node::Api(_)
+                | Node::Throw { .. }
+                | Node::StartIf { .. }
+                | Node::WaitFor { .. }
+                | Node::DoWhile { .. }
+                | Node::For(_)
+                | Node::Any(_)
+                | Node::If { .. }
+                | Node::Let { .. }
+                | Node::StopBlock { .. } => {}
             });
         }
         direct.push(raised);

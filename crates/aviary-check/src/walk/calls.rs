@@ -63,6 +63,9 @@ impl<'a> Checker<'a> {
             format!("to fly there, write `{} FlyTo WITH {}`", actors.join(" "), s.capability.name);
         let names_no_capability =
             format!("a statement ends with the capability: `{all} FlyTo WITH ...`");
+        // What a name means, not a construct: the rest (an unbound name, a value) has no
+        // hint of its own.
+        #[allow(clippy::wildcard_enum_match_arm)]
         let what = match self.lookup(&s.capability.name) {
             Meaning::Drone => Some(("a drone, not a capability", names_no_capability)),
             Meaning::Group => Some(("a group of drones, not a capability", names_no_capability)),
@@ -162,7 +165,9 @@ impl<'a> Checker<'a> {
                 Section::Defaults { entries, .. } => {
                     Some(entries.iter().map(|e| e.name.name.as_str()))
                 }
-                _ => None,
+                Section::Requirements { .. }
+                | Section::Perform { .. }
+                | Section::Exceptions { .. } => None,
             })
             .flatten()
             .collect();
@@ -286,7 +291,10 @@ impl<'a> Checker<'a> {
             .iter()
             .filter_map(|s| match s {
                 Section::Perform { name: Some(n), .. } => Some(n.name.as_str()),
-                _ => None,
+                Section::Requirements { .. }
+                | Section::Defaults { .. }
+                | Section::Perform { .. }
+                | Section::Exceptions { .. } => None,
             })
             .collect();
         let builtin = ["ABORT", "PAUSE", "RESUME"];

@@ -60,11 +60,15 @@ impl<'a> Checker<'a> {
             if actual == Kind::Symbol
                 && matches!(expected, Kind::Position | Kind::Area | Kind::Path)
             {
+                // Kinds of value, not constructs: the rest of the three is a position.
+                #[allow(clippy::wildcard_enum_match_arm)]
                 let noun = match expected {
                     Kind::Area => "area",
                     Kind::Path => "line or place",
                     _ => "place",
                 };
+                // As for `noun`.
+                #[allow(clippy::wildcard_enum_match_arm)]
                 let candidates: Vec<&str> = self.world.map_or(Vec::new(), |w| {
                     let areas = w.areas.iter().map(|a| a.name.as_str());
                     let places = w.places.iter().map(|p| p.name.as_str());
@@ -158,7 +162,22 @@ impl<'a> Checker<'a> {
             (Kind::Area, Kind::Position) => {
                 let what = match &e.kind {
                     ExprKind::Name(id) => format!("`{}` is a place, a single point", id.name),
-                    _ => "a position is a single point".to_string(),
+                    ExprKind::Number { .. }
+                    | ExprKind::String(_)
+                    | ExprKind::Bool(_)
+                    | ExprKind::Coordinates(_)
+                    | ExprKind::Geo(_)
+                    | ExprKind::Path(..)
+                    | ExprKind::Distance(..)
+                    | ExprKind::Arith(..)
+                    | ExprKind::Offset(..)
+                    | ExprKind::Midpoint(..)
+                    | ExprKind::Received(_)
+                    | ExprKind::Elapsed
+                    | ExprKind::Not(_)
+                    | ExprKind::Binary(..)
+                    | ExprKind::Paren(_)
+                    | ExprKind::Error => "a position is a single point".to_string(),
                 };
                 match world_example(true) {
                     Some(area) => format!("{what}, with no area to cover: name an area of the world file's [areas], such as `{area}`, or add one there (an area stands for its centre where a position is expected, so one area serves both)"),
@@ -216,13 +235,12 @@ impl<'a> Checker<'a> {
         );
         d.primary.message = format!("expected {}", expected.describe());
         let flown = REMAINDER_FLOWN;
-        d.help = Some(match expected {
-            Kind::Position => {
-                format!("{flown}; for where a drone is, name the drone or read `drone.position`")
-            }
-            _ => format!(
+        d.help = Some(if expected == Kind::Position {
+            format!("{flown}; for where a drone is, name the drone or read `drone.position`")
+        } else {
+            format!(
                 "{flown}; to compare how far a drone got, read its telemetry (`drone.position`)"
-            ),
+            )
         });
     }
 
@@ -240,7 +258,9 @@ impl<'a> Checker<'a> {
             Section::Defaults { entries, .. } => {
                 entries.iter().find(|d| d.name.name == id.name).map(|d| &d.value)
             }
-            _ => None,
+            Section::Requirements { .. } | Section::Perform { .. } | Section::Exceptions { .. } => {
+                None
+            }
         });
         Some((id.name.clone(), cap.name.name.clone(), default))
     }
@@ -248,13 +268,27 @@ impl<'a> Checker<'a> {
     /// `Some(Actor)` when `e` names a drone, group or alias; reports nothing.
     pub(super) fn kind_of_quietly(&self, e: &Expr) -> Option<Kind> {
         match &e.kind {
-            ExprKind::Name(id) => match self.lookup(&id.name) {
-                Meaning::Local(Binding::Actor) | Meaning::Drone | Meaning::Group => {
-                    Some(Kind::Actor)
-                }
-                _ => None,
-            },
-            _ => None,
+            ExprKind::Name(id) => matches!(
+                self.lookup(&id.name),
+                Meaning::Local(Binding::Actor) | Meaning::Drone | Meaning::Group
+            )
+            .then_some(Kind::Actor),
+            ExprKind::Number { .. }
+            | ExprKind::String(_)
+            | ExprKind::Bool(_)
+            | ExprKind::Coordinates(_)
+            | ExprKind::Geo(_)
+            | ExprKind::Path(..)
+            | ExprKind::Distance(..)
+            | ExprKind::Arith(..)
+            | ExprKind::Offset(..)
+            | ExprKind::Midpoint(..)
+            | ExprKind::Received(_)
+            | ExprKind::Elapsed
+            | ExprKind::Not(_)
+            | ExprKind::Binary(..)
+            | ExprKind::Paren(_)
+            | ExprKind::Error => None,
         }
     }
 
@@ -359,7 +393,10 @@ impl<'a> Checker<'a> {
             }
             ExprKind::Paren(inner) => self.kind_of(inner),
             ExprKind::Error => None,
-            _ => literal_kind(e),
+            ExprKind::Number { .. }
+            | ExprKind::String(_)
+            | ExprKind::Bool(_)
+            | ExprKind::Elapsed => literal_kind(e),
         }
     }
 
@@ -497,7 +534,22 @@ impl<'a> Checker<'a> {
 fn unparen(e: &Expr) -> &Expr {
     match &e.kind {
         ExprKind::Paren(inner) => unparen(inner),
-        _ => e,
+        ExprKind::Number { .. }
+        | ExprKind::String(_)
+        | ExprKind::Bool(_)
+        | ExprKind::Coordinates(_)
+        | ExprKind::Geo(_)
+        | ExprKind::Name(_)
+        | ExprKind::Path(..)
+        | ExprKind::Distance(..)
+        | ExprKind::Arith(..)
+        | ExprKind::Offset(..)
+        | ExprKind::Midpoint(..)
+        | ExprKind::Received(_)
+        | ExprKind::Elapsed
+        | ExprKind::Not(_)
+        | ExprKind::Binary(..)
+        | ExprKind::Error => e,
     }
 }
 

@@ -7,6 +7,7 @@
 use aviary_api::Kind;
 use aviary_diagnostics::{Code, Label};
 use aviary_syntax::ast::*;
+use aviary_syntax::visit::for_each_stmt;
 
 use super::Checker;
 use crate::env::*;
@@ -18,7 +19,7 @@ pub(super) type Hidden<'a> = (Vec<(&'a str, Binding)>, usize);
 pub(super) fn all_lets<'a>(bodies: &[&'a Body]) -> Vec<&'a Let> {
     let mut out = Vec::new();
     for body in bodies {
-        visit_stmts(body, &mut |stmt| {
+        for_each_stmt(body, |stmt| {
             if let Stmt::Let(l) = stmt {
                 out.push(l);
             }

@@ -5,6 +5,7 @@ use std::collections::HashSet;
 use aviary_api::{Descriptor, Kind};
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 use aviary_syntax::ast::*;
+use aviary_syntax::visit::for_each_stmt;
 use aviary_world::World;
 
 use crate::env::*;
@@ -33,7 +34,7 @@ pub(crate) fn check_program(
                 Item::Use(_) => vec![],
             };
             for body in bodies {
-                visit_stmts(body, &mut |stmt| match stmt {
+                for_each_stmt(body, |stmt| match stmt {
                     Stmt::Statement(Statement { capability, tag: Some(tag), .. }) => {
                         tags.push((capability.name.as_str(), tag.name.as_str()))
                     }
@@ -44,7 +45,21 @@ pub(crate) fn check_program(
                         aliases.insert(a.alias.name.as_str());
                     }
                     Stmt::Block(Block { name: Some(name), .. }) => blocks.push(name.name.as_str()),
-                    _ => {}
+                    Stmt::Block(_)
+                    | Stmt::Statement(_)
+                    | Stmt::Leash(_)
+                    | Stmt::Api(_)
+                    | Stmt::Requirement(_)
+                    | Stmt::Signal(_)
+                    | Stmt::Throw(_)
+                    | Stmt::Handler(_)
+                    | Stmt::ExceptionHandler(_)
+                    | Stmt::If(_)
+                    | Stmt::OperatorSignals(_)
+                    | Stmt::Let(_)
+                    | Stmt::Allow(_)
+                    | Stmt::StopBlock(_)
+                    | Stmt::Error(_) => {}
                 });
             }
         }
@@ -96,7 +111,7 @@ pub(crate) fn check_program(
                 {
                     checker.capability_def(c);
                 }
-                _ => {}
+                Item::Use(_) | Item::Capability(_) | Item::Mission(_) => {}
             }
         }
     }
@@ -289,7 +304,18 @@ impl<'a> Checker<'a> {
                 | Stmt::ExceptionHandler(_)
                 | Stmt::OperatorSignals(_)
                 | Stmt::Error(_) => self.stmt(stmt),
-                _ => {
+                Stmt::Block(_)
+                | Stmt::Statement(_)
+                | Stmt::Leash(_)
+                | Stmt::Api(_)
+                | Stmt::Requirement(_)
+                | Stmt::For(_)
+                | Stmt::Signal(_)
+                | Stmt::Throw(_)
+                | Stmt::If(_)
+                | Stmt::Any(_)
+                | Stmt::Allow(_)
+                | Stmt::StopBlock(_) => {
                     at_start = false;
                     self.stmt(stmt);
                 }
@@ -613,7 +639,16 @@ fn shown(e: &Expr) -> Option<String> {
         ExprKind::Received(id) => Some(format!("RECEIVED({})", id.name)),
         ExprKind::Distance(a, b) => Some(format!("distance({}, {})", shown(a)?, shown(b)?)),
         ExprKind::Paren(inner) => shown(inner).map(|s| format!("({s})")),
-        _ => None,
+        ExprKind::String(_)
+        | ExprKind::Bool(_)
+        | ExprKind::Coordinates(_)
+        | ExprKind::Geo(_)
+        | ExprKind::Arith(..)
+        | ExprKind::Offset(..)
+        | ExprKind::Midpoint(..)
+        | ExprKind::Not(_)
+        | ExprKind::Binary(..)
+        | ExprKind::Error => None,
     }
 }
 

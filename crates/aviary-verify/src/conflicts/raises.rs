@@ -41,6 +41,8 @@ impl Raises {
                 let widen = |range: &mut Option<(usize, usize)>, i: usize| {
                     *range = Some(range.map_or((i, i), |(lo, hi)| (lo.min(i), hi.max(i))))
                 };
+                // Steps of the analysis, not constructs: only items and instances are ranges.
+                #[allow(clippy::wildcard_enum_match_arm)]
                 match key {
                     Key::Item(i) => widen(&mut c.items, i),
                     Key::Instance(i) => widen(&mut c.instances, i),

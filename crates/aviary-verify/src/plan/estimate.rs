@@ -486,7 +486,9 @@ impl<'m> Estimator<'m> {
         for (actor, values) in &f.instances {
             let members = match actor {
                 ActorRef::Group(g) => g.clone(),
-                a => self.scope(ctx, t).actor(a).into_iter().collect(),
+                a @ (ActorRef::Drone(_) | ActorRef::Slot(_)) => {
+                    self.scope(ctx, t).actor(a).into_iter().collect()
+                }
             };
             for d in members {
                 // The values are read where the FOR stands, before its alias is set.
@@ -606,7 +608,25 @@ impl<'m> Estimator<'m> {
             self.guessed.set(self.guessed.get().min(t));
             let what = match condition {
                 Expr::Received(s) => format!("a WAITFOR RECEIVED({}) whose signal the estimate never raises is counted as no wait", self.mission.signals[*s]),
-                _ => "a WAITFOR whose condition is unknown before flight is counted as no wait".into(),
+                Expr::Const(_)
+                | Expr::Slot(_)
+                | Expr::Actor(_)
+                | Expr::Telemetry(..)
+                | Expr::Attribute(..)
+                | Expr::Point(_)
+                | Expr::Geo(_)
+                | Expr::Distance(..)
+                | Expr::Add(..)
+                | Expr::Sub(..)
+                | Expr::Offset(..)
+                | Expr::Midpoint(..)
+                | Expr::Elapsed
+                | Expr::Not(_)
+                | Expr::And(..)
+                | Expr::Or(..)
+                | Expr::Compare(..) => {
+                    "a WAITFOR whose condition is unknown before flight is counted as no wait".into()
+                }
             };
             self.note(ctx.statement, what);
         }
@@ -688,7 +708,9 @@ impl<'m> Estimator<'m> {
             .iter()
             .map(|a| match a {
                 ActorRef::Group(g) => g.clone(),
-                a => self.scope(ctx, t).actor(a).into_iter().collect(),
+                a @ (ActorRef::Drone(_) | ActorRef::Slot(_)) => {
+                    self.scope(ctx, t).actor(a).into_iter().collect()
+                }
             })
             .collect();
         let runs: Vec<Vec<DroneId>> = if cap.actors == 1 {

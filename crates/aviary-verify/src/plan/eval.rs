@@ -113,7 +113,13 @@ impl Scope<'_> {
     fn placed(&self, e: &Expr) -> Option<Value> {
         match self.eval(e)? {
             Value::Actor(d) => self.telemetry(d, Field::Position),
-            v => Some(v),
+            v @ (Value::Number(_)
+            | Value::Text(_)
+            | Value::Symbol(_)
+            | Value::Bool(_)
+            | Value::Position(_)
+            | Value::Area(_)
+            | Value::Remainder(_)) => Some(v),
         }
     }
 
@@ -121,7 +127,12 @@ impl Scope<'_> {
         match self.eval(e)? {
             Value::Position(p) => Some([p.x, p.y]),
             Value::Actor(d) => self.flyer(d).map(|f| [f.pos[0], f.pos[1]]),
-            _ => None,
+            Value::Number(_)
+            | Value::Text(_)
+            | Value::Symbol(_)
+            | Value::Bool(_)
+            | Value::Area(_)
+            | Value::Remainder(_) => None,
         }
     }
 
@@ -163,13 +174,25 @@ impl Scope<'_> {
 pub fn number(v: &Value) -> Option<f64> {
     match v {
         Value::Number(n) => Some(*n),
-        _ => None,
+        Value::Text(_)
+        | Value::Symbol(_)
+        | Value::Bool(_)
+        | Value::Position(_)
+        | Value::Area(_)
+        | Value::Actor(_)
+        | Value::Remainder(_) => None,
     }
 }
 
 fn truth(v: &Value) -> Option<bool> {
     match v {
         Value::Bool(b) => Some(*b),
-        _ => None,
+        Value::Number(_)
+        | Value::Text(_)
+        | Value::Symbol(_)
+        | Value::Position(_)
+        | Value::Area(_)
+        | Value::Actor(_)
+        | Value::Remainder(_) => None,
     }
 }

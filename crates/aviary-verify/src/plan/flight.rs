@@ -102,6 +102,8 @@ pub fn fly(
         // A motion not flown as legs here (an orbit, the way home): its points, in turn.
         let end = e.s.drones[d].pos;
         let mut points = vec![[before[0], before[1]]];
+        // Middle-layer functions, not constructs: only an orbit flies a circle.
+        #[allow(clippy::wildcard_enum_match_arm)]
         let circle = match function {
             Function::Orbit => {
                 e.position_arg(args.first().unwrap_or(&None), d, at).zip(number_arg(args, 1))

@@ -246,8 +246,7 @@ fn body_spans(body: &Body, out: &mut Vec<Span>) {
             Stmt::ExceptionHandler(h) => Some(h.span),
             Stmt::If(i) => Some(i.span),
             Stmt::Requirement(r) => r.body.as_ref().map(|_| r.span),
-            // An ANY holds a body but has had no folding range; kept so, not decided here.
-            Stmt::Any(_) => None,
+            Stmt::Any(a) => Some(a.span),
             Stmt::Statement(_)
             | Stmt::Leash(_)
             | Stmt::Api(_)

@@ -222,13 +222,11 @@ fn unfired<'m>(block: &'m Block, fired: &[usize]) -> Vec<&'m Handler> {
         | Node::DoWhile { body, .. }
         | Node::WaitFor { body: Some(body), .. } => visit(body),
         Node::For(f) => visit(&f.body),
+        Node::Any(a) => visit(&a.body),
         Node::If { branches, otherwise } => {
             branches.iter().for_each(|(_, b)| visit(b));
             otherwise.iter().for_each(&mut visit);
         }
-        // The handlers of an ANY's own body are not listed, as before this match named
-        // every node: whether they should be is a question of its own, not settled here.
-        Node::Any(_) => {}
         Node::Call(_)
         | Node::Leash(_)
         | Node::Api(_)

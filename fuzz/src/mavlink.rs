@@ -42,9 +42,9 @@ pub fn link(data: &[u8]) {
 
 /// What the ground station believes of system 1 after `data` came on a link of the
 /// example world, looking for its targets with a 40 m sensor.
-pub fn heard_on_a_link(data: &[u8]) -> aviary_mavlink::hear::Heard {
+pub fn heard_on_a_link(data: &[u8]) -> aviary_mavlink::receive::Heard {
     let world = example_world();
-    aviary_mavlink::hear::hear(data, origin(world), world.targets.clone(), 40.0)
+    aviary_mavlink::receive::hear(data, origin(world), world.targets.clone(), 40.0)
 }
 
 /// What the example world's `aviary vehicles` answers to `data` from a ground station

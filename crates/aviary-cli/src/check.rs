@@ -79,7 +79,7 @@ fn check_one(
     let mut figures = None;
     if want.ask && !checked.has_errors() {
         if let Some(world) = checked.world.as_mut() {
-            figures = Some(crate::figures::ask(world));
+            figures = Some(crate::vehicle_figures::ask(world));
         }
     }
     let verified = aviary_verify::preflight(&mut checked, &api);
@@ -110,7 +110,7 @@ fn check_one(
         Format::Text => {
             print(&sources, &diagnostics, format, path);
             match &figures {
-                Some(Ok(f)) if !f.is_empty() => out!("\nfigures of the MAVLink drones:\n{}", crate::figures::render(f)),
+                Some(Ok(f)) if !f.is_empty() => out!("\nfigures of the MAVLink drones:\n{}", crate::vehicle_figures::render(f)),
                 Some(Err(why)) => out!("\nfigures of the MAVLink drones: not asked ({why}); planned with the world's figures\n"),
                 _ => {}
             }
@@ -122,7 +122,7 @@ fn check_one(
             let mut doc = serde_json::json!({ "file": path.display().to_string(), "plan": plan, "diagnostics": diagnostics });
             match &figures {
                 Some(Ok(f)) if !f.is_empty() => {
-                    doc["vehicles"] = f.iter().map(crate::figures::json).collect()
+                    doc["vehicles"] = f.iter().map(crate::vehicle_figures::json).collect()
                 }
                 Some(Err(why)) => doc["vehicles_not_asked"] = why.as_str().into(),
                 _ => {}

@@ -11,7 +11,6 @@ mod check;
 mod ctl;
 mod ctl_table;
 mod export_plan;
-mod figures;
 mod files;
 mod fmt;
 mod gcs;
@@ -21,6 +20,7 @@ mod report;
 mod run;
 mod serve;
 mod test;
+mod vehicle_figures;
 mod vehicles;
 
 /// mimalloc, tuned before `main` (`aviary_alloc`; docs/BENCHMARKS.md).

@@ -318,7 +318,7 @@ impl Hooks for Shown<'_> {
     }
 
     fn connected(&mut self, replan: &aviary_backends::replan::Replan, sources: &SourceMap) {
-        crate::figures::before_flight(replan, sources, self.args.quiet);
+        crate::vehicle_figures::before_flight(replan, sources, self.args.quiet);
     }
 
     fn record(&mut self, record: &Record<'_>, backend: &dyn Backend) {

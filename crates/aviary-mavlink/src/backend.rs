@@ -17,9 +17,9 @@ use aviary_world::Sensor;
 use tokio::sync::{mpsc, oneshot, watch};
 use tokio::task::AbortHandle;
 
-use crate::craft::{failed, Craft, Doing};
+use crate::drone::{failed, Craft, Doing};
 use crate::facts::Facts;
-use crate::flight;
+use crate::functions;
 
 struct Slot {
     drone: DroneId,
@@ -298,7 +298,8 @@ impl Backend for MavlinkBackend {
         // Hold the table while spawning, so that a call that ends at once finds its slot.
         let mut calls = self.inner.calls.lock();
         let task = tokio::spawn(async move {
-            let end = match flight::run(&craft, function, &args, paused_rx, &inner.sensors).await {
+            let end = match functions::run(&craft, function, &args, paused_rx, &inner.sensors).await
+            {
                 Ok(()) => CallEnd::Done,
                 Err(failure) => CallEnd::Failed(failure),
             };

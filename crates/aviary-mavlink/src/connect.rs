@@ -13,7 +13,7 @@ use mavlink::dialects::ardupilotmega::MavCmd;
 use tokio::sync::mpsc;
 use tokio::time::Instant;
 
-use crate::craft::{Craft, Doing};
+use crate::drone::{Craft, Doing};
 use crate::facts::{self, Facts};
 use crate::vehicle::Vehicle;
 use crate::{battery, bindings, link, link_keys, signing_key, MavlinkBackend, Origin, Tuning};

@@ -21,7 +21,7 @@ use mavlink::dialects::ardupilotmega::{
 use tokio::sync::mpsc;
 use tokio::time::Instant;
 
-use crate::craft::{failed, timeout, Craft, Paused};
+use crate::drone::{failed, timeout, Craft, Paused};
 use crate::mode::{self, Mode};
 use crate::motion::{held, here, late, Pass, Waypoint};
 use crate::vehicle::Upload;

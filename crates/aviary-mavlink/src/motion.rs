@@ -9,7 +9,7 @@ use aviary_api::{BuiltinException, Failure};
 use mavlink::dialects::ardupilotmega::MavCmd;
 use tokio::time::Instant;
 
-use crate::craft::{failed, timeout, Craft, Doing, Paused};
+use crate::drone::{failed, timeout, Craft, Doing, Paused};
 use crate::mode::Mode;
 
 /// Legs an orbit is flown in, per lap.

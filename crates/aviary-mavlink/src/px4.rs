@@ -14,7 +14,7 @@ use aviary_api::Failure;
 use mavlink::dialects::ardupilotmega::{MavCmd, MavFrame};
 use tokio::time::Instant;
 
-use crate::craft::{failed, timeout, Craft, Paused};
+use crate::drone::{failed, timeout, Craft, Paused};
 use crate::mode::Mode;
 use crate::motion::here;
 

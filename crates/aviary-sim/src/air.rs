@@ -14,7 +14,7 @@ use aviary_api::{DroneId, FlightState};
 use aviary_world::{Falloff, FaultKind, Gps, Radio, World};
 
 use crate::fleet::Report;
-use crate::luck::{Purpose, Stream};
+use crate::randomness::{Purpose, Stream};
 
 /// Metres in a foot: MIL-F-8785C gives its scales in feet.
 const FOOT: f64 = 0.3048;

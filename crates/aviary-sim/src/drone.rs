@@ -111,7 +111,7 @@ pub(crate) struct Rare {
     /// Why the drone takes no more commands (a motor failure).
     pub disabled: Option<String>,
     /// The drone's stream for its sensors' chances, made at its first draw.
-    pub luck: Option<Box<crate::luck::Stream>>,
+    pub luck: Option<Box<crate::randomness::Stream>>,
     /// Paused motion calls set aside for a newer motion call, the last one on top
     /// ([`SimDrone::set_aside`]).
     pub aside: Vec<Aside>,

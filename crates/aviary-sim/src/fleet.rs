@@ -1,5 +1,5 @@
 //! The physics core: every drone of the world, advanced tick by tick. Pure: no clock, no
-//! channels, and no randomness but what the seed gives ([`crate::luck`]); the same seed,
+//! channels, and no randomness but what the seed gives ([`crate::randomness`]); the same seed,
 //! calls and steps give the same results bit for bit.
 
 use std::collections::{BTreeMap, HashMap, HashSet};
@@ -13,9 +13,9 @@ use crate::avoid::Track;
 use crate::clearance::Clearance;
 use crate::drone::{SimDrone, Spec};
 use crate::grid::Grid;
-use crate::hot::Hot;
-use crate::luck::{Purpose, Stream};
 use crate::nearby::Nearby;
+use crate::randomness::{Purpose, Stream};
+use crate::step_view::Hot;
 use aviary_api::Names;
 use aviary_route::Airspace;
 
@@ -90,7 +90,7 @@ pub struct Fleet {
     /// At least the largest `extent` of the envelope of a drone of `aloft` during this
     /// step (from `extent_bound`): how far, beyond the usual, separation must look for one.
     pub(crate) max_extent: f64,
-    /// Each drone as its last turn in a step left it (see [`crate::hot`]).
+    /// Each drone as its last turn in a step left it (see [`crate::step_view`]).
     pub(crate) hot: Vec<Hot>,
     /// The drones with a link or GPS outage, ascending.
     pub(crate) outages: Vec<DroneId>,

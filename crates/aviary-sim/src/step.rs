@@ -9,9 +9,9 @@ use aviary_api::{
 use crate::battery;
 use crate::drone::Rare;
 use crate::fleet::{Fleet, Report};
-use crate::hot::Hot;
-use crate::luck::{Purpose, Stream};
+use crate::randomness::{Purpose, Stream};
 use crate::sensors::scan;
+use crate::step_view::Hot;
 
 /// Metres the drones of the sky may drift from where [`Fleet::clearance`] measured them
 /// before it measures again.

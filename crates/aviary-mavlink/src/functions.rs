@@ -6,7 +6,7 @@ use aviary_api::geometry::centroid;
 use aviary_api::{Failure, Function, Value};
 use mavlink::dialects::ardupilotmega::MavCmd;
 
-use crate::craft::{failed, Craft, Paused};
+use crate::drone::{failed, Craft, Paused};
 use crate::mode::Flavour;
 use crate::motion::{
     arm, fly, fly_through, here, hover, land, orbit, routed, rtl, take_off, vertical, Pass,

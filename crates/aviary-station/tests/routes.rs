@@ -31,7 +31,7 @@ fn station(root: &Path) -> axum::Router {
         Box::new(|_: &Path| Ok(Box::new(NoFiles) as Box<dyn SourceProvider + Send>));
     let mode = Mode::Folder { folder: Folder::new(root).unwrap(), files };
     let bound = "127.0.0.1:7878".parse().unwrap();
-    aviary_station::router(mode, bound, TOKEN.into(), &[], serde_json::Value::Null)
+    aviary_station::router(mode, bound, TOKEN.into(), &[], serde_json::Value::Null, None)
 }
 
 /// A call with the token, as the page makes it: status and JSON answer.

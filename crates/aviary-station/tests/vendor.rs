@@ -19,7 +19,9 @@ fn vendored_files_match_their_recorded_digests() {
         checked.push(name.to_string());
     }
     assert_eq!(checked.iter().filter(|n| n.starts_with("leaflet-1.9.4/")).count(), 8);
-    for file in ["codemirror.bundle.js", "LICENSES.md", "package.json", "package-lock.json", "entry.js"] {
+    for file in
+        ["codemirror.bundle.js", "LICENSES.md", "package.json", "package-lock.json", "entry.js"]
+    {
         let name = format!("codemirror/{file}");
         assert!(checked.contains(&name), "{name} is listed");
     }

@@ -1,0 +1,99 @@
+// The station's editor speaks to the language server of `aviary lsp` (over `/api/lsp`):
+// an operator types an error into the paper's mission and sees it marked as they type,
+// starts a place's name and picks it from the completion list, hovers a capability and
+// reads its signature; the world file is checked by the same server.
+
+import { test, before, after } from "node:test";
+import assert from "node:assert/strict";
+import { browser, choose, examples, open, shot, start } from "./harness.mjs";
+
+let station, chromium;
+
+before(async () => {
+  station = await start(["gcs", examples(), "--listen", "0"]);
+  chromium = await browser();
+});
+
+after(async () => {
+  await chromium?.close();
+  station?.process.kill("SIGTERM");
+});
+
+/// Where the text `needle` starts in the file shown, `plus` characters on, on the screen.
+async function at(page, needle, plus = 0) {
+  return page.evaluate(({ needle, plus }) => {
+    const view = window.aviary.editor.view;
+    const pos = view.state.doc.toString().indexOf(needle);
+    if (pos < 0) return null;
+    const c = view.coordsAtPos(pos + plus);
+    return c && { x: c.left + 2, y: (c.top + c.bottom) / 2 };
+  }, { needle, plus });
+}
+
+test("the editor marks a typed error, completes a place and shows a capability's signature", async () => {
+  const page = await open(chromium, station);
+  await choose(page, "search_and_rescue.mission");
+  // The token was given after the page opened: the editor asks for the server when the
+  // operator clicks into it.
+  const line = page.locator(".editor-file[data-file=mission] .cm-line", { hasText: "video_drone1 FlyTo WITH BuildingA" });
+  await line.click();
+  await page.waitForFunction(() => window.aviary.editor.server.state === "on");
+  assert.equal(await page.textContent("#lsp-status"), "language server: on");
+  // At the line's end, the place becomes one the world does not have.
+  await page.keyboard.press("End");
+  for (let i = 0; i < "BuildingA".length; i++) await page.keyboard.press("Backspace");
+  await page.keyboard.type("Nowhere");
+  const error = page.locator(".editor-file[data-file=mission] .cm-lintRange-error", { hasText: "Nowhere" });
+  await error.waitFor();
+  await page.waitForSelector(".editor-file[data-file=mission] .cm-gutter-lint .cm-lint-marker-error");
+  assert.ok(await page.evaluate(() => window.aviary.editor.files.mission.dirty), "the file is changed");
+  assert.match(await page.evaluate(() => window.aviary.editor.files.mission.text), /video_drone1 FlyTo WITH Nowhere/);
+  // The error's message, as the server says it, on hovering the mark.
+  const marked = await at(page, "WITH Nowhere", 6);
+  await page.mouse.move(marked.x, marked.y);
+  const lint = await page.waitForSelector(".cm-tooltip-lint");
+  assert.match(await lint.textContent(), /Nowhere/);
+  await page.mouse.move(5, 5);
+
+  // The start of a place's name: the server's completion offers the world's places.
+  for (let i = 0; i < "Nowhere".length; i++) await page.keyboard.press("Backspace");
+  await page.keyboard.type("Buil");
+  const list = await page.waitForSelector(".cm-tooltip-autocomplete");
+  await page.waitForSelector(".cm-tooltip-autocomplete li:has-text('BuildingB')");
+  const offered = await list.$$eval("li", (items) => items.map((li) => li.textContent));
+  assert.ok(offered.some((t) => t.includes("BuildingA")), `offered: ${offered.join(", ")}`);
+  await shot(page, "station-editor");
+  // Picking one puts it in the text, and the error goes.
+  await page.click(".cm-tooltip-autocomplete li:has-text('BuildingA')");
+  await page.waitForFunction(() => /video_drone1 FlyTo WITH BuildingA\n/.test(window.aviary.editor.files.mission.text));
+  await page.waitForFunction(() => !document.querySelector(".editor-file[data-file=mission] .cm-lintRange-error"));
+
+  // Hovering a capability shows its signature.
+  const capability = await at(page, "FlyTo WITH BuildingA", 2);
+  await page.mouse.move(capability.x, capability.y);
+  const hover = await page.waitForSelector(".cm-tooltip-hover");
+  const shown = await hover.textContent();
+  assert.match(shown, /FlyTo/);
+  assert.match(shown, /\(/, `a signature: ${shown}`);
+  await shot(page, "station-editor-hover");
+  assert.deepEqual(page.foreign, [], "the page loaded nothing from elsewhere");
+  await page.close();
+});
+
+test("the world file is edited in the same editor and checked by the same server", async () => {
+  const page = await open(chromium, station);
+  await choose(page, "search_and_rescue.mission");
+  await page.click("#edit-world");
+  const world = page.locator(".editor-file[data-file=world] .cm-line", { hasText: /^\[site\]/ });
+  await world.click();
+  await page.waitForFunction(() => window.aviary.editor.server.state === "on");
+  await page.keyboard.press("End");
+  await page.keyboard.type("x");
+  await page.waitForSelector(".editor-file[data-file=world] .cm-lint-marker-error");
+  assert.ok(await page.evaluate(() => window.aviary.editor.files.world.dirty));
+  assert.ok(!(await page.evaluate(() => window.aviary.editor.files.mission.dirty)));
+  // Undone, the world is whole again.
+  await page.keyboard.press("Backspace");
+  await page.waitForFunction(() => !document.querySelector(".editor-file[data-file=world] .cm-lint-marker-error"));
+  await page.close();
+});

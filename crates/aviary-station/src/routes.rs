@@ -210,6 +210,8 @@ fn checked(
         place(&world.path)?;
     }
     let files = files_for(&path).map_err(|w| Refusal(StatusCode::CONFLICT, w))?;
+    let files: Box<dyn SourceProvider + Send> =
+        Box::new(checking::InFolder { root: folder.root().to_path_buf(), files });
     Ok((checking::check(mission, world, &*files), files))
 }
 

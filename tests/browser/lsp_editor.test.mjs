@@ -1,10 +1,14 @@
 // The station's editor speaks to the language server of `aviary lsp` (over `/api/lsp`):
 // an operator types an error into the paper's mission and sees it marked as they type,
 // starts a place's name and picks it from the completion list, hovers a capability and
-// reads its signature; the world file is checked by the same server.
+// reads its signature; the world file is checked by the same server; a capability of a
+// USEd file is read from the disk as `aviary lsp` reads it.
 
 import { test, before, after } from "node:test";
 import assert from "node:assert/strict";
+import { mkdirSync, mkdtempSync, writeFileSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join } from "node:path";
 import { browser, choose, examples, open, shot, start } from "./harness.mjs";
 
 let station, chromium;
@@ -96,4 +100,33 @@ test("the world file is edited in the same editor and checked by the same server
   await page.keyboard.press("Backspace");
   await page.waitForFunction(() => !document.querySelector(".editor-file[data-file=world] .cm-lint-marker-error"));
   await page.close();
+});
+
+test("a capability of a USEd file is found on the station's disk, as aviary lsp finds it", async () => {
+  const dir = mkdtempSync(join(tmpdir(), "aviary-gcs-use-"));
+  mkdirSync(join(dir, "lib"));
+  writeFileSync(join(dir, "site.world.toml"), "[places]\nHome = [0, 0]\n\n[drones.scout]\nhome = [0, 0]\n");
+  writeFileSync(join(dir, "lib/moves.mission"),
+    "// Back to the place called Home.\nCAPABILITY GoHome BY drone:\n    PERFORM:\n        drone FlyTo WITH Home\n");
+  writeFileSync(join(dir, "site.mission"), 'USE "lib/moves.mission"\n\nMISSION Site:\n    scout TakeOff\n    scout GoHome\n');
+  const own = await start(["gcs", dir, "--listen", "0"]);
+  try {
+    const page = await open(chromium, own);
+    await choose(page, "site.mission");
+    await page.locator(".editor-file[data-file=mission] .cm-line", { hasText: "scout GoHome" }).click();
+    await page.waitForFunction(() => window.aviary.editor.server.state === "on");
+    const used = await at(page, "GoHome", 2);
+    await page.mouse.move(used.x, used.y);
+    const hover = await page.waitForSelector(".cm-tooltip-hover");
+    assert.match(await hover.textContent(), /GoHome BY drone/);
+    assert.equal(await page.$(".editor-file[data-file=mission] .cm-lintRange-error"), null, "the USE is found");
+    await page.mouse.move(5, 5);
+    // A capability no file has is marked as typed.
+    await page.keyboard.press("End");
+    await page.keyboard.type("x");
+    await page.waitForSelector(".editor-file[data-file=mission] .cm-lintRange-error");
+    await page.close();
+  } finally {
+    own.process.kill("SIGTERM");
+  }
 });

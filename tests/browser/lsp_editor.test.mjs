@@ -130,3 +130,14 @@ test("a capability of a USEd file is found on the station's disk, as aviary lsp 
     own.process.kill("SIGTERM");
   }
 });
+
+test("what the server's Markdown holds reaches the page as text, but for plain elements", async () => {
+  const page = await open(chromium, station);
+  const shown = await page.evaluate(async () => {
+    const { sanitize } = await import("/assets/js/lsp.js");
+    return sanitize('<p onclick="x()">a <em>b</em></p><img src=x onerror="alert(1)"><script>alert(2)</script>' +
+      '<a href="javascript:alert(3)">c</a><a href="https://example.org/">d</a><iframe src="/"></iframe>');
+  });
+  assert.equal(shown, '<p>a <em>b</em></p>alert(2)<a>c</a><a href="https://example.org/">d</a>');
+  await page.close();
+});

@@ -110,7 +110,7 @@ export class LanguageServer {
 const ALLOWED = new Set(["P", "PRE", "CODE", "EM", "STRONG", "B", "I", "DEL", "UL", "OL", "LI", "BR", "HR",
   "BLOCKQUOTE", "H1", "H2", "H3", "H4", "H5", "H6", "SPAN", "DIV", "TABLE", "THEAD", "TBODY", "TR", "TH", "TD", "A"]);
 
-function sanitize(html) {
+export function sanitize(html) {
   const doc = new DOMParser().parseFromString(`<!doctype html><body>${html}`, "text/html");
   clean(doc.body);
   return doc.body.innerHTML;

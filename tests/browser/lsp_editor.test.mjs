@@ -141,3 +141,20 @@ test("what the server's Markdown holds reaches the page as text, but for plain e
   assert.equal(shown, '<p>a <em>b</em></p>alert(2)<a>c</a><a href="https://example.org/">d</a>');
   await page.close();
 });
+
+test("without the token the editor has no server until the operator gives it; a wrong one is refused", async () => {
+  const page = await open(chromium, station, { token: false });
+  await choose(page, "search_and_rescue.mission");
+  await page.click(".editor-file[data-file=mission] .cm-content");
+  assert.equal(await page.textContent("#lsp-status"), "language server: give the token (click)");
+  await page.evaluate(() => sessionStorage.setItem("aviary.token", "0123456789abcdef0123456789abcdef"));
+  await page.click(".editor-file[data-file=mission] .cm-content");
+  await page.waitForFunction(() => window.aviary.editor.server.state === "refused");
+  // A click on the note asks for the token; the right one connects.
+  await page.click("#lsp-status");
+  await page.fill("#token-input", station.token);
+  await page.click("#token-dialog button[value=ok]");
+  await page.waitForFunction(() => window.aviary.editor.server.state === "on");
+  await page.waitForSelector(".editor-file[data-file=mission] .cm-gutter-lint");
+  await page.close();
+});

@@ -34,7 +34,7 @@ export class Editor {
     }
     // The operator starts editing: the language server is asked for then if not before
     // (the token may have been given since the page opened).
-    host.addEventListener("focusin", () => this.server.connect());
+    for (const e of ["focusin", "pointerdown", "keydown"]) host.addEventListener(e, () => this.server.connect());
   }
 
   get view() {

@@ -19,12 +19,15 @@ export class LanguageServer {
     this.changed = changed;
     this.client = null;
     this.socket = null;
+    // The token the station last refused: not tried again until the operator asks.
+    this.refused = null;
     this.state = "off";
     if (status) {
       status.hidden = !this.offered;
+      // No token, or one the station refused (it restarted with a new one): asked for.
       status.onclick = async () => {
-        if (!api.token() && !(await api.askToken())) return;
-        this.connect();
+        if ((!api.token() || this.state === "refused") && !(await api.askToken())) return;
+        this.connect(true);
       };
     }
     this.say("off", "language server: not connected");
@@ -54,14 +57,16 @@ export class LanguageServer {
     this.status.dataset.state = state;
   }
 
-  /// Opens the socket, unless it is open or opening, or there is no server or token.
-  connect() {
+  /// Opens the socket, unless it is open or opening, or there is no server or token;
+  /// a token the station refused is tried again only when `asked` (the note clicked).
+  connect(asked = false) {
     if (!this.offered || this.client || this.socket) return;
     const token = api.token();
     if (!token) {
       this.say("off", "language server: give the token (click)");
       return;
     }
+    if (token === this.refused && !asked) return;
     const scheme = location.protocol === "https:" ? "wss:" : "ws:";
     const socket = new WebSocket(`${scheme}//${location.host}/api/lsp`, ["aviary", "aviary.bearer." + token]);
     this.socket = socket;
@@ -71,6 +76,7 @@ export class LanguageServer {
       for (const h of handlers) h(String(m.data));
     };
     socket.onopen = () => {
+      this.refused = null;
       const transport = {
         send(message) {
           if (socket.readyState !== WebSocket.OPEN) throw new Error("the language server's socket is closed");
@@ -100,7 +106,11 @@ export class LanguageServer {
         was.disconnect();
         this.changed();
       }
-      this.say("off", was ? "language server: disconnected (click to connect)" : "language server: refused (click to try again)");
+      if (was) this.say("off", "language server: disconnected (click to connect)");
+      else {
+        this.refused = token;
+        this.say("refused", "language server: refused (click to give the token)");
+      }
     };
   }
 }

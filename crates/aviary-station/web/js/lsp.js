@@ -105,9 +105,9 @@ export class LanguageServer {
       if (was) {
         was.disconnect();
         this.changed();
-      }
-      if (was) this.say("off", "language server: disconnected (click to connect)");
-      else {
+        this.say("off", "language server: disconnected (click to connect)");
+      } else {
+        // Never opened: a wrong token, too many editors, or no station.
         this.refused = token;
         this.say("refused", "language server: refused (click to give the token)");
       }

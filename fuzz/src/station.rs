@@ -72,6 +72,7 @@ pub fn station(data: &[u8]) {
         TOKEN.into(),
         &["ops.example.org".into()],
         serde_json::Value::Null,
+        None,
     );
     let runtime =
         tokio::runtime::Builder::new_multi_thread().worker_threads(1).enable_all().build().unwrap();

@@ -84,19 +84,39 @@ test("the paper's mission flies from the page: 7 drones move on the map and the 
 test("an edited mission with an error shows the diagnostic on its line and cannot fly", async () => {
   const page = await open(chromium, station);
   await page.waitForSelector("#check-summary.good");
-  const text = await page.inputValue("#text");
-  const lines = text.split("\n");
+  const before = await page.evaluate(() => window.aviary.editor.files.mission.text);
+  const lines = before.split("\n");
   const at = lines.findIndex((l) => l.includes("FlyTo WITH"));
   lines[at] = lines[at].replace(/FlyTo WITH \w+/, "FlyTo WITH Nowhere");
-  await page.fill("#text", lines.join("\n"));
+  const text = lines.join("\n");
+  // The operator selects the whole text and pastes the edited mission over it.
+  await page.click(".editor-file[data-file=mission] .cm-content");
+  await page.keyboard.press("Control+A");
+  await page.keyboard.insertText(text);
+  assert.equal(await page.evaluate(() => window.aviary.editor.files.mission.text), text);
   await page.click("#check");
   await page.waitForSelector("#diagnostics li.error");
   const d = await page.evaluate(() => {
     const li = document.querySelector("#diagnostics li.error");
     return { code: li.dataset.code, line: Number(li.dataset.line), text: li.textContent,
-      gutter: document.querySelector(`#gutter span.err[data-line="${li.dataset.line}"]`) !== null,
       fly: document.getElementById("fly").disabled };
   });
+  // A click on the diagnostic goes to its line, which the gutter marks as an error.
+  await page.click("#diagnostics li.error");
+  await page.waitForSelector(".editor-file[data-file=mission] .cm-gutter-lint .cm-lint-marker-error");
+  const marked = await page.evaluate(() => {
+    const box = document.querySelector(".editor-file[data-file=mission]");
+    const active = box.querySelector(".cm-lineNumbers .cm-activeLineGutter");
+    const top = active.getBoundingClientRect().top;
+    const beside = [...box.querySelectorAll(".cm-gutter-lint .cm-gutterElement")]
+      .find((e) => Math.abs(e.getBoundingClientRect().top - top) < 2);
+    return { line: Number(active.textContent), error: !!beside?.querySelector(".cm-lint-marker-error"),
+      selected: window.aviary.editor.view.state.sliceDoc(window.aviary.editor.view.state.selection.main.from,
+        window.aviary.editor.view.state.selection.main.to) };
+  });
+  d.gutter = marked.error;
+  assert.equal(marked.line, at + 1, "the click went to the diagnostic's line");
+  assert.match(marked.selected, /Nowhere/, "and selected what it is about");
   assert.equal(d.code, "E103");
   assert.equal(d.line, at + 1, "the diagnostic is on the edited line");
   assert.match(d.text, /unknown place `Nowhere`/);
@@ -112,7 +132,7 @@ test("an edited mission with an error shows the diagnostic on its line and canno
   assert.equal(refused.status, 409);
   assert.match(refused.body.error, /cannot fly/);
   // Nothing was saved: the file on disk is as it was.
-  assert.equal(readFileSync(join(dir, "search_and_rescue.mission"), "utf8"), text);
+  assert.equal(readFileSync(join(dir, "search_and_rescue.mission"), "utf8"), before);
 });
 
 test("control needs the token and other sites are refused", async () => {

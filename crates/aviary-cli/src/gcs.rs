@@ -4,7 +4,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use aviary_station::{FilesFor, Folder, Mode};
+use aviary_station::{FilesFor, Folder, Lsp, Mode};
 
 use crate::files::{use_roots, DiskProvider};
 use crate::serve::Serve;
@@ -24,12 +24,20 @@ pub fn run(dir: &Path, serve: &Serve, use_root: &[PathBuf]) -> u8 {
             return 2;
         }
     };
+    // The page's editor speaks to the language server of `aviary lsp`, reading as it does.
+    let lsp_roots = roots.clone();
+    let lsp = Lsp::new(move || crate::lsp::config(&lsp_roots));
     let files: FilesFor = Box::new(move |mission: &Path| {
         DiskProvider::new(mission, &roots)
             .map(|p| Box::new(p) as Box<dyn aviary_check::SourceProvider + Send>)
     });
     let shown = folder.root().display().to_string();
-    match crate::serve::station(serve, Mode::Folder { folder, files }, serde_json::Value::Null) {
+    match crate::serve::station(
+        serve,
+        Mode::Folder { folder, files },
+        serde_json::Value::Null,
+        Some(lsp),
+    ) {
         Ok(_serving) => {
             // Not `eprintln!`: a script that closed standard error must not stop the station.
             let _ = writeln!(

@@ -8,6 +8,19 @@ use aviary_check::SourceProvider;
 
 use crate::files::{use_roots as use_roots_of, DiskProvider};
 
+/// The server's configuration: the disk read by `DiskProvider` under `roots` (the
+/// `--use-root`s, resolved). `aviary gcs` gives its page's editor the same.
+pub fn config(roots: &[PathBuf]) -> aviary_lsp::Config {
+    let for_disk = roots.to_vec();
+    aviary_lsp::Config {
+        disk: Box::new(move |mission: &Path| {
+            DiskProvider::new(mission, &for_disk).map(|p| Box::new(p) as Box<dyn SourceProvider>)
+        }),
+        use_roots: roots.to_vec(),
+        std_file: std_file(),
+    }
+}
+
 pub fn run(use_roots: &[PathBuf]) -> u8 {
     let roots = match use_roots_of(use_roots) {
         Ok(r) => r,
@@ -16,15 +29,7 @@ pub fn run(use_roots: &[PathBuf]) -> u8 {
             return 2;
         }
     };
-    let for_disk = roots.clone();
-    let config = aviary_lsp::Config {
-        disk: Box::new(move |mission: &Path| {
-            DiskProvider::new(mission, &for_disk).map(|p| Box::new(p) as Box<dyn SourceProvider>)
-        }),
-        use_roots: roots,
-        std_file: std_file(),
-    };
-    match aviary_lsp::serve_stdio(config) {
+    match aviary_lsp::serve_stdio(config(&roots)) {
         Ok(()) => 0,
         Err(why) => {
             eprintln!("aviary lsp: {why}");

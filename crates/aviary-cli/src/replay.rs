@@ -32,7 +32,8 @@ pub fn run(trace: &Path, world: Option<&Path>, serve: &Serve) -> u8 {
         }
     };
     let map = world.as_ref().map(aviary_station::checking::map_of).unwrap_or_default();
-    match crate::serve::station(serve, Mode::Replay { name: name.clone(), trace: text }, map) {
+    match crate::serve::station(serve, Mode::Replay { name: name.clone(), trace: text }, map, None)
+    {
         Ok(_serving) => {
             // Not `eprintln!`: a script that closed standard error must not stop the replay.
             let _ = writeln!(std::io::stderr(), "aviary: replaying {name}; Ctrl-C stops");

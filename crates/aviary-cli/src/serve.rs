@@ -6,7 +6,7 @@ use std::net::SocketAddr;
 use aviary_engine::Controller;
 use aviary_ir::Mission;
 use aviary_server::{Bounds, Feed};
-use aviary_station::{Mode, Options, Serving};
+use aviary_station::{Lsp, Mode, Options, Serving};
 
 /// Where and how to serve.
 pub struct Serve {
@@ -17,8 +17,15 @@ pub struct Serve {
 
 /// The station in `mode`, announced on standard error (which the operator reads; nothing
 /// else ever prints or logs the token).
-pub fn station(serve: &Serve, mode: Mode, map: serde_json::Value) -> Result<Serving, String> {
-    let options = Options { address: serve.address, allowed_hosts: serve.allowed_hosts.clone() };
+/// `lsp` is the language server of the page's editor, for a folder's station.
+pub fn station(
+    serve: &Serve,
+    mode: Mode,
+    map: serde_json::Value,
+    lsp: Option<Lsp>,
+) -> Result<Serving, String> {
+    let options =
+        Options { address: serve.address, allowed_hosts: serve.allowed_hosts.clone(), lsp };
     let serving = aviary_station::serve(&options, mode, map)?;
     announce(&serving);
     Ok(serving)
@@ -61,7 +68,8 @@ pub fn start(
     map: serde_json::Value,
     controller: Controller,
 ) -> Result<(Serving, Feed), String> {
-    let options = Options { address: serve.address, allowed_hosts: serve.allowed_hosts.clone() };
+    let options =
+        Options { address: serve.address, allowed_hosts: serve.allowed_hosts.clone(), lsp: None };
     let serving = aviary_station::serve(&options, Mode::Run, serde_json::Value::Null)?;
     let feed = serving.serve_run(controller, mission, bounds, map);
     announce(&serving);

@@ -4,7 +4,9 @@
 //! front end and pre-flight analyses as `aviary check`; the texts are the page's, which
 //! may not be saved yet, and the files they `USE` come from the disk.
 
-use aviary_check::SourceProvider;
+use std::path::{Path, PathBuf};
+
+use aviary_check::{LoadError, SourceProvider};
 use aviary_diagnostics::{render_json, Diagnostic, SourceMap};
 use serde_json::{json, Value};
 
@@ -16,6 +18,34 @@ use crate::tree;
 pub struct Text {
     pub path: String,
     pub text: String,
+}
+
+/// The command line's provider for the page's texts, which are named relative to the
+/// station's folder: a `USE` (or a world's import) is read beside the file of the folder
+/// that says it, not beside a name taken from the station's working directory, and a file
+/// read is named back relative to the folder, as the page names files.
+pub struct InFolder {
+    pub root: PathBuf,
+    pub files: Box<dyn SourceProvider + Send>,
+}
+
+impl InFolder {
+    fn full(&self, name: &str) -> String {
+        self.root.join(name).to_string_lossy().into_owned()
+    }
+}
+
+impl SourceProvider for InFolder {
+    fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), LoadError> {
+        let (name, bytes) = self.files.load(&self.full(from), path)?;
+        let shown =
+            Path::new(&name).strip_prefix(&self.root).map(|p| p.to_string_lossy().into_owned());
+        Ok((shown.unwrap_or(name), bytes))
+    }
+
+    fn world_file(&self, world: &str, path: &str) -> Result<Vec<u8>, LoadError> {
+        self.files.world_file(&self.full(world), path)
+    }
 }
 
 /// What the page shows of a check.

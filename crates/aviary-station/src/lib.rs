@@ -18,6 +18,7 @@ pub mod campaign;
 pub mod checking;
 mod dir;
 mod flight;
+mod lsp;
 pub mod replay;
 pub mod report;
 mod routes;
@@ -34,6 +35,7 @@ use aviary_server::{Bounds, Feed, Gate, Kinds};
 use serde_json::Value;
 
 pub use dir::{refused_name, Access, Folder, Listing};
+pub use lsp::{Lsp, MAX_SOCKETS as MAX_LSP_SOCKETS};
 
 /// How the station finds the files a mission `USE`s: the command line's provider, made
 /// for a mission file (its folder, and the `--use-root`s).
@@ -93,6 +95,10 @@ pub(crate) struct Station {
     pub flying: std::sync::atomic::AtomicBool,
     /// The world of the flight or trace shown, as the map draws it.
     map: Mutex<Value>,
+    /// The language server for the page's editor (`/api/lsp`), if the station has one.
+    pub lsp: Option<Lsp>,
+    /// Its sockets open now (`lsp::MAX_SOCKETS` at most).
+    pub lsp_sockets: std::sync::atomic::AtomicUsize,
 }
 
 impl Station {
@@ -160,6 +166,9 @@ pub struct Options {
     pub address: SocketAddr,
     /// `--allow-host`: names to answer to besides loopback and the bound address.
     pub allowed_hosts: Vec<String>,
+    /// The language server of the page's editor (`/api/lsp`): `aviary lsp`'s, made by the
+    /// command line; none, and the editor checks only with the Check button.
+    pub lsp: Option<Lsp>,
 }
 
 /// A station being served.
@@ -207,8 +216,9 @@ pub fn router(
     token: String,
     allowed_hosts: &[String],
     map: Value,
+    lsp: Option<Lsp>,
 ) -> axum::Router {
-    routes::router(station(mode, bound, token, allowed_hosts, map))
+    routes::router(station(mode, bound, token, allowed_hosts, map, lsp))
 }
 
 fn station(
@@ -217,6 +227,7 @@ fn station(
     token: String,
     allowed_hosts: &[String],
     map: Value,
+    lsp: Option<Lsp>,
 ) -> Arc<Station> {
     Arc::new(Station {
         mode,
@@ -224,6 +235,8 @@ fn station(
         run: Mutex::new(None),
         flying: Default::default(),
         map: Mutex::new(map),
+        lsp,
+        lsp_sockets: Default::default(),
     })
 }
 
@@ -232,7 +245,8 @@ pub fn serve(options: &Options, mode: Mode, map: Value) -> Result<Serving, Strin
     let token = aviary_server::new_token()?;
     let mut made = None;
     let address = aviary_server::serve(options.address, "ground station", |bound| {
-        let s = station(mode, bound, token.clone(), &options.allowed_hosts, map);
+        let s =
+            station(mode, bound, token.clone(), &options.allowed_hosts, map, options.lsp.clone());
         made = Some(s.clone());
         routes::router(s)
     })?;

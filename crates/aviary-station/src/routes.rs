@@ -39,6 +39,9 @@ pub(crate) fn router(station: Arc<Station>) -> Router {
         .route("/api/station/save", post(save))
         .route("/api/station/fly", post(fly))
         .route("/api/station/campaign", post(campaign))
+        // The editor's language server: it reads files as `aviary lsp` does, for whoever
+        // holds the token (on loopback too), as a save does.
+        .route("/api/lsp", get(crate::lsp::socket))
         .route_layer(middleware::from_fn_with_state(gate.clone(), aviary_server::token));
     Router::new()
         .route("/", get(index))
@@ -125,6 +128,13 @@ async fn about(State(station): State<Arc<Station>>) -> Json<Value> {
     Json(json!({
         "mode": station.mode.name(),
         "reading_needs_token": station.gate.beyond_loopback(),
+        // Where the folder is on the station's machine: the editor names its files to
+        // the language server by their absolute path (`file://` URIs).
+        "folder": match &station.mode {
+            Mode::Folder { folder, .. } => Some(folder.root().display().to_string()),
+            _ => None,
+        },
+        "lsp": station.lsp.is_some(),
         "run": run,
         "map": station.map(),
     }))
@@ -200,6 +210,8 @@ fn checked(
         place(&world.path)?;
     }
     let files = files_for(&path).map_err(|w| Refusal(StatusCode::CONFLICT, w))?;
+    let files: Box<dyn SourceProvider + Send> =
+        Box::new(checking::InFolder { root: folder.root().to_path_buf(), files });
     Ok((checking::check(mission, world, &*files), files))
 }
 

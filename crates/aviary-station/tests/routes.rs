@@ -31,7 +31,7 @@ fn station(root: &Path) -> axum::Router {
         Box::new(|_: &Path| Ok(Box::new(NoFiles) as Box<dyn SourceProvider + Send>));
     let mode = Mode::Folder { folder: Folder::new(root).unwrap(), files };
     let bound = "127.0.0.1:7878".parse().unwrap();
-    aviary_station::router(mode, bound, TOKEN.into(), &[], serde_json::Value::Null)
+    aviary_station::router(mode, bound, TOKEN.into(), &[], serde_json::Value::Null, None)
 }
 
 /// A call with the token, as the page makes it: status and JSON answer.
@@ -101,4 +101,47 @@ fn a_flights_trace_is_never_written_through_a_link_out_of_the_folder() {
     assert!(why.contains("leads outside the station's folder"), "{why}");
     let written: Vec<_> = std::fs::read_dir(outside.join("elsewhere")).unwrap().collect();
     assert!(written.is_empty(), "written outside: {written:?}");
+}
+
+/// Reads a `USE` beside the file that says it, as the command line's `DiskProvider` does.
+struct Beside;
+
+impl SourceProvider for Beside {
+    fn load(&self, from: &str, path: &str) -> Result<(String, Vec<u8>), aviary_check::LoadError> {
+        let full = Path::new(from).parent().unwrap_or(Path::new("")).join(path);
+        match std::fs::read(&full) {
+            Ok(bytes) => Ok((full.display().to_string(), bytes)),
+            Err(e) => Err(format!("{}: {e}", full.display()).into()),
+        }
+    }
+}
+
+/// The page names its files relative to the folder: a mission's `USE` is read beside the
+/// mission in the folder (not in the station's working directory), and a used file's
+/// diagnostics name it as the page does.
+#[test]
+fn a_check_reads_what_the_mission_uses_beside_it_in_the_folder() {
+    let (root, _) = folders("uses");
+    std::fs::create_dir_all(root.join("lib")).unwrap();
+    std::fs::write(
+        root.join("lib/moves.mission"),
+        "CAPABILITY GoHome BY drone:\n    PERFORM:\n        drone FlyTo WITH Hmoe\n",
+    )
+    .unwrap();
+    let files: FilesFor =
+        Box::new(|_: &Path| Ok(Box::new(Beside) as Box<dyn SourceProvider + Send>));
+    let mode = Mode::Folder { folder: Folder::new(&root).unwrap(), files };
+    let bound = "127.0.0.1:7878".parse().unwrap();
+    let app = aviary_station::router(mode, bound, TOKEN.into(), &[], serde_json::Value::Null, None);
+    let body = serde_json::json!({
+        "mission": { "path": "m.mission", "text": "USE \"lib/moves.mission\"\n\nMISSION M:\n    a TakeOff\n    a GoHome\n" },
+        "world": { "path": "m.world.toml", "text": "[places]\nHome = [0, 0]\n\n[drones.a]\nhome = [0, 0]\n" },
+    });
+    let (status, answer) = call(&app, "POST", "/api/station/check", &body.to_string());
+    assert_eq!(status, 200, "{answer}");
+    let diagnostics = answer["diagnostics"].as_array().unwrap();
+    let errors: Vec<_> = diagnostics.iter().filter(|d| d["severity"] == "error").collect();
+    assert_eq!(errors.len(), 1, "only the used file's typo: {answer}");
+    assert_eq!(errors[0]["code"], "E103", "{answer}");
+    assert_eq!(errors[0]["file"], "lib/moves.mission", "named as the page names it: {answer}");
 }

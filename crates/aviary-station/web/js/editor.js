@@ -1,35 +1,92 @@
-// The mission and world editor: a text area with line numbers, and the check's
-// diagnostics on their lines (a mark in the gutter, the message below, a click goes to
-// the line).
+// The mission and world editor: CodeMirror 6 with line numbers, speaking to the language
+// server of `aviary lsp` over the station's WebSocket (`lsp.js`): its diagnostics as you
+// type (marked in the text and the gutter), completion and hover. The Check button's
+// diagnostics are listed below it; a click goes to the place.
+
+import {
+  EditorState, EditorView, Compartment, minimalSetup, lineNumbers, highlightActiveLine,
+  highlightActiveLineGutter, lintGutter, setDiagnostics,
+} from "../vendor/codemirror/codemirror.bundle.js";
+import { LanguageServer } from "./lsp.js";
+
+const WHICH = ["mission", "world"];
 
 export class Editor {
-  constructor() {
-    this.text = document.getElementById("text");
-    this.gutter = document.getElementById("gutter");
+  /// `about` is the station's `/api/station` answer: its folder and whether it serves a
+  /// language server.
+  constructor(about) {
     this.list = document.getElementById("diagnostics");
     this.files = { mission: { path: "", text: "" }, world: { path: "", text: "" } };
     this.showing = "mission";
     this.diagnostics = [];
-    this.text.addEventListener("input", () => {
-      this.files[this.showing].text = this.text.value;
-      this.files[this.showing].dirty = true;
-      this.numbers();
+    this.server = new LanguageServer(about, document.getElementById("lsp-status"), () => this.attach());
+    this.views = {};
+    this.slots = {};
+    const host = document.getElementById("editor");
+    for (const which of WHICH) {
+      const box = document.createElement("div");
+      box.className = "editor-file";
+      box.dataset.file = which;
+      box.hidden = which !== this.showing;
+      host.appendChild(box);
+      this.slots[which] = new Compartment();
+      this.views[which] = new EditorView({ state: this.state(which), parent: box });
+    }
+    // The operator starts editing: the language server is asked for then if not before
+    // (the token may have been given since the page opened).
+    for (const e of ["focusin", "pointerdown", "keydown"]) host.addEventListener(e, () => this.server.connect());
+  }
+
+  get view() {
+    return this.views[this.showing];
+  }
+
+  state(which) {
+    const f = this.files[which];
+    return EditorState.create({
+      doc: f.text,
+      extensions: [
+        minimalSetup,
+        lineNumbers(),
+        highlightActiveLine(),
+        highlightActiveLineGutter(),
+        lintGutter(),
+        EditorView.contentAttributes.of({ "aria-label": `the ${which} file's text`, spellcheck: "false" }),
+        EditorView.updateListener.of((u) => {
+          if (!u.docChanged) return;
+          this.files[which].text = u.state.doc.toString();
+          this.files[which].dirty = true;
+        }),
+        this.slots[which].of(this.server.plugin(f.path, which)),
+      ],
     });
-    this.text.addEventListener("scroll", () => { this.gutter.scrollTop = this.text.scrollTop; });
   }
 
   load(which, path, text) {
     this.files[which] = { path, text, dirty: false };
-    if (this.showing === which) this.show(which);
+    // A new state: the last file's server plugin goes (closing it there), this one's comes.
+    this.views[which].setState(this.state(which));
+    this.marks(which);
+    this.server.connect();
   }
 
   show(which) {
     this.showing = which;
-    this.text.value = this.files[which].text;
-    this.numbers();
+    for (const w of WHICH) this.views[w].dom.parentElement.hidden = w !== which;
+    this.views[which].requestMeasure();
   }
 
-  /// The diagnostics of a check, each shown on its line of its file.
+  /// The language server came or went: each file is opened there (or no longer).
+  attach() {
+    for (const which of WHICH) {
+      const plugin = this.server.plugin(this.files[which].path, which);
+      this.views[which].dispatch({ effects: this.slots[which].reconfigure(plugin) });
+      this.marks(which);
+    }
+  }
+
+  /// The diagnostics of a check, listed under the editor and, without a language server
+  /// (whose own are marked as the operator types), marked on their lines.
   mark(diagnostics) {
     this.diagnostics = diagnostics || [];
     this.list.textContent = "";
@@ -42,7 +99,31 @@ export class Editor {
       li.onclick = () => this.go(d);
       this.list.appendChild(li);
     }
-    this.numbers();
+    for (const which of WHICH) this.marks(which);
+  }
+
+  /// The check's diagnostics marked in a file, unless the language server marks it.
+  marks(which) {
+    if (this.server.serves(this.files[which].path)) return;
+    const view = this.views[which], path = this.files[which].path;
+    const shown = this.diagnostics.filter((d) => path && d.file === path).map((d) => {
+      const { from, to } = this.range(view.state.doc, d);
+      return { from, to, severity: d.severity === "error" ? "error" : d.severity === "warning" ? "warning" : "info",
+        message: `${d.code ? d.code + ": " : ""}${d.message || d.text || ""}` };
+    });
+    view.dispatch(setDiagnostics(view.state, shown));
+  }
+
+  /// Where a diagnostic (1-based line and column, `end_line`/`end_column` after it) is in
+  /// `doc`, held inside it.
+  range(doc, d) {
+    const at = (line, column) => {
+      const l = doc.line(Math.min(Math.max(1, line || 1), doc.lines));
+      return l.from + Math.min(Math.max(0, (column || 1) - 1), l.length);
+    };
+    const from = at(d.line, d.column);
+    const to = d.end_line ? at(d.end_line, d.end_column) : doc.lineAt(from).to;
+    return { from, to: Math.max(from, to) };
   }
 
   go(d) {
@@ -52,33 +133,9 @@ export class Editor {
       document.getElementById("edit-mission").classList.toggle("active", which === "mission");
       document.getElementById("edit-world").classList.toggle("active", which === "world");
     }
-    const lines = this.text.value.split("\n");
-    let offset = 0;
-    for (let i = 0; i < d.line - 1 && i < lines.length; i++) offset += lines[i].length + 1;
-    this.text.focus();
-    this.text.setSelectionRange(offset + d.column - 1, offset + (d.end_line === d.line ? d.end_column - 1 : lines[d.line - 1].length));
-    const lineHeight = 17;
-    this.text.scrollTop = Math.max(0, (d.line - 5) * lineHeight);
-  }
-
-  numbers() {
-    const path = this.files[this.showing].path;
-    const marks = new Map();
-    for (const d of this.diagnostics) {
-      if (d.file !== path) continue;
-      if (d.severity === "error" || !marks.has(d.line)) marks.set(d.line, d.severity === "error" ? "err" : "warn");
-    }
-    const count = this.text.value.split("\n").length;
-    const fragment = document.createDocumentFragment();
-    for (let i = 1; i <= count; i++) {
-      const span = document.createElement("span");
-      span.textContent = String(i);
-      const mark = marks.get(i);
-      if (mark) { span.className = mark; span.dataset.line = i; }
-      fragment.append(span, "\n");
-    }
-    this.gutter.textContent = "";
-    this.gutter.appendChild(fragment);
-    this.gutter.scrollTop = this.text.scrollTop;
+    const view = this.views[which];
+    const { from, to } = this.range(view.state.doc, d);
+    view.dispatch({ selection: { anchor: from, head: to }, effects: EditorView.scrollIntoView(from, { y: "center" }) });
+    view.focus();
   }
 }

@@ -263,7 +263,7 @@ function wireControls() {
 // The folder's missions: open, edit, check, save, fly.
 async function station() {
   $("files").hidden = false;
-  const editor = (page.editor = new Editor());
+  const editor = (page.editor = new Editor(page.about));
   const listing = (await api.call("GET", "/api/station/files")).body || { missions: [], worlds: [] };
   const missions = $("mission-file"), worlds = $("world-file");
   for (const m of listing.missions) missions.appendChild(new Option(m));

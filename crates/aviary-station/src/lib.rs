@@ -12,6 +12,7 @@
 //! Invariants: every request passes the gate (Host, Origin; the token for anything that
 //! changes something, and for reading beyond loopback); the page names files only inside
 //! the station's folder (`dir.rs`); no page loads anything from another site.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
 mod assets;
 pub mod campaign;
@@ -27,7 +28,9 @@ pub mod tree;
 
 use std::net::SocketAddr;
 use std::path::Path;
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::Arc;
+
+use parking_lot::Mutex;
 
 use aviary_check::SourceProvider;
 use aviary_engine::Controller;
@@ -102,10 +105,6 @@ pub(crate) struct Station {
 }
 
 impl Station {
-    fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
-        m.lock().unwrap_or_else(|p| p.into_inner())
-    }
-
     /// Serves the operator API of a run of `mission` from now on (the last one's goes);
     /// its events go to the feed returned. `bounds` are where its world lets the operator
     /// send a drone, `tree` is what the page shows of the mission, `trace` where its trace
@@ -124,7 +123,7 @@ impl Station {
             Kinds::of(mission).within(bounds),
         );
         let vehicle_plan = VehiclePlan::None;
-        *Self::lock(&self.run) =
+        *self.run.lock() =
             Some(Run { router, mission: mission.name.clone(), tree, trace, vehicle_plan });
         feed
     }
@@ -132,22 +131,22 @@ impl Station {
     /// The run's plan with the vehicles' figures: `Due` from the start of a flight with
     /// MAVLink drones, then what it says.
     pub(crate) fn set_vehicle_plan(&self, plan: VehiclePlan) {
-        if let Some(run) = Self::lock(&self.run).as_mut() {
+        if let Some(run) = self.run.lock().as_mut() {
             run.vehicle_plan = plan;
         }
     }
 
     pub fn set_map(&self, map: Value) {
-        *Self::lock(&self.map) = map;
+        *self.map.lock() = map;
     }
 
     pub fn map(&self) -> Value {
-        Self::lock(&self.map).clone()
+        self.map.lock().clone()
     }
 
     /// The routes of the flight in progress (or the last one), and what the page shows of it.
     pub fn run(&self) -> Option<(axum::Router, Value)> {
-        Self::lock(&self.run).as_ref().map(|r| {
+        self.run.lock().as_ref().map(|r| {
             let mut shown =
                 serde_json::json!({ "mission": r.mission, "tree": r.tree, "trace": r.trace });
             match &r.vehicle_plan {

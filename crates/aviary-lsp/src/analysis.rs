@@ -45,8 +45,9 @@ impl Analysis {
     }
 }
 
-/// `NAME.world.toml` beside the mission `NAME.mission` (open, or on disk).
-pub fn world_key(mission: &str, docs: &Docs) -> Option<String> {
+/// `NAME.world.toml` beside the mission `NAME.mission`: open, or on disk when the disk
+/// may be read for the mission (`on_disk`).
+pub fn world_key(mission: &str, docs: &Docs, on_disk: bool) -> Option<String> {
     let path = Path::new(mission);
     if !path.is_absolute() {
         return None;
@@ -54,7 +55,7 @@ pub fn world_key(mission: &str, docs: &Docs) -> Option<String> {
     let stem = path.file_stem()?.to_string_lossy().into_owned();
     let candidate = path.with_file_name(format!("{stem}.world.toml"));
     let key = candidate.to_string_lossy().into_owned();
-    (docs.contains_key(&key) || candidate.is_file()).then_some(key)
+    (docs.contains_key(&key) || (on_disk && candidate.is_file())).then_some(key)
 }
 
 pub fn is_world(key: &str) -> bool {
@@ -65,22 +66,23 @@ pub fn is_world(key: &str) -> bool {
 pub fn mission(key: &str, docs: &Docs, config: &Config) -> Analysis {
     let api = aviary_api::Descriptor::standard();
     let text = docs.get(key).map(|d| d.text.as_str()).unwrap_or("");
-    let world = world_key(key, docs).and_then(|w| {
+    let path = Path::new(key);
+    // The disk is read for a mission only where the caller's provider allows it (the
+    // station's: its folder); elsewhere only open documents are read, the world beside
+    // the mission included.
+    let disk: Option<Box<dyn SourceProvider>> = if path.is_absolute() {
+        (config.disk)(path).map_err(|why| eprintln!("aviary lsp: {why}")).ok()
+    } else {
+        None
+    };
+    let world = world_key(key, docs, disk.is_some()).and_then(|w| {
         let bytes = match docs.get(&w) {
             Some(doc) => Some(doc.text.as_bytes().to_vec()),
             None => std::fs::read(&w).ok(),
         };
         bytes.map(|b| (w, b))
     });
-    let path = Path::new(key);
-    let disk: Box<dyn SourceProvider> = if path.is_absolute() {
-        (config.disk)(path).unwrap_or_else(|why| {
-            eprintln!("aviary lsp: {why}");
-            Box::new(aviary_check::NoFiles)
-        })
-    } else {
-        Box::new(aviary_check::NoFiles)
-    };
+    let disk: Box<dyn SourceProvider> = disk.unwrap_or_else(|| Box::new(aviary_check::NoFiles));
     let roots: Vec<PathBuf> =
         if path.is_absolute() { roots_of(path, &config.use_roots) } else { Vec::new() };
     let overlay = Overlay { open: docs, roots, disk: &*disk };

@@ -208,3 +208,33 @@ fn a_few_servers_at_once_and_another_is_refused_until_one_closes() {
     });
     assert!(reopened.is_some(), "a socket opens again once one closed");
 }
+
+/// A mission named outside the station's folder: the server reads nothing of the disk for
+/// it, not even the world file beside it, so nothing of that file reaches the page.
+#[test]
+fn nothing_beside_a_mission_outside_the_folder_is_read() {
+    let root = folder("outside");
+    let outside = root.with_file_name("station_lsp_outside_secret");
+    let _ = std::fs::remove_dir_all(&outside);
+    std::fs::create_dir_all(&outside).unwrap();
+    // A world whose error would quote the file.
+    std::fs::write(outside.join("probe.world.toml"), "[site]\nsecret = \"the-hidden-text\"\n")
+        .unwrap();
+    let at = serve(&root);
+    let mut socket = open(at, &with_token()).expect("the socket opens");
+    send(
+        &mut socket,
+        json!({ "jsonrpc": "2.0", "id": 1, "method": "initialize", "params": { "capabilities": {} } }),
+    );
+    until(&mut socket, |m| m["id"] == 1);
+    send(&mut socket, json!({ "jsonrpc": "2.0", "method": "initialized", "params": {} }));
+    let uri = format!("file://{}/probe.mission", outside.display());
+    did_open(&mut socket, &uri, "aviary", "MISSION Probe:\n    a TakeOff\n");
+    let published = until(&mut socket, |m| {
+        m["method"] == "textDocument/publishDiagnostics" && m["params"]["uri"] == uri.as_str()
+    });
+    let text = published.to_string();
+    assert!(!text.contains("hidden-text") && !text.contains("probe.world.toml"), "{text}");
+    // Checked as a mission with no world: its drone is unknown to it.
+    assert!(text.contains("N302") || text.contains("no world"), "{text}");
+}

@@ -74,9 +74,9 @@ pub enum Stage {
     World,
     /// The mission: parse, load, infer, walk (`aviary_check`).
     Check,
-    /// The source texts dropped and the memory given back to the system
-    /// (`aviary_alloc::give_back`). Not with MAVLink drones: their warnings point into
-    /// the texts.
+    /// The source texts dropped, and the memory given back to the system by whoever
+    /// runs the process ([`Hooks::texts_freed`]). Not with MAVLink drones: their
+    /// warnings point into the texts.
     FreeTexts,
     /// `aviary_lower::compile`.
     Compile,
@@ -93,6 +93,11 @@ pub enum Stage {
 pub trait Hooks {
     fn begin(&mut self, _stage: Stage) {}
     fn end(&mut self, _stage: Stage) {}
+
+    /// The source texts have been dropped (a large world's text is megabytes): a process
+    /// that owns its allocator gives the memory back to the system here (`aviary run`
+    /// and `aviary bench` call `aviary_alloc::give_back`); a library never does.
+    fn texts_freed(&mut self) {}
 
     /// The mission compiled for its world and nothing has started: the caller opens where
     /// its trace goes. An `Err` ends the run here, with that reason ([`NotFlown::Failed`]).
@@ -199,7 +204,7 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
     } else {
         hooks.begin(Stage::FreeTexts);
         drop(sources);
-        aviary_alloc::give_back();
+        hooks.texts_freed();
         hooks.end(Stage::FreeTexts);
         None
     };

@@ -261,6 +261,10 @@ struct Shown<'a> {
 }
 
 impl Hooks for Shown<'_> {
+    fn texts_freed(&mut self) {
+        aviary_alloc::give_back();
+    }
+
     fn compiled(&mut self, mission: &Mission, world: &World) -> Result<(), String> {
         if self.args.serve.is_some() {
             self.map = aviary_station::checking::map_of(world);

@@ -82,15 +82,9 @@ fn check_one(
             figures = Some(crate::vehicle_figures::ask(world));
         }
     }
-    let verified = aviary_verify::preflight(&mut checked, &api);
-    let mut diagnostics = checked.diagnostics;
-    let mut plan = None;
-    let preflight = verified.is_some();
-    if let Some((_, v)) = verified {
-        diagnostics.extend(v.diagnostics);
-        plan = Some(v.plan);
-    }
-    aviary_check::acknowledge(&checked.allows, &mut diagnostics, preflight);
+    let verdict = aviary_verify::verdict(&mut checked, &api);
+    let diagnostics = verdict.diagnostics;
+    let plan = verdict.flight.map(|(_, plan)| plan);
     let failed = u8::from(diagnostics.iter().any(Diagnostic::is_error));
     if !want_plan {
         print(&sources, &diagnostics, format, path);

@@ -71,3 +71,35 @@ pub fn preflight(checked: &mut Checked, api: &Descriptor) -> Option<(Mission, Ve
     let verification = verify(&mission, world);
     Some((mission, verification))
 }
+
+/// What `aviary check` says of a checked mission, as every front end shows it (the CLI,
+/// the station): the checker's diagnostics and the pre-flight analyses' in one list, the
+/// `ALLOW` lines applied to it, and the compiled mission with its plan when it has them
+/// (no error, a world, a MISSION).
+pub struct Verdict {
+    pub diagnostics: Vec<Diagnostic>,
+    pub flight: Option<(Mission, Plan)>,
+}
+
+impl Verdict {
+    /// Whether the mission may fly: the checker found no error, and it has a world and a
+    /// MISSION (the pre-flight analyses warn; they do not refuse).
+    pub fn flyable(&self) -> bool {
+        self.flight.is_some()
+    }
+}
+
+/// [`preflight`], then the one rule of `ALLOW` (`aviary_check::acknowledge`) over every
+/// diagnostic. The world in `checked` is the one planned with: a caller that knows
+/// better figures (a MAVLink vehicle's own) puts them there first.
+pub fn verdict(checked: &mut Checked, api: &Descriptor) -> Verdict {
+    let verified = preflight(checked, api);
+    let mut diagnostics = std::mem::take(&mut checked.diagnostics);
+    let preflight_ran = verified.is_some();
+    let flight = verified.map(|(mission, v)| {
+        diagnostics.extend(v.diagnostics);
+        (mission, v.plan)
+    });
+    aviary_check::acknowledge(&checked.allows, &mut diagnostics, preflight_ran);
+    Verdict { diagnostics, flight }
+}

@@ -616,19 +616,25 @@ fn nothing_in_the_repository_points_outside_it() {
                 problems.push(format!("{at}: names the outside reference: {line}"));
             }
             // Every `NAME.md` named is a file of the repository: as written, beside the
-            // file, or in docs/.
+            // file, in docs/, or in the page's folder of a crate that serves one (`web/`,
+            // which the station's assets are named from).
             for word in line.split(|c: char| !(c.is_ascii_alphanumeric() || "_-./".contains(c))) {
                 let word = word.trim_start_matches("./").trim_end_matches('.');
                 if !word.ends_with(".md") || word.len() <= 3 {
                     continue;
                 }
-                let found = [root.join(word), dir.join(word), root.join("docs").join(word)]
-                    .iter()
-                    .any(|p| {
-                        p.is_file()
-                            && p.canonicalize()
-                                .is_ok_and(|p| p.starts_with(root.canonicalize().unwrap()))
-                    });
+                let found = [
+                    root.join(word),
+                    dir.join(word),
+                    root.join("docs").join(word),
+                    dir.join("../web").join(word),
+                ]
+                .iter()
+                .any(|p| {
+                    p.is_file()
+                        && p.canonicalize()
+                            .is_ok_and(|p| p.starts_with(root.canonicalize().unwrap()))
+                });
                 if !found {
                     problems.push(format!(
                         "{at}: names `{word}`, which is not a file of the repository"

@@ -7,7 +7,7 @@
 //!
 //! A library, so that what a run does with memory is said where the run is: the binary
 //! declares [`MiMalloc`] its `#[global_allocator]` and calls [`tune`] before `main`; the
-//! run's pipeline (`aviary_backends::fly`) calls [`give_back`] where it has just freed the
+//! run's pipeline (`aviary_pipeline::fly`) calls [`give_back`] where it has just freed the
 //! texts; a command calls [`short_lived`]. In a process whose allocator is another (a
 //! test), the tuning functions touch only mimalloc's own, unused, state: they change
 //! nothing and cost next to nothing.

@@ -6,7 +6,7 @@
 use std::io::Write;
 use std::time::Instant;
 
-use aviary_backends::pipeline::{NotFlown, Source, Texts};
+use aviary_pipeline::pipeline::{NotFlown, Source, Texts};
 use aviary_campaign::report::Flew;
 use aviary_campaign::{Campaign, Report, Seeds};
 

@@ -3,7 +3,7 @@
 //! there), and the benchmarks `aviary bench` runs on them, each a function that writes
 //! its report to the `Write` it is given: [`parse()`] (the front end), [`front()`] (all of
 //! `aviary check`), [`w()`] (the engine, W(N, K)) and [`swarm()`] (the simulator) and [`campaign()`] (`aviary test`, many seeds at once). The
-//! scale benchmarks fly through `aviary_backends::fly`, the pipeline of `aviary run`, so
+//! scale benchmarks fly through `aviary_pipeline::fly`, the pipeline of `aviary run`, so
 //! they measure what a user runs.
 //!
 //! Invariants: the generators' output is a function of their arguments only; a

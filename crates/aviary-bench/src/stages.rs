@@ -1,4 +1,4 @@
-//! The scale benchmarks' run: the pipeline of `aviary run` (`aviary_backends::fly`), from
+//! The scale benchmarks' run: the pipeline of `aviary run` (`aviary_pipeline::fly`), from
 //! text to the end of the mission, with the time each stage takes: world (TOML to
 //! `World`), check (parse, load, infer, walk), compile, free front end, simulator start
 //! (the physics core of every drone) and the engine's run.
@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use aviary_api::trace::{EventKind, Record};
 use aviary_api::Backend;
-use aviary_backends::pipeline::{Flown, Hooks, NotFlown, Options, Source, Stage, Texts};
+use aviary_pipeline::pipeline::{Flown, Hooks, NotFlown, Options, Source, Stage, Texts};
 use aviary_diagnostics::{render_text, SourceMap};
 use aviary_engine::TraceSink;
 
@@ -40,7 +40,7 @@ impl Stages {
 }
 
 /// Checks, compiles and runs `mission` in `world` on the simulator (at `--speed max`),
-/// through `aviary_backends::fly` as `aviary run` does, feeding every trace event to
+/// through `aviary_pipeline::fly` as `aviary run` does, feeding every trace event to
 /// `sink` and timing each stage into `stages`. A mission with errors is refused, as
 /// `aviary run` refuses it. The texts are handed over, not copied: a large world's text
 /// is megabytes.
@@ -56,7 +56,7 @@ pub fn fly(
         files: &NoFiles,
     };
     let mut timed = Timed { stages, sink, began: None, freeing: Duration::ZERO };
-    aviary_backends::fly(texts, &Options::default(), &mut timed).map_err(|why| match why {
+    aviary_pipeline::fly(texts, &Options::default(), &mut timed).map_err(|why| match why {
         NotFlown::Errors { diagnostics, sources } => render(&sources, &diagnostics),
         NotFlown::NoMission => "the mission has no MISSION".into(),
         NotFlown::Speed => "a speed was given for MAVLink drones".into(),

@@ -17,7 +17,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use aviary_api::trace::{EventKind, Record};
 use aviary_api::Backend;
-use aviary_backends::pipeline::{fly_prepared, prepare, Hooks, NotFlown, Options, Prepared, Texts};
+use aviary_pipeline::pipeline::{fly_prepared, prepare, Hooks, NotFlown, Options, Prepared, Texts};
 use aviary_ir::Mission;
 
 mod observe;
@@ -42,7 +42,7 @@ pub struct Campaign {
 }
 
 impl Campaign {
-    /// Checks and compiles the mission of `texts` once (`aviary_backends::pipeline::prepare`).
+    /// Checks and compiles the mission of `texts` once (`aviary_pipeline::pipeline::prepare`).
     pub fn prepare(texts: Texts<'_>) -> Result<Campaign, NotFlown> {
         let mission_file = texts.mission.name.to_owned();
         let world_file = texts.world.name.to_owned();

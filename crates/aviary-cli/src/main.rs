@@ -354,8 +354,8 @@ fn command(cli: Cli) -> u8 {
                         serve,
                         use_root,
                         clock: match clock {
-                            Clock::Vehicles => aviary_backends::pipeline::LiveClock::Vehicles,
-                            Clock::Wall => aviary_backends::pipeline::LiveClock::Wall,
+                            Clock::Vehicles => aviary_pipeline::pipeline::LiveClock::Vehicles,
+                            Clock::Wall => aviary_pipeline::pipeline::LiveClock::Wall,
                         },
                     })
                 }

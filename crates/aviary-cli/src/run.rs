@@ -1,6 +1,6 @@
 //! `aviary run`: check, compile and fly a mission on the drones its world binds (the
 //! built-in simulator), with a live progress line, a JSON Lines trace and a summary.
-//! The pipeline is `aviary_backends::fly`'s; here are the files, the terminal, the
+//! The pipeline is `aviary_pipeline::fly`'s; here are the files, the terminal, the
 //! signals and the operator server, through the pipeline's hooks.
 
 use std::io::Write;
@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use aviary_api::trace::{Event, RaisedBy, Record};
 use aviary_api::Backend;
-use aviary_backends::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
+use aviary_pipeline::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
 use aviary_diagnostics::{render_text, SourceMap};
 use aviary_engine::{Controller, RunOptions, Status};
 use aviary_ir::Mission;
@@ -16,7 +16,7 @@ use aviary_world::World;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::files::{color_wanted, use_roots, world_beside, DiskProvider};
-use aviary_backends::trace_file::{show_size, Cut, SharedTrace, TraceFile};
+use aviary_pipeline::trace_file::{show_size, Cut, SharedTrace, TraceFile};
 
 pub struct RunArgs {
     pub file: PathBuf,
@@ -35,7 +35,7 @@ pub struct RunArgs {
     /// Folders whose .mission files USE may read, besides the mission's own.
     pub use_root: Vec<PathBuf>,
     /// What a run with MAVLink drones keeps time by.
-    pub clock: aviary_backends::pipeline::LiveClock,
+    pub clock: aviary_pipeline::pipeline::LiveClock,
 }
 
 /// `7878` is loopback port 7878; `HOST:PORT` binds exactly that.
@@ -72,7 +72,7 @@ pub fn parse_size(text: &str) -> Result<u64, String> {
         _ => return Err(wrong()),
     };
     let bytes = number.checked_mul(scale).ok_or_else(wrong)?;
-    let least = aviary_backends::trace_file::MIN_MAX_BYTES;
+    let least = aviary_pipeline::trace_file::MIN_MAX_BYTES;
     if bytes < least {
         return Err(format!(
             "`{text}` is too small for --max-trace-size: a trace needs at least {}",
@@ -164,7 +164,7 @@ pub fn run(args: &RunArgs) -> u8 {
         summary: String::new(),
         expected: None,
     };
-    let flown = aviary_backends::fly(texts, &options, &mut shown);
+    let flown = aviary_pipeline::fly(texts, &options, &mut shown);
     let Shown { trace, server, progress, summary, expected, .. } = shown;
     if let (Ok(flown), Some(trace)) = (&flown, &trace) {
         if !flown.flew {
@@ -321,7 +321,7 @@ impl Hooks for Shown<'_> {
         Ok(())
     }
 
-    fn connected(&mut self, replan: &aviary_backends::replan::Replan, sources: &SourceMap) {
+    fn connected(&mut self, replan: &aviary_pipeline::replan::Replan, sources: &SourceMap) {
         crate::vehicle_figures::before_flight(replan, sources, self.args.quiet);
     }
 

@@ -6,7 +6,7 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use aviary_backends::pipeline::{Source, Texts};
+use aviary_pipeline::pipeline::{Source, Texts};
 use aviary_campaign::report::Flew;
 use aviary_campaign::{Campaign, Report, Seeds, Shard};
 use clap::{Args, Subcommand};

@@ -12,7 +12,7 @@ use crate::files::color_wanted;
 /// How long `aviary check --plan` waits for the vehicles, all at once.
 pub const ASK_WAIT: Duration = Duration::from_secs(5);
 
-pub use aviary_backends::replan::{apply, Figures as Source};
+pub use aviary_pipeline::replan::{apply, Figures as Source};
 
 /// Asks the MAVLink drones of `world` for their facts (within [`ASK_WAIT`]) and applies
 /// them. A world without MAVLink drones is not asked.
@@ -46,14 +46,14 @@ pub fn render(sources: &[Source]) -> String {
 }
 
 /// Before a run with MAVLink drones: the plan made again with the vehicles' facts
-/// (`aviary_backends::replan`, as the station shows it), and its battery warnings (W204)
+/// (`aviary_pipeline::replan`, as the station shows it), and its battery warnings (W204)
 /// on standard error. A drone whose battery the plan says runs out still flies: the
 /// mission's handlers (BatteryLow, BatteryCritical) and the autopilot's failsafe may bring
 /// it home, and only the operator knows whether the estimate is too cautious. So it is
 /// said loudly, even with `--quiet`, and the operator can stop (Ctrl-C) before take-off.
 /// Returns the drones that run out.
 pub fn before_flight(
-    replan: &aviary_backends::replan::Replan,
+    replan: &aviary_pipeline::replan::Replan,
     sources: &SourceMap,
     quiet: bool,
 ) -> Vec<String> {

@@ -313,7 +313,7 @@ pub fn fly(
     runs: u64,
     seed: u64,
 ) -> Result<(String, String), String> {
-    use aviary_backends::pipeline::{NotFlown, Source, Texts};
+    use aviary_pipeline::pipeline::{NotFlown, Source, Texts};
     use aviary_campaign::report::Flew;
     use aviary_campaign::{Campaign, Seeds};
     if !(1..=MOST_RUNS).contains(&runs) {

@@ -1,5 +1,5 @@
 //! A flight started from the page: the mission and world texts the page holds, flown
-//! through the same pipeline as `aviary run` (`aviary_backends::fly`) on a thread of its
+//! through the same pipeline as `aviary run` (`aviary_pipeline::fly`) on a thread of its
 //! own, its events fed to the operator API of that run, which the station serves while it
 //! flies and after it has ended, until the next flight.
 
@@ -7,8 +7,8 @@ use std::sync::Arc;
 
 use aviary_api::trace::Record;
 use aviary_api::Backend;
-use aviary_backends::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
-use aviary_backends::trace_file::{Cut, SharedTrace, TraceFile, DEFAULT_MAX_BYTES};
+use aviary_pipeline::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
+use aviary_pipeline::trace_file::{Cut, SharedTrace, TraceFile, DEFAULT_MAX_BYTES};
 use aviary_check::SourceProvider;
 use aviary_engine::{Controller, RunOptions};
 use aviary_ir::Mission;
@@ -90,7 +90,7 @@ pub fn start(
                 bounds: None,
                 live: false,
             };
-            let flown = aviary_backends::fly(texts, &options, &mut hooks);
+            let flown = aviary_pipeline::fly(texts, &options, &mut hooks);
             landed.flying.store(false, std::sync::atomic::Ordering::SeqCst);
             let why = match flown {
                 Ok(_) => return,
@@ -188,7 +188,7 @@ impl Hooks for Flight {
     /// go to the page, which shows each as an alarm before the drones are far.
     fn connected(
         &mut self,
-        replan: &aviary_backends::replan::Replan,
+        replan: &aviary_pipeline::replan::Replan,
         _sources: &aviary_diagnostics::SourceMap,
     ) {
         let mut warnings: Vec<serde_json::Value> = replan

@@ -33,7 +33,7 @@ pub mod show;
 pub mod sweep;
 pub mod trace;
 
-pub use builtin::{BuiltinException, BuiltinSignal};
+pub use builtin::{BuiltinException, BuiltinLeash, BuiltinSignal};
 pub use coverage::{Progress, Remainder};
 pub use function::{Function, Param, Signature};
 pub use geometry::centroid;

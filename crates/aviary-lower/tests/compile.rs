@@ -1,7 +1,7 @@
 //! The compiler on the paper's mission and on small missions: names become indices,
 //! handlers sit on the block they hear, defaults and units are resolved once.
 
-use aviary_api::{Descriptor, Point, Resource, Value};
+use aviary_api::{BuiltinLeash, Descriptor, Point, Resource, Value};
 use aviary_ir::*;
 use aviary_lower::compile;
 use aviary_test_support::harness;
@@ -176,7 +176,7 @@ fn leashes_resolve_their_section_and_tag() {
     assert_eq!((wider.action, wider.action_name.as_str()), (LeashAction::Section(0), "Wider"));
     assert_eq!(wider.args, [(0, Expr::Const(Value::Number(40.0)))]);
     let Node::Leash(abort) = &seq.items[2] else { panic!() };
-    assert_eq!(abort.action, LeashAction::Abort);
+    assert_eq!(abort.action, LeashAction::Builtin(BuiltinLeash::Abort));
 }
 
 /// The operator API checks a leash's arguments and a signal's values against these.

@@ -14,7 +14,8 @@ use aviary_ir::*;
 
 /// Compiles the checked `program` for the fleet of `world`. `None` when the program
 /// holds no MISSION (a library of capabilities has nothing to run).
-pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mission> {
+pub fn compile(program: &Program, world: &World) -> Option<Mission> {
+    let api = Descriptor::standard();
     let mission = program.mission()?;
     let mission_file = program.mission.map(|r| r.file).unwrap_or_default();
     let mut c = Compiler::new(program, world, api);

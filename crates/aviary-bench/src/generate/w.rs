@@ -75,6 +75,7 @@ mod tests {
                 assert!(diags.is_empty(), "{diags:#?}");
                 let mut world = world.unwrap();
                 world.drones.iter_mut().for_each(|d| d.span = Default::default());
+                world.groups.iter_mut().for_each(|g| g.spans.clear());
                 world
             };
             assert_eq!(read(&w_world(n)), read(&as_tables(n)), "{n} drones");

@@ -13,7 +13,6 @@ pub use mavlink::{
 pub use operator::operator;
 pub use station::station;
 
-use aviary_api::Descriptor;
 // Fuzzed missions `USE` nothing that can be read.
 use aviary_check::NoFiles;
 use aviary_diagnostics::{render_json, render_text, FileId, SourceMap};
@@ -48,7 +47,6 @@ pub fn mission(data: &[u8]) {
         ("fuzz.mission", data),
         Some(("world.toml", EXAMPLE_WORLD.as_bytes())),
         &NoFiles,
-        &Descriptor::standard(),
     );
     assert!(checked.world.is_some(), "the example world has problems");
     for d in &checked.diagnostics {
@@ -56,7 +54,7 @@ pub fn mission(data: &[u8]) {
         let _ = render_json(&sources, d);
     }
     // A mission without errors is compiled and goes through the pre-flight analyses.
-    if let Some((_, verified)) = aviary_verify::preflight(&mut checked, &Descriptor::standard()) {
+    if let Some((_, verified)) = aviary_verify::preflight(&mut checked) {
         for d in &verified.diagnostics {
             let _ = render_text(&sources, d, false);
         }

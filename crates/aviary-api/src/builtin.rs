@@ -92,6 +92,42 @@ impl BuiltinException {
     }
 }
 
+/// What a leash can tell any activity, whatever its capability (docs/LANGUAGE.md,
+/// section 14): the words the checker, the compiler, the engine and the operator server
+/// all read, spelt here once. A named `PERFORM` section is the capability's own, so it is
+/// not one of these.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum BuiltinLeash {
+    Abort,
+    Pause,
+    Resume,
+}
+
+impl BuiltinLeash {
+    pub const ALL: [BuiltinLeash; 3] =
+        [BuiltinLeash::Abort, BuiltinLeash::Pause, BuiltinLeash::Resume];
+
+    /// The word a mission (and the trace, and the operator) writes: `ABORT`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            BuiltinLeash::Abort => "ABORT",
+            BuiltinLeash::Pause => "PAUSE",
+            BuiltinLeash::Resume => "RESUME",
+        }
+    }
+
+    /// The action a word names, or `None` for anything else (a section's name).
+    pub fn parse(word: &str) -> Option<BuiltinLeash> {
+        BuiltinLeash::ALL.into_iter().find(|a| a.as_str() == word)
+    }
+}
+
+impl std::fmt::Display for BuiltinLeash {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 impl std::fmt::Display for BuiltinSignal {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
@@ -121,5 +157,12 @@ mod tests {
             assert_eq!(BuiltinException::from_name(e.name()), Some(*e));
         }
         assert_eq!(BuiltinException::from_name("Nope"), None);
+        for (i, a) in BuiltinLeash::ALL.iter().enumerate() {
+            assert_eq!(*a as usize, i, "{a:?}");
+            assert_eq!(format!("{a:?}").to_uppercase(), a.as_str());
+            assert_eq!(BuiltinLeash::parse(a.as_str()), Some(*a));
+        }
+        assert_eq!(BuiltinLeash::parse("Abort"), None);
+        assert_eq!(BuiltinLeash::parse("Widen"), None);
     }
 }

@@ -33,7 +33,7 @@ pub mod show;
 pub mod sweep;
 pub mod trace;
 
-pub use builtin::{BuiltinException, BuiltinSignal};
+pub use builtin::{BuiltinException, BuiltinLeash, BuiltinSignal};
 pub use coverage::{Progress, Remainder};
 pub use function::{Function, Param, Signature};
 pub use geometry::centroid;
@@ -96,8 +96,15 @@ impl Descriptor {
     }
 
     /// The functions of docs/LANGUAGE.md, section 19, which every backend offers, with the
-    /// telemetry and the built-ins.
-    pub fn standard() -> Descriptor {
+    /// telemetry and the built-ins: the one descriptor, built once, that the checker, the
+    /// compiler and the editors read (no backend offers another).
+    pub fn standard() -> &'static Descriptor {
+        static STANDARD: std::sync::LazyLock<Descriptor> =
+            std::sync::LazyLock::new(Descriptor::build);
+        &STANDARD
+    }
+
+    fn build() -> Descriptor {
         use Kind::*;
         Descriptor {
             functions: Function::ALL.map(Function::signature).into(),

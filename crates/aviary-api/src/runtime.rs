@@ -187,9 +187,8 @@ impl DroneEvent {
 /// A fleet of drones as the engine sees it. Implemented by the built-in simulator and by
 /// real-drone backends; the engine never knows which one it drives.
 pub trait Backend {
-    /// The functions, telemetry and built-ins this backend offers.
-    fn descriptor(&self) -> crate::Descriptor;
-    /// Starts `function` on `drone`. Arguments were checked against the descriptor.
+    /// Starts `function` on `drone`. Arguments were checked against the standard
+    /// descriptor ([`crate::Descriptor::standard`]), which every backend offers.
     fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall;
     fn interrupt(&self, call: CallId, how: Interrupt);
     fn telemetry(&self, drone: DroneId) -> Telemetry;

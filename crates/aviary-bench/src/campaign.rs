@@ -6,9 +6,9 @@
 use std::io::Write;
 use std::time::Instant;
 
-use aviary_pipeline::pipeline::{NotFlown, Source, Texts};
 use aviary_campaign::report::Flew;
 use aviary_campaign::{Campaign, Report, Seeds};
+use aviary_pipeline::pipeline::{NotFlown, Source, Texts};
 
 use crate::stages::{mib, peak_rss};
 use crate::Error;

@@ -108,7 +108,6 @@ pub fn front(
 /// What `aviary check` does with the mission, minus reading and printing: the front end,
 /// then `aviary_verify::preflight`'s two steps, each timed.
 fn once(mission: &str, world: &str) -> Timed {
-    let api = aviary_sim::descriptor();
     let start = Instant::now();
     let mut sources = SourceMap::new();
     let checked = aviary_check::check_sources(
@@ -116,7 +115,6 @@ fn once(mission: &str, world: &str) -> Timed {
         ("front.mission", mission.as_bytes()),
         Some(("front.world.toml", world.as_bytes())),
         &NoFiles,
-        &api,
     );
     let check = start.elapsed();
     let mut errors = checked.diagnostics.iter().filter(|d| d.is_error()).count();
@@ -126,7 +124,7 @@ fn once(mission: &str, world: &str) -> Timed {
     {
         let start = Instant::now();
         // As `aviary_verify::preflight` does: the tree is dropped before the analyses.
-        let compiled = aviary_lower::compile(&program, w, &api);
+        let compiled = aviary_lower::compile(&program, w);
         drop(program);
         compile = start.elapsed();
         if let Some(compiled) = compiled {

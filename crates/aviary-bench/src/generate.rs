@@ -356,7 +356,6 @@ fn world() -> String {
 
 #[cfg(test)]
 mod tests {
-    use aviary_api::Descriptor;
     use aviary_diagnostics::{FileId, SourceMap};
 
     use super::*;
@@ -374,13 +373,8 @@ mod tests {
         assert_eq!(world.drones.len(), DRONES);
         assert_eq!(world.groups.len(), GROUPS);
         let root = sources.add("generated.mission", mission);
-        let (program, diagnostics) = aviary_check::check(
-            &mut sources,
-            root,
-            Some(&world),
-            &NoFiles,
-            &Descriptor::standard(),
-        );
+        let (program, diagnostics) =
+            aviary_check::check(&mut sources, root, Some(&world), &NoFiles);
         let shown: Vec<String> = diagnostics
             .iter()
             .take(10)

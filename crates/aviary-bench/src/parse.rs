@@ -7,7 +7,6 @@
 use std::io::Write;
 use std::time::Instant;
 
-use aviary_api::Descriptor;
 use aviary_check::NoFiles;
 use aviary_diagnostics::{FileId, SourceMap};
 
@@ -88,7 +87,6 @@ fn parse_and_check(mission: &str, world_text: &str) -> (usize, usize) {
         ("generated.mission", mission.as_bytes()),
         Some(("generated.world.toml", world_text.as_bytes())),
         &NoFiles,
-        &Descriptor::standard(),
     );
     let errors = checked.diagnostics.iter().filter(|d| d.is_error()).count();
     (errors, checked.diagnostics.len() - errors)

@@ -7,9 +7,9 @@ use std::time::{Duration, Instant};
 
 use aviary_api::trace::{EventKind, Record};
 use aviary_api::Backend;
-use aviary_pipeline::pipeline::{Flown, Hooks, NotFlown, Options, Source, Stage, Texts};
 use aviary_diagnostics::{render_text, SourceMap};
 use aviary_engine::TraceSink;
+use aviary_pipeline::pipeline::{Flown, Hooks, NotFlown, Options, Source, Stage, Texts};
 
 use aviary_check::NoFiles;
 

@@ -17,8 +17,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use aviary_api::trace::{EventKind, Record};
 use aviary_api::Backend;
-use aviary_pipeline::pipeline::{fly_prepared, prepare, Hooks, NotFlown, Options, Prepared, Texts};
 use aviary_ir::Mission;
+use aviary_pipeline::pipeline::{fly_prepared, prepare, Hooks, NotFlown, Options, Prepared, Texts};
 
 mod observe;
 pub mod report;

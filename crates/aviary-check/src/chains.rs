@@ -171,7 +171,8 @@ fn later_in_chain(wait: &[Step], signal: &[Step]) -> bool {
         && !s.handler
 }
 
-pub(crate) fn check_chains(program: &Program, api: &Descriptor, diagnostics: &mut Vec<Diagnostic>) {
+pub(crate) fn check_chains(program: &Program, diagnostics: &mut Vec<Diagnostic>) {
+    let api = Descriptor::standard();
     let (Some(mission), Some(at)) = (program.mission(), program.mission) else { return };
     let file: FileId = at.file;
     let in_capabilities = raised_in_capabilities(program);

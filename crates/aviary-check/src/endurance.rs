@@ -47,16 +47,12 @@ struct Env {
     actors: HashMap<String, Drones>,
 }
 
-pub(crate) fn check_endurance(
-    program: &Program,
-    world: &World,
-    api: &Descriptor,
-    diagnostics: &mut Vec<Diagnostic>,
-) {
+pub(crate) fn check_endurance(program: &Program, world: &World, diagnostics: &mut Vec<Diagnostic>) {
+    let api = Descriptor::standard();
     let (Some(mission), Some(file)) = (program.mission(), program.mission.map(|r| r.file)) else {
         return;
     };
-    let timed = timed_capabilities(program, api);
+    let timed = timed_capabilities(program);
     if timed.is_empty() {
         return;
     }
@@ -77,7 +73,8 @@ pub(crate) fn check_endurance(
 
 /// The capabilities that make, themselves or through those they call, a middle-layer
 /// call with a duration: only statements of these are followed.
-fn timed_capabilities<'p>(program: &'p Program, api: &Descriptor) -> foldhash::HashSet<&'p str> {
+fn timed_capabilities(program: &Program) -> foldhash::HashSet<&str> {
+    let api = Descriptor::standard();
     let mut callers: foldhash::HashMap<&str, Vec<&str>> = foldhash::HashMap::default();
     let mut pending: Vec<&str> = Vec::new();
     for (_, c) in program.active_capabilities() {

@@ -28,10 +28,8 @@ pub struct KindOrigin {
 
 pub(crate) type Origins = ByName<Vec<Option<KindOrigin>>>;
 
-pub(crate) fn parameter_kinds(
-    program: &Program,
-    api: &Descriptor,
-) -> (ByName<Vec<Option<Kind>>>, Origins) {
+pub(crate) fn parameter_kinds(program: &Program) -> (ByName<Vec<Option<Kind>>>, Origins) {
+    let api = Descriptor::standard();
     // The capabilities with parameters, in name order, by index; names are looked up by
     // hash. One without parameters has nothing to learn, and so never tells a caller
     // anything, nor gets an entry (most capabilities of a long chain are such).
@@ -272,7 +270,7 @@ fn callers(
 
 #[cfg(test)]
 mod tests {
-    use aviary_api::{Descriptor, Kind};
+    use aviary_api::Kind;
     use aviary_diagnostics::SourceMap;
 
     use crate::NoFiles;
@@ -293,7 +291,6 @@ mod tests {
             ("m.mission", text.as_bytes()),
             Some(("w.toml", world.as_bytes())),
             &NoFiles,
-            &Descriptor::standard(),
         );
         let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).collect();
         assert!(errors.is_empty(), "{errors:?}");
@@ -325,7 +322,6 @@ mod tests {
             ("m.mission", text.as_bytes()),
             Some(("w.toml", world.as_bytes())),
             &NoFiles,
-            &Descriptor::standard(),
         );
         let program = checked.program.expect("program");
         for i in [0, 1, n / 2, n - 1] {

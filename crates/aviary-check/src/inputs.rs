@@ -4,7 +4,6 @@
 use std::borrow::Cow;
 use std::path::{Component, Path, PathBuf};
 
-use aviary_api::Descriptor;
 use aviary_diagnostics::{Code, Diagnostic, SourceMap};
 use aviary_world::World;
 
@@ -34,11 +33,10 @@ pub fn check_sources(
     mission: (&str, &[u8]),
     world: Option<(&str, &[u8])>,
     provider: &dyn SourceProvider,
-    api: &Descriptor,
 ) -> Checked {
     let world =
         world.map(|(name, bytes)| read_world(sources, name, Cow::Borrowed(bytes), provider));
-    check_against(sources, (mission.0, Cow::Borrowed(mission.1)), world, provider, api)
+    check_against(sources, (mission.0, Cow::Borrowed(mission.1)), world, provider)
 }
 
 /// A world file as [`read_world`] read it.
@@ -95,7 +93,6 @@ pub fn check_against(
     mission: (&str, Cow<'_, [u8]>),
     world: Option<WorldRead>,
     provider: &dyn SourceProvider,
-    api: &Descriptor,
 ) -> Checked {
     let world_failed = world.as_ref().is_some_and(|w| w.world.is_none());
     let (parsed_world, mut diagnostics) = match world {
@@ -109,7 +106,7 @@ pub fn check_against(
     if let Some(at) = invalid {
         diagnostics.push(aviary_syntax::invalid_utf8(root, at));
     } else {
-        let (p, d) = crate::check(sources, root, parsed_world.as_ref(), provider, api);
+        let (p, d) = crate::check(sources, root, parsed_world.as_ref(), provider);
         allows = p.allows.clone();
         program = Some(p);
         // With a broken world, its own errors say why names went unchecked.

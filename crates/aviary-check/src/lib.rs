@@ -33,7 +33,7 @@ mod walk;
 
 use std::collections::BTreeMap;
 
-use aviary_api::{Descriptor, Kind};
+use aviary_api::Kind;
 use aviary_diagnostics::{Diagnostic, FileId, SourceMap};
 use aviary_syntax::ast::{Capability, Item, Mission, SourceFile};
 use aviary_world::World;
@@ -199,21 +199,20 @@ pub fn check(
     root: FileId,
     world: Option<&World>,
     provider: &dyn SourceProvider,
-    api: &Descriptor,
 ) -> (Program, Vec<Diagnostic>) {
     let mut diagnostics = Vec::new();
     let mut program = load::load(sources, root, provider, &mut diagnostics);
     // Checks on a file that did not parse would only repeat its syntax errors.
     let syntax_ok =
         !diagnostics.iter().any(|d: &Diagnostic| d.is_error() && d.code.as_str().starts_with("E0"));
-    (program.param_kinds, program.param_origins) = infer::parameter_kinds(&program, api);
-    program.signal_values = signal_values::signal_values(&program, api);
+    (program.param_kinds, program.param_origins) = infer::parameter_kinds(&program);
+    program.signal_values = signal_values::signal_values(&program);
     if syntax_ok {
         let program = &program;
         let names = || {
             let mut out = Vec::new();
-            walk::check_program(program, world, api, root, &mut out);
-            signals::check_signals(program, api, &mut out);
+            walk::check_program(program, world, root, &mut out);
+            signals::check_signals(program, &mut out);
             signal_cycles::check_signal_cycles(program, &mut out);
             out
         };
@@ -221,11 +220,11 @@ pub fn check(
             let mut out = Vec::new();
             if let Some(world) = world {
                 geofence::check_geofence(program, world, &mut out);
-                endurance::check_endurance(program, world, api, &mut out);
+                endurance::check_endurance(program, world, &mut out);
             }
-            chains::check_chains(program, api, &mut out);
+            chains::check_chains(program, &mut out);
             recursion::check_recursion(program, &mut out);
-            unheard::check_unheard(program, world, api, &mut out);
+            unheard::check_unheard(program, world, &mut out);
             out
         };
         let large = sources.text(root).len() >= IN_PARALLEL_FROM;

@@ -174,7 +174,7 @@ fn index_definitions(program: &mut Program, std_id: FileId, diagnostics: &mut Ve
 
 #[cfg(test)]
 mod tests {
-    use aviary_api::Descriptor;
+
     use aviary_diagnostics::{Code, SourceMap};
 
     use super::NoFiles;
@@ -187,7 +187,6 @@ mod tests {
             ("m.mission", b"USE \"lib/beacons.mission\"\nMISSION M:\n    SIGNAL Go\n".as_slice()),
             None,
             &NoFiles,
-            &Descriptor::standard(),
         );
         let unreadable: Vec<(Code, &str)> = checked
             .diagnostics

@@ -178,7 +178,6 @@ mod tests {
             ("m.mission", mission.as_bytes()),
             None,
             &crate::NoFiles,
-            &aviary_api::Descriptor::standard(),
         );
         checked
             .diagnostics

@@ -18,10 +18,8 @@ use aviary_syntax::visit::for_each_stmt;
 use crate::env::{bind_args, literal_kind};
 use crate::Program;
 
-pub(crate) fn signal_values(
-    program: &Program,
-    api: &Descriptor,
-) -> BTreeMap<String, Vec<Option<Kind>>> {
+pub(crate) fn signal_values(program: &Program) -> BTreeMap<String, Vec<Option<Kind>>> {
+    let api = Descriptor::standard();
     let mut out: BTreeMap<String, Vec<Option<Kind>>> = BTreeMap::new();
     for s in &api.signals {
         out.insert(s.name().to_string(), s.values().iter().map(|(_, k)| Some(*k)).collect());
@@ -72,7 +70,7 @@ pub(crate) fn signal_values(
                                 &mut out,
                                 &h.signal.name,
                                 i,
-                                binding_kind(program, api, &b.name, &h.body),
+                                binding_kind(program, &b.name, &h.body),
                             );
                         }
                     }
@@ -102,7 +100,8 @@ pub(crate) fn signal_values(
 
 /// The kind a handler's body gives its binding `name`: the first capability or
 /// middle-layer parameter of known kind it is passed to.
-fn binding_kind(program: &Program, api: &Descriptor, name: &str, body: &Body) -> Option<Kind> {
+fn binding_kind(program: &Program, name: &str, body: &Body) -> Option<Kind> {
+    let api = Descriptor::standard();
     let is_binding = |e: &Expr| matches!(&e.kind, ExprKind::Name(id) if id.name == name);
     let mut found = None;
     for_each_stmt(body, |stmt| {
@@ -164,8 +163,7 @@ mod tests {
     fn values(mission: &str) -> BTreeMap<String, Vec<Option<Kind>>> {
         let mut sources = SourceMap::default();
         let root = sources.add("m.mission", mission);
-        let (program, _) =
-            crate::check(&mut sources, root, None, &NoFiles, &Descriptor::standard());
+        let (program, _) = crate::check(&mut sources, root, None, &NoFiles);
         program.signal_values
     }
 

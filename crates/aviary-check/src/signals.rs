@@ -23,11 +23,8 @@ struct Uses<'a> {
     received: Vec<(FileId, &'a Ident)>,
 }
 
-pub(crate) fn check_signals(
-    program: &Program,
-    api: &Descriptor,
-    diagnostics: &mut Vec<Diagnostic>,
-) {
+pub(crate) fn check_signals(program: &Program, diagnostics: &mut Vec<Diagnostic>) {
+    let api = Descriptor::standard();
     let uses = Uses::of(program);
     // A built-in one is refused where it is declared (E130), and said no more.
     let declared: Vec<&Ident> =
@@ -43,7 +40,7 @@ pub(crate) fn check_signals(
         .collect();
     let raised_set: HashSet<&str> = raised.iter().copied().collect();
     never_raised(&uses, &raised, &raised_set, diagnostics);
-    unknown_exceptions(&uses, api, &raised_set, diagnostics);
+    unknown_exceptions(&uses, &raised_set, diagnostics);
     never_handled(&uses, &declared, program, diagnostics);
     rethrows(program, diagnostics);
 }
@@ -144,12 +141,8 @@ fn never_raised(
 }
 
 /// Exception handlers of what is neither a built-in exception nor thrown (or is a signal).
-fn unknown_exceptions(
-    uses: &Uses,
-    api: &Descriptor,
-    raised_set: &HashSet<&str>,
-    diagnostics: &mut Vec<Diagnostic>,
-) {
+fn unknown_exceptions(uses: &Uses, raised_set: &HashSet<&str>, diagnostics: &mut Vec<Diagnostic>) {
+    let api = Descriptor::standard();
     let exceptions: Vec<&str> =
         api.exceptions.iter().map(|e| e.name()).chain(uses.thrown.iter().copied()).collect();
     let exception_set: HashSet<&str> = exceptions.iter().copied().collect();

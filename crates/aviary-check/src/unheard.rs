@@ -62,12 +62,8 @@ impl Drones {
     }
 }
 
-pub(crate) fn check_unheard(
-    program: &Program,
-    world: Option<&World>,
-    api: &Descriptor,
-    out: &mut Vec<Diagnostic>,
-) {
+pub(crate) fn check_unheard(program: &Program, world: Option<&World>, out: &mut Vec<Diagnostic>) {
+    let api = Descriptor::standard();
     let mut pass = Pass { program, world, api, named: HashMap::new(), catches: HashMap::new() };
     // Rule 1 resolves the drones of every statement and `FOR` it passes: on a mission of
     // a hundred thousand drones that is most of the checker's time, so it runs only where

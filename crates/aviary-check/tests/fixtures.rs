@@ -16,7 +16,6 @@
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-use aviary_api::Descriptor;
 use aviary_check::SourceProvider;
 use aviary_diagnostics::{render_text, summary_line, Code, Diagnostic, Severity, SourceMap};
 
@@ -95,13 +94,7 @@ fn check_fixture(rel: &str) -> Outcome {
         std::fs::read(fixtures_dir().join(w)).unwrap_or_else(|e| panic!("cannot read {w}: {e}"))
     });
     let world = world_rel.as_deref().zip(world_bytes.as_deref());
-    let checked = aviary_check::check_sources(
-        &mut sources,
-        (rel, &bytes),
-        world,
-        &FixtureProvider,
-        &Descriptor::standard(),
-    );
+    let checked = aviary_check::check_sources(&mut sources, (rel, &bytes), world, &FixtureProvider);
     let mut diagnostics = checked.diagnostics;
     // The pre-flight analyses do not run here: their codes' ALLOWs are not judged.
     aviary_check::acknowledge(&checked.allows, &mut diagnostics, false);

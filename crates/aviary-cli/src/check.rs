@@ -72,9 +72,7 @@ fn check_one(
     let mut sources = SourceMap::new();
     let world = world_name.as_deref().zip(world_bytes.as_deref());
     let name = path.display().to_string();
-    let api = aviary_sim::descriptor();
-    let mut checked =
-        aviary_check::check_sources(&mut sources, (&name, &bytes), world, &provider, &api);
+    let mut checked = aviary_check::check_sources(&mut sources, (&name, &bytes), world, &provider);
     // MAVLink drones fly with their vehicles' figures: the plan is made with them.
     let mut figures = None;
     if want.ask && !checked.has_errors() {
@@ -82,7 +80,7 @@ fn check_one(
             figures = Some(crate::vehicle_figures::ask(world));
         }
     }
-    let verdict = aviary_verify::verdict(&mut checked, &api);
+    let verdict = aviary_verify::verdict(&mut checked);
     let diagnostics = verdict.diagnostics;
     let plan = verdict.flight.map(|(_, plan)| plan);
     let failed = u8::from(diagnostics.iter().any(Diagnostic::is_error));

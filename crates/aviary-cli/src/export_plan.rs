@@ -75,15 +75,13 @@ fn plan_file(
     let world_bytes = read(&world_path)?;
     let mut sources = SourceMap::new();
     let name = mission.display().to_string();
-    let api = aviary_sim::descriptor();
     let mut checked = aviary_check::check_sources(
         &mut sources,
         (&name, &bytes),
         Some((&world_path.display().to_string(), &world_bytes)),
         &provider,
-        &api,
     );
-    let verified = aviary_verify::preflight(&mut checked, &api);
+    let verified = aviary_verify::preflight(&mut checked);
     let errors: Vec<&Diagnostic> = checked.diagnostics.iter().filter(|d| d.is_error()).collect();
     let (Some((compiled, _)), Some(world), true) =
         (verified, checked.world.as_ref(), errors.is_empty())

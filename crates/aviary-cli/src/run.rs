@@ -8,10 +8,10 @@ use std::path::PathBuf;
 
 use aviary_api::trace::{Event, RaisedBy, Record};
 use aviary_api::Backend;
-use aviary_pipeline::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
 use aviary_diagnostics::{render_text, SourceMap};
 use aviary_engine::{Controller, RunOptions, Status};
 use aviary_ir::Mission;
+use aviary_pipeline::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
 use aviary_world::World;
 use indicatif::{ProgressBar, ProgressStyle};
 

@@ -6,9 +6,9 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use aviary_pipeline::pipeline::{Source, Texts};
 use aviary_campaign::report::Flew;
 use aviary_campaign::{Campaign, Report, Seeds, Shard};
+use aviary_pipeline::pipeline::{Source, Texts};
 use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 

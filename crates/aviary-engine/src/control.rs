@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use aviary_api::trace::{Event, EventKind, OperatorAction};
-use aviary_api::Value;
+use aviary_api::{BuiltinLeash, Value};
 use aviary_diagnostics::suggest::{closest, did_you_mean};
 use aviary_ir::LeashAction;
 use tokio::sync::{mpsc, oneshot};
@@ -228,15 +228,15 @@ impl<'m> Engine<'m> {
                         spaced(mean)
                     )
                 })?;
-                let action_kind = match action.as_str() {
-                    "ABORT" => LeashAction::Abort,
-                    "PAUSE" => LeashAction::Pause,
-                    "RESUME" => LeashAction::Resume,
-                    name => {
+                let action_kind = match BuiltinLeash::parse(&action) {
+                    Some(builtin) => LeashAction::Builtin(builtin),
+                    None => {
+                        let name = action.as_str();
                         let sections = &self.m.capabilities[cap].sections;
                         let section =
                             sections.iter().position(|(n, _)| n == name).ok_or_else(|| {
-                                let known = ["ABORT", "PAUSE", "RESUME"].into_iter();
+                                let known =
+                                    BuiltinLeash::ALL.into_iter().map(|a| -> &str { a.as_str() });
                                 let mean = did_you_mean(
                                     name,
                                     known.chain(sections.iter().map(|(n, _)| n.as_str())),

@@ -8,7 +8,7 @@ use std::rc::Rc;
 use std::task::Poll;
 use std::time::Duration;
 
-use aviary_api::{DroneId, Value};
+use aviary_api::{BuiltinLeash, DroneId, Value};
 use aviary_ir::{ActorRef, Block, BlockKind, Call, Expr, For, Leash, LeashAction, Mission, Node};
 
 use crate::cancel::Token as CancellationToken;
@@ -580,14 +580,14 @@ impl<'m> Engine<'m> {
             self.instances.borrow().tagged(capability, tag).cloned().collect();
         for (instance, scope) in targets {
             match action {
-                LeashAction::Abort => {
+                LeashAction::Builtin(BuiltinLeash::Abort) => {
                     instance.by_leash.set(true);
                     instance.token.cancel();
                 }
                 // What else holds it (a drone the operator holds, a section) stays.
-                LeashAction::Pause | LeashAction::Resume => {
+                LeashAction::Builtin(pause @ (BuiltinLeash::Pause | BuiltinLeash::Resume)) => {
                     let before = instance.holding();
-                    instance.paused.set(action == LeashAction::Pause);
+                    instance.paused.set(pause == BuiltinLeash::Pause);
                     self.rehold(&instance, before);
                 }
                 LeashAction::Section(i) => {
@@ -624,7 +624,7 @@ impl<'m> Engine<'m> {
         self.trace(EventKind::Leash, || Event::Leash {
             capability: path.into(),
             tag: "".into(),
-            action: "ABORT".into(),
+            action: BuiltinLeash::Abort.as_str().into(),
             block: true,
             line: self.m.line_of(at),
         });

@@ -7,8 +7,8 @@ use std::sync::Mutex;
 use std::time::Duration;
 
 use aviary_api::{
-    Backend, BuiltinException, BuiltinSignal, CallEnd, CallId, Descriptor, DroneEvent, DroneId,
-    Ending, Failure, FlightState, Function, Interrupt, PendingCall, Telemetry, Value,
+    Backend, BuiltinException, BuiltinSignal, CallEnd, CallId, DroneEvent, DroneId, Ending,
+    Failure, FlightState, Function, Interrupt, PendingCall, Telemetry, Value,
 };
 use aviary_engine::{RunOptions, Status};
 use aviary_test_support::harness;
@@ -34,10 +34,6 @@ impl Scripted {
 }
 
 impl Backend for Scripted {
-    fn descriptor(&self) -> Descriptor {
-        Descriptor::standard()
-    }
-
     fn call(&self, _: DroneId, _: Function, _: &[Value]) -> PendingCall {
         let end = match self.refuse {
             Some(exception) => Ending::Now(CallEnd::Failed(Failure {

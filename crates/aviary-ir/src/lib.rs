@@ -338,9 +338,8 @@ pub struct Call {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LeashAction {
-    Abort,
-    Pause,
-    Resume,
+    /// `ABORT`, `PAUSE` or `RESUME`, which every capability understands.
+    Builtin(aviary_api::BuiltinLeash),
     /// A named `PERFORM` section, by its index in [`Capability::sections`].
     Section(usize),
 }

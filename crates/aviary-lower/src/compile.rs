@@ -2,7 +2,9 @@
 
 use std::collections::BTreeMap;
 
-use aviary_api::{arith, BuiltinException, BuiltinSignal, Descriptor, DroneId, Point, Value};
+use aviary_api::{
+    arith, BuiltinException, BuiltinLeash, BuiltinSignal, Descriptor, DroneId, Point, Value,
+};
 use aviary_check::{bind_args, Program};
 use aviary_diagnostics::FileId;
 use aviary_syntax::ast;
@@ -12,7 +14,8 @@ use aviary_ir::*;
 
 /// Compiles the checked `program` for the fleet of `world`. `None` when the program
 /// holds no MISSION (a library of capabilities has nothing to run).
-pub fn compile(program: &Program, world: &World, api: &Descriptor) -> Option<Mission> {
+pub fn compile(program: &Program, world: &World) -> Option<Mission> {
+    let api = Descriptor::standard();
     let mission = program.mission()?;
     let mission_file = program.mission.map(|r| r.file).unwrap_or_default();
     let mut c = Compiler::new(program, world, api);
@@ -281,7 +284,7 @@ impl<'a> Compiler<'a> {
                 ast::Section::Perform { name: Some(section), body, .. } => {
                     let path = format!("{name}/PERFORM {}", section.name);
                     let block = self.body(body, &path, BlockKind::Sequential, false);
-                    if section.name == "ABORT" {
+                    if BuiltinLeash::parse(&section.name) == Some(BuiltinLeash::Abort) {
                         out.abort_section = Some(out.sections.len());
                     }
                     out.sections.push((section.name.clone(), block));
@@ -569,11 +572,10 @@ impl<'a> Compiler<'a> {
     fn leash(&mut self, l: &ast::LeashCall) -> Option<Leash> {
         let capability = *self.caps.get(&l.capability.name)?;
         let callee = self.program.capability(&l.capability.name)?;
-        let action = match l.action.name.as_str() {
-            "ABORT" => LeashAction::Abort,
-            "PAUSE" => LeashAction::Pause,
-            "RESUME" => LeashAction::Resume,
-            name => {
+        let name = l.action.name.as_str();
+        let action = match BuiltinLeash::parse(name) {
+            Some(builtin) => LeashAction::Builtin(builtin),
+            None => {
                 let sections = callee.sections.iter().filter_map(|s| match s {
                     ast::Section::Perform { name: Some(n), .. } => Some(n.name.as_str()),
                     ast::Section::Requirements { .. }

@@ -1,7 +1,7 @@
 //! The compiler on the paper's mission and on small missions: names become indices,
 //! handlers sit on the block they hear, defaults and units are resolved once.
 
-use aviary_api::{Descriptor, Point, Resource, Value};
+use aviary_api::{BuiltinLeash, Point, Resource, Value};
 use aviary_ir::*;
 use aviary_lower::compile;
 use aviary_test_support::harness;
@@ -176,7 +176,7 @@ fn leashes_resolve_their_section_and_tag() {
     assert_eq!((wider.action, wider.action_name.as_str()), (LeashAction::Section(0), "Wider"));
     assert_eq!(wider.args, [(0, Expr::Const(Value::Number(40.0)))]);
     let Node::Leash(abort) = &seq.items[2] else { panic!() };
-    assert_eq!(abort.action, LeashAction::Abort);
+    assert_eq!(abort.action, LeashAction::Builtin(BuiltinLeash::Abort));
 }
 
 /// The operator API checks a leash's arguments and a signal's values against these.
@@ -219,16 +219,15 @@ fn builtins_and_the_abort_section_are_resolved_when_compiling() {
     );
 }
 
-/// Every built-in a backend may raise has an id of its own, even when the descriptor the
-/// mission is compiled with does not list it: never another name's id.
+/// Every built-in a backend may raise has an id of its own, never another name's id; the
+/// mission's own names follow them.
 #[test]
-fn every_builtin_has_its_own_id_whatever_the_descriptor_lists() {
+fn every_builtin_has_its_own_id() {
     let (_, checked) = harness::check(
         "MISSION M:\n    SIGNAL Go\n    THROW EXCEPTION Oops\n",
         "[drones.d1]\nhome = [0, 0]\n",
     );
-    let bare = Descriptor { signals: vec![], exceptions: vec![], ..Descriptor::standard() };
-    let m = compile(&checked.program.expect("program"), &checked.world.expect("world"), &bare)
+    let m = compile(&checked.program.expect("program"), &checked.world.expect("world"))
         .expect("a mission");
     for s in aviary_api::BuiltinSignal::ALL {
         assert_eq!(m.signals[m.builtins.signal(s)], s.name());
@@ -236,8 +235,8 @@ fn every_builtin_has_its_own_id_whatever_the_descriptor_lists() {
     for e in aviary_api::BuiltinException::ALL {
         assert_eq!(m.exceptions[m.builtins.exception(e)], e.name());
     }
-    assert_eq!(m.signals[0], "Go", "the mission's own names come first here");
-    assert_eq!(m.exceptions[0], "Oops");
+    assert_eq!(m.signals[aviary_api::BuiltinSignal::ALL.len()], "Go");
+    assert_eq!(m.exceptions[aviary_api::BuiltinException::ALL.len()], "Oops");
 }
 
 #[test]

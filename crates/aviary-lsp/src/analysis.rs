@@ -64,7 +64,6 @@ pub fn is_world(key: &str) -> bool {
 
 /// Checks the open document `key` as the root of a mission.
 pub fn mission(key: &str, docs: &Docs, config: &Config) -> Analysis {
-    let api = aviary_api::Descriptor::standard();
     let text = docs.get(key).map(|d| d.text.as_str()).unwrap_or("");
     let path = Path::new(key);
     // The disk is read for a mission only where the caller's provider allows it (the
@@ -89,7 +88,7 @@ pub fn mission(key: &str, docs: &Docs, config: &Config) -> Analysis {
     let mut sources = SourceMap::new();
     let world_in = world.as_ref().map(|(n, b)| (n.as_str(), b.as_slice()));
     let checked =
-        aviary_check::check_sources(&mut sources, (key, text.as_bytes()), world_in, &overlay, &api);
+        aviary_check::check_sources(&mut sources, (key, text.as_bytes()), world_in, &overlay);
     let world_file = world.is_some().then_some(FileId(0));
     let root = FileId(u32::from(world.is_some()));
     let mut diagnostics = checked.diagnostics;
@@ -98,7 +97,7 @@ pub fn mission(key: &str, docs: &Docs, config: &Config) -> Analysis {
     let mut preflight = false;
     if !diagnostics.iter().any(Diagnostic::is_error) {
         if let (Some(p), Some(w)) = (&program, &world) {
-            if let Some(compiled) = aviary_lower::compile(p, w, &api) {
+            if let Some(compiled) = aviary_lower::compile(p, w) {
                 diagnostics.extend(aviary_verify::verify(&compiled, w).diagnostics);
                 preflight = true;
             }
@@ -109,7 +108,7 @@ pub fn mission(key: &str, docs: &Docs, config: &Config) -> Analysis {
     let occurrences = match &program {
         Some(p) => {
             let files: Vec<_> = p.files.iter().map(|(f, t)| (*f, t)).collect();
-            index::index(&files, world_file.zip(world.as_ref()), &api)
+            index::index(&files, world_file.zip(world.as_ref()))
         }
         None => Vec::new(),
     };
@@ -118,7 +117,6 @@ pub fn mission(key: &str, docs: &Docs, config: &Config) -> Analysis {
 
 /// The world file `key` read alone.
 pub fn world_alone(key: &str, docs: &Docs, config: &Config) -> Analysis {
-    let api = aviary_api::Descriptor::standard();
     let text = docs.get(key).map(|d| d.text.clone()).unwrap_or_default();
     let mut sources = SourceMap::new();
     // The files its `[imports]` names, from the disk beside it.
@@ -133,7 +131,7 @@ pub fn world_alone(key: &str, docs: &Docs, config: &Config) -> Analysis {
         std::borrow::Cow::Owned(text.into_bytes()),
         &*disk,
     );
-    let occurrences = index::index(&[], read.world.as_ref().map(|w| (FileId(0), w)), &api);
+    let occurrences = index::index(&[], read.world.as_ref().map(|w| (FileId(0), w)));
     Analysis {
         sources,
         world_file: Some(FileId(0)),

@@ -63,11 +63,8 @@ pub struct Occurrence {
 
 /// Every occurrence in `files` (the program's, the standard library's included) and the
 /// definitions in the world file `world_file`.
-pub fn index(
-    files: &[(FileId, &SourceFile)],
-    world: Option<(FileId, &World)>,
-    api: &aviary_api::Descriptor,
-) -> Vec<Occurrence> {
+pub fn index(files: &[(FileId, &SourceFile)], world: Option<(FileId, &World)>) -> Vec<Occurrence> {
+    let api = aviary_api::Descriptor::standard();
     let mut walk = Walk {
         out: Vec::new(),
         file: FileId(0),

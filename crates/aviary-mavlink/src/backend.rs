@@ -10,8 +10,8 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use aviary_api::{
-    Backend, BuiltinException, BuiltinSignal, CallEnd, CallId, Descriptor, DroneEvent, DroneId,
-    Ending, Failure, Function, Interrupt, PendingCall, Progress, Telemetry, Value,
+    Backend, BuiltinException, BuiltinSignal, CallEnd, CallId, DroneEvent, DroneId, Ending,
+    Failure, Function, Interrupt, PendingCall, Progress, Telemetry, Value,
 };
 use aviary_world::Sensor;
 use tokio::sync::{mpsc, oneshot, watch};
@@ -261,10 +261,6 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
 }
 
 impl Backend for MavlinkBackend {
-    fn descriptor(&self) -> Descriptor {
-        Descriptor::standard()
-    }
-
     fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall {
         let id = CallId(self.inner.next.fetch_add(1, Ordering::SeqCst));
         let (tx, rx) = oneshot::channel();

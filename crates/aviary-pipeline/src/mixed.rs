@@ -7,8 +7,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 use aviary_api::{
-    Backend, CallId, Descriptor, DroneEvent, DroneId, Ending, Function, Interrupt, PendingCall,
-    Progress, Telemetry, Value,
+    Backend, CallId, DroneEvent, DroneId, Ending, Function, Interrupt, PendingCall, Progress,
+    Telemetry, Value,
 };
 use aviary_mavlink::MavlinkBackend;
 use aviary_sim::SimBackend;
@@ -63,10 +63,6 @@ impl Mixed {
 }
 
 impl Backend for Mixed {
-    fn descriptor(&self) -> Descriptor {
-        aviary_sim::descriptor()
-    }
-
     fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall {
         let by_mavlink = self.mavlink.serves(drone);
         let inner = if by_mavlink {

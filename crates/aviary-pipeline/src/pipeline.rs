@@ -189,11 +189,10 @@ pub enum NotFlown {
 /// at once. Runs on the calling thread, which needs the stack of
 /// `aviary_check::STACK`: the checker and the engine follow capability calls by recursion.
 pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result<Flown, NotFlown> {
-    let api = aviary_sim::descriptor();
     // The trace names the world it was flown in, so that a replay draws that one.
     let stamp = aviary_api::trace::WorldStamp::of(texts.world.name, &texts.world.bytes);
     let run = RunOptions { world: Some(stamp), ..options.run.clone() };
-    let (program, world, sources) = front_end(texts, &api, hooks)?;
+    let (program, world, sources) = front_end(texts, hooks)?;
     // Any MAVLink drone: the wall clock, and the simulated drones in real time with it.
     let live = !aviary_mavlink::bindings(&world).is_empty();
     // The source texts are needed only to show errors: they go before the mission is
@@ -209,7 +208,7 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
         None
     };
     hooks.begin(Stage::Compile);
-    let mission = aviary_lower::compile(&program, &world, &api);
+    let mission = aviary_lower::compile(&program, &world);
     hooks.end(Stage::Compile);
     let Some(mission) = mission else { return Err(NotFlown::NoMission) };
     hooks.begin(Stage::FreeTree);
@@ -304,7 +303,6 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
 /// its program, the world and the texts, or its errors.
 fn front_end(
     texts: Texts<'_>,
-    api: &aviary_api::Descriptor,
     hooks: &mut dyn Hooks,
 ) -> Result<(aviary_check::Program, World, SourceMap), NotFlown> {
     let mut sources = SourceMap::new();
@@ -322,7 +320,6 @@ fn front_end(
         (texts.mission.name, Cow::Owned(texts.mission.bytes)),
         Some(world),
         texts.files,
-        api,
     );
     hooks.end(Stage::Check);
     match (checked.has_errors(), checked.program, checked.world) {
@@ -351,8 +348,7 @@ pub struct Prepared {
 /// (a campaign cannot fly MAVLink vehicles thousands of times): [`NotFlown::Failed`] for
 /// a world with MAVLink drones.
 pub fn prepare(texts: Texts<'_>) -> Result<Prepared, NotFlown> {
-    let api = aviary_sim::descriptor();
-    let (program, world, sources) = front_end(texts, &api, &mut NoHooks)?;
+    let (program, world, sources) = front_end(texts, &mut NoHooks)?;
     let live = aviary_mavlink::bindings(&world);
     if let Some((drone, address, ..)) = live.first() {
         let name = world.drones.get(*drone).map_or("", |d| d.name.as_str());
@@ -361,7 +357,7 @@ pub fn prepare(texts: Texts<'_>) -> Result<Prepared, NotFlown> {
             live.len()
         )));
     }
-    let mission = aviary_lower::compile(&program, &world, &api).ok_or(NotFlown::NoMission)?;
+    let mission = aviary_lower::compile(&program, &world).ok_or(NotFlown::NoMission)?;
     Ok(Prepared { mission, world, sources })
 }
 

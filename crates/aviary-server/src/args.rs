@@ -123,7 +123,7 @@ impl Kinds {
         action: &str,
         args: &Map<String, JsonValue>,
     ) -> Result<Vec<(String, Value)>, String> {
-        if matches!(action, "PAUSE" | "RESUME" | "ABORT") {
+        if aviary_api::BuiltinLeash::parse(action).is_some() {
             return match args.is_empty() {
                 true => Ok(Vec::new()),
                 false => Err(format!("{action} takes no arguments; only a PERFORM section does")),

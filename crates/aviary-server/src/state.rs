@@ -1,6 +1,7 @@
 //! What the operator sees: the mission's state, folded from its trace events.
 
 use aviary_api::trace::{Event, OperatorAction, Params, Record};
+use aviary_api::BuiltinLeash;
 use serde_json::{json, Value};
 
 #[derive(Default)]
@@ -80,10 +81,10 @@ impl MissionState {
                 }
             }
             Event::Leash { capability, tag, action, .. } => {
-                let paused = match action.as_ref() {
-                    "PAUSE" => Some(true),
-                    "RESUME" => Some(false),
-                    _ => None,
+                let paused = match BuiltinLeash::parse(action.as_ref()) {
+                    Some(BuiltinLeash::Pause) => Some(true),
+                    Some(BuiltinLeash::Resume) => Some(false),
+                    Some(BuiltinLeash::Abort) | None => None,
                 };
                 if let Some(paused) = paused {
                     let tagged = |a: &&mut Activity| {

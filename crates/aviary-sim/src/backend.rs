@@ -14,8 +14,8 @@ use std::sync::{Arc, Weak};
 use std::time::Duration;
 
 use aviary_api::{
-    Backend, CallEnd, CallId, Descriptor, DroneEvent, DroneId, Ending, Function, Interrupt,
-    PendingCall, Telemetry, Value,
+    Backend, CallEnd, CallId, DroneEvent, DroneId, Ending, Function, Interrupt, PendingCall,
+    Telemetry, Value,
 };
 use aviary_world::World;
 use tokio::sync::{mpsc, oneshot};
@@ -203,10 +203,6 @@ async fn drive(backend: Weak<SimBackend>, options: SimOptions) {
 const PACE_POLL: Duration = Duration::from_millis(2);
 
 impl Backend for SimBackend {
-    fn descriptor(&self) -> Descriptor {
-        crate::descriptor()
-    }
-
     fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall {
         let mut state = self.state.lock();
         let (id, end) = state.fleet.call(drone, function, args);

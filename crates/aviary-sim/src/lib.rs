@@ -180,10 +180,5 @@ mod tests;
 pub use backend::{SimBackend, SimOptions};
 pub use pace::{Pace, Source as PaceSource};
 
-/// What the simulator offers: the standard middle layer (docs/LANGUAGE.md, section 19). The checker
-/// reads this before a run, so a function the simulator added would be known to it.
-pub fn descriptor() -> aviary_api::Descriptor {
-    aviary_api::Descriptor::standard()
-}
 pub use aviary_api::flight::{LOAD_MAX_ALTITUDE, LOAD_TIME};
 pub use fleet::{Fleet, Release, Report};

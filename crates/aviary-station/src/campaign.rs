@@ -313,9 +313,9 @@ pub fn fly(
     runs: u64,
     seed: u64,
 ) -> Result<(String, String), String> {
-    use aviary_pipeline::pipeline::{NotFlown, Source, Texts};
     use aviary_campaign::report::Flew;
     use aviary_campaign::{Campaign, Seeds};
+    use aviary_pipeline::pipeline::{NotFlown, Source, Texts};
     if !(1..=MOST_RUNS).contains(&runs) {
         return Err(format!("a campaign from the station has 1 to {MOST_RUNS} runs, not {runs}"));
     }

@@ -58,17 +58,15 @@ pub struct Report {
 /// Checks `mission` against `world` (none: as `aviary check` with no world file, a note
 /// says what was not checked), reading what it `USE`s through `files`.
 pub fn check(mission: &Text, world: Option<&Text>, files: &dyn SourceProvider) -> Report {
-    let api = aviary_sim::descriptor();
     let mut sources = SourceMap::new();
     let mut checked = aviary_check::check_sources(
         &mut sources,
         (&mission.path, mission.text.as_bytes()),
         world.map(|w| (w.path.as_str(), w.text.as_bytes())),
         files,
-        &api,
     );
     let map = checked.world.as_ref().map(map_of);
-    let verified = aviary_verify::preflight(&mut checked, &api);
+    let verified = aviary_verify::preflight(&mut checked);
     let mut diagnostics = checked.diagnostics;
     let mut plan = Value::Null;
     let mut tree = Value::Null;

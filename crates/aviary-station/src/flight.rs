@@ -7,11 +7,11 @@ use std::sync::Arc;
 
 use aviary_api::trace::Record;
 use aviary_api::Backend;
-use aviary_pipeline::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
-use aviary_pipeline::trace_file::{Cut, SharedTrace, TraceFile, DEFAULT_MAX_BYTES};
 use aviary_check::SourceProvider;
 use aviary_engine::{Controller, RunOptions};
 use aviary_ir::Mission;
+use aviary_pipeline::pipeline::{Hooks, NotFlown, Options, Source, Stop, Texts};
+use aviary_pipeline::trace_file::{Cut, SharedTrace, TraceFile, DEFAULT_MAX_BYTES};
 use aviary_server::Feed;
 use aviary_world::World;
 

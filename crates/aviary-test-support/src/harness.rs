@@ -2,7 +2,6 @@
 //! the steps before it (check, compile) for tests that stop there or run the compiled
 //! mission their own way.
 
-use aviary_api::Descriptor;
 use aviary_check::Checked;
 use aviary_diagnostics::SourceMap;
 use aviary_engine::{Control, Controller, Outcome, Record, RunOptions};
@@ -70,7 +69,6 @@ pub fn check(mission: &str, world: &str) -> (SourceMap, Checked) {
         ("m.mission", mission.as_bytes()),
         Some(("w.toml", world.as_bytes())),
         &NoFiles,
-        &Descriptor::standard(),
     );
     (sources, checked)
 }
@@ -97,8 +95,7 @@ pub fn try_compile(
     }
     let world = checked.world.expect("world");
     let mission =
-        aviary_lower::compile(&checked.program.expect("program"), &world, &Descriptor::standard())
-            .expect("mission");
+        aviary_lower::compile(&checked.program.expect("program"), &world).expect("mission");
     Ok((mission, world))
 }
 

@@ -16,7 +16,6 @@ mod conflicts;
 pub mod plan;
 mod sites;
 
-use aviary_api::Descriptor;
 use aviary_check::Checked;
 use aviary_diagnostics::Diagnostic;
 use aviary_ir::Mission;
@@ -59,13 +58,13 @@ fn large(mission: &Mission) -> bool {
 /// analyses read only the IR, and on a long mission the tree is a large part of the peak
 /// memory, whose fresh pages are much of the time `aviary check` takes; the analyses
 /// reuse what it frees (docs/BENCHMARKS.md, "Pre-flight analyses at scale").
-pub fn preflight(checked: &mut Checked, api: &Descriptor) -> Option<(Mission, Verification)> {
+pub fn preflight(checked: &mut Checked) -> Option<(Mission, Verification)> {
     if checked.has_errors() {
         return None;
     }
     let world = checked.world.as_ref()?;
     let program = checked.program.take()?;
-    let mission = aviary_lower::compile(&program, world, api);
+    let mission = aviary_lower::compile(&program, world);
     drop(program);
     let mission = mission?;
     let verification = verify(&mission, world);
@@ -92,8 +91,8 @@ impl Verdict {
 /// [`preflight`], then the one rule of `ALLOW` (`aviary_check::acknowledge`) over every
 /// diagnostic. The world in `checked` is the one planned with: a caller that knows
 /// better figures (a MAVLink vehicle's own) puts them there first.
-pub fn verdict(checked: &mut Checked, api: &Descriptor) -> Verdict {
-    let verified = preflight(checked, api);
+pub fn verdict(checked: &mut Checked) -> Verdict {
+    let verified = preflight(checked);
     let mut diagnostics = std::mem::take(&mut checked.diagnostics);
     let preflight_ran = verified.is_some();
     let flight = verified.map(|(mission, v)| {

@@ -9,7 +9,6 @@
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-use aviary_api::Descriptor;
 use aviary_diagnostics::{render_text, Code, Diagnostic, SourceMap};
 use aviary_test_support::NoFiles;
 
@@ -31,15 +30,13 @@ fn verify_fixture(name: &str) -> Outcome {
     };
     let (mission, world) = (read(name), read(&world_name));
     let mut sources = SourceMap::new();
-    let api = Descriptor::standard();
     let mut checked = aviary_check::check_sources(
         &mut sources,
         (name, &mission),
         Some((&world_name, &world)),
         &NoFiles,
-        &api,
     );
-    let verified = aviary_verify::preflight(&mut checked, &api);
+    let verified = aviary_verify::preflight(&mut checked);
     let mut diagnostics: Vec<Diagnostic> = checked.diagnostics;
     let mut text = String::new();
     let plan = verified.map(|(_, v)| {

@@ -25,8 +25,7 @@ const MISSION: &str = "MISSION Across:
 
 fn plan(world: &str) -> aviary_verify::Plan {
     let (_, mut checked) = harness::check(MISSION, world);
-    let api = aviary_api::Descriptor::standard();
-    let (_, verified) = aviary_verify::preflight(&mut checked, &api).expect("the mission checks");
+    let (_, verified) = aviary_verify::preflight(&mut checked).expect("the mission checks");
     verified.plan
 }
 

@@ -1,7 +1,7 @@
 //! The calls of the mission and its capabilities: a capability statement (its
 //! capability, actors and arguments), a leash call, and a middle-layer call.
 
-use aviary_api::Kind;
+use aviary_api::{BuiltinLeash, Kind};
 use aviary_diagnostics::{Code, Span};
 use aviary_syntax::ast::*;
 
@@ -297,8 +297,9 @@ impl<'a> Checker<'a> {
                 | Section::Exceptions { .. } => None,
             })
             .collect();
-        let builtin = ["ABORT", "PAUSE", "RESUME"];
-        if !builtin.contains(&l.action.name.as_str()) && !sections.contains(&l.action.name.as_str())
+        let builtin = BuiltinLeash::ALL.map(BuiltinLeash::as_str);
+        if BuiltinLeash::parse(&l.action.name).is_none()
+            && !sections.contains(&l.action.name.as_str())
         {
             let all: Vec<&str> = builtin
                 .iter()

@@ -19,10 +19,10 @@ mod lets;
 pub(crate) fn check_program(
     program: &Program,
     world: Option<&World>,
-    api: &Descriptor,
     root: FileId,
     diagnostics: &mut Vec<Diagnostic>,
 ) {
+    let api = Descriptor::standard();
     let mut tags = Vec::new();
     let mut aliases = HashSet::new();
     let mut blocks = Vec::new();

@@ -374,11 +374,9 @@ mod tests {
     fn may_run_in_parallel_is_symmetric() {
         let (text, world) = aviary_bench::generate::large_mission(150_000);
         let (_, checked) = harness::check(&text, &world);
-        let api = aviary_api::Descriptor::standard();
         let mission = aviary_lower::compile(
             checked.program.as_ref().expect("program"),
             checked.world.as_ref().expect("world"),
-            &api,
         )
         .expect("a mission");
         let sites = sites::collect(&mission);

@@ -26,6 +26,7 @@ pub mod flight;
 mod function;
 pub mod geo;
 pub mod geometry;
+pub mod operator;
 mod kind;
 mod names;
 mod runtime;

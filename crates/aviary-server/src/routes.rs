@@ -14,10 +14,10 @@ use axum::routing::{get, post};
 use axum::{middleware, Json, Router};
 use serde_json::{json, Value as JsonValue};
 
-use aviary_api::operator::{KindName, OperatorState, SignalValues};
 use crate::args::kind_name;
 use crate::reply::{error, Object, BODY_LIMIT};
 use crate::{guard, reply, stream, Shared};
+use aviary_api::operator::{KindName, OperatorState, SignalValues};
 
 pub(crate) fn router(shared: Arc<Shared>) -> Router {
     let reads = Router::new()

@@ -87,8 +87,17 @@ pub struct BlockNode<'m> {
 #[derive(Debug, Serialize)]
 #[serde(untagged)]
 pub enum Leash<'m> {
-    Activity { capability: Option<&'m str>, tag: Option<&'m str>, action: &'m str, line: Option<usize> },
-    Block { block: &'m str, action: &'m str, line: Option<usize> },
+    Activity {
+        capability: Option<&'m str>,
+        tag: Option<&'m str>,
+        action: &'m str,
+        line: Option<usize>,
+    },
+    Block {
+        block: &'m str,
+        action: &'m str,
+        line: Option<usize>,
+    },
 }
 
 /// A construct around a body: what it holds.

@@ -28,6 +28,7 @@ pub mod geo;
 pub mod geometry;
 mod kind;
 mod names;
+pub mod operator;
 mod runtime;
 pub mod show;
 pub mod sweep;

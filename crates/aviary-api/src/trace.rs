@@ -14,7 +14,7 @@
 //! and an event is made only for a sink that wants its kind ([`EventKind`], asked once
 //! per kind when a run starts).
 
-mod shown;
+pub(crate) mod shown;
 
 use std::borrow::Cow;
 

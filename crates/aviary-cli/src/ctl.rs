@@ -1,6 +1,7 @@
 //! `aviary ctl`: the command-line client of the operator API that `aviary run --serve`
 //! starts (docs/OPERATOR_API.md).
 
+use aviary_api::operator::OperatorState;
 use aviary_syntax::ast::{Expr, ExprKind};
 use clap::{Subcommand, ValueEnum};
 use serde_json::{json, Value};
@@ -64,13 +65,13 @@ pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
         CtlCommand::State { json } => {
             let got = get(&format!("{base}/api/state"), token);
             match (&got, json) {
-                (Ok((200, body)), false) => match serde_json::from_str::<Value>(body) {
+                (Ok((200, body)), false) => match serde_json::from_str::<OperatorState>(body) {
                     Ok(state) => {
                         out!("{}", crate::ctl_table::state_table(&state));
                         return 0;
                     }
                     Err(e) => {
-                        eprintln!("aviary: the state from {base} is not JSON ({e})");
+                        eprintln!("aviary: the state from {base} is not the state document ({e})");
                         return 2;
                     }
                 },

@@ -1,96 +1,88 @@
 //! `aviary ctl state` for people: the operator API's state document (docs/OPERATOR_API.md,
 //! `GET /api/state`) as a few lines and tables. `--json` prints the document itself.
 
-use serde_json::Value;
+use aviary_api::operator::{MissionStatus, OperatorState, Withdrawn};
 
-/// The state document as text; a field the document lacks is shown as `-`.
-pub fn state_table(state: &Value) -> String {
+/// The state document as text; a field the document leaves out is shown as `-`.
+pub fn state_table(state: &OperatorState) -> String {
     let mut out = String::new();
-    let text = |v: &Value| v.as_str().map(str::to_owned).unwrap_or_else(|| "-".to_owned());
+    let text = |v: &Option<String>| v.clone().unwrap_or_else(|| "-".to_owned());
     let mut head = format!(
         "mission {}   {}   t = {:.1} s",
-        text(&state["mission"]),
-        if state["status"].as_str().is_some_and(|s| !s.is_empty()) {
-            text(&state["status"])
-        } else {
-            "not started".to_owned()
+        text(&state.mission),
+        match state.status {
+            MissionStatus::NotStarted => "not started",
+            status => status.as_str(),
         },
-        state["t"].as_f64().unwrap_or(0.0)
+        state.t
     );
-    if state["paused"].as_bool() == Some(true) {
+    if state.paused {
         head.push_str("   PAUSED by the operator");
     }
-    if let Some(reason) = state["reason"].as_str() {
+    if let Some(reason) = &state.reason {
         head.push_str(&format!("   ({reason})"));
     }
     out.push_str(&head);
     out.push('\n');
 
-    let blocks: Vec<String> = list(&state["blocks"]).iter().map(text).collect();
     out.push_str(&format!(
         "blocks running: {}\n",
-        if blocks.is_empty() { "none".to_owned() } else { blocks.join(", ") }
+        if state.blocks.is_empty() { "none".to_owned() } else { state.blocks.join(", ") }
     ));
 
-    let activities = list(&state["activities"]);
-    if activities.is_empty() {
+    if state.activities.is_empty() {
         out.push_str("activities running: none\n");
     } else {
         out.push_str("activities running:\n");
-        let rows: Vec<Vec<String>> = activities
+        let rows: Vec<Vec<String>> = state
+            .activities
             .iter()
             .map(|a| {
-                let leash = match a["tag"].as_str() {
-                    Some(tag) => format!("{}-{tag}", text(&a["capability"])),
-                    None => text(&a["capability"]),
+                let leash = match &a.tag {
+                    Some(tag) => format!("{}-{tag}", a.capability),
+                    None => a.capability.clone(),
                 };
                 vec![
                     leash,
-                    text(&a["actor"]),
-                    format!("{:.1} s", a["since"].as_f64().unwrap_or(0.0)),
-                    if a["paused"].as_bool() == Some(true) { "paused" } else { "" }.to_owned(),
+                    a.actor.clone(),
+                    format!("{:.1} s", a.since),
+                    if a.paused { "paused" } else { "" }.to_owned(),
                 ]
             })
             .collect();
         out.push_str(&table(&["activity", "drones", "since", ""], &rows));
     }
 
-    let drones = list(&state["drones"]);
-    if !drones.is_empty() {
+    if !state.drones.is_empty() {
         out.push_str("drones:\n");
-        let rows: Vec<Vec<String>> = drones
+        let rows: Vec<Vec<String>> = state
+            .drones
             .iter()
             .map(|d| {
-                let position = match d["position"].as_array() {
-                    Some(p) => {
-                        let c: Vec<String> = p
-                            .iter()
-                            .map(|x| format!("{:.0}", x.as_f64().unwrap_or(f64::NAN)))
-                            .collect();
-                        format!("({})", c.join(", "))
+                let (flight, battery, position) = match &d.telemetry {
+                    Some(t) => {
+                        let c: Vec<String> = t.position.iter().map(|x| format!("{x:.0}")).collect();
+                        let battery = if t.battery.is_finite() {
+                            format!("{:.0}%", t.battery * 100.0)
+                        } else {
+                            "-".to_owned()
+                        };
+                        (t.state.as_str().to_owned(), battery, format!("({})", c.join(", ")))
                     }
-                    None => "-".to_owned(),
+                    None => ("-".to_owned(), "-".to_owned(), "-".to_owned()),
                 };
-                let battery = match d["battery"].as_f64() {
-                    Some(b) => format!("{:.0}%", b * 100.0),
-                    None => "-".to_owned(),
+                let steered = match (d.withdrawn, d.held) {
+                    (Some(Withdrawn::Home), _) => "sent home by the operator",
+                    (Some(Withdrawn::Land), _) => "landed by the operator",
+                    (None, true) => "held by the operator",
+                    (None, false) => "",
                 };
-                let steered = match (d["withdrawn"].as_str(), d["held"].as_bool()) {
-                    (Some("home"), _) => "sent home by the operator",
-                    (Some("land"), _) => "landed by the operator",
-                    (_, Some(true)) => "held by the operator",
-                    _ => "",
-                };
-                vec![text(&d["name"]), text(&d["state"]), battery, position, steered.to_owned()]
+                vec![d.name.clone(), flight, battery, position, steered.to_owned()]
             })
             .collect();
         out.push_str(&table(&["drone", "state", "battery", "position (m)", ""], &rows));
     }
     out
-}
-
-fn list(v: &Value) -> &[Value] {
-    v.as_array().map_or(&[], Vec::as_slice)
 }
 
 /// Columns padded to their widest cell, two spaces apart, indented by two; trailing
@@ -118,6 +110,10 @@ fn table(header: &[&str], rows: &[Vec<String>]) -> String {
 mod tests {
     use super::state_table;
     use serde_json::json;
+
+    fn read(value: serde_json::Value) -> aviary_api::operator::OperatorState {
+        serde_json::from_value(value).expect("a state document")
+    }
 
     #[test]
     fn a_running_mission_reads_as_lines_and_tables() {
@@ -147,7 +143,7 @@ mod tests {
             "  scout2  TakingOff  100%     (0, 0, 1)      held by the operator",
             "  spare   -          -        -              sent home by the operator",
         ];
-        assert_eq!(state_table(&state), expected.join("\n") + "\n");
+        assert_eq!(state_table(&read(state)), expected.join("\n") + "\n");
     }
 
     #[test]
@@ -155,12 +151,12 @@ mod tests {
         let empty = json!({"mission": null, "t": 0.0, "status": "", "reason": null, "paused": false,
             "blocks": [], "activities": [], "drones": []});
         assert_eq!(
-            state_table(&empty),
+            state_table(&read(empty)),
             "mission -   not started   t = 0.0 s\nblocks running: none\nactivities running: none\n"
         );
         let ended = json!({"mission": "M", "t": 9.0, "status": "failed", "reason": "unhandled exception", "paused": true,
             "blocks": [], "activities": [], "drones": []});
-        assert!(state_table(&ended).starts_with(
+        assert!(state_table(&read(ended)).starts_with(
             "mission M   failed   t = 9.0 s   PAUSED by the operator   (unhandled exception)\n"
         ));
     }

@@ -94,6 +94,11 @@ fn a_leash_round_trip_through_the_server() {
     assert!(table.starts_with("mission "), "{table}");
     let (_, state, _) = ctl(&url, None, &["state", "--json"], &dir);
     let state: serde_json::Value = serde_json::from_str(&state).expect("state is JSON");
+    // The state fits the schema docs/openapi.yaml gives it, generated from its types.
+    let schema = aviary_server::state_schema(&aviary_server::openapi());
+    let validator = jsonschema::validator_for(&schema).expect("a valid schema");
+    let errors: Vec<String> = validator.iter_errors(&state).map(|e| e.to_string()).collect();
+    assert!(errors.is_empty(), "{state:#}\n{errors:#?}");
     let fly = state["activities"]
         .as_array()
         .unwrap()

@@ -18,6 +18,7 @@
 mod args;
 mod bounds;
 mod guard;
+mod openapi;
 mod reply;
 mod routes;
 mod state;
@@ -26,6 +27,7 @@ mod stream;
 pub use args::{Kinds, MAX_MAGNITUDE};
 pub use bounds::Bounds;
 pub use guard::{read_token, same_origin, token, Gate, TOKEN_PROTOCOL};
+pub use openapi::{openapi, openapi_yaml, state_schema};
 pub use reply::{json_errors, BODY_LIMIT};
 
 use parking_lot::{Mutex, MutexGuard};

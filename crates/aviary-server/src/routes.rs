@@ -17,6 +17,7 @@ use serde_json::{json, Value as JsonValue};
 use crate::args::kind_name;
 use crate::reply::{error, Object, BODY_LIMIT};
 use crate::{guard, reply, stream, Shared};
+use aviary_api::operator::{KindName, OperatorState, SignalValues};
 
 pub(crate) fn router(shared: Arc<Shared>) -> Router {
     let reads = Router::new()
@@ -50,19 +51,28 @@ async fn control(shared: &Shared, control: Control) -> Response {
 
 /// The state folded from the trace, and the signals the operator may raise (which the
 /// trace does not say: they are the mission's).
-async fn state(State(shared): State<Arc<Shared>>) -> Json<JsonValue> {
-    let mut state = shared.state().to_json();
-    state["operator_signals"] = json!(shared.kinds.operator_signals());
+async fn state(State(shared): State<Arc<Shared>>) -> Json<OperatorState> {
+    let mut state = shared.state().document();
+    state.operator_signals = shared.kinds.operator_signals().to_vec();
     // What each carries, so that a form can read `x, y` as the one position it takes.
-    let values: serde_json::Map<String, JsonValue> = shared
-        .kinds
-        .operator_signal_values()
-        .map(|(name, kinds)| {
-            (name.to_string(), json!(kinds.iter().map(|k| k.map(kind_name)).collect::<Vec<_>>()))
-        })
-        .collect();
-    state["operator_signal_values"] = JsonValue::Object(values);
+    state.operator_signal_values = SignalValues(
+        shared
+            .kinds
+            .operator_signal_values()
+            .map(|(name, kinds)| {
+                (name.to_string(), kinds.iter().map(|k| k.map(wire_kind)).collect())
+            })
+            .collect(),
+    );
     Json(state)
+}
+
+/// A kind as the state names it: `aviary_api`'s [`KindName`], which `args.rs`'s
+/// `kind_name` (the name its errors use) must agree with.
+fn wire_kind(kind: aviary_api::Kind) -> KindName {
+    let name = KindName::from(kind);
+    debug_assert_eq!(serde_json::to_value(name).ok(), Some(json!(kind_name(kind))));
+    name
 }
 
 async fn events(

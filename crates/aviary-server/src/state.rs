@@ -1,23 +1,23 @@
 //! What the operator sees: the mission's state, folded from its trace events.
 
-use aviary_api::trace::{Event, OperatorAction, Params, Record};
+use aviary_api::operator::{self, MissionStatus, OperatorState, Telemetry, Withdrawn};
+use aviary_api::trace::{Event, OperatorAction, Record};
 use aviary_api::BuiltinLeash;
-use serde_json::{json, Value};
 
 #[derive(Default)]
 pub struct MissionState {
     mission: Option<String>,
     t: f64,
     /// `running`, then the outcome (`ok`, `failed`, `aborted`); empty before the start.
-    status: &'static str,
+    status: MissionStatus,
     reason: Option<String>,
     /// The operator paused the whole mission (`operator` events).
     paused: bool,
     blocks: Vec<String>,
     /// Running activities, in the order they started.
-    activities: Vec<Activity>,
+    activities: Vec<operator::Activity>,
     /// Each drone's last telemetry, by name, in the order first seen.
-    drones: Vec<(String, Value)>,
+    drones: Vec<(String, Telemetry)>,
     /// What the operator did to single drones, by name, in the order first steered.
     steered: Vec<(String, Steered)>,
 }
@@ -26,17 +26,7 @@ pub struct MissionState {
 #[derive(Clone, Copy, Default)]
 struct Steered {
     held: bool,
-    withdrawn: Option<&'static str>,
-}
-
-/// A running activity: who does what, since when, and whether it is paused.
-struct Activity {
-    capability: String,
-    tag: Option<String>,
-    actor: String,
-    args: Value,
-    since: f64,
-    paused: bool,
+    withdrawn: Option<Withdrawn>,
 }
 
 impl MissionState {
@@ -48,10 +38,10 @@ impl MissionState {
         match &record.event {
             Event::MissionStart { mission, .. } => {
                 self.mission = Some(mission.to_string());
-                self.status = "running";
+                self.status = MissionStatus::Running;
             }
             Event::MissionEnd { status, reason } => {
-                self.status = status.as_str();
+                self.status = (*status).into();
                 self.reason = reason.as_deref().map(str::to_string);
             }
             Event::BlockStart { block } => self.blocks.push(block.to_string()),
@@ -61,17 +51,17 @@ impl MissionState {
                 }
             }
             Event::CapabilityStart { actor, capability, tag, args, .. } => {
-                self.activities.push(Activity {
+                self.activities.push(operator::Activity {
                     capability: capability.to_string(),
                     tag: tag.as_deref().map(str::to_string),
                     actor: actor.to_string(),
-                    args: shown(args),
+                    args: args.clone().into_owned(),
                     since: record.t,
                     paused: false,
                 })
             }
             Event::CapabilityEnd { actor, capability, tag, .. } => {
-                let same = |a: &Activity| {
+                let same = |a: &operator::Activity| {
                     a.capability == *capability
                         && a.actor == *actor
                         && a.tag.as_deref() == tag.as_deref()
@@ -87,7 +77,7 @@ impl MissionState {
                     Some(BuiltinLeash::Abort) | None => None,
                 };
                 if let Some(paused) = paused {
-                    let tagged = |a: &&mut Activity| {
+                    let tagged = |a: &&mut operator::Activity| {
                         a.capability == *capability && a.tag.as_deref() == Some(tag.as_ref())
                     };
                     for a in self.activities.iter_mut().filter(tagged) {
@@ -96,7 +86,12 @@ impl MissionState {
                 }
             }
             Event::Telemetry { actor, position, battery, state } => {
-                let t = json!({ "position": position, "battery": battery, "state": state, "t": record.t });
+                let t = Telemetry {
+                    position: *position,
+                    battery: *battery,
+                    state: *state,
+                    t: record.t,
+                };
                 match self.drones.iter_mut().find(|(n, _)| n == actor) {
                     Some((_, v)) => *v = t,
                     None => self.drones.push((actor.to_string(), t)),
@@ -120,10 +115,10 @@ impl MissionState {
                     OperatorAction::Hold => steered.held = true,
                     OperatorAction::Resume => steered.held = false,
                     OperatorAction::ReturnHome => {
-                        *steered = Steered { held: false, withdrawn: Some("home") }
+                        *steered = Steered { held: false, withdrawn: Some(Withdrawn::Home) }
                     }
                     OperatorAction::Land => {
-                        *steered = Steered { held: false, withdrawn: Some("land") }
+                        *steered = Steered { held: false, withdrawn: Some(Withdrawn::Land) }
                     }
                     OperatorAction::Pause | OperatorAction::Abort => {}
                 }
@@ -139,54 +134,58 @@ impl MissionState {
         }
     }
 
-    pub fn to_json(&self) -> Value {
-        json!({
-            "mission": self.mission,
-            "t": self.t,
-            "status": self.status,
-            "reason": self.reason,
-            "paused": self.paused,
-            "blocks": self.blocks,
-            "activities": self.activities.iter().map(|a| json!({
-                "capability": a.capability, "tag": a.tag, "actor": a.actor, "args": a.args, "since": a.since, "paused": a.paused,
-            })).collect::<Vec<_>>(),
-            "drones": self.drones_json(),
-        })
+    /// The state as `GET /api/state` returns it, the operator's signals left empty
+    /// (the trace does not say them: they are the mission's).
+    pub fn document(&self) -> OperatorState {
+        OperatorState {
+            mission: self.mission.clone(),
+            t: self.t,
+            status: self.status,
+            reason: self.reason.clone(),
+            paused: self.paused,
+            blocks: self.blocks.clone(),
+            activities: self.activities.clone(),
+            drones: self.drones(),
+            operator_signals: Vec::new(),
+            operator_signal_values: Default::default(),
+        }
     }
 
     /// Each drone: its last telemetry and whether the operator holds it or took it out
-    /// of the mission (`withdrawn`: `home`, `land` or `null`); a drone steered before its
-    /// first telemetry is listed with the latter only.
-    fn drones_json(&self) -> Vec<Value> {
+    /// of the mission; a drone steered before its first telemetry is listed with the
+    /// latter only.
+    fn drones(&self) -> Vec<operator::Drone> {
         let steered = |name: &str| {
             self.steered.iter().find(|(n, _)| n == name).map(|(_, s)| *s).unwrap_or_default()
         };
-        let mut out: Vec<Value> = Vec::with_capacity(self.drones.len());
+        let mut out = Vec::with_capacity(self.drones.len());
         for (name, telemetry) in &self.drones {
-            let mut d = telemetry.clone();
             let s = steered(name);
-            d["name"] = json!(name);
-            d["held"] = json!(s.held);
-            d["withdrawn"] = json!(s.withdrawn);
-            out.push(d);
+            out.push(operator::Drone {
+                telemetry: Some(telemetry.clone()),
+                name: name.clone(),
+                held: s.held,
+                withdrawn: s.withdrawn,
+            });
         }
         for (name, s) in &self.steered {
             if !self.drones.iter().any(|(n, _)| n == name) {
-                out.push(json!({ "name": name, "held": s.held, "withdrawn": s.withdrawn }));
+                out.push(operator::Drone {
+                    telemetry: None,
+                    name: name.clone(),
+                    held: s.held,
+                    withdrawn: s.withdrawn,
+                });
             }
         }
         out
     }
 }
 
-/// An activity's arguments as the trace writes them.
-fn shown(args: &Params) -> Value {
-    serde_json::to_value(args).unwrap_or(Value::Null)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use serde_json::{json, Value};
 
     fn observe(state: &mut MissionState, t: f64, line: &str) {
         let mut record: Record = serde_json::from_str(line).expect("a trace line");
@@ -208,7 +207,7 @@ mod tests {
         observe(&mut state, 2.0, r#"{"t":0,"event":"operator","action":"hold","drone":"a"}"#);
         observe(&mut state, 2.0, r#"{"t":0,"event":"operator","action":"pause","drone":null}"#);
         observe(&mut state, 3.0, r#"{"t":0,"event":"operator","action":"land","drone":"c"}"#);
-        let json = state.to_json();
+        let json = serde_json::to_value(state.document()).unwrap();
         assert_eq!(json["paused"], true);
         let drone = |name: &str| {
             json["drones"].as_array().unwrap().iter().find(|d| d["name"] == name).unwrap().clone()
@@ -229,7 +228,7 @@ mod tests {
             4.0,
             r#"{"t":0,"event":"operator","action":"return_home","drone":"a"}"#,
         );
-        let json = state.to_json();
+        let json = serde_json::to_value(state.document()).unwrap();
         assert_eq!(json["paused"], false, "the mission's resume");
         let a = json["drones"].as_array().unwrap().iter().find(|d| d["name"] == "a").unwrap();
         assert_eq!((a["held"].clone(), a["withdrawn"].clone()), (json!(false), json!("home")));

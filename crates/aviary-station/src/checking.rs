@@ -8,7 +8,8 @@ use std::path::{Path, PathBuf};
 
 use aviary_check::{LoadError, SourceProvider};
 use aviary_diagnostics::{render_json, Diagnostic, SourceMap};
-use serde_json::{json, Value};
+use serde::Serialize;
+use serde_json::Value;
 
 use crate::tree;
 
@@ -55,6 +56,31 @@ pub struct Report {
     pub json: Value,
 }
 
+/// The check's document (`POST /api/check`), as the page reads it.
+#[derive(Serialize)]
+pub struct CheckResult<'m> {
+    /// Whether the mission may fly: no error, a world, and a MISSION.
+    pub flyable: bool,
+    pub errors: usize,
+    /// Errors, warnings and notes counted as `aviary check` counts them.
+    pub summary: String,
+    pub diagnostics: Vec<Shown>,
+    /// The energy and time plan, when the mission may fly (as `aviary check --plan`).
+    pub plan: Option<aviary_verify::Plan>,
+    /// The block tree, when the mission may fly.
+    pub tree: Option<tree::TreeNode<'m>>,
+    /// The world's map, when a world was given.
+    pub map: Option<WorldMap<'m>>,
+}
+
+/// A diagnostic as `aviary check --format json` gives it, with the text rendering too.
+#[derive(Debug, Serialize)]
+pub struct Shown {
+    #[serde(flatten)]
+    pub diagnostic: Value,
+    pub text: String,
+}
+
 /// Checks `mission` against `world` (none: as `aviary check` with no world file, a note
 /// says what was not checked), reading what it `USE`s through `files`.
 pub fn check(mission: &Text, world: Option<&Text>, files: &dyn SourceProvider) -> Report {
@@ -65,72 +91,99 @@ pub fn check(mission: &Text, world: Option<&Text>, files: &dyn SourceProvider) -
         world.map(|w| (w.path.as_str(), w.text.as_bytes())),
         files,
     );
-    let map = checked.world.as_ref().map(map_of);
-    let verified = aviary_verify::preflight(&mut checked);
-    let mut diagnostics = checked.diagnostics;
-    let mut plan = Value::Null;
-    let mut tree = Value::Null;
-    let flyable = verified.is_some();
-    if let Some((compiled, v)) = verified {
-        diagnostics.extend(v.diagnostics);
-        let mut v_plan = v.plan;
-        v_plan.locate_in(&sources);
-        plan = serde_json::to_value(&v_plan).unwrap_or(Value::Null);
-        tree = tree::of(&compiled, Some(&sources));
-    }
-    aviary_check::acknowledge(&checked.allows, &mut diagnostics, flyable);
-    let errors = diagnostics.iter().filter(|d| d.is_error()).count();
-    let shown: Vec<Value> = diagnostics.iter().map(|d| rendered(&sources, d)).collect();
-    Report {
+    // As `aviary check`: the checker's and the pre-flight analyses' diagnostics, ALLOW
+    // applied, by the one function both call.
+    let verdict = aviary_verify::verdict(&mut checked);
+    let flyable = verdict.flyable();
+    let diagnostics = verdict.diagnostics;
+    let (compiled, plan) = match verdict.flight {
+        Some((compiled, mut plan)) => {
+            plan.locate_in(&sources);
+            (Some(compiled), Some(plan))
+        }
+        None => (None, None),
+    };
+    let result = CheckResult {
         flyable,
-        json: json!({
-            "flyable": flyable,
-            "errors": errors,
-            // Errors, warnings and notes counted as `aviary check` counts them.
-            "summary": aviary_diagnostics::summary_line(&diagnostics),
-            "diagnostics": shown,
-            "plan": plan,
-            "tree": tree,
-            "map": map,
-        }),
-    }
+        errors: diagnostics.iter().filter(|d| d.is_error()).count(),
+        summary: aviary_diagnostics::summary_line(&diagnostics),
+        diagnostics: diagnostics.iter().map(|d| rendered(&sources, d)).collect(),
+        plan,
+        tree: compiled.as_ref().map(|c| tree::typed(c, Some(&sources))),
+        map: checked.world.as_ref().map(WorldMap::of),
+    };
+    Report { flyable, json: serde_json::to_value(&result).unwrap_or(Value::Null) }
 }
 
 /// A diagnostic as `aviary check --format json` gives it, with the text rendering too.
-fn rendered(sources: &SourceMap, d: &Diagnostic) -> Value {
-    let mut value = render_json(sources, d);
-    value["text"] = aviary_diagnostics::render_text(sources, d, false).into();
-    value
+fn rendered(sources: &SourceMap, d: &Diagnostic) -> Shown {
+    Shown {
+        diagnostic: render_json(sources, d),
+        text: aviary_diagnostics::render_text(sources, d, false),
+    }
 }
 
 /// What the map shows of a world: the site, places, areas, lines (`lines`: name, points
 /// `[x, y]`), no-fly zones (`no_fly`: name, polygon, `up_to`), homes and targets, in the
 /// local frame (metres east and north of the origin).
+#[derive(Debug, Serialize)]
+pub struct WorldMap<'w> {
+    pub site: &'w aviary_world::Site,
+    /// The map's tiles (`tiles.rs`).
+    pub base: Value,
+    pub places: &'w [aviary_world::Place],
+    pub areas: &'w [aviary_world::Area],
+    pub lines: Vec<MapLine<'w>>,
+    pub no_fly: &'w [aviary_world::NoFly],
+    pub drones: Vec<MapDrone<'w>>,
+    pub targets: &'w [aviary_world::Target],
+}
+
+/// A line of the world, on the ground.
+#[derive(Debug, Serialize)]
+pub struct MapLine<'w> {
+    pub name: &'w str,
+    pub points: Vec<[f64; 2]>,
+}
+
+/// A drone of the world: its home, group and sensors.
+#[derive(Debug, Serialize)]
+pub struct MapDrone<'w> {
+    pub name: &'w str,
+    pub home: [f64; 3],
+    pub group: Option<&'w str>,
+    pub sensors: &'w [String],
+}
+
+impl<'w> WorldMap<'w> {
+    pub fn of(world: &'w aviary_world::World) -> Self {
+        WorldMap {
+            site: &world.site,
+            base: crate::tiles::base_map(world),
+            places: &world.places,
+            areas: &world.areas,
+            lines: world
+                .lines
+                .iter()
+                .map(|l| MapLine { name: &l.name, points: l.ground() })
+                .collect(),
+            no_fly: &world.no_fly,
+            drones: world
+                .drones
+                .iter()
+                .map(|d| MapDrone {
+                    name: &d.name,
+                    home: d.home,
+                    group: d.group.as_deref(),
+                    sensors: &d.sensors,
+                })
+                .collect(),
+            targets: &world.targets,
+        }
+    }
+}
+
+/// The map of `world` as the page reads it ([`WorldMap`]).
 pub fn map_of(world: &aviary_world::World) -> Value {
-    let drones: Vec<Value> = world
-        .drones
-        .iter()
-        .map(|d| {
-            json!({
-                "name": d.name,
-                "home": d.home,
-                "group": d.group.as_deref(),
-                "sensors": d.sensors,
-            })
-        })
-        .collect();
-    json!({
-        "site": world.site,
-        "base": crate::tiles::base_map(world),
-        "places": world.places,
-        "areas": world.areas,
-        "lines": world
-            .lines
-            .iter()
-            .map(|l| json!({ "name": l.name, "points": l.ground() }))
-            .collect::<Vec<Value>>(),
-        "no_fly": world.no_fly,
-        "drones": drones,
-        "targets": world.targets,
-    })
+    serde_json::to_value(WorldMap::of(world)).unwrap_or(Value::Null)
 }

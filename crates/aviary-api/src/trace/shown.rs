@@ -200,12 +200,12 @@ impl<'de> Deserialize<'de> for Number {
 }
 
 /// `t`, `battery`: a number, or `null` (not finite) as NaN.
-pub(super) fn number<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+pub(crate) fn number<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     Ok(Number::deserialize(d)?.0)
 }
 
 /// `position`, `location`: `[x, y, z]`, a `null` coordinate as NaN.
-pub(super) fn coordinates<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
+pub(crate) fn coordinates<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
     let [x, y, z] = <[Number; 3]>::deserialize(d)?;
     Ok([x.0, y.0, z.0])
 }
@@ -285,5 +285,29 @@ impl schemars::JsonSchema for Params<'_> {
             "type": "object",
             "additionalProperties": value
         })
+    }
+}
+
+impl Shown<'_> {
+    /// The same value, owning its text.
+    pub fn into_owned(self) -> Shown<'static> {
+        match self {
+            Shown::Number(n) => Shown::Number(n),
+            Shown::Text(t) => Shown::Text(Cow::Owned(t.into_owned())),
+            Shown::Bool(b) => Shown::Bool(b),
+            Shown::Position(p) => Shown::Position(p),
+            Shown::Area(corners) => Shown::Area(Cow::Owned(corners.into_owned())),
+            Shown::Remainder(left) => Shown::Remainder(Cow::Owned(left.into_owned())),
+            Shown::Null => Shown::Null,
+        }
+    }
+}
+
+impl Params<'_> {
+    /// The same values, owning their text.
+    pub fn into_owned(self) -> Params<'static> {
+        Params(
+            self.0.into_iter().map(|(n, v)| (Cow::Owned(n.into_owned()), v.into_owned())).collect(),
+        )
     }
 }

@@ -20,8 +20,8 @@ fn answer(
     }
 }
 
-#[test]
-fn a_panicking_handler_is_answered_with_an_error_and_the_server_lives_on() {
+/// A server on a thread of its own, initialized (request 1), with its client.
+fn started() -> (Connection, std::thread::JoinHandle<Result<(), String>>) {
     let (server, client) = Connection::memory();
     let thread = std::thread::Builder::new()
         .stack_size(aviary_check::STACK)
@@ -32,6 +32,12 @@ fn a_panicking_handler_is_answered_with_an_error_and_the_server_lives_on() {
         .sender
         .send(Message::Notification(Notification::new("initialized".into(), json!({}))))
         .unwrap();
+    (client, thread)
+}
+
+#[test]
+fn a_panicking_handler_is_answered_with_an_error_and_the_server_lives_on() {
+    let (client, thread) = started();
     let failed = answer(&client, 2, "aviary/panic", json!({}));
     assert_eq!(failed["error"]["code"], -32603, "{failed}");
     assert!(failed["error"]["message"].as_str().unwrap().contains("a handler's bug, on purpose"));
@@ -73,16 +79,7 @@ fn the_benchmark_times_each_edit_to_its_diagnostics() {
 
 #[test]
 fn a_slow_request_does_not_hold_a_quick_one() {
-    let (server, client) = Connection::memory();
-    let thread = std::thread::Builder::new()
-        .stack_size(aviary_check::STACK)
-        .spawn(move || crate::run(server, crate::Config::open_documents_only()))
-        .unwrap();
-    answer(&client, 1, "initialize", json!({ "capabilities": {} }));
-    client
-        .sender
-        .send(Message::Notification(Notification::new("initialized".into(), json!({}))))
-        .unwrap();
+    let (client, thread) = started();
     let uri = "untitled:slow.mission";
     let open = json!({ "textDocument": { "uri": uri, "languageId": "aviary", "version": 1, "text": "MISSION M:\n    d TakeOff\n" } });
     client

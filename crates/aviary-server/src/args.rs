@@ -280,27 +280,6 @@ fn geo(o: &serde_json::Map<String, JsonValue>) -> Result<Given, String> {
     Ok(Given::Geo { lat, lon, alt })
 }
 
-/// A kind as `GET /api/state` names it (`operator_signal_values`): one word, stable.
-pub(crate) fn kind_name(kind: Kind) -> &'static str {
-    match kind {
-        Kind::Length => "length",
-        Kind::Duration => "duration",
-        Kind::Speed => "speed",
-        Kind::Angle => "angle",
-        Kind::Ratio => "ratio",
-        Kind::Number => "number",
-        Kind::Text => "string",
-        Kind::Bool => "bool",
-        Kind::Position => "position",
-        Kind::Area => "area",
-        Kind::Symbol => "symbol",
-        Kind::Actor => "actor",
-        Kind::Remainder => "remainder",
-        Kind::Line => "line",
-        Kind::Path => "path",
-    }
-}
-
 /// The kind a unit gives a number, as the checker reads it (`aviary_check`'s `unit_kind`).
 fn unit_kind(unit: Unit) -> Kind {
     match unit {

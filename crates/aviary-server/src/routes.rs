@@ -14,7 +14,6 @@ use axum::routing::{get, post};
 use axum::{middleware, Json, Router};
 use serde_json::{json, Value as JsonValue};
 
-use crate::args::kind_name;
 use crate::reply::{error, Object, BODY_LIMIT};
 use crate::{guard, reply, stream, Shared};
 use aviary_api::operator::{KindName, OperatorState, SignalValues};
@@ -67,12 +66,9 @@ async fn state(State(shared): State<Arc<Shared>>) -> Json<OperatorState> {
     Json(state)
 }
 
-/// A kind as the state names it: `aviary_api`'s [`KindName`], which `args.rs`'s
-/// `kind_name` (the name its errors use) must agree with.
+/// A kind as the state names it: `aviary_api`'s [`KindName`].
 fn wire_kind(kind: aviary_api::Kind) -> KindName {
-    let name = KindName::from(kind);
-    debug_assert_eq!(serde_json::to_value(name).ok(), Some(json!(kind_name(kind))));
-    name
+    KindName::from(kind)
 }
 
 async fn events(

@@ -24,6 +24,11 @@ use lsp_types::{notification as note, Uri};
 use crate::overlay::{Doc, Docs};
 use crate::{panic_text, send, Config, Server};
 
+/// A request's thread: a handler walks a tree the parser keeps within 64 levels, so it
+/// needs far less than a check, which follows capability calls (`aviary_check::STACK`);
+/// many requests may be in flight at once.
+const REQUEST_STACK: usize = 64 << 20;
+
 /// A check's result: the server it made, the edits it saw, and its diagnostics.
 struct Checked {
     server: Option<Server>,
@@ -188,7 +193,7 @@ impl Loop {
         let id = request.id.clone();
         let spawned = std::thread::Builder::new()
             .name("aviary-lsp-request".into())
-            .stack_size(aviary_check::STACK)
+            .stack_size(REQUEST_STACK)
             .spawn(move || {
                 let _ = sender.send(Message::Response(server.request(request)));
             });

@@ -25,8 +25,10 @@ pub fn run(dir: &Path, serve: &Serve, use_root: &[PathBuf]) -> u8 {
         }
     };
     // The page's editor speaks to the language server of `aviary lsp`, reading as it does.
+    // The standard library's file is written once, not for every page's socket.
     let lsp_roots = roots.clone();
-    let lsp = Lsp::new(move || crate::lsp::config(&lsp_roots));
+    let std = crate::lsp::std_file();
+    let lsp = Lsp::new(move || crate::lsp::config(&lsp_roots, std.clone()));
     let files: FilesFor = Box::new(move |mission: &Path| {
         DiskProvider::new(mission, &roots)
             .map(|p| Box::new(p) as Box<dyn aviary_check::SourceProvider + Send>)

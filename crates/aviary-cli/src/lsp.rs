@@ -9,15 +9,16 @@ use aviary_check::SourceProvider;
 use crate::files::{use_roots as use_roots_of, DiskProvider};
 
 /// The server's configuration: the disk read by `DiskProvider` under `roots` (the
-/// `--use-root`s, resolved). `aviary gcs` gives its page's editor the same.
-pub fn config(roots: &[PathBuf]) -> aviary_lsp::Config {
+/// `--use-root`s, resolved), and the standard library's file (`std_file`, made once by
+/// the caller). `aviary gcs` gives its page's editor the same.
+pub fn config(roots: &[PathBuf], std: Option<PathBuf>) -> aviary_lsp::Config {
     let for_disk = roots.to_vec();
     aviary_lsp::Config {
         disk: Box::new(move |mission: &Path| {
             DiskProvider::new(mission, &for_disk).map(|p| Box::new(p) as Box<dyn SourceProvider>)
         }),
         use_roots: roots.to_vec(),
-        std_file: std_file(),
+        std_file: std,
     }
 }
 
@@ -29,7 +30,7 @@ pub fn run(use_roots: &[PathBuf]) -> u8 {
             return 2;
         }
     };
-    match aviary_lsp::serve_stdio(config(&roots)) {
+    match aviary_lsp::serve_stdio(config(&roots, std_file())) {
         Ok(()) => 0,
         Err(why) => {
             eprintln!("aviary lsp: {why}");

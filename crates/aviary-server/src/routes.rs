@@ -59,16 +59,11 @@ async fn state(State(shared): State<Arc<Shared>>) -> Json<OperatorState> {
             .kinds
             .operator_signal_values()
             .map(|(name, kinds)| {
-                (name.to_string(), kinds.iter().map(|k| k.map(wire_kind)).collect())
+                (name.to_string(), kinds.iter().map(|k| k.map(KindName::from)).collect())
             })
             .collect(),
     );
     Json(state)
-}
-
-/// A kind as the state names it: `aviary_api`'s [`KindName`].
-fn wire_kind(kind: aviary_api::Kind) -> KindName {
-    KindName::from(kind)
 }
 
 async fn events(

@@ -9,7 +9,8 @@
 
 use std::cell::Cell;
 
-use aviary_api::{Kind, Value};
+use aviary_api::Value;
+use aviary_diagnostics::SourceMap;
 use aviary_engine::{Control, Controller};
 use aviary_server::{Kinds, Options, MAX_MAGNITUDE};
 use tower::ServiceExt;
@@ -29,43 +30,71 @@ const ROUTES: [(&str, &str); 8] = [
     ("POST", "/api/drone"),
 ];
 
-/// A mission's kinds with every sort of parameter and signal value.
-fn kinds() -> Kinds {
-    let mut k = Kinds::default();
-    let p = |n: &str, kind| (n.to_string(), kind);
-    k.capability(
-        "Watch",
-        vec![
-            p("center", Some(Kind::Position)),
-            p("radius", Some(Kind::Length)),
-            p("laps", Some(Kind::Number)),
-            p("kind", Some(Kind::Symbol)),
-            p("note", Some(Kind::Text)),
-            p("loud", Some(Kind::Bool)),
-            p("area", Some(Kind::Area)),
-            p("anything", None),
-        ],
+/// A mission with every sort of parameter and signal value, and signals the operator may
+/// raise (`Go`, `Any`) beside one it may not (`Bare`, heard by the mission).
+const MISSION: &str = "\
+CAPABILITY Watch BY d WITH center, radius, laps, kind, note, loud, area, anything:
+    PERFORM:
+        d.Orbit(center, radius, laps)
+        d.StartDetection(kind)
+        d.Sweep(area, 10m)
+        IF loud:
+            SIGNAL Noted WITH note
+    PERFORM Widen:
+        d.Orbit(center, radius)
+
+MISSION Fuzzed:
+    OPERATOR SIGNAL Go, Any
+    PARALLEL:
+        video_drone1 Watch-W1 WITH (0, 0), 10m, 2, Body, \"a note\", TRUE, Area1, 1
+        ON Go WITH where, wait, share:
+            WAITFOR ELAPSED >= wait
+            video_drone1 FlyTo WITH where
+        ON Any WITH x, y:
+            SIGNAL Bare
+        ON Bare:
+            video_drone1 Hover WITH 1s
+";
+
+/// The compiled [`MISSION`]'s kinds and names, in the example world: compiled once, for
+/// every input.
+fn kinds() -> &'static (Kinds, aviary_ir::Mission) {
+    static COMPILED: std::sync::OnceLock<(Kinds, aviary_ir::Mission)> = std::sync::OnceLock::new();
+    COMPILED.get_or_init(compile)
+}
+
+fn compile() -> (Kinds, aviary_ir::Mission) {
+    let mut sources = SourceMap::new();
+    let world = ("w.toml", crate::EXAMPLE_WORLD.as_bytes());
+    let checked = aviary_check::check_sources(
+        &mut sources,
+        ("m.mission", MISSION.as_bytes()),
+        Some(world),
+        &aviary_check::NoFiles,
     );
-    k.signal("Go", vec![Some(Kind::Position), Some(Kind::Duration), Some(Kind::Ratio)]);
-    k.signal("Any", vec![None, None]);
-    k.signal("Bare", vec![]);
-    // `Bare` is heard by the mission but not declared: the operator may not raise it.
-    k.operator_signal("Go");
-    k.operator_signal("Any");
+    let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).collect();
+    assert!(errors.is_empty(), "the operator target's mission: {errors:#?}");
+    let (Some(program), Some(world)) = (checked.program, checked.world) else {
+        panic!("the operator target's mission was not checked")
+    };
+    let mission = aviary_lower::compile(&program, &world).expect("the mission compiles");
     // An origin, so that a position by latitude and longitude is placed, not refused.
-    k.with_origin(aviary_api::geo::Origin { lat: 47.45, lon: 13.1, alt: 500.0 })
+    let origin = aviary_api::geo::Origin { lat: 47.45, lon: 13.1, alt: 500.0 };
+    (Kinds::of(&mission).with_origin(origin), mission)
 }
 
 pub fn operator(data: &[u8]) {
     let Some(Call { request, bound, carries_token, .. }) = call(data, &ROUTES, false) else {
         return;
     };
+    let (kinds, mission) = kinds();
+    let kinds = kinds.clone();
     let (controller, mut rx) = Controller::new();
     let (app, _feed) = aviary_server::router(
         bound,
         TOKEN.to_string(),
         controller,
-        Options { kinds: kinds(), allowed_hosts: vec!["ops.example.org".into()] },
+        Options { kinds, allowed_hosts: vec!["ops.example.org".into()] },
     );
     let reached = Cell::new(0);
     let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
@@ -73,7 +102,7 @@ pub fn operator(data: &[u8]) {
         let engine = async {
             while let Some((control, answer)) = rx.recv().await {
                 reached.set(reached.get() + 1);
-                checked(&control);
+                checked(&control, mission);
                 let _ = answer.send(Ok(()));
             }
             std::future::pending::<()>().await
@@ -105,12 +134,21 @@ pub fn operator(data: &[u8]) {
     }
 }
 
-/// What reaches the engine is what a mission could have written, or a drone's name (any
-/// text: the engine looks it up and refuses a name the fleet does not have); a signal
-/// only if the mission declares it for the operator.
-fn checked(control: &Control) {
-    if let Control::Signal { name, .. } = control {
-        assert!(["Go", "Any"].contains(&name.as_str()), "{name} reached the engine undeclared");
+/// What reaches the engine is what a mission could have written: the mission's own ids
+/// (or a name it does not have, for the engine to refuse), a signal only if the mission
+/// declares it for the operator, and values it can take.
+fn checked(control: &Control, mission: &aviary_ir::Mission) {
+    match control {
+        Control::Signal { signal, .. } => {
+            assert!(mission.operator_signals.contains(signal), "{signal} reached the engine undeclared")
+        }
+        Control::Leash { capability, tag, action, args } => {
+            let cap = &mission.capabilities[*capability];
+            assert!(cap.action_name(*action).is_some() && *tag < mission.tags.len());
+            assert!(args.iter().all(|(p, _)| *p < cap.params.len()));
+        }
+        Control::Drone { drone, .. } => assert!(*drone < mission.drones.len()),
+        _ => {}
     }
     let values: Vec<&Value> = match control {
         Control::Leash { args, .. } => args.iter().map(|(_, v)| v).collect(),

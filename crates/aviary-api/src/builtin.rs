@@ -90,6 +90,24 @@ impl BuiltinException {
     pub fn from_name(name: &str) -> Option<BuiltinException> {
         BuiltinException::ALL.into_iter().find(|e| e.name() == name)
     }
+
+    /// A fault of the drone itself (its battery, link, motors, position, the fence),
+    /// which the operator must see even when the mission handles it; the others say
+    /// that a call or a choice could not be made.
+    pub fn is_drone_fault(self) -> bool {
+        match self {
+            BuiltinException::BatteryCritical
+            | BuiltinException::ConnectionLost
+            | BuiltinException::DroneLost
+            | BuiltinException::MotorFailure
+            | BuiltinException::PositionLost
+            | BuiltinException::GeofenceViolation => true,
+            BuiltinException::CommandFailed
+            | BuiltinException::RequirementNotMet
+            | BuiltinException::Timeout
+            | BuiltinException::NoDroneAvailable => false,
+        }
+    }
 }
 
 /// What a leash can tell any activity, whatever its capability (docs/LANGUAGE.md,

@@ -282,3 +282,32 @@ mod tests {
         assert_eq!(before.status, MissionStatus::NotStarted);
     }
 }
+
+/// A control call's answer when the mission took it: `{"ok": true}`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+pub struct Accepted {
+    #[schemars(extend("const" = true))]
+    pub ok: bool,
+}
+
+impl Accepted {
+    pub const YES: Accepted = Accepted { ok: true };
+}
+
+/// Every refusal, with its status: `{"error": "..."}`, in words that say what to do.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+pub struct ApiError {
+    pub error: String,
+}
+
+/// A line of the event stream that is not an event: what the stream left out.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum StreamNote {
+    /// Before the history (`?from=start`): how many of its oldest events were let go.
+    HistoryDropped(u64),
+    /// The stream fell behind the mission: how many events it missed.
+    Lagged(u64),
+    /// In a batch (`?batch=`): how many events the batch left out.
+    Dropped(u64),
+}

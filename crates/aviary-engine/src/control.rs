@@ -9,37 +9,42 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use aviary_api::trace::{Event, EventKind, OperatorAction};
-use aviary_api::{BuiltinLeash, Value};
-use aviary_diagnostics::suggest::{closest, did_you_mean};
-use aviary_ir::LeashAction;
+use aviary_api::{DroneId, Value};
+use aviary_ir::{CapId, LeashAction, SignalId, TagId};
 use tokio::sync::{mpsc, oneshot};
 
+use crate::directory::spaced;
 use crate::engine::Engine;
 
-/// What an operator (or the process) asks of a running mission.
+/// What an operator (or the process) asks of a running mission, by the mission's ids:
+/// names are resolved before, by a [`crate::Directory`].
 #[derive(Clone, Debug, PartialEq)]
 pub enum Control {
-    /// A leash by tag, as a mission would write it: `FlyCircle-C1 PAUSE`.
+    /// A leash, as a mission's own statement pulls it: `FlyCircle-C1 PAUSE`, with a
+    /// section's arguments by parameter index.
     Leash {
-        capability: String,
-        tag: String,
-        action: String,
-        args: Vec<(String, Value)>,
+        capability: CapId,
+        tag: TagId,
+        action: LeashAction,
+        args: Vec<(usize, Value)>,
     },
     /// Raises a signal at mission level (no actor), as the mission's own `SIGNAL` would:
     /// one the mission declares with `OPERATOR SIGNAL`, and no other.
     Signal {
-        name: String,
+        signal: SignalId,
         args: Vec<Value>,
     },
     /// Holds every drone's activity where it is, until `Resume`.
     Pause,
     Resume,
-    /// Steers one drone, by name (`steer.rs`).
+    /// Steers one drone (`steer.rs`).
     Drone {
-        drone: String,
+        drone: DroneId,
         action: DroneAction,
     },
+    /// A name the mission does not have, refused in the engine's words: what runs now,
+    /// which only the engine knows, is what the operator can pull instead.
+    Unknown(Unknown),
     /// Ends the mission: the fleet returns home, and the mission ends `aborted`.
     Abort {
         reason: String,
@@ -48,6 +53,13 @@ pub enum Control {
     BackendLost {
         reason: String,
     },
+}
+
+/// A leash's name that resolves to nothing, with the name meant (`did you mean ...?`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Unknown {
+    Capability { name: String, meant: Option<String> },
+    Tag { capability: String, tag: String, meant: Option<String> },
 }
 
 /// What the operator does to one drone.
@@ -219,63 +231,32 @@ impl<'m> Engine<'m> {
         }
         match control {
             Control::Leash { capability, tag, action, args } => {
-                let caps = &self.m.capabilities;
-                let cap = caps.iter().position(|c| c.name == capability).ok_or_else(|| {
-                    let mean = did_you_mean(&capability, caps.iter().map(|c| c.name.as_str()));
-                    format!(
-                        "no capability is called {capability} ({}){}",
-                        self.running_leashes(),
-                        spaced(mean)
-                    )
-                })?;
-                let action_kind = match BuiltinLeash::parse(&action) {
-                    Some(builtin) => LeashAction::Builtin(builtin),
-                    None => {
-                        let name = action.as_str();
-                        let sections = &self.m.capabilities[cap].sections;
-                        let section =
-                            sections.iter().position(|(n, _)| n == name).ok_or_else(|| {
-                                let known =
-                                    BuiltinLeash::ALL.into_iter().map(|a| -> &str { a.as_str() });
-                                let mean = did_you_mean(
-                                    name,
-                                    known.chain(sections.iter().map(|(n, _)| n.as_str())),
-                                );
-                                format!(
-                                    "{capability} has no section PERFORM {name}{}",
-                                    spaced(mean)
-                                )
-                            })?;
-                        LeashAction::Section(section)
-                    }
-                };
-                let params = &self.m.capabilities[cap].params;
-                let mut values = Vec::new();
-                for (name, value) in args {
-                    let p = params
-                        .iter()
-                        .position(|p| *p == name)
-                        .ok_or_else(|| format!("{capability} has no parameter {name}"))?;
-                    values.push((p, value));
+                // Ids from a directory of this mission are always its own; others are
+                // refused, never followed.
+                let cap = self.m.capabilities.get(capability).ok_or("no such capability")?;
+                cap.action_name(action).ok_or("no such section")?;
+                if tag >= self.m.tags.len() || args.iter().any(|(p, _)| *p >= cap.params.len()) {
+                    return Err("no such tag or parameter".into());
                 }
-                // A tag no statement defines can never match: refuse it, as the checker would.
-                let tag_id = self.m.tags.iter().position(|t| *t == tag).ok_or_else(|| {
-                    let mean = closest(&tag, self.m.tags.iter().map(String::as_str))
-                        .map(|t| format!("did you mean `{capability}-{t}`?"));
-                    format!(
-                        "no statement starts an activity tagged {capability}-{tag} ({}){}",
-                        self.running_leashes(),
-                        spaced(mean)
-                    )
-                })?;
-                self.leash_by_id(cap, tag_id, action_kind, &action, values, None);
+                self.leash_by_id(capability, tag, action, args, None);
                 Ok(())
             }
-            Control::Signal { name, args } => {
-                // Only among the signals the mission declares with OPERATOR SIGNAL (by
-                // their ids, resolved when it was compiled).
-                let id = self.m.operator_signal(&name)?;
-                self.raise_from_outside(id, args);
+            Control::Unknown(Unknown::Capability { name, meant }) => Err(format!(
+                "no capability is called {name} ({}){}",
+                self.running_leashes(),
+                spaced(meant)
+            )),
+            Control::Unknown(Unknown::Tag { capability, tag, meant }) => Err(format!(
+                "no statement starts an activity tagged {capability}-{tag} ({}){}",
+                self.running_leashes(),
+                spaced(meant)
+            )),
+            Control::Signal { signal, args } => {
+                // Only the signals the mission declares with OPERATOR SIGNAL.
+                if !self.m.operator_signals.contains(&signal) {
+                    return Err("not an operator signal of the mission".into());
+                }
+                self.raise_from_outside(signal, args);
                 Ok(())
             }
             Control::Pause | Control::Resume => {
@@ -295,7 +276,7 @@ impl<'m> Engine<'m> {
                 }
                 Ok(())
             }
-            Control::Drone { drone, action } => self.steer(&drone, action),
+            Control::Drone { drone, action } => self.steer(drone, action),
             Control::Abort { reason } => {
                 self.operator(OperatorAction::Abort, None);
                 self.end_with(crate::Status::Aborted, reason, true);
@@ -326,9 +307,4 @@ impl Engine<'_> {
             format!("running now: {}", running.join(", "))
         }
     }
-}
-
-/// `: did you mean ...?` after a refusal, or nothing.
-fn spaced(mean: Option<String>) -> String {
-    mean.map(|m| format!(": {m}")).unwrap_or_default()
 }

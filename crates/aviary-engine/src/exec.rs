@@ -554,7 +554,7 @@ impl<'m> Engine<'m> {
             let env = self.env(&ctx.frame, &received);
             l.args.iter().map(|(p, e)| (*p, env.eval(e))).collect()
         };
-        self.leash_by_id(l.capability, l.tag, l.action, &l.action_name, values, Some(&l.origin));
+        self.leash_by_id(l.capability, l.tag, l.action, values, Some(&l.origin));
     }
 
     /// A leash on every running activity of `capability` tagged `tag`; recorded even when
@@ -564,7 +564,6 @@ impl<'m> Engine<'m> {
         capability: usize,
         tag: usize,
         action: LeashAction,
-        action_name: &str,
         values: Vec<(usize, Value)>,
         at: Option<&aviary_ir::Origin>,
     ) {
@@ -572,7 +571,8 @@ impl<'m> Engine<'m> {
         self.trace(EventKind::Leash, || Event::Leash {
             capability: cap.name.as_str().into(),
             tag: self.m.tags[tag].as_str().into(),
-            action: action_name.into(),
+            // Always a name: the lowering and `Control::Leash` give the capability's own.
+            action: cap.action_name(action).unwrap_or_default().into(),
             block: false,
             line: at.and_then(|o| self.m.line_of(o)),
         });

@@ -18,6 +18,7 @@ mod cancel;
 mod choose;
 mod control;
 mod coverage;
+mod directory;
 mod engine;
 mod exec;
 mod homing;
@@ -34,7 +35,8 @@ use aviary_api::Backend;
 
 pub use aviary_api::trace::{Event, EventKind, OperatorAction, Record, Status};
 use aviary_ir::Mission;
-pub use control::{Control, ControlRequest, Controller, Controls, DroneAction};
+pub use control::{Control, ControlRequest, Controller, Controls, DroneAction, Unknown};
+pub use directory::Directory;
 
 /// Where trace events go, in order: the typed events of `aviary_api::trace`, which a
 /// sink writes as JSON (the trace file, the operator API) or reads field by field.

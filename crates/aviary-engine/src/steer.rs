@@ -25,7 +25,6 @@ use std::rc::Rc;
 use std::task::Waker;
 
 use aviary_api::{CallId, DroneId, Interrupt};
-use aviary_diagnostics::suggest::closest;
 
 use crate::control::DroneAction;
 use crate::engine::{Engine, Instance};
@@ -113,9 +112,10 @@ impl Steering {
 }
 
 impl<'m> Engine<'m> {
-    /// Applies `action` to the drone called `name`, or says why not and what to do.
-    pub(crate) fn steer(&self, name: &str, action: DroneAction) -> Result<(), String> {
-        let d = self.drone_called(name)?;
+    /// Applies `action` to drone `d`, or says why not and what to do.
+    pub(crate) fn steer(&self, d: DroneId, action: DroneAction) -> Result<(), String> {
+        // An id from a directory of this mission is always in its fleet.
+        let name = self.m.drones.get(d).ok_or("no such drone")?;
         let now = self.steering.get(d);
         match (action, now) {
             (DroneAction::Hold, Steer::Free) => {
@@ -174,23 +174,6 @@ impl<'m> Engine<'m> {
                 "{name} is landing or has landed, out of the mission (the operator landed it): it takes no more orders"
             )),
         }
-    }
-
-    /// The drone called `name`, or why there is none, with the name meant if one is close.
-    fn drone_called(&self, name: &str) -> Result<DroneId, String> {
-        let drones = &self.m.drones;
-        if let Some(d) = drones.position(name) {
-            return Ok(d);
-        }
-        if let Some(close) = closest(name, drones.iter()) {
-            return Err(format!("no drone is called `{name}`: did you mean `{close}`?"));
-        }
-        const SHOWN: usize = 10;
-        let mut fleet: Vec<&str> = drones.iter().take(SHOWN).collect();
-        if drones.len() > SHOWN {
-            fleet.push("...");
-        }
-        Err(format!("no drone is called `{name}`: the fleet is {}", fleet.join(", ")))
     }
 
     /// Holds a root activity for a drone the operator holds: its calls in flight are

@@ -3,21 +3,21 @@
 use aviary_api::Value;
 use aviary_engine::{Control, Outcome, RunOptions, Status};
 use aviary_test_support::harness;
-use harness::Path;
+use harness::{Ask, Path};
 use serde_json::Value as Json;
 
 /// Runs `mission`, sending each control at its mission time; returns the outcome, the
 /// trace and the engine's answers.
 fn run_with_controls(
     mission: &str,
-    controls: Vec<(f64, Control)>,
+    controls: Vec<(f64, Ask)>,
 ) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
     run_with_controls_on(mission, controls, Path::AsUsersRun)
 }
 
 fn run_with_controls_on(
     mission: &str,
-    controls: Vec<(f64, Control)>,
+    controls: Vec<(f64, Ask)>,
     path: Path,
 ) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
     let (compiled, world) = harness::compile(mission, harness::WORLD);
@@ -44,24 +44,8 @@ fn an_operator_leash_pauses_and_resumes_by_tag() {
     let (outcome, trace, answers) = run_with_controls(
         "MISSION M:\n    a FlyTo-F1 WITH Far\n",
         vec![
-            (
-                10.0,
-                Control::Leash {
-                    capability: "FlyTo".into(),
-                    tag: "F1".into(),
-                    action: "PAUSE".into(),
-                    args: vec![],
-                },
-            ),
-            (
-                20.0,
-                Control::Leash {
-                    capability: "FlyTo".into(),
-                    tag: "F1".into(),
-                    action: "RESUME".into(),
-                    args: vec![],
-                },
-            ),
+            (10.0, Ask::leash("FlyTo", "F1", "PAUSE")),
+            (20.0, Ask::leash("FlyTo", "F1", "RESUME")),
         ],
     );
     assert_eq!(outcome.status, Status::Ok);
@@ -84,52 +68,12 @@ fn operator_controls_that_cannot_apply_are_refused_with_a_reason() {
     let (_, _, answers) = run_with_controls(
         "MISSION M:\n    a FlyTo-F1 WITH North\n    ON Go:\n        b Hover WITH 1s\n",
         vec![
-            (
-                1.0,
-                Control::Leash {
-                    capability: "FlyTo".into(),
-                    tag: "F9".into(),
-                    action: "PAUSE".into(),
-                    args: vec![],
-                },
-            ),
-            (
-                1.0,
-                Control::Leash {
-                    capability: "Fly".into(),
-                    tag: "F1".into(),
-                    action: "PAUSE".into(),
-                    args: vec![],
-                },
-            ),
-            (
-                1.0,
-                Control::Leash {
-                    capability: "FlyTo".into(),
-                    tag: "F1".into(),
-                    action: "Widen".into(),
-                    args: vec![],
-                },
-            ),
-            (1.0, Control::Signal { name: "Nobody".into(), args: vec![] }),
-            (
-                1.0,
-                Control::Leash {
-                    capability: "FlyT0".into(),
-                    tag: "F1".into(),
-                    action: "PAUSE".into(),
-                    args: vec![],
-                },
-            ),
-            (
-                1.0,
-                Control::Leash {
-                    capability: "FlyTo".into(),
-                    tag: "F1".into(),
-                    action: "PAUES".into(),
-                    args: vec![],
-                },
-            ),
+            (1.0, Ask::leash("FlyTo", "F9", "PAUSE")),
+            (1.0, Ask::leash("Fly", "F1", "PAUSE")),
+            (1.0, Ask::leash("FlyTo", "F1", "Widen")),
+            (1.0, Ask::Signal { name: "Nobody".into(), args: vec![] }),
+            (1.0, Ask::leash("FlyT0", "F1", "PAUSE")),
+            (1.0, Ask::leash("FlyTo", "F1", "PAUES")),
         ],
     );
     assert_eq!(
@@ -140,7 +84,7 @@ fn operator_controls_that_cannot_apply_are_refused_with_a_reason() {
     assert_eq!(answers[2], Err("FlyTo has no section PERFORM Widen".to_string()));
     assert_eq!(
         answers[3],
-        Err("the mission declares no signal an operator may raise, so not Nobody".to_string())
+        Err("the mission declares no signal an operator may raise, so not Nobody: it would need `OPERATOR SIGNAL Nobody` in its MISSION body".to_string())
     );
     assert_eq!(
         answers[4],
@@ -158,10 +102,10 @@ fn an_operator_signal_is_heard_by_the_mission() {
     let (outcome, trace, answers) = run_with_controls(
         "MISSION M:\n    OPERATOR SIGNAL Go, Stop\n    PARALLEL:\n        a Hover WITH 10s\n        ON Go WITH what:\n            b Hover WITH 1s\n        ON Halt:\n            b Hover WITH 1s\n        ON Stop:\n            SIGNAL Halt\n",
         vec![
-            (7.0, Control::Signal { name: "Go".into(), args: vec![Value::Text("now".into())] }),
+            (7.0, Ask::Signal { name: "Go".into(), args: vec![Value::Text("now".into())] }),
             // Heard by the mission, but not declared: the operator may not raise it.
-            (7.0, Control::Signal { name: "Halt".into(), args: vec![] }),
-            (7.0, Control::Signal { name: "Sotp".into(), args: vec![] }),
+            (7.0, Ask::Signal { name: "Halt".into(), args: vec![] }),
+            (7.0, Ask::Signal { name: "Sotp".into(), args: vec![] }),
         ],
     );
     assert_eq!(
@@ -189,7 +133,7 @@ fn an_operator_signal_is_heard_by_the_mission() {
 fn pausing_the_mission_holds_every_drone_and_resuming_goes_on() {
     let (outcome, trace, _) = run_with_controls(
         "MISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        b FlyTo WITH Field\n",
-        vec![(15.0, Control::Pause), (25.0, Control::Resume)],
+        vec![(15.0, Control::Pause.into()), (25.0, Control::Resume.into())],
     );
     assert_eq!(outcome.status, Status::Ok);
     for drone in ["a", "b"] {
@@ -216,7 +160,7 @@ fn an_activity_started_while_the_mission_is_paused_starts_held_on_either_path() 
     // Ping's calls end at once (an instant activity, src/instant.rs); it starts at 18 s,
     // inside the pause, and makes its first call only at the resume.
     let mission = "CAPABILITY Ping BY d:\n    PERFORM:\n        d.StartStreaming()\n        d.StopStreaming()\n\nMISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        SEQUENTIAL:\n            WAITFOR ELAPSED >= 18s\n            b Ping\n";
-    let controls = || vec![(15.0, Control::Pause), (25.0, Control::Resume)];
+    let controls = || vec![(15.0, Control::Pause.into()), (25.0, Control::Resume.into())];
     let (outcome, trace, _) = run_with_controls(mission, controls());
     let general = run_with_controls_on(mission, controls(), Path::GeneralOnly);
     assert_eq!((&outcome, &trace), (&general.0, &general.1), "the same trace both ways");
@@ -237,7 +181,7 @@ fn an_activity_started_while_the_mission_is_paused_starts_held_on_either_path() 
 fn aborting_the_mission_sends_the_fleet_home() {
     let (outcome, trace, _) = run_with_controls(
         "MISSION M:\n    PARALLEL:\n        a FlyTo WITH Far\n        b FlyTo WITH Field\n",
-        vec![(12.0, Control::Abort { reason: "aborted by the operator".into() })],
+        vec![(12.0, Control::Abort { reason: "aborted by the operator".into() }.into())],
     );
     assert_eq!(outcome.status, Status::Aborted);
     assert_eq!(outcome.reason.as_deref(), Some("aborted by the operator"));
@@ -277,7 +221,8 @@ fn a_lost_backend_ends_the_mission_at_once_without_commanding_anyone() {
         "MISSION M:\n    a FlyTo WITH Far\n",
         vec![(
             10.0,
-            Control::BackendLost { reason: "the simulator stopped: its task panicked".into() },
+            Control::BackendLost { reason: "the simulator stopped: its task panicked".into() }
+                .into(),
         )],
     );
     assert_eq!(outcome.status, Status::Failed);

@@ -6,7 +6,7 @@
 
 use aviary_engine::{Control, DroneAction, RunOptions, Status};
 use aviary_test_support::harness;
-use harness::Path;
+use harness::{Ask, Path};
 
 fn both_ways(mission: &str, world: &str) -> harness::Run {
     both_ways_with(mission, world, Vec::new())
@@ -14,7 +14,7 @@ fn both_ways(mission: &str, world: &str) -> harness::Run {
 
 /// Runs the mission as users run it and with every activity on the general path, with
 /// the operator's controls at their times; panics where the traces part.
-fn both_ways_with(mission: &str, world: &str, controls: Vec<(f64, Control)>) -> harness::Run {
+fn both_ways_with(mission: &str, world: &str, controls: Vec<(f64, Ask)>) -> harness::Run {
     let (compiled, world) = harness::compile(mission, world);
     let options = RunOptions::default();
     let run = |path| harness::run_compiled(&compiled, &world, &options, controls.clone(), path);
@@ -445,15 +445,14 @@ mod generated {
         })
     }
 
-    fn control() -> impl Strategy<Value = (f64, Control)> {
+    fn control() -> impl Strategy<Value = (f64, Ask)> {
         let drone = |action| {
-            prop::sample::select(vec!["a", "b", "c"])
-                .prop_map(move |d| Control::Drone { drone: d.into(), action })
+            prop::sample::select(vec!["a", "b", "c"]).prop_map(move |d| Ask::drone(d, action))
         };
         let control = prop_oneof![
-            4 => Just(Control::Pause),
-            4 => Just(Control::Resume),
-            1 => Just(Control::Abort { reason: "the operator".into() }),
+            4 => Just(Ask::Control(Control::Pause)),
+            4 => Just(Ask::Control(Control::Resume)),
+            1 => Just(Ask::Control(Control::Abort { reason: "the operator".into() })),
             3 => drone(DroneAction::Hold),
             3 => drone(DroneAction::Resume),
             1 => drone(DroneAction::ReturnHome),
@@ -466,7 +465,7 @@ mod generated {
     struct Case {
         mission: String,
         world: String,
-        controls: Vec<(f64, Control)>,
+        controls: Vec<(f64, Ask)>,
     }
 
     fn case() -> impl Strategy<Value = Case> {
@@ -480,10 +479,10 @@ mod generated {
                 // The operator always resumes in the end, the mission and each drone (a
                 // drone not held refuses, alike both ways): a mission held for ever would
                 // never end, on either path.
-                controls.push((25.0, Control::Resume));
+                controls.push((25.0, Control::Resume.into()));
                 for d in ["a", "b", "c"] {
                     let action = DroneAction::Resume;
-                    controls.push((25.0, Control::Drone { drone: d.into(), action }));
+                    controls.push((25.0, Ask::drone(d, action)));
                 }
                 Case {
                     mission: mission(&items),

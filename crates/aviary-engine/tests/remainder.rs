@@ -158,13 +158,14 @@ fn what_a_finished_sweep_leaves_is_nothing_and_sweeping_it_ends_at_once() {
 
 #[test]
 fn a_drone_the_operator_sends_home_leaves_the_rest_of_its_sweep() {
-    use aviary_engine::{Control, DroneAction};
+    use aviary_engine::DroneAction;
+    use harness::Ask;
     let mission = format!(
         "{SPRAY}\nMISSION Handover:\n    PARALLEL Fields:\n        SEQUENTIAL First:\n            a TakeOff WITH 20m\n            a Spray WITH Field\n            a ReturnHome\n        SEQUENTIAL Second:\n            WAITFOR ELAPSED >= 60s\n            b TakeOff WITH 20m\n            b Spray WITH a.remaining\n            b ReturnHome\n"
     );
     let (compiled, world) = harness::compile(&mission, harness::WORLD);
     let options = RunOptions { telemetry_hz: Some(20.0), ..RunOptions::default() };
-    let home = Control::Drone { drone: "a".into(), action: DroneAction::ReturnHome };
+    let home = Ask::drone("a", DroneAction::ReturnHome);
     let (r, answers) = harness::run_compiled(
         &compiled,
         &world,

@@ -4,7 +4,7 @@
 
 use aviary_engine::{Control, DroneAction, Outcome, RunOptions, Status};
 use aviary_test_support::harness;
-use harness::Path;
+use harness::{Ask, Path};
 use serde_json::Value as Json;
 
 /// The harness's world, with more far places, so that drones flying far do not meet at
@@ -16,17 +16,14 @@ fn world() -> String {
     )
 }
 
-fn run(
-    mission: &str,
-    controls: Vec<(f64, Control)>,
-) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
+fn run(mission: &str, controls: Vec<(f64, Ask)>) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
     run_on(mission, &world(), controls, Path::AsUsersRun)
 }
 
 fn run_on(
     mission: &str,
     world: &str,
-    controls: Vec<(f64, Control)>,
+    controls: Vec<(f64, Ask)>,
     path: Path,
 ) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
     let (compiled, world) = harness::compile(mission, world);
@@ -35,8 +32,8 @@ fn run_on(
     (run.outcome, run.trace, answers)
 }
 
-fn drone(name: &str, action: DroneAction) -> Control {
-    Control::Drone { drone: name.into(), action }
+fn drone(name: &str, action: DroneAction) -> Ask {
+    Ask::drone(name, action)
 }
 
 use DroneAction::{Hold, Land, Resume, ReturnHome};
@@ -145,9 +142,9 @@ fn a_hold_and_a_pause_of_the_mission_are_apart() {
     let (outcome, trace, answers) = run(
         TWO_FLY,
         vec![
-            (10.0, Control::Pause),
+            (10.0, Control::Pause.into()),
             (12.0, drone("a", Hold)),
-            (15.0, Control::Resume),
+            (15.0, Control::Resume.into()),
             (20.0, drone("a", Resume)),
         ],
     );
@@ -315,9 +312,9 @@ fn the_operator_is_told_why_a_drone_control_is_refused() {
             (1.0, drone("a", Resume)),
             (2.0, drone("a", Hold)),
             (2.0, drone("a", Hold)),
-            (3.0, Control::Pause),
+            (3.0, Control::Pause.into()),
             (3.0, drone("b", Resume)),
-            (4.0, Control::Resume),
+            (4.0, Control::Resume.into()),
             (5.0, drone("a", Land)),
             (5.0, drone("a", Resume)),
             (5.0, drone("a", ReturnHome)),

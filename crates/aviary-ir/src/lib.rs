@@ -117,18 +117,6 @@ pub fn undeclared_signal(name: &str, declared: &[&str]) -> String {
 }
 
 impl Mission {
-    /// The operator signal called `name`, or why an operator may not raise it: the
-    /// mission does not declare it with `OPERATOR SIGNAL` (with the ones it declares, and
-    /// the one meant when one is close). The engine and the operator API refuse with it.
-    pub fn operator_signal(&self, name: &str) -> Result<SignalId, String> {
-        let ops = &self.operator_signals;
-        if let Some(&id) = ops.iter().find(|&&s| self.signals[s] == name) {
-            return Ok(id);
-        }
-        let declared: Vec<&str> = ops.iter().map(|&s| self.signals[s].as_str()).collect();
-        Err(undeclared_signal(name, &declared))
-    }
-
     /// The line (from 1) of a statement at `origin`, when it is in the MISSION's file.
     pub fn line_of(&self, origin: &Origin) -> Option<u32> {
         let lines = &self.lines;
@@ -200,6 +188,15 @@ impl Capability {
         std::iter::once(&self.perform)
             .chain(self.sections.iter().map(|(_, b)| b))
             .chain(self.exception_handlers.iter().map(|h| &h.body))
+    }
+
+    /// How a leash names `action`, as the trace writes it: `PAUSE`, or a section's name
+    /// as the capability writes it; `None` for a section it does not have.
+    pub fn action_name(&self, action: LeashAction) -> Option<&str> {
+        match action {
+            LeashAction::Builtin(builtin) => Some(builtin.as_str()),
+            LeashAction::Section(i) => self.sections.get(i).map(|(name, _)| name.as_str()),
+        }
     }
 }
 
@@ -348,9 +345,8 @@ pub enum LeashAction {
 pub struct Leash {
     pub capability: CapId,
     pub tag: TagId,
+    /// Its name, for the trace, is the capability's to say ([`Capability::action_name`]).
     pub action: LeashAction,
-    /// The action as written, for the trace (`PAUSE`, `Widen`).
-    pub action_name: String,
     /// Parameter index and value, for a section's arguments.
     pub args: Vec<(usize, Expr)>,
     pub origin: Origin,

@@ -597,7 +597,6 @@ impl<'a> Compiler<'a> {
             capability,
             tag: self.tags.id(&l.tag.name),
             action,
-            action_name: l.action.name.clone(),
             args,
             origin: self.origin(l.span),
         })

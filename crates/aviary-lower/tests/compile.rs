@@ -173,7 +173,11 @@ fn leashes_resolve_their_section_and_tag() {
     let seq = block(&par.items[1]);
     assert_eq!(seq.path, "M/PARALLEL/SEQUENTIAL");
     let Node::Leash(wider) = &seq.items[1] else { panic!() };
-    assert_eq!((wider.action, wider.action_name.as_str()), (LeashAction::Section(0), "Wider"));
+    let watch_cap = &m.capabilities[wider.capability];
+    assert_eq!(
+        (wider.action, watch_cap.action_name(wider.action)),
+        (LeashAction::Section(0), Some("Wider"))
+    );
     assert_eq!(wider.args, [(0, Expr::Const(Value::Number(40.0)))]);
     let Node::Leash(abort) = &seq.items[2] else { panic!() };
     assert_eq!(abort.action, LeashAction::Builtin(BuiltinLeash::Abort));

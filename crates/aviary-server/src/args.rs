@@ -10,11 +10,12 @@
 //! placed by the world's one projection (`aviary_api::geo`) about the mission's origin.
 //! A position, however written, must lie where the world lets a drone fly (`bounds.rs`).
 
-use std::collections::HashMap;
 use std::sync::Arc;
 
 use aviary_api::geo::Origin;
 use aviary_api::{Kind, Point, Value};
+use aviary_engine::{Control, Directory, DroneAction};
+use aviary_ir::SignalId;
 use aviary_syntax::ast::Unit;
 use serde_json::{Map, Value as JsonValue};
 
@@ -23,41 +24,41 @@ use serde_json::{Map, Value as JsonValue};
 /// distance) stops meaning anything or overflows to infinity.
 pub const MAX_MAGNITUDE: f64 = 1e9;
 
-/// What the mission's operator-facing arguments must be, from the compiled mission.
+/// What an operator's request names and what its values must be, from the compiled
+/// mission: the names resolve to the mission's ids ([`Directory`]), and each value is
+/// checked against the kind the checker inferred.
 #[derive(Clone, Debug, Default)]
 pub struct Kinds {
-    capabilities: HashMap<String, Vec<(String, Option<Kind>)>>,
-    signals: HashMap<String, Vec<Option<Kind>>>,
-    /// The signals the mission declares with `OPERATOR SIGNAL`, in the order written: the
-    /// only ones an operator may raise.
-    operator: Vec<String>,
+    directory: Directory,
+    /// By capability id: the kind of each parameter, in order (`None`: any).
+    params: Vec<Vec<Option<Kind>>>,
+    /// By signal id: the kind of each value the signal carries.
+    signals: Vec<Vec<Option<Kind>>>,
     /// The world's `origin`, which places a `{"lat", "lon"}` position; `None` without one.
     origin: Option<Origin>,
     /// Where a position may be; `None`: anywhere (no world was given).
     bounds: Option<Arc<crate::Bounds>>,
 }
 
+/// Why a request was refused: a value it gives (400), or a name the mission does not
+/// have (409, as the engine refuses what it cannot do now).
+#[derive(Debug, PartialEq, Eq)]
+pub(crate) enum Refusal {
+    Value(String),
+    Name(String),
+}
+
 impl Kinds {
-    /// What a compiled mission's leash arguments and signal values must be: the kinds the
-    /// checker inferred, which the mission keeps.
+    /// What a compiled mission's requests may name, and the kinds the checker inferred
+    /// for leash arguments and signal values, which the mission keeps.
     pub fn of(mission: &aviary_ir::Mission) -> Kinds {
-        let mut kinds = Kinds::default();
-        for c in &mission.capabilities {
-            kinds.capability(
-                &c.name,
-                c.params.iter().cloned().zip(c.param_kinds.iter().copied()).collect(),
-            );
+        Kinds {
+            directory: Directory::of(mission),
+            params: mission.capabilities.iter().map(|c| c.param_kinds.clone()).collect(),
+            signals: mission.signal_values.clone(),
+            origin: mission.origin,
+            bounds: None,
         }
-        for (name, values) in mission.signals.iter().zip(&mission.signal_values) {
-            kinds.signal(name, values.clone());
-        }
-        for &id in &mission.operator_signals {
-            if let Some(name) = mission.signals.get(id) {
-                kinds.operator_signal(name);
-            }
-        }
-        kinds.origin = mission.origin;
-        kinds
     }
 
     /// These kinds, with positions held to the world's limits.
@@ -72,52 +73,49 @@ impl Kinds {
         self
     }
 
-    /// A capability's parameters, in order, with each one's kind (`None`: any).
-    pub fn capability(&mut self, name: &str, params: Vec<(String, Option<Kind>)>) {
-        self.capabilities.insert(name.to_string(), params);
-    }
-    /// The values a signal carries, in order, with each one's kind (`None`: any).
-    pub fn signal(&mut self, name: &str, values: Vec<Option<Kind>>) {
-        self.signals.insert(name.to_string(), values);
-    }
-
-    /// Lets the operator raise `name` (`OPERATOR SIGNAL name` in the mission).
-    pub fn operator_signal(&mut self, name: &str) {
-        if !self.operator.iter().any(|n| n == name) {
-            self.operator.push(name.to_string());
-        }
-    }
-
     /// The signals an operator may raise, in the order the mission declares them.
-    pub fn operator_signals(&self) -> &[String] {
-        &self.operator
+    pub fn operator_signals(&self) -> Vec<String> {
+        self.directory.operator_signals().map(|(_, name)| name.to_string()).collect()
     }
 
     /// The kinds of the values each operator signal carries, in its order (`None`: any
     /// value), as the ground station's Raise form reads them.
     pub fn operator_signal_values(&self) -> impl Iterator<Item = (&str, &[Option<Kind>])> {
-        self.operator
-            .iter()
-            .map(|n| (n.as_str(), self.signals.get(n).map_or(&[][..], Vec::as_slice)))
+        self.directory
+            .operator_signals()
+            .map(|(id, name)| (name, self.signals.get(id).map_or(&[][..], Vec::as_slice)))
     }
 
-    /// Whether the operator may raise `name`; if not, why, with the signals the mission
-    /// declares and the one meant when one is close.
-    pub(crate) fn may_raise(&self, name: &str) -> Result<(), String> {
-        if self.operator.iter().any(|n| n == name) {
-            return Ok(());
-        }
-        let declared: Vec<&str> = self.operator.iter().map(String::as_str).collect();
-        let why = aviary_ir::undeclared_signal(name, &declared);
-        Err(match declared.is_empty() {
-            true => format!("{why}: it would need `OPERATOR SIGNAL {name}` in its MISSION body"),
-            false => why,
-        })
+    /// A leash, `capability-tag action` with a section's arguments, as the engine takes
+    /// it. A capability or a tag the mission does not have is left to the engine to refuse
+    /// (409), since it says what runs now.
+    pub(crate) fn leash(
+        &self,
+        capability: &str,
+        tag: &str,
+        action: &str,
+        args: &Map<String, JsonValue>,
+    ) -> Result<Control, Refusal> {
+        let values = self.leash_args(capability, action, args).map_err(Refusal::Value)?;
+        self.directory.leash(capability, tag, action, values).map_err(Refusal::Name)
     }
 
-    /// A leash's arguments as the engine takes them. A capability the mission does not
-    /// have is left to the engine to refuse (409), as it refuses an unknown tag.
-    pub(crate) fn leash_args(
+    /// A signal the mission declares for the operator (or 409, with the ones it declares
+    /// and the one meant), with its values.
+    pub(crate) fn signal(&self, name: &str, args: &[JsonValue]) -> Result<Control, Refusal> {
+        let signal = self.directory.operator_signal(name).map_err(Refusal::Name)?;
+        let args = self.signal_args(signal, name, args).map_err(Refusal::Value)?;
+        Ok(Control::Signal { signal, args })
+    }
+
+    /// Steers the drone called `name` (or 409, with the name meant or the fleet).
+    pub(crate) fn drone(&self, name: &str, action: DroneAction) -> Result<Control, Refusal> {
+        self.directory.drone(name, action).map_err(Refusal::Name)
+    }
+
+    /// A leash's arguments, by parameter name. A capability the mission does not have
+    /// takes any value here: the engine refuses it by name.
+    fn leash_args(
         &self,
         capability: &str,
         action: &str,
@@ -129,14 +127,16 @@ impl Kinds {
                 false => Err(format!("{action} takes no arguments; only a PERFORM section does")),
             };
         }
-        let params = self.capabilities.get(capability);
+        let params = self.directory.capability(capability).map(|c| {
+            let kinds = self.params.get(c).map_or(&[][..], Vec::as_slice);
+            (self.directory.params(c), kinds)
+        });
         let mut out = Vec::new();
         for (name, v) in args {
             let kind = match params {
-                Some(params) => match params.iter().find(|(p, _)| p == name) {
-                    Some((_, kind)) => *kind,
+                Some((names, kinds)) => match names.iter().position(|p| p == name) {
+                    Some(p) => kinds.get(p).copied().flatten(),
                     None => {
-                        let names: Vec<&str> = params.iter().map(|(p, _)| p.as_str()).collect();
                         return Err(format!(
                             "{capability} has no parameter `{name}`; its parameters are: {}",
                             names.join(", ")
@@ -151,15 +151,13 @@ impl Kinds {
     }
 
     /// A signal's values as the engine takes them: as many as the signal carries.
-    pub(crate) fn signal_args(&self, name: &str, args: &[JsonValue]) -> Result<Vec<Value>, String> {
-        let Some(kinds) = self.signals.get(name) else {
-            // Unknown to the mission: the engine refuses it by name (409).
-            return args
-                .iter()
-                .enumerate()
-                .map(|(i, v)| self.value(v, None, &format!("value {} of {name}", i + 1)))
-                .collect();
-        };
+    fn signal_args(
+        &self,
+        signal: SignalId,
+        name: &str,
+        args: &[JsonValue],
+    ) -> Result<Vec<Value>, String> {
+        let kinds = self.signals.get(signal).map_or(&[][..], Vec::as_slice);
         if args.len() != kinds.len() {
             let wanted: Vec<&str> =
                 kinds.iter().map(|k| k.map_or("any value", Kind::describe)).collect();
@@ -404,29 +402,37 @@ fn example(kind: Kind) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::Kinds;
+    use super::{Kinds, Refusal};
+    use aviary_test_support::harness;
+
+    fn kinds(mission: &str) -> Kinds {
+        Kinds::of(&harness::compile(mission, harness::WORLD).0)
+    }
+
+    fn refusal(kinds: &Kinds, name: &str) -> Option<String> {
+        match kinds.signal(name, &[]) {
+            Err(Refusal::Name(why)) => Some(why),
+            Ok(_) | Err(Refusal::Value(_)) => None,
+        }
+    }
 
     #[test]
     fn only_a_declared_signal_may_be_raised_and_a_refusal_lists_them() {
-        let mut kinds = Kinds::default();
-        kinds.signal("Hold_Position", vec![]);
-        kinds.signal("Found", vec![None]);
+        let none = kinds("MISSION M:\n    ON Hold_Position:\n        a Hover WITH 1s\n");
         assert_eq!(
-            kinds.may_raise("Hold_Position"),
-            Err("the mission declares no signal an operator may raise, so not Hold_Position: it would need `OPERATOR SIGNAL Hold_Position` in its MISSION body".into())
+            refusal(&none, "Hold_Position"),
+            Some("the mission declares no signal an operator may raise, so not Hold_Position: it would need `OPERATOR SIGNAL Hold_Position` in its MISSION body".into())
         );
-        kinds.operator_signal("Hold_Position");
-        kinds.operator_signal("Carry_On");
-        kinds.operator_signal("Hold_Position");
-        assert_eq!(kinds.operator_signals(), ["Hold_Position", "Carry_On"], "each once, in order");
-        assert_eq!(kinds.may_raise("Hold_Position"), Ok(()));
+        let two = kinds("MISSION M:\n    OPERATOR SIGNAL Hold_Position, Carry_On\n    PARALLEL:\n        ON Hold_Position:\n            a Hover WITH 1s\n        ON Found WITH what:\n            a Hover WITH 1s\n        ON Carry_On:\n            SIGNAL Found WITH 1\n");
+        assert_eq!(two.operator_signals(), ["Hold_Position", "Carry_On"], "in order");
+        assert_eq!(refusal(&two, "Hold_Position"), None);
         assert_eq!(
-            kinds.may_raise("Hold_Postion"),
-            Err("the mission does not declare Hold_Postion as an operator signal: did you mean `Hold_Position`? It declares Hold_Position, Carry_On".into())
+            refusal(&two, "Hold_Postion"),
+            Some("the mission does not declare Hold_Postion as an operator signal: did you mean `Hold_Position`? It declares Hold_Position, Carry_On".into())
         );
         assert_eq!(
-            kinds.may_raise("Found"),
-            Err("the mission does not declare Found as an operator signal: it declares Hold_Position, Carry_On".into()),
+            refusal(&two, "Found"),
+            Some("the mission does not declare Found as an operator signal: it declares Hold_Position, Carry_On".into()),
             "heard by the mission, raised by it, and still not the operator's"
         );
     }

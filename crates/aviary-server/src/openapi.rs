@@ -3,7 +3,7 @@
 //! return, generated from the types (`aviary_api::operator`) with schemars, as JSON
 //! Schema 2020-12, the dialect of OpenAPI 3.1.
 
-use aviary_api::operator::OperatorState;
+use aviary_api::operator::{Accepted, ApiError, OperatorState};
 use schemars::generate::SchemaSettings;
 use serde_json::{json, Map, Value};
 
@@ -13,6 +13,8 @@ pub fn openapi() -> Value {
         .with(|s| s.definitions_path = "/components/schemas".into())
         .into_generator();
     let state = generator.subschema_for::<OperatorState>();
+    generator.subschema_for::<Accepted>();
+    generator.subschema_for::<ApiError>();
     let mut schemas: Map<String, Value> = hand_written_schemas();
     for (name, schema) in generator.take_definitions(true) {
         schemas.insert(name, schema);
@@ -78,14 +80,6 @@ fn hand_written_schemas() -> Map<String, Value> {
         ]
     });
     let mut schemas = Map::new();
-    schemas.insert(
-        "Ok".into(),
-        json!({ "type": "object", "properties": { "ok": { "const": true } } }),
-    );
-    schemas.insert(
-        "Error".into(),
-        json!({ "type": "object", "required": ["error"], "properties": { "error": { "type": "string" } } }),
-    );
     schemas.insert("Argument".into(), value);
     schemas
 }
@@ -93,7 +87,7 @@ fn hand_written_schemas() -> Map<String, Value> {
 fn error_response(description: &str) -> Value {
     json!({
         "description": description,
-        "content": { "application/json": { "schema": { "$ref": "#/components/schemas/Error" } } }
+        "content": { "application/json": { "schema": { "$ref": "#/components/schemas/ApiError" } } }
     })
 }
 
@@ -101,7 +95,7 @@ fn responses() -> Value {
     json!({
         "Done": {
             "description": "Done",
-            "content": { "application/json": { "schema": { "$ref": "#/components/schemas/Ok" } } }
+            "content": { "application/json": { "schema": { "$ref": "#/components/schemas/Accepted" } } }
         },
         "BadRequest": error_response("A malformed body, or an argument the mission cannot take"),
         "Unauthorized": error_response("Without the token or with a wrong one"),

@@ -1,19 +1,20 @@
 //! Answers: every error is `{"error": "..."}` with its status, whoever made it (a
 //! handler, an extractor's rejection, the router's 404 and 405, the body limit).
 
+use aviary_api::operator::ApiError;
 use axum::body::Body;
 use axum::extract::rejection::JsonRejection;
 use axum::extract::{FromRequest, Request};
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
-use serde_json::{json, Value};
+use serde_json::Value;
 
 /// A control call's body may be this large; the largest real one is a few hundred bytes.
 pub const BODY_LIMIT: usize = 64 * 1024;
 
 pub(crate) fn error(status: StatusCode, message: impl Into<String>) -> Response {
-    (status, Json(json!({ "error": message.into() }))).into_response()
+    (status, Json(ApiError { error: message.into() })).into_response()
 }
 
 /// A JSON object body. Its rejections are answered in JSON, and in words that say what
@@ -79,7 +80,7 @@ pub async fn json_errors(response: Response) -> Response {
     } else {
         text
     };
-    let body = json!({ "error": message }).to_string();
+    let body = serde_json::to_string(&ApiError { error: message }).unwrap_or_default();
     parts.headers.insert(header::CONTENT_TYPE, HeaderValue::from_static("application/json"));
     parts.headers.remove(header::CONTENT_LENGTH);
     Response::from_parts(parts, Body::from(body))

@@ -12,11 +12,12 @@ use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::{middleware, Json, Router};
-use serde_json::{json, Value as JsonValue};
+use serde_json::Value as JsonValue;
 
+use crate::args::Refusal;
 use crate::reply::{error, Object, BODY_LIMIT};
 use crate::{guard, reply, stream, Shared};
-use aviary_api::operator::{KindName, OperatorState, SignalValues};
+use aviary_api::operator::{Accepted, KindName, OperatorState, SignalValues};
 
 pub(crate) fn router(shared: Arc<Shared>) -> Router {
     let reads = Router::new()
@@ -41,9 +42,18 @@ pub(crate) fn router(shared: Arc<Shared>) -> Router {
         .with_state(shared)
 }
 
+/// A request resolved to the mission's ids, sent; or why it could not be.
+async fn resolved(shared: &Shared, control: Result<Control, Refusal>) -> Response {
+    match control {
+        Ok(control) => self::control(shared, control).await,
+        Err(Refusal::Value(why)) => error(StatusCode::BAD_REQUEST, why),
+        Err(Refusal::Name(why)) => error(StatusCode::CONFLICT, why),
+    }
+}
+
 async fn control(shared: &Shared, control: Control) -> Response {
     match shared.controller.ask(control).await {
-        Ok(()) => Json(json!({ "ok": true })).into_response(),
+        Ok(()) => Json(Accepted::YES).into_response(),
         Err(why) => error(StatusCode::CONFLICT, why),
     }
 }
@@ -175,13 +185,7 @@ async fn leash(State(shared): State<Arc<Shared>>, Object(body): Object) -> Respo
             )
         }
     };
-    match shared.kinds.leash_args(&capability, action, &args) {
-        Ok(args) => {
-            control(&shared, Control::Leash { capability, tag, action: action.to_string(), args })
-                .await
-        }
-        Err(why) => error(StatusCode::BAD_REQUEST, why),
-    }
+    resolved(&shared, shared.kinds.leash(&capability, &tag, action, &args)).await
 }
 
 /// `{"name": "Go", "args": [..]}`.
@@ -201,18 +205,12 @@ async fn signal(State(shared): State<Arc<Shared>>, Object(body): Object) -> Resp
     };
     // Only a signal the mission declares with OPERATOR SIGNAL: refused as the engine
     // would refuse it (409), with what the mission declares.
-    if let Err(why) = shared.kinds.may_raise(name) {
-        return error(StatusCode::CONFLICT, why);
-    }
-    match shared.kinds.signal_args(name, &args) {
-        Ok(args) => control(&shared, Control::Signal { name: name.to_string(), args }).await,
-        Err(why) => error(StatusCode::BAD_REQUEST, why),
-    }
+    resolved(&shared, shared.kinds.signal(name, &args)).await
 }
 
 /// `{"drone": "scout1", "action": "hold"}`: `hold`, `resume`, `home` (or `return_home`,
-/// as the trace writes it) or `land`. Which drones there are is the engine's to say (409,
-/// with the name meant): the server knows the fleet only from the trace.
+/// as the trace writes it) or `land`. A drone the fleet does not have is refused (409),
+/// with the name meant.
 async fn drone(State(shared): State<Arc<Shared>>, Object(body): Object) -> Response {
     const ACTIONS: &str = "\"action\": \"hold\", \"resume\", \"home\" or \"land\"";
     let Some(name) = body.get("drone").and_then(JsonValue::as_str) else {
@@ -234,7 +232,7 @@ async fn drone(State(shared): State<Arc<Shared>>, Object(body): Object) -> Respo
         }
         None => return error(StatusCode::BAD_REQUEST, format!("say what to do: {ACTIONS}")),
     };
-    control(&shared, Control::Drone { drone: name.to_string(), action }).await
+    resolved(&shared, shared.kinds.drone(name, action)).await
 }
 
 // The state's `paused` follows the trace's `operator` events (`state.rs`), which the

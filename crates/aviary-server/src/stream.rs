@@ -12,8 +12,8 @@ use std::collections::{BTreeMap, VecDeque};
 use std::sync::Arc;
 use std::time::Duration;
 
+use aviary_api::operator::StreamNote;
 use axum::extract::ws::{Message, WebSocket};
-use serde_json::json;
 use tokio::sync::broadcast::error::RecvError;
 use tokio::sync::{broadcast, Notify};
 
@@ -31,7 +31,7 @@ pub(crate) type Past = Option<(Vec<Arc<Line>>, u64)>;
 async fn history(socket: &mut WebSocket, past: Past) -> bool {
     let Some((lines, dropped)) = past else { return true };
     if dropped > 0 {
-        let note = json!({ "history_dropped": dropped }).to_string();
+        let note = note_line(StreamNote::HistoryDropped(dropped));
         if socket.send(Message::Text(note.into())).await.is_err() {
             return false;
         }
@@ -67,7 +67,7 @@ pub(crate) async fn each(
                 }
             }
             Err(RecvError::Lagged(missed)) => {
-                let note = json!({ "lagged": missed }).to_string();
+                let note = note_line(StreamNote::Lagged(missed));
                 if socket.send(Message::Text(note.into())).await.is_err() {
                     break;
                 }
@@ -165,7 +165,7 @@ pub(crate) async fn batched(
                 first = false;
                 text.push_str(s);
             };
-            let note = json!({ "dropped": batch.dropped }).to_string();
+            let note = note_line(StreamNote::Dropped(batch.dropped));
             if batch.dropped > 0 {
                 push(&note);
             }
@@ -183,4 +183,9 @@ pub(crate) async fn batched(
     }
     reader.abort();
     let _ = socket.send(Message::Close(None)).await;
+}
+
+/// A note as the stream sends it: `{"lagged": 12}`.
+fn note_line(note: StreamNote) -> String {
+    serde_json::to_string(&note).unwrap_or_default()
 }

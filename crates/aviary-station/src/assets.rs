@@ -3,6 +3,8 @@
 //! `web/`; third-party code in `web/vendor/`, pinned from the npm registry with its
 //! licence (`crates/aviary-station/web/vendor/README.md`).
 
+use std::sync::LazyLock;
+
 /// One file of the page.
 pub struct Asset {
     /// Its path under `web/`, as the page asks for it under `/assets/`.
@@ -47,9 +49,37 @@ pub const ASSETS: &[Asset] = &[
     asset!("vendor/leaflet-1.9.4/images/marker-shadow.png", "image/png"),
 ];
 
+/// The files the station writes from the language's own data when it starts, so that the
+/// page keeps no copy of it: `js/builtins.js`, the built-in exceptions that are drone
+/// faults ([`aviary_api::BuiltinException::is_drone_fault`]).
+static GENERATED: LazyLock<[Asset; 1]> = LazyLock::new(|| {
+    [Asset {
+        path: "js/builtins.js",
+        bytes: BUILTINS_JS.as_bytes(),
+        mime: "text/javascript; charset=utf-8",
+    }]
+});
+
+static BUILTINS_JS: LazyLock<String> = LazyLock::new(builtins_js);
+
+fn builtins_js() -> String {
+    let faults: Vec<&str> = aviary_api::BuiltinException::ALL
+        .into_iter()
+        .filter(|e| e.is_drone_fault())
+        .map(|e| e.name())
+        .collect();
+    let faults = serde_json::to_string(&faults).unwrap_or_else(|_| "[]".into());
+    format!(
+        "// Written by the station from the language's built-in exceptions \
+         (aviary_api::BuiltinException): not a file of web/.\n\
+         /** The exceptions that are faults of a drone: an alarm even when handled. */\n\
+         export const DRONE_FAULTS = new Set({faults});\n"
+    )
+}
+
 /// The asset at `path` (under `/assets/`), if the page has one.
 pub fn find(path: &str) -> Option<&'static Asset> {
-    ASSETS.iter().find(|a| a.path == path)
+    ASSETS.iter().chain(GENERATED.iter()).find(|a| a.path == path)
 }
 
 #[cfg(test)]
@@ -61,8 +91,14 @@ mod tests {
     const PNG: &str = "image/png";
 
     #[test]
+    fn the_drone_faults_are_the_languages() {
+        let js = std::str::from_utf8(find("js/builtins.js").unwrap().bytes).unwrap();
+        assert!(js.contains(r#"export const DRONE_FAULTS = new Set(["BatteryCritical","ConnectionLost","DroneLost","MotorFailure","PositionLost","GeofenceViolation"]);"#), "{js}");
+    }
+
+    #[test]
     fn every_asset_has_the_type_of_its_extension() {
-        for a in ASSETS {
+        for a in ASSETS.iter().chain(GENERATED.iter()) {
             let want = match a.path.rsplit('.').next() {
                 Some("js") => JS,
                 Some("css") => CSS,

@@ -182,7 +182,12 @@ impl<'m> Tree<'m, '_> {
             Node::Leash(l) => TreeNode::Leash(Leash::Activity {
                 capability: self.capability(l.capability),
                 tag: tag(l.tag),
-                action: &l.action_name,
+                action: self
+                    .m
+                    .capabilities
+                    .get(l.capability)
+                    .and_then(|c| c.action_name(l.action))
+                    .unwrap_or_default(),
                 line: self.line(&l.origin),
             }),
             Node::StopBlock { block, origin } => {

@@ -4,7 +4,7 @@
 
 use aviary_check::Checked;
 use aviary_diagnostics::SourceMap;
-use aviary_engine::{Control, Controller, Outcome, Record, RunOptions};
+use aviary_engine::{Control, Controller, Directory, DroneAction, Outcome, Record, RunOptions};
 use aviary_sim::{SimBackend, SimOptions};
 use serde_json::Value;
 
@@ -122,15 +122,75 @@ pub enum Path {
     GeneralOnly,
 }
 
+/// A control as an operator asks it: by the names a person uses, resolved against the
+/// compiled mission as the operator API resolves them ([`Directory`]), or one the engine
+/// takes as it is.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Ask {
+    Leash {
+        capability: String,
+        tag: String,
+        action: String,
+        args: Vec<(String, aviary_api::Value)>,
+    },
+    Signal {
+        name: String,
+        args: Vec<aviary_api::Value>,
+    },
+    Drone {
+        drone: String,
+        action: DroneAction,
+    },
+    Control(Control),
+}
+
+impl Ask {
+    /// A leash without arguments: `Ask::leash("FlyTo", "F1", "PAUSE")`.
+    pub fn leash(capability: &str, tag: &str, action: &str) -> Ask {
+        Ask::Leash {
+            capability: capability.into(),
+            tag: tag.into(),
+            action: action.into(),
+            args: Vec::new(),
+        }
+    }
+
+    pub fn drone(drone: &str, action: DroneAction) -> Ask {
+        Ask::Drone { drone: drone.into(), action }
+    }
+
+    /// The control, or why the operator API refuses it before the engine hears it.
+    pub fn resolve(self, directory: &Directory) -> Result<Control, String> {
+        match self {
+            Ask::Leash { capability, tag, action, args } => {
+                directory.leash(&capability, &tag, &action, args)
+            }
+            Ask::Signal { name, args } => {
+                let signal = directory.operator_signal(&name)?;
+                Ok(Control::Signal { signal, args })
+            }
+            Ask::Drone { drone, action } => directory.drone(&drone, action),
+            Ask::Control(control) => Ok(control),
+        }
+    }
+}
+
+impl From<Control> for Ask {
+    fn from(control: Control) -> Ask {
+        Ask::Control(control)
+    }
+}
+
 /// Runs a compiled mission, sending each control at its mission time; the run and the
-/// engine's answers to the controls.
+/// answers to the controls (a refusal by name is the directory's, as the operator API's).
 pub fn run_compiled(
     mission: &aviary_ir::Mission,
     world: &aviary_world::World,
     options: &RunOptions,
-    controls: Vec<(f64, Control)>,
+    controls: Vec<(f64, Ask)>,
     path: Path,
 ) -> (Run, Vec<Result<(), String>>) {
+    let directory = Directory::of(mission);
     paused_runtime().block_on(async {
         let sim = SimBackend::start(world, SimOptions::default());
         let (controller, rx) = Controller::new();
@@ -141,9 +201,12 @@ pub fn run_compiled(
         let operator = async {
             let start = tokio::time::Instant::now();
             let mut answers = Vec::new();
-            for (at, control) in controls {
+            for (at, ask) in controls {
                 tokio::time::sleep_until(start + std::time::Duration::from_secs_f64(at)).await;
-                answers.push(controller.ask(control).await);
+                answers.push(match ask.resolve(&directory) {
+                    Ok(control) => controller.ask(control).await,
+                    Err(why) => Err(why),
+                });
             }
             answers
         };

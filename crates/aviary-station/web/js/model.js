@@ -1,6 +1,9 @@
 // What the page knows of the mission, folded from trace events: the same events a
 // trace file holds, so a live run and a replay build the same state.
 
+// Written by the station from the language's own list (not a file of web/).
+import { DRONE_FAULTS } from "./builtins.js";
+
 export function newModel() {
   return {
     t: 0,
@@ -152,7 +155,7 @@ export function observe(model, e) {
       }
       const what = `${e.name}${e.actor ? " on " + e.actor : ""}`;
       if (!e.handled) alarm(model, e, "unhandled", e.actor, `unhandled exception ${what}`);
-      else if (["ConnectionLost", "BatteryCritical", "MotorFailure", "PositionLost", "DroneLost", "GeofenceViolation"].includes(e.name))
+      else if (DRONE_FAULTS.has(e.name))
         alarm(model, e, e.name, e.actor, `${what}: ${(e.args || []).join(" ")}`);
       // The simulator's separation layer: "scout waited 30 s for carrier to make room".
       else if (e.name === "Timeout" && /make room|separation/i.test((e.args || []).join(" ")))

@@ -42,18 +42,13 @@ impl Env<'_> {
                 d.and_then(|d| self.mission.attribute(*i, d)).unwrap_or(Value::Bool(false))
             }
             Expr::Point(parts) => {
-                let n: Vec<f64> = parts.iter().map(|p| number(&self.eval(p))).collect();
-                Value::Position(Point {
-                    x: n[0],
-                    y: n.get(1).copied().unwrap_or(0.0),
-                    z: n.get(2).copied(),
-                })
+                let n = parts.borrowed().map(|p| number(&self.eval(p)));
+                Value::Position(Point { x: n.x, y: n.y, z: n.z })
             }
             Expr::Geo(parts) => {
-                let n: Vec<f64> = parts.iter().map(|p| number(&self.eval(p))).collect();
+                let n = parts.borrowed().map(|p| number(&self.eval(p)));
                 let origin = self.mission.origin.unwrap_or_default();
-                let [x, y, z] =
-                    origin.place(n[0], n.get(1).copied().unwrap_or(0.0), n.get(2).copied());
+                let [x, y, z] = origin.place(n.x, n.y, n.z);
                 Value::Position(Point { x, y, z: (!z.is_nan()).then_some(z) })
             }
             Expr::Distance(a, b) => {

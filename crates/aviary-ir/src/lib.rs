@@ -492,6 +492,41 @@ impl Compare {
     }
 }
 
+/// The two or three parts of coordinates, `(x, y[, z])`, or of `GEO(lat, lon[, alt])`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Parts<T> {
+    pub x: T,
+    pub y: T,
+    pub z: Option<T>,
+}
+
+impl<T> Parts<T> {
+    /// Two or three parts, in order; `None` for another number of them (which the
+    /// checker refuses).
+    pub fn of(parts: Vec<T>) -> Option<Parts<T>> {
+        let mut parts = parts.into_iter();
+        let (x, y, z) = (parts.next()?, parts.next()?, parts.next());
+        parts.next().is_none().then_some(Parts { x, y, z })
+    }
+
+    pub fn map<U>(self, mut f: impl FnMut(T) -> U) -> Parts<U> {
+        Parts { x: f(self.x), y: f(self.y), z: self.z.map(f) }
+    }
+
+    pub fn borrowed(&self) -> Parts<&T> {
+        Parts { x: &self.x, y: &self.y, z: self.z.as_ref() }
+    }
+
+    /// Each part through `f`, or `None` when one of them gives none.
+    pub fn try_map<U>(self, mut f: impl FnMut(T) -> Option<U>) -> Option<Parts<U>> {
+        let z = match self.z {
+            Some(z) => Some(f(z)?),
+            None => None,
+        };
+        Some(Parts { x: f(self.x)?, y: f(self.y)?, z })
+    }
+}
+
 /// A value or condition, evaluated in a frame at run time.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Expr {
@@ -499,12 +534,12 @@ pub enum Expr {
     Slot(Slot),
     Actor(ActorRef),
     Telemetry(ActorRef, Field),
-    /// `attributes[index]` of the actor.
+    /// `attributes[index]` of the actor: an attribute some drone of the world has.
     Attribute(ActorRef, usize),
     /// Coordinates with a part that is not a literal: `(x, 20)`.
-    Point(Vec<Expr>),
+    Point(Box<Parts<Expr>>),
     /// `GEO(lat, lon[, alt])` with a part that is not a literal.
-    Geo(Vec<Expr>),
+    Geo(Box<Parts<Expr>>),
     Distance(Box<Expr>, Box<Expr>),
     /// `a + b`: two quantities of one kind, or a position and an offset in metres
     /// (`aviary_api::arith::add`).

@@ -13,7 +13,8 @@ use aviary_world::{AttributeValue, World};
 use aviary_ir::*;
 
 /// Compiles the checked `program` for the fleet of `world`. `None` when the program
-/// holds no MISSION (a library of capabilities has nothing to run).
+/// holds no MISSION (a library of capabilities has nothing to run), or something the
+/// checker refuses (compile only a program without errors).
 pub fn compile(program: &Program, world: &World) -> Option<Mission> {
     let api = Descriptor::standard();
     let mission = program.mission()?;
@@ -80,7 +81,7 @@ pub fn compile(program: &Program, world: &World) -> Option<Mission> {
             .unwrap_or_default(),
     };
     compute_claims(&mut out.capabilities);
-    Some(out)
+    (!c.unresolved).then_some(out)
 }
 
 /// Names (signals, exceptions, tags) to indices, in order of first use. Looked up by
@@ -121,6 +122,8 @@ struct Compiler<'a> {
     scopes: Vec<Vec<(String, Slot, bool)>>,
     frame_size: usize,
     file: FileId,
+    /// Something the checker refuses was met: no mission comes out.
+    unresolved: bool,
 }
 
 impl<'a> Compiler<'a> {
@@ -156,6 +159,7 @@ impl<'a> Compiler<'a> {
             scopes: Vec::new(),
             frame_size: 0,
             file: FileId::default(),
+            unresolved: false,
         }
     }
 
@@ -611,26 +615,21 @@ impl<'a> Compiler<'a> {
             K::String(s) => Expr::Const(Value::Text(s.clone())),
             K::Bool(b) => Expr::Const(Value::Bool(*b)),
             K::Coordinates(parts) => {
-                let parts: Vec<Expr> = parts.iter().map(|p| self.expr(p)).collect();
-                match literal_numbers(&parts) {
-                    Some(n) => Expr::Const(Value::Position(Point {
-                        x: n[0],
-                        y: n.get(1).copied().unwrap_or(0.0),
-                        z: n.get(2).copied(),
-                    })),
-                    None => Expr::Point(parts),
+                let Some(parts) = self.parts(parts) else { return self.unresolved() };
+                match parts.borrowed().try_map(literal_number) {
+                    Some(n) => Expr::Const(Value::Position(Point { x: n.x, y: n.y, z: n.z })),
+                    None => Expr::Point(Box::new(parts)),
                 }
             }
             K::Geo(parts) => {
-                let parts: Vec<Expr> = parts.iter().map(|p| self.expr(p)).collect();
-                match (literal_numbers(&parts), self.world.site.origin.as_ref()) {
+                let Some(parts) = self.parts(parts) else { return self.unresolved() };
+                match (parts.borrowed().try_map(literal_number), self.world.site.origin.as_ref()) {
                     (Some(n), Some(o)) => {
                         let o = aviary_api::geo::Origin { lat: o.lat, lon: o.lon, alt: o.alt };
-                        let [x, y, z] =
-                            o.place(n[0], n.get(1).copied().unwrap_or(0.0), n.get(2).copied());
+                        let [x, y, z] = o.place(n.x, n.y, n.z);
                         Expr::Const(Value::Position(Point { x, y, z: (!z.is_nan()).then_some(z) }))
                     }
-                    _ => Expr::Geo(parts),
+                    _ => Expr::Geo(Box::new(parts)),
                 }
             }
             K::Name(id) => self.name(&id.name),
@@ -638,14 +637,10 @@ impl<'a> Compiler<'a> {
                 let actor = self.actor(&a.name);
                 match telemetry_field(&field.name) {
                     Some(f) => Expr::Telemetry(actor, f),
-                    None => {
-                        let index = self
-                            .attribute_names
-                            .iter()
-                            .position(|n| n == &field.name)
-                            .unwrap_or(usize::MAX);
-                        Expr::Attribute(actor, index)
-                    }
+                    None => match self.attribute_names.iter().position(|n| n == &field.name) {
+                        Some(index) => Expr::Attribute(actor, index),
+                        None => self.unresolved(),
+                    },
                 }
             }
             K::Distance(a, b) => Expr::Distance(Box::new(self.expr(a)), Box::new(self.expr(b))),
@@ -704,9 +699,21 @@ impl<'a> Compiler<'a> {
                     ast::BinaryOp::Ge => Expr::Compare(l, Compare::Ge, r),
                 }
             }
-            // A checked program has none; a constant keeps the engine total.
-            K::Error => Expr::Const(Value::Bool(false)),
+            K::Error => self.unresolved(),
         }
+    }
+
+    /// The parts of coordinates or of a `GEO`, lowered: two or three of them.
+    fn parts(&mut self, parts: &[ast::Expr]) -> Option<Parts<Expr>> {
+        Parts::of(parts.iter().map(|p| self.expr(p)).collect())
+    }
+
+    /// What the checker refuses (an unknown attribute, a malformed point, a parse error):
+    /// the program does not compile ([`compile`] gives no mission), so this stand-in
+    /// never runs.
+    fn unresolved(&mut self) -> Expr {
+        self.unresolved = true;
+        Expr::Const(Value::Bool(false))
     }
 
     fn name(&self, name: &str) -> Expr {
@@ -752,31 +759,29 @@ fn empty_block(path: &str) -> Block {
     }
 }
 
-fn literal_numbers(parts: &[Expr]) -> Option<Vec<f64>> {
-    parts
-        .iter()
-        .map(|p| match p {
-            Expr::Const(Value::Number(n)) => Some(*n),
-            Expr::Const(_)
-            | Expr::Slot(_)
-            | Expr::Actor(_)
-            | Expr::Telemetry(..)
-            | Expr::Attribute(..)
-            | Expr::Point(_)
-            | Expr::Geo(_)
-            | Expr::Distance(..)
-            | Expr::Add(..)
-            | Expr::Sub(..)
-            | Expr::Offset(..)
-            | Expr::Midpoint(..)
-            | Expr::Elapsed
-            | Expr::Received(_)
-            | Expr::Not(_)
-            | Expr::And(..)
-            | Expr::Or(..)
-            | Expr::Compare(..) => None,
-        })
-        .collect()
+/// A literal number's value; `None` for any other expression.
+fn literal_number(e: &Expr) -> Option<f64> {
+    match e {
+        Expr::Const(Value::Number(n)) => Some(*n),
+        Expr::Const(_)
+        | Expr::Slot(_)
+        | Expr::Actor(_)
+        | Expr::Telemetry(..)
+        | Expr::Attribute(..)
+        | Expr::Point(_)
+        | Expr::Geo(_)
+        | Expr::Distance(..)
+        | Expr::Add(..)
+        | Expr::Sub(..)
+        | Expr::Offset(..)
+        | Expr::Midpoint(..)
+        | Expr::Elapsed
+        | Expr::Received(_)
+        | Expr::Not(_)
+        | Expr::And(..)
+        | Expr::Or(..)
+        | Expr::Compare(..) => None,
+    }
 }
 
 fn telemetry_field(name: &str) -> Option<Field> {

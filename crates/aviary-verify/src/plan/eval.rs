@@ -44,15 +44,13 @@ impl Scope<'_> {
             Expr::Telemetry(a, field) => self.telemetry(self.actor(a)?, *field)?,
             Expr::Attribute(a, i) => self.mission.attribute(*i, self.actor(a)?)?,
             Expr::Point(parts) => {
-                let n: Vec<f64> =
-                    parts.iter().map(|p| number(&self.eval(p)?)).collect::<Option<_>>()?;
-                Value::Position(Point { x: *n.first()?, y: *n.get(1)?, z: n.get(2).copied() })
+                let n = parts.borrowed().try_map(|p| number(&self.eval(p)?))?;
+                Value::Position(Point { x: n.x, y: n.y, z: n.z })
             }
             Expr::Geo(parts) => {
-                let n: Vec<f64> =
-                    parts.iter().map(|p| number(&self.eval(p)?)).collect::<Option<_>>()?;
-                let p = self.mission.origin?.place(*n.first()?, *n.get(1)?, n.get(2).copied());
-                Value::Position(Point { x: p[0], y: p[1], z: n.get(2).map(|_| p[2]) })
+                let n = parts.borrowed().try_map(|p| number(&self.eval(p)?))?;
+                let p = self.mission.origin?.place(n.x, n.y, n.z);
+                Value::Position(Point { x: p[0], y: p[1], z: n.z.map(|_| p[2]) })
             }
             Expr::Distance(a, b) => {
                 let (p, q) = (self.position(a)?, self.position(b)?);

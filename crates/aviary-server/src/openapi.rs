@@ -4,6 +4,7 @@
 //! Schema 2020-12, the dialect of OpenAPI 3.1.
 
 use aviary_api::operator::{Accepted, ApiError, OperatorState};
+use aviary_syntax::ast::Unit;
 use schemars::generate::SchemaSettings;
 use serde_json::{json, Map, Value};
 
@@ -49,6 +50,8 @@ pub fn openapi_yaml() -> String {
 /// The schemas of what the operator sends: written here, for the server reads them
 /// field by field (`args.rs`).
 fn hand_written_schemas() -> Map<String, Value> {
+    // The units as the language writes them, which `args.rs` reads (`Unit::parse`).
+    let units: Vec<&str> = Unit::ALL.iter().map(|u| u.as_str()).collect();
     let value = json!({
         "description": "An argument or a signal value, checked against the kind the mission gives it (docs/OPERATOR_API.md#values). Numbers are finite, at most 1e9 in SI units; a length, duration or speed is not negative.",
         "oneOf": [
@@ -60,7 +63,7 @@ fn hand_written_schemas() -> Map<String, Value> {
                 "additionalProperties": false,
                 "properties": {
                     "number": { "type": "number" },
-                    "unit": { "type": "string", "enum": ["m", "km", "s", "min", "h", "m/s", "km/h", "deg", "%"] }
+                    "unit": { "type": "string", "enum": units }
                 }
             },
             { "type": "string", "description": "a symbol or text" },

@@ -87,24 +87,14 @@ pub fn mission(key: &str, docs: &Docs, config: &Config) -> Analysis {
     let overlay = Overlay { open: docs, roots, disk: &*disk };
     let mut sources = SourceMap::new();
     let world_in = world.as_ref().map(|(n, b)| (n.as_str(), b.as_slice()));
-    let checked =
+    let mut checked =
         aviary_check::check_sources(&mut sources, (key, text.as_bytes()), world_in, &overlay);
     let world_file = world.is_some().then_some(FileId(0));
     let root = FileId(u32::from(world.is_some()));
-    let mut diagnostics = checked.diagnostics;
+    // As `aviary check` and the station say it, the tree kept for hover and completion.
+    let diagnostics = aviary_verify::verdict_keeping_tree(&mut checked).diagnostics;
     let program = checked.program;
     let world = checked.world;
-    let mut preflight = false;
-    if !diagnostics.iter().any(Diagnostic::is_error) {
-        if let (Some(p), Some(w)) = (&program, &world) {
-            if let Some(compiled) = aviary_lower::compile(p, w) {
-                diagnostics.extend(aviary_verify::verify(&compiled, w).diagnostics);
-                preflight = true;
-            }
-        }
-    }
-    // As `aviary check` and the station: one function applies the ALLOW lines.
-    aviary_check::acknowledge(&checked.allows, &mut diagnostics, preflight);
     let occurrences = match &program {
         Some(p) => {
             let files: Vec<_> = p.files.iter().map(|(f, t)| (*f, t)).collect();

@@ -59,14 +59,30 @@ fn large(mission: &Mission) -> bool {
 /// memory, whose fresh pages are much of the time `aviary check` takes; the analyses
 /// reuse what it frees (docs/BENCHMARKS.md, "Pre-flight analyses at scale").
 pub fn preflight(checked: &mut Checked) -> Option<(Mission, Verification)> {
+    analyse(checked, Tree::Drop)
+}
+
+/// What happens to the checked tree while the mission is compiled and verified.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Tree {
+    /// Dropped once compiled, for the memory (see [`preflight`]).
+    Drop,
+    /// Kept, for a caller that goes on reading it (an editor).
+    Keep,
+}
+
+fn analyse(checked: &mut Checked, tree: Tree) -> Option<(Mission, Verification)> {
     if checked.has_errors() {
         return None;
     }
     let world = checked.world.as_ref()?;
-    let program = checked.program.take()?;
-    let mission = aviary_lower::compile(&program, world);
-    drop(program);
-    let mission = mission?;
+    let mission = match tree {
+        Tree::Keep => aviary_lower::compile(checked.program.as_ref()?, world),
+        Tree::Drop => {
+            let program = checked.program.take()?;
+            aviary_lower::compile(&program, world)
+        }
+    }?;
     let verification = verify(&mission, world);
     Some((mission, verification))
 }
@@ -92,7 +108,17 @@ impl Verdict {
 /// diagnostic. The world in `checked` is the one planned with: a caller that knows
 /// better figures (a MAVLink vehicle's own) puts them there first.
 pub fn verdict(checked: &mut Checked) -> Verdict {
-    let verified = preflight(checked);
+    conclude(checked, Tree::Drop)
+}
+
+/// As [`verdict`], for a caller that goes on reading the checked tree (the language
+/// server: hover, completion): `checked.program` is kept; its diagnostics are taken.
+pub fn verdict_keeping_tree(checked: &mut Checked) -> Verdict {
+    conclude(checked, Tree::Keep)
+}
+
+fn conclude(checked: &mut Checked, tree: Tree) -> Verdict {
+    let verified = analyse(checked, tree);
     let mut diagnostics = std::mem::take(&mut checked.diagnostics);
     let preflight_ran = verified.is_some();
     let flight = verified.map(|(mission, v)| {

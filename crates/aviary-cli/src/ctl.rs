@@ -2,9 +2,10 @@
 //! starts (docs/OPERATOR_API.md).
 
 use aviary_api::operator::OperatorState;
+use aviary_server::requests::{Argument, DroneRequest, DroneVerb, LeashRequest, SignalRequest};
 use aviary_syntax::ast::{Expr, ExprKind};
 use clap::{Subcommand, ValueEnum};
-use serde_json::{json, Value};
+use serde_json::Value;
 
 #[derive(Subcommand)]
 pub enum CtlCommand {
@@ -49,12 +50,12 @@ pub enum DroneCtl {
 
 impl DroneCtl {
     /// As the operator API takes it.
-    fn as_str(self) -> &'static str {
+    fn verb(self) -> DroneVerb {
         match self {
-            DroneCtl::Hold => "hold",
-            DroneCtl::Resume => "resume",
-            DroneCtl::Home => "home",
-            DroneCtl::Land => "land",
+            DroneCtl::Hold => DroneVerb::Hold,
+            DroneCtl::Resume => DroneVerb::Resume,
+            DroneCtl::Home => DroneVerb::Home,
+            DroneCtl::Land => DroneVerb::Land,
         }
     }
 }
@@ -80,7 +81,7 @@ pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
         }
         CtlCommand::Events => return events(base, token),
         CtlCommand::Leash { activity, action, args } => {
-            let mut named = serde_json::Map::new();
+            let mut named = std::collections::BTreeMap::new();
             for a in &args {
                 let Some((k, v)) = a.split_once('=') else {
                     eprintln!("aviary: `{a}` is not `name=value`");
@@ -91,12 +92,15 @@ pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
                     Err(why) => return refuse_value(v, &why),
                 };
             }
-            post(
-                base,
-                "leash",
-                token,
-                json!({ "activity": activity, "action": action, "args": named }),
-            )
+            let args = (!named.is_empty()).then_some(named);
+            let request = LeashRequest {
+                activity: Some(activity),
+                capability: None,
+                tag: None,
+                action,
+                args,
+            };
+            post(base, "leash", token, &request)
         }
         CtlCommand::Signal { name, values } => {
             let mut args = Vec::new();
@@ -106,14 +110,14 @@ pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
                     Err(why) => return refuse_value(v, &why),
                 }
             }
-            post(base, "signal", token, json!({ "name": name, "args": args }))
+            post(base, "signal", token, &SignalRequest { name, args: Some(args) })
         }
         CtlCommand::Drone { name, action } => {
-            post(base, "drone", token, json!({ "drone": name, "action": action.as_str() }))
+            post(base, "drone", token, &DroneRequest { drone: name, action: action.verb() })
         }
-        CtlCommand::Pause => post(base, "pause", token, json!({})),
-        CtlCommand::Resume => post(base, "resume", token, json!({})),
-        CtlCommand::Abort => post(base, "abort", token, json!({})),
+        CtlCommand::Pause => post(base, "pause", token, &NoBody {}),
+        CtlCommand::Resume => post(base, "resume", token, &NoBody {}),
+        CtlCommand::Abort => post(base, "abort", token, &NoBody {}),
     };
     match result {
         Ok((200, body)) => {
@@ -152,13 +156,23 @@ fn get(url: &str, token: Option<&str>) -> Result<(u16, String), String> {
     Ok((status, body))
 }
 
-fn post(base: &str, call: &str, token: Option<&str>, body: Value) -> Result<(u16, String), String> {
+/// The body of a control call that takes none: `{}`.
+#[derive(serde::Serialize)]
+struct NoBody {}
+
+fn post(
+    base: &str,
+    call: &str,
+    token: Option<&str>,
+    body: &impl serde::Serialize,
+) -> Result<(u16, String), String> {
+    let body = serde_json::to_string(body).map_err(|e| e.to_string())?;
     let mut request =
         agent().post(format!("{base}/api/{call}")).header("Content-Type", "application/json");
     if let Some(token) = token {
         request = request.header("Authorization", format!("Bearer {token}"));
     }
-    let mut response = request.send(body.to_string()).map_err(|e| e.to_string())?;
+    let mut response = request.send(body).map_err(|e| e.to_string())?;
     let status = response.status().as_u16();
     let text = response.body_mut().read_to_string().map_err(|e| e.to_string())?;
     Ok((status, text))
@@ -218,22 +232,19 @@ fn refuse_value(text: &str, why: &str) -> u8 {
 /// API takes it: a number keeps its unit (`{"number": 10, "unit": "s"}`), so that the
 /// server can refuse `10s` where a length is expected; a position is `[x, y(, z)]` in
 /// metres, or `{"lat", "lon"(, "alt")}` for `GEO(...)`; a name or a string is a string.
-fn value(text: &str) -> Result<Value, String> {
+fn value(text: &str) -> Result<Argument, String> {
     let expr = aviary_syntax::parse_value(text)
         .map_err(|d| d.first().map(|d| d.message.clone()).unwrap_or_default())?;
-    to_json(&expr)
+    argument(&expr)
 }
 
-fn to_json(expr: &Expr) -> Result<Value, String> {
+fn argument(expr: &Expr) -> Result<Argument, String> {
     match &expr.kind {
-        ExprKind::Number { value, unit: Some(unit), .. } => {
-            Ok(json!({ "number": value, "unit": unit.as_str() }))
-        }
-        ExprKind::Number { value, unit: None, .. } => Ok(json!({ "number": value })),
-        ExprKind::String(s) => Ok(json!(s)),
-        ExprKind::Name(id) => Ok(json!(id.name)),
-        ExprKind::Bool(b) => Ok(json!(b)),
-        ExprKind::Paren(inner) => to_json(inner),
+        ExprKind::Number { value, unit, .. } => Ok(Argument::number(*value, *unit)),
+        ExprKind::String(s) => Ok(Argument::word(s)),
+        ExprKind::Name(id) => Ok(Argument::word(&id.name)),
+        ExprKind::Bool(b) => Ok(Argument::truth(*b)),
+        ExprKind::Paren(inner) => argument(inner),
         ExprKind::Coordinates(parts) => {
             let mut metres = Vec::new();
             for p in parts {
@@ -251,7 +262,7 @@ fn to_json(expr: &Expr) -> Result<Value, String> {
                     _ => return Err("a coordinate is a number of metres".into()),
                 }
             }
-            Ok(json!(metres))
+            Ok(Argument::metres(&metres))
         }
         // GEO(lat, lon[, alt]): the server places it about the world's origin.
         ExprKind::Geo(parts) => {
@@ -268,8 +279,8 @@ fn to_json(expr: &Expr) -> Result<Value, String> {
                 }
             }
             match n[..] {
-                [lat, lon] => Ok(json!({ "lat": lat, "lon": lon })),
-                [lat, lon, alt] => Ok(json!({ "lat": lat, "lon": lon, "alt": alt })),
+                [lat, lon] => Ok(Argument::geo(lat, lon, None)),
+                [lat, lon, alt] => Ok(Argument::geo(lat, lon, Some(alt))),
                 _ => Err("GEO takes a latitude and a longitude, and an altitude if the height matters: GEO(47.45, 13.1)".into()),
             }
         }

@@ -20,6 +20,7 @@ mod bounds;
 mod guard;
 mod openapi;
 mod reply;
+pub mod requests;
 mod routes;
 mod state;
 mod stream;

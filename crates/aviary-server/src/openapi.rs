@@ -4,7 +4,9 @@
 //! Schema 2020-12, the dialect of OpenAPI 3.1.
 
 use aviary_api::operator::{Accepted, ApiError, OperatorState};
-use aviary_syntax::ast::Unit;
+use schemars::Schema;
+
+use crate::requests::{DroneRequest, LeashRequest, SignalRequest};
 use schemars::generate::SchemaSettings;
 use serde_json::{json, Map, Value};
 
@@ -13,13 +15,16 @@ pub fn openapi() -> Value {
     let mut generator = SchemaSettings::draft2020_12()
         .with(|s| s.definitions_path = "/components/schemas".into())
         .into_generator();
-    let state = generator.subschema_for::<OperatorState>();
+    let schema = |s: Schema| serde_json::to_value(s).unwrap_or(Value::Null);
+    let state = schema(generator.subschema_for::<OperatorState>());
+    let bodies = Bodies {
+        leash: schema(generator.subschema_for::<LeashRequest>()),
+        signal: schema(generator.subschema_for::<SignalRequest>()),
+        drone: schema(generator.subschema_for::<DroneRequest>()),
+    };
     generator.subschema_for::<Accepted>();
     generator.subschema_for::<ApiError>();
-    let mut schemas: Map<String, Value> = hand_written_schemas();
-    for (name, schema) in generator.take_definitions(true) {
-        schemas.insert(name, schema);
-    }
+    let schemas: Map<String, Value> = generator.take_definitions(true).into_iter().collect();
     json!({
         "openapi": "3.1.0",
         "info": {
@@ -38,7 +43,7 @@ pub fn openapi() -> Value {
             "schemas": schemas,
             "responses": responses(),
         },
-        "paths": paths(serde_json::to_value(state).unwrap_or(Value::Null)),
+        "paths": paths(state, bodies),
     })
 }
 
@@ -47,44 +52,11 @@ pub fn openapi_yaml() -> String {
     serde_norway::to_string(&openapi()).unwrap_or_default()
 }
 
-/// The schemas of what the operator sends: written here, for the server reads them
-/// field by field (`args.rs`).
-fn hand_written_schemas() -> Map<String, Value> {
-    // The units as the language writes them, which `args.rs` reads (`Unit::parse`).
-    let units: Vec<&str> = Unit::ALL.iter().map(|u| u.as_str()).collect();
-    let value = json!({
-        "description": "An argument or a signal value, checked against the kind the mission gives it (docs/OPERATOR_API.md#values). Numbers are finite, at most 1e9 in SI units; a length, duration or speed is not negative.",
-        "oneOf": [
-            { "type": "number", "description": "a number in SI units (m, s, m/s, deg; a ratio as a fraction)" },
-            {
-                "type": "object",
-                "description": "a number as the language writes it; without unit, a plain number",
-                "required": ["number"],
-                "additionalProperties": false,
-                "properties": {
-                    "number": { "type": "number" },
-                    "unit": { "type": "string", "enum": units }
-                }
-            },
-            { "type": "string", "description": "a symbol or text" },
-            { "type": "boolean" },
-            { "type": "array", "items": { "type": "number" }, "minItems": 2, "maxItems": 3, "description": "a position [x, y] or [x, y, z], metres" },
-            {
-                "type": "object",
-                "description": "a position on Earth, GEO(lat, lon[, alt]): degrees, and metres above sea level; placed about the world's origin",
-                "required": ["lat", "lon"],
-                "additionalProperties": false,
-                "properties": {
-                    "lat": { "type": "number", "minimum": -90, "maximum": 90 },
-                    "lon": { "type": "number", "minimum": -180, "maximum": 180 },
-                    "alt": { "type": "number" }
-                }
-            }
-        ]
-    });
-    let mut schemas = Map::new();
-    schemas.insert("Argument".into(), value);
-    schemas
+/// The schemas of the control calls' bodies, from their types (`requests.rs`).
+struct Bodies {
+    leash: Value,
+    signal: Value,
+    drone: Value,
 }
 
 fn error_response(description: &str) -> Value {
@@ -141,8 +113,7 @@ fn body(schema: Value) -> Value {
 }
 
 /// Every route `routes.rs` serves, by path and method.
-fn paths(state: Value) -> Value {
-    let argument = json!({ "$ref": "#/components/schemas/Argument" });
+fn paths(state: Value, bodies: Bodies) -> Value {
     json!({
         "/api/state": {
             "get": {
@@ -192,17 +163,7 @@ fn paths(state: Value) -> Value {
             "post": {
                 "summary": "A leash on every running activity with a tag",
                 "security": [{ "token": [] }],
-                "requestBody": body(json!({
-                    "type": "object",
-                    "required": ["action"],
-                    "properties": {
-                        "activity": { "type": "string", "examples": ["FlyCircle-C1"] },
-                        "capability": { "type": "string" },
-                        "tag": { "type": "string" },
-                        "action": { "type": "string", "examples": ["PAUSE", "RESUME", "ABORT", "Widen"] },
-                        "args": { "type": "object", "additionalProperties": argument }
-                    }
-                })),
+                "requestBody": body(bodies.leash),
                 "responses": control_with_body(),
             }
         },
@@ -211,14 +172,7 @@ fn paths(state: Value) -> Value {
                 "summary": "Raise a signal the mission declares for the operator",
                 "description": "Only a signal the mission declares with `OPERATOR SIGNAL` (the state's `operator_signals`); any other is refused (409) with the signals the mission declares and, on a near miss, the one meant.",
                 "security": [{ "token": [] }],
-                "requestBody": body(json!({
-                    "type": "object",
-                    "required": ["name"],
-                    "properties": {
-                        "name": { "type": "string" },
-                        "args": { "type": "array", "items": argument }
-                    }
-                })),
+                "requestBody": body(bodies.signal),
                 "responses": control_with_body(),
             }
         },
@@ -227,14 +181,7 @@ fn paths(state: Value) -> Value {
                 "summary": "Steer one drone",
                 "description": "`hold` pauses every activity the drone takes part in (an activity of several drones whole) and those that start while it is held; `resume` undoes it (a pause of the whole mission holds on its own). `home` and `land` abort them and take the drone out of the mission, flying it home or landing it where it is; the rest of the fleet carries on. Refused (409, with the reason) for a drone the fleet does not have, a hold of a held drone, a resume of one not held, a drone already taken out (but a drone on its way home can be landed), or a mission that is ending. See docs/OPERATOR_API.md#steering-one-drone.",
                 "security": [{ "token": [] }],
-                "requestBody": body(json!({
-                    "type": "object",
-                    "required": ["drone", "action"],
-                    "properties": {
-                        "drone": { "type": "string", "examples": ["scout1"] },
-                        "action": { "type": "string", "enum": ["hold", "resume", "home", "return_home", "land"] }
-                    }
-                })),
+                "requestBody": body(bodies.drone),
                 "responses": control_with_body(),
             }
         },
@@ -331,6 +278,54 @@ mod tests {
         let mut wrong = value.clone();
         wrong["status"] = json!("maybe");
         assert!(!v.is_valid(&wrong));
+    }
+
+    /// What `aviary ctl` sends fits the documented request bodies, and the schema refuses
+    /// a body without what it needs.
+    #[test]
+    fn the_typed_requests_fit_their_schemas() {
+        use crate::requests::{Argument, DroneRequest, DroneVerb, LeashRequest, SignalRequest};
+        use aviary_syntax::ast::Unit;
+        let document = openapi();
+        let validator = |path: &str| {
+            let schema = json!({
+                "$schema": "https://json-schema.org/draft/2020-12/schema",
+                "$ref": document["paths"][path]["post"]["requestBody"]["content"]["application/json"]["schema"]["$ref"],
+                "components": document["components"],
+            });
+            jsonschema::validator_for(&schema).expect("a valid schema")
+        };
+        let args = [
+            ("radius".to_string(), Argument::number(200.0, Some(Unit::Metre))),
+            ("center".to_string(), Argument::metres(&[100.0, 50.0])),
+            ("at".to_string(), Argument::geo(47.45, 13.1, Some(520.0))),
+            ("kind".to_string(), Argument::word("Body")),
+            ("loud".to_string(), Argument::truth(true)),
+        ];
+        let leash = LeashRequest {
+            activity: Some("FlyCircle-C1".into()),
+            capability: None,
+            tag: None,
+            action: "Widen".into(),
+            args: Some(args.into_iter().collect()),
+        };
+        let signal =
+            SignalRequest { name: "Go".into(), args: Some(vec![Argument::number(3.0, None)]) };
+        let drone = DroneRequest { drone: "scout1".into(), action: DroneVerb::Home };
+        for (path, body) in [
+            ("/api/leash", serde_json::to_value(&leash)),
+            ("/api/signal", serde_json::to_value(&signal)),
+            ("/api/drone", serde_json::to_value(&drone)),
+        ] {
+            let body = body.expect("JSON");
+            let v = validator(path);
+            let errors: Vec<String> = v.iter_errors(&body).map(|e| e.to_string()).collect();
+            assert!(errors.is_empty(), "{path}: {body}: {errors:#?}");
+            assert!(!v.is_valid(&json!({})), "{path} takes {{}}");
+        }
+        let wrong_unit =
+            json!({ "action": "Widen", "args": { "radius": { "number": 2, "unit": "furlong" } } });
+        assert!(!validator("/api/leash").is_valid(&wrong_unit));
     }
 
     fn state_validator(document: &Value) -> jsonschema::Validator {

@@ -16,6 +16,7 @@ use serde_json::Value as JsonValue;
 
 use crate::args::Refusal;
 use crate::reply::{error, Object, BODY_LIMIT};
+use crate::requests::{Argument, DroneRequest, DroneVerb, LeashRequest, SignalRequest};
 use crate::{guard, reply, stream, Shared};
 use aviary_api::operator::{Accepted, KindName, OperatorState, SignalValues};
 
@@ -150,10 +151,21 @@ fn options(query: &str) -> Result<(bool, Option<std::time::Duration>), String> {
 /// `{"activity": "FlyCircle-C1", "action": "PAUSE", "args": {"radius": 40}}`, or with
 /// `capability` and `tag` apart.
 async fn leash(State(shared): State<Arc<Shared>>, Object(body): Object) -> Response {
-    let text = |key: &str| body.get(key).and_then(JsonValue::as_str);
-    let (capability, tag) = match (text("activity"), text("capability"), text("tag")) {
+    const NAME: &str = "name the activity: {\"activity\": \"FlyCircle-C1\", \"action\": \"PAUSE\"}";
+    let request: LeashRequest = match read(&body, |field, given| match (field, given) {
+        ("action", _) => {
+            Some("say what to do: \"action\": \"PAUSE\", \"RESUME\", \"ABORT\" or a section's name")
+        }
+        ("args", _) => Some("\"args\" is an object of the section's parameters: {\"radius\": 200}"),
+        ("activity" | "capability" | "tag", Some(_)) => Some(NAME),
+        _ => None,
+    }) {
+        Ok(request) => request,
+        Err(refused) => return refused,
+    };
+    let (capability, tag) = match (&request.activity, &request.capability, &request.tag) {
         (Some(activity), _, _) => match activity.split_once('-') {
-            Some((c, t)) => (c.to_string(), t.to_string()),
+            Some((c, t)) => (c, t),
             None => {
                 return error(
                     StatusCode::BAD_REQUEST,
@@ -161,78 +173,76 @@ async fn leash(State(shared): State<Arc<Shared>>, Object(body): Object) -> Respo
                 )
             }
         },
-        (None, Some(c), Some(t)) => (c.to_string(), t.to_string()),
-        _ => {
-            return error(
-                StatusCode::BAD_REQUEST,
-                "name the activity: {\"activity\": \"FlyCircle-C1\", \"action\": \"PAUSE\"}",
-            )
-        }
+        (None, Some(c), Some(t)) => (c.as_str(), t.as_str()),
+        _ => return error(StatusCode::BAD_REQUEST, NAME),
     };
-    let Some(action) = text("action") else {
-        return error(
-            StatusCode::BAD_REQUEST,
-            "say what to do: \"action\": \"PAUSE\", \"RESUME\", \"ABORT\" or a section's name",
-        );
-    };
-    let args = match body.get("args") {
-        None | Some(JsonValue::Null) => serde_json::Map::new(),
-        Some(JsonValue::Object(o)) => o.clone(),
-        Some(_) => {
-            return error(
-                StatusCode::BAD_REQUEST,
-                "\"args\" is an object of the section's parameters: {\"radius\": 200}",
-            )
-        }
-    };
-    resolved(&shared, shared.kinds.leash(&capability, &tag, action, &args)).await
+    let args: serde_json::Map<String, JsonValue> =
+        request.args.into_iter().flatten().map(|(k, Argument(v))| (k, v)).collect();
+    resolved(&shared, shared.kinds.leash(capability, tag, &request.action, &args)).await
 }
 
 /// `{"name": "Go", "args": [..]}`.
 async fn signal(State(shared): State<Arc<Shared>>, Object(body): Object) -> Response {
-    let Some(name) = body.get("name").and_then(JsonValue::as_str) else {
-        return error(StatusCode::BAD_REQUEST, "name the signal: {\"name\": \"Go\"}");
+    let request: SignalRequest = match read(&body, |field, _| match field {
+        "name" => Some("name the signal: {\"name\": \"Go\"}"),
+        "args" => Some("\"args\" is an array of the signal's values: [[100, 50]]"),
+        _ => None,
+    }) {
+        Ok(request) => request,
+        Err(refused) => return refused,
     };
-    let args = match body.get("args") {
-        None | Some(JsonValue::Null) => Vec::new(),
-        Some(JsonValue::Array(a)) => a.clone(),
-        Some(_) => {
-            return error(
-                StatusCode::BAD_REQUEST,
-                "\"args\" is an array of the signal's values: [[100, 50]]",
-            )
-        }
-    };
+    let args: Vec<JsonValue> = request.args.into_iter().flatten().map(|Argument(v)| v).collect();
     // Only a signal the mission declares with OPERATOR SIGNAL: refused as the engine
     // would refuse it (409), with what the mission declares.
-    resolved(&shared, shared.kinds.signal(name, &args)).await
+    resolved(&shared, shared.kinds.signal(&request.name, &args)).await
 }
 
 /// `{"drone": "scout1", "action": "hold"}`: `hold`, `resume`, `home` (or `return_home`,
 /// as the trace writes it) or `land`. A drone the fleet does not have is refused (409),
 /// with the name meant.
 async fn drone(State(shared): State<Arc<Shared>>, Object(body): Object) -> Response {
-    const ACTIONS: &str = "\"action\": \"hold\", \"resume\", \"home\" or \"land\"";
-    let Some(name) = body.get("drone").and_then(JsonValue::as_str) else {
-        return error(
-            StatusCode::BAD_REQUEST,
-            "name the drone: {\"drone\": \"scout1\", \"action\": \"hold\"}",
-        );
-    };
-    let action = match body.get("action").and_then(JsonValue::as_str) {
-        Some("hold") => DroneAction::Hold,
-        Some("resume") => DroneAction::Resume,
-        Some("home" | "return_home") => DroneAction::ReturnHome,
-        Some("land") => DroneAction::Land,
-        Some(other) => {
-            return error(
-                StatusCode::BAD_REQUEST,
-                format!("`{other}` is not something a drone is told: {ACTIONS}"),
-            )
+    let told = format!("say what to do: {}", DroneVerb::WORDS);
+    let request: DroneRequest = match read(&body, |field, given| match (field, given) {
+        ("drone", _) => {
+            Some("name the drone: {\"drone\": \"scout1\", \"action\": \"hold\"}".into())
         }
-        None => return error(StatusCode::BAD_REQUEST, format!("say what to do: {ACTIONS}")),
+        ("action", Some(JsonValue::String(other))) => {
+            Some(format!("`{other}` is not something a drone is told: {}", DroneVerb::WORDS))
+        }
+        ("action", _) => Some(told.clone()),
+        _ => None,
+    }) {
+        Ok(request) => request,
+        Err(refused) => return refused,
     };
-    resolved(&shared, shared.kinds.drone(name, action)).await
+    let action = match request.action {
+        DroneVerb::Hold => DroneAction::Hold,
+        DroneVerb::Resume => DroneAction::Resume,
+        DroneVerb::Home => DroneAction::ReturnHome,
+        DroneVerb::Land => DroneAction::Land,
+    };
+    resolved(&shared, shared.kinds.drone(&request.drone, action)).await
+}
+
+/// The body as a `T`; or, refused (400), why not: for the field that is missing or not
+/// of its type, in the words `why` gives for it (given what was sent), else in serde's.
+#[allow(clippy::result_large_err)] // a Response, handed back as it is
+fn read<T: serde::de::DeserializeOwned, W: Into<String>>(
+    body: &serde_json::Map<String, JsonValue>,
+    why: impl Fn(&str, Option<&JsonValue>) -> Option<W>,
+) -> Result<T, Response> {
+    let failed = match serde_path_to_error::deserialize(JsonValue::Object(body.clone())) {
+        Ok(request) => return Ok(request),
+        Err(failed) => failed,
+    };
+    let inner = failed.inner().to_string();
+    // A field of the wrong type is the path's; an absent one, serde's "missing field `x`".
+    let field = match failed.path().iter().next() {
+        Some(serde_path_to_error::Segment::Map { key }) => key.clone(),
+        _ => inner.split('`').nth(1).unwrap_or_default().to_string(),
+    };
+    let words = why(&field, body.get(&field)).map(Into::into).unwrap_or(inner);
+    Err(error(StatusCode::BAD_REQUEST, words))
 }
 
 // The state's `paused` follows the trace's `operator` events (`state.rs`), which the

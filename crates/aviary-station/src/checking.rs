@@ -129,8 +129,8 @@ fn rendered(sources: &SourceMap, d: &Diagnostic) -> Shown {
 #[derive(Debug, Serialize)]
 pub struct WorldMap<'w> {
     pub site: &'w aviary_world::Site,
-    /// The map's tiles (`tiles.rs`).
-    pub base: Value,
+    /// The map's tiles (`tiles.rs`); null without.
+    pub base: Option<crate::tiles::BaseMap>,
     pub places: &'w [aviary_world::Place],
     pub areas: &'w [aviary_world::Area],
     pub lines: Vec<MapLine<'w>>,

@@ -16,6 +16,7 @@ use aviary_server::Feed;
 use aviary_world::World;
 
 use crate::checking::{map_of, Text};
+use crate::wire::{VehiclePlan, VehicleWarning};
 use crate::{Mode, Station};
 
 /// The telemetry rate of a flight from the page, unless it asks for another: smooth
@@ -176,7 +177,7 @@ impl Hooks for Flight {
         };
         self.feed = Some(self.station.start_run(controller.clone(), mission, bounds, tree, trace));
         if self.live {
-            self.station.set_vehicle_plan(crate::VehiclePlan::Due);
+            self.station.set_vehicle_plan(VehiclePlan::Due);
         }
         if let Some(ready) = self.ready.take() {
             let _ = ready.send(Ok(()));
@@ -191,7 +192,7 @@ impl Hooks for Flight {
         replan: &aviary_pipeline::replan::Replan,
         _sources: &aviary_diagnostics::SourceMap,
     ) {
-        let mut warnings: Vec<serde_json::Value> = replan
+        let mut warnings: Vec<VehicleWarning> = replan
             .low_reserve
             .iter()
             .map(|d| {
@@ -199,13 +200,14 @@ impl Hooks for Flight {
                     Some(help) => format!("{} ({help})", d.message),
                     None => d.message.clone(),
                 };
-                serde_json::json!({ "code": d.code.as_str(), "text": text, "severe": false })
+                VehicleWarning { drone: None, code: d.code.as_str(), text, severe: false }
             })
             .collect();
         warnings.extend(replan.runs_out.iter().map(|r| {
-            serde_json::json!({ "drone": r.drone, "code": "W204", "text": r.warning(), "severe": true })
+            let drone = Some(r.drone.to_string());
+            VehicleWarning { drone, code: "W204", text: r.warning(), severe: true }
         }));
-        self.station.set_vehicle_plan(crate::VehiclePlan::Made(warnings));
+        self.station.set_vehicle_plan(VehiclePlan::Made(warnings));
     }
 
     fn record(&mut self, record: &Record<'_>, _backend: &dyn Backend) {

@@ -25,6 +25,7 @@ pub mod report;
 mod routes;
 mod tiles;
 pub mod tree;
+mod wire;
 
 use std::net::SocketAddr;
 use std::path::Path;
@@ -36,6 +37,8 @@ use aviary_check::SourceProvider;
 use aviary_engine::Controller;
 use aviary_server::{Bounds, Feed, Gate, Kinds};
 use serde_json::Value;
+
+use crate::wire::{RunShown, VehiclePlan};
 
 pub use dir::{refused_name, Access, Folder, Listing};
 pub use lsp::{Lsp, MAX_SOCKETS as MAX_LSP_SOCKETS};
@@ -76,18 +79,6 @@ pub(crate) struct Run {
     /// With MAVLink drones, the plan made again with the vehicles' figures: `None` until
     /// they answered, then its warnings (`vehicle_plan` of `/api/station`).
     pub vehicle_plan: VehiclePlan,
-}
-
-/// What the page is told of the plan made with the MAVLink vehicles' own figures.
-#[derive(Clone, Debug, Default)]
-pub(crate) enum VehiclePlan {
-    /// No MAVLink drone: nothing to plan again.
-    #[default]
-    None,
-    /// The vehicles are being asked.
-    Due,
-    /// Its warnings, each `{drone, code, text, severe}`.
-    Made(Vec<Value>),
 }
 
 pub(crate) struct Station {
@@ -145,15 +136,14 @@ impl Station {
     }
 
     /// The routes of the flight in progress (or the last one), and what the page shows of it.
-    pub fn run(&self) -> Option<(axum::Router, Value)> {
+    pub fn run(&self) -> Option<(axum::Router, RunShown)> {
         self.run.lock().as_ref().map(|r| {
-            let mut shown =
-                serde_json::json!({ "mission": r.mission, "tree": r.tree, "trace": r.trace });
-            match &r.vehicle_plan {
-                VehiclePlan::None => {}
-                VehiclePlan::Due => shown["vehicle_plan"] = "due".into(),
-                VehiclePlan::Made(w) => shown["vehicle_plan"] = w.clone().into(),
-            }
+            let shown = RunShown {
+                mission: r.mission.clone(),
+                tree: r.tree.clone(),
+                trace: r.trace.clone(),
+                vehicle_plan: r.vehicle_plan.clone(),
+            };
             (r.router.clone(), shown)
         })
     }

@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
+use aviary_api::operator::ApiError;
 use axum::extract::ws::rejection::WebSocketUpgradeRejection;
 use axum::extract::ws::{CloseFrame, Message as Frame, WebSocket, WebSocketUpgrade};
 use axum::extract::State;
@@ -19,7 +20,6 @@ use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
 use axum::Json;
 use lsp_server::{Connection, Message};
-use serde_json::json;
 
 use crate::{Mode, Station};
 
@@ -48,7 +48,7 @@ impl std::fmt::Debug for Lsp {
 }
 
 fn refused(status: StatusCode, message: impl Into<String>) -> Response {
-    (status, Json(json!({ "error": message.into() }))).into_response()
+    (status, Json(ApiError { error: message.into() })).into_response()
 }
 
 /// The route: a socket to a language server of its own, if the station has one to give.
@@ -196,20 +196,27 @@ fn framed(message: &Message) -> Option<String> {
     }
 }
 
-/// JSON-RPC's answer to a frame that is not a message.
+/// JSON-RPC's answer to a frame that is not a message: a response without an id.
 fn parse_error(why: &str) -> String {
+    #[derive(serde::Serialize)]
+    struct Unanswerable {
+        jsonrpc: &'static str,
+        id: Option<lsp_server::RequestId>,
+        error: lsp_server::ResponseError,
+    }
     let message: String = why.chars().take(300).collect();
-    json!({
-        "jsonrpc": "2.0",
-        "id": null,
-        "error": { "code": -32700, "message": format!("not a JSON-RPC message: {message}") },
-    })
-    .to_string()
+    let error = lsp_server::ResponseError {
+        code: lsp_server::ErrorCode::ParseError as i32,
+        message: format!("not a JSON-RPC message: {message}"),
+        data: None,
+    };
+    serde_json::to_string(&Unanswerable { jsonrpc: "2.0", id: None, error }).unwrap_or_default()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use serde_json::json;
 
     #[test]
     fn a_message_is_framed_as_json_rpc() {

@@ -12,13 +12,14 @@ use axum::middleware;
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::{Json, Router};
-use serde_json::{json, Value};
 use tower::ServiceExt;
 
 use aviary_check::SourceProvider;
 
 use crate::checking::{self, Text};
+use crate::wire::{About, CampaignReport, FlyRefused, Opened};
 use crate::{assets, dir, flight, tiles, Mode, Station};
+use aviary_api::operator::{Accepted, ApiError};
 
 /// The largest body a station call takes: a mission and a world of the largest size
 /// the station opens, with room for JSON's escapes.
@@ -57,7 +58,7 @@ pub(crate) fn router(station: Arc<Station>) -> Router {
 }
 
 fn error(status: StatusCode, message: impl Into<String>) -> Response {
-    (status, Json(json!({ "error": message.into() }))).into_response()
+    (status, Json(ApiError { error: message.into() })).into_response()
 }
 
 /// Why a call is refused, and its status: what the helpers below return, made a response
@@ -123,21 +124,19 @@ async fn operator(State(station): State<Arc<Station>>, request: Request<Body>) -
     }
 }
 
-async fn about(State(station): State<Arc<Station>>) -> Json<Value> {
+async fn about(State(station): State<Arc<Station>>) -> Json<About> {
     let run = station.run().map(|(_, shown)| shown);
-    Json(json!({
-        "mode": station.mode.name(),
-        "reading_needs_token": station.gate.beyond_loopback(),
-        // Where the folder is on the station's machine: the editor names its files to
-        // the language server by their absolute path (`file://` URIs).
-        "folder": match &station.mode {
+    Json(About {
+        mode: station.mode.name(),
+        reading_needs_token: station.gate.beyond_loopback(),
+        folder: match &station.mode {
             Mode::Folder { folder, .. } => Some(folder.root().display().to_string()),
-            _ => None,
+            Mode::Run | Mode::Replay { .. } => None,
         },
-        "lsp": station.lsp.is_some(),
-        "run": run,
-        "map": station.map(),
-    }))
+        lsp: station.lsp.is_some(),
+        run,
+        map: station.map(),
+    })
 }
 
 fn folder(station: &Station) -> Result<(&dir::Folder, &crate::FilesFor), Refusal> {
@@ -168,7 +167,7 @@ async fn open(State(station): State<Arc<Station>>, Query(named): Query<Named>) -
         Err(refusal) => return refusal.into_response(),
     };
     match folder.read(&named.path) {
-        Ok(text) => Json(json!({ "path": named.path, "text": text })).into_response(),
+        Ok(text) => Json(Opened { path: named.path, text }).into_response(),
         Err(why) => error(StatusCode::NOT_FOUND, why),
     }
 }
@@ -179,7 +178,7 @@ async fn save(State(station): State<Arc<Station>>, body: Json<Text>) -> Response
         Err(refusal) => return refusal.into_response(),
     };
     match folder.save(&body.path, &body.text) {
-        Ok(()) => Json(json!({ "ok": true })).into_response(),
+        Ok(()) => Json(Accepted::YES).into_response(),
         Err(why) => error(StatusCode::CONFLICT, why),
     }
 }
@@ -239,8 +238,7 @@ fn flyable(
         } else {
             "the mission cannot fly: fix the errors the check shows"
         };
-        let mut body = json!({ "error": why });
-        body["check"] = report.json;
+        let body = FlyRefused { error: why, check: report.json };
         return Err(Box::new((StatusCode::CONFLICT, Json(body)).into_response()));
     }
     Ok((report, files))
@@ -262,7 +260,7 @@ async fn fly(
         let tree = report.json["tree"].clone();
         let trace = trace_for(folder, &request.mission.path);
         match flight::start(station.clone(), request, tree, files, trace) {
-            Ok(()) => Json(json!({ "ok": true })).into_response(),
+            Ok(()) => Json(Accepted::YES).into_response(),
             Err(why) => error(StatusCode::CONFLICT, why),
         }
     };
@@ -297,7 +295,7 @@ async fn campaign(
             request.seed,
         );
         match flown {
-            Ok((text, html)) => Json(json!({ "text": text, "html": html })).into_response(),
+            Ok((text, html)) => Json(CampaignReport { text, html }).into_response(),
             Err(why) => error(StatusCode::CONFLICT, why),
         }
     };

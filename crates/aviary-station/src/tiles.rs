@@ -2,8 +2,6 @@
 //! the page's Content-Security-Policy lets images come from the station itself and from
 //! the tile servers of the worlds it may show, nowhere else.
 
-use serde_json::Value;
-
 use crate::{Mode, Station};
 
 /// The image sources of the page: its own files, and each tile server a world of the
@@ -67,20 +65,32 @@ pub(crate) fn policy(images: &[String]) -> String {
 /// the local frame's place on Earth as degrees per metre about the origin (the one
 /// projection, `aviary_api::geo::Origin`, is linear: the page applies these, it does not
 /// project again). `Null` for a world without tiles or origin.
-pub fn base_map(world: &aviary_world::World) -> Value {
+pub fn base_map(world: &aviary_world::World) -> Option<BaseMap> {
     let (Some(url), Some(o)) = (&world.site.tiles, &world.site.origin) else {
-        return Value::Null;
+        return None;
     };
     let origin = aviary_api::geo::Origin { lat: o.lat, lon: o.lon, alt: o.alt };
-    let (north, east) = origin.degrees_per_metre();
-    serde_json::json!({
-        "url": url,
-        "attribution": world.site.tiles_attribution,
-        "lat": o.lat,
-        "lon": o.lon,
-        "lat_per_m": north,
-        "lon_per_m": east,
+    let (lat_per_m, lon_per_m) = origin.degrees_per_metre();
+    Some(BaseMap {
+        url: url.clone(),
+        attribution: world.site.tiles_attribution.clone(),
+        lat: o.lat,
+        lon: o.lon,
+        lat_per_m,
+        lon_per_m,
     })
+}
+
+/// The tiles under the map, and how the local frame lies on them: the origin and how
+/// many degrees a metre north and a metre east are there.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct BaseMap {
+    pub url: String,
+    pub attribution: Option<String>,
+    pub lat: f64,
+    pub lon: f64,
+    pub lat_per_m: f64,
+    pub lon_per_m: f64,
 }
 
 #[cfg(test)]
@@ -118,12 +128,11 @@ mod tests {
         let text = "[site]\norigin = { lat = 46.6167, lon = 14.2650, alt = 440.0 }\ntiles = \"https://t.example/{z}/{x}/{y}.png\"\n";
         let (world, diags) = aviary_world::parse_world(aviary_diagnostics::FileId(0), text);
         assert!(diags.is_empty(), "{diags:?}");
-        let map = base_map(&world.unwrap());
+        let map = base_map(&world.unwrap()).unwrap();
         let origin = aviary_api::geo::Origin { lat: 46.6167, lon: 14.2650, alt: 440.0 };
         let (lat, lon) = origin.to_geodetic(350.0, -450.0);
-        let f = |k: &str| map[k].as_f64().unwrap();
         // Within 1e-10 degrees, about a hundredth of a millimetre.
-        assert!((f("lat") + -450.0 * f("lat_per_m") - lat).abs() < 1e-10);
-        assert!((f("lon") + 350.0 * f("lon_per_m") - lon).abs() < 1e-10);
+        assert!((map.lat + -450.0 * map.lat_per_m - lat).abs() < 1e-10);
+        assert!((map.lon + 350.0 * map.lon_per_m - lon).abs() < 1e-10);
     }
 }

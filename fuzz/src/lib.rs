@@ -3,10 +3,12 @@
 //! function panics when a property does not hold, which AFL records as a crash.
 
 mod call;
+mod lsp;
 mod mavlink;
 mod operator;
 mod station;
 
+pub use lsp::lsp;
 pub use mavlink::{
     answers_of_px4_vehicles, answers_of_the_vehicles, heard_on_a_link, link, vehicles,
 };

@@ -140,7 +140,10 @@ pub fn operator(data: &[u8]) {
 fn checked(control: &Control, mission: &aviary_ir::Mission) {
     match control {
         Control::Signal { signal, .. } => {
-            assert!(mission.operator_signals.contains(signal), "{signal} reached the engine undeclared")
+            assert!(
+                mission.operator_signals.contains(signal),
+                "{signal} reached the engine undeclared"
+            )
         }
         Control::Leash { capability, tag, action, args } => {
             let cap = &mission.capabilities[*capability];

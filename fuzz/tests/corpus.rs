@@ -38,6 +38,12 @@ fn seeds_and_regressions_of_fuzz_operator() {
 }
 
 #[test]
+fn seeds_and_regressions_of_fuzz_lsp() {
+    assert!(each_file("in/lsp", aviary_fuzz::lsp) > 0);
+    each_file("regressions/lsp", aviary_fuzz::lsp);
+}
+
+#[test]
 fn seeds_and_regressions_of_fuzz_link() {
     assert!(each_file("in/link", aviary_fuzz::link) > 0);
     each_file("regressions/link", aviary_fuzz::link);

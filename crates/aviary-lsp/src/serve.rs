@@ -9,6 +9,7 @@
 //!   waits for another. A request waits only for the check of the edits that came before
 //!   it (it is held, and started when that check is published), so it is never answered
 //!   from a text older than the one it names. `$/cancelRequest` answers a held request.
+//!   `shutdown` is answered after every request before it.
 //! - A panic in a check or a request is caught and written to stderr; a request is
 //!   answered with an error; the server lives on.
 
@@ -53,6 +54,8 @@ struct Loop {
     published: Option<BTreeSet<String>>,
     /// Requests that wait for a check.
     held: Vec<Request>,
+    /// The threads of the requests started, until they are seen to have ended.
+    running: Vec<std::thread::JoinHandle<()>>,
     results: (Sender<Checked>, Receiver<Checked>),
 }
 
@@ -71,6 +74,7 @@ pub fn run(connection: Connection, config: Config) -> Result<(), String> {
         checking: false,
         published: Some(BTreeSet::new()),
         held: Vec::new(),
+        running: Vec::new(),
         results: crossbeam_channel::unbounded(),
     };
     loop {
@@ -96,6 +100,12 @@ impl Loop {
     fn message(&mut self, message: Message) -> Result<bool, String> {
         match message {
             Message::Request(request) => {
+                if request.method
+                    == <lsp_types::request::Shutdown as lsp_types::request::Request>::METHOD
+                {
+                    // Every request before it is answered first.
+                    self.settle()?;
+                }
                 if self.connection.handle_shutdown(&request).map_err(|e| e.to_string())? {
                     return Ok(false);
                 }
@@ -186,8 +196,22 @@ impl Loop {
         Ok(())
     }
 
+    /// Before `shutdown`: waits for the checks of every edit, so that the requests held
+    /// for them start, and then for every request in flight to be answered.
+    fn settle(&mut self) -> Result<(), String> {
+        while self.checking {
+            let checked = self.results.1.recv().map_err(|e| e.to_string())?;
+            self.done(checked)?;
+        }
+        for running in std::mem::take(&mut self.running) {
+            let _ = running.join();
+        }
+        Ok(())
+    }
+
     /// Answers `request` on a thread of its own, over the last checked server.
-    fn start(&self, request: Request) {
+    fn start(&mut self, request: Request) {
+        self.running.retain(|r| !r.is_finished());
         let server = self.checked.clone();
         let sender = self.connection.sender.clone();
         let id = request.id.clone();
@@ -197,13 +221,16 @@ impl Loop {
             .spawn(move || {
                 let _ = sender.send(Message::Response(server.request(request)));
             });
-        if let Err(e) = spawned {
-            let why = format!("aviary lsp: no thread for the request: {e}");
-            let _ = self.connection.sender.send(Message::Response(Response::new_err(
-                id,
-                ErrorCode::InternalError as i32,
-                why,
-            )));
+        match spawned {
+            Ok(running) => self.running.push(running),
+            Err(e) => {
+                let why = format!("aviary lsp: no thread for the request: {e}");
+                let _ = self.connection.sender.send(Message::Response(Response::new_err(
+                    id,
+                    ErrorCode::InternalError as i32,
+                    why,
+                )));
+            }
         }
     }
 

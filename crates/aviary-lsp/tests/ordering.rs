@@ -1,5 +1,5 @@
 //! How requests and checks are ordered: a request waits for the check of the edits sent
-//! before it, and a held request can be cancelled (that no request waits for another is
+//! before it, a held request can be cancelled, `shutdown` is answered after the rest (that no request waits for another is
 //! tested in the crate, with a request only a test build answers). And
 //! the standard library's file, opened in the editor, is read as the library.
 
@@ -133,6 +133,35 @@ fn a_request_after_an_edit_waits_for_its_check_and_can_be_cancelled_meanwhile() 
     let shown = hovered["result"]["contents"]["value"].as_str().unwrap();
     assert!(shown.contains("BuildingB"), "{shown}");
     bye(client, thread);
+}
+
+/// A client that sends `shutdown` right after its requests (as a page that closes does)
+/// gets every answer first, the one held for a long check included.
+#[test]
+fn shutdown_is_answered_after_every_request_before_it() {
+    let (client, thread) = raw_server();
+    let doc = uri(&fixture("search_and_rescue.mission"));
+    let text = long_mission();
+    notify(
+        &client,
+        "textDocument/didOpen",
+        json!({ "textDocument": { "uri": doc, "languageId": "aviary", "version": 1, "text": text } }),
+    );
+    let at = json!({ "textDocument": { "uri": doc }, "position": { "line": 11, "character": 30 } });
+    request(&client, 1, "textDocument/hover", at.clone());
+    request(&client, 2, "textDocument/documentSymbol", json!({ "textDocument": { "uri": doc } }));
+    request(&client, 999, "shutdown", Value::Null);
+    let answered: Vec<Value> = until_answered(&client, &[999])
+        .into_iter()
+        .filter_map(|m| match m {
+            Message::Response(r) => Some(r.id.to_string().parse().unwrap()),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(answered.len(), 3, "{answered:?}");
+    assert_eq!(answered[2], json!(999), "shutdown last: {answered:?}");
+    notify(&client, "exit", Value::Null);
+    thread.join().unwrap().unwrap();
 }
 
 #[test]

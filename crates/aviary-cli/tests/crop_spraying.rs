@@ -8,15 +8,46 @@
 
 mod common;
 
-use aviary_api::sweep;
+use aviary_api::trace::{CallStatus, Event, EventKind, Record, Shown, Status};
+use aviary_api::{sweep, Function, Remainder};
 use aviary_test_support::lanes;
+use aviary_test_support::trace::Trace;
 use common::{aviary, repo, scratch};
-use serde_json::Value;
 
 const MISSION: &str = "examples/crop_spraying.mission";
 
-fn xy(v: &Value) -> [f64; 2] {
-    [v[0].as_f64().unwrap(), v[1].as_f64().unwrap()]
+/// `actor`'s `Sweep` calls: when each was made, and its first value.
+fn sweeps<'a>(events: &'a [Record<'static>], actor: &str) -> Vec<(f64, &'a Shown<'static>)> {
+    events
+        .iter()
+        .filter_map(|e| match &e.event {
+            Event::ApiCall { actor: a, function: Function::Sweep, args, .. } if a == actor => {
+                Some((e.t, &args[0]))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// How `actor`'s `Sweep` calls ended: when, how, where, and the metres they left.
+fn swept(events: &[Record<'static>], actor: &str) -> Vec<(f64, CallStatus, [f64; 3], Option<f64>)> {
+    events
+        .iter()
+        .filter_map(|e| match &e.event {
+            Event::ApiDone {
+                actor: a, function: Function::Sweep, status, position, left, ..
+            } if a == actor => Some((e.t, *status, *position, *left)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The corners of an area given as a value.
+fn corners(v: &Shown) -> Vec<[f64; 2]> {
+    match v {
+        Shown::Area(corners) => corners.to_vec(),
+        other => panic!("not an area: {other:?}"),
+    }
 }
 
 #[test]
@@ -32,46 +63,31 @@ fn the_lost_sprayers_field_is_sprayed_once_lane_by_lane() {
         &repo(),
     );
     assert_eq!(code, 0, "runs to its end: {out}{err}");
-    let events: Vec<Value> = std::fs::read_to_string(&trace)
-        .expect("the trace")
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("a trace line"))
-        .collect();
-    let find = |pred: &dyn Fn(&Value) -> bool| -> Vec<&Value> {
-        events.iter().filter(|e| pred(e)).collect()
-    };
-    assert_eq!(events.last().unwrap()["status"], "ok");
+    let events = Trace::read(&trace);
+    assert!(matches!(events.last().unwrap().event, Event::MissionEnd { status: Status::Ok, .. }));
 
     // One link loss, handled; sprayer2's sweep cut there, with what it left.
-    let lost = find(&|e| e["event"] == "exception");
+    let lost = events.events(EventKind::Exception);
     assert_eq!(lost.len(), 1);
-    assert_eq!(
-        (lost[0]["name"].as_str(), lost[0]["actor"].as_str()),
-        (Some("ConnectionLost"), Some("sprayer2"))
-    );
-    assert_eq!(lost[0]["handled"], true);
-    let sweep_of = |actor: &str, event: &str| -> Vec<&Value> {
-        events
-            .iter()
-            .filter(|e| e["event"] == event && e["actor"] == actor && e["function"] == "Sweep")
-            .collect()
-    };
-    let cut = sweep_of("sprayer2", "api_done")[0];
-    assert_eq!(cut["status"], "interrupted");
-    assert!(cut["left"].as_f64().unwrap() > 0.0);
-    let field: Vec<[f64; 2]> =
-        sweep_of("sprayer2", "api_call")[0]["args"][0].as_array().unwrap().iter().map(xy).collect();
+    let Event::Exception { name, actor, handled, .. } = &lost[0].event else { unreachable!() };
+    assert_eq!((&**name, actor.as_deref()), ("ConnectionLost", Some("sprayer2")));
+    assert!(*handled);
+    let cut = swept(&events, "sprayer2")[0];
+    assert_eq!(cut.1, CallStatus::Interrupted);
+    assert!(cut.3.unwrap() > 0.0);
+    let field = corners(sweeps(&events, "sprayer2")[0].1);
 
     // sprayer3: its own field, then nothing from sprayer1 (it finished: done at once), then
     // sprayer2's lanes left, the first from where sprayer2 stopped.
-    let calls = sweep_of("sprayer3", "api_call");
+    let calls = sweeps(&events, "sprayer3");
     assert_eq!(calls.len(), 3, "its field, sprayer1's remainder, sprayer2's");
-    assert_eq!(calls[1]["args"][0], serde_json::json!({"points": []}));
-    let done = sweep_of("sprayer3", "api_done");
-    assert_eq!((done[1]["status"].as_str(), &done[1]["t"]), (Some("ok"), &calls[1]["t"]));
-    let handed = &calls[2]["args"][0];
-    assert_eq!(xy(&handed["lanes"][0][0]), xy(&cut["position"]));
-    assert_eq!(done[2]["status"], "ok");
+    assert_eq!(calls[1].1, &Shown::Remainder(std::borrow::Cow::Owned(Remainder::Nothing)));
+    let done = swept(&events, "sprayer3");
+    assert_eq!((done[1].1, done[1].0), (CallStatus::Ok, calls[1].0));
+    let Shown::Remainder(handed) = calls[2].1 else { panic!("{:?}", calls[2]) };
+    let Remainder::Lanes { lanes, .. } = &**handed else { panic!("{handed:?}") };
+    assert_eq!(lanes[0][0], [cut.2[0], cut.2[1]]);
+    assert_eq!(done[2].1, CallStatus::Ok);
 
     // Lane by lane, from every sprayer's track.
     let tracks = lanes::tracks(&events, &["sprayer1", "sprayer2", "sprayer3"]);
@@ -84,8 +100,7 @@ fn the_lost_sprayers_field_is_sprayed_once_lane_by_lane() {
     assert!(owners[shared + 1..].iter().all(|o| o == &["sprayer3"]), "{owners:?}");
     // And the other fields, each by its own sprayer.
     for (d, area) in [("sprayer1", "North_Field"), ("sprayer3", "South_Field")] {
-        let call = sweep_of(d, "api_call")[0];
-        let polygon: Vec<[f64; 2]> = call["args"][0].as_array().unwrap().iter().map(xy).collect();
+        let polygon = corners(sweeps(&events, d)[0].1);
         let owners = lanes::each_lane_once(&sweep::lanes(&polygon, 10.0), &tracks);
         assert!(owners.iter().all(|o| o == &[d]), "{area}: {owners:?}");
     }

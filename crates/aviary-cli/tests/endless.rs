@@ -14,6 +14,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+use aviary_api::trace::{CallStatus, Event, EventKind, Record, Status};
+use aviary_api::Function;
+use aviary_test_support::trace::{is, Trace};
 use common::{scratch, wait_at_most};
 
 fn folder() -> PathBuf {
@@ -41,19 +44,26 @@ fn bounded(args: &[&str], dir: &Path, out: &Path, limit: Duration) -> (i32, Stri
     (code, read("stdout"), read("stderr"))
 }
 
-fn events(trace: &Path) -> Vec<serde_json::Value> {
+fn events(trace: &Path) -> Trace {
     let text = std::fs::read_to_string(trace).expect("the trace");
     assert!(text.is_empty() || text.ends_with('\n'), "the last line is whole");
-    text.lines().map(|l| serde_json::from_str(l).expect("a whole JSON event")).collect()
+    Trace::parse(&text)
 }
 
-fn brought_home(events: &[serde_json::Value], drone: &str) -> bool {
+fn brought_home(events: &[Record<'static>], drone: &str) -> bool {
     events.iter().any(|e| {
-        e["event"] == "api_done"
-            && e["function"] == "ReturnToLaunch"
-            && e["actor"] == drone
-            && e["status"] == "ok"
+        matches!(&e.event, Event::ApiDone {
+            function: Function::ReturnToLaunch, status: CallStatus::Ok, actor, ..
+        } if actor == drone)
     })
+}
+
+/// How the mission ended, and why: the trace's last event, its `mission_end`.
+fn ended<'a>(events: &'a [Record<'static>]) -> (Status, Option<&'a str>) {
+    match &events.last().expect("an event").event {
+        Event::MissionEnd { status, reason } => (*status, reason.as_deref()),
+        other => panic!("the trace ends with {other:?}"),
+    }
 }
 
 #[test]
@@ -87,19 +97,13 @@ fn every_endless_mission_is_warned_of_and_its_run_ends_with_the_reason() {
         assert!(ran.contains("mission failed: a cycle of signals at one instant: P/ON X"), "{ran}");
         let events = events(&trace);
         assert!(events.len() < 2_000, "{name}: {} events", events.len());
-        let end = events.last().expect("an event");
-        assert_eq!(
-            (end["event"].as_str(), end["status"].as_str()),
-            (Some("mission_end"), Some("failed"))
-        );
+        let (status, reason) = ended(&events);
+        assert_eq!(status, Status::Failed);
         assert!(
-            end["reason"]
-                .as_str()
-                .is_some_and(|r| r.starts_with("a cycle of signals at one instant")),
-            "{end}"
+            reason.is_some_and(|r| r.starts_with("a cycle of signals at one instant")),
+            "{reason:?}"
         );
-        let airborne =
-            events.iter().any(|e| e["event"] == "api_done" && e["function"] == "TakeOff");
+        let airborne = !events.find(is::done(Function::TakeOff)).is_empty();
         assert!(
             !airborne || brought_home(&events, "d"),
             "{name}: the drone in the air is brought home"
@@ -159,14 +163,13 @@ fn stop_signal_ends_a_busy_run(signal: &str, by: &str) {
     assert_eq!(code, 1, "an aborted mission exits 1");
     assert!(sent.elapsed() < Duration::from_secs(15));
     let events = events(&trace);
-    let end = events.last().expect("an event");
     let reason = format!("interrupted by {by}");
     assert_eq!(
-        (end["event"].as_str(), end["status"].as_str(), end["reason"].as_str()),
-        (Some("mission_end"), Some("aborted"), Some(reason.as_str())),
+        ended(&events),
+        (Status::Aborted, Some(reason.as_str())),
         "stopped by the signal, not at the end of the cycles"
     );
-    assert_eq!(events.iter().filter(|e| e["event"] == "mission_end").count(), 1);
+    assert_eq!(events.events(EventKind::MissionEnd).len(), 1);
     assert!(brought_home(&events, "d"), "the drone in the air is brought home");
 }
 
@@ -208,14 +211,9 @@ fn a_trace_at_its_size_limit_ends_the_run_with_the_fleet_home_and_exit_3() {
     );
     assert!(out.lines().any(|l| l.starts_with("d ") && l.ends_with("Landed")), "home:\n{out}");
     let events = events(&dir.join("t.jsonl"));
-    let end = events.last().expect("an event");
     assert_eq!(
-        (end["event"].as_str(), end["status"].as_str()),
-        (Some("mission_end"), Some("aborted"))
-    );
-    assert_eq!(
-        end["reason"],
-        "the trace reached its size limit of 64 KiB: the run was stopped here, its fleet sent home, and nothing after is recorded"
+        ended(&events),
+        (Status::Aborted, Some("the trace reached its size limit of 64 KiB: the run was stopped here, its fleet sent home, and nothing after is recorded"))
     );
 }
 

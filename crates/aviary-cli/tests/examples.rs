@@ -3,6 +3,8 @@
 
 mod common;
 
+use aviary_api::trace::{Event, EventKind, Status};
+use aviary_test_support::trace::Trace;
 use common::{aviary, repo, scratch};
 
 #[test]
@@ -23,27 +25,24 @@ fn every_fault_drill_raises_its_exception_once_and_handles_it() {
         let (code, out, err) =
             aviary(&["run", &mission, "--trace", &trace.to_string_lossy()], &repo());
         assert_eq!(code, 0, "{kind}: {out}{err}");
-        let events: Vec<serde_json::Value> = std::fs::read_to_string(&trace)
-            .unwrap()
-            .lines()
-            .map(|l| serde_json::from_str(l).unwrap())
-            .collect();
-        let raised: Vec<&serde_json::Value> =
-            events.iter().filter(|e| e["event"] == "exception").collect();
+        let events = Trace::read(&trace);
+        let raised = events.events(EventKind::Exception);
         assert_eq!(raised.len(), 1, "{kind}: one fault, one exception");
+        let Event::Exception { name, actor, handled, .. } = &raised[0].event else {
+            unreachable!()
+        };
         assert_eq!(
-            (
-                raised[0]["name"].as_str(),
-                raised[0]["actor"].as_str(),
-                raised[0]["handled"].as_bool()
-            ),
-            (Some(exception), Some("scout"), Some(true)),
+            (&**name, actor.as_deref(), *handled),
+            (exception, Some("scout"), true),
             "{kind}"
         );
         let carrier = events
             .iter()
-            .find(|e| e["event"] == "capability_end" && e["actor"] == "carrier")
+            .find_map(|e| match &e.event {
+                Event::CapabilityEnd { actor, status, .. } if actor == "carrier" => Some(*status),
+                _ => None,
+            })
             .unwrap();
-        assert_eq!(carrier["status"], "ok", "{kind}: the other drones carry on");
+        assert_eq!(carrier, Status::Ok, "{kind}: the other drones carry on");
     }
 }

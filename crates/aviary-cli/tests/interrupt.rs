@@ -8,6 +8,9 @@ mod common;
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
+use aviary_api::trace::{CallStatus, Event, EventKind, Record, Status};
+use aviary_api::Function;
+use aviary_test_support::trace::{is, Trace};
 use common::{aviary, repo, scratch};
 
 fn spawn(trace: &std::path::Path, speed: &str) -> Child {
@@ -32,6 +35,11 @@ fn lines(path: &std::path::Path) -> Vec<String> {
     let text = std::fs::read_to_string(path).unwrap_or_default();
     assert!(text.is_empty() || text.ends_with('\n'), "the last line is whole");
     text.lines().map(str::to_string).collect()
+}
+
+/// The records of the trace at `path`: its lines, each whole.
+fn records(path: &std::path::Path) -> Trace {
+    Trace::parse(&lines(path).join("\n"))
 }
 
 fn interrupt(child: &Child) {
@@ -84,7 +92,7 @@ fn a_killed_run_keeps_every_event_before_the_cut() {
         child.wait().expect("wait");
         let written = lines(&cut);
         for (n, line) in written.iter().enumerate() {
-            serde_json::from_str::<serde_json::Value>(line)
+            serde_json::from_str::<Record>(line)
                 .unwrap_or_else(|e| panic!("cut at {ms} ms, line {}: {e}", n + 1));
         }
         assert!(written.len() < reference.len(), "cut at {ms} ms: the run was cut before its end");
@@ -106,35 +114,34 @@ fn ends_gracefully_on(signal: &str, reason: &str) {
     send(&child, signal);
     let status = child.wait().expect("wait");
     assert_eq!(status.code(), Some(1), "an aborted mission exits 1");
-    let events: Vec<serde_json::Value> =
-        lines(&trace).iter().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let events = records(&trace);
     let end = events.last().unwrap();
-    assert_eq!(
-        (end["event"].as_str(), end["status"].as_str(), end["reason"].as_str()),
-        (Some("mission_end"), Some("aborted"), Some(reason))
-    );
-    assert_eq!(events.iter().filter(|e| e["event"] == "mission_end").count(), 1);
+    let Event::MissionEnd { status, reason: why } = &end.event else { panic!("{end:?}") };
+    assert_eq!((*status, why.as_deref()), (Status::Aborted, Some(reason)));
+    assert_eq!(events.events(EventKind::MissionEnd).len(), 1);
     let home: Vec<&str> = events
         .iter()
-        .filter(|e| {
-            e["event"] == "api_done" && e["function"] == "ReturnToLaunch" && e["status"] == "ok"
+        .filter_map(|e| match &e.event {
+            Event::ApiDone {
+                function: Function::ReturnToLaunch,
+                status: CallStatus::Ok,
+                actor,
+                ..
+            } => Some(&**actor),
+            _ => None,
         })
-        .map(|e| e["actor"].as_str().unwrap())
         .collect();
     assert!(home.contains(&"video_drone1"), "the drones in the air were brought home: {home:?}");
     // Ordering: the running activities are aborted first, then the drones are sent home,
     // and the trace ends only once every return has ended.
     let aborted = events
         .iter()
-        .position(|e| e["event"] == "api_done" && e["status"] == "aborted")
+        .position(|e| matches!(e.event, Event::ApiDone { status: CallStatus::Aborted, .. }))
         .expect("activities were aborted");
-    let first_home = events
-        .iter()
-        .position(|e| e["event"] == "api_call" && e["function"] == "ReturnToLaunch")
-        .expect("a return");
+    let first_home = events.index(is::call(Function::ReturnToLaunch));
     let last_home = events
         .iter()
-        .rposition(|e| e["event"] == "api_done" && e["function"] == "ReturnToLaunch")
+        .rposition(|e| is::done(Function::ReturnToLaunch)(&e.event))
         .expect("a return ended");
     assert!(
         aborted < first_home && last_home < events.len() - 1,
@@ -169,11 +176,9 @@ fn a_second_ctrl_c_stops_at_once_and_still_closes_the_trace() {
     let status = child.wait().expect("wait");
     assert_eq!(status.code(), Some(130));
     let written = lines(&trace);
-    let end: serde_json::Value = serde_json::from_str(written.last().unwrap()).unwrap();
-    assert_eq!(
-        (end["event"].as_str(), end["reason"].as_str()),
-        (Some("mission_end"), Some("stopped at once by a second Ctrl-C"))
-    );
+    let end: Record = serde_json::from_str(written.last().unwrap()).unwrap();
+    let Event::MissionEnd { reason, .. } = &end.event else { panic!("{end:?}") };
+    assert_eq!(reason.as_deref(), Some("stopped at once by a second Ctrl-C"));
     assert_eq!(written.iter().filter(|l| l.contains("\"mission_end\"")).count(), 1);
 }
 
@@ -225,17 +230,17 @@ fn ctrl_c_while_the_vehicles_connect_stops_at_once_with_a_whole_trace() {
         ),
         "{stdout}"
     );
-    let trace = lines(&dir.join("t.jsonl"));
-    let events: Vec<serde_json::Value> =
-        trace.iter().map(|l| serde_json::from_str(l).expect("JSON")).collect();
+    let events = records(&dir.join("t.jsonl"));
     assert_eq!(
-        events.iter().map(|e| e["event"].as_str().unwrap()).collect::<Vec<_>>(),
-        ["mission_start", "mission_end"]
+        events.iter().map(|e| e.event.kind()).collect::<Vec<_>>(),
+        [EventKind::MissionStart, EventKind::MissionEnd]
     );
-    assert_eq!(
-        (events[0]["mission"].as_str(), events[1]["status"].as_str()),
-        (Some("Waiting"), Some("aborted"))
-    );
+    let (Event::MissionStart { mission, .. }, Event::MissionEnd { status, .. }) =
+        (&events[0].event, &events[1].event)
+    else {
+        unreachable!()
+    };
+    assert_eq!((&**mission, *status), ("Waiting", Status::Aborted));
 }
 
 #[test]
@@ -247,10 +252,11 @@ fn two_quick_stops_while_the_vehicles_connect_leave_a_whole_trace() {
     std::thread::sleep(Duration::from_millis(5));
     let _ = Command::new("kill").args(["-TERM", &child.id().to_string()]).status();
     wait_at_most(&mut child, Duration::from_secs(3));
-    let events: Vec<serde_json::Value> = lines(&dir.join("t.jsonl"))
-        .iter()
-        .map(|l| serde_json::from_str(l).expect("JSON"))
-        .collect();
-    let kinds: Vec<&str> = events.iter().map(|e| e["event"].as_str().unwrap()).collect();
-    assert_eq!(kinds, ["mission_start", "mission_end"], "whole, whichever stop came first");
+    let events = records(&dir.join("t.jsonl"));
+    let kinds: Vec<EventKind> = events.iter().map(|e| e.event.kind()).collect();
+    assert_eq!(
+        kinds,
+        [EventKind::MissionStart, EventKind::MissionEnd],
+        "whole, whichever stop came first"
+    );
 }

@@ -8,31 +8,33 @@
 
 mod common;
 
+use aviary_api::trace::{Event, Record, Shown, Status};
+use aviary_test_support::trace::{is, Trace};
 use common::{aviary, repo, scratch};
-use serde_json::Value;
 
 const MISSION: &str = "examples/lost_hiker.mission";
 
-fn events(path: &std::path::Path) -> Vec<Value> {
-    std::fs::read_to_string(path)
-        .expect("the trace")
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("a trace line"))
-        .collect()
+fn events(path: &std::path::Path) -> Trace {
+    Trace::read(path)
+}
+
+/// A position given as a value, over the ground.
+fn xy(v: Option<&Shown>) -> [f64; 2] {
+    match v {
+        Some(Shown::Position(p)) => [p.x, p.y],
+        other => panic!("not a position: {other:?}"),
+    }
 }
 
 /// Where each FlyTo of the convergence flew to, and when it started: scout1's, scout2's.
-fn converge(events: &[Value]) -> Vec<(String, [f64; 2], f64)> {
+fn converge(events: &[Record<'static>]) -> Vec<(String, [f64; 2], f64)> {
     events
         .iter()
-        .filter(|e| e["event"] == "capability_start" && e["capability"] == "FlyTo")
-        .map(|e| {
-            let t = &e["args"]["target"];
-            (
-                e["actor"].as_str().unwrap().to_string(),
-                [t[0].as_f64().unwrap(), t[1].as_f64().unwrap()],
-                e["t"].as_f64().unwrap(),
-            )
+        .filter_map(|e| match &e.event {
+            Event::CapabilityStart { capability, actor, args, .. } if capability == "FlyTo" => {
+                Some((actor.to_string(), xy(args.get("target")), e.t))
+            }
+            _ => None,
         })
         .collect()
 }
@@ -51,17 +53,19 @@ fn a_find_stops_the_search_and_the_scouts_hold_20_m_either_side_of_the_hiker() {
         aviary(&["run", MISSION, "--quiet", "--trace", &trace.to_string_lossy()], &repo());
     assert_eq!(code, 0, "{out}{err}");
     let events = events(&trace);
-    assert_eq!(events.last().unwrap()["status"], "ok");
-    let found = events.iter().find(|e| e["event"] == "signal" && e["name"] == "Found").unwrap();
-    let t = found["t"].as_f64().unwrap();
-    let at = [found["args"][0][0].as_f64().unwrap(), found["args"][0][1].as_f64().unwrap()];
+    assert!(matches!(events.last().unwrap().event, Event::MissionEnd { status: Status::Ok, .. }));
+    let found = events.first(is::signal("Found"));
+    let t = found.t;
+    let Event::Signal { args, .. } = &found.event else { unreachable!() };
+    let at = xy(args.first());
     assert_eq!(at, [300.0, 400.0], "the hiker, where the world put them");
     // The search block ends at that instant, and nothing more of it runs.
-    let stop = events.iter().find(|e| e["event"] == "leash" && e["block"] == true).unwrap();
-    assert_eq!((stop["capability"].as_str(), stop["t"].as_f64()), (Some("Search_Valley"), Some(t)));
-    let ended =
-        events.iter().find(|e| e["event"] == "block_end" && e["block"] == "Search_Valley").unwrap();
-    assert_eq!((ended["status"].as_str(), ended["t"].as_f64()), (Some("aborted"), Some(t)));
+    let stop = events.first(|e| matches!(e, Event::Leash { block: true, .. }));
+    let Event::Leash { capability, .. } = &stop.event else { unreachable!() };
+    assert_eq!((&**capability, stop.t), ("Search_Valley", t));
+    let ended = events.first(is::block_end("Search_Valley"));
+    let Event::BlockEnd { status, .. } = ended.event else { unreachable!() };
+    assert_eq!((status, ended.t), (Status::Aborted, t));
     // Both scouts set off at once, to 20 m east and 20 m west: 40 m apart.
     let flights = converge(&events);
     assert_eq!(flights.len(), 2, "{flights:?}");

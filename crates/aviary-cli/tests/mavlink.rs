@@ -13,6 +13,9 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+use aviary_api::trace::{CallStatus, Event, EventKind, Record, Shown};
+use aviary_api::{Function, Remainder};
+use aviary_test_support::trace::{actor, Trace};
 use common::{aviary, repo, scratch};
 use serde_json::Value;
 
@@ -93,28 +96,33 @@ fn run_within(dir: &Path, args: &[&str], limit: Duration) -> i32 {
     common::wait_at_most(&mut child, limit, "aviary run")
 }
 
-fn events(path: &Path) -> Vec<Value> {
-    std::fs::read_to_string(path)
-        .unwrap_or_default()
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("a JSON line"))
-        .collect()
+fn events(path: &Path) -> Trace {
+    Trace::parse(&std::fs::read_to_string(path).unwrap_or_default())
 }
 
 /// Per event kind and actor, what a trace says, in a form two runs can be compared in:
-/// sorted, because the two runs' timing differs (which body is found first).
-fn facts(trace: &[Value], event: &str, key: &str) -> Vec<(String, String, Vec<f64>)> {
+/// sorted, because the two runs' timing differs (which body is found first). Of a signal
+/// its name and the numbers of its values; of a detection its kind and location; of a
+/// call its function and the numbers of its values; of a call's end its function and
+/// where it left the drone.
+fn facts(trace: &[Record<'static>], kind: EventKind) -> Vec<(String, String, Vec<f64>)> {
     let mut out: Vec<(String, String, Vec<f64>)> = trace
         .iter()
-        .filter(|e| e["event"] == event)
+        .filter(|e| e.event.kind() == kind)
         .map(|e| {
-            // A detection's location; a call's arguments; where a call ended.
-            let numbers =
-                match e.get("location").or_else(|| e.get("position")).or_else(|| e.get("args")) {
-                    Some(v) => flatten(v),
-                    None => Vec::new(),
-                };
-            (e["actor"].as_str().unwrap_or("").to_owned(), e[key].to_string(), numbers)
+            let known = |p: &[f64]| p.iter().copied().filter(|c| c.is_finite()).collect();
+            let (key, numbers) = match &e.event {
+                Event::Signal { name, args, .. } => (name.to_string(), flatten(args)),
+                Event::Detection { kind, location, .. } => (kind.to_string(), known(location)),
+                Event::ApiCall { function, args, .. } => {
+                    (function.name().to_string(), flatten(args))
+                }
+                Event::ApiDone { function, position, .. } => {
+                    (function.name().to_string(), known(position))
+                }
+                other => panic!("no facts of {other:?}"),
+            };
+            (actor(&e.event).unwrap_or("").to_owned(), key, numbers)
         })
         .collect();
     out.sort_by(|a, b| {
@@ -125,13 +133,47 @@ fn facts(trace: &[Value], event: &str, key: &str) -> Vec<(String, String, Vec<f6
     out
 }
 
-fn flatten(v: &Value) -> Vec<f64> {
-    match v {
-        Value::Number(n) => vec![n.as_f64().unwrap_or(0.0)],
-        Value::Array(a) => a.iter().flat_map(flatten).collect(),
-        Value::Object(o) => o.values().flat_map(flatten).collect(),
-        _ => Vec::new(),
-    }
+/// The numbers of values, in the order the trace writes them (a coordinate it does not
+/// know, written null, is none).
+fn flatten(values: &[Shown]) -> Vec<f64> {
+    let point = |p: &aviary_api::Point| [Some(p.x), Some(p.y), p.z];
+    let numbers: Vec<f64> = values
+        .iter()
+        .flat_map(|v| match v {
+            Shown::Number(n) => vec![*n],
+            Shown::Position(p) => point(p).into_iter().flatten().collect(),
+            Shown::Area(corners) => corners.iter().flatten().copied().collect(),
+            Shown::Remainder(left) => match &**left {
+                Remainder::Nothing => Vec::new(),
+                Remainder::Lanes { lanes, spacing } => {
+                    lanes.iter().flatten().flatten().copied().chain([*spacing]).collect()
+                }
+                Remainder::Points(points) => points.iter().flat_map(point).flatten().collect(),
+            },
+            Shown::Text(_) | Shown::Bool(_) | Shown::Null => Vec::new(),
+        })
+        .collect();
+    numbers.into_iter().filter(|n| n.is_finite()).collect()
+}
+
+/// The calls a drone made, in the order they ended.
+fn done_by(trace: &[Record<'static>], actor: &str) -> Vec<Function> {
+    trace
+        .iter()
+        .filter_map(|e| match &e.event {
+            Event::ApiDone { actor: a, function, .. } if a == actor => Some(*function),
+            _ => None,
+        })
+        .collect()
+}
+
+/// A flight out and home: the calls that end, in order.
+const FLIGHT: [Function; 4] =
+    [Function::Arm, Function::TakeOff, Function::FlyToPosition, Function::ReturnToLaunch];
+
+/// Whether the event is of `actor`.
+fn actor_is(e: &Record, actor: &str) -> bool {
+    aviary_test_support::trace::actor(&e.event) == Some(actor)
 }
 
 fn agree(
@@ -175,31 +217,24 @@ fn the_paper_mission_over_mavlink_agrees_with_a_simulated_run() {
     let direct = events(&dir.join("direct.jsonl"));
     let mavlink = events(&live.join("t.jsonl"));
     assert_eq!(code, 0, "the mission ends ok over MAVLink: {:?}", mavlink.last());
-    assert_eq!(mavlink.last().map(|e| e["status"].clone()), Some(Value::from("ok")));
+    assert!(
+        matches!(
+            mavlink.last().map(|e| &e.event),
+            Some(Event::MissionEnd { status: aviary_api::trace::Status::Ok, .. })
+        ),
+        "{:?}",
+        mavlink.last()
+    );
     // The same signals, the same finds at the same places, the same calls with the
     // same positions (the beacons fly to where the bodies were found).
-    agree("signals", &facts(&direct, "signal", "name"), &facts(&mavlink, "signal", "name"), 0.0);
-    agree(
-        "detections",
-        &facts(&direct, "detection", "kind"),
-        &facts(&mavlink, "detection", "kind"),
-        1.0,
-    );
-    agree(
-        "calls",
-        &facts(&direct, "api_call", "function"),
-        &facts(&mavlink, "api_call", "function"),
-        1.0,
-    );
+    use EventKind::{ApiCall, ApiDone, Detection, Signal};
+    agree("signals", &facts(&direct, Signal), &facts(&mavlink, Signal), 0.0);
+    agree("detections", &facts(&direct, Detection), &facts(&mavlink, Detection), 1.0);
+    agree("calls", &facts(&direct, ApiCall), &facts(&mavlink, ApiCall), 1.0);
     // Where each call left its drone: within the arrival tolerances (1 m over the
     // ground, 0.5 m in height) and the rounding of the reported position.
-    agree(
-        "positions",
-        &facts(&direct, "api_done", "function"),
-        &facts(&mavlink, "api_done", "function"),
-        1.5,
-    );
-    assert!(mavlink.iter().all(|e| e["event"] != "exception"), "no exception over MAVLink");
+    agree("positions", &facts(&direct, ApiDone), &facts(&mavlink, ApiDone), 1.5);
+    assert!(mavlink.events(EventKind::Exception).is_empty(), "no exception over MAVLink");
 }
 
 const SMALL_MISSION: &str = "\
@@ -248,7 +283,7 @@ fn a_killed_vehicle_raises_connection_lost_within_the_heartbeat_timeout() {
         .spawn()
         .expect("spawn aviary run");
     let trace = dir.join("t.jsonl");
-    let hovering = |e: &Value| e["event"] == "api_call" && e["function"] == "Hover";
+    let hovering = |e: &Record| matches!(e.event, Event::ApiCall { function: Function::Hover, .. });
     let start = Instant::now();
     while !events(&trace).iter().any(hovering) {
         assert!(
@@ -260,9 +295,10 @@ fn a_killed_vehicle_raises_connection_lost_within_the_heartbeat_timeout() {
     }
     vehicles.child.kill().expect("kill the vehicles");
     let killed = Instant::now();
-    let lost = |e: &Value| e["event"] == "exception" && e["name"] == "ConnectionLost";
+    let lost =
+        |e: &Record| matches!(&e.event, Event::Exception { name, .. } if name == "ConnectionLost");
     let exception = loop {
-        if let Some(e) = events(&trace).into_iter().find(lost) {
+        if let Some(e) = events(&trace).0.into_iter().find(lost) {
             break e;
         }
         // The heartbeat timeout is 3 s from the last HEARTBEAT (sent each second); allow
@@ -274,8 +310,9 @@ fn a_killed_vehicle_raises_connection_lost_within_the_heartbeat_timeout() {
         );
         std::thread::sleep(Duration::from_millis(20));
     };
-    let reason = exception["args"][0].as_str().unwrap_or("");
-    assert!(reason.contains("no HEARTBEAT from system 1 for 3.0 s"), "{exception}");
+    let Event::Exception { args, .. } = &exception.event else { unreachable!() };
+    let reason = args.first().and_then(Shown::as_str).unwrap_or("");
+    assert!(reason.contains("no HEARTBEAT from system 1 for 3.0 s"), "{exception:?}");
     let status = run.wait().expect("wait");
     assert_eq!(status.code(), Some(1), "unhandled, ConnectionLost fails the mission");
 }
@@ -297,16 +334,7 @@ fn a_mixed_fleet_flies_one_drone_over_mavlink_and_one_simulated() {
     let trace = events(&dir.join("t.jsonl"));
     assert_eq!(code, 0, "{:?}", trace.last());
     for actor in ["scout", "buddy"] {
-        let done: Vec<&str> = trace
-            .iter()
-            .filter(|e| e["event"] == "api_done" && e["actor"] == actor)
-            .filter_map(|e| e["function"].as_str())
-            .collect();
-        assert_eq!(
-            done,
-            ["Arm", "TakeOff", "FlyToPosition", "ReturnToLaunch"],
-            "{actor}: {trace:?}"
-        );
+        assert_eq!(done_by(&trace, actor), FLIGHT, "{actor}: {trace:?}");
     }
 }
 
@@ -537,30 +565,42 @@ fn remainder_handover(autopilot: &str) {
     );
     let trace = events(&dir.join("t.jsonl"));
     assert_eq!(code, 0, "{:?}", trace.last());
-    let sweep = |actor: &str, event: &str| -> Value {
+    let sweep = |actor: &str, kind: EventKind| -> &Record {
         trace
             .iter()
-            .find(|e| e["event"] == event && e["actor"] == actor && e["function"] == "Sweep")
-            .cloned()
-            .unwrap_or_else(|| panic!("no {event} of {actor}'s Sweep: {trace:?}"))
+            .find(|e| {
+                e.event.kind() == kind
+                    && actor_is(e, actor)
+                    && matches!(
+                        e.event,
+                        Event::ApiCall { function: Function::Sweep, .. }
+                            | Event::ApiDone { function: Function::Sweep, .. }
+                    )
+            })
+            .unwrap_or_else(|| panic!("no {kind:?} of {actor}'s Sweep: {trace:?}"))
     };
-    let cut = sweep("scout", "api_done");
-    assert_eq!(cut["status"], "aborted");
-    assert!(cut["left"].as_f64().unwrap() > 0.0, "{cut}");
-    let stop = [cut["position"][0].as_f64().unwrap(), cut["position"][1].as_f64().unwrap()];
+    let cut = sweep("scout", EventKind::ApiDone);
+    let Event::ApiDone { status, left, position, .. } = cut.event else { unreachable!() };
+    assert_eq!(status, CallStatus::Aborted);
+    assert!(left.unwrap() > 0.0, "{cut:?}");
+    let stop = [position[0], position[1]];
     assert!((stop[1] - 50.0).abs() < 2.0 && stop[0].abs() < 12.0, "stopped near Mid: {stop:?}");
 
     // What is left: the rest of the second lane from where the scout stopped, and the third.
-    let left = sweep("buddy", "api_call")["args"][0].clone();
-    let lanes = left["lanes"].as_array().unwrap_or_else(|| panic!("lanes: {left}"));
-    assert_eq!(lanes.len(), 2, "{left}");
-    let from = [lanes[0][0][0].as_f64().unwrap(), lanes[0][0][1].as_f64().unwrap()];
+    let Event::ApiCall { args, .. } = &sweep("buddy", EventKind::ApiCall).event else {
+        unreachable!()
+    };
+    let left = &args[0];
+    let Shown::Remainder(rest) = left else { panic!("lanes: {left:?}") };
+    let Remainder::Lanes { lanes, .. } = &**rest else { panic!("lanes: {left:?}") };
+    assert_eq!(lanes.len(), 2, "{left:?}");
+    let from = lanes[0][0];
     assert_eq!(from[1], 50.0, "on the lane");
     assert!((from[0] - stop[0]).abs() < 1.5, "where the scout stopped: {from:?} {stop:?}");
-    assert_eq!(lanes[0][1], serde_json::json!([-60.0, 50.0]));
-    assert_eq!(lanes[1], serde_json::json!([[-60.0, 70.0], [60.0, 70.0]]));
-    let done = sweep("buddy", "api_done");
-    assert_eq!(done["status"], "ok");
+    assert_eq!(lanes[0][1], [-60.0, 50.0]);
+    assert_eq!(lanes[1], [[-60.0, 70.0], [60.0, 70.0]]);
+    let done = sweep("buddy", EventKind::ApiDone);
+    assert!(matches!(done.event, Event::ApiDone { status: CallStatus::Ok, .. }));
 
     // From the telemetry: the middle of every lane (away from the corners a vehicle cuts)
     // is flown; the second lane by the scout east of where it stopped and by the buddy
@@ -643,10 +683,7 @@ fn a_flight_across_a_no_fly_zone_is_sent_as_waypoints_around_it() {
     let trace = events(&dir.join("t.jsonl"));
     assert_eq!(code, 0, "{:?}", trace.last());
     let zone = [[60.0, -40.0], [140.0, -40.0], [140.0, 40.0], [60.0, 40.0]];
-    let samples: Vec<[f64; 3]> = aviary_test_support::harness::positions_in(&trace, "scout")
-        .into_iter()
-        .map(|(_, p)| p)
-        .collect();
+    let samples: Vec<[f64; 3]> = trace.positions("scout").into_iter().map(|(_, p)| p).collect();
     assert!(samples.len() > 100, "{} samples", samples.len());
     // Never in the zone, and never into its margin by more than the arrival tolerance and
     // the vehicle's overshoot: a corner passed within the pass radius (up to 25 m) instead
@@ -665,12 +702,7 @@ fn a_flight_across_a_no_fly_zone_is_sent_as_waypoints_around_it() {
     let widest = samples.iter().map(|p| p[1].abs()).fold(0.0, f64::max);
     assert!(widest >= 40.0 + aviary_route::MARGIN - 2.0, "{widest}");
     assert!(samples.iter().any(|p| (p[0] - 200.0).abs() < 2.0 && p[1].abs() < 2.0));
-    let done: Vec<&str> = trace
-        .iter()
-        .filter(|e| e["event"] == "api_done" && e["actor"] == "scout")
-        .filter_map(|e| e["function"].as_str())
-        .collect();
-    assert_eq!(done, ["Arm", "TakeOff", "FlyToPosition", "ReturnToLaunch"], "{trace:?}");
+    assert_eq!(done_by(&trace, "scout"), FLIGHT, "{trace:?}");
 }
 
 /// The hop mission that first failed on PX4 SITL (PX4 read FlyTo's height above home as
@@ -696,18 +728,20 @@ fn the_hop_mission_flies_on_px4_vehicles_with_heights_above_sea_level() {
     );
     let trace = events(&dir.join("t.jsonl"));
     assert_eq!(code, 0, "{:?}", trace.last());
-    let done = |function: &str| {
+    let done = |function: Function| {
         trace
             .iter()
-            .find(|e| e["event"] == "api_done" && e["function"] == function)
-            .map(|e| flatten(&e["position"]))
-            .unwrap_or_else(|| panic!("no {function} done: {trace:?}"))
+            .find_map(|e| match e.event {
+                Event::ApiDone { function: f, position, .. } if f == function => Some(position),
+                _ => None,
+            })
+            .unwrap_or_else(|| panic!("no {function:?} done: {trace:?}"))
     };
-    let there = done("FlyToPosition");
+    let there = done(Function::FlyToPosition);
     assert!((there[0] - 30.0).hypot(there[1] - 30.0) < 1.5 && (there[2] - 12.0).abs() < 1.0);
-    let around = done("Orbit");
+    let around = done(Function::Orbit);
     assert!(((around[0] - 30.0).hypot(around[1] - 30.0) - 15.0).abs() < 3.0, "{around:?}");
-    assert!(done("Land")[2] < 0.3);
+    assert!(done(Function::Land)[2] < 0.3);
 }
 
 /// What PX4 SITL taught, held without it: PX4 acknowledges a DO_REPOSITION outside its
@@ -740,17 +774,17 @@ fn a_target_px4_refuses_in_words_fails_the_call_with_them_at_once() {
     assert_eq!(code, 0, "{:?}", trace.last());
     let refused = trace
         .iter()
-        .find(|e| e["event"] == "exception" && e["name"] == "CommandFailed")
+        .find(|e| matches!(&e.event, Event::Exception { name, .. } if name == "CommandFailed"))
         .unwrap_or_else(|| panic!("no CommandFailed: {trace:?}"));
-    let said = refused["args"].to_string();
+    let said = common::background::said(refused);
     assert!(said.contains("Reposition is outside geofence"), "PX4's words in {said}");
     let sent = trace
         .iter()
-        .find(|e| e["event"] == "api_call" && e["function"] == "FlyToPosition")
+        .find(|e| matches!(e.event, Event::ApiCall { function: Function::FlyToPosition, .. }))
         .expect("the flight out");
-    let took = refused["t"].as_f64().unwrap() - sent["t"].as_f64().unwrap();
+    let took = refused.t - sent.t;
     assert!(took < 5.0, "refused {took:.1} s after it was sent");
-    assert!(trace.iter().any(|e| e["event"] == "signal" && e["name"] == "Refused"));
+    assert!(common::background::signalled(&trace, "Refused"));
 }
 
 /// A PX4 path paused half way and resumed: the vehicle holds where it was (PX4's HOLD),
@@ -777,12 +811,12 @@ fn a_px4_path_paused_holds_and_resumed_flies_on_to_its_end() {
     let leash = |action: &str| {
         trace
             .iter()
-            .find(|e| e["event"] == "leash" && e["action"] == action)
-            .and_then(|e| e["t"].as_f64())
+            .find(|e| matches!(&e.event, Event::Leash { action: a, .. } if a == action))
+            .map(|e| e.t)
             .unwrap_or_else(|| panic!("no {action}: {trace:?}"))
     };
     let (paused, resumed) = (leash("PAUSE"), leash("RESUME"));
-    let track: Vec<(f64, [f64; 3])> = aviary_test_support::harness::positions_in(&trace, "copter");
+    let track: Vec<(f64, [f64; 3])> = trace.positions("copter");
     // Held: from 5 s after the PAUSE (braking) to the RESUME, within 2 m of one place.
     let held: Vec<[f64; 3]> =
         track.iter().filter(|(t, _)| *t > paused + 5.0 && *t < resumed).map(|(_, p)| *p).collect();
@@ -803,8 +837,8 @@ fn a_px4_path_paused_holds_and_resumed_flies_on_to_its_end() {
     }
     let done = trace
         .iter()
-        .find(|e| e["event"] == "api_done" && e["function"] == "FollowPath")
+        .find(|e| matches!(e.event, Event::ApiDone { function: Function::FollowPath, .. }))
         .expect("the path's end");
-    assert_eq!(done["status"], "ok", "{done}");
-    assert!(done["t"].as_f64().unwrap() > resumed);
+    assert!(matches!(done.event, Event::ApiDone { status: CallStatus::Ok, .. }), "{done:?}");
+    assert!(done.t > resumed);
 }

@@ -10,32 +10,23 @@ use std::process::{Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
+use aviary_api::trace::{CallStatus, Event, EventKind, Record, Shown};
+use aviary_api::Function;
+use aviary_test_support::trace::{actor, is, Trace};
 use common::{aviary, repo, scratch};
 use serde_json::Value;
 
-fn read_trace(path: &std::path::Path) -> Vec<Value> {
-    std::fs::read_to_string(path)
-        .expect("the trace")
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("a trace line is JSON"))
-        .collect()
+fn read_trace(path: &std::path::Path) -> Trace {
+    Trace::read(path)
 }
 
-fn t(e: &Value) -> f64 {
-    e["t"].as_f64().expect("t")
-}
-
-fn xyz(v: &Value) -> [f64; 3] {
-    [0, 1, 2].map(|i| v[i].as_f64().expect("a coordinate"))
+fn t(e: &Record) -> f64 {
+    e.t
 }
 
 /// Telemetry of one drone: (t, position).
-fn track(trace: &[Value], drone: &str) -> Vec<(f64, [f64; 3])> {
-    trace
-        .iter()
-        .filter(|e| e["event"] == "telemetry" && e["actor"] == drone)
-        .map(|e| (t(e), xyz(&e["position"])))
-        .collect()
+fn track(trace: &Trace, drone: &str) -> Vec<(f64, [f64; 3])> {
+    trace.positions(drone)
 }
 
 /// How far a point is, over the ground, from the segment `a`–`b`.
@@ -77,33 +68,28 @@ fn the_reserve_takes_over_the_tired_drones_side_and_it_is_never_unwatched() {
     let trace = read_trace(&trace_path);
 
     // BatteryLow of east_watch, heard inside its patrol (the capability's own handler).
-    let low = trace
-        .iter()
-        .find(|e| e["event"] == "signal" && e["name"] == "BatteryLow")
-        .expect("a BatteryLow");
-    assert_eq!(low["actor"], "east_watch", "only east_watch started the day half charged");
-    let heard = trace
-        .iter()
-        .find(|e| e["event"] == "handler_start" && e["signal"] == "BatteryLow")
-        .expect("the patrol hears it");
-    assert_eq!((heard["handler"].as_str(), t(heard)), (Some("Watch_Side/ON BatteryLow"), t(low)));
+    let low = trace.first(is::signal("BatteryLow"));
+    assert_eq!(
+        actor(&low.event),
+        Some("east_watch"),
+        "only east_watch started the day half charged"
+    );
+    let heard = trace.first(is::handler_start("BatteryLow"));
+    let Event::HandlerStart { handler, .. } = &heard.event else { unreachable!() };
+    assert_eq!((&**handler, t(heard)), ("Watch_Side/ON BatteryLow", t(low)));
 
     // The reserve takes over the east side after that, and flies it end to end.
-    let takes_over = trace
-        .iter()
-        .find(|e| {
-            e["event"] == "capability_start"
-                && e["actor"] == "reserve"
-                && e["capability"] == "Watch_Side"
-        })
-        .expect("the reserve watches a side");
+    let takes_over = trace.first(|e| {
+        matches!(e, Event::CapabilityStart { actor, capability, .. }
+            if actor == "reserve" && capability == "Watch_Side")
+    });
     assert!(t(takes_over) > t(low));
-    let xy = |v: &Value| [0, 1].map(|i| v[i].as_f64().expect("a coordinate"));
-    assert_eq!(
-        (xy(&takes_over["args"]["from"]), xy(&takes_over["args"]["to"])),
-        (NE, SE),
-        "the tired drone's side"
-    );
+    let Event::CapabilityStart { args, .. } = &takes_over.event else { unreachable!() };
+    let xy = |name: &str| match args.get(name) {
+        Some(Shown::Position(p)) => [p.x, p.y],
+        other => panic!("{name}: not a position: {other:?}"),
+    };
+    assert_eq!((xy("from"), xy("to")), (NE, SE), "the tired drone's side");
     let reserve = track(&trace, "reserve");
     let passes = |corner: [f64; 2]| {
         reserve
@@ -113,18 +99,11 @@ fn the_reserve_takes_over_the_tired_drones_side_and_it_is_never_unwatched() {
     assert!(passes(NE) && passes(SE), "the reserve flies the side from end to end");
 
     // The tired drone goes home once the reserve is there, and lands.
-    let on_station = trace
-        .iter()
-        .find(|e| e["event"] == "signal" && e["name"] == "Relief_On_Station")
-        .expect("the reserve reports on station");
-    let home_start = trace
-        .iter()
-        .find(|e| {
-            e["event"] == "capability_start"
-                && e["actor"] == "east_watch"
-                && e["capability"] == "ReturnHome"
-        })
-        .expect("east_watch goes home");
+    let on_station = trace.first(is::signal("Relief_On_Station"));
+    let home_start = trace.first(|e| {
+        matches!(e, Event::CapabilityStart { actor, capability, .. }
+            if actor == "east_watch" && capability == "ReturnHome")
+    });
     assert_eq!(t(home_start), t(on_station), "relieved on the spot");
     let east = track(&trace, "east_watch");
     let (_, last) = east.last().expect("east_watch's telemetry");
@@ -186,9 +165,12 @@ fn the_operator_holds_the_bridge_inspection_30_s_then_it_finishes() {
     let stream = events.stdout.take().expect("stdout");
     std::thread::spawn(move || {
         for line in BufReader::new(stream).lines().map_while(Result::ok) {
-            let e: Value = serde_json::from_str(&line).unwrap_or_default();
-            let slow = e["args"].as_array().is_some_and(|a| a.len() == 2);
-            if e["event"] == "api_call" && e["function"] == "FlyToPosition" && slow {
+            let e: Option<Record> = serde_json::from_str(&line).ok();
+            let slow_pass = e.is_some_and(|e| {
+                matches!(&e.event, Event::ApiCall { function: Function::FlyToPosition, args, .. }
+                    if args.len() == 2)
+            });
+            if slow_pass {
                 let _ = seen.send(());
             }
         }
@@ -212,12 +194,10 @@ fn the_operator_holds_the_bridge_inspection_30_s_then_it_finishes() {
     let _ = events.wait();
 
     let trace = read_trace(&dir.join("t.jsonl"));
-    let leash = trace
-        .iter()
-        .find(|e| e["event"] == "leash" && e["action"] == "Hold_For_Traffic")
-        .expect("the operator's leash is in the trace");
+    let leash =
+        trace.first(|e| matches!(e, Event::Leash { action, .. } if action == "Hold_For_Traffic"));
     let t0 = t(leash);
-    let hover: Vec<&Value> = trace.iter().filter(|e| e["function"] == "Hover").collect();
+    let hover = trace.find(|e| is::call(Function::Hover)(e) || is::done(Function::Hover)(e));
     assert_eq!(hover.len(), 2, "the section's hover, made and done");
     assert_eq!(t(hover[0]), t0, "the section starts at once");
     assert!((t(hover[1]) - (t0 + HOLD)).abs() < 1e-6, "and holds 30 s");
@@ -239,19 +219,24 @@ fn the_operator_holds_the_bridge_inspection_30_s_then_it_finishes() {
     assert!(inspector.get(from + still).is_some(), "the inspection goes on after the hold");
 
     // And the inspection finished: every leg flown, none failed, the whole pass and back.
-    assert!(trace.iter().all(|e| e["event"] != "exception"), "nothing failed");
-    let legs: Vec<&Value> = trace
+    assert!(trace.events(EventKind::Exception).is_empty(), "nothing failed");
+    let legs: Vec<(f64, CallStatus, [f64; 3])> = trace
         .iter()
-        .filter(|e| e["event"] == "api_done" && e["function"] == "FlyToPosition")
+        .filter_map(|e| match e.event {
+            Event::ApiDone { function: Function::FlyToPosition, status, position, .. } => {
+                Some((e.t, status, position))
+            }
+            _ => None,
+        })
         .collect();
     assert_eq!(legs.len(), 4);
-    assert!(legs.iter().all(|e| e["status"] == "ok"));
-    assert_eq!(xyz(&legs[1]["position"]), [150.0, 20.0, 12.0], "the held pass reached its end");
-    assert_eq!(xyz(&legs[3]["position"]), [-150.0, -20.0, 12.0], "and the pass back");
-    assert!(t(legs[1]) > t0 + HOLD);
-    let inspected = trace
-        .iter()
-        .find(|e| e["event"] == "capability_end" && e["capability"] == "Inspect_Bridge")
-        .expect("the inspection ends");
-    assert_eq!(inspected["status"], "ok");
+    assert!(legs.iter().all(|e| e.1 == CallStatus::Ok));
+    assert_eq!(legs[1].2, [150.0, 20.0, 12.0], "the held pass reached its end");
+    assert_eq!(legs[3].2, [-150.0, -20.0, 12.0], "and the pass back");
+    assert!(legs[1].0 > t0 + HOLD);
+    let inspected = trace.first(is::end_of("Inspect_Bridge"));
+    assert!(matches!(
+        inspected.event,
+        Event::CapabilityEnd { status: aviary_api::trace::Status::Ok, .. }
+    ));
 }

@@ -4,8 +4,9 @@
 
 mod common;
 
+use aviary_api::trace::{Event, Status};
+use aviary_test_support::trace::Trace;
 use common::{repo, scratch};
-use serde_json::Value;
 
 #[test]
 fn the_wildfire_example_flies_around_the_fire_and_over_the_corridor_never_into_a_zone() {
@@ -22,18 +23,15 @@ fn the_wildfire_example_flies_around_the_fire_and_over_the_corridor_never_into_a
     let (world, diagnostics) = aviary_world::parse_world(aviary_diagnostics::FileId(0), &text);
     let world = world.unwrap_or_else(|| panic!("{diagnostics:?}"));
     assert_eq!(world.no_fly.len(), 2);
-    let events: Vec<Value> = std::fs::read_to_string(&trace)
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    let events = Trace::read(&trace);
     let samples: Vec<(String, [f64; 3])> = events
         .iter()
-        .filter(|e| e["event"] == "telemetry")
-        .map(|e| {
-            let p = &e["position"];
-            let at = [0, 1, 2].map(|k| p[k].as_f64().unwrap());
-            (e["actor"].as_str().unwrap().to_string(), at)
+        .filter_map(|e| match &e.event {
+            Event::Telemetry { actor, position, .. } => {
+                assert!(position.iter().all(|c| c.is_finite()), "{e:?}");
+                Some((actor.to_string(), *position))
+            }
+            _ => None,
         })
         .collect();
     // 20 Hz over about 340 s, for two drones.
@@ -58,7 +56,7 @@ fn the_wildfire_example_flies_around_the_fire_and_over_the_corridor_never_into_a
     // scout2 crossed the corridor's ground, above it.
     let over = samples.iter().filter(|(d, p)| d == "scout2" && (250.0..=350.0).contains(&p[1]));
     assert!(over.clone().count() > 0 && over.clone().all(|(_, p)| p[2] > 60.0));
-    assert_eq!(events.last().unwrap()["status"], "ok");
+    assert!(matches!(events.last().unwrap().event, Event::MissionEnd { status: Status::Ok, .. }));
 
     // The report's map draws the zones, named, the one up to a height with it.
     let html = dir.join("report.html");

@@ -25,6 +25,8 @@ use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
+use aviary_api::trace::{Event, Status};
+use aviary_test_support::trace::{is, Trace};
 use common::{aviary, scratch};
 
 const WORLD: &str =
@@ -113,50 +115,24 @@ fn a_leash_round_trip_through_the_server() {
     assert_eq!(ctl(&url, Some(&token), &["leash", "FlyTo-F1", "ABORT"], &dir).0, 0);
     assert_eq!(child.wait().unwrap().code(), Some(0), "an aborted activity leaves the mission ok");
 
-    let trace: Vec<serde_json::Value> = std::fs::read_to_string(dir.join("t.jsonl"))
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
-    let at = |action: &str| {
-        trace
-            .iter()
-            .find(|e| e["event"] == "leash" && e["action"] == action)
-            .unwrap_or_else(|| panic!("no {action}"))["t"]
-            .as_f64()
-            .unwrap()
-    };
+    let trace = Trace::read(&dir.join("t.jsonl"));
+    let at = |action: &str| trace.t(|e| matches!(e, Event::Leash { action: a, .. } if a == action));
     let (paused, resumed, aborted) = (at("PAUSE"), at("RESUME"), at("ABORT"));
-    let held: Vec<&serde_json::Value> = trace
-        .iter()
-        .filter(|e| {
-            e["event"] == "telemetry"
-                && e["actor"] == "a"
-                && e["t"].as_f64().unwrap() > paused + 0.3
-                && e["t"].as_f64().unwrap() < resumed
-        })
-        .map(|e| &e["position"])
-        .collect();
+    let track = trace.positions("a");
+    let held: Vec<[f64; 3]> =
+        track.iter().filter(|(t, _)| *t > paused + 0.3 && *t < resumed).map(|(_, p)| *p).collect();
     assert!(
         held.len() >= 10 && held.iter().all(|p| *p == held[0]),
         "pause holds the drone: {held:?}"
     );
-    let moved = trace
+    let moved = track
         .iter()
-        .filter(|e| {
-            e["event"] == "telemetry"
-                && e["actor"] == "a"
-                && e["t"].as_f64().unwrap() > resumed + 0.5
-                && e["t"].as_f64().unwrap() < aborted
-        })
-        .any(|e| e["position"] != *held[0]);
+        .filter(|(t, _)| *t > resumed + 0.5 && *t < aborted)
+        .any(|(_, p)| *p != held[0]);
     assert!(moved, "resume goes on");
-    let end = trace
-        .iter()
-        .find(|e| e["event"] == "capability_end" && e["capability"] == "FlyTo")
-        .unwrap();
-    assert_eq!(end["status"], "aborted");
-    assert!(end["t"].as_f64().unwrap() >= aborted);
+    let end = trace.first(is::end_of("FlyTo"));
+    assert!(matches!(end.event, Event::CapabilityEnd { status: Status::Aborted, .. }));
+    assert!(end.t >= aborted);
 
     let (code, streamed, _) = events.join().unwrap();
     assert_eq!(code, 0);

@@ -8,8 +8,10 @@
 
 mod common;
 
+use aviary_api::trace::{CallStatus, Event, Shown, Status};
+use aviary_api::{Function, Point};
+use aviary_test_support::trace::{actor, is, Trace};
 use common::{aviary, repo, scratch};
-use serde_json::Value;
 
 const MISSION: &str = "examples/parcel_delivery.mission";
 
@@ -25,58 +27,54 @@ fn a_failed_couriers_parcel_goes_with_the_nearest_free_courier() {
     let (code, out, err) =
         aviary(&["run", MISSION, "--quiet", "--trace", &trace.to_string_lossy()], &repo());
     assert_eq!(code, 0, "runs to its end: {out}{err}");
-    let events: Vec<Value> = std::fs::read_to_string(&trace)
-        .expect("the trace")
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("a trace line"))
-        .collect();
-    assert_eq!(events.last().unwrap()["status"], "ok");
+    let events = Trace::read(&trace);
+    assert!(matches!(events.last().unwrap().event, Event::MissionEnd { status: Status::Ok, .. }));
 
     // Each Deliver: (courier, destination, start, end, status).
-    let delivers: Vec<(&str, Value, f64, f64, &str)> = events
-        .iter()
-        .filter(|e| e["event"] == "capability_start" && e["capability"] == "Deliver")
+    let delivers: Vec<(&str, Option<&Shown>, f64, f64, Status)> = events
+        .find(is::start_of("Deliver"))
+        .into_iter()
         .map(|s| {
-            let end = events
+            let Event::CapabilityStart { actor: courier, args, .. } = &s.event else {
+                unreachable!()
+            };
+            let (t, status) = events
                 .iter()
-                .find(|e| {
-                    e["event"] == "capability_end"
-                        && e["capability"] == "Deliver"
-                        && e["actor"] == s["actor"]
-                        && e["t"].as_f64() >= s["t"].as_f64()
+                .find_map(|e| match &e.event {
+                    Event::CapabilityEnd { capability, actor, status, .. }
+                        if capability == "Deliver" && actor == courier && e.t >= s.t =>
+                    {
+                        Some((e.t, *status))
+                    }
+                    _ => None,
                 })
                 .expect("every delivery ends");
-            (
-                s["actor"].as_str().unwrap(),
-                s["args"]["destination"].clone(),
-                s["t"].as_f64().unwrap(),
-                end["t"].as_f64().unwrap(),
-                end["status"].as_str().unwrap(),
-            )
+            (&**courier, args.get("destination"), s.t, t, status)
         })
         .collect();
-    let farm = serde_json::json!([600.0, 300.0]);
-    let clinic = serde_json::json!([-500.0, 400.0]);
+    let place = |x: f64, y: f64| Shown::Position(Point { x, y, z: None });
+    let (farm, clinic) = (place(600.0, 300.0), place(-500.0, 400.0));
+    let (farm, clinic) = (Some(&farm), Some(&clinic));
     // At the start the two nearest to the depot take the parcels, in the order asked.
     assert_eq!((delivers[0].0, &delivers[0].1, delivers[0].2), ("courier1", &farm, 0.0));
     assert_eq!((delivers[1].0, &delivers[1].1, delivers[1].2), ("courier2", &clinic, 0.0));
     // courier1's motor fails at 30 s; at that instant the farm's parcel goes with the
     // nearest courier free at the depot: courier4 (courier2 is busy, courier3 at the hub).
-    let failure = events
-        .iter()
-        .find(|e| e["event"] == "exception" && e["name"] == "MotorFailure")
-        .expect("the motor failure");
-    assert_eq!((failure["actor"].as_str(), failure["t"].as_f64()), (Some("courier1"), Some(30.0)));
+    let failure = events.first(is::exception("MotorFailure"));
+    assert_eq!((actor(&failure.event), failure.t), (Some("courier1"), 30.0));
     assert_eq!(delivers.len(), 3, "{delivers:?}");
     assert_eq!((delivers[2].0, &delivers[2].1, delivers[2].2), ("courier4", &farm, 30.0));
-    assert_eq!(delivers[2].4, "ok");
+    assert_eq!(delivers[2].4, Status::Ok);
     // Both parcels were released at their destination, each by the courier that got there.
     let released: Vec<&str> = events
-        .iter()
-        .filter(|e| {
-            e["event"] == "api_done" && e["function"] == "ReleasePayload" && e["status"] == "ok"
+        .find(|e| {
+            matches!(
+                e,
+                Event::ApiDone { function: Function::ReleasePayload, status: CallStatus::Ok, .. }
+            )
         })
-        .map(|e| e["actor"].as_str().unwrap())
+        .into_iter()
+        .map(|e| actor(&e.event).unwrap())
         .collect();
     assert_eq!(released, ["courier2", "courier4"]);
     // No courier carries two deliveries at once; courier3 is never taken.

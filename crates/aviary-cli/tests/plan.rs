@@ -4,6 +4,9 @@
 
 mod common;
 
+use aviary_api::trace::{Event, EventKind, Params, Shown, Status};
+use aviary_api::Point;
+use aviary_test_support::trace::Trace;
 use common::{aviary, repo, scratch, PAPER_DRONES};
 
 /// Per drone: (distance m, flight s), from the summary `aviary run` prints.
@@ -99,29 +102,37 @@ fn the_plan_agrees_with_simulated_runs_of_the_preflight_fixtures() {
     }
 }
 
-/// `(start, end)` of each activity of `actor` running `capability` with `args`, in order.
+/// `(start, end)` of each activity of `actor` running `capability` with `args` (by name,
+/// in any order), in order.
 fn activities(
     trace: &str,
     actor: &str,
     capability: &str,
-    args: &serde_json::Value,
+    args: &[(&str, Shown)],
 ) -> Vec<(f64, f64)> {
-    let events: Vec<serde_json::Value> =
-        trace.lines().map(|l| serde_json::from_str(l).expect("JSON line")).collect();
-    let mine = |e: &&serde_json::Value| {
-        e["actor"] == actor && e["capability"] == capability && e["args"] == *args
+    let events = Trace::parse(trace);
+    let same = |given: &Params| {
+        given.0.len() == args.len() && args.iter().all(|(k, v)| given.get(k) == Some(v))
     };
-    let starts = events
-        .iter()
-        .filter(|e| e["event"] == "capability_start")
-        .filter(mine)
-        .map(|e| e["t"].as_f64().expect("t"));
-    let ends = events
-        .iter()
-        .filter(|e| e["event"] == "capability_end")
-        .filter(mine)
-        .map(|e| e["t"].as_f64().expect("t"));
+    let mine = |a: &str, c: &str, given: &Params| a == actor && c == capability && same(given);
+    let starts = events.iter().filter_map(|e| match &e.event {
+        Event::CapabilityStart { actor, capability, args, .. } if mine(actor, capability, args) => {
+            Some(e.t)
+        }
+        _ => None,
+    });
+    let ends = events.iter().filter_map(|e| match &e.event {
+        Event::CapabilityEnd { actor, capability, args, .. } if mine(actor, capability, args) => {
+            Some(e.t)
+        }
+        _ => None,
+    });
     starts.zip(ends).collect()
+}
+
+/// `FlyTo`'s values: to a place, at the drone's own speed.
+fn fly_to(x: f64, y: f64) -> [(&'static str, Shown<'static>); 2] {
+    [("target", Shown::Position(Point { x, y, z: None })), ("speed", Shown::Number(0.0))]
 }
 
 #[test]
@@ -142,18 +153,8 @@ fn what_n303_says_waits_does_wait_in_the_engine() {
     );
     assert_eq!(code, 0, "{err}");
     let trace = std::fs::read_to_string(&trace).expect("trace");
-    let flow = activities(
-        &trace,
-        "scout1",
-        "FlyTo",
-        &serde_json::json!({ "target": [300.0, 0.0], "speed": 0.0 }),
-    );
-    let handler = activities(
-        &trace,
-        "scout1",
-        "FlyTo",
-        &serde_json::json!({ "target": [0.0, 300.0], "speed": 0.0 }),
-    );
+    let flow = activities(&trace, "scout1", "FlyTo", &fly_to(300.0, 0.0));
+    let handler = activities(&trace, "scout1", "FlyTo", &fly_to(0.0, 300.0));
     assert_eq!((flow.len(), handler.len()), (1, 1), "{trace}");
     assert!(
         handler[0].0 >= flow[0].1,
@@ -189,16 +190,17 @@ fn each_on_every_firing_waits_for_the_last_one_in_the_engine() {
     );
     assert_eq!(code, 0, "{err}");
     let trace = std::fs::read_to_string(&trace).expect("trace");
-    let events: Vec<serde_json::Value> =
-        trace.lines().map(|l| serde_json::from_str(l).expect("JSON line")).collect();
-    let of = |kind: &str| -> Vec<f64> {
-        events
-            .iter()
-            .filter(|e| e["event"] == kind && e["capability"] == "Deliver")
-            .map(|e| e["t"].as_f64().expect("t"))
-            .collect()
-    };
-    let (starts, ends) = (of("capability_start"), of("capability_end"));
+    let events = Trace::parse(&trace);
+    let starts: Vec<f64> = events
+        .find(|e| matches!(e, Event::CapabilityStart { capability, .. } if capability == "Deliver"))
+        .iter()
+        .map(|e| e.t)
+        .collect();
+    let ends: Vec<f64> = events
+        .find(|e| matches!(e, Event::CapabilityEnd { capability, .. } if capability == "Deliver"))
+        .iter()
+        .map(|e| e.t)
+        .collect();
     assert_eq!(starts.len(), 2, "one delivery per target: {starts:?}");
     assert!(
         starts[1] >= ends[0],
@@ -345,15 +347,10 @@ fn a_recursion_that_never_ends_in_flight_fails_the_mission_with_command_failed_n
         "{out}{err}"
     );
     let trace = std::fs::read_to_string(dir.join("rec.jsonl")).expect("trace");
-    let events: Vec<serde_json::Value> =
-        trace.lines().map(|l| serde_json::from_str(l).expect("JSON")).collect();
-    assert_eq!(events.iter().filter(|e| e["event"] == "capability_start").count(), 10_000);
+    let events = Trace::parse(&trace);
+    assert_eq!(events.events(EventKind::CapabilityStart).len(), 10_000);
     let last = events.last().expect("events");
-    assert_eq!(
-        (last["event"].as_str(), last["status"].as_str()),
-        (Some("mission_end"), Some("failed")),
-        "{last}"
-    );
+    assert!(matches!(last.event, Event::MissionEnd { status: Status::Failed, .. }), "{last:?}");
 }
 
 #[test]

@@ -7,11 +7,12 @@
 
 mod common;
 
+use aviary_api::trace::{Event, EventKind, Record};
+use aviary_api::Function;
 use common::background::{events, pos};
 use common::px4::{Px4, ORIGIN};
 use common::sitl::{Sitl, BIG_BATTERY};
 use common::{aviary, scratch};
-use serde_json::Value;
 
 /// A world of PX4 copters, each `(name, vehicle)` at its home.
 fn world(copters: &[(&str, [f64; 2], &Px4)], extra: &str) -> String {
@@ -31,13 +32,28 @@ fn world(copters: &[(&str, [f64; 2], &Px4)], extra: &str) -> String {
     w
 }
 
-/// The `api_done` of `function`, the first after `after` events.
-fn done<'a>(events: &'a [Value], function: &str) -> (usize, &'a Value) {
+/// The first `api_done` of `function`: its index, and it.
+fn done<'a>(events: &'a [Record<'static>], function: Function) -> (usize, &'a Record<'static>) {
     events
         .iter()
         .enumerate()
-        .find(|(_, e)| e["event"] == "api_done" && e["function"] == function)
-        .unwrap_or_else(|| panic!("no {function} done in {events:?}"))
+        .find(|(_, e)| matches!(&e.event, Event::ApiDone { function: f, .. } if *f == function))
+        .unwrap_or_else(|| panic!("no {function:?} done in {events:?}"))
+}
+
+/// Where a call left its drone (an `api_done`), or a find was made (a `detection`), or a
+/// drone was (`telemetry`).
+fn at(e: &Record) -> [f64; 3] {
+    match e.event {
+        Event::ApiDone { position, .. } | Event::Telemetry { position, .. } => pos(position),
+        Event::Detection { location, .. } => pos(location),
+        ref other => panic!("no position in {other:?}"),
+    }
+}
+
+/// Whether an event is a drone's telemetry.
+fn telemetry(e: &&Record) -> bool {
+    e.event.kind() == EventKind::Telemetry
 }
 
 /// The hop mission a PX4 user tried first: PX4 took off, then came down to land on the
@@ -65,18 +81,18 @@ fn the_hop_mission_takes_off_flies_orbits_and_lands() {
         aviary(&["run", "m.mission", "--trace", "t.jsonl", "--telemetry-hz", "4"], &dir);
     assert_eq!(code, 0, "{out}{err}\nsee {}", dir.display());
     let flown = events(&dir.join("t.jsonl"));
-    let (_, up) = done(&flown, "TakeOff");
-    assert!((pos(&up["position"])[2] - 12.0).abs() < 1.0, "{up}");
-    let (_, there) = done(&flown, "FlyToPosition");
-    let p = pos(&there["position"]);
-    assert!((p[0] - 30.0).hypot(p[1] - 30.0) < 2.0 && (p[2] - 12.0).abs() < 1.5, "{there}");
+    let (_, up) = done(&flown, Function::TakeOff);
+    assert!((at(up)[2] - 12.0).abs() < 1.0, "{up:?}");
+    let (_, there) = done(&flown, Function::FlyToPosition);
+    let p = at(there);
+    assert!((p[0] - 30.0).hypot(p[1] - 30.0) < 2.0 && (p[2] - 12.0).abs() < 1.5, "{there:?}");
     // Around the circle: once on it, within 3 m of its radius, through every quarter.
-    let (start, _) = done(&flown, "FlyToPosition");
-    let (end, _) = done(&flown, "Orbit");
+    let (start, _) = done(&flown, Function::FlyToPosition);
+    let (end, _) = done(&flown, Function::Orbit);
     let on: Vec<[f64; 3]> = flown[start..end]
         .iter()
-        .filter(|e| e["event"] == "telemetry")
-        .map(|e| pos(&e["position"]))
+        .filter(telemetry)
+        .map(at)
         .skip_while(|p| ((p[0] - 30.0).hypot(p[1] - 30.0) - 15.0).abs() > 3.0)
         .collect();
     assert!(on.len() > 20, "too few positions on the circle: {on:?}");
@@ -88,15 +104,14 @@ fn the_hop_mission_takes_off_flies_orbits_and_lands() {
     let mut seen = [false; 4];
     on.iter().for_each(|p| seen[quarter(p)] = true);
     assert_eq!(seen, [true; 4], "the orbit went all the way round: {on:?}");
-    let (_, down) = done(&flown, "Land");
-    assert!(pos(&down["position"])[2] < 0.5, "{down}");
+    let (_, down) = done(&flown, Function::Land);
+    assert!(at(down)[2] < 0.5, "{down:?}");
     assert!(out.contains("mission ok"), "{out}");
     // PX4's own flight log (ULog, from arming to disarming): every position of the trace
     // lies within 2.5 m of one PX4 logged.
     let log = px4.logs().pop().expect("PX4 wrote a flight log");
     let logged = common::logs::logged_positions(&log, ORIGIN);
-    let flown: Vec<[f64; 3]> =
-        flown.iter().filter(|e| e["event"] == "telemetry").map(|e| pos(&e["position"])).collect();
+    let flown: Vec<[f64; 3]> = flown.iter().filter(telemetry).map(at).collect();
     let (off, at) = common::logs::farthest_from_log(&flown, &logged);
     assert!(off < 2.5, "the trace's {at:?} is {off:.1} m from anything in {}", log.display());
 }
@@ -130,15 +145,11 @@ fn a_path_and_a_sweep_are_flown_through_as_px4_missions() {
     assert_eq!(code, 0, "{out}{err}\nsee {}", dir.display());
     let flown = events(&dir.join("t.jsonl"));
     let samples = |from: usize, to: usize| -> Vec<(f64, [f64; 3])> {
-        flown[from..to]
-            .iter()
-            .filter(|e| e["event"] == "telemetry")
-            .map(|e| (e["t"].as_f64().expect("t"), pos(&e["position"])))
-            .collect()
+        flown[from..to].iter().filter(telemetry).map(|e| (e.t, at(e))).collect()
     };
-    let (path_end, _) = done(&flown, "FollowPath");
-    let (sweep_end, _) = done(&flown, "Sweep");
-    let path = samples(done(&flown, "TakeOff").0, path_end);
+    let (path_end, _) = done(&flown, Function::FollowPath);
+    let (sweep_end, _) = done(&flown, Function::Sweep);
+    let path = samples(done(&flown, Function::TakeOff).0, path_end);
     // Through the bends at (60, 0) and (100, 40), close to each (point by point, the
     // drone turned up to its pass radius, 25 m, before them), and never stopped: from
     // 20 m out of the start to 20 m before the end, at least 0.5 m/s over any second
@@ -261,20 +272,20 @@ fn paper_mission(tag: &str, px4: &[&str], arducopter: &[&str]) {
         "the same signals and finds"
     );
     let finds: Vec<[f64; 3]> =
-        flown.iter().filter(|e| e["event"] == "detection").map(|e| pos(&e["location"])).collect();
-    let drops: Vec<&Value> = flown
+        flown.iter().filter(|e| e.event.kind() == EventKind::Detection).map(at).collect();
+    let drops: Vec<&Record> = flown
         .iter()
-        .filter(|e| e["event"] == "api_done" && e["function"] == "ReleasePayload")
+        .filter(|e| matches!(e.event, Event::ApiDone { function: Function::ReleasePayload, .. }))
         .collect();
     assert_eq!(drops.len(), finds.len(), "a beacon for every find");
     for drop in drops {
-        let at = pos(&drop["position"]);
+        let at = at(drop);
         let near =
             finds.iter().map(|f| (f[0] - at[0]).hypot(f[1] - at[1])).fold(f64::INFINITY, f64::min);
         assert!(
             near <= 5.0,
-            "{} dropped its beacon {near:.1} m from the nearest find",
-            drop["actor"]
+            "{:?} dropped its beacon {near:.1} m from the nearest find",
+            aviary_test_support::trace::actor(&drop.event)
         );
     }
     let real: Vec<&str> = px4.iter().chain(arducopter).copied().collect();
@@ -291,7 +302,7 @@ mod single {
 
     use super::*;
     use aviary_mavlink::mavlink::dialects::ardupilotmega as mav;
-    use common::background::{airborne, exception, finish, named, start_run, Run};
+    use common::background::{airborne, exception, finish, said, signalled, start_run, Run};
     use common::sitl::{wait_until, Gcs};
 
     /// A copter `d` at home (0, 0), set up by the test's ground station (`before`), and
@@ -314,10 +325,13 @@ mod single {
     }
 
     /// The exception `name`, raised on `d` and handled, with PX4's own action before it.
-    fn caught<'a>(flown: &'a [Value], name: &str, out: &str) -> &'a Value {
+    fn caught<'a>(flown: &'a [Record<'static>], name: &str, out: &str) -> &'a Record<'static> {
         let e = exception(flown, name).unwrap_or_else(|| panic!("no {name}:\n{out}"));
-        assert_eq!((e["actor"].as_str(), e["handled"].as_bool()), (Some("d"), Some(true)), "{e}");
-        assert!(named(flown, "signal").any(|s| s["name"] == "Caught"), "the handler ran:\n{out}");
+        assert!(
+            matches!(&e.event, Event::Exception { actor: Some(a), handled: true, .. } if a == "d"),
+            "{e:?}"
+        );
+        assert!(signalled(flown, "Caught"), "the handler ran:\n{out}");
         e
     }
 
@@ -349,7 +363,7 @@ mod single {
         let (code, out) = finish(&mut run, &dir, Duration::from_secs(300));
         let flown = events(&dir.join("t.jsonl"));
         let e = caught(&flown, "BatteryCritical", &out);
-        assert!(e["args"].to_string().contains("% left"), "from the charge PX4 reports: {e}");
+        assert!(said(e).contains("% left"), "from the charge PX4 reports: {e:?}");
         assert_eq!(code, 0, "{out}");
     }
 
@@ -366,9 +380,9 @@ mod single {
         let (dir, _px4, gcs, mut run) =
             one("px4_fence", "[places]\nFar = [0, 80]\n", mission, |_| {});
         wait_until(Duration::from_secs(200), "the flight out", || {
-            events(&dir.join("t.jsonl"))
-                .iter()
-                .any(|e| e["event"] == "api_done" && e["function"] == "FlyToPosition")
+            events(&dir.join("t.jsonl")).iter().any(|e| {
+                matches!(e.event, Event::ApiDone { function: Function::FlyToPosition, .. })
+            })
         });
         gcs.set_param_px4_int("GF_ACTION", 3);
         gcs.set_param("GF_MAX_HOR_DIST", 50.0);
@@ -395,12 +409,12 @@ mod single {
         let (code, out) = finish(&mut run, &dir, Duration::from_secs(300));
         let flown = events(&dir.join("t.jsonl"));
         let e = caught(&flown, "CommandFailed", &out);
-        let said = e["args"].to_string();
+        let said = said(e);
         assert!(said.contains("Reposition is outside geofence"), "PX4's own words in {said}");
         assert_eq!(code, 0, "{out}");
         // Refused at once, not after the flight's time ran out.
-        let (_, up) = done(&flown, "TakeOff");
-        let refused = e["t"].as_f64().unwrap() - up["t"].as_f64().unwrap();
+        let (_, up) = done(&flown, Function::TakeOff);
+        let refused = e.t - up.t;
         assert!(
             refused < 10.0,
             "refused {refused:.1} s after the take-off ({:?} in all)",
@@ -423,7 +437,7 @@ mod single {
         let flown = events(&dir.join("t.jsonl"));
         let e =
             exception(&flown, "PositionLost").unwrap_or_else(|| panic!("no PositionLost:\n{out}"));
-        assert_eq!(e["actor"].as_str(), Some("d"));
+        assert!(matches!(&e.event, Event::Exception { actor: Some(a), .. } if a == "d"));
     }
 
     #[test]
@@ -445,8 +459,13 @@ mod single {
         px4.restart();
         let (code, out) = finish(&mut run, &dir, Duration::from_secs(200));
         let flown = events(&dir.join("t.jsonl"));
-        let signals: Vec<&str> =
-            named(&flown, "signal").filter_map(|s| s["name"].as_str()).collect();
+        let signals: Vec<&str> = flown
+            .iter()
+            .filter_map(|e| match &e.event {
+                Event::Signal { name, .. } => Some(&**name),
+                _ => None,
+            })
+            .collect();
         for s in ["Offline", "ConnectionRestored", "Back"] {
             assert!(signals.contains(&s), "{s} in {signals:?}:\n{out}");
         }

@@ -4,8 +4,8 @@
 
 mod common;
 
+use aviary_test_support::trace::{actor, is, Trace};
 use common::{aviary, scratch};
-use serde_json::Value;
 
 fn fixture(name: &str) -> std::path::PathBuf {
     common::repo().join("crates/aviary-verify/tests/fixtures").join(name)
@@ -13,7 +13,7 @@ fn fixture(name: &str) -> std::path::PathBuf {
 
 /// Checks and runs the fixture `stem` in a scratch copy: the check's output, and the
 /// run's exit code and trace.
-fn check_and_run(stem: &str) -> (String, i32, Vec<Value>) {
+fn check_and_run(stem: &str) -> (String, i32, Trace) {
     let dir = scratch(&format!("radio_{stem}"));
     for ext in ["mission", "world.toml"] {
         std::fs::copy(fixture(&format!("{stem}.{ext}")), dir.join(format!("m.{ext}")))
@@ -21,11 +21,7 @@ fn check_and_run(stem: &str) -> (String, i32, Vec<Value>) {
     }
     let (_, checked, err) = aviary(&["check", "m.mission"], &dir);
     let (code, _, _) = aviary(&["run", "m.mission", "--trace", "t.jsonl"], &dir);
-    let trace = std::fs::read_to_string(dir.join("t.jsonl"))
-        .expect("trace")
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("a trace line"))
-        .collect();
+    let trace = Trace::read(&dir.join("t.jsonl"));
     (checked + &err, code, trace)
 }
 
@@ -40,11 +36,11 @@ fn a_path_out_of_reach_is_warned_before_flight_and_loses_its_link_there() {
     assert_eq!(code, 1, "the lost link is not handled: the mission fails");
     let lost = trace
         .iter()
-        .find(|e| e["event"] == "exception" && e["name"] == "ConnectionLost")
+        .find(|e| is::exception("ConnectionLost")(&e.event))
         .unwrap_or_else(|| panic!("no ConnectionLost: {trace:?}"));
-    assert_eq!(lost["actor"], "inspector");
+    assert_eq!(actor(&lost.event), Some("inspector"));
     // When the check said: about 100 s in.
-    let t = lost["t"].as_f64().expect("t");
+    let t = lost.t;
     assert!((80.0..=120.0).contains(&t), "lost at {t} s (the check: about 100 s)");
 }
 
@@ -53,8 +49,5 @@ fn a_relay_half_way_keeps_the_link_and_the_check_quiet() {
     let (checked, code, trace) = check_and_run("ok_pipeline_relayed");
     assert!(!checked.contains("W210"), "{checked}");
     assert_eq!(code, 0, "{:?}", trace.last());
-    assert!(
-        !trace.iter().any(|e| e["event"] == "exception" && e["name"] == "ConnectionLost"),
-        "the relay kept the link"
-    );
+    assert!(trace.find(is::exception("ConnectionLost")).is_empty(), "the relay kept the link");
 }

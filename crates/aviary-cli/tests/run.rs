@@ -4,6 +4,9 @@
 
 mod common;
 
+use aviary_api::trace::{AutopilotAction, Event, EventKind};
+use aviary_api::FlightState;
+use aviary_test_support::trace::Trace;
 use common::{aviary, repo, scratch};
 
 /// The schema of one trace line: the shared contract's copy when it is there, else ours.
@@ -244,14 +247,16 @@ fn in_the_trace_no_two_airborne_drones_come_closer_than_min_separation() {
         &repo(),
     );
     assert_eq!(code, 0, "{err}");
-    let mut by_time: std::collections::BTreeMap<String, Vec<[f64; 3]>> = Default::default();
-    for line in std::fs::read_to_string(&trace).unwrap().lines() {
-        let e: serde_json::Value = serde_json::from_str(line).unwrap();
-        let airborne = matches!(e["state"].as_str(), Some("TakingOff" | "Flying" | "Landing"));
-        if e["event"] == "telemetry" && airborne && e["position"][2].as_f64().unwrap() > 0.0 {
-            let p: Vec<f64> =
-                e["position"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
-            by_time.entry(e["t"].to_string()).or_default().push([p[0], p[1], p[2]]);
+    let mut by_time: std::collections::BTreeMap<u64, Vec<[f64; 3]>> = Default::default();
+    for e in Trace::read(&trace).iter() {
+        let Event::Telemetry { state, position: p, .. } = e.event else { continue };
+        let airborne =
+            matches!(state, FlightState::TakingOff | FlightState::Flying | FlightState::Landing);
+        if airborne {
+            assert!(p.iter().all(|c| c.is_finite()), "{e:?}");
+        }
+        if airborne && p[2] > 0.0 {
+            by_time.entry(e.t.to_bits()).or_default().push(p);
         }
     }
     assert!(by_time.len() > 5000, "telemetry at 20 Hz over the whole mission");
@@ -362,29 +367,30 @@ fn a_drone_acting_on_its_own_is_in_the_trace_and_the_summary() {
     .unwrap();
     let (code, out, err) = aviary(&["run", "drill.mission", "--trace", "t.jsonl"], &dir);
     assert_eq!(code, 0, "{out}{err}");
-    let trace: Vec<serde_json::Value> = std::fs::read_to_string(dir.join("t.jsonl"))
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
-    let autopilot: Vec<(f64, &str, &str)> = trace
+    let trace = Trace::read(&dir.join("t.jsonl"));
+    let autopilot: Vec<(f64, &str, AutopilotAction)> = trace
         .iter()
-        .filter(|e| e["event"] == "autopilot")
-        .map(|e| {
-            (e["t"].as_f64().unwrap(), e["actor"].as_str().unwrap(), e["action"].as_str().unwrap())
+        .filter_map(|e| match &e.event {
+            Event::Autopilot { actor, action, .. } => Some((e.t, &**actor, *action)),
+            _ => None,
         })
         .collect();
     assert_eq!(autopilot.len(), 2, "{autopilot:?}");
-    assert_eq!((autopilot[0].0, autopilot[0].1, autopilot[0].2), (20.0, "scout", "hold"));
-    assert_eq!((autopilot[1].1, autopilot[1].2), ("scout", "return_home"));
+    assert_eq!(
+        (autopilot[0].0, autopilot[0].1, autopilot[0].2),
+        (20.0, "scout", AutopilotAction::Hold)
+    );
+    assert_eq!((autopilot[1].1, autopilot[1].2), ("scout", AutopilotAction::ReturnHome));
     assert!(
         (autopilot[1].0 - 30.0).abs() <= 0.05 + 1e-9,
         "10 s after the link went: {autopilot:?}"
     );
     // The fault's exception comes first, then what the autopilot does about it.
-    let lost = trace.iter().position(|e| e["event"] == "exception").unwrap();
-    let held = trace.iter().position(|e| e["event"] == "autopilot").unwrap();
-    assert_eq!(trace[lost]["name"], "ConnectionLost");
+    let lost = trace.index(|e| e.kind() == EventKind::Exception);
+    let held = trace.index(|e| e.kind() == EventKind::Autopilot);
+    assert!(
+        matches!(&trace[lost].event, Event::Exception { name, .. } if name == "ConnectionLost")
+    );
     assert!(lost < held);
     assert!(out.contains("exceptions: ConnectionLost on scout (handled)\n"), "{out}");
     assert!(out.contains("operator actions: none\n"), "{out}");

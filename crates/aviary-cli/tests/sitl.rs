@@ -21,10 +21,11 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use common::background::{events, exception, finish, named, pos, start_run, Run};
+use aviary_api::trace::{Event, EventKind, Record, Status};
+use aviary_api::Function;
+use common::background::{events, exception, finish, named, pos, said, signalled, start_run, Run};
 use common::sitl::{wait_until, Sitl, BIG_BATTERY};
 use common::{aviary, repo, scratch, PAPER_DRONES};
-use serde_json::Value;
 
 fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
@@ -102,21 +103,28 @@ fn paper_mission(tag: &str, first_instance: u16, real: &[&str]) {
         common::paper_outcome(&simulated),
         "the same signals and finds as the simulated run"
     );
-    let finds: Vec<[f64; 3]> = named(&flown, "detection").map(|e| pos(&e["location"])).collect();
-    let drops: Vec<&Value> =
-        named(&flown, "api_done").filter(|e| e["function"] == "ReleasePayload").collect();
+    let finds: Vec<[f64; 3]> = named(&flown, EventKind::Detection)
+        .map(|e| match e.event {
+            Event::Detection { location, .. } => pos(location),
+            _ => unreachable!(),
+        })
+        .collect();
+    let drops: Vec<(&str, [f64; 3])> = flown
+        .iter()
+        .filter_map(|e| match &e.event {
+            Event::ApiDone { actor, function: Function::ReleasePayload, position, .. } => {
+                Some((&**actor, pos(*position)))
+            }
+            _ => None,
+        })
+        .collect();
     assert_eq!(drops.len(), finds.len(), "a beacon for every find");
-    for drop in drops {
-        let at = pos(&drop["position"]);
+    for (actor, at) in drops {
         let near = finds.iter().map(|f| dist2(*f, at)).fold(f64::INFINITY, f64::min);
-        assert!(
-            near <= 5.0,
-            "{} dropped its beacon {near:.1} m from the nearest find",
-            drop["actor"]
-        );
+        assert!(near <= 5.0, "{actor:?} dropped its beacon {near:.1} m from the nearest find");
     }
     let end = flown.last().expect("events");
-    assert_eq!((end["event"].as_str(), end["status"].as_str()), (Some("mission_end"), Some("ok")));
+    assert!(matches!(end.event, Event::MissionEnd { status: Status::Ok, .. }), "{end:?}");
 
     // Flight times: SITL's (from the track it reported) against the simulator's and the
     // plan's for the same drone.
@@ -294,13 +302,13 @@ mod facts {
         assert!((140.0..170.0).contains(&needs) && said.contains("starts with 100%"), "{said}");
         // Said before the take-off, which waits for SITL's GPS and EKF (tens of seconds).
         assert!(
-            !events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_done"),
+            named(&events(&dir.join("t.jsonl")), EventKind::ApiDone).next().is_none(),
             "the warning comes before anything flies"
         );
         wait_until(Duration::from_secs(120), "the take-off", || {
             events(&dir.join("t.jsonl"))
                 .iter()
-                .any(|e| e["event"] == "api_call" && e["function"] == "TakeOff")
+                .any(|e| matches!(e.event, Event::ApiCall { function: Function::TakeOff, .. }))
         });
     }
 
@@ -326,19 +334,25 @@ mod facts {
         let (_, out) = finish(&mut run, &dir, Duration::from_secs(300));
         let flown = events(&dir.join("t.jsonl"));
         // The charge the drone reported last before `event`.
-        let charge_before = |event: &Value| -> f64 {
-            let t = event["t"].as_f64().expect("t");
-            named(&flown, "telemetry")
-                .filter(|e| e["actor"] == "d" && e["t"].as_f64() <= Some(t))
-                .last()
-                .and_then(|e| e["battery"].as_f64())
+        let charge_before = |event: &Record| -> f64 {
+            let t = event.t;
+            flown
+                .iter()
+                .filter_map(|e| match &e.event {
+                    Event::Telemetry { actor, battery, .. } if actor == "d" && e.t <= t => {
+                        Some(*battery)
+                    }
+                    _ => None,
+                })
+                .next_back()
+                .filter(|b| b.is_finite())
                 .expect("telemetry before")
         };
-        let low = named(&flown, "signal")
-            .find(|e| e["name"] == "BatteryLow")
+        let low = flown
+            .iter()
+            .find(|e| matches!(&e.event, Event::Signal { name, .. } if name == "BatteryLow"))
             .unwrap_or_else(|| panic!("no BatteryLow:\n{out}"));
-        let critical = named(&flown, "exception")
-            .find(|e| e["name"] == "BatteryCritical")
+        let critical = exception(&flown, "BatteryCritical")
             .unwrap_or_else(|| panic!("no BatteryCritical:\n{out}"));
         let (at_low, at_critical) = (charge_before(low), charge_before(critical));
         eprintln!(
@@ -348,10 +362,10 @@ mod facts {
         );
         assert!((0.60..=0.85).contains(&at_low), "BatteryLow at {at_low}:\n{out}");
         assert!((0.30..=0.55).contains(&at_critical), "BatteryCritical at {at_critical}:\n{out}");
-        assert_eq!(critical["handled"].as_bool(), Some(true));
+        assert!(matches!(critical.event, Event::Exception { handled: true, .. }));
         assert!(
-            critical["args"].to_string().contains("about what it needs to get home"),
-            "the backend's rule, not SITL's failsafe: {critical}"
+            said(critical).contains("about what it needs to get home"),
+            "the backend's rule, not SITL's failsafe: {critical:?}"
         );
     }
 }
@@ -405,8 +419,12 @@ mod single {
         // station (10 Hz, so within a metre or two of some point of it).
         let track = gcs.seen.lock().unwrap().track.clone();
         assert!(track.len() > 100, "the ground station saw the flight");
-        let points: Vec<[f64; 3]> =
-            named(&flown, "telemetry").map(|e| pos(&e["position"])).collect();
+        let points: Vec<[f64; 3]> = named(&flown, EventKind::Telemetry)
+            .map(|e| match e.event {
+                Event::Telemetry { position, .. } => pos(position),
+                _ => unreachable!(),
+            })
+            .collect();
         assert!(points.len() > 50, "telemetry in the trace");
         for p in &points {
             let near = track
@@ -428,20 +446,27 @@ mod single {
             );
         }
         // It landed where the trace says, and SITL agrees.
-        let end = named(&flown, "api_done")
-            .filter(|e| e["function"] == "Land")
-            .last()
+        let end = flown
+            .iter()
+            .filter_map(|e| match e.event {
+                Event::ApiDone { function: Function::Land, position, .. } => Some(position),
+                _ => None,
+            })
+            .next_back()
             .expect("Land ended");
         let landed = gcs.last().expect("a last position");
-        assert!(
-            dist2(pos(&end["position"]), landed) < 1.0 && landed[2].abs() < 0.5,
-            "landed at {landed:?}"
-        );
+        assert!(dist2(pos(end), landed) < 1.0 && landed[2].abs() < 0.5, "landed at {landed:?}");
         // Orbit legs are flown through: the lap (126 m) takes nowhere near the ~5 s a stop
         // at each of its 24 points would add.
-        let orbit = named(&flown, "api_call").find(|e| e["function"] == "Orbit").expect("orbit");
-        let done = named(&flown, "api_done").find(|e| e["function"] == "Orbit").expect("orbit end");
-        let took = done["t"].as_f64().unwrap() - orbit["t"].as_f64().unwrap();
+        let orbit = flown
+            .iter()
+            .find(|e| matches!(e.event, Event::ApiCall { function: Function::Orbit, .. }))
+            .expect("orbit");
+        let done = flown
+            .iter()
+            .find(|e| matches!(e.event, Event::ApiDone { function: Function::Orbit, .. }))
+            .expect("orbit end");
+        let took = done.t - orbit.t;
         assert!(took < 60.0, "the orbit took {took:.0} s");
         // ArduPilot's own flight log (DataFlash, POS): every position of the trace lies
         // within 2.5 m of one it logged.
@@ -467,8 +492,10 @@ mod single {
         let flown = events(&dir.join("t.jsonl"));
         let e = exception(&flown, "BatteryCritical")
             .unwrap_or_else(|| panic!("no BatteryCritical:\n{out}"));
-        assert_eq!((e["actor"].as_str(), e["handled"].as_bool()), (Some("d"), Some(true)));
-        assert!(named(&flown, "signal").any(|s| s["name"] == "Caught"));
+        assert!(
+            matches!(&e.event, Event::Exception { actor: Some(a), handled: true, .. } if a == "d")
+        );
+        assert!(signalled(&flown, "Caught"));
     }
 
     #[test]
@@ -485,17 +512,19 @@ mod single {
         let mission = "MISSION Drill:\n    SEQUENTIAL Fly:\n        d TakeOff WITH 10m\n        d FlyTo WITH Far\n        d Hover WITH 120s\n    ON EXCEPTION GeofenceViolation BY d:\n        SIGNAL Caught\n";
         let (dir, sitl, mut run) = one("sitl_fence", &params, "[places]\nFar = [0, 80]\n", mission);
         wait_until(Duration::from_secs(200), "the flight out", || {
-            events(&dir.join("t.jsonl"))
-                .iter()
-                .any(|e| e["event"] == "api_done" && e["function"] == "FlyToPosition")
+            events(&dir.join("t.jsonl")).iter().any(|e| {
+                matches!(e.event, Event::ApiDone { function: Function::FlyToPosition, .. })
+            })
         });
         sitl.gcs(Duration::from_secs(10)).set_param("FENCE_ENABLE", 1.0);
         let (_, out) = finish(&mut run, &dir, Duration::from_secs(200));
         let flown = events(&dir.join("t.jsonl"));
         let e = exception(&flown, "GeofenceViolation")
             .unwrap_or_else(|| panic!("no GeofenceViolation:\n{out}"));
-        assert_eq!((e["actor"].as_str(), e["handled"].as_bool()), (Some("d"), Some(true)));
-        assert!(named(&flown, "signal").any(|s| s["name"] == "Caught"));
+        assert!(
+            matches!(&e.event, Event::Exception { actor: Some(a), handled: true, .. } if a == "d")
+        );
+        assert!(signalled(&flown, "Caught"));
     }
 
     #[test]
@@ -512,7 +541,7 @@ mod single {
         let flown = events(&dir.join("t.jsonl"));
         let e =
             exception(&flown, "PositionLost").unwrap_or_else(|| panic!("no PositionLost:\n{out}"));
-        assert_eq!(e["actor"].as_str(), Some("d"));
+        assert!(matches!(&e.event, Event::Exception { actor: Some(a), .. } if a == "d"));
     }
 
     #[test]
@@ -535,26 +564,33 @@ mod single {
         let noticed = lost_at.elapsed();
         assert!(noticed < Duration::from_secs(8), "the lost link was noticed after {noticed:?}");
         wait_until(Duration::from_secs(20), "the second ConnectionLost", || {
-            named(&events(&dir.join("t.jsonl")), "signal").any(|s| s["name"] == "Still_Offline")
+            signalled(&events(&dir.join("t.jsonl")), "Still_Offline")
         });
         sitl.restart();
         let (code, out) = finish(&mut run, &dir, Duration::from_secs(120));
         let flown = events(&dir.join("t.jsonl"));
-        let signals: Vec<&str> =
-            named(&flown, "signal").filter_map(|s| s["name"].as_str()).collect();
+        let signals: Vec<&str> = flown
+            .iter()
+            .filter_map(|e| match &e.event {
+                Event::Signal { name, .. } => Some(&**name),
+                _ => None,
+            })
+            .collect();
         for s in ["Offline", "Still_Offline", "ConnectionRestored", "Back"] {
             assert!(signals.contains(&s), "{s} in {signals:?}:\n{out}");
         }
-        let lost: Vec<&Value> =
-            named(&flown, "exception").filter(|e| e["name"] == "ConnectionLost").collect();
+        let lost: Vec<&Record> = flown
+            .iter()
+            .filter(
+                |e| matches!(&e.event, Event::Exception { name, .. } if name == "ConnectionLost"),
+            )
+            .collect();
         assert!(
-            lost.len() >= 2 && lost.iter().all(|e| e["handled"] == true),
+            lost.len() >= 2
+                && lost.iter().all(|e| matches!(e.event, Event::Exception { handled: true, .. })),
             "both ConnectionLost handled: {lost:?}"
         );
-        assert!(
-            !named(&flown, "exception").any(|e| e["name"] == "CommandFailed"),
-            "no CommandFailed on a lost drone"
-        );
+        assert!(exception(&flown, "CommandFailed").is_none(), "no CommandFailed on a lost drone");
         assert_eq!(code, 0, "{out}");
     }
 
@@ -573,7 +609,7 @@ mod single {
         let flown = events(&dir.join("t.jsonl"));
         let e = exception(&flown, "CommandFailed")
             .unwrap_or_else(|| panic!("no CommandFailed:\n{out}"));
-        let reason = e["args"].to_string();
+        let reason = said(e);
         assert!(reason.to_ascii_lowercase().contains("arm"), "ArduPilot's reason in {reason}");
         assert!(
             reason.contains("PreArm") || reason.contains("Arm:"),
@@ -598,7 +634,7 @@ mod single {
         assert_eq!(code, 2, "{out}");
         assert!(out.contains("40") && out.contains("home"), "says how far from home: {out}");
         assert!(
-            !events(&dir.join("t.jsonl")).iter().any(|e| e["event"] == "api_call"),
+            named(&events(&dir.join("t.jsonl")), EventKind::ApiCall).next().is_none(),
             "nothing flew"
         );
     }
@@ -630,9 +666,13 @@ mod wind {
 
     fn flight(dir: &Path, out: &str) -> Flight {
         let flown = events(&dir.join("t.jsonl"));
-        let charge: Vec<f64> = named(&flown, "telemetry")
-            .filter(|e| e["actor"] == "d")
-            .filter_map(|e| e["battery"].as_f64())
+        let charge: Vec<f64> = flown
+            .iter()
+            .filter_map(|e| match &e.event {
+                Event::Telemetry { actor, battery, .. } if actor == "d" => Some(*battery),
+                _ => None,
+            })
+            .filter(|b| b.is_finite())
             .collect();
         let row = common::summary_rows(out).into_iter().find(|r| r.0 == "d").expect("d's row");
         Flight { time: row.2, used: charge[0] - charge[charge.len() - 1] }

@@ -6,13 +6,14 @@
 use std::sync::Mutex;
 use std::time::Duration;
 
+use aviary_api::trace::{Event, Record, Shown};
 use aviary_api::{
     Backend, BuiltinException, BuiltinSignal, CallEnd, CallId, DroneEvent, DroneId, Ending,
     Failure, FlightState, Function, Interrupt, PendingCall, Telemetry, Value,
 };
 use aviary_engine::{RunOptions, Status};
 use aviary_test_support::harness;
-use serde_json::Value as Json;
+use aviary_test_support::trace::{is, Trace};
 use tokio::sync::{mpsc, oneshot};
 
 /// A backend that answers every call as it is told, and reports the drone events it is
@@ -71,18 +72,18 @@ impl Backend for Scripted {
     }
 }
 
-fn run(mission: &str, backend: &Scripted) -> (Status, Vec<Json>) {
+fn run(mission: &str, backend: &Scripted) -> (Status, Trace) {
     let (mission, _) = harness::compile(mission, harness::WORLD);
     let runtime = harness::paused_runtime();
     let mut trace = Vec::new();
-    let mut sink = |r: &aviary_engine::Record| trace.push(harness::json(r));
+    let mut sink = |r: &aviary_engine::Record| trace.push(Trace::line(r));
     let outcome =
         runtime.block_on(aviary_engine::run(&mission, backend, &mut sink, &RunOptions::default()));
-    (outcome.status, trace)
+    (outcome.status, Trace(trace))
 }
 
-fn signalled(trace: &[Json], name: &str) -> bool {
-    trace.iter().any(|e| e["event"] == "signal" && e["name"] == name)
+fn signalled(trace: &Trace, name: &str) -> bool {
+    !trace.find(is::signal(name)).is_empty()
 }
 
 #[test]
@@ -93,11 +94,12 @@ fn a_call_refused_with_any_builtin_exception_raises_that_exception() {
         );
         let (status, trace) = run(&mission, &Scripted::new(Some(exception), vec![]));
         assert_eq!(status, Status::Ok, "{exception}: {trace:#?}");
-        let raised: Vec<&Json> = trace.iter().filter(|e| e["event"] == "exception").collect();
+        let raised: Vec<&Record> = trace.find(|e| matches!(e, Event::Exception { .. }));
         assert_eq!(raised.len(), 1, "{exception}: {trace:#?}");
-        assert_eq!(raised[0]["name"], exception.name());
-        assert_eq!(raised[0]["handled"], true);
-        assert_eq!(raised[0]["args"], serde_json::json!([format!("refused with {exception}")]));
+        let Event::Exception { name, handled, args, .. } = &raised[0].event else { unreachable!() };
+        assert_eq!(name, exception.name());
+        assert!(*handled);
+        assert_eq!(args, &[Shown::Text(format!("refused with {exception}").into())]);
         assert!(signalled(&trace, "Caught"), "{exception}: the handler ran");
     }
 }
@@ -118,9 +120,9 @@ fn faults_and_signals_a_backend_reports_start_their_handlers() {
     for name in ["BatteryLow", "ConnectionRestored", "Low", "Back", "Broken"] {
         assert!(signalled(&trace, name), "{name}: {trace:#?}");
     }
-    let e = trace.iter().find(|e| e["event"] == "exception").expect("an exception");
-    assert_eq!(
-        (&e["name"], &e["actor"], &e["handled"]),
-        (&"MotorFailure".into(), &"a".into(), &true.into())
-    );
+    let e = trace.iter().find(|e| matches!(e.event, Event::Exception { .. }));
+    let Event::Exception { name, actor, handled, .. } = &e.expect("an exception").event else {
+        unreachable!()
+    };
+    assert_eq!((&**name, actor.as_deref(), *handled), ("MotorFailure", Some("a"), true));
 }

@@ -1,17 +1,18 @@
 //! Live control of a running mission, as the operator API and Ctrl-C use it.
 
-use aviary_api::Value;
-use aviary_engine::{Control, Outcome, RunOptions, Status};
+use aviary_api::trace::{Event, Shown};
+use aviary_api::{Function, Value};
+use aviary_engine::{Control, OperatorAction, Outcome, RunOptions, Status};
 use aviary_test_support::harness;
+use aviary_test_support::trace::{actor, is, Trace};
 use harness::{Ask, Path};
-use serde_json::Value as Json;
 
 /// Runs `mission`, sending each control at its mission time; returns the outcome, the
 /// trace and the engine's answers.
 fn run_with_controls(
     mission: &str,
     controls: Vec<(f64, Ask)>,
-) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
+) -> (Outcome, Trace, Vec<Result<(), String>>) {
     run_with_controls_on(mission, controls, Path::AsUsersRun)
 }
 
@@ -19,23 +20,30 @@ fn run_with_controls_on(
     mission: &str,
     controls: Vec<(f64, Ask)>,
     path: Path,
-) -> (Outcome, Vec<Json>, Vec<Result<(), String>>) {
+) -> (Outcome, Trace, Vec<Result<(), String>>) {
     let (compiled, world) = harness::compile(mission, harness::WORLD);
     let options = RunOptions { telemetry_hz: Some(10.0), ..RunOptions::default() };
     let (run, answers) = harness::run_compiled(&compiled, &world, &options, controls, path);
     (run.outcome, run.trace, answers)
 }
 
-fn positions(trace: &[Json], actor: &str, from: f64, to: f64) -> Vec<Json> {
+fn positions(trace: &Trace, actor: &str, from: f64, to: f64) -> Vec<[f64; 3]> {
+    trace
+        .positions(actor)
+        .into_iter()
+        .filter(|(t, _)| *t > from && *t < to)
+        .map(|(_, p)| p)
+        .collect()
+}
+
+/// `(t, action, drone)` of every `operator` event, in order.
+fn operator_events(trace: &Trace) -> Vec<(f64, OperatorAction, Option<&str>)> {
     trace
         .iter()
-        .filter(|e| {
-            e["event"] == "telemetry"
-                && e["actor"] == actor
-                && e["t"].as_f64().unwrap() > from
-                && e["t"].as_f64().unwrap() < to
+        .filter_map(|e| match &e.event {
+            Event::Operator { action, drone } => Some((e.t, *action, drone.as_deref())),
+            _ => None,
         })
-        .map(|e| e["position"].clone())
         .collect()
 }
 
@@ -57,8 +65,10 @@ fn an_operator_leash_pauses_and_resumes_by_tag() {
     );
     let leashes: Vec<&str> = trace
         .iter()
-        .filter(|e| e["event"] == "leash")
-        .map(|e| e["action"].as_str().unwrap())
+        .filter_map(|e| match &e.event {
+            Event::Leash { action, .. } => Some(&**action),
+            _ => None,
+        })
         .collect();
     assert_eq!(leashes, ["PAUSE", "RESUME"]);
 }
@@ -117,16 +127,12 @@ fn an_operator_signal_is_heard_by_the_mission() {
             Err("the mission does not declare Sotp as an operator signal: did you mean `Stop`? It declares Go, Stop".to_string()),
         ]
     );
-    assert_eq!(trace.iter().filter(|e| e["event"] == "signal").count(), 1, "only Go was raised");
+    let signals = trace.find(|e| matches!(e, Event::Signal { .. }));
+    assert_eq!(signals.len(), 1, "only Go was raised");
     assert_eq!(outcome.status, Status::Ok);
-    let signal = trace.iter().find(|e| e["event"] == "signal").unwrap();
-    assert_eq!(
-        (signal["actor"].clone(), signal["args"][0].clone()),
-        (Json::Null, Json::from("now"))
-    );
-    let hover =
-        trace.iter().find(|e| e["event"] == "capability_start" && e["actor"] == "b").unwrap();
-    assert_eq!(hover["t"].as_f64().unwrap(), 7.0);
+    let Event::Signal { actor, args, .. } = &signals[0].event else { unreachable!() };
+    assert_eq!((actor, args.first()), (&None, Some(&Shown::Text("now".into()))));
+    assert_eq!(trace.t(is::start_by("b")), 7.0);
 }
 
 #[test]
@@ -143,14 +149,9 @@ fn pausing_the_mission_holds_every_drone_and_resuming_goes_on() {
             "{drone} holds while the mission is paused"
         );
     }
-    let operator: Vec<(f64, &str, &Json)> = trace
-        .iter()
-        .filter(|e| e["event"] == "operator")
-        .map(|e| (e["t"].as_f64().unwrap(), e["action"].as_str().unwrap(), &e["drone"]))
-        .collect();
     assert_eq!(
-        operator,
-        [(15.0, "pause", &Json::Null), (25.0, "resume", &Json::Null)],
+        operator_events(&trace),
+        [(15.0, OperatorAction::Pause, None), (25.0, OperatorAction::Resume, None)],
         "each written when the operator did it, for the whole mission"
     );
 }
@@ -164,16 +165,10 @@ fn an_activity_started_while_the_mission_is_paused_starts_held_on_either_path() 
     let (outcome, trace, _) = run_with_controls(mission, controls());
     let general = run_with_controls_on(mission, controls(), Path::GeneralOnly);
     assert_eq!((&outcome, &trace), (&general.0, &general.1), "the same trace both ways");
-    let start = trace
-        .iter()
-        .find(|e| e["event"] == "capability_start" && e["capability"] == "Ping")
-        .unwrap();
-    let call = trace
-        .iter()
-        .find(|e| e["event"] == "api_call" && e["function"] == "StartStreaming")
-        .unwrap();
-    assert!((start["t"].as_f64().unwrap() - 18.0).abs() < 0.11, "{start}");
-    assert_eq!(call["t"].as_f64().unwrap(), 25.0, "held until the resume");
+    let start = trace.first(is::start_of("Ping"));
+    let call = trace.first(is::call(Function::StartStreaming));
+    assert!((start.t - 18.0).abs() < 0.11, "{start:?}");
+    assert_eq!(call.t, 25.0, "held until the resume");
     assert_eq!(outcome.status, Status::Ok);
 }
 
@@ -185,30 +180,21 @@ fn aborting_the_mission_sends_the_fleet_home() {
     );
     assert_eq!(outcome.status, Status::Aborted);
     assert_eq!(outcome.reason.as_deref(), Some("aborted by the operator"));
-    let said = trace.iter().position(|e| e["event"] == "operator").unwrap();
-    assert_eq!(
-        (trace[said]["t"].as_f64(), trace[said]["action"].as_str(), &trace[said]["drone"]),
-        (Some(12.0), Some("abort"), &Json::Null)
-    );
+    let said = trace.iter().position(|e| matches!(e.event, Event::Operator { .. })).unwrap();
+    assert_eq!(operator_events(&trace)[0], (12.0, OperatorAction::Abort, None));
     assert!(
-        trace[said + 1..].iter().all(|e| e["event"] != "capability_start"),
+        trace[said + 1..].iter().all(|e| !matches!(e.event, Event::CapabilityStart { .. })),
         "written before what it does"
     );
     let home: Vec<&str> = trace
+        .find(is::done(Function::ReturnToLaunch))
         .iter()
-        .filter(|e| e["event"] == "api_done" && e["function"] == "ReturnToLaunch")
-        .map(|e| e["actor"].as_str().unwrap())
+        .map(|e| actor(&e.event).unwrap())
         .collect();
     assert!(home.contains(&"a") && home.contains(&"b"), "both drones were sent home: {home:?}");
     let last = trace.last().unwrap();
-    assert_eq!(
-        (last["event"].as_str(), last["status"].as_str()),
-        (Some("mission_end"), Some("aborted"))
-    );
-    let aborted = trace
-        .iter()
-        .filter(|e| e["event"] == "capability_end" && e["capability"] == "FlyTo")
-        .count();
+    assert!(matches!(last.event, Event::MissionEnd { status: Status::Aborted, .. }), "{last:?}");
+    let aborted = trace.find(is::end_of("FlyTo")).len();
     assert_eq!(
         aborted, 0,
         "the activities were cut off with the mission: no end is invented for them"
@@ -227,13 +213,8 @@ fn a_lost_backend_ends_the_mission_at_once_without_commanding_anyone() {
     );
     assert_eq!(outcome.status, Status::Failed);
     let last = trace.last().unwrap();
-    assert_eq!(
-        (last["event"].as_str(), last["reason"].as_str()),
-        (Some("mission_end"), Some("the simulator stopped: its task panicked"))
-    );
-    assert_eq!(last["t"].as_f64().unwrap(), 10.0, "at once");
-    assert!(
-        !trace.iter().any(|e| e["event"] == "api_call" && e["function"] == "ReturnToLaunch"),
-        "nobody can be commanded"
-    );
+    let Event::MissionEnd { reason, .. } = &last.event else { panic!("{last:?}") };
+    assert_eq!(reason.as_deref(), Some("the simulator stopped: its task panicked"));
+    assert_eq!(last.t, 10.0, "at once");
+    assert!(trace.find(is::call(Function::ReturnToLaunch)).is_empty(), "nobody can be commanded");
 }

@@ -2,8 +2,10 @@
 //! checker lets through (behind a condition) ends in a language exception, never in a
 //! stack overflow. The limit is small here so the test thread's stack holds it.
 
+use aviary_api::trace::Event;
 use aviary_engine::{RunOptions, Status};
 use aviary_test_support::harness;
+use aviary_test_support::trace::is;
 use harness::{run_with, WORLD};
 
 /// Calls itself for as long as the battery is above 1%, which it stays: no time passes.
@@ -20,15 +22,16 @@ fn a_recursion_past_the_limit_raises_command_failed_and_the_mission_ends() {
     let reason = r.outcome.reason.clone().unwrap_or_default();
     assert!(reason.contains("unhandled exception CommandFailed on a: calling `Rec` would nest capability calls 41 deep, past the limit of 40"), "{reason}");
     // The 40 that started, and not one more; each ends, failed, as the exception unwinds.
-    assert_eq!(r.find("capability_start", "capability", "Rec").len(), 40);
+    assert_eq!(r.find(is::start_of("Rec")).len(), 40);
     assert_eq!(r.ends("Rec", "a").len(), 40);
-    assert!(r.ends("Rec", "a").iter().all(|e| e["status"] == "failed"), "{}", r.dump());
-    let exception = r.first("exception", "name", "CommandFailed");
-    assert_eq!(exception["actor"], "a");
-    assert_eq!(exception["handled"], false);
+    assert!(r.ends("Rec", "a").iter().all(|e| e.status == Status::Failed), "{}", r.dump());
+    let exception = r.first(is::exception("CommandFailed"));
+    let Event::Exception { actor, handled, .. } = &exception.event else { unreachable!() };
+    assert_eq!(actor.as_deref(), Some("a"));
+    assert!(!handled);
     let end = r.trace.last().expect("events");
-    assert_eq!(end["event"], "mission_end", "{}", r.dump());
-    assert_eq!(end["status"], "failed");
+    let Event::MissionEnd { status, .. } = end.event else { panic!("{}", r.dump()) };
+    assert_eq!(status, Status::Failed);
 }
 
 #[test]
@@ -39,7 +42,10 @@ fn a_handler_can_catch_the_limit_and_the_mission_goes_on() {
     );
     let r = run_with(&mission, WORLD, &limited(25));
     assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
-    assert_eq!(r.first("exception", "name", "CommandFailed")["handled"], true);
+    assert!(matches!(
+        r.first(is::exception("CommandFailed")).event,
+        Event::Exception { handled: true, .. }
+    ));
     assert_eq!(r.ends("TakeOff", "b").len(), 1);
     assert_eq!(r.ends("TakeOff", "c").len(), 1);
 }
@@ -55,5 +61,5 @@ fn a_chain_exactly_as_deep_as_the_limit_runs() {
     let r = run_with(&mission, WORLD, &limited(n));
     assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
     assert_eq!(r.ends(&format!("C{}", n - 1), "a").len(), 1);
-    assert!(r.find("exception", "name", "CommandFailed").is_empty());
+    assert!(r.find(is::exception("CommandFailed")).is_empty());
 }

@@ -1,8 +1,11 @@
 //! One end-to-end test per fault kind of the world file: the built-in exception it
 //! raises, the handler that takes it, and the other drones carrying on.
 
+use aviary_api::trace::{CallStatus, Event, Record, Shown};
+use aviary_api::{Function, Point};
 use aviary_engine::Status;
 use aviary_test_support::harness;
+use aviary_test_support::trace::{actor, is};
 
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() < 0.11
@@ -10,6 +13,14 @@ fn close(a: f64, b: f64) -> bool {
 
 fn with_fault(fault: &str) -> String {
     format!("{}\n[[faults]]\ndrone = \"a\"\n{fault}\n", harness::WORLD)
+}
+
+/// An exception's actor and whether a handler took it.
+fn taken<'e>(e: &'e Record<'static>) -> (Option<&'e str>, bool) {
+    match &e.event {
+        Event::Exception { actor, handled, .. } => (actor.as_deref(), *handled),
+        other => panic!("not an exception: {other:?}"),
+    }
 }
 
 /// `a` flies far away; `b` hovers on its own for 30 s.
@@ -22,16 +33,14 @@ fn a_crash_is_drone_lost_and_the_others_carry_on() {
         &with_fault("at = 8.0\nkind = \"crash\""),
     );
     assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
-    let e = r.first("exception", "name", "DroneLost");
-    assert_eq!((e["actor"].as_str(), e["handled"].as_bool()), (Some("a"), Some(true)));
-    assert!(close(e["t"].as_f64().unwrap(), 8.0));
-    assert!(close(r.t("capability_start", "actor", "c"), 8.0), "the handler runs at once");
-    assert_eq!(r.ends("FlyTo", "a")[0]["status"], "failed", "the crashed drone's activity ends");
-    assert_eq!(r.ends("Hover", "b")[0]["status"], "ok");
+    let e = r.first(is::exception("DroneLost"));
+    assert_eq!(taken(e), (Some("a"), true));
+    assert!(close(e.t, 8.0));
+    assert!(close(r.t(is::start_by("c")), 8.0), "the handler runs at once");
+    assert_eq!(r.ends("FlyTo", "a")[0].status, Status::Failed, "the crashed drone's activity ends");
+    assert_eq!(r.ends("Hover", "b")[0].status, Status::Ok);
     assert!(
-        !r.trace.iter().any(|e| e["event"] == "api_call"
-            && e["function"] == "ReturnToLaunch"
-            && e["actor"] == "a"),
+        r.find(is::call(Function::ReturnToLaunch)).iter().all(|e| actor(&e.event) != Some("a")),
         "a lost drone is not sent home"
     );
 }
@@ -49,14 +58,13 @@ fn an_unhandled_crash_fails_the_mission_and_sends_the_others_home() {
         r.outcome.reason
     );
     let home = r
-        .trace
-        .iter()
-        .find(|e| {
-            e["event"] == "api_done" && e["function"] == "ReturnToLaunch" && e["actor"] == "b"
-        })
+        .find(is::done(Function::ReturnToLaunch))
+        .into_iter()
+        .find(|e| actor(&e.event) == Some("b"))
         .expect("b is sent home");
-    assert_eq!(home["status"], "ok");
-    assert_eq!(r.trace.last().unwrap()["status"], "failed");
+    assert!(matches!(home.event, Event::ApiDone { status: CallStatus::Ok, .. }));
+    let last = r.trace.last().unwrap();
+    assert!(matches!(last.event, Event::MissionEnd { status: Status::Failed, .. }), "{last:?}");
 }
 
 #[test]
@@ -66,11 +74,13 @@ fn a_motor_failure_reaches_the_capability_flying_the_drone() {
         &with_fault("at = 10.0\nkind = \"motor_failure\""),
     );
     assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
-    let e = r.first("exception", "name", "MotorFailure");
-    assert_eq!(e["handler"], "Deliver/ON EXCEPTION MotorFailure");
-    assert_eq!(r.first("signal", "name", "Down")["args"][0], "a");
-    assert!(close(r.t("capability_start", "actor", "c"), 10.0));
-    assert_eq!(r.ends("Hover", "b")[0]["status"], "ok");
+    let e = r.first(is::exception("MotorFailure"));
+    let Event::Exception { handler, .. } = &e.event else { unreachable!() };
+    assert_eq!(handler.as_deref(), Some("Deliver/ON EXCEPTION MotorFailure"));
+    let Event::Signal { args, .. } = &r.first(is::signal("Down")).event else { unreachable!() };
+    assert_eq!(args[0].as_str(), Some("a"));
+    assert!(close(r.t(is::start_by("c")), 10.0));
+    assert_eq!(r.ends("Hover", "b")[0].status, Status::Ok);
 }
 
 #[test]
@@ -79,10 +89,10 @@ fn a_gps_loss_is_position_lost() {
         &format!("MISSION M:\n    PARALLEL:\n{BUSY}    ON EXCEPTION PositionLost BY a:\n        c Hover WITH 1s\n"),
         &with_fault("at = 6.0\nkind = \"gps_loss\"\nduration = 4.0"),
     );
-    let e = r.first("exception", "name", "PositionLost");
-    assert_eq!((e["actor"].as_str(), e["handled"].as_bool()), (Some("a"), Some(true)));
-    assert!(close(r.t("capability_start", "actor", "c"), 6.0));
-    assert_eq!(r.ends("Hover", "b")[0]["status"], "ok");
+    let e = r.first(is::exception("PositionLost"));
+    assert_eq!(taken(e), (Some("a"), true));
+    assert!(close(r.t(is::start_by("c")), 6.0));
+    assert_eq!(r.ends("Hover", "b")[0].status, Status::Ok);
     assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
 }
 
@@ -93,23 +103,22 @@ fn a_link_loss_is_connection_lost_and_its_return_is_connection_restored() {
         &with_fault("at = 6.0\nkind = \"link_loss\"\nduration = 3.0"),
     );
     assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
-    let lost = r.first("exception", "name", "ConnectionLost");
-    assert!(close(lost["t"].as_f64().unwrap(), 6.0));
-    let restored = r.first("signal", "name", "ConnectionRestored");
-    assert_eq!(restored["actor"], "a");
-    assert!(close(restored["t"].as_f64().unwrap(), 9.0), "when the link is back");
+    let lost = r.first(is::exception("ConnectionLost"));
+    assert!(close(lost.t, 6.0));
+    let restored = r.first(is::signal("ConnectionRestored"));
+    assert_eq!(actor(&restored.event), Some("a"));
+    assert!(close(restored.t, 9.0), "when the link is back");
+    let north = Shown::Position(Point { x: 0.0, y: 100.0, z: None });
     let again = r
         .trace
         .iter()
         .find(|e| {
-            e["event"] == "capability_start"
-                && e["actor"] == "a"
-                && e["capability"] == "FlyTo"
-                && e["args"]["target"] == serde_json::json!([0.0, 100.0])
+            matches!(&e.event, Event::CapabilityStart { actor, capability, args, .. }
+                if actor == "a" && capability == "FlyTo" && args.get("target") == Some(&north))
         })
         .expect("a flies again");
-    assert!(close(again["t"].as_f64().unwrap(), 9.0));
-    assert_eq!(r.ends("Hover", "b")[0]["status"], "ok");
+    assert!(close(again.t, 9.0));
+    assert_eq!(r.ends("Hover", "b")[0].status, Status::Ok);
 }
 
 #[test]
@@ -119,17 +128,13 @@ fn a_geofence_refusal_is_geofence_violation() {
     let r = harness::run(
         "MISSION M:\n    SEQUENTIAL:\n        a TakeOff\n        SIGNAL Go WITH (5000, 0)\n    ON Go WITH spot:\n        a FlyTo WITH spot\n    ON EXCEPTION GeofenceViolation BY a:\n        a ReturnHome\n",
     );
-    let e = r.first("exception", "name", "GeofenceViolation");
-    assert_eq!(e["handled"], true);
-    let refused = r
-        .trace
-        .iter()
-        .find(|e| e["event"] == "api_done" && e["function"] == "FlyToPosition")
-        .unwrap();
-    assert_eq!(refused["status"], "failed");
-    assert!(
-        refused["position"][0].as_f64().unwrap().abs() < 0.01,
-        "refused before it was sent: the drone did not move"
-    );
+    let e = r.first(is::exception("GeofenceViolation"));
+    assert!(taken(e).1);
+    let Event::ApiDone { status, position, .. } = r.first(is::done(Function::FlyToPosition)).event
+    else {
+        unreachable!()
+    };
+    assert_eq!(status, CallStatus::Failed);
+    assert!(position[0].abs() < 0.01, "refused before it was sent: the drone did not move");
     assert_eq!(r.outcome.status, Status::Ok);
 }

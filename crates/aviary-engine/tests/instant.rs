@@ -4,8 +4,11 @@
 //! instant activity has to wait and becomes a general one (its claims are busy, its root
 //! is paused, a call takes time, a call fails), and generated ones (`mod generated`).
 
+use aviary_api::trace::{Event, EventKind};
+use aviary_api::Function;
 use aviary_engine::{Control, DroneAction, RunOptions, Status};
 use aviary_test_support::harness;
+use aviary_test_support::trace::{actor, is};
 use harness::{Ask, Path};
 
 fn both_ways(mission: &str, world: &str) -> harness::Run {
@@ -60,33 +63,40 @@ fn instant_steps_end_in_the_instant_they_start_and_in_order() {
         &format!("{PING}MISSION M:\n    a Ping\n    b Ping\n    a Hover WITH 2s\n    a Ping\n"),
         harness::WORLD,
     );
-    let pings: Vec<(&str, &str, f64)> = r
+    let pings: Vec<(EventKind, &str, f64)> = r
         .trace
         .iter()
-        .filter(|e| e["capability"] == "Ping")
-        .map(|e| {
-            (e["event"].as_str().unwrap(), e["actor"].as_str().unwrap(), e["t"].as_f64().unwrap())
+        .filter_map(|e| match &e.event {
+            Event::CapabilityStart { capability, actor, .. }
+            | Event::CapabilityEnd { capability, actor, .. }
+                if capability == "Ping" =>
+            {
+                Some((e.event.kind(), &**actor, e.t))
+            }
+            _ => None,
         })
         .collect();
     assert_eq!(pings.len(), 6);
     assert_eq!(
         pings[..4].iter().map(|p| (p.0, p.1)).collect::<Vec<_>>(),
         [
-            ("capability_start", "a"),
-            ("capability_end", "a"),
-            ("capability_start", "b"),
-            ("capability_end", "b")
+            (EventKind::CapabilityStart, "a"),
+            (EventKind::CapabilityEnd, "a"),
+            (EventKind::CapabilityStart, "b"),
+            (EventKind::CapabilityEnd, "b")
         ]
     );
     assert!(pings[..4].iter().all(|p| p.2 == 0.0), "no time passes: {pings:?}");
     assert!(pings[4..].iter().all(|p| (p.2 - 2.0).abs() < 0.11), "after the hover: {pings:?}");
-    let calls: Vec<&str> = r
+    let calls: Vec<Function> = r
         .trace
         .iter()
-        .filter(|e| e["event"] == "api_done" && e["actor"] == "a")
-        .map(|e| e["function"].as_str().unwrap())
+        .filter_map(|e| match &e.event {
+            Event::ApiDone { actor, function, .. } if actor == "a" => Some(*function),
+            _ => None,
+        })
         .collect();
-    assert_eq!(calls[..2], ["StartStreaming", "StopStreaming"]);
+    assert_eq!(calls[..2], [Function::StartStreaming, Function::StopStreaming]);
 }
 
 #[test]
@@ -94,15 +104,10 @@ fn an_instant_activity_on_busy_claims_waits_its_turn() {
     // Film holds a's camera for 3 s; Ping needs it and starts when Film ends.
     let film = "CAPABILITY Film BY d:\n    PERFORM:\n        d.StartStreaming()\n        d.Hover(3s)\n        d.StopStreaming()\n\n";
     let r = both_ways(&format!("{PING}{film}MISSION M:\n    a TakeOff\n    PARALLEL:\n        a Film\n        a Ping\n"), harness::WORLD);
-    let film_end = r.index("capability_end", "capability", "Film");
-    let ping_start = r.index("capability_start", "capability", "Ping");
+    let film_end = r.index(is::end_of("Film"));
+    let ping_start = r.index(is::start_of("Ping"));
     assert!(film_end < ping_start, "{}", r.dump());
-    assert!(
-        (r.t("capability_start", "capability", "Ping")
-            - r.t("capability_end", "capability", "Film"))
-        .abs()
-            < 1e-9
-    );
+    assert!((r.t(is::start_of("Ping")) - r.t(is::end_of("Film"))).abs() < 1e-9);
 }
 
 #[test]
@@ -113,16 +118,8 @@ fn an_instant_activity_inside_a_paused_one_waits_for_its_resume() {
         &format!("{PING}{watch}MISSION M:\n    PARALLEL:\n        a Watch-W1\n        SEQUENTIAL:\n            b TakeOff\n            Watch-W1 PAUSE\n            SIGNAL Go\n            b Hover WITH 5s\n            Watch-W1 RESUME\n"),
         harness::WORLD,
     );
-    let resumed =
-        r.trace.iter().find(|e| e["event"] == "leash" && e["action"] == "RESUME").unwrap()["t"]
-            .as_f64()
-            .unwrap();
-    let calls: Vec<f64> = r
-        .trace
-        .iter()
-        .filter(|e| e["event"] == "api_call" && e["function"] == "StartStreaming")
-        .map(|e| e["t"].as_f64().unwrap())
-        .collect();
+    let resumed = r.t(|e| matches!(e, Event::Leash { action, .. } if action == "RESUME"));
+    let calls: Vec<f64> = r.find(is::call(Function::StartStreaming)).iter().map(|e| e.t).collect();
     assert_eq!(calls.len(), 1);
     assert!(calls[0] >= resumed, "the call waits for RESUME ({resumed}): {calls:?}\n{}", r.dump());
     assert_eq!(r.outcome.status, Status::Ok);
@@ -138,13 +135,16 @@ fn an_instant_call_that_fails_is_its_activitys_exception() {
         harness::WORLD,
     );
     let ping_c = r.ends("Ping", "c");
-    assert_eq!(ping_c[0]["status"], "failed", "{}", r.dump());
+    assert_eq!(ping_c[0].status, Status::Failed, "{}", r.dump());
     assert!(
-        r.find("api_call", "function", "StopStreaming").iter().all(|e| e["actor"] != "c"),
+        r.find(is::call(Function::StopStreaming)).iter().all(|e| actor(&e.event) != Some("c")),
         "the failed call ends the sequence"
     );
-    assert_eq!(r.ends("Ping", "a")[0]["status"], "ok", "the handler ran");
-    assert_eq!(r.first("exception", "name", "CommandFailed")["handled"], true);
+    assert_eq!(r.ends("Ping", "a")[0].status, Status::Ok, "the handler ran");
+    assert!(matches!(
+        r.first(is::exception("CommandFailed")).event,
+        Event::Exception { handled: true, .. }
+    ));
 }
 
 #[test]
@@ -154,22 +154,20 @@ fn a_capability_whose_calls_take_time_goes_on_where_it_stood() {
         "MISSION M:\n    PARALLEL:\n        a TakeOff\n        b TakeOff WITH 20m\n",
         harness::WORLD,
     );
-    let a: Vec<&str> = r
+    let a: Vec<EventKind> = r
         .trace
         .iter()
-        .filter(|e| e["actor"] == "a" && e["event"] != "telemetry")
-        .map(|e| e["event"].as_str().unwrap())
+        .filter(|e| actor(&e.event) == Some("a") && e.event.kind() != EventKind::Telemetry)
+        .map(|e| e.event.kind())
         .collect();
+    use EventKind::{ApiCall, ApiDone, CapabilityEnd, CapabilityStart};
     assert_eq!(
         a[..6],
-        ["capability_start", "api_call", "api_done", "api_call", "api_done", "capability_end"],
+        [CapabilityStart, ApiCall, ApiDone, ApiCall, ApiDone, CapabilityEnd],
         "{}",
         r.dump()
     );
-    assert!(
-        r.ends("TakeOff", "b")[0]["t"].as_f64().unwrap()
-            > r.ends("TakeOff", "a")[0]["t"].as_f64().unwrap()
-    );
+    assert!(r.ends("TakeOff", "b")[0].t > r.ends("TakeOff", "a")[0].t);
 }
 
 /// `ONE AT A TIME` firings whose activities end at once (`Ping`) or take time (`Hover`):
@@ -181,19 +179,9 @@ fn one_at_a_time_firings_of_instant_activities_run_in_turn() {
         &format!("{PING}MISSION M:\n    PARALLEL P:\n        SEQUENTIAL:\n            SIGNAL Go WITH 1s\n            SIGNAL Go WITH 0s\n            SIGNAL Go WITH 2s\n        ON EVERY Go WITH how_long ONE AT A TIME:\n            a Ping\n            STARTIF how_long > 0s:\n                a Hover WITH how_long\n            a Ping\n"),
         harness::WORLD,
     );
-    let starts: Vec<f64> = r
-        .trace
-        .iter()
-        .filter(|e| e["event"] == "handler_start")
-        .map(|e| e["t"].as_f64().unwrap())
-        .collect();
+    let starts: Vec<f64> = r.events(EventKind::HandlerStart).iter().map(|e| e.t).collect();
     assert_eq!(starts, [0.0, 1.0, 1.0], "{}", r.dump());
-    let pings: Vec<f64> = r
-        .trace
-        .iter()
-        .filter(|e| e["event"] == "capability_start" && e["capability"] == "Ping")
-        .map(|e| e["t"].as_f64().unwrap())
-        .collect();
+    let pings: Vec<f64> = r.find(is::start_of("Ping")).iter().map(|e| e.t).collect();
     assert_eq!(pings, [0.0, 1.0, 1.0, 1.0, 1.0, 3.0], "each firing whole, in turn");
 }
 

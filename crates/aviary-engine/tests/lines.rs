@@ -1,8 +1,11 @@
 //! A line of the world file (`[lines]`) flown by `FollowPath`, from the trace: the drone
 //! passes through each of its points in order, at the height a point gives.
 
+use aviary_api::trace::{Event, Shown};
+use aviary_api::{Point, Remainder};
 use aviary_engine::{RunOptions, Status};
 use aviary_test_support::harness;
+use aviary_test_support::trace::is;
 
 /// Telemetry at every step of the simulator (0.05 s).
 fn run(mission: &str, world: &str) -> harness::Run {
@@ -35,11 +38,14 @@ fn a_line_is_flown_through_its_points_in_order() {
     let mission = "MISSION Along:\n    a TakeOff WITH 20m\n    a FollowPath WITH Pipeline\n    a ReturnHome\n";
     let r = run(mission, &world());
     assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
-    let start = r.first("capability_start", "capability", "FollowPath");
-    assert_eq!(
-        start["args"]["path"],
-        serde_json::json!({"points": [[0.0, 50.0], [150.0, 50.0, 40.0], [150.0, 250.0]]})
-    );
+    let start = r.first(is::start_of("FollowPath"));
+    let Event::CapabilityStart { args, .. } = &start.event else { unreachable!() };
+    let path = Remainder::Points(vec![
+        Point { x: 0.0, y: 50.0, z: None },
+        Point { x: 150.0, y: 50.0, z: Some(40.0) },
+        Point { x: 150.0, y: 250.0, z: None },
+    ]);
+    assert_eq!(args.get("path"), Some(&Shown::Remainder(std::borrow::Cow::Owned(path))));
     let positions = r.positions("a");
     let times = passes(&positions, &[[0.0, 50.0], [150.0, 50.0], [150.0, 250.0]], 1.0);
     assert!(times.iter().all(Option::is_some), "{times:?}");
@@ -69,8 +75,8 @@ fn fastest(r: &harness::Run, from: f64, to: f64) -> f64 {
 
 /// From the start of `capability` to its end.
 fn span_of(r: &harness::Run, capability: &str) -> (f64, f64) {
-    let start = r.t("capability_start", "capability", capability);
-    let end = r.t("capability_end", "capability", capability);
+    let start = r.t(is::start_of(capability));
+    let end = r.t(is::end_of(capability));
     (start, end)
 }
 
@@ -92,8 +98,9 @@ fn follow_path_and_fly_to_keep_the_speed_asked_for() {
     let top = fastest(&r, s, e);
     assert!((top - 2.0).abs() < 0.05, "FlyTo at {top} m/s, asked 2 m/s");
     // The trace says what was asked.
-    let start = r.first("capability_start", "capability", "FlyTo");
-    assert_eq!(start["args"]["speed"], 2.0);
+    let start = r.first(is::start_of("FlyTo"));
+    let Event::CapabilityStart { args, .. } = &start.event else { unreachable!() };
+    assert_eq!(args.get("speed"), Some(&Shown::Number(2.0)));
 }
 
 #[test]

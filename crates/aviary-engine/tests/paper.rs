@@ -1,7 +1,10 @@
 //! The paper's search-and-rescue mission, flown end to end on the simulator.
 
+use aviary_api::trace::Event;
+use aviary_api::Function;
 use aviary_engine::Status;
 use aviary_test_support::harness;
+use aviary_test_support::trace::is;
 
 fn paper() -> harness::Run {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/");
@@ -15,19 +18,21 @@ fn the_paper_mission_flies_to_its_end() {
     let r = paper();
     assert_eq!(r.outcome.status, Status::Ok, "{:?}\n{}", r.outcome.reason, r.dump());
     let end = r.trace.last().unwrap();
-    assert_eq!((end["event"].as_str(), end["status"].as_str()), (Some("mission_end"), Some("ok")));
+    assert!(matches!(end.event, Event::MissionEnd { status: Status::Ok, .. }), "{end:?}");
 
     let detections: Vec<(&str, &str)> = r
         .trace
         .iter()
-        .filter(|e| e["event"] == "detection")
-        .map(|e| (e["actor"].as_str().unwrap(), e["kind"].as_str().unwrap()))
+        .filter_map(|e| match &e.event {
+            Event::Detection { actor, kind, .. } => Some((&**actor, &**kind)),
+            _ => None,
+        })
         .collect();
     assert_eq!(detections.len(), 3, "{detections:?}");
     assert_eq!(detections.iter().filter(|(_, k)| *k == "Body").count(), 2);
     assert_eq!(detections.iter().filter(|(_, k)| *k == "Radiation").count(), 1);
-    assert_eq!(r.find("signal", "name", "Body_Detected").len(), 2);
-    assert_eq!(r.find("signal", "name", "Radiation_Detected").len(), 1);
+    assert_eq!(r.find(is::signal("Body_Detected")).len(), 2);
+    assert_eq!(r.find(is::signal("Radiation_Detected")).len(), 1);
 
     // Every beacon is released within 5 m of the find it marks.
     let targets =
@@ -41,15 +46,14 @@ fn the_paper_mission_flies_to_its_end() {
     }
 
     // The FLIR drones take off only after video_drone1 has reached its height.
-    let ready = r.index("signal", "name", "Video1_Ready");
+    let ready = r.index(is::signal("Video1_Ready"));
     for flir in ["flir_drone1", "flir_drone2"] {
         let takeoff = r
             .trace
             .iter()
             .position(|e| {
-                e["event"] == "capability_start"
-                    && e["actor"] == flir
-                    && e["capability"] == "TakeOff"
+                matches!(&e.event, Event::CapabilityStart { actor, capability, .. }
+                    if actor == flir && capability == "TakeOff")
             })
             .unwrap();
         assert!(takeoff > ready, "{flir} takes off after Video1_Ready");
@@ -57,21 +61,19 @@ fn the_paper_mission_flies_to_its_end() {
     let video_up = r
         .trace
         .iter()
-        .find(|e| {
-            e["event"] == "api_done" && e["actor"] == "video_drone1" && e["function"] == "TakeOff"
+        .find_map(|e| match &e.event {
+            Event::ApiDone { actor, function: Function::TakeOff, position, .. }
+                if actor == "video_drone1" =>
+            {
+                Some(*position)
+            }
+            _ => None,
         })
         .unwrap();
-    assert!(
-        (video_up["position"][2].as_f64().unwrap() - 20.0).abs() < 0.2,
-        "Video1_Ready comes at 20 m"
-    );
+    assert!((video_up[2] - 20.0).abs() < 0.2, "Video1_Ready comes at 20 m");
 
     // Every drone ends landed.
-    let final_states = r
-        .trace
-        .iter()
-        .filter(|e| e["event"] == "api_done" && e["function"] == "ReturnToLaunch")
-        .count();
+    let final_states = r.find(is::done(Function::ReturnToLaunch)).len();
     assert!(final_states >= 7, "each drone returns home");
 }
 

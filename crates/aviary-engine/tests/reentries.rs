@@ -4,7 +4,9 @@
 //! would not even hear Ctrl-C. Past the limit the handler is passed over and the exception
 //! goes on outward. Time passing between two rounds starts the count again.
 
+use aviary_api::trace::Event;
 use aviary_test_support::harness;
+use aviary_test_support::trace::is;
 
 use aviary_engine::{Record, RunOptions, Status};
 use harness::{run_with, WORLD};
@@ -19,10 +21,12 @@ fn limited(reentries: usize) -> RunOptions {
 fn exceptions(r: &harness::Run) -> Vec<(String, String)> {
     r.trace
         .iter()
-        .filter(|e| e["event"] == "exception")
-        .map(|e| {
-            let text = |v: &serde_json::Value| v.as_str().unwrap_or("").to_string();
-            (text(&e["handler"]), text(&e["skipped"]))
+        .filter_map(|e| match &e.event {
+            Event::Exception { handler, skipped, .. } => Some((
+                handler.as_deref().unwrap_or("").to_string(),
+                skipped.as_deref().unwrap_or("").to_string(),
+            )),
+            _ => None,
         })
         .collect()
 }
@@ -57,17 +61,18 @@ fn a_handler_that_catches_again_after_time_has_passed_is_not_cut_off() {
     let r = run_with(&mission, WORLD, &limited(2));
     assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
     let times: Vec<f64> = r
-        .find("exception", "name", "CommandFailed")
+        .find(is::exception("CommandFailed"))
         .iter()
         .map(|e| {
-            assert_eq!(e["handled"], true);
-            assert!(e.get("skipped").is_none());
-            e["t"].as_f64().unwrap()
+            let Event::Exception { handled, skipped, .. } = &e.event else { unreachable!() };
+            assert!(*handled);
+            assert!(skipped.is_none());
+            e.t
         })
         .collect();
     assert!(times.len() > 10, "{times:?}");
     assert!(times.windows(2).all(|w| w[1] >= w[0] + 0.99), "a second apart: {times:?}");
-    assert_eq!(r.ends("TakeOff", "a")[0]["status"], "ok", "and the mission goes on");
+    assert_eq!(r.ends("TakeOff", "a")[0].status, Status::Ok, "and the mission goes on");
 }
 
 #[test]
@@ -86,14 +91,16 @@ fn a_handler_passed_over_leaves_the_exception_to_the_handlers_around_it() {
             "Inner/ON EXCEPTION CommandFailed, line 10, re-entered 3 times at t = 0 s without time passing".to_string()
         )
     );
-    assert_eq!(r.first("block_end", "block", "Inner")["status"], "aborted");
-    assert_eq!(r.ends("TakeOff", "a")[0]["status"], "ok", "the outer handler runs");
+    assert!(matches!(
+        r.first(is::block_end("Inner")).event,
+        Event::BlockEnd { status: Status::Aborted, .. }
+    ));
+    assert_eq!(r.ends("TakeOff", "a")[0].status, Status::Ok, "the outer handler runs");
     assert!(
-        r.index("capability_end", "capability", "TakeOff")
-            < r.index("capability_start", "capability", "Hover"),
+        r.index(is::end_of("TakeOff")) < r.index(is::start_of("Hover")),
         "in place of Inner, and Outer goes on with its next item"
     );
-    assert_eq!(r.ends("TakeOff", "b")[0]["status"], "ok", "and the mission goes on");
+    assert_eq!(r.ends("TakeOff", "b")[0].status, Status::Ok, "and the mission goes on");
 }
 
 #[test]
@@ -125,7 +132,7 @@ fn a_capabilitys_own_handler_is_bound_alike() {
         all[3].1,
         "Careful/ON EXCEPTION CommandFailed, line 10, re-entered 2 times at t = 0 s without time passing"
     );
-    assert_eq!(r.ends("Careful", "c")[0]["status"], "failed");
+    assert_eq!(r.ends("Careful", "c")[0].status, Status::Failed);
 }
 
 #[test]
@@ -137,7 +144,7 @@ fn exceptions_of_many_branches_at_one_instant_are_not_re_entries() {
         format!("MISSION M:\n    PARALLEL P:\n{branches}        ON EXCEPTION X:\n            SIGNAL Caught\n");
     let r = run_with(&mission, WORLD, &limited(1));
     assert_eq!(r.outcome.status, Status::Ok, "{}", r.dump());
-    assert_eq!(r.find("signal", "name", "Caught").len(), 10);
+    assert_eq!(r.find(is::signal("Caught")).len(), 10);
     assert!(exceptions(&r).iter().all(|(h, s)| h == "P/ON EXCEPTION X" && s.is_empty()));
 }
 
@@ -188,7 +195,8 @@ fn a_body_that_fails_twice_at_once_is_bound_in_all_not_per_branch() {
     );
     let r = harness::run(&mission);
     assert_eq!(r.outcome.status, Status::Failed);
-    let handled = r.trace.iter().filter(|e| e["event"] == "exception" && e["handled"] == true);
+    let handled =
+        r.trace.iter().filter(|e| matches!(e.event, Event::Exception { handled: true, .. }));
     assert_eq!(handled.count(), 1 + aviary_engine::MAX_HANDLER_REENTRIES);
     let reason = r.outcome.reason.unwrap_or_default();
     assert!(reason.contains("re-entered 100 times at t = 0 s without time passing"), "{reason}");

@@ -12,9 +12,11 @@
 use std::sync::mpsc;
 use std::time::Duration;
 
-use aviary_engine::{Outcome, Record, RunOptions, Status, MAX_HANDLER_REENTRIES};
+use aviary_api::trace::{CallStatus, Event};
+use aviary_api::Function;
+use aviary_engine::{OperatorAction, Outcome, Record, RunOptions, Status, MAX_HANDLER_REENTRIES};
 use aviary_test_support::harness::{self, WORLD};
-use serde_json::Value;
+use aviary_test_support::trace::Trace;
 
 /// More events than any of these missions makes when it is bound: a run past it is
 /// taken as endless.
@@ -28,7 +30,7 @@ fn fixture(name: &str) -> String {
 
 /// Runs `mission` in the harness's world with `options` on the paused clock, or on the
 /// wall clock with `wall`; its outcome and trace, or a panic if it does not end.
-fn bounded(mission: &str, options: RunOptions, wall: bool) -> (Outcome, Vec<Value>) {
+fn bounded(mission: &str, options: RunOptions, wall: bool) -> (Outcome, Vec<Record<'static>>) {
     let (mission, world) = harness::compile(mission, WORLD);
     let (done, ended) = mpsc::channel();
     std::thread::spawn(move || {
@@ -42,7 +44,7 @@ fn bounded(mission: &str, options: RunOptions, wall: bool) -> (Outcome, Vec<Valu
             let mut trace = Vec::new();
             let mut sink = |r: &Record| {
                 assert!(trace.len() < ENDLESS, "more than {ENDLESS} events: the run does not end");
-                trace.push(harness::json(r));
+                trace.push(Trace::line(r));
             };
             let outcome = aviary_engine::run(&mission, &*sim, &mut sink, &options).await;
             sim.shutdown().await;
@@ -59,26 +61,32 @@ fn limited(reentries: usize) -> RunOptions {
     RunOptions { max_handler_reentries: reentries, ..RunOptions::default() }
 }
 
-fn count(trace: &[Value], event: &str, field: &str, value: &str) -> usize {
-    trace.iter().filter(|e| e["event"] == event && e[field] == value).count()
+/// How many times the handler at `path` started.
+fn starts(trace: &[Record], path: &str) -> usize {
+    trace
+        .iter()
+        .filter(|e| matches!(&e.event, Event::HandlerStart { handler, .. } if handler == path))
+        .count()
+}
+
+/// Whether a `ReturnToLaunch` (by `actor`, or by any drone) ended ok.
+fn brought_home(trace: &[Record], actor: Option<&str>) -> bool {
+    trace.iter().any(|e| {
+        matches!(&e.event, Event::ApiDone {
+            function: Function::ReturnToLaunch, status: CallStatus::Ok, actor: a, ..
+        } if actor.is_none_or(|actor| a == actor))
+    })
 }
 
 /// The mission failed with `reason`, said in the trace's `mission_end` as well, and `a`,
 /// in the air when the loop began, was brought home.
-fn failed_and_home(outcome: &Outcome, trace: &[Value], reason: &str) {
+fn failed_and_home(outcome: &Outcome, trace: &[Record], reason: &str) {
     assert_eq!(outcome.status, Status::Failed);
     assert_eq!(outcome.reason.as_deref(), Some(reason));
     let end = trace.last().expect("a trace");
-    assert_eq!(
-        (end["event"].as_str(), end["status"].as_str(), end["reason"].as_str()),
-        (Some("mission_end"), Some("failed"), Some(reason))
-    );
-    let home = trace.iter().any(|e| {
-        e["event"] == "api_done"
-            && e["function"] == "ReturnToLaunch"
-            && e["actor"] == "a"
-            && e["status"] == "ok"
-    });
+    let Event::MissionEnd { status, reason: said } = &end.event else { panic!("{end:?}") };
+    assert_eq!((*status, said.as_deref()), (Status::Failed, Some(reason)));
+    let home = brought_home(trace, Some("a"));
     assert!(home, "the drone in the air was brought home");
 }
 
@@ -92,11 +100,7 @@ fn an_on_every_that_raises_its_own_signal_at_once_ends_the_mission() {
             &trace,
             &format!("a cycle of signals at one instant: P/ON X, line 7, started again {limit} times at t = 4.35 s by what its own firings raised, without time passing"),
         );
-        assert_eq!(
-            count(&trace, "handler_start", "handler", "P/ON X"),
-            limit + 1,
-            "the first firing and {limit} more"
-        );
+        assert_eq!(starts(&trace, "P/ON X"), limit + 1, "the first firing and {limit} more");
     }
 }
 
@@ -110,8 +114,8 @@ fn handlers_that_raise_each_others_signal_at_once_end_the_mission() {
         &trace,
         "a cycle of signals at one instant: P/ON X, line 6, started again 100 times at t = 4.35 s by what its own firings raised, without time passing",
     );
-    assert_eq!(count(&trace, "handler_start", "handler", "P/ON X"), 101);
-    assert_eq!(count(&trace, "handler_start", "handler", "P/ON Y"), 101);
+    assert_eq!(starts(&trace, "P/ON X"), 101);
+    assert_eq!(starts(&trace, "P/ON Y"), 101);
 }
 
 #[test]
@@ -125,7 +129,7 @@ fn a_one_at_a_time_handler_that_raises_its_signal_twice_ends_the_mission() {
     );
     // Every firing raises two: the count grows by two a firing, and nothing starts once
     // the mission has failed (the firings still waiting their turn are dropped).
-    assert_eq!(count(&trace, "handler_start", "handler", "P/ON X"), 51);
+    assert_eq!(starts(&trace, "P/ON X"), 51);
 }
 
 #[test]
@@ -137,7 +141,7 @@ fn a_signal_handler_and_an_exception_handler_in_a_cycle_end_the_mission() {
         &trace,
         "a cycle of signals at one instant: P/ON X, line 6, started again 100 times at t = 4.35 s by what its own firings raised, without time passing",
     );
-    assert_eq!(count(&trace, "handler_start", "handler", "P/ON X"), 101);
+    assert_eq!(starts(&trace, "P/ON X"), 101);
 }
 
 #[test]
@@ -150,7 +154,7 @@ fn firings_of_many_signals_at_one_instant_are_not_re_entries() {
     );
     let (outcome, trace) = bounded(&mission, limited(1), false);
     assert_eq!(outcome.status, Status::Ok, "{outcome:?}");
-    assert_eq!(count(&trace, "handler_start", "handler", "P/ON Y"), 150);
+    assert_eq!(starts(&trace, "P/ON Y"), 150);
 }
 
 #[test]
@@ -160,7 +164,7 @@ fn a_handler_that_raises_its_signal_again_after_time_has_passed_is_not_cut_off()
     let mission = "MISSION M:\n    PARALLEL P:\n        SIGNAL X\n        ON EVERY X:\n            a Hover WITH 1s\n            STARTIF ELAPSED < 20s:\n                SIGNAL X\n";
     let (outcome, trace) = bounded(mission, limited(2), false);
     assert_eq!(outcome.status, Status::Ok, "{outcome:?}");
-    assert!(count(&trace, "handler_start", "handler", "P/ON X") > 10);
+    assert!(starts(&trace, "P/ON X") > 10);
 }
 
 /// With MAVLink drones the clock is the wall clock: there "at one instant" is without the
@@ -177,7 +181,7 @@ fn the_bound_holds_with_the_wall_clock() {
         ),
         "{reason}"
     );
-    assert_eq!(count(&trace, "handler_start", "handler", "P/ON X"), 101);
+    assert_eq!(starts(&trace, "P/ON X"), 101);
 }
 
 /// A mission busy at one instant for a long time (here 2,000 cycles, each cut off after
@@ -201,7 +205,7 @@ fn an_interrupt_is_heard_by_a_mission_that_never_waits() {
                 controller.interrupt("interrupted by SIGTERM".into());
             }
             assert!(trace.len() < ENDLESS, "more than {ENDLESS} events: the stop was not heard");
-            trace.push(harness::json(r));
+            trace.push(Trace::line(r));
         };
         let outcome = aviary_engine::run_controlled(
             &mission,
@@ -217,10 +221,10 @@ fn an_interrupt_is_heard_by_a_mission_that_never_waits() {
     assert_eq!(outcome.status, Status::Aborted);
     assert_eq!(outcome.reason.as_deref(), Some("interrupted by SIGTERM"));
     assert!(trace.len() < 1_100, "heard at once: {} events", trace.len());
-    let abort = trace.iter().filter(|e| e["event"] == "operator" && e["action"] == "abort");
+    let abort = trace
+        .iter()
+        .filter(|e| matches!(e.event, Event::Operator { action: OperatorAction::Abort, .. }));
     assert_eq!(abort.count(), 1, "one abort, written as the operator's");
-    let home = trace.iter().any(|e| {
-        e["event"] == "api_done" && e["function"] == "ReturnToLaunch" && e["status"] == "ok"
-    });
+    let home = brought_home(&trace, None);
     assert!(home, "the drone in the air was brought home");
 }

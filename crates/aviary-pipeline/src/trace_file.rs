@@ -236,12 +236,12 @@ mod tests {
         assert_eq!(trace.failed(), Some("it reached its size limit of 4 KiB"));
         let text = String::from_utf8(out.0.lock().clone()).unwrap();
         assert!(text.len() <= 4096, "{} bytes", text.len());
-        let last: serde_json::Value = serde_json::from_str(text.lines().last().unwrap()).unwrap();
-        assert_eq!(last["event"], "mission_end");
-        assert_eq!(last["status"], "aborted");
+        let last: Record = serde_json::from_str(text.lines().last().unwrap()).unwrap();
+        let Event::MissionEnd { status, reason } = &last.event else { panic!("{last:?}") };
+        assert_eq!(*status, Status::Aborted);
         assert_eq!(
-            last["reason"],
-            "the trace reached its size limit of 4 KiB: the run was stopped here, its fleet sent home, and nothing after is recorded"
+            reason.as_deref(),
+            Some("the trace reached its size limit of 4 KiB: the run was stopped here, its fleet sent home, and nothing after is recorded")
         );
         // The events before the cut are whole, and written up to the room kept.
         assert!(text.len() > 4096 - 2 * CLOSING_ROOM as usize, "{} bytes", text.len());

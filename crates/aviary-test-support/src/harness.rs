@@ -6,8 +6,8 @@ use aviary_check::Checked;
 use aviary_diagnostics::SourceMap;
 use aviary_engine::{Control, Controller, Directory, DroneAction, Outcome, Record, RunOptions};
 use aviary_sim::{SimBackend, SimOptions};
-use serde_json::Value;
 
+use crate::trace::Trace;
 use crate::NoFiles;
 
 /// A small world: drones a, b, c at the origin's corners, a place and an area.
@@ -40,14 +40,11 @@ kind = "Body"
 at = [150, 150]
 "#;
 
-/// An event as the trace file has it, to look at by key.
-pub fn json(record: &Record) -> Value {
-    serde_json::to_value(record).expect("an event is JSON")
-}
-
 pub struct Run {
     pub outcome: Outcome,
-    pub trace: Vec<Value>,
+    /// The run's events, each as the trace file would have it (see [`Trace`], which a
+    /// run reads as).
+    pub trace: Trace,
     /// Every payload release: (drone, kind, position).
     pub releases: Vec<(usize, String, [f64; 3])>,
 }
@@ -197,7 +194,7 @@ pub fn run_compiled(
         // Without controls, as a run without an operator: no channel at all.
         let rx = (!controls.is_empty()).then_some(rx);
         let mut trace = Vec::new();
-        let mut sink = |r: &Record| trace.push(json(r));
+        let mut sink = |r: &Record| trace.push(Trace::line(r));
         let operator = async {
             let start = tokio::time::Instant::now();
             let mut answers = Vec::new();
@@ -229,62 +226,14 @@ pub fn run_compiled(
         let (outcome, answers) = tokio::join!(run, operator);
         sim.shutdown().await;
         let releases = sim.releases().into_iter().map(|r| (r.drone, r.kind, r.position)).collect();
-        (Run { outcome, trace, releases }, answers)
+        (Run { outcome, trace: Trace(trace), releases }, answers)
     })
 }
 
-impl Run {
-    /// Events of one kind with a field equal to a value.
-    pub fn find(&self, event: &str, field: &str, value: &str) -> Vec<&Value> {
-        self.trace.iter().filter(|e| e["event"] == event && e[field] == value).collect()
+/// A run reads as its trace: `run.find(..)`, `run.t(..)`, `run.iter()`.
+impl std::ops::Deref for Run {
+    type Target = Trace;
+    fn deref(&self) -> &Trace {
+        &self.trace
     }
-    /// The time of the first such event.
-    pub fn t(&self, event: &str, field: &str, value: &str) -> f64 {
-        self.first(event, field, value)["t"].as_f64().expect("t")
-    }
-    pub fn first(&self, event: &str, field: &str, value: &str) -> &Value {
-        self.find(event, field, value)
-            .into_iter()
-            .next()
-            .unwrap_or_else(|| panic!("no {event} with {field} = {value}:\n{}", self.dump()))
-    }
-    /// The index of the first such event in the trace.
-    pub fn index(&self, event: &str, field: &str, value: &str) -> usize {
-        self.trace
-            .iter()
-            .position(|e| e["event"] == event && e[field] == value)
-            .unwrap_or_else(|| panic!("no {event} with {field} = {value}:\n{}", self.dump()))
-    }
-    /// Capability ends of `capability` on `actor`.
-    pub fn ends(&self, capability: &str, actor: &str) -> Vec<&Value> {
-        self.trace
-            .iter()
-            .filter(|e| {
-                e["event"] == "capability_end"
-                    && e["capability"] == capability
-                    && e["actor"] == actor
-            })
-            .collect()
-    }
-    /// Telemetry positions of a drone, by time.
-    pub fn positions(&self, actor: &str) -> Vec<(f64, [f64; 3])> {
-        positions_in(&self.trace, actor)
-    }
-    pub fn dump(&self) -> String {
-        self.trace.iter().map(|e| e.to_string()).collect::<Vec<_>>().join("\n")
-    }
-}
-
-/// Telemetry positions of a drone in a trace (its lines as JSON), by time: a run of the
-/// harness's, or a trace file `aviary run` wrote.
-pub fn positions_in(trace: &[Value], actor: &str) -> Vec<(f64, [f64; 3])> {
-    trace
-        .iter()
-        .filter(|e| e["event"] == "telemetry" && e["actor"] == actor)
-        .map(|e| {
-            let p = &e["position"];
-            let n = |v: &Value| v.as_f64().expect("a number");
-            (n(&e["t"]), [n(&p[0]), n(&p[1]), n(&p[2])])
-        })
-        .collect()
 }

@@ -12,13 +12,16 @@
 
 use aviary_api::sweep::Lane;
 
-/// Each drone's track in a trace (its lines as JSON): its telemetry positions, for
-/// [`passes`] and [`each_lane_once`].
-pub fn tracks(trace: &[serde_json::Value], drones: &[&str]) -> Vec<(String, Vec<[f64; 3]>)> {
+/// Each drone's track in a trace: its telemetry positions, for [`passes`] and
+/// [`each_lane_once`].
+pub fn tracks(
+    trace: &[aviary_api::trace::Record<'static>],
+    drones: &[&str],
+) -> Vec<(String, Vec<[f64; 3]>)> {
     drones
         .iter()
         .map(|d| {
-            let track = crate::harness::positions_in(trace, d).into_iter().map(|(_, p)| p);
+            let track = crate::trace::positions_in(trace, d).into_iter().map(|(_, p)| p);
             (d.to_string(), track.collect())
         })
         .collect()

@@ -50,7 +50,7 @@ fn the_plan_flies_the_detour_out_and_back() {
 
     // And the simulator takes as long as the plan says, within 2%.
     let run = harness::run_in(MISSION, &zoned);
-    let landed = run.trace.last().and_then(|e| e["t"].as_f64()).expect("a mission end");
+    let landed = run.trace.last().map(|e| e.t).expect("a mission end");
     let planned = around.mission_time;
     assert!((landed - planned).abs() <= 0.02 * planned, "flown in {landed} s, planned {planned} s");
 }

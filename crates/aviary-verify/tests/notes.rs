@@ -11,9 +11,14 @@
 //! this firing's statements"; with `ONE AT A TIME` nothing is reported and each firing
 //! runs whole.
 
+use aviary_api::trace::{Event, Params, Shown};
+use aviary_api::Point;
 use aviary_diagnostics::{Code, Diagnostic};
 use aviary_test_support::harness::{self, Run};
-use serde_json::Value;
+use aviary_test_support::trace::{actor, is};
+
+/// An activity's values.
+type Args = Params<'static>;
 
 const WORLD: &str = include_str!("fixtures/world.toml");
 
@@ -45,17 +50,20 @@ fn activities<'r>(
     r: &'r Run,
     capability: &str,
     actor: &str,
-) -> Vec<(usize, usize, f64, f64, &'r Value)> {
-    let mut open: Vec<(usize, f64, &Value)> = Vec::new();
+) -> Vec<(usize, usize, f64, f64, &'r Args)> {
+    let mut open: Vec<(usize, f64, &Args)> = Vec::new();
     let mut out = Vec::new();
     for (i, e) in r.trace.iter().enumerate() {
-        if e["capability"] != capability || e["actor"] != actor {
-            continue;
-        }
-        let t = e["t"].as_f64().unwrap();
-        match e["event"].as_str() {
-            Some("capability_start") => open.push((i, t, &e["args"])),
-            Some("capability_end") => {
+        let t = e.t;
+        match &e.event {
+            Event::CapabilityStart { capability: c, actor: a, args, .. }
+                if c == capability && a == actor =>
+            {
+                open.push((i, t, args))
+            }
+            Event::CapabilityEnd { capability: c, actor: a, .. }
+                if c == capability && a == actor =>
+            {
                 let (si, st, args) = open.remove(0);
                 out.push((si, i, st, t, args));
             }
@@ -67,12 +75,17 @@ fn activities<'r>(
     out
 }
 
+/// A place of the fixtures' world, as an activity's value shows it.
+fn at(x: f64, y: f64) -> Shown<'static> {
+    Shown::Position(Point { x, y, z: None })
+}
+
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() < 0.11
 }
 
 /// Activities that never overlap: each starts once the one before has ended.
-fn one_at_a_time(acts: &[(usize, usize, f64, f64, &Value)]) {
+fn one_at_a_time(acts: &[(usize, usize, f64, f64, &Args)]) {
     for w in acts.windows(2) {
         assert!(w[1].0 > w[0].1, "an activity starts only after the one before ended: {acts:?}");
     }
@@ -104,18 +117,14 @@ fn a_firing_that_reaches_the_statement_while_another_runs_waits_until_it_ends() 
     assert_eq!(flights.len(), 3, "{}", r.dump());
     one_at_a_time(&flights);
     // The second and third firings start at 10 s, while the first flight runs: they wait.
-    let starts: Vec<f64> = r
-        .find("handler_start", "signal", "Found")
-        .iter()
-        .map(|e| e["t"].as_f64().unwrap())
-        .collect();
+    let starts: Vec<f64> = r.find(is::handler_start("Found")).iter().map(|e| e.t).collect();
     assert!(close(starts[1], 10.0) && close(starts[2], 10.0), "{starts:?}");
     assert!(flights[0].3 > 10.0, "the first flight was still running: {flights:?}");
     assert!(close(flights[1].2, flights[0].3), "the next starts when it ends: {flights:?}");
     assert!(close(flights[2].2, flights[1].3), "{flights:?}");
     // First come, first served: in the order the firings asked.
-    let targets: Vec<String> = flights.iter().map(|f| f.4["target"].to_string()).collect();
-    assert_eq!(targets, ["[0.0,300.0]", "[300.0,0.0]", "[0.0,-300.0]"]);
+    let targets: Vec<&Shown> = flights.iter().map(|f| f.4.get("target").unwrap()).collect();
+    assert_eq!(targets, [&at(0.0, 300.0), &at(300.0, 0.0), &at(0.0, -300.0)]);
 }
 
 #[test]
@@ -125,7 +134,7 @@ fn the_every_firing_fixture_takes_the_carrier_one_firing_at_a_time() {
     assert_eq!(lines(mission, &found, Code::CommandsQueue), [9], "{found:#?}");
     let r = fly(mission);
     let deliveries = activities(&r, "Deliver", "carrier");
-    assert_eq!(deliveries.len(), r.find("signal", "name", "Found").len(), "one per find");
+    assert_eq!(deliveries.len(), r.find(is::signal("Found")).len(), "one per find");
     assert!(deliveries.len() >= 2, "{}", r.dump());
     one_at_a_time(&deliveries);
 }
@@ -139,10 +148,10 @@ fn the_flow_after_the_signal_goes_first_and_the_handler_waits_until_it_ends() {
     let flights = activities(&r, "FlyTo", "scout1");
     assert_eq!(flights.len(), 2, "{}", r.dump());
     let (flow, handler) = (flights[0], flights[1]);
-    assert_eq!(flow.4["target"].to_string(), "[300.0,0.0]", "the flow's FlyTo East goes first");
-    let signal = r.t("signal", "name", "Ready");
+    assert_eq!(flow.4.get("target"), Some(&at(300.0, 0.0)), "the flow's FlyTo East goes first");
+    let signal = r.t(is::signal("Ready"));
     assert!(close(flow.2, signal), "at once after the SIGNAL: {flow:?}");
-    assert!(close(r.t("handler_start", "signal", "Ready"), signal), "the handler starts");
+    assert!(close(r.t(is::handler_start("Ready")), signal), "the handler starts");
     assert!(close(handler.2, flow.3), "and its FlyTo waits until the flow's ends: {flights:?}");
     one_at_a_time(&flights);
 }
@@ -166,7 +175,7 @@ fn when_the_handler_starts_first_the_flow_waits_until_it_ends() {
     assert_eq!(lines(mission, &found, Code::CommandsQueue), [9], "{found:#?}");
     let r = fly(mission);
     let flights = activities(&r, "FlyTo", "scout1");
-    assert_eq!(flights[0].4["target"].to_string(), "[0.0,300.0]", "the handler's goes first");
+    assert_eq!(flights[0].4.get("target"), Some(&at(0.0, 300.0)), "the handler's goes first");
     assert!(flights[0].3 > 10.0, "and still flies when the flow wants scout1: {flights:?}");
     assert!(close(flights[1].2, flights[0].3), "the flow's waits until it ends: {flights:?}");
 }
@@ -192,8 +201,8 @@ fn another_firing_takes_the_drone_between_this_firings_statements() {
     // The second firing's TakeOff comes between the first's TakeOff and its patrol.
     let takeoffs = activities(&r, "TakeOff", "carrier");
     assert_eq!(takeoffs.len(), 2, "{}", r.dump());
-    assert!(r.find("capability_start", "capability", "FlyToAndPatrol").is_empty());
-    assert_eq!(r.first("exception", "name", "CommandFailed")["actor"], "carrier");
+    assert!(r.find(is::start_of("FlyToAndPatrol")).is_empty());
+    assert_eq!(actor(&r.first(is::exception("CommandFailed")).event), Some("carrier"));
 }
 
 #[test]
@@ -202,16 +211,20 @@ fn one_at_a_time_firings_never_meet_and_nothing_is_reported() {
     assert!(findings(&mission).is_empty(), "{:#?}", findings(&mission));
     let r = fly(&mission);
     assert_eq!(r.outcome.status, aviary_engine::Status::Ok, "{}", r.dump());
-    let mut all: Vec<(usize, usize, f64, f64, &Value)> =
-        ["TakeOff", "FlyToAndPatrol", "ReturnHome"]
-            .iter()
-            .flat_map(|c| activities(&r, c, "carrier"))
-            .collect();
+    let mut all: Vec<(usize, usize, f64, f64, &Args)> = ["TakeOff", "FlyToAndPatrol", "ReturnHome"]
+        .iter()
+        .flat_map(|c| activities(&r, c, "carrier"))
+        .collect();
     all.sort_by_key(|a| a.0);
     assert_eq!(all.len(), 6);
     one_at_a_time(&all);
-    let order: Vec<&str> =
-        all.iter().map(|a| r.trace[a.0]["capability"].as_str().unwrap()).collect();
+    let order: Vec<&str> = all
+        .iter()
+        .map(|a| match &r.trace[a.0].event {
+            Event::CapabilityStart { capability, .. } => &**capability,
+            _ => unreachable!(),
+        })
+        .collect();
     assert_eq!(
         order,
         ["TakeOff", "FlyToAndPatrol", "ReturnHome", "TakeOff", "FlyToAndPatrol", "ReturnHome"]

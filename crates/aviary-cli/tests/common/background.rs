@@ -5,7 +5,9 @@ use std::path::Path;
 use std::process::{Child, Command};
 use std::time::Duration;
 
-use serde_json::Value;
+use aviary_api::trace::{Event, EventKind, Record};
+use aviary_api::Function;
+use aviary_test_support::trace::Trace;
 
 /// `aviary run` started in a folder, killed if the test ends first.
 pub struct Run(Child);
@@ -39,31 +41,40 @@ pub fn finish(run: &mut Run, dir: &Path, limit: Duration) -> (i32, String) {
     (code, out)
 }
 
-/// The events of a trace, as far as it is written.
-pub fn events(path: &Path) -> Vec<Value> {
-    std::fs::read_to_string(path)
-        .unwrap_or_default()
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("a whole JSON event"))
-        .collect()
+/// The events of a trace, as far as it is written: every line a whole record.
+pub fn events(path: &Path) -> Trace {
+    Trace::parse(&std::fs::read_to_string(path).unwrap_or_default())
 }
 
 /// The events of one kind.
-pub fn named<'a>(events: &'a [Value], event: &str) -> impl Iterator<Item = &'a Value> {
-    let event = event.to_owned();
-    events.iter().filter(move |e| e["event"] == event.as_str())
+pub fn named<'a>(
+    events: &'a [Record<'static>],
+    kind: EventKind,
+) -> impl Iterator<Item = &'a Record<'static>> {
+    events.iter().filter(move |e| e.event.kind() == kind)
 }
 
 /// The first exception of that name.
-pub fn exception<'a>(events: &'a [Value], name: &str) -> Option<&'a Value> {
-    named(events, "exception").find(|e| e["name"] == name)
+pub fn exception<'a>(events: &'a [Record<'static>], name: &str) -> Option<&'a Record<'static>> {
+    events.iter().find(|e| matches!(&e.event, Event::Exception { name: n, .. } if n == name))
 }
 
-/// A position of the trace, `[x, y, z]`.
-pub fn pos(v: &Value) -> [f64; 3] {
-    let a = v.as_array().expect("a position");
-    let n = |i: usize| a.get(i).and_then(Value::as_f64).unwrap_or(0.0);
-    [n(0), n(1), n(2)]
+/// Whether a signal of that name was raised.
+pub fn signalled(events: &[Record<'static>], name: &str) -> bool {
+    events.iter().any(|e| matches!(&e.event, Event::Signal { name: n, .. } if n == name))
+}
+
+/// What an exception's values (`args`) say, as the trace writes them: its reason, in words.
+pub fn said(e: &Record) -> String {
+    match &e.event {
+        Event::Exception { args, .. } => serde_json::to_string(args).expect("values are JSON"),
+        other => panic!("not an exception: {other:?}"),
+    }
+}
+
+/// A position of the trace, `[x, y, z]`, a coordinate it does not know (written null) 0.
+pub fn pos(p: [f64; 3]) -> [f64; 3] {
+    p.map(|c| if c.is_finite() { c } else { 0.0 })
 }
 
 /// Waits until the trace in `dir` shows the take-off done.
@@ -71,6 +82,6 @@ pub fn airborne(dir: &Path, limit: Duration) {
     super::sitl::wait_until(limit, "the take-off", || {
         events(&dir.join("t.jsonl"))
             .iter()
-            .any(|e| e["event"] == "api_done" && e["function"] == "TakeOff")
+            .any(|e| matches!(e.event, Event::ApiDone { function: Function::TakeOff, .. }))
     });
 }

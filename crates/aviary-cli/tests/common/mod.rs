@@ -86,7 +86,7 @@ pub const PX4: &str = "climb_rate = 3\ntakeoff_speed = 1.5\ndescent_rate = 1.5\n
 pub fn simulated_and_planned(
     dir: &Path,
     keys: impl Fn(&str) -> String,
-) -> (String, Vec<serde_json::Value>, serde_json::Value) {
+) -> (String, aviary_test_support::trace::Trace, serde_json::Value) {
     let world = dir.join("sim.world.toml");
     std::fs::write(&world, example_world_with(keys)).expect("world");
     let world = world.to_string_lossy().into_owned();
@@ -199,15 +199,26 @@ pub fn paper_home(name: &str) -> [f64; 2] {
 
 /// The signals (with their counts) and finds of a trace, which must not depend on
 /// whether the drones are real or simulated.
-pub fn paper_outcome(events: &[serde_json::Value]) -> (Vec<String>, Vec<(String, i64, i64)>) {
-    let named = |kind: &'static str| events.iter().filter(move |e| e["event"] == kind);
-    let mut signals: Vec<String> =
-        named("signal").map(|e| e["name"].as_str().unwrap_or("").to_owned()).collect();
+pub fn paper_outcome(
+    events: &[aviary_api::trace::Record<'static>],
+) -> (Vec<String>, Vec<(String, i64, i64)>) {
+    use aviary_api::trace::Event;
+    let mut signals: Vec<String> = events
+        .iter()
+        .filter_map(|e| match &e.event {
+            Event::Signal { name, .. } => Some(name.to_string()),
+            _ => None,
+        })
+        .collect();
     signals.sort();
-    let mut finds: Vec<(String, i64, i64)> = named("detection")
-        .map(|e| {
-            let at = |i: usize| e["location"][i].as_f64().unwrap_or(0.0).round() as i64;
-            (e["kind"].as_str().unwrap_or("").to_owned(), at(0), at(1))
+    let mut finds: Vec<(String, i64, i64)> = events
+        .iter()
+        .filter_map(|e| match &e.event {
+            Event::Detection { kind, location, .. } => {
+                let at = |i: usize| background::pos(*location)[i].round() as i64;
+                Some((kind.to_string(), at(0), at(1)))
+            }
+            _ => None,
         })
         .collect();
     finds.sort();

@@ -4,6 +4,9 @@
 
 use super::serve::{http, post, raise, serve, Run};
 use crate::common::{aviary, scratch};
+use aviary_api::trace::{Event, EventKind, RaisedBy, Shown};
+use aviary_api::Point;
+use aviary_test_support::trace::Trace;
 
 /// `Watch`'s `radius` is a length (its default); `Go` carries a position and a duration
 /// (what its handler passes them to), and is the one signal the operator may raise.
@@ -139,26 +142,37 @@ fn leash_arguments_and_signal_values_are_checked_against_the_mission_kinds() {
 
     // Only the good calls reached the mission, with their values in SI.
     let trace = std::fs::read_to_string(dir.join("t.jsonl")).unwrap();
-    let events: Vec<serde_json::Value> =
-        trace.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
-    let signals: Vec<String> = events
+    let events = Trace::parse(&trace);
+    let signals: Vec<&[Shown]> = events
         .iter()
-        .filter(|e| e["event"] == "signal" && e["actor"].is_null())
-        .map(|e| e["args"].to_string())
+        .filter_map(|e| match &e.event {
+            Event::Signal { actor: None, args, .. } => Some(&args[..]),
+            _ => None,
+        })
         .collect();
-    assert_eq!(signals, ["[[100.0,-50.0],120.0]", "[[3.0,4.0,5.0],7.0]"]);
+    let at = |x: f64, y: f64, z: Option<f64>| Shown::Position(Point { x, y, z });
+    assert_eq!(
+        signals,
+        [
+            &[at(100.0, -50.0, None), Shown::Number(120.0)][..],
+            &[at(3.0, 4.0, Some(5.0)), Shown::Number(7.0)][..]
+        ]
+    );
     // The operator's signals say so (`by`), for the summary's operator actions; the
     // mission's own signals do not.
-    for e in events.iter().filter(|e| e["event"] == "signal") {
-        let by_operator = e["name"] == "Go";
-        assert_eq!(e["by"] == "operator", by_operator, "{e}");
-        assert_eq!(e.get("by").is_some(), by_operator, "no `by` on the mission's own: {e}");
+    for e in events.iter() {
+        let Event::Signal { name, by, .. } = &e.event else { continue };
+        let by_operator = name == "Go";
+        assert_eq!(*by == Some(RaisedBy::Operator), by_operator, "{e:?}");
+        assert_eq!(by.is_some(), by_operator, "no `by` on the mission's own: {e:?}");
     }
-    let widened: Vec<String> = events
+    let widened: Vec<&[Shown]> = events
         .iter()
-        .filter(|e| e["event"] == "signal" && e["name"] == "Widened")
-        .map(|e| e["args"].to_string())
+        .filter_map(|e| match &e.event {
+            Event::Signal { name, args, .. } if name == "Widened" => Some(&args[..]),
+            _ => None,
+        })
         .collect();
-    assert_eq!(widened, ["[200.0]", "[30.0]"]);
-    assert_eq!(events.iter().filter(|e| e["event"] == "leash").count(), 2);
+    assert_eq!(widened, [&[Shown::Number(200.0)][..], &[Shown::Number(30.0)][..]]);
+    assert_eq!(events.events(EventKind::Leash).len(), 2);
 }

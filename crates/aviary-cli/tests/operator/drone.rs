@@ -6,6 +6,9 @@ use std::time::Duration;
 
 use super::serve::{bearer, http, serve};
 use crate::common::{aviary, repo, scratch};
+use aviary_api::trace::{CallStatus, Event, OperatorAction, Status};
+use aviary_api::Function;
+use aviary_test_support::trace::{is, Trace};
 
 const WORLD: &str =
     "[places]\nFar = [0, 400]\n[drones.a]\nhome = [0, 0]\n[drones.b]\nhome = [10, 0]\n";
@@ -121,43 +124,60 @@ fn a_drone_is_held_resumed_and_sent_home_through_aviary_ctl() {
         let errors: Vec<String> = validator.iter_errors(e).map(|e| e.to_string()).collect();
         assert!(errors.is_empty(), "{e}\n{errors:#?}");
     }
-    let t = |e: &serde_json::Value| e["t"].as_f64().unwrap();
-    let operator: Vec<(f64, &str, &str)> = trace
+    let trace = Trace::parse(&text);
+    let operator: Vec<(f64, OperatorAction, &str)> = trace
         .iter()
-        .filter(|e| e["event"] == "operator")
-        .map(|e| (t(e), e["action"].as_str().unwrap(), e["drone"].as_str().unwrap()))
+        .filter_map(|e| match &e.event {
+            Event::Operator { action, drone } => Some((e.t, *action, drone.as_deref().unwrap())),
+            _ => None,
+        })
         .collect();
-    let actions: Vec<(&str, &str)> = operator.iter().map(|(_, a, d)| (*a, *d)).collect();
+    let actions: Vec<(OperatorAction, &str)> = operator.iter().map(|(_, a, d)| (*a, *d)).collect();
     assert_eq!(
         actions,
-        [("hold", "a"), ("resume", "a"), ("return_home", "b")],
+        [
+            (OperatorAction::Hold, "a"),
+            (OperatorAction::Resume, "a"),
+            (OperatorAction::ReturnHome, "b")
+        ],
         "refusals are not written"
     );
     let (held, resumed, home) = (operator[0].0, operator[1].0, operator[2].0);
-    let a_at: Vec<&serde_json::Value> = trace
-        .iter()
-        .filter(|e| {
-            e["event"] == "telemetry" && e["actor"] == "a" && t(e) > held + 0.3 && t(e) < resumed
-        })
-        .map(|e| &e["position"])
+    let a_at: Vec<[f64; 3]> = trace
+        .positions("a")
+        .into_iter()
+        .filter(|(t, _)| *t > held + 0.3 && *t < resumed)
+        .map(|(_, p)| p)
         .collect();
     assert!(a_at.len() >= 10 && a_at.iter().all(|p| *p == a_at[0]), "a holds: {a_at:?}");
-    let hovers: Vec<(&str, f64)> = trace
+    let hovers: Vec<(Status, f64)> = trace
+        .find(is::end_of("Hover"))
         .iter()
-        .filter(|e| e["event"] == "capability_end" && e["capability"] == "Hover")
-        .map(|e| (e["status"].as_str().unwrap(), t(e)))
+        .map(|e| match e.event {
+            Event::CapabilityEnd { status, .. } => (status, e.t),
+            _ => unreachable!(),
+        })
         .collect();
-    assert_eq!(hovers, [("aborted", home), ("aborted", home)], "the hover, and the next at once");
+    assert_eq!(
+        hovers,
+        [(Status::Aborted, home), (Status::Aborted, home)],
+        "the hover, and the next at once"
+    );
     let back = trace
         .iter()
-        .find(|e| {
-            e["event"] == "api_done" && e["actor"] == "b" && e["function"] == "ReturnToLaunch"
+        .find_map(|e| match &e.event {
+            Event::ApiDone { actor, function: Function::ReturnToLaunch, status, .. }
+                if actor == "b" =>
+            {
+                Some(*status)
+            }
+            _ => None,
         })
         .expect("b was sent home");
-    assert_eq!(back["status"], "ok");
-    let fly = trace
-        .iter()
-        .find(|e| e["event"] == "capability_end" && e["capability"] == "FlyTo")
-        .unwrap();
-    assert_eq!(fly["status"], "ok", "a flew on to the end");
+    assert_eq!(back, CallStatus::Ok);
+    let fly = trace.first(is::end_of("FlyTo"));
+    assert!(
+        matches!(fly.event, Event::CapabilityEnd { status: Status::Ok, .. }),
+        "a flew on to the end"
+    );
 }

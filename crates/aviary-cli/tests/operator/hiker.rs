@@ -5,7 +5,8 @@
 
 use super::serve::{raise, serve};
 use crate::common::{repo, scratch};
-use serde_json::Value;
+use aviary_api::trace::{Event, RaisedBy, Shown};
+use aviary_test_support::trace::{is, Trace};
 
 const MISSION: &str = "examples/lost_hiker.mission";
 
@@ -32,21 +33,20 @@ fn the_operator_raises_found_with_a_position_and_a_bad_one_is_refused() {
     let (status, body) = raise(&run, "Found", &format!("[{{\"lat\": {lat}, \"lon\": {lon}}}]"));
     assert_eq!(status, 200, "{body}");
     assert_eq!(run.child.wait().unwrap().code(), Some(0), "the mission ends ok");
-    let events: Vec<Value> = std::fs::read_to_string(dir.join("t.jsonl"))
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
-    let found: Vec<&Value> =
-        events.iter().filter(|e| e["event"] == "signal" && e["name"] == "Found").collect();
+    let events = Trace::read(&dir.join("t.jsonl"));
+    let found = events.find(is::signal("Found"));
     assert_eq!(found.len(), 1, "only the good position reached the mission");
-    assert_eq!(found[0]["by"], "operator");
+    assert!(matches!(found[0].event, Event::Signal { by: Some(RaisedBy::Operator), .. }));
     let flights: Vec<(&str, [f64; 2])> = events
         .iter()
-        .filter(|e| e["event"] == "capability_start" && e["capability"] == "FlyTo")
-        .map(|e| {
-            let t = &e["args"]["target"];
-            (e["actor"].as_str().unwrap(), [t[0].as_f64().unwrap(), t[1].as_f64().unwrap()])
+        .filter_map(|e| match &e.event {
+            Event::CapabilityStart { capability, actor, args, .. } if capability == "FlyTo" => {
+                match args.get("target") {
+                    Some(Shown::Position(p)) => Some((&**actor, [p.x, p.y])),
+                    other => panic!("not a position: {other:?}"),
+                }
+            }
+            _ => None,
         })
         .collect();
     assert_eq!(flights.len(), 2, "{flights:?}");

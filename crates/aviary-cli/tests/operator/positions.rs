@@ -5,6 +5,8 @@
 
 use super::serve::{http, raise, serve, Run};
 use crate::common::{aviary, scratch};
+use aviary_api::trace::{Event, Shown, Status};
+use aviary_test_support::trace::{is, Trace};
 
 /// `Go` carries where `b` is to fly; `a` hovers meanwhile, so the run lasts 60 s.
 const MISSION: &str = "MISSION M:
@@ -85,12 +87,17 @@ fn a_position_is_taken_by_latitude_and_longitude_or_metres_and_refused_beyond_th
     // only the positions it was given, placed about the origin.
     assert_eq!(run.child.wait().unwrap().code(), Some(0), "the mission ends ok");
     let trace = std::fs::read_to_string(dir.join("t.jsonl")).unwrap();
-    let events: Vec<serde_json::Value> =
-        trace.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let events = Trace::parse(&trace);
     let heard: Vec<Vec<f64>> = events
+        .find(is::signal("Go"))
         .iter()
-        .filter(|e| e["event"] == "signal" && e["name"] == "Go")
-        .map(|e| e["args"][0].as_array().unwrap().iter().map(|c| c.as_f64().unwrap()).collect())
+        .map(|e| match &e.event {
+            Event::Signal { args, .. } => match &args[0] {
+                Shown::Position(p) => [Some(p.x), Some(p.y), p.z].into_iter().flatten().collect(),
+                other => panic!("not a position: {other:?}"),
+            },
+            _ => unreachable!(),
+        })
         .collect();
     // 0.0005° of latitude is 55.6 m; of longitude, at 47.45° N, 37.6 m.
     let expected = [vec![37.6, 55.6, 30.0], vec![-75.1, -111.2], vec![-50.0, 40.0]];
@@ -99,6 +106,6 @@ fn a_position_is_taken_by_latitude_and_longitude_or_metres_and_refused_beyond_th
         assert_eq!(got.len(), want.len(), "{got:?}");
         assert!(got.iter().zip(want).all(|(g, w)| (g - w).abs() < 0.1), "{got:?} is not {want:?}");
     }
-    let end = events.iter().find(|e| e["event"] == "mission_end").expect("mission_end");
-    assert_eq!(end["status"], "ok", "{end}");
+    let end = events.first(|e| matches!(e, Event::MissionEnd { .. }));
+    assert!(matches!(end.event, Event::MissionEnd { status: Status::Ok, .. }), "{end:?}");
 }

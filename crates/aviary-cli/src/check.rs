@@ -109,20 +109,35 @@ fn check_one(
             out!("\n{}", plan.render_text());
         }
         Format::Json => {
-            let diagnostics: Vec<serde_json::Value> =
-                diagnostics.iter().map(|d| render_json(&sources, d)).collect();
-            let mut doc = serde_json::json!({ "file": path.display().to_string(), "plan": plan, "diagnostics": diagnostics });
-            match &figures {
-                Some(Ok(f)) if !f.is_empty() => {
-                    doc["vehicles"] = f.iter().map(crate::vehicle_figures::json).collect()
-                }
-                Some(Err(why)) => doc["vehicles_not_asked"] = why.as_str().into(),
-                _ => {}
-            }
-            outln!("{doc}");
+            let (vehicles, vehicles_not_asked) = match figures {
+                Some(Ok(f)) if !f.is_empty() => (Some(f), None),
+                Some(Err(why)) => (None, Some(why)),
+                _ => (None, None),
+            };
+            let doc = PlanReport {
+                file: path.display().to_string(),
+                plan: &plan,
+                diagnostics: diagnostics.iter().map(|d| render_json(&sources, d)).collect(),
+                vehicles,
+                vehicles_not_asked,
+            };
+            outln!("{}", serde_json::to_string(&doc).unwrap_or_default());
         }
     }
     failed
+}
+
+/// `aviary check --plan --format json`: the file, its plan and diagnostics, and the
+/// MAVLink drones' own figures when they were asked.
+#[derive(serde::Serialize)]
+struct PlanReport<'a> {
+    file: String,
+    plan: &'a aviary_verify::plan::Plan,
+    diagnostics: Vec<aviary_diagnostics::JsonDiagnostic>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    vehicles: Option<Vec<crate::vehicle_figures::Source>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    vehicles_not_asked: Option<String>,
 }
 
 fn why_no_plan(errors: bool, world: bool) -> &'static str {

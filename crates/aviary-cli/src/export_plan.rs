@@ -11,19 +11,10 @@ use std::path::{Path, PathBuf};
 
 use aviary_api::geo::Origin;
 use aviary_diagnostics::{Diagnostic, SourceMap};
-use serde_json::{json, Value};
+use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavAutopilot, MavCmd, MavFrame, MavType};
+use serde::Serialize;
 
 use crate::files::{color_wanted, world_beside, DiskProvider};
-
-/// MAVLink's commands and frames, as QGC writes them.
-const MAV_CMD_NAV_WAYPOINT: u16 = 16;
-const MAV_CMD_NAV_RETURN_TO_LAUNCH: u16 = 20;
-const MAV_CMD_NAV_TAKEOFF: u16 = 22;
-const MAV_FRAME_MISSION: u8 = 2;
-const MAV_FRAME_GLOBAL_RELATIVE_ALT: u8 = 3;
-/// A multicopter (MAV_TYPE_QUADROTOR), on ArduPilot (MAV_AUTOPILOT_ARDUPILOTMEGA).
-const VEHICLE_TYPE: u8 = 2;
-const FIRMWARE_TYPE: u8 = 3;
 
 pub fn run(
     mission: &Path,
@@ -54,7 +45,7 @@ fn plan_file(
     world: Option<&Path>,
     drone: &str,
     use_roots: &[PathBuf],
-) -> Result<Value, (u8, String)> {
+) -> Result<PlanFile, (u8, String)> {
     let read = |p: &Path| {
         std::fs::read(p).map_err(|e| (2, format!("aviary: cannot read {}: {e}\n", p.display())))
     };
@@ -120,31 +111,33 @@ fn document(
     world: &aviary_world::World,
     d: &aviary_world::Drone,
     points: &[[f64; 3]],
-) -> Value {
+) -> PlanFile {
     let lat_lon = |x: f64, y: f64| {
         let (lat, lon) = origin.to_geodetic(x, y);
         [round(lat, 1e7), round(lon, 1e7)]
     };
-    let mut items = Vec::new();
-    let mut item = |command: u16, frame: u8, at: Option<([f64; 2], f64)>| {
-        let params = match at {
-            Some(([lat, lon], alt)) => json!([0, 0, 0, null, lat, lon, alt]),
-            None => json!([0, 0, 0, 0, 0, 0, 0]),
+    let mut items: Vec<SimpleItem> = Vec::new();
+    let mut item = |command: MavCmd, frame: MavFrame, at: Option<([f64; 2], f64)>| {
+        let (params, placed) = match at {
+            Some(([lat, lon], alt)) => {
+                let params =
+                    [Some(0.0), Some(0.0), Some(0.0), None, Some(lat), Some(lon), Some(alt)];
+                (
+                    params,
+                    Some(Placed { amsl_alt_above_terrain: None, altitude: alt, altitude_mode: 1 }),
+                )
+            }
+            None => ([Some(0.0); 7], None),
         };
-        let mut it = json!({
-            "type": "SimpleItem",
-            "autoContinue": true,
-            "command": command,
-            "doJumpId": items.len() + 1,
-            "frame": frame,
-            "params": params,
+        items.push(SimpleItem {
+            kind: "SimpleItem",
+            auto_continue: true,
+            command: command as u16,
+            do_jump_id: items.len() + 1,
+            frame: frame as u8,
+            params,
+            placed,
         });
-        if let Some((_, alt)) = at {
-            it["AMSLAltAboveTerrain"] = Value::Null;
-            it["Altitude"] = json!(alt);
-            it["AltitudeMode"] = json!(1);
-        }
-        items.push(it);
     };
     // Points on the ground are landings (the way home ends there): the return to launch
     // stands for them. Consecutive repeats (a climb where the drone stands, the takeoff's
@@ -158,48 +151,122 @@ fn document(
             last = *p;
         }
     }
+    let relative = MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT;
     let home = lat_lon(d.home[0], d.home[1]);
-    item(MAV_CMD_NAV_TAKEOFF, MAV_FRAME_GLOBAL_RELATIVE_ALT, Some((home, round(first_alt, 100.0))));
+    item(MavCmd::MAV_CMD_NAV_TAKEOFF, relative, Some((home, round(first_alt, 100.0))));
     for p in &way {
         let alt = round(p[2], 100.0);
-        item(MAV_CMD_NAV_WAYPOINT, MAV_FRAME_GLOBAL_RELATIVE_ALT, Some((lat_lon(p[0], p[1]), alt)));
+        item(MavCmd::MAV_CMD_NAV_WAYPOINT, relative, Some((lat_lon(p[0], p[1]), alt)));
     }
-    item(MAV_CMD_NAV_RETURN_TO_LAUNCH, MAV_FRAME_MISSION, None);
-    let polygon = |corners: &[[f64; 2]]| -> Vec<[f64; 2]> {
-        corners.iter().map(|c| lat_lon(c[0], c[1])).collect()
+    item(MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH, MavFrame::MAV_FRAME_MISSION, None);
+    let polygon = |inclusion: bool, corners: &[[f64; 2]]| FencePolygon {
+        inclusion,
+        polygon: corners.iter().map(|c| lat_lon(c[0], c[1])).collect(),
+        version: 1,
     };
     let mut polygons = Vec::new();
     if let Some(fence) = &world.site.geofence {
-        polygons.push(json!({ "inclusion": true, "polygon": polygon(fence), "version": 1 }));
+        polygons.push(polygon(true, fence));
     }
-    for z in &world.no_fly {
-        polygons.push(json!({ "inclusion": false, "polygon": polygon(&z.polygon), "version": 1 }));
-    }
-    let rally: Vec<Value> = world
+    polygons.extend(world.no_fly.iter().map(|z| polygon(false, &z.polygon)));
+    let rally = world
         .places
         .iter()
         .map(|p| {
             let [lat, lon] = lat_lon(p.at[0], p.at[1]);
-            json!([lat, lon, round(p.at[2], 100.0)])
+            [lat, lon, round(p.at[2], 100.0)]
         })
         .collect();
-    json!({
-        "fileType": "Plan",
-        "version": 1,
-        "groundStation": "Aviary",
-        "mission": {
-            "version": 2,
-            "firmwareType": FIRMWARE_TYPE,
-            "vehicleType": VEHICLE_TYPE,
-            "cruiseSpeed": d.max_speed,
-            "hoverSpeed": d.max_speed,
-            "globalPlanAltitudeMode": 1,
-            "plannedHomePosition": [home[0], home[1], round(origin.alt + d.home[2], 100.0)],
-            "items": items,
+    PlanFile {
+        file_type: "Plan",
+        version: 1,
+        ground_station: "Aviary",
+        mission: PlanMission {
+            version: 2,
+            firmware_type: MavAutopilot::MAV_AUTOPILOT_ARDUPILOTMEGA as u8,
+            vehicle_type: MavType::MAV_TYPE_QUADROTOR as u8,
+            cruise_speed: d.max_speed,
+            hover_speed: d.max_speed,
+            global_plan_altitude_mode: 1,
+            planned_home_position: [home[0], home[1], round(origin.alt + d.home[2], 100.0)],
+            items,
         },
-        "geoFence": { "version": 2, "circles": [], "polygons": polygons },
-        "rallyPoints": { "version": 2, "points": rally },
-    })
+        geo_fence: GeoFence { version: 2, circles: [], polygons },
+        rally_points: RallyPoints { version: 2, points: rally },
+    }
+}
+
+/// QGroundControl's `.plan` file, as QGC writes one (its keys and versions).
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct PlanFile {
+    file_type: &'static str,
+    version: u8,
+    ground_station: &'static str,
+    mission: PlanMission,
+    geo_fence: GeoFence,
+    rally_points: RallyPoints,
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct PlanMission {
+    version: u8,
+    /// MAV_AUTOPILOT: ArduPilot.
+    firmware_type: u8,
+    /// MAV_TYPE: a multicopter.
+    vehicle_type: u8,
+    cruise_speed: f64,
+    hover_speed: f64,
+    global_plan_altitude_mode: u8,
+    planned_home_position: [f64; 3],
+    items: Vec<SimpleItem>,
+}
+
+/// One command of the mission: MAV_CMD, its frame and its seven parameters.
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct SimpleItem {
+    #[serde(rename = "type")]
+    kind: &'static str,
+    auto_continue: bool,
+    command: u16,
+    do_jump_id: usize,
+    frame: u8,
+    params: [Option<f64>; 7],
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    placed: Option<Placed>,
+}
+
+/// What QGC adds to an item at a place: its altitude, above home (mode 1).
+#[derive(Serialize)]
+struct Placed {
+    #[serde(rename = "AMSLAltAboveTerrain")]
+    amsl_alt_above_terrain: Option<f64>,
+    #[serde(rename = "Altitude")]
+    altitude: f64,
+    #[serde(rename = "AltitudeMode")]
+    altitude_mode: u8,
+}
+
+#[derive(Serialize)]
+struct GeoFence {
+    version: u8,
+    circles: [(); 0],
+    polygons: Vec<FencePolygon>,
+}
+
+#[derive(Serialize)]
+struct FencePolygon {
+    inclusion: bool,
+    polygon: Vec<[f64; 2]>,
+    version: u8,
+}
+
+#[derive(Serialize)]
+struct RallyPoints {
+    version: u8,
+    points: Vec<[f64; 3]>,
 }
 
 /// `v` to the nearest 1/`scale`.

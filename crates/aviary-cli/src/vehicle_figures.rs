@@ -28,11 +28,6 @@ pub fn ask(world: &mut World) -> Result<Vec<Source>, String> {
     Ok(apply(world, &facts))
 }
 
-/// A drone's figures as `aviary check --plan --format json` writes them.
-pub fn json(s: &Source) -> serde_json::Value {
-    serde_json::json!({ "drone": s.drone, "source": s.source, "differences": s.differences })
-}
-
 /// The sources as text: each drone's line, then what differs, indented.
 pub fn render(sources: &[Source]) -> String {
     let mut out = String::new();

@@ -12,7 +12,7 @@ mod source;
 pub mod suggest;
 
 pub use code::Code;
-pub use render::{render_json, render_text, summary_line};
+pub use render::{render_json, render_text, summary_line, JsonDiagnostic, JsonLabel};
 pub use source::{FileId, LineCol, SourceMap};
 
 /// A byte range into one source text.

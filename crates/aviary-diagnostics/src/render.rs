@@ -4,7 +4,6 @@
 
 use codespan_reporting::diagnostic as cs;
 use codespan_reporting::term::{self, termcolor};
-use serde_json::json;
 
 use crate::source::clamp_to_char;
 use crate::{Diagnostic, Label, Severity, SourceMap, Span};
@@ -60,34 +59,72 @@ fn visible(text: &str, span: Span) -> std::ops::Range<usize> {
     start..end
 }
 
+/// A diagnostic as JSON (`aviary check --json`, the station's check): where, with
+/// 1-based lines and columns, what and why.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct JsonDiagnostic {
+    pub file: String,
+    pub line: usize,
+    pub column: usize,
+    pub end_line: usize,
+    pub end_column: usize,
+    /// `error`, `warning` or `note`.
+    pub severity: &'static str,
+    pub code: &'static str,
+    pub message: String,
+    /// What the caret under the primary span says.
+    pub label: String,
+    pub help: Option<String>,
+    /// The secondary labels, each where it points.
+    pub related: Vec<JsonLabel>,
+}
+
+/// A label of a diagnostic, where it points.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct JsonLabel {
+    pub file: String,
+    pub line: usize,
+    pub column: usize,
+    pub end_line: usize,
+    pub end_column: usize,
+    pub message: String,
+}
+
 /// One JSON object per diagnostic, with 1-based lines and columns.
-pub fn render_json(sources: &SourceMap, diagnostic: &Diagnostic) -> serde_json::Value {
+pub fn render_json(sources: &SourceMap, diagnostic: &Diagnostic) -> JsonDiagnostic {
     let place = |l: &Label| {
         let start = sources.line_col(l.file, l.span.start);
         let end = sources.line_col(l.file, l.span.end);
-        json!({
-            "file": sources.name(l.file),
-            "line": start.line,
-            "column": start.column,
-            "end_line": end.line,
-            "end_column": end.column,
-            "message": l.message,
-        })
+        JsonLabel {
+            file: sources.name(l.file).to_string(),
+            line: start.line,
+            column: start.column,
+            end_line: end.line,
+            end_column: end.column,
+            message: l.message.clone(),
+        }
     };
     let primary = place(&diagnostic.primary);
-    json!({
-        "file": primary["file"],
-        "line": primary["line"],
-        "column": primary["column"],
-        "end_line": primary["end_line"],
-        "end_column": primary["end_column"],
-        "severity": diagnostic.severity.as_str(),
-        "code": diagnostic.code.as_str(),
-        "message": diagnostic.message,
-        "label": diagnostic.primary.message,
-        "help": diagnostic.help,
-        "related": diagnostic.secondary.iter().map(place).collect::<Vec<_>>(),
-    })
+    JsonDiagnostic {
+        file: primary.file,
+        line: primary.line,
+        column: primary.column,
+        end_line: primary.end_line,
+        end_column: primary.end_column,
+        severity: diagnostic.severity.as_str(),
+        code: diagnostic.code.as_str(),
+        message: diagnostic.message.clone(),
+        label: primary.message,
+        help: diagnostic.help.clone(),
+        related: diagnostic.secondary.iter().map(place).collect(),
+    }
+}
+
+impl std::fmt::Display for JsonDiagnostic {
+    /// As one line of JSON.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&serde_json::to_string(self).map_err(|_| std::fmt::Error)?)
+    }
 }
 
 /// `2 errors, 1 warning` (empty when there is nothing to count).

@@ -80,8 +80,14 @@ pub fn to_lsp(
         message,
         related_information: (!related.is_empty()).then_some(related),
         tags: None,
-        data: d.help.as_ref().map(|h| serde_json::json!({ "help": h })),
+        data: d.help.as_ref().and_then(|help| serde_json::to_value(Help { help }).ok()),
     }
+}
+
+/// A diagnostic's `data`: its help, for a client that shows it apart.
+#[derive(serde::Serialize)]
+struct Help<'a> {
+    help: &'a str,
 }
 
 /// Every analysis's diagnostics by the URI of their file, each once.

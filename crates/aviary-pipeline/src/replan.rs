@@ -7,7 +7,9 @@ use aviary_diagnostics::{Code, Diagnostic};
 use aviary_mavlink::Facts;
 use aviary_world::World;
 
-/// Where one drone's figures came from, and what differs from the world's.
+/// Where one drone's figures came from, and what differs from the world's (as
+/// `aviary check --plan --format json` writes it, under `vehicles`).
+#[derive(Clone, Debug, serde::Serialize)]
 pub struct Figures {
     pub drone: String,
     pub source: String,

@@ -77,7 +77,7 @@ pub struct CheckResult<'m> {
 #[derive(Debug, Serialize)]
 pub struct Shown {
     #[serde(flatten)]
-    pub diagnostic: Value,
+    pub diagnostic: aviary_diagnostics::JsonDiagnostic,
     pub text: String,
 }
 

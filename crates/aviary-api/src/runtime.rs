@@ -36,6 +36,10 @@ pub enum Value {
     /// What a drone's last `Sweep` or `FollowPath` left (`drone.remaining`); shared, since
     /// a mission passes it on as it is.
     Remainder(std::sync::Arc<crate::Remainder>),
+    /// No value: what a drone reads that it does not have (an attribute the world does not
+    /// give it, a wind sensor it lacks, a payload it does not carry). It equals nothing,
+    /// not even itself, orders with nothing, is not true, and a trace writes it `null`.
+    Absent,
 }
 
 /// What a drone is doing, as telemetry's `state` reports it (and the trace writes it).

@@ -105,6 +105,7 @@ impl fmt::Display for Value {
                 (Some(n), m) => write!(f, "{n} lanes left ({} m)", fixed(m, 1)),
                 (None, m) => write!(f, "a path left ({} m)", fixed(m, 1)),
             },
+            Value::Absent => f.write_str("no value"),
         }
     }
 }

@@ -47,8 +47,8 @@ pub(crate) fn frame_values<'a>(
 ) -> impl ExactSizeIterator<Item = Value> + 'a {
     let size = cap.frame_size.max(cap.actors + cap.params.len());
     (0..size).map(move |i| match i.checked_sub(cap.actors) {
-        None => actors.get(i).map_or(Value::Bool(false), |d| Value::Actor(*d)),
-        Some(j) => args.get(j).cloned().unwrap_or(Value::Bool(false)),
+        None => actors.get(i).map_or(Value::Absent, |d| Value::Actor(*d)),
+        Some(j) => args.get(j).cloned().unwrap_or(Value::Absent),
     })
 }
 

@@ -472,7 +472,7 @@ impl<'m> Engine<'m> {
             handlers: &[],
             fired: RefCell::new(Vec::new()),
             exception_handlers: &[],
-            frame: RefCell::new(Rc::from(vec![Value::Bool(false); self.m.frame_size])),
+            frame: RefCell::new(Rc::from(vec![Value::Absent; self.m.frame_size])),
             jobs: Jobs::default(),
             unwinding: Cell::new(false),
             deferred: RefCell::new(Vec::new()),

@@ -679,7 +679,7 @@ impl Drop for Listed<'_, '_> {
 
 pub(crate) fn set(frame: &mut Vec<Value>, slot: usize, value: Value) {
     if frame.len() <= slot {
-        frame.resize(slot + 1, Value::Bool(false));
+        frame.resize(slot + 1, Value::Absent);
     }
     frame[slot] = value;
 }

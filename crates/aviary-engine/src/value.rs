@@ -30,16 +30,16 @@ impl Env<'_> {
     pub fn eval(&self, e: &Expr) -> Value {
         match e {
             Expr::Const(v) => v.clone(),
-            Expr::Slot(s) => self.frame.get(*s).cloned().unwrap_or(Value::Bool(false)),
-            Expr::Actor(r) => self.actor(r).map_or(Value::Bool(false), Value::Actor),
+            Expr::Slot(s) => self.frame.get(*s).cloned().unwrap_or(Value::Absent),
+            Expr::Actor(r) => self.actor(r).map_or(Value::Absent, Value::Actor),
             Expr::Telemetry(r, field) => match self.actor(r) {
                 Some(d) if *field == Field::Remaining => self.coverage.remaining(d),
                 Some(d) => telemetry(self.backend, d, *field),
-                None => Value::Bool(false),
+                None => Value::Absent,
             },
             Expr::Attribute(r, i) => {
                 let d = self.actor(r);
-                d.and_then(|d| self.mission.attribute(*i, d)).unwrap_or(Value::Bool(false))
+                d.and_then(|d| self.mission.attribute(*i, d)).unwrap_or(Value::Absent)
             }
             Expr::Point(parts) => {
                 let n = parts.borrowed().map(|p| number(&self.eval(p)));
@@ -58,7 +58,7 @@ impl Env<'_> {
             Expr::Add(a, b) | Expr::Sub(a, b) => {
                 let sign = if matches!(e, Expr::Add(..)) { 1.0 } else { -1.0 };
                 let (a, b) = (self.placed(self.eval(a)), self.eval(b));
-                arith::add(&a, &b, sign).unwrap_or(Value::Bool(false))
+                arith::add(&a, &b, sign).unwrap_or(Value::Absent)
             }
             Expr::Offset(p, d, b) => {
                 let p = arith::point_of(&self.placed(self.eval(p)));
@@ -66,7 +66,7 @@ impl Env<'_> {
                     (Some(p), Value::Number(d), Value::Number(b)) => {
                         Value::Position(arith::offset(p, d, b))
                     }
-                    _ => Value::Bool(false),
+                    _ => Value::Absent,
                 }
             }
             Expr::Midpoint(a, b) => {
@@ -74,7 +74,7 @@ impl Env<'_> {
                 let b = arith::point_of(&self.placed(self.eval(b)));
                 match (a, b) {
                     (Some(a), Some(b)) => Value::Position(arith::midpoint(a, b)),
-                    _ => Value::Bool(false),
+                    _ => Value::Absent,
                 }
             }
             Expr::Elapsed => {
@@ -130,12 +130,12 @@ fn telemetry(backend: &dyn Backend, d: usize, field: Field) -> Value {
         Field::Battery => Value::Number(t.battery),
         Field::State => Value::Symbol(t.state.as_str().to_string()),
         Field::Link => Value::Symbol(if t.link { "Connected" } else { "Lost" }.to_string()),
-        // Without a wind sensor, as a drone without an attribute reads it.
-        Field::Wind => t.wind.map_or(Value::Bool(false), |w| Value::Number(w[0].hypot(w[1]))),
-        // Carrying nothing, as a drone without an attribute reads it.
-        Field::Payload => backend.payload(d).map_or(Value::Bool(false), Value::Symbol),
+        // Without a wind sensor: no value, as for an attribute the drone does not have.
+        Field::Wind => t.wind.map_or(Value::Absent, |w| Value::Number(w[0].hypot(w[1]))),
+        // Carrying nothing: no value, as for an attribute the drone does not have.
+        Field::Payload => backend.payload(d).map_or(Value::Absent, Value::Symbol),
         // The engine's, not the backend's: read in `Env::eval`.
-        Field::Remaining => Value::Bool(false),
+        Field::Remaining => Value::Absent,
     }
 }
 

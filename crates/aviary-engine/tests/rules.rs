@@ -361,6 +361,43 @@ fn for_aliases_read_attributes_and_telemetry() {
     assert_eq!(durations, [("a".to_string(), 2.0), ("b".to_string(), 1.0)]);
 }
 
+/// What a drone does not have (an attribute the world gives another drone only) reads no
+/// value: it equals nothing, `FALSE` included, differs from everything, is not true, and
+/// a signal that carries it shows `null` (docs/LANGUAGE.md, "No value").
+#[test]
+fn an_attribute_a_drone_does_not_have_reads_no_value() {
+    let world = harness::WORLD.replace("[drones.a]\n", "[drones.a]\narmed = true\n");
+    let r = harness::run_in(
+        "MISSION M:\n    PARALLEL FOR team AS d:\n        IF d.armed = FALSE:\n            SIGNAL Equal_False WITH d\n        IF d.armed != TRUE:\n            SIGNAL Not_True WITH d\n        IF d.armed:\n            SIGNAL Armed WITH d\n        IF NOT d.armed:\n            SIGNAL Not_Armed WITH d\n        SIGNAL Read WITH d.armed\n",
+        &world,
+    );
+    assert_eq!(r.outcome.status, Status::Ok, "{:?}", r.outcome.reason);
+    let raised = |name: &str| -> Vec<String> {
+        r.find(is::signal(name))
+            .iter()
+            .filter_map(|e| match &e.event {
+                Event::Signal { args, .. } => {
+                    args.first().and_then(Shown::as_str).map(str::to_string)
+                }
+                _ => None,
+            })
+            .collect()
+    };
+    assert_eq!(raised("Equal_False"), Vec::<String>::new(), "no value is not FALSE");
+    assert_eq!(raised("Not_True"), ["b"], "no value differs from TRUE");
+    assert_eq!(raised("Armed"), ["a"]);
+    assert_eq!(raised("Not_Armed"), ["b"], "no value is not true");
+    let read: Vec<Shown> = r
+        .find(is::signal("Read"))
+        .iter()
+        .filter_map(|e| match &e.event {
+            Event::Signal { args, .. } => args.first().cloned(),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(read, [Shown::Bool(true), Shown::Null]);
+}
+
 /// Branches of a `PARALLEL` block that wake at one instant go on in the order they are
 /// written, and so raise their signals in that order: for a small block (polled in index
 /// order) and a large one (polled as woken: they were woken in that order). The engine

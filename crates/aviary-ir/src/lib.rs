@@ -459,6 +459,10 @@ impl Compare {
     /// section 3: symbols only equal themselves). The engine and the pre-flight plan both decide
     /// conditions with it.
     pub fn holds(self, a: &Value, b: &Value) -> bool {
+        // What a drone does not have equals nothing (so it differs from everything).
+        if matches!(a, Value::Absent) || matches!(b, Value::Absent) {
+            return self == Compare::Ne;
+        }
         if let (Value::Number(x), Value::Number(y)) = (a, b) {
             return match self {
                 Compare::Eq => x == y,
@@ -477,7 +481,8 @@ impl Compare {
                 | Value::Position(_)
                 | Value::Area(_)
                 | Value::Actor(_)
-                | Value::Remainder(_) => None,
+                | Value::Remainder(_)
+                | Value::Absent => None,
             }
         }
         let equal = match (text(a), text(b)) {

@@ -567,10 +567,11 @@ impl<'a> Compiler<'a> {
         })
     }
 
-    /// The default of parameter `i` of a capability, for a call that leaves it out.
+    /// The default of parameter `i` of a capability, for a call that leaves it out (none:
+    /// no value).
     fn default_of(&self, capability: CapId, i: usize) -> Expr {
         let default = self.defaults.get(capability).and_then(|d| d.get(i)).cloned().flatten();
-        default.unwrap_or(Expr::Const(Value::Bool(false)))
+        default.unwrap_or(Expr::Const(Value::Absent))
     }
 
     fn leash(&mut self, l: &ast::LeashCall) -> Option<Leash> {
@@ -713,7 +714,7 @@ impl<'a> Compiler<'a> {
     /// never runs.
     fn unresolved(&mut self) -> Expr {
         self.unresolved = true;
-        Expr::Const(Value::Bool(false))
+        Expr::Const(Value::Absent)
     }
 
     fn name(&self, name: &str) -> Expr {

@@ -13,7 +13,8 @@ use crate::{Names, Point, Remainder, Value};
 /// and drones (by name); booleans; a position as `[x, y]` or `[x, y, z]`; an area as its
 /// corners `[[x, y], …]`; what a Sweep or FollowPath left as an object, `{"lanes": …,
 /// "spacing": …}` or `{"points": …}` ([`crate::Remainder`]). A number that is not finite is written `null`, as is a drone
-/// the fleet does not have; `null` reads back as [`Shown::Null`], and `null` inside a
+/// the fleet does not have and a value a drone does not have ([`Value::Absent`]); `null`
+/// reads back as [`Shown::Null`], and `null` inside a
 /// position or an area as NaN.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Shown<'a> {
@@ -37,6 +38,7 @@ impl<'a> Shown<'a> {
             Value::Area(corners) => Shown::Area(Cow::Borrowed(corners)),
             Value::Actor(d) => drones.get(*d).map_or(Shown::Null, |n| Shown::Text(n.into())),
             Value::Remainder(left) => Shown::Remainder(Cow::Borrowed(left)),
+            Value::Absent => Shown::Null,
         }
     }
 

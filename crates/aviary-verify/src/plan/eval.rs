@@ -42,7 +42,10 @@ impl Scope<'_> {
             Expr::Slot(s) => self.frame.get(*s)?.clone()?,
             Expr::Actor(a) => Value::Actor(self.actor(a)?),
             Expr::Telemetry(a, field) => self.telemetry(self.actor(a)?, *field)?,
-            Expr::Attribute(a, i) => self.mission.attribute(*i, self.actor(a)?)?,
+            // The world says which drones have the attribute: one without reads no value.
+            Expr::Attribute(a, i) => {
+                self.mission.attribute(*i, self.actor(a)?).unwrap_or(Value::Absent)
+            }
             Expr::Point(parts) => {
                 let n = parts.borrowed().try_map(|p| number(&self.eval(p)?))?;
                 Value::Position(Point { x: n.x, y: n.y, z: n.z })
@@ -117,7 +120,8 @@ impl Scope<'_> {
             | Value::Bool(_)
             | Value::Position(_)
             | Value::Area(_)
-            | Value::Remainder(_)) => Some(v),
+            | Value::Remainder(_)
+            | Value::Absent) => Some(v),
         }
     }
 
@@ -130,7 +134,8 @@ impl Scope<'_> {
             | Value::Symbol(_)
             | Value::Bool(_)
             | Value::Area(_)
-            | Value::Remainder(_) => None,
+            | Value::Remainder(_)
+            | Value::Absent => None,
         }
     }
 
@@ -178,13 +183,16 @@ pub fn number(v: &Value) -> Option<f64> {
         | Value::Position(_)
         | Value::Area(_)
         | Value::Actor(_)
-        | Value::Remainder(_) => None,
+        | Value::Remainder(_)
+        | Value::Absent => None,
     }
 }
 
 fn truth(v: &Value) -> Option<bool> {
     match v {
         Value::Bool(b) => Some(*b),
+        // What a drone does not have is not true, as the engine reads it.
+        Value::Absent => Some(false),
         Value::Number(_)
         | Value::Text(_)
         | Value::Symbol(_)

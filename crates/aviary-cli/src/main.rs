@@ -10,6 +10,7 @@ mod bench;
 mod check;
 mod ctl;
 mod ctl_table;
+mod export;
 mod export_plan;
 mod files;
 mod fmt;
@@ -181,6 +182,19 @@ enum Command {
         /// Where to write the report
         #[arg(short, long, value_name = "OUT.html", value_parser = report_file)]
         output: PathBuf,
+    },
+    /// Write a recorded trace as a ROS 2 bag (rosbag2, MCAP): every event, and each drone's
+    /// pose and position on the Earth from the telemetry (docs/ROS2.md)
+    Export {
+        /// The trace, as `aviary run --trace` writes it
+        #[arg(value_parser = recorded_trace)]
+        trace: PathBuf,
+        /// The world file the mission flew in, whose origin places the drones on the Earth
+        #[arg(long, value_parser = world_file)]
+        world: Option<PathBuf>,
+        /// The bag to write: a new folder holding the MCAP file and metadata.yaml
+        #[arg(long, value_name = "BAG", value_parser = folder)]
+        mcap: PathBuf,
     },
     /// Write one drone's part of a mission as a QGroundControl plan (.plan): the waypoints
     /// its plan flies through (as `aviary check --plan` times them), the world's geofence
@@ -386,6 +400,7 @@ fn command(cli: Cli) -> u8 {
             }
         },
         Command::Report { trace, world, output } => report::run(&trace, world.as_deref(), &output),
+        Command::Export { trace, world, mcap } => export::run(&trace, world.as_deref(), &mcap),
         Command::ExportPlan { mission, world, drone, output, use_root } => {
             export_plan::run(&mission, world.as_deref(), &drone, &output, &use_root)
         }

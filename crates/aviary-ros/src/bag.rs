@@ -1,0 +1,307 @@
+//! A recorded trace as a rosbag2 bag: a folder holding one MCAP file (`ros2` profile,
+//! `ros2msg` schemas, CDR messages) and the `metadata.yaml` that `ros2 bag` and rosbags
+//! read first. Foxglove opens the MCAP file alone.
+//!
+//! Its topics: `/aviary/events` (`aviary_msgs/msg/Event`, every event of the trace),
+//! and for each drone `/aviary/DRONE/pose` (`geometry_msgs/msg/PoseStamped`, in the
+//! mission's local frame `map`: metres east, north and up of the world's origin) and,
+//! when the world places that origin on the Earth, `/aviary/DRONE/fix`
+//! (`sensor_msgs/msg/NavSatFix`), each from the trace's telemetry. Times are mission
+//! time: the bag starts at 0 (1 January 1970, as a bag reader shows it).
+
+use std::collections::BTreeMap;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use aviary_api::geo::Origin;
+use aviary_api::trace::{Event as TraceEvent, Record};
+use serde::Serialize;
+
+use crate::msgs::{
+    self, Event, Header, Message, NavSatFix, NavSatStatus, Point, Pose, PoseStamped, Quaternion,
+    Time,
+};
+
+/// The frame of the poses: the mission's local east-north-up metres.
+pub const LOCAL_FRAME: &str = "map";
+/// The topic of the trace's events.
+pub const EVENTS: &str = "/aviary/events";
+
+/// What a bag holds.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Written {
+    /// The MCAP file.
+    pub file: PathBuf,
+    pub topics: Vec<Topic>,
+}
+
+/// A topic of a bag: its name, its message type and how many messages it has.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Topic {
+    pub name: String,
+    pub ty: &'static str,
+    pub messages: u64,
+}
+
+/// Writes the trace's `records` as a bag in `folder` (made; it must not exist, as
+/// `ros2 bag record` wants), placing positions on the Earth about `origin` when there
+/// is one.
+pub fn write(
+    folder: &Path,
+    records: &[Record<'_>],
+    origin: Option<Origin>,
+) -> Result<Written, String> {
+    let name = folder
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .ok_or_else(|| format!("{} is no folder's name", folder.display()))?;
+    if folder.exists() {
+        return Err(format!("{} exists already: a bag is a new folder", folder.display()));
+    }
+    std::fs::create_dir_all(folder)
+        .map_err(|e| format!("cannot make {}: {e}", folder.display()))?;
+    let file_name = format!("{name}_0.mcap");
+    let file = folder.join(&file_name);
+    let out = std::fs::File::create(&file)
+        .map_err(|e| format!("cannot write {}: {e}", file.display()))?;
+    let mut bag = Bag::start(BufWriter::new(out), origin).map_err(|e| e.to_string())?;
+    for record in records {
+        bag.record(record).map_err(|e| e.to_string())?;
+    }
+    let (topics, end) = bag.finish().map_err(|e| e.to_string())?;
+    let metadata = Metadata::of(&file_name, &topics, end);
+    let yaml = serde_norway::to_string(&metadata).map_err(|e| e.to_string())?;
+    let metadata_file = folder.join("metadata.yaml");
+    std::fs::write(&metadata_file, yaml)
+        .map_err(|e| format!("cannot write {}: {e}", metadata_file.display()))?;
+    Ok(Written { file, topics })
+}
+
+/// A failure while writing: MCAP's, or a message's encoding.
+#[derive(Debug)]
+enum Failed {
+    Mcap(mcap::McapError),
+    Encoding(String),
+}
+
+impl std::fmt::Display for Failed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Failed::Mcap(e) => write!(f, "MCAP: {e}"),
+            Failed::Encoding(why) => f.write_str(why),
+        }
+    }
+}
+
+impl From<mcap::McapError> for Failed {
+    fn from(e: mcap::McapError) -> Failed {
+        Failed::Mcap(e)
+    }
+}
+
+/// The MCAP file as it is written: its channels by topic, with their counts.
+struct Bag<W: std::io::Write + std::io::Seek> {
+    mcap: mcap::Writer<W>,
+    origin: Option<Origin>,
+    /// Topic → (channel, type, messages so far).
+    channels: BTreeMap<String, (u16, &'static str, u64)>,
+    schemas: BTreeMap<&'static str, u16>,
+    end: Time,
+}
+
+impl<W: std::io::Write + std::io::Seek> Bag<W> {
+    fn start(out: W, origin: Option<Origin>) -> Result<Self, Failed> {
+        let mcap = mcap::WriteOptions::new()
+            .profile("ros2")
+            .library(concat!("aviary ", env!("CARGO_PKG_VERSION")))
+            .compression(None)
+            // Unchunked: the bag starts at time 0, and a reader may take a chunk that
+            // starts there for an empty one (rosbags 0.10 skips it); a reader scans an
+            // unchunked file from end to end instead.
+            .use_chunks(false)
+            .create(out)?;
+        Ok(Bag {
+            mcap,
+            origin,
+            channels: BTreeMap::new(),
+            schemas: BTreeMap::new(),
+            end: Time::default(),
+        })
+    }
+
+    fn record(&mut self, record: &Record<'_>) -> Result<(), Failed> {
+        let stamp = Time::of(record.t);
+        self.end = stamp;
+        let header = || Header { stamp, frame_id: LOCAL_FRAME.into() };
+        let json = serde_json::to_string(record).map_err(|e| Failed::Encoding(e.to_string()))?;
+        let kind = record.event.kind().as_str().to_string();
+        self.write(EVENTS, stamp, &Event { header: header(), event: kind, json })?;
+        if let TraceEvent::Telemetry { actor, position, .. } = &record.event {
+            let [x, y, z] = *position;
+            let pose = PoseStamped {
+                header: header(),
+                pose: Pose { position: Point { x, y, z }, orientation: Quaternion::IDENTITY },
+            };
+            self.write(&format!("/aviary/{actor}/pose"), stamp, &pose)?;
+            if let Some(origin) = self.origin {
+                self.write(
+                    &format!("/aviary/{actor}/fix"),
+                    stamp,
+                    &fix(origin, header(), *position),
+                )?;
+            }
+        }
+        Ok(())
+    }
+
+    fn write<M: Message>(&mut self, topic: &str, stamp: Time, message: &M) -> Result<(), Failed> {
+        let data = msgs::cdr(message).map_err(Failed::Encoding)?;
+        let channel = match self.channels.get_mut(topic) {
+            Some((channel, _, count)) => {
+                *count += 1;
+                *channel
+            }
+            None => {
+                let schema = match self.schemas.get(M::TYPE) {
+                    Some(&id) => id,
+                    None => {
+                        let id =
+                            self.mcap.add_schema(M::TYPE, "ros2msg", M::definition().as_bytes())?;
+                        self.schemas.insert(M::TYPE, id);
+                        id
+                    }
+                };
+                let channel = self.mcap.add_channel(schema, topic, "cdr", &BTreeMap::new())?;
+                self.channels.insert(topic.to_string(), (channel, M::TYPE, 1));
+                channel
+            }
+        };
+        let sequence = self.channels.get(topic).map_or(0, |(_, _, n)| *n as u32);
+        let header = mcap::records::MessageHeader {
+            channel_id: channel,
+            sequence,
+            log_time: stamp.nanos(),
+            publish_time: stamp.nanos(),
+        };
+        self.mcap.write_to_known_channel(&header, &data)?;
+        Ok(())
+    }
+
+    fn finish(mut self) -> Result<(Vec<Topic>, Time), Failed> {
+        self.mcap.finish()?;
+        let topics = self
+            .channels
+            .into_iter()
+            .map(|(name, (_, ty, messages))| Topic { name, ty, messages })
+            .collect();
+        Ok((topics, self.end))
+    }
+}
+
+/// Where a drone at local `position` is on the Earth; no fix where the trace has no
+/// position (a coordinate that is not finite).
+fn fix(origin: Origin, header: Header, position: [f64; 3]) -> NavSatFix {
+    let [x, y, z] = position;
+    let (latitude, longitude) = origin.to_geodetic(x, y);
+    let known = position.iter().all(|c| c.is_finite());
+    NavSatFix {
+        header,
+        status: NavSatStatus { status: if known { 0 } else { -1 }, service: 1 },
+        latitude,
+        longitude,
+        altitude: origin.alt + z,
+        position_covariance: [0.0; 9],
+        position_covariance_type: 0,
+    }
+}
+
+/// `metadata.yaml`, as rosbag2 writes it (version 5).
+#[derive(Serialize)]
+struct Metadata {
+    rosbag2_bagfile_information: Information,
+}
+
+#[derive(Serialize)]
+struct Information {
+    version: u8,
+    storage_identifier: &'static str,
+    duration: Nanoseconds,
+    starting_time: SinceEpoch,
+    message_count: u64,
+    topics_with_message_count: Vec<TopicCount>,
+    compression_format: &'static str,
+    compression_mode: &'static str,
+    relative_file_paths: Vec<String>,
+    files: Vec<FileInformation>,
+}
+
+#[derive(Serialize)]
+struct Nanoseconds {
+    nanoseconds: u64,
+}
+
+#[derive(Serialize)]
+struct SinceEpoch {
+    nanoseconds_since_epoch: u64,
+}
+
+#[derive(Serialize)]
+struct TopicCount {
+    topic_metadata: TopicMetadata,
+    message_count: u64,
+}
+
+#[derive(Serialize)]
+struct TopicMetadata {
+    name: String,
+    #[serde(rename = "type")]
+    ty: &'static str,
+    serialization_format: &'static str,
+    offered_qos_profiles: &'static str,
+}
+
+#[derive(Serialize)]
+struct FileInformation {
+    path: String,
+    starting_time: SinceEpoch,
+    duration: Nanoseconds,
+    message_count: u64,
+}
+
+impl Metadata {
+    fn of(file: &str, topics: &[Topic], end: Time) -> Metadata {
+        let message_count = topics.iter().map(|t| t.messages).sum();
+        let topics_with_message_count = topics
+            .iter()
+            .map(|t| TopicCount {
+                topic_metadata: TopicMetadata {
+                    name: t.name.clone(),
+                    ty: t.ty,
+                    serialization_format: "cdr",
+                    offered_qos_profiles: "",
+                },
+                message_count: t.messages,
+            })
+            .collect();
+        let duration = end.nanos();
+        Metadata {
+            rosbag2_bagfile_information: Information {
+                version: 5,
+                storage_identifier: "mcap",
+                duration: Nanoseconds { nanoseconds: duration },
+                starting_time: SinceEpoch { nanoseconds_since_epoch: 0 },
+                message_count,
+                topics_with_message_count,
+                compression_format: "",
+                compression_mode: "",
+                relative_file_paths: vec![file.to_string()],
+                files: vec![FileInformation {
+                    path: file.to_string(),
+                    starting_time: SinceEpoch { nanoseconds_since_epoch: 0 },
+                    duration: Nanoseconds { nanoseconds: duration },
+                    message_count,
+                }],
+            },
+        }
+    }
+}

@@ -9,15 +9,8 @@ use aviary_api::geo::Origin;
 use aviary_api::trace::Record;
 
 pub fn run(trace: &Path, world: Option<&Path>, bag: &Path) -> u8 {
-    let (name, bytes) = match crate::files::recorded_trace(trace) {
+    let (name, bytes, world) = match crate::files::recorded_trace_and_world(trace, world) {
         Ok(read) => read,
-        Err(shown) => {
-            eprint!("{shown}");
-            return 2;
-        }
-    };
-    let world = match crate::files::world_of_trace(trace, &bytes, world) {
-        Ok(w) => w,
         Err(shown) => {
             eprint!("{shown}");
             return 2;

@@ -251,8 +251,20 @@ fn world_of_bytes(path: &Path, bytes: Vec<u8>) -> Result<aviary_world::World, St
     })
 }
 
-/// A recorded trace's bytes (`aviary replay`, `aviary report`): its name as messages show
-/// it and the bytes, or what to print of why not.
+/// A recorded trace and the world it flew in (`aviary replay`, `aviary report`, `aviary
+/// export`): its name as messages show it, its bytes, and the world as
+/// [`world_of_trace`] finds it; or what to print of why not.
+pub fn recorded_trace_and_world(
+    trace: &Path,
+    given: Option<&Path>,
+) -> Result<(String, Vec<u8>, Option<aviary_world::World>), String> {
+    let (name, bytes) = recorded_trace(trace)?;
+    let world = world_of_trace(trace, &bytes, given)?;
+    Ok((name, bytes, world))
+}
+
+/// A recorded trace's bytes: its name as messages show it and the bytes, or what to print
+/// of why not.
 pub fn recorded_trace(path: &Path) -> Result<(String, Vec<u8>), String> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| format!("aviary: cannot read {name}: {e}\n"))?;

@@ -4,15 +4,8 @@
 use std::path::Path;
 
 pub fn run(trace: &Path, world: Option<&Path>, out: &Path) -> u8 {
-    let (name, bytes) = match crate::files::recorded_trace(trace) {
+    let (name, bytes, world) = match crate::files::recorded_trace_and_world(trace, world) {
         Ok(read) => read,
-        Err(shown) => {
-            eprint!("{shown}");
-            return 2;
-        }
-    };
-    let world = match crate::files::world_of_trace(trace, &bytes, world) {
-        Ok(w) => w,
         Err(shown) => {
             eprint!("{shown}");
             return 2;

@@ -1,6 +1,7 @@
 // What the browser tests share: the real `aviary` started on a free loopback port, and
-// Debian's Chromium, headless, driven by playwright-core. Screenshots go to docs/gcs/,
-// which docs/GCS.md shows.
+// Debian's Chromium, headless, driven by playwright-core. Screenshots go to
+// target/screenshots/, or, with UPDATE_SCREENSHOTS=1, to docs/gcs/, which docs/GCS.md
+// shows: a test run leaves the repository as it was.
 
 import { spawn } from "node:child_process";
 import { cpSync, mkdtempSync, mkdirSync, readFileSync, writeFileSync } from "node:fs";
@@ -11,7 +12,7 @@ import { chromium } from "playwright-core";
 
 export const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), "../..");
 export const AVIARY = process.env.AVIARY_BIN || join(ROOT, "target/debug/aviary");
-export const SHOTS = join(ROOT, "docs/gcs");
+export const SHOTS = process.env.UPDATE_SCREENSHOTS ? join(ROOT, "docs/gcs") : join(ROOT, "target/screenshots");
 
 /// A copy of the examples and of the tests' own missions (`fixtures/`), so that a test may
 /// edit and save without touching the repository.

@@ -92,7 +92,7 @@ fn call_args() -> impl Strategy<Value = (Function, Vec<Value>)> {
 proptest! {
     #[test]
     fn every_signature_is_read_and_shown_as_given((f, args) in call_args()) {
-        let call = FunctionCall::new(f, &args).map_err(|e| TestCaseError::fail(e))?;
+        let call = FunctionCall::new(f, &args).map_err(TestCaseError::fail)?;
         prop_assert_eq!(call.function(), f);
         let drones = Names::default();
         prop_assert_eq!(call.shown(), Shown::all(&args, &drones));

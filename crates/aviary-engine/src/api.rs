@@ -37,14 +37,21 @@ pub(crate) struct Made {
 /// is refused without reaching the backend).
 pub(crate) enum Asked {
     Read(FunctionCall),
-    Unread { function: Function, args: Vec<Value>, reason: String },
+    /// Boxed: rare, and no larger a call than a read one to keep.
+    Unread(Box<Unread>),
+}
+
+pub(crate) struct Unread {
+    function: Function,
+    args: Vec<Value>,
+    reason: String,
 }
 
 impl Asked {
     pub fn function(&self) -> Function {
         match self {
             Asked::Read(call) => call.function(),
-            Asked::Unread { function, .. } => *function,
+            Asked::Unread(u) => u.function,
         }
     }
 
@@ -52,7 +59,7 @@ impl Asked {
     pub fn shown<'a>(&'a self, engine: &'a Engine<'_>) -> Vec<Shown<'a>> {
         match self {
             Asked::Read(call) => call.shown(),
-            Asked::Unread { args, .. } => engine.values(args),
+            Asked::Unread(u) => engine.values(&u.args),
         }
     }
 }
@@ -101,7 +108,7 @@ impl<'m> Engine<'m> {
         self.calling(drone, a.origin);
         let asked = match FunctionCall::new(function, &args) {
             Ok(call) => Asked::Read(call),
-            Err(reason) => Asked::Unread { function, args, reason },
+            Err(reason) => Asked::Unread(Box::new(Unread { function, args, reason })),
         };
         self.trace(EventKind::ApiCall, || Event::ApiCall {
             actor: self.name(drone).into(),
@@ -116,8 +123,8 @@ impl<'m> Engine<'m> {
             }
             // Refused as a backend refuses what it cannot do (`CommandFailed`), before
             // any backend sees it: no call id of the backend's.
-            Asked::Unread { reason, .. } => {
-                let reason = reason.clone();
+            Asked::Unread(u) => {
+                let reason = u.reason.clone();
                 let failure = Failure { exception: BuiltinException::CommandFailed, reason };
                 aviary_api::PendingCall {
                     id: CallId(u64::MAX),

@@ -16,8 +16,9 @@ use aviary_api::{CallEnd, DroneId, Function, FunctionCall, Remainder, Value};
 
 use crate::engine::Engine;
 
-/// A `Sweep` or `FollowPath` in progress, with its arguments.
-type PathCall = FunctionCall;
+/// A `Sweep` or `FollowPath` in progress, with its arguments: boxed, so that a drone
+/// without one (most of a large fleet) keeps a pointer's width, not a call's.
+type PathCall = Box<FunctionCall>;
 
 pub(crate) struct Coverage {
     /// Per drone: its path call in progress.
@@ -63,7 +64,7 @@ impl Engine<'_> {
     pub(crate) fn path_begun(&self, drone: DroneId, call: &FunctionCall) {
         if flies_path(call.function()) {
             if let Some(slot) = self.coverage.flying.borrow_mut().get_mut(drone) {
-                *slot = Some(call.clone());
+                *slot = Some(Box::new(call.clone()));
             }
         }
     }

@@ -172,3 +172,15 @@ fn a_place_stands_for_a_finite_point_or_an_area_s_centroid() {
     assert_eq!(Place::Area(Vec::new()).point(), None);
     assert_eq!(Place::Area(Vec::new()).to_string(), "an area of 0 corners");
 }
+
+/// A call is made, moved and kept for every middle-layer call of a run (a million in
+/// W(100k, 10)): it stays the size of its largest variant's fields, nothing boxed in.
+#[test]
+fn a_call_is_no_larger_than_its_largest_arguments() {
+    assert_eq!(std::mem::size_of::<Place>(), std::mem::size_of::<Point>());
+    assert!(std::mem::size_of::<FunctionCall>() <= 56);
+    assert_eq!(
+        std::mem::size_of::<Result<FunctionCall, String>>(),
+        std::mem::size_of::<FunctionCall>()
+    );
+}

@@ -19,8 +19,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::call::{FunctionCall, Region, Waypoint};
 use crate::sweep::{self, Lane};
-use crate::{Function, Point, Value};
+use crate::Point;
 
 /// What a `Sweep` or `FollowPath` left: the lanes of a sweep, or the rest of a path.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -99,10 +100,10 @@ impl Remainder {
 /// The lanes `Sweep(area, spacing)` flies: an area's ([`sweep::lanes`]), or those a
 /// remainder left. A remainder of a path, or of a sweep laid out at another spacing, is
 /// refused, with the reason.
-pub fn sweep_lanes(area: &Value, spacing: f64) -> Result<Vec<Lane>, String> {
+pub fn sweep_lanes(area: &Region, spacing: f64) -> Result<Vec<Lane>, String> {
     match area {
-        Value::Area(polygon) => Ok(sweep::lanes(polygon, spacing)),
-        Value::Remainder(left) => match &**left {
+        Region::Area(polygon) => Ok(sweep::lanes(polygon, spacing)),
+        Region::Left(left) => match &**left {
             Remainder::Nothing => Ok(Vec::new()),
             Remainder::Lanes { lanes, spacing: laid } => {
                 if (laid - spacing).abs() > 1e-6 * laid.abs().max(1.0) {
@@ -120,35 +121,22 @@ pub fn sweep_lanes(area: &Value, spacing: f64) -> Result<Vec<Lane>, String> {
                     .into())
             }
         },
-        other => Err(format!("`area` must be an area, or what a Sweep left, not {other}")),
     }
 }
 
 /// The points `FollowPath(points...)` flies through, in order: a position is itself, an
 /// area its centroid, a remainder the points of its path. A position whose coordinates
-/// are not finite, or any other value, is refused, with the reason.
-/// A last argument that is a number is the speed (`FollowPath(points...[, speed])`,
-/// [`follow_speed`]), and is not a point.
-pub fn follow_points(args: &[Value]) -> Result<Vec<Point>, String> {
+/// are not finite, or an area without corners, is refused, with the reason.
+pub fn follow_points(points: &[Waypoint]) -> Result<Vec<Point>, String> {
     let mut out = Vec::new();
-    let args = match args.split_last() {
-        Some((Value::Number(_), points)) => points,
-        _ => args,
-    };
-    for (i, v) in args.iter().enumerate() {
+    for (i, v) in points.iter().enumerate() {
         match v {
-            Value::Position(p)
-                if p.x.is_finite()
-                    && p.y.is_finite()
-                    && !matches!(p.z, Some(z) if !z.is_finite()) =>
-            {
-                out.push(*p)
-            }
-            Value::Area(polygon) if !polygon.is_empty() => {
+            Waypoint::Point(p) if crate::call::finite(p) => out.push(*p),
+            Waypoint::Area(polygon) if !polygon.is_empty() => {
                 let c = crate::centroid(polygon);
                 out.push(Point::flat(c[0], c[1]));
             }
-            Value::Remainder(left) => out.extend(left.path()),
+            Waypoint::Left(left) => out.extend(left.path()),
             other => {
                 return Err(format!(
                 "`points[{i}]` must be a position, or what a Sweep or FollowPath left, not {other}"
@@ -159,40 +147,37 @@ pub fn follow_points(args: &[Value]) -> Result<Vec<Point>, String> {
     Ok(out)
 }
 
-/// The speed `FollowPath(points...[, speed])` was asked to fly at: its last argument when
-/// that is a number (m/s), above 0; `None` when it has none (the drone's own speed).
-pub fn follow_speed(args: &[Value]) -> Result<Option<f64>, String> {
-    match args.last() {
-        Some(Value::Number(s)) if s.is_finite() && *s > 0.0 => Ok(Some(*s)),
-        Some(Value::Number(s)) => {
-            Err(format!("`speed` must be above 0 m/s, not {} m/s", crate::show::number(*s)))
-        }
-        _ => Ok(None),
+/// The speed `FollowPath(points...[, speed])` was asked to fly at (m/s), above 0; `None`
+/// when it has none (the drone's own speed).
+pub fn follow_speed(speed: Option<f64>) -> Result<Option<f64>, String> {
+    match speed {
+        Some(s) if s.is_finite() && s > 0.0 => Ok(Some(s)),
+        Some(s) => Err(format!("`speed` must be above 0 m/s, not {} m/s", crate::show::number(s))),
+        None => Ok(None),
     }
 }
 
-/// What a call of `function` with `args` left when it stopped at `progress` (`None`: it
-/// stopped before it moved, so all of it is left). `None` for a function that flies no
-/// path, or arguments no backend would fly. A sweep of a remainder leaves lanes at that
-/// remainder's own spacing, whatever spacing it was given.
-pub fn left(function: Function, args: &[Value], progress: Option<Progress>) -> Option<Remainder> {
-    match function {
-        Function::Sweep => {
-            let (lanes, spacing) = match (args.first(), args.get(1)) {
-                (Some(Value::Remainder(left)), _) => match &**left {
+/// What `call` left when it stopped at `progress` (`None`: it stopped before it moved,
+/// so all of it is left). `None` for a function that flies no path, or arguments no
+/// backend would fly. A sweep of a remainder leaves lanes at that remainder's own
+/// spacing, whatever spacing it was given.
+pub fn left(call: &FunctionCall, progress: Option<Progress>) -> Option<Remainder> {
+    match call {
+        FunctionCall::Sweep { area, spacing } => {
+            let (lanes, spacing) = match area {
+                Region::Left(left) => match &**left {
                     Remainder::Lanes { lanes, spacing } => (lanes.clone(), *spacing),
                     Remainder::Nothing => return Some(Remainder::Nothing),
                     // Refused: a path is not swept, so it is all still left.
                     Remainder::Points(_) => return Some((**left).clone()),
                 },
-                (Some(area @ Value::Area(_)), Some(Value::Number(spacing))) => {
-                    (sweep_lanes(area, *spacing).ok()?, *spacing)
-                }
-                _ => return None,
+                Region::Area(_) => (sweep_lanes(area, *spacing).ok()?, *spacing),
             };
             Some(lanes_left(lanes, spacing, progress))
         }
-        Function::FollowPath => Some(points_left(&follow_points(args).ok()?, progress)),
+        FunctionCall::FollowPath { points, .. } => {
+            Some(points_left(&follow_points(points).ok()?, progress))
+        }
         _ => None,
     }
 }

@@ -21,6 +21,7 @@
 
 pub mod arith;
 mod builtin;
+mod call;
 pub mod coverage;
 pub mod flight;
 mod function;
@@ -35,6 +36,7 @@ pub mod sweep;
 pub mod trace;
 
 pub use builtin::{BuiltinException, BuiltinLeash, BuiltinSignal};
+pub use call::{FunctionCall, Place, Region, Waypoint};
 pub use coverage::{Progress, Remainder};
 pub use function::{Function, Param, Signature};
 pub use geometry::centroid;

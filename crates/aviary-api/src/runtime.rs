@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 use tokio::sync::{mpsc, oneshot};
 
-use crate::{BuiltinException, BuiltinSignal, Function};
+use crate::{BuiltinException, BuiltinSignal};
 
 /// A drone, by its index in the world file's order.
 pub type DroneId = usize;
@@ -191,9 +191,11 @@ impl DroneEvent {
 /// A fleet of drones as the engine sees it. Implemented by the built-in simulator and by
 /// real-drone backends; the engine never knows which one it drives.
 pub trait Backend {
-    /// Starts `function` on `drone`. Arguments were checked against the standard
-    /// descriptor ([`crate::Descriptor::standard`]), which every backend offers.
-    fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall;
+    /// Starts `call` on `drone`: a function with its arguments read
+    /// ([`crate::FunctionCall::new`], against the standard descriptor's signatures,
+    /// [`crate::Descriptor::standard`], which every backend offers). Whether their values
+    /// can be flown (finite, inside the site's limits) is the backend's to refuse.
+    fn call(&self, drone: DroneId, call: &crate::FunctionCall) -> PendingCall;
     fn interrupt(&self, call: CallId, how: Interrupt);
     fn telemetry(&self, drone: DroneId) -> Telemetry;
     /// The kind of payload drone `drone` carries now (`drone.payload`), `None` when it

@@ -8,7 +8,11 @@
 use std::cell::Cell;
 use std::rc::Rc;
 
-use aviary_api::{CallEnd, CallId, DroneId, Ending, Function, Interrupt, Value};
+use aviary_api::trace::Shown;
+use aviary_api::{
+    BuiltinException, CallEnd, CallId, DroneId, Ending, Failure, Function, FunctionCall, Interrupt,
+    Value,
+};
 use aviary_ir::ApiCall;
 
 use crate::engine::{Ctx, Engine, Instance};
@@ -24,9 +28,40 @@ pub(crate) struct Begun {
 /// Which call was made, with what.
 pub(crate) struct Made {
     pub drone: DroneId,
-    pub function: Function,
-    pub args: Vec<Value>,
+    pub asked: Asked,
     pub id: CallId,
+}
+
+/// What a call asked for: its arguments read ([`FunctionCall::new`], the one place they
+/// are), or, when they could not be, the values given (for the trace) and why (the call
+/// is refused without reaching the backend).
+pub(crate) enum Asked {
+    Read(FunctionCall),
+    /// Boxed: rare, and no larger a call than a read one to keep.
+    Unread(Box<Unread>),
+}
+
+pub(crate) struct Unread {
+    function: Function,
+    args: Vec<Value>,
+    reason: String,
+}
+
+impl Asked {
+    pub fn function(&self) -> Function {
+        match self {
+            Asked::Read(call) => call.function(),
+            Asked::Unread(u) => u.function,
+        }
+    }
+
+    /// The arguments as the trace shows them.
+    pub fn shown<'a>(&'a self, engine: &'a Engine<'_>) -> Vec<Shown<'a>> {
+        match self {
+            Asked::Read(call) => call.shown(),
+            Asked::Unread(u) => engine.values(&u.args),
+        }
+    }
 }
 
 /// Whether a call's ending is remembered with the scope that made it (detection: finds
@@ -71,14 +106,33 @@ impl<'m> Engine<'m> {
         };
         let function = a.function;
         self.calling(drone, a.origin);
+        let asked = match FunctionCall::new(function, &args) {
+            Ok(call) => Asked::Read(call),
+            Err(reason) => Asked::Unread(Box::new(Unread { function, args, reason })),
+        };
         self.trace(EventKind::ApiCall, || Event::ApiCall {
             actor: self.name(drone).into(),
             function,
-            args: self.values(&args),
+            args: asked.shown(self),
         });
-        let pending = self.backend.call(drone, function, &args);
-        self.path_begun(drone, function, &args);
-        Begun { call: Made { drone, function, args, id: pending.id }, end: pending.end }
+        let pending = match &asked {
+            Asked::Read(call) => {
+                let pending = self.backend.call(drone, call);
+                self.path_begun(drone, call);
+                pending
+            }
+            // Refused as a backend refuses what it cannot do (`CommandFailed`), before
+            // any backend sees it: no call id of the backend's.
+            Asked::Unread(u) => {
+                let reason = u.reason.clone();
+                let failure = Failure { exception: BuiltinException::CommandFailed, reason };
+                aviary_api::PendingCall {
+                    id: CallId(u64::MAX),
+                    end: Ending::Now(CallEnd::Failed(failure)),
+                }
+            }
+        };
+        Begun { call: Made { drone, asked, id: pending.id }, end: pending.end }
     }
 
     /// The rest of a call's statement: waits for its ending, records `api_done`, and
@@ -116,10 +170,14 @@ impl<'m> Engine<'m> {
                 end
             }
         };
-        let Made { drone, function, ref args, .. } = call;
-        self.trace_done(drone, function, args, &end);
+        let Made { drone, ref asked, .. } = call;
+        self.trace_done(drone, asked.function(), || asked.shown(self), &end);
         match end {
-            CallEnd::Done => self.after_call(function, drone, args, ctx),
+            CallEnd::Done => {
+                if let Asked::Read(call) = asked {
+                    self.after_call(call, drone, ctx)
+                }
+            }
             CallEnd::Failed(f) => self.fail(f, drone, &ctx.scope),
             CallEnd::Interrupted => {
                 // A fault interrupted it: raise that first, while this activity still runs.
@@ -129,18 +187,11 @@ impl<'m> Engine<'m> {
         }
     }
 
-    fn after_call(&self, function: Function, drone: DroneId, args: &[Value], ctx: &Ctx<'m>) {
-        if !remembers_scope(function) {
-            return;
-        }
-        let kind = match args.first() {
-            Some(Value::Symbol(k) | Value::Text(k)) => k.clone(),
-            _ => return,
-        };
-        if function == Function::StartDetection {
-            self.detections.borrow_mut().insert((drone, kind), ctx.scope.clone());
-        } else {
-            self.detections.borrow_mut().remove(&(drone, kind));
+    fn after_call(&self, call: &FunctionCall, drone: DroneId, ctx: &Ctx<'m>) {
+        if let FunctionCall::StartDetection { kind } = call {
+            self.detections.borrow_mut().insert((drone, kind.clone()), ctx.scope.clone());
+        } else if let FunctionCall::StopDetection { kind } = call {
+            self.detections.borrow_mut().remove(&(drone, kind.clone()));
         }
     }
 }
@@ -163,11 +214,12 @@ impl Drop for CallGuard<'_, '_> {
             self.engine.backend.interrupt(call.id, Interrupt::Abort);
             let engine = self.engine;
             // Ended early: any way but done.
-            let left = engine.path_ended(call.drone, call.function, &CallEnd::Interrupted);
+            let function = call.asked.function();
+            let left = engine.path_ended(call.drone, function, &CallEnd::Interrupted);
             engine.trace(EventKind::ApiDone, || Event::ApiDone {
                 actor: engine.name(call.drone).into(),
-                function: call.function,
-                args: engine.values(&call.args),
+                function,
+                args: call.asked.shown(engine),
                 status: CallStatus::Aborted,
                 position: engine.backend.telemetry(call.drone).position,
                 left,

@@ -12,12 +12,13 @@
 use std::cell::RefCell;
 use std::sync::Arc;
 
-use aviary_api::{CallEnd, DroneId, Function, Remainder, Value};
+use aviary_api::{CallEnd, DroneId, Function, FunctionCall, Remainder, Value};
 
 use crate::engine::Engine;
 
-/// A `Sweep` or `FollowPath` in progress, with its arguments.
-type PathCall = (Function, Vec<Value>);
+/// A `Sweep` or `FollowPath` in progress, with its arguments: boxed, so that a drone
+/// without one (most of a large fleet) keeps a pointer's width, not a call's.
+type PathCall = Box<FunctionCall>;
 
 pub(crate) struct Coverage {
     /// Per drone: its path call in progress.
@@ -60,10 +61,10 @@ impl Coverage {
 
 impl Engine<'_> {
     /// A call was made: a path call is remembered until it ends.
-    pub(crate) fn path_begun(&self, drone: DroneId, function: Function, args: &[Value]) {
-        if flies_path(function) {
+    pub(crate) fn path_begun(&self, drone: DroneId, call: &FunctionCall) {
+        if flies_path(call.function()) {
             if let Some(slot) = self.coverage.flying.borrow_mut().get_mut(drone) {
-                *slot = Some((function, args.to_vec()));
+                *slot = Some(Box::new(call.clone()));
             }
         }
     }
@@ -71,8 +72,8 @@ impl Engine<'_> {
     /// The drone's path call in progress, if it has one, ended early: what it left.
     pub(crate) fn path_stopped(&self, drone: DroneId) {
         let flying = self.coverage.flying.borrow_mut().get_mut(drone).and_then(Option::take);
-        let Some((function, args)) = flying else { return };
-        let left = aviary_api::coverage::left(function, &args, self.backend.stopped(drone));
+        let Some(call) = flying else { return };
+        let left = aviary_api::coverage::left(&call, self.backend.stopped(drone));
         self.coverage.set_left(drone, left.unwrap_or_default());
     }
 

@@ -591,11 +591,13 @@ impl<'m> Engine<'m> {
         self.root.borrow().clone().expect("the run has a root scope")
     }
 
-    pub fn trace_done(
-        &self,
+    /// `api_done` of a call of `function` on `d`, its arguments shown by `args` (only
+    /// when the trace wants the event).
+    pub(crate) fn trace_done<'a>(
+        &'a self,
         d: DroneId,
         function: Function,
-        args: &[Value],
+        args: impl FnOnce() -> Vec<Shown<'a>>,
         end: &aviary_api::CallEnd,
     ) {
         let status = match end {
@@ -607,7 +609,7 @@ impl<'m> Engine<'m> {
         self.trace(EventKind::ApiDone, || Event::ApiDone {
             actor: self.name(d).into(),
             function,
-            args: self.values(args),
+            args: args(),
             status,
             position: self.backend.telemetry(d).position,
             left,

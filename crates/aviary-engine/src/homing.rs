@@ -18,7 +18,9 @@ use std::rc::Rc;
 use std::task::Poll;
 use std::time::Duration;
 
-use aviary_api::{BuiltinException, CallEnd, DroneEvent, DroneId, FlightState, Function};
+use aviary_api::{
+    BuiltinException, CallEnd, DroneEvent, DroneId, FlightState, Function, FunctionCall,
+};
 use futures_util::stream::{FuturesUnordered, StreamExt};
 use tokio::time::Instant;
 
@@ -128,13 +130,14 @@ impl<'m> Engine<'m> {
                 }
                 continue;
             }
-            let function = self.way_down(d);
+            let down = self.way_down(d);
+            let function = down.function();
             self.trace(EventKind::ApiCall, || Event::ApiCall {
                 actor: name.into(),
                 function,
                 args: Vec::new(),
             });
-            let pending = self.backend.call(d, function, &[]);
+            let pending = self.backend.call(d, &down);
             let end = {
                 let guard = DownGuard { engine: self, drone: d, function, done: Cell::new(false) };
                 self.steering.calls.borrow_mut().push((d, pending.id));
@@ -148,7 +151,7 @@ impl<'m> Engine<'m> {
                 self.trace_cut(d, function);
                 continue;
             }
-            self.trace_done(d, function, &[], &end);
+            self.trace_done(d, function, Vec::new, &end);
             if end == CallEnd::Done {
                 refused_since = None;
                 continue;
@@ -169,13 +172,13 @@ impl<'m> Engine<'m> {
 
     /// How `d` comes down now: landed where it is when the operator said so or its fault
     /// requires it, else home.
-    fn way_down(&self, d: DroneId) -> Function {
+    fn way_down(&self, d: DroneId) -> FunctionCall {
         if self.steering.withdrawn(d) == Some(Down::Land)
             || self.down_faults.last(d).is_some_and(lands_where_it_is)
         {
-            Function::Land
+            FunctionCall::Land
         } else {
-            Function::ReturnToLaunch
+            FunctionCall::ReturnToLaunch
         }
     }
 

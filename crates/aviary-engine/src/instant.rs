@@ -173,12 +173,9 @@ impl<'m> Engine<'m> {
             if !matches!(begun.end, Ending::Now(CallEnd::Done)) {
                 return Some(Stopped::At { id, needs, frame, args, at, begun: Some(begun) });
             }
-            self.trace_done(
-                begun.call.drone,
-                begun.call.function,
-                &begun.call.args,
-                &CallEnd::Done,
-            );
+            let made = &begun.call;
+            let shown = || made.asked.shown(self);
+            self.trace_done(made.drone, made.asked.function(), shown, &CallEnd::Done);
         }
         self.capability_end(call, &actors, &args, Status::Ok);
         None

@@ -9,7 +9,7 @@ use std::time::Duration;
 use aviary_api::trace::{Event, Record, Shown};
 use aviary_api::{
     Backend, BuiltinException, BuiltinSignal, CallEnd, CallId, DroneEvent, DroneId, Ending,
-    Failure, FlightState, Function, Interrupt, PendingCall, Telemetry, Value,
+    Failure, FlightState, FunctionCall, Interrupt, PendingCall, Telemetry,
 };
 use aviary_engine::{RunOptions, Status};
 use aviary_test_support::harness;
@@ -35,7 +35,7 @@ impl Scripted {
 }
 
 impl Backend for Scripted {
-    fn call(&self, _: DroneId, _: Function, _: &[Value]) -> PendingCall {
+    fn call(&self, _: DroneId, _: &FunctionCall) -> PendingCall {
         let end = match self.refuse {
             Some(exception) => Ending::Now(CallEnd::Failed(Failure {
                 exception,

@@ -11,7 +11,7 @@ use std::time::Duration;
 
 use aviary_api::{
     Backend, BuiltinException, BuiltinSignal, CallEnd, CallId, DroneEvent, DroneId, Ending,
-    Failure, Function, Interrupt, PendingCall, Progress, Telemetry, Value,
+    Failure, Function, FunctionCall, Interrupt, PendingCall, Progress, Telemetry,
 };
 use aviary_world::Sensor;
 use tokio::sync::{mpsc, oneshot, watch};
@@ -261,7 +261,8 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
 }
 
 impl Backend for MavlinkBackend {
-    fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall {
+    fn call(&self, drone: DroneId, call: &FunctionCall) -> PendingCall {
+        let function = call.function();
         let id = CallId(self.inner.next.fetch_add(1, Ordering::SeqCst));
         let (tx, rx) = oneshot::channel();
         let Some(Some(craft)) = self.inner.crafts.get(drone).cloned() else {
@@ -290,12 +291,11 @@ impl Backend for MavlinkBackend {
         }
         let (paused_tx, paused_rx) = watch::channel(false);
         let inner = Arc::clone(&self.inner);
-        let args = args.to_vec();
+        let call = call.clone();
         // Hold the table while spawning, so that a call that ends at once finds its slot.
         let mut calls = self.inner.calls.lock();
         let task = tokio::spawn(async move {
-            let end = match functions::run(&craft, function, &args, paused_rx, &inner.sensors).await
-            {
+            let end = match functions::run(&craft, &call, paused_rx, &inner.sensors).await {
                 Ok(()) => CallEnd::Done,
                 Err(failure) => CallEnd::Failed(failure),
             };

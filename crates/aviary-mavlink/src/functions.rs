@@ -3,7 +3,7 @@
 //! with `Timeout` and never hangs the mission.
 
 use aviary_api::geometry::centroid;
-use aviary_api::{Failure, Function, Value};
+use aviary_api::{Failure, FunctionCall, Place, Region, Value, Waypoint};
 use mavlink::dialects::ardupilotmega::MavCmd;
 
 use crate::drone::{failed, Craft, Paused};
@@ -18,36 +18,35 @@ use aviary_api::flight::{LOAD_MAX_ALTITUDE, LOAD_TIME};
 /// Runs one call to its end.
 pub async fn run(
     c: &Craft,
-    function: Function,
-    args: &[Value],
+    call: &FunctionCall,
     paused: Paused,
     sensors: &[aviary_world::Sensor],
 ) -> Result<(), Failure> {
-    match function {
-        Function::Arm => arm(c).await,
-        Function::Disarm => disarm(c).await,
-        Function::TakeOff => take_off(c, number(args, 0, "alt")?, paused).await,
-        Function::Land => land(c).await,
-        Function::ReturnToLaunch => rtl(c, paused).await,
-        Function::FlyToPosition => fly_to_position(c, args, paused).await,
-        Function::DescendTo | Function::AscendTo => {
+    match call {
+        FunctionCall::Arm => arm(c).await,
+        FunctionCall::Disarm => disarm(c).await,
+        FunctionCall::TakeOff { alt } => take_off(c, number(*alt, "alt")?, paused).await,
+        FunctionCall::Land => land(c).await,
+        FunctionCall::ReturnToLaunch => rtl(c, paused).await,
+        FunctionCall::FlyToPosition { pos, speed } => fly_to_position(c, pos, *speed, paused).await,
+        FunctionCall::DescendTo { alt } | FunctionCall::AscendTo { alt } => {
             let here = here(c)?;
-            let alt = number(args, 0, "alt")?;
+            let alt = number(*alt, "alt")?;
             vertical(c, here, alt)?;
             fly(c, &[[here[0], here[1], alt]], c.max_speed, paused).await
         }
-        Function::Hover => hover(number(args, 0, "duration")?, paused).await,
-        Function::Orbit => orbit_around(c, args, paused).await,
-        Function::Sweep => sweep(c, args, paused).await,
-        Function::FollowPath => follow_path(c, args, paused).await,
-        Function::StartStreaming | Function::StopStreaming => {
-            streaming(c, function == Function::StartStreaming)
+        FunctionCall::Hover { duration } => hover(number(*duration, "duration")?, paused).await,
+        FunctionCall::Orbit { center, radius, laps } => {
+            orbit_around(c, center, *radius, *laps, paused).await
         }
-        Function::StartDetection | Function::StopDetection => {
-            detection(c, function == Function::StartDetection, args, sensors)
-        }
-        Function::LoadPayload => load(c, args, paused).await,
-        Function::ReleasePayload => release(c).await,
+        FunctionCall::Sweep { area, spacing } => sweep(c, area, *spacing, paused).await,
+        FunctionCall::FollowPath { points, speed } => follow_path(c, points, *speed, paused).await,
+        FunctionCall::StartStreaming => streaming(c, true),
+        FunctionCall::StopStreaming => streaming(c, false),
+        FunctionCall::StartDetection { kind } => detection(c, true, kind, sensors),
+        FunctionCall::StopDetection { kind } => detection(c, false, kind, sensors),
+        FunctionCall::LoadPayload { kind } => load(c, kind, paused).await,
+        FunctionCall::ReleasePayload => release(c).await,
     }
 }
 
@@ -62,11 +61,19 @@ async fn disarm(c: &Craft) -> Result<(), Failure> {
 
 /// `FlyToPosition`: at the speed asked for, at most the drone's, around the no-fly zones
 /// (the detour's corners sent one after the other, each reached before the next).
-async fn fly_to_position(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
-    let to = point(c, args.first(), "pos")?;
-    let speed = match args.get(1) {
-        Some(Value::Number(s)) if *s > 0.0 => s.min(c.max_speed),
-        Some(other) => return Err(failed(format!("`speed` must be above 0 m/s, not {other}"))),
+async fn fly_to_position(
+    c: &Craft,
+    pos: &Place,
+    speed: Option<f64>,
+    paused: Paused,
+) -> Result<(), Failure> {
+    let to = point(c, pos, "pos")?;
+    let speed = match speed {
+        Some(s) if s > 0.0 => s.min(c.max_speed),
+        Some(other) => {
+            let other = Value::Number(other);
+            return Err(failed(format!("`speed` must be above 0 m/s, not {other}")));
+        }
         None => c.max_speed,
     };
     let way = routed(c, here(c)?, &[to])?;
@@ -75,11 +82,17 @@ async fn fly_to_position(c: &Craft, args: &[Value], paused: Paused) -> Result<()
 
 /// `Orbit`: to the circle around the no-fly zones, then through its points, at the speed
 /// its radius allows; a circle that enters a zone is refused.
-async fn orbit_around(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
-    let center = point(c, args.first(), "center")?;
-    let radius = number(args, 1, "radius")?;
-    let laps = match args.get(2) {
-        Some(_) => number(args, 2, "laps")?,
+async fn orbit_around(
+    c: &Craft,
+    center: &Place,
+    radius: f64,
+    laps: Option<f64>,
+    paused: Paused,
+) -> Result<(), Failure> {
+    let center = point(c, center, "center")?;
+    let radius = number(radius, "radius")?;
+    let laps = match laps {
+        Some(laps) => number(laps, "laps")?,
         None => 1.0,
     };
     if radius <= 0.0 || laps <= 0.0 {
@@ -107,12 +120,8 @@ async fn orbit_around(c: &Craft, args: &[Value], paused: Paused) -> Result<(), F
 /// `Sweep`: to the area's lawnmower path, or to the lanes a remainder left (the
 /// contract's, `aviary_api::coverage`), around the no-fly zones; then along it, each lane
 /// flown to its end, at the altitude kept. A sweep that enters a zone is refused.
-async fn sweep(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
-    let area = match args.first() {
-        Some(area @ (Value::Area(_) | Value::Remainder(_))) => area,
-        _ => return Err(failed("`area` must be an area, or what a Sweep left")),
-    };
-    let spacing = number(args, 1, "spacing")?;
+async fn sweep(c: &Craft, area: &Region, spacing: f64, paused: Paused) -> Result<(), Failure> {
+    let spacing = number(spacing, "spacing")?;
     if spacing <= 0.0 {
         return Err(failed(format!("sweep spacing must be above 0 m, not {spacing} m")));
     }
@@ -126,8 +135,8 @@ async fn sweep(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure>
     let flat = aviary_api::sweep::path(&lanes);
     // A remainder has no area: its lanes alone must keep out of the zones.
     let outline: &[[f64; 2]] = match area {
-        Value::Area(a) => a,
-        _ => &[],
+        Region::Area(a) => a,
+        Region::Left(_) => &[],
     };
     if let Some(reason) = c.airspace.sweep_refusal(outline, &flat, z) {
         return Err(Failure { exception: aviary_api::BuiltinException::GeofenceViolation, reason });
@@ -146,9 +155,14 @@ async fn sweep(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure>
 /// `FollowPath`: through the points (a remainder's in its place), each a transit around
 /// the no-fly zones from the one before; one without an altitude keeps the one before.
 /// At the speed asked for (its last argument), at most the drone's, as `FlyToPosition`.
-async fn follow_path(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
-    let points = aviary_api::coverage::follow_points(args).map_err(failed)?;
-    let speed = aviary_api::coverage::follow_speed(args).map_err(failed)?;
+async fn follow_path(
+    c: &Craft,
+    points: &[Waypoint],
+    speed: Option<f64>,
+    paused: Paused,
+) -> Result<(), Failure> {
+    let points = aviary_api::coverage::follow_points(points).map_err(failed)?;
+    let speed = aviary_api::coverage::follow_speed(speed).map_err(failed)?;
     let speed = speed.map_or(c.max_speed, |s| s.min(c.max_speed));
     if points.is_empty() {
         return Ok(());
@@ -184,40 +198,35 @@ async fn release(c: &Craft) -> Result<(), Failure> {
     Ok(())
 }
 
-fn number(args: &[Value], i: usize, name: &str) -> Result<f64, Failure> {
-    match args.get(i) {
-        Some(Value::Number(n)) if n.is_finite() => Ok(*n),
-        other => Err(failed(format!("`{name}` must be a finite number, not {}", given(other)))),
+fn number(n: f64, name: &str) -> Result<f64, Failure> {
+    if n.is_finite() {
+        return Ok(n);
     }
+    Err(failed(format!("`{name}` must be a finite number, not {}", Value::Number(n))))
 }
 
 /// A position argument in local metres; without a height, the altitude kept.
-fn point(c: &Craft, v: Option<&Value>, name: &str) -> Result<[f64; 3], Failure> {
+fn point(c: &Craft, v: &Place, name: &str) -> Result<[f64; 3], Failure> {
     let here_z = c.level();
     match v {
-        Some(Value::Position(p)) if p.x.is_finite() && p.y.is_finite() => {
+        Place::Point(p) if p.x.is_finite() && p.y.is_finite() => {
             Ok([p.x, p.y, p.z.unwrap_or(here_z)])
         }
-        Some(Value::Area(a)) if !a.is_empty() => {
+        Place::Area(a) if !a.is_empty() => {
             let m = centroid(a);
             Ok([m[0], m[1], here_z])
         }
-        other => Err(failed(format!("`{name}` must be a position, not {}", given(other)))),
+        other => Err(failed(format!("`{name}` must be a position, not {other}"))),
     }
 }
 
 fn detection(
     c: &Craft,
     start: bool,
-    args: &[Value],
+    kind: &str,
     sensors: &[aviary_world::Sensor],
 ) -> Result<(), Failure> {
-    let kind = match args.first() {
-        Some(Value::Symbol(s) | Value::Text(s)) => s.clone(),
-        other => {
-            return Err(failed(format!("`kind` must be a kind such as Body, not {}", given(other))))
-        }
-    };
+    let kind = kind.to_owned();
     let range = sensors
         .iter()
         .filter(|s| c.sensors.contains(&s.kind) && s.detects.contains(&kind))
@@ -234,13 +243,8 @@ fn detection(
 }
 
 /// Closes the gripper (MAV_CMD_DO_GRIPPER grab) and gives the crew `LOAD_TIME` to hook on.
-async fn load(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> {
-    let kind = match args.first() {
-        Some(Value::Symbol(s) | Value::Text(s)) => s.clone(),
-        other => {
-            return Err(failed(format!("`kind` must be a kind such as Body, not {}", given(other))))
-        }
-    };
+async fn load(c: &Craft, kind: &str, paused: Paused) -> Result<(), Failure> {
+    let kind = kind.to_owned();
     if !c.payload.contains(&kind) {
         return Err(failed(format!("{} cannot carry {kind}", c.name)));
     }
@@ -258,9 +262,4 @@ async fn load(c: &Craft, args: &[Value], paused: Paused) -> Result<(), Failure> 
     hover(LOAD_TIME, paused).await?;
     *c.carrying.lock() = Some(kind);
     Ok(())
-}
-
-/// An argument as a refusal shows it: in the language's notation, or that it is missing.
-fn given(v: Option<&Value>) -> String {
-    v.map_or_else(|| "nothing (the argument is missing)".into(), Value::to_string)
 }

@@ -7,8 +7,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 use aviary_api::{
-    Backend, CallId, DroneEvent, DroneId, Ending, Function, Interrupt, PendingCall, Progress,
-    Telemetry, Value,
+    Backend, CallId, DroneEvent, DroneId, Ending, FunctionCall, Interrupt, PendingCall, Progress,
+    Telemetry,
 };
 use aviary_mavlink::MavlinkBackend;
 use aviary_sim::SimBackend;
@@ -63,13 +63,10 @@ impl Mixed {
 }
 
 impl Backend for Mixed {
-    fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall {
+    fn call(&self, drone: DroneId, call: &FunctionCall) -> PendingCall {
         let by_mavlink = self.mavlink.serves(drone);
-        let inner = if by_mavlink {
-            self.mavlink.call(drone, function, args)
-        } else {
-            self.sim.call(drone, function, args)
-        };
+        let inner =
+            if by_mavlink { self.mavlink.call(drone, call) } else { self.sim.call(drone, call) };
         let id = CallId(self.next.fetch_add(1, Ordering::SeqCst));
         let inner_end = match inner.end {
             Ending::Now(end) => return PendingCall { id, end: Ending::Now(end) },

@@ -1,7 +1,7 @@
 //! Reading a call's arguments, and the refusals a call can meet before it starts.
 
 use aviary_api::show::fixed;
-use aviary_api::{BuiltinException, Failure, Point, Value};
+use aviary_api::{BuiltinException, Failure, Place, Point, Value};
 
 use aviary_route::Airspace;
 
@@ -15,67 +15,36 @@ pub(crate) fn fence_violation(reason: impl Into<String>) -> Failure {
     Failure { exception: BuiltinException::GeofenceViolation, reason: reason.into() }
 }
 
-fn arg<'a>(args: &'a [Value], i: usize, name: &str) -> Result<&'a Value, Failure> {
-    args.get(i).ok_or_else(|| failed(format!("missing argument `{name}`")))
-}
-
-fn number_value(v: &Value, name: &str) -> Result<f64, Failure> {
-    match v {
-        Value::Number(n) if n.is_finite() => Ok(*n),
-        other => Err(failed(format!("`{name}` must be a finite number, not {other}"))),
+/// A number the call was given, refused when it is not finite.
+pub(crate) fn finite(n: f64, name: &str) -> Result<f64, Failure> {
+    if n.is_finite() {
+        Ok(n)
+    } else {
+        Err(failed(format!("`{name}` must be a finite number, not {}", Value::Number(n))))
     }
 }
 
-pub(crate) fn number(args: &[Value], i: usize, name: &str) -> Result<f64, Failure> {
-    number_value(arg(args, i, name)?, name)
-}
-
-pub(crate) fn opt_number(args: &[Value], i: usize, name: &str) -> Result<Option<f64>, Failure> {
-    args.get(i).map(|v| number_value(v, name)).transpose()
+pub(crate) fn opt_finite(n: Option<f64>, name: &str) -> Result<Option<f64>, Failure> {
+    n.map(|n| finite(n, name)).transpose()
 }
 
 /// A position; an area stands for its centroid (at the altitude the drone keeps).
-pub(crate) fn point_value(v: &Value, name: &str) -> Result<Point, Failure> {
-    match v {
-        Value::Position(p)
-            if p.x.is_finite() && p.y.is_finite() && !matches!(p.z, Some(z) if !z.is_finite()) =>
-        {
-            Ok(*p)
-        }
-        Value::Area(polygon) if !polygon.is_empty() => {
-            let c = geom::centroid(polygon);
-            Ok(Point::flat(c[0], c[1]))
-        }
-        other => Err(failed(format!("`{name}` must be a position, not {other}"))),
-    }
+pub(crate) fn point(place: &Place, name: &str) -> Result<Point, Failure> {
+    place.point().ok_or_else(|| failed(format!("`{name}` must be a position, not {place}")))
 }
 
-pub(crate) fn point(args: &[Value], i: usize, name: &str) -> Result<Point, Failure> {
-    point_value(arg(args, i, name)?, name)
-}
-
-pub(crate) fn polygon(args: &[Value], i: usize, name: &str) -> Result<Vec<[f64; 2]>, Failure> {
-    match arg(args, i, name)? {
-        Value::Area(p)
-            if p.len() >= 3 && p.iter().all(|c| c[0].is_finite() && c[1].is_finite()) =>
-        {
-            if geom::area(p) <= 1e-9 {
-                return Err(failed(format!("`{name}` encloses no area")));
-            }
-            Ok(p.clone())
+/// An area to sweep: at least 3 finite corners, enclosing something.
+pub(crate) fn polygon(corners: &[[f64; 2]], name: &str) -> Result<Vec<[f64; 2]>, Failure> {
+    if corners.len() >= 3 && corners.iter().all(|c| c[0].is_finite() && c[1].is_finite()) {
+        if geom::area(corners) <= 1e-9 {
+            return Err(failed(format!("`{name}` encloses no area")));
         }
-        other => {
-            Err(failed(format!("`{name}` must be an area of at least 3 corners, not {other}")))
-        }
+        return Ok(corners.to_vec());
     }
-}
-
-/// A kind of target or payload: a symbol (or a text).
-pub(crate) fn kind(args: &[Value], i: usize, name: &str) -> Result<String, Failure> {
-    match arg(args, i, name)? {
-        Value::Symbol(s) | Value::Text(s) => Ok(s.clone()),
-        other => Err(failed(format!("`{name}` must be a kind such as Body, not {other}"))),
-    }
+    Err(failed(format!(
+        "`{name}` must be an area of at least 3 corners, not {}",
+        Value::Area(corners.to_vec())
+    )))
 }
 
 /// The site's limits on where a drone may fly.

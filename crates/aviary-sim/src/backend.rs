@@ -14,8 +14,8 @@ use std::sync::{Arc, Weak};
 use std::time::Duration;
 
 use aviary_api::{
-    Backend, CallEnd, CallId, DroneEvent, DroneId, Ending, Function, Interrupt, PendingCall,
-    Telemetry, Value,
+    Backend, CallEnd, CallId, DroneEvent, DroneId, Ending, FunctionCall, Interrupt, PendingCall,
+    Telemetry,
 };
 use aviary_world::World;
 use tokio::sync::{mpsc, oneshot};
@@ -203,9 +203,9 @@ async fn drive(backend: Weak<SimBackend>, options: SimOptions) {
 const PACE_POLL: Duration = Duration::from_millis(2);
 
 impl Backend for SimBackend {
-    fn call(&self, drone: DroneId, function: Function, args: &[Value]) -> PendingCall {
+    fn call(&self, drone: DroneId, call: &FunctionCall) -> PendingCall {
         let mut state = self.state.lock();
-        let (id, end) = state.fleet.call(drone, function, args);
+        let (id, end) = state.fleet.call(drone, call);
         let end = match end {
             Some(end) => Ending::Now(end),
             None => {

@@ -1,8 +1,8 @@
 //! What each middle-layer function does when called (docs/LANGUAGE.md, section 19).
 
-use aviary_api::{show, CallId, DroneId, Failure, FlightState, Function, Resource, Value};
+use aviary_api::{show, CallId, DroneId, Failure, FlightState, Function, FunctionCall, Resource};
 
-use crate::args::{failed, kind, Limits};
+use crate::args::{failed, Limits};
 use crate::drone::Loading;
 use crate::fleet::{Fleet, Release};
 use crate::legs::{hover_legs, Mover};
@@ -33,10 +33,9 @@ impl Fleet {
         &mut self,
         id: DroneId,
         call: CallId,
-        function: Function,
-        args: &[Value],
+        function: &FunctionCall,
     ) -> Result<bool, Failure> {
-        let motion = function.resource() == Resource::Motion;
+        let motion = function.function().resource() == Resource::Motion;
         if motion {
             // A motion call forgets where the last path call stopped (`Backend::stopped`),
             // before anything can refuse it: a refused call has not moved.
@@ -71,7 +70,7 @@ impl Fleet {
         if aside {
             d.set_aside();
         }
-        let start = self.begin(id, call, function, args);
+        let start = self.begin(id, call, function);
         if aside && !matches!(start, Ok(Start::Moves(..))) {
             // Refused, or nothing to fly: the paused call is back at once, as it was.
             self.drones[id].bring_back();
@@ -98,36 +97,38 @@ impl Fleet {
         &mut self,
         id: DroneId,
         call: CallId,
-        function: Function,
-        args: &[Value],
+        function: &FunctionCall,
     ) -> Result<Start, Failure> {
         let m = Mover { d: &self.drones[id], name: &self.names[id], limits: self.limits() };
         let mut path = None;
         let legs = match function {
-            Function::Arm | Function::Disarm => return self.arm(id, function),
-            Function::TakeOff => m.take_off(args)?,
-            Function::Land => m.land()?,
-            Function::ReturnToLaunch => m.return_home()?,
-            Function::FlyToPosition => m.fly_to(args)?,
-            Function::DescendTo | Function::AscendTo => m.to_altitude(args)?,
-            Function::Hover => hover_legs(args)?,
-            Function::Orbit => m.orbit(args)?,
-            Function::Sweep | Function::FollowPath => {
-                let (legs, points) = match function {
-                    Function::Sweep => m.sweep(args)?,
-                    _ => m.follow_path(args)?,
-                };
+            FunctionCall::Arm => return self.arm(id, Function::Arm),
+            FunctionCall::Disarm => return self.arm(id, Function::Disarm),
+            FunctionCall::TakeOff { alt } => m.take_off(*alt)?,
+            FunctionCall::Land => m.land()?,
+            FunctionCall::ReturnToLaunch => m.return_home()?,
+            FunctionCall::FlyToPosition { pos, speed } => m.fly_to(pos, *speed)?,
+            FunctionCall::DescendTo { alt } | FunctionCall::AscendTo { alt } => {
+                m.to_altitude(*alt)?
+            }
+            FunctionCall::Hover { duration } => hover_legs(*duration)?,
+            FunctionCall::Orbit { center, radius, laps } => m.orbit(center, *radius, *laps)?,
+            FunctionCall::Sweep { area, spacing } => {
+                let (legs, points) = m.sweep(area, *spacing)?;
                 path = Some(points);
                 legs
             }
-            Function::StartStreaming | Function::StopStreaming => {
-                return self.stream(id, function == Function::StartStreaming)
+            FunctionCall::FollowPath { points, speed } => {
+                let (legs, points) = m.follow_path(points, *speed)?;
+                path = Some(points);
+                legs
             }
-            Function::StartDetection | Function::StopDetection => {
-                return self.detect(id, function == Function::StartDetection, args)
-            }
-            Function::LoadPayload => return self.load(id, call, args),
-            Function::ReleasePayload => return self.release(id),
+            FunctionCall::StartStreaming => return self.stream(id, true),
+            FunctionCall::StopStreaming => return self.stream(id, false),
+            FunctionCall::StartDetection { kind } => return self.detect(id, true, kind),
+            FunctionCall::StopDetection { kind } => return self.detect(id, false, kind),
+            FunctionCall::LoadPayload { kind } => return self.load(id, call, kind),
+            FunctionCall::ReleasePayload => return self.release(id),
         };
         Ok(if legs.is_empty() { Start::Done } else { Start::Moves(legs, path) })
     }
@@ -154,9 +155,9 @@ impl Fleet {
         Ok(Start::Done)
     }
 
-    fn detect(&mut self, id: DroneId, start: bool, args: &[Value]) -> Result<Start, Failure> {
+    fn detect(&mut self, id: DroneId, start: bool, kind: &str) -> Result<Start, Failure> {
         let d = &mut self.drones[id];
-        let kind = kind(args, 0, "kind")?;
+        let kind = kind.to_owned();
         let Some((range, probability)) = detection_range(&self.sensors, &d.spec.sensors, &kind)
         else {
             return Err(failed(format!("{} has no sensor that detects {kind}", &self.names[id])));
@@ -179,9 +180,9 @@ impl Fleet {
         Ok(Start::Done)
     }
 
-    fn load(&mut self, id: DroneId, call: CallId, args: &[Value]) -> Result<Start, Failure> {
+    fn load(&mut self, id: DroneId, call: CallId, kind: &str) -> Result<Start, Failure> {
         let d = &mut self.drones[id];
-        let kind = kind(args, 0, "kind")?;
+        let kind = kind.to_owned();
         if !d.spec.payload_kinds.contains(&kind) {
             let can = if d.spec.payload_kinds.is_empty() {
                 "nothing".to_owned()

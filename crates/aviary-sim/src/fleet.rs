@@ -5,7 +5,7 @@
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::sync::Arc;
 
-use aviary_api::{CallEnd, CallId, DroneEvent, DroneId, Function, Interrupt, Telemetry, Value};
+use aviary_api::{CallEnd, CallId, DroneEvent, DroneId, FunctionCall, Interrupt, Telemetry};
 use aviary_world::{FaultKind, Sensor, Target, World};
 
 use crate::air::AirState;
@@ -336,19 +336,14 @@ impl Fleet {
             .unwrap_or_default()
     }
 
-    /// Starts `function` on `drone`. Returns the call's id and, when the call is already
+    /// Starts `call` on `drone`. Returns the call's id and, when the call is already
     /// over (an instant function, or a refusal), how it ended; otherwise the end comes in a
     /// later [`Fleet::step`] (or [`Fleet::interrupt`]).
-    pub fn call(
-        &mut self,
-        drone: DroneId,
-        function: Function,
-        args: &[Value],
-    ) -> (CallId, Option<CallEnd>) {
+    pub fn call(&mut self, drone: DroneId, call: &FunctionCall) -> (CallId, Option<CallEnd>) {
         let id = CallId(self.next_call);
         self.next_call += 1;
         self.touch(drone);
-        let end = match self.start(drone, id, function, args) {
+        let end = match self.start(drone, id, call) {
             Ok(true) => {
                 self.calls.insert(id, drone);
                 None

@@ -22,9 +22,6 @@ pub(crate) fn area(polygon: &[[f64; 2]]) -> f64 {
     edges(polygon).map(|(a, b)| a[0] * b[1] - b[0] * a[1]).sum::<f64>().abs() / 2.0
 }
 
-/// The area centroid; the corners' mean when the polygon encloses no area.
-pub(crate) use aviary_api::centroid;
-
 /// `y.atan2(x)`, bit for bit, without libm when a side is zero (a drone moving along an
 /// axis, as a sweep's legs do): then the result is one of ±0, ±π/2, ±π (C99 Annex F).
 fn atan2(y: f64, x: f64) -> f64 {
@@ -73,7 +70,10 @@ mod tests {
         assert!(circle_inside(&L, [20.0, 20.0], 20.0));
         assert!(!circle_inside(&L, [20.0, 20.0], 21.0));
         assert_eq!(area(&L), 100.0 * 40.0 + 40.0 * 60.0);
-        assert_eq!(centroid(&[[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]), [1.0, 1.0]);
+        assert_eq!(
+            aviary_api::centroid(&[[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]),
+            [1.0, 1.0]
+        );
     }
 
     #[test]

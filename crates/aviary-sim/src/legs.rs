@@ -1,9 +1,9 @@
 //! The legs a motion call flies, and the refusals it can meet before it starts: each
 //! function's arguments read, and its path held to the site's limits.
 
-use aviary_api::{show, Failure, FlightState, Value};
+use aviary_api::{show, Failure, FlightState, Place, Region, Waypoint};
 
-use crate::args::{failed, number, opt_number, point, polygon, Limits};
+use crate::args::{failed, finite, opt_finite, point, polygon, Limits};
 use crate::drone::SimDrone;
 use crate::geom::dist;
 use crate::motion::{orbit_legs, Leg};
@@ -40,10 +40,10 @@ impl Mover<'_> {
     }
 
     /// `TakeOff`: straight up from the ground, or to the altitude when in the air already.
-    pub fn take_off(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
+    pub fn take_off(&self, alt: f64) -> Result<Vec<Leg>, Failure> {
         let d = self.d;
         let here = d.pos;
-        let alt = number(args, 0, "alt")?;
+        let alt = finite(alt, "alt")?;
         if alt <= 0.0 {
             return Err(failed(format!("take-off altitude must be above 0 m, not {alt} m")));
         }
@@ -94,11 +94,11 @@ impl Mover<'_> {
     }
 
     /// `FlyToPosition`: a transit, at the altitude kept when the position has none.
-    pub fn fly_to(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
+    pub fn fly_to(&self, pos: &Place, speed: Option<f64>) -> Result<Vec<Leg>, Failure> {
         let d = self.d;
         self.in_air()?;
-        let p = point(args, 0, "pos")?;
-        let speed = match opt_number(args, 1, "speed")? {
+        let p = point(pos, "pos")?;
+        let speed = match opt_finite(speed, "speed")? {
             Some(s) if s <= 0.0 => {
                 return Err(failed(format!(
                     "speed must be above 0 m/s, not {} m/s",
@@ -118,10 +118,10 @@ impl Mover<'_> {
     }
 
     /// `DescendTo` and `AscendTo`: straight up or down.
-    pub fn to_altitude(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
+    pub fn to_altitude(&self, alt: f64) -> Result<Vec<Leg>, Failure> {
         let d = self.d;
         self.in_air()?;
-        let alt = number(args, 0, "alt")?;
+        let alt = finite(alt, "alt")?;
         if alt < 0.0 {
             return Err(failed(format!("altitude {} m is below the ground", show::number(alt))));
         }
@@ -132,11 +132,16 @@ impl Mover<'_> {
 
     /// `Orbit`: to the circle (a transit), then round it (its own path, which must keep
     /// out of the zones).
-    pub fn orbit(&self, args: &[Value]) -> Result<Vec<Leg>, Failure> {
+    pub fn orbit(
+        &self,
+        center: &Place,
+        radius: f64,
+        laps: Option<f64>,
+    ) -> Result<Vec<Leg>, Failure> {
         self.in_air()?;
-        let c = point(args, 0, "center")?;
-        let radius = number(args, 1, "radius")?;
-        let laps = opt_number(args, 2, "laps")?.unwrap_or(1.0);
+        let c = point(center, "center")?;
+        let radius = finite(radius, "radius")?;
+        let laps = opt_finite(laps, "laps")?.unwrap_or(1.0);
         if radius <= 0.0 || laps <= 0.0 {
             return Err(failed(format!(
                 "an orbit needs a radius and laps above 0 (got {radius} m, {laps})"
@@ -158,17 +163,17 @@ impl Mover<'_> {
     /// around the no-fly zones), then along it (the contract's path, `aviary_api::coverage`,
     /// which must keep out of the zones), at the altitude kept. With the legs, the path's
     /// points, which [`crate::motion::PathTrack`] follows for where a cut sweep stopped.
-    pub fn sweep(&self, args: &[Value]) -> Result<(Vec<Leg>, Vec<[f64; 3]>), Failure> {
+    pub fn sweep(&self, area: &Region, spacing: f64) -> Result<(Vec<Leg>, Vec<[f64; 3]>), Failure> {
         let d = self.d;
         self.in_air()?;
-        let (area, lanes) = match args.first() {
-            Some(Value::Remainder(_)) => {
-                let spacing = number(args, 1, "spacing")?;
-                (Vec::new(), coverage::sweep_lanes(&args[0], spacing).map_err(failed)?)
+        let (area, lanes) = match area {
+            Region::Left(_) => {
+                let spacing = finite(spacing, "spacing")?;
+                (Vec::new(), coverage::sweep_lanes(area, spacing).map_err(failed)?)
             }
-            _ => {
-                let area = polygon(args, 0, "area")?;
-                let spacing = number(args, 1, "spacing")?;
+            Region::Area(corners) => {
+                let area = polygon(corners, "area")?;
+                let spacing = finite(spacing, "spacing")?;
                 if spacing <= 0.0 {
                     return Err(failed(format!(
                         "sweep spacing must be above 0 m, not {spacing} m"
@@ -196,14 +201,18 @@ impl Mover<'_> {
     /// the one before (around the zones); one without an altitude keeps the one before.
     /// At the speed asked for (its last argument), at most the drone's, as `FlyToPosition`.
     /// With the legs, the points, as for `Sweep`.
-    pub fn follow_path(&self, args: &[Value]) -> Result<(Vec<Leg>, Vec<[f64; 3]>), Failure> {
+    pub fn follow_path(
+        &self,
+        points: &[Waypoint],
+        speed: Option<f64>,
+    ) -> Result<(Vec<Leg>, Vec<[f64; 3]>), Failure> {
         let d = self.d;
         self.in_air()?;
-        let speed = coverage::follow_speed(args).map_err(failed)?;
+        let speed = coverage::follow_speed(speed).map_err(failed)?;
         let speed = speed.map_or(d.spec.max_speed, |s| s.min(d.spec.max_speed));
         let mut z = d.level();
         let mut path = Vec::new();
-        for p in coverage::follow_points(args).map_err(failed)? {
+        for p in coverage::follow_points(points).map_err(failed)? {
             z = p.z.unwrap_or(z);
             if z < 0.0 {
                 return Err(failed(format!("altitude {} m is below the ground", show::number(z))));
@@ -222,8 +231,8 @@ impl Mover<'_> {
 }
 
 /// `Hover`: a hold where the drone is, in the air or on the ground.
-pub(crate) fn hover_legs(args: &[Value]) -> Result<Vec<Leg>, Failure> {
-    let duration = number(args, 0, "duration")?;
+pub(crate) fn hover_legs(duration: f64) -> Result<Vec<Leg>, Failure> {
+    let duration = finite(duration, "duration")?;
     if duration < 0.0 {
         return Err(failed(format!("a hover cannot last {} s", show::number(duration))));
     }

@@ -3,7 +3,7 @@
 //! reasons, GUIDED position targets, and the telemetry messages. No IO and no clock: the
 //! server feeds it messages and simulated seconds, and sends what it returns.
 
-use aviary_api::{BuiltinException, CallEnd, CallId, DroneEvent, FlightState, Function, Value};
+use aviary_api::{BuiltinException, CallEnd, CallId, DroneEvent, FlightState, FunctionCall};
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavMessage, MavSeverity, STATUSTEXT_DATA};
 use aviary_mavlink::mode::{Flavour, COPTER_RTL};
 use aviary_mavlink::Origin;
@@ -244,7 +244,7 @@ impl Autopilot {
                     ));
                     self.copters[drone].mode = COPTER_RTL;
                     self.copters[drone].failsafe = true;
-                    if let Err(why) = self.motion(drone, Function::ReturnToLaunch, &[]) {
+                    if let Err(why) = self.motion(drone, &FunctionCall::ReturnToLaunch) {
                         out.push(text(system, MavSeverity::MAV_SEVERITY_CRITICAL, &why));
                     }
                 }
@@ -294,16 +294,11 @@ impl Autopilot {
     }
 
     /// Starts a motion call, replacing the one in progress. `Err` has the reason.
-    pub(crate) fn motion(
-        &mut self,
-        i: usize,
-        function: Function,
-        args: &[Value],
-    ) -> Result<(), String> {
+    pub(crate) fn motion(&mut self, i: usize, function: &FunctionCall) -> Result<(), String> {
         if let Some(call) = self.copters[i].call.take() {
             self.fleet.interrupt(call, aviary_api::Interrupt::Abort);
         }
-        let (call, end) = self.fleet.call(i, function, args);
+        let (call, end) = self.fleet.call(i, function);
         match end {
             None => {
                 self.copters[i].call = Some(call);

@@ -2,7 +2,7 @@
 //! answered with the result ArduCopter would give, the reason it says first, and what a
 //! request asks for (AUTOPILOT_VERSION, HOME_POSITION, a telemetry message).
 
-use aviary_api::{CallEnd, FlightState, Function, Value};
+use aviary_api::{CallEnd, FlightState, FunctionCall};
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavCmd, MavResult, MavSeverity};
 use aviary_mavlink::mode::{COPTER_GUIDED, COPTER_LAND, COPTER_RTL};
 
@@ -81,9 +81,9 @@ impl Autopilot {
             MavCmd::MAV_CMD_DO_GRIPPER => {
                 if p[1] >= 0.5 {
                     let kind = self.copters[i].payload.clone().unwrap_or_default();
-                    done(system, self.instant(i, Function::LoadPayload, &[Value::Symbol(kind)]))
+                    done(system, self.instant(i, &FunctionCall::LoadPayload { kind }))
                 } else {
-                    done(system, self.instant(i, Function::ReleasePayload, &[]))
+                    done(system, self.instant(i, &FunctionCall::ReleasePayload))
                 }
             }
             MavCmd::MAV_CMD_GET_HOME_POSITION => match self.home_position(i) {
@@ -129,7 +129,7 @@ impl Autopilot {
         if self.copters[i].armed {
             return Answer::of(MAV_RESULT_ACCEPTED);
         }
-        let mut a = done(system, self.instant(i, Function::Arm, &[]));
+        let mut a = done(system, self.instant(i, &FunctionCall::Arm));
         self.copters[i].armed = a.result == MAV_RESULT_ACCEPTED;
         // ArduCopter sets home where it arms, and says so on every link; the
         // simulator's home does not move, so the same home is said again.
@@ -145,7 +145,7 @@ impl Autopilot {
         if self.state(i).airborne() {
             return refused(system, "Disarm: vehicle is flying");
         }
-        let a = done(system, self.instant(i, Function::Disarm, &[]));
+        let a = done(system, self.instant(i, &FunctionCall::Disarm));
         self.copters[i].armed &= a.result != MavResult::MAV_RESULT_ACCEPTED;
         a
     }
@@ -173,17 +173,12 @@ impl Autopilot {
         if state != FlightState::Landed {
             return refused(system, "Takeoff: already flying");
         }
-        done(system, self.motion(i, Function::TakeOff, &[Value::Number(f64::from(alt))]))
+        done(system, self.motion(i, &FunctionCall::TakeOff { alt: f64::from(alt) }))
     }
 
     /// A call that does not move the drone (arming, the gripper): left to finish alone.
-    pub(crate) fn instant(
-        &mut self,
-        i: usize,
-        function: Function,
-        args: &[Value],
-    ) -> Result<(), String> {
-        match self.fleet.call(i, function, args).1 {
+    pub(crate) fn instant(&mut self, i: usize, call: &FunctionCall) -> Result<(), String> {
+        match self.fleet.call(i, call).1 {
             Some(CallEnd::Failed(f)) => Err(f.reason),
             _ => Ok(()),
         }

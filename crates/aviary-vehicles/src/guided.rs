@@ -1,7 +1,7 @@
 //! Modes and GUIDED targets: SET_MODE / DO_SET_MODE, SET_POSITION_TARGET_GLOBAL_INT and
 //! DO_REPOSITION, with their altitude frames converted as ArduCopter does.
 
-use aviary_api::{FlightState, Function, Point, Value};
+use aviary_api::{FlightState, FunctionCall, Place, Point};
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavResult, MavSeverity};
 use aviary_mavlink::mode::{COPTER_BRAKE, COPTER_GUIDED, COPTER_LAND, COPTER_LOITER, COPTER_RTL};
 
@@ -56,11 +56,8 @@ impl Autopilot {
         }
         self.copters[i].target = Some(to);
         let speed = self.copters[i].speed;
-        self.motion(
-            i,
-            Function::FlyToPosition,
-            &[Value::Position(Point { x: to[0], y: to[1], z: Some(to[2]) }), Value::Number(speed)],
-        )
+        let pos = Place::Point(Point { x: to[0], y: to[1], z: Some(to[2]) });
+        self.motion(i, &FunctionCall::FlyToPosition { pos, speed: Some(speed) })
     }
 
     /// MAV_CMD_DO_REPOSITION (COMMAND_INT), as ArduCopter's
@@ -126,8 +123,8 @@ impl Autopilot {
                 }
                 Ok(())
             }
-            COPTER_RTL if airborne => self.motion(i, Function::ReturnToLaunch, &[]),
-            COPTER_LAND if airborne => self.motion(i, Function::Land, &[]),
+            COPTER_RTL if airborne => self.motion(i, &FunctionCall::ReturnToLaunch),
+            COPTER_LAND if airborne => self.motion(i, &FunctionCall::Land),
             COPTER_RTL | COPTER_LAND => Ok(()),
             other => {
                 return (

@@ -5,7 +5,9 @@
 use std::time::Duration;
 
 use aviary_api::trace::AutopilotAction;
-use aviary_api::{Backend, BuiltinException, BuiltinSignal, CallEnd, DroneEvent, Function, Value};
+use aviary_api::{
+    Backend, BuiltinException, BuiltinSignal, CallEnd, DroneEvent, Function, FunctionCall, Value,
+};
 use aviary_mavlink::Tuning;
 use aviary_vehicles::{Behaviour, Listen, Options};
 use aviary_world::World;
@@ -33,8 +35,13 @@ fn quick() -> Tuning {
     }
 }
 
+/// A call as the engine reads it.
+fn fc(function: Function, args: &[Value]) -> FunctionCall {
+    FunctionCall::new(function, args).unwrap_or_else(|e| panic!("{function}: {e}"))
+}
+
 async fn call(backend: &dyn Backend, function: Function, args: &[Value]) -> CallEnd {
-    let pending = backend.call(0, function, args);
+    let pending = backend.call(0, &fc(function, args));
     tokio::time::timeout(Duration::from_secs(30), pending.end.wait())
         .await
         .expect("the call ends")
@@ -82,7 +89,7 @@ async fn a_battery_failsafe_rtl_raises_battery_critical() {
     let mut events = backend.events().unwrap();
     let armed = call(&backend, Function::Arm, &[]).await;
     assert_eq!(armed, CallEnd::Done, "{:?}", events.try_recv());
-    let hover = backend.call(0, Function::Hover, &[Value::Number(60.0)]);
+    let hover = backend.call(0, &fc(Function::Hover, &[Value::Number(60.0)]));
     async fn next(events: &mut tokio::sync::mpsc::UnboundedReceiver<DroneEvent>) -> DroneEvent {
         tokio::time::timeout(Duration::from_secs(20), events.recv())
             .await
@@ -184,7 +191,7 @@ async fn pause_holds_resume_goes_on_and_abort_stops() {
     assert_eq!(call(&backend, Function::Arm, &[]).await, CallEnd::Done);
     assert_eq!(call(&backend, Function::TakeOff, &[Value::Number(5.0)]).await, CallEnd::Done);
     let far = Value::Position(aviary_api::Point { x: 300.0, y: 0.0, z: None });
-    let flight = backend.call(0, Function::FlyToPosition, &[far]);
+    let flight = backend.call(0, &fc(Function::FlyToPosition, &[far]));
     tokio::time::sleep(Duration::from_secs(2)).await;
     backend.interrupt(flight.id, aviary_api::Interrupt::Pause);
     // Braking from 10 m/s and coming back to where it was paused takes a few seconds.
@@ -266,7 +273,7 @@ async fn the_battery_rule_signals_low_then_raises_critical_once() {
     .unwrap();
     let mut events = backend.events().unwrap();
     assert_eq!(call(&backend, Function::Arm, &[]).await, CallEnd::Done);
-    let _climb = backend.call(0, Function::TakeOff, &[Value::Number(10.0)]);
+    let _climb = backend.call(0, &fc(Function::TakeOff, &[Value::Number(10.0)]));
     let mut seen = Vec::new();
     let until = tokio::time::Instant::now() + Duration::from_secs(10);
     while let Ok(Some(e)) = tokio::time::timeout_at(until, events.recv()).await {
@@ -314,7 +321,7 @@ async fn a_crash_raises_drone_lost() {
     let mut events = backend.events().unwrap();
     assert_eq!(call(&backend, Function::Arm, &[]).await, CallEnd::Done);
     assert_eq!(call(&backend, Function::TakeOff, &[Value::Number(10.0)]).await, CallEnd::Done);
-    let hover = backend.call(0, Function::Hover, &[Value::Number(300.0)]);
+    let hover = backend.call(0, &fc(Function::Hover, &[Value::Number(300.0)]));
     match tokio::time::timeout(Duration::from_secs(15), events.recv())
         .await
         .expect("an event")

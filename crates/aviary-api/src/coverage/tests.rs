@@ -1,6 +1,26 @@
 use std::sync::Arc;
 
 use super::*;
+use crate::{Function, Value};
+
+/// What a call of `function` with `args` left, read as the engine reads a call.
+fn left(function: Function, args: &[Value], progress: Option<Progress>) -> Option<Remainder> {
+    super::left(&FunctionCall::new(function, args).ok()?, progress)
+}
+
+fn region(v: &Value) -> Region {
+    match FunctionCall::new(Function::Sweep, &[v.clone(), Value::Number(1.0)]) {
+        Ok(FunctionCall::Sweep { area, .. }) => area,
+        other => panic!("{other:?}"),
+    }
+}
+
+fn waypoints(args: &[Value]) -> (Vec<Waypoint>, Option<f64>) {
+    match FunctionCall::new(Function::FollowPath, args) {
+        Ok(FunctionCall::FollowPath { points, speed }) => (points, speed),
+        other => panic!("{other:?}"),
+    }
+}
 
 const FIELD: [[f64; 2]; 4] = [[0.0, 0.0], [200.0, 0.0], [200.0, 100.0], [0.0, 100.0]];
 
@@ -45,7 +65,7 @@ fn a_sweep_stopped_between_lanes_leaves_the_next_lane_whole() {
     let all = left_all(&args, Progress { next: 0, at: [-50.0, -50.0, 30.0] });
     assert_eq!(all, Remainder::lanes(sweep::lanes(&FIELD, 20.0), 20.0));
     // Refused before it moved: everything too.
-    assert_eq!(super::left(Function::Sweep, &args, None), Some(all));
+    assert_eq!(self::left(Function::Sweep, &args, None), Some(all));
 }
 
 fn left_all(args: &[Value], p: Progress) -> Remainder {
@@ -107,12 +127,12 @@ fn what_was_flown_and_what_is_left_make_every_lane_once() {
 fn a_remainder_is_swept_at_its_own_spacing_only() {
     let lanes = sweep::lanes(&FIELD, 20.0);
     let r = Value::Remainder(Arc::new(Remainder::lanes(lanes.clone(), 20.0)));
-    assert_eq!(sweep_lanes(&r, 20.0), Ok(lanes));
-    let wrong = sweep_lanes(&r, 15.0).unwrap_err();
+    assert_eq!(sweep_lanes(&region(&r), 20.0), Ok(lanes));
+    let wrong = sweep_lanes(&region(&r), 15.0).unwrap_err();
     assert!(wrong.contains("20 m apart") && wrong.contains("not 15 m"), "{wrong}");
     let path = Value::Remainder(Arc::new(Remainder::points(vec![Point::flat(1.0, 2.0)])));
-    assert!(sweep_lanes(&path, 20.0).unwrap_err().contains("FollowPath"));
-    assert_eq!(sweep_lanes(&Value::Remainder(Arc::default()), 20.0), Ok(Vec::new()));
+    assert!(sweep_lanes(&region(&path), 20.0).unwrap_err().contains("FollowPath"));
+    assert_eq!(sweep_lanes(&region(&Value::Remainder(Arc::default())), 20.0), Ok(Vec::new()));
 }
 
 #[test]
@@ -136,13 +156,14 @@ fn a_path_left_starts_where_the_drone_stopped_with_the_heights_it_would_have_flo
     let Some(left) = left else { unreachable!() };
     assert_eq!(left.length(), 170.0);
     // Flown again by FollowPath: its points, in order.
-    assert_eq!(follow_points(&[Value::Remainder(Arc::new(left.clone()))]), Ok(left.path()));
+    let (points, _) = waypoints(&[Value::Remainder(Arc::new(left.clone()))]);
+    assert_eq!(follow_points(&points), Ok(left.path()));
     // Nothing left once the last point was reached.
     assert_eq!(
-        super::left(Function::FollowPath, &args, Some(Progress { next: 4, at: [0.0; 3] })),
+        self::left(Function::FollowPath, &args, Some(Progress { next: 4, at: [0.0; 3] })),
         Some(Remainder::Nothing)
     );
-    assert_eq!(super::left(Function::Hover, &[Value::Number(1.0)], None), None);
+    assert_eq!(self::left(Function::Hover, &[Value::Number(1.0)], None), None);
 }
 
 #[test]
@@ -167,13 +188,16 @@ fn a_remainder_is_written_and_read_back_as_it_was() {
 fn a_last_number_of_follow_path_is_its_speed_and_no_point() {
     use crate::coverage::{follow_points, follow_speed};
     let a = Value::Position(Point::flat(1.0, 2.0));
-    let args = [a.clone(), Value::Number(3.0)];
-    assert_eq!(follow_points(&args), Ok(vec![Point::flat(1.0, 2.0)]));
-    assert_eq!(follow_speed(&args), Ok(Some(3.0)));
-    assert_eq!(follow_speed(std::slice::from_ref(&a)), Ok(None));
-    assert!(follow_speed(&[a.clone(), Value::Number(0.0)]).is_err());
+    let (points, speed) = waypoints(&[a.clone(), Value::Number(3.0)]);
+    assert_eq!(follow_points(&points), Ok(vec![Point::flat(1.0, 2.0)]));
+    assert_eq!(follow_speed(speed), Ok(Some(3.0)));
+    assert_eq!(waypoints(std::slice::from_ref(&a)).1, None);
+    assert_eq!(follow_speed(None), Ok(None));
+    assert!(follow_speed(Some(0.0)).is_err());
     // A number among the points is no point.
-    assert!(follow_points(&[Value::Number(3.0), a]).is_err());
+    assert!(FunctionCall::new(Function::FollowPath, &[Value::Number(3.0), a]).is_err());
+    // Nor is a position that is not finite.
+    assert!(follow_points(&[Waypoint::Point(Point::flat(f64::NAN, 0.0))]).is_err());
     let f = crate::Function::FollowPath.signature();
     assert_eq!(f.signature(), "FollowPath(points...[, speed])");
     assert_eq!(f.param_at(1, 2, Some(crate::Kind::Speed)).map(|p| p.name), Some("speed"));

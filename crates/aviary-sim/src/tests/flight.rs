@@ -267,13 +267,13 @@ fn a_call_set_aside_is_kept_on_a_refusal_and_ended_by_an_abort_or_a_fault() {
     let first = start(&mut fleet, 0, Function::FlyToPosition, &[pos(200.0, 0.0)]);
     run_for(&mut fleet, 3.0);
     fleet.interrupt(first, Interrupt::Pause);
-    let (_, refused) = fleet.call(0, Function::FlyToPosition, &[pos(5000.0, 0.0)]);
+    let (_, refused) = fleet.call(0, &fc(Function::FlyToPosition, &[pos(5000.0, 0.0)]));
     assert!(matches!(refused, Some(CallEnd::Failed(_))), "outside the geofence: {refused:?}");
-    let (busy, end) = fleet.call(0, Function::Hover, &[num(60.0)]);
+    let (busy, end) = fleet.call(0, &fc(Function::Hover, &[num(60.0)]));
     assert_eq!(end, None, "the paused call was back, and gives way again");
     assert_eq!(fleet.interrupt(first, Interrupt::Abort), Some(CallEnd::Interrupted));
     fleet.interrupt(busy, Interrupt::Pause);
-    let (last, _) = fleet.call(0, Function::Hover, &[num(60.0)]);
+    let (last, _) = fleet.call(0, &fc(Function::Hover, &[num(60.0)]));
     let mut reports = Vec::new();
     fleet.fault(0, aviary_api::BuiltinException::MotorFailure, "test".into(), &mut reports);
     let ended: Vec<CallId> = reports
@@ -330,25 +330,32 @@ at = [120, 60]
     let mut log = Vec::new();
     let mut reports = Vec::new();
     for d in 0..2 {
-        fleet.call(d, Function::Arm, &[]);
-        fleet.call(d, Function::TakeOff, &[num(12.5 + d as f64)]);
+        fleet.call(d, &fc(Function::Arm, &[]));
+        fleet.call(d, &fc(Function::TakeOff, &[num(12.5 + d as f64)]));
     }
     for i in 0..6000 {
         match i {
             300 => {
-                fleet.call(0, Function::StartDetection, &[sym("Body")]);
+                fleet.call(0, &fc(Function::StartDetection, &[sym("Body")]));
                 fleet.call(
                     0,
-                    Function::Sweep,
-                    &[
-                        Value::Area(vec![[50.0, 20.0], [200.0, 20.0], [200.0, 90.0], [50.0, 90.0]]),
-                        num(15.0),
-                    ],
+                    &fc(
+                        Function::Sweep,
+                        &[
+                            Value::Area(vec![
+                                [50.0, 20.0],
+                                [200.0, 20.0],
+                                [200.0, 90.0],
+                                [50.0, 90.0],
+                            ]),
+                            num(15.0),
+                        ],
+                    ),
                 );
-                fleet.call(1, Function::Orbit, &[pos(-40.0, 30.0), num(25.0), num(1.5)]);
+                fleet.call(1, &fc(Function::Orbit, &[pos(-40.0, 30.0), num(25.0), num(1.5)]));
             }
             4000 => {
-                fleet.call(1, Function::ReturnToLaunch, &[]);
+                fleet.call(1, &fc(Function::ReturnToLaunch, &[]));
             }
             _ => {}
         }

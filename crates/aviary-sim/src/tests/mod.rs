@@ -16,7 +16,7 @@ mod sky;
 mod start;
 
 pub(crate) use aviary_api::{BuiltinException, Function};
-use aviary_api::{CallEnd, CallId, DroneEvent, Point, Telemetry, Value};
+use aviary_api::{CallEnd, CallId, DroneEvent, FunctionCall, Point, Telemetry, Value};
 use aviary_diagnostics::FileId;
 use aviary_world::{parse_world, World};
 
@@ -62,6 +62,11 @@ at = [300, 0]
     )
 }
 
+/// A call as the engine reads it: the arguments must fit the function's signature.
+pub(crate) fn fc(f: Function, args: &[Value]) -> FunctionCall {
+    FunctionCall::new(f, args).unwrap_or_else(|e| panic!("{f}: {e}"))
+}
+
 pub(crate) fn num(x: f64) -> Value {
     Value::Number(x)
 }
@@ -80,14 +85,14 @@ pub(crate) fn sym(s: &str) -> Value {
 
 /// A call that must start (not end at once).
 pub(crate) fn start(fleet: &mut Fleet, drone: usize, f: Function, args: &[Value]) -> CallId {
-    let (id, end) = fleet.call(drone, f, args);
+    let (id, end) = fleet.call(drone, &fc(f, args));
     assert_eq!(end, None, "{f} ended at once");
     id
 }
 
 /// A call that must end at once, with this end.
 pub(crate) fn instant(fleet: &mut Fleet, drone: usize, f: Function, args: &[Value]) -> CallEnd {
-    fleet.call(drone, f, args).1.unwrap_or_else(|| panic!("{f} did not end at once"))
+    fleet.call(drone, &fc(f, args)).1.unwrap_or_else(|| panic!("{f} did not end at once"))
 }
 
 /// The exception of a refused call.

@@ -146,7 +146,7 @@ fn a_path_cut_on_a_detour_leaves_its_own_points_not_the_corners() {
     assert_eq!(fleet.interrupt(id, Interrupt::Abort), Some(CallEnd::Interrupted));
     let stop = fleet.stopped(0).expect("noted at the abort");
     assert_eq!(stop.next, 1, "flying to the path's second point, by a corner of the detour");
-    let left = coverage::left(Function::FollowPath, &args, Some(stop)).unwrap();
+    let left = coverage::left(&fc(Function::FollowPath, &args), Some(stop)).unwrap();
     let Remainder::Points(points) = &left else { panic!("{left:?}") };
     let flat: Vec<[f64; 2]> = points.iter().map(|p| [p.x, p.y]).collect();
     let here = fleet.telemetry(0).unwrap().position;

@@ -27,7 +27,7 @@ fn an_aborted_sweep_stops_on_its_lane_and_leaves_the_rest_from_there() {
     let Some(Progress { next, at }) = fleet.stopped(0) else { panic!("no stop noted") };
     assert_eq!(at, here);
     let lanes = sweep::lanes(&FIELD, 20.0);
-    let left = coverage::left(Function::Sweep, &field(), fleet.stopped(0)).unwrap();
+    let left = coverage::left(&fc(Function::Sweep, &field()), fleet.stopped(0)).unwrap();
     let Remainder::Lanes { lanes: left_lanes, .. } = &left else { panic!("{left:?}") };
     // It was on a lane: what is left of it starts where the drone is.
     assert!(sweep::points(&lanes)[next].1 .1, "on a lane, not a turn");
@@ -98,7 +98,7 @@ fn a_follow_path_stopped_leaves_its_rest_and_flying_it_goes_on_from_there() {
     run_for(&mut fleet, 20.0);
     fleet.interrupt(id, Interrupt::Abort);
     let here = fleet.telemetry(0).unwrap().position;
-    let left = coverage::left(Function::FollowPath, &points, fleet.stopped(0)).unwrap();
+    let left = coverage::left(&fc(Function::FollowPath, &points), fleet.stopped(0)).unwrap();
     let Remainder::Points(rest) = &left else { panic!("{left:?}") };
     assert_eq!([rest[0].x, rest[0].y], [here[0], here[1]]);
     assert_eq!(rest.last().map(|p| (p.x, p.y, p.z)), Some((0.0, 100.0, Some(30.0))));

@@ -14,10 +14,12 @@ fn takeoff_needs_arming_and_flights_need_the_air() {
     assert!(reason.contains("not armed"), "{reason}");
     let (_, reason) = refused(&mut fleet, 0, Function::FlyToPosition, &[pos(10.0, 0.0)]);
     assert!(reason.contains("take off first"), "{reason}");
-    assert_eq!(
-        refused(&mut fleet, 0, Function::TakeOff, &[sym("high")]).0,
-        BuiltinException::CommandFailed
-    );
+    // A value of the wrong kind is refused as the call is read (`FunctionCall::new`); a
+    // number that is not finite, by the simulator.
+    assert!(aviary_api::FunctionCall::new(Function::TakeOff, &[sym("high")]).is_err());
+    let (exception, reason) = refused(&mut fleet, 0, Function::TakeOff, &[num(f64::NAN)]);
+    assert_eq!(exception, BuiltinException::CommandFailed);
+    assert!(reason.contains("finite"), "{reason}");
     assert_eq!(instant(&mut fleet, 0, Function::Land, &[]), CallEnd::Done, "landed already");
     assert_eq!(
         instant(&mut fleet, 0, Function::ReturnToLaunch, &[]),

@@ -6,7 +6,7 @@ use std::collections::VecDeque;
 use aviary_api::{CallEnd, CallId, Function, Telemetry, Value};
 use aviary_world::World;
 
-use super::DT;
+use super::{fc, DT};
 use crate::{Fleet, Report};
 
 /// One step of a drone's script.
@@ -78,7 +78,7 @@ pub(crate) fn fly(world: &World, scripts: Vec<Vec<Act>>, limit: f64) -> Flight {
                     }
                     Some(Act::At(t)) if fleet.time() + 1e-9 < t => break,
                     Some(Act::At(_)) => {}
-                    Some(Act::Call(f, args)) => match fleet.call(d, f, &args) {
+                    Some(Act::Call(f, args)) => match fleet.call(d, &fc(f, &args)) {
                         (_, Some(CallEnd::Done)) => {}
                         (_, Some(end)) => panic!("drone {d}: {f} ended {end:?}"),
                         (id, None) => waiting[d] = Some((id, f)),

@@ -8,7 +8,7 @@
 // PROTOCOL_VERSION, which PX4 still answers.
 #![allow(deprecated)]
 
-use aviary_api::{Failure, FlightState, Function, Value};
+use aviary_api::{Failure, FlightState, FunctionCall};
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
     MavCmd, MavMessage, MavResult, MavSeverity, COMMAND_ACK_DATA, PROTOCOL_VERSION_DATA,
 };
@@ -218,7 +218,7 @@ impl Autopilot {
             ));
             return Err(out);
         }
-        if let Err(why) = self.instant(i, Function::Arm, &[]) {
+        if let Err(why) = self.instant(i, &FunctionCall::Arm) {
             return Err(self.say(i, CRITICAL, &why));
         }
         let now = self.fleet.time();
@@ -248,7 +248,7 @@ impl Autopilot {
             return Err(self.say(i, CRITICAL, "Disarming denied: not landed\t"));
         }
         self.px4_stop(i);
-        let _ = self.instant(i, Function::Disarm, &[]);
+        let _ = self.instant(i, &FunctionCall::Disarm);
         let c = &mut self.copters[i];
         c.armed = false;
         c.failsafe = false;
@@ -607,9 +607,9 @@ impl Autopilot {
         }
         let done = if grab {
             let kind = self.copters[i].payload.clone().unwrap_or_default();
-            self.instant(i, Function::LoadPayload, &[Value::Symbol(kind)])
+            self.instant(i, &FunctionCall::LoadPayload { kind })
         } else {
-            self.instant(i, Function::ReleasePayload, &[])
+            self.instant(i, &FunctionCall::ReleasePayload)
         };
         if let Err(why) = done {
             a.result = MAV_RESULT_FAILED;

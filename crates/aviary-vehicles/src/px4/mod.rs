@@ -20,7 +20,7 @@ mod params;
 
 use std::collections::VecDeque;
 
-use aviary_api::{Function, Value};
+use aviary_api::FunctionCall;
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavMessage, MavSeverity, STATUSTEXT_DATA};
 use aviary_mavlink::mode::px4;
 
@@ -116,7 +116,7 @@ pub(crate) enum For {
 #[derive(Clone, Debug)]
 pub(crate) enum Step {
     /// A call to the simulator; the next step waits for its end.
-    Call(Function, Vec<Value>, For),
+    Call(FunctionCall, For),
     /// Mission item `seq` is reached: say so, go on with the mission.
     Reached(u16),
     /// The take-off is done: Takeoff hands over to Hold (PX4's COM_TAKEOFF_ACT 0).

@@ -13,7 +13,7 @@
 //! - Mission flies its items in order from the current one, with PX4's climb first when
 //!   it starts on the ground.
 
-use aviary_api::{CallEnd, Failure, Function, Interrupt, Point, Value};
+use aviary_api::{CallEnd, Failure, Function, FunctionCall, Interrupt, Place, Point};
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
     MavMessage, MavSeverity, MISSION_ITEM_REACHED_DATA,
 };
@@ -24,12 +24,17 @@ use crate::autopilot::{Autopilot, Out};
 
 use MavSeverity::{MAV_SEVERITY_CRITICAL as CRITICAL, MAV_SEVERITY_INFO as INFO};
 
-fn position(p: [f64; 3]) -> Value {
-    Value::Position(Point { x: p[0], y: p[1], z: Some(p[2]) })
+fn position(p: [f64; 3]) -> Place {
+    Place::Point(Point { x: p[0], y: p[1], z: Some(p[2]) })
 }
 
-fn call(f: Function, args: Vec<Value>, doing: For) -> Step {
-    Step::Call(f, args, doing)
+fn call(f: FunctionCall, doing: For) -> Step {
+    Step::Call(f, doing)
+}
+
+/// `FlyToPosition(to, speed)`.
+fn fly_to(to: [f64; 3], speed: f64) -> FunctionCall {
+    FunctionCall::FlyToPosition { pos: position(to), speed: Some(speed) }
 }
 
 /// MAV_CMD numbers of the mission items with a position the vehicle flies to.
@@ -62,22 +67,16 @@ impl Autopilot {
 
     /// Starts a call to the simulator in place of the one in progress: `Ok(true)` while it
     /// goes on, `Ok(false)` when it is done already.
-    fn px4_call(
-        &mut self,
-        i: usize,
-        f: Function,
-        args: &[Value],
-        doing: For,
-    ) -> Result<bool, Failure> {
+    fn px4_call(&mut self, i: usize, f: &FunctionCall, doing: For) -> Result<bool, Failure> {
         if let Some(call) = self.copters[i].call.take() {
             self.fleet.interrupt(call, Interrupt::Abort);
         }
-        if f == Function::TakeOff && !self.state(i).airborne() {
+        if f.function() == Function::TakeOff && !self.state(i).airborne() {
             // The simulator disarms a drone at touchdown; PX4 stays armed a while.
-            let _ = self.instant(i, Function::Arm, &[]);
+            let _ = self.instant(i, &FunctionCall::Arm);
         }
         self.px4_mut(i).doing = doing;
-        let (call, end) = self.fleet.call(i, f, args);
+        let (call, end) = self.fleet.call(i, f);
         match end {
             None => {
                 self.copters[i].call = Some(call);
@@ -95,14 +94,14 @@ impl Autopilot {
         while self.copters[i].call.is_none() {
             let Some(step) = self.px4_mut(i).plan.pop_front() else { break };
             match step {
-                Step::Call(f, args, doing) => {
-                    let to = match (&f, args.first()) {
-                        (Function::FlyToPosition, Some(Value::Position(p))) => {
+                Step::Call(f, doing) => {
+                    let to = match &f {
+                        FunctionCall::FlyToPosition { pos: Place::Point(p), .. } => {
                             Some([p.x, p.y, p.z.unwrap_or(0.0)])
                         }
                         _ => None,
                     };
-                    match self.px4_call(i, f, &args, doing) {
+                    match self.px4_call(i, &f, doing) {
                         Ok(going) => {
                             self.px4_mut(i).flying = to.filter(|_| going).map(|t| (t, doing))
                         }
@@ -145,7 +144,7 @@ impl Autopilot {
                 out.extend(self.px4_plan_takeoff(i));
             }
             Nav::Land if self.state(i).airborne() => {
-                self.px4_mut(i).plan.push_back(call(Function::Land, Vec::new(), For::Other));
+                self.px4_mut(i).plan.push_back(call(FunctionCall::Land, For::Other));
             }
             Nav::Rtl => {
                 self.px4_mut(i).cruise = None;
@@ -163,11 +162,7 @@ impl Autopilot {
                     (amsl - self.origin.alt).ceil() as i64
                 );
                 out.extend(self.say(i, INFO, &text));
-                self.px4_mut(i).plan.push_back(call(
-                    Function::ReturnToLaunch,
-                    Vec::new(),
-                    For::Other,
-                ));
+                self.px4_mut(i).plan.push_back(call(FunctionCall::ReturnToLaunch, For::Other));
             }
             Nav::Mission => out.extend(self.px4_mission_activate(i)),
             // Orbit flies what DO_ORBIT gives it; the manual modes fly nothing here.
@@ -201,19 +196,17 @@ impl Autopilot {
             // Straight at a point under the ground: it touches down where the line meets it.
             let t = here[2] / (here[2] - to[2]);
             let ground = [here[0] + t * (to[0] - here[0]), here[1] + t * (to[1] - here[1]), 0.0];
-            let args = vec![position(ground), Value::Number(speed)];
-            plan.push_back(call(Function::FlyToPosition, args, For::Reposition));
-            plan.push_back(call(Function::Land, Vec::new(), For::Reposition));
+            plan.push_back(call(fly_to(ground, speed), For::Reposition));
+            plan.push_back(call(FunctionCall::Land, For::Reposition));
             return;
         }
         if !airborne {
             if to[2] <= 0.0 {
                 return;
             }
-            plan.push_back(call(Function::TakeOff, vec![Value::Number(to[2])], For::Reposition));
+            plan.push_back(call(FunctionCall::TakeOff { alt: to[2] }, For::Reposition));
         }
-        let args = vec![position(to), Value::Number(speed)];
-        plan.push_back(call(Function::FlyToPosition, args, For::Reposition));
+        plan.push_back(call(fly_to(to, speed), For::Reposition));
     }
 
     /// Takeoff's target (Takeoff::set_takeoff_position): NAV_TAKEOFF's altitude above sea
@@ -242,7 +235,7 @@ impl Autopilot {
         };
         let plan = &mut self.copters[i].px4.plan;
         if z > here[2] + 0.01 {
-            plan.push_back(call(Function::TakeOff, vec![Value::Number(z)], For::Other));
+            plan.push_back(call(FunctionCall::TakeOff { alt: z }, For::Other));
         }
         plan.push_back(Step::TakeoffDone);
         out
@@ -260,15 +253,15 @@ impl Autopilot {
         let z = o.z.max(0.0);
         let plan = &mut self.copters[i].px4.plan;
         if (z - here[2]).abs() > ALT_RADIUS {
-            plan.push_back(call(Function::AscendTo, vec![Value::Number(z)], For::Orbit));
+            plan.push_back(call(FunctionCall::AscendTo { alt: z }, For::Orbit));
         }
-        let args = vec![
-            position([o.center[0], o.center[1], z]),
-            Value::Number(o.radius),
+        let orbit = FunctionCall::Orbit {
+            center: position([o.center[0], o.center[1], z]),
+            radius: o.radius,
             // For ever, as far as a flight goes.
-            Value::Number(1e6),
-        ];
-        plan.push_back(call(Function::Orbit, args, For::Orbit));
+            laps: Some(1e6),
+        };
+        plan.push_back(call(orbit, For::Orbit));
         self.px4_run(i)
     }
 
@@ -280,12 +273,7 @@ impl Autopilot {
             return Vec::new();
         };
         let speed = self.cruise(i);
-        match self.px4_call(
-            i,
-            Function::FlyToPosition,
-            &[position(to), Value::Number(speed)],
-            doing,
-        ) {
+        match self.px4_call(i, &fly_to(to, speed), doing) {
             Ok(going) => {
                 self.px4_mut(i).flying = going.then_some((to, doing));
                 Vec::new()
@@ -331,8 +319,12 @@ impl Autopilot {
             .and_then(|it| self.px4_item_place(it));
         if let Some(to) = next.filter(|to| to[2] - here[2] > ALT_RADIUS) {
             out.extend(self.say(i, INFO, &format!("Climb to {:.1} meters above home\t", to[2])));
-            let f = if self.state(i).airborne() { Function::AscendTo } else { Function::TakeOff };
-            self.px4_mut(i).plan.push_back(call(f, vec![Value::Number(to[2])], For::Other));
+            let f = if self.state(i).airborne() {
+                FunctionCall::AscendTo { alt: to[2] }
+            } else {
+                FunctionCall::TakeOff { alt: to[2] }
+            };
+            self.px4_mut(i).plan.push_back(call(f, For::Other));
         }
         out.extend(self.px4_item(i, seq));
         out
@@ -361,22 +353,17 @@ impl Autopilot {
             WAYPOINT | TAKEOFF | LOITER_TIME | LOITER_UNLIM | LOITER_TO_ALT => {
                 if let Some(to) = place {
                     if !airborne && to[2] > 0.0 {
-                        steps.push(call(
-                            Function::TakeOff,
-                            vec![Value::Number(to[2])],
-                            For::Waypoint(seq),
-                        ));
+                        steps.push(call(FunctionCall::TakeOff { alt: to[2] }, For::Waypoint(seq)));
                     }
                     if airborne || to[2] > 0.0 {
-                        let args =
-                            vec![position([to[0], to[1], to[2].max(0.0)]), Value::Number(speed)];
-                        steps.push(call(Function::FlyToPosition, args, For::Waypoint(seq)));
+                        let to = [to[0], to[1], to[2].max(0.0)];
+                        steps.push(call(fly_to(to, speed), For::Waypoint(seq)));
                     }
                 }
                 // The time inside: WAYPOINT's param1, LOITER_TIME's.
                 let inside = f64::from(item.p[0]);
                 if matches!(command, WAYPOINT | LOITER_TIME) && inside > 0.0 {
-                    steps.push(call(Function::Hover, vec![Value::Number(inside)], For::Other));
+                    steps.push(call(FunctionCall::Hover { duration: inside }, For::Other));
                 }
                 if command != LOITER_UNLIM {
                     steps.push(Step::Reached(seq));
@@ -389,10 +376,10 @@ impl Autopilot {
                         _ => [here[0], here[1]],
                     };
                     if (at[0] - here[0]).hypot(at[1] - here[1]) > self.px4(i).nav_acc_rad {
-                        let args = vec![position([at[0], at[1], here[2]]), Value::Number(speed)];
-                        steps.push(call(Function::FlyToPosition, args, For::Waypoint(seq)));
+                        let to = [at[0], at[1], here[2]];
+                        steps.push(call(fly_to(to, speed), For::Waypoint(seq)));
                     }
-                    steps.push(call(Function::Land, Vec::new(), For::Other));
+                    steps.push(call(FunctionCall::Land, For::Other));
                 }
                 steps.push(Step::Reached(seq));
             }
@@ -405,7 +392,7 @@ impl Autopilot {
             }
             DELAY => {
                 let wait = f64::from(item.p[0]).max(0.0);
-                steps.push(call(Function::Hover, vec![Value::Number(wait)], For::Other));
+                steps.push(call(FunctionCall::Hover { duration: wait }, For::Other));
                 steps.push(Step::Reached(seq));
             }
             CHANGE_SPEED => {
@@ -419,9 +406,9 @@ impl Autopilot {
                     let grab = item.p[1].round() == 1.0;
                     let done = if grab {
                         let kind = self.copters[i].payload.clone().unwrap_or_default();
-                        self.instant(i, Function::LoadPayload, &[Value::Symbol(kind)])
+                        self.instant(i, &FunctionCall::LoadPayload { kind })
                     } else {
-                        self.instant(i, Function::ReleasePayload, &[])
+                        self.instant(i, &FunctionCall::ReleasePayload)
                     };
                     match done {
                         Ok(()) => self.px4_mut(i).grabbed = Some(grab),
@@ -430,7 +417,7 @@ impl Autopilot {
                         }
                     }
                 }
-                steps.push(call(Function::Hover, vec![Value::Number(GRIPPER_TIME)], For::Other));
+                steps.push(call(FunctionCall::Hover { duration: GRIPPER_TIME }, For::Other));
                 steps.push(Step::Reached(seq));
             }
             // Camera, gimbal, ROI and the other DO items: done at once.

@@ -1,7 +1,7 @@
 //! Each middle-layer function's cost in the estimate (docs/LANGUAGE.md, section 19), as the simulator
 //! flies it.
 
-use aviary_api::{DroneId, Function, Value};
+use aviary_api::{DroneId, Function, FunctionCall, Value};
 use aviary_ir::Origin;
 
 use super::estimate::{number_arg, Estimator, Raise};
@@ -65,14 +65,14 @@ pub fn fly(
                 _ => 0.0,
             }
         }
-        Function::Sweep => match (args.first(), number_arg(args, 1)) {
-            (Some(Some(area @ (Value::Area(_) | Value::Remainder(_)))), Some(spacing)) => {
-                match aviary_api::coverage::sweep_lanes(area, spacing) {
+        Function::Sweep => match (known(function, args), args.first()) {
+            (Some(FunctionCall::Sweep { area, spacing }), _) => {
+                match aviary_api::coverage::sweep_lanes(&area, spacing) {
                     Ok(lanes) => sweep(e, d, &aviary_api::sweep::path(&lanes), t, &mut raises),
                     Err(_) => 0.0,
                 }
             }
-            (Some(None), _) => {
+            (_, Some(None)) => {
                 e.note(at, "an area known only in flight (a signal's value, or what a Sweep left: `drone.remaining`) is not counted: the plan assumes every Sweep finishes and leaves nothing".into());
                 0.0
             }
@@ -123,6 +123,13 @@ pub fn fly(
         record_polyline(e, d, &points, t, duration);
     }
     (duration, raises)
+}
+
+/// The call, read as the engine reads it ([`FunctionCall::new`]), when every argument is
+/// known before the flight.
+fn known(function: Function, args: &[Option<Value>]) -> Option<FunctionCall> {
+    let args: Option<Vec<Value>> = args.iter().cloned().collect();
+    FunctionCall::new(function, &args?).ok()
 }
 
 /// Keeps the legs through `points` for the radio's check, the time `took` shared by

@@ -110,6 +110,32 @@ pub struct Failure {
     pub exception: BuiltinException,
     /// Why, for people: the trace's `reason` and the summary.
     pub reason: String,
+    /// Why, for a machine, where one exception has causes an operator tells apart.
+    pub cause: Option<Cause>,
+}
+
+impl Failure {
+    pub fn new(exception: BuiltinException, reason: impl Into<String>) -> Failure {
+        Failure { exception, reason: reason.into(), cause: None }
+    }
+
+    /// A `Timeout` of the separation between drones: a motion held back, waiting for
+    /// another drone to make room, for longer than the mission lets it.
+    pub fn separation(reason: impl Into<String>) -> Failure {
+        let cause = Some(Cause::Separation);
+        Failure { exception: BuiltinException::Timeout, reason: reason.into(), cause }
+    }
+}
+
+/// What caused an exception, where the trace says it (`cause`): so that a ground station
+/// tells a separation wait from a silent vehicle (both `Timeout`) by a word, not by
+/// reading the reason's text.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Cause {
+    /// Drones kept apart: a motion waited for another drone to make room until it timed
+    /// out.
+    Separation,
 }
 
 /// How a call ended.

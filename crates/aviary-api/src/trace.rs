@@ -161,7 +161,9 @@ pub enum Event<'a> {
     /// `args` of a built-in exception: the reason, in words. `during` is `return home` for
     /// a fault after the mission's body has ended, which no handler can take. `skipped`:
     /// a handler that would have taken it and did not, and why (it was re-entered too
-    /// often at one instant, docs/LANGUAGE.md section 12).
+    /// often at one instant, docs/LANGUAGE.md section 12). `cause`: what caused it, where
+    /// one exception has causes an operator tells apart (`separation`: a motion that waited
+    /// for another drone to make room until it timed out).
     Exception {
         name: Text<'a>,
         actor: Option<Text<'a>>,
@@ -176,6 +178,8 @@ pub enum Event<'a> {
         /// identifies the statement to a page that follows the run.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         line: Option<u32>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        cause: Option<crate::Cause>,
     },
     /// `action`: `PAUSE`, `RESUME`, `ABORT` or a section's name.
     /// A block stopped (`Name ABORT`) is a leash on the block: `block` is `true`,

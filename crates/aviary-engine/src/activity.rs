@@ -136,7 +136,7 @@ impl<'m> Engine<'m> {
             drop(held);
             let id = self.m.builtins.exception(BuiltinException::RequirementNotMet);
             let why = format!("a requirement of {} does not hold", cap.name);
-            self.throw(id, vec![Value::Text(why)], actor, &ctx.scope, Some(call.origin));
+            self.throw(id, vec![Value::Text(why)], actor, &ctx.scope, Some(call.origin), None);
             return None;
         }
         Some(Started { instance, held, frame, claims, listed, args })
@@ -267,6 +267,7 @@ impl<'m> Engine<'m> {
             actors.first().copied(),
             &ctx.scope,
             Some(call.origin),
+            None,
         );
         true
     }

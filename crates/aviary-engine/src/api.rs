@@ -125,7 +125,7 @@ impl<'m> Engine<'m> {
             // any backend sees it: no call id of the backend's.
             Asked::Unread(u) => {
                 let reason = u.reason.clone();
-                let failure = Failure { exception: BuiltinException::CommandFailed, reason };
+                let failure = Failure::new(BuiltinException::CommandFailed, reason);
                 aviary_api::PendingCall {
                     id: CallId(u64::MAX),
                     end: Ending::Now(CallEnd::Failed(failure)),

@@ -173,6 +173,6 @@ impl<'m> Engine<'m> {
     /// `NoDroneAvailable`, thrown where the `ANY` stands, with why.
     fn no_drone(&self, a: &Any, why: String, ctx: &Ctx<'m>) {
         let exception = self.m.builtins.exception(BuiltinException::NoDroneAvailable);
-        self.throw(exception, vec![Value::Text(why)], ctx.actor, &ctx.scope, Some(a.origin));
+        self.throw(exception, vec![Value::Text(why)], ctx.actor, &ctx.scope, Some(a.origin), None);
     }
 }

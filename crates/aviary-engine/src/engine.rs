@@ -728,7 +728,8 @@ impl<'m> Engine<'m> {
     /// Raises a backend's failure on `drone` as its built-in exception, with the reason.
     pub(crate) fn fail(&self, failure: aviary_api::Failure, drone: DroneId, from: &Rc<Scope<'m>>) {
         let id = self.m.builtins.exception(failure.exception);
-        self.throw(id, vec![Value::Text(failure.reason)], Some(drone), from, None);
+        let cause = failure.cause;
+        self.throw(id, vec![Value::Text(failure.reason)], Some(drone), from, None, cause);
     }
 
     fn matches(&self, by: &Option<ActorFilter>, frame: &[Value], actor: Option<DroneId>) -> bool {
@@ -854,6 +855,7 @@ impl<'m> Engine<'m> {
 
     /// `THROW EXCEPTION` (or a drone fault): abort the thrower's chain up to the nearest
     /// handler, abort its other activities, and start the handler in that place.
+    /// `caused_by`: what the trace says caused it, for a fault that says (`Failure::cause`).
     pub fn throw(
         &self,
         exception: usize,
@@ -861,6 +863,7 @@ impl<'m> Engine<'m> {
         actor: Option<DroneId>,
         from: &Rc<Scope<'m>>,
         at: Option<aviary_ir::Origin>,
+        caused_by: Option<aviary_api::Cause>,
     ) {
         self.heed_interrupt();
         if self.stopped() {
@@ -906,6 +909,7 @@ impl<'m> Engine<'m> {
             during: None,
             skipped: skipped.as_deref().map(Cow::Borrowed),
             line: at.as_ref().and_then(|o| self.m.line_of(o)),
+            cause: caused_by,
         });
         let Some((handler_scope, index, reentry)) = found else {
             for scope in from.chain() {

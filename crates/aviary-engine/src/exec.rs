@@ -317,7 +317,7 @@ impl<'m> Engine<'m> {
                 Node::Signal { signal, args, origin } => self.signal(*signal, args, origin, ctx),
                 Node::Throw { exception, args, origin } => {
                     let args = self.eval_all(args, ctx);
-                    self.throw(*exception, args, ctx.actor, &ctx.scope, Some(*origin));
+                    self.throw(*exception, args, ctx.actor, &ctx.scope, Some(*origin), None);
                 }
                 Node::StartIf { condition, body } => {
                     if self.truth(condition, ctx) {

@@ -262,6 +262,7 @@ impl<'m> Engine<'m> {
                     during: Some("return home".into()),
                     skipped: None,
                     line: None,
+                    cause: failure.cause,
                 });
             }
             DroneEvent::Signal { drone, signal } => {

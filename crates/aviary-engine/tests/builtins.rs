@@ -37,10 +37,10 @@ impl Scripted {
 impl Backend for Scripted {
     fn call(&self, _: DroneId, _: &FunctionCall) -> PendingCall {
         let end = match self.refuse {
-            Some(exception) => Ending::Now(CallEnd::Failed(Failure {
+            Some(exception) => Ending::Now(CallEnd::Failed(Failure::new(
                 exception,
-                reason: format!("refused with {exception}"),
-            })),
+                format!("refused with {exception}"),
+            ))),
             None => {
                 let (tx, rx) = oneshot::channel();
                 tokio::spawn(async move {
@@ -111,7 +111,7 @@ fn faults_and_signals_a_backend_reports_start_their_handlers() {
         DroneEvent::Signal { drone: 0, signal: BuiltinSignal::ConnectionRestored },
         DroneEvent::Fault {
             drone: 0,
-            failure: Failure { exception: BuiltinException::MotorFailure, reason: "motor".into() },
+            failure: Failure::new(BuiltinException::MotorFailure, "motor"),
         },
     ];
     let mission = "MISSION M:\n    PARALLEL Watch:\n        a Hover WITH 5s\n        ON BatteryLow BY a:\n            SIGNAL Low\n        ON ConnectionRestored BY a:\n            SIGNAL Back\n        ON EXCEPTION MotorFailure BY a:\n            SIGNAL Broken\n";

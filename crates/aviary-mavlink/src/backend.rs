@@ -199,7 +199,7 @@ impl Inner {
                 c.name,
                 battery * 100.0
             );
-            self.fault(drone, Failure { exception: BuiltinException::BatteryCritical, reason });
+            self.fault(drone, Failure::new(BuiltinException::BatteryCritical, reason));
         }
     }
 }
@@ -250,10 +250,7 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
                         limit.as_secs_f64(),
                         c.link.address
                     );
-                    inner.fault(
-                        drone,
-                        Failure { exception: BuiltinException::ConnectionLost, reason },
-                    );
+                    inner.fault(drone, Failure::new(BuiltinException::ConnectionLost, reason));
                 }
             }
         }
@@ -280,13 +277,12 @@ impl Backend for MavlinkBackend {
         if self.inner.lost.lock()[drone] {
             // The drone stays lost to the mission until its link is back: what is asked
             // of it meanwhile raises the exception a handler of the loss already knows.
-            let _ = tx.send(CallEnd::Failed(Failure {
-                exception: BuiltinException::ConnectionLost,
-                reason: format!(
-                    "{}: no link since its HEARTBEATs stopped; `{function}` was not sent",
-                    craft.name
-                ),
-            }));
+            let reason = format!(
+                "{}: no link since its HEARTBEATs stopped; `{function}` was not sent",
+                craft.name
+            );
+            let _ =
+                tx.send(CallEnd::Failed(Failure::new(BuiltinException::ConnectionLost, reason)));
             return PendingCall { id, end: Ending::Later(rx) };
         }
         let (paused_tx, paused_rx) = watch::channel(false);

@@ -72,11 +72,11 @@ pub struct Craft {
 const IN_PROGRESS_LIMIT: Duration = Duration::from_secs(30);
 
 pub fn failed(reason: impl Into<String>) -> Failure {
-    Failure { exception: BuiltinException::CommandFailed, reason: reason.into() }
+    Failure::new(BuiltinException::CommandFailed, reason)
 }
 
 pub fn timeout(reason: impl Into<String>) -> Failure {
-    Failure { exception: BuiltinException::Timeout, reason: reason.into() }
+    Failure::new(BuiltinException::Timeout, reason)
 }
 
 impl Craft {

@@ -25,10 +25,7 @@ pub fn failsafe(name: &str, mode: &str, why: &str, state: Option<BuiltinExceptio
     };
     let said =
         if why.is_empty() { "no reason given".to_owned() } else { format!("it said: {why}") };
-    Failure {
-        exception,
-        reason: format!("{name}: the autopilot switched to {mode} by itself ({said})"),
-    }
+    Failure::new(exception, format!("{name}: the autopilot switched to {mode} by itself ({said})"))
 }
 
 #[cfg(test)]

@@ -103,7 +103,7 @@ async fn orbit_around(
     let here = here(c)?;
     let center = [center[0], center[1]];
     if let Some(reason) = c.airspace.circle_refusal(center, radius, c.level()) {
-        return Err(Failure { exception: aviary_api::BuiltinException::GeofenceViolation, reason });
+        return Err(Failure::new(aviary_api::BuiltinException::GeofenceViolation, reason));
     }
     let circle = orbit(here, center, radius, laps, c.tuning.arrive_xy);
     let mut way = routed(c, here, &circle[..1])?;
@@ -139,7 +139,7 @@ async fn sweep(c: &Craft, area: &Region, spacing: f64, paused: Paused) -> Result
         Region::Left(_) => &[],
     };
     if let Some(reason) = c.airspace.sweep_refusal(outline, &flat, z) {
-        return Err(Failure { exception: aviary_api::BuiltinException::GeofenceViolation, reason });
+        return Err(Failure::new(aviary_api::BuiltinException::GeofenceViolation, reason));
     }
     let path: Vec<[f64; 3]> = flat.into_iter().map(|p| [p[0], p[1], z]).collect();
     // Each lane is flown to its end, as the simulator flies it: the pass radius is often

@@ -197,11 +197,9 @@ pub(crate) fn routed(
     for &p in points {
         let to = [p[0], p[1], if p[2].is_nan() { c.level() } else { p[2] }];
         let low = if prev[2].is_nan() { to[2] } else { prev[2].min(to[2]) };
-        let way =
-            c.airspace.route([prev[0], prev[1]], [to[0], to[1]], low).map_err(|b| Failure {
-                exception: BuiltinException::GeofenceViolation,
-                reason: c.airspace.refusal(b, prev, to),
-            })?;
+        let way = c.airspace.route([prev[0], prev[1]], [to[0], to[1]], low).map_err(|b| {
+            Failure::new(BuiltinException::GeofenceViolation, c.airspace.refusal(b, prev, to))
+        })?;
         let corners = way.len().saturating_sub(1);
         out.extend(way.into_iter().take(corners).map(|q| ([q[0], q[1], to[2]], Pass::Corner)));
         out.push((p, Pass::Cut));
@@ -214,7 +212,7 @@ pub(crate) fn routed(
 /// it would come down into a no-fly zone.
 pub(crate) fn vertical(c: &Craft, here: [f64; 3], z: f64) -> Result<(), Failure> {
     match c.airspace.vertical_refusal(here, z) {
-        Some(reason) => Err(Failure { exception: BuiltinException::GeofenceViolation, reason }),
+        Some(reason) => Err(Failure::new(BuiltinException::GeofenceViolation, reason)),
         None => Ok(()),
     }
 }
@@ -325,8 +323,7 @@ pub(crate) async fn held(c: &Craft, paused: &mut Paused) -> Result<(), Failure> 
 /// The world's geofence and ceiling hold for MAVLink drones too: a path that leaves them
 /// is refused before anything is sent (`GeofenceViolation`).
 pub(crate) fn fenced(c: &Craft, path: &[[f64; 3]]) -> Result<(), Failure> {
-    let violation =
-        |reason: String| Failure { exception: BuiltinException::GeofenceViolation, reason };
+    let violation = |reason: String| Failure::new(BuiltinException::GeofenceViolation, reason);
     for p in path {
         if let Some(max) = c.max_altitude.filter(|m| p[2] > m + 1e-9) {
             return Err(violation(format!(

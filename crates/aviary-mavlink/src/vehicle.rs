@@ -315,9 +315,8 @@ impl Vehicle {
             let why = seen.words.last().unwrap_or_else(|| "no reason given".to_owned());
             let reason =
                 format!("{}: the autopilot reports {:?} ({why})", self.name, hb.system_status);
-            let _ = self
-                .alarms
-                .send((self.drone, Failure { exception: BuiltinException::DroneLost, reason }));
+            let _ =
+                self.alarms.send((self.drone, Failure::new(BuiltinException::DroneLost, reason)));
         }
         let after = mode::classify(flavour, hb.custom_mode);
         let changed = before.is_some_and(|b| b != after);
@@ -396,9 +395,8 @@ impl Vehicle {
             if jump >= 1000.0 { format!("{:.0} km", jump / 1000.0) } else { format!("{jump:.0} m") },
             dt
         );
-        let _ = self
-            .alarms
-            .send((self.drone, Failure { exception: BuiltinException::PositionLost, reason }));
+        let _ =
+            self.alarms.send((self.drone, Failure::new(BuiltinException::PositionLost, reason)));
     }
 
     /// Names a pending failsafe once the vehicle's state or words say what it was, or

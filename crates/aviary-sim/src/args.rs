@@ -8,11 +8,11 @@ use aviary_route::Airspace;
 use crate::geom::{self, circle_inside, contains, segment_inside};
 
 pub(crate) fn failed(reason: impl Into<String>) -> Failure {
-    Failure { exception: BuiltinException::CommandFailed, reason: reason.into() }
+    Failure::new(BuiltinException::CommandFailed, reason)
 }
 
 pub(crate) fn fence_violation(reason: impl Into<String>) -> Failure {
-    Failure { exception: BuiltinException::GeofenceViolation, reason: reason.into() }
+    Failure::new(BuiltinException::GeofenceViolation, reason)
 }
 
 /// A number the call was given, refused when it is not finite.

@@ -23,7 +23,7 @@
 //! call that separation holds back for too long ends: see [`Fleet::held_back`].
 
 use aviary_api::geometry::{hypot, norm_below};
-use aviary_api::{BuiltinException, CallEnd, DroneId, Failure, FlightState};
+use aviary_api::{CallEnd, DroneId, Failure, FlightState};
 
 use crate::avoid::MARGIN;
 use crate::drone::SimDrone;
@@ -440,9 +440,6 @@ impl Fleet {
         d.humble = false;
         d.stalled = 0.0;
         d.settle();
-        Some(Report::Ended {
-            call,
-            end: CallEnd::Failed(Failure { exception: BuiltinException::Timeout, reason }),
-        })
+        Some(Report::Ended { call, end: CallEnd::Failed(Failure::separation(reason)) })
     }
 }

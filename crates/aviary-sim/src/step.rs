@@ -225,7 +225,7 @@ impl Fleet {
     ) {
         out.push(Report::Event(DroneEvent::Fault {
             drone: id,
-            failure: Failure { exception, reason },
+            failure: Failure::new(exception, reason),
         }));
         for call in self.drones[id].cut_calls() {
             out.push(Report::Ended { call, end: CallEnd::Interrupted });

@@ -242,11 +242,22 @@ fn event() -> impl Strategy<Value = Event<'static>> {
         ),
         (
             (text(), opt(text()), values(), any::<bool>()),
-            (opt(text()), opt(text()), opt(text()), line())
+            (opt(text()), opt(text()), opt(text()), line(), any::<bool>())
         )
             .prop_map(
-                |((name, actor, args, handled), (handler, during, skipped, line))| {
-                    Event::Exception { name, actor, args, handled, handler, during, skipped, line }
+                |((name, actor, args, handled), (handler, during, skipped, line, separation))| {
+                    let cause = separation.then_some(crate::Cause::Separation);
+                    Event::Exception {
+                        name,
+                        actor,
+                        args,
+                        handled,
+                        handler,
+                        during,
+                        skipped,
+                        line,
+                        cause,
+                    }
                 }
             ),
         (text(), text(), text(), any::<bool>(), line()).prop_map(

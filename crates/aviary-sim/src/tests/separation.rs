@@ -353,6 +353,11 @@ fn two_drones_sent_to_the_same_point_the_second_times_out_and_hovers() {
     let CallEnd::Failed(failure) = end else { panic!("{end:?}") };
     assert_eq!(failure.exception, BuiltinException::Timeout);
     assert_eq!(failure.reason, "b waited 30 s for a to make room");
+    assert_eq!(
+        failure.cause,
+        Some(aviary_api::Cause::Separation),
+        "said as data, not only in words"
+    );
     let waited = at - last_gain(&log, *at);
     assert!((29.99..31.0).contains(&waited), "{waited}");
     // Then it hovers where it is, clear of the first drone, and takes new calls.

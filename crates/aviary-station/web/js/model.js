@@ -157,8 +157,9 @@ export function observe(model, e) {
       if (!e.handled) alarm(model, e, "unhandled", e.actor, `unhandled exception ${what}`);
       else if (DRONE_FAULTS.has(e.name))
         alarm(model, e, e.name, e.actor, `${what}: ${(e.args || []).join(" ")}`);
-      // The simulator's separation layer: "scout waited 30 s for carrier to make room".
-      else if (e.name === "Timeout" && /make room|separation/i.test((e.args || []).join(" ")))
+      // The simulator's separation layer: a motion that waited for another drone to make
+      // room until it timed out (the trace's `cause`, not its words).
+      else if (e.cause === "separation")
         alarm(model, e, "separation", e.actor, `${what}: ${(e.args || []).join(" ")}`, false);
       break;
     }

@@ -70,9 +70,10 @@ for m in "${missions[@]}"; do
         bin=${!who}
         world=()
         if [[ -f "$work/$who/$name.world.toml" ]]; then
-            world=(--world "$work/$who/$name.world.toml")
+            # Named alike for both builds (`mission_start` writes the world's name as given).
+            world=(--world "$name.world.toml")
         fi
-        "$bin" run "$m" "${world[@]}" --quiet --telemetry-hz 1 --trace "$work/$name.$who.jsonl" || true
+        (cd "$work/$who" && "$bin" run "$m" "${world[@]}" --quiet --telemetry-hz 1 --trace "$work/$name.$who.jsonl") || true
     done
     compare "$name" "$name"
 done

@@ -165,7 +165,7 @@ fn checked(control: &Control, mission: &aviary_ir::Mission) {
             Value::Position(p) => {
                 assert!(fine(p.x) && fine(p.y) && p.z.is_none_or(fine), "{p:?} reached the engine")
             }
-            Value::Area(_) | Value::Actor(_) | Value::Remainder(_) => {
+            Value::Area(_) | Value::Actor(_) | Value::Remainder(_) | Value::Absent => {
                 panic!("{v:?} reached the engine from outside")
             }
             Value::Text(_) | Value::Symbol(_) | Value::Bool(_) => {}

@@ -29,7 +29,7 @@ pub use args::{Kinds, MAX_MAGNITUDE};
 pub use bounds::Bounds;
 pub use guard::{read_token, same_origin, token, Gate, TOKEN_PROTOCOL};
 pub use openapi::{openapi, openapi_yaml, state_schema};
-pub use reply::{json_errors, BODY_LIMIT};
+pub use reply::{error, json_errors, BODY_LIMIT};
 
 use parking_lot::{Mutex, MutexGuard};
 use std::net::SocketAddr;

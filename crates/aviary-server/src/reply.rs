@@ -13,7 +13,9 @@ use serde_json::Value;
 /// A control call's body may be this large; the largest real one is a few hundred bytes.
 pub const BODY_LIMIT: usize = 64 * 1024;
 
-pub(crate) fn error(status: StatusCode, message: impl Into<String>) -> Response {
+/// An error answer, `{"error": "..."}` with its status: the operator API's, and the ground
+/// station's own calls'.
+pub fn error(status: StatusCode, message: impl Into<String>) -> Response {
     (status, Json(ApiError { error: message.into() })).into_response()
 }
 

@@ -12,13 +12,12 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
-use aviary_api::operator::ApiError;
+use aviary_server::error;
 use axum::extract::ws::rejection::WebSocketUpgradeRejection;
 use axum::extract::ws::{CloseFrame, Message as Frame, WebSocket, WebSocketUpgrade};
 use axum::extract::State;
 use axum::http::StatusCode;
-use axum::response::{IntoResponse, Response};
-use axum::Json;
+use axum::response::Response;
 use lsp_server::{Connection, Message};
 
 use crate::{Mode, Station};
@@ -47,17 +46,13 @@ impl std::fmt::Debug for Lsp {
     }
 }
 
-fn refused(status: StatusCode, message: impl Into<String>) -> Response {
-    (status, Json(ApiError { error: message.into() })).into_response()
-}
-
 /// The route: a socket to a language server of its own, if the station has one to give.
 pub(crate) async fn socket(
     State(station): State<Arc<Station>>,
     ws: Result<WebSocketUpgrade, WebSocketUpgradeRejection>,
 ) -> Response {
     let Some(lsp) = station.lsp.clone() else {
-        return refused(
+        return error(
             StatusCode::NOT_FOUND,
             "this station has no language server: `aviary gcs DIR` serves one beside its editor",
         );
@@ -65,7 +60,7 @@ pub(crate) async fn socket(
     let ws = match ws {
         Ok(ws) => ws,
         Err(rejection) => {
-            return refused(
+            return error(
                 rejection.status(),
                 format!("{}: open it as a WebSocket", rejection.body_text()),
             )
@@ -73,7 +68,7 @@ pub(crate) async fn socket(
     };
     if station.lsp_sockets.fetch_add(1, Ordering::SeqCst) >= MAX_SOCKETS {
         station.lsp_sockets.fetch_sub(1, Ordering::SeqCst);
-        return refused(
+        return error(
             StatusCode::SERVICE_UNAVAILABLE,
             format!("the station runs {MAX_SOCKETS} language servers already: close another page's editor"),
         );

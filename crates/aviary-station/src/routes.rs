@@ -19,7 +19,8 @@ use aviary_check::SourceProvider;
 use crate::checking::{self, Text};
 use crate::wire::{About, CampaignReport, FlyRefused, Opened};
 use crate::{assets, dir, flight, tiles, Mode, Station};
-use aviary_api::operator::{Accepted, ApiError};
+use aviary_api::operator::Accepted;
+use aviary_server::error;
 
 /// The largest body a station call takes: a mission and a world of the largest size
 /// the station opens, with room for JSON's escapes.
@@ -55,10 +56,6 @@ pub(crate) fn router(station: Arc<Station>) -> Router {
         // Every error in JSON, an extractor's rejection too (axum's are plain text).
         .layer(middleware::map_response(aviary_server::json_errors))
         .with_state(station)
-}
-
-fn error(status: StatusCode, message: impl Into<String>) -> Response {
-    (status, Json(ApiError { error: message.into() })).into_response()
 }
 
 /// Why a call is refused, and its status: what the helpers below return, made a response

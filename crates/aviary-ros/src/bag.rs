@@ -105,7 +105,6 @@ struct Bag<W: std::io::Write + std::io::Seek> {
     origin: Option<Origin>,
     /// Topic → (channel, type, messages so far).
     channels: BTreeMap<String, (u16, &'static str, u64)>,
-    schemas: BTreeMap<&'static str, u16>,
     end: Time,
 }
 
@@ -120,13 +119,7 @@ impl<W: std::io::Write + std::io::Seek> Bag<W> {
             // unchunked file from end to end instead.
             .use_chunks(false)
             .create(out)?;
-        Ok(Bag {
-            mcap,
-            origin,
-            channels: BTreeMap::new(),
-            schemas: BTreeMap::new(),
-            end: Time::default(),
-        })
+        Ok(Bag { mcap, origin, channels: BTreeMap::new(), end: Time::default() })
     }
 
     fn record(&mut self, record: &Record<'_>) -> Result<(), Failed> {
@@ -156,30 +149,23 @@ impl<W: std::io::Write + std::io::Seek> Bag<W> {
 
     fn write<M: Message>(&mut self, topic: &str, stamp: Time, message: &M) -> Result<(), Failed> {
         let data = msgs::cdr(message).map_err(Failed::Encoding)?;
-        let channel = match self.channels.get_mut(topic) {
+        let (channel, sequence) = match self.channels.get_mut(topic) {
             Some((channel, _, count)) => {
                 *count += 1;
-                *channel
+                (*channel, *count)
             }
             None => {
-                let schema = match self.schemas.get(M::TYPE) {
-                    Some(&id) => id,
-                    None => {
-                        let id =
-                            self.mcap.add_schema(M::TYPE, "ros2msg", M::definition().as_bytes())?;
-                        self.schemas.insert(M::TYPE, id);
-                        id
-                    }
-                };
+                // MCAP keeps each schema once, however many topics add it.
+                let definition = M::definition();
+                let schema = self.mcap.add_schema(M::TYPE, "ros2msg", definition.as_bytes())?;
                 let channel = self.mcap.add_channel(schema, topic, "cdr", &BTreeMap::new())?;
                 self.channels.insert(topic.to_string(), (channel, M::TYPE, 1));
-                channel
+                (channel, 1)
             }
         };
-        let sequence = self.channels.get(topic).map_or(0, |(_, _, n)| *n as u32);
         let header = mcap::records::MessageHeader {
             channel_id: channel,
-            sequence,
+            sequence: u32::try_from(sequence).unwrap_or(u32::MAX),
             log_time: stamp.nanos(),
             publish_time: stamp.nanos(),
         };

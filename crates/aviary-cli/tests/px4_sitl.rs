@@ -302,7 +302,9 @@ mod single {
 
     use super::*;
     use aviary_mavlink::mavlink::dialects::ardupilotmega as mav;
-    use common::background::{airborne, exception, finish, said, signalled, start_run, Run};
+    use common::background::{
+        airborne, exception, finish, said, signal_names, signalled, start_run, Run,
+    };
     use common::sitl::{wait_until, Gcs};
 
     /// A copter `d` at home (0, 0), set up by the test's ground station (`before`), and
@@ -459,13 +461,7 @@ mod single {
         px4.restart();
         let (code, out) = finish(&mut run, &dir, Duration::from_secs(200));
         let flown = events(&dir.join("t.jsonl"));
-        let signals: Vec<&str> = flown
-            .iter()
-            .filter_map(|e| match &e.event {
-                Event::Signal { name, .. } => Some(&**name),
-                _ => None,
-            })
-            .collect();
+        let signals = signal_names(&flown);
         for s in ["Offline", "ConnectionRestored", "Back"] {
             assert!(signals.contains(&s), "{s} in {signals:?}:\n{out}");
         }

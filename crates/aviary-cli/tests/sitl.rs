@@ -23,7 +23,9 @@ use std::time::{Duration, Instant};
 
 use aviary_api::trace::{Event, EventKind, Record, Status};
 use aviary_api::Function;
-use common::background::{events, exception, finish, named, pos, said, signalled, start_run, Run};
+use common::background::{
+    events, exception, finish, named, pos, said, signal_names, signalled, start_run, Run,
+};
 use common::sitl::{wait_until, Sitl, BIG_BATTERY};
 use common::{aviary, repo, scratch, PAPER_DRONES};
 
@@ -569,13 +571,7 @@ mod single {
         sitl.restart();
         let (code, out) = finish(&mut run, &dir, Duration::from_secs(120));
         let flown = events(&dir.join("t.jsonl"));
-        let signals: Vec<&str> = flown
-            .iter()
-            .filter_map(|e| match &e.event {
-                Event::Signal { name, .. } => Some(&**name),
-                _ => None,
-            })
-            .collect();
+        let signals = signal_names(&flown);
         for s in ["Offline", "Still_Offline", "ConnectionRestored", "Back"] {
             assert!(signals.contains(&s), "{s} in {signals:?}:\n{out}");
         }

@@ -59,6 +59,17 @@ pub fn exception<'a>(events: &'a [Record<'static>], name: &str) -> Option<&'a Re
     events.iter().find(|e| matches!(&e.event, Event::Exception { name: n, .. } if n == name))
 }
 
+/// The names of the signals raised, in order.
+pub fn signal_names<'a>(events: &'a [Record<'static>]) -> Vec<&'a str> {
+    events
+        .iter()
+        .filter_map(|e| match &e.event {
+            Event::Signal { name, .. } => Some(&**name),
+            _ => None,
+        })
+        .collect()
+}
+
 /// Whether a signal of that name was raised.
 pub fn signalled(events: &[Record<'static>], name: &str) -> bool {
     events.iter().any(|e| matches!(&e.event, Event::Signal { name: n, .. } if n == name))

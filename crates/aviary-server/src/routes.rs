@@ -63,7 +63,7 @@ async fn control(shared: &Shared, control: Control) -> Response {
 /// trace does not say: they are the mission's).
 async fn state(State(shared): State<Arc<Shared>>) -> Json<OperatorState> {
     let mut state = shared.state().document();
-    state.operator_signals = shared.kinds.operator_signals().to_vec();
+    state.operator_signals = shared.kinds.operator_signals();
     // What each carries, so that a form can read `x, y` as the one position it takes.
     state.operator_signal_values = SignalValues(
         shared

@@ -99,17 +99,22 @@ impl<'m> Engine<'m> {
 
     /// Evaluates the arguments, records `api_call` and makes the call.
     pub(crate) fn api_begin(&self, a: &'m ApiCall, drone: DroneId, frame: &[Value]) -> Begun {
-        let args = {
-            let received = self.received.borrow();
-            let env = self.env(frame, &received);
-            a.args.iter().map(|e| env.eval(e)).collect::<Vec<_>>()
-        };
         let function = a.function;
-        self.calling(drone, a.origin);
-        let asked = match FunctionCall::new(function, &args) {
-            Ok(call) => Asked::Read(call),
-            Err(reason) => Asked::Unread(Box::new(Unread { function, args, reason })),
+        let asked = match &a.read {
+            Some(call) => Asked::Read(call.clone()),
+            None => {
+                let args = {
+                    let received = self.received.borrow();
+                    let env = self.env(frame, &received);
+                    a.args.iter().map(|e| env.eval(e)).collect::<Vec<_>>()
+                };
+                match FunctionCall::new(function, &args) {
+                    Ok(call) => Asked::Read(call),
+                    Err(reason) => Asked::Unread(Box::new(Unread { function, args, reason })),
+                }
+            }
         };
+        self.calling(drone, a.origin);
         self.trace(EventKind::ApiCall, || Event::ApiCall {
             actor: self.name(drone).into(),
             function,

@@ -21,7 +21,9 @@
 // enum that is no language construct may be matched with `_`, allowed where it is.
 #![deny(clippy::wildcard_enum_match_arm)]
 
-use aviary_api::{BuiltinException, BuiltinSignal, DroneId, Function, Kind, Resource, Value};
+use aviary_api::{
+    BuiltinException, BuiltinSignal, DroneId, Function, FunctionCall, Kind, Resource, Value,
+};
 use aviary_diagnostics::{FileId, Span};
 
 /// Indices into the tables of [`Mission`].
@@ -357,6 +359,10 @@ pub struct ApiCall {
     pub actor: ActorRef,
     pub function: Function,
     pub args: Vec<Expr>,
+    /// The call read when compiled ([`FunctionCall::new`] on `args`' values), when every
+    /// argument is a constant and reads: the engine makes it as it is, with nothing to
+    /// evaluate or read. Derived from `args` by the lowering and by nothing else.
+    pub read: Option<FunctionCall>,
     pub origin: Origin,
 }
 

@@ -3,7 +3,8 @@
 use std::collections::BTreeMap;
 
 use aviary_api::{
-    arith, BuiltinException, BuiltinLeash, BuiltinSignal, Descriptor, DroneId, Point, Value,
+    arith, BuiltinException, BuiltinLeash, BuiltinSignal, Descriptor, DroneId, Function,
+    FunctionCall, Point, Value,
 };
 use aviary_check::{bind_args, Program};
 use aviary_diagnostics::FileId;
@@ -437,12 +438,17 @@ impl<'a> Compiler<'a> {
             ast::Stmt::StopBlock(s) => {
                 Node::StopBlock { block: s.block.name.clone(), origin: self.origin(s.span) }
             }
-            ast::Stmt::Api(a) => Node::Api(ApiCall {
-                actor: self.actor(&a.actor.name),
-                function: self.api.function(&a.function.name)?.function,
-                args: a.args.iter().map(|e| self.expr(e)).collect(),
-                origin: self.origin(a.span),
-            }),
+            ast::Stmt::Api(a) => {
+                let function = self.api.function(&a.function.name)?.function;
+                let args: Vec<Expr> = a.args.iter().map(|e| self.expr(e)).collect();
+                Node::Api(ApiCall {
+                    actor: self.actor(&a.actor.name),
+                    function,
+                    read: read_when_compiled(function, &args),
+                    args,
+                    origin: self.origin(a.span),
+                })
+            }
             ast::Stmt::Signal(r) => Node::Signal {
                 signal: self.signals.id(&r.name.name),
                 args: self.args(&r.args),
@@ -761,6 +767,20 @@ fn empty_block(path: &str) -> Block {
 }
 
 /// A literal number's value; `None` for any other expression.
+/// A call whose arguments are all constants, read once here rather than each time it is
+/// made. One that does not read (a kind the checker let through) is left to the engine,
+/// which refuses it in flight as it refuses any call it cannot read.
+fn read_when_compiled(function: Function, args: &[Expr]) -> Option<FunctionCall> {
+    let values = args
+        .iter()
+        .map(|e| match e {
+            Expr::Const(v) => Some(v.clone()),
+            _ => None,
+        })
+        .collect::<Option<Vec<Value>>>()?;
+    FunctionCall::new(function, &values).ok()
+}
+
 fn literal_number(e: &Expr) -> Option<f64> {
     match e {
         Expr::Const(Value::Number(n)) => Some(*n),

@@ -1,7 +1,7 @@
 //! The compiler on the paper's mission and on small missions: names become indices,
 //! handlers sit on the block they hear, defaults and units are resolved once.
 
-use aviary_api::{BuiltinLeash, Point, Resource, Value};
+use aviary_api::{BuiltinLeash, FunctionCall, Point, Resource, Value};
 use aviary_ir::*;
 use aviary_lower::compile;
 use aviary_test_support::harness;
@@ -258,4 +258,24 @@ fn operator_signals_become_ids_once_each_and_one_at_a_time_is_kept() {
     assert!(compiled("MISSION M:\n    a Hover WITH 1s\n", harness::WORLD)
         .operator_signals
         .is_empty());
+}
+
+#[test]
+fn a_call_of_constants_is_read_when_compiled_and_one_of_parameters_when_made() {
+    let m = compiled(
+        "CAPABILITY Up BY d WITH alt:\n    PERFORM:\n        d.TakeOff(alt)\n        d.Hover(2min)\n        d.StartDetection(Body)\n\nMISSION M:\n    d1 Up WITH 10m\n",
+        "[site]\norigin = { lat = 46.6167, lon = 14.2650, alt = 440.0 }\n[drones.d1]\nhome = [0, 0]\n",
+    );
+    let calls: Vec<&ApiCall> = cap(&m, "Up")
+        .perform
+        .items
+        .iter()
+        .map(|n| match n {
+            Node::Api(a) => a,
+            other => panic!("not a call: {other:?}"),
+        })
+        .collect();
+    assert_eq!(calls[0].read, None, "a parameter's value is known when the call is made");
+    assert_eq!(calls[1].read, Some(FunctionCall::Hover { duration: 120.0 }));
+    assert_eq!(calls[2].read, Some(FunctionCall::StartDetection { kind: "Body".into() }));
 }

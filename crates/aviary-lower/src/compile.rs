@@ -773,10 +773,8 @@ fn empty_block(path: &str) -> Block {
 fn read_when_compiled(function: Function, args: &[Expr]) -> Option<FunctionCall> {
     let values = args
         .iter()
-        .map(|e| match e {
-            Expr::Const(v) => Some(v.clone()),
-            _ => None,
-        })
+        // Only a constant is known now, whatever expressions come: no match to extend.
+        .map(|e| if let Expr::Const(v) = e { Some(v.clone()) } else { None })
         .collect::<Option<Vec<Value>>>()?;
     FunctionCall::new(function, &values).ok()
 }

@@ -147,7 +147,7 @@ fn checked(control: &Control, mission: &aviary_ir::Mission) {
         }
         Control::Leash { capability, tag, action, args } => {
             let cap = &mission.capabilities[*capability];
-            assert!(cap.action_name(*action).is_some() && *tag < mission.tags.len());
+            assert!(cap.action_name(*action).is_some() && mission.tags.get(*tag).is_some());
             assert!(args.iter().all(|(p, _)| *p < cap.params.len()));
         }
         Control::Drone { drone, .. } => assert!(*drone < mission.drones.len()),

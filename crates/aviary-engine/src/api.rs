@@ -13,7 +13,7 @@ use aviary_api::{
     BuiltinException, CallEnd, CallId, DroneId, Ending, Failure, Function, FunctionCall, Interrupt,
     Value,
 };
-use aviary_ir::ApiCall;
+use aviary_ir::{ApiCall, TiSlice};
 
 use crate::engine::{Ctx, Engine, Instance};
 use crate::place::Level;
@@ -94,7 +94,7 @@ impl<'m> Engine<'m> {
 
     /// The drone a call is made to, if its actor reference stands for one here.
     pub(crate) fn api_drone(&self, a: &ApiCall, frame: &[Value]) -> Option<DroneId> {
-        self.env(frame, &[]).actor(&a.actor)
+        self.env(frame, TiSlice::from_ref(&[])).actor(&a.actor)
     }
 
     /// Evaluates the arguments, records `api_call` and makes the call.

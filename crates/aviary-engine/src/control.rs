@@ -235,7 +235,9 @@ impl<'m> Engine<'m> {
                 // refused, never followed.
                 let cap = self.m.capabilities.get(capability).ok_or("no such capability")?;
                 cap.action_name(action).ok_or("no such section")?;
-                if tag >= self.m.tags.len() || args.iter().any(|(p, _)| *p >= cap.params.len()) {
+                if self.m.tags.get(tag).is_none()
+                    || args.iter().any(|(p, _)| *p >= cap.params.len())
+                {
                     return Err("no such tag or parameter".into());
                 }
                 self.leash_by_id(capability, tag, action, args, None);

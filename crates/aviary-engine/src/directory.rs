@@ -6,7 +6,7 @@
 
 use aviary_api::{BuiltinLeash, Names, Value};
 use aviary_diagnostics::suggest::{closest, did_you_mean};
-use aviary_ir::{CapId, LeashAction, Mission, SignalId};
+use aviary_ir::{CapId, LeashAction, Mission, SignalId, TagId, TiVec};
 
 use crate::control::{Control, DroneAction, Unknown};
 
@@ -14,9 +14,9 @@ use crate::control::{Control, DroneAction, Unknown};
 /// the whole run.
 #[derive(Clone, Debug, Default)]
 pub struct Directory {
-    capabilities: Vec<CapabilityNames>,
-    tags: Vec<String>,
-    signals: Vec<String>,
+    capabilities: TiVec<CapId, CapabilityNames>,
+    tags: TiVec<TagId, String>,
+    signals: TiVec<SignalId, String>,
     /// The signals the mission declares with `OPERATOR SIGNAL`, in the order written.
     operator_signals: Vec<SignalId>,
     drones: Names,
@@ -55,7 +55,7 @@ impl Directory {
 
     /// The capability called `name`, if the mission has it.
     pub fn capability(&self, name: &str) -> Option<CapId> {
-        self.capabilities.iter().position(|c| c.name == name)
+        self.capabilities.position(|c| c.name == name)
     }
 
     /// A capability's parameters, in order.
@@ -106,7 +106,7 @@ impl Directory {
             .collect::<Result<Vec<_>, _>>()?;
         // A tag no statement defines can never match: the engine refuses it, as the checker
         // would, with the tagged activities that run.
-        let Some(tag_id) = self.tags.iter().position(|t| t == tag) else {
+        let Some(tag_id) = self.tags.position(|t| t == tag) else {
             let meant = closest(tag, self.tags.iter().map(String::as_str))
                 .map(|t| format!("did you mean `{capability}-{t}`?"));
             return Ok(Control::Unknown(Unknown::Tag {

@@ -11,7 +11,10 @@ use std::borrow::Cow;
 
 use aviary_api::trace::{AutopilotAction, CallStatus, Event, EventKind, RaisedBy, Record, Shown};
 use aviary_api::{Backend, DroneEvent, DroneId, Function, Value};
-use aviary_ir::{ActorFilter, ExceptionHandler, Handler, Mission};
+use aviary_ir::{
+    ActorFilter, CapId, ExceptionHandler, ExceptionId, Handler, Mission, SignalId, TagId, TiSlice,
+    TiVec,
+};
 use tokio::sync::{mpsc, Notify};
 
 use crate::cancel::Token as CancellationToken;
@@ -33,7 +36,7 @@ pub(crate) enum Job<'m> {
         handler: &'m Handler,
         args: Vec<Value>,
         actor: Option<DroneId>,
-        signal: usize,
+        signal: SignalId,
         entry: Rc<Entry>,
     },
     Exception {
@@ -222,8 +225,8 @@ pub(crate) type Calls = smallvec::SmallVec<[aviary_api::CallId; 2]>;
 /// A running capability instance (an activity).
 pub(crate) struct Instance {
     pub id: u64,
-    pub capability: usize,
-    pub tag: Option<usize>,
+    pub capability: CapId,
+    pub tag: Option<TagId>,
     pub actors: Actors,
     /// The instance a statement of the mission started: pausing it pauses all inside it.
     pub root: Option<Rc<Instance>>,
@@ -310,7 +313,7 @@ pub(crate) struct Engine<'m> {
     /// What the sink wants, by kind (asked once).
     wanted: [bool; EventKind::ALL.len()],
     start: Instant,
-    pub received: RefCell<Vec<bool>>,
+    pub received: RefCell<TiVec<SignalId, bool>>,
     pub changed: Notify,
     pub arbiter: Rc<RefCell<Arbiter>>,
     pub instances: RefCell<Registry<'m>>,
@@ -351,7 +354,7 @@ pub(crate) struct Engine<'m> {
     pub mission_scope: RefCell<Option<Rc<Scope<'m>>>>,
     pub next_id: Cell<u64>,
     /// Which capabilities may run as instant activities (`instant.rs`).
-    pub instant: Vec<bool>,
+    pub instant: TiVec<CapId, bool>,
     /// [`crate::RunOptions::max_call_depth`].
     pub max_call_depth: usize,
     /// [`crate::RunOptions::max_handler_reentries`].
@@ -383,7 +386,7 @@ impl<'m> Engine<'m> {
             wanted: EventKind::ALL.map(|k| sink.wants(k)),
             sink: RefCell::new(sink),
             start: Instant::now(),
-            received: RefCell::new(vec![false; m.signals.len()]),
+            received: RefCell::new(vec![false; m.signals.len()].into()),
             changed: Notify::new(),
             arbiter: Rc::new(RefCell::new(Arbiter::default())),
             instances: RefCell::new(Registry::default()),
@@ -444,7 +447,7 @@ impl<'m> Engine<'m> {
         Shown::all(values, &self.m.drones)
     }
 
-    pub fn env<'a>(&'a self, frame: &'a [Value], received: &'a [bool]) -> Env<'a> {
+    pub fn env<'a>(&'a self, frame: &'a [Value], received: &'a TiSlice<SignalId, bool>) -> Env<'a> {
         Env {
             mission: self.m,
             backend: self.backend,
@@ -744,7 +747,7 @@ impl<'m> Engine<'m> {
 
     /// A signal from outside the mission (the operator): heard by every running handler
     /// that matches, at once (there is no signalling block to wait for).
-    pub fn raise_from_outside(&self, signal: usize, args: Vec<Value>) {
+    pub fn raise_from_outside(&self, signal: SignalId, args: Vec<Value>) {
         self.trace(EventKind::Signal, || Event::Signal {
             name: self.m.signals[signal].as_str().into(),
             actor: None,
@@ -771,7 +774,7 @@ impl<'m> Engine<'m> {
     /// `at`: the `SIGNAL` statement, whose line the trace names; none for a drone's signal.
     pub fn raise(
         &self,
-        signal: usize,
+        signal: SignalId,
         args: Vec<Value>,
         actor: Option<DroneId>,
         from: &Rc<Scope<'m>>,
@@ -820,7 +823,7 @@ impl<'m> Engine<'m> {
     fn deliver(
         &self,
         scope: &Rc<Scope<'m>>,
-        signal: usize,
+        signal: SignalId,
         args: &[Value],
         actor: Option<DroneId>,
         signalling_block: Option<&Rc<Scope<'m>>>,
@@ -858,7 +861,7 @@ impl<'m> Engine<'m> {
     /// `caused_by`: what the trace says caused it, for a fault that says (`Failure::cause`).
     pub fn throw(
         &self,
-        exception: usize,
+        exception: ExceptionId,
         args: Vec<Value>,
         actor: Option<DroneId>,
         from: &Rc<Scope<'m>>,

@@ -9,7 +9,10 @@ use std::task::Poll;
 use std::time::Duration;
 
 use aviary_api::{BuiltinLeash, DroneId, Value};
-use aviary_ir::{ActorRef, Block, BlockKind, Call, Expr, For, Leash, LeashAction, Mission, Node};
+use aviary_ir::{
+    ActorRef, Block, BlockKind, Call, CapId, Expr, For, Leash, LeashAction, Mission, Node,
+    SignalId, TagId,
+};
 
 use crate::cancel::Token as CancellationToken;
 use futures_util::future::{Either, LocalBoxFuture};
@@ -359,7 +362,7 @@ impl<'m> Engine<'m> {
     }
 
     /// `SIGNAL`: raised by the actor of this place, from its scope.
-    fn signal(&self, signal: usize, args: &[Expr], origin: &aviary_ir::Origin, ctx: &Ctx<'m>) {
+    fn signal(&self, signal: SignalId, args: &[Expr], origin: &aviary_ir::Origin, ctx: &Ctx<'m>) {
         let args = self.eval_all(args, ctx);
         self.raise(signal, args, ctx.actor, &ctx.scope, Some(origin));
     }
@@ -561,8 +564,8 @@ impl<'m> Engine<'m> {
     /// none runs (docs/LANGUAGE.md, section 14).
     pub(crate) fn leash_by_id(
         &self,
-        capability: usize,
-        tag: usize,
+        capability: CapId,
+        tag: TagId,
         action: LeashAction,
         values: Vec<(usize, Value)>,
         at: Option<&aviary_ir::Origin>,

@@ -25,7 +25,7 @@ use futures_util::future::LocalBoxFuture;
 use smallvec::SmallVec;
 
 use aviary_api::{CallEnd, DroneId, Ending, Value};
-use aviary_ir::{ActorRef, BlockKind, Call, Capability, Mission, Node};
+use aviary_ir::{ActorRef, BlockKind, Call, CapId, Capability, Mission, Node, TiVec};
 
 use crate::activity::{frame_values, Resume};
 use crate::api::{remembers_scope, Begun};
@@ -34,7 +34,7 @@ use crate::engine::{Actors, Ctx, Engine};
 use aviary_api::trace::{EventKind, Status};
 
 /// Which capabilities may run as instant activities, by index.
-pub(crate) fn instant_capabilities(m: &Mission) -> Vec<bool> {
+pub(crate) fn instant_capabilities(m: &Mission) -> TiVec<CapId, bool> {
     m.capabilities.iter().map(may_be_instant).collect()
 }
 

@@ -12,6 +12,7 @@ use std::collections::BTreeMap;
 use std::rc::Rc;
 
 use aviary_api::DroneId;
+use aviary_ir::{CapId, TagId};
 use smallvec::SmallVec;
 
 use crate::engine::{Instance, Scope};
@@ -21,7 +22,7 @@ pub(crate) type Entry<'m> = (Rc<Instance>, Rc<Scope<'m>>);
 #[derive(Default)]
 pub(crate) struct Registry<'m> {
     by_actor: Vec<SmallVec<[Entry<'m>; 1]>>,
-    by_tag: BTreeMap<(usize, usize, u64), Entry<'m>>,
+    by_tag: BTreeMap<(CapId, TagId, u64), Entry<'m>>,
     /// Instances without an actor (all of whose actor references were empty), so that
     /// `all` still sees them.
     loose: BTreeMap<u64, Entry<'m>>,
@@ -103,14 +104,14 @@ impl<'m> Registry<'m> {
     }
 
     /// Each (capability, tag) that a running instance has, once, in that order.
-    pub fn tags(&self) -> Vec<(usize, usize)> {
-        let mut tags: Vec<(usize, usize)> = self.by_tag.keys().map(|&(c, t, _)| (c, t)).collect();
+    pub fn tags(&self) -> Vec<(CapId, TagId)> {
+        let mut tags: Vec<(CapId, TagId)> = self.by_tag.keys().map(|&(c, t, _)| (c, t)).collect();
         tags.dedup();
         tags
     }
 
     /// The instances of `capability` tagged `tag`, in the order they started.
-    pub fn tagged(&self, capability: usize, tag: usize) -> impl Iterator<Item = &Entry<'m>> {
+    pub fn tagged(&self, capability: CapId, tag: TagId) -> impl Iterator<Item = &Entry<'m>> {
         self.by_tag.range((capability, tag, 0)..=(capability, tag, u64::MAX)).map(|(_, e)| e)
     }
 }

@@ -1,7 +1,7 @@
 //! Evaluating expressions at run time.
 
 use aviary_api::{arith, Backend, Point, Value};
-use aviary_ir::{ActorRef, Expr, Field, Mission};
+use aviary_ir::{ActorRef, Expr, Field, Mission, SignalId, TiSlice};
 
 /// What an expression needs from the run: the frame, telemetry, signals, the clock.
 pub(crate) struct Env<'a> {
@@ -9,7 +9,7 @@ pub(crate) struct Env<'a> {
     pub backend: &'a dyn Backend,
     pub coverage: &'a crate::coverage::Coverage,
     pub frame: &'a [Value],
-    pub received: &'a [bool],
+    pub received: &'a TiSlice<SignalId, bool>,
     /// When the mission started: `ELAPSED` is read from the clock only when evaluated
     /// (most expressions never ask, and reading tokio's clock is not free).
     pub start: tokio::time::Instant,

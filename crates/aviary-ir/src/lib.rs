@@ -26,11 +26,52 @@ use aviary_api::{
 };
 use aviary_diagnostics::{FileId, Span};
 
-/// Indices into the tables of [`Mission`].
-pub type CapId = usize;
-pub type SignalId = usize;
-pub type ExceptionId = usize;
-pub type TagId = usize;
+pub use typed_index_collections::{TiSlice, TiVec};
+
+/// An index into one table of [`Mission`], of a type of its own: a table is a [`TiVec`]
+/// that takes only its own kind of id, so that a signal's id cannot pick a capability.
+macro_rules! id {
+    ($(#[$doc:meta])* $name:ident) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+        pub struct $name(pub usize);
+
+        impl From<usize> for $name {
+            fn from(i: usize) -> $name {
+                $name(i)
+            }
+        }
+
+        impl From<$name> for usize {
+            fn from(id: $name) -> usize {
+                id.0
+            }
+        }
+
+        impl std::fmt::Display for $name {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                self.0.fmt(f)
+            }
+        }
+    };
+}
+
+id!(
+    /// A capability: [`Mission::capabilities`].
+    CapId
+);
+id!(
+    /// A signal: [`Mission::signals`].
+    SignalId
+);
+id!(
+    /// An exception: [`Mission::exceptions`].
+    ExceptionId
+);
+id!(
+    /// A capability's tag: [`Mission::tags`].
+    TagId
+);
 /// A variable of the frame a node runs in.
 pub type Slot = usize;
 
@@ -47,20 +88,20 @@ pub struct Mission {
     pub body: Block,
     /// Variables of the mission frame (FOR aliases and parameters, handler bindings, LETs).
     pub frame_size: usize,
-    pub capabilities: Vec<Capability>,
+    pub capabilities: TiVec<CapId, Capability>,
     /// Drone names, by `DroneId`.
     pub drones: aviary_api::Names,
-    pub signals: Vec<String>,
+    pub signals: TiVec<SignalId, String>,
     /// By `SignalId`: the values the signal carries, each one's kind where the checker
     /// knows it. The engine does not need them; the operator API checks a signal raised
     /// from outside against them.
-    pub signal_values: Vec<Vec<Option<Kind>>>,
+    pub signal_values: TiVec<SignalId, Vec<Option<Kind>>>,
     /// The signals the mission declares with `OPERATOR SIGNAL`, each once, in the order
     /// written: the only ones an operator may raise while it runs.
     pub operator_signals: Vec<SignalId>,
-    pub exceptions: Vec<String>,
+    pub exceptions: TiVec<ExceptionId, String>,
     /// `Capability-Tag` names, as written after the dash.
-    pub tags: Vec<String>,
+    pub tags: TiVec<TagId, String>,
     /// `attributes[a][d]`: attribute `a` of drone `d`, from the world file.
     pub attribute_names: Vec<String>,
     pub attributes: Vec<Column>,
@@ -601,17 +642,17 @@ mod column_tests {
                 exception_handlers: vec![],
             },
             frame_size: 0,
-            capabilities: vec![],
+            capabilities: TiVec::new(),
             drones: aviary_api::Names::new(["a", "b", "c"].into_iter()),
-            signals: vec![],
-            signal_values: vec![],
+            signals: TiVec::new(),
+            signal_values: TiVec::new(),
             operator_signals: vec![],
-            exceptions: vec![],
-            tags: vec![],
+            exceptions: TiVec::new(),
+            tags: TiVec::new(),
             attribute_names: vec![],
             attributes,
             origin: None,
-            builtins: Builtins { signals: [0; 3], exceptions: [0; 10] },
+            builtins: Builtins { signals: [SignalId(0); 3], exceptions: [ExceptionId(0); 10] },
             lines: Lines::default(),
         }
     }

@@ -24,10 +24,10 @@ pub fn compile(program: &Program, world: &World) -> Option<Mission> {
     c.collect_aliases(&mission.body);
     let actives: Vec<(FileId, &ast::Capability)> = program.active_capabilities().collect();
     for (i, (_, cap)) in actives.iter().enumerate() {
-        c.caps.insert(cap.name.name.clone(), i);
+        c.caps.insert(cap.name.name.clone(), CapId(i));
     }
     c.defaults = actives.iter().map(|(_, cap)| c.defaults_of(cap)).collect();
-    let capabilities: Vec<Capability> =
+    let capabilities: TiVec<CapId, Capability> =
         actives.iter().map(|(file, cap)| c.capability(*file, cap)).collect();
     c.file = mission_file;
     c.scopes.clear();
@@ -87,20 +87,25 @@ pub fn compile(program: &Program, world: &World) -> Option<Mission> {
 
 /// Names (signals, exceptions, tags) to indices, in order of first use. Looked up by
 /// hash: a scan of the names so far would make a mission of N signals cost N².
-#[derive(Default)]
-struct Interner {
-    names: Vec<String>,
-    index: foldhash::HashMap<String, usize>,
+struct Interner<I> {
+    names: TiVec<I, String>,
+    index: foldhash::HashMap<String, I>,
 }
 
-impl Interner {
-    fn id(&mut self, name: &str) -> usize {
+impl<I> Default for Interner<I> {
+    fn default() -> Self {
+        Interner { names: TiVec::new(), index: foldhash::HashMap::default() }
+    }
+}
+
+impl<I: From<usize> + Copy> Interner<I> {
+    fn id(&mut self, name: &str) -> I {
         if let Some(&i) = self.index.get(name) {
             return i;
         }
-        self.names.push(name.to_string());
-        self.index.insert(name.to_string(), self.names.len() - 1);
-        self.names.len() - 1
+        let i = self.names.push_and_get_key(name.to_string());
+        self.index.insert(name.to_string(), i);
+        i
     }
 }
 
@@ -109,10 +114,10 @@ struct Compiler<'a> {
     world: &'a World,
     api: &'a Descriptor,
     caps: foldhash::HashMap<String, CapId>,
-    defaults: Vec<Vec<Option<Expr>>>,
-    signals: Interner,
-    exceptions: Interner,
-    tags: Interner,
+    defaults: TiVec<CapId, Vec<Option<Expr>>>,
+    signals: Interner<SignalId>,
+    exceptions: Interner<ExceptionId>,
+    tags: Interner<TagId>,
     attribute_names: Vec<String>,
     /// The world's names, looked up once each: a scan per name would make a group of N
     /// drones cost N² to compile.
@@ -150,7 +155,7 @@ impl<'a> Compiler<'a> {
             world,
             api,
             caps: foldhash::HashMap::default(),
-            defaults: Vec::new(),
+            defaults: TiVec::new(),
             signals,
             exceptions,
             tags: Interner::default(),
@@ -844,12 +849,12 @@ fn attribute_table(world: &World, names: &[String]) -> Vec<Column> {
 /// through every statement it makes on its actors, what the called capabilities claim.
 /// A worklist: when a capability's claims grow, only its callers are looked at again, so
 /// a chain of N capabilities costs N steps, not N rounds of N.
-fn compute_claims(caps: &mut [Capability]) {
-    let mut claims: Vec<Vec<(usize, aviary_api::Resource)>> =
+fn compute_claims(caps: &mut TiSlice<CapId, Capability>) {
+    let mut claims: TiVec<CapId, Vec<(usize, aviary_api::Resource)>> =
         caps.iter().map(direct_claims).collect();
     // Who calls each capability: (caller, the call), in caller order.
-    let mut callers: Vec<Vec<(usize, &Call)>> = vec![Vec::new(); caps.len()];
-    for (i, cap) in caps.iter().enumerate() {
+    let mut callers: TiVec<CapId, Vec<(CapId, &Call)>> = vec![Vec::new(); caps.len()].into();
+    for (i, cap) in caps.iter_enumerated() {
         let mut calls = Vec::new();
         for block in cap.bodies() {
             visit_calls(block, &mut calls);
@@ -860,8 +865,9 @@ fn compute_claims(caps: &mut [Capability]) {
             }
         }
     }
-    let mut pending: Vec<usize> = (0..caps.len()).filter(|&c| !claims[c].is_empty()).collect();
-    let mut queued: Vec<bool> = (0..caps.len()).map(|c| !claims[c].is_empty()).collect();
+    let mut pending: Vec<CapId> =
+        claims.iter_enumerated().filter(|(_, c)| !c.is_empty()).map(|(id, _)| id).collect();
+    let mut queued: TiVec<CapId, bool> = claims.iter().map(|c| !c.is_empty()).collect();
     while let Some(callee) = pending.pop() {
         queued[callee] = false;
         for &(i, call) in &callers[callee] {

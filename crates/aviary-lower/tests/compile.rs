@@ -64,7 +64,7 @@ fn the_paper_mission_compiles_with_handlers_on_their_block() {
 #[test]
 fn defaults_fill_missing_arguments_in_si_units() {
     let m = paper();
-    let takeoff = m.capabilities.iter().position(|c| c.name == "TakeOff").unwrap();
+    let takeoff = m.capabilities.position(|c| c.name == "TakeOff").unwrap();
     let launch = block(&block(&m.body.items[0]).items[0]);
     let Node::Call(first) = &launch.items[0] else { panic!() };
     assert_eq!(first.capability, takeoff);
@@ -168,8 +168,8 @@ fn leashes_resolve_their_section_and_tag() {
     );
     let par = block(&m.body.items[0]);
     let Node::Call(watch) = &par.items[0] else { panic!() };
-    assert_eq!(watch.tag, Some(0));
-    assert_eq!(m.tags, ["W1"]);
+    assert_eq!(watch.tag, Some(TagId(0)));
+    assert_eq!(m.tags.raw, ["W1"]);
     let seq = block(&par.items[1]);
     assert_eq!(seq.path, "M/PARALLEL/SEQUENTIAL");
     let Node::Leash(wider) = &seq.items[1] else { panic!() };
@@ -194,9 +194,9 @@ fn the_inferred_kinds_of_parameters_and_signal_values_are_kept() {
     let circle = cap(&m, "FlyCircle");
     assert_eq!(circle.params, ["center", "radius", "laps"]);
     assert_eq!(circle.param_kinds, [Some(Kind::Position), Some(Kind::Length), Some(Kind::Number)]);
-    let go = m.signals.iter().position(|s| s == "Go").expect("Go is a signal");
+    let go = m.signals.position(|s| s == "Go").expect("Go is a signal");
     assert_eq!(m.signal_values[go], [Some(Kind::Position)]);
-    let detected = m.signals.iter().position(|s| s == "Detected").expect("a built-in signal");
+    let detected = m.signals.position(|s| s == "Detected").expect("a built-in signal");
     assert_eq!(m.signal_values[detected], [Some(Kind::Symbol), Some(Kind::Position)]);
 }
 
@@ -239,8 +239,8 @@ fn every_builtin_has_its_own_id() {
     for e in aviary_api::BuiltinException::ALL {
         assert_eq!(m.exceptions[m.builtins.exception(e)], e.name());
     }
-    assert_eq!(m.signals[aviary_api::BuiltinSignal::ALL.len()], "Go");
-    assert_eq!(m.exceptions[aviary_api::BuiltinException::ALL.len()], "Oops");
+    assert_eq!(m.signals[SignalId(aviary_api::BuiltinSignal::ALL.len())], "Go");
+    assert_eq!(m.exceptions[ExceptionId(aviary_api::BuiltinException::ALL.len())], "Oops");
 }
 
 #[test]

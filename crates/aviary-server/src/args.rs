@@ -15,7 +15,7 @@ use std::sync::Arc;
 use aviary_api::geo::Origin;
 use aviary_api::{Kind, Point, Value};
 use aviary_engine::{Control, Directory, DroneAction};
-use aviary_ir::SignalId;
+use aviary_ir::{CapId, SignalId, TiVec};
 use aviary_syntax::ast::Unit;
 use serde_json::{Map, Value as JsonValue};
 
@@ -31,9 +31,9 @@ pub const MAX_MAGNITUDE: f64 = 1e9;
 pub struct Kinds {
     directory: Directory,
     /// By capability id: the kind of each parameter, in order (`None`: any).
-    params: Vec<Vec<Option<Kind>>>,
+    params: TiVec<CapId, Vec<Option<Kind>>>,
     /// By signal id: the kind of each value the signal carries.
-    signals: Vec<Vec<Option<Kind>>>,
+    signals: TiVec<SignalId, Vec<Option<Kind>>>,
     /// The world's `origin`, which places a `{"lat", "lon"}` position; `None` without one.
     origin: Option<Origin>,
     /// Where a position may be; `None`: anywhere (no world was given).

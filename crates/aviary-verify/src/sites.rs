@@ -16,7 +16,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use aviary_api::{BuiltinSignal, DroneId, Function, Resource};
 use aviary_ir::{
     ActorFilter, ActorRef, Block, BlockKind, Call, CapId, ExceptionId, Expr, Mission, Node, Origin,
-    SignalId,
+    SignalId, TiSlice, TiVec,
 };
 
 /// Which child of a construct a step goes to.
@@ -165,12 +165,12 @@ pub fn collect(mission: &Mission) -> Sites {
 
 struct Walk<'m> {
     mission: &'m Mission,
-    raises_of: Vec<BTreeSet<SignalId>>,
+    raises_of: TiVec<CapId, BTreeSet<SignalId>>,
     /// What each capability's named sections raise: raised at the statement that calls
     /// it, since the sections are not walked.
-    section_raises: Vec<BTreeSet<SignalId>>,
+    section_raises: TiVec<CapId, BTreeSet<SignalId>>,
     /// The capabilities whose bodies are walked (see the module's comment).
-    foreign: Vec<bool>,
+    foreign: TiVec<CapId, bool>,
     /// The drones each frame slot may hold (FOR aliases; in a capability's body, its
     /// `BY` drones and its parameters that hold drones).
     env: Vec<Vec<DroneId>>,
@@ -367,11 +367,11 @@ type Claim = (DroneId, Resource);
 
 /// The capabilities whose bodies give work to a drone that is not one of their own `BY`
 /// drones, directly or through the capabilities they call.
-fn foreign_capabilities(mission: &Mission) -> Vec<bool> {
+fn foreign_capabilities(mission: &Mission) -> TiVec<CapId, bool> {
     let caps = &mission.capabilities;
-    let mut foreign = vec![false; caps.len()];
-    let mut callers: Vec<Vec<CapId>> = vec![Vec::new(); caps.len()];
-    for (i, cap) in caps.iter().enumerate() {
+    let mut foreign: TiVec<CapId, bool> = vec![false; caps.len()].into();
+    let mut callers: TiVec<CapId, Vec<CapId>> = vec![Vec::new(); caps.len()].into();
+    for (i, cap) in caps.iter_enumerated() {
         for block in
             std::iter::once(&cap.perform).chain(cap.exception_handlers.iter().map(|h| &h.body))
         {
@@ -386,7 +386,8 @@ fn foreign_capabilities(mission: &Mission) -> Vec<bool> {
             });
         }
     }
-    let mut pending: Vec<CapId> = (0..caps.len()).filter(|&c| foreign[c]).collect();
+    let mut pending: Vec<CapId> =
+        foreign.iter_enumerated().filter(|(_, f)| **f).map(|(c, _)| c).collect();
     while let Some(callee) = pending.pop() {
         for &caller in &callers[callee] {
             if !foreign[caller] {
@@ -399,7 +400,10 @@ fn foreign_capabilities(mission: &Mission) -> Vec<bool> {
 }
 
 /// What each capability's named sections raise, through the capabilities they call.
-fn section_raises(mission: &Mission, raises_of: &[BTreeSet<SignalId>]) -> Vec<BTreeSet<SignalId>> {
+fn section_raises(
+    mission: &Mission,
+    raises_of: &TiSlice<CapId, BTreeSet<SignalId>>,
+) -> TiVec<CapId, BTreeSet<SignalId>> {
     let detected = mission.builtins.signal(BuiltinSignal::Detected);
     mission
         .capabilities
@@ -437,10 +441,10 @@ fn section_raises(mission: &Mission, raises_of: &[BTreeSet<SignalId>]) -> Vec<BT
 
 /// The signals each capability can raise while it runs, through the capabilities it
 /// calls: its own `SIGNAL`s, and `Detected` when it starts detection.
-fn capability_raises(mission: &Mission) -> Vec<BTreeSet<SignalId>> {
+fn capability_raises(mission: &Mission) -> TiVec<CapId, BTreeSet<SignalId>> {
     let detected = mission.builtins.signal(BuiltinSignal::Detected);
-    let mut direct: Vec<BTreeSet<SignalId>> = Vec::new();
-    let mut calls: Vec<BTreeSet<CapId>> = Vec::new();
+    let mut direct: TiVec<CapId, BTreeSet<SignalId>> = TiVec::new();
+    let mut calls: TiVec<CapId, BTreeSet<CapId>> = TiVec::new();
     for cap in &mission.capabilities {
         let (mut raised, mut called) = (BTreeSet::new(), BTreeSet::new());
         for block in cap.bodies() {
@@ -474,13 +478,14 @@ fn capability_raises(mission: &Mission) -> Vec<BTreeSet<SignalId>> {
     }
     // To a fixpoint, by a worklist: when a capability's signals grow, only its callers
     // take them up, so a chain of N capabilities costs N steps, not N rounds of N.
-    let mut callers: Vec<Vec<CapId>> = vec![Vec::new(); direct.len()];
-    for (i, called) in calls.iter().enumerate() {
+    let mut callers: TiVec<CapId, Vec<CapId>> = vec![Vec::new(); direct.len()].into();
+    for (i, called) in calls.iter_enumerated() {
         for &c in called {
             callers[c].push(i);
         }
     }
-    let mut pending: Vec<CapId> = (0..direct.len()).filter(|&c| !direct[c].is_empty()).collect();
+    let mut pending: Vec<CapId> =
+        direct.iter_enumerated().filter(|(_, d)| !d.is_empty()).map(|(c, _)| c).collect();
     while let Some(callee) = pending.pop() {
         for &caller in &callers[callee] {
             if caller == callee {

@@ -8,8 +8,8 @@
 
 use aviary_api::{DroneId, Resource, Value};
 use aviary_ir::{
-    ActorFilter, ActorRef, ApiCall, Block, BlockKind, Call, Expr, For, Handler, Mission, Node,
-    Origin, SignalId,
+    ActorFilter, ActorRef, ApiCall, Block, BlockKind, Call, CapId, Expr, For, Handler, Mission,
+    Node, Origin, SignalId, TiVec,
 };
 use aviary_world::World;
 use std::cell::RefCell;
@@ -102,7 +102,7 @@ impl Pending {
     }
 }
 
-pub use super::state::State;
+pub use super::state::{RaiseTimes, State};
 
 /// Where the walk is. One `Ctx` serves a whole walk of the mission body: a FOR instance
 /// or a handler sets its slots in place and puts back what they held ([`Estimator::with`]),
@@ -124,13 +124,13 @@ pub struct Estimator<'m> {
     /// The world's geofence and no-fly zones: transits are costed along their routes.
     pub airspace: aviary_route::Airspace,
     /// First raise times from the previous pass, for `WAITFOR RECEIVED` ahead of its signal.
-    pub known: Vec<Option<f64>>,
+    pub known: RaiseTimes,
     /// The part of `known` a condition on `RECEIVED` may read ahead of its signal: the
     /// raises of the walk before that came before its first guess ([`Estimator::guessed`]).
     /// A guess (an unknown `WAITFOR` counted as no wait) can only make what follows it
     /// earlier, and a loop ended by so early a raise would be counted short; without a
     /// sure time the loop runs as before, to its worst case.
-    pub known_sure: Vec<Option<f64>>,
+    pub known_sure: RaiseTimes,
     /// Whether the walk read `known` (a `WAITFOR RECEIVED`, or a condition on `RECEIVED`
     /// ahead of its signal): a walk that did not would be the same again.
     pub read_known: std::cell::Cell<bool>,
@@ -141,9 +141,9 @@ pub struct Estimator<'m> {
     pub s: State,
     /// The capabilities being walked, by index: a flag each, so that a chain of N
     /// capabilities asks N times in O(1), not in O(depth).
-    calling: Vec<bool>,
+    calling: TiVec<CapId, bool>,
     /// Per capability, the actor slots whose motion it claims (asked at every call).
-    motion: Vec<std::rc::Rc<[usize]>>,
+    motion: TiVec<CapId, std::rc::Rc<[usize]>>,
     /// The built-in `Detected` signal, when the mission can hear it.
     detected: SignalId,
     /// Capability calls the walk may still follow ([`call_budget`]), and whether it ran out.
@@ -183,8 +183,8 @@ impl<'m> Estimator<'m> {
     pub fn new(
         mission: &'m Mission,
         world: &'m World,
-        known: Vec<Option<f64>>,
-        known_sure: Vec<Option<f64>>,
+        known: RaiseTimes,
+        known_sure: RaiseTimes,
     ) -> Estimator<'m> {
         let wind = world.air.wind.as_ref();
         let drones: Vec<Flyer> = world.drones.iter().map(|d| Flyer::new(d, wind)).collect();
@@ -196,7 +196,7 @@ impl<'m> Estimator<'m> {
             known_sure,
             read_known: std::cell::Cell::new(false),
             guessed: std::cell::Cell::new(f64::INFINITY),
-            calling: vec![false; mission.capabilities.len()],
+            calling: vec![false; mission.capabilities.len()].into(),
             motion: mission
                 .capabilities
                 .iter()

@@ -2,7 +2,7 @@
 //! (a binding of a signal nobody can predict, telemetry the model does not follow).
 
 use aviary_api::{arith, DroneId, FlightState, Point, Value};
-use aviary_ir::{ActorRef, Expr, Field, Mission};
+use aviary_ir::{ActorRef, Expr, Field, Mission, SignalId, TiSlice};
 
 use super::model::Flyer;
 
@@ -14,10 +14,10 @@ pub struct Scope<'a> {
     pub mission: &'a Mission,
     pub frame: &'a Frame,
     pub drones: &'a [Flyer],
-    pub raised: &'a [Option<f64>],
+    pub raised: &'a TiSlice<SignalId, Option<f64>>,
     /// The first raise times of the walk before, for a signal this walk has not raised
     /// yet (a branch walked later may raise it earlier in time), and whether they were read.
-    pub known: &'a [Option<f64>],
+    pub known: &'a TiSlice<SignalId, Option<f64>>,
     pub read_known: &'a std::cell::Cell<bool>,
     /// When the walk first guessed; a drone read ahead of `t` is a guess.
     pub guessed: &'a std::cell::Cell<f64>,

@@ -93,12 +93,12 @@ const PASSES: usize = 4;
 /// raised (at most [`PASSES`]), and the end the last one found. `keep_legs`: every leg is
 /// kept, as for the radio's check, even without a radio.
 fn walked<'m>(mission: &'m Mission, world: &'m World, keep_legs: bool) -> (Estimator<'m>, f64) {
-    let new = |known: Vec<Option<f64>>, sure: Vec<Option<f64>>| {
+    let new = |known: state::RaiseTimes, sure: state::RaiseTimes| {
         let mut est = Estimator::new(mission, world, known, sure);
         est.radio |= keep_legs;
         est
     };
-    let mut known = vec![None; mission.signals.len()];
+    let mut known: state::RaiseTimes = vec![None; mission.signals.len()].into();
     let mut est = new(known.clone(), known.clone());
     let mut end = est.run();
     for _ in 1..PASSES {

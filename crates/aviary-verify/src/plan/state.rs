@@ -7,7 +7,10 @@
 //! `IF`s in a row, or N unfired handlers, so costs what the walks cost, not N copies of
 //! everything.
 
-use aviary_ir::Origin;
+use aviary_ir::{Origin, SignalId, TiVec};
+
+/// Per signal, when it is first raised (`None`: not yet, or not known).
+pub type RaiseTimes = TiVec<SignalId, Option<f64>>;
 
 use super::model::Flyer;
 use super::radio::Leg;
@@ -22,9 +25,9 @@ pub struct State {
     /// Per drone; only ever pushed to.
     pub activities: Vec<Vec<Activity>>,
     /// Per signal, when it is first raised; changed only by [`State::raise`].
-    pub raised: Vec<Option<f64>>,
+    pub raised: RaiseTimes,
     /// Each change to `raised`: the signal and what it held before.
-    raised_log: Vec<(usize, Option<f64>)>,
+    raised_log: Vec<(SignalId, Option<f64>)>,
     /// Per drone: the mission-level statement during which the reserve fell under 20%.
     pub reserve: Vec<Option<Origin>>,
     /// What the estimate had to assume, with where, as noted (each may come more than
@@ -53,7 +56,7 @@ pub struct Mark {
 pub struct Tail {
     drones: Vec<Flyer>,
     /// The changes to `raised`, last first: the signal and what it held after.
-    raised: Vec<(usize, Option<f64>)>,
+    raised: Vec<(SignalId, Option<f64>)>,
     reserve: Vec<Option<Origin>>,
     activities: Vec<Vec<Activity>>,
     assumptions: Vec<Note>,
@@ -74,7 +77,7 @@ impl State {
         State {
             drones,
             activities: vec![Vec::new(); n],
-            raised: vec![None; signals],
+            raised: vec![None; signals].into(),
             raised_log: Vec::new(),
             reserve: vec![None; n],
             assumptions: Vec::new(),
@@ -84,7 +87,7 @@ impl State {
     }
 
     /// `signal` is raised at `t`: its first raise time becomes `t` if that is earlier.
-    pub fn raise(&mut self, signal: usize, t: f64) {
+    pub fn raise(&mut self, signal: SignalId, t: f64) {
         let first = self.raised[signal];
         if first.map_or(true, |f| t < f) {
             self.raised_log.push((signal, first));
@@ -169,7 +172,7 @@ impl State {
     }
 
     /// Undoes the changes to `raised` past the log's length `to`; what each held after.
-    fn unraise(&mut self, to: usize) -> Vec<(usize, Option<f64>)> {
+    fn unraise(&mut self, to: usize) -> Vec<(SignalId, Option<f64>)> {
         let undone = self.raised_log.split_off(to.min(self.raised_log.len()));
         undone
             .into_iter()

@@ -346,11 +346,16 @@ async fn takeoff_climbs_in_takeoff_mode_then_holds_and_a_landing_disarms() {
     arm(&mut gcs).await;
     // No altitude: MIS_TAKEOFF_ALT (2.5 m) above where it is.
     gcs.send(&command_long(1, MavCmd::MAV_CMD_NAV_TAKEOFF, [NAN; 7])).await;
-    let (climb, _) = hear(
-        &mut gcs,
-        10 * SECOND,
-        |m| matches!(m, MavMessage::HEARTBEAT(h) if h.custom_mode == HOLD),
-    )
+    // Until Hold after Takeoff: the vehicle was in Hold before it too, and a HEARTBEAT
+    // sent before the command may still be on its way (a loaded machine reads it late).
+    let mut took_off = false;
+    let (climb, _) = hear(&mut gcs, 10 * SECOND, |m| match m {
+        MavMessage::HEARTBEAT(h) => {
+            took_off |= h.custom_mode == TAKEOFF;
+            took_off && h.custom_mode == HOLD
+        }
+        _ => false,
+    })
     .await;
     assert_eq!(ack_of(&climb, MavCmd::MAV_CMD_NAV_TAKEOFF), MAV_RESULT_ACCEPTED);
     let texts = climb.texts.clone();

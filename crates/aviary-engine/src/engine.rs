@@ -12,8 +12,8 @@ use std::borrow::Cow;
 use aviary_api::trace::{AutopilotAction, CallStatus, Event, EventKind, RaisedBy, Record, Shown};
 use aviary_api::{Backend, DroneEvent, DroneId, Function, Value};
 use aviary_ir::{
-    ActorFilter, CapId, ExceptionHandler, ExceptionId, Handler, Mission, SignalId, TagId, TiSlice,
-    TiVec,
+    ActorFilter, CapId, ExceptionHandler, ExceptionId, Handler, Mission, SignalId, Slots, TagId,
+    TiSlice, TiVec,
 };
 use tokio::sync::{mpsc, Notify};
 
@@ -740,7 +740,7 @@ impl<'m> Engine<'m> {
             None => true,
             Some(ActorFilter::Drones(ds)) => actor.is_some_and(|a| ds.contains(&a)),
             Some(ActorFilter::Slot(s)) => {
-                matches!((frame.get(*s), actor), (Some(Value::Actor(d)), Some(a)) if *d == a)
+                matches!((frame.slot(*s), actor), (Some(Value::Actor(d)), Some(a)) if *d == a)
             }
         }
     }

@@ -11,7 +11,7 @@ use std::time::Duration;
 use aviary_api::{BuiltinLeash, DroneId, Value};
 use aviary_ir::{
     ActorRef, Block, BlockKind, Call, CapId, Expr, For, Leash, LeashAction, Mission, Node,
-    SignalId, TagId,
+    SignalId, Slot, Slots, TagId,
 };
 
 use crate::cancel::Token as CancellationToken;
@@ -230,7 +230,7 @@ impl<'m> Engine<'m> {
     /// `LET`: the value taken now, once (a drone's position read now stays what it
     /// was), into `slot` of a new frame for the items after it; the body's handlers
     /// that start from now on start from it too.
-    fn bind(&self, slot: usize, value: &Expr, ctx: &Ctx<'m>) -> Ctx<'m> {
+    fn bind(&self, slot: Slot, value: &Expr, ctx: &Ctx<'m>) -> Ctx<'m> {
         let value = {
             let received = self.received.borrow();
             self.env(&ctx.frame, &received).eval(value)
@@ -406,7 +406,7 @@ impl<'m> Engine<'m> {
         match r {
             ActorRef::Drone(d) => vec![*d],
             ActorRef::Group(g) => g.clone(),
-            ActorRef::Slot(s) => match ctx.frame.get(*s) {
+            ActorRef::Slot(s) => match ctx.frame.slot(*s) {
                 Some(Value::Actor(d)) => vec![*d],
                 _ => Vec::new(),
             },
@@ -458,7 +458,7 @@ impl<'m> Engine<'m> {
                     return self.instance(call, Actors::from_elem(*d, 1), args, ctx).await
                 }
                 ActorRef::Slot(s) => {
-                    if let Some(Value::Actor(d)) = ctx.frame.get(*s) {
+                    if let Some(Value::Actor(d)) = ctx.frame.slot(*s) {
                         self.instance(call, Actors::from_elem(*d, 1), args, ctx).await;
                     }
                     return;
@@ -596,7 +596,7 @@ impl<'m> Engine<'m> {
                 LeashAction::Section(i) => {
                     let mut frame = scope.frame.borrow().to_vec();
                     for (p, v) in &values {
-                        set(&mut frame, cap.actors + p, v.clone());
+                        set(&mut frame, Slot::param(cap.actors, *p), v.clone());
                     }
                     scope
                         .jobs
@@ -680,7 +680,7 @@ impl Drop for Listed<'_, '_> {
     }
 }
 
-pub(crate) fn set(frame: &mut Vec<Value>, slot: usize, value: Value) {
+pub(crate) fn set(frame: &mut Vec<Value>, Slot(slot): Slot, value: Value) {
     if frame.len() <= slot {
         frame.resize(slot + 1, Value::Absent);
     }

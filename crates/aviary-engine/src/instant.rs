@@ -25,7 +25,7 @@ use futures_util::future::LocalBoxFuture;
 use smallvec::SmallVec;
 
 use aviary_api::{CallEnd, DroneId, Ending, Value};
-use aviary_ir::{ActorRef, BlockKind, Call, CapId, Capability, Mission, Node, TiVec};
+use aviary_ir::{ActorRef, BlockKind, Call, CapId, Capability, Mission, Node, Slots, TiVec};
 
 use crate::activity::{frame_values, Resume};
 use crate::api::{remembers_scope, Begun};
@@ -95,7 +95,7 @@ impl<'m> Engine<'m> {
         let drone = match call.actors.as_slice() {
             [ActorRef::Drone(d)] => *d,
             // Not an actor here: `call` does nothing either.
-            [ActorRef::Slot(s)] => match ctx.frame.get(*s) {
+            [ActorRef::Slot(s)] => match ctx.frame.slot(*s) {
                 Some(Value::Actor(d)) => *d,
                 _ => return None,
             },

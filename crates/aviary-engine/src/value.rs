@@ -1,7 +1,7 @@
 //! Evaluating expressions at run time.
 
 use aviary_api::{arith, Backend, Point, Value};
-use aviary_ir::{ActorRef, Expr, Field, Mission, SignalId, TiSlice};
+use aviary_ir::{ActorRef, Expr, Field, Mission, SignalId, Slots, TiSlice};
 
 /// What an expression needs from the run: the frame, telemetry, signals, the clock.
 pub(crate) struct Env<'a> {
@@ -20,7 +20,7 @@ impl Env<'_> {
         match r {
             ActorRef::Drone(d) => Some(*d),
             ActorRef::Group(g) => g.first().copied(),
-            ActorRef::Slot(s) => match self.frame.get(*s) {
+            ActorRef::Slot(s) => match self.frame.slot(*s) {
                 Some(Value::Actor(d)) => Some(*d),
                 _ => None,
             },
@@ -30,7 +30,7 @@ impl Env<'_> {
     pub fn eval(&self, e: &Expr) -> Value {
         match e {
             Expr::Const(v) => v.clone(),
-            Expr::Slot(s) => self.frame.get(*s).cloned().unwrap_or(Value::Absent),
+            Expr::Slot(s) => self.frame.slot(*s).cloned().unwrap_or(Value::Absent),
             Expr::Actor(r) => self.actor(r).map_or(Value::Absent, Value::Actor),
             Expr::Telemetry(r, field) => match self.actor(r) {
                 Some(d) if *field == Field::Remaining => self.coverage.remaining(d),

@@ -72,8 +72,40 @@ id!(
     /// A capability's tag: [`Mission::tags`].
     TagId
 );
-/// A variable of the frame a node runs in.
-pub type Slot = usize;
+id!(
+    /// A variable of the frame a node runs in (`Mission::frame_size`,
+    /// `Capability::frame_size` of them).
+    Slot
+);
+
+/// A frame's variables, read by [`Slot`]: the engine's values, the plan's known values.
+pub trait Slots<V> {
+    fn slot(&self, s: Slot) -> Option<&V>;
+    fn slot_mut(&mut self, s: Slot) -> Option<&mut V>;
+}
+
+impl<V> Slots<V> for [V] {
+    fn slot(&self, s: Slot) -> Option<&V> {
+        self.get(s.0)
+    }
+    fn slot_mut(&mut self, s: Slot) -> Option<&mut V> {
+        self.get_mut(s.0)
+    }
+}
+
+impl Slot {
+    /// In a capability's frame the `BY` actors come first (`Capability::actors` of them):
+    /// which of them this slot holds, if it holds one.
+    pub fn actor(self, actors: usize) -> Option<usize> {
+        (self.0 < actors).then_some(self.0)
+    }
+
+    /// The slot of parameter `i` of a capability with `actors` `BY` actors: they come
+    /// first, its parameters after them, in order.
+    pub fn param(actors: usize, i: usize) -> Slot {
+        Slot(actors + i)
+    }
+}
 
 /// A place in the source.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

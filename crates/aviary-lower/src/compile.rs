@@ -175,7 +175,7 @@ impl<'a> Compiler<'a> {
 
     fn slot(&mut self) -> Slot {
         self.frame_size += 1;
-        self.frame_size - 1
+        Slot(self.frame_size - 1)
     }
 
     fn local(&self, name: &str) -> Option<(Slot, bool)> {
@@ -253,12 +253,12 @@ impl<'a> Compiler<'a> {
     fn capability(&mut self, file: FileId, cap: &ast::Capability) -> Capability {
         self.file = file;
         let mut scope: Vec<(String, Slot, bool)> =
-            cap.actors.iter().enumerate().map(|(i, a)| (a.name.clone(), i, true)).collect();
+            cap.actors.iter().enumerate().map(|(i, a)| (a.name.clone(), Slot(i), true)).collect();
         scope.extend(
             cap.params
                 .iter()
                 .enumerate()
-                .map(|(i, p)| (p.name.clone(), cap.actors.len() + i, false)),
+                .map(|(i, p)| (p.name.clone(), Slot::param(cap.actors.len(), i), false)),
         );
         self.frame_size = scope.len();
         self.scopes.clear();
@@ -880,9 +880,9 @@ fn compute_claims(caps: &mut TiSlice<CapId, Capability>) {
                     call.actors.get(j..=j).unwrap_or(&[])
                 };
                 for target in targets {
-                    if let ActorRef::Slot(slot) = target {
-                        if *slot < caps[i].actors && !claims[i].contains(&(*slot, resource)) {
-                            claims[i].push((*slot, resource));
+                    if let Some(actor) = slot_actor(target, caps[i].actors) {
+                        if !claims[i].contains(&(actor, resource)) {
+                            claims[i].push((actor, resource));
                             grew = true;
                         }
                     }
@@ -906,15 +906,21 @@ fn direct_claims(cap: &Capability) -> Vec<(usize, aviary_api::Resource)> {
     for block in cap.bodies() {
         block.visit(&mut |n| {
             if let Node::Api(a) = n {
-                if let ActorRef::Slot(s) = &a.actor {
-                    if *s < cap.actors {
-                        out.push((*s, a.function.resource()));
-                    }
+                if let Some(actor) = slot_actor(&a.actor, cap.actors) {
+                    out.push((actor, a.function.resource()));
                 }
             }
         });
     }
     out
+}
+
+/// The `BY` actor of a capability with `actors` of them that `r` names, if it names one.
+fn slot_actor(r: &ActorRef, actors: usize) -> Option<usize> {
+    match r {
+        ActorRef::Slot(s) => s.actor(actors),
+        ActorRef::Drone(_) | ActorRef::Group(_) => None,
+    }
 }
 
 fn visit_calls<'b>(block: &'b Block, out: &mut Vec<&'b Call>) {

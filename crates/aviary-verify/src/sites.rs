@@ -16,7 +16,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use aviary_api::{BuiltinSignal, DroneId, Function, Resource};
 use aviary_ir::{
     ActorFilter, ActorRef, Block, BlockKind, Call, CapId, ExceptionId, Expr, Mission, Node, Origin,
-    SignalId, TiSlice, TiVec,
+    SignalId, Slot, TiSlice, TiVec,
 };
 
 /// Which child of a construct a step goes to.
@@ -147,7 +147,7 @@ pub fn collect(mission: &Mission) -> Sites {
         section_raises: section_raises(mission, &raises),
         raises_of: raises,
         foreign: foreign_capabilities(mission),
-        env: vec![Vec::new(); mission.frame_size],
+        env: vec![Vec::new(); mission.frame_size].into(),
         path: Vec::new(),
         held: Vec::new(),
         inside: Vec::new(),
@@ -173,7 +173,7 @@ struct Walk<'m> {
     foreign: TiVec<CapId, bool>,
     /// The drones each frame slot may hold (FOR aliases; in a capability's body, its
     /// `BY` drones and its parameters that hold drones).
-    env: Vec<Vec<DroneId>>,
+    env: TiVec<Slot, Vec<DroneId>>,
     path: Vec<Step>,
     /// What the activities around the walk hold: their statements share it.
     held: Vec<(DroneId, Resource)>,
@@ -336,13 +336,14 @@ impl Walk<'_> {
     /// exception handlers (they take the PERFORM's place).
     fn capability_body(&mut self, call: &Call, slots: Vec<Vec<DroneId>>, claims: Vec<Claim>) {
         let cap = &self.mission.capabilities[call.capability];
-        let mut env = vec![Vec::new(); cap.frame_size.max(cap.actors + cap.params.len())];
+        let mut env: TiVec<Slot, Vec<DroneId>> =
+            vec![Vec::new(); cap.frame_size.max(cap.actors + cap.params.len())].into();
         for (slot, drones) in slots.into_iter().enumerate().take(cap.actors) {
-            env[slot] = drones;
+            env[Slot(slot)] = drones;
         }
         // A parameter given a drone names it inside.
         for (i, arg) in call.args.iter().enumerate() {
-            if let (Expr::Actor(r), Some(slot)) = (arg, env.get_mut(cap.actors + i)) {
+            if let (Expr::Actor(r), Some(slot)) = (arg, env.get_mut(Slot::param(cap.actors, i))) {
                 *slot = match r {
                     ActorRef::Drone(d) => vec![*d],
                     ActorRef::Group(g) => g.clone(),
@@ -377,7 +378,7 @@ fn foreign_capabilities(mission: &Mission) -> TiVec<CapId, bool> {
         {
             block.visit(&mut |node| {
                 if let Node::Call(c) = node {
-                    let own = |a: &ActorRef| matches!(a, ActorRef::Slot(s) if *s < cap.actors);
+                    let own = |a: &ActorRef| matches!(a, ActorRef::Slot(s) if s.actor(cap.actors).is_some());
                     if !c.actors.iter().all(own) {
                         foreign[i] = true;
                     }

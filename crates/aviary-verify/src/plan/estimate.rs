@@ -9,7 +9,7 @@
 use aviary_api::{DroneId, Resource, Value};
 use aviary_ir::{
     ActorFilter, ActorRef, ApiCall, Block, BlockKind, Call, CapId, Expr, For, Handler, Mission,
-    Node, Origin, SignalId, TiVec,
+    Node, Origin, SignalId, Slot, Slots, TiVec,
 };
 use aviary_world::World;
 use std::cell::RefCell;
@@ -304,13 +304,13 @@ impl<'m> Estimator<'m> {
     fn with<R>(
         &mut self,
         ctx: &mut Ctx,
-        slots: impl IntoIterator<Item = (usize, Option<Value>)>,
+        slots: impl IntoIterator<Item = (Slot, Option<Value>)>,
         actor: Option<DroneId>,
         walk: impl FnOnce(&mut Self, &mut Ctx) -> R,
     ) -> R {
         let mut held = Vec::new();
         for (slot, value) in slots {
-            if let Some(s) = ctx.frame.get_mut(slot) {
+            if let Some(s) = ctx.frame.slot_mut(slot) {
                 held.push((slot, std::mem::replace(s, value)));
             }
         }
@@ -318,7 +318,9 @@ impl<'m> Estimator<'m> {
         let r = walk(self, ctx);
         ctx.actor = outer;
         for (slot, value) in held.into_iter().rev() {
-            ctx.frame[slot] = value;
+            if let Some(s) = ctx.frame.slot_mut(slot) {
+                *s = value;
+            }
         }
         r
     }
@@ -435,7 +437,7 @@ impl<'m> Estimator<'m> {
             // where what it reads is, as a signal's values are.
             Node::Let { slot, value, .. } => {
                 let value = self.scope(ctx, t).eval(value);
-                if let Some(s) = ctx.frame.get_mut(*slot) {
+                if let Some(s) = ctx.frame.slot_mut(*slot) {
                     *s = value;
                 }
                 (t, Vec::new())
@@ -883,7 +885,7 @@ fn matches(h: &Handler, frame: &Frame, actor: Option<DroneId>) -> bool {
         None => true,
         Some(ActorFilter::Drones(ds)) => actor.is_some_and(|a| ds.contains(&a)),
         Some(ActorFilter::Slot(s)) => {
-            matches!((frame.get(*s), actor), (Some(Some(Value::Actor(d))), Some(a)) if *d == a)
+            matches!((frame.slot(*s), actor), (Some(Some(Value::Actor(d))), Some(a)) if *d == a)
         }
     }
 }

@@ -2,7 +2,7 @@
 //! (a binding of a signal nobody can predict, telemetry the model does not follow).
 
 use aviary_api::{arith, DroneId, FlightState, Point, Value};
-use aviary_ir::{ActorRef, Expr, Field, Mission, SignalId, TiSlice};
+use aviary_ir::{ActorRef, Expr, Field, Mission, SignalId, Slots, TiSlice};
 
 use super::model::Flyer;
 
@@ -29,7 +29,7 @@ impl Scope<'_> {
         match actor {
             ActorRef::Drone(d) => Some(*d),
             ActorRef::Group(g) => g.first().copied(),
-            ActorRef::Slot(s) => match self.frame.get(*s)? {
+            ActorRef::Slot(s) => match self.frame.slot(*s)? {
                 Some(Value::Actor(d)) => Some(*d),
                 _ => None,
             },
@@ -39,7 +39,7 @@ impl Scope<'_> {
     pub fn eval(&self, e: &Expr) -> Option<Value> {
         Some(match e {
             Expr::Const(v) => v.clone(),
-            Expr::Slot(s) => self.frame.get(*s)?.clone()?,
+            Expr::Slot(s) => self.frame.slot(*s)?.clone()?,
             Expr::Actor(a) => Value::Actor(self.actor(a)?),
             Expr::Telemetry(a, field) => self.telemetry(self.actor(a)?, *field)?,
             // The world says which drones have the attribute: one without reads no value.

@@ -58,21 +58,31 @@ impl Directory {
         self.capabilities.position(|c| c.name == name)
     }
 
-    /// A capability's parameters, in order.
-    pub fn params(&self, capability: CapId) -> &[String] {
-        self.capabilities.get(capability).map_or(&[], |c| c.params.as_slice())
+    /// The parameter of `capability` called `name`, by its index, or why there is none
+    /// (with the parameters it has).
+    pub fn param(&self, capability: CapId, name: &str) -> Result<usize, String> {
+        let Some(cap) = self.capabilities.get(capability) else {
+            return Err(format!("no capability has the id {capability}"));
+        };
+        cap.params.iter().position(|p| p == name).ok_or_else(|| {
+            format!(
+                "{} has no parameter `{name}`; its parameters are: {}",
+                cap.name,
+                cap.params.join(", ")
+            )
+        })
     }
 
-    /// A leash, `capability-tag action`, with a section's arguments by parameter name. An
-    /// unknown capability or tag is left to the engine to refuse ([`Control::Unknown`]),
-    /// since only it knows which activities run; an action or a parameter the capability
-    /// does not have is refused here.
+    /// A leash, `capability-tag action`, with a section's arguments by parameter index
+    /// ([`Directory::param`]). An unknown capability or tag is left to the engine to
+    /// refuse ([`Control::Unknown`]), since only it knows which activities run; an action
+    /// the capability does not have is refused here.
     pub fn leash(
         &self,
         capability: &str,
         tag: &str,
         action: &str,
-        args: Vec<(String, Value)>,
+        args: Vec<(usize, Value)>,
     ) -> Result<Control, String> {
         let Some(cap) = self.capability(capability) else {
             let names = self.capabilities.iter().map(|c| c.name.as_str());
@@ -97,13 +107,6 @@ impl Directory {
                 }
             },
         };
-        let args = args
-            .into_iter()
-            .map(|(name, value)| match names.params.iter().position(|p| *p == name) {
-                Some(p) => Ok((p, value)),
-                None => Err(format!("{capability} has no parameter {name}")),
-            })
-            .collect::<Result<Vec<_>, _>>()?;
         // A tag no statement defines can never match: the engine refuses it, as the checker
         // would, with the tagged activities that run.
         let Some(tag_id) = self.tags.position(|t| t == tag) else {

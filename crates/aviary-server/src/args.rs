@@ -113,39 +113,29 @@ impl Kinds {
         self.directory.drone(name, action).map_err(Refusal::Name)
     }
 
-    /// A leash's arguments, by parameter name. A capability the mission does not have
-    /// takes any value here: the engine refuses it by name.
+    /// A leash's arguments, by parameter index, each name resolved once
+    /// ([`Directory::param`]). A capability the mission does not have takes any value here
+    /// and keeps none: the engine refuses it by name, after a value that is wrong (400)
+    /// has been refused.
     fn leash_args(
         &self,
         capability: &str,
         action: &str,
         args: &Map<String, JsonValue>,
-    ) -> Result<Vec<(String, Value)>, String> {
+    ) -> Result<Vec<(usize, Value)>, String> {
         if aviary_api::BuiltinLeash::parse(action).is_some() {
             return match args.is_empty() {
                 true => Ok(Vec::new()),
                 false => Err(format!("{action} takes no arguments; only a PERFORM section does")),
             };
         }
-        let params = self.directory.capability(capability).map(|c| {
-            let kinds = self.params.get(c).map_or(&[][..], Vec::as_slice);
-            (self.directory.params(c), kinds)
-        });
+        let cap = self.directory.capability(capability);
         let mut out = Vec::new();
         for (name, v) in args {
-            let kind = match params {
-                Some((names, kinds)) => match names.iter().position(|p| p == name) {
-                    Some(p) => kinds.get(p).copied().flatten(),
-                    None => {
-                        return Err(format!(
-                            "{capability} has no parameter `{name}`; its parameters are: {}",
-                            names.join(", ")
-                        ));
-                    }
-                },
-                None => None,
-            };
-            out.push((name.clone(), self.value(v, kind, &format!("`{name}` of {capability}"))?));
+            let param = cap.map(|c| self.directory.param(c, name)).transpose()?;
+            let kind = cap.zip(param).and_then(|(c, p)| self.params.get(c)?.get(p).copied()?);
+            let value = self.value(v, kind, &format!("`{name}` of {capability}"))?;
+            out.extend(param.map(|p| (p, value)));
         }
         Ok(out)
     }

@@ -160,6 +160,14 @@ impl Ask {
     pub fn resolve(self, directory: &Directory) -> Result<Control, String> {
         match self {
             Ask::Leash { capability, tag, action, args } => {
+                // As the operator API does: each parameter by its name, once.
+                let args = match directory.capability(&capability) {
+                    Some(c) => args
+                        .into_iter()
+                        .map(|(name, v)| Ok((directory.param(c, &name)?, v)))
+                        .collect::<Result<Vec<_>, String>>()?,
+                    None => Vec::new(),
+                };
                 directory.leash(&capability, &tag, &action, args)
             }
             Ask::Signal { name, args } => {

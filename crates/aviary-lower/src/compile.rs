@@ -106,7 +106,6 @@ impl Interner {
 struct Compiler<'a> {
     program: &'a Program,
     world: &'a World,
-    api: &'a Descriptor,
     caps: foldhash::HashMap<String, CapId>,
     defaults: Vec<Vec<Option<Expr>>>,
     signals: Interner,
@@ -147,7 +146,6 @@ impl<'a> Compiler<'a> {
         Compiler {
             program,
             world,
-            api,
             caps: foldhash::HashMap::default(),
             defaults: Vec::new(),
             signals,
@@ -439,7 +437,7 @@ impl<'a> Compiler<'a> {
             }
             ast::Stmt::Api(a) => Node::Api(ApiCall {
                 actor: self.actor(&a.actor.name),
-                function: self.api.function(&a.function.name)?.function,
+                function: self.program.api_function(self.file, a)?.function,
                 args: a.args.iter().map(|e| self.expr(e)).collect(),
                 origin: self.origin(a.span),
             }),

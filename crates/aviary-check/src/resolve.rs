@@ -6,8 +6,9 @@
 //! the descriptor's names again.
 //!
 //! A call is known by its file and where its function's name starts: a key every pass
-//! has at hand (each knows the file it walks), where the node's address would not survive
-//! a tree moved or cloned. Two calls cannot start their names at one byte of one file.
+//! has at hand (each knows the file it walks) and that names the same call in any copy of
+//! the tree, as a node's address would not. Two calls cannot start their names at one
+//! byte of one file.
 
 use aviary_api::{Descriptor, Signature};
 use aviary_diagnostics::FileId;

@@ -9,17 +9,17 @@
 //! middle-layer call, and with them the drones the call's actor can be. The warning is
 //! at the number as written, with the call as a second place when it is elsewhere.
 
-use std::cell::OnceCell;
 use std::collections::{HashMap, HashSet};
 use std::rc::Rc;
 
 use aviary_api::show::number;
-use aviary_api::{Descriptor, Kind};
+use aviary_api::Kind;
 use aviary_diagnostics::{Code, Diagnostic, FileId, Span};
 use aviary_syntax::ast::*;
 use aviary_syntax::visit::for_each_stmt;
 use aviary_world::World;
 
+use crate::actors::Actors;
 use crate::env::{bind_args, capability_bodies};
 use crate::Program;
 
@@ -47,8 +47,12 @@ struct Env {
     actors: HashMap<String, Drones>,
 }
 
-pub(crate) fn check_endurance(program: &Program, world: &World, diagnostics: &mut Vec<Diagnostic>) {
-    let api = Descriptor::standard();
+pub(crate) fn check_endurance(
+    program: &Program,
+    world: &World,
+    actors: &Actors,
+    diagnostics: &mut Vec<Diagnostic>,
+) {
     let (Some(mission), Some(file)) = (program.mission(), program.mission.map(|r| r.file)) else {
         return;
     };
@@ -57,16 +61,8 @@ pub(crate) fn check_endurance(program: &Program, world: &World, diagnostics: &mu
         return;
     }
     let budget = crate::geofence::follow_budget(&mission.body);
-    let mut walker = Walker {
-        program,
-        world,
-        api,
-        timed,
-        by_name: OnceCell::new(),
-        reported: HashSet::new(),
-        out: Vec::new(),
-        budget,
-    };
+    let mut walker =
+        Walker { program, world, timed, actors, reported: HashSet::new(), out: Vec::new(), budget };
     walker.body(&mission.body, &Env::default(), file, 0);
     diagnostics.extend(walker.out);
 }
@@ -74,10 +70,9 @@ pub(crate) fn check_endurance(program: &Program, world: &World, diagnostics: &mu
 /// The capabilities that make, themselves or through those they call, a middle-layer
 /// call with a duration: only statements of these are followed.
 fn timed_capabilities(program: &Program) -> foldhash::HashSet<&str> {
-    let api = Descriptor::standard();
     let mut callers: foldhash::HashMap<&str, Vec<&str>> = foldhash::HashMap::default();
     let mut pending: Vec<&str> = Vec::new();
-    for (_, c) in program.active_capabilities() {
+    for (file, c) in program.active_capabilities() {
         for body in capability_bodies(c) {
             for_each_stmt(body, |stmt| match stmt {
                 Stmt::Statement(s) => callers
@@ -85,8 +80,8 @@ fn timed_capabilities(program: &Program) -> foldhash::HashSet<&str> {
                     .or_default()
                     .push(c.name.name.as_str()),
                 Stmt::Api(a)
-                    if api
-                        .function(&a.function.name)
+                    if program
+                        .api_function(file, a)
                         .is_some_and(|f| f.params.iter().any(|p| p.kind == Kind::Duration)) =>
                 {
                     pending.push(c.name.name.as_str())
@@ -119,13 +114,12 @@ fn timed_capabilities(program: &Program) -> foldhash::HashSet<&str> {
     timed
 }
 
-struct Walker<'a> {
+struct Walker<'a, 'w> {
     program: &'a Program,
     world: &'a World,
-    api: &'a Descriptor,
     timed: foldhash::HashSet<&'a str>,
-    /// Drones by name, made when first asked (a mission naming no drone needs none).
-    by_name: OnceCell<foldhash::HashMap<&'a str, usize>>,
+    /// The drones each name of the world stands for.
+    actors: &'a Actors<'w>,
     /// Each written number once, however many statements reach it.
     reported: HashSet<(FileId, u32)>,
     out: Vec<Diagnostic>,
@@ -133,7 +127,7 @@ struct Walker<'a> {
     budget: usize,
 }
 
-impl Walker<'_> {
+impl Walker<'_, '_> {
     fn body(&mut self, body: &Body, env: &Env, file: FileId, depth: usize) {
         for stmt in &body.items {
             match stmt {
@@ -176,13 +170,7 @@ impl Walker<'_> {
         if let Some(known) = env.actors.get(&actor.name) {
             return known.clone();
         }
-        if let Some(g) = self.world.group(&actor.name) {
-            return Some(g.members.as_slice().into());
-        }
-        let by_name = self.by_name.get_or_init(|| {
-            self.world.drones.iter().enumerate().map(|(i, d)| (d.name.as_str(), i)).collect()
-        });
-        by_name.get(actor.name.as_str()).map(|&i| Rc::from([i].as_slice()))
+        self.actors.drones(&actor.name).map(Rc::from)
     }
 
     fn duration(&self, e: &Expr, env: &Env, file: FileId) -> Option<Written> {
@@ -220,10 +208,7 @@ impl Walker<'_> {
             return;
         }
         self.budget -= 1;
-        let (Some(callee), Some(callee_file)) = (
-            self.program.capability(&s.capability.name),
-            self.program.capability_file(&s.capability.name),
-        ) else {
+        let Some((callee_file, callee)) = self.program.capability_in(&s.capability.name) else {
             return;
         };
         let mut inner = Env::default();
@@ -254,7 +239,7 @@ impl Walker<'_> {
     }
 
     fn api_call(&mut self, call: &ApiCall, env: &Env, file: FileId) {
-        let Some(f) = self.api.function(&call.function.name) else { return };
+        let Some(f) = self.program.api_function(file, call) else { return };
         for (j, arg) in call.args.iter().enumerate() {
             let Some(p) = f.param_at(j, call.args.len(), None) else {
                 continue;

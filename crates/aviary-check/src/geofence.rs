@@ -17,6 +17,7 @@ use aviary_syntax::ast::*;
 use aviary_syntax::visit::for_each_stmt;
 use aviary_world::World;
 
+use crate::actors::Actors;
 use crate::env::{bind_args, capability_bodies};
 use crate::Program;
 
@@ -53,7 +54,12 @@ fn known_point(p: Point) -> Known {
     Known::Point([p.x, p.y], p.z)
 }
 
-pub(crate) fn check_geofence(program: &Program, world: &World, diagnostics: &mut Vec<Diagnostic>) {
+pub(crate) fn check_geofence(
+    program: &Program,
+    world: &World,
+    actors: &Actors,
+    diagnostics: &mut Vec<Diagnostic>,
+) {
     let (fence, ceiling) = (world.site.geofence.as_deref(), world.site.max_altitude);
     if fence.is_none() && ceiling.is_none() && world.no_fly.is_empty() {
         return;
@@ -64,6 +70,7 @@ pub(crate) fn check_geofence(program: &Program, world: &World, diagnostics: &mut
     let mut walker = Walker {
         program,
         world,
+        actors,
         fence,
         ceiling,
         zones: crate::no_fly::Zones::of(world),
@@ -73,9 +80,11 @@ pub(crate) fn check_geofence(program: &Program, world: &World, diagnostics: &mut
     walker.body(&mission.body, &Values::new(), None, file, 0);
 }
 
-pub(crate) struct Walker<'a> {
+pub(crate) struct Walker<'a, 'w> {
     program: &'a Program,
     pub(crate) world: &'a World,
+    /// The drones each name of the world stands for.
+    pub(crate) actors: &'a Actors<'w>,
     fence: Option<&'a [[f64; 2]]>,
     ceiling: Option<f64>,
     /// The no-fly zones, when the world has any.
@@ -97,7 +106,7 @@ pub(crate) fn follow_budget(mission: &Body) -> usize {
     statements.saturating_mul(64).saturating_add(1_000_000)
 }
 
-impl Walker<'_> {
+impl Walker<'_, '_> {
     fn value(&self, e: &Expr, values: &Values) -> Option<Known> {
         match &e.kind {
             ExprKind::Number { value, unit, .. } => {
@@ -249,10 +258,7 @@ impl Walker<'_> {
         site: Option<(FileId, Span)>,
         depth: usize,
     ) {
-        let (Some(callee), Some(file)) = (
-            self.program.capability(&s.capability.name),
-            self.program.capability_file(&s.capability.name),
-        ) else {
+        let Some((file, callee)) = self.program.capability_in(&s.capability.name) else {
             return;
         };
         if depth >= MAX_CALLS || self.budget == 0 {
@@ -280,7 +286,9 @@ impl Walker<'_> {
         let known: Vec<Option<Known>> = call.args.iter().map(|e| self.value(e, values)).collect();
         let arg = |i: usize| known.get(i).cloned().flatten();
         // A name the middle layer does not have is the walk's error, not a flight.
-        let Some(function) = Function::from_name(&call.function.name) else { return };
+        let Some(function) = self.program.api_function(file, call).map(|f| f.function) else {
+            return;
+        };
         match function {
             Function::FlyToPosition => {
                 if let Some(k) = arg(0) {

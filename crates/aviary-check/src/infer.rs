@@ -8,8 +8,8 @@
 
 use std::collections::BTreeSet;
 
-use aviary_api::{Descriptor, Kind};
-use aviary_diagnostics::Span;
+use aviary_api::Kind;
+use aviary_diagnostics::{FileId, Span};
 use aviary_syntax::ast::*;
 
 use aviary_syntax::visit::for_each_stmt;
@@ -29,15 +29,14 @@ pub struct KindOrigin {
 pub(crate) type Origins = ByName<Vec<Option<KindOrigin>>>;
 
 pub(crate) fn parameter_kinds(program: &Program) -> (ByName<Vec<Option<Kind>>>, Origins) {
-    let api = Descriptor::standard();
     // The capabilities with parameters, in name order, by index; names are looked up by
     // hash. One without parameters has nothing to learn, and so never tells a caller
     // anything, nor gets an entry (most capabilities of a long chain are such).
-    let mut learners: Vec<(&str, &Capability)> =
-        program.capabilities().filter(|(_, c)| !c.params.is_empty()).collect();
-    learners.sort_unstable_by_key(|(name, _)| *name);
-    let names: Vec<&str> = learners.iter().map(|(name, _)| *name).collect();
-    let caps: Vec<Option<&Capability>> = learners.iter().map(|(_, c)| Some(*c)).collect();
+    let mut learners: Vec<(&str, FileId, &Capability)> =
+        program.capabilities().filter(|(_, _, c)| !c.params.is_empty()).collect();
+    learners.sort_unstable_by_key(|(name, _, _)| *name);
+    let names: Vec<&str> = learners.iter().map(|(name, _, _)| *name).collect();
+    let caps: Vec<Option<&Capability>> = learners.iter().map(|(_, _, c)| Some(*c)).collect();
     let index: foldhash::HashMap<&str, usize> =
         names.iter().enumerate().map(|(i, n)| (*n, i)).collect();
     let mut kinds: Vec<Option<Vec<Option<Kind>>>> = vec![None; names.len()];
@@ -64,7 +63,8 @@ pub(crate) fn parameter_kinds(program: &Program) -> (ByName<Vec<Option<Kind>>>, 
         let mut next_round: BTreeSet<usize> = BTreeSet::new();
         while let Some(ci) = round.pop_first() {
             let Some(c) = caps[ci] else { continue };
-            let learned = Uses { api, caps: &caps, index: &index, kinds: &kinds }.of(c);
+            let file = learners[ci].1;
+            let learned = Uses { program, caps: &caps, index: &index, kinds: &kinds }.of(file, c);
             let mut grew = false;
             if let (Some(k), Some(o)) = (kinds[ci].as_mut(), origins[ci].as_mut()) {
                 for (i, kind, origin) in learned {
@@ -135,18 +135,20 @@ type Learned = (usize, Kind, KindOrigin);
 /// What a visit of a capability learns from where its parameters go: to the middle
 /// layer's parameters, and to capabilities' parameters of the kinds known so far.
 struct Uses<'a> {
-    api: &'a Descriptor,
+    /// Where the middle-layer calls' functions were resolved.
+    program: &'a Program,
     caps: &'a [Option<&'a Capability>],
     index: &'a foldhash::HashMap<&'a str, usize>,
     kinds: &'a [Option<Vec<Option<Kind>>>],
 }
 
 impl Uses<'_> {
-    fn of(&self, c: &Capability) -> Vec<Learned> {
+    /// `c`, defined in `file`.
+    fn of(&self, file: FileId, c: &Capability) -> Vec<Learned> {
         let mut learned = Vec::new();
         for body in capability_bodies(c) {
             for_each_stmt(body, |stmt| match stmt {
-                Stmt::Api(call) => self.api_call(c, call, &mut learned),
+                Stmt::Api(call) => self.api_call(file, c, call, &mut learned),
                 Stmt::Statement(s) => self.capability_call(c, s, &mut learned),
                 Stmt::Block(_)
                 | Stmt::Leash(_)
@@ -169,8 +171,8 @@ impl Uses<'_> {
     }
 
     /// A parameter passed to a middle-layer function takes the kind of its parameter.
-    fn api_call(&self, c: &Capability, call: &ApiCall, learned: &mut Vec<Learned>) {
-        let Some(f) = self.api.function(&call.function.name) else { return };
+    fn api_call(&self, file: FileId, c: &Capability, call: &ApiCall, learned: &mut Vec<Learned>) {
+        let Some(f) = self.program.api_function(file, call) else { return };
         let last = call.args.last().and_then(literal_kind);
         for (j, arg) in call.args.iter().enumerate() {
             let p = f.param_at(j, call.args.len(), last);

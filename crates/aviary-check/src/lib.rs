@@ -14,6 +14,7 @@
 // enum that is no language construct may be matched with `_`, allowed where it is.
 #![deny(clippy::wildcard_enum_match_arm)]
 
+mod actors;
 mod allow;
 mod chains;
 mod endurance;
@@ -24,6 +25,7 @@ mod inputs;
 mod load;
 mod no_fly;
 mod recursion;
+mod resolve;
 mod signal_cycles;
 mod signal_values;
 mod signals;
@@ -33,9 +35,9 @@ mod walk;
 
 use std::collections::BTreeMap;
 
-use aviary_api::Kind;
+use aviary_api::{Kind, Signature};
 use aviary_diagnostics::{Diagnostic, FileId, SourceMap};
-use aviary_syntax::ast::{Capability, Item, Mission, SourceFile};
+use aviary_syntax::ast::{ApiCall, Capability, Item, Mission, SourceFile};
 use aviary_world::World;
 
 pub use allow::{acknowledge, Allow};
@@ -78,6 +80,9 @@ pub struct Program {
     /// capabilities, where a tree would compare strings all the way down;
     /// [`Program::capability_names`] gives them in order.
     index: foldhash::HashMap<Box<str>, DefRef>,
+    /// The function each API call names, resolved once as the files are loaded
+    /// (`resolve.rs`); read through [`Program::api_function`].
+    api_functions: resolve::ApiFunctions,
 }
 
 impl Program {
@@ -85,9 +90,14 @@ impl Program {
         self.files.iter().find(|(f, _)| *f == id).map(|(_, t)| t)
     }
     pub fn capability(&self, name: &str) -> Option<&Capability> {
+        self.capability_in(name).map(|(_, c)| c)
+    }
+    /// The capability a name means, with the file that holds it: one lookup for a walk
+    /// that goes into its body (whose spans and calls are that file's).
+    pub fn capability_in(&self, name: &str) -> Option<(FileId, &Capability)> {
         let r = self.index.get(name)?;
         match self.file(r.file)?.items.get(r.index)? {
-            Item::Capability(c) => Some(c),
+            Item::Capability(c) => Some((r.file, c)),
             Item::Use(_) | Item::Mission(_) => None,
         }
     }
@@ -136,10 +146,11 @@ impl Program {
         names.sort_unstable();
         names
     }
-    /// Each name that means a capability, with the capability it means, in no order.
-    pub fn capabilities(&self) -> impl Iterator<Item = (&str, &Capability)> {
+    /// Each name that means a capability, with the file that holds it and the capability
+    /// it means, in no order.
+    pub fn capabilities(&self) -> impl Iterator<Item = (&str, FileId, &Capability)> {
         self.index.iter().filter_map(|(name, r)| match self.file(r.file)?.items.get(r.index)? {
-            Item::Capability(c) => Some((&**name, c)),
+            Item::Capability(c) => Some((&**name, r.file, c)),
             Item::Use(_) | Item::Mission(_) => None,
         })
     }
@@ -149,6 +160,12 @@ impl Program {
     }
     pub fn capability_file(&self, name: &str) -> Option<FileId> {
         self.index.get(name).map(|r| r.file)
+    }
+    /// The middle-layer function that `call`, in `file`, names: resolved once, when the
+    /// program was loaded, for every pass and the lowering; `None` for a name the middle
+    /// layer does not have (which the checker reports, E109).
+    pub fn api_function(&self, file: FileId, call: &ApiCall) -> Option<&'static Signature> {
+        self.api_functions.get(file, call)
     }
 }
 
@@ -218,13 +235,16 @@ pub fn check(
         };
         let walks = || {
             let mut out = Vec::new();
-            if let Some(world) = world {
-                geofence::check_geofence(program, world, &mut out);
-                endurance::check_endurance(program, world, &mut out);
+            // The drones each of the world's names stands for: one table for the walks
+            // that follow drones, made when one first asks.
+            let actors = world.map(actors::Actors::new);
+            if let (Some(world), Some(actors)) = (world, &actors) {
+                geofence::check_geofence(program, world, actors, &mut out);
+                endurance::check_endurance(program, world, actors, &mut out);
             }
             chains::check_chains(program, &mut out);
             recursion::check_recursion(program, &mut out);
-            unheard::check_unheard(program, world, &mut out);
+            unheard::check_unheard(program, world, actors.as_ref(), &mut out);
             out
         };
         let large = sources.text(root).len() >= IN_PARALLEL_FROM;

@@ -111,6 +111,7 @@ pub(crate) fn load(
         }
         files.push((id, tree));
     }
+    let api_functions = crate::resolve::ApiFunctions::of(&files);
     let mut program = Program {
         files,
         mission: None,
@@ -120,6 +121,7 @@ pub(crate) fn load(
         unreadable,
         allows: Vec::new(),
         index: Default::default(),
+        api_functions,
     };
     index_definitions(&mut program, std_id, diagnostics);
     program

@@ -16,7 +16,6 @@
 //! the zones that hold at every height only, the others being checked in flight. So every
 //! E128 is true, and each one can be answered in the mission.
 
-use std::cell::OnceCell;
 use std::collections::HashMap;
 
 use aviary_api::show::number;
@@ -33,28 +32,12 @@ pub(crate) struct Zones {
     space: Airspace,
     /// Whether a drone from a home reaches a point at a height: by the three's bits.
     reached: HashMap<([u64; 2], [u64; 2], u64), Option<Blocked>>,
-    /// The drones (by index) each drone's or group's name stands for, made on first use:
-    /// a world may have millions of drones, which are not looked through name by name.
-    actors: OnceCell<HashMap<String, Vec<usize>>>,
 }
 
 impl Zones {
     pub fn of(world: &World) -> Option<Zones> {
-        (!world.no_fly.is_empty()).then(|| Zones {
-            space: Airspace::of(world),
-            reached: HashMap::new(),
-            actors: OnceCell::new(),
-        })
-    }
-
-    /// The drones a drone's or a group's name stands for.
-    fn drones(&self, world: &World, name: &str) -> Option<&Vec<usize>> {
-        let actors = self.actors.get_or_init(|| {
-            let drones = world.drones.iter().enumerate().map(|(i, d)| (d.name.clone(), vec![i]));
-            let groups = world.groups.iter().map(|g| (g.name.clone(), g.members.clone()));
-            drones.chain(groups).collect()
-        });
-        actors.get(name)
+        (!world.no_fly.is_empty())
+            .then(|| Zones { space: Airspace::of(world), reached: HashMap::new() })
     }
 
     fn reach(&mut self, home: [f64; 2], to: [f64; 2], z: f64) -> Option<Blocked> {
@@ -100,15 +83,15 @@ fn help_inside(up_to: Option<f64>, p: [f64; 2]) -> String {
     }
 }
 
-impl Walker<'_> {
+impl Walker<'_, '_> {
     /// The drones an actor's name stands for: an alias or a parameter bound on the way, a
     /// drone, or a group. Followed only in a world with zones, which alone needs them.
     pub(crate) fn actor(&self, name: &str, values: &Values) -> Option<Known> {
-        let zones = self.zones.as_ref()?;
+        self.zones.as_ref()?;
         match values.get(name) {
             Some(Known::Drones(d)) => Some(Known::Drones(d.clone())),
             Some(_) => None,
-            None => zones.drones(self.world, name).cloned().map(Known::Drones),
+            None => self.actors.drones(name).map(|d| Known::Drones(d.to_vec())),
         }
     }
 

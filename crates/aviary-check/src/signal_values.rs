@@ -11,6 +11,7 @@
 use std::collections::BTreeMap;
 
 use aviary_api::{Descriptor, Kind};
+use aviary_diagnostics::FileId;
 use aviary_syntax::ast::*;
 
 use aviary_syntax::visit::for_each_stmt;
@@ -70,7 +71,7 @@ pub(crate) fn signal_values(program: &Program) -> BTreeMap<String, Vec<Option<Ki
                                 &mut out,
                                 &h.signal.name,
                                 i,
-                                binding_kind(program, &b.name, &h.body),
+                                binding_kind(program, *file, &b.name, &h.body),
                             );
                         }
                     }
@@ -98,10 +99,9 @@ pub(crate) fn signal_values(program: &Program) -> BTreeMap<String, Vec<Option<Ki
     out
 }
 
-/// The kind a handler's body gives its binding `name`: the first capability or
-/// middle-layer parameter of known kind it is passed to.
-fn binding_kind(program: &Program, name: &str, body: &Body) -> Option<Kind> {
-    let api = Descriptor::standard();
+/// The kind a handler's body (in `file`) gives its binding `name`: the first capability
+/// or middle-layer parameter of known kind it is passed to.
+fn binding_kind(program: &Program, file: FileId, name: &str, body: &Body) -> Option<Kind> {
     let is_binding = |e: &Expr| matches!(&e.kind, ExprKind::Name(id) if id.name == name);
     let mut found = None;
     for_each_stmt(body, |stmt| {
@@ -124,7 +124,7 @@ fn binding_kind(program: &Program, name: &str, body: &Body) -> Option<Kind> {
                     .find_map(|(arg, kind)| arg.filter(|a| is_binding(a)).and(*kind));
             }
             Stmt::Api(call) => {
-                let Some(f) = api.function(&call.function.name) else {
+                let Some(f) = program.api_function(file, call) else {
                     return;
                 };
                 let last = call.args.last().and_then(literal_kind);

@@ -35,6 +35,7 @@ use aviary_world::World;
 
 use aviary_syntax::visit::for_each_stmt;
 
+use crate::actors::Actors;
 use crate::env::capability_bodies;
 use crate::Program;
 
@@ -62,9 +63,15 @@ impl Drones {
     }
 }
 
-pub(crate) fn check_unheard(program: &Program, world: Option<&World>, out: &mut Vec<Diagnostic>) {
+pub(crate) fn check_unheard(
+    program: &Program,
+    world: Option<&World>,
+    actors: Option<&Actors>,
+    out: &mut Vec<Diagnostic>,
+) {
     let api = Descriptor::standard();
-    let mut pass = Pass { program, world, api, named: HashMap::new(), catches: HashMap::new() };
+    let mut pass =
+        Pass { program, world, actors, api, named: HashMap::new(), catches: HashMap::new() };
     // Rule 1 resolves the drones of every statement and `FOR` it passes: on a mission of
     // a hundred thousand drones that is most of the checker's time, so it runs only where
     // there is a handler for it to judge.
@@ -130,9 +137,11 @@ struct Scope<'a> {
     aliases: Vec<(&'a str, Rc<Drones>)>,
 }
 
-struct Pass<'a> {
+struct Pass<'a, 'w> {
     program: &'a Program,
     world: Option<&'a World>,
+    /// The drones each name of the world stands for.
+    actors: Option<&'a Actors<'w>>,
     api: &'a Descriptor,
     /// The drones each capability names in its statements, through what it calls.
     named: HashMap<&'a str, Drones>,
@@ -140,7 +149,7 @@ struct Pass<'a> {
     catches: HashMap<&'a str, bool>,
 }
 
-impl<'a> Pass<'a> {
+impl<'a> Pass<'a, '_> {
     /// Rule 1 on every handler of `body` and of the bodies inside it.
     fn body(&mut self, body: &'a Body, scope: &Scope<'a>, place: Place, out: &mut Vec<Diagnostic>) {
         for stmt in &body.items {
@@ -259,19 +268,16 @@ impl<'a> Pass<'a> {
             d.own.insert(name.to_string());
             return d;
         }
-        let Some(world) = self.world else {
+        let (Some(world), Some(actors)) = (self.world, self.actors) else {
             d.any = true;
             return d;
         };
-        if world.drone(name).is_some() {
-            d.world.insert(name.to_string());
-        } else if let Some(g) = world.group(name) {
-            d.world.extend(
-                g.members.iter().filter_map(|m| world.drones.get(*m)).map(|x| x.name.clone()),
-            );
-        } else {
+        match actors.drones(name) {
+            Some(drones) => d
+                .world
+                .extend(drones.iter().filter_map(|m| world.drones.get(*m)).map(|x| x.name.clone())),
             // A parameter, or a name the walk reports as unknown.
-            d.any = true;
+            None => d.any = true,
         }
         d
     }

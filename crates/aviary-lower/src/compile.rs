@@ -112,7 +112,6 @@ impl<I: From<usize> + Copy> Interner<I> {
 struct Compiler<'a> {
     program: &'a Program,
     world: &'a World,
-    api: &'a Descriptor,
     caps: foldhash::HashMap<String, CapId>,
     defaults: TiVec<CapId, Vec<Option<Expr>>>,
     signals: Interner<SignalId>,
@@ -153,7 +152,6 @@ impl<'a> Compiler<'a> {
         Compiler {
             program,
             world,
-            api,
             caps: foldhash::HashMap::default(),
             defaults: TiVec::new(),
             signals,
@@ -444,7 +442,7 @@ impl<'a> Compiler<'a> {
                 Node::StopBlock { block: s.block.name.clone(), origin: self.origin(s.span) }
             }
             ast::Stmt::Api(a) => {
-                let function = self.api.function(&a.function.name)?.function;
+                let function = self.program.api_function(self.file, a)?.function;
                 let args: Vec<Expr> = a.args.iter().map(|e| self.expr(e)).collect();
                 Node::Api(ApiCall {
                     actor: self.actor(&a.actor.name),

@@ -347,7 +347,7 @@ impl<'a> Checker<'a> {
                 call.function.name
             ));
         }
-        let Some(f) = self.api.function(&call.function.name) else {
+        let Some(f) = self.program.api_function(self.file, call) else {
             self.unknown_api_function(call);
             return;
         };

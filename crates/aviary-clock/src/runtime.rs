@@ -98,7 +98,7 @@ impl Builder {
 async fn pacer(held: Arc<Notify>) {
     loop {
         held.notified().await;
-        #[allow(clippy::disallowed_methods, reason = "the pacer waits in real time")]
+        #[allow(clippy::disallowed_methods)] // the pacer waits in real time
         tokio::time::sleep(PACE_POLL).await;
     }
 }

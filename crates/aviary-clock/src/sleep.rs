@@ -181,9 +181,10 @@ impl Future for Sleep {
                     }
                     None => false,
                 },
+                // Outside a runtime of ours: real time, on tokio's timer.
+                #[allow(clippy::disallowed_methods, clippy::disallowed_types)]
                 None => {
                     let at = tokio::time::Instant::from_std(epoch() + this.deadline.0);
-                    #[allow(clippy::disallowed_methods, reason = "real time outside a runtime of ours")]
                     let real = tokio::time::sleep_until(at);
                     this.state = State::Real(Box::pin(real));
                     drop(coop);

@@ -22,7 +22,7 @@ use aviary_api::{
     BuiltinException, CallEnd, DroneEvent, DroneId, FlightState, Function, FunctionCall,
 };
 use futures_util::stream::{FuturesUnordered, StreamExt};
-use tokio::time::Instant;
+use aviary_clock::Instant;
 
 use crate::engine::{Engine, Instance};
 use crate::steer::Down;
@@ -166,7 +166,7 @@ impl<'m> Engine<'m> {
                     ),
                 ));
             }
-            tokio::time::sleep(RETRY).await;
+            aviary_clock::sleep(RETRY).await;
         }
     }
 
@@ -296,7 +296,7 @@ impl<'m> Engine<'m> {
             if t.link || !t.state.airborne() {
                 return true;
             }
-            tokio::time::sleep(LINK_POLL).await;
+            aviary_clock::sleep(LINK_POLL).await;
         }
         false
     }

@@ -14,7 +14,7 @@ use mavlink::dialects::ardupilotmega::{
     HEARTBEAT_DATA,
 };
 use tokio::sync::{mpsc, oneshot};
-use tokio::time::Instant;
+use aviary_clock::Instant;
 
 use crate::battery::{self, Draw};
 use crate::failsafe::{failsafe, FAILSAFE_WAIT};

@@ -6,7 +6,7 @@
 //! an event: the tab is no part of them.
 
 use std::collections::VecDeque;
-use tokio::time::Instant;
+use aviary_clock::Instant;
 
 /// How many texts are kept: enough for the reasons around one refusal or failsafe.
 const KEPT: usize = 16;
@@ -82,7 +82,7 @@ impl Text {
 mod tests {
     use super::Words;
     use std::time::Duration;
-    use tokio::time::Instant;
+    use aviary_clock::Instant;
 
     /// The 50-byte field as a vehicle sends it.
     fn field(text: &str) -> [u8; 50] {

@@ -109,7 +109,10 @@ enum State {
     /// Not polled since it was made or reset.
     Idle,
     /// In a runtime's queue.
-    Virtual { clock: Clock, key: Key },
+    Virtual {
+        clock: Clock,
+        key: Key,
+    },
     /// Outside a runtime of ours: tokio's real-time timer.
     Real(Pin<Box<tokio::time::Sleep>>),
     Done,

@@ -21,8 +21,8 @@ use std::time::Duration;
 use aviary_api::{
     BuiltinException, CallEnd, DroneEvent, DroneId, FlightState, Function, FunctionCall,
 };
-use futures_util::stream::{FuturesUnordered, StreamExt};
 use aviary_clock::Instant;
+use futures_util::stream::{FuturesUnordered, StreamExt};
 
 use crate::engine::{Engine, Instance};
 use crate::steer::Down;

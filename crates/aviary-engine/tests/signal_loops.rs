@@ -47,7 +47,11 @@ fn bounded(mission: &str, options: RunOptions, wall: bool) -> (Outcome, Vec<Reco
             (outcome, trace)
         };
         let run = if wall {
-            tokio::runtime::Builder::new_current_thread().enable_time().build().unwrap().block_on(run)
+            tokio::runtime::Builder::new_current_thread()
+                .enable_time()
+                .build()
+                .unwrap()
+                .block_on(run)
         } else {
             harness::simulated_runtime().block_on(run)
         };

@@ -8,10 +8,10 @@ use std::sync::Arc;
 
 use aviary_api::flight::Descent;
 use aviary_api::DroneId;
+use aviary_clock::Instant;
 use aviary_world::{Drone, World};
 use mavlink::dialects::ardupilotmega::MavCmd;
 use tokio::sync::mpsc;
-use aviary_clock::Instant;
 
 use crate::drone::{Craft, Doing};
 use crate::facts::{self, Facts};

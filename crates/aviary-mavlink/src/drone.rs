@@ -8,12 +8,12 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use aviary_api::{BuiltinException, Failure, FlightState};
+use aviary_clock::Instant;
 use mavlink::dialects::ardupilotmega::{
     MavCmd, MavFrame, MavMessage, MavModeFlag, MavResult, PositionTargetTypemask, COMMAND_INT_DATA,
     COMMAND_LONG_DATA, SET_POSITION_TARGET_GLOBAL_INT_DATA,
 };
 use tokio::sync::watch;
-use aviary_clock::Instant;
 
 use crate::link::Link;
 use crate::mode::{self, Flavour, Mode};

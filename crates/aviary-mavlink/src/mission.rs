@@ -14,12 +14,12 @@ use std::time::Duration;
 
 use aviary_api::geometry::dist;
 use aviary_api::Failure;
+use aviary_clock::Instant;
 use mavlink::dialects::ardupilotmega::{
     MavCmd, MavFrame, MavMessage, MavMissionResult, MavMissionType, MISSION_COUNT_DATA,
     MISSION_ITEM_INT_DATA,
 };
 use tokio::sync::mpsc;
-use aviary_clock::Instant;
 
 use crate::drone::{failed, timeout, Craft, Paused};
 use crate::mode::{self, Mode};

@@ -6,8 +6,8 @@ use std::time::Duration;
 use aviary_api::geometry::{contains, dist};
 use aviary_api::show::fixed;
 use aviary_api::{BuiltinException, Failure};
-use mavlink::dialects::ardupilotmega::MavCmd;
 use aviary_clock::Instant;
+use mavlink::dialects::ardupilotmega::MavCmd;
 
 use crate::drone::{failed, timeout, Craft, Doing, Paused};
 use crate::mode::Mode;

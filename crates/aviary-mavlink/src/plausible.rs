@@ -129,7 +129,10 @@ mod tests {
                     assert_eq!(x(&v), Some(5.0), "the last believable position stands");
                 }
                 let (drone, failure) = alarms.try_recv().expect("PositionLost");
-                assert_eq!((drone, failure.exception), (0, aviary_api::BuiltinException::PositionLost));
+                assert_eq!(
+                    (drone, failure.exception),
+                    (0, aviary_api::BuiltinException::PositionLost)
+                );
                 assert!(failure.reason.contains("300 km"), "{}", failure.reason);
                 assert!(alarms.try_recv().is_err(), "raised once");
                 // Believable again: taken, and the odometer never saw the jump.

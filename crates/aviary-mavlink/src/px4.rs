@@ -11,8 +11,8 @@ use std::time::Duration;
 
 use aviary_api::show::fixed;
 use aviary_api::Failure;
-use mavlink::dialects::ardupilotmega::{MavCmd, MavFrame};
 use aviary_clock::Instant;
+use mavlink::dialects::ardupilotmega::{MavCmd, MavFrame};
 
 use crate::drone::{failed, timeout, Craft, Paused};
 use crate::mode::Mode;

@@ -5,12 +5,12 @@
 use std::sync::Arc;
 use std::time::Duration;
 
+use aviary_clock::Instant;
 use aviary_world::World;
 use mavlink::dialects::ardupilotmega::{
     MavCmd, MavMessage, COMMAND_LONG_DATA, PARAM_REQUEST_READ_DATA,
 };
 use tokio::sync::mpsc;
-use aviary_clock::Instant;
 
 use super::{table, Facts};
 use crate::link::Link;

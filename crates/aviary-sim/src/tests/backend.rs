@@ -45,7 +45,10 @@ fn calls_end_at_the_simulated_time_they_take() {
         let took = t1.elapsed().as_secs_f64();
         assert!((took - (50.0 + 10.0 / 3.0)).abs() < 0.6, "{took}");
         let t = sim.telemetry(0);
-        assert_eq!((t.position, t.state, t.link), ([300.0, 400.0, 20.0], FlightState::Flying, true));
+        assert_eq!(
+            (t.position, t.state, t.link),
+            ([300.0, 400.0, 20.0], FlightState::Flying, true)
+        );
         assert_eq!(sim.telemetry(42).state, FlightState::Lost);
         match done(sim.call(0, &fc(Function::FlyToPosition, &[pos(5000.0, 0.0)]))).await {
             CallEnd::Failed(f) => assert_eq!(f.exception, BuiltinException::GeofenceViolation),
@@ -133,7 +136,9 @@ fn the_driver_ends_when_stopped_or_dropped() {
             .expect("no panic");
 
         let sim = SimBackend::start(&one_drone(), SimOptions::default());
-        aviary_clock::timeout(Duration::from_secs(1), sim.shutdown()).await.expect("shutdown returns");
+        aviary_clock::timeout(Duration::from_secs(1), sim.shutdown())
+            .await
+            .expect("shutdown returns");
     })
 }
 

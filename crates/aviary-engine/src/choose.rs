@@ -63,7 +63,7 @@ impl<'m> Engine<'m> {
                 Some(Value::Number(s)) if s.is_finite() => s.clamp(0.0, 1e9),
                 _ => 0.0,
             });
-        let deadline = within.map(|s| tokio::time::Instant::now() + Duration::from_secs_f64(s));
+        let deadline = within.map(|s| aviary_clock::Instant::now() + Duration::from_secs_f64(s));
         let chosen = loop {
             let changed = self.changed.notified();
             match self.choose(a, ctx) {
@@ -79,14 +79,14 @@ impl<'m> Engine<'m> {
             }
             let timed_out = async {
                 match deadline {
-                    Some(at) => tokio::time::sleep_until(at).await,
+                    Some(at) => aviary_clock::sleep_until(at).await,
                     None => std::future::pending().await,
                 }
             };
             tokio::select! {
                 biased;
                 _ = changed => {}
-                _ = tokio::time::sleep(RECHECK) => {}
+                _ = aviary_clock::sleep(RECHECK) => {}
                 _ = timed_out => {
                     // The last look, at the deadline itself.
                     if let Ok(chosen) = self.choose(a, ctx) {

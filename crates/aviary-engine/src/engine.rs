@@ -20,7 +20,7 @@ use tokio::sync::{mpsc, Notify};
 use crate::cancel::Token as CancellationToken;
 use crate::jobs::Jobs;
 use crate::registry::Registry;
-use tokio::time::Instant;
+use aviary_clock::Instant;
 
 use crate::arbiter::{Arbiter, Claims};
 use crate::value::Env;
@@ -626,7 +626,7 @@ impl<'m> Engine<'m> {
         loop {
             self.sample_telemetry();
             next += period;
-            tokio::time::sleep_until(next).await;
+            aviary_clock::sleep_until(next).await;
         }
     }
 

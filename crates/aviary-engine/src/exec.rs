@@ -342,7 +342,7 @@ impl<'m> Engine<'m> {
                         self.block(body, ctx).await;
                         // A round that takes no time must not starve the clock.
                         if self.now() == before {
-                            tokio::time::sleep(RECHECK).await;
+                            aviary_clock::sleep(RECHECK).await;
                         }
                     }
                 }
@@ -396,7 +396,7 @@ impl<'m> Engine<'m> {
                 biased;
                 _ = stopped.as_mut() => return,
                 _ = changed => {}
-                _ = tokio::time::sleep(RECHECK) => {}
+                _ = aviary_clock::sleep(RECHECK) => {}
             }
         }
     }

@@ -21,8 +21,8 @@ use std::time::Duration;
 use aviary_api::{
     BuiltinException, CallEnd, DroneEvent, DroneId, FlightState, Function, FunctionCall,
 };
+use aviary_clock::Instant;
 use futures_util::stream::{FuturesUnordered, StreamExt};
-use tokio::time::Instant;
 
 use crate::engine::{Engine, Instance};
 use crate::steer::Down;
@@ -166,7 +166,7 @@ impl<'m> Engine<'m> {
                     ),
                 ));
             }
-            tokio::time::sleep(RETRY).await;
+            aviary_clock::sleep(RETRY).await;
         }
     }
 
@@ -296,7 +296,7 @@ impl<'m> Engine<'m> {
             if t.link || !t.state.airborne() {
                 return true;
             }
-            tokio::time::sleep(LINK_POLL).await;
+            aviary_clock::sleep(LINK_POLL).await;
         }
         false
     }

@@ -4,9 +4,9 @@
 //! concurrently (`FuturesUnordered`) on one thread: lightweight tasks that borrow the IR
 //! (tokio tasks would need `'static` copies of it).
 //! Cancellation is dropping: resource claims and calls in flight are released by drop
-//! guards, so an abort can never leave a claim held or a drone commanded. Time is tokio's:
-//! with a paused clock a simulated run takes no real time, and on one thread the same
-//! inputs give the same trace.
+//! guards, so an abort can never leave a claim held or a drone commanded. Time is the
+//! run's clock (`aviary_clock`): in a simulated run a virtual clock that takes no real
+//! time, and on one thread the same inputs give the same trace.
 //!
 //! Invariant: the engine knows no backend; it talks to `aviary_api::Backend` only.
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]

@@ -12,7 +12,7 @@ pub(crate) struct Env<'a> {
     pub received: &'a TiSlice<SignalId, bool>,
     /// When the mission started: `ELAPSED` is read from the clock only when evaluated
     /// (most expressions never ask, and reading tokio's clock is not free).
-    pub start: tokio::time::Instant,
+    pub start: aviary_clock::Instant,
 }
 
 impl Env<'_> {
@@ -78,7 +78,7 @@ impl Env<'_> {
                 }
             }
             Expr::Elapsed => {
-                Value::Number((tokio::time::Instant::now() - self.start).as_secs_f64())
+                Value::Number((aviary_clock::Instant::now() - self.start).as_secs_f64())
             }
             Expr::Received(s) => Value::Bool(self.received.get(*s).copied().unwrap_or(false)),
             Expr::Not(x) => Value::Bool(!truth(&self.eval(x))),

@@ -44,7 +44,7 @@ impl Backend for Scripted {
             None => {
                 let (tx, rx) = oneshot::channel();
                 tokio::spawn(async move {
-                    tokio::time::sleep(Duration::from_secs(1)).await;
+                    aviary_clock::sleep(Duration::from_secs(1)).await;
                     let _ = tx.send(CallEnd::Done);
                 });
                 Ending::Later(rx)
@@ -74,7 +74,7 @@ impl Backend for Scripted {
 
 fn run(mission: &str, backend: &Scripted) -> (Status, Trace) {
     let (mission, _) = harness::compile(mission, harness::WORLD);
-    let runtime = harness::paused_runtime();
+    let runtime = harness::simulated_runtime();
     let mut trace = Vec::new();
     let mut sink = |r: &aviary_engine::Record| trace.push(Trace::line(r));
     let outcome =

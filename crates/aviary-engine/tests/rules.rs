@@ -1,5 +1,5 @@
 //! One trace-based test per rule of the language's semantics (docs/LANGUAGE.md), asserting
-//! order and timing, on the built-in simulator with a paused clock (so every time below is
+//! order and timing, on the built-in simulator with a simulated clock (so every time below is
 //! simulated seconds). The missions are files, `tests/rules/*.mission`, and each one's
 //! whole trace is a snapshot (`tests/snapshots/rules__traces@*.snap`), taken with a
 //! handler re-entered at most [`SNAPSHOT_REENTRIES`] times at one instant.

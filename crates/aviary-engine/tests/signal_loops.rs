@@ -28,18 +28,14 @@ fn fixture(name: &str) -> String {
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
 }
 
-/// Runs `mission` in the harness's world with `options` on the paused clock, or on the
-/// wall clock with `wall`; its outcome and trace, or a panic if it does not end.
+/// Runs `mission` in the harness's world with `options` on the simulated clock, or on the
+/// wall clock with `wall` (a plain tokio runtime, where `aviary_clock` is real time); its
+/// outcome and trace, or a panic if it does not end.
 fn bounded(mission: &str, options: RunOptions, wall: bool) -> (Outcome, Vec<Record<'static>>) {
     let (mission, world) = harness::compile(mission, WORLD);
     let (done, ended) = mpsc::channel();
     std::thread::spawn(move || {
-        let runtime = if wall {
-            tokio::runtime::Builder::new_current_thread().enable_time().build().unwrap()
-        } else {
-            harness::paused_runtime()
-        };
-        let run = runtime.block_on(async {
+        let run = async {
             let sim = aviary_sim::SimBackend::start(&world, aviary_sim::SimOptions::default());
             let mut trace = Vec::new();
             let mut sink = |r: &Record| {
@@ -49,7 +45,16 @@ fn bounded(mission: &str, options: RunOptions, wall: bool) -> (Outcome, Vec<Reco
             let outcome = aviary_engine::run(&mission, &*sim, &mut sink, &options).await;
             sim.shutdown().await;
             (outcome, trace)
-        });
+        };
+        let run = if wall {
+            tokio::runtime::Builder::new_current_thread()
+                .enable_time()
+                .build()
+                .unwrap()
+                .block_on(run)
+        } else {
+            harness::simulated_runtime().block_on(run)
+        };
         let _ = done.send(run);
     });
     ended
@@ -195,7 +200,7 @@ fn an_interrupt_is_heard_by_a_mission_that_never_waits() {
         "MISSION Busy:\n    a TakeOff\n    PARALLEL P:\n{signals}        ON EVERY X:\n            SIGNAL X\n"
     );
     let (mission, world) = harness::compile(&mission, WORLD);
-    let (outcome, trace) = harness::paused_runtime().block_on(async {
+    let (outcome, trace) = harness::simulated_runtime().block_on(async {
         let sim = aviary_sim::SimBackend::start(&world, aviary_sim::SimOptions::default());
         let (controller, controls) = aviary_engine::Controller::new();
         let mut trace = Vec::new();

@@ -173,7 +173,7 @@ impl Inner {
     /// `max_speed`, wait and land as the vehicle does, at the current it has been drawing,
     /// `BatteryLow` under `2 × need + 10 %`, `BatteryCritical` under `need + 10 %`.
     fn battery_rule(&self, drone: DroneId, c: &Craft) {
-        let now = tokio::time::Instant::now();
+        let now = aviary_clock::Instant::now();
         let (fix, battery, drawn) = {
             let seen = c.v.seen();
             (seen.fix, seen.battery, seen.draw.average(now))
@@ -217,11 +217,11 @@ async fn alarms_task(
 /// HEARTBEAT watchdog: none for `limit` → `ConnectionLost`; the first one after →
 /// `ConnectionRestored`.
 async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
-    let mut every = tokio::time::interval(Duration::from_millis(100));
+    let mut every = aviary_clock::interval(Duration::from_millis(100));
     loop {
         every.tick().await;
         let Some(inner) = inner.upgrade() else { return };
-        let now = tokio::time::Instant::now();
+        let now = aviary_clock::Instant::now();
         for (drone, craft) in inner.crafts.iter().enumerate() {
             let Some(c) = craft else { continue };
             inner.battery_rule(drone, c);

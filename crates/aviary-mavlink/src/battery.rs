@@ -12,7 +12,7 @@ use std::collections::VecDeque;
 use std::time::Duration;
 
 use aviary_api::flight::{time_home, Descent};
-use tokio::time::Instant;
+use aviary_clock::Instant;
 
 /// The measured draw averages this much of the latest flight.
 pub const WINDOW: Duration = Duration::from_secs(60);

@@ -8,10 +8,10 @@ use std::sync::Arc;
 
 use aviary_api::flight::Descent;
 use aviary_api::DroneId;
+use aviary_clock::Instant;
 use aviary_world::{Drone, World};
 use mavlink::dialects::ardupilotmega::MavCmd;
 use tokio::sync::mpsc;
-use tokio::time::Instant;
 
 use crate::drone::{Craft, Doing};
 use crate::facts::{self, Facts};
@@ -58,7 +58,7 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
         })?;
     }
     // One deadline for all: the vehicles boot side by side.
-    let homes_by = tokio::time::Instant::now() + tuning.home_wait;
+    let homes_by = aviary_clock::Instant::now() + tuning.home_wait;
     for c in crafts.iter().flatten() {
         check_home(c, tuning, homes_by).await?;
     }
@@ -98,7 +98,7 @@ async fn hear_all(vehicles: &[Bound], tuning: Tuning) -> Result<(), String> {
                     link.address
                 ));
             }
-            tokio::time::sleep(tuning.poll).await;
+            aviary_clock::sleep(tuning.poll).await;
         }
     }
     Ok(())
@@ -195,7 +195,7 @@ fn craft(
 async fn check_home(
     c: &Arc<Craft>,
     tuning: Tuning,
-    by: tokio::time::Instant,
+    by: aviary_clock::Instant,
 ) -> Result<(), String> {
     // HOME_POSITION was asked for with the streams; a moment for its first one.
     let _ = c
@@ -205,7 +205,7 @@ async fn check_home(
         .await;
     if c.v.seen().armed {
         // Already flying: only its home says where it started.
-        let left = by.saturating_duration_since(tokio::time::Instant::now());
+        let left = by.saturating_duration_since(aviary_clock::Instant::now());
         let _ = c.wait_for(left, "", |c| c.v.seen().home.is_some()).await;
     }
     let (home, how) = {

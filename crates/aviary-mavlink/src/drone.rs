@@ -8,12 +8,12 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use aviary_api::{BuiltinException, Failure, FlightState};
+use aviary_clock::Instant;
 use mavlink::dialects::ardupilotmega::{
     MavCmd, MavFrame, MavMessage, MavModeFlag, MavResult, PositionTargetTypemask, COMMAND_INT_DATA,
     COMMAND_LONG_DATA, SET_POSITION_TARGET_GLOBAL_INT_DATA,
 };
 use tokio::sync::watch;
-use tokio::time::Instant;
 
 use crate::link::Link;
 use crate::mode::{self, Flavour, Mode};
@@ -182,7 +182,7 @@ impl Craft {
             let sent = std::time::Instant::now();
             let mut wait = self.tuning.ack_timeout;
             let result = loop {
-                match tokio::time::timeout(wait, &mut ack).await {
+                match aviary_clock::timeout(wait, &mut ack).await {
                     Ok(Ok(result)) => break Some(result),
                     // Said to be in progress (PX4's gripper): its final answer is waited for,
                     // not asked again, which PX4 would refuse as a second of the same.
@@ -206,7 +206,7 @@ impl Craft {
                 Some(MavResult::MAV_RESULT_ACCEPTED) => return Ok(()),
                 Some(result) => {
                     // The reason usually comes just before the ACK; give a late one a moment.
-                    tokio::time::sleep(Duration::from_millis(50)).await;
+                    aviary_clock::sleep(Duration::from_millis(50)).await;
                     let why =
                         self.v.texts_since(started).unwrap_or_else(|| "no reason given".into());
                     return Err(failed(format!(
@@ -245,7 +245,7 @@ impl Craft {
                     limit.as_secs_f64()
                 )));
             }
-            tokio::time::sleep(self.tuning.poll).await;
+            aviary_clock::sleep(self.tuning.poll).await;
         }
     }
 

@@ -90,7 +90,7 @@ impl Link {
 
     async fn connect(&self) -> Result<Arc<Conn>, String> {
         let open = mavlink::connect_async::<MavMessage>(&self.target);
-        let mut conn = match tokio::time::timeout(CONNECT_TIMEOUT, open).await {
+        let mut conn = match aviary_clock::timeout(CONNECT_TIMEOUT, open).await {
             Ok(Ok(c)) => c,
             Ok(Err(e)) => return Err(e.to_string()),
             Err(_) => return Err(format!("no answer within {} s", CONNECT_TIMEOUT.as_secs())),
@@ -147,7 +147,7 @@ async fn read(link: std::sync::Weak<Link>, mut conn: Arc<Conn>) {
                 loop {
                     let Some(l) = link.upgrade() else { return };
                     *l.slot() = None;
-                    tokio::time::sleep(REOPEN_EVERY).await;
+                    aviary_clock::sleep(REOPEN_EVERY).await;
                     if let Ok(c) = l.connect().await {
                         *l.slot() = Some(c.clone());
                         conn = c;
@@ -169,7 +169,7 @@ async fn heartbeat(link: std::sync::Weak<Link>) {
         system_status: MavState::MAV_STATE_ACTIVE,
         mavlink_version: 3,
     });
-    let mut every = tokio::time::interval(Duration::from_secs(1));
+    let mut every = aviary_clock::interval(Duration::from_secs(1));
     loop {
         every.tick().await;
         let Some(link) = link.upgrade() else { return };

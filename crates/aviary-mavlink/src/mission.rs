@@ -14,12 +14,12 @@ use std::time::Duration;
 
 use aviary_api::geometry::dist;
 use aviary_api::Failure;
+use aviary_clock::Instant;
 use mavlink::dialects::ardupilotmega::{
     MavCmd, MavFrame, MavMessage, MavMissionResult, MavMissionType, MISSION_COUNT_DATA,
     MISSION_ITEM_INT_DATA,
 };
 use tokio::sync::mpsc;
-use tokio::time::Instant;
 
 use crate::drone::{failed, timeout, Craft, Paused};
 use crate::mode::{self, Mode};
@@ -164,7 +164,7 @@ pub(crate) async fn fly(
         if left.is_zero() {
             return Err(late(c, "fly its path to", end));
         }
-        tokio::time::sleep(c.tuning.poll).await;
+        aviary_clock::sleep(c.tuning.poll).await;
         left = left.saturating_sub(c.tuning.poll);
     }
     // At the end: HOLD, where PX4 brakes and stays (it may have gone there by itself).
@@ -210,7 +210,7 @@ async fn upload(c: &Craft, items: &[MISSION_ITEM_INT_DATA]) -> Result<(), Failur
         loop {
             let sent = std::time::Instant::now();
             let heard = loop {
-                match tokio::time::timeout(c.tuning.ack_timeout, rx.recv()).await {
+                match aviary_clock::timeout(c.tuning.ack_timeout, rx.recv()).await {
                     Ok(heard) => break heard,
                     // Silent by the mission's clock; by the wall's too? (As for commands:
                     // a vehicle that lags the others has had less of the mission's time.)
@@ -233,7 +233,7 @@ async fn upload(c: &Craft, items: &[MISSION_ITEM_INT_DATA]) -> Result<(), Failur
                 Some(Upload::Ack(MavMissionResult::MAV_MISSION_ACCEPTED)) => return Ok(()),
                 Some(Upload::Ack(result)) => {
                     // The reason usually comes with the answer; give a late one a moment.
-                    tokio::time::sleep(Duration::from_millis(50)).await;
+                    aviary_clock::sleep(Duration::from_millis(50)).await;
                     let why = c.v.texts_since(began).unwrap_or_else(|| "no reason given".into());
                     return Err(failed(format!("{} refused its path ({result:?}): {why}", c.name)));
                 }
@@ -273,7 +273,7 @@ async fn begin(c: &Craft) -> Result<(), Failure> {
                 if f.exception == aviary_api::BuiltinException::CommandFailed
                     && Instant::now() < deadline =>
             {
-                tokio::time::sleep(Duration::from_millis(250)).await;
+                aviary_clock::sleep(Duration::from_millis(250)).await;
             }
             Err(f) => return Err(f),
         }

@@ -6,8 +6,8 @@ use std::time::Duration;
 use aviary_api::geometry::{contains, dist};
 use aviary_api::show::fixed;
 use aviary_api::{BuiltinException, Failure};
+use aviary_clock::Instant;
 use mavlink::dialects::ardupilotmega::MavCmd;
-use tokio::time::Instant;
 
 use crate::drone::{failed, timeout, Craft, Doing, Paused};
 use crate::mode::Mode;
@@ -45,7 +45,7 @@ pub(crate) async fn arm(c: &Craft) -> Result<(), Failure> {
             Err(f)
                 if f.exception == BuiltinException::CommandFailed && Instant::now() < deadline =>
             {
-                tokio::time::sleep(c.tuning.arm_retry).await;
+                aviary_clock::sleep(c.tuning.arm_retry).await;
             }
             Err(f) => return Err(f),
         }
@@ -291,7 +291,7 @@ pub(crate) async fn fly_through(
             if left.is_zero() {
                 return Err(late(c, "reach", to));
             }
-            tokio::time::sleep(c.tuning.poll).await;
+            aviary_clock::sleep(c.tuning.poll).await;
             left = left.saturating_sub(c.tuning.poll);
         }
     }
@@ -351,7 +351,7 @@ pub(crate) async fn hover(duration: f64, paused: Paused) -> Result<(), Failure> 
     let step = Duration::from_millis(50);
     let mut left = Duration::from_secs_f64(duration);
     while !left.is_zero() {
-        tokio::time::sleep(step.min(left)).await;
+        aviary_clock::sleep(step.min(left)).await;
         if !*paused.borrow() {
             left = left.saturating_sub(step);
         }

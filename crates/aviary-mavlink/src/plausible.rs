@@ -77,6 +77,11 @@ mod tests {
         use tokio::sync::mpsc;
 
         use crate::vehicle::Vehicle;
+
+        /// Runs `f` on a runtime of the run's clock, which only `advance` moves here.
+        fn simulated(f: impl std::future::Future<Output = ()>) {
+            aviary_clock::Runtime::new().unwrap().block_on(f);
+        }
         use aviary_api::geo::Origin;
 
         const ORIGIN: Origin = Origin { lat: 46.6167, lon: 14.265, alt: 440.0 };
@@ -110,55 +115,64 @@ mod tests {
             (Vehicle::new(0, "d".into(), 1, ORIGIN, Vec::new(), events, alarms), rx)
         }
 
-        #[tokio::test(start_paused = true)]
-        async fn positions_that_jump_are_not_taken_and_become_position_lost() {
-            let (v, mut alarms) = vehicle();
-            v.observe(&at(0.0, 0.0, 10.0));
-            tokio::time::advance(std::time::Duration::from_millis(100)).await;
-            v.observe(&at(5.0, 0.0, 10.0));
-            // 300 km away a tenth of a second later, and again for 3 s.
-            for _ in 0..30 {
-                tokio::time::advance(std::time::Duration::from_millis(100)).await;
-                v.observe(&at(300_000.0, 0.0, 10.0));
-                assert_eq!(x(&v), Some(5.0), "the last believable position stands");
-            }
-            let (drone, failure) = alarms.try_recv().expect("PositionLost");
-            assert_eq!((drone, failure.exception), (0, aviary_api::BuiltinException::PositionLost));
-            assert!(failure.reason.contains("300 km"), "{}", failure.reason);
-            assert!(alarms.try_recv().is_err(), "raised once");
-            // Believable again: taken, and the odometer never saw the jump.
-            tokio::time::advance(std::time::Duration::from_millis(100)).await;
-            v.observe(&at(8.0, 0.0, 10.0));
-            assert_eq!(x(&v), Some(8.0));
-            assert!(v.seen().odometer < 10.0);
-        }
-
-        #[tokio::test(start_paused = true)]
-        async fn a_vehicle_faster_than_real_time_is_believed_by_its_own_clock() {
-            let (v, mut alarms) = vehicle();
-            // 300 m per wall-clock tenth of a second, 15 m/s by the vehicle's clock.
-            for k in 0..40u32 {
-                let mut m = at(f64::from(k) * 300.0, 0.0, 10.0);
-                if let MavMessage::GLOBAL_POSITION_INT(p) = &mut m {
-                    p.time_boot_ms = 1_000 + k * 20_000;
+        #[test]
+        fn positions_that_jump_are_not_taken_and_become_position_lost() {
+            simulated(async {
+                let (v, mut alarms) = vehicle();
+                v.observe(&at(0.0, 0.0, 10.0));
+                aviary_clock::advance(std::time::Duration::from_millis(100)).await;
+                v.observe(&at(5.0, 0.0, 10.0));
+                // 300 km away a tenth of a second later, and again for 3 s.
+                for _ in 0..30 {
+                    aviary_clock::advance(std::time::Duration::from_millis(100)).await;
+                    v.observe(&at(300_000.0, 0.0, 10.0));
+                    assert_eq!(x(&v), Some(5.0), "the last believable position stands");
                 }
-                v.observe(&m);
-                tokio::time::advance(std::time::Duration::from_millis(100)).await;
-            }
-            assert_eq!(x(&v), Some(39.0 * 300.0));
-            assert!(alarms.try_recv().is_err(), "no PositionLost");
+                let (drone, failure) = alarms.try_recv().expect("PositionLost");
+                assert_eq!(
+                    (drone, failure.exception),
+                    (0, aviary_api::BuiltinException::PositionLost)
+                );
+                assert!(failure.reason.contains("300 km"), "{}", failure.reason);
+                assert!(alarms.try_recv().is_err(), "raised once");
+                // Believable again: taken, and the odometer never saw the jump.
+                aviary_clock::advance(std::time::Duration::from_millis(100)).await;
+                v.observe(&at(8.0, 0.0, 10.0));
+                assert_eq!(x(&v), Some(8.0));
+                assert!(v.seen().odometer < 10.0);
+            })
         }
 
-        #[tokio::test(start_paused = true)]
-        async fn a_short_glitch_is_dropped_without_an_exception() {
-            let (v, mut alarms) = vehicle();
-            v.observe(&at(0.0, 0.0, 10.0));
-            tokio::time::advance(std::time::Duration::from_millis(100)).await;
-            v.observe(&at(9_000.0, 0.0, 10.0));
-            tokio::time::advance(std::time::Duration::from_millis(100)).await;
-            v.observe(&at(1.0, 0.0, 10.0));
-            assert_eq!(x(&v), Some(1.0));
-            assert!(alarms.try_recv().is_err());
+        #[test]
+        fn a_vehicle_faster_than_real_time_is_believed_by_its_own_clock() {
+            simulated(async {
+                let (v, mut alarms) = vehicle();
+                // 300 m per wall-clock tenth of a second, 15 m/s by the vehicle's clock.
+                for k in 0..40u32 {
+                    let mut m = at(f64::from(k) * 300.0, 0.0, 10.0);
+                    if let MavMessage::GLOBAL_POSITION_INT(p) = &mut m {
+                        p.time_boot_ms = 1_000 + k * 20_000;
+                    }
+                    v.observe(&m);
+                    aviary_clock::advance(std::time::Duration::from_millis(100)).await;
+                }
+                assert_eq!(x(&v), Some(39.0 * 300.0));
+                assert!(alarms.try_recv().is_err(), "no PositionLost");
+            })
+        }
+
+        #[test]
+        fn a_short_glitch_is_dropped_without_an_exception() {
+            simulated(async {
+                let (v, mut alarms) = vehicle();
+                v.observe(&at(0.0, 0.0, 10.0));
+                aviary_clock::advance(std::time::Duration::from_millis(100)).await;
+                v.observe(&at(9_000.0, 0.0, 10.0));
+                aviary_clock::advance(std::time::Duration::from_millis(100)).await;
+                v.observe(&at(1.0, 0.0, 10.0));
+                assert_eq!(x(&v), Some(1.0));
+                assert!(alarms.try_recv().is_err());
+            })
         }
 
         #[test]

@@ -11,8 +11,8 @@ use std::time::Duration;
 
 use aviary_api::show::fixed;
 use aviary_api::Failure;
+use aviary_clock::Instant;
 use mavlink::dialects::ardupilotmega::{MavCmd, MavFrame};
-use tokio::time::Instant;
 
 use crate::drone::{failed, timeout, Craft, Paused};
 use crate::mode::Mode;
@@ -59,7 +59,7 @@ pub(crate) async fn orbit(
             )));
         }
         let started = Instant::now();
-        tokio::time::sleep(c.tuning.poll).await;
+        aviary_clock::sleep(c.tuning.poll).await;
         left = left.saturating_sub(started.elapsed());
     }
     // Done: HOLD, where PX4 brakes and stays.

@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 use aviary_api::geometry::dist_to_segment;
 use aviary_api::trace::AutopilotAction;
 use aviary_api::{BuiltinException, DroneEvent, DroneId, Failure};
+use aviary_clock::Instant;
 use aviary_world::Target;
 use mavlink::dialects::ardupilotmega::{
     MavCmd, MavLandedState, MavMessage, MavMissionResult, MavMissionType, MavModeFlag,
@@ -14,7 +15,6 @@ use mavlink::dialects::ardupilotmega::{
     HEARTBEAT_DATA,
 };
 use tokio::sync::{mpsc, oneshot};
-use tokio::time::Instant;
 
 use crate::battery::{self, Draw};
 use crate::failsafe::{failsafe, FAILSAFE_WAIT};

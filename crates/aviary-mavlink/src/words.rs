@@ -5,8 +5,8 @@
 //! a text in one message. PX4 ends a text with a tab when the same words also go out as
 //! an event: the tab is no part of them.
 
+use aviary_clock::Instant;
 use std::collections::VecDeque;
-use tokio::time::Instant;
 
 /// How many texts are kept: enough for the reasons around one refusal or failsafe.
 const KEPT: usize = 16;
@@ -81,8 +81,8 @@ impl Text {
 #[cfg(test)]
 mod tests {
     use super::Words;
+    use aviary_clock::Instant;
     use std::time::Duration;
-    use tokio::time::Instant;
 
     /// The 50-byte field as a vehicle sends it.
     fn field(text: &str) -> [u8; 50] {

@@ -126,15 +126,19 @@ impl Backend for Mixed {
     }
 }
 
-/// The runtime of a run with MAVLink drones: one thread on tokio's paused clock, as a
-/// simulated run (the engine relies on both), with sockets. The simulator's driver holds
-/// the clock to the run's `aviary_sim::Pace`: without it, an idle runtime would jump to
-/// its next timer.
-pub fn live_runtime() -> std::io::Result<tokio::runtime::Runtime> {
-    tokio::runtime::Builder::new_current_thread().enable_all().start_paused(true).build()
+/// The runtime of a run with MAVLink drones: one thread on the run's virtual clock, as a
+/// simulated run (the engine relies on both), with sockets, paced by the run's
+/// `aviary_sim::Pace`: without it, an idle runtime would jump to its next timer.
+pub fn live_runtime(pace: Arc<aviary_sim::Pace>) -> std::io::Result<aviary_clock::Runtime> {
+    aviary_clock::Builder::new().enable_io().paced(pace).build()
 }
 
-/// The runtime of a simulated run: one thread, tokio's paused clock, no sockets.
-pub fn simulated_runtime() -> std::io::Result<tokio::runtime::Runtime> {
-    tokio::runtime::Builder::new_current_thread().enable_time().start_paused(true).build()
+/// The runtime of a simulated run: one thread, the virtual clock, no sockets; at `speed`
+/// times real time if asked (the clock then never runs ahead of the wall clock times it).
+pub fn simulated_runtime(speed: Option<f64>) -> std::io::Result<aviary_clock::Runtime> {
+    let builder = aviary_clock::Builder::new();
+    match speed.filter(|s| s.is_finite() && *s > 0.0) {
+        Some(speed) => builder.paced(Arc::new(aviary_clock::Speed::new(speed))).build(),
+        None => builder.build(),
+    }
 }

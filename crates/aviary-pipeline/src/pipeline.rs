@@ -43,7 +43,7 @@ pub struct Texts<'a> {
 /// How to fly.
 #[derive(Clone, Debug, Default)]
 pub struct Options {
-    /// Times real time; `None`, as fast as possible, on tokio's paused clock. A world
+    /// Times real time; `None`, as fast as possible, on the virtual clock. A world
     /// with MAVLink drones flies in real time and refuses a speed.
     pub speed: Option<f64>,
     /// The simulator's seed: every chance the world asks for is drawn from it.
@@ -218,12 +218,15 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
     if live && options.speed.is_some() {
         return Err(NotFlown::Speed);
     }
-    // Every run is on tokio's paused clock, which the simulator's driver lets move: as
-    // fast as it goes, at `speed`, or, with MAVLink drones, at the pace of the wall clock
-    // and then of the vehicles' (`aviary_sim::Pace`).
-    let runtime = if live { live_runtime() } else { simulated_runtime() }
-        .map_err(|e| NotFlown::Failed(format!("cannot start the runtime: {e}")))?;
+    // Every run is on a virtual clock (`aviary_clock`), which moves as fast as it goes, at
+    // `speed`, or, with MAVLink drones, at the pace of the wall clock and then of the
+    // vehicles' (`aviary_sim::Pace`).
     let pace = live.then(|| Arc::new(aviary_sim::Pace::default()));
+    let runtime = match &pace {
+        Some(pace) => live_runtime(pace.clone()),
+        None => simulated_runtime(options.speed),
+    }
+    .map_err(|e| NotFlown::Failed(format!("cannot start the runtime: {e}")))?;
     let (controller, controls) = Controller::new();
     // The first stop, also seen before the engine runs (while vehicles connect).
     let (stop, stopped) = watch::channel(None::<&'static str>);
@@ -238,10 +241,7 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
         // The chances the world asks for (a sensor's `probability`, a fault's range of
         // times) are drawn from the seed.
         let fleet = fleet.seeded(options.seed);
-        let sim = SimBackend::start_with(
-            fleet,
-            SimOptions { speed: options.speed, pace: pace.clone(), ..SimOptions::default() },
-        );
+        let sim = SimBackend::start_with(fleet, SimOptions::default());
         hooks.end(Stage::SimStart);
         let mixed = match &world {
             Some(world) => {
@@ -370,14 +370,14 @@ pub fn fly_prepared(
     options: &Options,
     hooks: &mut dyn Hooks,
 ) -> Result<Flown, NotFlown> {
-    let runtime = simulated_runtime()
+    let runtime = simulated_runtime(None)
         .map_err(|e| NotFlown::Failed(format!("cannot start the runtime: {e}")))?;
     let (controller, controls) = Controller::new();
     let mission = &prepared.mission;
     runtime.block_on(async {
         hooks.begin(Stage::SimStart);
         let fleet = Fleet::new(&prepared.world).seeded(options.seed);
-        let sim = SimBackend::start_with(fleet, SimOptions { speed: None, ..SimOptions::default() });
+        let sim = SimBackend::start_with(fleet, SimOptions::default());
         hooks.end(Stage::SimStart);
         let backend: &dyn Backend = &*sim;
         let watch = watch_backend(sim.take_driver(), controller.clone());

@@ -6,6 +6,8 @@
 //! stalled page never slows the mission and never makes the server hold more than one
 //! window's worth of telemetry (a sample per drone) and `QUEUE` other events; beyond
 //! that the oldest are let go, and the next batch says how many.
+// The operator server runs on a real-time runtime of its own: its streams' periods are real time.
+#![allow(clippy::disallowed_methods, clippy::disallowed_types)]
 
 use parking_lot::Mutex;
 use std::collections::{BTreeMap, VecDeque};

@@ -1,11 +1,11 @@
 //! [`SimBackend`]: the physics core behind the engine's [`Backend`] trait, driven by one
-//! tokio task that steps it every `tick` seconds of tokio time.
+//! tokio task that steps it every `tick` seconds of the run's clock.
 //!
-//! Tokio time is simulated time: the runtime runs on tokio's paused clock (its
-//! `test-util` feature, kept in production builds on purpose), the one clock the engine's
-//! timers and the simulator share, deterministic and free: with every task waiting, it
-//! moves to the next tick at once. With [`SimOptions::speed`] the driver also waits for
-//! the wall clock, off the engine's thread (see [`drive`]).
+//! The run's clock is simulated time: the runtime is an `aviary_clock::Runtime`, whose
+//! virtual clock is the one the engine's timers and the simulator share, deterministic and
+//! free: with every task waiting, it moves to the next tick at once. Pacing (`--speed`, or
+//! a live run following the vehicles' clocks through [`crate::Pace`]) is the clock's own:
+//! a paced runtime never lets it pass its reference, so the driver knows nothing of it.
 
 use parking_lot::Mutex;
 use std::collections::BTreeMap;
@@ -20,31 +20,20 @@ use aviary_api::{
 use aviary_world::World;
 use tokio::sync::{mpsc, oneshot};
 use tokio::task::JoinHandle;
-use tokio::time::MissedTickBehavior;
 
 use crate::fleet::{Fleet, Release, Report};
-use crate::pace::Pace;
 
 /// How the simulator runs.
 #[derive(Clone)]
 pub struct SimOptions {
-    /// Simulated seconds per physics step (default 0.05). Tokio's timer counts whole
-    /// milliseconds, so keep it a multiple of 0.001.
+    /// Simulated seconds per physics step (default 0.05). The clock counts whole
+    /// milliseconds (a deadline rounds up to the next), so keep it a multiple of 0.001.
     pub tick: f64,
-    /// `None`: as fast as the tokio clock goes (with a paused clock, no real time at all).
-    /// `Some(x)`: `x` times real time; the driver sleeps (blocking its thread) so that
-    /// simulated time never runs ahead of `x` × wall time. Run the runtime with a paused
-    /// clock in both cases, so that tokio time is simulated time.
-    pub speed: Option<f64>,
-    /// A live run's reference (with MAVLink drones): simulated time never runs ahead of
-    /// it (the wall clock, or the vehicles' clocks once it follows them). Instead of
-    /// `speed`.
-    pub pace: Option<Arc<Pace>>,
 }
 
 impl Default for SimOptions {
     fn default() -> SimOptions {
-        SimOptions { tick: 0.05, speed: None, pace: None }
+        SimOptions { tick: 0.05 }
     }
 }
 
@@ -77,8 +66,8 @@ pub struct SimBackend {
 }
 
 impl SimBackend {
-    /// Builds the fleet of `world` and spawns the driver task. Call it inside a tokio
-    /// runtime (for determinism and speed, a current-thread one with a paused clock).
+    /// Builds the fleet of `world` and spawns the driver task. Call it inside an
+    /// `aviary_clock::Runtime` (simulated time; elsewhere the steps follow the wall clock).
     ///
     /// # Panics
     /// Outside a tokio runtime, or when `options.tick` is not a positive number.
@@ -159,10 +148,9 @@ impl SimBackend {
 
 async fn drive(backend: Weak<SimBackend>, options: SimOptions) {
     let period = Duration::from_secs_f64(options.tick);
-    let mut interval = tokio::time::interval_at(tokio::time::Instant::now() + period, period);
-    interval.set_missed_tick_behavior(MissedTickBehavior::Burst);
-    let wall = std::time::Instant::now();
-    let mut ticks: u64 = 0;
+    // Burst (the clock's only behaviour): a tick late in real time is not skipped, so the
+    // steps stay on their grid of simulated time.
+    let mut interval = aviary_clock::interval_at(aviary_clock::Instant::now() + period, period);
     loop {
         interval.tick().await;
         let Some(sim) = backend.upgrade() else { return };
@@ -170,37 +158,8 @@ async fn drive(backend: Weak<SimBackend>, options: SimOptions) {
             return;
         }
         sim.tick(options.tick);
-        drop(sim);
-        ticks += 1;
-        if let Some(pace) = &options.pace {
-            // Until the reference has reached this tick's time, in waits of a few
-            // milliseconds, each a blocking task that holds the paused clock still.
-            let due = ticks as f64 * options.tick;
-            while pace.now() < due {
-                let running =
-                    backend.upgrade().is_some_and(|sim| !sim.stopped.load(Ordering::SeqCst));
-                if !running {
-                    return;
-                }
-                let _ = tokio::task::spawn_blocking(|| std::thread::sleep(PACE_POLL)).await;
-            }
-        } else if let Some(speed) = options.speed.filter(|s| s.is_finite() && *s > 0.0) {
-            let due = Duration::from_secs_f64(ticks as f64 * options.tick / speed);
-            let elapsed = wall.elapsed();
-            if due > elapsed {
-                // On the blocking pool, not on this thread: the engine shares it and goes
-                // on with what does not need the clock (an operator's request, a drone
-                // event). A blocking task also holds the paused clock still (tokio does
-                // not advance it while one runs), so simulated time waits for the wall.
-                let wait = due - elapsed;
-                let _ = tokio::task::spawn_blocking(move || std::thread::sleep(wait)).await;
-            }
-        }
     }
 }
-
-/// How often a paced driver looks at its reference while it waits.
-const PACE_POLL: Duration = Duration::from_millis(2);
 
 impl Backend for SimBackend {
     fn call(&self, drone: DroneId, call: &FunctionCall) -> PendingCall {

@@ -6,7 +6,7 @@
 //!   aborted with [`Fleet::interrupt`], and end (with the drone events) in the [`Report`]s
 //!   that `step` returns.
 //! - [`SimBackend`], the [`aviary_api::Backend`] the engine drives: the core behind a
-//!   mutex, stepped by one tokio task every [`SimOptions::tick`] seconds of tokio time,
+//!   mutex, stepped by one tokio task every [`SimOptions::tick`] seconds of the run's clock,
 //!   answering calls through their oneshot channels and sending drone events.
 //!
 //! # Invariants
@@ -17,8 +17,8 @@
 //!   world-file order. A world that asks for no chance runs the same whatever the seed.
 //! - The physics core is pure: nothing async, no clock, no IO. Simulated time is the sum
 //!   of the steps.
-//! - No wall clock, unless [`SimOptions::speed`] is set: then the driver only *waits* on
-//!   the wall clock to pace itself; what happens does not depend on it.
+//! - No wall clock: a paced run (`--speed`, a live run's [`Pace`]) only *waits* on it,
+//!   through its runtime's clock (`aviary_clock`); what happens does not depend on it.
 //!
 //! # Model (and what it leaves out)
 //! - Each drone is a point mass, landed and disarmed at its home (on the ground, z = 0;
@@ -146,8 +146,8 @@
 //! # Driver
 //! [`SimBackend::start`] spawns the driver; it ends at its next tick after
 //! [`SimBackend::stop`] (or [`SimBackend::shutdown`], which also waits for it), or once
-//! the last `Arc<SimBackend>` is dropped. Simulated time equals tokio time since the start
-//! (as long as the runtime keeps up, as it does with a paused clock).
+//! the last `Arc<SimBackend>` is dropped. Simulated time equals the run's clock since the
+//! start (as long as the runtime keeps up, as it does on `aviary_clock`'s virtual clock).
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
 mod air;

@@ -1,12 +1,13 @@
-//! What a live run's time follows. A run with MAVLink drones runs on tokio's paused clock
-//! too, held still by the simulator's driver while it waits (`backend::drive`), so that
-//! one clock serves the engine, the simulated drones and the MAVLink backend's waits. The
-//! driver lets it run up to [`Pace::now`]: the wall clock at first (while the vehicles
-//! connect), then, once [`Pace::follow`] names one, the vehicles' own clocks, so that a
-//! SITL running five times faster than real time has a mission five times faster too.
+//! What a live run's time follows. A run with MAVLink drones runs on the virtual clock of
+//! `aviary_clock` too, so that one clock serves the engine, the simulated drones and the
+//! MAVLink backend's waits; its runtime is paced by a [`Pace`] (an
+//! `aviary_clock::Reference`), which lets the clock run up to [`Pace::now`]: the wall
+//! clock at first (while the vehicles connect), then, once [`Pace::follow`] names one, the
+//! vehicles' own clocks, so that a SITL running five times faster than real time has a
+//! mission five times faster too.
 
 use parking_lot::Mutex;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Seconds a clock has moved on since it was last asked, or `None` when it cannot say
 /// (no vehicle heard lately): then the wall clock's are taken.
@@ -46,6 +47,12 @@ impl Pace {
         let moved = s.source.as_mut().and_then(|f| f()).unwrap_or(by_wall);
         s.now += moved.max(0.0);
         s.now
+    }
+}
+
+impl aviary_clock::Reference for Pace {
+    fn now(&self) -> Duration {
+        Duration::try_from_secs_f64(Pace::now(self)).unwrap_or(Duration::MAX)
     }
 }
 

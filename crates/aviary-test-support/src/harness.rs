@@ -96,14 +96,10 @@ pub fn try_compile(
     Ok((mission, world))
 }
 
-/// The runtime a simulated run takes: one thread, its clock paused, so that simulated
-/// time passes as soon as every task waits and a run takes no real time.
-pub fn paused_runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_current_thread()
-        .enable_time()
-        .start_paused(true)
-        .build()
-        .expect("runtime")
+/// The runtime a simulated run takes: one thread and a virtual clock (`aviary_clock`),
+/// so that simulated time passes as soon as every task waits and a run takes no real time.
+pub fn simulated_runtime() -> aviary_clock::Runtime {
+    aviary_clock::Runtime::new().expect("runtime")
 }
 
 pub fn run_with(mission: &str, world: &str, options: &RunOptions) -> Run {
@@ -196,7 +192,7 @@ pub fn run_compiled(
     path: Path,
 ) -> (Run, Vec<Result<(), String>>) {
     let directory = Directory::of(mission);
-    paused_runtime().block_on(async {
+    simulated_runtime().block_on(async {
         let sim = SimBackend::start(world, SimOptions::default());
         let (controller, rx) = Controller::new();
         // Without controls, as a run without an operator: no channel at all.
@@ -204,10 +200,10 @@ pub fn run_compiled(
         let mut trace = Vec::new();
         let mut sink = |r: &Record| trace.push(Trace::line(r));
         let operator = async {
-            let start = tokio::time::Instant::now();
+            let start = aviary_clock::Instant::now();
             let mut answers = Vec::new();
             for (at, ask) in controls {
-                tokio::time::sleep_until(start + std::time::Duration::from_secs_f64(at)).await;
+                aviary_clock::sleep_until(start + std::time::Duration::from_secs_f64(at)).await;
                 answers.push(match ask.resolve(&directory) {
                     Ok(control) => controller.ask(control).await,
                     Err(why) => Err(why),

@@ -93,7 +93,8 @@ pub struct Vehicles {
 }
 
 /// Binds `listen` and starts serving `world`'s drones. Call inside a tokio runtime with
-/// a real clock (not paused).
+/// a real clock (a plain one, not `aviary_clock`'s): the vehicles pace themselves against
+/// the wall clock, as a SITL does.
 pub async fn serve(world: &World, listen: Listen, options: Options) -> std::io::Result<Vehicles> {
     let ap = autopilot::Autopilot::new(world, options.behaviour);
     let systems = ap.copters.iter().map(|c| c.system).collect();

@@ -2,6 +2,8 @@
 //! each client with its own queue (`client`), and the pacing task that steps the
 //! simulation at `speed` times real time and fills every client's queue with the streams
 //! it asked for.
+// The vehicles pace themselves in real time, as a SITL does: tokio's timer, not the run's clock.
+#![allow(clippy::disallowed_methods, clippy::disallowed_types)]
 
 use parking_lot::Mutex;
 use std::net::SocketAddr;

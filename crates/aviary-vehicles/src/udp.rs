@@ -1,5 +1,7 @@
 //! The UDP socket: every peer that has sent a datagram in the last [`PEER_EXPIRY`] is a
 //! client, with its own queue and sequence numbers, up to [`MAX_PEERS`] at once.
+// A silent peer is forgotten after real seconds: tokio's timer, not the run's clock.
+#![allow(clippy::disallowed_methods, clippy::disallowed_types)]
 
 use std::collections::HashMap;
 use std::net::SocketAddr;

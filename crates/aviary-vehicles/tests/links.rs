@@ -1,6 +1,8 @@
 //! Each ground station's link: its own sequence numbers per vehicle, its own queue (one
 //! client's flood of commands is answered to it alone and costs the others nothing), and
 //! heartbeats that are never dropped.
+// These tests talk to `aviary vehicles` in real time (its own clock is the wall's).
+#![allow(clippy::disallowed_methods, clippy::disallowed_types)]
 
 mod common;
 

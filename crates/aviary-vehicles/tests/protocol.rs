@@ -1,6 +1,8 @@
 //! The MAVLink backend against the simulated vehicles, both in this process but talking
 //! MAVLink 2 over real loopback sockets: refusals carry the autopilot's reason, a
 //! failsafe RTL becomes the matching exception, UDP works, and signing is enforced.
+// These tests talk to `aviary vehicles` in real time (its own clock is the wall's).
+#![allow(clippy::disallowed_methods, clippy::disallowed_types)]
 
 use std::time::Duration;
 

@@ -4,6 +4,8 @@
 //! level whatever the frame (as PX4's mavlink receiver and navigator read it), Orbit, the
 //! mission protocol and a mission flown, the parameters bytewise, and the backend reading
 //! the vehicle's figures under PX4's names.
+// These tests talk to `aviary vehicles` in real time (its own clock is the wall's).
+#![allow(clippy::disallowed_methods, clippy::disallowed_types)]
 
 mod common;
 

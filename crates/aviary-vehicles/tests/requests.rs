@@ -1,6 +1,8 @@
 //! Commands and requests answered as ArduCopter answers them: ACKs addressed to the
 //! asker, UNSUPPORTED for unknown commands, AUTOPILOT_VERSION, HOME_POSITION and the
 //! health a ground station arms by, FTP refused at once.
+// These tests talk to `aviary vehicles` in real time (its own clock is the wall's).
+#![allow(clippy::disallowed_methods, clippy::disallowed_types)]
 
 mod common;
 

@@ -1,6 +1,8 @@
 //! UDP peers: every peer that sends is served, up to MAX_PEERS at once, and one silent
 //! for PEER_EXPIRY is no longer sent anything (before, every source port ever seen was
 //! sent every message for ever).
+// These tests talk to `aviary vehicles` in real time (its own clock is the wall's).
+#![allow(clippy::disallowed_methods, clippy::disallowed_types)]
 
 mod common;
 

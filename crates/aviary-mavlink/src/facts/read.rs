@@ -5,12 +5,12 @@
 use std::sync::Arc;
 use std::time::Duration;
 
+use aviary_clock::Instant;
 use aviary_world::World;
 use mavlink::dialects::ardupilotmega::{
     MavCmd, MavMessage, COMMAND_LONG_DATA, PARAM_REQUEST_READ_DATA,
 };
 use tokio::sync::mpsc;
-use tokio::time::Instant;
 
 use super::{table, Facts};
 use crate::link::Link;
@@ -33,7 +33,7 @@ pub(crate) async fn read(drone: usize, link: &Link, v: &Vehicle, until: Instant)
         if Instant::now() >= until {
             return Facts::unheard(drone, &v.name, &link.address, v.system, "no HEARTBEAT".into());
         }
-        tokio::time::sleep(POLL).await;
+        aviary_clock::sleep(POLL).await;
     }
     let flavour = v.flavour();
     let table = table(flavour);
@@ -79,7 +79,7 @@ pub(crate) async fn read(drone: usize, link: &Link, v: &Vehicle, until: Instant)
                 .await;
             }
         }
-        tokio::time::sleep(POLL).await;
+        aviary_clock::sleep(POLL).await;
     }
     let seen = v.seen();
     Facts::answered_by(
@@ -117,7 +117,7 @@ pub async fn ask(world: &World, wait: Duration) -> Result<Vec<Facts>, String> {
         let (events, alarms) = (events.clone(), alarms.clone());
         tasks.spawn(async move {
             let key = key.as_deref().map(crate::signing_key);
-            let opened = tokio::time::timeout_at(until, Link::open(&address, key)).await;
+            let opened = aviary_clock::timeout_at(until, Link::open(&address, key)).await;
             let link = match opened {
                 Ok(Ok(link)) => link,
                 Ok(Err(why)) => {

@@ -1,4 +1,4 @@
-//! Tests of the physics core (plain) and of the backend (tokio, paused clock).
+//! Tests of the physics core (plain) and of the backend (on `aviary_clock`'s runtime).
 
 mod air;
 mod backend;

@@ -104,10 +104,23 @@ mod tests {
             v.seen().fix.map(|f| (f.pos[0] * 10.0).round() / 10.0)
         }
 
-        fn vehicle() -> (Vehicle, mpsc::UnboundedReceiver<(usize, aviary_api::Failure)>) {
+        fn vehicle(
+        ) -> (Vehicle, mpsc::UnboundedReceiver<(aviary_api::DroneId, aviary_api::Failure)>)
+        {
             let (events, _) = mpsc::unbounded_channel::<DroneEvent>();
             let (alarms, rx) = mpsc::unbounded_channel();
-            (Vehicle::new(0, "d".into(), 1, ORIGIN, Vec::new(), events, alarms), rx)
+            (
+                Vehicle::new(
+                    aviary_api::DroneId(0),
+                    "d".into(),
+                    1,
+                    ORIGIN,
+                    Vec::new(),
+                    events,
+                    alarms,
+                ),
+                rx,
+            )
         }
 
         #[tokio::test(start_paused = true)]
@@ -123,7 +136,10 @@ mod tests {
                 assert_eq!(x(&v), Some(5.0), "the last believable position stands");
             }
             let (drone, failure) = alarms.try_recv().expect("PositionLost");
-            assert_eq!((drone, failure.exception), (0, aviary_api::BuiltinException::PositionLost));
+            assert_eq!(
+                (drone.0, failure.exception),
+                (0, aviary_api::BuiltinException::PositionLost)
+            );
             assert!(failure.reason.contains("300 km"), "{}", failure.reason);
             assert!(alarms.try_recv().is_err(), "raised once");
             // Believable again: taken, and the odometer never saw the jump.

@@ -3,18 +3,20 @@
 
 use std::ops::Index;
 
+use typed_index_collections::TiVec;
+
 use crate::DroneId;
 
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Names {
     text: String,
     /// Where each name ends in `text`.
-    ends: Vec<usize>,
+    ends: TiVec<DroneId, usize>,
 }
 
 impl Names {
     pub fn new<'a>(names: impl ExactSizeIterator<Item = &'a str>) -> Names {
-        let mut out = Names { text: String::new(), ends: Vec::with_capacity(names.len()) };
+        let mut out = Names { text: String::new(), ends: TiVec::with_capacity(names.len()) };
         for name in names {
             out.text.push_str(name);
             out.ends.push(out.text.len());
@@ -34,18 +36,18 @@ impl Names {
     /// The drone's name, if the fleet has it.
     pub fn get(&self, id: DroneId) -> Option<&str> {
         let end = *self.ends.get(id)?;
-        let start = id.checked_sub(1).map_or(0, |before| self.ends[before]);
+        let start = id.0.checked_sub(1).map_or(0, |before| self.ends[DroneId(before)]);
         self.text.get(start..end)
     }
 
     /// Every name, in drone order.
     pub fn iter(&self) -> impl ExactSizeIterator<Item = &str> + '_ {
-        (0..self.len()).map(|d| &self[d])
+        (0..self.len()).map(|d| &self[DroneId(d)])
     }
 
     /// The drone of this name (the first, if two share it).
     pub fn position(&self, name: &str) -> Option<DroneId> {
-        self.iter().position(|n| n == name)
+        self.iter().position(|n| n == name).map(DroneId)
     }
 }
 
@@ -64,9 +66,13 @@ mod tests {
     #[test]
     fn each_name_in_order() {
         let names = Names::new(["alpha", "", "b2"].into_iter());
-        assert_eq!((&names[0], &names[1], &names[2], &names[3]), ("alpha", "", "b2", ""));
-        assert_eq!((names.len(), names.get(2), names.get(3)), (3, Some("b2"), None));
+        let d = DroneId;
+        assert_eq!(
+            (&names[d(0)], &names[d(1)], &names[d(2)], &names[d(3)]),
+            ("alpha", "", "b2", "")
+        );
+        assert_eq!((names.len(), names.get(d(2)), names.get(d(3))), (3, Some("b2"), None));
         assert_eq!(names.iter().collect::<Vec<_>>(), ["alpha", "", "b2"]);
-        assert_eq!((names.position("b2"), names.position("c")), (Some(2), None));
+        assert_eq!((names.position("b2"), names.position("c")), (Some(d(2)), None));
     }
 }

@@ -5,8 +5,32 @@ use tokio::sync::{mpsc, oneshot};
 
 use crate::{BuiltinException, BuiltinSignal};
 
-/// A drone, by its index in the world file's order.
-pub type DroneId = usize;
+/// A drone, by its index in the world file's order: a type of its own, so that a table
+/// of the fleet (a [`typed_index_collections::TiVec`]) takes only a drone. Serialized as
+/// the number it holds.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize,
+)]
+#[serde(transparent)]
+pub struct DroneId(pub usize);
+
+impl From<usize> for DroneId {
+    fn from(i: usize) -> DroneId {
+        DroneId(i)
+    }
+}
+
+impl From<DroneId> for usize {
+    fn from(id: DroneId) -> usize {
+        id.0
+    }
+}
+
+impl std::fmt::Display for DroneId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
 
 /// A point in the world's local frame (metres: x east, y north, z up). Without `z`, a
 /// flight keeps the altitude it has.

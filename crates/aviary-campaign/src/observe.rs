@@ -2,7 +2,7 @@
 //! [`Observer`] gathers it, and [`Observer::finish`] sums it up as a [`RunRecord`].
 
 use aviary_api::trace::{Event, EventKind, Record, Status};
-use aviary_api::Backend;
+use aviary_api::{Backend, DroneId};
 use aviary_diagnostics::SourceMap;
 use aviary_engine::Outcome;
 use aviary_ir::{Mission, Origin};
@@ -102,7 +102,7 @@ impl Observer {
     fn battery(&mut self, actor: &str, backend: &dyn Backend) -> [f64; 3] {
         let Some(d) = self.drones.position(actor) else { return [f64::NAN; 3] };
         let t = backend.telemetry(d);
-        if let Some(low) = self.lowest.get_mut(d) {
+        if let Some(low) = self.lowest.get_mut(d.0) {
             *low = low.min(t.battery);
         }
         t.position
@@ -132,7 +132,7 @@ impl Observer {
     /// The fleet is home: each drone's battery now.
     pub fn landed(&mut self, backend: &dyn Backend) {
         for (d, low) in self.lowest.iter_mut().enumerate() {
-            *low = low.min(backend.telemetry(d).battery);
+            *low = low.min(backend.telemetry(DroneId(d)).battery);
         }
     }
 

@@ -7,7 +7,7 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use aviary_api::trace::{Event, RaisedBy, Record};
-use aviary_api::Backend;
+use aviary_api::{Backend, DroneId};
 use aviary_diagnostics::{render_text, SourceMap};
 use aviary_engine::{Controller, RunOptions, Status};
 use aviary_ir::Mission;
@@ -505,7 +505,8 @@ impl Stats {
         let ended = matches!(record.event, Event::MissionEnd { .. });
         if t - self.last_shown >= 1.0 || ended {
             self.last_shown = t;
-            let flying = (0..drones).filter(|d| backend.telemetry(*d).state.airborne()).count();
+            let flying =
+                (0..drones).filter(|d| backend.telemetry(DroneId(*d)).state.airborne()).count();
             progress.set_message(format!(
                 "t = {t:7.1} s   activities running: {:3}   drones in the air: {flying}",
                 self.running
@@ -565,7 +566,7 @@ fn summary(
         "drone", "distance m", "flight s", "battery", "state"
     ));
     for (d, name) in mission.drones.iter().enumerate() {
-        let t = backend.telemetry(d);
+        let t = backend.telemetry(DroneId(d));
         let (distance, airborne) = match odometry(d) {
             Some((m, s)) => (format!("{m:.0}"), format!("{s:.0}")),
             None => ("-".to_owned(), "-".to_owned()),

@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 use std::rc::Rc;
 
 use aviary_api::{DroneId, Resource};
+use aviary_ir::TiVec;
 use smallvec::SmallVec;
 use tokio::sync::oneshot;
 
@@ -47,7 +48,7 @@ pub(crate) struct Arbiter {
 /// are an index and a mask, whatever the fleet's size.
 #[derive(Default)]
 struct ClaimSet {
-    bits: Vec<u8>,
+    bits: TiVec<DroneId, u8>,
 }
 
 impl ClaimSet {
@@ -60,8 +61,8 @@ impl ClaimSet {
     }
 
     fn insert(&mut self, (d, r): Claim) {
-        if self.bits.len() <= d {
-            self.bits.resize(d + 1, 0);
+        if self.bits.len() <= d.0 {
+            self.bits.resize(d.0 + 1, 0);
         }
         self.bits[d] |= Self::mask(r);
     }
@@ -194,7 +195,7 @@ mod tests {
     #[test]
     fn first_come_first_served_all_at_once() {
         let arbiter = Rc::new(RefCell::new(Arbiter::default()));
-        let m = |d| (d, Resource::Motion);
+        let m = |d| (DroneId(d), Resource::Motion);
         let mut first = pin!(acquire(&arbiter, smallvec::smallvec![m(0)]));
         let Poll::Ready(a) = poll_once(first.as_mut()) else { panic!("free: granted at once") };
         // Needs 0 and 1: waits for 0.
@@ -213,7 +214,7 @@ mod tests {
     #[test]
     fn granted_at_once_only_when_free_and_nobody_waits() {
         let arbiter = Rc::new(RefCell::new(Arbiter::default()));
-        let m = |d| (d, Resource::Motion);
+        let m = |d| (DroneId(d), Resource::Motion);
         let Ok(a) = try_acquire(&arbiter, smallvec::smallvec![m(0)]) else { panic!("free") };
         let refused =
             try_acquire(&arbiter, smallvec::smallvec![m(0), m(1)]).err().expect("0 is held");
@@ -229,7 +230,7 @@ mod tests {
     #[test]
     fn a_cancelled_waiter_leaks_nothing() {
         let arbiter = Rc::new(RefCell::new(Arbiter::default()));
-        let m = (0, Resource::Motion);
+        let m = (DroneId(0), Resource::Motion);
         let mut first = pin!(acquire(&arbiter, smallvec::smallvec![m]));
         let Poll::Ready(a) = poll_once(first.as_mut()) else { panic!() };
         {

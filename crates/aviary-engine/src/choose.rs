@@ -10,7 +10,7 @@ use std::cell::RefCell;
 use std::time::Duration;
 
 use aviary_api::{BuiltinException, DroneId, FlightState, Value};
-use aviary_ir::Any;
+use aviary_ir::{Any, TiVec};
 
 use crate::engine::{Ctx, Engine};
 use crate::exec::{set, RECHECK};
@@ -18,7 +18,7 @@ use crate::join::join_in_order;
 
 /// Which drones an `ANY` holds, by drone.
 #[derive(Default)]
-pub(crate) struct Taken(RefCell<Vec<bool>>);
+pub(crate) struct Taken(RefCell<TiVec<DroneId, bool>>);
 
 impl Taken {
     pub fn holds(&self, d: DroneId) -> bool {
@@ -27,8 +27,8 @@ impl Taken {
 
     fn set(&self, d: DroneId, held: bool) {
         let mut taken = self.0.borrow_mut();
-        if taken.len() <= d {
-            taken.resize(d + 1, false);
+        if taken.len() <= d.0 {
+            taken.resize(d.0 + 1, false);
         }
         taken[d] = held;
     }

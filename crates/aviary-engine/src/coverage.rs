@@ -13,6 +13,7 @@ use std::cell::RefCell;
 use std::sync::Arc;
 
 use aviary_api::{CallEnd, DroneId, Function, FunctionCall, Remainder, Value};
+use aviary_ir::TiVec;
 
 use crate::engine::Engine;
 
@@ -22,9 +23,9 @@ type PathCall = Box<FunctionCall>;
 
 pub(crate) struct Coverage {
     /// Per drone: its path call in progress.
-    flying: RefCell<Vec<Option<PathCall>>>,
+    flying: RefCell<TiVec<DroneId, Option<PathCall>>>,
     /// Per drone: what its last one left; `None` for nothing.
-    left: RefCell<Vec<Option<Arc<Remainder>>>>,
+    left: RefCell<TiVec<DroneId, Option<Arc<Remainder>>>>,
     nothing: Arc<Remainder>,
 }
 
@@ -36,8 +37,8 @@ pub(crate) fn flies_path(function: Function) -> bool {
 impl Coverage {
     pub fn new(drones: usize) -> Coverage {
         Coverage {
-            flying: RefCell::new(vec![None; drones]),
-            left: RefCell::new(vec![None; drones]),
+            flying: RefCell::new(vec![None; drones].into()),
+            left: RefCell::new(vec![None; drones].into()),
             nothing: Arc::new(Remainder::Nothing),
         }
     }

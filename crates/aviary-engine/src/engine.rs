@@ -327,7 +327,7 @@ pub(crate) struct Engine<'m> {
     failed_at: Cell<Option<aviary_ir::Origin>>,
     /// Per drone, the statement of its latest middle-layer call: where a fault or a
     /// refusal on it is said to have happened.
-    last_call: RefCell<Vec<Option<aviary_ir::Origin>>>,
+    last_call: RefCell<TiVec<DroneId, Option<aviary_ir::Origin>>>,
     /// False once the backend cannot answer: then nobody can be sent home.
     backend_alive: Cell<bool>,
     /// The operator paused the whole mission.
@@ -394,7 +394,7 @@ impl<'m> Engine<'m> {
             places: Default::default(),
             ending: RefCell::new(None),
             failed_at: Cell::new(None),
-            last_call: RefCell::new(vec![None; m.drones.len()]),
+            last_call: RefCell::new(vec![None; m.drones.len()].into()),
             backend_alive: Cell::new(true),
             mission_paused: Cell::new(false),
             steering: Default::default(),
@@ -632,7 +632,7 @@ impl<'m> Engine<'m> {
 
     /// One telemetry sample of every drone, in the trace.
     fn sample_telemetry(&self) {
-        for d in 0..self.m.drones.len() {
+        for d in (0..self.m.drones.len()).map(DroneId) {
             let t = self.backend.telemetry(d);
             self.trace(EventKind::Telemetry, || Event::Telemetry {
                 actor: self.name(d).into(),

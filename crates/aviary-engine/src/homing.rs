@@ -83,6 +83,7 @@ impl<'m> Engine<'m> {
         // A drone the operator took out is brought down by its own withdrawal, which
         // goes on here, whether it is still on its way or was left to its autopilot.
         let flying: Vec<DroneId> = (0..self.m.drones.len())
+            .map(DroneId)
             .filter(|&d| {
                 self.steering.withdrawn(d).is_none() && self.backend.telemetry(d).state.airborne()
             })

@@ -26,6 +26,7 @@ use std::cell::RefCell;
 use std::rc::Rc;
 
 use aviary_api::DroneId;
+use aviary_ir::TiVec;
 use smallvec::SmallVec;
 
 use crate::engine::{Engine, Scope};
@@ -49,7 +50,7 @@ struct Place<'m> {
 
 #[derive(Default)]
 pub(crate) struct Places<'m> {
-    by_drone: RefCell<Vec<SmallVec<[Place<'m>; 2]>>>,
+    by_drone: RefCell<TiVec<DroneId, SmallVec<[Place<'m>; 2]>>>,
     next: std::cell::Cell<u64>,
 }
 
@@ -93,8 +94,8 @@ impl<'m> Engine<'m> {
         self.places.next.set(seq);
         let mut places = self.places.by_drone.borrow_mut();
         for d in drones {
-            if places.len() <= *d {
-                places.resize_with(*d + 1, SmallVec::new);
+            if places.len() <= d.0 {
+                places.resize_with(d.0 + 1, SmallVec::new);
             }
             places[*d].push(Place { rank: (depth, level, seq), scope: scope.clone() });
         }

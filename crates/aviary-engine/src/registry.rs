@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 use std::rc::Rc;
 
 use aviary_api::DroneId;
-use aviary_ir::{CapId, TagId};
+use aviary_ir::{CapId, TagId, TiVec};
 use smallvec::SmallVec;
 
 use crate::engine::{Instance, Scope};
@@ -21,7 +21,7 @@ pub(crate) type Entry<'m> = (Rc<Instance>, Rc<Scope<'m>>);
 
 #[derive(Default)]
 pub(crate) struct Registry<'m> {
-    by_actor: Vec<SmallVec<[Entry<'m>; 1]>>,
+    by_actor: TiVec<DroneId, SmallVec<[Entry<'m>; 1]>>,
     by_tag: BTreeMap<(CapId, TagId, u64), Entry<'m>>,
     /// Instances without an actor (all of whose actor references were empty), so that
     /// `all` still sees them.
@@ -38,8 +38,8 @@ impl<'m> Registry<'m> {
             self.loose.insert(id, (instance.clone(), scope.clone()));
         }
         for d in &instance.actors {
-            if self.by_actor.len() <= *d {
-                self.by_actor.resize_with(*d + 1, SmallVec::new);
+            if self.by_actor.len() <= d.0 {
+                self.by_actor.resize_with(d.0 + 1, SmallVec::new);
             }
             // Ids grow, so a push keeps the list in starting order. A drone named twice
             // in one instance is listed once.

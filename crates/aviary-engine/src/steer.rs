@@ -25,6 +25,7 @@ use std::rc::Rc;
 use std::task::Waker;
 
 use aviary_api::{CallId, DroneId, Interrupt};
+use aviary_ir::TiVec;
 
 use crate::control::DroneAction;
 use crate::engine::{Engine, Instance};
@@ -50,7 +51,7 @@ enum Steer {
 pub(crate) struct Steering {
     /// By drone; empty until the operator steers one, so a run without that looks at
     /// an empty list.
-    drones: RefCell<Vec<Steer>>,
+    drones: RefCell<TiVec<DroneId, Steer>>,
     /// Drones taken out of the mission, to bring down, with the root activities aborted
     /// for them (`Engine::withdrawals` takes them).
     pub queued: RefCell<Vec<(DroneId, Vec<Rc<Instance>>)>>,
@@ -73,8 +74,8 @@ impl Steering {
 
     fn set(&self, d: DroneId, steer: Steer) {
         let mut drones = self.drones.borrow_mut();
-        if drones.len() <= d {
-            drones.resize(d + 1, Steer::Free);
+        if drones.len() <= d.0 {
+            drones.resize(d.0 + 1, Steer::Free);
         }
         drones[d] = steer;
     }
@@ -107,7 +108,7 @@ impl Steering {
     /// The drones the operator holds.
     fn held_drones(&self) -> Vec<DroneId> {
         let drones = self.drones.borrow();
-        (0..drones.len()).filter(|d| drones[*d] == Steer::Held).collect()
+        (0..drones.len()).map(DroneId).filter(|d| drones[*d] == Steer::Held).collect()
     }
 }
 

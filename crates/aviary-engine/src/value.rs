@@ -1,6 +1,6 @@
 //! Evaluating expressions at run time.
 
-use aviary_api::{arith, Backend, Point, Value};
+use aviary_api::{arith, Backend, DroneId, Point, Value};
 use aviary_ir::{ActorRef, Expr, Field, Mission, SignalId, Slots, TiSlice};
 
 /// What an expression needs from the run: the frame, telemetry, signals, the clock.
@@ -16,7 +16,7 @@ pub(crate) struct Env<'a> {
 }
 
 impl Env<'_> {
-    pub fn actor(&self, r: &ActorRef) -> Option<usize> {
+    pub fn actor(&self, r: &ActorRef) -> Option<DroneId> {
         match r {
             ActorRef::Drone(d) => Some(*d),
             ActorRef::Group(g) => g.first().copied(),
@@ -115,7 +115,7 @@ impl Env<'_> {
     }
 }
 
-fn telemetry(backend: &dyn Backend, d: usize, field: Field) -> Value {
+fn telemetry(backend: &dyn Backend, d: DroneId, field: Field) -> Value {
     let t = backend.telemetry(d);
     match field {
         // What the GPS says: the true position plus its error, when the backend has one.

@@ -107,10 +107,10 @@ fn a_call_refused_with_any_builtin_exception_raises_that_exception() {
 #[test]
 fn faults_and_signals_a_backend_reports_start_their_handlers() {
     let events = vec![
-        DroneEvent::Signal { drone: 0, signal: BuiltinSignal::BatteryLow },
-        DroneEvent::Signal { drone: 0, signal: BuiltinSignal::ConnectionRestored },
+        DroneEvent::Signal { drone: DroneId(0), signal: BuiltinSignal::BatteryLow },
+        DroneEvent::Signal { drone: DroneId(0), signal: BuiltinSignal::ConnectionRestored },
         DroneEvent::Fault {
-            drone: 0,
+            drone: DroneId(0),
             failure: Failure::new(BuiltinException::MotorFailure, "motor"),
         },
     ];

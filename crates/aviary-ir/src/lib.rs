@@ -203,9 +203,9 @@ impl Mission {
     pub fn attribute(&self, a: usize, d: DroneId) -> Option<Value> {
         match self.attributes.get(a)? {
             Column::Numbers { values, present } => {
-                present.get(d)?.then(|| Value::Number(values[d]))
+                present.get(d.0)?.then(|| Value::Number(values[d.0]))
             }
-            Column::Values(values) => values.get(d)?.clone(),
+            Column::Values(values) => values.get(d.0)?.clone(),
         }
     }
 }
@@ -654,7 +654,7 @@ mod tests {
         assert!(!Compare::Lt.holds(&sym, &text));
         assert!(Compare::Le.holds(&Value::Number(1.0), &Value::Number(1.0)));
         assert!(!Compare::Eq.holds(&Value::Number(f64::NAN), &Value::Number(f64::NAN)));
-        assert!(Compare::Ne.holds(&Value::Actor(0), &Value::Actor(1)));
+        assert!(Compare::Ne.holds(&Value::Actor(DroneId(0)), &Value::Actor(DroneId(1))));
     }
 }
 
@@ -698,11 +698,11 @@ mod column_tests {
         assert!(matches!(columns[1], Column::Values(_)));
         let m = mission(columns);
         for d in 0..3 {
-            assert_eq!(m.attribute(0, d), numbers[d]);
-            assert_eq!(m.attribute(1, d), mixed[d]);
+            assert_eq!(m.attribute(0, DroneId(d)), numbers[d]);
+            assert_eq!(m.attribute(1, DroneId(d)), mixed[d]);
         }
         assert_eq!(
-            (m.attribute(0, 3), m.attribute(2, 0)),
+            (m.attribute(0, DroneId(3)), m.attribute(2, DroneId(0))),
             (None, None),
             "no such drone, no such attribute"
         );

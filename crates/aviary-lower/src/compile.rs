@@ -213,7 +213,8 @@ impl<'a> Compiler<'a> {
         if let Some(&i) = self.index.drones.get(name) {
             return ActorRef::Drone(i);
         }
-        let members = self.index.groups.get(name).map(|g| g.members.clone());
+        let members =
+            self.index.groups.get(name).map(|g| g.members.iter().map(|&d| DroneId(d)).collect());
         ActorRef::Group(members.unwrap_or_default())
     }
 
@@ -955,7 +956,7 @@ impl<'w> WorldIndex<'w> {
             map
         }
         WorldIndex {
-            drones: first(w.drones.iter().enumerate().map(|(i, d)| (d.name.as_str(), i))),
+            drones: first(w.drones.iter().enumerate().map(|(i, d)| (d.name.as_str(), DroneId(i)))),
             groups: first(w.groups.iter().map(|g| (g.name.as_str(), g))),
             places: first(w.places.iter().map(|p| (p.name.as_str(), p))),
             areas: first(w.areas.iter().map(|a| (a.name.as_str(), a))),

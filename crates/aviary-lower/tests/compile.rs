@@ -1,7 +1,7 @@
 //! The compiler on the paper's mission and on small missions: names become indices,
 //! handlers sit on the block they hear, defaults and units are resolved once.
 
-use aviary_api::{BuiltinLeash, FunctionCall, Point, Resource, Value};
+use aviary_api::{BuiltinLeash, DroneId, FunctionCall, Point, Resource, Value};
 use aviary_ir::*;
 use aviary_lower::compile;
 use aviary_test_support::harness;
@@ -56,7 +56,7 @@ fn the_paper_mission_compiles_with_handlers_on_their_block() {
     let sensor = m.drones.position("sensor_drone").unwrap();
     assert_eq!(start.handlers[2].by, Some(ActorFilter::Drones(vec![sensor])));
     // `BY flir_drone` names the FOR alias of a sibling handler: any of its instances.
-    let flirs: Vec<usize> =
+    let flirs: Vec<DroneId> =
         ["flir_drone1", "flir_drone2"].iter().map(|n| m.drones.position(n).unwrap()).collect();
     assert_eq!(start.handlers[3].by, Some(ActorFilter::Drones(flirs)));
 }
@@ -116,7 +116,7 @@ fn units_become_si_and_geo_becomes_local() {
     assert_eq!(
         **battery,
         Expr::Compare(
-            Box::new(Expr::Telemetry(ActorRef::Drone(0), Field::Battery)),
+            Box::new(Expr::Telemetry(ActorRef::Drone(DroneId(0)), Field::Battery)),
             Compare::Gt,
             Box::new(Expr::Const(Value::Number(0.25)))
         )
@@ -144,15 +144,15 @@ fn for_instances_groups_and_slots() {
     );
     let Node::For(f) = &m.body.items[0] else { panic!() };
     assert!(f.parallel);
-    assert_eq!(f.instances[0].0, ActorRef::Group(vec![0, 1]));
-    assert_eq!(f.instances[1].0, ActorRef::Drone(2));
+    assert_eq!(f.instances[0].0, ActorRef::Group(vec![DroneId(0), DroneId(1)]));
+    assert_eq!(f.instances[1].0, ActorRef::Drone(DroneId(2)));
     let Node::Call(fly) = &f.body.items[0] else { panic!() };
     assert_eq!(fly.actors, [ActorRef::Slot(f.alias)]);
     assert_eq!(fly.args, [Expr::Slot(f.params[0]), Expr::Const(Value::Number(0.0))]);
     let handler = &m.body.handlers[0];
     assert_eq!(
         handler.by,
-        Some(ActorFilter::Drones(vec![0, 1, 2])),
+        Some(ActorFilter::Drones(vec![DroneId(0), DroneId(1), DroneId(2)])),
         "the alias stands for every instance"
     );
     let Node::Call(land) = &handler.body.items[0] else { panic!() };

@@ -92,19 +92,19 @@ impl MavlinkBackend {
 
     /// Whether `drone` is one of this backend's.
     pub fn serves(&self, drone: DroneId) -> bool {
-        self.inner.crafts.get(drone).is_some_and(Option::is_some)
+        self.inner.crafts.get(drone.0).is_some_and(Option::is_some)
     }
 
     /// Metres flown and seconds in the air, from the track the drone reported.
     pub fn odometry(&self, drone: DroneId) -> Option<(f64, f64)> {
-        let c = self.inner.crafts.get(drone)?.as_ref()?;
+        let c = self.inner.crafts.get(drone.0)?.as_ref()?;
         let seen = c.v.seen();
         Some((seen.odometer, seen.flight_time))
     }
 
     /// Whether the video stream is on, and what the drone carries.
     pub fn payload_state(&self, drone: DroneId) -> Option<(bool, Option<String>)> {
-        let c = self.inner.crafts.get(drone)?.as_ref()?;
+        let c = self.inner.crafts.get(drone.0)?.as_ref()?;
         Some((c.streaming(), c.carrying.lock().clone()))
     }
 }
@@ -126,9 +126,9 @@ impl Inner {
         if !matches!(slot.function, Function::Sweep | Function::FollowPath) {
             return;
         }
-        let Some(Some(c)) = self.crafts.get(slot.drone) else { return };
+        let Some(Some(c)) = self.crafts.get(slot.drone.0) else { return };
         let (Some(next), Some(fix)) = (c.flying_to(), c.fix()) else { return };
-        if let Some(stop) = self.stops.lock().get_mut(slot.drone) {
+        if let Some(stop) = self.stops.lock().get_mut(slot.drone.0) {
             *stop = Some(Progress { next, at: fix.pos });
         }
     }
@@ -140,10 +140,10 @@ impl Inner {
             // The rule below and the autopilot's battery failsafe may both see it: one
             // fault, one exception.
             let mut flags = self.battery.lock();
-            if flags[drone].1 {
+            if flags[drone.0].1 {
                 return;
             }
-            flags[drone].1 = true;
+            flags[drone.0].1 = true;
         }
         let cut: Vec<Slot> = {
             let mut calls = self.calls.lock();
@@ -161,7 +161,7 @@ impl Inner {
         for slot in cut {
             let _ = slot.end.send(CallEnd::Interrupted);
         }
-        if let Some(Some(c)) = self.crafts.get(drone) {
+        if let Some(Some(c)) = self.crafts.get(drone.0) {
             c.set_doing(Doing::Other);
         }
     }
@@ -187,9 +187,9 @@ impl Inner {
         let home = aviary_api::geometry::dist([fix.pos[0], fix.pos[1]], c.home);
         let need = c.battery.need(home, fix.pos[2], drawn);
         let (is_low, is_critical) = crate::battery::alarms(battery, need);
-        let (low, critical) = self.battery.lock()[drone];
+        let (low, critical) = self.battery.lock()[drone.0];
         if !low && is_low {
-            self.battery.lock()[drone].0 = true;
+            self.battery.lock()[drone.0].0 = true;
             let _ =
                 self.events.send(DroneEvent::Signal { drone, signal: BuiltinSignal::BatteryLow });
         }
@@ -224,7 +224,7 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
         let now = aviary_clock::Instant::now();
         for (drone, craft) in inner.crafts.iter().enumerate() {
             let Some(c) = craft else { continue };
-            inner.battery_rule(drone, c);
+            inner.battery_rule(DroneId(drone), c);
             // Lost only when silent by both clocks. The mission's follows the vehicles'
             // (`clock`): on a machine too busy for its SITLs one vehicle may lag a second
             // of the wall's while the others set the pace, which is many seconds of theirs,
@@ -239,7 +239,7 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
                 inner.lost.lock()[drone] = !fresh;
                 if fresh {
                     let _ = inner.events.send(DroneEvent::Signal {
-                        drone,
+                        drone: DroneId(drone),
                         signal: BuiltinSignal::ConnectionRestored,
                     });
                 } else {
@@ -250,7 +250,10 @@ async fn watchdog(inner: std::sync::Weak<Inner>, limit: Duration) {
                         limit.as_secs_f64(),
                         c.link.address
                     );
-                    inner.fault(drone, Failure::new(BuiltinException::ConnectionLost, reason));
+                    inner.fault(
+                        DroneId(drone),
+                        Failure::new(BuiltinException::ConnectionLost, reason),
+                    );
                 }
             }
         }
@@ -262,7 +265,7 @@ impl Backend for MavlinkBackend {
         let function = call.function();
         let id = CallId(self.inner.next.fetch_add(1, Ordering::SeqCst));
         let (tx, rx) = oneshot::channel();
-        let Some(Some(craft)) = self.inner.crafts.get(drone).cloned() else {
+        let Some(Some(craft)) = self.inner.crafts.get(drone.0).cloned() else {
             let _ = tx.send(CallEnd::Failed(failed(format!(
                 "drone number {drone} is not a MAVLink drone"
             ))));
@@ -272,9 +275,9 @@ impl Backend for MavlinkBackend {
             // A motion call forgets where the last path call stopped, before anything can
             // refuse it: a refused call has not moved.
             craft.set_flying_to(None);
-            self.inner.stops.lock()[drone] = None;
+            self.inner.stops.lock()[drone.0] = None;
         }
-        if self.inner.lost.lock()[drone] {
+        if self.inner.lost.lock()[drone.0] {
             // The drone stays lost to the mission until its link is back: what is asked
             // of it meanwhile raises the exception a handler of the loss already knows.
             let reason = format!(
@@ -312,7 +315,7 @@ impl Backend for MavlinkBackend {
                 };
                 slot.task.abort();
                 self.inner.note_stop(&slot);
-                if let Some(Some(c)) = self.inner.crafts.get(slot.drone).cloned() {
+                if let Some(Some(c)) = self.inner.crafts.get(slot.drone.0).cloned() {
                     c.set_doing(Doing::Other);
                     // The drone stops where it is and hovers (the task that flew it is gone).
                     if c.state().airborne() {
@@ -333,12 +336,12 @@ impl Backend for MavlinkBackend {
     /// gripper reports no kind (MAVLink has no message for what it holds), so this is
     /// what Aviary asked for and the autopilot accepted, not what a sensor saw.
     fn payload(&self, drone: DroneId) -> Option<String> {
-        let Some(Some(c)) = self.inner.crafts.get(drone) else { return None };
+        let Some(Some(c)) = self.inner.crafts.get(drone.0) else { return None };
         c.carrying.lock().clone()
     }
 
     fn telemetry(&self, drone: DroneId) -> Telemetry {
-        let Some(Some(c)) = self.inner.crafts.get(drone) else {
+        let Some(Some(c)) = self.inner.crafts.get(drone.0) else {
             return Telemetry::LOST;
         };
         let state = c.state();
@@ -353,12 +356,12 @@ impl Backend for MavlinkBackend {
             heading: fix.map_or(0.0, |f| f.heading),
             battery: seen.battery.unwrap_or(1.0),
             state,
-            link: !self.inner.lost.lock()[drone],
+            link: !self.inner.lost.lock()[drone.0],
         }
     }
 
     fn stopped(&self, drone: DroneId) -> Option<Progress> {
-        self.inner.stops.lock().get(drone).copied().flatten()
+        self.inner.stops.lock().get(drone.0).copied().flatten()
     }
 
     fn events(&self) -> Option<mpsc::UnboundedReceiver<DroneEvent>> {

@@ -35,7 +35,7 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
     for (i, address, system, _) in &bound {
         let link = Arc::clone(&links[address]);
         let v = Arc::new(Vehicle::new(
-            *i,
+            DroneId(*i),
             world.drones[*i].name.clone(),
             *system,
             origin,
@@ -44,7 +44,7 @@ pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, St
             alarms_tx.clone(),
         ));
         link.add(Arc::clone(&v));
-        vehicles.push((*i, link, v));
+        vehicles.push((DroneId(*i), link, v));
     }
     hear_all(&vehicles, tuning).await?;
     let all = read_facts(&vehicles, tuning).await;
@@ -110,7 +110,7 @@ async fn read_facts(vehicles: &[Bound], tuning: Tuning) -> Vec<Facts> {
     let mut reads = tokio::task::JoinSet::new();
     for (i, link, v) in vehicles {
         let (i, link, v) = (*i, Arc::clone(link), Arc::clone(v));
-        reads.spawn(async move { facts::read(i, &link, &v, until).await });
+        reads.spawn(async move { facts::read(i.0, &link, &v, until).await });
     }
     let mut all: Vec<Facts> = Vec::new();
     while let Some(done) = reads.join_next().await {
@@ -131,8 +131,8 @@ fn crafts(
     let mut crafts: Vec<Option<Arc<Craft>>> = vec![None; world.drones.len()];
     let airspace = Arc::new(aviary_route::Airspace::of(world));
     for (i, link, v) in vehicles {
-        let mut d = world.drones[i].clone();
-        let landing = match all.iter().find(|f| f.drone == i) {
+        let mut d = world.drones[i.0].clone();
+        let landing = match all.iter().find(|f| f.drone == i.0) {
             Some(f) => {
                 f.apply(&mut d);
                 f.landing(&d)
@@ -140,7 +140,7 @@ fn crafts(
             None => d.descent(),
         };
         let craft = craft(&d, landing, (link, v), world, Arc::clone(&airspace), tuning);
-        crafts[i] = Some(Arc::new(craft));
+        crafts[i.0] = Some(Arc::new(craft));
     }
     crafts
 }

@@ -109,10 +109,23 @@ mod tests {
             v.seen().fix.map(|f| (f.pos[0] * 10.0).round() / 10.0)
         }
 
-        fn vehicle() -> (Vehicle, mpsc::UnboundedReceiver<(usize, aviary_api::Failure)>) {
+        fn vehicle(
+        ) -> (Vehicle, mpsc::UnboundedReceiver<(aviary_api::DroneId, aviary_api::Failure)>)
+        {
             let (events, _) = mpsc::unbounded_channel::<DroneEvent>();
             let (alarms, rx) = mpsc::unbounded_channel();
-            (Vehicle::new(0, "d".into(), 1, ORIGIN, Vec::new(), events, alarms), rx)
+            (
+                Vehicle::new(
+                    aviary_api::DroneId(0),
+                    "d".into(),
+                    1,
+                    ORIGIN,
+                    Vec::new(),
+                    events,
+                    alarms,
+                ),
+                rx,
+            )
         }
 
         #[test]
@@ -130,7 +143,7 @@ mod tests {
                 }
                 let (drone, failure) = alarms.try_recv().expect("PositionLost");
                 assert_eq!(
-                    (drone, failure.exception),
+                    (drone.0, failure.exception),
                     (0, aviary_api::BuiltinException::PositionLost)
                 );
                 assert!(failure.reason.contains("300 km"), "{}", failure.reason);

@@ -39,7 +39,15 @@ pub fn hear(bytes: &[u8], origin: Origin, targets: Vec<Target>, range: f64) -> H
     kinds.sort();
     kinds.dedup();
     let n = targets.len();
-    let vehicle = Vehicle::new(0, "heard".into(), 1, origin, targets, events_tx, alarms_tx);
+    let vehicle = Vehicle::new(
+        aviary_api::DroneId(0),
+        "heard".into(),
+        1,
+        origin,
+        targets,
+        events_tx,
+        alarms_tx,
+    );
     for kind in kinds {
         vehicle.seen().detecting.push(Activation { kind, range, found: vec![false; n] });
     }

@@ -29,7 +29,7 @@ impl Mixed {
     pub fn new(sim: Arc<SimBackend>, mavlink: MavlinkBackend) -> Mixed {
         let (tx, rx) = mpsc::unbounded_channel();
         let served: Vec<bool> =
-            (0..sim.with_fleet(|f| f.len())).map(|d| mavlink.serves(d)).collect();
+            (0..sim.with_fleet(|f| f.len())).map(|d| mavlink.serves(DroneId(d))).collect();
         if let Some(mut from_sim) = sim.events() {
             let tx = tx.clone();
             let served = served.clone();
@@ -37,7 +37,7 @@ impl Mixed {
                 while let Some(e) = from_sim.recv().await {
                     // The simulator also models the MAVLink drones (idle at home): drop
                     // what it says of them.
-                    if !served.get(e.drone()).copied().unwrap_or(false) && tx.send(e).is_err() {
+                    if !served.get(e.drone().0).copied().unwrap_or(false) && tx.send(e).is_err() {
                         return;
                     }
                 }

@@ -13,7 +13,7 @@ use std::convert::Infallible;
 use std::sync::Arc;
 
 use aviary_api::trace::{EventKind, Record, Status};
-use aviary_api::Backend;
+use aviary_api::{Backend, DroneId};
 use aviary_check::SourceProvider;
 use aviary_diagnostics::{Diagnostic, SourceMap};
 use aviary_engine::{Control, Controller, Outcome, RunOptions, TraceSink};
@@ -290,9 +290,9 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
         hooks.end(Stage::Flight);
         sim.stop();
         // A MAVLink drone's distance and flight time come from the track it reported.
-        let odometry = |d: usize| match mixed.as_ref().filter(|m| m.mavlink.serves(d)) {
-            Some(m) => m.mavlink.odometry(d),
-            None => Some(sim.with_fleet(|f| f.odometry(d))),
+        let odometry = |d: usize| match mixed.as_ref().filter(|m| m.mavlink.serves(DroneId(d))) {
+            Some(m) => m.mavlink.odometry(DroneId(d)),
+            None => Some(sim.with_fleet(|f| f.odometry(DroneId(d)))),
         };
         hooks.landed(&mission, backend, &odometry);
         Ok(Flown { outcome, flew: true, simulated: sim.time() })
@@ -390,7 +390,7 @@ pub fn fly_prepared(
         };
         hooks.end(Stage::Flight);
         sim.stop();
-        let odometry = |d: usize| Some(sim.with_fleet(|f| f.odometry(d)));
+        let odometry = |d: usize| Some(sim.with_fleet(|f| f.odometry(DroneId(d))));
         hooks.landed(mission, backend, &odometry);
         Ok(Flown { outcome, flew: true, simulated: sim.time() })
     })
@@ -466,7 +466,8 @@ mod tests {
             backend: &dyn Backend,
             _: &dyn Fn(usize) -> Option<(f64, f64)>,
         ) {
-            let landed = (0..mission.drones.len()).all(|d| !backend.telemetry(d).state.airborne());
+            let landed =
+                (0..mission.drones.len()).all(|d| !backend.telemetry(DroneId(d)).state.airborne());
             self.said.push(format!("landed {landed}"));
         }
     }

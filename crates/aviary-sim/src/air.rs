@@ -209,7 +209,7 @@ impl AirState {
     /// the wind at the drone afterwards.
     pub fn blow(&mut self, id: DroneId, z: f64, v: f64, dt: f64) -> Option<[f64; 2]> {
         let wind = self.wind.as_ref()?;
-        let a = &mut self.drones[id];
+        let a = &mut self.drones[id.0];
         if let (Some(w20), Some(luck)) = (wind.w20, a.gust_luck.as_deref_mut()) {
             // The standard's figures change slowly with height: worked out again only
             // when the drone has climbed or descended a metre.
@@ -254,9 +254,9 @@ impl AirState {
     /// The factor of the drain of a drone flying at `ground` velocity in `wind`:
     /// `P(airspeed) / P(ground speed)`, so that still air drains as the endurance says.
     pub fn drain_factor(&self, id: DroneId, ground: [f64; 2], max_speed: f64) -> f64 {
-        let capacity = self.drones[id].capacity;
+        let capacity = self.drones[id.0].capacity;
         let Some(wind) = &self.wind else { return 1.0 / capacity };
-        aviary_api::flight::wind_drain(ground, self.drones[id].wind, max_speed, wind.drain)
+        aviary_api::flight::wind_drain(ground, self.drones[id.0].wind, max_speed, wind.drain)
             / capacity
     }
 
@@ -336,7 +336,7 @@ impl crate::fleet::Fleet {
             }
             a.out_of_reach = out_now;
             let held = std::mem::take(&mut a.fault_until);
-            self.touch(id);
+            self.touch(DroneId(id));
             let outage = self.drones[id].rare.as_mut().and_then(|r| r.link_loss.as_mut());
             match (out_now, outage) {
                 (true, Some(o)) => {
@@ -348,10 +348,10 @@ impl crate::fleet::Fleet {
                     }
                 }
                 (true, None) => {
-                    let name = &self.names[id];
+                    let name = &self.names[DroneId(id)];
                     let reason =
                         format!("{name}: out of radio reach of the station and every relay");
-                    self.lose_link(id, end, f64::INFINITY, reason, out);
+                    self.lose_link(DroneId(id), end, f64::INFINITY, reason, out);
                 }
                 // Back in reach: the outage ends now, or when a fault's does
                 // (`ConnectionRestored`, with the faults' outages).
@@ -366,11 +366,11 @@ impl crate::fleet::Fleet {
     /// its motion flies in.
     pub(crate) fn air_wind(&mut self, id: DroneId) {
         let Some(air) = self.air.as_deref_mut() else { return };
-        let d = &mut self.drones[id];
+        let d = &mut self.drones[id.0];
         if air.wind.is_none() || !d.state.airborne() {
             return;
         }
-        let v = air.drones[id].wind;
+        let v = air.drones[id.0].wind;
         let wind = match air.span {
             Some(span) => {
                 let airspeed = aviary_api::geometry::hypot(d.vel[0] - v[0], d.vel[1] - v[1]);
@@ -387,23 +387,23 @@ impl crate::fleet::Fleet {
     /// `None` without `[air]`.
     pub(crate) fn air_drain(&self, id: DroneId) -> Option<(f64, f64)> {
         let air = self.air.as_deref()?;
-        let d = &self.drones[id];
+        let d = &self.drones[id.0];
         let factor = air.drain_factor(id, [d.vel[0], d.vel[1]], d.spec.max_speed);
-        Some((factor, air.drones[id].capacity))
+        Some((factor, air.drones[id.0].capacity))
     }
 
     /// The random faults of drone `id` due by its flight time, each fired and the next
     /// of its kind drawn; `now` is the end of the step.
     pub(crate) fn air_faults(&mut self, id: DroneId, now: f64, out: &mut Vec<Report>) {
-        let flown = self.drones[id].flight_time;
+        let flown = self.drones[id.0].flight_time;
         loop {
             let Some(air) = self.air.as_deref_mut().filter(|a| a.any_faults) else { return };
-            let Some(f) = air.drones[id].faults.iter_mut().find(|f| f.at <= flown) else {
+            let Some(f) = air.drones[id.0].faults.iter_mut().find(|f| f.at <= flown) else {
                 return;
             };
             let (kind, duration) = (f.kind, f.duration);
             f.at += f.luck.exponential(f.rate) * 3600.0;
-            if self.drones[id].state == FlightState::Lost {
+            if self.drones[id.0].state == FlightState::Lost {
                 return;
             }
             self.touch(id);

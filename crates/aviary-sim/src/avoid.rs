@@ -168,7 +168,7 @@ impl Fleet {
     /// `id` (only a humble drone looks at them) have not moved yet: they are predicted
     /// afresh, going their own way as if they did not yield.
     fn track(&mut self, j: DroneId, id: DroneId) -> Track {
-        let d = &self.drones[j];
+        let d = &self.drones[j.0];
         if j > id {
             let mut plain = d.clone();
             plain.avoid = None;
@@ -179,9 +179,9 @@ impl Fleet {
 
     /// Chooses how drone `id` gives way this tick (see the module doc); sets its `avoid`.
     pub(crate) fn plan(&mut self, id: DroneId, dt: f64, near: &[Envelope]) {
-        let d = &self.drones[id];
+        let d = &self.drones[id.0];
         if !d.state.airborne() {
-            self.drones[id].avoid = None;
+            self.drones[id.0].avoid = None;
             return;
         }
         // A drone held back for long gives way to everyone, not only to those before it,
@@ -189,30 +189,30 @@ impl Fleet {
         let humble = d.humble || d.stalled >= STALL;
         let higher = self.to_give_way_to(id, humble);
         if higher.is_empty() && d.avoid.is_none() {
-            self.drones[id].humble = false;
+            self.drones[id.0].humble = false;
             return;
         }
         if d.avoid.is_none() && self.clear_ahead(id, &higher, dt) {
             // Going on as planned is clear: what the prediction below would find.
-            self.drones[id].humble = false;
+            self.drones[id.0].humble = false;
             return;
         }
         let theirs: Vec<Track> = higher.iter().map(|&j| self.track(j, id)).collect();
-        let d = &self.drones[id];
+        let d = &self.drones[id.0];
         let judge = Judge { d, theirs: &theirs, dt, near, sep: self.min_separation };
         let current = d.avoid;
         let back_to = current.filter(|y| y.alt.is_some()).map_or(d.pos[2], |y| y.back_to);
         let nominal = coming_back(d, current, back_to);
         let first = judge.score(nominal, current.is_none());
         if first.room >= 0.0 {
-            self.drones[id].avoid = nominal;
-            self.drones[id].humble = humble && nominal.is_some();
+            self.drones[id.0].avoid = nominal;
+            self.drones[id.0].humble = humble && nominal.is_some();
             return;
         }
         let ways = self.ways_to_give_way(d, current, back_to, &theirs, &first.close);
         let way = judge.choose(ways, (first.free, first.room, nominal));
-        self.drones[id].avoid = way;
-        self.drones[id].humble = humble && way.is_some();
+        self.drones[id.0].avoid = way;
+        self.drones[id.0].humble = humble && way.is_some();
     }
 
     /// Whether drone `id`, going on as planned without a yield, surely keeps
@@ -221,7 +221,7 @@ impl Fleet {
     /// Then no track need be predicted (most ticks, when drones fly apart).
     fn clear_ahead(&mut self, id: DroneId, higher: &[DroneId], dt: f64) -> bool {
         let sep = self.min_separation;
-        let Some(mine) = reach_box(&self.drones[id], dt + HORIZON) else {
+        let Some(mine) = reach_box(&self.drones[id.0], dt + HORIZON) else {
             return false;
         };
         for &j in higher {
@@ -237,7 +237,7 @@ impl Fleet {
     /// Where drone `j` can be over the horizon, for the planning of drone `id`: the box
     /// of its legs, or, when it yields, of its predicted track (`None`: never in the air).
     fn their_box(&mut self, j: DroneId, id: DroneId) -> Option<Bounds> {
-        match reach_box(&self.drones[j], HORIZON) {
+        match reach_box(&self.drones[j.0], HORIZON) {
             Some(b) => Some(b),
             None => Bounds::of_points(self.track(j, id).iter().flatten()),
         }
@@ -248,7 +248,7 @@ impl Fleet {
     #[cfg(debug_assertions)]
     #[allow(clippy::panic)] // a debug build's own check of its reasoning: it must stop loudly
     fn check_boxes(&mut self, id: DroneId, dt: f64, mine: Bounds, higher: &[DroneId]) {
-        let (track, _) = predict_with(&self.drones[id], None, dt, &[], self.min_separation);
+        let (track, _) = predict_with(&self.drones[id.0], None, dt, &[], self.min_separation);
         let outside = |t: &Track, b: Bounds| t.iter().flatten().find(|p| !b.holds(**p)).copied();
         if let Some(p) = outside(&track, mine) {
             panic!("drone {id} reaches {p:?} outside its box {mine:?}");
@@ -271,18 +271,19 @@ impl Fleet {
     /// humble) that could come near it within the horizon, in index order.
     fn to_give_way_to(&self, id: DroneId, humble: bool) -> Vec<DroneId> {
         let sep = self.min_separation;
-        let d = &self.drones[id];
+        let d = &self.drones[id.0];
         let speed = |d: &SimDrone| d.spec.fastest;
         let range = |o: &SimDrone| sep + MARGIN + HORIZON * (speed(d) + speed(o)) + 1.0;
         // Every drone that could be in range, in index order, from the sky's grid.
         let mut candidates = Vec::new();
         self.sky.around(d.xy(), d.xy(), reach(self, d), &mut candidates);
         (candidates.iter().copied())
-            .filter(|&j| j < id || (humble && j != id))
+            .filter(|&j| j < id.0 || (humble && j != id.0))
             .filter(|&j| {
                 let o = &self.drones[j];
                 o.state.airborne() && norm_below(sub(o.pos, d.pos), range(o))
             })
+            .map(DroneId)
             .collect()
     }
 

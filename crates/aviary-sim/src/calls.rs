@@ -39,12 +39,14 @@ impl Fleet {
         if motion {
             // A motion call forgets where the last path call stopped (`Backend::stopped`),
             // before anything can refuse it: a refused call has not moved.
-            if let Some(rare) = self.drones.get_mut(id).and_then(|d| d.rare.as_deref_mut()) {
+            if let Some(rare) = self.drones.get_mut(id.0).and_then(|d| d.rare.as_deref_mut()) {
                 rare.stopped = None;
             }
         }
-        let d =
-            self.drones.get(id).ok_or_else(|| failed(format!("there is no drone number {id}")))?;
+        let d = self
+            .drones
+            .get(id.0)
+            .ok_or_else(|| failed(format!("there is no drone number {id}")))?;
         if d.state == FlightState::Lost {
             return Err(failed(format!("{} is lost", &self.names[id])));
         }
@@ -66,20 +68,20 @@ impl Fleet {
         if motion && d.gps_loss().is_some() {
             return Err(failed(format!("{} has no position fix", &self.names[id])));
         }
-        let d = &mut self.drones[id];
+        let d = &mut self.drones[id.0];
         if aside {
             d.set_aside();
         }
         let start = self.begin(id, call, function);
         if aside && !matches!(start, Ok(Start::Moves(..))) {
             // Refused, or nothing to fly: the paused call is back at once, as it was.
-            self.drones[id].bring_back();
+            self.drones[id.0].bring_back();
         }
         match start? {
             Start::Done => Ok(false),
             Start::Pending => Ok(true),
             Start::Moves(legs, path) => {
-                let d = &mut self.drones[id];
+                let d = &mut self.drones[id.0];
                 if d.motion.take().is_some() {
                     d.settle();
                 }
@@ -99,7 +101,7 @@ impl Fleet {
         call: CallId,
         function: &FunctionCall,
     ) -> Result<Start, Failure> {
-        let m = Mover { d: &self.drones[id], name: &self.names[id], limits: self.limits() };
+        let m = Mover { d: &self.drones[id.0], name: &self.names[id], limits: self.limits() };
         let mut path = None;
         let legs = match function {
             FunctionCall::Arm => return self.arm(id, Function::Arm),
@@ -135,19 +137,19 @@ impl Fleet {
 
     /// `Arm` and `Disarm`, on the ground only.
     fn arm(&mut self, id: DroneId, function: Function) -> Result<Start, Failure> {
-        if self.drones[id].state != FlightState::Landed {
+        if self.drones[id.0].state != FlightState::Landed {
             return Err(failed(format!(
                 "{} can only {} on the ground",
                 &self.names[id],
                 function.name().to_lowercase()
             )));
         }
-        self.drones[id].armed = function == Function::Arm;
+        self.drones[id.0].armed = function == Function::Arm;
         Ok(Start::Done)
     }
 
     fn stream(&mut self, id: DroneId, on: bool) -> Result<Start, Failure> {
-        let d = &mut self.drones[id];
+        let d = &mut self.drones[id.0];
         if !d.spec.sensors.iter().any(|s| s == "camera") {
             return Err(failed(format!("{} has no camera", &self.names[id])));
         }
@@ -156,7 +158,7 @@ impl Fleet {
     }
 
     fn detect(&mut self, id: DroneId, start: bool, kind: &str) -> Result<Start, Failure> {
-        let d = &mut self.drones[id];
+        let d = &mut self.drones[id.0];
         let kind = kind.to_owned();
         let Some((range, probability)) = detection_range(&self.sensors, &d.spec.sensors, &kind)
         else {
@@ -166,7 +168,7 @@ impl Fleet {
         detections.retain(|a| a.kind != kind);
         if start {
             let falloff = self.air.as_ref().and_then(|a| a.falloff.clone());
-            let d = &mut self.drones[id];
+            let d = &mut self.drones[id.0];
             let detections = &mut d.rare_mut().detections;
             detections.push(Activation {
                 kind,
@@ -181,7 +183,7 @@ impl Fleet {
     }
 
     fn load(&mut self, id: DroneId, call: CallId, kind: &str) -> Result<Start, Failure> {
-        let d = &mut self.drones[id];
+        let d = &mut self.drones[id.0];
         let kind = kind.to_owned();
         if !d.spec.payload_kinds.contains(&kind) {
             let can = if d.spec.payload_kinds.is_empty() {
@@ -213,7 +215,7 @@ impl Fleet {
 
     fn release(&mut self, id: DroneId) -> Result<Start, Failure> {
         let time = self.time;
-        let d = &mut self.drones[id];
+        let d = &mut self.drones[id.0];
         let Some(kind) = d.rare.as_mut().and_then(|r| r.carrying.take()) else {
             return Err(failed(format!("{} carries nothing to release", &self.names[id])));
         };

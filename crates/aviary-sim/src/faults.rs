@@ -42,7 +42,7 @@ impl Fleet {
             f.fired = true;
             let (id, kind, at, until) = (f.drone, f.kind, f.at, f.at + f.duration);
             self.touch(id);
-            if self.drones[id].state == FlightState::Lost {
+            if self.drones[id.0].state == FlightState::Lost {
                 continue;
             }
             self.fire(id, kind, at, until, out);
@@ -51,7 +51,10 @@ impl Fleet {
         self.return_without_link(end, out);
         let drones = &self.drones;
         self.outages.retain(|&id| {
-            drones[id].rare.as_ref().is_some_and(|r| r.link_loss.is_some() || r.gps_loss.is_some())
+            drones[id.0]
+                .rare
+                .as_ref()
+                .is_some_and(|r| r.link_loss.is_some() || r.gps_loss.is_some())
         });
     }
 
@@ -69,7 +72,7 @@ impl Fleet {
         match kind {
             FaultKind::BatteryCritical => {
                 let capacity = self.capacity(id);
-                let d = &mut self.drones[id];
+                let d = &mut self.drones[id.0];
                 if d.critical_sent {
                     return;
                 }
@@ -98,7 +101,7 @@ impl Fleet {
                     format!("{name}: GPS lost (simulated fault)"),
                     out,
                 );
-                self.drones[id].rare_mut().gps_loss =
+                self.drones[id.0].rare_mut().gps_loss =
                     Some(Outage { since: at, until, returned: false });
                 self.outage(id);
                 self.on_its_own(id, AutopilotAction::Hold, "GPS lost: holds where it is", out);
@@ -117,7 +120,7 @@ impl Fleet {
         out: &mut Vec<Report>,
     ) {
         self.fault(id, BuiltinException::ConnectionLost, reason, out);
-        self.drones[id].rare_mut().link_loss = Some(Outage { since: at, until, returned: false });
+        self.drones[id.0].rare_mut().link_loss = Some(Outage { since: at, until, returned: false });
         self.outage(id);
         self.on_its_own(id, AutopilotAction::Hold, "link lost: holds where it is", out);
     }
@@ -132,7 +135,7 @@ impl Fleet {
             out,
         );
         self.on_its_own(id, AutopilotAction::Land, "motor failure: lands where it is", out);
-        let d = &mut self.drones[id];
+        let d = &mut self.drones[id.0];
         d.rare_mut().disabled = Some(format!("{name} had a motor failure"));
         if d.state.airborne() {
             let to = [d.pos[0], d.pos[1], 0.0];
@@ -145,7 +148,7 @@ impl Fleet {
     /// Tells the engine what the autopilot of drone `id` does on its own after a fault,
     /// when the drone is in the air (on the ground it just stays there).
     fn on_its_own(&self, id: DroneId, action: AutopilotAction, why: &str, out: &mut Vec<Report>) {
-        if self.drones[id].state.airborne() {
+        if self.drones[id.0].state.airborne() {
             let reason = format!("{}: {why}", &self.names[id]);
             out.push(Report::Event(DroneEvent::Autopilot { drone: id, action, reason }));
         }
@@ -155,7 +158,7 @@ impl Fleet {
     /// (`ConnectionRestored`). Only drones with an outage have anything to end.
     fn end_outages(&mut self, end: f64, out: &mut Vec<Report>) {
         for &id in &self.outages {
-            let d = &mut self.drones[id];
+            let d = &mut self.drones[id.0];
             let Some(rare) = d.rare.as_deref_mut() else { continue };
             if rare.link_loss.as_ref().is_some_and(|o| o.until <= end + 1e-9) {
                 rare.link_loss = None;
@@ -181,7 +184,7 @@ impl Fleet {
             airspace: &self.airspace,
         };
         for &id in &self.outages {
-            let d = &mut self.drones[id];
+            let d = &mut self.drones[id.0];
             let Some(outage) = d.rare.as_mut().and_then(|r| r.link_loss.as_mut()) else {
                 continue;
             };
@@ -189,7 +192,7 @@ impl Fleet {
                 continue;
             }
             outage.returned = true;
-            self.hot[id].known = false;
+            self.hot[id.0].known = false;
             let on_its_own = d.state.airborne() && d.motion.is_none() && d.disabled().is_none();
             if on_its_own {
                 if let Ok(legs) = return_legs(d, &self.names[id], false, &limits) {
@@ -206,7 +209,7 @@ impl Fleet {
     }
 
     /// Notes that drone `id` has an outage (the list stays ascending, without repeats).
-    pub(crate) fn outage(&mut self, id: usize) {
+    pub(crate) fn outage(&mut self, id: DroneId) {
         if let Err(at) = self.outages.binary_search(&id) {
             self.outages.insert(at, id);
         }

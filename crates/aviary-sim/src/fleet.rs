@@ -75,7 +75,7 @@ pub struct Fleet {
     pub(crate) releases: Vec<Release>,
     /// The drones in an airborne state at the start of this step (the only ones that
     /// can take part in separation during it), in order.
-    pub(crate) aloft: Vec<DroneId>,
+    pub(crate) aloft: Vec<usize>,
     /// The planner's predicted tracks of drones that moved already in this step.
     pub(crate) tracks: BTreeMap<DroneId, Track>,
     /// Whether each drone is in `aloft`.
@@ -217,7 +217,7 @@ impl Fleet {
             .filter_map(|f| {
                 let drone = world.drones.iter().position(|d| d.name == f.drone)?;
                 Some(ScheduledFault {
-                    drone,
+                    drone: DroneId(drone),
                     kind: f.kind,
                     at: f.at,
                     window: f.latest.map(|latest| [f.at, latest]),
@@ -276,8 +276,8 @@ impl Fleet {
 
     /// The drone's state now; `None` for an index the world does not have.
     pub fn telemetry(&self, drone: DroneId) -> Option<Telemetry> {
-        let mut t = self.drones.get(drone).map(SimDrone::telemetry)?;
-        if let Some(a) = self.air.as_deref().and_then(|air| air.drones.get(drone)) {
+        let mut t = self.drones.get(drone.0).map(SimDrone::telemetry)?;
+        if let Some(a) = self.air.as_deref().and_then(|air| air.drones.get(drone.0)) {
             t.gps_position[0] += a.gps[0];
             t.gps_position[1] += a.gps[1];
             if a.anemometer && self.air.as_ref().is_some_and(|air| air.wind.is_some()) {
@@ -293,19 +293,19 @@ impl Fleet {
     pub fn wind(&self, drone: DroneId) -> Option<[f64; 2]> {
         let air = self.air.as_deref()?;
         air.wind.as_ref()?;
-        air.drones.get(drone).map(|a| a.wind)
+        air.drones.get(drone.0).map(|a| a.wind)
     }
 
     /// The fraction of its nominal capacity that the drone's battery holds
     /// (`[air.battery] capacity_spread`; 1 without it).
     pub fn capacity(&self, drone: DroneId) -> f64 {
-        self.air.as_deref().and_then(|a| a.drones.get(drone)).map_or(1.0, |a| a.capacity)
+        self.air.as_deref().and_then(|a| a.drones.get(drone.0)).map_or(1.0, |a| a.capacity)
     }
 
     /// (metres flown, seconds in the air) of the drone so far; zeros for an index the
     /// world does not have.
     pub fn odometry(&self, drone: DroneId) -> (f64, f64) {
-        self.drones.get(drone).map_or((0.0, 0.0), |d| (d.odometer, d.flight_time))
+        self.drones.get(drone.0).map_or((0.0, 0.0), |d| (d.odometer, d.flight_time))
     }
 
     /// Every `ReleasePayload` so far, in order.
@@ -316,22 +316,22 @@ impl Fleet {
     /// What the drone carries.
     /// Where `drone`'s last `Sweep` or `FollowPath` stopped, when it ended early.
     pub fn stopped(&self, drone: DroneId) -> Option<aviary_api::Progress> {
-        self.drones.get(drone)?.rare.as_ref()?.stopped
+        self.drones.get(drone.0)?.rare.as_ref()?.stopped
     }
 
     pub fn carrying(&self, drone: DroneId) -> Option<&str> {
-        self.drones.get(drone)?.carrying().map(String::as_str)
+        self.drones.get(drone.0)?.carrying().map(String::as_str)
     }
 
     /// Whether the drone's video stream is on.
     pub fn streaming(&self, drone: DroneId) -> bool {
-        self.drones.get(drone).is_some_and(|d| d.streaming)
+        self.drones.get(drone.0).is_some_and(|d| d.streaming)
     }
 
     /// The kinds the drone is detecting, in the order detection started.
     pub fn detecting(&self, drone: DroneId) -> Vec<String> {
         self.drones
-            .get(drone)
+            .get(drone.0)
             .map(|d| d.detections().iter().map(|a| a.kind.clone()).collect())
             .unwrap_or_default()
     }
@@ -368,7 +368,7 @@ impl Fleet {
         // Only the call's own drone can have it in progress.
         let &drone = self.calls.get(&call)?;
         self.touch(drone);
-        if let Some(d) = self.drones.get_mut(drone) {
+        if let Some(d) = self.drones.get_mut(drone.0) {
             if d.motion.as_ref().is_some_and(|t| t.call == Some(call)) {
                 match how {
                     Interrupt::Abort => {
@@ -425,7 +425,7 @@ impl Fleet {
 
     /// Forgets what the fleet keeps about drone `id` between steps (it may have changed).
     pub(crate) fn touch(&mut self, id: DroneId) {
-        if let Some(h) = self.hot.get_mut(id) {
+        if let Some(h) = self.hot.get_mut(id.0) {
             h.known = false;
         }
     }

@@ -281,7 +281,7 @@ pub(crate) fn clear_of(d: &SimDrone, near: &[Envelope], sep: f64) -> bool {
 impl Fleet {
     /// The envelopes of the other drones in the air that drone `id` could reach in a tick.
     fn near(&self, id: DroneId, dt: f64) -> Vec<Envelope> {
-        let me = &self.drones[id];
+        let me = &self.drones[id.0];
         let (here, reach) = (me.pos, reach(me, dt));
         // The sky's grid gives every drone that could be that near, in index order.
         let mut candidates = Vec::new();
@@ -289,7 +289,7 @@ impl Fleet {
         self.sky.around(xy, xy, self.min_separation + reach + self.max_extent, &mut candidates);
         candidates
             .iter()
-            .filter(|&&j| j != id && counts(&self.drones[j]))
+            .filter(|&&j| j != id.0 && counts(&self.drones[j]))
             .map(|&j| (self.drones[j].pos, envelope(&self.drones[j])))
             .filter(|(p, e)| {
                 let apart = [p[0] - here[0], p[1] - here[1], p[2] - here[2]];
@@ -302,35 +302,35 @@ impl Fleet {
     /// Whether no other drone of the sky is within reach of drone `id`, neither of
     /// separation (`near`) nor of the planner (`plan`), and it is giving way to nobody.
     fn alone(&mut self, id: DroneId, dt: f64) -> bool {
-        let d = &self.drones[id];
+        let d = &self.drones[id.0];
         if d.avoid.is_some() {
             return false;
         }
         let separation = self.min_separation + reach(d, dt) + self.max_extent;
         let r = separation.max(crate::avoid::reach(self, d));
         let p = d.xy();
-        if self.clearance.clear(id, p, r) {
+        if self.clearance.clear(id.0, p, r) {
             #[cfg(test)]
-            self.check_clear(id, r);
+            self.check_clear(id.0, r);
             return true;
         }
         // The sky holds every drone of `aloft` where it is now (moved ones included).
         self.fresh_sky();
-        !self.sky.any_within(p, r, id)
+        !self.sky.any_within(p, r, id.0)
     }
 
     /// Moves drone `id` by one tick: the planner's choice if its envelope stays clear of
     /// every other drone in the air, else hard braking. Returns the task that finished.
     pub(crate) fn move_drone(&mut self, id: DroneId, dt: f64) -> Option<MotionTask> {
-        if self.min_separation <= 0.0 || !self.drones[id].state.airborne() {
-            self.drones[id].avoid = None;
-            self.drones[id].stalled = 0.0;
-            return self.drones[id].tick_motion(dt);
+        if self.min_separation <= 0.0 || !self.drones[id.0].state.airborne() {
+            self.drones[id.0].avoid = None;
+            self.drones[id.0].stalled = 0.0;
+            return self.drones[id.0].tick_motion(dt);
         }
         if self.alone(id, dt) {
             // What `near` and `plan` would conclude with nobody in reach: nothing to keep
             // clear of, no way to give (most drones of a large fleet, most of the time).
-            let d = &mut self.drones[id];
+            let d = &mut self.drones[id.0];
             d.humble = false;
             d.stalled = 0.0;
             return d.tick_motion(dt);
@@ -339,16 +339,16 @@ impl Fleet {
         let near = self.near(id, dt);
         self.plan(id, dt, &near);
         if near.is_empty() {
-            self.drones[id].stalled = 0.0;
-            return self.drones[id].tick_motion(dt);
+            self.drones[id.0].stalled = 0.0;
+            return self.drones[id.0].tick_motion(dt);
         }
-        let saved = self.drones[id].snapshot();
-        let finished = self.drones[id].tick_motion(dt);
-        if clear_of(&self.drones[id], &near, self.min_separation) {
-            self.drones[id].stalled = 0.0;
+        let saved = self.drones[id.0].snapshot();
+        let finished = self.drones[id.0].tick_motion(dt);
+        if clear_of(&self.drones[id.0], &near, self.min_separation) {
+            self.drones[id.0].stalled = 0.0;
             return finished;
         }
-        let d = &mut self.drones[id];
+        let d = &mut self.drones[id.0];
         d.restore(saved);
         d.brake_all(dt);
         d.stalled += dt;
@@ -402,12 +402,12 @@ impl Fleet {
     /// never left it).
     pub(crate) fn held_back(&mut self, id: DroneId, dt: f64) -> Option<Report> {
         let (sep, limit) = (self.min_separation, self.separation_timeout);
-        let d = &self.drones[id];
+        let d = &self.drones[id.0];
         let task = d.motion.as_ref()?;
         let now = progress(d, task);
         let acted = d.stalled > 0.0 || d.avoid.is_some();
         let counting = sep > 0.0 && d.state.airborne() && task.call.is_some() && !task.paused;
-        let d = &mut self.drones[id];
+        let d = &mut self.drones[id.0];
         let task = d.motion.as_mut()?;
         if !counting || nearer(now, task.best) {
             task.best = now;
@@ -422,18 +422,21 @@ impl Fleet {
             return None;
         }
         let call = task.call?;
-        let d = &self.drones[id];
+        let d = &self.drones[id.0];
         let blocker = (self.drones.iter().enumerate())
-            .filter(|&(j, o)| j != id && counts(o))
+            .filter(|&(j, o)| j != id.0 && counts(o))
             .map(|(j, o)| {
                 let gap = |k: usize| o.pos[k] - d.pos[k];
                 (hypot(hypot(gap(0), gap(1)), gap(2)), j)
             })
             .filter(|(apart, _)| *apart <= 2.0 * sep + MARGIN)
             .min_by(|a, b| a.0.total_cmp(&b.0))
-            .map_or_else(|| "the drones near it".to_owned(), |(_, j)| self.names[j].to_owned());
+            .map_or_else(
+                || "the drones near it".to_owned(),
+                |(_, j)| self.names[DroneId(j)].to_owned(),
+            );
         let reason = format!("{} waited {limit} s for {blocker} to make room", &self.names[id]);
-        let d = &mut self.drones[id];
+        let d = &mut self.drones[id.0];
         d.note_stop();
         d.motion = None;
         d.avoid = None;

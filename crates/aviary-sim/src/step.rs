@@ -70,7 +70,7 @@ impl Fleet {
             if self.hot[id].idle {
                 continue;
             }
-            self.step_drone(id, dt, &mut out);
+            self.step_drone(DroneId(id), dt, &mut out);
             let h = Hot::of(&self.drones[id]);
             self.hot[id] = h;
             // Keep the sky current for the drones after this one.
@@ -119,12 +119,12 @@ impl Fleet {
     }
 
     fn step_drone(&mut self, id: DroneId, dt: f64, out: &mut Vec<Report>) {
-        if self.drones[id].state == FlightState::Lost {
+        if self.drones[id.0].state == FlightState::Lost {
             return;
         }
-        let airborne = self.drones[id].state.airborne();
-        let from = self.drones[id].xy();
-        let before = self.drones[id].pos;
+        let airborne = self.drones[id.0].state.airborne();
+        let from = self.drones[id.0].xy();
+        let before = self.drones[id.0].pos;
         if self.air.is_some() {
             self.air_wind(id);
         }
@@ -134,7 +134,7 @@ impl Fleet {
                 out.push(report);
             }
         }
-        let d = &mut self.drones[id];
+        let d = &mut self.drones[id.0];
         if let Some(task) = finished {
             if let Some(call) = task.call {
                 out.push(Report::Ended { call, end: CallEnd::Done });
@@ -165,10 +165,10 @@ impl Fleet {
 
     /// Detection along the way drone `id` flew in this tick, from `from` to `to`.
     fn detect_along(&mut self, id: DroneId, from: [f64; 2], to: [f64; 2], out: &mut Vec<Report>) {
-        let d = &mut self.drones[id];
+        let d = &mut self.drones[id.0];
         // Only the targets near the way flown, in their order.
         let nearby = match d.detections().iter().map(|a| a.range).reduce(f64::max) {
-            Some(range) => self.near_targets[id].get_or_insert_with(Box::default).around(
+            Some(range) => self.near_targets[id.0].get_or_insert_with(Box::default).around(
                 &self.target_grid,
                 from,
                 to,
@@ -179,7 +179,7 @@ impl Fleet {
         if let Some(rare) = d.rare.as_deref_mut() {
             let (luck, seed) = (&mut rare.luck, self.seed);
             let mut draw = || {
-                luck.get_or_insert_with(|| Box::new(Stream::new(seed, Purpose::Detection, id)))
+                luck.get_or_insert_with(|| Box::new(Stream::new(seed, Purpose::Detection, id.0)))
                     .uniform()
             };
             let found = scan(id, &mut rare.detections, &self.targets, nearby, from, to, &mut draw);
@@ -193,7 +193,7 @@ impl Fleet {
     /// `BatteryCritical`, and a drone lost when it is empty.
     fn drain_battery(&mut self, id: DroneId, dt: f64, airborne: bool, out: &mut Vec<Report>) {
         let factor = if airborne { self.air_drain(id) } else { None };
-        let d = &mut self.drones[id];
+        let d = &mut self.drones[id.0];
         let alarms = battery::drain(d, dt, airborne, factor);
         if alarms.low {
             out.push(Report::Event(DroneEvent::Signal {
@@ -227,7 +227,7 @@ impl Fleet {
             drone: id,
             failure: Failure::new(exception, reason),
         }));
-        for call in self.drones[id].cut_calls() {
+        for call in self.drones[id.0].cut_calls() {
             out.push(Report::Ended { call, end: CallEnd::Interrupted });
         }
     }
@@ -235,7 +235,7 @@ impl Fleet {
     /// The drone falls to the ground and is gone for good (`DroneLost`).
     pub(crate) fn lose(&mut self, id: DroneId, reason: String, out: &mut Vec<Report>) {
         self.fault(id, BuiltinException::DroneLost, reason, out);
-        let d = &mut self.drones[id];
+        let d = &mut self.drones[id.0];
         d.state = FlightState::Lost;
         d.avoid = None;
         d.armed = false;

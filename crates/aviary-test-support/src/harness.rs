@@ -229,7 +229,8 @@ pub fn run_compiled(
         };
         let (outcome, answers) = tokio::join!(run, operator);
         sim.shutdown().await;
-        let releases = sim.releases().into_iter().map(|r| (r.drone, r.kind, r.position)).collect();
+        let releases =
+            sim.releases().into_iter().map(|r| (r.drone.0, r.kind, r.position)).collect();
         (Run { outcome, trace: Trace(trace), releases }, answers)
     })
 }

@@ -3,7 +3,9 @@
 //! reasons, GUIDED position targets, and the telemetry messages. No IO and no clock: the
 //! server feeds it messages and simulated seconds, and sends what it returns.
 
-use aviary_api::{BuiltinException, CallEnd, CallId, DroneEvent, FlightState, FunctionCall};
+use aviary_api::{
+    BuiltinException, CallEnd, CallId, DroneEvent, DroneId, FlightState, FunctionCall,
+};
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavMessage, MavSeverity, STATUSTEXT_DATA};
 use aviary_mavlink::mode::{Flavour, COPTER_RTL};
 use aviary_mavlink::Origin;
@@ -195,12 +197,12 @@ impl Autopilot {
 
     /// The drone's flight state (Lost when the simulator has no such drone).
     pub(crate) fn state(&self, i: usize) -> FlightState {
-        self.fleet.telemetry(i).map_or(FlightState::Lost, |t| t.state)
+        self.fleet.telemetry(DroneId(i)).map_or(FlightState::Lost, |t| t.state)
     }
 
     /// Whether the drone's radio works (a world `link_loss` fault silences it).
     pub fn link(&self, i: usize) -> bool {
-        self.fleet.telemetry(i).is_some_and(|t| t.link)
+        self.fleet.telemetry(DroneId(i)).is_some_and(|t| t.link)
     }
 
     /// Advances the simulation; returns what every client is told: the STATUSTEXTs that
@@ -230,21 +232,21 @@ impl Autopilot {
                     if failure.exception == BuiltinException::BatteryCritical
                         && self.px4_flavour() =>
                 {
-                    out.extend(self.px4_battery_failsafe(drone));
+                    out.extend(self.px4_battery_failsafe(drone.0));
                 }
                 Report::Event(DroneEvent::Fault { drone, failure })
                     if failure.exception == BuiltinException::BatteryCritical =>
                 {
                     // ArduCopter's battery failsafe: say so, then return to launch.
-                    let system = self.copters[drone].system;
+                    let system = self.copters[drone.0].system;
                     out.push(text(
                         system,
                         MavSeverity::MAV_SEVERITY_CRITICAL,
                         "Battery 1 is critical: failsafe RTL",
                     ));
-                    self.copters[drone].mode = COPTER_RTL;
-                    self.copters[drone].failsafe = true;
-                    if let Err(why) = self.motion(drone, &FunctionCall::ReturnToLaunch) {
+                    self.copters[drone.0].mode = COPTER_RTL;
+                    self.copters[drone.0].failsafe = true;
+                    if let Err(why) = self.motion(drone.0, &FunctionCall::ReturnToLaunch) {
                         out.push(text(system, MavSeverity::MAV_SEVERITY_CRITICAL, &why));
                     }
                 }
@@ -252,7 +254,7 @@ impl Autopilot {
                     if failure.exception == BuiltinException::DroneLost =>
                 {
                     // Down for good: HEARTBEAT says EMERGENCY from now on; say why first.
-                    let system = self.copters[drone].system;
+                    let system = self.copters[drone.0].system;
                     let why = format!("Crash: {}", failure.reason);
                     if self.px4_flavour() {
                         out.extend(self.px4_text(
@@ -283,7 +285,7 @@ impl Autopilot {
             return out;
         }
         for (i, c) in self.copters.iter_mut().enumerate() {
-            let state = self.fleet.telemetry(i).map_or(FlightState::Lost, |t| t.state);
+            let state = self.fleet.telemetry(DroneId(i)).map_or(FlightState::Lost, |t| t.state);
             if c.was_airborne && !state.airborne() {
                 // Down (landed, or fallen): the motors stop, as ArduCopter's auto-disarm.
                 c.armed = false;
@@ -298,7 +300,7 @@ impl Autopilot {
         if let Some(call) = self.copters[i].call.take() {
             self.fleet.interrupt(call, aviary_api::Interrupt::Abort);
         }
-        let (call, end) = self.fleet.call(i, function);
+        let (call, end) = self.fleet.call(DroneId(i), function);
         match end {
             None => {
                 self.copters[i].call = Some(call);

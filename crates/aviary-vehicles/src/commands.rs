@@ -2,7 +2,7 @@
 //! answered with the result ArduCopter would give, the reason it says first, and what a
 //! request asks for (AUTOPILOT_VERSION, HOME_POSITION, a telemetry message).
 
-use aviary_api::{CallEnd, FlightState, FunctionCall};
+use aviary_api::{CallEnd, DroneId, FlightState, FunctionCall};
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavCmd, MavResult, MavSeverity};
 use aviary_mavlink::mode::{COPTER_GUIDED, COPTER_LAND, COPTER_RTL};
 
@@ -178,7 +178,7 @@ impl Autopilot {
 
     /// A call that does not move the drone (arming, the gripper): left to finish alone.
     pub(crate) fn instant(&mut self, i: usize, call: &FunctionCall) -> Result<(), String> {
-        match self.fleet.call(i, call).1 {
+        match self.fleet.call(DroneId(i), call).1 {
             Some(CallEnd::Failed(f)) => Err(f.reason),
             _ => Ok(()),
         }

@@ -1,7 +1,7 @@
 //! Modes and GUIDED targets: SET_MODE / DO_SET_MODE, SET_POSITION_TARGET_GLOBAL_INT and
 //! DO_REPOSITION, with their altitude frames converted as ArduCopter does.
 
-use aviary_api::{FlightState, FunctionCall, Place, Point};
+use aviary_api::{DroneId, FlightState, FunctionCall, Place, Point};
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavResult, MavSeverity};
 use aviary_mavlink::mode::{COPTER_BRAKE, COPTER_GUIDED, COPTER_LAND, COPTER_LOITER, COPTER_RTL};
 
@@ -46,7 +46,7 @@ impl Autopilot {
         // (commanded in this very tick) would be cancelled by the flight that then fails,
         // so the target is refused and the take-off goes on.
         if self.state(i) == FlightState::TakingOff
-            && self.fleet.telemetry(i).is_some_and(|t| t.position[2] <= 0.0)
+            && self.fleet.telemetry(DroneId(i)).is_some_and(|t| t.position[2] <= 0.0)
         {
             return Err("position target ignored: still taking off".into());
         }

@@ -1,6 +1,7 @@
 //! What a vehicle reports of its GPS, its estimate, its home and itself: GPS_RAW_INT,
 //! EKF_STATUS_REPORT, HOME_POSITION and AUTOPILOT_VERSION.
 
+use aviary_api::DroneId;
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
     EkfStatusFlags, GpsFixType, MavMessage, MavProtocolCapability, AUTOPILOT_VERSION_DATA,
     EKF_STATUS_REPORT_DATA, GPS_RAW_INT_DATA, HOME_POSITION_DATA,
@@ -17,7 +18,7 @@ impl Autopilot {
     /// time, then a 3D fix where the drone is. The simulated receiver has no accuracy,
     /// satellites or noise to report: those fields say "unknown".
     pub fn gps_raw_int(&self, i: usize) -> Option<MavMessage> {
-        let t = self.fleet.telemetry(i)?;
+        let t = self.fleet.telemetry(DroneId(i))?;
         let mut g = GPS_RAW_INT_DATA {
             time_usec: self.time_usec(),
             fix_type: GpsFixType::GPS_FIX_TYPE_NO_FIX,

@@ -4,7 +4,7 @@
 //! EXTENDED_SYS_STATE, and HOME_POSITION (off unless asked for, as on ArduPilot), from the
 //! simulator's telemetry.
 
-use aviary_api::FlightState;
+use aviary_api::{DroneId, FlightState};
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
     MavAutopilot, MavBatteryFunction, MavBatteryType, MavLandedState, MavMessage, MavModeFlag,
     MavState, MavSysStatusSensor, MavType, MavVtolState, BATTERY_STATUS_DATA,
@@ -96,7 +96,7 @@ impl Autopilot {
             return self.px4_heartbeat(i);
         }
         let c = &self.copters[i];
-        let state = self.fleet.telemetry(i).map_or(FlightState::Lost, |t| t.state);
+        let state = self.fleet.telemetry(DroneId(i)).map_or(FlightState::Lost, |t| t.state);
         let mut base = MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
             | MavModeFlag::MAV_MODE_FLAG_STABILIZE_ENABLED;
         if c.mode == COPTER_GUIDED {
@@ -136,7 +136,7 @@ impl Autopilot {
     fn px4_heartbeat(&self, i: usize) -> MavMessage {
         let c = &self.copters[i];
         let nav = c.px4.nav;
-        let state = self.fleet.telemetry(i).map_or(FlightState::Lost, |t| t.state);
+        let state = self.fleet.telemetry(DroneId(i)).map_or(FlightState::Lost, |t| t.state);
         let mut base = MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED;
         if c.armed {
             base |= MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED;
@@ -173,7 +173,7 @@ impl Autopilot {
     }
 
     pub fn position(&self, i: usize) -> Option<MavMessage> {
-        let t = self.fleet.telemetry(i)?;
+        let t = self.fleet.telemetry(DroneId(i))?;
         let [x, y, z] = t.position;
         let (lat, lon) = self.origin.to_e7(x, y);
         let h = t.heading.to_radians();
@@ -200,7 +200,7 @@ impl Autopilot {
     /// battery turns unhealthy with its failsafe.
     pub fn sys_status(&self, i: usize) -> Option<MavMessage> {
         use MavSysStatusSensor as S;
-        let t = self.fleet.telemetry(i)?;
+        let t = self.fleet.telemetry(DroneId(i))?;
         let always = S::MAV_SYS_STATUS_SENSOR_3D_GYRO
             | S::MAV_SYS_STATUS_SENSOR_3D_ACCEL
             | S::MAV_SYS_STATUS_SENSOR_3D_MAG
@@ -243,7 +243,7 @@ impl Autopilot {
     }
 
     pub fn battery_status(&self, i: usize) -> Option<MavMessage> {
-        let t = self.fleet.telemetry(i)?;
+        let t = self.fleet.telemetry(DroneId(i))?;
         Some(MavMessage::BATTERY_STATUS(BATTERY_STATUS_DATA {
             current_consumed: -1,
             energy_consumed: -1,
@@ -259,7 +259,7 @@ impl Autopilot {
     }
 
     pub fn extended_sys_state(&self, i: usize) -> Option<MavMessage> {
-        let t = self.fleet.telemetry(i)?;
+        let t = self.fleet.telemetry(DroneId(i))?;
         let landed = match t.state {
             FlightState::Landed | FlightState::Lost => MavLandedState::MAV_LANDED_STATE_ON_GROUND,
             FlightState::TakingOff => MavLandedState::MAV_LANDED_STATE_TAKEOFF,

@@ -8,7 +8,8 @@ use std::time::Duration;
 
 use aviary_api::trace::AutopilotAction;
 use aviary_api::{
-    Backend, BuiltinException, BuiltinSignal, CallEnd, DroneEvent, Function, FunctionCall, Value,
+    Backend, BuiltinException, BuiltinSignal, CallEnd, DroneEvent, DroneId, Function, FunctionCall,
+    Value,
 };
 use aviary_mavlink::Tuning;
 use aviary_vehicles::{Behaviour, Listen, Options};
@@ -43,7 +44,7 @@ fn fc(function: Function, args: &[Value]) -> FunctionCall {
 }
 
 async fn call(backend: &dyn Backend, function: Function, args: &[Value]) -> CallEnd {
-    let pending = backend.call(0, &fc(function, args));
+    let pending = backend.call(DroneId(0), &fc(function, args));
     tokio::time::timeout(Duration::from_secs(30), pending.end.wait())
         .await
         .expect("the call ends")
@@ -91,7 +92,7 @@ async fn a_battery_failsafe_rtl_raises_battery_critical() {
     let mut events = backend.events().unwrap();
     let armed = call(&backend, Function::Arm, &[]).await;
     assert_eq!(armed, CallEnd::Done, "{:?}", events.try_recv());
-    let hover = backend.call(0, &fc(Function::Hover, &[Value::Number(60.0)]));
+    let hover = backend.call(DroneId(0), &fc(Function::Hover, &[Value::Number(60.0)]));
     async fn next(events: &mut tokio::sync::mpsc::UnboundedReceiver<DroneEvent>) -> DroneEvent {
         tokio::time::timeout(Duration::from_secs(20), events.recv())
             .await
@@ -100,7 +101,7 @@ async fn a_battery_failsafe_rtl_raises_battery_critical() {
     }
     // What the autopilot did is said as it is seen, then the fault it stands for.
     match next(&mut events).await {
-        DroneEvent::Autopilot { drone: 0, action, reason } => {
+        DroneEvent::Autopilot { drone: DroneId(0), action, reason } => {
             assert_eq!(action, AutopilotAction::ReturnHome);
             assert!(reason.contains("switched to RTL by itself"), "{reason}");
         }
@@ -108,7 +109,7 @@ async fn a_battery_failsafe_rtl_raises_battery_critical() {
     }
     let event = next(&mut events).await;
     match event {
-        DroneEvent::Fault { drone: 0, failure } => {
+        DroneEvent::Fault { drone: DroneId(0), failure } => {
             assert_eq!(failure.exception, BuiltinException::BatteryCritical);
             assert!(
                 failure.reason.contains("switched to RTL by itself")
@@ -144,13 +145,13 @@ async fn take_off_and_land_over_udp() {
     .unwrap();
     assert_eq!(call(&backend, Function::Arm, &[]).await, CallEnd::Done);
     assert_eq!(call(&backend, Function::TakeOff, &[Value::Number(5.0)]).await, CallEnd::Done);
-    let t = backend.telemetry(0);
+    let t = backend.telemetry(DroneId(0));
     assert!(
         (t.position[2] - 5.0).abs() <= 0.5 && t.state == aviary_api::FlightState::Flying,
         "{t:?}"
     );
     assert_eq!(call(&backend, Function::Land, &[]).await, CallEnd::Done);
-    assert_eq!(backend.telemetry(0).state, aviary_api::FlightState::Landed);
+    assert_eq!(backend.telemetry(DroneId(0)).state, aviary_api::FlightState::Landed);
     assert_eq!(call(&backend, Function::Disarm, &[]).await, CallEnd::Done);
     vehicles.stop();
 }
@@ -193,25 +194,25 @@ async fn pause_holds_resume_goes_on_and_abort_stops() {
     assert_eq!(call(&backend, Function::Arm, &[]).await, CallEnd::Done);
     assert_eq!(call(&backend, Function::TakeOff, &[Value::Number(5.0)]).await, CallEnd::Done);
     let far = Value::Position(aviary_api::Point { x: 300.0, y: 0.0, z: None });
-    let flight = backend.call(0, &fc(Function::FlyToPosition, &[far]));
+    let flight = backend.call(DroneId(0), &fc(Function::FlyToPosition, &[far]));
     tokio::time::sleep(Duration::from_secs(2)).await;
     backend.interrupt(flight.id, aviary_api::Interrupt::Pause);
     // Braking from 10 m/s and coming back to where it was paused takes a few seconds.
     tokio::time::sleep(Duration::from_secs(3)).await;
-    let held = backend.telemetry(0).position;
+    let held = backend.telemetry(DroneId(0)).position;
     tokio::time::sleep(Duration::from_secs(1)).await;
-    let still = backend.telemetry(0).position;
+    let still = backend.telemetry(DroneId(0)).position;
     assert!(held[0] > 1.0 && (still[0] - held[0]).abs() < 0.5, "paused: {held:?} then {still:?}");
     backend.interrupt(flight.id, aviary_api::Interrupt::Resume);
     tokio::time::sleep(Duration::from_secs(2)).await;
-    let moved = backend.telemetry(0).position;
+    let moved = backend.telemetry(DroneId(0)).position;
     assert!(moved[0] > still[0] + 1.0, "resumed: {still:?} then {moved:?}");
     backend.interrupt(flight.id, aviary_api::Interrupt::Abort);
     assert_eq!(flight.end.wait().await.unwrap(), CallEnd::Interrupted);
     tokio::time::sleep(Duration::from_secs(2)).await;
-    let stopped = backend.telemetry(0).position;
+    let stopped = backend.telemetry(DroneId(0)).position;
     tokio::time::sleep(Duration::from_secs(1)).await;
-    let after = backend.telemetry(0).position;
+    let after = backend.telemetry(DroneId(0)).position;
     assert!(
         stopped[0] < 290.0 && (after[0] - stopped[0]).abs() < 0.5,
         "aborted: {stopped:?} then {after:?}"
@@ -239,7 +240,7 @@ async fn a_vehicle_that_goes_and_comes_back_raises_lost_then_restored() {
         matches!(&lost, DroneEvent::Fault { failure, .. } if failure.exception == BuiltinException::ConnectionLost),
         "{lost:?}"
     );
-    assert!(!backend.telemetry(0).link);
+    assert!(!backend.telemetry(DroneId(0)).link);
     match call(&backend, Function::Arm, &[]).await {
         CallEnd::Failed(f) => assert!(f.reason.contains("no link"), "{}", f.reason),
         other => panic!("{other:?}"),
@@ -250,8 +251,11 @@ async fn a_vehicle_that_goes_and_comes_back_raises_lost_then_restored() {
         .await
         .expect("an event")
         .unwrap();
-    assert_eq!(back, DroneEvent::Signal { drone: 0, signal: BuiltinSignal::ConnectionRestored });
-    assert!(backend.telemetry(0).link);
+    assert_eq!(
+        back,
+        DroneEvent::Signal { drone: DroneId(0), signal: BuiltinSignal::ConnectionRestored }
+    );
+    assert!(backend.telemetry(DroneId(0)).link);
     assert_eq!(call(&backend, Function::Arm, &[]).await, CallEnd::Done);
     second.stop();
 }
@@ -275,7 +279,7 @@ async fn the_battery_rule_signals_low_then_raises_critical_once() {
     .unwrap();
     let mut events = backend.events().unwrap();
     assert_eq!(call(&backend, Function::Arm, &[]).await, CallEnd::Done);
-    let _climb = backend.call(0, &fc(Function::TakeOff, &[Value::Number(10.0)]));
+    let _climb = backend.call(DroneId(0), &fc(Function::TakeOff, &[Value::Number(10.0)]));
     let mut seen = Vec::new();
     let until = tokio::time::Instant::now() + Duration::from_secs(10);
     while let Ok(Some(e)) = tokio::time::timeout_at(until, events.recv()).await {
@@ -323,13 +327,13 @@ async fn a_crash_raises_drone_lost() {
     let mut events = backend.events().unwrap();
     assert_eq!(call(&backend, Function::Arm, &[]).await, CallEnd::Done);
     assert_eq!(call(&backend, Function::TakeOff, &[Value::Number(10.0)]).await, CallEnd::Done);
-    let hover = backend.call(0, &fc(Function::Hover, &[Value::Number(300.0)]));
+    let hover = backend.call(DroneId(0), &fc(Function::Hover, &[Value::Number(300.0)]));
     match tokio::time::timeout(Duration::from_secs(15), events.recv())
         .await
         .expect("an event")
         .unwrap()
     {
-        DroneEvent::Fault { drone: 0, failure } => {
+        DroneEvent::Fault { drone: DroneId(0), failure } => {
             assert_eq!(failure.exception, BuiltinException::DroneLost);
             assert!(
                 failure.reason.contains("MAV_STATE_EMERGENCY") && failure.reason.contains("Crash"),

@@ -68,8 +68,8 @@ fn what_is_not_a_trace_line_is_an_error() {
 fn a_value_is_shown_with_its_text_borrowed_and_a_drone_by_name() {
     let drones = Names::new(["scout"].into_iter());
     let values = [
-        Value::Actor(0),
-        Value::Actor(7),
+        Value::Actor(crate::DroneId(0)),
+        Value::Actor(crate::DroneId(7)),
         Value::Symbol("Body".into()),
         Value::Position(Point::flat(1.0, 2.0)),
         Value::Area(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]),

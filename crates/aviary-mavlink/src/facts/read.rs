@@ -5,6 +5,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
+use aviary_api::DroneId;
 use aviary_clock::Instant;
 use aviary_world::World;
 use mavlink::dialects::ardupilotmega::{
@@ -138,7 +139,7 @@ pub async fn ask(world: &World, wait: Duration) -> Result<Vec<Facts>, String> {
             let mut reads = tokio::task::JoinSet::new();
             for (i, name, system) in drones {
                 let v = Arc::new(Vehicle::new(
-                    i,
+                    DroneId(i),
                     name,
                     system,
                     origin,

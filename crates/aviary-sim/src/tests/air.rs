@@ -33,7 +33,7 @@ fn leg_east(air: &str) -> f64 {
     let go = start(&mut fleet, 0, Function::FlyToPosition, &[pos(900.0, 0.0)]);
     let run = run_until(&mut fleet, 0, go, 600.0);
     assert_eq!(run.end, CallEnd::Done);
-    assert_eq!(fleet.telemetry(0).unwrap().position, [900.0, 0.0, 20.0]);
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().position, [900.0, 0.0, 20.0]);
     run.took
 }
 
@@ -58,10 +58,10 @@ fn a_head_wind_lengthens_a_leg_as_the_wind_triangle_says() {
 /// The charge used hovering 120 s at 20 m (then flying 500 m east) in the air of `air`.
 fn used(air: &str, sensors: &str) -> (f64, Fleet) {
     let mut fleet = up(&format!("[drones.d]\nhome = [0, 0]\n{sensors}\n{air}"), 0, 20.0);
-    let before = fleet.telemetry(0).unwrap().battery;
+    let before = fleet.telemetry(DroneId(0)).unwrap().battery;
     let go = start(&mut fleet, 0, Function::FlyToPosition, &[pos(500.0, 0.0)]);
     run_until(&mut fleet, 0, go, 600.0);
-    (before - fleet.telemetry(0).unwrap().battery, fleet)
+    (before - fleet.telemetry(DroneId(0)).unwrap().battery, fleet)
 }
 
 #[test]
@@ -74,11 +74,11 @@ fn the_drain_grows_with_airspeed() {
     let (head, fleet) = used("[air.wind]\nspeed = 4\nfrom = 90\n", "sensors = [\"wind\"]");
     let cruise = (1.0 + 0.5) / (1.0 + 0.5 * 0.36) * (10.0 / 6.0);
     assert!(head > still * 1.5 && head < still * cruise * 1.05, "{head} vs {still}");
-    let wind = fleet.telemetry(0).unwrap().wind.expect("it has a wind sensor");
+    let wind = fleet.telemetry(DroneId(0)).unwrap().wind.expect("it has a wind sensor");
     assert!((wind[0] + 4.0).abs() < 1e-9 && wind[1].abs() < 1e-9, "{wind:?}");
     // No sensor, no reading.
     let (_, fleet) = used("[air.wind]\nspeed = 4\nfrom = 90\n", "");
-    assert_eq!(fleet.telemetry(0).unwrap().wind, None);
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().wind, None);
 }
 
 #[test]
@@ -96,7 +96,7 @@ fn dryden_gusts_have_the_standards_intensity() {
         // Every second; the wind blows south, so the gust along it is -(north + 5).
         along.extend(run.samples.iter().step_by(20).map(|t| -(t.wind.unwrap()[1]) - 5.0));
         // The drone held its place whatever the gusts.
-        assert_eq!(fleet.telemetry(0).unwrap().position, [0.0, 0.0, 30.0]);
+        assert_eq!(fleet.telemetry(DroneId(0)).unwrap().position, [0.0, 0.0, 30.0]);
     }
     let n = along.len() as f64;
     let mean = along.iter().sum::<f64>() / n;
@@ -127,7 +127,7 @@ fn out_of_radio_reach_the_link_is_lost_and_comes_back_in_reach() {
         r,
         Report::Event(DroneEvent::Signal { signal: BuiltinSignal::ConnectionRestored, .. })
     )));
-    let t = fleet.telemetry(0).unwrap();
+    let t = fleet.telemetry(DroneId(0)).unwrap();
     assert!(t.link && t.position[0] < 300.0, "{t:?}");
 }
 
@@ -147,7 +147,7 @@ fn a_relay_in_reach_keeps_the_link_of_a_drone_beyond_it() {
     let go = start(&mut fleet, 0, Function::FlyToPosition, &[pos(600.0, 0.0)]);
     let run = run_until(&mut fleet, 0, go, 120.0);
     assert_eq!(run.end, CallEnd::Interrupted);
-    assert!(!fleet.telemetry(0).unwrap().link);
+    assert!(!fleet.telemetry(DroneId(0)).unwrap().link);
 }
 
 /// Over `seeds` runs past four bodies 0, 5, 10 and 15 m beside the track, how often each
@@ -202,9 +202,9 @@ fn a_known_fault_rate_fails_within_its_binomial_interval() {
         let mut fleet = Fleet::new(&w).seeded(seed);
         instant(&mut fleet, 0, Function::Arm, &[]);
         start(&mut fleet, 0, Function::TakeOff, &[num(20.0)]);
-        while fleet.odometry(0).1 < 100.0 - 1e-9 {
+        while fleet.odometry(DroneId(0)).1 < 100.0 - 1e-9 {
             fleet.step(DT);
-            if fleet.telemetry(0).unwrap().state == FlightState::Lost {
+            if fleet.telemetry(DroneId(0)).unwrap().state == FlightState::Lost {
                 crashed += 1;
                 break;
             }
@@ -239,7 +239,7 @@ fn the_gps_reading_errs_by_its_size_and_the_truth_stays() {
     assert!((lag - (-0.01f64).exp()).abs() < 0.01, "{lag}");
     // A drone's own error.
     let own = world("[drones.d]\nhome = [0, 0]\nair = { gps_error = 0 }\n[air.gps]\nerror = 2.5\n");
-    let t = Fleet::new(&own).seeded(1).telemetry(0).unwrap();
+    let t = Fleet::new(&own).seeded(1).telemetry(DroneId(0)).unwrap();
     assert_eq!(t.gps_position, t.position);
 }
 
@@ -249,7 +249,7 @@ fn capacities_spread_from_drone_to_drone() {
         "[fleets.f]\ncount = 400\nhomes = { grid = [0, 0], spacing = 10, columns = 40 }\n[air.battery]\ncapacity_spread = 0.05\n",
     );
     let fleet = Fleet::new(&w).seeded(5);
-    let caps: Vec<f64> = (0..fleet.len()).map(|i| fleet.capacity(i)).collect();
+    let caps: Vec<f64> = (0..fleet.len()).map(|i| fleet.capacity(DroneId(i))).collect();
     let n = caps.len() as f64;
     let mean = caps.iter().sum::<f64>() / n;
     let sd = (caps.iter().map(|c| (c - mean) * (c - mean)).sum::<f64>() / n).sqrt();
@@ -258,9 +258,9 @@ fn capacities_spread_from_drone_to_drone() {
     // A smaller battery drains faster, by its capacity.
     let one = "[drones.d]\nhome = [0, 0]\n[air.battery]\ncapacity_spread = 0.1\n";
     let mut fleet = up(one, 9, 20.0);
-    let (b0, c) = (fleet.telemetry(0).unwrap().battery, fleet.capacity(0));
+    let (b0, c) = (fleet.telemetry(DroneId(0)).unwrap().battery, fleet.capacity(DroneId(0)));
     run_for(&mut fleet, 100.0);
-    let used = b0 - fleet.telemetry(0).unwrap().battery;
+    let used = b0 - fleet.telemetry(DroneId(0)).unwrap().battery;
     assert!((used - 100.0 / 1800.0 / c).abs() < 1e-9, "{used} with capacity {c}");
     // Its critical level is the way home as a part of its own capacity.
     let fault = "[[faults]]\ndrone = \"d\"\nat = 60\nkind = \"battery_critical\"\n";
@@ -268,7 +268,7 @@ fn capacities_spread_from_drone_to_drone() {
     let go = start(&mut fleet, 0, Function::FlyToPosition, &[pos(800.0, 800.0)]);
     assert_eq!(run_until(&mut fleet, 0, go, 400.0).end, CallEnd::Interrupted);
     let level = crate::battery::energy_home(&fleet.drones[0]) / c + 0.10;
-    let reading = fleet.telemetry(0).unwrap().battery;
+    let reading = fleet.telemetry(DroneId(0)).unwrap().battery;
     assert!((reading - level).abs() < 1e-3 && (c - 1.0).abs() > 1e-3, "{reading} vs {level}");
 }
 
@@ -283,7 +283,7 @@ fn windy_flight(seed: u64) -> String {
         for r in fleet.step(DT) {
             log.push_str(&format!("{r:?}\n"));
         }
-        log.push_str(&format!("{:?}\n", fleet.telemetry(0)));
+        log.push_str(&format!("{:?}\n", fleet.telemetry(DroneId(0))));
     }
     log
 }
@@ -316,7 +316,7 @@ fn a_battery_critical_fault_sets_the_reading() {
     let go = start(&mut fleet, 0, Function::FlyToPosition, &[pos(500.0, 0.0)]);
     let run = run_until(&mut fleet, 0, go, 120.0);
     assert_eq!(run.end, CallEnd::Interrupted);
-    let t = fleet.telemetry(0).unwrap();
+    let t = fleet.telemetry(DroneId(0)).unwrap();
     let d = &fleet.drones[0];
     let critical = crate::battery::energy_home(d) + 0.10;
     assert!((t.battery - critical).abs() < 1e-3, "{} vs {critical}", t.battery);
@@ -342,12 +342,12 @@ fn a_link_loss_fault_out_of_reach_gives_no_link_back_until_in_reach() {
                 restored_at.get_or_insert(fleet.time());
             }
         }
-        let t = fleet.telemetry(0).unwrap();
+        let t = fleet.telemetry(DroneId(0)).unwrap();
         if t.position[0] > 300.5 {
             assert!(!t.link, "linked out of reach at {}: {t:?}", fleet.time());
         }
     }
     let back = restored_at.expect("the link comes back in reach");
     assert!(back > 45.0, "{back}");
-    assert!(fleet.telemetry(0).unwrap().link);
+    assert!(fleet.telemetry(DroneId(0)).unwrap().link);
 }

@@ -3,7 +3,9 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use aviary_api::{Backend, CallEnd, DroneEvent, Ending, FlightState, Interrupt, PendingCall};
+use aviary_api::{
+    Backend, CallEnd, DroneEvent, DroneId, Ending, FlightState, Interrupt, PendingCall,
+};
 use aviary_clock::Instant;
 
 use super::*;
@@ -24,8 +26,11 @@ async fn done(call: PendingCall) -> CallEnd {
 }
 
 async fn take_off(sim: &Arc<SimBackend>, alt: f64) {
-    assert_eq!(done(sim.call(0, &fc(Function::Arm, &[]))).await, CallEnd::Done);
-    assert_eq!(done(sim.call(0, &fc(Function::TakeOff, &[num(alt)]))).await, CallEnd::Done);
+    assert_eq!(done(sim.call(DroneId(0), &fc(Function::Arm, &[]))).await, CallEnd::Done);
+    assert_eq!(
+        done(sim.call(DroneId(0), &fc(Function::TakeOff, &[num(alt)]))).await,
+        CallEnd::Done
+    );
 }
 
 #[test]
@@ -39,18 +44,18 @@ fn calls_end_at_the_simulated_time_they_take() {
         assert!((sim.time() - took).abs() < 1e-6, "simulated time is the clock's");
         let t1 = Instant::now();
         assert_eq!(
-            done(sim.call(0, &fc(Function::FlyToPosition, &[pos(300.0, 400.0)]))).await,
+            done(sim.call(DroneId(0), &fc(Function::FlyToPosition, &[pos(300.0, 400.0)]))).await,
             CallEnd::Done
         );
         let took = t1.elapsed().as_secs_f64();
         assert!((took - (50.0 + 10.0 / 3.0)).abs() < 0.6, "{took}");
-        let t = sim.telemetry(0);
+        let t = sim.telemetry(DroneId(0));
         assert_eq!(
             (t.position, t.state, t.link),
             ([300.0, 400.0, 20.0], FlightState::Flying, true)
         );
-        assert_eq!(sim.telemetry(42).state, FlightState::Lost);
-        match done(sim.call(0, &fc(Function::FlyToPosition, &[pos(5000.0, 0.0)]))).await {
+        assert_eq!(sim.telemetry(DroneId(42)).state, FlightState::Lost);
+        match done(sim.call(DroneId(0), &fc(Function::FlyToPosition, &[pos(5000.0, 0.0)]))).await {
             CallEnd::Failed(f) => assert_eq!(f.exception, BuiltinException::GeofenceViolation),
             other => panic!("{other:?}"),
         }
@@ -66,11 +71,11 @@ fn events_are_taken_once_and_detections_arrive() {
         assert!(sim.events().is_none());
         take_off(&sim, 20.0).await;
         assert_eq!(
-            done(sim.call(0, &fc(Function::StartDetection, &[sym("Body")]))).await,
+            done(sim.call(DroneId(0), &fc(Function::StartDetection, &[sym("Body")]))).await,
             CallEnd::Done
         );
         assert_eq!(
-            done(sim.call(0, &fc(Function::FlyToPosition, &[pos(320.0, 0.0)]))).await,
+            done(sim.call(DroneId(0), &fc(Function::FlyToPosition, &[pos(320.0, 0.0)]))).await,
             CallEnd::Done
         );
         let mut found = Vec::new();
@@ -89,25 +94,28 @@ fn pause_resume_and_abort_through_the_backend() {
     simulated(async {
         let sim = SimBackend::start(&one_drone(), SimOptions::default());
         take_off(&sim, 20.0).await;
-        let call = sim.call(0, &fc(Function::FlyToPosition, &[pos(200.0, 0.0)]));
+        let call = sim.call(DroneId(0), &fc(Function::FlyToPosition, &[pos(200.0, 0.0)]));
         aviary_clock::sleep(Duration::from_secs(5)).await;
         sim.interrupt(call.id, Interrupt::Pause);
-        let held = sim.telemetry(0);
+        let held = sim.telemetry(DroneId(0));
         aviary_clock::sleep(Duration::from_secs(10)).await;
-        assert_eq!(sim.telemetry(0).position, held.position);
+        assert_eq!(sim.telemetry(DroneId(0)).position, held.position);
         let Ending::Later(mut end) = call.end else { panic!("a flight does not end at once") };
         assert!(end.try_recv().is_err(), "still in progress");
         sim.interrupt(call.id, Interrupt::Resume);
         assert_eq!(end.await, Ok(CallEnd::Done));
-        assert_eq!(sim.telemetry(0).position, [200.0, 0.0, 20.0]);
+        assert_eq!(sim.telemetry(DroneId(0)).position, [200.0, 0.0, 20.0]);
 
-        let call = sim.call(0, &fc(Function::FlyToPosition, &[pos(0.0, 0.0)]));
+        let call = sim.call(DroneId(0), &fc(Function::FlyToPosition, &[pos(0.0, 0.0)]));
         aviary_clock::sleep(Duration::from_secs(3)).await;
         sim.interrupt(call.id, Interrupt::Abort);
         assert_eq!(done(call).await, CallEnd::Interrupted);
-        let here = sim.telemetry(0);
+        let here = sim.telemetry(DroneId(0));
         aviary_clock::sleep(Duration::from_secs(3)).await;
-        assert_eq!((sim.telemetry(0).position, sim.telemetry(0).speed), (here.position, 0.0));
+        assert_eq!(
+            (sim.telemetry(DroneId(0)).position, sim.telemetry(DroneId(0)).speed),
+            (here.position, 0.0)
+        );
         sim.shutdown().await;
     })
 }
@@ -148,7 +156,7 @@ fn a_runtime_with_the_simulator_finishes() {
     let end = rt.block_on(async {
         let sim = SimBackend::start(&one_drone(), SimOptions::default());
         take_off(&sim, 10.0).await;
-        let end = done(sim.call(0, &fc(Function::Land, &[]))).await;
+        let end = done(sim.call(DroneId(0), &fc(Function::Land, &[]))).await;
         sim.shutdown().await;
         end
     });
@@ -166,16 +174,16 @@ async fn scripted() -> Vec<Telemetry> {
             let mut every = aviary_clock::interval(Duration::from_millis(250));
             for _ in 0..600 {
                 every.tick().await;
-                log.lock().push(sim.telemetry(0));
+                log.lock().push(sim.telemetry(DroneId(0)));
             }
         })
     };
     take_off(&sim, 15.0).await;
-    done(sim.call(0, &fc(Function::StartDetection, &[sym("Body")]))).await;
+    done(sim.call(DroneId(0), &fc(Function::StartDetection, &[sym("Body")]))).await;
     let area =
         aviary_api::Value::Area(vec![[50.0, -20.0], [150.0, -20.0], [150.0, 60.0], [50.0, 60.0]]);
-    done(sim.call(0, &fc(Function::Sweep, &[area, num(20.0)]))).await;
-    done(sim.call(0, &fc(Function::ReturnToLaunch, &[]))).await;
+    done(sim.call(DroneId(0), &fc(Function::Sweep, &[area, num(20.0)]))).await;
+    done(sim.call(DroneId(0), &fc(Function::ReturnToLaunch, &[]))).await;
     sampler.await.unwrap();
     sim.shutdown().await;
     let log = log.lock().clone();
@@ -197,7 +205,7 @@ fn speed_paces_against_the_wall_clock() {
     paced(Arc::new(aviary_clock::Speed::new(50.0)), async {
         let sim = SimBackend::start(&one_drone(), SimOptions::default());
         let wall = std::time::Instant::now();
-        done(sim.call(0, &fc(Function::Hover, &[num(2.0)]))).await;
+        done(sim.call(DroneId(0), &fc(Function::Hover, &[num(2.0)]))).await;
         // 2 s of simulated time at 50x: at least 40 ms of wall time.
         assert!(wall.elapsed() >= Duration::from_millis(39), "{:?}", wall.elapsed());
         sim.shutdown().await;
@@ -217,7 +225,7 @@ fn a_pace_holds_simulated_time_to_its_source() {
     }));
     paced(pace, async {
         let sim = SimBackend::start(&one_drone(), SimOptions::default());
-        let hover = sim.call(0, &fc(Function::Hover, &[num(60.0)]));
+        let hover = sim.call(DroneId(0), &fc(Function::Hover, &[num(60.0)]));
         // 300 ms of wall time, told from another thread (a wait of this task's own is on
         // the run's clock, which the pace holds).
         let (tx, rx) = tokio::sync::oneshot::channel();
@@ -242,7 +250,7 @@ fn pacing_leaves_the_thread_free_and_the_clock_still() {
     // thread, not when the wait is over; and the simulated clock has not moved meanwhile.
     paced(Arc::new(aviary_clock::Speed::new(0.1)), async {
         let sim = SimBackend::start(&one_drone(), SimOptions::default());
-        let hover = sim.call(0, &fc(Function::Hover, &[num(10.0)]));
+        let hover = sim.call(DroneId(0), &fc(Function::Hover, &[num(10.0)]));
         aviary_clock::sleep(Duration::from_millis(60)).await;
         let (tx, mut rx) = tokio::sync::mpsc::unbounded_channel();
         let sent = std::time::Instant::now();
@@ -273,9 +281,12 @@ fn pacing_leaves_the_thread_free_and_the_clock_still() {
 fn a_call_done_as_it_is_made_ends_now_and_a_flight_later() {
     simulated(async {
         let sim = SimBackend::start(&one_drone(), SimOptions::default());
-        assert!(matches!(sim.call(0, &fc(Function::Arm, &[])).end, Ending::Now(CallEnd::Done)));
+        assert!(matches!(
+            sim.call(DroneId(0), &fc(Function::Arm, &[])).end,
+            Ending::Now(CallEnd::Done)
+        ));
         take_off(&sim, 20.0).await;
-        let flight = sim.call(0, &fc(Function::FlyToPosition, &[pos(50.0, 0.0)]));
+        let flight = sim.call(DroneId(0), &fc(Function::FlyToPosition, &[pos(50.0, 0.0)]));
         assert!(matches!(flight.end, Ending::Later(_)));
         assert_eq!(done(flight).await, CallEnd::Done);
     })

@@ -12,7 +12,7 @@ fn takeoff_climb_time_matches_the_trapezoid() {
     let mut fleet = Fleet::new(&w);
     instant(&mut fleet, 0, Function::Arm, &[]);
     let id = start(&mut fleet, 0, Function::TakeOff, &[num(20.0)]);
-    assert_eq!(fleet.telemetry(0).unwrap().state, FlightState::TakingOff);
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().state, FlightState::TakingOff);
     let run = run_until(&mut fleet, 0, id, 60.0);
     // climb_rate 3 m/s, acceleration 3 m/s²: 1 s up to speed and 1 s to stop (3 m), 17 m at 3 m/s.
     let analytic = 2.0 + 17.0 / 3.0;
@@ -21,7 +21,7 @@ fn takeoff_climb_time_matches_the_trapezoid() {
         "took {} s, trapezoid {analytic} s",
         run.took
     );
-    let t = fleet.telemetry(0).unwrap();
+    let t = fleet.telemetry(DroneId(0)).unwrap();
     assert!((t.position[2] - 20.0).abs() <= 0.1);
     assert_eq!(t.state, FlightState::Flying);
     for w in run.samples.windows(2) {
@@ -43,7 +43,7 @@ fn a_long_flight_keeps_speed_and_acceleration_bounds() {
         "took {} s, expected {expected} s",
         run.took
     );
-    let end = fleet.telemetry(0).unwrap();
+    let end = fleet.telemetry(DroneId(0)).unwrap();
     assert!(dist([end.position[0], end.position[1]], [300.0, 400.0]) <= 0.5);
     assert_eq!(end.position[2], 20.0);
     assert_eq!(end.speed, 0.0);
@@ -59,10 +59,10 @@ fn a_long_flight_keeps_speed_and_acceleration_bounds() {
         fastest = fastest.max(w[1].speed);
     }
     assert!(fastest > 9.99);
-    let (metres, seconds) = fleet.odometry(0);
+    let (metres, seconds) = fleet.odometry(DroneId(0));
     assert!((metres - 520.0).abs() < 1e-6, "{metres}");
     assert!((seconds - fleet.time()).abs() < 1e-9, "in the air since the take-off call");
-    assert_eq!(fleet.odometry(7), (0.0, 0.0));
+    assert_eq!(fleet.odometry(DroneId(7)), (0.0, 0.0));
     // A slower speed asked is kept.
     let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(300.0, 300.0), num(4.0)]);
     let run = run_until(&mut fleet, 0, id, 200.0);
@@ -75,7 +75,7 @@ fn battery_drains_exactly_while_airborne_only() {
     let w = world("[drones.d]\nhome = [0, 0]\nbattery = 80\nendurance = 600\n");
     let mut fleet = Fleet::new(&w);
     run_for(&mut fleet, 10.0);
-    assert_eq!(fleet.telemetry(0).unwrap().battery, 0.8, "no drain on the ground");
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().battery, 0.8, "no drain on the ground");
     instant(&mut fleet, 0, Function::Arm, &[]);
     start(&mut fleet, 0, Function::TakeOff, &[num(30.0)]);
     let steps = 2400; // 120 s
@@ -83,7 +83,7 @@ fn battery_drains_exactly_while_airborne_only() {
         fleet.step(DT);
     }
     let flown = steps as f64 * DT;
-    let battery = fleet.telemetry(0).unwrap().battery;
+    let battery = fleet.telemetry(DroneId(0)).unwrap().battery;
     assert!((battery - (0.8 - flown / 600.0)).abs() < 1e-9, "{battery}");
 }
 
@@ -112,7 +112,7 @@ fn battery_low_comes_before_critical_each_once_then_the_drone_is_lost() {
     assert_eq!(seen, ["BatteryLow", "BatteryCritical", "DroneLost"]);
     // The flight was cut by BatteryCritical: the drone held there and then fell.
     assert_eq!(ended.map(|e| e.0), Some(CallEnd::Interrupted));
-    let t = fleet.telemetry(0).unwrap();
+    let t = fleet.telemetry(DroneId(0)).unwrap();
     assert_eq!((t.state, t.battery, t.position[2]), (FlightState::Lost, 0.0, 0.0));
     assert!(t.position[0] > 500.0 && t.position[0] < 700.0, "{t:?}");
     assert_eq!(refused(&mut fleet, 0, Function::Land, &[]).0, BuiltinException::CommandFailed);
@@ -130,7 +130,7 @@ fn detection_fires_once_per_target_per_activation_and_only_in_range() {
         events
             .iter()
             .filter_map(|e| match e {
-                DroneEvent::Detected { drone: 0, kind, location } if kind == "Body" => {
+                DroneEvent::Detected { drone: DroneId(0), kind, location } if kind == "Body" => {
                     Some(*location)
                 }
                 _ => None,
@@ -147,7 +147,7 @@ fn detection_fires_once_per_target_per_activation_and_only_in_range() {
     assert_eq!(found(&run_until(&mut fleet, 0, id, 100.0).events), [[100.0, 10.0, 0.0]]);
     // Stopped: nothing.
     instant(&mut fleet, 0, Function::StopDetection, &[sym("Body")]);
-    assert!(fleet.detecting(0).is_empty());
+    assert!(fleet.detecting(DroneId(0)).is_empty());
     let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(50.0, 0.0)]);
     assert!(found(&run_until(&mut fleet, 0, id, 100.0).events).is_empty());
 }
@@ -174,7 +174,7 @@ fn orbit_keeps_its_radius_and_speed() {
     // Two laps of 2π·30 m at ≈ 6.7 m/s, at least.
     let laps_time = on_circle.len() as f64 * DT;
     assert!(laps_time >= 2.0 * std::f64::consts::TAU * 30.0 / 45f64.sqrt());
-    let end = fleet.telemetry(0).unwrap();
+    let end = fleet.telemetry(DroneId(0)).unwrap();
     assert!(dist([end.position[0], end.position[1]], [70.0, 0.0]) < 1e-6, "ends where it began");
 }
 
@@ -209,19 +209,19 @@ fn pause_holds_the_drone_and_resume_completes_the_move() {
     let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(200.0, 0.0)]);
     run_for(&mut fleet, 5.0);
     assert_eq!(fleet.interrupt(id, Interrupt::Pause), None);
-    let held = fleet.telemetry(0).unwrap();
+    let held = fleet.telemetry(DroneId(0)).unwrap();
     assert_eq!(held.speed, 0.0);
     for r in run_for(&mut fleet, 10.0) {
         assert!(!matches!(r, Report::Ended { call, .. } if call == id), "a paused call goes on");
-        assert_eq!(fleet.telemetry(0).unwrap().position, held.position);
+        assert_eq!(fleet.telemetry(DroneId(0)).unwrap().position, held.position);
     }
-    let after = fleet.telemetry(0).unwrap();
+    let after = fleet.telemetry(DroneId(0)).unwrap();
     assert_eq!(after.position, held.position);
     assert!(after.battery < held.battery, "hovering still drains");
     fleet.interrupt(id, Interrupt::Resume);
     let run = run_until(&mut fleet, 0, id, 100.0);
     assert_eq!(run.end, CallEnd::Done);
-    assert_eq!(fleet.telemetry(0).unwrap().position, [200.0, 0.0, 20.0]);
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().position, [200.0, 0.0, 20.0]);
 }
 
 /// A motion call while another is paused (a leash section while its activity's body is
@@ -234,15 +234,15 @@ fn a_paused_motion_call_gives_way_to_a_newer_one_and_comes_back_after_it() {
     let orbit = start(&mut fleet, 0, Function::Orbit, &[pos(0.0, 100.0), num(50.0), num(1.0)]);
     run_for(&mut fleet, 20.0);
     fleet.interrupt(orbit, Interrupt::Pause);
-    let held = fleet.telemetry(0).unwrap().position;
+    let held = fleet.telemetry(DroneId(0)).unwrap().position;
     let section = start(&mut fleet, 0, Function::FlyToPosition, &[pos(0.0, 0.0)]);
     let run = run_until(&mut fleet, 0, section, 100.0);
     assert_eq!(run.end, CallEnd::Done, "not refused as busy");
-    assert_eq!(fleet.telemetry(0).unwrap().position, [0.0, 0.0, 20.0]);
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().position, [0.0, 0.0, 20.0]);
     for r in run_for(&mut fleet, 5.0) {
         assert!(!matches!(r, Report::Ended { call, .. } if call == orbit), "still paused");
     }
-    assert_eq!(fleet.telemetry(0).unwrap().position, [0.0, 0.0, 20.0], "held: not flying");
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().position, [0.0, 0.0, 20.0], "held: not flying");
     fleet.interrupt(orbit, Interrupt::Resume);
     let run = run_until(&mut fleet, 0, orbit, 300.0);
     assert_eq!(run.end, CallEnd::Done);
@@ -254,7 +254,7 @@ fn a_paused_motion_call_gives_way_to_a_newer_one_and_comes_back_after_it() {
     // From there along the circle, the rest of its lap only: it ends where the lap began.
     let on_circle = |p: [f64; 3]| (p[0].hypot(p[1] - 100.0) - 50.0).abs() < 1e-6;
     assert!(run.samples[back..].iter().all(|t| on_circle(t.position)));
-    let end = fleet.telemetry(0).unwrap().position;
+    let end = fleet.telemetry(DroneId(0)).unwrap().position;
     assert!(end[0].abs() < 1e-6 && (end[1] - 50.0).abs() < 1e-6, "{end:?}");
 }
 
@@ -267,15 +267,20 @@ fn a_call_set_aside_is_kept_on_a_refusal_and_ended_by_an_abort_or_a_fault() {
     let first = start(&mut fleet, 0, Function::FlyToPosition, &[pos(200.0, 0.0)]);
     run_for(&mut fleet, 3.0);
     fleet.interrupt(first, Interrupt::Pause);
-    let (_, refused) = fleet.call(0, &fc(Function::FlyToPosition, &[pos(5000.0, 0.0)]));
+    let (_, refused) = fleet.call(DroneId(0), &fc(Function::FlyToPosition, &[pos(5000.0, 0.0)]));
     assert!(matches!(refused, Some(CallEnd::Failed(_))), "outside the geofence: {refused:?}");
-    let (busy, end) = fleet.call(0, &fc(Function::Hover, &[num(60.0)]));
+    let (busy, end) = fleet.call(DroneId(0), &fc(Function::Hover, &[num(60.0)]));
     assert_eq!(end, None, "the paused call was back, and gives way again");
     assert_eq!(fleet.interrupt(first, Interrupt::Abort), Some(CallEnd::Interrupted));
     fleet.interrupt(busy, Interrupt::Pause);
-    let (last, _) = fleet.call(0, &fc(Function::Hover, &[num(60.0)]));
+    let (last, _) = fleet.call(DroneId(0), &fc(Function::Hover, &[num(60.0)]));
     let mut reports = Vec::new();
-    fleet.fault(0, aviary_api::BuiltinException::MotorFailure, "test".into(), &mut reports);
+    fleet.fault(
+        DroneId(0),
+        aviary_api::BuiltinException::MotorFailure,
+        "test".into(),
+        &mut reports,
+    );
     let ended: Vec<CallId> = reports
         .iter()
         .filter_map(|r| match r {
@@ -294,18 +299,18 @@ fn abort_ends_the_call_interrupted_and_the_drone_hovers() {
     run_for(&mut fleet, 5.0);
     assert_eq!(fleet.interrupt(id, Interrupt::Abort), Some(CallEnd::Interrupted));
     assert_eq!(fleet.interrupt(id, Interrupt::Abort), None, "once");
-    let here = fleet.telemetry(0).unwrap();
+    let here = fleet.telemetry(DroneId(0)).unwrap();
     run_for(&mut fleet, 5.0);
-    let later = fleet.telemetry(0).unwrap();
+    let later = fleet.telemetry(DroneId(0)).unwrap();
     assert_eq!(
         (later.position, later.speed, later.state),
         (here.position, 0.0, FlightState::Flying)
     );
     // The drone takes a new move at once.
     let id = start(&mut fleet, 0, Function::Land, &[]);
-    assert_eq!(fleet.telemetry(0).unwrap().state, FlightState::Landing);
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().state, FlightState::Landing);
     assert_eq!(run_until(&mut fleet, 0, id, 100.0).end, CallEnd::Done);
-    assert_eq!(fleet.telemetry(0).unwrap().state, FlightState::Landed);
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().state, FlightState::Landed);
 }
 
 /// A scripted mission on two drones: every telemetry sample and report.
@@ -330,15 +335,15 @@ at = [120, 60]
     let mut log = Vec::new();
     let mut reports = Vec::new();
     for d in 0..2 {
-        fleet.call(d, &fc(Function::Arm, &[]));
-        fleet.call(d, &fc(Function::TakeOff, &[num(12.5 + d as f64)]));
+        fleet.call(DroneId(d), &fc(Function::Arm, &[]));
+        fleet.call(DroneId(d), &fc(Function::TakeOff, &[num(12.5 + d as f64)]));
     }
     for i in 0..6000 {
         match i {
             300 => {
-                fleet.call(0, &fc(Function::StartDetection, &[sym("Body")]));
+                fleet.call(DroneId(0), &fc(Function::StartDetection, &[sym("Body")]));
                 fleet.call(
-                    0,
+                    DroneId(0),
                     &fc(
                         Function::Sweep,
                         &[
@@ -352,15 +357,18 @@ at = [120, 60]
                         ],
                     ),
                 );
-                fleet.call(1, &fc(Function::Orbit, &[pos(-40.0, 30.0), num(25.0), num(1.5)]));
+                fleet.call(
+                    DroneId(1),
+                    &fc(Function::Orbit, &[pos(-40.0, 30.0), num(25.0), num(1.5)]),
+                );
             }
             4000 => {
-                fleet.call(1, &fc(Function::ReturnToLaunch, &[]));
+                fleet.call(DroneId(1), &fc(Function::ReturnToLaunch, &[]));
             }
             _ => {}
         }
         reports.extend(fleet.step(DT));
-        log.extend((0..2).map(|d| fleet.telemetry(d).unwrap()));
+        log.extend((0..2).map(|d| fleet.telemetry(DroneId(d)).unwrap()));
     }
     (log, reports)
 }

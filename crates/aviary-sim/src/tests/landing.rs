@@ -37,7 +37,7 @@ fn a_landing_descends_at_its_rate_and_touches_down_at_the_landing_speed() {
         let limit = if pair[0].position[2] <= 10.0 + 1e-9 { 0.5 } else { 1.5 };
         assert!(down <= limit + 1e-9, "{down} m/s down at {} m", pair[0].position[2]);
     }
-    let end = fleet.telemetry(0).unwrap();
+    let end = fleet.telemetry(DroneId(0)).unwrap();
     assert_eq!((end.position[2], end.state), (0.0, FlightState::Landed));
 }
 

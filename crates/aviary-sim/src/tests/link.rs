@@ -52,7 +52,7 @@ fn cut_off(w: &World) -> Fleet {
     let reports = run_to(&mut fleet, 20.0);
     assert_eq!(names(&reports), ["ConnectionLost"]);
     assert!(reports.contains(&Report::Ended { call: id, end: CallEnd::Interrupted }));
-    let t = fleet.telemetry(0).unwrap();
+    let t = fleet.telemetry(DroneId(0)).unwrap();
     assert!(!t.link && t.position[0] > 50.0, "{t:?}");
     fleet
 }
@@ -62,26 +62,26 @@ fn link_loss_holds_then_returns_to_launch_after_the_timeout() {
     let w = linked("link_loss_rtl_after = 8", &link_loss(20.0, 60.0));
     assert_eq!(w.site.link_loss_rtl_after, 8.0);
     let mut fleet = cut_off(&w);
-    let held = fleet.telemetry(0).unwrap().position;
+    let held = fleet.telemetry(DroneId(0)).unwrap().position;
     // Holds for 8 s, taking no commands.
     while fleet.time() + DT < 28.0 - DT / 2.0 {
         assert!(names(&fleet.step(DT)).is_empty());
-        let t = fleet.telemetry(0).unwrap();
+        let t = fleet.telemetry(DroneId(0)).unwrap();
         assert_eq!((t.position, t.speed), (held, 0.0));
         let (_, reason) = refused(&mut fleet, 0, Function::FlyToPosition, &[pos(0.0, 0.0)]);
         assert!(reason.contains("no link"), "{reason}");
     }
     // Then flies home on its own and lands, still without a link.
     run_to(&mut fleet, 28.5);
-    let t = fleet.telemetry(0).unwrap();
+    let t = fleet.telemetry(DroneId(0)).unwrap();
     assert!(t.position[0] < held[0] && t.speed > 0.0, "{t:?}");
     let reports = run_to(&mut fleet, 79.9);
     assert!(names(&reports).is_empty());
-    let t = fleet.telemetry(0).unwrap();
+    let t = fleet.telemetry(DroneId(0)).unwrap();
     assert_eq!((t.position, t.state, t.link), ([0.0, 0.0, 0.0], FlightState::Landed, false));
     // The link comes back when the fault's duration ends.
     assert!(comes_at(&mut fleet, "ConnectionRestored", 80.0));
-    assert!(fleet.telemetry(0).unwrap().link);
+    assert!(fleet.telemetry(DroneId(0)).unwrap().link);
     assert_eq!(instant(&mut fleet, 0, Function::Arm, &[]), CallEnd::Done);
 }
 
@@ -91,21 +91,21 @@ fn a_short_loss_only_holds_and_the_default_timeout_is_ten_seconds() {
     let w = linked("", &faults);
     assert_eq!(w.site.link_loss_rtl_after, 10.0);
     let mut fleet = cut_off(&w);
-    let held = fleet.telemetry(0).unwrap().position;
+    let held = fleet.telemetry(DroneId(0)).unwrap().position;
     assert!(comes_at(&mut fleet, "ConnectionRestored", 29.5));
-    let t = fleet.telemetry(0).unwrap();
+    let t = fleet.telemetry(DroneId(0)).unwrap();
     assert_eq!((t.position, t.speed, t.link), (held, 0.0, true));
     // Commands again: fly on, until the second loss at 40 s.
     let id = start(&mut fleet, 0, Function::FlyToPosition, &[pos(400.0, 0.0)]);
     let reports = run_to(&mut fleet, 40.0);
     assert_eq!(names(&reports), ["ConnectionLost"]);
     assert!(reports.contains(&Report::Ended { call: id, end: CallEnd::Interrupted }));
-    let held = fleet.telemetry(0).unwrap().position;
+    let held = fleet.telemetry(DroneId(0)).unwrap().position;
     run_to(&mut fleet, 50.0 - DT);
-    assert_eq!(fleet.telemetry(0).unwrap().position, held, "holds 10 s");
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().position, held, "holds 10 s");
     fleet.step(DT);
     run_to(&mut fleet, 50.5);
-    assert!(fleet.telemetry(0).unwrap().position[0] < held[0], "returns after 10 s");
+    assert!(fleet.telemetry(DroneId(0)).unwrap().position[0] < held[0], "returns after 10 s");
 }
 
 #[test]
@@ -113,21 +113,21 @@ fn a_return_started_on_its_own_goes_on_after_the_link_is_back_until_commanded() 
     let w = linked("link_loss_rtl_after = 2", &link_loss(20.0, 5.0));
     let mut fleet = cut_off(&w);
     assert!(comes_at(&mut fleet, "ConnectionRestored", 25.0));
-    let t = fleet.telemetry(0).unwrap();
+    let t = fleet.telemetry(DroneId(0)).unwrap();
     assert!(t.speed > 0.0 && t.link, "still returning: {t:?}");
     // Left alone, it lands at home.
     let mut alone = fleet.clone();
     run_to(&mut alone, 80.0);
-    let t = alone.telemetry(0).unwrap();
+    let t = alone.telemetry(DroneId(0)).unwrap();
     assert_eq!((t.position, t.state), ([0.0, 0.0, 0.0], FlightState::Landed));
     // A command replaces the return (the drone stops where it is, then obeys).
     let id = start(&mut fleet, 0, Function::Hover, &[num(3.0)]);
-    let here = fleet.telemetry(0).unwrap().position;
+    let here = fleet.telemetry(DroneId(0)).unwrap().position;
     let run = run_until(&mut fleet, 0, id, 10.0);
     assert_eq!(run.end, CallEnd::Done);
     assert!(run.samples.iter().all(|t| t.position == here));
     run_to(&mut fleet, 80.0);
-    assert_eq!(fleet.telemetry(0).unwrap().position, here, "the return is over");
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().position, here, "the return is over");
 }
 
 #[test]
@@ -137,7 +137,7 @@ fn a_crash_during_a_link_loss_ends_the_drone() {
     let mut fleet = cut_off(&w);
     let reports = run_to(&mut fleet, 70.0);
     assert_eq!(names(&reports), ["DroneLost"], "no return, no ConnectionRestored");
-    let t = fleet.telemetry(0).unwrap();
+    let t = fleet.telemetry(DroneId(0)).unwrap();
     assert_eq!((t.state, t.position[2]), (FlightState::Lost, 0.0));
 }
 
@@ -164,12 +164,12 @@ fn battery_critical_two_km_out_leaves_enough_to_get_home() {
         }
     }
     assert_eq!(seen, ["BatteryLow", "BatteryCritical"]);
-    let critical = fleet.telemetry(0).unwrap();
+    let critical = fleet.telemetry(DroneId(0)).unwrap();
     assert_eq!(critical.position, [2000.0, 0.0, 20.0]);
     let id = start(&mut fleet, 0, Function::ReturnToLaunch, &[]);
     let home = run_until(&mut fleet, 0, id, 400.0);
     assert_eq!(home.end, CallEnd::Done);
-    let t = fleet.telemetry(0).unwrap();
+    let t = fleet.telemetry(DroneId(0)).unwrap();
     assert_eq!((t.position, t.state), ([0.0, 0.0, 0.0], FlightState::Landed));
     assert!(t.battery > 0.05, "landed with {:.3} left", t.battery);
     // Raised at "energy to get home + 10 %", and the way home took about that energy.

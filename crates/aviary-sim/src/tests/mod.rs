@@ -16,7 +16,7 @@ mod sky;
 mod start;
 
 pub(crate) use aviary_api::{BuiltinException, Function};
-use aviary_api::{CallEnd, CallId, DroneEvent, FunctionCall, Point, Telemetry, Value};
+use aviary_api::{CallEnd, CallId, DroneEvent, DroneId, FunctionCall, Point, Telemetry, Value};
 use aviary_diagnostics::FileId;
 use aviary_world::{parse_world, World};
 
@@ -85,14 +85,14 @@ pub(crate) fn sym(s: &str) -> Value {
 
 /// A call that must start (not end at once).
 pub(crate) fn start(fleet: &mut Fleet, drone: usize, f: Function, args: &[Value]) -> CallId {
-    let (id, end) = fleet.call(drone, &fc(f, args));
+    let (id, end) = fleet.call(DroneId(drone), &fc(f, args));
     assert_eq!(end, None, "{f} ended at once");
     id
 }
 
 /// A call that must end at once, with this end.
 pub(crate) fn instant(fleet: &mut Fleet, drone: usize, f: Function, args: &[Value]) -> CallEnd {
-    fleet.call(drone, &fc(f, args)).1.unwrap_or_else(|| panic!("{f} did not end at once"))
+    fleet.call(DroneId(drone), &fc(f, args)).1.unwrap_or_else(|| panic!("{f} did not end at once"))
 }
 
 /// The exception of a refused call.
@@ -121,7 +121,7 @@ pub(crate) struct Run {
 /// Steps until `call` ends (at most `limit` seconds), recording drone `drone`.
 pub(crate) fn run_until(fleet: &mut Fleet, drone: usize, call: CallId, limit: f64) -> Run {
     let t0 = fleet.time();
-    let mut samples = vec![fleet.telemetry(drone).unwrap()];
+    let mut samples = vec![fleet.telemetry(DroneId(drone)).unwrap()];
     let mut events = Vec::new();
     while fleet.time() - t0 < limit {
         let mut ended = None;
@@ -132,7 +132,7 @@ pub(crate) fn run_until(fleet: &mut Fleet, drone: usize, call: CallId, limit: f6
                 Report::Event(e) => events.push(e),
             }
         }
-        samples.push(fleet.telemetry(drone).unwrap());
+        samples.push(fleet.telemetry(DroneId(drone)).unwrap());
         if let Some(end) = ended {
             return Run { end, took: fleet.time() - t0, samples, events };
         }

@@ -46,7 +46,7 @@ fn a_flight_across_a_zone_goes_around_it_and_ends_where_asked() {
     let run = run_until(&mut fleet, 0, id, 200.0);
     assert_eq!(run.end, CallEnd::Done);
     outside_zones(&w, &run);
-    let end = fleet.telemetry(0).unwrap().position;
+    let end = fleet.telemetry(DroneId(0)).unwrap().position;
     assert!((end[0] - 300.0).abs() < 1e-9 && end[1].abs() < 1e-9, "{end:?}");
     // Around, not through: it left the line y = 0 by the zone's half-width and the margin.
     let widest = run.samples.iter().map(|t| t.position[1].abs()).fold(0.0, f64::max);
@@ -87,7 +87,7 @@ fn work_inside_a_zone_is_refused_before_the_drone_moves() {
     // Climbing over the corridor from below it passes through it.
     let (_, reason) = refused(&mut fleet, 0, Function::FollowPath, &[pos3(0.0, 230.0, 60.0)]);
     assert!(reason.contains("climb above it first"), "{reason}");
-    assert_eq!(fleet.telemetry(0).unwrap().position, [0.0, 0.0, 20.0]);
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().position, [0.0, 0.0, 20.0]);
     // An orbit around the whole zone is allowed, and flown outside it.
     let id = start(&mut fleet, 0, Function::Orbit, &[pos(150.0, 0.0), num(120.0)]);
     let run = run_until(&mut fleet, 0, id, 400.0);
@@ -137,19 +137,19 @@ fn a_path_cut_on_a_detour_leaves_its_own_points_not_the_corners() {
     loop {
         run_for(&mut fleet, 0.5);
         t += 0.5;
-        let p = fleet.telemetry(0).unwrap().position;
+        let p = fleet.telemetry(DroneId(0)).unwrap().position;
         if p[1].abs() > 20.0 && p[0] > 100.0 {
             break;
         }
         assert!(t < 60.0, "the detour was never flown: {p:?}");
     }
     assert_eq!(fleet.interrupt(id, Interrupt::Abort), Some(CallEnd::Interrupted));
-    let stop = fleet.stopped(0).expect("noted at the abort");
+    let stop = fleet.stopped(DroneId(0)).expect("noted at the abort");
     assert_eq!(stop.next, 1, "flying to the path's second point, by a corner of the detour");
     let left = coverage::left(&fc(Function::FollowPath, &args), Some(stop)).unwrap();
     let Remainder::Points(points) = &left else { panic!("{left:?}") };
     let flat: Vec<[f64; 2]> = points.iter().map(|p| [p.x, p.y]).collect();
-    let here = fleet.telemetry(0).unwrap().position;
+    let here = fleet.telemetry(DroneId(0)).unwrap().position;
     assert_eq!(flat, [[here[0], here[1]], [300.0, 0.0]]);
 
     // Flown on, the rest goes around the zone again and ends where the path ends.
@@ -158,6 +158,6 @@ fn a_path_cut_on_a_detour_leaves_its_own_points_not_the_corners() {
     let run = run_until(&mut fleet, 0, again, 200.0);
     assert_eq!(run.end, CallEnd::Done);
     outside_zones(&w, &run);
-    let end = fleet.telemetry(0).unwrap().position;
+    let end = fleet.telemetry(DroneId(0)).unwrap().position;
     assert!((end[0] - 300.0).abs() < 1e-9 && end[1].abs() < 1e-9, "{end:?}");
 }

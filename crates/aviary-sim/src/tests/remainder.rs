@@ -23,11 +23,11 @@ fn an_aborted_sweep_stops_on_its_lane_and_leaves_the_rest_from_there() {
     // To the field (about 140 m), the first lane (200 m) and into the second.
     run_for(&mut fleet, 50.0);
     assert_eq!(fleet.interrupt(id, Interrupt::Abort), Some(CallEnd::Interrupted));
-    let here = fleet.telemetry(0).unwrap().position;
-    let Some(Progress { next, at }) = fleet.stopped(0) else { panic!("no stop noted") };
+    let here = fleet.telemetry(DroneId(0)).unwrap().position;
+    let Some(Progress { next, at }) = fleet.stopped(DroneId(0)) else { panic!("no stop noted") };
     assert_eq!(at, here);
     let lanes = sweep::lanes(&FIELD, 20.0);
-    let left = coverage::left(&fc(Function::Sweep, &field()), fleet.stopped(0)).unwrap();
+    let left = coverage::left(&fc(Function::Sweep, &field()), fleet.stopped(DroneId(0))).unwrap();
     let Remainder::Lanes { lanes: left_lanes, .. } = &left else { panic!("{left:?}") };
     // It was on a lane: what is left of it starts where the drone is.
     assert!(sweep::points(&lanes)[next].1 .1, "on a lane, not a turn");
@@ -39,10 +39,10 @@ fn an_aborted_sweep_stops_on_its_lane_and_leaves_the_rest_from_there() {
     // whole sweep would have.
     let again =
         start(&mut fleet, 0, Function::Sweep, &[Value::Remainder(Arc::new(left)), num(20.0)]);
-    assert_eq!(fleet.stopped(0), None, "a motion call forgets the last stop");
+    assert_eq!(fleet.stopped(DroneId(0)), None, "a motion call forgets the last stop");
     let run = run_until(&mut fleet, 0, again, 500.0);
     assert_eq!(run.end, CallEnd::Done);
-    let end = fleet.telemetry(0).unwrap().position;
+    let end = fleet.telemetry(DroneId(0)).unwrap().position;
     let last = *sweep::lawnmower(&FIELD, 20.0).last().unwrap();
     assert_eq!([end[0], end[1]], last);
     assert!(run.samples.iter().all(|t| (t.position[2] - 20.0).abs() < 1e-9));
@@ -57,7 +57,7 @@ fn a_fault_notes_the_stop_and_a_refused_sweep_none() {
     let id = start(&mut fleet, 0, Function::Sweep, &field());
     let run = run_until(&mut fleet, 0, id, 100.0);
     assert_eq!(run.end, CallEnd::Interrupted);
-    let stop = fleet.stopped(0).expect("noted at the fault");
+    let stop = fleet.stopped(DroneId(0)).expect("noted at the fault");
     assert_eq!(stop.at, run.samples.last().unwrap().position);
     assert!(stop.next > 0);
 
@@ -67,7 +67,7 @@ fn a_fault_notes_the_stop_and_a_refused_sweep_none() {
         refused(&mut fleet, 0, Function::Sweep, &wide).0,
         BuiltinException::GeofenceViolation
     );
-    assert_eq!(fleet.stopped(0), None, "refused before it moved");
+    assert_eq!(fleet.stopped(DroneId(0)), None, "refused before it moved");
 }
 
 #[test]
@@ -97,12 +97,13 @@ fn a_follow_path_stopped_leaves_its_rest_and_flying_it_goes_on_from_there() {
     let id = start(&mut fleet, 0, Function::FollowPath, &points);
     run_for(&mut fleet, 20.0);
     fleet.interrupt(id, Interrupt::Abort);
-    let here = fleet.telemetry(0).unwrap().position;
-    let left = coverage::left(&fc(Function::FollowPath, &points), fleet.stopped(0)).unwrap();
+    let here = fleet.telemetry(DroneId(0)).unwrap().position;
+    let left =
+        coverage::left(&fc(Function::FollowPath, &points), fleet.stopped(DroneId(0))).unwrap();
     let Remainder::Points(rest) = &left else { panic!("{left:?}") };
     assert_eq!([rest[0].x, rest[0].y], [here[0], here[1]]);
     assert_eq!(rest.last().map(|p| (p.x, p.y, p.z)), Some((0.0, 100.0, Some(30.0))));
     let again = start(&mut fleet, 0, Function::FollowPath, &[Value::Remainder(Arc::new(left))]);
     assert_eq!(run_until(&mut fleet, 0, again, 200.0).end, CallEnd::Done);
-    assert_eq!(fleet.telemetry(0).unwrap().position, [0.0, 100.0, 30.0]);
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().position, [0.0, 100.0, 30.0]);
 }

@@ -38,12 +38,12 @@ fn takeoff_needs_arming_and_flights_need_the_air() {
     // In the air, TakeOff climbs or descends to the altitude.
     let id = start(&mut fleet, 0, Function::TakeOff, &[num(4.0)]);
     run_until(&mut fleet, 0, id, 60.0);
-    assert_eq!(fleet.telemetry(0).unwrap().position[2], 4.0);
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().position[2], 4.0);
     let id = start(&mut fleet, 0, Function::AscendTo, &[num(30.0)]);
     run_until(&mut fleet, 0, id, 60.0);
     let id = start(&mut fleet, 0, Function::DescendTo, &[num(12.0)]);
     run_until(&mut fleet, 0, id, 60.0);
-    assert_eq!(fleet.telemetry(0).unwrap().position, [0.0, 0.0, 12.0]);
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().position, [0.0, 0.0, 12.0]);
     assert_eq!(
         refused(&mut fleet, 999, Function::Hover, &[num(1.0)]).0,
         BuiltinException::CommandFailed
@@ -65,11 +65,11 @@ fn hover_waits_and_return_to_launch_lands_at_home_disarmed() {
     );
     let run = run_until(&mut fleet, 0, id, 200.0);
     assert!(run.samples.iter().any(|t| t.position == [50.0, 0.0, 5.0]));
-    assert_eq!(fleet.telemetry(0).unwrap().position, [0.0, 50.0, 30.0]);
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().position, [0.0, 50.0, 30.0]);
     let id = start(&mut fleet, 0, Function::ReturnToLaunch, &[]);
     let run = run_until(&mut fleet, 0, id, 200.0);
     assert!(run.samples.iter().all(|t| t.position[2] <= 30.0));
-    let t = fleet.telemetry(0).unwrap();
+    let t = fleet.telemetry(DroneId(0)).unwrap();
     assert_eq!((t.position, t.state), ([0.0, 0.0, 0.0], FlightState::Landed));
     let (_, reason) = refused(&mut fleet, 0, Function::TakeOff, &[num(10.0)]);
     assert!(reason.contains("not armed"), "landing disarms: {reason}");
@@ -95,7 +95,7 @@ fn payload_rules() {
     let run = run_until(&mut fleet, 0, id, 10.0);
     assert_eq!(run.end, CallEnd::Done);
     assert!((run.took - LOAD_TIME).abs() < 1e-9);
-    assert_eq!(fleet.carrying(0), Some("Body"));
+    assert_eq!(fleet.carrying(DroneId(0)), Some("Body"));
     let (_, reason) = refused(&mut fleet, 0, Function::LoadPayload, &[sym("Body")]);
     assert!(reason.contains("already carries Body"), "{reason}");
     // Release in flight, at the drone's position, and logged.
@@ -108,7 +108,7 @@ fn payload_rules() {
     let release = &fleet.releases()[0];
     assert_eq!(
         (release.drone, release.kind.as_str(), release.position),
-        (0, "Body", [30.0, 40.0, 3.0])
+        (DroneId(0), "Body", [30.0, 40.0, 3.0])
     );
     assert_eq!(release.time, fleet.time());
     // Loading at 3 m is fine; at 20 m it is too high.
@@ -124,14 +124,14 @@ fn payload_rules() {
     let id = start(&mut fleet, 0, Function::LoadPayload, &[sym("Body")]);
     fleet.step(DT);
     assert_eq!(fleet.interrupt(id, Interrupt::Abort), Some(CallEnd::Interrupted));
-    assert_eq!(fleet.carrying(0), None);
+    assert_eq!(fleet.carrying(DroneId(0)), None);
 }
 
 #[test]
 fn geofence_and_ceiling_refuse_at_once_without_moving() {
     let w = one_drone();
     let mut fleet = airborne(&w, 20.0);
-    let before = fleet.telemetry(0).unwrap();
+    let before = fleet.telemetry(DroneId(0)).unwrap();
     let cases: Vec<(Function, Vec<Value>)> = vec![
         (Function::FlyToPosition, vec![pos(1500.0, 0.0)]),
         (Function::FlyToPosition, vec![pos3(10.0, 0.0, 150.0)]),
@@ -152,7 +152,7 @@ fn geofence_and_ceiling_refuse_at_once_without_moving() {
         assert_eq!(exception, BuiltinException::GeofenceViolation, "{f}: {reason}");
     }
     run_for(&mut fleet, 2.0);
-    let after = fleet.telemetry(0).unwrap();
+    let after = fleet.telemetry(DroneId(0)).unwrap();
     assert_eq!((after.position, after.speed), (before.position, 0.0));
     // A non-convex fence: the straight way across the notch is refused.
     let mut w = one_drone();
@@ -182,9 +182,9 @@ fn camera_and_sensors_are_needed() {
     let (_, reason) = refused(&mut fleet, 0, Function::StartStreaming, &[]);
     assert!(reason.contains("no camera"), "{reason}");
     assert_eq!(instant(&mut fleet, 1, Function::StartStreaming, &[]), CallEnd::Done);
-    assert!(fleet.streaming(1));
+    assert!(fleet.streaming(DroneId(1)));
     assert_eq!(instant(&mut fleet, 1, Function::StopStreaming, &[]), CallEnd::Done);
-    assert!(!fleet.streaming(1));
+    assert!(!fleet.streaming(DroneId(1)));
     let (_, reason) = refused(&mut fleet, 1, Function::StartDetection, &[sym("Body")]);
     assert!(reason.contains("no sensor that detects Body"), "{reason}");
 }
@@ -226,13 +226,13 @@ kind = "motor_failure"
     for r in run_for(&mut fleet, 30.0) {
         match r {
             Report::Event(DroneEvent::Fault { drone, failure }) => {
-                seen.push((drone, failure.exception.name()))
+                seen.push((drone.0, failure.exception.name()))
             }
             Report::Event(DroneEvent::Signal { drone, signal }) => {
-                seen.push((drone, signal.name()))
+                seen.push((drone.0, signal.name()))
             }
             Report::Event(DroneEvent::Autopilot { drone, action, .. }) => {
-                seen.push((drone, action.as_str()))
+                seen.push((drone.0, action.as_str()))
             }
             Report::Ended { call, end } => assert_eq!(end, CallEnd::Interrupted, "{call:?}"),
             Report::Event(other) => panic!("{other:?}"),
@@ -250,9 +250,9 @@ kind = "motor_failure"
             (0, "ConnectionRestored")
         ]
     );
-    assert_eq!(fleet.telemetry(1).unwrap().state, FlightState::Lost);
-    let c = fleet.telemetry(2).unwrap();
+    assert_eq!(fleet.telemetry(DroneId(1)).unwrap().state, FlightState::Lost);
+    let c = fleet.telemetry(DroneId(2)).unwrap();
     assert_eq!((c.state, c.position[2]), (FlightState::Landed, 0.0), "emergency landing");
     assert_eq!(refused(&mut fleet, 2, Function::Arm, &[]).0, BuiltinException::CommandFailed);
-    assert!(fleet.telemetry(0).unwrap().link);
+    assert!(fleet.telemetry(DroneId(0)).unwrap().link);
 }

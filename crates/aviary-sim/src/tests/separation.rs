@@ -42,7 +42,7 @@ fn unseparated(mut world: World, alt: f64, targets: &[[f64; 2]]) -> f64 {
 
 fn assert_arrived(f: &Flight, alt: f64, targets: &[[f64; 2]]) {
     for (d, t) in targets.iter().enumerate() {
-        let end = f.fleet.telemetry(d).unwrap();
+        let end = f.fleet.telemetry(DroneId(d)).unwrap();
         assert_eq!(end.position, [t[0], t[1], alt], "drone {d} at its target");
         assert_eq!((end.speed, end.state), (0.0, FlightState::Flying));
     }
@@ -197,7 +197,7 @@ fn the_paper_world_keeps_separation_and_everyone_gets_home() {
     let f = paper_flight(&w);
     assert!(f.closest >= 5.0);
     for (d, drone) in w.drones.iter().enumerate() {
-        let t = f.fleet.telemetry(d).unwrap();
+        let t = f.fleet.telemetry(DroneId(d)).unwrap();
         assert_eq!(t.state, FlightState::Landed, "{}", drone.name);
         assert_eq!([t.position[0], t.position[1]], [drone.home[0], drone.home[1]]);
     }
@@ -315,7 +315,7 @@ fn same_point(site: &str) -> (Fleet, Vec<(CallEnd, f64)>, Vec<Telemetry>) {
                 }
             }
         }
-        log.push(fleet.telemetry(1).unwrap());
+        log.push(fleet.telemetry(DroneId(1)).unwrap());
     }
     let ends = ends.into_iter().map(|e| e.expect("the call ended")).collect();
     (fleet, ends, log)
@@ -346,7 +346,7 @@ fn two_drones_sent_to_the_same_point_the_second_times_out_and_hovers() {
     assert_eq!(ends[0].0, CallEnd::Done);
     let nominal = 10.0 + 100.0 / 10.0 + 10.0 / 3.0;
     assert!((ends[0].1 - nominal).abs() < 0.2, "{}", ends[0].1);
-    assert_eq!(fleet.telemetry(0).unwrap().position, [0.0, 100.0, 20.0]);
+    assert_eq!(fleet.telemetry(DroneId(0)).unwrap().position, [0.0, 100.0, 20.0]);
     // The second one passes above it and waits there, over the point; 30 s after it last
     // got nearer, its call ends with `Timeout`.
     let (end, at) = &ends[1];
@@ -361,7 +361,7 @@ fn two_drones_sent_to_the_same_point_the_second_times_out_and_hovers() {
     let waited = at - last_gain(&log, *at);
     assert!((29.99..31.0).contains(&waited), "{waited}");
     // Then it hovers where it is, clear of the first drone, and takes new calls.
-    let held = fleet.telemetry(1).unwrap();
+    let held = fleet.telemetry(DroneId(1)).unwrap();
     assert_eq!((held.speed, held.state), (0.0, FlightState::Flying));
     let apart = |t: &Telemetry| {
         let p = t.position;
@@ -369,7 +369,7 @@ fn two_drones_sent_to_the_same_point_the_second_times_out_and_hovers() {
     };
     assert!(apart(&held) >= 5.0, "{held:?}");
     run_for(&mut fleet, 10.0);
-    assert_eq!(fleet.telemetry(1).unwrap().position, held.position);
+    assert_eq!(fleet.telemetry(DroneId(1)).unwrap().position, held.position);
     let id = start(&mut fleet, 1, Function::FlyToPosition, &[pos(10.0, 0.0)]);
     assert_eq!(run_until(&mut fleet, 1, id, 60.0).end, CallEnd::Done);
 }

@@ -3,7 +3,7 @@
 
 use std::collections::VecDeque;
 
-use aviary_api::{CallEnd, CallId, Function, Telemetry, Value};
+use aviary_api::{CallEnd, CallId, DroneId, Function, Telemetry, Value};
 use aviary_world::World;
 
 use super::{fc, DT};
@@ -78,7 +78,7 @@ pub(crate) fn fly(world: &World, scripts: Vec<Vec<Act>>, limit: f64) -> Flight {
                     }
                     Some(Act::At(t)) if fleet.time() + 1e-9 < t => break,
                     Some(Act::At(_)) => {}
-                    Some(Act::Call(f, args)) => match fleet.call(d, &fc(f, &args)) {
+                    Some(Act::Call(f, args)) => match fleet.call(DroneId(d), &fc(f, &args)) {
                         (_, Some(CallEnd::Done)) => {}
                         (_, Some(end)) => panic!("drone {d}: {f} ended {end:?}"),
                         (id, None) => waiting[d] = Some((id, f)),
@@ -114,7 +114,7 @@ pub(crate) fn fly(world: &World, scripts: Vec<Vec<Act>>, limit: f64) -> Flight {
             reports.push(r);
         }
         let snapshot: Vec<Telemetry> =
-            (0..fleet.len()).map(|d| fleet.telemetry(d).unwrap()).collect();
+            (0..fleet.len()).map(|d| fleet.telemetry(DroneId(d)).unwrap()).collect();
         let c = closest_pair(&snapshot);
         assert!(
             c >= sep - 1e-9,

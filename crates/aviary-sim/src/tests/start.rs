@@ -36,24 +36,27 @@ kind = "crash"
 fn fly(mut fleet: Fleet) -> Vec<String> {
     let mut seen = Vec::new();
     for d in 0..fleet.len() {
-        seen.push(format!("{:?}", fleet.call(d, &fc(Function::Arm, &[]))));
-        seen.push(format!("{:?}", fleet.call(d, &fc(Function::TakeOff, &[num(10.0)]))));
+        seen.push(format!("{:?}", fleet.call(DroneId(d), &fc(Function::Arm, &[]))));
+        seen.push(format!("{:?}", fleet.call(DroneId(d), &fc(Function::TakeOff, &[num(10.0)]))));
     }
     for step in 0..1200 {
         if step == 200 {
             for d in 0..fleet.len() {
                 seen.push(format!(
                     "{:?}",
-                    fleet.call(d, &fc(Function::StartDetection, &[sym("Body")]))
+                    fleet.call(DroneId(d), &fc(Function::StartDetection, &[sym("Body")]))
                 ));
                 seen.push(format!(
                     "{:?}",
-                    fleet.call(d, &fc(Function::FlyToPosition, &[pos(d as f64 * 30.0, 150.0)]))
+                    fleet.call(
+                        DroneId(d),
+                        &fc(Function::FlyToPosition, &[pos(d as f64 * 30.0, 150.0)])
+                    )
                 ));
             }
         }
         seen.extend(fleet.step(DT).iter().map(|r| format!("{r:?}")));
-        seen.extend((0..fleet.len()).map(|d| format!("{:?}", fleet.telemetry(d))));
+        seen.extend((0..fleet.len()).map(|d| format!("{:?}", fleet.telemetry(DroneId(d)))));
     }
     seen
 }

@@ -20,7 +20,7 @@ mod params;
 
 use std::collections::VecDeque;
 
-use aviary_api::FunctionCall;
+use aviary_api::{DroneId, FunctionCall};
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{MavMessage, MavSeverity, STATUSTEXT_DATA};
 use aviary_mavlink::mode::px4;
 
@@ -278,6 +278,6 @@ impl Autopilot {
 
     /// Where the drone is, local metres.
     pub(crate) fn here(&self, i: usize) -> [f64; 3] {
-        self.fleet.telemetry(i).map_or([0.0; 3], |t| t.position)
+        self.fleet.telemetry(DroneId(i)).map_or([0.0; 3], |t| t.position)
     }
 }

@@ -13,7 +13,7 @@
 //! - Mission flies its items in order from the current one, with PX4's climb first when
 //!   it starts on the ground.
 
-use aviary_api::{CallEnd, Failure, Function, FunctionCall, Interrupt, Place, Point};
+use aviary_api::{CallEnd, DroneId, Failure, Function, FunctionCall, Interrupt, Place, Point};
 use aviary_mavlink::mavlink::dialects::ardupilotmega::{
     MavMessage, MavSeverity, MISSION_ITEM_REACHED_DATA,
 };
@@ -76,7 +76,7 @@ impl Autopilot {
             let _ = self.instant(i, &FunctionCall::Arm);
         }
         self.px4_mut(i).doing = doing;
-        let (call, end) = self.fleet.call(i, f);
+        let (call, end) = self.fleet.call(DroneId(i), f);
         match end {
             None => {
                 self.copters[i].call = Some(call);

@@ -268,7 +268,7 @@ impl<'m> Estimator<'m> {
             let now = &self.s.drones[d];
             if now.distance > then.distance {
                 out.push((
-                    d,
+                    DroneId(d),
                     (
                         now.distance - then.distance,
                         now.flight_time - then.flight_time,
@@ -747,7 +747,7 @@ impl<'m> Estimator<'m> {
             if top {
                 for &slot in motion.iter() {
                     if let Some(&d) = actors.get(slot) {
-                        start = start.max(self.s.drones[d].free_at);
+                        start = start.max(self.s.drones[d.0].free_at);
                     }
                 }
             }
@@ -782,12 +782,12 @@ impl<'m> Estimator<'m> {
     fn ran_at_top(&mut self, c: &Call, actors: &[DroneId], motion: &[usize], start: f64, end: f64) {
         for &slot in motion {
             if let Some(&d) = actors.get(slot) {
-                self.s.drones[d].free_at = self.s.drones[d].free_at.max(end);
+                self.s.drones[d.0].free_at = self.s.drones[d.0].free_at.max(end);
             }
         }
         let what = &self.mission.capabilities[c.capability].name;
         for &d in actors {
-            self.s.activities[d].push(Activity {
+            self.s.activities[d.0].push(Activity {
                 start,
                 end,
                 what: what.clone(),
@@ -803,9 +803,9 @@ impl<'m> Estimator<'m> {
         let args: Vec<Option<Value>> = a.args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
         let (duration, raises) = super::flight::fly(self, d, a.function, &args, ctx.statement, t);
         let end = t + duration;
-        let f = &self.s.drones[d];
-        if f.battery_at(end) < super::RESERVE && self.s.reserve[d].is_none() {
-            self.s.reserve[d] = ctx.statement;
+        let f = &self.s.drones[d.0];
+        if f.battery_at(end) < super::RESERVE && self.s.reserve[d.0].is_none() {
+            self.s.reserve[d.0] = ctx.statement;
         }
         (end, raises)
     }
@@ -822,7 +822,7 @@ impl<'m> Estimator<'m> {
     ) -> Vec<Raise> {
         let detected = self.detected;
         let mut out = Vec::new();
-        for (kind, range, found) in self.s.drones[d].detecting.iter_mut() {
+        for (kind, range, found) in self.s.drones[d.0].detecting.iter_mut() {
             for (i, target) in self.world.targets.iter().enumerate() {
                 if target.kind != *kind || found.contains(&i) {
                     continue;
@@ -854,15 +854,15 @@ impl<'m> Estimator<'m> {
         at: Option<Origin>,
     ) -> Option<[f64; 3]> {
         match v {
-            Some(Value::Position(p)) => Some([p.x, p.y, p.z.unwrap_or(self.s.drones[d].pos[2])]),
-            Some(Value::Actor(o)) => self.s.drones.get(*o).map(|f| f.pos),
+            Some(Value::Position(p)) => Some([p.x, p.y, p.z.unwrap_or(self.s.drones[d.0].pos[2])]),
+            Some(Value::Actor(o)) => self.s.drones.get(o.0).map(|f| f.pos),
             Some(Value::Area(polygon)) => {
                 let c = aviary_api::centroid(polygon);
-                Some([c[0], c[1], self.s.drones[d].pos[2]])
+                Some([c[0], c[1], self.s.drones[d.0].pos[2]])
             }
             _ => {
                 // Unknown before flight: the farthest corner of the geofence is the worst case.
-                let here = self.s.drones[d].pos;
+                let here = self.s.drones[d.0].pos;
                 let far = self.world.site.geofence.as_ref().and_then(|fence| {
                     fence.iter().copied().max_by(|p, q| dist2(*p, here).total_cmp(&dist2(*q, here)))
                 });

@@ -143,7 +143,7 @@ impl Scope<'_> {
     /// (the walk goes branch by branch, not in time): what is read then is its state
     /// later on, a guess.
     fn flyer(&self, d: DroneId) -> Option<&Flyer> {
-        let f = self.drones.get(d)?;
+        let f = self.drones.get(d.0)?;
         if f.free_at > self.t + 1e-9 {
             self.guessed.set(self.guessed.get().min(self.t));
         }

@@ -20,11 +20,11 @@ pub fn fly(
     let max_altitude = e.world.site.max_altitude;
     let mut raises = Vec::new();
     e.leg_origin = at;
-    let (before, legs) = (e.s.drones[d].pos, e.s.tracks[d].len());
+    let (before, legs) = (e.s.drones[d.0].pos, e.s.tracks[d.0].len());
     let duration = match function {
         Function::TakeOff => {
             let alt = number_arg(args, 0).unwrap_or(10.0);
-            let f = &mut e.s.drones[d];
+            let f = &mut e.s.drones[d.0];
             let from_the_ground = !f.airborne;
             f.take_off(t);
             if from_the_ground {
@@ -34,20 +34,20 @@ pub fn fly(
             }
         }
         Function::Land => {
-            let f = &mut e.s.drones[d];
+            let f = &mut e.s.drones[d.0];
             let took = f.land_here();
             f.land(t + took);
             took
         }
         Function::ReturnToLaunch => {
-            let f = &mut e.s.drones[d];
+            let f = &mut e.s.drones[d.0];
             let took = f.return_home(&e.airspace, max_altitude);
             f.land(t + took);
             took
         }
         Function::DescendTo | Function::AscendTo => match number_arg(args, 0) {
             Some(alt) => {
-                let f = &mut e.s.drones[d];
+                let f = &mut e.s.drones[d.0];
                 f.leg([f.pos[0], f.pos[1], alt])
             }
             None => 0.0,
@@ -60,7 +60,7 @@ pub fn fly(
             match (center, radius) {
                 (Some(c), Some(r)) => {
                     let laps = number_arg(args, 2).unwrap_or(1.0);
-                    e.s.drones[d].orbit(&e.airspace, [c[0], c[1]], r, laps)
+                    e.s.drones[d.0].orbit(&e.airspace, [c[0], c[1]], r, laps)
                 }
                 _ => 0.0,
             }
@@ -87,7 +87,7 @@ pub fn fly(
         }
         Function::StopDetection => {
             if let Some(Some(Value::Symbol(kind))) = args.first() {
-                e.s.drones[d].detecting.retain(|(k, _, _)| k != kind);
+                e.s.drones[d.0].detecting.retain(|(k, _, _)| k != kind);
             }
             0.0
         }
@@ -98,9 +98,9 @@ pub fn fly(
         | Function::StopStreaming
         | Function::ReleasePayload => 0.0,
     };
-    if e.radio && e.s.tracks[d].len() == legs && duration > 0.0 {
+    if e.radio && e.s.tracks[d.0].len() == legs && duration > 0.0 {
         // A motion not flown as legs here (an orbit, the way home): its points, in turn.
-        let end = e.s.drones[d].pos;
+        let end = e.s.drones[d.0].pos;
         let mut points = vec![[before[0], before[1]]];
         // Middle-layer functions, not constructs: only an orbit flies a circle.
         #[allow(clippy::wildcard_enum_match_arm)]
@@ -140,8 +140,8 @@ fn record_polyline(e: &mut Estimator, d: DroneId, points: &[[f64; 2]], t: f64, t
     let mut at = t;
     for w in points.windows(2) {
         let share = if total > 0.0 { took * length(w[0], w[1]) / total } else { 0.0 };
-        let z = e.s.drones[d].pos[2];
-        e.s.tracks[d].push(Leg { t: at, took: share, from: w[0], to: w[1], z, at: e.leg_origin });
+        let z = e.s.drones[d.0].pos[2];
+        e.s.tracks[d.0].push(Leg { t: at, took: share, from: w[0], to: w[1], z, at: e.leg_origin });
         at += share;
     }
 }
@@ -158,7 +158,7 @@ fn fly_to_position(
     let Some(to) = e.position_arg(args.first().unwrap_or(&None), d, at) else {
         return 0.0;
     };
-    let f = &e.s.drones[d];
+    let f = &e.s.drones[d.0];
     let speed = number_arg(args, 1).map_or(f.max_speed, |s| s.min(f.max_speed));
     transit(e, d, to, speed, t, raises)
 }
@@ -166,10 +166,10 @@ fn fly_to_position(
 /// `Sweep`: to its path (an area's lawnmower path, or a remainder's lanes; a transit),
 /// then along it, at the altitude the drone is at.
 fn sweep(e: &mut Estimator, d: DroneId, path: &[[f64; 2]], t: f64, raises: &mut Vec<Raise>) -> f64 {
-    let z = e.s.drones[d].pos[2];
+    let z = e.s.drones[d.0].pos[2];
     let mut took = 0.0;
     for (i, p) in path.iter().enumerate() {
-        let speed = e.s.drones[d].max_speed;
+        let speed = e.s.drones[d.0].max_speed;
         let to = [p[0], p[1], z];
         took += if i == 0 {
             transit(e, d, to, speed, t + took, raises)
@@ -190,7 +190,7 @@ fn follow_path(
     t: f64,
     raises: &mut Vec<Raise>,
 ) -> f64 {
-    let max = e.s.drones[d].max_speed;
+    let max = e.s.drones[d.0].max_speed;
     // `FollowPath(points...[, speed])`: a last number is the speed, at most the drone's.
     let (speed, args) = match args.split_last() {
         Some((Some(Value::Number(s)), points)) if *s > 0.0 => (s.min(max), points),
@@ -217,7 +217,7 @@ fn follow_path(
 /// `StartDetection(kind)`: detecting `kind` at the longest range of the drone's sensors
 /// that detect it (an activation of the same kind is replaced).
 fn start_detection(e: &mut Estimator, d: DroneId, kind: &String) {
-    let f = &e.s.drones[d];
+    let f = &e.s.drones[d.0];
     let range = e
         .world
         .sensors
@@ -225,7 +225,7 @@ fn start_detection(e: &mut Estimator, d: DroneId, kind: &String) {
         .filter(|s| f.sensors.contains(&s.kind) && s.detects.contains(kind))
         .map(|s| s.range)
         .reduce(f64::max);
-    let f = &mut e.s.drones[d];
+    let f = &mut e.s.drones[d.0];
     f.detecting.retain(|(k, _, _)| k != kind);
     if let Some(range) = range {
         f.detecting.push((kind.clone(), range, Vec::new()));
@@ -243,7 +243,7 @@ fn transit(
     raises: &mut Vec<Raise>,
 ) -> f64 {
     let mut took = 0.0;
-    for p in e.s.drones[d].way(&e.airspace, to) {
+    for p in e.s.drones[d.0].way(&e.airspace, to) {
         took += leg(e, d, p, speed, t + took, raises);
     }
     took
@@ -258,8 +258,8 @@ fn leg(
     t: f64,
     raises: &mut Vec<Raise>,
 ) -> f64 {
-    let from = e.s.drones[d].pos;
-    let took = e.s.drones[d].leg_at(to, speed);
+    let from = e.s.drones[d.0].pos;
+    let took = e.s.drones[d.0].leg_at(to, speed);
     raises.extend(e.scan(d, [from[0], from[1]], [to[0], to[1]], t, took));
     if e.radio {
         let leg = Leg {
@@ -270,7 +270,7 @@ fn leg(
             z: to[2],
             at: e.leg_origin,
         };
-        e.s.tracks[d].push(leg);
+        e.s.tracks[d.0].push(leg);
     }
     took
 }

@@ -166,7 +166,7 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
         let label =
             format!("ON {}{}", if h.every { "EVERY " } else { "" }, mission.signals[h.signal]);
         for (d, b) in est.bound(h, end) {
-            drones[d].worst_case.push(Bound {
+            drones[d.0].worst_case.push(Bound {
                 handler: label.clone(),
                 distance: b.0,
                 flight_time: b.1,

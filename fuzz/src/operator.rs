@@ -150,7 +150,7 @@ fn checked(control: &Control, mission: &aviary_ir::Mission) {
             assert!(cap.action_name(*action).is_some() && mission.tags.get(*tag).is_some());
             assert!(args.iter().all(|(p, _)| *p < cap.params.len()));
         }
-        Control::Drone { drone, .. } => assert!(*drone < mission.drones.len()),
+        Control::Drone { drone, .. } => assert!(drone.0 < mission.drones.len()),
         _ => {}
     }
     let values: Vec<&Value> = match control {

@@ -410,7 +410,9 @@ impl Vehicle {
             Some(Flavour::Px4) => std::time::Duration::from_secs(10),
             _ => std::time::Duration::from_secs(3),
         };
-        let why = seen.words.since(at.checked_sub(look_back).unwrap_or(at));
+        // At most `look_back` before, and never before the run's clock began (it starts at
+        // zero: the subtraction stops there).
+        let why = seen.words.since(at - look_back);
         let state = if seen.battery_failing {
             Some(BuiltinException::BatteryCritical)
         } else if seen.fence_unhealthy || seen.fence_breached {

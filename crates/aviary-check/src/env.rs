@@ -26,6 +26,15 @@ pub(crate) enum Meaning {
     Unbound,
 }
 
+/// Every body of an item: a mission's, or a capability's ([`capability_bodies`]).
+pub(crate) fn item_bodies(item: &Item) -> Vec<&Body> {
+    match item {
+        Item::Mission(m) => vec![&m.body],
+        Item::Capability(c) => capability_bodies(c),
+        Item::Use(_) => vec![],
+    }
+}
+
 /// Every body of a capability: PERFORM sections and exception handlers.
 pub(crate) fn capability_bodies(c: &Capability) -> Vec<&Body> {
     let mut out = Vec::new();

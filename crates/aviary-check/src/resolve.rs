@@ -58,10 +58,10 @@ impl ApiFunctions {
 mod tests {
     use aviary_api::Function;
     use aviary_diagnostics::SourceMap;
-    use aviary_syntax::ast::{Item, Stmt};
+    use aviary_syntax::ast::Stmt;
     use aviary_syntax::visit::for_each_stmt;
 
-    use crate::env::capability_bodies;
+    use crate::env::item_bodies;
     use crate::NoFiles;
 
     /// Every call of every body is resolved, to the function its name says; a name the
@@ -76,12 +76,7 @@ mod tests {
         let mut seen = Vec::new();
         for (file, tree) in &program.files {
             for item in &tree.items {
-                let bodies = match item {
-                    Item::Mission(m) => vec![&m.body],
-                    Item::Capability(c) => capability_bodies(c),
-                    Item::Use(_) => vec![],
-                };
-                for body in bodies {
+                for body in item_bodies(item) {
                     for_each_stmt(body, |stmt| {
                         if let Stmt::Api(call) = stmt {
                             let resolved = program.api_function(*file, call).map(|f| f.function);

@@ -28,12 +28,7 @@ pub(crate) fn check_program(
     let mut blocks = Vec::new();
     for (_, tree) in &program.files {
         for item in &tree.items {
-            let bodies = match item {
-                Item::Mission(m) => vec![&m.body],
-                Item::Capability(c) => capability_bodies(c),
-                Item::Use(_) => vec![],
-            };
-            for body in bodies {
+            for body in item_bodies(item) {
                 for_each_stmt(body, |stmt| match stmt {
                     Stmt::Statement(Statement { capability, tag: Some(tag), .. }) => {
                         tags.push((capability.name.as_str(), tag.name.as_str()))

@@ -43,130 +43,203 @@ pub enum Waypoint {
     Left(Arc<Remainder>),
 }
 
-/// A middle-layer call's function and its arguments, read ([`FunctionCall::new`]). An
-/// optional argument not given is `None`; the field names are the parameters' names of
-/// [`Function::signature`].
+/// When a call's arguments are read, and so what one argument is: in flight, a value
+/// ([`Flown`]); before it, in the plan, a value that may be known only in flight
+/// ([`Planned`]). One reading of the signature ([`CallOf::new`]) serves both.
+pub trait Stage: Clone + fmt::Debug + PartialEq {
+    /// An argument as the caller has it.
+    type Arg;
+    /// A field read from one argument: the value (in flight), or the value if known.
+    type Of<T: Clone + fmt::Debug + PartialEq>: Clone + fmt::Debug + PartialEq;
+    /// Reads one argument with `read`, which refuses a value of the wrong kind.
+    fn read<T: Clone + fmt::Debug + PartialEq>(
+        arg: &Self::Arg,
+        read: impl FnOnce(&Value) -> Result<T, String>,
+    ) -> Result<Self::Of<T>, String>;
+    /// The argument's value, where it is known.
+    fn known(arg: &Self::Arg) -> Option<&Value>;
+}
+
+/// In flight: every argument is a value, and one of the wrong kind refuses the call.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Flown {}
+
+/// Before the flight (the plan): an argument is `None` when its value is known only in
+/// flight (a signal's value passed on). A value of the wrong kind is read as unknown: the
+/// flight would refuse the call, and the plan does not guess which way.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Planned {}
+
+impl Stage for Flown {
+    type Arg = Value;
+    type Of<T: Clone + fmt::Debug + PartialEq> = T;
+    #[inline]
+    fn read<T: Clone + fmt::Debug + PartialEq>(
+        arg: &Value,
+        read: impl FnOnce(&Value) -> Result<T, String>,
+    ) -> Result<T, String> {
+        read(arg)
+    }
+    #[inline]
+    fn known(arg: &Value) -> Option<&Value> {
+        Some(arg)
+    }
+}
+
+impl Stage for Planned {
+    type Arg = Option<Value>;
+    type Of<T: Clone + fmt::Debug + PartialEq> = Option<T>;
+    fn read<T: Clone + fmt::Debug + PartialEq>(
+        arg: &Option<Value>,
+        read: impl FnOnce(&Value) -> Result<T, String>,
+    ) -> Result<Option<T>, String> {
+        Ok(arg.as_ref().and_then(|v| read(v).ok()))
+    }
+    fn known(arg: &Option<Value>) -> Option<&Value> {
+        arg.as_ref()
+    }
+}
+
+/// A middle-layer call as flown: its function and its arguments, read
+/// ([`CallOf::new`]).
+pub type FunctionCall = CallOf<Flown>;
+
+/// A middle-layer call as the plan reads it before the flight: each argument's value
+/// where it is known then.
+pub type PlannedCall = CallOf<Planned>;
+
+/// A middle-layer call's function and its arguments, read ([`CallOf::new`]) at a
+/// [`Stage`]. An optional argument not given is `None`; the field names are the
+/// parameters' names of [`Function::signature`].
 #[derive(Clone, Debug, PartialEq)]
-pub enum FunctionCall {
+pub enum CallOf<S: Stage> {
     Arm,
     Disarm,
     TakeOff {
-        alt: f64,
+        alt: S::Of<f64>,
     },
     Land,
     ReturnToLaunch,
     FlyToPosition {
-        pos: Place,
-        speed: Option<f64>,
+        pos: S::Of<Place>,
+        speed: Option<S::Of<f64>>,
     },
     DescendTo {
-        alt: f64,
+        alt: S::Of<f64>,
     },
     AscendTo {
-        alt: f64,
+        alt: S::Of<f64>,
     },
     Hover {
-        duration: f64,
+        duration: S::Of<f64>,
     },
     Orbit {
-        center: Place,
-        radius: f64,
-        laps: Option<f64>,
+        center: S::Of<Place>,
+        radius: S::Of<f64>,
+        laps: Option<S::Of<f64>>,
     },
     Sweep {
-        area: Region,
-        spacing: f64,
+        area: S::Of<Region>,
+        spacing: S::Of<f64>,
     },
     StartStreaming,
     StopStreaming,
     /// `kind`: a kind of target, a symbol (or a text).
     StartDetection {
-        kind: String,
+        kind: S::Of<String>,
     },
     StopDetection {
-        kind: String,
+        kind: S::Of<String>,
     },
     /// `kind`: a kind of payload, a symbol (or a text).
     LoadPayload {
-        kind: String,
+        kind: S::Of<String>,
     },
     ReleasePayload,
     /// `points...[, speed]`: the speed is a last argument that is a number.
     FollowPath {
-        points: Vec<Waypoint>,
-        speed: Option<f64>,
+        points: Vec<S::Of<Waypoint>>,
+        speed: Option<S::Of<f64>>,
     },
 }
 
+/// `FollowPath`'s points and its speed, as read at a stage.
+type Path<S> = (Vec<<S as Stage>::Of<Waypoint>>, Option<<S as Stage>::Of<f64>>);
+
 /// The arguments of one call, read in order; each reader says what it wanted.
-struct Reader<'a> {
+struct Reader<'a, S: Stage> {
     function: Function,
-    args: &'a [Value],
+    args: &'a [S::Arg],
     next: usize,
 }
 
-impl<'a> Reader<'a> {
-    fn value(&mut self, name: &str) -> Result<&'a Value, String> {
+impl<'a, S: Stage> Reader<'a, S> {
+    fn value(&mut self, name: &str) -> Result<&'a S::Arg, String> {
         let v = self.args.get(self.next).ok_or_else(|| format!("missing argument `{name}`"))?;
         self.next += 1;
         Ok(v)
     }
 
-    fn optional(&mut self) -> Option<&'a Value> {
+    fn optional(&mut self) -> Option<&'a S::Arg> {
         let v = self.args.get(self.next)?;
         self.next += 1;
         Some(v)
     }
 
-    fn number(&mut self, name: &str) -> Result<f64, String> {
-        number(self.value(name)?, name)
+    fn number(&mut self, name: &str) -> Result<S::Of<f64>, String> {
+        S::read(self.value(name)?, |v| number(v, name))
     }
 
-    fn opt_number(&mut self, name: &str) -> Result<Option<f64>, String> {
-        self.optional().map(|v| number(v, name)).transpose()
+    fn opt_number(&mut self, name: &str) -> Result<Option<S::Of<f64>>, String> {
+        self.optional().map(|v| S::read(v, |v| number(v, name))).transpose()
     }
 
-    fn place(&mut self, name: &str) -> Result<Place, String> {
-        match self.value(name)? {
+    fn place(&mut self, name: &str) -> Result<S::Of<Place>, String> {
+        S::read(self.value(name)?, |v| match v {
             Value::Position(p) => Ok(Place::Point(*p)),
             Value::Area(corners) => Ok(Place::Area(corners.clone())),
             other => Err(format!("`{name}` must be a position, not {other}")),
-        }
+        })
     }
 
-    fn region(&mut self, name: &str) -> Result<Region, String> {
-        match self.value(name)? {
+    fn region(&mut self, name: &str) -> Result<S::Of<Region>, String> {
+        S::read(self.value(name)?, |v| match v {
             Value::Area(corners) => Ok(Region::Area(corners.clone())),
             Value::Remainder(left) => Ok(Region::Left(left.clone())),
             other => Err(format!("`{name}` must be an area of at least 3 corners, not {other}")),
-        }
+        })
     }
 
-    fn kind(&mut self, name: &str) -> Result<String, String> {
-        match self.value(name)? {
+    fn kind(&mut self, name: &str) -> Result<S::Of<String>, String> {
+        S::read(self.value(name)?, |v| match v {
             Value::Symbol(s) | Value::Text(s) => Ok(s.clone()),
             other => Err(format!("`{name}` must be a kind such as Body, not {other}")),
-        }
+        })
     }
 
-    /// `FollowPath`'s arguments: every one a point, but a last number, the speed.
-    fn path(&mut self) -> Result<(Vec<Waypoint>, Option<f64>), String> {
+    /// `FollowPath`'s arguments: every one a point, but a last number, the speed (a last
+    /// argument known only in flight is read as a point).
+    fn path(&mut self) -> Result<Path<S>, String> {
         let rest = &self.args[self.next.min(self.args.len())..];
         self.next += rest.len();
         let (points, speed) = match rest.split_last() {
-            Some((Value::Number(s), points)) => (points, Some(*s)),
+            Some((last, points)) if matches!(S::known(last), Some(Value::Number(_))) => {
+                (points, Some(S::read(last, |v| number(v, "speed"))?))
+            }
             _ => (rest, None),
         };
         let points = points
             .iter()
             .enumerate()
-            .map(|(i, v)| match v {
-                Value::Position(p) => Ok(Waypoint::Point(*p)),
-                Value::Area(corners) => Ok(Waypoint::Area(corners.clone())),
-                Value::Remainder(left) => Ok(Waypoint::Left(left.clone())),
-                other => Err(format!(
-                    "`points[{i}]` must be a position, or what a Sweep or FollowPath left, not {other}"
-                )),
+            .map(|(i, v)| {
+                S::read(v, |v| match v {
+                    Value::Position(p) => Ok(Waypoint::Point(*p)),
+                    Value::Area(corners) => Ok(Waypoint::Area(corners.clone())),
+                    Value::Remainder(left) => Ok(Waypoint::Left(left.clone())),
+                    other => Err(format!(
+                        "`points[{i}]` must be a position, or what a Sweep or FollowPath left, not {other}"
+                    )),
+                })
             })
             .collect::<Result<Vec<_>, _>>()?;
         Ok((points, speed))
@@ -200,43 +273,43 @@ fn number(v: &Value, name: &str) -> Result<f64, String> {
     }
 }
 
-impl FunctionCall {
+impl<S: Stage> CallOf<S> {
     /// Reads the arguments a mission gave `function`, in the order of its signature
     /// ([`Function::signature`]). The one place they are read: refused, with the reason,
-    /// when one is missing, one too many, or one of a kind the parameter does not take.
-    /// (Inline: the engine reads every call it makes with it.)
+    /// when one is missing, one too many, or (in flight) one of a kind the parameter does
+    /// not take. (Inline: the engine reads every call it makes with it.)
     #[inline]
-    pub fn new(function: Function, args: &[Value]) -> Result<FunctionCall, String> {
-        let mut r = Reader { function, args, next: 0 };
+    pub fn new(function: Function, args: &[S::Arg]) -> Result<CallOf<S>, String> {
+        let mut r = Reader::<S> { function, args, next: 0 };
         let call = match function {
-            Function::Arm => FunctionCall::Arm,
-            Function::Disarm => FunctionCall::Disarm,
-            Function::TakeOff => FunctionCall::TakeOff { alt: r.number("alt")? },
-            Function::Land => FunctionCall::Land,
-            Function::ReturnToLaunch => FunctionCall::ReturnToLaunch,
+            Function::Arm => CallOf::Arm,
+            Function::Disarm => CallOf::Disarm,
+            Function::TakeOff => CallOf::TakeOff { alt: r.number("alt")? },
+            Function::Land => CallOf::Land,
+            Function::ReturnToLaunch => CallOf::ReturnToLaunch,
             Function::FlyToPosition => {
-                FunctionCall::FlyToPosition { pos: r.place("pos")?, speed: r.opt_number("speed")? }
+                CallOf::FlyToPosition { pos: r.place("pos")?, speed: r.opt_number("speed")? }
             }
-            Function::DescendTo => FunctionCall::DescendTo { alt: r.number("alt")? },
-            Function::AscendTo => FunctionCall::AscendTo { alt: r.number("alt")? },
-            Function::Hover => FunctionCall::Hover { duration: r.number("duration")? },
-            Function::Orbit => FunctionCall::Orbit {
+            Function::DescendTo => CallOf::DescendTo { alt: r.number("alt")? },
+            Function::AscendTo => CallOf::AscendTo { alt: r.number("alt")? },
+            Function::Hover => CallOf::Hover { duration: r.number("duration")? },
+            Function::Orbit => CallOf::Orbit {
                 center: r.place("center")?,
                 radius: r.number("radius")?,
                 laps: r.opt_number("laps")?,
             },
             Function::Sweep => {
-                FunctionCall::Sweep { area: r.region("area")?, spacing: r.number("spacing")? }
+                CallOf::Sweep { area: r.region("area")?, spacing: r.number("spacing")? }
             }
-            Function::StartStreaming => FunctionCall::StartStreaming,
-            Function::StopStreaming => FunctionCall::StopStreaming,
-            Function::StartDetection => FunctionCall::StartDetection { kind: r.kind("kind")? },
-            Function::StopDetection => FunctionCall::StopDetection { kind: r.kind("kind")? },
-            Function::LoadPayload => FunctionCall::LoadPayload { kind: r.kind("kind")? },
-            Function::ReleasePayload => FunctionCall::ReleasePayload,
+            Function::StartStreaming => CallOf::StartStreaming,
+            Function::StopStreaming => CallOf::StopStreaming,
+            Function::StartDetection => CallOf::StartDetection { kind: r.kind("kind")? },
+            Function::StopDetection => CallOf::StopDetection { kind: r.kind("kind")? },
+            Function::LoadPayload => CallOf::LoadPayload { kind: r.kind("kind")? },
+            Function::ReleasePayload => CallOf::ReleasePayload,
             Function::FollowPath => {
                 let (points, speed) = r.path()?;
-                FunctionCall::FollowPath { points, speed }
+                CallOf::FollowPath { points, speed }
             }
         };
         r.done()?;
@@ -247,90 +320,112 @@ impl FunctionCall {
     #[inline]
     pub fn function(&self) -> Function {
         match self {
-            FunctionCall::Arm => Function::Arm,
-            FunctionCall::Disarm => Function::Disarm,
-            FunctionCall::TakeOff { .. } => Function::TakeOff,
-            FunctionCall::Land => Function::Land,
-            FunctionCall::ReturnToLaunch => Function::ReturnToLaunch,
-            FunctionCall::FlyToPosition { .. } => Function::FlyToPosition,
-            FunctionCall::DescendTo { .. } => Function::DescendTo,
-            FunctionCall::AscendTo { .. } => Function::AscendTo,
-            FunctionCall::Hover { .. } => Function::Hover,
-            FunctionCall::Orbit { .. } => Function::Orbit,
-            FunctionCall::Sweep { .. } => Function::Sweep,
-            FunctionCall::StartStreaming => Function::StartStreaming,
-            FunctionCall::StopStreaming => Function::StopStreaming,
-            FunctionCall::StartDetection { .. } => Function::StartDetection,
-            FunctionCall::StopDetection { .. } => Function::StopDetection,
-            FunctionCall::LoadPayload { .. } => Function::LoadPayload,
-            FunctionCall::ReleasePayload => Function::ReleasePayload,
-            FunctionCall::FollowPath { .. } => Function::FollowPath,
+            CallOf::Arm => Function::Arm,
+            CallOf::Disarm => Function::Disarm,
+            CallOf::TakeOff { .. } => Function::TakeOff,
+            CallOf::Land => Function::Land,
+            CallOf::ReturnToLaunch => Function::ReturnToLaunch,
+            CallOf::FlyToPosition { .. } => Function::FlyToPosition,
+            CallOf::DescendTo { .. } => Function::DescendTo,
+            CallOf::AscendTo { .. } => Function::AscendTo,
+            CallOf::Hover { .. } => Function::Hover,
+            CallOf::Orbit { .. } => Function::Orbit,
+            CallOf::Sweep { .. } => Function::Sweep,
+            CallOf::StartStreaming => Function::StartStreaming,
+            CallOf::StopStreaming => Function::StopStreaming,
+            CallOf::StartDetection { .. } => Function::StartDetection,
+            CallOf::StopDetection { .. } => Function::StopDetection,
+            CallOf::LoadPayload { .. } => Function::LoadPayload,
+            CallOf::ReleasePayload => Function::ReleasePayload,
+            CallOf::FollowPath { .. } => Function::FollowPath,
+        }
+    }
+}
+
+/// One argument of a flown call, as read: what [`FunctionCall::shown`] and
+/// [`FunctionCall::args`] each turn into their form, so the two cannot disagree on the
+/// order.
+enum Part<'a> {
+    Number(f64),
+    Place(&'a Place),
+    Region(&'a Region),
+    Kind(&'a str),
+    Waypoint(&'a Waypoint),
+}
+
+impl FunctionCall {
+    /// Each argument given, in order.
+    fn parts<'a>(&'a self, mut each: impl FnMut(Part<'a>)) {
+        fn opt<'a>(n: &Option<f64>, each: &mut impl FnMut(Part<'a>)) {
+            if let Some(n) = n {
+                each(Part::Number(*n));
+            }
+        }
+        match self {
+            CallOf::Arm
+            | CallOf::Disarm
+            | CallOf::Land
+            | CallOf::ReturnToLaunch
+            | CallOf::StartStreaming
+            | CallOf::StopStreaming
+            | CallOf::ReleasePayload => {}
+            CallOf::TakeOff { alt } | CallOf::DescendTo { alt } | CallOf::AscendTo { alt } => {
+                each(Part::Number(*alt))
+            }
+            CallOf::Hover { duration } => each(Part::Number(*duration)),
+            CallOf::FlyToPosition { pos, speed } => {
+                each(Part::Place(pos));
+                opt(speed, &mut each);
+            }
+            CallOf::Orbit { center, radius, laps } => {
+                each(Part::Place(center));
+                each(Part::Number(*radius));
+                opt(laps, &mut each);
+            }
+            CallOf::Sweep { area, spacing } => {
+                each(Part::Region(area));
+                each(Part::Number(*spacing));
+            }
+            CallOf::StartDetection { kind }
+            | CallOf::StopDetection { kind }
+            | CallOf::LoadPayload { kind } => each(Part::Kind(kind)),
+            CallOf::FollowPath { points, speed } => {
+                points.iter().for_each(|p| each(Part::Waypoint(p)));
+                opt(speed, &mut each);
+            }
         }
     }
 
     /// The arguments as the trace's `args` shows them: those given, in order, each as
     /// the mission gave it (a kind given as a text and as a symbol show alike).
     pub fn shown(&self) -> Vec<Shown<'_>> {
-        let num = |n: &f64| Shown::Number(*n);
-        let opt = |n: &Option<f64>| n.as_ref().map(num);
-        match self {
-            FunctionCall::Arm
-            | FunctionCall::Disarm
-            | FunctionCall::Land
-            | FunctionCall::ReturnToLaunch
-            | FunctionCall::StartStreaming
-            | FunctionCall::StopStreaming
-            | FunctionCall::ReleasePayload => Vec::new(),
-            FunctionCall::TakeOff { alt }
-            | FunctionCall::DescendTo { alt }
-            | FunctionCall::AscendTo { alt } => vec![num(alt)],
-            FunctionCall::Hover { duration } => vec![num(duration)],
-            FunctionCall::FlyToPosition { pos, speed } => {
-                std::iter::once(pos.shown()).chain(opt(speed)).collect()
-            }
-            FunctionCall::Orbit { center, radius, laps } => {
-                [center.shown(), num(radius)].into_iter().chain(opt(laps)).collect()
-            }
-            FunctionCall::Sweep { area, spacing } => vec![area.shown(), num(spacing)],
-            FunctionCall::StartDetection { kind }
-            | FunctionCall::StopDetection { kind }
-            | FunctionCall::LoadPayload { kind } => vec![Shown::Text(kind.as_str().into())],
-            FunctionCall::FollowPath { points, speed } => {
-                points.iter().map(Waypoint::shown).chain(opt(speed)).collect()
-            }
-        }
+        let mut out = Vec::new();
+        self.parts(|p| {
+            out.push(match p {
+                Part::Number(n) => Shown::Number(n),
+                Part::Place(place) => place.shown(),
+                Part::Region(region) => region.shown(),
+                Part::Kind(kind) => Shown::Text(kind.into()),
+                Part::Waypoint(point) => point.shown(),
+            })
+        });
+        out
     }
 
     /// The arguments as values, in order: what [`FunctionCall::new`] reads back as this
     /// call (a kind is a symbol).
     pub fn args(&self) -> Vec<Value> {
-        let opt = |n: &Option<f64>| n.map(Value::Number);
-        match self {
-            FunctionCall::Arm
-            | FunctionCall::Disarm
-            | FunctionCall::Land
-            | FunctionCall::ReturnToLaunch
-            | FunctionCall::StartStreaming
-            | FunctionCall::StopStreaming
-            | FunctionCall::ReleasePayload => Vec::new(),
-            FunctionCall::TakeOff { alt }
-            | FunctionCall::DescendTo { alt }
-            | FunctionCall::AscendTo { alt } => vec![Value::Number(*alt)],
-            FunctionCall::Hover { duration } => vec![Value::Number(*duration)],
-            FunctionCall::FlyToPosition { pos, speed } => {
-                std::iter::once(pos.value()).chain(opt(speed)).collect()
-            }
-            FunctionCall::Orbit { center, radius, laps } => {
-                [center.value(), Value::Number(*radius)].into_iter().chain(opt(laps)).collect()
-            }
-            FunctionCall::Sweep { area, spacing } => vec![area.value(), Value::Number(*spacing)],
-            FunctionCall::StartDetection { kind }
-            | FunctionCall::StopDetection { kind }
-            | FunctionCall::LoadPayload { kind } => vec![Value::Symbol(kind.clone())],
-            FunctionCall::FollowPath { points, speed } => {
-                points.iter().map(Waypoint::value).chain(opt(speed)).collect()
-            }
-        }
+        let mut out = Vec::new();
+        self.parts(|p| {
+            out.push(match p {
+                Part::Number(n) => Value::Number(n),
+                Part::Place(place) => place.value(),
+                Part::Region(region) => region.value(),
+                Part::Kind(kind) => Value::Symbol(kind.to_string()),
+                Part::Waypoint(point) => point.value(),
+            })
+        });
+        out
     }
 }
 

@@ -36,7 +36,7 @@ pub mod sweep;
 pub mod trace;
 
 pub use builtin::{BuiltinException, BuiltinLeash, BuiltinSignal};
-pub use call::{FunctionCall, Place, Region, Waypoint};
+pub use call::{CallOf, Flown, FunctionCall, Place, Planned, PlannedCall, Region, Stage, Waypoint};
 pub use coverage::{Progress, Remainder};
 pub use function::{Function, Param, Signature};
 pub use geometry::centroid;

@@ -10,6 +10,7 @@ use aviary_api::{
     Backend, CallId, DroneEvent, DroneId, Ending, FunctionCall, Interrupt, PendingCall, Progress,
     Telemetry,
 };
+use aviary_ir::TiVec;
 use aviary_mavlink::MavlinkBackend;
 use aviary_sim::SimBackend;
 use tokio::sync::{mpsc, oneshot};
@@ -28,7 +29,7 @@ impl Mixed {
     /// Call inside the tokio runtime (it starts the task that merges the event streams).
     pub fn new(sim: Arc<SimBackend>, mavlink: MavlinkBackend) -> Mixed {
         let (tx, rx) = mpsc::unbounded_channel();
-        let served: Vec<bool> =
+        let served: TiVec<DroneId, bool> =
             (0..sim.with_fleet(|f| f.len())).map(|d| mavlink.serves(DroneId(d))).collect();
         if let Some(mut from_sim) = sim.events() {
             let tx = tx.clone();
@@ -37,7 +38,7 @@ impl Mixed {
                 while let Some(e) = from_sim.recv().await {
                     // The simulator also models the MAVLink drones (idle at home): drop
                     // what it says of them.
-                    if !served.get(e.drone().0).copied().unwrap_or(false) && tx.send(e).is_err() {
+                    if !served.get(e.drone()).copied().unwrap_or(false) && tx.send(e).is_err() {
                         return;
                     }
                 }

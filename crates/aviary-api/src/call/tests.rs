@@ -184,3 +184,79 @@ fn a_call_is_no_larger_than_its_largest_arguments() {
         std::mem::size_of::<FunctionCall>()
     );
 }
+
+/// The flown call with every field known: what the plan reads when every argument is
+/// known before the flight.
+fn foreseen(call: &FunctionCall) -> PlannedCall {
+    match call {
+        CallOf::Arm => CallOf::Arm,
+        CallOf::Disarm => CallOf::Disarm,
+        CallOf::TakeOff { alt } => CallOf::TakeOff { alt: Some(*alt) },
+        CallOf::Land => CallOf::Land,
+        CallOf::ReturnToLaunch => CallOf::ReturnToLaunch,
+        CallOf::FlyToPosition { pos, speed } => {
+            CallOf::FlyToPosition { pos: Some(pos.clone()), speed: speed.map(Some) }
+        }
+        CallOf::DescendTo { alt } => CallOf::DescendTo { alt: Some(*alt) },
+        CallOf::AscendTo { alt } => CallOf::AscendTo { alt: Some(*alt) },
+        CallOf::Hover { duration } => CallOf::Hover { duration: Some(*duration) },
+        CallOf::Orbit { center, radius, laps } => CallOf::Orbit {
+            center: Some(center.clone()),
+            radius: Some(*radius),
+            laps: laps.map(Some),
+        },
+        CallOf::Sweep { area, spacing } => {
+            CallOf::Sweep { area: Some(area.clone()), spacing: Some(*spacing) }
+        }
+        CallOf::StartStreaming => CallOf::StartStreaming,
+        CallOf::StopStreaming => CallOf::StopStreaming,
+        CallOf::StartDetection { kind } => CallOf::StartDetection { kind: Some(kind.clone()) },
+        CallOf::StopDetection { kind } => CallOf::StopDetection { kind: Some(kind.clone()) },
+        CallOf::LoadPayload { kind } => CallOf::LoadPayload { kind: Some(kind.clone()) },
+        CallOf::ReleasePayload => CallOf::ReleasePayload,
+        CallOf::FollowPath { points, speed } => CallOf::FollowPath {
+            points: points.iter().cloned().map(Some).collect(),
+            speed: speed.map(Some),
+        },
+    }
+}
+
+proptest! {
+    /// The plan and the flight read one signature: with every argument known before the
+    /// flight, the plan's call is the flown one.
+    #[test]
+    fn a_call_known_before_the_flight_is_planned_as_it_is_flown((f, args) in call_args()) {
+        let flown = FunctionCall::new(f, &args).map_err(TestCaseError::fail)?;
+        let known: Vec<Option<Value>> = args.into_iter().map(Some).collect();
+        prop_assert_eq!(PlannedCall::new(f, &known), Ok(foreseen(&flown)));
+    }
+}
+
+#[test]
+fn an_argument_known_only_in_flight_is_planned_as_unknown_and_the_others_are_read() {
+    let n = |x: f64| Some(Value::Number(x));
+    assert_eq!(
+        PlannedCall::new(Function::Orbit, &[None, n(20.0)]),
+        Ok(CallOf::Orbit { center: None, radius: Some(20.0), laps: None })
+    );
+    // A value of the wrong kind (a signal's value the checker could not judge): unknown.
+    assert_eq!(
+        PlannedCall::new(Function::TakeOff, &[Some(Value::Symbol("high".into()))]),
+        Ok(CallOf::TakeOff { alt: None })
+    );
+    // FollowPath: a last number is the speed; a last argument known only in flight is a
+    // point.
+    let p = Point::flat(1.0, 2.0);
+    assert_eq!(
+        PlannedCall::new(Function::FollowPath, &[Some(Value::Position(p)), None]),
+        Ok(CallOf::FollowPath { points: vec![Some(Waypoint::Point(p)), None], speed: None })
+    );
+    assert_eq!(
+        PlannedCall::new(Function::FollowPath, &[None, n(4.0)]),
+        Ok(CallOf::FollowPath { points: vec![None], speed: Some(Some(4.0)) })
+    );
+    // The count of arguments is known before the flight: a missing or an extra one is
+    // refused, as in flight.
+    assert_eq!(PlannedCall::new(Function::TakeOff, &[]), Err("missing argument `alt`".into()));
+    assert!(PlannedCall::new(Function::Land, &[None]).is_err());
+}

@@ -6,7 +6,7 @@
 //! queueing follows program order. Handlers run after their block's items, in the order
 //! of their signals' times. Detections come from the world's targets (simulation data).
 
-use aviary_api::{DroneId, Resource, Value};
+use aviary_api::{DroneId, Place, PlannedCall, Resource, Value};
 use aviary_ir::{
     ActorFilter, ActorRef, ApiCall, Block, BlockKind, Call, CapId, Expr, For, Handler, Mission,
     Node, Origin, SignalId, Slot, Slots, TiVec,
@@ -15,7 +15,7 @@ use aviary_world::World;
 use std::cell::RefCell;
 use std::rc::Rc;
 
-use super::eval::{number, Frame, Scope};
+use super::eval::{Frame, Scope};
 use super::model::{first_within, Flyer};
 use super::Activity;
 
@@ -216,7 +216,7 @@ impl<'m> Estimator<'m> {
             blank: Vec::new(),
             radio: world.air.radio.is_some(),
             leg_origin: None,
-            s: State::new(drones, mission.signals.len()),
+            s: State::new(drones.into(), mission.signals.len()),
         }
     }
 
@@ -230,7 +230,7 @@ impl<'m> Estimator<'m> {
         };
         let (end, _) = self.block(&self.mission.body, &mut ctx, 0.0);
         let mut last = end;
-        for d in 0..self.s.drones.len() {
+        for d in self.s.drones.keys() {
             if self.s.drones[d].airborne {
                 let f = &mut self.s.drones[d];
                 let start = end.max(f.free_at);
@@ -259,7 +259,7 @@ impl<'m> Estimator<'m> {
         let (end, _) = self.block(&h.body, &mut ctx, t);
         self.blank = ctx.frame;
         let mut out = Vec::new();
-        for (d, then) in mark.drones().iter().enumerate() {
+        for (d, then) in mark.drones().iter_enumerated() {
             let f = &mut self.s.drones[d];
             if f.airborne {
                 let took = f.return_home(&self.airspace, self.world.site.max_altitude);
@@ -268,7 +268,7 @@ impl<'m> Estimator<'m> {
             let now = &self.s.drones[d];
             if now.distance > then.distance {
                 out.push((
-                    DroneId(d),
+                    d,
                     (
                         now.distance - then.distance,
                         now.flight_time - then.flight_time,
@@ -747,7 +747,7 @@ impl<'m> Estimator<'m> {
             if top {
                 for &slot in motion.iter() {
                     if let Some(&d) = actors.get(slot) {
-                        start = start.max(self.s.drones[d.0].free_at);
+                        start = start.max(self.s.drones[d].free_at);
                     }
                 }
             }
@@ -782,12 +782,12 @@ impl<'m> Estimator<'m> {
     fn ran_at_top(&mut self, c: &Call, actors: &[DroneId], motion: &[usize], start: f64, end: f64) {
         for &slot in motion {
             if let Some(&d) = actors.get(slot) {
-                self.s.drones[d.0].free_at = self.s.drones[d.0].free_at.max(end);
+                self.s.drones[d].free_at = self.s.drones[d].free_at.max(end);
             }
         }
         let what = &self.mission.capabilities[c.capability].name;
         for &d in actors {
-            self.s.activities[d.0].push(Activity {
+            self.s.activities[d].push(Activity {
                 start,
                 end,
                 what: what.clone(),
@@ -801,11 +801,14 @@ impl<'m> Estimator<'m> {
     fn api(&mut self, a: &ApiCall, ctx: &Ctx, t: f64) -> (f64, Vec<Raise>) {
         let Some(d) = self.scope(ctx, t).actor(&a.actor) else { return (t, Vec::new()) };
         let args: Vec<Option<Value>> = a.args.iter().map(|e| self.scope(ctx, t).eval(e)).collect();
-        let (duration, raises) = super::flight::fly(self, d, a.function, &args, ctx.statement, t);
+        // The checker holds a call to its signature's count of arguments: one it refused
+        // takes no time here.
+        let Ok(call) = PlannedCall::new(a.function, &args) else { return (t, Vec::new()) };
+        let (duration, raises) = super::flight::fly(self, d, &call, ctx.statement, t);
         let end = t + duration;
-        let f = &self.s.drones[d.0];
-        if f.battery_at(end) < super::RESERVE && self.s.reserve[d.0].is_none() {
-            self.s.reserve[d.0] = ctx.statement;
+        let f = &self.s.drones[d];
+        if f.battery_at(end) < super::RESERVE && self.s.reserve[d].is_none() {
+            self.s.reserve[d] = ctx.statement;
         }
         (end, raises)
     }
@@ -822,7 +825,7 @@ impl<'m> Estimator<'m> {
     ) -> Vec<Raise> {
         let detected = self.detected;
         let mut out = Vec::new();
-        for (kind, range, found) in self.s.drones[d.0].detecting.iter_mut() {
+        for (kind, range, found) in self.s.drones[d].detecting.iter_mut() {
             for (i, target) in self.world.targets.iter().enumerate() {
                 if target.kind != *kind || found.contains(&i) {
                     continue;
@@ -847,22 +850,24 @@ impl<'m> Estimator<'m> {
         out
     }
 
+    /// Where a position argument takes drone `d`: a position (at the drone's altitude
+    /// when it gives none), an area's centroid, or, known only in flight (`None`), the
+    /// worst case.
     pub fn position_arg(
         &mut self,
-        v: &Option<Value>,
+        place: Option<&Place>,
         d: DroneId,
         at: Option<Origin>,
     ) -> Option<[f64; 3]> {
-        match v {
-            Some(Value::Position(p)) => Some([p.x, p.y, p.z.unwrap_or(self.s.drones[d.0].pos[2])]),
-            Some(Value::Actor(o)) => self.s.drones.get(o.0).map(|f| f.pos),
-            Some(Value::Area(polygon)) => {
+        match place {
+            Some(Place::Point(p)) => Some([p.x, p.y, p.z.unwrap_or(self.s.drones[d].pos[2])]),
+            Some(Place::Area(polygon)) => {
                 let c = aviary_api::centroid(polygon);
-                Some([c[0], c[1], self.s.drones[d.0].pos[2]])
+                Some([c[0], c[1], self.s.drones[d].pos[2]])
             }
-            _ => {
+            None => {
                 // Unknown before flight: the farthest corner of the geofence is the worst case.
-                let here = self.s.drones[d.0].pos;
+                let here = self.s.drones[d].pos;
                 let far = self.world.site.geofence.as_ref().and_then(|fence| {
                     fence.iter().copied().max_by(|p, q| dist2(*p, here).total_cmp(&dist2(*q, here)))
                 });
@@ -888,8 +893,4 @@ fn matches(h: &Handler, frame: &Frame, actor: Option<DroneId>) -> bool {
             matches!((frame.slot(*s), actor), (Some(Some(Value::Actor(d))), Some(a)) if *d == a)
         }
     }
-}
-
-pub fn number_arg(args: &[Option<Value>], i: usize) -> Option<f64> {
-    args.get(i)?.as_ref().and_then(number)
 }

@@ -13,7 +13,7 @@ pub type Frame = Vec<Option<Value>>;
 pub struct Scope<'a> {
     pub mission: &'a Mission,
     pub frame: &'a Frame,
-    pub drones: &'a [Flyer],
+    pub drones: &'a TiSlice<DroneId, Flyer>,
     pub raised: &'a TiSlice<SignalId, Option<f64>>,
     /// The first raise times of the walk before, for a signal this walk has not raised
     /// yet (a branch walked later may raise it earlier in time), and whether they were read.
@@ -143,7 +143,7 @@ impl Scope<'_> {
     /// (the walk goes branch by branch, not in time): what is read then is its state
     /// later on, a guess.
     fn flyer(&self, d: DroneId) -> Option<&Flyer> {
-        let f = self.drones.get(d.0)?;
+        let f = self.drones.get(d)?;
         if f.free_at > self.t + 1e-9 {
             self.guessed.set(self.guessed.get().min(self.t));
         }
@@ -174,7 +174,7 @@ impl Scope<'_> {
     }
 }
 
-pub fn number(v: &Value) -> Option<f64> {
+fn number(v: &Value) -> Option<f64> {
     match v {
         Value::Number(n) => Some(*n),
         Value::Text(_)

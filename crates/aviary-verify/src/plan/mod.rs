@@ -119,7 +119,7 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
     let (mut est, end) = walked(mission, world, false);
     // The activities are moved into the plan, not copied (a long mission has millions);
     // the worst-case walks below go on with empty lists, which the plan does not read.
-    let empty = vec![Vec::new(); est.s.activities.len()];
+    let empty = vec![Vec::new(); est.s.activities.len()].into();
     let activities = std::mem::replace(&mut est.s.activities, empty);
     let mut drones: Vec<DronePlan> = world
         .drones
@@ -135,16 +135,16 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
             worst_case: Vec::new(),
         })
         .collect();
-    for (d, at) in est.s.reserve.iter().enumerate() {
+    for (d, at) in est.s.reserve.iter_enumerated() {
         // Crossed on the way home after the mission's end: at the drone's last statement.
         let after_end = at.is_none();
         let at = at.or_else(|| {
-            (drones[d].battery_left < RESERVE)
-                .then(|| drones[d].activities.iter().rev().find_map(|a| a.origin))
+            (drones[d.0].battery_left < RESERVE)
+                .then(|| drones[d.0].activities.iter().rev().find_map(|a| a.origin))
                 .flatten()
         });
         if let Some(o) = at {
-            let p = &drones[d];
+            let p = &drones[d.0];
             let end = if p.battery_left > 0.0 {
                 format!("{}% left at the end", fixed(p.battery_left * 100.0, 0))
             } else {
@@ -174,7 +174,7 @@ pub fn estimate(mission: &Mission, world: &World, diagnostics: &mut Vec<Diagnost
             });
         }
     }
-    for out in radio::out_of_reach(world, &est.s.tracks) {
+    for out in radio::out_of_reach(world, &est.s.tracks.raw) {
         let name = &world.drones[out.drone].name;
         let reach = world.air.radio.as_ref().map_or(0.0, |r| r.range);
         diagnostics.push(

@@ -7,7 +7,8 @@
 //! `IF`s in a row, or N unfired handlers, so costs what the walks cost, not N copies of
 //! everything.
 
-use aviary_ir::{Origin, SignalId, TiVec};
+use aviary_api::DroneId;
+use aviary_ir::{Origin, SignalId, TiSlice, TiVec};
 
 /// Per signal, when it is first raised (`None`: not yet, or not known).
 pub type RaiseTimes = TiVec<SignalId, Option<f64>>;
@@ -21,15 +22,15 @@ pub type Note = (Option<(u32, u32)>, String);
 
 #[derive(Clone)]
 pub struct State {
-    pub drones: Vec<Flyer>,
+    pub drones: TiVec<DroneId, Flyer>,
     /// Per drone; only ever pushed to.
-    pub activities: Vec<Vec<Activity>>,
+    pub activities: TiVec<DroneId, Vec<Activity>>,
     /// Per signal, when it is first raised; changed only by [`State::raise`].
     pub raised: RaiseTimes,
     /// Each change to `raised`: the signal and what it held before.
     raised_log: Vec<(SignalId, Option<f64>)>,
     /// Per drone: the mission-level statement during which the reserve fell under 20%.
-    pub reserve: Vec<Option<Origin>>,
+    pub reserve: TiVec<DroneId, Option<Origin>>,
     /// What the estimate had to assume, with where, as noted (each may come more than
     /// once: [`State::notes`] gives them sorted, each once).
     pub assumptions: Vec<Note>,
@@ -37,52 +38,52 @@ pub struct State {
     pub fired: Vec<usize>,
     /// Per drone, the legs it flies, when the world has a radio (`super::radio`); only
     /// ever pushed to, as the activities.
-    pub tracks: Vec<Vec<Leg>>,
+    pub tracks: TiVec<DroneId, Vec<Leg>>,
 }
 
 /// The state at a moment: the small parts, and the lengths of the growing ones.
 pub struct Mark {
-    drones: Vec<Flyer>,
+    drones: TiVec<DroneId, Flyer>,
     raised: usize,
-    reserve: Vec<Option<Origin>>,
-    activities: Vec<usize>,
+    reserve: TiVec<DroneId, Option<Origin>>,
+    activities: TiVec<DroneId, usize>,
     assumptions: usize,
     fired: usize,
-    tracks: Vec<usize>,
+    tracks: TiVec<DroneId, usize>,
 }
 
 /// What a walk changed since a [`Mark`]: the small parts as they are after it, and what
 /// the growing ones gained.
 pub struct Tail {
-    drones: Vec<Flyer>,
+    drones: TiVec<DroneId, Flyer>,
     /// The changes to `raised`, last first: the signal and what it held after.
     raised: Vec<(SignalId, Option<f64>)>,
-    reserve: Vec<Option<Origin>>,
-    activities: Vec<Vec<Activity>>,
+    reserve: TiVec<DroneId, Option<Origin>>,
+    activities: TiVec<DroneId, Vec<Activity>>,
     assumptions: Vec<Note>,
     fired: Vec<usize>,
-    tracks: Vec<Vec<Leg>>,
+    tracks: TiVec<DroneId, Vec<Leg>>,
 }
 
 impl Mark {
     /// The drones as they were at the mark.
-    pub fn drones(&self) -> &[Flyer] {
+    pub fn drones(&self) -> &TiSlice<DroneId, Flyer> {
         &self.drones
     }
 }
 
 impl State {
-    pub fn new(drones: Vec<Flyer>, signals: usize) -> State {
+    pub fn new(drones: TiVec<DroneId, Flyer>, signals: usize) -> State {
         let n = drones.len();
         State {
             drones,
-            activities: vec![Vec::new(); n],
+            activities: vec![Vec::new(); n].into(),
             raised: vec![None; signals].into(),
             raised_log: Vec::new(),
-            reserve: vec![None; n],
+            reserve: vec![None; n].into(),
             assumptions: Vec::new(),
             fired: Vec::new(),
-            tracks: vec![Vec::new(); n],
+            tracks: vec![Vec::new(); n].into(),
         }
     }
 

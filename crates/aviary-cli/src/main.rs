@@ -23,6 +23,7 @@ mod serve;
 mod test;
 mod vehicle_figures;
 mod vehicles;
+mod zenoh;
 
 /// mimalloc, tuned before `main` (`aviary_alloc`; docs/BENCHMARKS.md).
 #[global_allocator]
@@ -129,6 +130,14 @@ enum Command {
         /// or this machine's name on the network); may be repeated
         #[arg(long, value_name = "NAME", requires = "serve")]
         allow_host: Vec<String>,
+        /// Publish the mission on Zenoh (its events, telemetry and operator state) and answer
+        /// the operator API there, with Zenoh's JSON5 configuration file CONFIG or Zenoh's
+        /// defaults (docs/DISTRIBUTED.md); runs in real time unless --speed says otherwise
+        #[arg(long, value_name = "CONFIG", num_args = 0..=1)]
+        zenoh: Option<Option<PathBuf>>,
+        /// With --zenoh: the key prefix of the mission's keys (default: aviary/MISSION)
+        #[arg(long, value_name = "KEY", requires = "zenoh")]
+        zenoh_prefix: Option<String>,
         /// A folder whose .mission files USE may read, besides the mission's own (repeatable)
         #[arg(long, value_name = "DIR", value_parser = folder)]
         use_root: Vec<PathBuf>,
@@ -346,14 +355,26 @@ fn command(cli: Cli) -> u8 {
             quiet,
             serve,
             allow_host,
+            zenoh,
+            zenoh_prefix,
             use_root,
             clock,
         } => {
             // Served to an operator, a mission runs in real time unless told otherwise.
-            let speed =
-                speed.unwrap_or_else(|| if serve.is_some() { "1".into() } else { "max".into() });
-            match (run::parse_speed(&speed), serve.as_deref().map(run::parse_serve).transpose()) {
-                (Ok(speed), Ok(serve)) => {
+            let served = serve.is_some() || zenoh.is_some();
+            let speed = speed.unwrap_or_else(|| if served { "1".into() } else { "max".into() });
+            let zenoh = zenoh
+                .map(|config| {
+                    let keys = zenoh_prefix.as_deref().map(aviary_zenoh::Keys::new).transpose()?;
+                    Ok::<_, String>(run::Zenoh { config, keys })
+                })
+                .transpose();
+            match (
+                run::parse_speed(&speed),
+                serve.as_deref().map(run::parse_serve).transpose(),
+                zenoh,
+            ) {
+                (Ok(speed), Ok(serve), Ok(zenoh)) => {
                     let serve =
                         serve.map(|address| serve::Serve { address, allowed_hosts: allow_host });
                     run::run(&run::RunArgs {
@@ -366,6 +387,7 @@ fn command(cli: Cli) -> u8 {
                         telemetry_hz,
                         quiet,
                         serve,
+                        zenoh,
                         use_root,
                         clock: match clock {
                             Clock::Vehicles => aviary_pipeline::pipeline::LiveClock::Vehicles,
@@ -373,7 +395,7 @@ fn command(cli: Cli) -> u8 {
                         },
                     })
                 }
-                (Err(why), _) | (_, Err(why)) => {
+                (Err(why), _, _) | (_, Err(why), _) | (_, _, Err(why)) => {
                     eprintln!("aviary: {why}");
                     2
                 }

@@ -32,6 +32,8 @@ pub struct RunArgs {
     pub quiet: bool,
     /// Where to serve the operator API.
     pub serve: Option<crate::serve::Serve>,
+    /// `--zenoh`: the mission on Zenoh too.
+    pub zenoh: Option<Zenoh>,
     /// Folders whose .mission files USE may read, besides the mission's own.
     pub use_root: Vec<PathBuf>,
     /// What a run with MAVLink drones keeps time by.
@@ -39,6 +41,14 @@ pub struct RunArgs {
 }
 
 /// `7878` is loopback port 7878; `HOST:PORT` binds exactly that.
+/// `--zenoh [CONFIG]` and `--zenoh-prefix KEY`.
+pub struct Zenoh {
+    /// Zenoh's JSON5 configuration file; Zenoh's defaults without one.
+    pub config: Option<PathBuf>,
+    /// `None`: `aviary/MISSION`.
+    pub keys: Option<aviary_zenoh::Keys>,
+}
+
 pub fn parse_serve(text: &str) -> Result<std::net::SocketAddr, String> {
     if let Ok(port) = text.parse::<u16>() {
         return Ok(std::net::SocketAddr::from(([127, 0, 0, 1], port)));
@@ -145,7 +155,9 @@ pub fn run(args: &RunArgs) -> u8 {
         seed: args.seed,
         // The operator's view of the drones comes from telemetry events.
         run: RunOptions {
-            telemetry_hz: args.telemetry_hz.or(args.serve.as_ref().map(|_| 2.0)),
+            telemetry_hz: args
+                .telemetry_hz
+                .or((args.serve.is_some() || args.zenoh.is_some()).then_some(2.0)),
             ..RunOptions::default()
         },
         clock: args.clock,
@@ -156,8 +168,10 @@ pub fn run(args: &RunArgs) -> u8 {
         controller: None,
         server: None,
         feed: None,
+        zenoh: None,
         map: serde_json::Value::Null,
         bounds: None,
+        zenoh_bounds: None,
         progress: None,
         stats: Stats::default(),
         drones: 0,
@@ -165,7 +179,7 @@ pub fn run(args: &RunArgs) -> u8 {
         expected: None,
     };
     let flown = aviary_pipeline::fly(texts, &options, &mut shown);
-    let Shown { trace, server, progress, summary, expected, .. } = shown;
+    let Shown { trace, server, zenoh, progress, summary, expected, .. } = shown;
     if let (Ok(flown), Some(trace)) = (&flown, &trace) {
         if !flown.flew {
             // Stopped while the vehicles connected: the trace is whole all the same.
@@ -192,6 +206,9 @@ pub fn run(args: &RunArgs) -> u8 {
     };
     if let Some((_, feed)) = &server {
         feed.finish(std::time::Duration::from_secs(2));
+    }
+    if let Some((bridge, _)) = zenoh {
+        bridge.finish(std::time::Duration::from_secs(2));
     }
     if !args.quiet {
         out!("{summary}");
@@ -247,10 +264,14 @@ struct Shown<'a> {
     /// The station serving this run, and where the run's events go.
     server: Option<(aviary_station::Serving, aviary_server::Feed)>,
     feed: Option<aviary_server::Feed>,
+    /// The run on Zenoh (`--zenoh`), and where its events go.
+    zenoh: Option<(aviary_zenoh::Bridge, aviary_server::Feed)>,
     /// The world as the station's map draws it, and where it lets the operator send a
     /// drone, kept from `compiled` for `starting`.
     map: serde_json::Value,
     bounds: Option<aviary_server::Bounds>,
+    /// The same, for the operator API on Zenoh.
+    zenoh_bounds: Option<aviary_server::Bounds>,
     /// Made once the run starts.
     progress: Option<ProgressBar>,
     stats: Stats,
@@ -269,6 +290,9 @@ impl Hooks for Shown<'_> {
         if self.args.serve.is_some() {
             self.map = aviary_station::checking::map_of(world);
             self.bounds = Some(aviary_server::Bounds::of(world));
+        }
+        if self.args.zenoh.is_some() {
+            self.zenoh_bounds = Some(aviary_server::Bounds::of(world));
         }
         self.expected = Some(Expected {
             observer: aviary_campaign::Observer::new(mission),
@@ -316,6 +340,13 @@ impl Hooks for Shown<'_> {
             self.feed = Some(feed.clone());
             self.server = Some((serving, feed));
         }
+        if let Some(zenoh) = &self.args.zenoh {
+            let bounds =
+                self.zenoh_bounds.take().ok_or("the run starts before its world was read")?;
+            let token = self.server.as_ref().map(|(serving, _)| serving.token.clone());
+            self.zenoh =
+                Some(crate::zenoh::start(zenoh, mission, bounds, controller.clone(), token)?);
+        }
         self.progress = Some(progress_bar(self.args.quiet));
         self.drones = mission.drones.len();
         Ok(())
@@ -350,6 +381,9 @@ impl Hooks for Shown<'_> {
             }
         }
         if let Some(feed) = &self.feed {
+            feed.publish(record);
+        }
+        if let Some((_, feed)) = &self.zenoh {
             feed.publish(record);
         }
     }

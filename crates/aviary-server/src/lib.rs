@@ -35,6 +35,7 @@ use parking_lot::{Mutex, MutexGuard};
 use std::net::SocketAddr;
 use std::sync::Arc;
 
+use aviary_api::operator::{KindName, OperatorState, SignalValues};
 use aviary_api::trace::Record;
 use aviary_engine::Controller;
 use tokio::sync::broadcast;
@@ -50,7 +51,8 @@ const HISTORY: usize = 100_000;
 
 /// An event as streams send it: its trace line, and what a stream needs to know of it
 /// without reading the line again.
-pub(crate) struct Line {
+pub struct Line {
+    /// The trace file's line, without its newline.
     pub text: Box<str>,
     /// The drone, for a telemetry sample.
     pub telemetry_of: Option<Box<str>>,
@@ -93,6 +95,23 @@ impl Shared {
         self.state.lock()
     }
 
+    /// `GET /api/state`: the state folded from the trace, and the signals the operator
+    /// may raise (which the trace does not say: they are the mission's).
+    pub fn document(&self) -> OperatorState {
+        let mut state = self.state().document();
+        state.operator_signals = self.kinds.operator_signals();
+        // What each carries, so that a form can read `x, y` as the one position it takes.
+        state.operator_signal_values = SignalValues(
+            self.kinds
+                .operator_signal_values()
+                .map(|(name, kinds)| {
+                    (name.to_string(), kinds.iter().map(|k| k.map(KindName::from)).collect())
+                })
+                .collect(),
+        );
+        state
+    }
+
     pub fn history(&self) -> MutexGuard<'_, History> {
         self.history.lock()
     }
@@ -114,6 +133,18 @@ impl Feed {
         {
             std::thread::sleep(std::time::Duration::from_millis(10));
         }
+    }
+
+    /// The operator state now, as `GET /api/state` answers it.
+    pub fn document(&self) -> OperatorState {
+        self.shared.document()
+    }
+
+    /// Every event from now on, as its line, for a stream of the caller's own (the Zenoh
+    /// bridge's). A receiver that falls [`BACKLOG`] events behind misses the oldest and
+    /// is told so (`RecvError::Lagged`).
+    pub fn subscribe(&self) -> broadcast::Receiver<Arc<Line>> {
+        self.shared.events.subscribe()
     }
 
     /// Folds the event into the mission's state and sends it to every stream, as the

@@ -18,7 +18,7 @@ use crate::args::Refusal;
 use crate::reply::{error, Object, BODY_LIMIT};
 use crate::requests::{Argument, DroneRequest, DroneVerb, LeashRequest, SignalRequest};
 use crate::{guard, reply, stream, Shared};
-use aviary_api::operator::{Accepted, KindName, OperatorState, SignalValues};
+use aviary_api::operator::{Accepted, OperatorState};
 
 pub(crate) fn router(shared: Arc<Shared>) -> Router {
     let reads = Router::new()
@@ -59,22 +59,9 @@ async fn control(shared: &Shared, control: Control) -> Response {
     }
 }
 
-/// The state folded from the trace, and the signals the operator may raise (which the
-/// trace does not say: they are the mission's).
+/// The state folded from the trace, and the signals the operator may raise.
 async fn state(State(shared): State<Arc<Shared>>) -> Json<OperatorState> {
-    let mut state = shared.state().document();
-    state.operator_signals = shared.kinds.operator_signals();
-    // What each carries, so that a form can read `x, y` as the one position it takes.
-    state.operator_signal_values = SignalValues(
-        shared
-            .kinds
-            .operator_signal_values()
-            .map(|(name, kinds)| {
-                (name.to_string(), kinds.iter().map(|k| k.map(KindName::from)).collect())
-            })
-            .collect(),
-    );
-    Json(state)
+    Json(shared.document())
 }
 
 async fn events(

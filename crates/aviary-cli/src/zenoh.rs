@@ -1,0 +1,47 @@
+//! `aviary run --zenoh`: the run's operator API behind a router of its own, carried on
+//! Zenoh by `aviary_zenoh`, with the token printed once (the station's, when `--serve`
+//! serves one too).
+
+use std::net::{Ipv4Addr, SocketAddr};
+
+use aviary_engine::Controller;
+use aviary_ir::Mission;
+use aviary_server::{Bounds, Feed, Kinds};
+use aviary_zenoh::{Api, Bridge, Keys};
+
+use crate::run::Zenoh;
+
+/// Opens the session and starts the bridge; says where on standard error.
+pub fn start(
+    zenoh: &Zenoh,
+    mission: &Mission,
+    bounds: Bounds,
+    controller: Controller,
+    token: Option<String>,
+) -> Result<(Bridge, Feed), String> {
+    let config = aviary_zenoh::config(zenoh.config.as_deref())?;
+    let keys = zenoh.keys.clone().unwrap_or_else(|| Keys::of_mission(&mission.name));
+    let shared_token = token.is_some();
+    let token = match token {
+        Some(token) => token,
+        None => aviary_server::new_token()?,
+    };
+    // A router no socket reaches: the bridge hands it each query as a request from this
+    // machine, so reading needs no token (what it reads is published anyway) and every
+    // control call does.
+    let bound = SocketAddr::from((Ipv4Addr::LOCALHOST, 0));
+    let options = aviary_server::Options {
+        kinds: Kinds::of(mission).within(bounds),
+        allowed_hosts: Vec::new(),
+    };
+    let (router, feed) = aviary_server::router(bound, token.clone(), controller, options);
+    let bridge = Bridge::start(config, keys, Api { router, bound, feed: feed.clone() })?;
+    let prefix = bridge.keys().prefix().to_string();
+    use std::io::Write;
+    let _ = writeln!(
+        std::io::stderr(),
+        "aviary: on Zenoh under {prefix}/: events, telemetry/DRONE, state; operator API {prefix}/api/CALL  token {}",
+        if shared_token { "(the same)".to_string() } else { token }
+    );
+    Ok((bridge, feed))
+}

@@ -1,0 +1,200 @@
+//! `aviary run --zenoh` seen from another Zenoh peer: a session of the test's own (the
+//! `zenoh` crate, as any Rust client would use it) connects to the run's endpoint,
+//! subscribes to its keys, reads the state and steers the mission through the
+//! queryables. What it receives is the trace file's own lines; a call without the token,
+//! or with a body that is not JSON, changes nothing and is logged; a pause is seen on
+//! the events key within a second. Without `--zenoh`, a run opens no socket.
+
+mod common;
+
+use std::io::{BufRead, BufReader, Read};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use common::{scratch, wait_at_most};
+use zenoh::Wait;
+
+const WORLD: &str =
+    "[places]\nFar = [0, 400]\n[drones.a]\nhome = [0, 0]\n[drones.b]\nhome = [10, 0]\n";
+const MISSION: &str =
+    "MISSION M:\n    PARALLEL:\n        a FlyTo-F1 WITH Far\n        b Hover WITH 40s\n";
+
+fn free_port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
+}
+
+/// A peer that finds no one by scouting: it listens or connects where it is told, and no
+/// other test's Zenoh session on this machine can join it.
+fn peer(endpoints: &str, port: u16) -> String {
+    format!(
+        r#"{{ mode: "peer", {endpoints}: {{ endpoints: ["tcp/127.0.0.1:{port}"] }},
+            scouting: {{ multicast: {{ enabled: false }}, gossip: {{ enabled: false }} }} }}"#
+    )
+}
+
+fn get(
+    session: &zenoh::Session,
+    key: &str,
+    body: Option<&str>,
+    token: Option<&str>,
+) -> Result<serde_json::Value, serde_json::Value> {
+    let mut get = session.get(key).timeout(Duration::from_secs(5));
+    if let Some(body) = body {
+        get = get.payload(body.to_string());
+    }
+    if let Some(token) = token {
+        get = get.attachment(token.to_string());
+    }
+    let replies = get.wait().expect("a query is sent");
+    let reply = replies.recv().expect("the run answers");
+    let json = |bytes: &zenoh::bytes::ZBytes| {
+        serde_json::from_slice(&bytes.to_bytes()).expect("the answer is JSON")
+    };
+    match reply.result() {
+        Ok(sample) => Ok(json(sample.payload())),
+        Err(error) => Err(json(error.payload())),
+    }
+}
+
+#[test]
+fn a_peer_watches_and_steers_a_run_on_zenoh() {
+    let dir = scratch("zenoh_run");
+    std::fs::write(dir.join("m.mission"), MISSION).unwrap();
+    std::fs::write(dir.join("m.world.toml"), WORLD).unwrap();
+    let port = free_port();
+    std::fs::write(dir.join("zenoh.json5"), peer("listen", port)).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(["run", "m.mission", "--zenoh", "zenoh.json5", "--zenoh-prefix", "test/ops"])
+        .args(["--speed", "10", "--quiet", "--trace", "t.jsonl"])
+        .current_dir(&dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    stderr.read_line(&mut line).unwrap();
+    // aviary: on Zenoh under test/ops/: events, ...; operator API test/ops/api/CALL  token TOKEN
+    assert!(line.contains("on Zenoh under test/ops/"), "{line}");
+    let token = line.split_whitespace().last().expect("token").to_string();
+
+    let config = zenoh::Config::from_json5(&peer("connect", port)).unwrap();
+    let session = zenoh::open(config).wait().expect("the test's peer opens");
+    let heard = session.declare_subscriber("test/ops/**").wait().unwrap();
+    // The subscription reaches the run before the calls below are made.
+    let state = get(&session, "test/ops/api/state", None, None).expect("reading needs no token");
+    assert!(state["drones"].is_array(), "{state}");
+
+    let refused = get(&session, "test/ops/api/pause", None, None).unwrap_err();
+    assert!(refused["error"].as_str().unwrap().contains("token"), "{refused}");
+    let refused = get(&session, "test/ops/api/pause", None, Some("not-the-token")).unwrap_err();
+    assert!(refused["error"].is_string(), "{refused}");
+    let garbage = get(&session, "test/ops/api/leash", Some("{not json"), Some(&token)).unwrap_err();
+    assert!(garbage["error"].is_string(), "{garbage}");
+    let unknown = get(&session, "test/ops/api/launch", Some("{}"), Some(&token)).unwrap_err();
+    assert!(unknown["error"].as_str().unwrap().contains("the calls are"), "{unknown}");
+
+    let asked = Instant::now();
+    assert!(get(&session, "test/ops/api/pause", None, Some(&token)).is_ok());
+    let mut samples: Vec<(String, String, Duration)> = Vec::new();
+    let mut resumed = false;
+    let deadline = Instant::now() + Duration::from_secs(60);
+    loop {
+        let Ok(Some(sample)) = heard.recv_timeout(Duration::from_millis(100)) else {
+            assert!(Instant::now() < deadline, "no mission_end on test/ops/events");
+            continue;
+        };
+        let key = sample.key_expr().as_str().to_string();
+        let text = sample.payload().try_to_string().unwrap().into_owned();
+        let end = key == "test/ops/events" && text.contains(r#""event":"mission_end""#);
+        samples.push((key, text, asked.elapsed()));
+        if !resumed
+            && samples.iter().any(|(_, t, _)| t.contains(r#""event":"operator","action":"pause""#))
+        {
+            std::thread::sleep(Duration::from_millis(500));
+            assert!(get(&session, "test/ops/api/resume", None, Some(&token)).is_ok());
+            resumed = true;
+        }
+        if end {
+            break;
+        }
+    }
+    // The state once more, after the end: the publisher sends it last.
+    while let Ok(Some(sample)) = heard.recv_timeout(Duration::from_secs(2)) {
+        let key = sample.key_expr().as_str().to_string();
+        let text = sample.payload().try_to_string().unwrap().into_owned();
+        let last = key == "test/ops/state";
+        samples.push((key, text, asked.elapsed()));
+        if last {
+            break;
+        }
+    }
+    assert_eq!(wait_at_most(&mut child, Duration::from_secs(20), "the run"), 0);
+    let mut log = String::new();
+    stderr.read_to_string(&mut log).unwrap();
+    session.close().wait().unwrap();
+
+    // What was published is what the trace file holds, line for line.
+    let trace = std::fs::read_to_string(dir.join("t.jsonl")).unwrap();
+    let lines: std::collections::HashSet<&str> = trace.lines().collect();
+    for (key, text, _) in samples.iter().filter(|(k, _, _)| !k.ends_with("/state")) {
+        assert!(lines.contains(text.as_str()), "{key}: {text} is not a line of the trace");
+    }
+    let on = |key: &str| samples.iter().filter(|(k, _, _)| k == key).count();
+    assert!(on("test/ops/telemetry/a") >= 5 && on("test/ops/telemetry/b") >= 5);
+    let last_state = samples.iter().rev().find(|(k, _, _)| k == "test/ops/state").expect("a state");
+    let last_state: serde_json::Value = serde_json::from_str(&last_state.1).unwrap();
+    assert_eq!(last_state["status"], "ok", "{last_state}");
+    // The pause, asked of the run, is heard on the events key within a second.
+    let (_, _, heard_after) = samples
+        .iter()
+        .find(|(_, t, _)| t.contains(r#""event":"operator","action":"pause""#))
+        .expect("the pause");
+    assert!(*heard_after < Duration::from_secs(1), "the pause was heard after {heard_after:?}");
+    assert!(samples.iter().any(|(_, t, _)| t.contains(r#""event":"operator","action":"resume""#)));
+    // Each refusal was logged for the operator.
+    assert!(log.matches("test/ops/api/pause refused (401)").count() == 2, "{log}");
+    assert!(log.contains("test/ops/api/leash refused (400)"), "{log}");
+}
+
+#[test]
+fn without_zenoh_a_run_opens_no_socket() {
+    let dir = scratch("zenoh_off");
+    std::fs::write(dir.join("m.mission"), MISSION).unwrap();
+    std::fs::write(dir.join("m.world.toml"), WORLD).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(["run", "m.mission", "--speed", "10", "--quiet"])
+        .current_dir(&dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("spawn");
+    // Mid-flight: the sockets the process holds (the signal handler's pair of its own),
+    // none of them TCP or UDP.
+    std::thread::sleep(Duration::from_millis(1500));
+    let pid = child.id();
+    let fds = std::fs::read_dir(format!("/proc/{pid}/fd")).expect("/proc");
+    let sockets: Vec<String> = fds
+        .filter_map(|fd| std::fs::read_link(fd.ok()?.path()).ok())
+        .filter_map(|target| {
+            let inode = target.to_str()?.strip_prefix("socket:[")?.strip_suffix(']')?;
+            Some(inode.to_string())
+        })
+        .collect();
+    let network: Vec<String> = ["tcp", "tcp6", "udp", "udp6"]
+        .iter()
+        .filter_map(|table| std::fs::read_to_string(format!("/proc/{pid}/net/{table}")).ok())
+        .flat_map(|table| {
+            // The inode is the tenth column of each line after the header.
+            table
+                .lines()
+                .skip(1)
+                .filter_map(|l| l.split_whitespace().nth(9).map(String::from))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    assert!(child.try_wait().unwrap().is_none(), "the run was still flying");
+    let open: Vec<&String> = sockets.iter().filter(|s| network.contains(s)).collect();
+    assert!(open.is_empty(), "network sockets {open:?} among {sockets:?}");
+    assert_eq!(wait_at_most(&mut child, Duration::from_secs(30), "the run"), 0);
+}

@@ -1,0 +1,87 @@
+//! A run on Zenoh (`aviary run --zenoh`, docs/DISTRIBUTED.md): every trace event, each
+//! drone's telemetry and the operator state are published under one key prefix, and the
+//! operator API is answered as queryables, so that machines other than the one flying
+//! the mission can watch and steer it.
+//!
+//! Invariants:
+//! - The bridge adds no second operator API. A query is turned into the HTTP request it
+//!   stands for and answered by the run's own router (`aviary_server`), with its checks
+//!   of the token, the names and the values; a Zenoh reply is that response.
+//! - What is published is the trace's own lines, byte for byte, and the state document
+//!   of `GET /api/state`: a subscriber reads what a trace file or the HTTP API gives.
+//! - It runs on threads of its own in real time, beside the engine: the engine only
+//!   publishes to the run's `Feed`, which never waits for a slow peer.
+//! - Without `--zenoh` nothing here runs and no socket is opened.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+
+mod keys;
+mod publish;
+mod queries;
+
+pub use keys::Keys;
+
+use std::net::SocketAddr;
+use std::path::Path;
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use zenoh::Wait;
+
+/// The session's configuration: Zenoh's JSON5 file (its own format,
+/// <https://zenoh.io/docs/manual/configuration/>), or Zenoh's defaults (a peer that finds
+/// others by multicast scouting and listens on a free TCP port).
+pub fn config(file: Option<&Path>) -> Result<zenoh::Config, String> {
+    match file {
+        Some(path) => zenoh::Config::from_file(path)
+            .map_err(|e| format!("cannot read the Zenoh configuration {}: {e}", path.display())),
+        None => Ok(zenoh::Config::default()),
+    }
+}
+
+/// The run's operator API as the bridge reaches it: the router, the address the router
+/// believes it is bound at (its `Host`), and the feed of events.
+pub struct Api {
+    pub router: axum::Router,
+    pub bound: SocketAddr,
+    pub feed: aviary_server::Feed,
+}
+
+/// A run on Zenoh, until [`Bridge::finish`].
+pub struct Bridge {
+    session: zenoh::Session,
+    keys: Keys,
+    publisher: Option<JoinHandle<()>>,
+}
+
+impl Bridge {
+    /// Opens the session and starts publishing what `api.feed` carries and answering
+    /// queries under `keys`. Call before the run's first event.
+    pub fn start(config: zenoh::Config, keys: Keys, api: Api) -> Result<Bridge, String> {
+        let session =
+            zenoh::open(config).wait().map_err(|e| format!("cannot open a Zenoh session: {e}"))?;
+        let lines = api.feed.subscribe();
+        let publisher = publish::start(session.clone(), keys.clone(), lines, api.feed.clone())?;
+        queries::start(session.clone(), keys.clone(), api.router, api.bound)?;
+        Ok(Bridge { session, keys, publisher: Some(publisher) })
+    }
+
+    /// The key prefix, for the operator's message.
+    pub fn keys(&self) -> &Keys {
+        &self.keys
+    }
+
+    /// After `mission_end`: waits (at most `limit`) until the publisher has sent it and
+    /// the last state, then closes the session, so that no peer misses how the mission
+    /// ended.
+    pub fn finish(mut self, limit: Duration) {
+        if let Some(publisher) = self.publisher.take() {
+            let start = std::time::Instant::now();
+            while !publisher.is_finished() && start.elapsed() < limit {
+                std::thread::sleep(Duration::from_millis(10));
+            }
+        }
+        if let Err(e) = self.session.close().wait() {
+            eprintln!("aviary: zenoh: the session did not close cleanly: {e}");
+        }
+    }
+}

@@ -1,0 +1,132 @@
+//! The publisher: each line the run's feed carries, on its key, and the operator state
+//! once a second while events come, and once more at the end.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use aviary_server::{Feed, Line};
+use tokio::sync::broadcast::{error::RecvError, Receiver};
+use zenoh::bytes::Encoding;
+use zenoh::pubsub::Publisher;
+use zenoh::Wait;
+
+use crate::Keys;
+
+/// How often the state is published while the run goes on.
+const STATE_EVERY: Duration = Duration::from_secs(1);
+
+pub(crate) fn start(
+    session: zenoh::Session,
+    keys: Keys,
+    lines: Receiver<Arc<Line>>,
+    feed: Feed,
+) -> Result<JoinHandle<()>, String> {
+    let declare = |key: String| {
+        session
+            .declare_publisher(key.clone())
+            .encoding(Encoding::APPLICATION_JSON)
+            .wait()
+            .map_err(|e| format!("cannot publish on {key}: {e}"))
+    };
+    let events = declare(keys.events())?;
+    let state = declare(keys.state())?;
+    std::thread::Builder::new()
+        .name("aviary zenoh publisher".into())
+        .spawn(move || {
+            let mut publisher = Publishing {
+                session,
+                keys,
+                events,
+                state,
+                telemetry: HashMap::new(),
+                feed,
+                last_state: None,
+            };
+            publisher.run(lines)
+        })
+        .map_err(|e| format!("cannot start the Zenoh publisher: {e}"))
+}
+
+struct Publishing {
+    session: zenoh::Session,
+    keys: Keys,
+    events: Publisher<'static>,
+    state: Publisher<'static>,
+    /// One publisher per drone, declared at its first sample.
+    telemetry: HashMap<Box<str>, Publisher<'static>>,
+    feed: Feed,
+    last_state: Option<Instant>,
+}
+
+impl Publishing {
+    fn run(&mut self, mut lines: Receiver<Arc<Line>>) {
+        loop {
+            match lines.blocking_recv() {
+                Ok(line) => {
+                    self.line(&line);
+                    if line.end {
+                        self.publish_state();
+                        return;
+                    }
+                    if self.last_state.is_none_or(|t| t.elapsed() >= STATE_EVERY) {
+                        self.publish_state();
+                    }
+                }
+                Err(RecvError::Lagged(missed)) => eprintln!(
+                    "aviary: zenoh: the publisher fell behind and {missed} events were not published"
+                ),
+                Err(RecvError::Closed) => {
+                    self.publish_state();
+                    return;
+                }
+            }
+        }
+    }
+
+    fn line(&mut self, line: &Line) {
+        let text = line.text.as_bytes().to_vec();
+        let sent = match &line.telemetry_of {
+            None => self.events.put(text).wait(),
+            Some(drone) => {
+                if !self.telemetry.contains_key(drone) {
+                    let key = self.keys.telemetry(drone);
+                    match self
+                        .session
+                        .declare_publisher(key.clone())
+                        .encoding(Encoding::APPLICATION_JSON)
+                        .wait()
+                    {
+                        Ok(p) => {
+                            self.telemetry.insert(drone.clone(), p);
+                        }
+                        Err(e) => {
+                            eprintln!("aviary: zenoh: cannot publish on {key}: {e}");
+                            return;
+                        }
+                    }
+                }
+                match self.telemetry.get(drone) {
+                    Some(p) => p.put(text).wait(),
+                    None => return,
+                }
+            }
+        };
+        if let Err(e) = sent {
+            eprintln!("aviary: zenoh: an event was not published: {e}");
+        }
+    }
+
+    fn publish_state(&mut self) {
+        self.last_state = Some(Instant::now());
+        match serde_json::to_vec(&self.feed.document()) {
+            Ok(bytes) => {
+                if let Err(e) = self.state.put(bytes).wait() {
+                    eprintln!("aviary: zenoh: the state was not published: {e}");
+                }
+            }
+            Err(e) => eprintln!("aviary: zenoh: the state could not be written: {e}"),
+        }
+    }
+}

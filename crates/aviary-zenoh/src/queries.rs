@@ -1,0 +1,117 @@
+//! The operator API as queryables: a query on `PREFIX/api/CALL` is the HTTP request it
+//! stands for (`GET /api/state`, or `POST /api/CALL` with the query's payload as its JSON
+//! body and the query's attachment as its token), answered by the run's own router. A
+//! success is the reply, anything else an error reply with the same JSON, and logged: a
+//! peer that sends garbage or calls without the token changes nothing, and the operator
+//! sees that it tried.
+
+use std::net::SocketAddr;
+use std::thread::JoinHandle;
+
+use axum::body::Body;
+use axum::http::{header, Method, Request, StatusCode};
+use tower::ServiceExt;
+use zenoh::bytes::Encoding;
+use zenoh::query::Query;
+use zenoh::Wait;
+
+use crate::keys::CALLS;
+use crate::Keys;
+
+/// The longest answer read back from the router (a state document of a large fleet).
+const ANSWER_LIMIT: usize = 64 << 20;
+
+pub(crate) fn start(
+    session: zenoh::Session,
+    keys: Keys,
+    router: axum::Router,
+    bound: SocketAddr,
+) -> Result<JoinHandle<()>, String> {
+    let queryable = session
+        .declare_queryable(keys.api())
+        .wait()
+        .map_err(|e| format!("cannot answer on {}: {e}", keys.api()))?;
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .build()
+        .map_err(|e| format!("cannot start the Zenoh queryables: {e}"))?;
+    std::thread::Builder::new()
+        .name("aviary zenoh queryables".into())
+        .spawn(move || {
+            // Until the session closes.
+            while let Ok(query) = queryable.recv() {
+                let (status, body) = runtime.block_on(answer(&keys, &router, bound, &query));
+                reply(&query, status, body);
+            }
+        })
+        .map_err(|e| format!("cannot start the Zenoh queryables: {e}"))
+}
+
+/// The router's answer to the request `query` stands for.
+async fn answer(
+    keys: &Keys,
+    router: &axum::Router,
+    bound: SocketAddr,
+    query: &Query,
+) -> (StatusCode, Vec<u8>) {
+    let key = query.key_expr().as_str();
+    let Some(call) = keys.call(key) else {
+        let why = format!("{key} is not a call: the calls are {}", CALLS.join(", "));
+        return (StatusCode::NOT_FOUND, error(&why));
+    };
+    let method = if call == "state" { Method::GET } else { Method::POST };
+    let mut request = Request::builder()
+        .method(method)
+        .uri(format!("/api/{call}"))
+        .header(header::HOST, bound.to_string())
+        .header(header::CONTENT_TYPE, "application/json");
+    if let Some(token) = query.attachment() {
+        match token.try_to_string() {
+            Ok(token) => request = request.header(header::AUTHORIZATION, format!("Bearer {token}")),
+            Err(_) => {
+                return (
+                    StatusCode::UNAUTHORIZED,
+                    error("the attachment must be the token, as text"),
+                )
+            }
+        }
+    }
+    let body = query.payload().map(|p| p.to_bytes().into_owned()).unwrap_or_default();
+    let request = match request.body(Body::from(body)) {
+        Ok(r) => r,
+        Err(e) => return (StatusCode::BAD_REQUEST, error(&e.to_string())),
+    };
+    let response = match router.clone().oneshot(request).await {
+        Ok(r) => r,
+        Err(never) => match never {},
+    };
+    let status = response.status();
+    match axum::body::to_bytes(response.into_body(), ANSWER_LIMIT).await {
+        Ok(bytes) => (status, bytes.to_vec()),
+        Err(e) => (StatusCode::INTERNAL_SERVER_ERROR, error(&e.to_string())),
+    }
+}
+
+fn reply(query: &Query, status: StatusCode, body: Vec<u8>) {
+    let key = query.key_expr().clone();
+    let sent = if status.is_success() {
+        query.reply(key.clone(), body).encoding(Encoding::APPLICATION_JSON).wait()
+    } else {
+        eprintln!(
+            "aviary: zenoh: {key} refused ({}): {}",
+            status.as_u16(),
+            String::from_utf8_lossy(&body)
+                .chars()
+                .filter(|c| !c.is_control())
+                .take(200)
+                .collect::<String>()
+        );
+        query.reply_err(body).encoding(Encoding::APPLICATION_JSON).wait()
+    };
+    if let Err(e) = sent {
+        eprintln!("aviary: zenoh: the answer on {key} was not sent: {e}");
+    }
+}
+
+fn error(why: &str) -> Vec<u8> {
+    serde_json::to_vec(&serde_json::json!({ "error": why })).unwrap_or_default()
+}

@@ -81,6 +81,20 @@ fn a_peer_watches_and_steers_a_run_on_zenoh() {
     let config = zenoh::Config::from_json5(&peer("connect", port)).unwrap();
     let session = zenoh::open(config).wait().expect("the test's peer opens");
     let heard = session.declare_subscriber("test/ops/**").wait().unwrap();
+    // A second station, on a session of its own, that only watches.
+    let config = zenoh::Config::from_json5(&peer("connect", port)).unwrap();
+    let other = zenoh::open(config).wait().expect("the second peer opens");
+    // When each event reached it.
+    let (arrived, other_heard) = std::sync::mpsc::channel::<(Instant, String)>();
+    let _other_subscriber = other
+        .declare_subscriber("test/ops/events")
+        .callback(move |sample| {
+            let text = sample.payload().try_to_string().unwrap_or_default().into_owned();
+            let _ = arrived.send((Instant::now(), text));
+        })
+        .wait()
+        .unwrap();
+    get(&other, "test/ops/api/state", None, None).expect("the second peer reads the state");
     // The subscription reaches the run before the calls below are made.
     let state = get(&session, "test/ops/api/state", None, None).expect("reading needs no token");
     assert!(state["drones"].is_array(), "{state}");
@@ -151,6 +165,15 @@ fn a_peer_watches_and_steers_a_run_on_zenoh() {
         .find(|(_, t, _)| t.contains(r#""event":"operator","action":"pause""#))
         .expect("the pause");
     assert!(*heard_after < Duration::from_secs(1), "the pause was heard after {heard_after:?}");
+    // The other station heard the same pause, within a second of the asking too.
+    let pause = |text: &str| text.contains(r#""event":"operator","action":"pause""#);
+    let (at, text) = other_heard
+        .try_iter()
+        .find(|(_, text)| pause(text))
+        .expect("the other station heard the pause");
+    assert!(at.duration_since(asked) < Duration::from_secs(1), "{:?}", at.duration_since(asked));
+    assert!(samples.iter().any(|(_, t, _)| *t == text), "both heard the one pause: {text}");
+    other.close().wait().unwrap();
     assert!(samples.iter().any(|(_, t, _)| t.contains(r#""event":"operator","action":"resume""#)));
     // Each refusal was logged for the operator.
     assert!(log.matches("test/ops/api/pause refused (401)").count() == 2, "{log}");
@@ -196,5 +219,85 @@ fn without_zenoh_a_run_opens_no_socket() {
     assert!(child.try_wait().unwrap().is_none(), "the run was still flying");
     let open: Vec<&String> = sockets.iter().filter(|s| network.contains(s)).collect();
     assert!(open.is_empty(), "network sockets {open:?} among {sockets:?}");
+    assert_eq!(wait_at_most(&mut child, Duration::from_secs(30), "the run"), 0);
+}
+
+/// A certificate authority of the test's own, and a certificate for `localhost` it signed:
+/// `(ca.pem, server.pem, server.key)`, written into `dir`.
+fn certificates(dir: &std::path::Path) -> (String, String, String) {
+    use rcgen::{BasicConstraints, CertificateParams, IsCa, Issuer, KeyPair};
+    let ca_key = KeyPair::generate().unwrap();
+    let mut ca_params = CertificateParams::new(Vec::<String>::new()).unwrap();
+    ca_params.is_ca = IsCa::Ca(BasicConstraints::Unconstrained);
+    let ca = ca_params.self_signed(&ca_key).unwrap();
+    let issuer = Issuer::new(ca_params, ca_key);
+    let key = KeyPair::generate().unwrap();
+    let server = CertificateParams::new(vec!["localhost".to_string()])
+        .unwrap()
+        .signed_by(&key, &issuer)
+        .unwrap();
+    let write = |name: &str, text: String| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path.display().to_string()
+    };
+    (
+        write("ca.pem", ca.pem()),
+        write("server.pem", server.pem()),
+        write("server.key", key.serialize_pem()),
+    )
+}
+
+/// With TLS on (docs/SECURITY.md): the run listens on a `tls/` endpoint with its
+/// certificate; a peer that trusts the authority that signed it watches the run, and one
+/// that does not cannot join.
+#[test]
+fn over_tls_only_a_peer_that_trusts_the_certificate_joins() {
+    let dir = scratch("zenoh_tls");
+    std::fs::write(dir.join("m.mission"), MISSION).unwrap();
+    std::fs::write(dir.join("m.world.toml"), WORLD).unwrap();
+    let (ca, cert, key) = certificates(&dir);
+    let port = free_port();
+    let no_scouting = "scouting: { multicast: { enabled: false }, gossip: { enabled: false } }";
+    let listen = format!(
+        r#"{{ mode: "peer", listen: {{ endpoints: ["tls/localhost:{port}"] }}, {no_scouting},
+            transport: {{ link: {{ tls: {{ listen_certificate: "{cert}", listen_private_key: "{key}" }} }} }} }}"#
+    );
+    std::fs::write(dir.join("zenoh.json5"), listen).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(["run", "m.mission", "--zenoh", "zenoh.json5", "--zenoh-prefix", "tls/ops"])
+        .args(["--speed", "10", "--quiet"])
+        .current_dir(&dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    stderr.read_line(&mut line).unwrap();
+    assert!(line.contains("on Zenoh under tls/ops/"), "{line}");
+
+    let client = |ca: Option<&str>| {
+        let tls = ca.map_or(String::new(), |ca| {
+            format!(r#", transport: {{ link: {{ tls: {{ root_ca_certificate: "{ca}" }} }} }}"#)
+        });
+        let config = format!(
+            r#"{{ mode: "peer", connect: {{ endpoints: ["tls/localhost:{port}"], timeout_ms: 3000, exit_on_failure: true }},
+                {no_scouting}{tls} }}"#
+        );
+        zenoh::open(zenoh::Config::from_json5(&config).unwrap()).wait()
+    };
+    // The authority's certificate is not one the system trusts: no TLS session.
+    match client(None) {
+        Ok(_) => panic!("a peer that does not trust the certificate joined"),
+        Err(e) => eprintln!("refused, as it should be: {e}"),
+    }
+    let session = client(Some(&ca)).expect("a peer that trusts the certificate joins");
+    let state = get(&session, "tls/ops/api/state", None, None).expect("the state over TLS");
+    assert!(state["drones"].is_array(), "{state}");
+    let heard = session.declare_subscriber("tls/ops/telemetry/*").wait().unwrap();
+    let sample = heard.recv_timeout(Duration::from_secs(10)).unwrap().expect("telemetry over TLS");
+    assert!(sample.payload().try_to_string().unwrap().contains(r#""event":"telemetry""#));
+    session.close().wait().unwrap();
     assert_eq!(wait_at_most(&mut child, Duration::from_secs(30), "the run"), 0);
 }

@@ -1,5 +1,6 @@
 //! `aviary ctl`: the command-line client of the operator API that `aviary run --serve`
-//! starts (docs/OPERATOR_API.md).
+//! starts (docs/OPERATOR_API.md), or that `aviary run --zenoh` answers on Zenoh
+//! (docs/DISTRIBUTED.md): the same calls, the same answers.
 
 use aviary_api::operator::OperatorState;
 use aviary_server::requests::{Argument, DroneRequest, DroneVerb, LeashRequest, SignalRequest};
@@ -60,11 +61,57 @@ impl DroneCtl {
     }
 }
 
-pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
-    let base = url.trim_end_matches('/');
+/// Where the operator API is.
+pub enum Reach {
+    /// `--url`: the HTTP server's address.
+    Http(String),
+    /// `--zenoh`: a run on Zenoh, under its key prefix.
+    Zenoh(aviary_zenoh::Client, String),
+}
+
+impl Reach {
+    /// The operator API's `call` with its JSON body (none for `state`): the HTTP status
+    /// and the answer.
+    fn call(
+        &self,
+        call: &str,
+        token: Option<&str>,
+        body: Option<String>,
+    ) -> Result<(u16, String), String> {
+        match self {
+            Reach::Http(base) => match body {
+                None => get(&format!("{base}/api/{call}"), token),
+                Some(body) => post(base, call, token, body),
+            },
+            Reach::Zenoh(client, _) => client.call(call, body, token),
+        }
+    }
+
+    /// Where, for messages.
+    fn place(&self) -> String {
+        match self {
+            Reach::Http(base) => base.clone(),
+            Reach::Zenoh(_, prefix) => format!("{prefix}/api on Zenoh"),
+        }
+    }
+}
+
+/// A control call's body, as JSON.
+fn control(
+    reach: &Reach,
+    call: &str,
+    token: Option<&str>,
+    body: &impl serde::Serialize,
+) -> Result<(u16, String), String> {
+    let body = serde_json::to_string(body).map_err(|e| e.to_string())?;
+    reach.call(call, token, Some(body))
+}
+
+pub fn run(reach: &Reach, token: Option<&str>, command: CtlCommand) -> u8 {
+    let base = reach.place();
     let result = match command {
         CtlCommand::State { json } => {
-            let got = get(&format!("{base}/api/state"), token);
+            let got = reach.call("state", token, None);
             match (&got, json) {
                 (Ok((200, body)), false) => match serde_json::from_str::<OperatorState>(body) {
                     Ok(state) => {
@@ -79,7 +126,23 @@ pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
                 _ => got,
             }
         }
-        CtlCommand::Events => return events(base, token),
+        CtlCommand::Events => {
+            return match reach {
+                Reach::Http(base) => events(base, token),
+                Reach::Zenoh(client, _) => {
+                    match client.events(|line| {
+                        outln!("{line}");
+                        !crate::out::closed()
+                    }) {
+                        Ok(()) => 0,
+                        Err(why) => {
+                            eprintln!("aviary: {why}");
+                            2
+                        }
+                    }
+                }
+            }
+        }
         CtlCommand::Leash { activity, action, args } => {
             let mut named = std::collections::BTreeMap::new();
             for a in &args {
@@ -100,7 +163,7 @@ pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
                 action,
                 args,
             };
-            post(base, "leash", token, &request)
+            control(reach, "leash", token, &request)
         }
         CtlCommand::Signal { name, values } => {
             let mut args = Vec::new();
@@ -110,14 +173,14 @@ pub fn run(url: &str, token: Option<&str>, command: CtlCommand) -> u8 {
                     Err(why) => return refuse_value(v, &why),
                 }
             }
-            post(base, "signal", token, &SignalRequest { name, args: Some(args) })
+            control(reach, "signal", token, &SignalRequest { name, args: Some(args) })
         }
         CtlCommand::Drone { name, action } => {
-            post(base, "drone", token, &DroneRequest { drone: name, action: action.verb() })
+            control(reach, "drone", token, &DroneRequest { drone: name, action: action.verb() })
         }
-        CtlCommand::Pause => post(base, "pause", token, &NoBody {}),
-        CtlCommand::Resume => post(base, "resume", token, &NoBody {}),
-        CtlCommand::Abort => post(base, "abort", token, &NoBody {}),
+        CtlCommand::Pause => control(reach, "pause", token, &NoBody {}),
+        CtlCommand::Resume => control(reach, "resume", token, &NoBody {}),
+        CtlCommand::Abort => control(reach, "abort", token, &NoBody {}),
     };
     match result {
         Ok((200, body)) => {
@@ -164,9 +227,8 @@ fn post(
     base: &str,
     call: &str,
     token: Option<&str>,
-    body: &impl serde::Serialize,
+    body: String,
 ) -> Result<(u16, String), String> {
-    let body = serde_json::to_string(body).map_err(|e| e.to_string())?;
     let mut request =
         agent().post(format!("{base}/api/{call}")).header("Content-Type", "application/json");
     if let Some(token) = token {

@@ -227,11 +227,23 @@ enum Command {
     /// Talk to a running mission's operator API (see `aviary run --serve`)
     Ctl {
         /// The API's address, as the run printed it
-        #[arg(long, env = "AVIARY_URL")]
-        url: String,
+        #[arg(
+            long,
+            env = "AVIARY_URL",
+            required_unless_present = "zenoh",
+            conflicts_with = "zenoh"
+        )]
+        url: Option<String>,
         /// The run's token (needed for control calls)
         #[arg(long, env = "AVIARY_TOKEN")]
         token: Option<String>,
+        /// Reach a run on Zenoh (`aviary run --zenoh`) instead, with Zenoh's JSON5
+        /// configuration file CONFIG or Zenoh's defaults (docs/DISTRIBUTED.md)
+        #[arg(long, value_name = "CONFIG", num_args = 0..=1, requires = "zenoh_prefix")]
+        zenoh: Option<Option<PathBuf>>,
+        /// With --zenoh: the run's key prefix, as it printed it (aviary/MISSION)
+        #[arg(long, value_name = "KEY", requires = "zenoh")]
+        zenoh_prefix: Option<String>,
         #[command(subcommand)]
         command: ctl::CtlCommand,
     },
@@ -426,7 +438,27 @@ fn command(cli: Cli) -> u8 {
         Command::ExportPlan { mission, world, drone, output, use_root } => {
             export_plan::run(&mission, world.as_deref(), &drone, &output, &use_root)
         }
-        Command::Ctl { url, token, command } => ctl::run(&url, token.as_deref(), command),
+        Command::Ctl { url, token, zenoh, zenoh_prefix, command } => {
+            let reach = match (url, zenoh, zenoh_prefix) {
+                (Some(url), _, _) => Ok(ctl::Reach::Http(url.trim_end_matches('/').to_string())),
+                (None, Some(config), Some(prefix)) => {
+                    aviary_zenoh::Keys::new(&prefix).and_then(|keys| {
+                        let config = aviary_zenoh::config(config.as_deref())?;
+                        let client = aviary_zenoh::Client::open(config, keys.clone())?;
+                        Ok(ctl::Reach::Zenoh(client, keys.prefix().to_string()))
+                    })
+                }
+                _ => Err("say where the run is: --url URL, or --zenoh [CONFIG] --zenoh-prefix KEY"
+                    .into()),
+            };
+            match reach {
+                Ok(reach) => ctl::run(&reach, token.as_deref(), command),
+                Err(why) => {
+                    eprintln!("aviary: {why}");
+                    2
+                }
+            }
+        }
         Command::Vehicles { world, listen, speed, signing_key, autopilot } => {
             vehicles::run(&vehicles::VehiclesArgs {
                 world: &world,

@@ -8,7 +8,7 @@
 mod common;
 
 use std::io::{BufRead, BufReader, Read};
-use std::process::{Command, Stdio};
+use std::process::{Child, ChildStderr, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use common::{scratch, wait_at_most};
@@ -30,6 +30,34 @@ fn peer(endpoints: &str, port: u16) -> String {
         r#"{{ mode: "peer", {endpoints}: {{ endpoints: ["tcp/127.0.0.1:{port}"] }},
             scouting: {{ multicast: {{ enabled: false }}, gossip: {{ enabled: false }} }} }}"#
     )
+}
+
+/// `aviary run --zenoh` of the test's mission in `dir`, at 10 times real time, with the
+/// Zenoh configuration `config` and the key prefix `prefix`, its trace in `t.jsonl`: the
+/// process, its standard error after the first line, and the token that line gives.
+fn on_zenoh(
+    dir: &std::path::Path,
+    config: &str,
+    prefix: &str,
+) -> (Child, BufReader<ChildStderr>, String) {
+    std::fs::write(dir.join("m.mission"), MISSION).unwrap();
+    std::fs::write(dir.join("m.world.toml"), WORLD).unwrap();
+    std::fs::write(dir.join("zenoh.json5"), config).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(["run", "m.mission", "--zenoh", "zenoh.json5", "--zenoh-prefix", prefix])
+        .args(["--speed", "10", "--quiet", "--trace", "t.jsonl"])
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    stderr.read_line(&mut line).unwrap();
+    // aviary: on Zenoh under PREFIX/: events, ...; operator API PREFIX/api/CALL  token TOKEN
+    assert!(line.contains(&format!("on Zenoh under {prefix}/")), "{line}");
+    let token = line.split_whitespace().last().expect("token").to_string();
+    (child, stderr, token)
 }
 
 fn get(
@@ -59,24 +87,8 @@ fn get(
 #[test]
 fn a_peer_watches_and_steers_a_run_on_zenoh() {
     let dir = scratch("zenoh_run");
-    std::fs::write(dir.join("m.mission"), MISSION).unwrap();
-    std::fs::write(dir.join("m.world.toml"), WORLD).unwrap();
     let port = free_port();
-    std::fs::write(dir.join("zenoh.json5"), peer("listen", port)).unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
-        .args(["run", "m.mission", "--zenoh", "zenoh.json5", "--zenoh-prefix", "test/ops"])
-        .args(["--speed", "10", "--quiet", "--trace", "t.jsonl"])
-        .current_dir(&dir)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn");
-    let mut stderr = BufReader::new(child.stderr.take().unwrap());
-    let mut line = String::new();
-    stderr.read_line(&mut line).unwrap();
-    // aviary: on Zenoh under test/ops/: events, ...; operator API test/ops/api/CALL  token TOKEN
-    assert!(line.contains("on Zenoh under test/ops/"), "{line}");
-    let token = line.split_whitespace().last().expect("token").to_string();
+    let (mut child, mut stderr, token) = on_zenoh(&dir, &peer("listen", port), "test/ops");
 
     let config = zenoh::Config::from_json5(&peer("connect", port)).unwrap();
     let session = zenoh::open(config).wait().expect("the test's peer opens");
@@ -254,8 +266,6 @@ fn certificates(dir: &std::path::Path) -> (String, String, String) {
 #[test]
 fn over_tls_only_a_peer_that_trusts_the_certificate_joins() {
     let dir = scratch("zenoh_tls");
-    std::fs::write(dir.join("m.mission"), MISSION).unwrap();
-    std::fs::write(dir.join("m.world.toml"), WORLD).unwrap();
     let (ca, cert, key) = certificates(&dir);
     let port = free_port();
     let no_scouting = "scouting: { multicast: { enabled: false }, gossip: { enabled: false } }";
@@ -263,19 +273,7 @@ fn over_tls_only_a_peer_that_trusts_the_certificate_joins() {
         r#"{{ mode: "peer", listen: {{ endpoints: ["tls/localhost:{port}"] }}, {no_scouting},
             transport: {{ link: {{ tls: {{ listen_certificate: "{cert}", listen_private_key: "{key}" }} }} }} }}"#
     );
-    std::fs::write(dir.join("zenoh.json5"), listen).unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
-        .args(["run", "m.mission", "--zenoh", "zenoh.json5", "--zenoh-prefix", "tls/ops"])
-        .args(["--speed", "10", "--quiet"])
-        .current_dir(&dir)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn");
-    let mut stderr = BufReader::new(child.stderr.take().unwrap());
-    let mut line = String::new();
-    stderr.read_line(&mut line).unwrap();
-    assert!(line.contains("on Zenoh under tls/ops/"), "{line}");
+    let (mut child, _stderr, _) = on_zenoh(&dir, &listen, "tls/ops");
 
     let client = |ca: Option<&str>| {
         let tls = ca.map_or(String::new(), |ca| {
@@ -300,4 +298,50 @@ fn over_tls_only_a_peer_that_trusts_the_certificate_joins() {
     assert!(sample.payload().try_to_string().unwrap().contains(r#""event":"telemetry""#));
     session.close().wait().unwrap();
     assert_eq!(wait_at_most(&mut child, Duration::from_secs(30), "the run"), 0);
+}
+
+/// `aviary ctl --zenoh` reads and steers a run on Zenoh as `--url` does over HTTP: the
+/// state's table, a refusal without the token (exit 1, with the status), a pause and a
+/// resume, and the events until the mission ends.
+#[test]
+fn ctl_steers_a_run_on_zenoh_as_it_does_over_http() {
+    let dir = scratch("zenoh_ctl");
+    let port = free_port();
+    let (mut child, _stderr, token) = on_zenoh(&dir, &peer("listen", port), "ctl/ops");
+    std::fs::write(dir.join("client.json5"), peer("connect", port)).unwrap();
+    let ctl = |args: &[&str]| {
+        let mut all = vec!["ctl", "--zenoh", "client.json5", "--zenoh-prefix", "ctl/ops"];
+        all.extend(args);
+        common::aviary(&all, &dir)
+    };
+    let events = {
+        let dir = dir.clone();
+        std::thread::spawn(move || {
+            common::aviary(
+                &["ctl", "--zenoh", "client.json5", "--zenoh-prefix", "ctl/ops", "events"],
+                &dir,
+            )
+        })
+    };
+    // The stream's session joins before the pause is asked.
+    std::thread::sleep(Duration::from_secs(1));
+    let (code, table, err) = ctl(&["state"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(table.starts_with("mission "), "{table}");
+    let (code, _, err) = ctl(&["pause"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("refused (401)"), "{err}");
+    assert_eq!(ctl(&["--token", &token, "pause"]).0, 0);
+    std::thread::sleep(Duration::from_millis(500));
+    assert_eq!(ctl(&["--token", &token, "resume"]).0, 0);
+    assert_eq!(wait_at_most(&mut child, Duration::from_secs(60), "the run"), 0);
+    let (code, streamed, err) = events.join().unwrap();
+    assert_eq!(code, 0, "{err}");
+    assert!(streamed.lines().any(|l| l.contains(r#""event":"operator","action":"pause""#)));
+    assert!(streamed.lines().last().is_some_and(|l| l.contains(r#""event":"mission_end""#)));
+    // Without a prefix, or with one that is no key, ctl says what to write.
+    let (code, _, err) =
+        common::aviary(&["ctl", "--zenoh", "--zenoh-prefix", "a/*", "state"], &dir);
+    assert_eq!(code, 2);
+    assert!(err.contains("cannot be a Zenoh key prefix"), "{err}");
 }

@@ -14,10 +14,12 @@
 //! - Without `--zenoh` nothing here runs and no socket is opened.
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
+mod client;
 mod keys;
 mod publish;
 mod queries;
 
+pub use client::Client;
 pub use keys::Keys;
 
 use std::net::SocketAddr;

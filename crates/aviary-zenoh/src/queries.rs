@@ -93,6 +93,7 @@ async fn answer(
 
 fn reply(query: &Query, status: StatusCode, body: Vec<u8>) {
     let key = query.key_expr().clone();
+    let body = if status.is_success() { body } else { with_status(body, status) };
     let sent = if status.is_success() {
         query.reply(key.clone(), body).encoding(Encoding::APPLICATION_JSON).wait()
     } else {
@@ -114,4 +115,45 @@ fn reply(query: &Query, status: StatusCode, body: Vec<u8>) {
 
 fn error(why: &str) -> Vec<u8> {
     serde_json::to_vec(&serde_json::json!({ "error": why })).unwrap_or_default()
+}
+
+/// An error's JSON with the HTTP status it stands for (`{"error": ..., "status": 401}`):
+/// a Zenoh error reply has no status of its own.
+fn with_status(body: Vec<u8>, status: StatusCode) -> Vec<u8> {
+    let mut error = match serde_json::from_slice::<serde_json::Value>(&body) {
+        Ok(serde_json::Value::Object(error)) => error,
+        _ => {
+            let mut error = serde_json::Map::new();
+            error.insert("error".into(), String::from_utf8_lossy(&body).into_owned().into());
+            error
+        }
+    };
+    error.insert("status".into(), status.as_u16().into());
+    serde_json::to_vec(&error).unwrap_or(body)
+}
+
+/// The status an error reply carries ([`with_status`]); 500 when it carries none.
+pub(crate) fn status_of(body: &str) -> u16 {
+    serde_json::from_str::<serde_json::Value>(body)
+        .ok()
+        .and_then(|v| v["status"].as_u64())
+        .and_then(|s| u16::try_from(s).ok())
+        .unwrap_or(500)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_error_reply_carries_its_status_beside_the_reason() {
+        let body = with_status(br#"{"error":"no token"}"#.to_vec(), StatusCode::UNAUTHORIZED);
+        let text = String::from_utf8(body).unwrap();
+        assert_eq!(text, r#"{"error":"no token","status":401}"#);
+        assert_eq!(status_of(&text), 401);
+        let body = with_status(b"not json".to_vec(), StatusCode::BAD_REQUEST);
+        let text = String::from_utf8(body).unwrap();
+        assert_eq!(text, r#"{"error":"not json","status":400}"#);
+        assert_eq!(status_of("{}"), 500);
+    }
 }

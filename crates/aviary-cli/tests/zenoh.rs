@@ -344,4 +344,9 @@ fn ctl_steers_a_run_on_zenoh_as_it_does_over_http() {
         common::aviary(&["ctl", "--zenoh", "--zenoh-prefix", "a/*", "state"], &dir);
     assert_eq!(code, 2);
     assert!(err.contains("cannot be a Zenoh key prefix"), "{err}");
+    // A configuration that is not there: said with its name, before anything flies.
+    let (code, _, err) = common::aviary(&["run", "m.mission", "--zenoh", "nope.json5"], &dir);
+    assert_eq!(code, 2);
+    assert!(err.contains("cannot read the Zenoh configuration nope.json5: No such file"), "{err}");
+    assert!(!err.contains(".rs:"), "no source location of Zenoh's: {err}");
 }

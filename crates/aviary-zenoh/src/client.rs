@@ -18,8 +18,9 @@ pub struct Client {
 
 impl Client {
     pub fn open(config: zenoh::Config, keys: Keys) -> Result<Client, String> {
-        let session =
-            zenoh::open(config).wait().map_err(|e| format!("cannot open a Zenoh session: {e}"))?;
+        let session = zenoh::open(config)
+            .wait()
+            .map_err(|e| format!("cannot open a Zenoh session: {}", crate::reason(&e)))?;
         Ok(Client { session, keys })
     }
 
@@ -40,7 +41,7 @@ impl Client {
         if let Some(token) = token {
             get = get.attachment(token.to_string());
         }
-        let replies = get.wait().map_err(|e| format!("cannot ask {key}: {e}"))?;
+        let replies = get.wait().map_err(|e| format!("cannot ask {key}: {}", crate::reason(&e)))?;
         let reply = replies
             .recv()
             .map_err(|_| format!("no run answered on {key} within {ANSWER_WITHIN:?}"))?;
@@ -61,7 +62,7 @@ impl Client {
             .session
             .declare_subscriber(&all)
             .wait()
-            .map_err(|e| format!("cannot subscribe to {all}: {e}"))?;
+            .map_err(|e| format!("cannot subscribe to {all}: {}", crate::reason(&e)))?;
         let events = self.keys.events();
         let telemetry = self.keys.telemetry("");
         while let Ok(sample) = heard.recv() {

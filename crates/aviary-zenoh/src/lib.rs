@@ -35,7 +35,13 @@ use zenoh::Wait;
 pub fn config(file: Option<&Path>) -> Result<zenoh::Config, String> {
     match file {
         Some(path) => zenoh::Config::from_file(path)
-            .map_err(|e| format!("cannot read the Zenoh configuration {}: {e}", path.display())),
+            .map_err(|e| {
+                format!(
+                    "cannot read the Zenoh configuration {}: {} (Zenoh's JSON5 format: https://zenoh.io/docs/manual/configuration/)",
+                    path.display(),
+                    reason(&e)
+                )
+            }),
         None => Ok(zenoh::Config::default()),
     }
 }
@@ -59,8 +65,9 @@ impl Bridge {
     /// Opens the session and starts publishing what `api.feed` carries and answering
     /// queries under `keys`. Call before the run's first event.
     pub fn start(config: zenoh::Config, keys: Keys, api: Api) -> Result<Bridge, String> {
-        let session =
-            zenoh::open(config).wait().map_err(|e| format!("cannot open a Zenoh session: {e}"))?;
+        let session = zenoh::open(config)
+            .wait()
+            .map_err(|e| format!("cannot open a Zenoh session: {}", reason(&e)))?;
         let lines = api.feed.subscribe();
         let publisher = publish::start(session.clone(), keys.clone(), lines, api.feed.clone())?;
         queries::start(session.clone(), keys.clone(), api.router, api.bound)?;
@@ -85,5 +92,33 @@ impl Bridge {
         if let Err(e) = self.session.close().wait() {
             eprintln!("aviary: zenoh: the session did not close cleanly: {e}");
         }
+    }
+}
+
+/// A Zenoh error's reason, without the source location Zenoh appends
+/// (` at /.../zenoh-config-1.10.2/src/lib.rs:1507.`), which says nothing to an operator.
+pub(crate) fn reason(e: &dyn std::fmt::Display) -> String {
+    let text = e.to_string();
+    match text.rfind(" at ") {
+        Some(i)
+            if text[i..].trim_end_matches('.').rsplit_once(':').is_some_and(|(path, line)| {
+                path.ends_with(".rs")
+                    && !line.is_empty()
+                    && line.bytes().all(|b| b.is_ascii_digit())
+            }) =>
+        {
+            text[..i].to_string()
+        }
+        _ => text,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_zenoh_error_is_said_without_its_source_location() {
+        let e = "No such file or directory (os error 2) at /root/.cargo/registry/src/x/zenoh-config-1.10.2/src/lib.rs:1507.";
+        assert_eq!(super::reason(&e), "No such file or directory (os error 2)");
+        assert_eq!(super::reason(&"meet at noon"), "meet at noon");
     }
 }

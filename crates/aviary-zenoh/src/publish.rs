@@ -28,7 +28,7 @@ pub(crate) fn start(
             .declare_publisher(key.clone())
             .encoding(Encoding::APPLICATION_JSON)
             .wait()
-            .map_err(|e| format!("cannot publish on {key}: {e}"))
+            .map_err(|e| format!("cannot publish on {key}: {}", crate::reason(&e)))
     };
     let events = declare(keys.events())?;
     let state = declare(keys.state())?;

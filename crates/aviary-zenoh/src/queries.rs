@@ -30,7 +30,7 @@ pub(crate) fn start(
     let queryable = session
         .declare_queryable(keys.api())
         .wait()
-        .map_err(|e| format!("cannot answer on {}: {e}", keys.api()))?;
+        .map_err(|e| format!("cannot answer on {}: {}", keys.api(), crate::reason(&e)))?;
     let runtime = tokio::runtime::Builder::new_current_thread()
         .build()
         .map_err(|e| format!("cannot start the Zenoh queryables: {e}"))?;

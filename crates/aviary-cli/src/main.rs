@@ -226,13 +226,9 @@ enum Command {
     },
     /// Talk to a running mission's operator API (see `aviary run --serve`)
     Ctl {
-        /// The API's address, as the run printed it
-        #[arg(
-            long,
-            env = "AVIARY_URL",
-            required_unless_present = "zenoh",
-            conflicts_with = "zenoh"
-        )]
+        /// The API's address, as the run printed it (not needed with --zenoh, which wins
+        /// over an AVIARY_URL of the environment)
+        #[arg(long, env = "AVIARY_URL", required_unless_present = "zenoh")]
         url: Option<String>,
         /// The run's token (needed for control calls)
         #[arg(long, env = "AVIARY_TOKEN")]
@@ -440,14 +436,14 @@ fn command(cli: Cli) -> u8 {
         }
         Command::Ctl { url, token, zenoh, zenoh_prefix, command } => {
             let reach = match (url, zenoh, zenoh_prefix) {
-                (Some(url), _, _) => Ok(ctl::Reach::Http(url.trim_end_matches('/').to_string())),
-                (None, Some(config), Some(prefix)) => {
+                (_, Some(config), Some(prefix)) => {
                     aviary_zenoh::Keys::new(&prefix).and_then(|keys| {
                         let config = aviary_zenoh::config(config.as_deref())?;
                         let client = aviary_zenoh::Client::open(config, keys.clone())?;
                         Ok(ctl::Reach::Zenoh(client, keys.prefix().to_string()))
                     })
                 }
+                (Some(url), None, _) => Ok(ctl::Reach::Http(url.trim_end_matches('/').to_string())),
                 _ => Err("say where the run is: --url URL, or --zenoh [CONFIG] --zenoh-prefix KEY"
                     .into()),
             };

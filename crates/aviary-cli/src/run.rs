@@ -40,7 +40,6 @@ pub struct RunArgs {
     pub clock: aviary_pipeline::pipeline::LiveClock,
 }
 
-/// `7878` is loopback port 7878; `HOST:PORT` binds exactly that.
 /// `--zenoh [CONFIG]` and `--zenoh-prefix KEY`.
 pub struct Zenoh {
     /// Zenoh's JSON5 configuration file; Zenoh's defaults without one.
@@ -49,6 +48,7 @@ pub struct Zenoh {
     pub keys: Option<aviary_zenoh::Keys>,
 }
 
+/// `7878` is loopback port 7878; `HOST:PORT` binds exactly that.
 pub fn parse_serve(text: &str) -> Result<std::net::SocketAddr, String> {
     if let Ok(port) = text.parse::<u16>() {
         return Ok(std::net::SocketAddr::from(([127, 0, 0, 1], port)));

@@ -309,10 +309,17 @@ fn ctl_steers_a_run_on_zenoh_as_it_does_over_http() {
     let port = free_port();
     let (mut child, _stderr, token) = on_zenoh(&dir, &peer("listen", port), "ctl/ops");
     std::fs::write(dir.join("client.json5"), peer("connect", port)).unwrap();
+    // An AVIARY_URL in the environment does not stand in the way of --zenoh.
     let ctl = |args: &[&str]| {
-        let mut all = vec!["ctl", "--zenoh", "client.json5", "--zenoh-prefix", "ctl/ops"];
-        all.extend(args);
-        common::aviary(&all, &dir)
+        let out = Command::new(env!("CARGO_BIN_EXE_aviary"))
+            .args(["ctl", "--zenoh", "client.json5", "--zenoh-prefix", "ctl/ops"])
+            .args(args)
+            .env("AVIARY_URL", "http://127.0.0.1:9")
+            .current_dir(&dir)
+            .output()
+            .expect("run aviary ctl");
+        let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+        (out.status.code().unwrap_or(-1), text(&out.stdout), text(&out.stderr))
     };
     let events = {
         let dir = dir.clone();

@@ -172,8 +172,8 @@ fn sweep(e: &mut Estimator, d: DroneId, path: &[[f64; 2]], t: f64, raises: &mut 
 }
 
 /// `FollowPath`: a transit to each point that is known before the flight, at the speed
-/// asked for (at most the drone's). A point known only in flight is the worst case
-/// ([`Estimator::position_arg`]).
+/// asked for (at most the drone's; one the flight refuses flies nothing, as there). A
+/// point known only in flight is the worst case ([`Estimator::position_arg`]).
 fn follow_path(
     e: &mut Estimator,
     d: DroneId,
@@ -183,8 +183,10 @@ fn follow_path(
     t: f64,
     raises: &mut Vec<Raise>,
 ) -> f64 {
+    // A speed the flight refuses (not above 0 m/s) fails the call there: no flight here.
+    let Ok(speed) = aviary_api::coverage::follow_speed(speed) else { return 0.0 };
     let max = e.s.drones[d].max_speed;
-    let speed = speed.filter(|s| *s > 0.0).map_or(max, |s| s.min(max));
+    let speed = speed.map_or(max, |s| s.min(max));
     let mut took = 0.0;
     for point in points {
         // A line of the world file (or what a FollowPath left) stands for its points.

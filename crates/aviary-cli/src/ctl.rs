@@ -65,8 +65,8 @@ impl DroneCtl {
 pub enum Reach {
     /// `--url`: the HTTP server's address.
     Http(String),
-    /// `--zenoh`: a run on Zenoh, under its key prefix.
-    Zenoh(aviary_zenoh::Client, String),
+    /// `--zenoh`: a run on Zenoh.
+    Zenoh(aviary_zenoh::Client),
 }
 
 impl Reach {
@@ -83,7 +83,7 @@ impl Reach {
                 None => get(&format!("{base}/api/{call}"), token),
                 Some(body) => post(base, call, token, body),
             },
-            Reach::Zenoh(client, _) => client.call(call, body, token),
+            Reach::Zenoh(client) => client.call(call, body, token),
         }
     }
 
@@ -91,7 +91,7 @@ impl Reach {
     fn place(&self) -> String {
         match self {
             Reach::Http(base) => base.clone(),
-            Reach::Zenoh(_, prefix) => format!("{prefix}/api on Zenoh"),
+            Reach::Zenoh(client) => format!("{} on Zenoh", client.keys().api()),
         }
     }
 }
@@ -129,7 +129,7 @@ pub fn run(reach: &Reach, token: Option<&str>, command: CtlCommand) -> u8 {
         CtlCommand::Events => {
             return match reach {
                 Reach::Http(base) => events(base, token),
-                Reach::Zenoh(client, _) => {
+                Reach::Zenoh(client) => {
                     match client.events(|line| {
                         outln!("{line}");
                         !crate::out::closed()

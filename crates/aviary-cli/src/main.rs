@@ -439,8 +439,7 @@ fn command(cli: Cli) -> u8 {
                 (_, Some(config), Some(prefix)) => {
                     aviary_zenoh::Keys::new(&prefix).and_then(|keys| {
                         let config = aviary_zenoh::config(config.as_deref())?;
-                        let client = aviary_zenoh::Client::open(config, keys.clone())?;
-                        Ok(ctl::Reach::Zenoh(client, keys.prefix().to_string()))
+                        Ok(ctl::Reach::Zenoh(aviary_zenoh::Client::open(config, keys)?))
                     })
                 }
                 (Some(url), None, _) => Ok(ctl::Reach::Http(url.trim_end_matches('/').to_string())),

@@ -35,8 +35,8 @@ pub fn start(
         allowed_hosts: Vec::new(),
     };
     let (router, feed) = aviary_server::router(bound, token.clone(), controller, options);
+    let prefix = keys.prefix().to_string();
     let bridge = Bridge::start(config, keys, Api { router, bound, feed: feed.clone() })?;
-    let prefix = bridge.keys().prefix().to_string();
     use std::io::Write;
     let _ = writeln!(
         std::io::stderr(),

@@ -17,6 +17,11 @@ pub struct Client {
 }
 
 impl Client {
+    /// The run's keys.
+    pub fn keys(&self) -> &Keys {
+        &self.keys
+    }
+
     pub fn open(config: zenoh::Config, keys: Keys) -> Result<Client, String> {
         let session = zenoh::open(config)
             .wait()
@@ -33,7 +38,7 @@ impl Client {
         body: Option<String>,
         token: Option<&str>,
     ) -> Result<(u16, String), String> {
-        let key = format!("{}/api/{call}", self.keys.prefix());
+        let key = self.keys.call(call);
         let mut get = self.session.get(&key).timeout(ANSWER_WITHIN);
         if let Some(body) = body {
             get = get.payload(body);

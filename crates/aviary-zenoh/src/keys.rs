@@ -63,11 +63,16 @@ impl Keys {
 
     /// The queryables of the operator API: `PREFIX/api/*`.
     pub fn api(&self) -> String {
-        format!("{}/api/*", self.prefix)
+        self.call("*")
+    }
+
+    /// The key of one call of the operator API: `PREFIX/api/CALL`.
+    pub fn call(&self, call: &str) -> String {
+        format!("{}/api/{call}", self.prefix)
     }
 
     /// The call a query's key names (`PREFIX/api/pause` → `pause`), if it is one.
-    pub fn call<'a>(&self, key: &'a str) -> Option<&'a str> {
+    pub fn call_of<'a>(&self, key: &'a str) -> Option<&'a str> {
         let call = key.strip_prefix(&self.prefix)?.strip_prefix("/api/")?;
         CALLS.contains(&call).then_some(call)
     }
@@ -82,9 +87,10 @@ mod tests {
         let keys = Keys::new("field/team_a/").unwrap();
         assert_eq!(keys.events(), "field/team_a/events");
         assert_eq!(keys.telemetry("scout1"), "field/team_a/telemetry/scout1");
-        assert_eq!(keys.call("field/team_a/api/pause"), Some("pause"));
-        assert_eq!(keys.call("field/team_a/api/launch"), None);
-        assert_eq!(keys.call("field/team_b/api/pause"), None);
+        assert_eq!(keys.call("pause"), "field/team_a/api/pause");
+        assert_eq!(keys.call_of("field/team_a/api/pause"), Some("pause"));
+        assert_eq!(keys.call_of("field/team_a/api/launch"), None);
+        assert_eq!(keys.call_of("field/team_b/api/pause"), None);
         for bad in ["a/*", "a/**/b", "a//b", "a?x", "$x", ""] {
             assert!(Keys::new(bad).is_err(), "{bad}");
         }

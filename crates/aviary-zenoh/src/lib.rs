@@ -57,7 +57,6 @@ pub struct Api {
 /// A run on Zenoh, until [`Bridge::finish`].
 pub struct Bridge {
     session: zenoh::Session,
-    keys: Keys,
     publisher: Option<JoinHandle<()>>,
 }
 
@@ -70,13 +69,8 @@ impl Bridge {
             .map_err(|e| format!("cannot open a Zenoh session: {}", reason(&e)))?;
         let lines = api.feed.subscribe();
         let publisher = publish::start(session.clone(), keys.clone(), lines, api.feed.clone())?;
-        queries::start(session.clone(), keys.clone(), api.router, api.bound)?;
-        Ok(Bridge { session, keys, publisher: Some(publisher) })
-    }
-
-    /// The key prefix, for the operator's message.
-    pub fn keys(&self) -> &Keys {
-        &self.keys
+        queries::start(session.clone(), keys, api.router, api.bound)?;
+        Ok(Bridge { session, publisher: Some(publisher) })
     }
 
     /// After `mission_end`: waits (at most `limit`) until the publisher has sent it and

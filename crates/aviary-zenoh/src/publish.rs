@@ -1,7 +1,7 @@
 //! The publisher: each line the run's feed carries, on its key, and the operator state
 //! once a second while events come, and once more at the end.
 
-use std::collections::HashMap;
+use std::collections::hash_map::{Entry, HashMap};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -23,15 +23,8 @@ pub(crate) fn start(
     lines: Receiver<Arc<Line>>,
     feed: Feed,
 ) -> Result<JoinHandle<()>, String> {
-    let declare = |key: String| {
-        session
-            .declare_publisher(key.clone())
-            .encoding(Encoding::APPLICATION_JSON)
-            .wait()
-            .map_err(|e| format!("cannot publish on {key}: {}", crate::reason(&e)))
-    };
-    let events = declare(keys.events())?;
-    let state = declare(keys.state())?;
+    let events = declare(&session, keys.events())?;
+    let state = declare(&session, keys.state())?;
     std::thread::Builder::new()
         .name("aviary zenoh publisher".into())
         .spawn(move || {
@@ -47,6 +40,15 @@ pub(crate) fn start(
             publisher.run(lines)
         })
         .map_err(|e| format!("cannot start the Zenoh publisher: {e}"))
+}
+
+/// A publisher of JSON on `key`.
+fn declare(session: &zenoh::Session, key: String) -> Result<Publisher<'static>, String> {
+    session
+        .declare_publisher(key.clone())
+        .encoding(Encoding::APPLICATION_JSON)
+        .wait()
+        .map_err(|e| format!("cannot publish on {key}: {}", crate::reason(&e)))
 }
 
 struct Publishing {
@@ -87,34 +89,21 @@ impl Publishing {
 
     fn line(&mut self, line: &Line) {
         let text = line.text.as_bytes().to_vec();
-        let sent = match &line.telemetry_of {
-            None => self.events.put(text).wait(),
-            Some(drone) => {
-                if !self.telemetry.contains_key(drone) {
-                    let key = self.keys.telemetry(drone);
-                    match self
-                        .session
-                        .declare_publisher(key.clone())
-                        .encoding(Encoding::APPLICATION_JSON)
-                        .wait()
-                    {
-                        Ok(p) => {
-                            self.telemetry.insert(drone.clone(), p);
-                        }
-                        Err(e) => {
-                            eprintln!("aviary: zenoh: cannot publish on {key}: {e}");
-                            return;
-                        }
+        let publisher = match &line.telemetry_of {
+            None => &self.events,
+            Some(drone) => match self.telemetry.entry(drone.clone()) {
+                Entry::Occupied(known) => known.into_mut(),
+                Entry::Vacant(new) => match declare(&self.session, self.keys.telemetry(drone)) {
+                    Ok(publisher) => new.insert(publisher),
+                    Err(why) => {
+                        eprintln!("aviary: zenoh: {why}");
+                        return;
                     }
-                }
-                match self.telemetry.get(drone) {
-                    Some(p) => p.put(text).wait(),
-                    None => return,
-                }
-            }
+                },
+            },
         };
-        if let Err(e) = sent {
-            eprintln!("aviary: zenoh: an event was not published: {e}");
+        if let Err(e) = publisher.put(text).wait() {
+            eprintln!("aviary: zenoh: an event was not published: {}", crate::reason(&e));
         }
     }
 
@@ -123,7 +112,7 @@ impl Publishing {
         match serde_json::to_vec(&self.feed.document()) {
             Ok(bytes) => {
                 if let Err(e) = self.state.put(bytes).wait() {
-                    eprintln!("aviary: zenoh: the state was not published: {e}");
+                    eprintln!("aviary: zenoh: the state was not published: {}", crate::reason(&e));
                 }
             }
             Err(e) => eprintln!("aviary: zenoh: the state could not be written: {e}"),

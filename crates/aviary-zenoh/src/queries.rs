@@ -54,7 +54,7 @@ async fn answer(
     query: &Query,
 ) -> (StatusCode, Vec<u8>) {
     let key = query.key_expr().as_str();
-    let Some(call) = keys.call(key) else {
+    let Some(call) = keys.call_of(key) else {
         let why = format!("{key} is not a call: the calls are {}", CALLS.join(", "));
         return (StatusCode::NOT_FOUND, error(&why));
     };
@@ -93,10 +93,10 @@ async fn answer(
 
 fn reply(query: &Query, status: StatusCode, body: Vec<u8>) {
     let key = query.key_expr().clone();
-    let body = if status.is_success() { body } else { with_status(body, status) };
     let sent = if status.is_success() {
         query.reply(key.clone(), body).encoding(Encoding::APPLICATION_JSON).wait()
     } else {
+        let body = with_status(body, status);
         eprintln!(
             "aviary: zenoh: {key} refused ({}): {}",
             status.as_u16(),
@@ -109,7 +109,7 @@ fn reply(query: &Query, status: StatusCode, body: Vec<u8>) {
         query.reply_err(body).encoding(Encoding::APPLICATION_JSON).wait()
     };
     if let Err(e) = sent {
-        eprintln!("aviary: zenoh: the answer on {key} was not sent: {e}");
+        eprintln!("aviary: zenoh: the answer on {key} was not sent: {}", crate::reason(&e));
     }
 }
 

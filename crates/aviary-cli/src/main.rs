@@ -261,6 +261,22 @@ enum Command {
         #[arg(long, value_enum, default_value = "ardupilot")]
         autopilot: vehicles::Autopilot,
     },
+    /// Beside an autopilot: hold its MAVLink link and carry it on Zenoh, so that a mission
+    /// on another machine flies it (`mavlink = "agent:NAME"` in its world), until Ctrl-C
+    /// (docs/DISTRIBUTED.md)
+    Agent {
+        /// The agent's name, as the mission's world names it (letters, digits, -, _, .)
+        #[arg(long)]
+        name: String,
+        /// The vehicle's link: tcp:HOST:PORT, udp:HOST:PORT, udpout:HOST:PORT, ... (as a
+        /// world's `mavlink =` address)
+        #[arg(long)]
+        mavlink: String,
+        /// Zenoh's JSON5 configuration file (Zenoh's defaults without one: a peer that
+        /// finds others by multicast scouting)
+        #[arg(long, value_name = "CONFIG")]
+        zenoh: Option<PathBuf>,
+    },
     /// Fly a mission on many seeds of the simulator at once and report how often it
     /// succeeds, how it fails, and the spread of its time, batteries and finds
     /// (docs/CAMPAIGNS.md); `aviary test merge`: the reports of shards as one
@@ -463,6 +479,7 @@ fn command(cli: Cli) -> u8 {
                 autopilot,
             })
         }
+        Command::Agent { name, mavlink, zenoh } => zenoh::agent(&name, &mavlink, zenoh.as_deref()),
         Command::Test(args) => test::run(args),
         Command::Explain { code } => explain(&code),
         Command::Lsp { use_root, stdio: _ } => lsp::run(&use_root),

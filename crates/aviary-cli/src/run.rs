@@ -150,6 +150,14 @@ pub fn run(args: &RunArgs) -> u8 {
         world: Source { name: &world_name, bytes: world_bytes },
         files: &provider,
     };
+    // Opened before the vehicles connect: the world's `agent:NAME` drones are reached on it.
+    let session = match args.zenoh.as_ref().map(crate::zenoh::open).transpose() {
+        Ok(session) => session,
+        Err(why) => {
+            eprintln!("aviary: {why}");
+            return 2;
+        }
+    };
     let options = Options {
         speed: args.speed,
         seed: args.seed,
@@ -161,9 +169,14 @@ pub fn run(args: &RunArgs) -> u8 {
             ..RunOptions::default()
         },
         clock: args.clock,
+        carrier: session.clone().map(|s| {
+            std::sync::Arc::new(aviary_zenoh::Agents::new(s))
+                as std::sync::Arc<dyn aviary_mavlink::Carrier>
+        }),
     };
     let mut shown = Shown {
         args,
+        session,
         trace: None,
         controller: None,
         server: None,
@@ -264,7 +277,9 @@ struct Shown<'a> {
     /// The station serving this run, and where the run's events go.
     server: Option<(aviary_station::Serving, aviary_server::Feed)>,
     feed: Option<aviary_server::Feed>,
-    /// The run on Zenoh (`--zenoh`), and where its events go.
+    /// The run's Zenoh session (`--zenoh`), until the bridge takes it.
+    session: Option<aviary_zenoh::Session>,
+    /// The run on Zenoh, and where its events go.
     zenoh: Option<(aviary_zenoh::Bridge, aviary_server::Feed)>,
     /// The world as the station's map draws it, and where it lets the operator send a
     /// drone, kept from `compiled` for `starting`.
@@ -340,12 +355,18 @@ impl Hooks for Shown<'_> {
             self.feed = Some(feed.clone());
             self.server = Some((serving, feed));
         }
-        if let Some(zenoh) = &self.args.zenoh {
+        if let (Some(zenoh), Some(session)) = (&self.args.zenoh, self.session.take()) {
             let bounds =
                 self.zenoh_bounds.take().ok_or("the run starts before its world was read")?;
             let token = self.server.as_ref().map(|(serving, _)| serving.token.clone());
-            self.zenoh =
-                Some(crate::zenoh::start(zenoh, mission, bounds, controller.clone(), token)?);
+            self.zenoh = Some(crate::zenoh::start(
+                session,
+                zenoh,
+                mission,
+                bounds,
+                controller.clone(),
+                token,
+            )?);
         }
         self.progress = Some(progress_bar(self.args.quiet));
         self.drones = mission.drones.len();

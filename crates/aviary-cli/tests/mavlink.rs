@@ -8,67 +8,16 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use aviary_api::trace::{CallStatus, Event, EventKind, Record, Shown};
 use aviary_api::{Function, Remainder};
 use aviary_test_support::trace::{actor, Trace};
+use common::vehicles::Vehicles;
 use common::{aviary, repo, scratch};
 use serde_json::Value;
-
-/// A running `aviary vehicles`, killed when dropped.
-struct Vehicles {
-    child: Child,
-    port: u16,
-    /// Kept open: the server's later lines must have somewhere to go.
-    _stdout: BufReader<std::process::ChildStdout>,
-}
-
-impl Vehicles {
-    fn start(world: &Path, speed: &str) -> Vehicles {
-        Vehicles::start_as(world, speed, "ardupilot")
-    }
-
-    /// `aviary vehicles --autopilot AUTOPILOT`.
-    fn start_as(world: &Path, speed: &str, autopilot: &str) -> Vehicles {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
-            .args([
-                "vehicles",
-                "--world",
-                &world.to_string_lossy(),
-                "--listen",
-                "tcp:127.0.0.1:0",
-                "--speed",
-                speed,
-                "--autopilot",
-                autopilot,
-            ])
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("spawn aviary vehicles");
-        let mut first = String::new();
-        let mut stdout = BufReader::new(child.stdout.take().expect("stdout"));
-        stdout.read_line(&mut first).expect("read the first line");
-        let port = first
-            .trim()
-            .rsplit(':')
-            .next()
-            .and_then(|p| p.parse().ok())
-            .unwrap_or_else(|| panic!("no port in {first:?}"));
-        Vehicles { child, port, _stdout: stdout }
-    }
-}
-
-impl Drop for Vehicles {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
 
 /// The world with `mavlink = "tcp:127.0.0.1:PORT"` given to the drones named.
 fn bind(world: &str, port: u16, drones: &[&str]) -> String {

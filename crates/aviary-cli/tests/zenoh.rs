@@ -11,7 +11,7 @@ use std::io::{BufRead, BufReader, Read};
 use std::process::{Child, ChildStderr, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::{scratch, wait_at_most};
+use common::{free_port, scratch, wait_at_most};
 use zenoh::Wait;
 
 const WORLD: &str =
@@ -19,17 +19,10 @@ const WORLD: &str =
 const MISSION: &str =
     "MISSION M:\n    PARALLEL:\n        a FlyTo-F1 WITH Far\n        b Hover WITH 40s\n";
 
-fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
-}
-
 /// A peer that finds no one by scouting: it listens or connects where it is told, and no
 /// other test's Zenoh session on this machine can join it.
 fn peer(endpoints: &str, port: u16) -> String {
-    format!(
-        r#"{{ mode: "peer", {endpoints}: {{ endpoints: ["tcp/127.0.0.1:{port}"] }},
-            scouting: {{ multicast: {{ enabled: false }}, gossip: {{ enabled: false }} }} }}"#
-    )
+    common::zenoh_peer(endpoints, &format!("tcp/127.0.0.1:{port}"))
 }
 
 /// `aviary run --zenoh` of the test's mission in `dir`, at 10 times real time, with the

@@ -13,6 +13,7 @@ use aviary_world::{Drone, World};
 use mavlink::dialects::ardupilotmega::MavCmd;
 use tokio::sync::mpsc;
 
+use crate::carried::Carrier;
 use crate::drone::{Craft, Doing};
 use crate::facts::{self, Facts};
 use crate::vehicle::Vehicle;
@@ -20,13 +21,23 @@ use crate::{battery, bindings, link, link_keys, signing_key, MavlinkBackend, Ori
 
 /// Connects to every MAVLink drone of `world`, and flies each with its vehicle's facts
 /// ([`MavlinkBackend::facts`]). Errors are sentences for the operator: an unreachable
-/// address, a vehicle that never sends HEARTBEAT, two drones on one system id.
+/// address, a vehicle that never sends HEARTBEAT, two drones on one system id. An
+/// `agent:NAME` address is one of them here: it needs [`connect_through`] a carrier.
 pub async fn connect(world: &World, tuning: Tuning) -> Result<MavlinkBackend, String> {
+    connect_through(world, tuning, None).await
+}
+
+/// [`connect`], with the world's `agent:NAME` addresses reached through `carrier`.
+pub async fn connect_through(
+    world: &World,
+    tuning: Tuning,
+    carrier: Option<&dyn Carrier>,
+) -> Result<MavlinkBackend, String> {
     let bound = bindings(world);
     let origin = origin(world)?;
     let mut links = BTreeMap::new();
     for (address, key) in link_keys(world, &bound)? {
-        let link = link::Link::open(&address, key.as_deref().map(signing_key)).await?;
+        let link = link::Link::open(&address, key.as_deref().map(signing_key), carrier).await?;
         links.insert(address, link);
     }
     let (events_tx, events_rx) = mpsc::unbounded_channel();

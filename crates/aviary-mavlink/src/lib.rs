@@ -23,6 +23,7 @@
 
 mod backend;
 pub mod battery;
+pub mod carried;
 pub mod clock;
 mod connect;
 mod drone;
@@ -47,7 +48,8 @@ use sha2::{Digest, Sha256};
 
 pub use aviary_api::geo::Origin;
 pub use backend::MavlinkBackend;
-pub use connect::connect;
+pub use carried::{Carrier, Frames};
+pub use connect::{connect, connect_through};
 pub use facts::Facts;
 pub use mavlink;
 

@@ -1,6 +1,8 @@
 //! One MAVLink connection (one `mavlink =` address of the world), shared by every vehicle
 //! on it: messages are routed to vehicles by system id. A lost TCP connection is opened
-//! again every second, so a link that comes back is noticed (`ConnectionRestored`).
+//! again every second, so a link that comes back is noticed (`ConnectionRestored`). An
+//! `agent:NAME` address is carried ([`crate::carried`]): its frames come and go through
+//! the run's carrier, and a silent agent is a silent link, watched as any other.
 
 use parking_lot::Mutex;
 use std::collections::BTreeMap;
@@ -14,9 +16,30 @@ use mavlink::dialects::ardupilotmega::{
 use mavlink::error::MessageReadError;
 use mavlink::{AsyncMavConnection, MavHeader};
 
+use crate::carried::{agent_of, CarriedConn, Carrier};
 use crate::vehicle::Vehicle;
 
-type Conn = mavlink::AsyncConnection<MavMessage>;
+/// A link's connection: a socket's, or an agent's frames.
+enum Conn {
+    Socket(mavlink::AsyncConnection<MavMessage>),
+    Carried(CarriedConn),
+}
+
+impl Conn {
+    async fn recv(&self) -> Result<(MavHeader, MavMessage), MessageReadError> {
+        match self {
+            Conn::Socket(c) => c.recv().await,
+            Conn::Carried(c) => c.recv().await,
+        }
+    }
+
+    async fn send(&self, header: &MavHeader, msg: &MavMessage) {
+        let _ = match self {
+            Conn::Socket(c) => c.send(header, msg).await,
+            Conn::Carried(c) => c.send(header, msg),
+        };
+    }
+}
 
 /// The ground station's ids: 255 is the usual GCS system, 190 MAV_COMP_ID_MISSIONPLANNER.
 pub const GCS_SYSTEM: u8 = 255;
@@ -40,6 +63,11 @@ pub fn crate_address(address: &str) -> Result<String, String> {
         "udp" | "udpin" => "udpin",
         "udpout" => "udpout",
         "udpbcast" => "udpbcast",
+        "agent" => {
+            return Err(format!(
+                "`{address}` is reached through an agent on Zenoh: run the mission with `--zenoh [CONFIG]` (docs/DISTRIBUTED.md)"
+            ))
+        }
         "serial" => {
             return Err(format!(
                 "`{address}`: serial links are not built in (the serial transport needs libudev); \
@@ -54,7 +82,8 @@ pub fn crate_address(address: &str) -> Result<String, String> {
 pub struct Link {
     /// As the world wrote it, for messages.
     pub address: String,
-    target: String,
+    /// The mavlink crate's address; `None` for an agent's, which is not opened again.
+    target: Option<String>,
     conn: Mutex<Option<Arc<Conn>>>,
     vehicles: Mutex<BTreeMap<u8, Arc<Vehicle>>>,
     signing: Option<[u8; 32]>,
@@ -63,9 +92,17 @@ pub struct Link {
 
 impl Link {
     /// Opens the connection (an unreachable address is an error, said plainly) and
-    /// starts the reader and the ground station's heartbeat.
-    pub async fn open(address: &str, signing: Option<[u8; 32]>) -> Result<Arc<Link>, String> {
-        let target = crate_address(address)?;
+    /// starts the reader and the ground station's heartbeat. An `agent:NAME` address is
+    /// opened through `carrier`.
+    pub async fn open(
+        address: &str,
+        signing: Option<[u8; 32]>,
+        carrier: Option<&dyn Carrier>,
+    ) -> Result<Arc<Link>, String> {
+        let target = match (agent_of(address), carrier) {
+            (Some(_), Some(_)) => None,
+            _ => Some(crate_address(address)?),
+        };
         let link = Arc::new(Link {
             address: address.to_owned(),
             target,
@@ -74,10 +111,19 @@ impl Link {
             signing,
             sequence: AtomicU8::new(0),
         });
-        let conn = link
-            .connect()
-            .await
-            .map_err(|e| format!("cannot reach the MAVLink address `{address}`: {e}"))?;
+        let conn = match (agent_of(address), carrier) {
+            (Some(agent), Some(carrier)) => {
+                // The carrier bounds its own wait, and says what it looked for.
+                let frames = carrier.open(agent).await?;
+                let signing =
+                    link.signing.map(|key| mavlink::SigningData::from_config(signing_config(key)));
+                Arc::new(Conn::Carried(CarriedConn::new(frames, signing)))
+            }
+            _ => link
+                .connect()
+                .await
+                .map_err(|e| format!("cannot reach the MAVLink address `{address}`: {e}"))?,
+        };
         *link.slot() = Some(conn.clone());
         tokio::spawn(read(Arc::downgrade(&link), conn));
         tokio::spawn(heartbeat(Arc::downgrade(&link)));
@@ -89,7 +135,10 @@ impl Link {
     }
 
     async fn connect(&self) -> Result<Arc<Conn>, String> {
-        let open = mavlink::connect_async::<MavMessage>(&self.target);
+        let Some(target) = &self.target else {
+            return Err("an agent's link is not opened again".into());
+        };
+        let open = mavlink::connect_async::<MavMessage>(target);
         let mut conn = match aviary_clock::timeout(CONNECT_TIMEOUT, open).await {
             Ok(Ok(c)) => c,
             Ok(Err(e)) => return Err(e.to_string()),
@@ -98,11 +147,9 @@ impl Link {
         conn.set_protocol_version(mavlink::MavlinkVersion::V2);
         conn.set_allow_recv_any_version(true);
         if let Some(key) = self.signing {
-            // Sign what we send; take only signed messages (a replayed or forged command
-            // from elsewhere on the link is dropped).
-            conn.setup_signing(Some(mavlink::SigningConfig::new(key, 0, true, false)));
+            conn.setup_signing(Some(signing_config(key)));
         }
-        Ok(Arc::new(conn))
+        Ok(Arc::new(Conn::Socket(conn)))
     }
 
     pub fn add(&self, vehicle: Arc<Vehicle>) {
@@ -124,8 +171,14 @@ impl Link {
             component_id: GCS_COMPONENT,
             sequence: self.sequence.fetch_add(1, Ordering::Relaxed),
         };
-        let _ = conn.send(&header, msg).await;
+        conn.send(&header, msg).await;
     }
+}
+
+/// Sign what we send; take only signed messages (a replayed or forged command from
+/// elsewhere on the link is dropped).
+fn signing_config(key: [u8; 32]) -> mavlink::SigningConfig {
+    mavlink::SigningConfig::new(key, 0, true, false)
 }
 
 async fn read(link: std::sync::Weak<Link>, mut conn: Arc<Conn>) {
@@ -143,9 +196,13 @@ async fn read(link: std::sync::Weak<Link>, mut conn: Arc<Conn>) {
             Err(MessageReadError::Parse(_)) => {}
             Err(_) => {
                 // The connection is gone (the vehicle's end closed). Open it again until
-                // it answers; the heartbeat watchdog meanwhile raises ConnectionLost.
+                // it answers; the heartbeat watchdog meanwhile raises ConnectionLost. An
+                // agent's carrier closes only as the run ends.
                 loop {
                     let Some(l) = link.upgrade() else { return };
+                    if l.target.is_none() {
+                        return;
+                    }
                     *l.slot() = None;
                     aviary_clock::sleep(REOPEN_EVERY).await;
                     if let Ok(c) = l.connect().await {

@@ -41,10 +41,11 @@ pub struct Texts<'a> {
 }
 
 /// How to fly.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Default)]
 pub struct Options {
     /// Times real time; `None`, as fast as possible, on the virtual clock. A world
-    /// with MAVLink drones flies in real time and refuses a speed.
+    /// with MAVLink drones flies in real time (the vehicles' pace) and refuses any other
+    /// speed than 1.
     pub speed: Option<f64>,
     /// The simulator's seed: every chance the world asks for is drawn from it.
     pub seed: u64,
@@ -52,6 +53,9 @@ pub struct Options {
     pub run: RunOptions,
     /// What the time of a run with MAVLink drones follows.
     pub clock: LiveClock,
+    /// What reaches the agents of the world's `agent:NAME` drones (Zenoh, for
+    /// `aviary run --zenoh`); without one, such a drone is an error at connect.
+    pub carrier: Option<Arc<dyn aviary_mavlink::Carrier>>,
 }
 
 /// The clock of a run with MAVLink drones: its `Hover`, `WAITFOR ELAPSED`, `ON EVERY`,
@@ -172,7 +176,8 @@ pub enum NotFlown {
     Errors { diagnostics: Vec<Diagnostic>, sources: SourceMap },
     /// The mission file holds only capabilities.
     NoMission,
-    /// A speed was asked of a world with MAVLink drones, which fly in real time.
+    /// A speed other than 1 was asked of a world with MAVLink drones, which fly in real
+    /// time.
     Speed,
     /// Anything else: the runtime, a hook, the vehicles' connection.
     Failed(String),
@@ -215,7 +220,8 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
     drop(program);
     hooks.end(Stage::FreeTree);
     hooks.compiled(&mission, &world).map_err(NotFlown::Failed)?;
-    if live && options.speed.is_some() {
+    // 1 is real time, which a served run asks by default: a live run keeps it anyway.
+    if live && options.speed.is_some_and(|x| x != 1.0) {
         return Err(NotFlown::Speed);
     }
     // Every run is on a virtual clock (`aviary_clock`), which moves as fast as it goes, at
@@ -249,7 +255,7 @@ pub fn fly(texts: Texts<'_>, options: &Options, hooks: &mut dyn Hooks) -> Result
                 // A stop while the vehicles connect is answered at once: nothing has
                 // flown, so there is nothing to bring home.
                 let mavlink = tokio::select! {
-                    connected = aviary_mavlink::connect(world, aviary_mavlink::Tuning::default()) => {
+                    connected = aviary_mavlink::connect_through(world, aviary_mavlink::Tuning::default(), options.carrier.as_deref()) => {
                         connected.map_err(NotFlown::Failed)?
                     }
                     by = stopped.wait_for(Option::is_some) => {

@@ -45,6 +45,20 @@ pub fn parse_world_with(
     build::parse(file, text, files)
 }
 
+/// Whether `name` may name an agent (`mavlink = "agent:NAME"`, `aviary agent --name`): one
+/// Zenoh key chunk of letters, digits, `-`, `_` and `.`, so that it is found by name alone.
+pub fn agent_name(name: &str) -> Result<(), String> {
+    if name.is_empty() {
+        return Err("an agent's name is empty".into());
+    }
+    match name.chars().find(|c| !(c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))) {
+        Some(c) => Err(format!(
+            "an agent's name holds only letters, digits, `-`, `_` and `.`, and `{name}` holds `{c}`"
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Supplies the files a world file's `[imports]` names (GeoJSON), as
 /// `aviary_check::SourceProvider` supplies the files a mission `USE`s: the crate reads
 /// none itself. The CLI's reads the disk beside the world file.

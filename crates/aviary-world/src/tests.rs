@@ -590,6 +590,14 @@ fn backend_problems() {
         msg,
         "the `mavlink` address `udp:127.0.0.1:99999` of drone `d` has `99999` where the port number (0 to 65535) belongs"
     );
+    let (msg, at, _) = error(&format!("{HOME}mavlink = \"agent:field/1\"\n"));
+    assert_eq!(
+        msg,
+        "the `mavlink` address `agent:field/1` of drone `d`: an agent's name holds only letters, digits, `-`, `_` and `.`, and `field/1` holds `/`"
+    );
+    assert_eq!(at, "\"agent:field/1\"");
+    let (msg, _, _) = error(&format!("{HOME}mavlink = \"agent:\"\n"));
+    assert_eq!(msg, "the `mavlink` address `agent:` of drone `d`: an agent's name is empty");
     let (msg, at, _) = error(&format!("{HOME}backend = \"px4\"\n"));
     assert_eq!(msg, "unknown backend `px4` for drone `d`");
     assert_eq!(at, "\"px4\"");

@@ -23,9 +23,7 @@ impl Client {
     }
 
     pub fn open(config: zenoh::Config, keys: Keys) -> Result<Client, String> {
-        let session = zenoh::open(config)
-            .wait()
-            .map_err(|e| format!("cannot open a Zenoh session: {}", crate::reason(&e)))?;
+        let session = crate::open(config)?;
         Ok(Client { session, keys })
     }
 

@@ -78,9 +78,51 @@ impl Keys {
     }
 }
 
+/// The keys of one agent (`aviary agent`), under `aviary-agent/NAME`: apart from every
+/// mission's prefix, so that an agent is found by its name alone.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AgentKeys {
+    prefix: String,
+}
+
+impl AgentKeys {
+    /// The keys of agent `name`, refused with the reason when the name is not one
+    /// (`aviary_world::agent_name`'s rule: one chunk of letters, digits, `-`, `_`, `.`).
+    pub fn new(name: &str) -> Result<AgentKeys, String> {
+        aviary_world::agent_name(name)?;
+        Ok(AgentKeys { prefix: format!("aviary-agent/{name}") })
+    }
+
+    /// The liveliness token the agent holds while it runs.
+    pub fn alive(&self) -> &str {
+        &self.prefix
+    }
+
+    /// The frames the vehicle sends, one MAVLink frame a sample, published by the agent.
+    pub fn from_vehicle(&self) -> String {
+        format!("{}/vehicle", self.prefix)
+    }
+
+    /// The frames for the vehicle, one MAVLink frame a sample, published by the mission.
+    pub fn to_vehicle(&self) -> String {
+        format!("{}/gcs", self.prefix)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_agent_s_keys_are_apart_from_every_mission_s() {
+        let keys = AgentKeys::new("field-laptop.1").unwrap();
+        assert_eq!(keys.alive(), "aviary-agent/field-laptop.1");
+        assert_eq!(keys.from_vehicle(), "aviary-agent/field-laptop.1/vehicle");
+        assert_eq!(keys.to_vehicle(), "aviary-agent/field-laptop.1/gcs");
+        for bad in ["", "a/b", "a*", "$x", "a b", "a?"] {
+            assert!(AgentKeys::new(bad).is_err(), "{bad}");
+        }
+    }
 
     #[test]
     fn a_prefix_is_a_key_of_its_own_and_names_each_call() {

@@ -12,15 +12,22 @@
 //! - It runs on threads of its own in real time, beside the engine: the engine only
 //!   publishes to the run's `Feed`, which never waits for a slow peer.
 //! - Without `--zenoh` nothing here runs and no socket is opened.
+//! - An agent ([`agent`]) and a mission's [`Agents`] carry a vehicle's MAVLink frames
+//!   unchanged, one frame a sample: neither reads what it carries, so signing holds end
+//!   to end and the link's loss is seen as a MAVLink link's is, by its silence.
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
+pub mod agent;
+mod carrier;
 mod client;
 mod keys;
 mod publish;
 mod queries;
 
+pub use carrier::Agents;
 pub use client::Client;
-pub use keys::Keys;
+pub use keys::{AgentKeys, Keys};
+pub use zenoh::Session;
 
 use std::net::SocketAddr;
 use std::path::Path;
@@ -54,6 +61,11 @@ pub struct Api {
     pub feed: aviary_server::Feed,
 }
 
+/// Opens a session with `config`.
+pub fn open(config: zenoh::Config) -> Result<zenoh::Session, String> {
+    zenoh::open(config).wait().map_err(|e| format!("cannot open a Zenoh session: {}", reason(&e)))
+}
+
 /// A run on Zenoh, until [`Bridge::finish`].
 pub struct Bridge {
     session: zenoh::Session,
@@ -61,12 +73,9 @@ pub struct Bridge {
 }
 
 impl Bridge {
-    /// Opens the session and starts publishing what `api.feed` carries and answering
-    /// queries under `keys`. Call before the run's first event.
-    pub fn start(config: zenoh::Config, keys: Keys, api: Api) -> Result<Bridge, String> {
-        let session = zenoh::open(config)
-            .wait()
-            .map_err(|e| format!("cannot open a Zenoh session: {}", reason(&e)))?;
+    /// Starts publishing, on `session`, what `api.feed` carries and answering queries
+    /// under `keys`. Call before the run's first event.
+    pub fn start(session: zenoh::Session, keys: Keys, api: Api) -> Result<Bridge, String> {
         let lines = api.feed.subscribe();
         let publisher = publish::start(session.clone(), keys.clone(), lines, api.feed.clone())?;
         queries::start(session.clone(), keys, api.router, api.bound)?;

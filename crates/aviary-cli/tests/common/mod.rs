@@ -64,10 +64,33 @@ pub fn scratch(name: &str) -> PathBuf {
     std::fs::create_dir_all(&dir).expect("scratch dir");
     dir
 }
+/// A Zenoh peer's JSON5 configuration that finds no one by scouting: it `listen`s or
+/// `connect`s (`role`) at `endpoint` (`tcp/127.0.0.1:7447`) only, so no other test's
+/// session on this machine can join it.
+pub fn zenoh_peer(role: &str, endpoint: &str) -> String {
+    format!(
+        r#"{{ mode: "peer", {role}: {{ endpoints: ["{endpoint}"] }},
+            scouting: {{ multicast: {{ enabled: false }}, gossip: {{ enabled: false }} }} }}"#
+    )
+}
+
+/// A Zenoh client's JSON5 configuration: it reaches everyone through the router at
+/// `endpoint`, which relays between its clients (peers it would leave to meet directly).
+pub fn zenoh_client(endpoint: &str) -> String {
+    format!(r#"{{ mode: "client", connect: {{ endpoints: ["{endpoint}"] }} }}"#)
+}
+
+/// A free TCP port on loopback, for a server the test starts.
+pub fn free_port() -> u16 {
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").expect("bind loopback");
+    listener.local_addr().expect("its address").port()
+}
+
 pub mod background;
 pub mod logs;
 pub mod px4;
 pub mod sitl;
+pub mod vehicles;
 
 /// ArduCopter's own figures (its default parameters) as a drone's world keys:
 /// WPNAV_SPEED_UP 250 cm/s, WPNAV_SPEED_DN 150 cm/s, WPNAV_ACCEL 250 cm/s², LAND_SPEED

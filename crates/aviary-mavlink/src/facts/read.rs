@@ -118,7 +118,7 @@ pub async fn ask(world: &World, wait: Duration) -> Result<Vec<Facts>, String> {
         let (events, alarms) = (events.clone(), alarms.clone());
         tasks.spawn(async move {
             let key = key.as_deref().map(crate::signing_key);
-            let opened = aviary_clock::timeout_at(until, Link::open(&address, key)).await;
+            let opened = aviary_clock::timeout_at(until, Link::open(&address, key, None)).await;
             let link = match opened {
                 Ok(Ok(link)) => link,
                 Ok(Err(why)) => {

@@ -46,7 +46,7 @@ const SCHEMES: &[&str] =
 /// Telemetry fields: `d.speed` reads these, so no attribute may take their names.
 const TELEMETRY: &[&str] = &["position", "altitude", "speed", "heading", "state", "link", "wind"];
 const ADDRESS_HELP: &str =
-    "write `mavlink = \"udp:127.0.0.1:14550\"` or `\"tcp:HOST:PORT\"` (schemes: tcp, tcpin, tcpout, udp, udpin, udpout, udpbcast, serial)";
+    "write `mavlink = \"udp:127.0.0.1:14550\"`, `\"tcp:HOST:PORT\"` or `\"agent:NAME\"` (schemes: tcp, tcpin, tcpout, udp, udpin, udpout, udpbcast, serial, agent)";
 
 /// The drones of `[drones.NAME]` and `[fleets.NAME]`, in file order. What needs other
 /// tables (the sensors' kinds) waits for [`Drones::finish`].
@@ -446,8 +446,19 @@ fn system_id(cx: &mut Ctx, owner: Owner, e: &Entry) -> Option<u8> {
     }
 }
 
-/// `SCHEME:HOST:PORT` (for `serial`, `serial:DEVICE:BAUD`).
+/// `SCHEME:HOST:PORT` (for `serial`, `serial:DEVICE:BAUD`), or `agent:NAME`.
 fn check_address(cx: &mut Ctx, owner: Owner, address: &str, span: Span) {
+    if let Some(name) = address.strip_prefix("agent:") {
+        if let Err(why) = crate::agent_name(name) {
+            let msg = format!("the `mavlink` address `{address}` of {owner}: {why}");
+            cx.error(
+                span,
+                msg,
+                "write the name `aviary agent --name NAME` was given, e.g. `agent:field-1`",
+            );
+        }
+        return;
+    }
     let parts = address.split_once(':').and_then(|(scheme, rest)| {
         let (host, port) = rest.rsplit_once(':')?;
         Some((scheme, host, port))

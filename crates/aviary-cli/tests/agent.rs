@@ -1,0 +1,240 @@
+//! `aviary agent` between a mission and its vehicles, on one machine: `aviary vehicles`
+//! serves the vehicles, an agent holds their MAVLink link and carries it on Zenoh, and
+//! `aviary run --zenoh` flies them through it (`mavlink = "agent:field1"` in the world).
+//! Nothing is mocked: the three are the programs a user runs.
+//!
+//! The operation over three machines (network namespaces and a `zenohd` router) is
+//! `three_machines.rs`.
+
+mod common;
+
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use aviary_api::trace::{CallStatus, Event, Record, Shown};
+use aviary_api::Function;
+use aviary_test_support::trace::{actor, Trace};
+use common::vehicles::Vehicles;
+use common::{free_port, scratch, wait_at_most, zenoh_peer};
+use zenoh::Wait;
+
+const WORLD: &str = "\
+[site]
+origin = { lat = 46.6167, lon = 14.2650, alt = 440.0 }
+geofence = [[-100, -100], [100, -100], [100, 100], [-100, 100]]
+
+[places]
+Near = [10, 10]
+Far = [-20, 10]
+
+[drones.scout]
+home = [0, 0]
+
+[drones.buddy]
+home = [10, 0]
+";
+
+/// The scout hovers long enough for its agent to be cut off mid-flight.
+const MISSION: &str = "\
+MISSION Hold:
+    PARALLEL Both:
+        SEQUENTIAL First:
+            scout TakeOff WITH 10m
+            scout FlyTo WITH Near
+            scout Hover WITH HOVER
+        SEQUENTIAL Second:
+            buddy TakeOff WITH 10m
+            buddy FlyTo WITH Far
+            buddy ReturnHome
+";
+
+/// The world with both drones behind agent `field1`.
+fn behind_the_agent() -> String {
+    WORLD.replace("home = [", "mavlink = \"agent:field1\"\nhome = [")
+}
+
+/// An `aviary agent`, its standard error kept as it comes; killed when dropped.
+struct Agent {
+    child: Child,
+    said: Arc<Mutex<String>>,
+}
+
+impl Agent {
+    fn start(dir: &Path, config: &str, vehicles: u16) -> Agent {
+        std::fs::write(dir.join("agent.json5"), config).expect("config");
+        let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
+            .args(["agent", "--name", "field1", "--zenoh", "agent.json5", "--mavlink"])
+            .arg(format!("tcp:127.0.0.1:{vehicles}"))
+            .current_dir(dir)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("spawn aviary agent");
+        let said = Arc::new(Mutex::new(String::new()));
+        let stderr = BufReader::new(child.stderr.take().expect("stderr"));
+        let into = Arc::clone(&said);
+        std::thread::spawn(move || {
+            for line in stderr.lines().map_while(Result::ok) {
+                let mut said = into.lock().expect("lock");
+                said.push_str(&line);
+                said.push('\n');
+            }
+        });
+        Agent { child, said }
+    }
+
+    fn said(&self) -> String {
+        self.said.lock().expect("lock").clone()
+    }
+}
+
+impl Drop for Agent {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// `aviary run --zenoh` of the mission (hovering `hover`) in `dir`, its trace `t.jsonl`.
+fn start_run(dir: &Path, config: &str, hover: &str) -> Child {
+    std::fs::write(dir.join("m.mission"), MISSION.replace("HOVER", hover)).expect("mission");
+    std::fs::write(dir.join("m.world.toml"), behind_the_agent()).expect("world");
+    std::fs::write(dir.join("run.json5"), config).expect("config");
+    Command::new(env!("CARGO_BIN_EXE_aviary"))
+        .args(["run", "m.mission", "--zenoh", "run.json5", "--quiet", "--trace", "t.jsonl"])
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn aviary run")
+}
+
+fn events(dir: &Path) -> Trace {
+    Trace::parse(&std::fs::read_to_string(dir.join("t.jsonl")).unwrap_or_default())
+}
+
+fn stderr_of(child: &mut Child) -> String {
+    let mut text = String::new();
+    if let Some(mut err) = child.stderr.take() {
+        let _ = std::io::Read::read_to_string(&mut err, &mut text);
+    }
+    text
+}
+
+/// Both drones fly the whole mission through the agent, and a foreign peer's garbage on
+/// the agent's command key reaches no vehicle: the agent refuses it and says so.
+#[test]
+fn a_mission_flies_its_vehicles_through_an_agent_and_garbage_reaches_none() {
+    let dir = scratch("agent_flies");
+    std::fs::write(dir.join("vehicles.world.toml"), WORLD).expect("world");
+    let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
+    let port = free_port();
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    // The agent listens; the run and the foreign peer connect to it (peers relay nothing
+    // for one another: that takes a router, as in three_machines.rs).
+    let agent = Agent::start(&dir, &zenoh_peer("listen", &endpoint), vehicles.port);
+    let mut run = start_run(&dir, &zenoh_peer("connect", &endpoint), "5s");
+    // A peer of the test's own, as anyone on the network could be.
+    let foreign =
+        zenoh::open(zenoh::Config::from_json5(&zenoh_peer("connect", &endpoint)).expect("config"))
+            .wait()
+            .expect("the foreign peer joins");
+    let start = Instant::now();
+    while !agent.said().contains("refused a sample") {
+        assert!(start.elapsed() < Duration::from_secs(30), "agent said: {}", agent.said());
+        foreign.put("aviary-agent/field1/gcs", "not a MAVLink frame").wait().expect("put");
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    let code = wait_at_most(&mut run, Duration::from_secs(120), "aviary run");
+    let trace = events(&dir);
+    assert_eq!(code, 0, "{}\n{:?}", stderr_of(&mut run), trace.last());
+    // Every call of the mission, and the scout's way home after it, flown and done.
+    use Function::{Arm, FlyToPosition, Hover, ReturnToLaunch, TakeOff};
+    for (drone, calls) in [
+        ("scout", vec![Arm, TakeOff, FlyToPosition, Hover, ReturnToLaunch]),
+        ("buddy", vec![Arm, TakeOff, FlyToPosition, ReturnToLaunch]),
+    ] {
+        let done: Vec<(Function, CallStatus)> = trace
+            .iter()
+            .filter_map(|e| match &e.event {
+                Event::ApiDone { function, status, .. } if actor(&e.event) == Some(drone) => {
+                    Some((*function, *status))
+                }
+                _ => None,
+            })
+            .collect();
+        let ok: Vec<(Function, CallStatus)> =
+            calls.into_iter().map(|f| (f, CallStatus::Ok)).collect();
+        assert_eq!(done, ok, "{drone} flew through the agent");
+    }
+    let said = agent.said();
+    assert!(said.contains("agent `field1` carries tcp:127.0.0.1:"), "{said}");
+    assert!(
+        said.contains(
+            "refused a sample of 19 bytes on aviary-agent/field1/gcs: not one MAVLink frame"
+        ),
+        "{said}"
+    );
+}
+
+/// The agent gone mid-flight is a silent link: `ConnectionLost` within the heartbeat
+/// timeout, as when a vehicle's own link goes. An agent started again restores the link,
+/// and the run brings its vehicles down and ends. A world whose agent is not there at all
+/// is a clear error before anything flies.
+#[test]
+fn a_lost_agent_is_connection_lost_and_a_missing_one_a_clear_error() {
+    let dir = scratch("agent_lost");
+    let port = free_port();
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let mut alone = start_run(&dir, &zenoh_peer("listen", &endpoint), "60s");
+    let code = wait_at_most(&mut alone, Duration::from_secs(30), "aviary run");
+    let err = stderr_of(&mut alone);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("no agent `field1` on Zenoh (looked 5 s for aviary-agent/field1): is `aviary agent --name field1` running"),
+        "{err}"
+    );
+
+    std::fs::write(dir.join("vehicles.world.toml"), WORLD).expect("world");
+    let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
+    let mut run = start_run(&dir, &zenoh_peer("listen", &endpoint), "60s");
+    let mut agent = Agent::start(&dir, &zenoh_peer("connect", &endpoint), vehicles.port);
+    let hovering = |e: &Record| matches!(e.event, Event::ApiCall { function: Function::Hover, .. });
+    let start = Instant::now();
+    while !events(&dir).iter().any(hovering) {
+        assert!(start.elapsed() < Duration::from_secs(60), "no hover: {:?}", events(&dir).last());
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    agent.child.kill().expect("kill the agent");
+    let killed = Instant::now();
+    let lost =
+        |e: &Record| matches!(&e.event, Event::Exception { name, .. } if name == "ConnectionLost");
+    let exception = loop {
+        if let Some(e) = events(&dir).0.into_iter().find(lost) {
+            break e;
+        }
+        // The heartbeat timeout is 3 s; allow 3 s more for a loaded machine.
+        assert!(killed.elapsed() < Duration::from_secs(6), "{:?}", events(&dir).last());
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let Event::Exception { args, .. } = &exception.event else { unreachable!() };
+    let reason = args.first().and_then(Shown::as_str).unwrap_or("");
+    assert!(reason.contains("for 3.0 s"), "{exception:?}");
+    // Back again: the run reaches the vehicles and lands them (out of reach, it would
+    // wait 120 s for them and leave them to their failsafes).
+    let _again = Agent::start(&dir, &zenoh_peer("connect", &endpoint), vehicles.port);
+    let code = wait_at_most(&mut run, Duration::from_secs(60), "aviary run");
+    assert_eq!(code, 1, "unhandled, ConnectionLost fails the mission");
+    let trace = events(&dir);
+    let restored =
+        |e: &Record| matches!(&e.event, Event::Signal { name, .. } if name == "ConnectionRestored");
+    assert!(trace.iter().any(restored), "{:?}", trace.last());
+    let home = |e: &Record| {
+        matches!(&e.event, Event::ApiDone { function: Function::ReturnToLaunch, status, .. }
+            if *status == CallStatus::Ok)
+    };
+    assert_eq!(trace.iter().filter(|e| home(e)).count(), 2, "both brought home: {trace:?}");
+}

@@ -1,0 +1,68 @@
+//! `aviary vehicles` for tests: the simulated MAVLink vehicles a user runs, on a free
+//! loopback port that its first line says.
+
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+
+/// A running `aviary vehicles`, killed when dropped.
+pub struct Vehicles {
+    pub child: Child,
+    pub port: u16,
+    /// Kept open: the server's later lines must have somewhere to go.
+    _stdout: BufReader<std::process::ChildStdout>,
+}
+
+impl Vehicles {
+    pub fn start(world: &Path, speed: &str) -> Vehicles {
+        Vehicles::start_as(world, speed, "ardupilot")
+    }
+
+    /// `aviary vehicles --autopilot AUTOPILOT`.
+    pub fn start_as(world: &Path, speed: &str, autopilot: &str) -> Vehicles {
+        Vehicles::spawn(Command::new(env!("CARGO_BIN_EXE_aviary")), world, speed, autopilot)
+    }
+
+    /// In the network namespace `netns` (`ip netns exec`), listening on its loopback.
+    pub fn start_in(netns: &str, world: &Path, speed: &str) -> Vehicles {
+        let mut command = Command::new("ip");
+        command.args(["netns", "exec", netns, env!("CARGO_BIN_EXE_aviary")]);
+        Vehicles::spawn(command, world, speed, "ardupilot")
+    }
+
+    fn spawn(mut command: Command, world: &Path, speed: &str, autopilot: &str) -> Vehicles {
+        let mut child = command
+            .args([
+                "vehicles",
+                "--world",
+                &world.to_string_lossy(),
+                "--listen",
+                "tcp:127.0.0.1:0",
+                "--speed",
+                speed,
+                "--autopilot",
+                autopilot,
+            ])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("spawn aviary vehicles");
+        let mut first = String::new();
+        let mut stdout = BufReader::new(child.stdout.take().expect("stdout"));
+        stdout.read_line(&mut first).expect("read the first line");
+        let port = first
+            .trim()
+            .rsplit(':')
+            .next()
+            .and_then(|p| p.parse().ok())
+            .unwrap_or_else(|| panic!("no port in {first:?}"));
+        Vehicles { child, port, _stdout: stdout }
+    }
+}
+
+impl Drop for Vehicles {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}

@@ -162,6 +162,18 @@ enum Command {
         /// A folder whose .mission files USE may read, besides the mission's own (repeatable)
         #[arg(long, value_name = "DIR", value_parser = folder)]
         use_root: Vec<PathBuf>,
+        /// Instead of a folder: the station of a run on another machine (`aviary run
+        /// --zenoh`), reached with Zenoh's JSON5 configuration file CONFIG or Zenoh's
+        /// defaults (docs/DISTRIBUTED.md)
+        #[arg(long, value_name = "CONFIG", num_args = 0..=1, requires = "zenoh_prefix")]
+        zenoh: Option<Option<PathBuf>>,
+        /// With --zenoh: the run's key prefix, as it printed it (aviary/MISSION)
+        #[arg(long, value_name = "KEY", requires = "zenoh")]
+        zenoh_prefix: Option<String>,
+        /// With --zenoh: the run's token, to steer it from the page (without it the station
+        /// only watches)
+        #[arg(long, env = "AVIARY_TOKEN", requires = "zenoh")]
+        token: Option<String>,
     },
     /// Play a recorded trace back in the ground station: map, fleet grid, log and a
     /// scrubber over the mission's time (docs/GCS.md)
@@ -425,15 +437,29 @@ fn command(cli: Cli) -> u8 {
                 }
             }
         }
-        Command::Gcs { dir, listen, allow_host, use_root } => match run::parse_serve(&listen) {
-            Ok(address) => {
-                gcs::run(&dir, &serve::Serve { address, allowed_hosts: allow_host }, &use_root)
+        Command::Gcs { dir, listen, allow_host, use_root, zenoh, zenoh_prefix, token } => {
+            match run::parse_serve(&listen) {
+                Ok(address) => {
+                    let serve = serve::Serve { address, allowed_hosts: allow_host };
+                    match (zenoh, zenoh_prefix) {
+                        (Some(config), Some(prefix)) => {
+                            match zenoh::client(config.as_deref(), &prefix) {
+                                Ok(client) => zenoh::station(client, token, &serve),
+                                Err(why) => {
+                                    eprintln!("aviary: {why}");
+                                    2
+                                }
+                            }
+                        }
+                        _ => gcs::run(&dir, &serve, &use_root),
+                    }
+                }
+                Err(why) => {
+                    eprintln!("aviary: {}", why.replace("--serve", "--listen"));
+                    2
+                }
             }
-            Err(why) => {
-                eprintln!("aviary: {}", why.replace("--serve", "--listen"));
-                2
-            }
-        },
+        }
         Command::Replay { trace, world, listen, allow_host } => match run::parse_serve(&listen) {
             Ok(address) => replay::run(
                 &trace,
@@ -453,10 +479,7 @@ fn command(cli: Cli) -> u8 {
         Command::Ctl { url, token, zenoh, zenoh_prefix, command } => {
             let reach = match (url, zenoh, zenoh_prefix) {
                 (_, Some(config), Some(prefix)) => {
-                    aviary_zenoh::Keys::new(&prefix).and_then(|keys| {
-                        let config = aviary_zenoh::config(config.as_deref())?;
-                        Ok(ctl::Reach::Zenoh(aviary_zenoh::Client::open(config, keys)?))
-                    })
+                    zenoh::client(config.as_deref(), &prefix).map(ctl::Reach::Zenoh)
                 }
                 (Some(url), None, _) => Ok(ctl::Reach::Http(url.trim_end_matches('/').to_string())),
                 _ => Err("say where the run is: --url URL, or --zenoh [CONFIG] --zenoh-prefix KEY"

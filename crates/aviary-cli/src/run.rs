@@ -185,6 +185,7 @@ pub fn run(args: &RunArgs) -> u8 {
         map: serde_json::Value::Null,
         bounds: None,
         zenoh_bounds: None,
+        zenoh_map: serde_json::Value::Null,
         progress: None,
         stats: Stats::default(),
         drones: 0,
@@ -287,6 +288,7 @@ struct Shown<'a> {
     bounds: Option<aviary_server::Bounds>,
     /// The same, for the operator API on Zenoh.
     zenoh_bounds: Option<aviary_server::Bounds>,
+    zenoh_map: serde_json::Value,
     /// Made once the run starts.
     progress: Option<ProgressBar>,
     stats: Stats,
@@ -308,6 +310,7 @@ impl Hooks for Shown<'_> {
         }
         if self.args.zenoh.is_some() {
             self.zenoh_bounds = Some(aviary_server::Bounds::of(world));
+            self.zenoh_map = aviary_station::checking::map_of(world);
         }
         self.expected = Some(Expected {
             observer: aviary_campaign::Observer::new(mission),
@@ -359,11 +362,12 @@ impl Hooks for Shown<'_> {
             let bounds =
                 self.zenoh_bounds.take().ok_or("the run starts before its world was read")?;
             let token = self.server.as_ref().map(|(serving, _)| serving.token.clone());
+            let map = std::mem::take(&mut self.zenoh_map);
             self.zenoh = Some(crate::zenoh::start(
                 session,
                 zenoh,
                 mission,
-                bounds,
+                (bounds, map),
                 controller.clone(),
                 token,
             )?);

@@ -33,7 +33,7 @@ pub fn station(
 
 /// Where the station is and its token: said once the station answers every call it
 /// will, since a client may call as soon as it reads the first line.
-fn announce(serving: &Serving) {
+pub fn announce(serving: &Serving) {
     let url = serving.url();
     // The operator API's line first, then the warning, as they always were: scripts read
     // the first line, and the operator sees the warning before anything else. A script

@@ -17,12 +17,13 @@ pub fn open(zenoh: &Zenoh) -> Result<aviary_zenoh::Session, String> {
     aviary_zenoh::open(aviary_zenoh::config(zenoh.config.as_deref())?)
 }
 
-/// Starts the bridge on the run's `session`; says where on standard error.
+/// Starts the bridge on the run's `session`; says where on standard error. `bounds` are
+/// where the world lets an operator send a drone, `map` what a station draws of it.
 pub fn start(
     session: aviary_zenoh::Session,
     zenoh: &Zenoh,
     mission: &Mission,
-    bounds: Bounds,
+    (bounds, map): (Bounds, serde_json::Value),
     controller: Controller,
     token: Option<String>,
 ) -> Result<(Bridge, Feed), String> {
@@ -42,7 +43,13 @@ pub fn start(
     };
     let (router, feed) = aviary_server::router(bound, token.clone(), controller, options);
     let prefix = keys.prefix().to_string();
-    let bridge = Bridge::start(session, keys, Api { router, bound, feed: feed.clone() })?;
+    let shown = serde_json::json!({
+        "mission": mission.name,
+        "tree": aviary_station::tree::of(mission, None),
+        "map": map,
+    });
+    let api = Api { router, bound, feed: feed.clone(), mission: shown };
+    let bridge = Bridge::start(session, keys, api)?;
     use std::io::Write;
     let _ = writeln!(
         std::io::stderr(),
@@ -70,6 +77,59 @@ pub fn agent(name: &str, mavlink: &str, config: Option<&std::path::Path>) -> u8 
     };
     match runtime.block_on(aviary_zenoh::agent::serve(session, name, mavlink)) {
         Ok(()) => 0,
+        Err(why) => {
+            eprintln!("aviary: {why}");
+            2
+        }
+    }
+}
+
+/// A client of the run under `prefix` (`--zenoh [CONFIG] --zenoh-prefix KEY`).
+pub fn client(
+    config: Option<&std::path::Path>,
+    prefix: &str,
+) -> Result<aviary_zenoh::Client, String> {
+    let keys = aviary_zenoh::Keys::new(prefix)?;
+    aviary_zenoh::Client::open(aviary_zenoh::config(config)?, keys)
+}
+
+/// `aviary gcs --zenoh [CONFIG] --zenoh-prefix KEY [--token TOKEN]`: the ground station of
+/// a run on another machine, served until Ctrl-C.
+pub fn station(
+    client: aviary_zenoh::Client,
+    token: Option<String>,
+    serve: &crate::serve::Serve,
+) -> u8 {
+    let watched = || -> Result<aviary_station::Serving, String> {
+        let shown = aviary_zenoh::remote::shown(&client)?;
+        let prefix = client.keys().prefix().to_string();
+        let options = aviary_station::Options {
+            address: serve.address,
+            allowed_hosts: serve.allowed_hosts.clone(),
+            lsp: None,
+        };
+        let serving =
+            aviary_station::serve(&options, aviary_station::Mode::Run, serde_json::Value::Null)?;
+        let router = aviary_zenoh::remote::router(client, token.clone(), serving.gate())?;
+        serving.serve_remote(router, shown.mission, shown.tree, shown.map);
+        crate::serve::announce(&serving);
+        use std::io::Write;
+        let _ = writeln!(
+            std::io::stderr(),
+            "aviary: watching the run under {prefix}/ on Zenoh{}; Ctrl-C stops",
+            if token.is_some() {
+                " (and steering it with its token)"
+            } else {
+                " (without its token: watching only)"
+            }
+        );
+        Ok(serving)
+    };
+    match watched() {
+        Ok(_serving) => loop {
+            // The station serves on its own thread until the process ends.
+            std::thread::park();
+        },
         Err(why) => {
             eprintln!("aviary: {why}");
             2

@@ -65,7 +65,7 @@ pub fn crate_address(address: &str) -> Result<String, String> {
         "udpbcast" => "udpbcast",
         "agent" => {
             return Err(format!(
-                "`{address}` is reached through an agent on Zenoh: run the mission with `--zenoh [CONFIG]` (docs/DISTRIBUTED.md)"
+                "`{address}` is a vehicle behind an agent, reached on Zenoh: `aviary run --zenoh [CONFIG]` flies it (docs/DISTRIBUTED.md)"
             ))
         }
         "serial" => {
@@ -244,5 +244,6 @@ mod tests {
         assert_eq!(crate_address("udp:0.0.0.0:14550").unwrap(), "udpin:0.0.0.0:14550");
         assert_eq!(crate_address("udpout:10.0.0.2:14555").unwrap(), "udpout:10.0.0.2:14555");
         assert!(crate_address("serial:/dev/ttyUSB0:57600").unwrap_err().contains("libudev"));
+        assert!(crate_address("agent:field1").unwrap_err().contains("`aviary run --zenoh"));
     }
 }

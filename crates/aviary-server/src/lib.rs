@@ -19,6 +19,7 @@ mod args;
 mod bounds;
 mod guard;
 mod openapi;
+mod relay;
 mod reply;
 pub mod requests;
 mod routes;
@@ -29,7 +30,9 @@ pub use args::{Kinds, MAX_MAGNITUDE};
 pub use bounds::Bounds;
 pub use guard::{read_token, same_origin, token, Gate, TOKEN_PROTOCOL};
 pub use openapi::{openapi, openapi_yaml, state_schema};
+pub use relay::{Line, Relay};
 pub use reply::{error, json_errors, BODY_LIMIT};
+pub use routes::events_router;
 
 use parking_lot::{Mutex, MutexGuard};
 use std::net::SocketAddr;
@@ -42,41 +45,12 @@ use tokio::sync::broadcast;
 
 use crate::state::MissionState;
 
-/// How many events a slow WebSocket client may fall behind before it misses some.
-const BACKLOG: usize = 4096;
-
-/// How many events (telemetry aside) a stream `?from=start` can replay: a page that opens
-/// mid-mission sees the blocks, activities and signals so far. Beyond, the oldest go.
-const HISTORY: usize = 100_000;
-
-/// An event as streams send it: its trace line, and what a stream needs to know of it
-/// without reading the line again.
-pub struct Line {
-    /// The trace file's line, without its newline.
-    pub text: Box<str>,
-    /// The drone, for a telemetry sample.
-    pub telemetry_of: Option<Box<str>>,
-    /// `mission_end`: the last.
-    pub end: bool,
-}
-
-/// The events so far, telemetry aside, as their lines.
-#[derive(Default)]
-pub(crate) struct History {
-    pub lines: std::collections::VecDeque<Arc<Line>>,
-    /// How many of the oldest were let go.
-    pub dropped: u64,
-}
-
 pub(crate) struct Shared {
-    /// Event streams still open.
-    pub streams: std::sync::atomic::AtomicUsize,
     pub gate: Arc<Gate>,
     pub controller: Controller,
     pub state: Mutex<MissionState>,
-    pub events: broadcast::Sender<Arc<Line>>,
-    /// Appended and broadcast under one lock, so a new stream takes both at one instant.
-    pub history: Mutex<History>,
+    /// The run's lines, to the event streams.
+    pub relay: Arc<Relay>,
     pub kinds: Kinds,
 }
 
@@ -111,10 +85,6 @@ impl Shared {
         );
         state
     }
-
-    pub fn history(&self) -> MutexGuard<'_, History> {
-        self.history.lock()
-    }
 }
 
 /// The engine's side: every trace event goes through here.
@@ -127,12 +97,7 @@ impl Feed {
     /// After `mission_end`: waits (at most `limit`) until every open event stream has
     /// delivered it, so that no client misses how the mission ended.
     pub fn finish(&self, limit: std::time::Duration) {
-        let start = std::time::Instant::now();
-        while self.shared.streams.load(std::sync::atomic::Ordering::SeqCst) > 0
-            && start.elapsed() < limit
-        {
-            std::thread::sleep(std::time::Duration::from_millis(10));
-        }
+        self.shared.relay.finish(limit);
     }
 
     /// The operator state now, as `GET /api/state` answers it.
@@ -141,33 +106,23 @@ impl Feed {
     }
 
     /// Every event from now on, as its line, for a stream of the caller's own (the Zenoh
-    /// bridge's). A receiver that falls [`BACKLOG`] events behind misses the oldest and
-    /// is told so (`RecvError::Lagged`).
+    /// bridge's), as [`Relay::subscribe`] gives them.
     pub fn subscribe(&self) -> broadcast::Receiver<Arc<Line>> {
-        self.shared.events.subscribe()
+        self.shared.relay.subscribe()
+    }
+
+    /// The events so far (telemetry aside), and how many older ones were let go: what a
+    /// stream `?from=start` begins with.
+    pub fn past(&self) -> (Vec<Arc<Line>>, u64) {
+        self.shared.relay.past()
     }
 
     /// Folds the event into the mission's state and sends it to every stream, as the
     /// line the trace file has.
     pub fn publish(&self, record: &Record) {
         self.shared.state().observe(record);
-        if let Ok(text) = serde_json::to_string(record) {
-            use aviary_api::trace::Event;
-            let telemetry_of = match &record.event {
-                Event::Telemetry { actor, .. } => Some(Box::from(&**actor)),
-                _ => None,
-            };
-            let end = matches!(record.event, Event::MissionEnd { .. });
-            let line = Arc::new(Line { text: text.into_boxed_str(), telemetry_of, end });
-            let mut history = self.shared.history();
-            if line.telemetry_of.is_none() {
-                history.lines.push_back(line.clone());
-                if history.lines.len() > HISTORY {
-                    history.lines.pop_front();
-                    history.dropped += 1;
-                }
-            }
-            let _ = self.shared.events.send(line);
+        if let Some(line) = Line::of(record) {
+            self.shared.relay.push(line);
         }
     }
 }
@@ -191,17 +146,8 @@ pub fn router_behind(
     controller: Controller,
     kinds: Kinds,
 ) -> (axum::Router, Feed) {
-    let (events, _) = broadcast::channel(BACKLOG);
     let state = Mutex::new(MissionState::default());
-    let shared = Arc::new(Shared {
-        streams: Default::default(),
-        gate,
-        controller,
-        state,
-        events,
-        history: Default::default(),
-        kinds,
-    });
+    let shared = Arc::new(Shared { gate, controller, state, relay: Relay::new(), kinds });
     (routes::router(shared.clone()), Feed { shared })
 }
 

@@ -17,13 +17,13 @@ use serde_json::Value as JsonValue;
 use crate::args::Refusal;
 use crate::reply::{error, Object, BODY_LIMIT};
 use crate::requests::{Argument, DroneRequest, DroneVerb, LeashRequest, SignalRequest};
-use crate::{guard, reply, stream, Shared};
+use crate::{guard, reply, stream, Gate, Relay, Shared};
 use aviary_api::operator::{Accepted, OperatorState};
 
 pub(crate) fn router(shared: Arc<Shared>) -> Router {
     let reads = Router::new()
         .route("/api/state", get(state))
-        .route("/api/events", get(events))
+        .route_service("/api/events", get(events).with_state(shared.relay.clone()))
         .route_layer(middleware::from_fn_with_state(shared.gate.clone(), guard::read_token));
     let controls = Router::new()
         .route("/api/leash", post(leash))
@@ -41,6 +41,17 @@ pub(crate) fn router(shared: Arc<Shared>) -> Router {
         .layer(middleware::from_fn_with_state(shared.gate.clone(), guard::same_origin))
         .layer(middleware::map_response(reply::json_errors))
         .with_state(shared)
+}
+
+/// `GET /api/events` alone, streaming what `relay` carries, behind `gate` as every route
+/// here: for a station that watches a run on another machine, whose other calls go there.
+pub fn events_router(gate: Arc<Gate>, relay: Arc<Relay>) -> Router {
+    Router::new()
+        .route("/api/events", get(events))
+        .route_layer(middleware::from_fn_with_state(gate.clone(), guard::read_token))
+        .layer(middleware::from_fn_with_state(gate, guard::same_origin))
+        .layer(middleware::map_response(reply::json_errors))
+        .with_state(relay)
 }
 
 /// A request resolved to the mission's ids, sent; or why it could not be.
@@ -65,7 +76,7 @@ async fn state(State(shared): State<Arc<Shared>>) -> Json<OperatorState> {
 }
 
 async fn events(
-    State(shared): State<Arc<Shared>>,
+    State(relay): State<Arc<Relay>>,
     uri: axum::http::Uri,
     ws: Result<WebSocketUpgrade, WebSocketUpgradeRejection>,
 ) -> Response {
@@ -84,15 +95,11 @@ async fn events(
     };
     // The history and the subscription at one instant, so that no event is missed or
     // sent twice between them.
-    let (past, rx) = {
-        let history = shared.history();
-        let past = from_start.then(|| (history.lines.iter().cloned().collect(), history.dropped));
-        (past, shared.events.subscribe())
-    };
+    let (past, rx) = relay.open(from_start);
     // Counted from the handshake on, so that a stream opened just before the mission
     // ends still gets `mission_end` (`Feed::finish` waits for it).
-    shared.streams.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
-    let failed = shared.clone();
+    relay.streams.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+    let failed = relay.clone();
     // A browser that offered `aviary` (beside its token) must get it back, or it drops the socket.
     ws.protocols(["aviary"])
         .on_failed_upgrade(move |_| {
@@ -103,7 +110,7 @@ async fn events(
                 Some(every) => stream::batched(socket, past, rx, every).await,
                 None => stream::each(socket, past, rx).await,
             }
-            shared.streams.fetch_sub(1, std::sync::atomic::Ordering::SeqCst);
+            relay.streams.fetch_sub(1, std::sync::atomic::Ordering::SeqCst);
         })
 }
 

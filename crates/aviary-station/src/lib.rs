@@ -119,6 +119,13 @@ impl Station {
         feed
     }
 
+    /// Serves a run that flies on another machine: `router` answers its operator API's
+    /// calls, `mission` and `tree` are what the page shows of it.
+    pub fn watch(&self, router: axum::Router, mission: String, tree: Value) {
+        let vehicle_plan = VehiclePlan::None;
+        *self.run.lock() = Some(Run { router, mission, tree, trace: None, vehicle_plan });
+    }
+
     /// The run's plan with the vehicles' figures: `Due` from the start of a flight with
     /// MAVLink drones, then what it says.
     pub(crate) fn set_vehicle_plan(&self, plan: VehiclePlan) {
@@ -194,6 +201,21 @@ impl Serving {
     ) -> Feed {
         self.station.set_map(map);
         self.station.start_run(controller, mission, bounds, tree::of(mission, None), None)
+    }
+}
+
+impl Serving {
+    /// For `aviary gcs --zenoh`: a run on another machine, whose operator API `router`
+    /// reaches (behind this station's [`Serving::gate`]). `mission`, `tree` and `map` are
+    /// what the page shows of it, as the run gives them.
+    pub fn serve_remote(&self, router: axum::Router, mission: String, tree: Value, map: Value) {
+        self.station.set_map(map);
+        self.station.watch(router, mission, tree);
+    }
+
+    /// Who may call this station: the routes of a run it serves stand behind it too.
+    pub fn gate(&self) -> Arc<Gate> {
+        self.station.gate.clone()
     }
 }
 

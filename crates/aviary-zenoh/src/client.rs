@@ -22,6 +22,11 @@ impl Client {
         &self.keys
     }
 
+    /// The session it reaches the run on.
+    pub(crate) fn session(&self) -> &zenoh::Session {
+        &self.session
+    }
+
     pub fn open(config: zenoh::Config, keys: Keys) -> Result<Client, String> {
         let session = crate::open(config)?;
         Ok(Client { session, keys })

@@ -9,9 +9,14 @@ pub struct Keys {
     prefix: String,
 }
 
-/// The operator API's calls, each a queryable `PREFIX/api/CALL`: `state` is read, the
-/// others are the control calls of `POST /api/CALL`.
-pub const CALLS: [&str; 7] = ["state", "leash", "signal", "drone", "pause", "resume", "abort"];
+/// The operator API's calls, each a queryable `PREFIX/api/CALL`: `state`, `mission`
+/// (what a station shows of the mission: its name, block tree and map) and `history` (the
+/// events so far) are read, the others are the control calls of `POST /api/CALL`.
+pub const CALLS: [&str; 9] =
+    ["state", "mission", "history", "leash", "signal", "drone", "pause", "resume", "abort"];
+
+/// The calls that only read.
+pub const READS: [&str; 3] = ["state", "mission", "history"];
 
 impl Keys {
     /// The keys under `prefix`, refused with the reason when it is not a key expression

@@ -23,6 +23,7 @@ mod client;
 mod keys;
 mod publish;
 mod queries;
+pub mod remote;
 
 pub use carrier::Agents;
 pub use client::Client;
@@ -54,11 +55,13 @@ pub fn config(file: Option<&Path>) -> Result<zenoh::Config, String> {
 }
 
 /// The run's operator API as the bridge reaches it: the router, the address the router
-/// believes it is bound at (its `Host`), and the feed of events.
+/// believes it is bound at (its `Host`), and the feed of events; and what a station shows
+/// of the mission, `{"mission": NAME, "tree": ..., "map": ...}` (`PREFIX/api/mission`).
 pub struct Api {
     pub router: axum::Router,
     pub bound: SocketAddr,
     pub feed: aviary_server::Feed,
+    pub mission: serde_json::Value,
 }
 
 /// Opens a session with `config`.
@@ -78,7 +81,8 @@ impl Bridge {
     pub fn start(session: zenoh::Session, keys: Keys, api: Api) -> Result<Bridge, String> {
         let lines = api.feed.subscribe();
         let publisher = publish::start(session.clone(), keys.clone(), lines, api.feed.clone())?;
-        queries::start(session.clone(), keys, api.router, api.bound)?;
+        let mission = serde_json::to_vec(&api.mission).map_err(|e| e.to_string())?;
+        queries::start(session.clone(), keys, api.router, api.bound, (mission, api.feed))?;
         Ok(Bridge { session, publisher: Some(publisher) })
     }
 

@@ -102,7 +102,13 @@ impl Publishing {
                 },
             },
         };
-        if let Err(e) = publisher.put(text).wait() {
+        // An event's place in the run, beside it: a station that asked for the history
+        // (`PREFIX/api/history`) joins it to what it hears by it.
+        let put = match line.telemetry_of {
+            None => publisher.put(text).attachment(line.seq.to_string()),
+            Some(_) => publisher.put(text),
+        };
+        if let Err(e) = put.wait() {
             eprintln!("aviary: zenoh: an event was not published: {}", crate::reason(&e));
         }
     }

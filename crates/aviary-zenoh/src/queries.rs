@@ -1,6 +1,8 @@
 //! The operator API as queryables: a query on `PREFIX/api/CALL` is the HTTP request it
 //! stands for (`GET /api/state`, or `POST /api/CALL` with the query's payload as its JSON
-//! body and the query's attachment as its token), answered by the run's own router. A
+//! body and the query's attachment as its token), answered by the run's own router; and
+//! `PREFIX/api/mission` and `PREFIX/api/history` are answered with what a station shows
+//! of the mission and the events so far. A
 //! success is the reply, anything else an error reply with the same JSON, and logged: a
 //! peer that sends garbage or calls without the token changes nothing, and the operator
 //! sees that it tried.
@@ -15,7 +17,7 @@ use zenoh::bytes::Encoding;
 use zenoh::query::Query;
 use zenoh::Wait;
 
-use crate::keys::CALLS;
+use crate::keys::{CALLS, READS};
 use crate::Keys;
 
 /// The longest answer read back from the router (a state document of a large fleet).
@@ -26,6 +28,7 @@ pub(crate) fn start(
     keys: Keys,
     router: axum::Router,
     bound: SocketAddr,
+    (mission, feed): (Vec<u8>, aviary_server::Feed),
 ) -> Result<JoinHandle<()>, String> {
     let queryable = session
         .declare_queryable(keys.api())
@@ -39,7 +42,11 @@ pub(crate) fn start(
         .spawn(move || {
             // Until the session closes.
             while let Ok(query) = queryable.recv() {
-                let (status, body) = runtime.block_on(answer(&keys, &router, bound, &query));
+                let (status, body) = match keys.call_of(query.key_expr().as_str()) {
+                    Some("mission") => (StatusCode::OK, mission.clone()),
+                    Some("history") => (StatusCode::OK, history(&feed)),
+                    _ => runtime.block_on(answer(&keys, &router, bound, &query)),
+                };
                 reply(&query, status, body);
             }
         })
@@ -58,7 +65,7 @@ async fn answer(
         let why = format!("{key} is not a call: the calls are {}", CALLS.join(", "));
         return (StatusCode::NOT_FOUND, error(&why));
     };
-    let method = if call == "state" { Method::GET } else { Method::POST };
+    let method = if READS.contains(&call) { Method::GET } else { Method::POST };
     let mut request = Request::builder()
         .method(method)
         .uri(format!("/api/{call}"))
@@ -111,6 +118,18 @@ fn reply(query: &Query, status: StatusCode, body: Vec<u8>) {
     if let Err(e) = sent {
         eprintln!("aviary: zenoh: the answer on {key} was not sent: {}", crate::reason(&e));
     }
+}
+
+/// The events so far as JSON Lines: first `{"dropped": N}` (how many of the oldest the
+/// run let go), then each event's trace line, the `N`th first.
+fn history(feed: &aviary_server::Feed) -> Vec<u8> {
+    let (lines, dropped) = feed.past();
+    let mut out = format!("{{\"dropped\":{dropped}}}\n").into_bytes();
+    for line in lines {
+        out.extend_from_slice(line.text.as_bytes());
+        out.push(b'\n');
+    }
+    out
 }
 
 fn error(why: &str) -> Vec<u8> {

@@ -5,7 +5,9 @@ run's endpoint and holds the payloads to docs/DISTRIBUTED.md: every event on
 PREFIX/events and every sample on PREFIX/telemetry/DRONE is one JSON object of the trace
 (`t`, `event`; a sample's `actor` is the key's last chunk), PREFIX/state is the operator
 state (`status`, `drones`), and PREFIX/api/CALL answers as the HTTP API does: reading
-with no token, a control without the token refused, with it accepted.
+with no token, a control without the token refused, with it accepted. Each event's
+attachment is its place in the run, and PREFIX/api/history holds the events so far, the
+same lines in the same places; PREFIX/api/mission gives the mission's name, tree and map.
 
     python tests/zenoh/watch.py path/to/aviary
 """
@@ -42,14 +44,20 @@ def peer(endpoints, port):
     )
 
 
-def ask(session, key, token=None):
-    """The one reply to a query: (ok, the JSON it carries)."""
+def ask_text(session, key, token=None):
+    """The one reply to a query: (ok, the text it carries)."""
     kwargs = {"attachment": token} if token else {}
     for reply in session.get(key, timeout=5.0, **kwargs):
         if reply.ok is not None:
-            return True, json.loads(reply.ok.payload.to_string())
-        return False, json.loads(reply.err.payload.to_string())
+            return True, reply.ok.payload.to_string()
+        return False, reply.err.payload.to_string()
     fail(f"no reply on {key}")
+
+
+def ask(session, key, token=None):
+    """The one reply to a query: (ok, the JSON it carries)."""
+    ok, text = ask_text(session, key, token)
+    return ok, json.loads(text)
 
 
 def main():
@@ -79,6 +87,12 @@ def main():
     ok, state = ask(session, "aviary/M/api/state")
     if not ok or not isinstance(state.get("drones"), list):
         fail(f"the state query: {state}")
+    ok, shown = ask(session, "aviary/M/api/mission")
+    if not ok or shown.get("mission") != "M" or shown["tree"].get("name") != "M" or "map" not in shown:
+        fail(f"the mission query: {shown}")
+    ok, history = ask_text(session, "aviary/M/api/history")
+    if not ok:
+        fail(f"the history query: {history}")
     ok, refused = ask(session, "aviary/M/api/pause")
     if ok or "token" not in refused.get("error", ""):
         fail(f"a pause without the token was not refused: {refused}")
@@ -86,7 +100,7 @@ def main():
     if not ok:
         fail(f"an abort with the token was refused: {accepted}")
 
-    events, telemetry, states, ended = [], {}, [], False
+    events, places, lines, telemetry, states, ended = [], [], {}, {}, [], False
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline and not (ended and states and states[-1]["status"] != "running"):
         sample = heard.try_recv()
@@ -100,6 +114,11 @@ def main():
         if key == "aviary/M/events":
             if not isinstance(payload.get("t"), (int, float)) or "event" not in payload:
                 fail(f"an event without t or event: {payload}")
+            place = int(sample.attachment.to_string()) if sample.attachment is not None else None
+            if events and place != places[-1] + 1:
+                fail(f"event {payload} at place {place} after {places[-1]}")
+            places.append(place)
+            lines[place] = sample.payload.to_string()
             events.append(payload)
             ended = ended or payload["event"] == "mission_end"
         elif key.startswith("aviary/M/telemetry/"):
@@ -111,6 +130,15 @@ def main():
             states.append(payload)
         else:
             fail(f"a key docs/DISTRIBUTED.md does not list: {key}")
+    # The history, asked after the subscription began, holds the same lines in the same
+    # places as heard, and reaches the first one heard: none is missed between the two.
+    first, *past = history.splitlines()
+    dropped = json.loads(first)["dropped"]
+    if not places or places[0] > dropped + len(past):
+        fail(f"the first event heard is at {places[:1]}, after a history of {len(past)}")
+    for place, line in lines.items():
+        if dropped <= place < dropped + len(past) and past[place - dropped] != line:
+            fail(f"history place {place}: {past[place - dropped]!r}, heard {line!r}")
     session.close()
     code = run.wait(timeout=30)
     if not ended:

@@ -5,7 +5,6 @@
 
 use std::path::Path;
 
-use aviary_api::geo::Origin;
 use aviary_api::trace::Record;
 
 pub fn run(trace: &Path, world: Option<&Path>, bag: &Path) -> u8 {
@@ -30,11 +29,7 @@ pub fn run(trace: &Path, world: Option<&Path>, bag: &Path) -> u8 {
             }
         }
     }
-    let origin = world.as_ref().and_then(|w| w.site.origin.as_ref()).map(|o| Origin {
-        lat: o.lat,
-        lon: o.lon,
-        alt: o.alt,
-    });
+    let origin = world.as_ref().and_then(|w| w.site.origin.as_ref()).map(aviary_world::Geo::origin);
     if origin.is_none() {
         eprintln!("aviary: no world with an origin: the bag has the drones' poses in the local frame, no positions on the Earth");
     }

@@ -138,6 +138,10 @@ enum Command {
         /// With --zenoh: the key prefix of the mission's keys (default: aviary/MISSION)
         #[arg(long, value_name = "KEY", requires = "zenoh")]
         zenoh_prefix: Option<String>,
+        /// With --zenoh: also for ROS 2 on rmw_zenoh, in the domain ROS_DOMAIN_ID (0 when
+        /// unset): the events, and each drone's pose and fix (docs/ROS2.md)
+        #[arg(long, requires = "zenoh")]
+        ros: bool,
         /// A folder whose .mission files USE may read, besides the mission's own (repeatable)
         #[arg(long, value_name = "DIR", value_parser = folder)]
         use_root: Vec<PathBuf>,
@@ -314,6 +318,16 @@ enum Command {
     },
 }
 
+/// `ROS_DOMAIN_ID`, as ROS 2 reads it: 0 when unset.
+fn ros_domain() -> Result<u32, String> {
+    match std::env::var("ROS_DOMAIN_ID") {
+        Ok(text) if !text.trim().is_empty() => text.trim().parse::<u32>().map_err(|_| {
+            format!("ROS_DOMAIN_ID is `{text}`: it must be a whole number, such as 0 or 42")
+        }),
+        _ => Ok(0),
+    }
+}
+
 /// A file name from the command line: not empty. (An empty one would read as "no such
 /// file", or as clap's "none was supplied", neither of which says what was empty.)
 fn nonempty(s: &str, what: &str) -> Result<PathBuf, String> {
@@ -393,6 +407,7 @@ fn command(cli: Cli) -> u8 {
             allow_host,
             zenoh,
             zenoh_prefix,
+            ros,
             use_root,
             clock,
         } => {
@@ -402,7 +417,8 @@ fn command(cli: Cli) -> u8 {
             let zenoh = zenoh
                 .map(|config| {
                     let keys = zenoh_prefix.as_deref().map(aviary_zenoh::Keys::new).transpose()?;
-                    Ok::<_, String>(run::Zenoh { config, keys })
+                    let ros = ros.then(ros_domain).transpose()?;
+                    Ok::<_, String>(run::Zenoh { config, keys, ros })
                 })
                 .transpose();
             match (

@@ -46,6 +46,8 @@ pub struct Zenoh {
     pub config: Option<PathBuf>,
     /// `None`: `aviary/MISSION`.
     pub keys: Option<aviary_zenoh::Keys>,
+    /// `--ros`: also for ROS 2 on rmw_zenoh, in this domain.
+    pub ros: Option<u32>,
 }
 
 /// `7878` is loopback port 7878; `HOST:PORT` binds exactly that.
@@ -184,8 +186,7 @@ pub fn run(args: &RunArgs) -> u8 {
         zenoh: None,
         map: serde_json::Value::Null,
         bounds: None,
-        zenoh_bounds: None,
-        zenoh_map: serde_json::Value::Null,
+        zenoh_world: None,
         progress: None,
         stats: Stats::default(),
         drones: 0,
@@ -287,8 +288,7 @@ struct Shown<'a> {
     map: serde_json::Value,
     bounds: Option<aviary_server::Bounds>,
     /// The same, for the operator API on Zenoh.
-    zenoh_bounds: Option<aviary_server::Bounds>,
-    zenoh_map: serde_json::Value,
+    zenoh_world: Option<crate::zenoh::Seen>,
     /// Made once the run starts.
     progress: Option<ProgressBar>,
     stats: Stats,
@@ -309,8 +309,7 @@ impl Hooks for Shown<'_> {
             self.bounds = Some(aviary_server::Bounds::of(world));
         }
         if self.args.zenoh.is_some() {
-            self.zenoh_bounds = Some(aviary_server::Bounds::of(world));
-            self.zenoh_map = aviary_station::checking::map_of(world);
+            self.zenoh_world = Some(crate::zenoh::Seen::of(world));
         }
         self.expected = Some(Expected {
             observer: aviary_campaign::Observer::new(mission),
@@ -359,15 +358,13 @@ impl Hooks for Shown<'_> {
             self.server = Some((serving, feed));
         }
         if let (Some(zenoh), Some(session)) = (&self.args.zenoh, self.session.take()) {
-            let bounds =
-                self.zenoh_bounds.take().ok_or("the run starts before its world was read")?;
+            let seen = self.zenoh_world.take().ok_or("the run starts before its world was read")?;
             let token = self.server.as_ref().map(|(serving, _)| serving.token.clone());
-            let map = std::mem::take(&mut self.zenoh_map);
             self.zenoh = Some(crate::zenoh::start(
                 session,
                 zenoh,
                 mission,
-                (bounds, map),
+                seen,
                 controller.clone(),
                 token,
             )?);

@@ -17,13 +17,32 @@ pub fn open(zenoh: &Zenoh) -> Result<aviary_zenoh::Session, String> {
     aviary_zenoh::open(aviary_zenoh::config(zenoh.config.as_deref())?)
 }
 
-/// Starts the bridge on the run's `session`; says where on standard error. `bounds` are
-/// where the world lets an operator send a drone, `map` what a station draws of it.
+/// What the bridge needs of the world, kept from the time it is read.
+pub struct Seen {
+    /// Where the world lets an operator send a drone.
+    bounds: Bounds,
+    /// What a station draws of it.
+    map: serde_json::Value,
+    /// Where its frame sits on the Earth, for ROS 2's fixes.
+    origin: Option<aviary_api::geo::Origin>,
+}
+
+impl Seen {
+    pub fn of(world: &aviary_world::World) -> Seen {
+        Seen {
+            bounds: Bounds::of(world),
+            map: aviary_station::checking::map_of(world),
+            origin: world.site.origin.as_ref().map(aviary_world::Geo::origin),
+        }
+    }
+}
+
+/// Starts the bridge on the run's `session`; says where on standard error.
 pub fn start(
     session: aviary_zenoh::Session,
     zenoh: &Zenoh,
     mission: &Mission,
-    (bounds, map): (Bounds, serde_json::Value),
+    Seen { bounds, map, origin }: Seen,
     controller: Controller,
     token: Option<String>,
 ) -> Result<(Bridge, Feed), String> {
@@ -48,7 +67,8 @@ pub fn start(
         "tree": aviary_station::tree::of(mission, None),
         "map": map,
     });
-    let api = Api { router, bound, feed: feed.clone(), mission: shown };
+    let ros = zenoh.ros.map(|domain| aviary_zenoh::ros::Ros { domain, origin });
+    let api = Api { router, bound, feed: feed.clone(), mission: shown, ros };
     let bridge = Bridge::start(session, keys, api)?;
     use std::io::Write;
     let _ = writeln!(

@@ -92,7 +92,7 @@ fn origin(world: &World) -> Result<Origin, String> {
     let Some(g) = world.site.origin.as_ref() else {
         return Err("a world with MAVLink drones needs `origin = { lat, lon, alt }` in [site]: where the local frame sits on the Earth".into());
     };
-    Ok(Origin { lat: g.lat, lon: g.lon, alt: g.alt })
+    Ok(g.origin())
 }
 
 /// Waits for each vehicle's first HEARTBEAT, each within the connect timeout.

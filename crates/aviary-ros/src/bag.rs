@@ -2,30 +2,20 @@
 //! `ros2msg` schemas, CDR messages) and the `metadata.yaml` that `ros2 bag` and rosbags
 //! read first. Foxglove opens the MCAP file alone.
 //!
-//! Its topics: `/aviary/events` (`aviary_msgs/msg/Event`, every event of the trace),
-//! and for each drone `/aviary/DRONE/pose` (`geometry_msgs/msg/PoseStamped`, in the
-//! mission's local frame `map`: metres east, north and up of the world's origin) and,
-//! when the world places that origin on the Earth, `/aviary/DRONE/fix`
-//! (`sensor_msgs/msg/NavSatFix`), each from the trace's telemetry. Times are mission
-//! time: the bag starts at 0 (1 January 1970, as a bag reader shows it).
+//! Its topics are [`crate::topics`]'s. Times are mission time: the bag starts at 0
+//! (1 January 1970, as a bag reader shows it).
 
 use std::collections::BTreeMap;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 use aviary_api::geo::Origin;
-use aviary_api::trace::{Event as TraceEvent, Record};
+use aviary_api::trace::Record;
 use serde::Serialize;
 
-use crate::msgs::{
-    self, Event, Header, Message, NavSatFix, NavSatStatus, Point, Pose, PoseStamped, Quaternion,
-    Time,
-};
-
-/// The frame of the poses: the mission's local east-north-up metres.
-pub const LOCAL_FRAME: &str = "map";
-/// The topic of the trace's events.
-pub const EVENTS: &str = "/aviary/events";
+use crate::msgs::Time;
+use crate::topics::{self, Sent};
+pub use crate::topics::{EVENTS, LOCAL_FRAME};
 
 /// What a bag holds.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -125,30 +115,14 @@ impl<W: std::io::Write + std::io::Seek> Bag<W> {
     fn record(&mut self, record: &Record<'_>) -> Result<(), Failed> {
         let stamp = Time::of(record.t);
         self.end = stamp;
-        let header = || Header { stamp, frame_id: LOCAL_FRAME.into() };
-        let json = serde_json::to_string(record).map_err(|e| Failed::Encoding(e.to_string()))?;
-        let kind = record.event.kind().as_str().to_string();
-        self.write(EVENTS, stamp, &Event { header: header(), event: kind, json })?;
-        if let TraceEvent::Telemetry { actor, position, .. } = &record.event {
-            let [x, y, z] = *position;
-            let pose = PoseStamped {
-                header: header(),
-                pose: Pose { position: Point { x, y, z }, orientation: Quaternion::IDENTITY },
-            };
-            self.write(&format!("/aviary/{actor}/pose"), stamp, &pose)?;
-            if let Some(origin) = self.origin {
-                self.write(
-                    &format!("/aviary/{actor}/fix"),
-                    stamp,
-                    &fix(origin, header(), *position),
-                )?;
-            }
+        for (topic, message) in topics::of(record, self.origin).map_err(Failed::Encoding)? {
+            self.write(&topic, stamp, &message)?;
         }
         Ok(())
     }
 
-    fn write<M: Message>(&mut self, topic: &str, stamp: Time, message: &M) -> Result<(), Failed> {
-        let data = msgs::cdr(message).map_err(Failed::Encoding)?;
+    fn write(&mut self, topic: &str, stamp: Time, message: &Sent) -> Result<(), Failed> {
+        let data = message.cdr().map_err(Failed::Encoding)?;
         let (channel, sequence) = match self.channels.get_mut(topic) {
             Some((channel, _, count)) => {
                 *count += 1;
@@ -156,10 +130,11 @@ impl<W: std::io::Write + std::io::Seek> Bag<W> {
             }
             None => {
                 // MCAP keeps each schema once, however many topics add it.
-                let definition = M::definition();
-                let schema = self.mcap.add_schema(M::TYPE, "ros2msg", definition.as_bytes())?;
+                let definition = message.definition();
+                let ty = message.ty();
+                let schema = self.mcap.add_schema(ty, "ros2msg", definition.as_bytes())?;
                 let channel = self.mcap.add_channel(schema, topic, "cdr", &BTreeMap::new())?;
-                self.channels.insert(topic.to_string(), (channel, M::TYPE, 1));
+                self.channels.insert(topic.to_string(), (channel, ty, 1));
                 (channel, 1)
             }
         };
@@ -181,23 +156,6 @@ impl<W: std::io::Write + std::io::Seek> Bag<W> {
             .map(|(name, (_, ty, messages))| Topic { name, ty, messages })
             .collect();
         Ok((topics, self.end))
-    }
-}
-
-/// Where a drone at local `position` is on the Earth; no fix where the trace has no
-/// position (a coordinate that is not finite).
-fn fix(origin: Origin, header: Header, position: [f64; 3]) -> NavSatFix {
-    let [x, y, z] = position;
-    let (latitude, longitude) = origin.to_geodetic(x, y);
-    let known = position.iter().all(|c| c.is_finite());
-    NavSatFix {
-        header,
-        status: NavSatStatus { status: if known { 0 } else { -1 }, service: 1 },
-        latitude,
-        longitude,
-        altitude: origin.alt + z,
-        position_covariance: [0.0; 9],
-        position_covariance_type: 0,
     }
 }
 

@@ -5,4 +5,6 @@
 //! Invariant: no IO but the bag's files, which [`bag::write`] is given the folder of.
 
 pub mod bag;
+pub mod hash;
 pub mod msgs;
+pub mod topics;

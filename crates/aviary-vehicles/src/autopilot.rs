@@ -156,11 +156,8 @@ impl Autopilot {
                 }
             })
             .collect();
-        let origin = world.site.origin.as_ref().map_or(Origin::default(), |g| Origin {
-            lat: g.lat,
-            lon: g.lon,
-            alt: g.alt,
-        });
+        let origin =
+            world.site.origin.as_ref().map_or(Origin::default(), aviary_world::Geo::origin);
         // An autopilot knows its geofence, not Aviary's no-fly zones: a real ArduCopter
         // flies a GUIDED target and its own RTL straight, so the detour must be the
         // backend's (aviary-mavlink sends it as waypoints), and the test of it means

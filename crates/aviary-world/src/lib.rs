@@ -189,6 +189,13 @@ pub struct Geo {
     pub alt: f64,
 }
 
+impl Geo {
+    /// As the projection between local metres and the Earth takes it.
+    pub fn origin(&self) -> aviary_api::geo::Origin {
+        aviary_api::geo::Origin { lat: self.lat, lon: self.lon, alt: self.alt }
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Place {
     pub name: String,

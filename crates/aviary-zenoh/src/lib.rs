@@ -24,6 +24,7 @@ mod keys;
 mod publish;
 mod queries;
 pub mod remote;
+pub mod ros;
 
 pub use carrier::Agents;
 pub use client::Client;
@@ -62,6 +63,8 @@ pub struct Api {
     pub bound: SocketAddr,
     pub feed: aviary_server::Feed,
     pub mission: serde_json::Value,
+    /// Also for ROS 2 on rmw_zenoh (`--ros`).
+    pub ros: Option<ros::Ros>,
 }
 
 /// Opens a session with `config`.
@@ -72,7 +75,8 @@ pub fn open(config: zenoh::Config) -> Result<zenoh::Session, String> {
 /// A run on Zenoh, until [`Bridge::finish`].
 pub struct Bridge {
     session: zenoh::Session,
-    publisher: Option<JoinHandle<()>>,
+    /// The publishers, each until it has sent `mission_end`.
+    publishers: Vec<JoinHandle<()>>,
 }
 
 impl Bridge {
@@ -80,21 +84,23 @@ impl Bridge {
     /// under `keys`. Call before the run's first event.
     pub fn start(session: zenoh::Session, keys: Keys, api: Api) -> Result<Bridge, String> {
         let lines = api.feed.subscribe();
-        let publisher = publish::start(session.clone(), keys.clone(), lines, api.feed.clone())?;
+        let mut publishers =
+            vec![publish::start(session.clone(), keys.clone(), lines, api.feed.clone())?];
+        if let Some(ros) = api.ros {
+            publishers.push(ros::start(session.clone(), api.feed.subscribe(), ros)?);
+        }
         let mission = serde_json::to_vec(&api.mission).map_err(|e| e.to_string())?;
         queries::start(session.clone(), keys, api.router, api.bound, (mission, api.feed))?;
-        Ok(Bridge { session, publisher: Some(publisher) })
+        Ok(Bridge { session, publishers })
     }
 
     /// After `mission_end`: waits (at most `limit`) until the publisher has sent it and
     /// the last state, then closes the session, so that no peer misses how the mission
     /// ended.
-    pub fn finish(mut self, limit: Duration) {
-        if let Some(publisher) = self.publisher.take() {
-            let start = std::time::Instant::now();
-            while !publisher.is_finished() && start.elapsed() < limit {
-                std::thread::sleep(Duration::from_millis(10));
-            }
+    pub fn finish(self, limit: Duration) {
+        let start = std::time::Instant::now();
+        while self.publishers.iter().any(|p| !p.is_finished()) && start.elapsed() < limit {
+            std::thread::sleep(Duration::from_millis(10));
         }
         if let Err(e) = self.session.close().wait() {
             eprintln!("aviary: zenoh: the session did not close cleanly: {e}");

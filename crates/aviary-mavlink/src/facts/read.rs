@@ -102,9 +102,11 @@ pub async fn ask(world: &World, wait: Duration) -> Result<Vec<Facts>, String> {
     let until = Instant::now() + wait;
     let bound = crate::bindings(world);
     let links = crate::link_keys(world, &bound)?;
-    let origin = world.site.origin.as_ref().map_or(Origin { lat: 0.0, lon: 0.0, alt: 0.0 }, |g| {
-        Origin { lat: g.lat, lon: g.lon, alt: g.alt }
-    });
+    let origin = world
+        .site
+        .origin
+        .as_ref()
+        .map_or(Origin { lat: 0.0, lon: 0.0, alt: 0.0 }, aviary_world::Geo::origin);
     // Nobody listens: asking flies nothing, so nothing is detected or raised.
     let (events, _) = mpsc::unbounded_channel();
     let (alarms, _) = mpsc::unbounded_channel();

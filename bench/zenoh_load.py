@@ -5,7 +5,12 @@ second and the lag of each sample (when it arrived, less when it was due: the ru
 first sample's arrival plus its mission time), in the first and the last seconds, so
 that a lag that grows shows.
 
-    python bench/zenoh_load.py ./target/release/aviary [--drones 1000] [--hz 10] [--seconds 60]
+With `--router ZENOHD`, the run and the receiver are Zenoh clients of a `zenohd` router
+that the script starts, as a mission and a station on two machines would be. With
+`--check`, it fails (exit 1) unless 95 % of the samples arrived and the median lag of the
+last 5 s is within 250 ms of the first 5 s's: `.ci/run` runs it so.
+
+    python bench/zenoh_load.py ./target/release/aviary [--drones 1000] [--hz 10] [--seconds 60] [--router zenohd] [--check]
 """
 
 import argparse
@@ -32,6 +37,8 @@ def main():
     parser.add_argument("--drones", type=int, default=1000)
     parser.add_argument("--hz", type=float, default=10)
     parser.add_argument("--seconds", type=float, default=60)
+    parser.add_argument("--router", help="a zenohd binary: both sides are its clients")
+    parser.add_argument("--check", action="store_true", help="fail unless the samples arrive and the lag holds")
     args = parser.parse_args()
     aviary = os.path.abspath(args.aviary)
     work = tempfile.mkdtemp(prefix="aviary-zenoh-load-")
@@ -40,16 +47,26 @@ def main():
             subprocess.run([aviary, "bench", "swarm", "--drones", str(args.drones), flag], stdout=f, check=True)
     port = free_port()
     no_scouting = "scouting: { multicast: { enabled: false }, gossip: { enabled: false } }"
+    router = None
+    if args.router:
+        router = subprocess.Popen(
+            [os.path.abspath(args.router), "--listen", "tcp/127.0.0.1:%d" % port, "--no-multicast-scouting"],
+            cwd=work, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        )
+        time.sleep(1)
+        run_side = receiver = '{ mode: "client", connect: { endpoints: ["tcp/127.0.0.1:%d"] } }' % port
+    else:
+        run_side = '{ mode: "peer", listen: { endpoints: ["tcp/127.0.0.1:%d"] }, %s }' % (port, no_scouting)
+        receiver = '{ mode: "peer", connect: { endpoints: ["tcp/127.0.0.1:%d"] }, %s }' % (port, no_scouting)
     with open(os.path.join(work, "zenoh.json5"), "w") as f:
-        f.write('{ mode: "peer", listen: { endpoints: ["tcp/127.0.0.1:%d"] }, %s }' % (port, no_scouting))
+        f.write(run_side)
     run = subprocess.Popen(
         [aviary, "run", "swarm.mission", "--world", "swarm.world.toml", "--zenoh", "zenoh.json5",
          "--zenoh-prefix", "load", "--speed", "1", "--telemetry-hz", str(args.hz), "--quiet"],
         cwd=work, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
     )
     run.stderr.readline()
-    session = zenoh.open(zenoh.Config.from_json5(
-        '{ mode: "peer", connect: { endpoints: ["tcp/127.0.0.1:%d"] }, %s }' % (port, no_scouting)))
+    session = zenoh.open(zenoh.Config.from_json5(receiver))
     arrivals = []  # (arrival, mission time)
 
     def heard(sample):
@@ -61,6 +78,9 @@ def main():
     session.close()
     run.terminate()
     run.wait(timeout=30)
+    if router:
+        router.terminate()
+        router.wait(timeout=30)
     if not arrivals:
         raise SystemExit("no telemetry arrived")
     first_arrival, first_t = arrivals[0]
@@ -76,6 +96,12 @@ def main():
           f"{len(arrivals) / span:.0f} a second (expected {args.drones * args.hz:.0f})")
     print(f"lag, first 5 s: median {ms(early, 50):.1f} ms, 95th {ms(early, 95):.1f} ms")
     print(f"lag, last 5 s:  median {ms(late, 50):.1f} ms, 95th {ms(late, 95):.1f} ms")
+    if args.check:
+        rate = len(arrivals) / span / (args.drones * args.hz)
+        grown = ms(late, 50) - ms(early, 50)
+        if rate < 0.95 or not grown < 250:
+            raise SystemExit(f"zenoh_load: FAILED: {rate:.1%} of the samples arrived, the median lag grew {grown:.0f} ms")
+        print(f"zenoh_load: {rate:.1%} of the samples arrived, the median lag moved {grown:.0f} ms: OK")
 
 
 if __name__ == "__main__":

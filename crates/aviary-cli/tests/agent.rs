@@ -8,15 +8,14 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
-use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use aviary_api::trace::{CallStatus, Event, Record, Shown};
 use aviary_api::Function;
 use aviary_test_support::trace::{actor, Trace};
+use common::agent::Agent;
 use common::vehicles::Vehicles;
 use common::{free_port, scratch, wait_at_most, zenoh_peer};
 use zenoh::Wait;
@@ -54,48 +53,6 @@ MISSION Hold:
 /// The world with both drones behind agent `field1`.
 fn behind_the_agent() -> String {
     WORLD.replace("home = [", "mavlink = \"agent:field1\"\nhome = [")
-}
-
-/// An `aviary agent`, its standard error kept as it comes; killed when dropped.
-struct Agent {
-    child: Child,
-    said: Arc<Mutex<String>>,
-}
-
-impl Agent {
-    fn start(dir: &Path, config: &str, vehicles: u16) -> Agent {
-        std::fs::write(dir.join("agent.json5"), config).expect("config");
-        let mut child = Command::new(env!("CARGO_BIN_EXE_aviary"))
-            .args(["agent", "--name", "field1", "--zenoh", "agent.json5", "--mavlink"])
-            .arg(format!("tcp:127.0.0.1:{vehicles}"))
-            .current_dir(dir)
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("spawn aviary agent");
-        let said = Arc::new(Mutex::new(String::new()));
-        let stderr = BufReader::new(child.stderr.take().expect("stderr"));
-        let into = Arc::clone(&said);
-        std::thread::spawn(move || {
-            for line in stderr.lines().map_while(Result::ok) {
-                let mut said = into.lock().expect("lock");
-                said.push_str(&line);
-                said.push('\n');
-            }
-        });
-        Agent { child, said }
-    }
-
-    fn said(&self) -> String {
-        self.said.lock().expect("lock").clone()
-    }
-}
-
-impl Drop for Agent {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
 }
 
 /// `aviary run --zenoh` of the mission (hovering `hover`) in `dir`, its trace `t.jsonl`.

@@ -3,7 +3,7 @@
 //! rmw_zenoh, ROS 2's middleware on Zenoh, publishes them, so that ROS 2 nodes on
 //! `rmw_zenoh` see the fleet (`ros2 topic echo /aviary/scout/fix`).
 //!
-//! As rmw_zenoh has it (its `docs/design.md`, `liveliness_utils.cpp`,
+//! As rmw_zenoh has it (its design document, and its `liveliness_utils.cpp` and
 //! `attachment_helpers.cpp`):
 //! - a message is put on `DOMAIN/TOPIC/TYPE/HASH` (the topic without its leading `/`, the
 //!   type in its DDS form `pkg::msg::dds_::Name_`, the hash RIHS01), as CDR;

@@ -86,6 +86,7 @@ pub fn free_port() -> u16 {
     listener.local_addr().expect("its address").port()
 }
 
+pub mod agent;
 pub mod background;
 pub mod logs;
 pub mod px4;

@@ -16,25 +16,9 @@ use aviary_api::trace::{CallStatus, Event, Record, Shown};
 use aviary_api::Function;
 use aviary_test_support::trace::{actor, Trace};
 use common::agent::Agent;
-use common::vehicles::Vehicles;
+use common::vehicles::{Vehicles, SMALL_WORLD};
 use common::{free_port, scratch, wait_at_most, zenoh_peer};
 use zenoh::Wait;
-
-const WORLD: &str = "\
-[site]
-origin = { lat = 46.6167, lon = 14.2650, alt = 440.0 }
-geofence = [[-100, -100], [100, -100], [100, 100], [-100, 100]]
-
-[places]
-Near = [10, 10]
-Far = [-20, 10]
-
-[drones.scout]
-home = [0, 0]
-
-[drones.buddy]
-home = [10, 0]
-";
 
 /// The scout hovers long enough for its agent to be cut off mid-flight.
 const MISSION: &str = "\
@@ -52,7 +36,7 @@ MISSION Hold:
 
 /// The world with both drones behind agent `field1`.
 fn behind_the_agent() -> String {
-    WORLD.replace("home = [", "mavlink = \"agent:field1\"\nhome = [")
+    SMALL_WORLD.replace("home = [", "mavlink = \"agent:field1\"\nhome = [")
 }
 
 /// `aviary run --zenoh` of the mission (hovering `hover`) in `dir`, its trace `t.jsonl`.
@@ -86,7 +70,7 @@ fn stderr_of(child: &mut Child) -> String {
 #[test]
 fn a_mission_flies_its_vehicles_through_an_agent_and_garbage_reaches_none() {
     let dir = scratch("agent_flies");
-    std::fs::write(dir.join("vehicles.world.toml"), WORLD).expect("world");
+    std::fs::write(dir.join("vehicles.world.toml"), SMALL_WORLD).expect("world");
     let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
     let port = free_port();
     let endpoint = format!("tcp/127.0.0.1:{port}");
@@ -155,7 +139,7 @@ fn a_lost_agent_is_connection_lost_and_a_missing_one_a_clear_error() {
         "{err}"
     );
 
-    std::fs::write(dir.join("vehicles.world.toml"), WORLD).expect("world");
+    std::fs::write(dir.join("vehicles.world.toml"), SMALL_WORLD).expect("world");
     let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
     let mut run = start_run(&dir, &zenoh_peer("listen", &endpoint), "60s");
     let mut agent = Agent::start(&dir, &zenoh_peer("connect", &endpoint), vehicles.port);

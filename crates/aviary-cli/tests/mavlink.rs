@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use aviary_api::trace::{CallStatus, Event, EventKind, Record, Shown};
 use aviary_api::{Function, Remainder};
 use aviary_test_support::trace::{actor, Trace};
-use common::vehicles::Vehicles;
+use common::vehicles::{Vehicles, SMALL_WORLD};
 use common::{aviary, repo, scratch};
 use serde_json::Value;
 
@@ -197,23 +197,6 @@ MISSION Hold:
             buddy TakeOff WITH 10m
             buddy FlyTo WITH Far
             buddy ReturnHome
-";
-
-const SMALL_WORLD: &str = "\
-[site]
-name = \"Loopback field\"
-origin = { lat = 46.6167, lon = 14.2650, alt = 440.0 }
-geofence = [[-100, -100], [100, -100], [100, 100], [-100, 100]]
-
-[places]
-Near = [10, 10]
-Far = [-20, 10]
-
-[drones.scout]
-home = [0, 0]
-
-[drones.buddy]
-home = [10, 0]
 ";
 
 #[test]

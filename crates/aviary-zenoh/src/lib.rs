@@ -108,6 +108,30 @@ impl Bridge {
     }
 }
 
+/// Each line `lines` carries, to `each`, until `mission_end` (given to `each` too) or
+/// the feed's end. Lines missed by falling behind are said, naming `who`.
+pub(crate) fn follow(
+    mut lines: tokio::sync::broadcast::Receiver<std::sync::Arc<aviary_server::Line>>,
+    who: &str,
+    mut each: impl FnMut(&aviary_server::Line),
+) {
+    use tokio::sync::broadcast::error::RecvError;
+    loop {
+        match lines.blocking_recv() {
+            Ok(line) => {
+                each(&line);
+                if line.end {
+                    return;
+                }
+            }
+            Err(RecvError::Lagged(missed)) => {
+                eprintln!("aviary: {who} fell behind and {missed} events were not published")
+            }
+            Err(RecvError::Closed) => return,
+        }
+    }
+}
+
 /// A Zenoh error's reason, without the source location Zenoh appends
 /// (` at /.../zenoh-config-1.10.2/src/lib.rs:1507.`), which says nothing to an operator.
 pub(crate) fn reason(e: &dyn std::fmt::Display) -> String {

@@ -7,7 +7,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use aviary_server::{Feed, Line};
-use tokio::sync::broadcast::{error::RecvError, Receiver};
+use tokio::sync::broadcast::Receiver;
 use zenoh::bytes::Encoding;
 use zenoh::pubsub::Publisher;
 use zenoh::Wait;
@@ -63,28 +63,15 @@ struct Publishing {
 }
 
 impl Publishing {
-    fn run(&mut self, mut lines: Receiver<Arc<Line>>) {
-        loop {
-            match lines.blocking_recv() {
-                Ok(line) => {
-                    self.line(&line);
-                    if line.end {
-                        self.publish_state();
-                        return;
-                    }
-                    if self.last_state.is_none_or(|t| t.elapsed() >= STATE_EVERY) {
-                        self.publish_state();
-                    }
-                }
-                Err(RecvError::Lagged(missed)) => eprintln!(
-                    "aviary: zenoh: the publisher fell behind and {missed} events were not published"
-                ),
-                Err(RecvError::Closed) => {
-                    self.publish_state();
-                    return;
-                }
+    fn run(&mut self, lines: Receiver<Arc<Line>>) {
+        crate::follow(lines, "zenoh: the publisher", |line| {
+            self.line(line);
+            if self.last_state.is_none_or(|t| t.elapsed() >= STATE_EVERY) {
+                self.publish_state();
             }
-        }
+        });
+        // The state after `mission_end`, or as the feed ended.
+        self.publish_state();
     }
 
     fn line(&mut self, line: &Line) {

@@ -22,7 +22,7 @@ use aviary_api::trace::Record;
 use aviary_ros::topics::{self, Sent};
 use aviary_server::Line;
 use sha2::{Digest, Sha256};
-use tokio::sync::broadcast::{error::RecvError, Receiver};
+use tokio::sync::broadcast::Receiver;
 use zenoh::liveliness::LivelinessToken;
 use zenoh::pubsub::Publisher;
 use zenoh::Wait;
@@ -122,21 +122,8 @@ struct Publishing {
 }
 
 impl Publishing {
-    fn run(&mut self, mut lines: Receiver<Arc<Line>>) {
-        loop {
-            match lines.blocking_recv() {
-                Ok(line) => {
-                    self.line(&line);
-                    if line.end {
-                        return;
-                    }
-                }
-                Err(RecvError::Lagged(missed)) => eprintln!(
-                    "aviary: ros 2: the publisher fell behind and {missed} events were not published"
-                ),
-                Err(RecvError::Closed) => return,
-            }
-        }
+    fn run(&mut self, lines: Receiver<Arc<Line>>) {
+        crate::follow(lines, "ros 2: the publisher", |line| self.line(line));
     }
 
     fn line(&mut self, line: &Line) {

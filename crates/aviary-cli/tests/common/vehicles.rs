@@ -5,6 +5,25 @@ use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 
+/// A field of two drones, `scout` and `buddy`, with two places, `Near` and `Far`, on the
+/// Earth: what the MAVLink tests fly on loopback.
+pub const SMALL_WORLD: &str = "\
+[site]
+name = \"Loopback field\"
+origin = { lat = 46.6167, lon = 14.2650, alt = 440.0 }
+geofence = [[-100, -100], [100, -100], [100, 100], [-100, 100]]
+
+[places]
+Near = [10, 10]
+Far = [-20, 10]
+
+[drones.scout]
+home = [0, 0]
+
+[drones.buddy]
+home = [10, 0]
+";
+
 /// A running `aviary vehicles`, killed when dropped.
 pub struct Vehicles {
     pub child: Child,

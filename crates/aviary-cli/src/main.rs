@@ -458,6 +458,10 @@ fn command(cli: Cli) -> u8 {
                 Ok(address) => {
                     let serve = serve::Serve { address, allowed_hosts: allow_host };
                     match (zenoh, zenoh_prefix) {
+                        (Some(_), _) if dir != std::path::Path::new(".") => {
+                            eprintln!("aviary: a station serves a folder (DIR) or a run on Zenoh (--zenoh), not both: leave out {}", dir.display());
+                            2
+                        }
                         (Some(config), Some(prefix)) => {
                             match zenoh::client(config.as_deref(), &prefix) {
                                 Ok(client) => zenoh::station(client, token, &serve),

@@ -81,7 +81,11 @@ pub fn start(
 
 /// `aviary agent --name NAME --mavlink ADDRESS [--zenoh CONFIG]`, until Ctrl-C.
 pub fn agent(name: &str, mavlink: &str, config: Option<&std::path::Path>) -> u8 {
-    let session = match aviary_zenoh::config(config).and_then(aviary_zenoh::open) {
+    // A name or an address that cannot work is said before anything joins the network.
+    let checked = aviary_zenoh::AgentKeys::new(name)
+        .and_then(|_| aviary_mavlink::link::crate_address(mavlink))
+        .and_then(|_| aviary_zenoh::config(config));
+    let session = match checked.and_then(aviary_zenoh::open) {
         Ok(session) => session,
         Err(why) => {
             eprintln!("aviary: {why}");

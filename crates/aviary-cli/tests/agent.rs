@@ -17,7 +17,7 @@ use aviary_api::Function;
 use aviary_test_support::trace::{actor, Trace};
 use common::agent::Agent;
 use common::vehicles::{Vehicles, SMALL_WORLD};
-use common::{free_port, scratch, wait_at_most, zenoh_peer};
+use common::{aviary, free_port, scratch, wait_at_most, zenoh_peer};
 use zenoh::Wait;
 
 /// The scout hovers long enough for its agent to be cut off mid-flight.
@@ -178,4 +178,42 @@ fn a_lost_agent_is_connection_lost_and_a_missing_one_a_clear_error() {
             if *status == CallStatus::Ok)
     };
     assert_eq!(trace.iter().filter(|e| home(e)).count(), 2, "both brought home: {trace:?}");
+}
+
+/// What cannot work is said at once, with what to do: an agent's name that is no key
+/// chunk, an address that is none, a station asked for a folder and a run at once, and a
+/// station whose run is not on Zenoh.
+#[test]
+fn bad_agent_and_station_arguments_are_clear_errors() {
+    let dir = scratch("agent_arguments");
+    let (code, _, err) =
+        aviary(&["agent", "--name", "field/1", "--mavlink", "tcp:127.0.0.1:1"], &dir);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains(
+            "an agent's name holds only letters, digits, `-`, `_` and `.`, and `field/1` holds `/`"
+        ),
+        "{err}"
+    );
+    let (code, _, err) =
+        aviary(&["agent", "--name", "field1", "--mavlink", "carrier-pigeon"], &dir);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("`carrier-pigeon` is not SCHEME:HOST:PORT"), "{err}");
+    let (code, _, err) =
+        aviary(&["gcs", "missions", "--zenoh", "--zenoh-prefix", "aviary/M"], &dir);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("a folder (DIR) or a run on Zenoh (--zenoh), not both"), "{err}");
+    std::fs::write(
+        dir.join("alone.json5"),
+        zenoh_peer("listen", &format!("tcp/127.0.0.1:{}", free_port())),
+    )
+    .expect("config");
+    let start = Instant::now();
+    let (code, _, err) = aviary(
+        &["gcs", "--zenoh", "alone.json5", "--zenoh-prefix", "aviary/M", "--listen", "0"],
+        &dir,
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("is `aviary run --zenoh` flying under aviary/M"), "{err}");
+    assert!(start.elapsed() < Duration::from_secs(30), "it gave up after {:?}", start.elapsed());
 }

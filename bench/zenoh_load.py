@@ -53,7 +53,16 @@ def main():
             [os.path.abspath(args.router), "--listen", "tcp/127.0.0.1:%d" % port, "--no-multicast-scouting"],
             cwd=work, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
         )
-        time.sleep(1)
+        # A client gives up at once on a router that does not listen yet.
+        deadline = time.monotonic() + 30
+        while True:
+            try:
+                socket.create_connection(("127.0.0.1", port), timeout=0.2).close()
+                break
+            except OSError:
+                if time.monotonic() > deadline:
+                    raise SystemExit("zenohd does not listen")
+                time.sleep(0.05)
         run_side = receiver = '{ mode: "client", connect: { endpoints: ["tcp/127.0.0.1:%d"] } }' % port
     else:
         run_side = '{ mode: "peer", listen: { endpoints: ["tcp/127.0.0.1:%d"] }, %s }' % (port, no_scouting)

@@ -82,7 +82,7 @@ fn a_router_s_access_control_keeps_a_station_from_commanding_a_vehicle() {
     let dir = scratch("access_control");
     let port = free_port();
     let mut zenohd = router(&dir, port);
-    std::thread::sleep(Duration::from_millis(500));
+    common::wait_for_listener(&format!("127.0.0.1:{port}"), Duration::from_secs(30));
     std::fs::write(dir.join("vehicles.world.toml"), WORLD).expect("world");
     let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
     let agent = Agent::start(&dir, &client(port, "agent", "agent-secret"), vehicles.port);

@@ -205,6 +205,7 @@ fn an_operation_over_three_machines_flies_and_survives_a_cut() {
     )
     .expect("config");
     let _router = Running::start(Command::new(zenohd()).args(["-c", "router.json5"]), &dir);
+    common::wait_for_listener(ROUTER.trim_start_matches("tcp/"), Duration::from_secs(30));
     std::fs::write(dir.join("client.json5"), zenoh_client(ROUTER)).expect("config");
 
     // The agent's machine: the paper's vehicles at 20 times real time, and the agent.

@@ -80,6 +80,20 @@ pub fn zenoh_client(endpoint: &str) -> String {
     format!(r#"{{ mode: "client", connect: {{ endpoints: ["{endpoint}"] }} }}"#)
 }
 
+/// Waits (at most `limit`) until something listens on `address`: a server the test
+/// started, before its clients connect (a Zenoh client gives up at once on a router that
+/// is not there yet).
+pub fn wait_for_listener(address: &str, limit: std::time::Duration) {
+    let address: std::net::SocketAddr = address.parse().expect("an address");
+    let start = std::time::Instant::now();
+    while std::net::TcpStream::connect_timeout(&address, std::time::Duration::from_millis(200))
+        .is_err()
+    {
+        assert!(start.elapsed() < limit, "nothing listens on {address} after {limit:?}");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+}
+
 /// A free TCP port on loopback, for a server the test starts.
 pub fn free_port() -> u16 {
     let listener = std::net::TcpListener::bind("127.0.0.1:0").expect("bind loopback");

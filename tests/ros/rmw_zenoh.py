@@ -30,6 +30,7 @@ import zenoh
 import zenoh_ros2_sdk
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from zenoh_ros2_sdk import ROS2Subscriber
+from zenoh_ros2_sdk.session import ZenohSession
 
 ORIGIN = (46.6167, 14.2650, 440.0)
 WORLD = f"""[site]
@@ -155,6 +156,9 @@ def main():
         fail(f"the liveliness tokens: {tokens}")
     print(f"rmw_zenoh: zenoh-ros2-sdk decoded {len(fixes)} NavSatFix; {len(samples)} samples on "
           f"{len(topics)} topics, hashes, attachments and CDR as rmw_zenoh's; {len(tokens)} tokens: OK")
+    # Both sessions closed, or their threads keep the interpreter from ending.
+    sdk.close()
+    ZenohSession.get_instance().close()
     session.close()
 
 

@@ -56,21 +56,33 @@ fn zenohd() -> PathBuf {
     binary
 }
 
+/// A process killed when dropped (also when the test fails).
+struct Killed(Child);
+
+impl Drop for Killed {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
 /// The router with docs/zenoh/router-acl.json5, listening on loopback `port`.
-fn router(dir: &Path, port: u16) -> Child {
+fn router(dir: &Path, port: u16) -> Killed {
     let config = std::fs::read_to_string(repo().join("docs/zenoh/router-acl.json5"))
         .expect("docs/zenoh/router-acl.json5");
     let here = config.replace("tcp/0.0.0.0:7447", &format!("tcp/127.0.0.1:{port}"));
     assert_ne!(here, config, "the documented router listens on tcp/0.0.0.0:7447");
     std::fs::write(dir.join("router.json5"), here).expect("config");
     std::fs::write(dir.join("users.txt"), USERS).expect("users");
-    Command::new(zenohd())
-        .args(["-c", "router.json5"])
-        .current_dir(dir)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("spawn zenohd")
+    Killed(
+        Command::new(zenohd())
+            .args(["-c", "router.json5"])
+            .current_dir(dir)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("spawn zenohd"),
+    )
 }
 
 #[test]
@@ -81,7 +93,7 @@ fn router(dir: &Path, port: u16) -> Child {
 fn a_router_s_access_control_keeps_a_station_from_commanding_a_vehicle() {
     let dir = scratch("access_control");
     let port = free_port();
-    let mut zenohd = router(&dir, port);
+    let _zenohd = router(&dir, port);
     common::wait_for_listener(&format!("127.0.0.1:{port}"), Duration::from_secs(30));
     std::fs::write(dir.join("vehicles.world.toml"), WORLD).expect("world");
     let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
@@ -147,6 +159,4 @@ fn a_router_s_access_control_keeps_a_station_from_commanding_a_vehicle() {
         zenoh::open(zenoh::Config::from_json5(&client(port, "station", "guess")).expect("config"))
             .wait();
     assert!(stranger.is_err(), "a wrong password joined");
-    let _ = zenohd.kill();
-    let _ = zenohd.wait();
 }

@@ -39,10 +39,11 @@ fn behind_the_agent() -> String {
     SMALL_WORLD.replace("home = [", "mavlink = \"agent:field1\"\nhome = [")
 }
 
-/// `aviary run --zenoh` of the mission (hovering `hover`) in `dir`, its trace `t.jsonl`.
-fn start_run(dir: &Path, config: &str, hover: &str) -> Child {
+/// `aviary run --zenoh` of the mission (hovering `hover`) in `world` in `dir`, its trace
+/// `t.jsonl`.
+fn start_run(dir: &Path, config: &str, hover: &str, world: &str) -> Child {
     std::fs::write(dir.join("m.mission"), MISSION.replace("HOVER", hover)).expect("mission");
-    std::fs::write(dir.join("m.world.toml"), behind_the_agent()).expect("world");
+    std::fs::write(dir.join("m.world.toml"), world).expect("world");
     std::fs::write(dir.join("run.json5"), config).expect("config");
     Command::new(env!("CARGO_BIN_EXE_aviary"))
         .args(["run", "m.mission", "--zenoh", "run.json5", "--quiet", "--trace", "t.jsonl"])
@@ -77,7 +78,7 @@ fn a_mission_flies_its_vehicles_through_an_agent_and_garbage_reaches_none() {
     // The agent listens; the run and the foreign peer connect to it (peers relay nothing
     // for one another: that takes a router, as in three_machines.rs).
     let agent = Agent::start(&dir, &zenoh_peer("listen", &endpoint), vehicles.port);
-    let mut run = start_run(&dir, &zenoh_peer("connect", &endpoint), "5s");
+    let mut run = start_run(&dir, &zenoh_peer("connect", &endpoint), "5s", &behind_the_agent());
     // A peer of the test's own, as anyone on the network could be.
     let foreign =
         zenoh::open(zenoh::Config::from_json5(&zenoh_peer("connect", &endpoint)).expect("config"))
@@ -121,6 +122,35 @@ fn a_mission_flies_its_vehicles_through_an_agent_and_garbage_reaches_none() {
     );
 }
 
+/// MAVLink 2 signing holds end to end through the agent, which carries the frames and
+/// cannot sign them: vehicles that take only signed commands fly the mission whose world
+/// gives their drones the key; with another key, the mission believes none of their
+/// frames.
+#[test]
+fn signed_frames_go_through_the_agent_unchanged() {
+    let dir = scratch("agent_signed");
+    std::fs::write(dir.join("vehicles.world.toml"), SMALL_WORLD).expect("world");
+    let vehicles =
+        Vehicles::start_signed(&dir.join("vehicles.world.toml"), "5", "the field team's key");
+    let port = free_port();
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let _agent = Agent::start(&dir, &zenoh_peer("listen", &endpoint), vehicles.port);
+    let signed = behind_the_agent().replace(
+        "mavlink = \"agent:field1\"\n",
+        "mavlink = \"agent:field1\"\nsigning_key = \"the field team's key\"\n",
+    );
+    let mut run = start_run(&dir, &zenoh_peer("connect", &endpoint), "2s", &signed);
+    let code = wait_at_most(&mut run, Duration::from_secs(120), "aviary run");
+    assert_eq!(code, 0, "{}\n{:?}", stderr_of(&mut run), events(&dir).last());
+    // Another key: the vehicles' frames are not believed, so nothing is heard of them.
+    let wrong = signed.replace("the field team's key", "a guess");
+    let mut run = start_run(&dir, &zenoh_peer("connect", &endpoint), "2s", &wrong);
+    let code = wait_at_most(&mut run, Duration::from_secs(60), "aviary run");
+    let err = stderr_of(&mut run);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("for a HEARTBEAT from system 1 (drone `scout`) on agent:field1"), "{err}");
+}
+
 /// The agent gone mid-flight is a silent link: `ConnectionLost` within the heartbeat
 /// timeout, as when a vehicle's own link goes. An agent started again restores the link,
 /// and the run brings its vehicles down and ends. A world whose agent is not there at all
@@ -130,7 +160,7 @@ fn a_lost_agent_is_connection_lost_and_a_missing_one_a_clear_error() {
     let dir = scratch("agent_lost");
     let port = free_port();
     let endpoint = format!("tcp/127.0.0.1:{port}");
-    let mut alone = start_run(&dir, &zenoh_peer("listen", &endpoint), "60s");
+    let mut alone = start_run(&dir, &zenoh_peer("listen", &endpoint), "60s", &behind_the_agent());
     let code = wait_at_most(&mut alone, Duration::from_secs(30), "aviary run");
     let err = stderr_of(&mut alone);
     assert_eq!(code, 2, "{err}");
@@ -141,7 +171,7 @@ fn a_lost_agent_is_connection_lost_and_a_missing_one_a_clear_error() {
 
     std::fs::write(dir.join("vehicles.world.toml"), SMALL_WORLD).expect("world");
     let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
-    let mut run = start_run(&dir, &zenoh_peer("listen", &endpoint), "60s");
+    let mut run = start_run(&dir, &zenoh_peer("listen", &endpoint), "60s", &behind_the_agent());
     let mut agent = Agent::start(&dir, &zenoh_peer("connect", &endpoint), vehicles.port);
     let hovering = |e: &Record| matches!(e.event, Event::ApiCall { function: Function::Hover, .. });
     let start = Instant::now();

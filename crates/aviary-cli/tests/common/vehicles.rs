@@ -39,29 +39,41 @@ impl Vehicles {
 
     /// `aviary vehicles --autopilot AUTOPILOT`.
     pub fn start_as(world: &Path, speed: &str, autopilot: &str) -> Vehicles {
-        Vehicles::spawn(Command::new(env!("CARGO_BIN_EXE_aviary")), world, speed, autopilot)
+        let mut command = Command::new(env!("CARGO_BIN_EXE_aviary"));
+        command.args(["vehicles", "--autopilot", autopilot]);
+        Vehicles::spawn(command, world, speed)
+    }
+
+    /// Listening on loopback `port`: vehicles started again where the last ones were.
+    pub fn start_on(world: &Path, speed: &str, port: u16) -> Vehicles {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_aviary"));
+        command.args(["vehicles", "--listen", &format!("tcp:127.0.0.1:{port}")]);
+        Vehicles::spawn(command, world, speed)
+    }
+
+    /// Taking only commands signed with `key` (MAVLink 2 signing), and signing their own.
+    pub fn start_signed(world: &Path, speed: &str, key: &str) -> Vehicles {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_aviary"));
+        command.args(["vehicles", "--signing-key", key]);
+        Vehicles::spawn(command, world, speed)
     }
 
     /// In the network namespace `netns` (`ip netns exec`), listening on its loopback.
     pub fn start_in(netns: &str, world: &Path, speed: &str) -> Vehicles {
         let mut command = Command::new("ip");
-        command.args(["netns", "exec", netns, env!("CARGO_BIN_EXE_aviary")]);
-        Vehicles::spawn(command, world, speed, "ardupilot")
+        command.args(["netns", "exec", netns, env!("CARGO_BIN_EXE_aviary"), "vehicles"]);
+        Vehicles::spawn(command, world, speed)
     }
 
-    fn spawn(mut command: Command, world: &Path, speed: &str, autopilot: &str) -> Vehicles {
+    /// `command` (`aviary vehicles` and its own options) serving `world` at `speed`, on a
+    /// free loopback port unless the command says where.
+    fn spawn(mut command: Command, world: &Path, speed: &str) -> Vehicles {
+        if !command.get_args().any(|a| a == "--listen") {
+            command.args(["--listen", "tcp:127.0.0.1:0"]);
+        }
         let mut child = command
-            .args([
-                "vehicles",
-                "--world",
-                &world.to_string_lossy(),
-                "--listen",
-                "tcp:127.0.0.1:0",
-                "--speed",
-                speed,
-                "--autopilot",
-                autopilot,
-            ])
+            .args(["--world", &world.to_string_lossy()])
+            .args(["--speed", speed])
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
             .spawn()

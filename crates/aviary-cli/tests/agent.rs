@@ -16,6 +16,7 @@ use aviary_api::trace::{CallStatus, Event, Record, Shown};
 use aviary_api::Function;
 use aviary_test_support::trace::{actor, Trace};
 use common::agent::Agent;
+use common::background;
 use common::vehicles::{Vehicles, SMALL_WORLD};
 use common::{aviary, free_port, scratch, wait_at_most, zenoh_peer};
 use zenoh::Wait;
@@ -55,7 +56,7 @@ fn start_run(dir: &Path, config: &str, hover: &str, world: &str) -> Child {
 }
 
 fn events(dir: &Path) -> Trace {
-    Trace::parse(&std::fs::read_to_string(dir.join("t.jsonl")).unwrap_or_default())
+    background::events(&dir.join("t.jsonl"))
 }
 
 fn stderr_of(child: &mut Child) -> String {
@@ -173,24 +174,13 @@ fn a_lost_agent_is_connection_lost_and_a_missing_one_a_clear_error() {
     let vehicles = Vehicles::start(&dir.join("vehicles.world.toml"), "5");
     let mut run = start_run(&dir, &zenoh_peer("listen", &endpoint), "60s", &behind_the_agent());
     let mut agent = Agent::start(&dir, &zenoh_peer("connect", &endpoint), vehicles.port);
-    let hovering = |e: &Record| matches!(e.event, Event::ApiCall { function: Function::Hover, .. });
-    let start = Instant::now();
-    while !events(&dir).iter().any(hovering) {
-        assert!(start.elapsed() < Duration::from_secs(60), "no hover: {:?}", events(&dir).last());
-        std::thread::sleep(Duration::from_millis(50));
-    }
+    let trace = dir.join("t.jsonl");
+    let hover = |e: &Record| background::is_call(e, Function::Hover);
+    background::first_event(&trace, Duration::from_secs(60), "hover", hover);
     agent.child.kill().expect("kill the agent");
-    let killed = Instant::now();
-    let lost =
-        |e: &Record| matches!(&e.event, Event::Exception { name, .. } if name == "ConnectionLost");
-    let exception = loop {
-        if let Some(e) = events(&dir).0.into_iter().find(lost) {
-            break e;
-        }
-        // The heartbeat timeout is 3 s; allow 3 s more for a loaded machine.
-        assert!(killed.elapsed() < Duration::from_secs(6), "{:?}", events(&dir).last());
-        std::thread::sleep(Duration::from_millis(20));
-    };
+    // The heartbeat timeout is 3 s; allow 3 s more for a loaded machine.
+    let lost = |e: &Record| background::is_exception(e, "ConnectionLost");
+    let exception = background::first_event(&trace, Duration::from_secs(6), "ConnectionLost", lost);
     let Event::Exception { args, .. } = &exception.event else { unreachable!() };
     let reason = args.first().and_then(Shown::as_str).unwrap_or("");
     assert!(reason.contains("for 3.0 s"), "{exception:?}");
@@ -200,9 +190,7 @@ fn a_lost_agent_is_connection_lost_and_a_missing_one_a_clear_error() {
     let code = wait_at_most(&mut run, Duration::from_secs(60), "aviary run");
     assert_eq!(code, 1, "unhandled, ConnectionLost fails the mission");
     let trace = events(&dir);
-    let restored =
-        |e: &Record| matches!(&e.event, Event::Signal { name, .. } if name == "ConnectionRestored");
-    assert!(trace.iter().any(restored), "{:?}", trace.last());
+    assert!(background::signalled(&trace, "ConnectionRestored"), "{:?}", trace.last());
     let home = |e: &Record| {
         matches!(&e.event, Event::ApiDone { function: Function::ReturnToLaunch, status, .. }
             if *status == CallStatus::Ok)

@@ -14,7 +14,8 @@ use std::time::{Duration, Instant};
 
 use aviary_api::trace::{CallStatus, Event, EventKind, Record, Shown};
 use aviary_api::{Function, Remainder};
-use aviary_test_support::trace::{actor, Trace};
+use aviary_test_support::trace::actor;
+use common::background::{self, events};
 use common::vehicles::{Vehicles, SMALL_WORLD};
 use common::{aviary, repo, scratch};
 use serde_json::Value;
@@ -43,10 +44,6 @@ fn run_within(dir: &Path, args: &[&str], limit: Duration) -> i32 {
         .spawn()
         .expect("spawn aviary run");
     common::wait_at_most(&mut child, limit, "aviary run")
-}
-
-fn events(path: &Path) -> Trace {
-    Trace::parse(&std::fs::read_to_string(path).unwrap_or_default())
 }
 
 /// Per event kind and actor, what a trace says, in a form two runs can be compared in:
@@ -215,33 +212,18 @@ fn a_killed_vehicle_raises_connection_lost_within_the_heartbeat_timeout() {
         .spawn()
         .expect("spawn aviary run");
     let trace = dir.join("t.jsonl");
-    let hovering = |e: &Record| matches!(e.event, Event::ApiCall { function: Function::Hover, .. });
-    let start = Instant::now();
-    while !events(&trace).iter().any(hovering) {
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "the scout never got to hover: {:?}",
-            events(&trace)
-        );
-        std::thread::sleep(Duration::from_millis(50));
-    }
+    let hover = |e: &Record| background::is_call(e, Function::Hover);
+    background::first_event(&trace, Duration::from_secs(60), "hover of the scout", hover);
     vehicles.child.kill().expect("kill the vehicles");
-    let killed = Instant::now();
-    let lost =
-        |e: &Record| matches!(&e.event, Event::Exception { name, .. } if name == "ConnectionLost");
-    let exception = loop {
-        if let Some(e) = events(&trace).0.into_iter().find(lost) {
-            break e;
-        }
-        // The heartbeat timeout is 3 s from the last HEARTBEAT (sent each second); allow
-        // 3 s more for a loaded machine.
-        assert!(
-            killed.elapsed() < Duration::from_secs(6),
-            "no ConnectionLost 6 s after the kill: {:?}",
-            events(&trace)
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    };
+    // The heartbeat timeout is 3 s from the last HEARTBEAT (sent each second); allow 3 s
+    // more for a loaded machine.
+    let lost = |e: &Record| background::is_exception(e, "ConnectionLost");
+    let exception = background::first_event(
+        &trace,
+        Duration::from_secs(6),
+        "ConnectionLost after the kill",
+        lost,
+    );
     let Event::Exception { args, .. } = &exception.event else { unreachable!() };
     let reason = args.first().and_then(Shown::as_str).unwrap_or("");
     assert!(reason.contains("no HEARTBEAT from system 1 for 3.0 s"), "{exception:?}");
@@ -251,9 +233,8 @@ fn a_killed_vehicle_raises_connection_lost_within_the_heartbeat_timeout() {
     let _back = Vehicles::start_on(&dir.join("vehicles.world.toml"), "5", vehicles.port);
     let code = common::wait_at_most(&mut run, Duration::from_secs(60), "aviary run");
     assert_eq!(code, 1, "unhandled, ConnectionLost fails the mission");
-    let restored =
-        |e: &Record| matches!(&e.event, Event::Signal { name, .. } if name == "ConnectionRestored");
-    assert!(events(&trace).iter().any(restored), "{:?}", events(&trace).last());
+    let flown = events(&trace);
+    assert!(background::signalled(&flown, "ConnectionRestored"), "{:?}", flown.last());
 }
 
 #[test]

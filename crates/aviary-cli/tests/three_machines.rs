@@ -19,7 +19,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use aviary_api::trace::{Event, Record, Shown, Status};
-use aviary_test_support::trace::Trace;
+use common::background;
 use common::vehicles::Vehicles;
 use common::{repo, scratch, wait_at_most, zenoh_client};
 
@@ -178,10 +178,6 @@ fn paper_world_behind_the_agent() -> String {
     })
 }
 
-fn trace(path: &Path) -> Trace {
-    Trace::parse(&std::fs::read_to_string(path).unwrap_or_default())
-}
-
 /// The events a station printed, without telemetry (whose samples a late joiner may
 /// take up at another one).
 fn events_of(printed: &str) -> Vec<String> {
@@ -254,7 +250,7 @@ fn an_operation_over_three_machines_flies_and_survives_a_cut() {
         &dir,
     );
     let code = wait_at_most(&mut run.child, Duration::from_secs(240), "the paper's mission");
-    let flown = trace(&dir.join("t.jsonl"));
+    let flown = background::events(&dir.join("t.jsonl"));
     assert_eq!(code, 0, "{}\nagent: {}\n{:?}", run.err(), _agent.err(), flown.last());
     assert!(
         matches!(
@@ -296,36 +292,19 @@ fn an_operation_over_three_machines_flies_and_survives_a_cut() {
         ),
         &dir,
     );
-    let hovering = |e: &Record| matches!(&e.event, Event::ApiCall { function, .. } if *function == aviary_api::Function::Hover);
-    let start = Instant::now();
-    while !trace(&dir.join("hold.jsonl")).iter().any(hovering) {
-        assert!(start.elapsed() < Duration::from_secs(60), "{:?}", trace(&dir.join("hold.jsonl")));
-        std::thread::sleep(Duration::from_millis(50));
-    }
+    let held = dir.join("hold.jsonl");
+    let hover = |e: &Record| background::is_call(e, aviary_api::Function::Hover);
+    background::first_event(&held, Duration::from_secs(60), "hover", hover);
     network.connect("agent", false);
-    let cut = Instant::now();
-    let lost =
-        |e: &Record| matches!(&e.event, Event::Exception { name, .. } if name == "ConnectionLost");
-    let exception = loop {
-        if let Some(e) = trace(&dir.join("hold.jsonl")).0.into_iter().find(lost) {
-            break e;
-        }
-        // 3 s of silence, on the vehicles' clock (20 times real time) or the wall's.
-        assert!(
-            cut.elapsed() < Duration::from_secs(6),
-            "{:?}",
-            trace(&dir.join("hold.jsonl")).last()
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    };
+    // 3 s of silence, on the vehicles' clock (20 times real time) or the wall's.
+    let lost = |e: &Record| background::is_exception(e, "ConnectionLost");
+    let exception = background::first_event(&held, Duration::from_secs(6), "ConnectionLost", lost);
     let Event::Exception { args, .. } = &exception.event else { unreachable!() };
     let reason = args.first().and_then(Shown::as_str).unwrap_or("");
     assert!(reason.contains("on agent:field1"), "{exception:?}");
     network.connect("agent", true);
     let code = wait_at_most(&mut hold.child, Duration::from_secs(90), "the cut mission");
     assert_eq!(code, 1, "unhandled, ConnectionLost fails the mission");
-    let held = trace(&dir.join("hold.jsonl"));
-    let restored =
-        |e: &Record| matches!(&e.event, Event::Signal { name, .. } if name == "ConnectionRestored");
-    assert!(held.iter().any(restored), "{held:?}");
+    let held = background::events(&held);
+    assert!(background::signalled(&held, "ConnectionRestored"), "{held:?}");
 }

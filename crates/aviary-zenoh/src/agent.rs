@@ -17,16 +17,14 @@ use aviary_mavlink::mavlink::dialects::ardupilotmega::MavMessage;
 use aviary_mavlink::mavlink::error::MessageReadError;
 use aviary_mavlink::mavlink::{self, AsyncMavConnection, MAVLinkMessageRaw, MavlinkReader};
 use tokio::sync::{mpsc, Mutex};
-use zenoh::bytes::Encoding;
 use zenoh::pubsub::Publisher;
 
+use crate::frames;
 use crate::keys::AgentKeys;
 
 type Conn = mavlink::AsyncConnection<MavMessage>;
 type FromMission = Arc<Mutex<mpsc::Receiver<Vec<u8>>>>;
 
-/// Frames from the mission waiting for the vehicle's link.
-const QUEUE: usize = 1024;
 /// A lost or unreachable vehicle link is tried again this often.
 const REOPEN_EVERY: Duration = Duration::from_secs(1);
 /// A refused sample is said at most this often (a foreign peer may send many).
@@ -41,19 +39,8 @@ pub async fn serve(session: zenoh::Session, name: &str, address: &str) -> Result
         session.liveliness().declare_token(keys.alive()).await.map_err(|e| {
             format!("cannot declare agent `{name}` on Zenoh: {}", crate::reason(&e))
         })?;
-    let to_mission = session
-        .declare_publisher(keys.from_vehicle())
-        .encoding(Encoding::APPLICATION_OCTET_STREAM)
-        .await
-        .map_err(|e| format!("cannot publish on {}: {}", keys.from_vehicle(), crate::reason(&e)))?;
-    let (from_tx, from_rx) = mpsc::channel(QUEUE);
-    let _from_mission = session
-        .declare_subscriber(keys.to_vehicle())
-        .callback(move |sample| {
-            let _ = from_tx.try_send(sample.payload().to_bytes().into_owned());
-        })
-        .await
-        .map_err(|e| format!("cannot subscribe to {}: {}", keys.to_vehicle(), crate::reason(&e)))?;
+    let to_mission = frames::speak(&session, keys.from_vehicle()).await?;
+    let (_from_mission, from_rx) = frames::hear(&session, keys.to_vehicle()).await?;
     let from_mission: FromMission = Arc::new(Mutex::new(from_rx));
     let writer_keys = keys.to_vehicle();
     let mut said_unreachable = false;

@@ -9,13 +9,11 @@ use std::time::Duration;
 
 use aviary_mavlink::{Carrier, Frames};
 use tokio::sync::mpsc;
-use zenoh::bytes::Encoding;
 use zenoh::sample::SampleKind;
 
+use crate::frames;
 use crate::keys::AgentKeys;
 
-/// Frames waiting either way; beyond, the newest are dropped, as a radio drops them.
-const QUEUE: usize = 1024;
 /// How long an agent's liveliness token is looked for: as long as a socket's link is
 /// waited for, and a peer that is still joining the network has time to.
 const LOOK_FOR: Duration = Duration::from_secs(5);
@@ -58,22 +56,9 @@ impl Agents {
                 keys.alive()
             ));
         }
-        let (from_tx, from_vehicle) = mpsc::channel(QUEUE);
-        let subscriber = self
-            .session
-            .declare_subscriber(keys.from_vehicle())
-            .callback(move |sample| {
-                let _ = from_tx.try_send(sample.payload().to_bytes().into_owned());
-            })
-            .await
-            .map_err(|e| format!("cannot hear agent `{name}`: {}", crate::reason(&e)))?;
-        let publisher = self
-            .session
-            .declare_publisher(keys.to_vehicle())
-            .encoding(Encoding::APPLICATION_OCTET_STREAM)
-            .await
-            .map_err(|e| format!("cannot speak to agent `{name}`: {}", crate::reason(&e)))?;
-        let (to_vehicle, mut to_rx) = mpsc::channel::<Vec<u8>>(QUEUE);
+        let (subscriber, from_vehicle) = frames::hear(&self.session, keys.from_vehicle()).await?;
+        let publisher = frames::speak(&self.session, keys.to_vehicle()).await?;
+        let (to_vehicle, mut to_rx) = mpsc::channel::<Vec<u8>>(frames::QUEUE);
         // Both live as long as the link writes: its end undeclares them.
         tokio::spawn(async move {
             let _subscriber = subscriber;

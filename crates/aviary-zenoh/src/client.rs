@@ -72,10 +72,9 @@ impl Client {
             .wait()
             .map_err(|e| format!("cannot subscribe to {all}: {}", crate::reason(&e)))?;
         let events = self.keys.events();
-        let telemetry = self.keys.telemetry("");
         while let Ok(sample) = heard.recv() {
             let key = sample.key_expr().as_str();
-            if key != events && !key.starts_with(&telemetry) {
+            if !self.keys.carries_lines(key) {
                 continue;
             }
             let line = text(sample.payload());

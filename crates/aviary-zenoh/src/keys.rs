@@ -60,6 +60,11 @@ impl Keys {
         format!("{}/telemetry/{drone}", self.prefix)
     }
 
+    /// Whether `key` carries the run's lines: its events or a drone's telemetry.
+    pub fn carries_lines(&self, key: &str) -> bool {
+        key == self.events() || key.starts_with(&self.telemetry(""))
+    }
+
     /// The operator state (`GET /api/state`'s document), once a second while it changes
     /// and once more at the end.
     pub fn state(&self) -> String {
@@ -134,6 +139,10 @@ mod tests {
         let keys = Keys::new("field/team_a/").unwrap();
         assert_eq!(keys.events(), "field/team_a/events");
         assert_eq!(keys.telemetry("scout1"), "field/team_a/telemetry/scout1");
+        assert!(keys.carries_lines("field/team_a/events"));
+        assert!(keys.carries_lines("field/team_a/telemetry/scout1"));
+        assert!(!keys.carries_lines("field/team_a/state"));
+        assert!(!keys.carries_lines("field/team_a/api/pause"));
         assert_eq!(keys.call("pause"), "field/team_a/api/pause");
         assert_eq!(keys.call_of("field/team_a/api/pause"), Some("pause"));
         assert_eq!(keys.call_of("field/team_a/api/launch"), None);

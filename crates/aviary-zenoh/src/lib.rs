@@ -20,6 +20,7 @@
 pub mod agent;
 mod carrier;
 mod client;
+mod frames;
 mod keys;
 mod publish;
 mod queries;

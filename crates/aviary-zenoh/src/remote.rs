@@ -133,10 +133,10 @@ fn hear(client: &Client, joining: Arc<Mutex<Joining>>) -> Result<(), String> {
         .declare_subscriber(&all)
         .callback(move |sample| {
             let key = sample.key_expr().as_str();
-            let event = key == keys.events();
-            if !event && !key.starts_with(&keys.telemetry("")) {
+            if !keys.carries_lines(key) {
                 return;
             }
+            let event = key == keys.events();
             let text = String::from_utf8_lossy(&sample.payload().to_bytes()).into_owned();
             let seq = sample
                 .attachment()

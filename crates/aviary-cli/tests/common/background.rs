@@ -56,7 +56,36 @@ pub fn named<'a>(
 
 /// The first exception of that name.
 pub fn exception<'a>(events: &'a [Record<'static>], name: &str) -> Option<&'a Record<'static>> {
-    events.iter().find(|e| matches!(&e.event, Event::Exception { name: n, .. } if n == name))
+    events.iter().find(|e| is_exception(e, name))
+}
+
+/// Whether `e` is an exception of that name.
+pub fn is_exception(e: &Record, name: &str) -> bool {
+    matches!(&e.event, Event::Exception { name: n, .. } if n == name)
+}
+
+/// Whether `e` is a call of `function` starting.
+pub fn is_call(e: &Record, function: Function) -> bool {
+    matches!(&e.event, Event::ApiCall { function: f, .. } if *f == function)
+}
+
+/// Waits (at most `limit`, from now) for the first event of the trace at `path` that
+/// `wanted` picks, as the run writes it; fails the test with `what` and the trace's last
+/// event otherwise.
+pub fn first_event(
+    path: &Path,
+    limit: Duration,
+    what: &str,
+    wanted: impl Fn(&Record) -> bool,
+) -> Record<'static> {
+    let start = std::time::Instant::now();
+    loop {
+        if let Some(e) = events(path).0.into_iter().find(|e| wanted(e)) {
+            return e;
+        }
+        assert!(start.elapsed() < limit, "no {what} within {limit:?}: {:?}", events(path).last());
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }
 
 /// The names of the signals raised, in order.
